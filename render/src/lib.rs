@@ -1,0 +1,3 @@
+//! GPU side: wgpu device, BVH upload (obvhs), WGSL passes, GPU timing, readback.
+
+pub mod scene;

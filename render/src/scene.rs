@@ -1,0 +1,117 @@
+//! The scene as the renderer sees it: plain data, no ECS.
+//!
+//! `sim` builds these from its world (glTF import, built-in scenes) and `systems::extract`
+//! refreshes the dynamic parts (instances, lights, camera, materials) every frame.
+//! Units: metres, radians; radiance in W/(sr m^2) on a linear RGB scale.
+
+use glam::{Mat4, Vec2, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// Shared geometry in object space. One BLAS is built per mesh, once.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    pub name: String,
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals; empty means flat (geometric) normals.
+    pub normals: Vec<Vec3>,
+    /// Per-vertex texture coordinates; empty means all zero.
+    pub uvs: Vec<Vec2>,
+    pub indices: Vec<[u32; 3]>,
+}
+
+/// An RGBA8 texture in sRGB encoding (glTF base colour textures are sRGB).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Texture {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<u8>,
+}
+
+/// glTF metallic-roughness material.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Material {
+    /// Linear base colour (multiplied by the texture when there is one).
+    pub base_color: Vec3,
+    /// Index into `SceneDesc::textures`.
+    pub base_color_texture: Option<u32>,
+    /// Emitted radiance; non-zero makes every triangle using it an area light.
+    pub emission: Vec3,
+    /// Perceptual roughness in [0, 1]; GGX alpha = roughness^2.
+    pub roughness: f32,
+    pub metallic: f32,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Self {
+            base_color: Vec3::splat(0.8),
+            base_color_texture: None,
+            emission: Vec3::ZERO,
+            roughness: 1.0,
+            metallic: 0.0,
+        }
+    }
+}
+
+/// One placed copy of a mesh. The TLAS is built over instances.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Instance {
+    /// Index into `SceneDesc::meshes`.
+    pub mesh: u32,
+    /// Index into `SceneDesc::materials`.
+    pub material: u32,
+    /// Object to world.
+    pub transform: Mat4,
+}
+
+/// Analytic lights (emissive meshes are lights too, through their material).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Light {
+    /// Light arriving from a cone of directions around `-direction`, `direction` pointing
+    /// from the light into the scene. `irradiance` is measured on a surface facing the light.
+    Directional { direction: Vec3, irradiance: Vec3, angular_radius: f32 },
+    /// Isotropic point light; `intensity` in W/sr.
+    Point { position: Vec3, intensity: Vec3 },
+    /// Spot light with a smooth falloff between the inner and outer cone half-angles.
+    Spot { position: Vec3, direction: Vec3, intensity: Vec3, inner_angle: f32, outer_angle: f32 },
+}
+
+/// Pinhole camera.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Camera {
+    pub position: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    /// Vertical field of view in radians.
+    pub vfov: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Self { position: Vec3::new(0.0, 1.0, 3.0), target: Vec3::new(0.0, 1.0, 0.0), up: Vec3::Y, vfov: 45f32.to_radians() }
+    }
+}
+
+impl Camera {
+    pub fn view(&self) -> Mat4 {
+        Mat4::look_at_rh(self.position, self.target, self.up)
+    }
+
+    pub fn projection(&self, aspect: f32) -> Mat4 {
+        Mat4::perspective_rh(self.vfov, aspect, 0.01, 1000.0)
+    }
+}
+
+/// Everything one frame renders.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneDesc {
+    pub meshes: Vec<Mesh>,
+    pub textures: Vec<Texture>,
+    pub materials: Vec<Material>,
+    pub instances: Vec<Instance>,
+    pub lights: Vec<Light>,
+    /// Constant environment radiance seen by rays that leave the scene.
+    pub environment: Vec3,
+    pub camera: Camera,
+}

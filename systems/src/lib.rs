@@ -1,0 +1,1 @@
+//! Per-frame systems tying sim to render, and scenario playback.
