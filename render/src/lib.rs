@@ -1,3 +1,4 @@
 //! GPU side: wgpu device, BVH upload (obvhs), WGSL passes, GPU timing, readback.
 
 pub mod scene;
+pub mod gpu;

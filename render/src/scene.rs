@@ -95,11 +95,12 @@ impl Default for Camera {
 
 impl Camera {
     pub fn view(&self) -> Mat4 {
-        Mat4::look_at_rh(self.position, self.target, self.up)
+        glam::camera::rh::view::look_at_mat4(self.position, self.target, self.up)
     }
 
     pub fn projection(&self, aspect: f32) -> Mat4 {
-        Mat4::perspective_rh(self.vfov, aspect, 0.01, 1000.0)
+        // wgpu's clip space: z in [0, 1], y up (the DirectX convention).
+        glam::camera::rh::proj::directx::perspective(self.vfov, aspect, 0.01, 1000.0)
     }
 }
 
