@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Installs what flicker needs on a fresh Debian machine without a GPU (run as root):
+# Mesa's lavapipe (CPU Vulkan) for wgpu, Chromium to test the HTML report, and NVIDIA's
+# FLIP reference implementation (PyPI `flip-evaluator`) that the FLIP tests compare against.
+set -euo pipefail
+need_apt=()
+[ -e /usr/share/vulkan/icd.d/lvp_icd.x86_64.json ] || [ -e /usr/share/vulkan/icd.d/lvp_icd.json ] || need_apt+=(mesa-vulkan-drivers)
+ldconfig -p | grep -q 'libvulkan.so.1' || need_apt+=(libvulkan1)
+command -v chromium >/dev/null || need_apt+=(chromium)
+if [ ${#need_apt[@]} -gt 0 ]; then
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq
+    apt-get install -y -qq --no-install-recommends "${need_apt[@]}" >/dev/null
+fi
+python3 -c 'import flip_evaluator' 2>/dev/null || python3 -m pip install --quiet flip-evaluator

@@ -1,0 +1,109 @@
+//! One row of `frames.csv`: timings and metrics of one method at one frame.
+
+use std::fmt::Write as _;
+
+#[derive(Clone, Debug, Default)]
+pub struct FrameRecord {
+    pub method: String,
+    pub frame: u32,
+    pub cpu_ms: f64,
+    /// GPU time per pass, in the order the passes ran; `None` without timestamp queries.
+    pub passes: Vec<(String, Option<f64>)>,
+    pub smape: Option<f64>,
+    pub smape_reprojected: Option<f64>,
+    pub disoccluded: Option<u64>,
+    pub flip: Option<f64>,
+    pub mse: Option<f64>,
+    pub rel_mse: Option<f64>,
+    pub psnr: Option<f64>,
+    /// Per region of interest: (name, flip, smape).
+    pub regions: Vec<(String, Option<f64>, Option<f64>)>,
+}
+
+/// Writes the CSV; pass columns are the union over rows, so methods with different passes share
+/// one table. Empty cells mean "not measured".
+pub fn to_csv(rows: &[FrameRecord]) -> String {
+    let mut passes: Vec<String> = Vec::new();
+    let mut regions: Vec<String> = Vec::new();
+    for row in rows {
+        for (p, _) in &row.passes {
+            if !passes.contains(p) {
+                passes.push(p.clone());
+            }
+        }
+        for (r, _, _) in &row.regions {
+            if !regions.contains(r) {
+                regions.push(r.clone());
+            }
+        }
+    }
+    let mut out = String::from("method,frame,cpu_ms,gpu_ms_total");
+    for p in &passes {
+        write!(out, ",gpu_ms_{p}").unwrap();
+    }
+    out.push_str(",smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr");
+    for r in &regions {
+        write!(out, ",{r}_flip,{r}_smape").unwrap();
+    }
+    out.push('\n');
+    for row in rows {
+        let times: Vec<Option<f64>> = passes
+            .iter()
+            .map(|p| row.passes.iter().find(|(q, _)| q == p).and_then(|(_, t)| *t))
+            .collect();
+        let total = if row.passes.iter().all(|(_, t)| t.is_some()) && !row.passes.is_empty() {
+            Some(row.passes.iter().filter_map(|(_, t)| *t).sum())
+        } else {
+            None
+        };
+        write!(out, "{},{},{:.4},{}", row.method, row.frame, row.cpu_ms, cell(total)).unwrap();
+        for t in times {
+            write!(out, ",{}", cell(t)).unwrap();
+        }
+        write!(
+            out,
+            ",{},{},{},{},{},{},{}",
+            cell(row.smape),
+            cell(row.smape_reprojected),
+            row.disoccluded.map(|d| d.to_string()).unwrap_or_default(),
+            cell(row.flip),
+            cell(row.mse),
+            cell(row.rel_mse),
+            cell(row.psnr)
+        )
+        .unwrap();
+        for r in &regions {
+            let found = row.regions.iter().find(|(q, _, _)| q == r);
+            write!(out, ",{},{}", cell(found.and_then(|f| f.1)), cell(found.and_then(|f| f.2))).unwrap();
+        }
+        out.push('\n');
+    }
+    out
+}
+
+fn cell(v: Option<f64>) -> String {
+    v.map(|v| format!("{v:.6}")).unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn union_of_passes_and_empty_cells() {
+        let a = FrameRecord {
+            method: "pt_1spp".into(),
+            frame: 0,
+            cpu_ms: 2.0,
+            passes: vec![("trace".into(), Some(1.5))],
+            smape: Some(0.25),
+            ..Default::default()
+        };
+        let b = FrameRecord { method: "pt_4spp".into(), frame: 0, passes: vec![("shade".into(), None)], ..Default::default() };
+        let csv = to_csv(&[a, b]);
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines[0], "method,frame,cpu_ms,gpu_ms_total,gpu_ms_trace,gpu_ms_shade,smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr");
+        assert_eq!(lines[1], "pt_1spp,0,2.0000,1.500000,1.500000,,0.250000,,,,,,");
+        assert_eq!(lines[2], "pt_4spp,0,0.0000,,,,,,,,,,");
+    }
+}

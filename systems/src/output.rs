@@ -1,0 +1,115 @@
+//! Atomic writes of run outputs: every file appears whole or not at all.
+//!
+//! Each writer writes `NAME.tmp` beside the target and renames it into place, so an interrupted
+//! run never leaves a truncated image, CSV or manifest behind.
+
+use std::fs;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use image::ImageEncoder;
+
+use crate::tonemap;
+
+/// Writes `bytes` to `path` through a temporary file and a rename.
+pub fn write_atomic(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {
+    if let Some(dir) = path.parent() {
+        fs::create_dir_all(dir).with_context(|| format!("creating folder {}", dir.display()))?;
+    }
+    let tmp = tmp_path(path);
+    let result = (|| {
+        let file = fs::File::create(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
+        let mut out = BufWriter::new(file);
+        write(&mut out)?;
+        out.flush()?;
+        out.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        fs::rename(&tmp, path).with_context(|| format!("renaming {} to {}", tmp.display(), path.display()))
+    })();
+    if result.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    result
+}
+
+fn tmp_path(path: &Path) -> PathBuf {
+    let mut name = path.file_name().unwrap_or_default().to_os_string();
+    name.push(".tmp");
+    path.with_file_name(name)
+}
+
+pub fn write_text(path: &Path, text: &str) -> Result<()> {
+    write_atomic(path, |w| Ok(w.write_all(text.as_bytes())?))
+}
+
+pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
+    let text = serde_json::to_string_pretty(value)?;
+    write_text(path, &text)
+}
+
+/// Linear HDR radiance as a 32-bit float RGBA OpenEXR file.
+pub fn write_exr(path: &Path, width: u32, height: u32, rgba: &[[f32; 4]]) -> Result<()> {
+    anyhow::ensure!(rgba.len() == (width * height) as usize, "image of {width}x{height} has {} pixels", rgba.len());
+    write_atomic(path, |w| {
+        let mut cursor = std::io::Cursor::new(Vec::new());
+        image::codecs::openexr::OpenExrEncoder::new(&mut cursor)
+            .write_image(bytemuck::cast_slice(rgba), width, height, image::ExtendedColorType::Rgba32F)
+            .with_context(|| format!("encoding {}", path.display()))?;
+        w.write_all(cursor.get_ref())?;
+        Ok(())
+    })
+}
+
+/// Tone-mapped 8-bit sRGB PNG of linear radiance.
+pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[[f32; 4]], exposure: f32) -> Result<()> {
+    let ldr = tonemap::to_srgb8(rgba, exposure);
+    write_atomic(path, |w| {
+        image::codecs::png::PngEncoder::new(w)
+            .write_image(&ldr, width, height, image::ExtendedColorType::Rgb8)
+            .with_context(|| format!("encoding {}", path.display()))
+    })
+}
+
+/// Reads an RGBA32F EXR written by [`write_exr`].
+pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
+    let img = image::open(path).with_context(|| format!("reading {}", path.display()))?.into_rgba32f();
+    let (w, h) = img.dimensions();
+    let pixels = img.pixels().map(|p| p.0).collect();
+    Ok((w, h, pixels))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exr_round_trips_and_leaves_no_temporary() {
+        let dir = std::env::temp_dir().join(format!("flicker-output-{}", std::process::id()));
+        let path = dir.join("a/0000.exr");
+        let px = vec![[0.25, 1.5, 1e3, 1.0], [0.0, 0.125, 7.0, 1.0]];
+        write_exr(&path, 2, 1, &px).unwrap();
+        let (w, h, back) = read_exr(&path).unwrap();
+        assert_eq!((w, h), (2, 1));
+        assert_eq!(back, px);
+        assert!(!tmp_path(&path).exists());
+        write_png(&dir.join("a/0000.png"), 2, 1, &px, 1.0).unwrap();
+        let png = image::open(dir.join("a/0000.png")).unwrap().into_rgb8();
+        assert_eq!(png.dimensions(), (2, 1));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn failed_write_keeps_the_old_file() {
+        let dir = std::env::temp_dir().join(format!("flicker-output-fail-{}", std::process::id()));
+        let path = dir.join("keep.txt");
+        write_text(&path, "old").unwrap();
+        let err = write_atomic(&path, |w| {
+            w.write_all(b"half")?;
+            anyhow::bail!("interrupted")
+        });
+        assert!(err.is_err());
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
+        assert!(!tmp_path(&path).exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

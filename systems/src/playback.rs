@@ -1,0 +1,188 @@
+//! `flicker run`: plays a scenario frame by frame, renders every method, the references it
+//! asks for, measures, and records everything in a run folder.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use render::gpu::Gpu;
+use render::path_tracer::{PathTracer, PathTracerSettings};
+use sim::{Scenario, Simulation};
+
+use crate::frame_record::{self, FrameRecord};
+use crate::measure;
+use crate::output;
+use crate::reference_cache::{ReferenceCache, ReferenceKey};
+use crate::run_folder::RunFolder;
+
+/// Command-line overrides of the scenario's own settings.
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    pub frames: Option<u32>,
+    pub resolution: Option<(u32, u32)>,
+    pub spp: Option<u32>,
+    pub seed: Option<u64>,
+    pub out: Option<PathBuf>,
+}
+
+pub struct RunOptions {
+    pub scenario: PathBuf,
+    pub overrides: Overrides,
+    /// Where references are cached; `None` for the default location.
+    pub cache_dir: Option<PathBuf>,
+    pub progress: bool,
+}
+
+/// What a finished run reports back.
+pub struct RunSummary {
+    pub folder: PathBuf,
+    pub records: Vec<FrameRecord>,
+    pub references_rendered: u32,
+    pub references_cached: u32,
+}
+
+/// Loads the scenario and applies the overrides; every input error surfaces here, before
+/// anything is written.
+pub fn load_scenario(path: &Path, o: &Overrides) -> Result<Scenario> {
+    let mut scenario = Scenario::load(path)?;
+    if let Some(f) = o.frames {
+        scenario.frames = f;
+    }
+    if let Some(r) = o.resolution {
+        scenario.resolution = r;
+    }
+    if let Some(spp) = o.spp {
+        for m in &mut scenario.methods {
+            m.set_spp(spp);
+        }
+    }
+    if let Some(s) = o.seed {
+        scenario.seed = s;
+    }
+    if let Some(out) = &o.out {
+        scenario.output = out.clone();
+    }
+    if scenario.frames == 0 {
+        bail!("{}: frames must be at least 1", path.display());
+    }
+    if scenario.methods.is_empty() {
+        bail!("{}: no methods to run; add e.g. `methods: [PathTracing(spp: 1)]`", path.display());
+    }
+    Ok(scenario)
+}
+
+pub fn run(opts: &RunOptions) -> Result<RunSummary> {
+    let scenario = load_scenario(&opts.scenario, &opts.overrides)?;
+    let mut sim = Simulation::new(&scenario)?;
+    let gpu = Gpu::new()?;
+    let (width, height) = scenario.resolution;
+    let settings = PathTracerSettings { width, height, max_depth: scenario.max_depth, rr_start_depth: 3 };
+    let mut tracer = PathTracer::new(&gpu, sim.scene(), settings)
+        .with_context(|| format!("{}: preparing the path tracer", opts.scenario.display()))?;
+
+    let folder = RunFolder::new(&scenario.output);
+    folder.prepare()?;
+    let manifest = crate::manifest::build(&scenario, &opts.scenario, &gpu, &opts.overrides)?;
+    output::write_json(&folder.manifest(), &manifest)?;
+
+    let cache = ReferenceCache::new(opts.cache_dir.clone().unwrap_or_else(ReferenceCache::default_location));
+    let methods: Vec<(String, u32)> = scenario.methods.iter().map(|m| (m.label(), m.spp())).collect();
+    let bar = progress_bar(opts.progress, (scenario.warmup_frames + scenario.frames) as u64);
+
+    // Warm-up frames are simulated and rendered (caches learn from them) but not recorded.
+    for _ in 0..scenario.warmup_frames {
+        bar.set_message("warm-up");
+        tracer.update(&gpu, sim.scene());
+        for (_, spp) in &methods {
+            tracer.render(&gpu, *spp, scenario.seed, sim.frame())?;
+        }
+        sim.step();
+        bar.inc(1);
+    }
+
+    let mut records = Vec::new();
+    let mut previous: Vec<Option<measure::Frame>> = vec![None; methods.len()];
+    let (mut rendered, mut cached) = (0, 0);
+    for frame in 0..scenario.frames {
+        let global_frame = sim.frame();
+        tracer.update(&gpu, sim.scene());
+
+        let reference = if scenario.reference.wants(frame, scenario.frames) {
+            let key = ReferenceCache::key(
+                sim.scene(),
+                &ReferenceKey {
+                    width,
+                    height,
+                    spp: scenario.reference.spp,
+                    seed: reference_seed(scenario.seed),
+                    max_depth: scenario.max_depth,
+                    adapter: &gpu.summary.to_string(),
+                    shader_source: PathTracer::shader_source(),
+                },
+            );
+            let pixels = match cache.load(&key, width, height) {
+                Some(px) => {
+                    cached += 1;
+                    px
+                }
+                None => {
+                    bar.set_message(format!("reference {frame:04}"));
+                    let spp = scenario.reference.spp;
+                    let px = tracer.render_reference(&gpu, spp, reference_seed(scenario.seed), global_frame, &mut |done, total| {
+                        bar.set_message(format!("reference {frame:04}: {done}/{total} spp"));
+                    })?;
+                    cache.store(&key, width, height, &px)?;
+                    rendered += 1;
+                    px
+                }
+            };
+            output::write_exr(&folder.reference(frame, "exr"), width, height, &pixels)?;
+            output::write_png(&folder.reference(frame, "png"), width, height, &pixels, 1.0)?;
+            Some(measure::Frame::from_radiance(width, height, &pixels, None))
+        } else {
+            None
+        };
+
+        for (m, (label, spp)) in methods.iter().enumerate() {
+            bar.set_message(format!("{label} frame {frame:04}"));
+            let start = Instant::now();
+            let out = tracer.render(&gpu, *spp, scenario.seed, global_frame)?;
+            let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+            output::write_exr(&folder.frame(label, frame, "exr"), width, height, &out.radiance)?;
+            output::write_png(&folder.frame(label, frame, "png"), width, height, &out.radiance, 1.0)?;
+            let current = measure::Frame::from_radiance(width, height, &out.radiance, Some(&out.gbuffer.motion));
+            let mut record = measure::record(&current, previous[m].as_ref(), reference.as_ref(), &scenario);
+            record.method = label.clone();
+            record.frame = frame;
+            record.cpu_ms = cpu_ms;
+            record.passes = out.timings.iter().map(|t| (t.pass.clone(), t.gpu_ms)).collect();
+            records.push(record);
+            previous[m] = Some(current);
+        }
+        // Rewritten every frame so an interrupted run still has a complete table of what it did.
+        output::write_text(&folder.frames_csv(), &frame_record::to_csv(&records))?;
+        sim.step();
+        bar.inc(1);
+    }
+    bar.finish_with_message("done");
+    crate::finish::write_summary_and_report(&folder.root)?;
+    Ok(RunSummary { folder: folder.root, records, references_rendered: rendered, references_cached: cached })
+}
+
+/// References use their own random sequence, so they never share noise with a method.
+fn reference_seed(seed: u64) -> u64 {
+    seed ^ 0x5eed_0f_4e_fe_4e_9ce
+}
+
+fn progress_bar(enabled: bool, len: u64) -> ProgressBar {
+    if !enabled {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} {pos}/{len} frames  {elapsed_precise} elapsed, ETA {eta_precise}  {msg}")
+            .expect("valid progress template"),
+    );
+    bar
+}

@@ -1,0 +1,99 @@
+//! The layout of a run folder, in one place (README.md documents it for users).
+//!
+//! ```text
+//! RUN/manifest.json              scenario, commit, adapter, seed, settings, events, regions
+//! RUN/frames.csv                 one row per (method, frame): timings and metrics
+//! RUN/frames/METHOD/NNNN.exr     linear HDR radiance, and NNNN.png tone-mapped
+//! RUN/reference/NNNN.exr         path-traced reference of frame NNNN, and NNNN.png
+//! RUN/summary.json, RUN/report.html, RUN/charts/
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, bail};
+
+pub struct RunFolder {
+    pub root: PathBuf,
+}
+
+impl RunFolder {
+    pub fn new(root: impl Into<PathBuf>) -> Self {
+        Self { root: root.into() }
+    }
+
+    pub fn manifest(&self) -> PathBuf {
+        self.root.join("manifest.json")
+    }
+
+    pub fn frames_csv(&self) -> PathBuf {
+        self.root.join("frames.csv")
+    }
+
+    pub fn frame(&self, method: &str, frame: u32, ext: &str) -> PathBuf {
+        self.root.join("frames").join(method).join(format!("{frame:04}.{ext}"))
+    }
+
+    pub fn reference(&self, frame: u32, ext: &str) -> PathBuf {
+        self.root.join("reference").join(format!("{frame:04}.{ext}"))
+    }
+
+    /// Makes the folder ready for a new run. A folder holding an earlier run (it has a
+    /// manifest) is replaced; a non-empty folder that is not a run is refused, so a typo in
+    /// `--out` can never delete someone's files.
+    pub fn prepare(&self) -> Result<()> {
+        if self.root.exists() {
+            let is_empty = std::fs::read_dir(&self.root)
+                .with_context(|| format!("reading {}", self.root.display()))?
+                .next()
+                .is_none();
+            if !is_empty {
+                if !self.manifest().exists() {
+                    bail!(
+                        "output folder {} is not empty and holds no earlier run (no manifest.json); choose another --out",
+                        self.root.display()
+                    );
+                }
+                for entry in ["frames", "reference", "charts"] {
+                    remove_if_exists(&self.root.join(entry))?;
+                }
+                for file in ["manifest.json", "frames.csv", "summary.json", "report.html"] {
+                    remove_if_exists(&self.root.join(file))?;
+                }
+            }
+        }
+        std::fs::create_dir_all(&self.root).with_context(|| format!("creating {}", self.root.display()))
+    }
+}
+
+fn remove_if_exists(path: &Path) -> Result<()> {
+    let result = if path.is_dir() { std::fs::remove_dir_all(path) } else { std::fs::remove_file(path) };
+    match result {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e).with_context(|| format!("removing {}", path.display())),
+        _ => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn refuses_foreign_folders_and_replaces_runs() {
+        let dir = std::env::temp_dir().join(format!("flicker-runfolder-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("thesis.tex"), "precious").unwrap();
+        let run = RunFolder::new(&dir);
+        let err = run.prepare().unwrap_err().to_string();
+        assert!(err.contains("not empty"), "{err}");
+        assert!(dir.join("thesis.tex").exists());
+
+        std::fs::remove_file(dir.join("thesis.tex")).unwrap();
+        std::fs::write(run.manifest(), "{}").unwrap();
+        std::fs::create_dir_all(run.frame("pt_1spp", 0, "exr").parent().unwrap()).unwrap();
+        std::fs::write(run.frame("pt_1spp", 0, "exr"), "old").unwrap();
+        run.prepare().unwrap();
+        assert!(!run.frame("pt_1spp", 0, "exr").exists());
+        assert!(!run.manifest().exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
