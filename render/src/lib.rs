@@ -2,3 +2,5 @@
 
 pub mod scene;
 pub mod gpu;
+pub mod bvh;
+pub mod error;

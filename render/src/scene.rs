@@ -40,6 +40,14 @@ pub struct Material {
     /// Perceptual roughness in [0, 1]; GGX alpha = roughness^2.
     pub roughness: f32,
     pub metallic: f32,
+    /// KHR_materials_specular factor: scales the dielectric Fresnel term (F = specular * Schlick(0.04)).
+    /// 0 leaves a pure Lambertian diffuse (furnace tests); glTF's default is 1.
+    #[serde(default = "one")]
+    pub specular: f32,
+}
+
+fn one() -> f32 {
+    1.0
 }
 
 impl Default for Material {
@@ -50,6 +58,7 @@ impl Default for Material {
             emission: Vec3::ZERO,
             roughness: 1.0,
             metallic: 0.0,
+            specular: 1.0,
         }
     }
 }
