@@ -1,1 +1,24 @@
 //! Image metrics for temporal stability and accuracy.
+//!
+//! - [`smape`]: frame-to-frame flicker (SMAPE), optionally after motion-vector reprojection.
+//! - [`flip`]: LDR-FLIP and HDR-FLIP (Andersson et al. 2020, 2021) against a reference.
+//! - [`error`]: MSE, relative MSE, PSNR.
+//! - [`region`]: named rectangles of interest; any per-pixel map can be averaged over one.
+//! - [`compare`]: the `compare REFERENCE TEST` command.
+
+pub mod bench;
+pub mod colormap;
+pub mod compare;
+pub mod error;
+pub mod flip;
+pub mod image;
+pub mod region;
+pub mod smape;
+
+pub use crate::image::{Image, load_image, write_exr, write_png_srgb};
+pub use colormap::{magma, write_map_png};
+pub use compare::{CompareArgs, compare};
+pub use error::{mse, psnr, psnr_from_mse, relative_mse};
+pub use flip::{DEFAULT_PPD, FlipResult, Percentiles, flip_hdr, flip_ldr, pixels_per_degree};
+pub use region::Region;
+pub use smape::{SmapeResult, smape, smape_reprojected};

@@ -1,0 +1,143 @@
+//! The image type all metrics take, and PNG/EXR input/output.
+//!
+//! Pixels are linear RGB. PNG files are sRGB-encoded, so they are decoded to linear on load and
+//! encoded on save; EXR files are already linear.
+
+use std::path::Path;
+
+use anyhow::{Context, bail};
+
+/// A linear-RGB image (HDR, or LDR in [0, 1]), row-major, top row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub rgb: Vec<[f32; 3]>,
+}
+
+impl Image {
+    pub fn new(width: u32, height: u32, rgb: Vec<[f32; 3]>) -> Self {
+        assert_eq!(rgb.len(), width as usize * height as usize, "pixel count must be width * height");
+        Self { width, height, rgb }
+    }
+
+    pub fn filled(width: u32, height: u32, value: [f32; 3]) -> Self {
+        Self::new(width, height, vec![value; width as usize * height as usize])
+    }
+
+    pub fn from_fn(width: u32, height: u32, f: impl Fn(u32, u32) -> [f32; 3]) -> Self {
+        let rgb = (0..height).flat_map(|y| (0..width).map(move |x| (x, y))).map(|(x, y)| f(x, y)).collect();
+        Self::new(width, height, rgb)
+    }
+
+    pub fn len(&self) -> usize {
+        self.rgb.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.rgb.is_empty()
+    }
+
+    pub fn get(&self, x: u32, y: u32) -> [f32; 3] {
+        self.rgb[y as usize * self.width as usize + x as usize]
+    }
+
+    /// Panics with both sizes when two images that must be compared pixel by pixel differ.
+    pub(crate) fn assert_same_size(&self, other: &Image, what: &str) {
+        assert!(
+            self.width == other.width && self.height == other.height,
+            "{what}: images differ in size ({}x{} vs {}x{})",
+            self.width,
+            self.height,
+            other.width,
+            other.height
+        );
+    }
+}
+
+/// sRGB transfer function, decoding (IEC 61966-2-1).
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+/// sRGB transfer function, encoding.
+pub fn linear_to_srgb(c: f32) -> f32 {
+    if c <= 0.003_130_8 { c * 12.92 } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+}
+
+fn extension(path: &Path) -> String {
+    path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase()
+}
+
+/// Loads a PNG (sRGB, converted to linear) or an EXR (linear) as an [`Image`].
+pub fn load_image(path: impl AsRef<Path>) -> anyhow::Result<Image> {
+    let path = path.as_ref();
+    let ext = extension(path);
+    if ext != "png" && ext != "exr" {
+        bail!("{}: expected a .png or .exr image", path.display());
+    }
+    let decoded = ::image::open(path).with_context(|| format!("cannot read image {}", path.display()))?;
+    let (width, height) = (decoded.width(), decoded.height());
+    let rgb = if ext == "png" {
+        // 8-bit sRGB like the FLIP reference tool reads it; 16-bit keeps its precision.
+        let px = decoded.to_rgb32f();
+        px.pixels().map(|p| [srgb_to_linear(p[0]), srgb_to_linear(p[1]), srgb_to_linear(p[2])]).collect()
+    } else {
+        let px = decoded.to_rgb32f();
+        px.pixels().map(|p| [p[0], p[1], p[2]]).collect()
+    };
+    Ok(Image::new(width, height, rgb))
+}
+
+/// Writes linear RGB clamped to [0, 1] as an 8-bit sRGB PNG.
+pub fn write_png_srgb(image: &Image, path: impl AsRef<Path>) -> anyhow::Result<()> {
+    let path = path.as_ref();
+    let bytes: Vec<u8> = image
+        .rgb
+        .iter()
+        .flat_map(|p| p.map(|c| (linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8))
+        .collect();
+    let buf = ::image::RgbImage::from_raw(image.width, image.height, bytes).expect("buffer size matches");
+    buf.save(path).with_context(|| format!("cannot write PNG {}", path.display()))
+}
+
+/// Writes linear RGB as a 32-bit float EXR.
+pub fn write_exr(image: &Image, path: impl AsRef<Path>) -> anyhow::Result<()> {
+    let path = path.as_ref();
+    let floats: Vec<f32> = image.rgb.iter().flatten().copied().collect();
+    let buf = ::image::Rgb32FImage::from_raw(image.width, image.height, floats).expect("buffer size matches");
+    buf.save(path).with_context(|| format!("cannot write EXR {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_round_trip() {
+        for i in 0..=255 {
+            let s = i as f32 / 255.0;
+            assert!((linear_to_srgb(srgb_to_linear(s)) - s).abs() < 1e-5, "{s}");
+        }
+        assert!((srgb_to_linear(0.5) - 0.214_041_14).abs() < 1e-6);
+    }
+
+    #[test]
+    fn png_and_exr_round_trip() {
+        let dir = std::env::temp_dir().join(format!("metrics-image-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let img = Image::from_fn(7, 5, |x, y| [x as f32 / 6.0, y as f32 / 4.0, 0.25]);
+        write_exr(&img, dir.join("a.exr")).unwrap();
+        assert_eq!(load_image(dir.join("a.exr")).unwrap(), img);
+        write_png_srgb(&img, dir.join("a.png")).unwrap();
+        let back = load_image(dir.join("a.png")).unwrap();
+        for (a, b) in img.rgb.iter().zip(&back.rgb) {
+            for c in 0..3 {
+                assert!((a[c] - b[c]).abs() < 0.01, "{a:?} {b:?}");
+            }
+        }
+        let err = load_image(dir.join("a.jpg")).unwrap_err().to_string();
+        assert!(err.contains("a.jpg") && err.contains(".png or .exr"), "{err}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
