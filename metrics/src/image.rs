@@ -101,12 +101,21 @@ pub fn write_png_srgb(image: &Image, path: impl AsRef<Path>) -> anyhow::Result<(
     buf.save(path).with_context(|| format!("cannot write PNG {}", path.display()))
 }
 
-/// Writes linear RGB as a 32-bit float EXR.
+/// Writes linear RGB as a 32-bit float EXR: scan lines, ZIP compression, the most widely
+/// readable layout (tinyexr, used by NVIDIA's FLIP tool, rejects other layouts).
 pub fn write_exr(image: &Image, path: impl AsRef<Path>) -> anyhow::Result<()> {
+    use exr::prelude::*;
     let path = path.as_ref();
-    let floats: Vec<f32> = image.rgb.iter().flatten().copied().collect();
-    let buf = ::image::Rgb32FImage::from_raw(image.width, image.height, floats).expect("buffer size matches");
-    buf.save(path).with_context(|| format!("cannot write EXR {}", path.display()))
+    let w = image.width as usize;
+    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+        let p = image.rgb[y * w + x];
+        (p[0], p[1], p[2])
+    });
+    let encoding = Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
+    exr::image::Image::from_encoded_channels((w, image.height as usize), encoding, channels)
+        .write()
+        .to_file(path)
+        .with_context(|| format!("cannot write EXR {}", path.display()))
 }
 
 #[cfg(test)]
