@@ -1,0 +1,19 @@
+//! Throughput of the GPU cache at width 64 on this adapter:
+//! `cargo run --release -p nirc --example nirc_bench [batch] [queries] [reps]`.
+
+use nirc::NircConfig;
+use nirc::gpu::shaders::WeightPlacement;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<u32> = std::env::args().skip(1).map(|a| a.parse().expect("numbers: batch queries reps")).collect();
+    let batch = args.first().copied().unwrap_or(4096);
+    let queries = args.get(1).copied().unwrap_or(16384);
+    let reps = args.get(2).copied().unwrap_or(3);
+    let gpu = render::gpu::Gpu::new()?;
+    let config = NircConfig::default();
+    for placement in [WeightPlacement::Workgroup, WeightPlacement::Storage] {
+        let r = nirc::bench::run(&gpu, &config, Some(placement), batch, queries, reps)?;
+        println!("{r:#?}");
+    }
+    Ok(())
+}

@@ -1,0 +1,74 @@
+// Training pass 3: Adam on every parameter, then the debiased EMA
+// w̄_t = (α w̄_{t-1} (1 - α^{t-1}) + (1 - α) w_t) / (1 - α^t) (CPU mirror: src/cpu/optimizer.rs).
+// `check` computes every update without writing and raises the flag on any non-finite value;
+// `apply` recomputes and writes only if no pass raised it, so a bad step leaves no trace.
+
+@group(0) @binding(0) var<uniform> call: Call;
+@group(0) @binding(1) var<uniform> hyper: Hyper;
+@group(0) @binding(2) var<storage, read_write> params: array<f32>;
+@group(0) @binding(3) var<storage, read_write> ema: array<f32>;
+@group(0) @binding(4) var<storage, read_write> adam_m: array<f32>;
+@group(0) @binding(5) var<storage, read_write> adam_v: array<f32>;
+@group(0) @binding(6) var<storage, read> grad: array<f32>;
+@group(0) @binding(7) var<storage, read> grid_accum: array<u32>;
+@group(0) @binding(8) var<storage, read_write> counters: CountersAtomic;
+
+struct Update {
+    w: f32,
+    m: f32,
+    v: f32,
+    e: f32,
+    g: f32,
+}
+
+fn update(i: u32) -> Update {
+    var g: f32;
+    if i < MLP_PARAMS {
+        g = grad[i];
+    } else {
+        let b = 3u * (i - MLP_PARAMS);
+        g = fixed_to_f32(grid_accum[b], grid_accum[b + 1u], grid_accum[b + 2u]) * call.inv_n;
+    }
+    let b1t = counters.beta1_pow * hyper.beta1;
+    let b2t = counters.beta2_pow * hyper.beta2;
+    let at = counters.alpha_pow * hyper.alpha;
+    let m1 = hyper.beta1 * adam_m[i] + (1.0 - hyper.beta1) * g;
+    let v1 = hyper.beta2 * adam_v[i] + (1.0 - hyper.beta2) * (g * g);
+    let m_hat = m1 / (1.0 - b1t);
+    let v_hat = v1 / (1.0 - b2t);
+    let w1 = params[i] - hyper.learning_rate * m_hat / (sqrt(v_hat) + hyper.adam_epsilon);
+    // Debiased EMA as the convex combination w̄ + β_t (w - w̄), β_t = (1 - α) / (1 - α^t)
+    // (same as the notes' formula, exact on constants); at t = 1 it is w_1.
+    var e1 = w1;
+    if counters.alpha_pow != 1.0 {
+        let beta = (1.0 - hyper.alpha) / (1.0 - at);
+        e1 = ema[i] + beta * (w1 - ema[i]);
+    }
+    return Update(w1, m1, v1, e1, g);
+}
+
+@compute @workgroup_size(64)
+fn check(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    var ok = true;
+    for (var i = gid.x; i < TOTAL_PARAMS; i += groups.x * 64u) {
+        let u = update(i);
+        ok = ok && is_finite(u.g) && is_finite(u.w) && is_finite(u.m) && is_finite(u.v) && is_finite(u.e);
+    }
+    if !ok {
+        atomicOr(&counters.flag, 1u);
+    }
+}
+
+@compute @workgroup_size(64)
+fn apply(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    if atomicLoad(&counters.flag) != 0u {
+        return;
+    }
+    for (var i = gid.x; i < TOTAL_PARAMS; i += groups.x * 64u) {
+        let u = update(i);
+        params[i] = u.w;
+        adam_m[i] = u.m;
+        adam_v[i] = u.v;
+        ema[i] = u.e;
+    }
+}

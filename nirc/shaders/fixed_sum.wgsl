@@ -1,0 +1,72 @@
+// Order-independent sums of f32 (CPU mirror: src/fixed_sum.rs). A value is converted exactly to
+// a 96-bit two's-complement integer with 48 fractional bits and added word by word with
+// atomicAdd, carrying by hand: integer addition is associative, so the total does not depend on
+// the order the threads run in. The pass declares `accum: array<atomic<u32>>` (lo, mid, hi).
+
+// |x| >= 2^32 is refused; 2^15 such values cannot overflow the 96 bits.
+const FIXED_MAX_EXPONENT: u32 = 158u;
+
+// Adds x to the accumulator whose lo word is accum[base]. False if x is not finite or too large.
+fn fixed_add(base: u32, x: f32) -> bool {
+    let bits = bitcast<u32>(x);
+    let e = (bits >> 23u) & 0xffu;
+    if e == 0xffu || e > FIXED_MAX_EXPONENT {
+        return false;
+    }
+    if e == 0u {
+        return true; // zero or subnormal: below 2^-48
+    }
+    // x = m * 2^(e - 150); fixed = x * 2^48 = m * 2^(e - 102).
+    var m = (bits & 0x7fffffu) | 0x800000u;
+    var shift = i32(e) - 102;
+    if shift < 0 {
+        if shift <= -24 {
+            return true;
+        }
+        m = m >> u32(-shift); // truncation toward zero of the magnitude
+        shift = 0;
+    }
+    let q = u32(shift) / 32u;
+    let r = u32(shift) % 32u;
+    let low = m << r;
+    let high = select(m >> (32u - r), 0u, r == 0u);
+    var w = array<u32, 3>(0u, 0u, 0u);
+    w[q] = low;
+    if q < 2u {
+        w[q + 1u] = high;
+    }
+    if (bits >> 31u) == 1u {
+        // Two's complement negation of the 96 bits.
+        w[0] = ~w[0];
+        w[1] = ~w[1];
+        w[2] = ~w[2];
+        w[0] = w[0] + 1u;
+        if w[0] == 0u {
+            w[1] = w[1] + 1u;
+            if w[1] == 0u {
+                w[2] = w[2] + 1u;
+            }
+        }
+    }
+    fixed_add_words(base, w[0], w[1], w[2]);
+    return true;
+}
+
+fn fixed_add_words(base: u32, w0: u32, w1: u32, w2: u32) {
+    let old0 = atomicAdd(&accum[base], w0);
+    let carry0 = select(0u, 1u, old0 + w0 < old0);
+    let w1c = w1 + carry0;
+    // w1 = 0xffffffff plus a carry wraps to 0: the carry moves on to the top word.
+    let carry_through = select(0u, 1u, w1c < w1);
+    let old1 = atomicAdd(&accum[base + 1u], w1c);
+    let carry1 = select(0u, 1u, old1 + w1c < old1);
+    atomicAdd(&accum[base + 2u], w2 + carry1 + carry_through);
+}
+
+// Adds x clamped to ±(2^32 - 2^8) (statistics: a firefly must not void a step).
+fn fixed_add_clamped(base: u32, x: f32) -> bool {
+    if !is_finite(x) {
+        return false;
+    }
+    return fixed_add(base, clamp(x, -4294967040.0, 4294967040.0));
+}

@@ -1,0 +1,45 @@
+// Reliability grid lookups (CPU mirror: src/reliability.rs): the hashed voxel cell of a
+// position, eq. 3 averaged over RGB, and the blend weight of the High-LR predictor.
+
+// Per cell: [M^y, Q^y, M^f_cur, Q^f_cur, C_cur, M^f_ema, Q^f_ema, C_ema] x RGB.
+const MOMENTS_PER_CELL: u32 = 24u;
+// Per cell accumulator: 24 fixed-point sums of 3 words, then the sample count.
+const ACCUM_PER_CELL: u32 = 73u;
+const MOMENTS_CUR: u32 = 6u;
+const MOMENTS_EMA: u32 = 15u;
+
+fn cell_index(position: vec3<f32>) -> u32 {
+    let p = normalize_to_bounds(hyper, position);
+    let r = hyper.reliability_resolution;
+    let v = min(vec3<u32>(p * f32(r)), vec3<u32>(r - 1u));
+    return spatial_hash(v) & (CELL_COUNT - 1u);
+}
+
+// r̄ = mean over RGB of c / sqrt((s^y + ε)(s^f + ε)).
+fn mean_correlation(my: vec3<f32>, qy: vec3<f32>, mf: vec3<f32>, qf: vec3<f32>, cyf: vec3<f32>) -> f32 {
+    var sum = 0.0;
+    for (var c = 0u; c < 3u; c++) {
+        let sy = max(qy[c] - my[c] * my[c], 0.0);
+        let sf = max(qf[c] - mf[c] * mf[c], 0.0);
+        let cov = cyf[c] - my[c] * mf[c];
+        sum += cov / sqrt((sy + hyper.reliability_epsilon) * (sf + hyper.reliability_epsilon));
+    }
+    return sum / 3.0;
+}
+
+// Modes: 0 EMA-only, 1 High-LR only, 2 blend, 3 switch. Markers are off during warm-up.
+fn high_lr_weight(mode: u32, grid_updates: u32, r_cur: f32, r_ema: f32) -> f32 {
+    if mode == 0u {
+        return 0.0;
+    }
+    if mode == 1u {
+        return 1.0;
+    }
+    if grid_updates < hyper.warmup {
+        return 0.0;
+    }
+    if mode == 2u {
+        return 1.0 / (1.0 + exp(-hyper.kappa * (r_cur - r_ema)));
+    }
+    return select(0.0, 1.0, r_cur > r_ema);
+}

@@ -1,0 +1,36 @@
+// Reliability grid, step 1 of an update (one thread per sample): adds the sample's 24
+// quantities (y, y^2, f, f^2, y f per predictor, per channel) to its cell's exact fixed-point
+// sums and counts it. Order-independent, hence deterministic.
+
+@group(0) @binding(0) var<uniform> call: Call;
+@group(0) @binding(1) var<uniform> hyper: Hyper;
+@group(0) @binding(2) var<storage, read> samples: array<ReliabilitySample>;
+@group(0) @binding(3) var<storage, read_write> accum: array<atomic<u32>>;
+@group(0) @binding(4) var<storage, read_write> counters: CountersAtomic;
+
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    var ok = true;
+    for (var s = gid.x; s < call.n; s += groups.x * 64u) {
+        let sample = samples[s];
+        let cell = cell_index(sample.position.xyz);
+        let base = cell * ACCUM_PER_CELL;
+        atomicAdd(&accum[base + 72u], 1u);
+        for (var c = 0u; c < 3u; c++) {
+            let y = sample.target_rgb[c];
+            let fc = sample.f_cur[c];
+            let fe = sample.f_ema[c];
+            ok = fixed_add_clamped(base + 3u * c, y) && ok;
+            ok = fixed_add_clamped(base + 3u * (3u + c), y * y) && ok;
+            ok = fixed_add_clamped(base + 3u * (MOMENTS_CUR + c), fc) && ok;
+            ok = fixed_add_clamped(base + 3u * (MOMENTS_CUR + 3u + c), fc * fc) && ok;
+            ok = fixed_add_clamped(base + 3u * (MOMENTS_CUR + 6u + c), y * fc) && ok;
+            ok = fixed_add_clamped(base + 3u * (MOMENTS_EMA + c), fe) && ok;
+            ok = fixed_add_clamped(base + 3u * (MOMENTS_EMA + 3u + c), fe * fe) && ok;
+            ok = fixed_add_clamped(base + 3u * (MOMENTS_EMA + 6u + c), y * fe) && ok;
+        }
+    }
+    if !ok {
+        atomicOr(&counters.flag, 1u);
+    }
+}

@@ -1,0 +1,116 @@
+//! CPU reference of the optimiser step: Adam on every parameter, then the debiased EMA of the
+//! weights. The powers β1^t, β2^t, α^t are carried as running products (not pow) so that the
+//! GPU, which does the same multiplications, gets the same bits.
+
+use crate::config::{AdamConfig, EmaConfig};
+use serde::{Deserialize, Serialize};
+
+/// Step counters, laid out as the GPU's `Counters` buffer.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Counters {
+    /// Committed training steps t.
+    pub step: u32,
+    /// Steps rolled back because a loss, gradient or weight was not finite.
+    pub rejected_steps: u32,
+    /// Updates of the reliability grid (one per committed step that carried samples).
+    pub grid_updates: u32,
+    /// Scratch of the step in flight on the GPU (non-finite flag); always 0 at rest.
+    pub flag: u32,
+    pub beta1_pow: f32,
+    pub beta2_pow: f32,
+    pub alpha_pow: f32,
+    pub _pad: u32,
+}
+
+impl Default for Counters {
+    fn default() -> Self {
+        Self { step: 0, rejected_steps: 0, grid_updates: 0, flag: 0, beta1_pow: 1.0, beta2_pow: 1.0, alpha_pow: 1.0, _pad: 0 }
+    }
+}
+
+/// The powers after this step: β1^t, β2^t, α^t with t = step + 1.
+pub fn next_powers(c: &Counters, adam: &AdamConfig, ema: &EmaConfig) -> (f32, f32, f32) {
+    (c.beta1_pow * adam.beta1, c.beta2_pow * adam.beta2, c.alpha_pow * ema.alpha)
+}
+
+/// β_t = (1 - α) / (1 - α^t), the weight of the newest weights in the debiased EMA.
+#[inline]
+pub fn ema_weight(alpha: f32, alpha_pow: f32) -> f32 {
+    (1.0 - alpha) / (1.0 - alpha_pow)
+}
+
+/// New (w, m, v, w̄) of one parameter for gradient g. `powers` are from `next_powers`;
+/// `alpha_pow_prev` = α^{t-1}.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub fn adam_ema_update(
+    adam: &AdamConfig,
+    ema: &EmaConfig,
+    powers: (f32, f32, f32),
+    alpha_pow_prev: f32,
+    w: f32,
+    m: f32,
+    v: f32,
+    w_ema: f32,
+    g: f32,
+) -> (f32, f32, f32, f32) {
+    let (b1t, b2t, at) = powers;
+    let m1 = adam.beta1 * m + (1.0 - adam.beta1) * g;
+    let v1 = adam.beta2 * v + (1.0 - adam.beta2) * (g * g);
+    let m_hat = m1 / (1.0 - b1t);
+    let v_hat = v1 / (1.0 - b2t);
+    let w1 = w - adam.learning_rate * m_hat / (v_hat.sqrt() + adam.epsilon);
+    // w̄_t = (α w̄_{t-1} (1 - α^{t-1}) + (1 - α) w_t) / (1 - α^t) written as the convex
+    // combination w̄_{t-1} + β_t (w_t - w̄_{t-1}), β_t = (1 - α) / (1 - α^t): algebraically the
+    // same, and exact on a constant sequence. At t = 1 (β = 1, α^{t-1} = 1) it is w_1 itself.
+    let e1 = if alpha_pow_prev == 1.0 { w1 } else { w_ema + ema_weight(ema.alpha, at) * (w1 - w_ema) };
+    (w1, m1, v1, e1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn debiased_ema_of_a_constant_sequence_is_the_constant() {
+        let adam = AdamConfig::default();
+        for alpha in [0.5f32, 0.9, 0.99, 0.999] {
+            let ema = EmaConfig { alpha };
+            let w = 0.737_f32;
+            // The first debiased value is w_1 itself whatever the initial w̄.
+            let mut e = 123.0f32;
+            let mut c = Counters::default();
+            for t in 1..=2000 {
+                let powers = next_powers(&c, &adam, &ema);
+                // g = 0 with m = v = 0 keeps w fixed, so the EMA sees a constant sequence.
+                let (w1, _, _, e1) = adam_ema_update(&adam, &ema, powers, c.alpha_pow, w, 0.0, 0.0, e, 0.0);
+                assert_eq!(w1, w);
+                assert_eq!(e1, w, "α={alpha} t={t}");
+                e = e1;
+                c.step = t;
+                (c.beta1_pow, c.beta2_pow, c.alpha_pow) = powers;
+            }
+        }
+    }
+
+    #[test]
+    fn debiased_ema_matches_the_plain_average_form() {
+        // w̄_t equals (Σ_s (1-α) α^{t-s} w_s) / (1 - α^t): check in f64 against the update in f32.
+        let ema = EmaConfig { alpha: 0.9 };
+        let adam = AdamConfig::default();
+        let ws: Vec<f32> = (0..50).map(|i| (i as f32 * 0.37).sin()).collect();
+        let mut e = 0.0f32;
+        let mut c = Counters::default();
+        for (t, &w) in ws.iter().enumerate() {
+            let powers = next_powers(&c, &adam, &ema);
+            e = adam_ema_update(&adam, &ema, powers, c.alpha_pow, w, 0.0, 0.0, e, 0.0).3;
+            c.step += 1;
+            (c.beta1_pow, c.beta2_pow, c.alpha_pow) = powers;
+            let a = 0.9f64;
+            let num: f64 = ws[..=t].iter().enumerate().map(|(s, &x)| (1.0 - a) * a.powi((t - s) as i32) * x as f64).sum();
+            let expected = num / (1.0 - a.powi(t as i32 + 1));
+            assert!((e as f64 - expected).abs() < 1e-5, "t={t}: {e} vs {expected}");
+        }
+    }
+}

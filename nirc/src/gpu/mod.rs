@@ -1,0 +1,470 @@
+//! The cache on the GPU: buffers of the whole state, the WGSL passes, and the calls a path
+//! tracer makes (`train` on a buffer of training records, `infer` on a buffer of queries).
+//!
+//! A training step is one submission of these passes (nirc/shaders/):
+//! 1. train_forward_backward  per record: both forwards, loss, backward; hash-grid gradients as
+//!                            exact fixed-point sums; reliability samples (y, f_cur, f_ema)
+//! 2. reliability_accumulate  per sample: fixed-point sums per reliability cell
+//! 3. weight_gradient         per weight and chunk of records, then over chunks (no atomics)
+//! 4. adam_ema check, apply   Adam + debiased EMA; any non-finite value raises a flag and
+//!                            nothing is written
+//! 5. reliability_update      per cell: EMA of the moments towards the batch means
+//! 6. finish_step             commit the counters, or count the rolled-back step
+//! Every sum has a fixed order or is exact, so a step is deterministic.
+
+pub mod readback;
+pub mod shaders;
+
+use crate::bounds::SceneBounds;
+use crate::config::{NircConfig, PredictorMode};
+use crate::cpu::optimizer::Counters;
+use crate::error::NircError;
+use crate::layout::ParameterLayout;
+use crate::records::{CacheAnswer, CacheQuery, ReliabilitySample, TrainingRecord};
+use crate::reliability::{MOMENTS_PER_CELL, cell_count};
+use crate::state::CacheState;
+use bytemuck::{Pod, Zeroable};
+use render::gpu::Gpu;
+use shaders::{CHUNK, WORKGROUP_SIZE, WeightPlacement};
+use std::path::Path;
+use wgpu::util::DeviceExt;
+
+/// u32 words per reliability cell accumulator (24 sums x 3 words + count).
+const ACCUM_PER_CELL: u64 = 73;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct Hyper {
+    bounds_min: [f32; 4],
+    inv_extent: [f32; 4],
+    learning_rate: f32,
+    beta1: f32,
+    beta2: f32,
+    adam_epsilon: f32,
+    alpha: f32,
+    loss_epsilon: f32,
+    lambda: f32,
+    reliability_epsilon: f32,
+    kappa: f32,
+    warmup: u32,
+    reliability_resolution: u32,
+    loss_luminance: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct Call {
+    n: u32,
+    inv_n: f32,
+    mode: u32,
+    num_chunks: u32,
+}
+
+struct Pipelines {
+    train_forward_backward: wgpu::ComputePipeline,
+    weight_partial: wgpu::ComputePipeline,
+    weight_reduce: wgpu::ComputePipeline,
+    adam_check: wgpu::ComputePipeline,
+    adam_apply: wgpu::ComputePipeline,
+    reliability_accumulate: wgpu::ComputePipeline,
+    reliability_update: wgpu::ComputePipeline,
+    finish_step: wgpu::ComputePipeline,
+    infer: wgpu::ComputePipeline,
+}
+
+struct Buffers {
+    hyper: wgpu::Buffer,
+    call: wgpu::Buffer,
+    params: wgpu::Buffer,
+    ema: wgpu::Buffer,
+    adam_m: wgpu::Buffer,
+    adam_v: wgpu::Buffer,
+    grad: wgpu::Buffer,
+    partials: wgpu::Buffer,
+    scratch: wgpu::Buffer,
+    grid_accum: wgpu::Buffer,
+    samples: wgpu::Buffer,
+    losses: wgpu::Buffer,
+    reliability_accum: wgpu::Buffer,
+    moments: wgpu::Buffer,
+    counters: wgpu::Buffer,
+}
+
+/// Bind groups that do not depend on the caller's buffers.
+struct FixedBindGroups {
+    weight_partial: wgpu::BindGroup,
+    weight_reduce: wgpu::BindGroup,
+    adam_check: wgpu::BindGroup,
+    adam_apply: wgpu::BindGroup,
+    accumulate_own_samples: wgpu::BindGroup,
+    reliability_update: wgpu::BindGroup,
+    finish_step: wgpu::BindGroup,
+}
+
+/// The neural incident radiance cache on the GPU.
+pub struct NeuralCache {
+    pub config: NircConfig,
+    pub bounds: SceneBounds,
+    pub layout: ParameterLayout,
+    pub placement: WeightPlacement,
+    pipelines: Pipelines,
+    buffers: Buffers,
+    groups: FixedBindGroups,
+}
+
+fn groups_for(threads: u64) -> u32 {
+    threads.div_ceil(WORKGROUP_SIZE as u64).clamp(1, 65535) as u32
+}
+
+fn storage(gpu: &Gpu, label: &str, bytes: u64) -> Result<wgpu::Buffer, NircError> {
+    gpu.check_buffer_size(label, bytes)?;
+    Ok(gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(16),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    }))
+}
+
+fn storage_init(gpu: &Gpu, label: &str, data: &[u8]) -> Result<wgpu::Buffer, NircError> {
+    gpu.check_buffer_size(label, data.len() as u64)?;
+    Ok(gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: data,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+    }))
+}
+
+fn bind(gpu: &Gpu, label: &str, pipeline: &wgpu::ComputePipeline, entries: &[(u32, &wgpu::Buffer)]) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout: &pipeline.get_bind_group_layout(0), entries: &entries })
+}
+
+fn dispatch(pass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, group: &wgpu::BindGroup, workgroups: u32) {
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, group, &[]);
+    pass.dispatch_workgroups(workgroups, 1, 1);
+}
+
+/// A storage buffer holding `records` (for tests, benchmarks and callers without their own).
+pub fn upload<T: Pod>(gpu: &Gpu, label: &str, items: &[T]) -> wgpu::Buffer {
+    gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::cast_slice(items),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+    })
+}
+
+/// An output buffer for `n` answers.
+pub fn answer_buffer(gpu: &Gpu, n: u32) -> wgpu::Buffer {
+    gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("nirc answers"),
+        size: (n as u64 * std::mem::size_of::<CacheAnswer>() as u64).max(16),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    })
+}
+
+impl NeuralCache {
+    /// A fresh cache (initial weights from `config.seed`) over `scene_bounds`.
+    pub fn new(gpu: &Gpu, config: &NircConfig, scene_bounds: SceneBounds) -> Result<Self, NircError> {
+        Self::from_state(gpu, &CacheState::initial(config, scene_bounds)?, None)
+    }
+
+    /// Uploads a whole state. `placement` None chooses workgroup memory when one predictor's
+    /// weights fit the adapter's workgroup memory budget, else the storage buffer.
+    pub fn from_state(gpu: &Gpu, state: &CacheState, placement: Option<WeightPlacement>) -> Result<Self, NircError> {
+        let config = state.config.clone();
+        config.validate()?;
+        let layout = ParameterLayout::new(&config);
+        let wg_bytes = shaders::workgroup_bytes(&layout, WeightPlacement::Workgroup);
+        let placement = match placement {
+            Some(WeightPlacement::Workgroup) => {
+                gpu.check_workgroup_memory("nirc forward (MLP weights in workgroup memory)", wg_bytes)?;
+                WeightPlacement::Workgroup
+            }
+            Some(WeightPlacement::Storage) => WeightPlacement::Storage,
+            None if gpu.check_workgroup_memory("nirc forward", wg_bytes).is_ok() => WeightPlacement::Workgroup,
+            None => WeightPlacement::Storage,
+        };
+        if config.max_batch.div_ceil(WORKGROUP_SIZE) > gpu.limits.max_compute_workgroups_per_dimension {
+            return Err(NircError::Config(format!("max_batch {} needs more workgroups than this adapter dispatches", config.max_batch)));
+        }
+        let pipelines = Self::pipelines(gpu, &config, &layout, placement);
+        let buffers = Self::buffers(gpu, &config, &layout, state)?;
+        let groups = Self::fixed_groups(gpu, &pipelines, &buffers);
+        Ok(Self { bounds: state.bounds, config, layout, placement, pipelines, buffers, groups })
+    }
+
+    fn pipelines(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, placement: WeightPlacement) -> Pipelines {
+        let module = |pass: &str| {
+            gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(pass),
+                source: wgpu::ShaderSource::Wgsl(shaders::source(config, layout, placement, pass).into()),
+            })
+        };
+        let pipeline = |m: &wgpu::ShaderModule, label: &str, entry: &str| {
+            gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(label),
+                layout: None,
+                module: m,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let fb = module("train_forward_backward");
+        let wgrad = module("weight_gradient");
+        let adam = module("adam_ema");
+        let acc = module("reliability_accumulate");
+        let upd = module("reliability_update");
+        let fin = module("finish_step");
+        let inf = module("infer");
+        Pipelines {
+            train_forward_backward: pipeline(&fb, "nirc train_forward_backward", "main"),
+            weight_partial: pipeline(&wgrad, "nirc weight_gradient partial", "partial_sums"),
+            weight_reduce: pipeline(&wgrad, "nirc weight_gradient reduce", "reduce"),
+            adam_check: pipeline(&adam, "nirc adam check", "check"),
+            adam_apply: pipeline(&adam, "nirc adam apply", "apply"),
+            reliability_accumulate: pipeline(&acc, "nirc reliability_accumulate", "main"),
+            reliability_update: pipeline(&upd, "nirc reliability_update", "main"),
+            finish_step: pipeline(&fin, "nirc finish_step", "main"),
+            infer: pipeline(&inf, "nirc infer", "main"),
+        }
+    }
+
+    fn hyper(config: &NircConfig, bounds: &SceneBounds) -> Hyper {
+        let inv = bounds.inv_extent();
+        Hyper {
+            bounds_min: [bounds.min[0], bounds.min[1], bounds.min[2], 0.0],
+            inv_extent: [inv[0], inv[1], inv[2], 0.0],
+            learning_rate: config.optimizer.learning_rate,
+            beta1: config.optimizer.beta1,
+            beta2: config.optimizer.beta2,
+            adam_epsilon: config.optimizer.epsilon,
+            alpha: config.ema.alpha,
+            loss_epsilon: config.loss.epsilon,
+            lambda: config.reliability.lambda,
+            reliability_epsilon: config.reliability.epsilon,
+            kappa: config.reliability.kappa,
+            warmup: config.reliability.warmup,
+            reliability_resolution: config.reliability.resolution,
+            loss_luminance: (config.loss.normalization == crate::config::LossNormalization::Luminance) as u32,
+        }
+    }
+
+    fn buffers(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, state: &CacheState) -> Result<Buffers, NircError> {
+        let n = layout.total_params as usize;
+        for (name, len, expected) in [
+            ("params", state.params.len(), n),
+            ("ema", state.ema.len(), n),
+            ("adam_m", state.adam_m.len(), n),
+            ("adam_v", state.adam_v.len(), n),
+            ("reliability", state.reliability.len(), cell_count(&config.reliability) as usize * MOMENTS_PER_CELL),
+        ] {
+            if len != expected {
+                return Err(NircError::Config(format!("state.{name} has {len} values, the config needs {expected}")));
+            }
+        }
+        let max_batch = config.max_batch as u64;
+        let chunks = max_batch.div_ceil(CHUNK as u64);
+        let uniform = |label: &str, data: &[u8]| {
+            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: data,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            })
+        };
+        let mut counters = state.counters;
+        counters.flag = 0;
+        Ok(Buffers {
+            hyper: uniform("nirc hyper", bytemuck::bytes_of(&Self::hyper(config, &state.bounds))),
+            call: uniform("nirc call", bytemuck::bytes_of(&Call { n: 0, inv_n: 0.0, mode: 0, num_chunks: 0 })),
+            params: storage_init(gpu, "nirc params", bytemuck::cast_slice(&state.params))?,
+            ema: storage_init(gpu, "nirc ema params", bytemuck::cast_slice(&state.ema))?,
+            adam_m: storage_init(gpu, "nirc adam m", bytemuck::cast_slice(&state.adam_m))?,
+            adam_v: storage_init(gpu, "nirc adam v", bytemuck::cast_slice(&state.adam_v))?,
+            grad: storage(gpu, "nirc mlp gradient", layout.mlp_params as u64 * 4)?,
+            partials: storage(gpu, "nirc gradient partial sums", chunks * layout.mlp_params as u64 * 4)?,
+            scratch: storage(gpu, "nirc training scratch", max_batch * (layout.activation_floats() + layout.delta_floats()) as u64 * 4)?,
+            grid_accum: storage(gpu, "nirc hash-grid gradient sums", layout.grid_params() as u64 * 12)?,
+            samples: storage(gpu, "nirc reliability samples", max_batch * std::mem::size_of::<ReliabilitySample>() as u64)?,
+            losses: storage(gpu, "nirc losses", max_batch * 4)?,
+            reliability_accum: storage(gpu, "nirc reliability sums", cell_count(&config.reliability) as u64 * ACCUM_PER_CELL * 4)?,
+            moments: storage_init(gpu, "nirc reliability moments", bytemuck::cast_slice(&state.reliability))?,
+            counters: storage_init(gpu, "nirc counters", bytemuck::bytes_of(&counters))?,
+        })
+    }
+
+    fn fixed_groups(gpu: &Gpu, p: &Pipelines, b: &Buffers) -> FixedBindGroups {
+        let adam_entries: &[(u32, &wgpu::Buffer)] =
+            &[(0, &b.call), (1, &b.hyper), (2, &b.params), (3, &b.ema), (4, &b.adam_m), (5, &b.adam_v), (6, &b.grad), (7, &b.grid_accum), (8, &b.counters)];
+        FixedBindGroups {
+            weight_partial: bind(gpu, "nirc weight partial", &p.weight_partial, &[(0, &b.call), (1, &b.scratch), (2, &b.partials)]),
+            weight_reduce: bind(gpu, "nirc weight reduce", &p.weight_reduce, &[(0, &b.call), (2, &b.partials), (3, &b.grad)]),
+            adam_check: bind(gpu, "nirc adam check", &p.adam_check, adam_entries),
+            adam_apply: bind(gpu, "nirc adam apply", &p.adam_apply, adam_entries),
+            accumulate_own_samples: bind(
+                gpu,
+                "nirc reliability accumulate",
+                &p.reliability_accumulate,
+                &[(0, &b.call), (1, &b.hyper), (2, &b.samples), (3, &b.reliability_accum), (4, &b.counters)],
+            ),
+            reliability_update: bind(gpu, "nirc reliability update", &p.reliability_update, &[(1, &b.hyper), (2, &b.reliability_accum), (3, &b.moments), (4, &b.counters)]),
+            finish_step: bind(gpu, "nirc finish", &p.finish_step, &[(0, &b.call), (1, &b.hyper), (2, &b.counters)]),
+        }
+    }
+
+    fn check_items(what: &str, buffer: &wgpu::Buffer, n: u32, item: u64) -> Result<(), NircError> {
+        let needed = n as u64 * item;
+        if buffer.size() < needed {
+            return Err(NircError::BufferTooSmall { what: what.into(), bytes: buffer.size(), needed, count: n });
+        }
+        Ok(())
+    }
+
+    /// One training step on the first `n` records of `records` (array of `TrainingRecord`).
+    /// Submits its own command buffer. A step with a non-finite loss, gradient or weight is
+    /// rolled back on the GPU and counted in `Counters::rejected_steps`.
+    pub fn train(&self, gpu: &Gpu, records: &wgpu::Buffer, n: u32) -> Result<(), NircError> {
+        if n == 0 {
+            return Ok(());
+        }
+        if n > self.config.max_batch {
+            return Err(NircError::BatchTooLarge { requested: n, max: self.config.max_batch });
+        }
+        Self::check_items("training records", records, n, std::mem::size_of::<TrainingRecord>() as u64)?;
+        let b = &self.buffers;
+        let p = &self.pipelines;
+        let num_chunks = n.div_ceil(CHUNK);
+        gpu.queue.write_buffer(&b.call, 0, bytemuck::bytes_of(&Call { n, inv_n: 1.0 / n as f32, mode: 0, num_chunks }));
+        let fb = bind(
+            gpu,
+            "nirc train_forward_backward",
+            &p.train_forward_backward,
+            &[(0, &b.call), (1, &b.hyper), (2, records), (3, &b.params), (4, &b.ema), (5, &b.scratch), (6, &b.grid_accum), (7, &b.samples), (8, &b.losses), (9, &b.counters)],
+        );
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc train") });
+        encoder.clear_buffer(&b.grid_accum, 0, None);
+        encoder.clear_buffer(&b.reliability_accum, 0, None);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc train"), timestamp_writes: None });
+            let g = &self.groups;
+            dispatch(&mut pass, &p.train_forward_backward, &fb, n.div_ceil(WORKGROUP_SIZE));
+            dispatch(&mut pass, &p.reliability_accumulate, &g.accumulate_own_samples, groups_for(n as u64));
+            dispatch(&mut pass, &p.weight_partial, &g.weight_partial, groups_for(self.layout.mlp_params as u64 * num_chunks as u64));
+            dispatch(&mut pass, &p.weight_reduce, &g.weight_reduce, groups_for(self.layout.mlp_params as u64));
+            let all = groups_for(self.layout.total_params as u64);
+            dispatch(&mut pass, &p.adam_check, &g.adam_check, all);
+            dispatch(&mut pass, &p.adam_apply, &g.adam_apply, all);
+            dispatch(&mut pass, &p.reliability_update, &g.reliability_update, groups_for(cell_count(&self.config.reliability) as u64));
+            dispatch(&mut pass, &p.finish_step, &g.finish_step, 1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// One update of the reliability grid from explicit samples (no training): what a training
+    /// step does with its own samples. For tests and for callers that score other predictors.
+    pub fn update_reliability(&self, gpu: &Gpu, samples: &wgpu::Buffer, n: u32) -> Result<(), NircError> {
+        if n == 0 {
+            return Ok(());
+        }
+        Self::check_items("reliability samples", samples, n, std::mem::size_of::<ReliabilitySample>() as u64)?;
+        let b = &self.buffers;
+        let p = &self.pipelines;
+        gpu.queue.write_buffer(&b.call, 0, bytemuck::bytes_of(&Call { n, inv_n: 1.0 / n as f32, mode: 1, num_chunks: 0 }));
+        let acc = bind(gpu, "nirc reliability accumulate", &p.reliability_accumulate, &[(0, &b.call), (1, &b.hyper), (2, samples), (3, &b.reliability_accum), (4, &b.counters)]);
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc reliability") });
+        encoder.clear_buffer(&b.reliability_accum, 0, None);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc reliability"), timestamp_writes: None });
+            dispatch(&mut pass, &p.reliability_accumulate, &acc, groups_for(n as u64));
+            dispatch(&mut pass, &p.reliability_update, &self.groups.reliability_update, groups_for(cell_count(&self.config.reliability) as u64));
+            dispatch(&mut pass, &p.finish_step, &self.groups.finish_step, 1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// Answers the first `n` queries of `queries` (array of `CacheQuery`) into `out` (array of
+    /// `CacheAnswer`): radiance max(0, (1 - σ) f_EMA + σ f_cur) and σ. Submits its own commands.
+    pub fn infer(&self, gpu: &Gpu, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: PredictorMode) -> Result<(), NircError> {
+        if n == 0 {
+            return Ok(());
+        }
+        Self::check_items("cache queries", queries, n, std::mem::size_of::<CacheQuery>() as u64)?;
+        Self::check_items("cache answers", out, n, std::mem::size_of::<CacheAnswer>() as u64)?;
+        let groups = n.div_ceil(WORKGROUP_SIZE);
+        if groups > gpu.limits.max_compute_workgroups_per_dimension {
+            return Err(NircError::Config(format!("{n} queries need {groups} workgroups, over this adapter's limit")));
+        }
+        let b = &self.buffers;
+        gpu.queue.write_buffer(&b.call, 0, bytemuck::bytes_of(&Call { n, inv_n: 1.0 / n as f32, mode: mode.code(), num_chunks: 0 }));
+        let group = bind(
+            gpu,
+            "nirc infer",
+            &self.pipelines.infer,
+            &[(0, &b.call), (1, &b.hyper), (2, queries), (3, &b.params), (4, &b.ema), (5, &b.moments), (6, &b.counters), (7, out)],
+        );
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc infer") });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc infer"), timestamp_writes: None });
+            dispatch(&mut pass, &self.pipelines.infer, &group, groups);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    pub fn counters(&self, gpu: &Gpu) -> Result<Counters, NircError> {
+        Ok(*bytemuck::from_bytes(&readback::read_bytes(gpu, &self.buffers.counters, "nirc counters")?[..std::mem::size_of::<Counters>()]))
+    }
+
+    /// Mean loss of the last training step's first `n` records (before that step's update).
+    pub fn last_loss(&self, gpu: &Gpu, n: u32) -> Result<f64, NircError> {
+        let losses: Vec<f32> = readback::read_f32(gpu, &self.buffers.losses, "nirc losses")?;
+        let n = (n as usize).min(losses.len());
+        Ok(losses[..n].iter().map(|&l| l as f64).sum::<f64>() / n.max(1) as f64)
+    }
+
+    /// The whole state, read back from the GPU.
+    pub fn download_state(&self, gpu: &Gpu) -> Result<CacheState, NircError> {
+        let b = &self.buffers;
+        let n = self.layout.total_params as usize;
+        let read = |buf: &wgpu::Buffer, what: &str, len: usize| -> Result<Vec<f32>, NircError> { Ok(readback::read_f32(gpu, buf, what)?[..len].to_vec()) };
+        Ok(CacheState {
+            config: self.config.clone(),
+            bounds: self.bounds,
+            params: read(&b.params, "nirc params", n)?,
+            ema: read(&b.ema, "nirc ema", n)?,
+            adam_m: read(&b.adam_m, "nirc adam m", n)?,
+            adam_v: read(&b.adam_v, "nirc adam v", n)?,
+            counters: self.counters(gpu)?,
+            reliability: read(&b.moments, "nirc reliability moments", cell_count(&self.config.reliability) as usize * MOMENTS_PER_CELL)?,
+        })
+    }
+
+    /// Writes the whole state (weights, EMA weights, Adam moments, counters, reliability grid).
+    pub fn save(&self, gpu: &Gpu, path: &Path) -> Result<(), NircError> {
+        self.download_state(gpu)?.save(path)
+    }
+
+    /// A cache continuing exactly from a saved state.
+    pub fn load(gpu: &Gpu, path: &Path) -> Result<Self, NircError> {
+        Self::from_state(gpu, &CacheState::load(path)?, None)
+    }
+
+    /// Convenience for callers holding records on the CPU: uploads and trains.
+    pub fn train_records(&self, gpu: &Gpu, records: &[TrainingRecord]) -> Result<(), NircError> {
+        self.train(gpu, &upload(gpu, "nirc training records", records), records.len() as u32)
+    }
+
+    /// Convenience: uploads queries, infers and reads the answers back.
+    pub fn infer_queries(&self, gpu: &Gpu, queries: &[CacheQuery], mode: PredictorMode) -> Result<Vec<CacheAnswer>, NircError> {
+        let n = queries.len() as u32;
+        let out = answer_buffer(gpu, n);
+        self.infer(gpu, &upload(gpu, "nirc queries", queries), n, &out, mode)?;
+        let bytes = readback::read_bytes(gpu, &out, "nirc answers")?;
+        Ok(bytemuck::cast_slice::<u8, CacheAnswer>(&bytes[..queries.len() * std::mem::size_of::<CacheAnswer>()]).to_vec())
+    }
+}

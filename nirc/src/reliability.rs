@@ -1,0 +1,237 @@
+//! Reliability grid (reliability-weighted-nirc.txt, sections 3.1 and 3.2), CPU reference.
+//!
+//! A single-resolution voxel grid over the scene bounds: a position is normalised to the box,
+//! truncated to integer voxel coordinates and hashed into 2^log2_cells cells; collisions are
+//! ignored. Each cell keeps, per colour channel, EMAs (parameter λ) of the target moments
+//! M^y, Q^y (shared) and, per predictor (High-LR "cur" and EMA), M^f, Q^f, C^{y,f}.
+//!
+//! One *update of the grid* is one committed training step: every cell that received training
+//! samples in that batch moves its moments once towards the batch means of the samples that fell
+//! into it (X <- λ X + (1 - λ) mean); cells without samples are unchanged. Averaging within the
+//! batch (instead of one EMA step per sample) makes the result independent of the order in which
+//! GPU threads see the samples. The warm-up K counts these updates for the whole grid.
+
+use crate::bounds::SceneBounds;
+use crate::config::{PredictorMode, ReliabilityConfig};
+use crate::fixed_sum::FixedSum;
+use crate::layout::spatial_hash;
+use crate::records::ReliabilitySample;
+
+/// Floats per cell: [M^y, Q^y, M^f_cur, Q^f_cur, C^{y,f}_cur, M^f_ema, Q^f_ema, C^{y,f}_ema] x RGB.
+pub const MOMENTS_PER_CELL: usize = 24;
+const CUR: usize = 6;
+const EMA: usize = 15;
+
+pub fn cell_count(config: &ReliabilityConfig) -> u32 {
+    1 << config.log2_cells
+}
+
+/// The hashed cell of a world-space position.
+pub fn cell_index(config: &ReliabilityConfig, bounds: &SceneBounds, position: [f32; 3]) -> u32 {
+    let p = bounds.normalize(position);
+    let r = config.resolution;
+    let v: [u32; 3] = std::array::from_fn(|a| ((p[a] * r as f32) as u32).min(r - 1));
+    spatial_hash(v[0], v[1], v[2]) & (cell_count(config) - 1)
+}
+
+/// The 24 quantities a sample contributes, in the order of the moments.
+pub fn sample_quantities(s: &ReliabilitySample) -> [f32; MOMENTS_PER_CELL] {
+    let mut q = [0.0; MOMENTS_PER_CELL];
+    for c in 0..3 {
+        let (y, fc, fe) = (s.target[c], s.f_cur[c], s.f_ema[c]);
+        q[c] = y;
+        q[3 + c] = y * y;
+        q[CUR + c] = fc;
+        q[CUR + 3 + c] = fc * fc;
+        q[CUR + 6 + c] = y * fc;
+        q[EMA + c] = fe;
+        q[EMA + 3 + c] = fe * fe;
+        q[EMA + 6 + c] = y * fe;
+    }
+    q
+}
+
+/// One grid update from a batch of samples. Returns false (and changes nothing) if a sample is
+/// not finite.
+pub fn update(config: &ReliabilityConfig, bounds: &SceneBounds, moments: &mut [f32], samples: &[ReliabilitySample]) -> bool {
+    let cells = cell_count(config) as usize;
+    assert_eq!(moments.len(), cells * MOMENTS_PER_CELL, "reliability moments sized for another grid");
+    let mut sums = vec![FixedSum::default(); cells * MOMENTS_PER_CELL];
+    let mut counts = vec![0u32; cells];
+    for s in samples {
+        let cell = cell_index(config, bounds, [s.position[0], s.position[1], s.position[2]]) as usize;
+        counts[cell] += 1;
+        for (k, q) in sample_quantities(s).into_iter().enumerate() {
+            if !sums[cell * MOMENTS_PER_CELL + k].add_clamped(q) {
+                return false;
+            }
+        }
+    }
+    for cell in 0..cells {
+        if counts[cell] == 0 {
+            continue;
+        }
+        for k in 0..MOMENTS_PER_CELL {
+            let i = cell * MOMENTS_PER_CELL + k;
+            moments[i] = ema_step(config.lambda, moments[i], sums[i].to_f32() / counts[cell] as f32);
+        }
+    }
+    true
+}
+
+#[inline]
+pub fn ema_step(lambda: f32, x: f32, mean: f32) -> f32 {
+    lambda * x + (1.0 - lambda) * mean
+}
+
+/// Eq. 3 averaged over RGB: (r̄_cur, r̄_ema) of one cell.
+pub fn reliabilities(config: &ReliabilityConfig, cell_moments: &[f32]) -> (f32, f32) {
+    let m = cell_moments;
+    let r = |p: usize| {
+        let mut sum = 0.0f32;
+        for c in 0..3 {
+            let (my, qy) = (m[c], m[3 + c]);
+            let (mf, qf, cyf) = (m[p + c], m[p + 3 + c], m[p + 6 + c]);
+            let sy = (qy - my * my).max(0.0);
+            let sf = (qf - mf * mf).max(0.0);
+            let cov = cyf - my * mf;
+            sum += cov / ((sy + config.epsilon) * (sf + config.epsilon)).sqrt();
+        }
+        sum / 3.0
+    };
+    (r(CUR), r(EMA))
+}
+
+/// Weight of the High-LR predictor for a query in a cell with these moments.
+pub fn high_lr_weight(config: &ReliabilityConfig, mode: PredictorMode, grid_updates: u32, cell_moments: &[f32]) -> f32 {
+    match mode {
+        PredictorMode::EmaOnly => 0.0,
+        PredictorMode::HighLrOnly => 1.0,
+        // During warm-up the markers are disabled: the EMA baseline answers.
+        _ if grid_updates < config.warmup => 0.0,
+        PredictorMode::Blend => {
+            let (r_cur, r_ema) = reliabilities(config, cell_moments);
+            1.0 / (1.0 + (-config.kappa * (r_cur - r_ema)).exp())
+        }
+        PredictorMode::Switch => {
+            let (r_cur, r_ema) = reliabilities(config, cell_moments);
+            if r_cur > r_ema { 1.0 } else { 0.0 }
+        }
+    }
+}
+
+/// L̂ = (1 - σ) f_EMA + σ f_cur, clamped to >= 0.
+pub fn combine(sigma: f32, f_cur: [f32; 3], f_ema: [f32; 3]) -> [f32; 3] {
+    std::array::from_fn(|c| ((1.0 - sigma) * f_ema[c] + sigma * f_cur[c]).max(0.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lcg(state: &mut u64) -> f32 {
+        *state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((*state >> 40) as f32) / (1u64 << 24) as f32
+    }
+
+    fn config() -> ReliabilityConfig {
+        ReliabilityConfig { resolution: 4, log2_cells: 6, warmup: 8, ..Default::default() }
+    }
+
+    /// Feeds `frames` updates of one sample each into the cell at the origin.
+    fn run(frames: usize, mut sample: impl FnMut(usize) -> ([f32; 3], [f32; 3], [f32; 3])) -> Vec<f32> {
+        let cfg = config();
+        let bounds = SceneBounds::new([0.0; 3], [1.0; 3]);
+        let mut moments = vec![0.0; cell_count(&cfg) as usize * MOMENTS_PER_CELL];
+        for t in 0..frames {
+            let (y, fc, fe) = sample(t);
+            let s = ReliabilitySample {
+                position: [0.1, 0.1, 0.1, 0.0],
+                target: [y[0], y[1], y[2], 0.0],
+                f_cur: [fc[0], fc[1], fc[2], 0.0],
+                f_ema: [fe[0], fe[1], fe[2], 0.0],
+            };
+            assert!(update(&cfg, &bounds, &mut moments, &[s]));
+        }
+        let cell = cell_index(&cfg, &bounds, [0.1, 0.1, 0.1]) as usize;
+        moments[cell * MOMENTS_PER_CELL..(cell + 1) * MOMENTS_PER_CELL].to_vec()
+    }
+
+    #[test]
+    fn linearly_related_stream_has_correlation_one() {
+        let mut rng = 1u64;
+        let m = run(400, |_| {
+            let y = [lcg(&mut rng) * 4.0, lcg(&mut rng) * 2.0, lcg(&mut rng) + 1.0];
+            // f = 0.5 y + 0.2 (cur) and f = 2 y (ema): both perfectly linear in y.
+            (y, y.map(|v| 0.5 * v + 0.2), y.map(|v| 2.0 * v))
+        });
+        let cfg = ReliabilityConfig { epsilon: 1e-7, ..config() };
+        let (r_cur, r_ema) = reliabilities(&cfg, &m);
+        assert!((r_cur - 1.0).abs() < 1e-3 && (r_ema - 1.0).abs() < 1e-3, "{r_cur} {r_ema}");
+    }
+
+    #[test]
+    fn uncorrelated_stream_has_correlation_near_zero_and_anticorrelated_minus_one() {
+        let mut rng = 7u64;
+        let mut r_sum = 0.0;
+        let mut windows = 0;
+        // Average over many independent windows: one EMA window (λ = 0.9) holds ~10 samples.
+        for _ in 0..100 {
+            // 200 updates: the zero start has decayed (λ^200 ~ 1e-9).
+            let m = run(200, |_| {
+                let y = [lcg(&mut rng), lcg(&mut rng), lcg(&mut rng)];
+                let f = [lcg(&mut rng), lcg(&mut rng), lcg(&mut rng)];
+                (y, f, y.map(|v| 1.0 - v))
+            });
+            let (r_cur, r_ema) = reliabilities(&ReliabilityConfig { epsilon: 1e-7, ..config() }, &m);
+            assert!((r_ema + 1.0).abs() < 1e-3, "anti-correlated: {r_ema}");
+            r_sum += r_cur;
+            windows += 1;
+        }
+        let mean = r_sum / windows as f32;
+        assert!(mean.abs() < 0.05, "mean correlation of independent streams {mean}");
+    }
+
+    #[test]
+    fn blend_weight_follows_the_reliabilities() {
+        let cfg = ReliabilityConfig { epsilon: 1e-7, ..config() };
+        let mut rng = 3u64;
+        // cur tracks y, ema is noise: σ -> logistic(κ (1 - ~0)) close to 1/(1+e^-4).
+        let m = run(300, |_| {
+            let y = [lcg(&mut rng), lcg(&mut rng), lcg(&mut rng)];
+            (y, y, [lcg(&mut rng), lcg(&mut rng), lcg(&mut rng)])
+        });
+        let (r_cur, r_ema) = reliabilities(&cfg, &m);
+        let sigma = high_lr_weight(&cfg, PredictorMode::Blend, 1000, &m);
+        let expected = 1.0 / (1.0 + (-4.0 * (r_cur - r_ema)).exp());
+        assert!(r_cur > 0.99 && r_ema.abs() < 0.6, "{r_cur} {r_ema}");
+        assert!((sigma - expected).abs() < 1e-6 && sigma > 0.85, "σ = {sigma}");
+        assert_eq!(high_lr_weight(&cfg, PredictorMode::Switch, 1000, &m), 1.0);
+        // The mirror image prefers EMA.
+        let m3 = run(300, |_| {
+            let y = [lcg(&mut rng), lcg(&mut rng), lcg(&mut rng)];
+            (y, [lcg(&mut rng), lcg(&mut rng), lcg(&mut rng)], y)
+        });
+        let s3 = high_lr_weight(&cfg, PredictorMode::Blend, 1000, &m3);
+        assert!(s3 < 0.15, "σ = {s3}");
+        assert_eq!(high_lr_weight(&cfg, PredictorMode::Switch, 1000, &m3), 0.0);
+        // Warm-up: markers disabled, EMA answers.
+        assert_eq!(high_lr_weight(&cfg, PredictorMode::Blend, cfg.warmup - 1, &m), 0.0);
+        // Equal reliabilities: an even blend.
+        let (rc, re) = reliabilities(&cfg, &m);
+        let mut same = m.clone();
+        same.copy_within(CUR..CUR + 9, EMA);
+        assert!((high_lr_weight(&cfg, PredictorMode::Blend, 1000, &same) - 0.5).abs() < 1e-6, "{rc} {re}");
+        assert_eq!(combine(0.25, [4.0, 0.0, -8.0], [0.0, 4.0, -8.0]), [1.0, 3.0, 0.0]);
+    }
+
+    #[test]
+    fn cells_follow_the_voxel_grid() {
+        let cfg = config();
+        let b = SceneBounds::new([-2.0; 3], [2.0; 3]);
+        // Same voxel -> same cell; positions are clamped to the box.
+        assert_eq!(cell_index(&cfg, &b, [-1.9, -1.9, -1.9]), cell_index(&cfg, &b, [-1.1, -1.5, -1.01]));
+        assert_eq!(cell_index(&cfg, &b, [5.0, 5.0, 5.0]), cell_index(&cfg, &b, [1.9, 1.9, 1.9]));
+        assert_eq!(cell_index(&cfg, &b, [0.5, 0.5, 0.5]), spatial_hash(2, 2, 2) & 63);
+    }
+}

@@ -1,0 +1,188 @@
+//! The WGSL passes against the CPU reference, on the adapter (lavapipe on CI): forward, one
+//! training step, the reliability grid, save/load exactness, rollback of a non-finite step.
+
+mod common;
+
+use common::*;
+use nirc::config::PredictorMode;
+use nirc::gpu::shaders::WeightPlacement;
+use nirc::gpu::upload;
+use nirc::{CacheState, CpuCache, NeuralCache, ReliabilitySample};
+use render::gpu::Gpu;
+use std::sync::OnceLock;
+
+fn gpu() -> &'static Gpu {
+    static GPU: OnceLock<Gpu> = OnceLock::new();
+    GPU.get_or_init(|| Gpu::new().expect("a wgpu adapter (lavapipe on CI)"))
+}
+
+fn close(a: f32, b: f32, rel: f32, abs: f32) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs()) + abs
+}
+
+fn assert_vec_close(what: &str, gpu: &[f32], cpu: &[f32], rel: f32, abs: f32) {
+    assert_eq!(gpu.len(), cpu.len(), "{what}: lengths");
+    let mut bad = Vec::new();
+    for (i, (g, c)) in gpu.iter().zip(cpu).enumerate() {
+        if !close(*g, *c, rel, abs) {
+            bad.push((i, *g, *c));
+        }
+    }
+    assert!(bad.is_empty(), "{what}: {} of {} values differ, first: {:?}", bad.len(), gpu.len(), &bad[..bad.len().min(8)]);
+}
+
+#[test]
+fn forward_matches_cpu_in_both_weight_placements() {
+    let config = small_config();
+    let state = randomized_state(&config, 21);
+    let cpu = CpuCache::new(state.clone());
+    let mut rng = Rng(4);
+    let queries: Vec<_> = records(&mut rng, 200).iter().map(|r| r.query()).collect();
+    for placement in [WeightPlacement::Workgroup, WeightPlacement::Storage] {
+        let cache = NeuralCache::from_state(gpu(), &state, Some(placement)).unwrap();
+        for mode in [PredictorMode::HighLrOnly, PredictorMode::EmaOnly] {
+            let got = cache.infer_queries(gpu(), &queries, mode).unwrap();
+            let want = cpu.infer(&queries, mode);
+            let mut nonzero = 0;
+            for (g, w) in got.iter().zip(&want) {
+                assert_eq!(g.sigma, w.sigma);
+                for c in 0..3 {
+                    assert!(close(g.radiance[c], w.radiance[c], 1e-4, 1e-6), "{placement:?} {mode:?}: {:?} vs {:?}", g.radiance, w.radiance);
+                    nonzero += (w.radiance[c] > 1e-3) as usize;
+                }
+            }
+            assert!(nonzero > 100, "the test needs non-trivial outputs ({nonzero})");
+        }
+    }
+}
+
+#[test]
+fn one_training_step_matches_cpu() {
+    let config = small_config();
+    let state = randomized_state(&config, 33);
+    let mut rng = Rng(6);
+    // 300 records: two weight-gradient chunks, one partial.
+    let batch = records(&mut rng, 300);
+    let mut cpu = CpuCache::new(state.clone());
+    let report = cpu.train_step(&batch);
+    assert!(report.committed);
+    for placement in [WeightPlacement::Workgroup, WeightPlacement::Storage] {
+        let cache = NeuralCache::from_state(gpu(), &state, Some(placement)).unwrap();
+        cache.train_records(gpu(), &batch).unwrap();
+        let got = cache.download_state(gpu()).unwrap();
+        assert_eq!(got.counters, cpu.state.counters, "{placement:?}");
+        let loss = cache.last_loss(gpu(), batch.len() as u32).unwrap();
+        assert!((loss - report.loss).abs() <= 1e-5 * report.loss, "loss {loss} vs {}", report.loss);
+        let lr = config.optimizer.learning_rate;
+        // First Adam step moves each weight by about lr; compare to a small fraction of it.
+        assert_vec_close("params", &got.params, &cpu.state.params, 1e-5, 1e-3 * lr);
+        assert_vec_close("ema", &got.ema, &cpu.state.ema, 1e-5, 1e-3 * lr);
+        assert_vec_close("adam m", &got.adam_m, &cpu.state.adam_m, 1e-3, 1e-9);
+        assert_vec_close("adam v", &got.adam_v, &cpu.state.adam_v, 2e-3, 1e-12);
+        assert_vec_close("reliability", &got.reliability, &cpu.state.reliability, 1e-4, 1e-6);
+        // The step really moved the weights.
+        let moved = got.params.iter().zip(&state.params).filter(|(a, b)| (*a - *b).abs() > 0.5 * lr).count();
+        assert!(moved > got.params.len() / 10, "only {moved} parameters moved");
+    }
+}
+
+#[test]
+fn reliability_grid_matches_cpu_on_a_random_stream() {
+    let mut config = small_config();
+    config.reliability.warmup = 3;
+    let state = CacheState::initial(&config, bounds()).unwrap();
+    let cache = NeuralCache::from_state(gpu(), &state, None).unwrap();
+    let mut moments = state.reliability.clone();
+    let mut rng = Rng(77);
+    let b = bounds();
+    for update in 0..6 {
+        let samples: Vec<ReliabilitySample> = (0..400)
+            .map(|_| {
+                let p = [rng.range(b.min[0], b.max[0]), rng.range(b.min[1], b.max[1]), rng.range(b.min[2], b.max[2])];
+                let y = [rng.range(0.0, 3.0), rng.range(0.0, 1.0), rng.range(0.0, 0.1)];
+                // cur tracks y, ema lags with noise: distinct correlations per cell.
+                let fc = y.map(|v| 0.9 * v + 0.1);
+                let fe = [rng.range(0.0, 3.0), y[1] * 0.5, rng.range(0.0, 0.1)];
+                ReliabilitySample { position: [p[0], p[1], p[2], 0.0], target: [y[0], y[1], y[2], 0.0], f_cur: [fc[0], fc[1], fc[2], 0.0], f_ema: [fe[0], fe[1], fe[2], 0.0] }
+            })
+            .collect();
+        assert!(nirc::reliability::update(&config.reliability, &b, &mut moments, &samples));
+        cache.update_reliability(gpu(), &upload(gpu(), "samples", &samples), samples.len() as u32).unwrap();
+        let got = cache.download_state(gpu()).unwrap();
+        assert_vec_close(&format!("moments after update {update}"), &got.reliability, &moments, 1e-5, 1e-7);
+        assert_eq!(got.counters.grid_updates, update + 1);
+    }
+    // Blend and switch answers follow the CPU reliabilities (warm-up over).
+    let cpu = CpuCache::new(CacheState { reliability: moments, counters: cache.counters(gpu()).unwrap(), ..state });
+    let queries: Vec<_> = records(&mut rng, 300).iter().map(|r| r.query()).collect();
+    for mode in [PredictorMode::Blend, PredictorMode::Switch] {
+        let got = cache.infer_queries(gpu(), &queries, mode).unwrap();
+        let want = cpu.infer(&queries, mode);
+        let mut off_half = 0;
+        for (g, w) in got.iter().zip(&want) {
+            assert!(close(g.sigma, w.sigma, 1e-4, 1e-5), "{mode:?}: σ {} vs {}", g.sigma, w.sigma);
+            off_half += ((w.sigma - 0.5).abs() > 0.2) as usize;
+        }
+        assert!(off_half > 100, "{mode:?}: the reliabilities must decide ({off_half})");
+    }
+}
+
+#[test]
+fn save_load_reproduces_the_next_step_and_inference_exactly() {
+    let config = small_config();
+    let mut rng = Rng(12);
+    let cache = NeuralCache::new(gpu(), &config, bounds()).unwrap();
+    for _ in 0..3 {
+        cache.train_records(gpu(), &records(&mut rng, 200)).unwrap();
+    }
+    let dir = std::env::temp_dir().join(format!("nirc-gpu-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("warm.nirc");
+    cache.save(gpu(), &path).unwrap();
+    let loaded = NeuralCache::load(gpu(), &path).unwrap();
+    assert_eq!(loaded.download_state(gpu()).unwrap(), cache.download_state(gpu()).unwrap());
+    let next = records(&mut rng, 200);
+    cache.train_records(gpu(), &next).unwrap();
+    loaded.train_records(gpu(), &next).unwrap();
+    let a = cache.download_state(gpu()).unwrap();
+    let b = loaded.download_state(gpu()).unwrap();
+    // Bit-exact: the state and the answers, in every mode.
+    assert_eq!(a.params, b.params);
+    assert_eq!(a.ema, b.ema);
+    assert_eq!(a.adam_m, b.adam_m);
+    assert_eq!(a.adam_v, b.adam_v);
+    assert_eq!(a.reliability, b.reliability);
+    assert_eq!(a.counters, b.counters);
+    let q: Vec<_> = next.iter().map(|r| r.query()).collect();
+    for mode in [PredictorMode::EmaOnly, PredictorMode::HighLrOnly, PredictorMode::Blend, PredictorMode::Switch] {
+        assert_eq!(cache.infer_queries(gpu(), &q, mode).unwrap(), loaded.infer_queries(gpu(), &q, mode).unwrap(), "{mode:?}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn nan_target_rolls_the_step_back_and_is_counted() {
+    let config = small_config();
+    let mut rng = Rng(13);
+    let cache = NeuralCache::new(gpu(), &config, bounds()).unwrap();
+    cache.train_records(gpu(), &records(&mut rng, 128)).unwrap();
+    let before = cache.download_state(gpu()).unwrap();
+    let mut bad = records(&mut rng, 128);
+    bad[77].target[2] = f32::NAN;
+    cache.train_records(gpu(), &bad).unwrap();
+    let after = cache.download_state(gpu()).unwrap();
+    assert_eq!(after.params, before.params);
+    assert_eq!(after.ema, before.ema);
+    assert_eq!(after.adam_m, before.adam_m);
+    assert_eq!(after.adam_v, before.adam_v);
+    assert_eq!(after.reliability, before.reliability);
+    assert_eq!(after.counters.rejected_steps, 1);
+    assert_eq!(after.counters.step, before.counters.step);
+    assert_eq!(after.counters.flag, 0);
+    // The CPU reference agrees, and training goes on afterwards.
+    let mut cpu = CpuCache::new(before.clone());
+    assert!(!cpu.train_step(&bad).committed);
+    cache.train_records(gpu(), &records(&mut rng, 128)).unwrap();
+    let c = cache.counters(gpu()).unwrap();
+    assert_eq!((c.step, c.rejected_steps), (before.counters.step + 1, 1));
+}
