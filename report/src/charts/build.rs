@@ -1,0 +1,114 @@
+//! The charts of a run: every metric against frame (events marked), and speed against accuracy
+//! (mean frame time against mean FLIP and mean SMAPE, Pareto front drawn).
+
+use std::path::Path;
+
+use anyhow::Context;
+
+use super::{Chart, Kind, Series, pareto_front, raster, svg};
+use crate::run::{Frames, Manifest};
+
+/// Human-readable names of the known columns.
+fn label(column: &str) -> String {
+    match column {
+        "flip" => "FLIP vs reference".into(),
+        "smape" => "SMAPE vs previous frame".into(),
+        "smape_reprojected" => "SMAPE vs reprojected previous frame".into(),
+        "disoccluded" => "disoccluded pixels".into(),
+        "psnr" => "PSNR (dB)".into(),
+        "mse" => "MSE".into(),
+        "rel_mse" => "relative MSE".into(),
+        "cpu_ms" => "CPU time (ms)".into(),
+        "gpu_ms_total" => "GPU time (ms)".into(),
+        c => c.replace('_', " "),
+    }
+}
+
+/// Columns charted against frame, in this order, then per-region FLIP and SMAPE.
+const FRAME_COLUMNS: [&str; 7] = ["flip", "smape", "smape_reprojected", "psnr", "rel_mse", "gpu_ms_total", "cpu_ms"];
+
+fn mean(v: &[(f64, f64)]) -> Option<f64> {
+    let f: Vec<f64> = v.iter().map(|p| p.1).filter(|x| x.is_finite()).collect();
+    (!f.is_empty()).then(|| f.iter().sum::<f64>() / f.len() as f64)
+}
+
+pub fn frame_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)> {
+    let methods = frames.methods();
+    let last_frame = frames.rows.iter().map(|r| r.frame).max().unwrap_or(0).max(manifest.frames.unwrap_or(1).saturating_sub(1)) as f64;
+    let events: Vec<(f64, String)> = manifest.events.iter().map(|e| (e.frame as f64, e.label.clone())).collect();
+    let region_columns = manifest.regions.iter().flat_map(|r| [format!("{}_flip", r.name), format!("{}_smape", r.name)]);
+    let columns: Vec<String> = FRAME_COLUMNS.iter().map(|s| s.to_string()).chain(region_columns).collect();
+    columns
+        .into_iter()
+        .filter_map(|name| {
+            let c = frames.column(&name).filter(|&c| frames.has_data(c))?;
+            let series = methods.iter().map(|m| Series { name: m.clone(), points: frames.series(m, c) }).collect();
+            let chart = Chart {
+                title: format!("{} — {}", label(&name), manifest.scenario),
+                x_label: "frame".into(),
+                y_label: label(&name),
+                kind: Kind::Lines,
+                series,
+                events: events.clone(),
+                pareto: vec![],
+                x_extent: vec![0.0, last_frame],
+            };
+            Some((format!("frames_{name}"), chart))
+        })
+        .collect()
+}
+
+pub fn speed_accuracy_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)> {
+    let time_col = ["gpu_ms_total", "cpu_ms"].into_iter().find(|c| frames.column(c).is_some_and(|i| frames.has_data(i)));
+    let Some(time_col) = time_col else { return vec![] };
+    let t = frames.column(time_col).unwrap();
+    let mut out = Vec::new();
+    for metric in ["flip", "smape"] {
+        let Some(m) = frames.column(metric).filter(|&m| frames.has_data(m)) else { continue };
+        let series: Vec<Series> = frames
+            .methods()
+            .into_iter()
+            .filter_map(|method| {
+                let (x, y) = (mean(&frames.series(&method, t))?, mean(&frames.series(&method, m))?);
+                Some(Series { name: method, points: vec![(x, y)] })
+            })
+            .collect();
+        let pts: Vec<(f64, f64)> = series.iter().map(|s| s.points[0]).collect();
+        out.push((
+            format!("speed_vs_{metric}"),
+            Chart {
+                title: format!("Speed vs accuracy: {} — {}", label(metric), manifest.scenario),
+                x_label: format!("mean {}", label(time_col)),
+                y_label: format!("mean {}", label(metric)),
+                kind: Kind::Scatter,
+                pareto: pareto_front(&pts),
+                series,
+                events: vec![],
+                x_extent: vec![],
+            },
+        ));
+    }
+    out
+}
+
+/// A chart written to RUN/charts/<stem>.svg and .png.
+pub struct WrittenChart {
+    pub stem: String,
+    pub title: String,
+    pub svg: String,
+}
+
+pub fn write_charts(run_dir: &Path, manifest: &Manifest, frames: &Frames) -> anyhow::Result<Vec<WrittenChart>> {
+    let dir = run_dir.join("charts");
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let mut out = Vec::new();
+    for (stem, chart) in frame_charts(manifest, frames).into_iter().chain(speed_accuracy_charts(manifest, frames)) {
+        let svg = svg::to_svg(&chart);
+        let svg_path = dir.join(format!("{stem}.svg"));
+        std::fs::write(&svg_path, &svg).with_context(|| format!("cannot write {}", svg_path.display()))?;
+        let png_path = dir.join(format!("{stem}.png"));
+        std::fs::write(&png_path, raster::to_png(&chart)).with_context(|| format!("cannot write {}", png_path.display()))?;
+        out.push(WrittenChart { stem, title: chart.title, svg });
+    }
+    Ok(out)
+}

@@ -1,0 +1,105 @@
+//! summary.json: per method, the mean of every frames.csv column over named frame windows:
+//! before the first event, the N frames after each event (the transient), the rest until the next
+//! event (the steady state), and overall.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::Context;
+use serde::Serialize;
+
+use crate::run::{Frames, Manifest};
+
+/// Frames after an event counted as its transient.
+pub const DEFAULT_WINDOW: u32 = 10;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Window {
+    pub name: String,
+    /// First and last frame, inclusive.
+    pub first: u32,
+    pub last: u32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub event: Option<String>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct MethodSummary {
+    pub method: String,
+    /// window name -> column -> mean over the window's measured frames.
+    pub means: BTreeMap<String, BTreeMap<String, f64>>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub scenario: String,
+    pub window_frames: u32,
+    pub windows: Vec<Window>,
+    pub methods: Vec<MethodSummary>,
+}
+
+/// The named windows of a run of `frame_count` frames.
+pub fn windows(manifest: &Manifest, frame_count: u32, n: u32) -> Vec<Window> {
+    let last = frame_count.saturating_sub(1);
+    let mut out = Vec::new();
+    let events: Vec<_> = manifest.events.iter().filter(|e| e.frame <= last).collect();
+    if let Some(first) = events.first()
+        && first.frame > 0
+    {
+        out.push(Window { name: "before_first_event".into(), first: 0, last: first.frame - 1, event: None });
+    }
+    for (i, e) in events.iter().enumerate() {
+        let end = events.get(i + 1).map(|next| next.frame.saturating_sub(1)).unwrap_or(last);
+        let transient_end = (e.frame + n.max(1) - 1).min(end);
+        let label = Some(format!("frame {}: {}", e.frame, e.label));
+        out.push(Window { name: format!("after_event_{i}"), first: e.frame, last: transient_end, event: label.clone() });
+        if transient_end < end {
+            out.push(Window { name: format!("steady_after_event_{i}"), first: transient_end + 1, last: end, event: label });
+        }
+    }
+    out.push(Window { name: "overall".into(), first: 0, last, event: None });
+    out
+}
+
+pub fn summarize(manifest: &Manifest, frames: &Frames, n: u32) -> Summary {
+    let frame_count = frames.rows.iter().map(|r| r.frame + 1).max().unwrap_or(0).max(manifest.frames.unwrap_or(0));
+    let windows = windows(manifest, frame_count, n);
+    let methods = frames
+        .methods()
+        .into_iter()
+        .map(|method| {
+            let rows: Vec<_> = frames.rows.iter().filter(|r| r.method == method).collect();
+            let means = windows
+                .iter()
+                .map(|w| {
+                    let in_window: Vec<_> = rows.iter().filter(|r| r.frame >= w.first && r.frame <= w.last).collect();
+                    let cols = frames
+                        .columns
+                        .iter()
+                        .enumerate()
+                        .filter_map(|(c, name)| {
+                            let vals: Vec<f64> = in_window.iter().filter_map(|r| r.values[c]).filter(|v| v.is_finite()).collect();
+                            (!vals.is_empty()).then(|| (name.clone(), vals.iter().sum::<f64>() / vals.len() as f64))
+                        })
+                        .collect();
+                    (w.name.clone(), cols)
+                })
+                .collect();
+            MethodSummary { method, means }
+        })
+        .collect();
+    Summary { scenario: manifest.scenario.clone(), window_frames: n, windows, methods }
+}
+
+/// Writes RUN/summary.json with the default transient length.
+pub fn write_summary(run_dir: &Path) -> anyhow::Result<()> {
+    write_summary_with_window(run_dir, DEFAULT_WINDOW)
+}
+
+pub fn write_summary_with_window(run_dir: &Path, n: u32) -> anyhow::Result<()> {
+    let manifest = Manifest::load(run_dir)?;
+    let frames = Frames::load(run_dir)?;
+    let summary = summarize(&manifest, &frames, n);
+    let path = run_dir.join("summary.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&summary)?).with_context(|| format!("cannot write {}", path.display()))
+}

@@ -1,0 +1,103 @@
+//! A fake run folder, as the playback writes it, from synthetic images measured with the real
+//! metrics: a scene whose right half brightens at the event frame (a light rotating), a
+//! reference, and two "methods" with different noise that adapt to the change over some frames.
+
+#![allow(dead_code)]
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use metrics::bench::hash01;
+use metrics::{DEFAULT_PPD, Image, Region, flip_hdr, mse, psnr, relative_mse, smape, write_exr, write_png_srgb};
+
+pub const W: u32 = 64;
+pub const H: u32 = 36;
+pub const FRAMES: u32 = 30;
+pub const EVENT: u32 = 20;
+pub const METHODS: [&str; 2] = ["pt_1spp", "cache_ema"];
+
+fn scene(after_event: f32) -> Image {
+    Image::from_fn(W, H, |x, y| {
+        let base = [0.2 + 0.5 * x as f32 / W as f32, 0.3, 0.2 + 0.4 * y as f32 / H as f32];
+        let checker = 0.5 + 0.5 * ((x / 4 + y / 4) % 2) as f32;
+        let light = if x >= W / 2 { 1.0 + 2.0 * after_event } else { 1.0 };
+        base.map(|c| c * checker * light)
+    })
+}
+
+/// The scene as method `m` renders frame `f`: noise, and a lag adapting to the event.
+fn render(m: usize, f: u32) -> Image {
+    let lag = [1.0, 6.0][m];
+    let adapt = if f < EVENT { 0.0 } else { (((f - EVENT) as f32 + 1.0) / lag).min(1.0) };
+    let clean = scene(adapt);
+    let amp = [0.5, 0.1][m];
+    Image::from_fn(W, H, |x, y| clean.get(x, y).map(|c| c * (1.0 + amp * (hash01(x, y, f * 7 + m as u32) - 0.5))))
+}
+
+pub fn regions() -> Vec<Region> {
+    vec![
+        Region { name: "steady".into(), x: 0, y: 0, width: 16, height: 16 },
+        Region { name: "changing".into(), x: 40, y: 10, width: 16, height: 16 },
+    ]
+}
+
+/// Writes the run folder and returns its path.
+pub fn fake_run(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("report-fake-run-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("reference")).unwrap();
+    let reference_frames = [0, EVENT];
+    for &f in &reference_frames {
+        let r = scene(if f >= EVENT { 1.0 } else { 0.0 });
+        write_exr(&r, dir.join(format!("reference/{f:04}.exr"))).unwrap();
+        write_png_srgb(&r, dir.join(format!("reference/{f:04}.png"))).unwrap();
+    }
+    let mut csv = String::from("method,frame,cpu_ms,gpu_ms_total,gpu_ms_trace,smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr");
+    for r in regions() {
+        write!(csv, ",{0}_flip,{0}_smape", r.name).unwrap();
+    }
+    csv.push('\n');
+    for (m, method) in METHODS.iter().enumerate() {
+        std::fs::create_dir_all(dir.join("frames").join(method)).unwrap();
+        let mut prev: Option<Image> = None;
+        for f in 0..FRAMES {
+            let img = render(m, f);
+            write_exr(&img, dir.join(format!("frames/{method}/{f:04}.exr"))).unwrap();
+            write_png_srgb(&img, dir.join(format!("frames/{method}/{f:04}.png"))).unwrap();
+            let s = prev.as_ref().map(|p| smape(&img, p, 0.01));
+            let gpu = [1.0, 2.5][m] + 0.01 * f as f64;
+            write!(csv, "{method},{f},{:.3},{gpu:.4},{gpu:.4},", gpu + 0.5).unwrap();
+            write!(csv, "{},,,", s.as_ref().map(|s| format!("{:.6}", s.mean)).unwrap_or_default()).unwrap();
+            let flip = reference_frames.contains(&f).then(|| {
+                let r = scene(if f >= EVENT { 1.0 } else { 0.0 });
+                (flip_hdr(&r, &img, DEFAULT_PPD), mse(&r, &img), relative_mse(&r, &img), psnr(&r, &img))
+            });
+            match &flip {
+                Some((fl, e, rel, p)) => write!(csv, "{:.6},{e:.6},{rel:.6},{p:.4}", fl.mean).unwrap(),
+                None => csv.push_str(",,,"),
+            }
+            for r in regions() {
+                let rf = flip.as_ref().and_then(|(fl, ..)| r.mean_of(&fl.map, W));
+                let rs = s.as_ref().and_then(|s| r.mean_of(&s.map, W));
+                let cell = |v: Option<f64>| v.map(|v| format!("{v:.6}")).unwrap_or_default();
+                write!(csv, ",{},{}", cell(rf), cell(rs)).unwrap();
+            }
+            csv.push('\n');
+            prev = Some(img);
+        }
+    }
+    std::fs::write(dir.join("frames.csv"), csv).unwrap();
+    let manifest = serde_json::json!({
+        "scenario": "fake_box", "scenario_file": "scenarios/fake_box.ron", "commit": "0000000",
+        "adapter": {"name": "none", "backend": "test"}, "seed": 1, "resolution": [W, H], "frames": FRAMES,
+        "methods": METHODS, "reference": {"spp": 64, "frames": reference_frames},
+        "events": [{"frame": EVENT, "label": "rotate light 'sun' by 30°"}],
+        "regions": regions(), "settings": {"smape_eps": 0.01}
+    });
+    std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
+    dir
+}
+
+pub fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}

@@ -1,0 +1,70 @@
+//! summary.json windows and means, charts and report.html from a fake run folder.
+
+mod common;
+
+use common::*;
+use report::run::Frames;
+
+#[test]
+fn summary_windows_and_means() {
+    let run = fake_run("summary");
+    report::write_summary_with_window(&run, 5).unwrap();
+    let s = read_json(&run.join("summary.json"));
+    let names: Vec<&str> = s["windows"].as_array().unwrap().iter().map(|w| w["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["before_first_event", "after_event_0", "steady_after_event_0", "overall"]);
+    let w = &s["windows"][1];
+    assert_eq!((w["first"].as_u64(), w["last"].as_u64()), (Some(20), Some(24)));
+    assert_eq!(s["windows"][2]["last"].as_u64(), Some(29));
+
+    // Means are recomputed from frames.csv, independently of the summary code.
+    let frames = Frames::load(&run).unwrap();
+    let c = frames.column("smape").unwrap();
+    for method in METHODS {
+        let manual = |lo: u32, hi: u32| {
+            let v: Vec<f64> = frames.rows.iter().filter(|r| r.method == method && r.frame >= lo && r.frame <= hi).filter_map(|r| r.values[c]).collect();
+            v.iter().sum::<f64>() / v.len() as f64
+        };
+        let m = s["methods"].as_array().unwrap().iter().find(|m| m["method"] == method).unwrap();
+        let before = m["means"]["before_first_event"]["smape"].as_f64().unwrap();
+        let after = m["means"]["after_event_0"]["smape"].as_f64().unwrap();
+        let steady = m["means"]["steady_after_event_0"]["smape"].as_f64().unwrap();
+        assert!((before - manual(0, 19)).abs() < 1e-9);
+        assert!((after - manual(20, 24)).abs() < 1e-9);
+        assert!((steady - manual(25, 29)).abs() < 1e-9);
+        // FLIP only on reference frames: before-window mean is frame 0's value.
+        let f0 = frames.rows.iter().find(|r| r.method == method && r.frame == 0).unwrap().values[frames.column("flip").unwrap()].unwrap();
+        assert!((m["means"]["before_first_event"]["flip"].as_f64().unwrap() - f0).abs() < 1e-9);
+    }
+    // The slowly adapting method flickers more right after the event than before it.
+    let ema = s["methods"].as_array().unwrap().iter().find(|m| m["method"] == "cache_ema").unwrap();
+    assert!(ema["means"]["after_event_0"]["smape"].as_f64().unwrap() > ema["means"]["before_first_event"]["smape"].as_f64().unwrap());
+    std::fs::remove_dir_all(&run).ok();
+}
+
+#[test]
+fn report_is_self_contained_with_charts_maps_and_crops() {
+    let run = fake_run("report");
+    let path = report::rebuild(&run).unwrap();
+    assert_eq!(path, run.join("report.html"));
+    let html = std::fs::read_to_string(&path).unwrap();
+    for stem in ["frames_flip", "frames_smape", "frames_psnr", "frames_gpu_ms_total", "frames_steady_flip", "frames_changing_smape", "speed_vs_flip", "speed_vs_smape"] {
+        for ext in ["svg", "png"] {
+            let f = run.join("charts").join(format!("{stem}.{ext}"));
+            assert!(f.exists() && std::fs::metadata(&f).unwrap().len() > 500, "{} missing or empty", f.display());
+        }
+    }
+    // smape_reprojected has no data in this run: no chart for it.
+    assert!(!run.join("charts/frames_smape_reprojected.svg").exists());
+    for f in ["flip_pt_1spp_0020.png", "flip_cache_ema_0000.png", "crops_steady_0020.png", "crops_changing_0000.png"] {
+        assert!(run.join("charts").join(f).exists(), "{f}");
+    }
+    // Every image is inlined.
+    let imgs = html.matches("<img ").count();
+    assert_eq!(imgs, html.matches("src=\"data:image/").count());
+    assert_eq!(imgs, 12 + 2 * (1 + 2 + 2 + 2), "12 charts (7 metrics, 2 regions x 2, 2 speed); per reference frame: reference, 2 frames, 2 maps, 2 crops");
+    assert!(html.contains("id=\"summary\"") && html.contains("rotate light"));
+    // The event is drawn on the frame charts.
+    let svg = std::fs::read_to_string(run.join("charts/frames_flip.svg")).unwrap();
+    assert!(svg.contains("rotate light") && svg.contains("pt_1spp") && svg.contains("cache_ema"));
+    std::fs::remove_dir_all(&run).ok();
+}
