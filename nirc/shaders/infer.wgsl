@@ -17,7 +17,7 @@ fn moment3(base: u32) -> vec3<f32> {
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let qi = gid.x;
-    let active = qi < call.n;
+    let in_range = qi < call.n;
     let q = queries[min(qi, call.n - 1u)];
     let pos = q.position.xyz;
     let dir = q.direction.xyz;
@@ -27,19 +27,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
     var f_cur = vec3<f32>(0.0);
     if mode != 1u {
         load_weights(1u, lid);
-        if active {
+        if in_range {
             encode_input(1u, pos, dir);
             f_ema = mlp_forward(1u);
         }
     }
     if mode != 0u {
         load_weights(0u, lid);
-        if active {
+        if in_range {
             encode_input(0u, pos, dir);
             f_cur = mlp_forward(0u);
         }
     }
-    if !active {
+    if !in_range {
         return;
     }
     var r_cur = 0.0;

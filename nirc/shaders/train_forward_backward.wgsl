@@ -17,19 +17,19 @@
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let r = gid.x;
-    let active = r < call.n;
+    let in_range = r < call.n;
     let rec = records[min(r, call.n - 1u)];
     let pos = rec.position.xyz;
     let dir = rec.direction.xyz;
 
     load_weights(1u, lid);
     var f_ema = vec3<f32>(0.0);
-    if active {
+    if in_range {
         encode_input(1u, pos, dir);
         f_ema = mlp_forward(1u);
     }
     load_weights(0u, lid);
-    if !active {
+    if !in_range {
         return;
     }
     encode_input(0u, pos, dir);
