@@ -43,6 +43,25 @@ enum Command {
     },
     /// List the built-in scenes.
     Scenes,
+    /// Compare a test image with a reference (PNG or EXR): mean FLIP, SMAPE, PSNR, error map.
+    Compare(metrics::CompareArgs),
+    /// Rebuild summary.json, the charts and report.html of a run folder.
+    Report(report::ReportArgs),
+    /// Measure speed: BVH traversal (WGSL vs obvhs CPU), frame time per pass, FLIP and SMAPE.
+    Bench {
+        /// Also write the Markdown table to this file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Rays per traversal measurement.
+        #[arg(long, default_value_t = 1 << 18)]
+        rays: u32,
+        /// Timed frames per scene and resolution.
+        #[arg(long, default_value_t = 5)]
+        frames: u32,
+        /// Skip the image-metric benchmark (FLIP against NVIDIA's flip-evaluator, SMAPE).
+        #[arg(long)]
+        no_metrics: bool,
+    },
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -53,6 +72,28 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
         return Err(format!("width and height must be at least 1, got '{s}'"));
     }
     Ok((w, h))
+}
+
+fn bench(out: Option<PathBuf>, rays: u32, frames: u32, no_metrics: bool) -> anyhow::Result<()> {
+    let opts = systems::bench::BenchOptions { rays, frames, ..Default::default() };
+    let mut md = systems::bench::run(&opts, |step| eprintln!("bench: {step}"))?;
+    if !no_metrics {
+        eprintln!("bench: image metrics at 1280x720");
+        let args = metrics::bench::BenchArgs { width: 1280, height: 720, repeats: 5, no_reference: false };
+        let r = metrics::bench::bench(&args)?;
+        md.push_str(&format!(
+            "\n## Image metrics, {}x{} HDR pair ({} threads)\n\n| metric | ms |\n|---|---:|\n| SMAPE | {:.2} |\n| HDR-FLIP (flicker) | {:.1} |\n",
+            r.width, r.height, r.threads, r.smape_ms, r.flip_hdr_ms
+        ));
+        if let (Some(ms), Some(speedup)) = (r.reference_flip_ms, r.speedup) {
+            md.push_str(&format!("| HDR-FLIP (flip-evaluator) | {ms:.1} |\n\nflip-evaluator time / flicker time: {speedup:.2}\n"));
+        }
+    }
+    print!("{md}");
+    if let Some(path) = out {
+        systems::output::write_text(&path, &md)?;
+    }
+    Ok(())
 }
 
 fn main() -> ExitCode {
@@ -76,11 +117,15 @@ fn main() -> ExitCode {
             })
         }
         Command::Scenes => {
-            for (name, description) in sim::scenes::list() {
+            for name in sim::scenes::names() {
+                let description = sim::scenes::describe(name).unwrap_or_default();
                 println!("{name:<16} {description}");
             }
             Ok(())
         }
+        Command::Compare(args) => metrics::compare(&args),
+        Command::Report(args) => report::report(&args).map(|path| println!("wrote {}", path.display())),
+        Command::Bench { out, rays, frames, no_metrics } => bench(out, rays, frames, no_metrics),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

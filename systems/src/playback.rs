@@ -8,7 +8,7 @@ use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
-use sim::{Scenario, Simulation};
+use sim::{MethodSpec, Scenario, Simulation};
 
 use crate::frame_record::{self, FrameRecord};
 use crate::measure;
@@ -54,7 +54,9 @@ pub fn load_scenario(path: &Path, o: &Overrides) -> Result<Scenario> {
     }
     if let Some(spp) = o.spp {
         for m in &mut scenario.methods {
-            m.set_spp(spp);
+            match m {
+                MethodSpec::PathTracing { spp: s } => *s = spp,
+            }
         }
     }
     if let Some(s) = o.seed {
@@ -87,7 +89,7 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary> {
     output::write_json(&folder.manifest(), &manifest)?;
 
     let cache = ReferenceCache::new(opts.cache_dir.clone().unwrap_or_else(ReferenceCache::default_location));
-    let methods: Vec<(String, u32)> = scenario.methods.iter().map(|m| (m.label(), m.spp())).collect();
+    let methods: Vec<(String, u32)> = scenario.methods.iter().map(|m| (m.label(), method_spp(m))).collect();
     let bar = progress_bar(opts.progress, (scenario.warmup_frames + scenario.frames) as u64);
 
     // Warm-up frames are simulated and rendered (caches learn from them) but not recorded.
@@ -166,7 +168,7 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary> {
         bar.inc(1);
     }
     bar.finish_with_message("done");
-    crate::finish::write_summary_and_report(&folder.root)?;
+    report::rebuild(&folder.root).with_context(|| format!("writing the report of {}", folder.root.display()))?;
     Ok(RunSummary { folder: folder.root, records, references_rendered: rendered, references_cached: cached })
 }
 
@@ -185,4 +187,11 @@ fn progress_bar(enabled: bool, len: u64) -> ProgressBar {
             .expect("valid progress template"),
     );
     bar
+}
+
+/// Samples per pixel a method spends per frame.
+pub fn method_spp(method: &MethodSpec) -> u32 {
+    match method {
+        MethodSpec::PathTracing { spp } => *spp,
+    }
 }
