@@ -281,3 +281,33 @@ impl NircConfig {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_the_public_nrc_settings_and_valid() {
+        let c = NircConfig::default();
+        c.validate().unwrap();
+        assert_eq!((c.encoding.levels, c.encoding.features_per_level), (16, 2));
+        assert_eq!((c.optimizer.beta2, c.optimizer.epsilon, c.ema.alpha), (0.99, 1e-15, 0.99));
+        assert_eq!((c.reliability.lambda, c.reliability.warmup, c.reliability.kappa), (0.9, 128, 4.0));
+        assert_eq!(c.loss.epsilon, 0.01);
+    }
+
+    #[test]
+    fn partial_settings_fill_in_defaults_and_unknown_fields_are_refused() {
+        let c: NircConfig = serde_json::from_str(r#"{"network": {"width": 32}, "direction": {"SphericalHarmonics": {"bands": 2}}}"#).unwrap();
+        assert_eq!(c.network, NetworkConfig { width: 32, hidden_layers: 2 });
+        assert_eq!(c.direction.dims(), 4);
+        assert_eq!(c.encoding, HashGridConfig::default());
+        let back: NircConfig = serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
+        assert_eq!(back, c);
+        let err = serde_json::from_str::<NircConfig>(r#"{"network": {"widht": 32}}"#).unwrap_err().to_string();
+        assert!(err.contains("widht"), "{err}");
+        let bad = NircConfig { network: NetworkConfig { width: 64, hidden_layers: 7 }, ..Default::default() };
+        let err = bad.validate().unwrap_err().to_string();
+        assert!(err.contains("network.hidden_layers") && err.contains('7'), "{err}");
+    }
+}

@@ -69,7 +69,7 @@ mod tests {
 
     #[test]
     fn sums_are_exact_and_order_independent() {
-        let values: Vec<f32> = (0..1000).map(|i| ((i as f32 * 0.7319).sin() * 10f32.powi(i % 9 - 4))).collect();
+        let values: Vec<f32> = (0..1000).map(|i| (i as f32 * 0.7319).sin() * 10f32.powi(i % 9 - 4)).collect();
         let mut forward = FixedSum::default();
         let mut backward = FixedSum::default();
         for &v in &values {

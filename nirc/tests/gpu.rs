@@ -186,3 +186,49 @@ fn nan_target_rolls_the_step_back_and_is_counted() {
     let c = cache.counters(gpu()).unwrap();
     assert_eq!((c.step, c.rejected_steps), (before.counters.step + 1, 1));
 }
+
+#[test]
+fn other_encodings_widths_and_loss_normalisation_match_cpu() {
+    use nirc::config::{DirectionEncoding, LossNormalization, NetworkConfig};
+    let variants = [
+        (DirectionEncoding::Identity, LossNormalization::Luminance, NetworkConfig { width: 32, hidden_layers: 1 }),
+        (DirectionEncoding::None, LossNormalization::PerChannel, NetworkConfig { width: 16, hidden_layers: 3 }),
+    ];
+    for (direction, normalization, network) in variants {
+        let mut config = small_config();
+        config.direction = direction;
+        config.loss.normalization = normalization;
+        config.network = network.clone();
+        let state = randomized_state(&config, 44);
+        let mut rng = Rng(45);
+        let batch = records(&mut rng, 100);
+        let mut cpu = CpuCache::new(state.clone());
+        assert!(cpu.train_step(&batch).committed);
+        let cache = NeuralCache::from_state(gpu(), &state, None).unwrap();
+        cache.train_records(gpu(), &batch).unwrap();
+        let got = cache.download_state(gpu()).unwrap();
+        let what = format!("{direction:?} {normalization:?} {network:?}");
+        let lr = config.optimizer.learning_rate;
+        assert_vec_close(&format!("{what} params"), &got.params, &cpu.state.params, 1e-5, 1e-3 * lr);
+        assert_vec_close(&format!("{what} adam m"), &got.adam_m, &cpu.state.adam_m, 1e-3, 1e-9);
+        let q: Vec<_> = batch.iter().map(|r| r.query()).collect();
+        let (g, w) = (cache.infer_queries(gpu(), &q, PredictorMode::HighLrOnly).unwrap(), cpu.infer(&q, PredictorMode::HighLrOnly));
+        for (a, b) in g.iter().zip(&w) {
+            for c in 0..3 {
+                assert!(close(a.radiance[c], b.radiance[c], 1e-4, 1e-6), "{what}: {:?} vs {:?}", a.radiance, b.radiance);
+            }
+        }
+    }
+}
+
+#[test]
+fn refuses_oversized_batches_and_short_buffers_clearly() {
+    let config = small_config();
+    let cache = NeuralCache::new(gpu(), &config, bounds()).unwrap();
+    let mut rng = Rng(1);
+    let err = cache.train_records(gpu(), &records(&mut rng, 513)).unwrap_err().to_string();
+    assert!(err.contains("513") && err.contains("max_batch"), "{err}");
+    let recs = upload(gpu(), "few", &records(&mut rng, 4));
+    let err = cache.train(gpu(), &recs, 8).unwrap_err().to_string();
+    assert!(err.contains("training records") && err.contains("8 items"), "{err}");
+}
