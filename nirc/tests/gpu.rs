@@ -232,3 +232,29 @@ fn refuses_oversized_batches_and_short_buffers_clearly() {
     let err = cache.train(gpu(), &recs, 8).unwrap_err().to_string();
     assert!(err.contains("training records") && err.contains("8 items"), "{err}");
 }
+
+#[test]
+fn steps_recorded_in_one_encoder_equal_separate_submissions() {
+    let config = small_config();
+    let state = randomized_state(&config, 55);
+    let mut rng = Rng(56);
+    let (b1, b2) = (records(&mut rng, 150), records(&mut rng, 90));
+    let q: Vec<_> = records(&mut rng, 64).iter().map(|r| r.query()).collect();
+    let separate = NeuralCache::from_state(gpu(), &state, None).unwrap();
+    separate.train_records(gpu(), &b1).unwrap();
+    separate.train_records(gpu(), &b2).unwrap();
+    let want = separate.infer_queries(gpu(), &q, PredictorMode::Blend).unwrap();
+
+    let together = NeuralCache::from_state(gpu(), &state, None).unwrap();
+    let (r1, r2, qb) = (upload(gpu(), "b1", &b1), upload(gpu(), "b2", &b2), upload(gpu(), "q", &q));
+    let out = nirc::gpu::answer_buffer(gpu(), q.len() as u32);
+    let mut encoder = gpu().device.create_command_encoder(&Default::default());
+    together.encode_train(gpu(), &mut encoder, &r1, b1.len() as u32).unwrap();
+    together.encode_train(gpu(), &mut encoder, &r2, b2.len() as u32).unwrap();
+    together.encode_infer(gpu(), &mut encoder, &qb, q.len() as u32, &out, PredictorMode::Blend).unwrap();
+    gpu().queue.submit([encoder.finish()]);
+    let bytes = nirc::gpu::readback::read_bytes(gpu(), &out, "answers").unwrap();
+    let got: &[nirc::CacheAnswer] = bytemuck::cast_slice(&bytes[..q.len() * 16]);
+    assert_eq!(got, &want[..]);
+    assert_eq!(together.download_state(gpu()).unwrap(), separate.download_state(gpu()).unwrap());
+}

@@ -74,7 +74,6 @@ struct Pipelines {
 
 struct Buffers {
     hyper: wgpu::Buffer,
-    call: wgpu::Buffer,
     params: wgpu::Buffer,
     ema: wgpu::Buffer,
     adam_m: wgpu::Buffer,
@@ -90,15 +89,9 @@ struct Buffers {
     counters: wgpu::Buffer,
 }
 
-/// Bind groups that do not depend on the caller's buffers.
+/// Bind groups that depend on neither the caller's buffers nor the call's uniforms.
 struct FixedBindGroups {
-    weight_partial: wgpu::BindGroup,
-    weight_reduce: wgpu::BindGroup,
-    adam_check: wgpu::BindGroup,
-    adam_apply: wgpu::BindGroup,
-    accumulate_own_samples: wgpu::BindGroup,
     reliability_update: wgpu::BindGroup,
-    finish_step: wgpu::BindGroup,
 }
 
 /// The neural incident radiance cache on the GPU.
@@ -279,7 +272,6 @@ impl NeuralCache {
         counters.flag = 0;
         Ok(Buffers {
             hyper: uniform("nirc hyper", bytemuck::bytes_of(&Self::hyper(config, &state.bounds))),
-            call: uniform("nirc call", bytemuck::bytes_of(&Call { n: 0, inv_n: 0.0, mode: 0, num_chunks: 0 })),
             params: storage_init(gpu, "nirc params", bytemuck::cast_slice(&state.params))?,
             ema: storage_init(gpu, "nirc ema params", bytemuck::cast_slice(&state.ema))?,
             adam_m: storage_init(gpu, "nirc adam m", bytemuck::cast_slice(&state.adam_m))?,
@@ -297,22 +289,15 @@ impl NeuralCache {
     }
 
     fn fixed_groups(gpu: &Gpu, p: &Pipelines, b: &Buffers) -> FixedBindGroups {
-        let adam_entries: &[(u32, &wgpu::Buffer)] =
-            &[(0, &b.call), (1, &b.hyper), (2, &b.params), (3, &b.ema), (4, &b.adam_m), (5, &b.adam_v), (6, &b.grad), (7, &b.grid_accum), (8, &b.counters)];
         FixedBindGroups {
-            weight_partial: bind(gpu, "nirc weight partial", &p.weight_partial, &[(0, &b.call), (1, &b.scratch), (2, &b.partials)]),
-            weight_reduce: bind(gpu, "nirc weight reduce", &p.weight_reduce, &[(0, &b.call), (2, &b.partials), (3, &b.grad)]),
-            adam_check: bind(gpu, "nirc adam check", &p.adam_check, adam_entries),
-            adam_apply: bind(gpu, "nirc adam apply", &p.adam_apply, adam_entries),
-            accumulate_own_samples: bind(
-                gpu,
-                "nirc reliability accumulate",
-                &p.reliability_accumulate,
-                &[(0, &b.call), (1, &b.hyper), (2, &b.samples), (3, &b.reliability_accum), (4, &b.counters)],
-            ),
             reliability_update: bind(gpu, "nirc reliability update", &p.reliability_update, &[(1, &b.hyper), (2, &b.reliability_accum), (3, &b.moments), (4, &b.counters)]),
-            finish_step: bind(gpu, "nirc finish", &p.finish_step, &[(0, &b.call), (1, &b.hyper), (2, &b.counters)]),
         }
+    }
+
+    /// The per-call uniforms live in their own small buffer, so that several calls can be
+    /// recorded into one command encoder.
+    fn call_buffer(gpu: &Gpu, call: Call) -> wgpu::Buffer {
+        gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("nirc call"), contents: bytemuck::bytes_of(&call), usage: wgpu::BufferUsages::UNIFORM })
     }
 
     fn check_items(what: &str, buffer: &wgpu::Buffer, n: u32, item: u64) -> Result<(), NircError> {
@@ -323,10 +308,19 @@ impl NeuralCache {
         Ok(())
     }
 
-    /// One training step on the first `n` records of `records` (array of `TrainingRecord`).
-    /// Submits its own command buffer. A step with a non-finite loss, gradient or weight is
-    /// rolled back on the GPU and counted in `Counters::rejected_steps`.
+    /// One training step on the first `n` records of `records` (array of `TrainingRecord`),
+    /// submitted at once. A step with a non-finite loss, gradient or weight is rolled back on
+    /// the GPU and counted in `Counters::rejected_steps`.
     pub fn train(&self, gpu: &Gpu, records: &wgpu::Buffer, n: u32) -> Result<(), NircError> {
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc train") });
+        self.encode_train(gpu, &mut encoder, records, n)?;
+        gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// Records one training step into the caller's encoder (e.g. after the path tracer's pass
+    /// that wrote `records`). Steps recorded in order run in order.
+    pub fn encode_train(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, records: &wgpu::Buffer, n: u32) -> Result<(), NircError> {
         if n == 0 {
             return Ok(());
         }
@@ -337,30 +331,33 @@ impl NeuralCache {
         let b = &self.buffers;
         let p = &self.pipelines;
         let num_chunks = n.div_ceil(CHUNK);
-        gpu.queue.write_buffer(&b.call, 0, bytemuck::bytes_of(&Call { n, inv_n: 1.0 / n as f32, mode: 0, num_chunks }));
+        let call = Self::call_buffer(gpu, Call { n, inv_n: 1.0 / n as f32, mode: 0, num_chunks });
         let fb = bind(
             gpu,
             "nirc train_forward_backward",
             &p.train_forward_backward,
-            &[(0, &b.call), (1, &b.hyper), (2, records), (3, &b.params), (4, &b.ema), (5, &b.scratch), (6, &b.grid_accum), (7, &b.samples), (8, &b.losses), (9, &b.counters)],
+            &[(0, &call), (1, &b.hyper), (2, records), (3, &b.params), (4, &b.ema), (5, &b.scratch), (6, &b.grid_accum), (7, &b.samples), (8, &b.losses), (9, &b.counters)],
         );
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc train") });
+        let accumulate = bind(gpu, "nirc reliability accumulate", &p.reliability_accumulate, &[(0, &call), (1, &b.hyper), (2, &b.samples), (3, &b.reliability_accum), (4, &b.counters)]);
+        let partial = bind(gpu, "nirc weight partial", &p.weight_partial, &[(0, &call), (1, &b.scratch), (2, &b.partials)]);
+        let reduce = bind(gpu, "nirc weight reduce", &p.weight_reduce, &[(0, &call), (2, &b.partials), (3, &b.grad)]);
+        let adam_entries: &[(u32, &wgpu::Buffer)] =
+            &[(0, &call), (1, &b.hyper), (2, &b.params), (3, &b.ema), (4, &b.adam_m), (5, &b.adam_v), (6, &b.grad), (7, &b.grid_accum), (8, &b.counters)];
+        let check = bind(gpu, "nirc adam check", &p.adam_check, adam_entries);
+        let apply = bind(gpu, "nirc adam apply", &p.adam_apply, adam_entries);
+        let finish = bind(gpu, "nirc finish", &p.finish_step, &[(0, &call), (1, &b.hyper), (2, &b.counters)]);
         encoder.clear_buffer(&b.grid_accum, 0, None);
         encoder.clear_buffer(&b.reliability_accum, 0, None);
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc train"), timestamp_writes: None });
-            let g = &self.groups;
-            dispatch(&mut pass, &p.train_forward_backward, &fb, n.div_ceil(WORKGROUP_SIZE));
-            dispatch(&mut pass, &p.reliability_accumulate, &g.accumulate_own_samples, groups_for(n as u64));
-            dispatch(&mut pass, &p.weight_partial, &g.weight_partial, groups_for(self.layout.mlp_params as u64 * num_chunks as u64));
-            dispatch(&mut pass, &p.weight_reduce, &g.weight_reduce, groups_for(self.layout.mlp_params as u64));
-            let all = groups_for(self.layout.total_params as u64);
-            dispatch(&mut pass, &p.adam_check, &g.adam_check, all);
-            dispatch(&mut pass, &p.adam_apply, &g.adam_apply, all);
-            dispatch(&mut pass, &p.reliability_update, &g.reliability_update, groups_for(cell_count(&self.config.reliability) as u64));
-            dispatch(&mut pass, &p.finish_step, &g.finish_step, 1);
-        }
-        gpu.queue.submit([encoder.finish()]);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc train"), timestamp_writes: None });
+        dispatch(&mut pass, &p.train_forward_backward, &fb, n.div_ceil(WORKGROUP_SIZE));
+        dispatch(&mut pass, &p.reliability_accumulate, &accumulate, groups_for(n as u64));
+        dispatch(&mut pass, &p.weight_partial, &partial, groups_for(self.layout.mlp_params as u64 * num_chunks as u64));
+        dispatch(&mut pass, &p.weight_reduce, &reduce, groups_for(self.layout.mlp_params as u64));
+        let all = groups_for(self.layout.total_params as u64);
+        dispatch(&mut pass, &p.adam_check, &check, all);
+        dispatch(&mut pass, &p.adam_apply, &apply, all);
+        dispatch(&mut pass, &p.reliability_update, &self.groups.reliability_update, groups_for(cell_count(&self.config.reliability) as u64));
+        dispatch(&mut pass, &p.finish_step, &finish, 1);
         Ok(())
     }
 
@@ -373,23 +370,32 @@ impl NeuralCache {
         Self::check_items("reliability samples", samples, n, std::mem::size_of::<ReliabilitySample>() as u64)?;
         let b = &self.buffers;
         let p = &self.pipelines;
-        gpu.queue.write_buffer(&b.call, 0, bytemuck::bytes_of(&Call { n, inv_n: 1.0 / n as f32, mode: 1, num_chunks: 0 }));
-        let acc = bind(gpu, "nirc reliability accumulate", &p.reliability_accumulate, &[(0, &b.call), (1, &b.hyper), (2, samples), (3, &b.reliability_accum), (4, &b.counters)]);
+        let call = Self::call_buffer(gpu, Call { n, inv_n: 1.0 / n as f32, mode: 1, num_chunks: 0 });
+        let acc = bind(gpu, "nirc reliability accumulate", &p.reliability_accumulate, &[(0, &call), (1, &b.hyper), (2, samples), (3, &b.reliability_accum), (4, &b.counters)]);
+        let finish = bind(gpu, "nirc finish", &p.finish_step, &[(0, &call), (1, &b.hyper), (2, &b.counters)]);
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc reliability") });
         encoder.clear_buffer(&b.reliability_accum, 0, None);
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc reliability"), timestamp_writes: None });
             dispatch(&mut pass, &p.reliability_accumulate, &acc, groups_for(n as u64));
             dispatch(&mut pass, &p.reliability_update, &self.groups.reliability_update, groups_for(cell_count(&self.config.reliability) as u64));
-            dispatch(&mut pass, &p.finish_step, &self.groups.finish_step, 1);
+            dispatch(&mut pass, &p.finish_step, &finish, 1);
         }
         gpu.queue.submit([encoder.finish()]);
         Ok(())
     }
 
     /// Answers the first `n` queries of `queries` (array of `CacheQuery`) into `out` (array of
-    /// `CacheAnswer`): radiance max(0, (1 - σ) f_EMA + σ f_cur) and σ. Submits its own commands.
+    /// `CacheAnswer`): radiance max(0, (1 - σ) f_EMA + σ f_cur) and σ. Submitted at once.
     pub fn infer(&self, gpu: &Gpu, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: PredictorMode) -> Result<(), NircError> {
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc infer") });
+        self.encode_infer(gpu, &mut encoder, queries, n, out, mode)?;
+        gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// Records the inference of `n` queries into the caller's encoder.
+    pub fn encode_infer(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: PredictorMode) -> Result<(), NircError> {
         if n == 0 {
             return Ok(());
         }
@@ -400,19 +406,15 @@ impl NeuralCache {
             return Err(NircError::Config(format!("{n} queries need {groups} workgroups, over this adapter's limit")));
         }
         let b = &self.buffers;
-        gpu.queue.write_buffer(&b.call, 0, bytemuck::bytes_of(&Call { n, inv_n: 1.0 / n as f32, mode: mode.code(), num_chunks: 0 }));
+        let call = Self::call_buffer(gpu, Call { n, inv_n: 1.0 / n as f32, mode: mode.code(), num_chunks: 0 });
         let group = bind(
             gpu,
             "nirc infer",
             &self.pipelines.infer,
-            &[(0, &b.call), (1, &b.hyper), (2, queries), (3, &b.params), (4, &b.ema), (5, &b.moments), (6, &b.counters), (7, out)],
+            &[(0, &call), (1, &b.hyper), (2, queries), (3, &b.params), (4, &b.ema), (5, &b.moments), (6, &b.counters), (7, out)],
         );
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc infer") });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc infer"), timestamp_writes: None });
-            dispatch(&mut pass, &self.pipelines.infer, &group, groups);
-        }
-        gpu.queue.submit([encoder.finish()]);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc infer"), timestamp_writes: None });
+        dispatch(&mut pass, &self.pipelines.infer, &group, groups);
         Ok(())
     }
 
