@@ -6,6 +6,11 @@ use crate::gpu::GpuError;
 pub enum RenderError {
     #[error(transparent)]
     Gpu(#[from] GpuError),
+    #[error(transparent)]
+    Bvh(#[from] crate::bvh::BvhError),
+    /// A WGSL pass failed to compile or validate (a bug, or an adapter missing a capability).
+    #[error("pass '{pass}': {message}")]
+    Shader { pass: String, message: String },
     /// The scene description is inconsistent (an index out of range, an empty mesh, ...).
     #[error("invalid scene: {0}")]
     Scene(String),

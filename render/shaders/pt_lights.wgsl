@@ -1,0 +1,123 @@
+// Light sampling for next-event estimation. One table holds the analytic lights followed by the
+// emissive triangles (area lights); triangles are chosen by power (luminance x area) through the
+// cumulative distribution in `cdf`, so the area pdf of any emissive point is luminance(Le) / W.
+// Emissive triangles emit from both faces (glTF says nothing about an emission side).
+
+const LIGHT_DIRECTIONAL: u32 = 0u;
+const LIGHT_POINT: u32 = 1u;
+const LIGHT_SPOT: u32 = 2u;
+const LIGHT_TRIANGLE: u32 = 3u;
+
+// Directional: p1 = direction into the scene, radiance = irradiance E on a facing surface,
+//   a = 1 - cos(angular radius) (0: a delta light), b = 1 / (pi sin^2 r): disk radiance = E b.
+// Point: p0 = position, radiance = intensity. Spot: p0 = position, p1 = axis, radiance =
+//   intensity, a = cos(outer angle), b = cos(inner angle).
+// Triangle: p0, p1, p2 = world vertices, radiance = emitted radiance, cdf = inclusive CDF.
+struct GpuLight {
+    p0: vec3f,
+    kind: u32,
+    p1: vec3f,
+    cdf: f32,
+    p2: vec3f,
+    a: f32,
+    radiance: vec3f,
+    b: f32,
+}
+
+struct LightSample {
+    wi: vec3f,
+    dist: f32,
+    // Incident radiance divided by the sampling pdf (delta lights: the irradiance-like term).
+    weight: vec3f,
+    // Solid-angle pdf; 0 marks a delta light (no MIS).
+    pdf: f32,
+}
+
+const FAR: f32 = 1.0e30;
+
+fn spot_falloff(cos_axis: f32, cos_outer: f32, cos_inner: f32) -> f32 {
+    if cos_inner <= cos_outer {
+        return select(0.0, 1.0, cos_axis >= cos_outer);
+    }
+    let t = clamp((cos_axis - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+}
+
+fn cone_solid_angle(one_minus_cos: f32) -> f32 {
+    return TWO_PI * one_minus_cos;
+}
+
+fn sample_analytic_light(l: GpuLight, p: vec3f, u: vec2f) -> LightSample {
+    var s: LightSample;
+    if l.kind == LIGHT_DIRECTIONAL {
+        let axis = -normalize(l.p1);
+        s.dist = FAR;
+        if l.a > 0.0 {
+            let local = sample_uniform_cone(u, 1.0 - l.a);
+            s.wi = normalize(to_world(local, axis));
+            s.pdf = 1.0 / cone_solid_angle(l.a);
+            s.weight = l.radiance * l.b / s.pdf;
+        } else {
+            s.wi = axis;
+            s.pdf = 0.0;
+            s.weight = l.radiance;
+        }
+        return s;
+    }
+    let d = l.p0 - p;
+    let dist2 = max(dot(d, d), 1.0e-20);
+    s.dist = sqrt(dist2);
+    s.wi = d / s.dist;
+    s.pdf = 0.0;
+    s.weight = l.radiance / dist2;
+    if l.kind == LIGHT_SPOT {
+        s.weight *= spot_falloff(dot(-s.wi, normalize(l.p1)), l.a, l.b);
+    }
+    return s;
+}
+
+// Index of the emissive triangle whose CDF interval holds u (binary search, <= 32 steps).
+fn find_emitter(first: u32, count: u32, u: f32) -> u32 {
+    var lo = first;
+    var hi = first + count - 1u;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if lights[mid].cdf > u {
+            hi = mid;
+        } else {
+            lo = mid + 1u;
+        }
+    }
+    return lo;
+}
+
+fn sample_emitter(first: u32, count: u32, p: vec3f, u_select: f32, u: vec2f) -> LightSample {
+    var s: LightSample;
+    s.pdf = 0.0;
+    s.weight = vec3f(0.0);
+    let i = find_emitter(first, count, u_select);
+    let l = lights[i];
+    var cdf_before = 0.0;
+    if i > first {
+        cdf_before = lights[i - 1u].cdf;
+    }
+    let p_select = l.cdf - cdf_before;
+    let b = sample_triangle(u);
+    let x = b.x * l.p0 + b.y * l.p1 + (1.0 - b.x - b.y) * l.p2;
+    let c = cross(l.p1 - l.p0, l.p2 - l.p0);
+    let double_area = length(c);
+    let d = x - p;
+    let dist2 = dot(d, d);
+    if p_select <= 0.0 || double_area <= 0.0 || dist2 <= 0.0 {
+        return s;
+    }
+    s.dist = sqrt(dist2);
+    s.wi = d / s.dist;
+    let cos_light = abs(dot(c / double_area, s.wi));
+    if cos_light <= 0.0 {
+        return s;
+    }
+    s.pdf = p_select / (0.5 * double_area) * dist2 / cos_light;
+    s.weight = l.radiance / s.pdf;
+    return s;
+}

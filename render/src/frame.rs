@@ -1,0 +1,107 @@
+//! Per-dispatch constants of the path tracer (the WGSL `Frame` uniform) and the pinhole camera
+//! model it uses, with the same math on the CPU for tests and motion-vector checks.
+
+use crate::scene::Camera;
+use bytemuck::{Pod, Zeroable};
+use glam::{Vec2, Vec3};
+
+/// Orthonormal pinhole camera basis, as the shader sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraBasis {
+    pub position: Vec3,
+    pub forward: Vec3,
+    pub right: Vec3,
+    pub up: Vec3,
+    pub tan_half_fov: f32,
+    pub aspect: f32,
+}
+
+impl CameraBasis {
+    pub fn new(camera: &Camera, width: u32, height: u32) -> Self {
+        let forward = (camera.target - camera.position).normalize_or(Vec3::NEG_Z);
+        let right = forward.cross(camera.up).normalize_or(Vec3::X);
+        let up = right.cross(forward);
+        Self { position: camera.position, forward, right, up, tan_half_fov: (0.5 * camera.vfov).tan(), aspect: width as f32 / height as f32 }
+    }
+
+    /// Direction of the ray through image point `pixel` (x right, y down, pixel centres at +0.5).
+    pub fn ray_direction(&self, pixel: Vec2, width: u32, height: u32) -> Vec3 {
+        let ndc = Vec2::new(2.0 * pixel.x / width as f32 - 1.0, 1.0 - 2.0 * pixel.y / height as f32);
+        (self.forward + ndc.x * self.tan_half_fov * self.aspect * self.right + ndc.y * self.tan_half_fov * self.up).normalize()
+    }
+
+    /// Image point of a world position, `None` behind the camera.
+    pub fn project(&self, point: Vec3, width: u32, height: u32) -> Option<Vec2> {
+        let d = point - self.position;
+        let z = d.dot(self.forward);
+        if z <= 0.0 {
+            return None;
+        }
+        let ndc = Vec2::new(d.dot(self.right) / (z * self.tan_half_fov * self.aspect), d.dot(self.up) / (z * self.tan_half_fov));
+        Some(Vec2::new((0.5 * ndc.x + 0.5) * width as f32, (0.5 - 0.5 * ndc.y) * height as f32))
+    }
+
+    fn gpu(&self) -> GpuCamera {
+        GpuCamera {
+            position: self.position.extend(self.tan_half_fov).to_array(),
+            forward: self.forward.extend(self.aspect).to_array(),
+            right: self.right.extend(0.0).to_array(),
+            up: self.up.extend(0.0).to_array(),
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub(crate) struct GpuCamera {
+    position: [f32; 4],
+    forward: [f32; 4],
+    right: [f32; 4],
+    up: [f32; 4],
+}
+
+/// WGSL `Frame` (path_tracer.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub(crate) struct GpuFrame {
+    camera: GpuCamera,
+    previous_camera: GpuCamera,
+    environment: [f32; 4],
+    size: [u32; 4],
+    seed: [u32; 4],
+    counts: [u32; 4],
+}
+
+const _: () = assert!(size_of::<GpuFrame>() == 192);
+
+/// Everything that changes between dispatches.
+pub(crate) struct FrameParams {
+    pub camera: CameraBasis,
+    pub previous_camera: CameraBasis,
+    pub environment: Vec3,
+    pub emitter_weight: f32,
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub first_sample: u32,
+    pub seed: u64,
+    pub frame: u32,
+    pub max_depth: u32,
+    pub rr_start_depth: u32,
+    pub analytic_lights: u32,
+    pub emitters: u32,
+    pub accumulate: bool,
+}
+
+impl FrameParams {
+    pub fn gpu(&self) -> GpuFrame {
+        GpuFrame {
+            camera: self.camera.gpu(),
+            previous_camera: self.previous_camera.gpu(),
+            environment: self.environment.extend(self.emitter_weight).to_array(),
+            size: [self.width, self.height, self.spp, self.first_sample],
+            seed: [self.seed as u32, (self.seed >> 32) as u32, self.frame, self.max_depth],
+            counts: [self.rr_start_depth, self.analytic_lights, self.emitters, self.accumulate as u32],
+        }
+    }
+}

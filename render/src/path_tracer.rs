@@ -1,0 +1,459 @@
+//! The WGSL path tracer: per frame, HDR radiance and a primary-hit G-buffer read back to the
+//! CPU, GPU time per pass; and converged references accumulated in bounded batches.
+//!
+//! Shaders: render/shaders/path_tracer.wgsl (+ pt_sampling, pt_bsdf, pt_lights), concatenated
+//! after the scene geometry interface (`SceneGeometry::WGSL`, bind group 1). This pass's own
+//! bindings are group 0: the `Frame` uniform, materials, texture atlas, light table, the
+//! radiance sum and the G-buffer.
+
+use crate::bvh::SceneGeometry;
+use crate::error::RenderError;
+use crate::frame::{CameraBasis, FrameParams, GpuFrame};
+use crate::gpu::Gpu;
+use crate::lights::{LightTable, build_light_table};
+use crate::materials::pack_materials;
+use crate::readback::read_buffer;
+use crate::scene::{Camera, SceneDesc};
+use crate::timing::{PassTimestamps, PassTiming};
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use std::time::Instant;
+use wgpu::util::DeviceExt;
+
+/// `Hit::instance`/`primitive` of a pixel whose primary ray left the scene.
+pub const NO_HIT: u32 = u32::MAX;
+
+/// Paths (pixels x samples) one dispatch may trace, so that no submission runs long enough to
+/// trip a GPU watchdog (about 2 s on desktop drivers) even on slow adapters.
+pub const PATHS_PER_DISPATCH: u64 = 1 << 20;
+
+/// The pass names in [`FrameOutput::timings`].
+pub const GBUFFER_PASS: &str = "gbuffer";
+pub const PATH_TRACE_PASS: &str = "path_trace";
+
+const WORKGROUP: u32 = 8;
+/// Storage buffers of group 0 (materials, texels, lights, radiance, G-buffer).
+const STORAGE_BUFFERS: u32 = 5;
+/// Storage buffers of scene_geometry.wgsl (group 1).
+const GEOMETRY_STORAGE_BUFFERS: u32 = 8;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct PathTracerSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Maximum number of scattering events: 1 = direct lighting only.
+    pub max_depth: u32,
+    /// Russian roulette applies to bounces from this depth on (1 = after the first bounce).
+    pub rr_start_depth: u32,
+}
+
+/// Primary-hit attributes of the pixel-centre ray, row-major, `width * height` each.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GBuffer {
+    /// Distance from the camera to the hit along the ray; `f32::INFINITY` on a miss.
+    pub depth: Vec<f32>,
+    /// World shading normal turned towards the camera; zero on a miss.
+    pub normal: Vec<[f32; 3]>,
+    /// Linear base colour at the hit (texture included); zero on a miss.
+    pub albedo: Vec<[f32; 3]>,
+    /// Pixel offset from where the point is now to where it was in the previous rendered frame
+    /// (previous camera and instance transform); x right, y down. Misses: the offset of the
+    /// direction at infinity (camera rotation only).
+    pub motion: Vec<[f32; 2]>,
+    /// Index into `SceneDesc::instances`; [`NO_HIT`] on a miss.
+    pub instance_id: Vec<u32>,
+    /// Triangle index in the instance's mesh; [`NO_HIT`] on a miss.
+    pub primitive_id: Vec<u32>,
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameOutput {
+    pub width: u32,
+    pub height: u32,
+    /// Linear HDR radiance, mean of the frame's samples, row-major; alpha = 1.
+    pub radiance: Vec<[f32; 4]>,
+    pub gbuffer: GBuffer,
+    /// One entry per pass: [`GBUFFER_PASS`], [`PATH_TRACE_PASS`] (readback excluded).
+    pub timings: Vec<PassTiming>,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuGBufferTexel {
+    normal: [f32; 3],
+    depth: f32,
+    albedo: [f32; 3],
+    instance: u32,
+    motion: [f32; 2],
+    primitive: u32,
+    _pad: u32,
+}
+
+const _: () = assert!(size_of::<GpuGBufferTexel>() == 48);
+
+/// Bytes per pixel of the per-pixel buffers (radiance sum and G-buffer texel).
+const BYTES_PER_PIXEL: u64 = 16 + size_of::<GpuGBufferTexel>() as u64;
+
+pub struct PathTracer {
+    settings: PathTracerSettings,
+    geometry: SceneGeometry,
+    layout: wgpu::BindGroupLayout,
+    trace_pipeline: wgpu::ComputePipeline,
+    gbuffer_pipeline: wgpu::ComputePipeline,
+    frame_buffer: wgpu::Buffer,
+    materials: wgpu::Buffer,
+    texels: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    radiance_sum: wgpu::Buffer,
+    gbuffer: wgpu::Buffer,
+    radiance_readback: wgpu::Buffer,
+    gbuffer_readback: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    timestamps: Option<PassTimestamps>,
+    light_table: LightTable,
+    camera: Camera,
+    /// Camera of the last `render`, for motion vectors; `None` before the first frame.
+    previous_camera: Option<Camera>,
+    environment: Vec3,
+    paths_per_dispatch: u64,
+}
+
+impl PathTracer {
+    pub fn new(gpu: &Gpu, scene: &SceneDesc, settings: PathTracerSettings) -> Result<Self, RenderError> {
+        if settings.max_depth == 0 {
+            return Err(RenderError::Settings("max_depth must be at least 1 (1 = direct lighting)".into()));
+        }
+        gpu.check_resolution(settings.width, settings.height, BYTES_PER_PIXEL)?;
+        let needed = STORAGE_BUFFERS + GEOMETRY_STORAGE_BUFFERS;
+        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
+        if needed > limit {
+            return Err(crate::gpu::GpuError::OverLimit {
+                what: "storage buffers of the path tracer pass".into(),
+                requested: needed as u64,
+                limit: limit as u64,
+                adapter: gpu.summary.name.clone(),
+            }
+            .into());
+        }
+        // No workgroup memory is declared (var<workgroup>): nothing to check against the budget.
+        gpu.check_workgroup_memory("path_trace", 0)?;
+
+        let geometry = SceneGeometry::new(gpu, scene)?;
+        let (materials, texels) = pack_materials(scene)?;
+        let light_table = build_light_table(scene)?;
+        let device = &gpu.device;
+        let storage = |label: &str, contents: &[u8]| -> Result<wgpu::Buffer, RenderError> {
+            gpu.check_buffer_size(label, contents.len() as u64)?;
+            Ok(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            }))
+        };
+        let materials = storage("materials", bytemuck::cast_slice(&materials))?;
+        let texels = storage("base-colour texels", bytemuck::cast_slice(&texels))?;
+        let lights = storage("lights", bytemuck::cast_slice(&light_table.lights))?;
+        let pixels = settings.width as u64 * settings.height as u64;
+        let per_pixel = |label: &str, size: u64, usage: wgpu::BufferUsages| {
+            device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+        };
+        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        let readback = wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST;
+        let radiance_size = pixels * 16;
+        let gbuffer_size = pixels * size_of::<GpuGBufferTexel>() as u64;
+        let radiance_sum = per_pixel("radiance sum", radiance_size, rw);
+        let gbuffer = per_pixel("gbuffer", gbuffer_size, rw);
+        let radiance_readback = per_pixel("radiance readback", radiance_size, readback);
+        let gbuffer_readback = per_pixel("gbuffer readback", gbuffer_size, readback);
+        let frame_buffer = per_pixel("path tracer frame", size_of::<GpuFrame>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+
+        let layout = bind_group_layout(device);
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("path tracer"),
+            bind_group_layouts: &[Some(&layout), Some(geometry.bind_group_layout())],
+            immediate_size: 0,
+        });
+        let source = [
+            SceneGeometry::WGSL,
+            include_str!("../shaders/pt_sampling.wgsl"),
+            include_str!("../shaders/pt_bsdf.wgsl"),
+            include_str!("../shaders/pt_lights.wgsl"),
+            include_str!("../shaders/path_tracer.wgsl"),
+        ]
+        .join("\n");
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("path_tracer.wgsl"), source: wgpu::ShaderSource::Wgsl(source.into()) });
+        let pipeline = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let trace_pipeline = pipeline("trace_main");
+        let gbuffer_pipeline = pipeline("gbuffer_main");
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(RenderError::Shader { pass: "path_tracer.wgsl".into(), message: e.to_string() });
+        }
+
+        let bind_group = make_bind_group(device, &layout, [&frame_buffer, &materials, &texels, &lights, &radiance_sum, &gbuffer]);
+        Ok(Self {
+            settings,
+            geometry,
+            layout,
+            trace_pipeline,
+            gbuffer_pipeline,
+            frame_buffer,
+            materials,
+            texels,
+            lights,
+            radiance_sum,
+            gbuffer,
+            radiance_readback,
+            gbuffer_readback,
+            bind_group,
+            timestamps: PassTimestamps::new(gpu, 2),
+            light_table,
+            camera: scene.camera,
+            previous_camera: None,
+            environment: scene.environment,
+            paths_per_dispatch: PATHS_PER_DISPATCH,
+        })
+    }
+
+    pub fn settings(&self) -> PathTracerSettings {
+        self.settings
+    }
+
+    pub fn geometry(&self) -> &SceneGeometry {
+        &self.geometry
+    }
+
+    /// Refreshes the dynamic parts: instance transforms, materials (and textures), lights
+    /// (emissive triangles follow their instances), camera, environment. Meshes are fixed at
+    /// `new`. The camera of the last rendered frame is kept for motion vectors.
+    pub fn update(&mut self, gpu: &Gpu, scene: &SceneDesc) {
+        if let Err(e) = self.try_update(gpu, scene) {
+            panic!("PathTracer::update: {e}");
+        }
+    }
+
+    /// [`Self::update`] that reports an inconsistent scene instead of panicking.
+    pub fn try_update(&mut self, gpu: &Gpu, scene: &SceneDesc) -> Result<(), RenderError> {
+        let (materials, texels) = pack_materials(scene)?;
+        let light_table = build_light_table(scene)?;
+        self.geometry.try_update_instances(gpu, &scene.instances)?;
+        let mut rebind = false;
+        for (buffer, label, bytes) in [
+            (&mut self.materials, "materials", bytemuck::cast_slice::<_, u8>(&materials)),
+            (&mut self.texels, "base-colour texels", bytemuck::cast_slice(&texels)),
+            (&mut self.lights, "lights", bytemuck::cast_slice(&light_table.lights)),
+        ] {
+            if buffer.size() == bytes.len() as u64 {
+                gpu.queue.write_buffer(buffer, 0, bytes);
+            } else {
+                gpu.check_buffer_size(label, bytes.len() as u64)?;
+                *buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: bytes,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                });
+                rebind = true;
+            }
+        }
+        if rebind {
+            self.bind_group = make_bind_group(
+                &gpu.device,
+                &self.layout,
+                [&self.frame_buffer, &self.materials, &self.texels, &self.lights, &self.radiance_sum, &self.gbuffer],
+            );
+        }
+        self.light_table = light_table;
+        self.camera = scene.camera;
+        self.environment = scene.environment;
+        Ok(())
+    }
+
+    /// One frame: G-buffer of the pixel-centre rays, then `spp` jittered paths per pixel.
+    pub fn render(&mut self, gpu: &Gpu, spp: u32, seed: u64, frame: u32) -> Result<FrameOutput, RenderError> {
+        if spp == 0 {
+            return Err(RenderError::Settings("spp must be at least 1".into()));
+        }
+        let previous = self.previous_camera.unwrap_or(self.camera);
+        // G-buffer pass.
+        let start = Instant::now();
+        self.write_frame(gpu, &previous, 0, 0, seed, frame, false);
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer") });
+        self.dispatch(&mut encoder, &self.gbuffer_pipeline, GBUFFER_PASS, 0);
+        let gbuffer_gpu = self.submit_timed(gpu, encoder, 0)?;
+        let gbuffer_timing = PassTiming { pass: GBUFFER_PASS.into(), gpu_ms: gbuffer_gpu, cpu_ms: ms(start) };
+
+        // Path-trace pass, in batches of bounded work.
+        let start = Instant::now();
+        let trace_gpu = self.trace_batches(gpu, &previous, spp, seed, frame, &mut |_, _| {})?;
+        let trace_timing = PassTiming { pass: PATH_TRACE_PASS.into(), gpu_ms: trace_gpu, cpu_ms: ms(start) };
+
+        let radiance = self.read_radiance(gpu)?;
+        let gbuffer = self.read_gbuffer(gpu)?;
+        self.previous_camera = Some(self.camera);
+        Ok(FrameOutput { width: self.settings.width, height: self.settings.height, radiance, gbuffer, timings: vec![gbuffer_timing, trace_timing] })
+    }
+
+    /// The current scene accumulated to `spp` samples per pixel in batches of at most
+    /// [`PATHS_PER_DISPATCH`] paths, one submission each; `progress(done_spp, total_spp)` after
+    /// every batch. Radiance only (no G-buffer); the motion-vector camera is left untouched.
+    pub fn render_reference(&mut self, gpu: &Gpu, spp: u32, seed: u64, frame: u32, progress: &mut dyn FnMut(u32, u32)) -> Result<Vec<[f32; 4]>, RenderError> {
+        if spp == 0 {
+            return Err(RenderError::Settings("reference spp must be at least 1".into()));
+        }
+        let previous = self.previous_camera.unwrap_or(self.camera);
+        self.trace_batches(gpu, &previous, spp, seed, frame, progress)?;
+        self.read_radiance(gpu)
+    }
+
+    /// Samples per pixel in one dispatch at this resolution (at least 1).
+    pub fn samples_per_dispatch(&self) -> u32 {
+        let pixels = self.settings.width as u64 * self.settings.height as u64;
+        (self.paths_per_dispatch / pixels).clamp(1, u32::MAX as u64) as u32
+    }
+
+    /// Changes the work bound of one dispatch (default [`PATHS_PER_DISPATCH`]): lower it for a
+    /// slow adapter with a watchdog, raise it for a fast one. The image does not depend on it
+    /// beyond float summation order.
+    pub fn set_paths_per_dispatch(&mut self, paths: u64) {
+        self.paths_per_dispatch = paths.max(1);
+    }
+
+    /// Traces `spp` samples into the radiance sum; returns the summed GPU time of the batches.
+    fn trace_batches(&self, gpu: &Gpu, previous: &Camera, spp: u32, seed: u64, frame: u32, progress: &mut dyn FnMut(u32, u32)) -> Result<Option<f64>, RenderError> {
+        let per_dispatch = self.samples_per_dispatch();
+        let mut done = 0;
+        let mut gpu_ms = Some(0.0);
+        while done < spp {
+            let batch = per_dispatch.min(spp - done);
+            self.write_frame(gpu, previous, batch, done, seed, frame, done > 0);
+            let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path trace") });
+            self.dispatch(&mut encoder, &self.trace_pipeline, PATH_TRACE_PASS, 1);
+            let t = self.submit_timed(gpu, encoder, 1)?;
+            gpu_ms = gpu_ms.zip(t).map(|(a, b)| a + b);
+            done += batch;
+            progress(done, spp);
+        }
+        Ok(gpu_ms)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn write_frame(&self, gpu: &Gpu, previous: &Camera, spp: u32, first_sample: u32, seed: u64, frame: u32, accumulate: bool) {
+        let (w, h) = (self.settings.width, self.settings.height);
+        let params = FrameParams {
+            camera: CameraBasis::new(&self.camera, w, h),
+            previous_camera: CameraBasis::new(previous, w, h),
+            environment: self.environment,
+            emitter_weight: self.light_table.emitter_weight,
+            width: w,
+            height: h,
+            spp,
+            first_sample,
+            seed,
+            frame,
+            max_depth: self.settings.max_depth,
+            rr_start_depth: self.settings.rr_start_depth,
+            analytic_lights: self.light_table.analytic,
+            emitters: self.light_table.emitters,
+            accumulate,
+        };
+        gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&params.gpu()));
+    }
+
+    fn dispatch(&self, encoder: &mut wgpu::CommandEncoder, pipeline: &wgpu::ComputePipeline, label: &str, pass_index: u32) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(label),
+            timestamp_writes: self.timestamps.as_ref().map(|t| t.writes(pass_index)),
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.set_bind_group(1, self.geometry.bind_group(), &[]);
+        pass.dispatch_workgroups(self.settings.width.div_ceil(WORKGROUP), self.settings.height.div_ceil(WORKGROUP), 1);
+    }
+
+    /// Submits, waits, and returns the GPU time of pass `pass_index` where timestamps exist.
+    fn submit_timed(&self, gpu: &Gpu, mut encoder: wgpu::CommandEncoder, pass_index: u32) -> Result<Option<f64>, RenderError> {
+        if let Some(t) = &self.timestamps {
+            t.resolve(&mut encoder);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        match &self.timestamps {
+            None => {
+                gpu.device
+                    .poll(wgpu::PollType::wait_indefinitely())
+                    .map_err(|e| RenderError::Readback { what: "path tracer submission".into(), reason: e.to_string() })?;
+                Ok(None)
+            }
+            Some(t) => {
+                let ms = t.read(gpu).map_err(|reason| RenderError::Readback { what: "timestamps".into(), reason })?;
+                Ok(Some(ms[pass_index as usize]))
+            }
+        }
+    }
+
+    fn read_radiance(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, RenderError> {
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("radiance readback") });
+        encoder.copy_buffer_to_buffer(&self.radiance_sum, 0, &self.radiance_readback, 0, self.radiance_sum.size());
+        gpu.queue.submit([encoder.finish()]);
+        let sums: Vec<[f32; 4]> = read_buffer(gpu, &self.radiance_readback).map_err(|reason| RenderError::Readback { what: "radiance".into(), reason })?;
+        // w holds the sample count: the mean is sum / count.
+        Ok(sums.into_iter().map(|s| if s[3] > 0.0 { [s[0] / s[3], s[1] / s[3], s[2] / s[3], 1.0] } else { [0.0, 0.0, 0.0, 1.0] }).collect())
+    }
+
+    fn read_gbuffer(&self, gpu: &Gpu) -> Result<GBuffer, RenderError> {
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer readback") });
+        encoder.copy_buffer_to_buffer(&self.gbuffer, 0, &self.gbuffer_readback, 0, self.gbuffer.size());
+        gpu.queue.submit([encoder.finish()]);
+        let texels: Vec<GpuGBufferTexel> = read_buffer(gpu, &self.gbuffer_readback).map_err(|reason| RenderError::Readback { what: "gbuffer".into(), reason })?;
+        let mut g = GBuffer::default();
+        for t in texels {
+            g.depth.push(if t.instance == NO_HIT { f32::INFINITY } else { t.depth });
+            g.normal.push(t.normal);
+            g.albedo.push(t.albedo);
+            g.motion.push(t.motion);
+            g.instance_id.push(t.instance);
+            g.primitive_id.push(t.primitive);
+        }
+        Ok(g)
+    }
+}
+
+fn ms(start: Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
+}
+
+fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let buffer = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    };
+    let read = wgpu::BufferBindingType::Storage { read_only: true };
+    let write = wgpu::BufferBindingType::Storage { read_only: false };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("path tracer"),
+        entries: &[
+            buffer(0, wgpu::BufferBindingType::Uniform),
+            buffer(1, read),
+            buffer(2, read),
+            buffer(3, read),
+            buffer(4, write),
+            buffer(5, write),
+        ],
+    })
+}
+
+fn make_bind_group(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, buffers: [&wgpu::Buffer; 6]) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> =
+        buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("path tracer"), layout, entries: &entries })
+}
