@@ -258,3 +258,26 @@ fn steps_recorded_in_one_encoder_equal_separate_submissions() {
     assert_eq!(got, &want[..]);
     assert_eq!(together.download_state(gpu()).unwrap(), separate.download_state(gpu()).unwrap());
 }
+
+#[test]
+fn gpu_training_converges_like_the_cpu_reference() {
+    let config = small_config();
+    let gpu_cache = NeuralCache::new(gpu(), &config, bounds()).unwrap();
+    let mut cpu = CpuCache::new(CacheState::initial(&config, bounds()).unwrap());
+    let mut rng = Rng(321);
+    let mut first = None;
+    let (mut gpu_loss, mut cpu_loss) = (0.0, 0.0);
+    for _ in 0..150 {
+        let batch = records(&mut rng, 256);
+        gpu_cache.train_records(gpu(), &batch).unwrap();
+        gpu_loss = gpu_cache.last_loss(gpu(), 256).unwrap();
+        cpu_loss = cpu.train_step(&batch).loss;
+        first.get_or_insert(gpu_loss);
+    }
+    let first = first.unwrap();
+    eprintln!("GPU loss {first} -> {gpu_loss}, CPU loss at the last step {cpu_loss}");
+    assert!(gpu_loss < first / 1000.0, "GPU loss {first} -> {gpu_loss}");
+    // 150 steps apart, the two implementations still train alike (round-off only).
+    assert!((gpu_loss - cpu_loss).abs() < 0.1 * cpu_loss, "GPU {gpu_loss} vs CPU {cpu_loss}");
+    assert_eq!(gpu_cache.counters(gpu()).unwrap().step, 150);
+}
