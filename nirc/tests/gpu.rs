@@ -281,3 +281,26 @@ fn gpu_training_converges_like_the_cpu_reference() {
     assert!((gpu_loss - cpu_loss).abs() < 0.1 * cpu_loss, "GPU {gpu_loss} vs CPU {cpu_loss}");
     assert_eq!(gpu_cache.counters(gpu()).unwrap().step, 150);
 }
+
+#[test]
+fn weights_over_the_workgroup_budget_fall_back_to_storage_or_are_refused() {
+    let small = NeuralCache::new(gpu(), &small_config(), bounds()).unwrap();
+    assert_eq!(small.placement, WeightPlacement::Workgroup);
+    let mut config = small_config();
+    // 21 + 128 x 128 + ... floats: 80 KiB of weights, over 32 KiB.
+    config.network = nirc::config::NetworkConfig { width: 128, hidden_layers: 2 };
+    let big = NeuralCache::new(gpu(), &config, bounds()).unwrap();
+    assert_eq!(big.placement, WeightPlacement::Storage);
+    let state = CacheState::initial(&config, bounds()).unwrap();
+    let err = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Workgroup)).err().expect("refused").to_string();
+    assert!(err.contains("workgroup memory") && err.contains("32768"), "{err}");
+    // The fallback computes the same thing.
+    let cpu = CpuCache::new(state);
+    let q: Vec<_> = records(&mut Rng(9), 32).iter().map(|r| r.query()).collect();
+    let got = big.infer_queries(gpu(), &q, PredictorMode::EmaOnly).unwrap();
+    for (g, w) in got.iter().zip(cpu.infer(&q, PredictorMode::EmaOnly)) {
+        for c in 0..3 {
+            assert!(close(g.radiance[c], w.radiance[c], 1e-4, 1e-7));
+        }
+    }
+}
