@@ -1,0 +1,373 @@
+// Scene geometry: two-level CWBVH traversal (Ylitie, Karras & Laine 2017, "Efficient Incoherent
+// Ray Traversal on GPUs Through Compressed Wide BVHs") and hit attributes.
+// Concatenate before a pass's own WGSL (SceneGeometry::WGSL). All bindings are in @group(1);
+// internal names start with `sg_`.
+
+const NO_HIT: u32 = 0xffffffffu;
+
+// instance == NO_HIT on a miss; barycentrics = (u, v), the weights of vertices 1 and 2.
+struct Hit { t: f32, instance: u32, primitive: u32, barycentrics: vec2f }
+
+struct SurfacePoint {
+    position: vec3f,
+    geometric_normal: vec3f,
+    shading_normal: vec3f,
+    uv: vec2f,
+    material: u32,
+}
+
+// obvhs's CwBvhNode, 80 bytes.
+struct SgNode {
+    origin: vec3f,          // min corner of the node's child grid
+    exponents_imask: u32,   // bytes: exponent x, y, z of the grid scale (2^(e-127)), imask
+    child_base: u32,        // first child node (children are contiguous)
+    primitive_base: u32,    // first leaf primitive slot
+    child_meta: vec2u,      // one byte per child slot: leaf = count (unary, bits 5-7) | offset; inner = 24 + slot
+    bounds_x: vec4u,        // .xy: quantized child minima (one byte per child), .zw: maxima
+    bounds_y: vec4u,
+    bounds_z: vec4u,
+}
+
+// A BLAS triangle in leaf order, object space.
+struct SgTriangle { v0: vec3f, primitive: u32, v1: vec3f, sg_pad1: u32, v2: vec3f, sg_pad2: u32 }
+
+struct SgMesh {
+    node_offset: u32,       // root of this mesh's BLAS in sg_blas_nodes
+    node_count: u32,
+    triangle_offset: u32,   // first slot in sg_blas_triangles
+    triangle_count: u32,
+    vertex_offset: u32,     // first vertex in sg_vertices
+    index_offset: u32,      // first triangle in sg_indices (3 indices each)
+    flags: u32,             // bit 0: has shading normals, bit 1: has uvs
+    sg_pad: u32,
+}
+
+struct SgVertex { position: vec3f, u: f32, normal: vec3f, v: f32 }
+
+struct SgInstance {
+    object_to_world: mat4x4f,
+    world_to_object: mat4x4f,
+    previous_object_to_world: mat4x4f,
+    mesh: u32,
+    material: u32,
+    sg_pad: vec2u,
+}
+
+struct SgInstanceTable {
+    count: u32,
+    tlas_node_count: u32,
+    sg_pad: vec2u,
+    records: array<SgInstance>,
+}
+
+@group(1) @binding(0) var<storage, read> sg_blas_nodes: array<SgNode>;
+@group(1) @binding(1) var<storage, read> sg_blas_triangles: array<SgTriangle>;
+@group(1) @binding(2) var<storage, read> sg_meshes: array<SgMesh>;
+@group(1) @binding(3) var<storage, read> sg_vertices: array<SgVertex>;
+@group(1) @binding(4) var<storage, read> sg_indices: array<u32>;
+@group(1) @binding(5) var<storage, read> sg_tlas_nodes: array<SgNode>;
+@group(1) @binding(6) var<storage, read> sg_tlas_instances: array<u32>;
+@group(1) @binding(7) var<storage, read> sg_instances: SgInstanceTable;
+
+// Node groups on the traversal stack (TRAVERSAL_STACK_SIZE on the Rust side). The scene is
+// refused on the CPU if TLAS depth + BLAS depth + 1 could exceed it; were it ever exceeded, the
+// push is dropped: the siblings in that group are skipped (possible missed hits, no hang).
+const SG_STACK_SIZE: u32 = 32u;
+const SG_FLT_EPSILON: f32 = 1.1920929e-7;
+
+struct SgRay {
+    origin: vec3f,
+    direction: vec3f,
+    inv_direction: vec3f,
+    octant_inv4: u32,   // (7 - octant) in every byte: child slots are visited in ray order
+    axes: vec3u,        // watertight test: kx, ky, kz (kz = dominant axis of the direction)
+    shear: vec3f,       // d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz]
+}
+
+// 1/x, kept finite for |x| <= epsilon (as obvhs's safe_inverse); the sign follows `x < 0`, like
+// the octant, so a -0.0 component does not flip one without the other.
+fn sg_safe_inverse(x: f32) -> f32 {
+    if abs(x) <= SG_FLT_EPSILON {
+        return select(1.0, -1.0, x < 0.0) / SG_FLT_EPSILON;
+    }
+    return 1.0 / x;
+}
+
+fn sg_make_ray(origin: vec3f, direction: vec3f) -> SgRay {
+    var r: SgRay;
+    r.origin = origin;
+    r.direction = direction;
+    r.inv_direction = vec3f(sg_safe_inverse(direction.x), sg_safe_inverse(direction.y), sg_safe_inverse(direction.z));
+    r.octant_inv4 = select(0x04040404u, 0u, direction.x < 0.0)
+        | select(0x02020202u, 0u, direction.y < 0.0)
+        | select(0x01010101u, 0u, direction.z < 0.0);
+    let a = abs(direction);
+    var kz = 2u;
+    if a.x >= a.y && a.x >= a.z {
+        kz = 0u;
+    } else if a.y >= a.z {
+        kz = 1u;
+    }
+    var kx = (kz + 1u) % 3u;
+    var ky = (kx + 1u) % 3u;
+    if direction[kz] < 0.0 {
+        let swap = kx;
+        kx = ky;
+        ky = swap;
+    }
+    let inv = 1.0 / direction[kz];
+    r.axes = vec3u(kx, ky, kz);
+    r.shear = vec3f(direction[kx] * inv, direction[ky] * inv, inv);
+    return r;
+}
+
+// Watertight ray-triangle test (Woop, Benthin & Wald 2013), the twin of bvh/triangle.rs.
+// Returns (t, u, v, 1) for a hit with 0 < t < t_max, else vec4f(0).
+fn sg_intersect_triangle(ray: SgRay, v0: vec3f, v1: vec3f, v2: vec3f, t_max: f32) -> vec4f {
+    let kx = ray.axes.x;
+    let ky = ray.axes.y;
+    let kz = ray.axes.z;
+    let s = ray.shear;
+    let a = v0 - ray.origin;
+    let b = v1 - ray.origin;
+    let c = v2 - ray.origin;
+    let ax = a[kx] - s.x * a[kz];
+    let ay = a[ky] - s.y * a[kz];
+    let bx = b[kx] - s.x * b[kz];
+    let by = b[ky] - s.y * b[kz];
+    let cx = c[kx] - s.x * c[kz];
+    let cy = c[ky] - s.y * c[kz];
+    let u = cx * by - cy * bx;
+    let v = ax * cy - ay * cx;
+    let w = bx * ay - by * ax;
+    if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+        return vec4f(0.0);
+    }
+    let det = u + v + w;
+    if det == 0.0 {
+        return vec4f(0.0);
+    }
+    let az = s.z * a[kz];
+    let bz = s.z * b[kz];
+    let cz = s.z * c[kz];
+    let t = (u * az + v * bz + w * cz) / det;
+    if !(t > 0.0 && t < t_max) {
+        return vec4f(0.0);
+    }
+    return vec4f(t, v / det, w / det, 1.0);
+}
+
+// Intersects the ray with the 8 quantized child boxes of a node, in the node's grid frame
+// (t = q * e / d + (p - o) / d). Returns the hit mask: bits 24-31 for inner children at
+// 24 + (slot ^ octant_inv) (so the highest bit is the nearest in ray order), bits 0-23 for the
+// primitives of hit leaves.
+fn sg_intersect_node(node: SgNode, ray: SgRay, t_max: f32) -> u32 {
+    let e = vec3f(
+        bitcast<f32>((node.exponents_imask & 0xffu) << 23u),
+        bitcast<f32>(((node.exponents_imask >> 8u) & 0xffu) << 23u),
+        bitcast<f32>(((node.exponents_imask >> 16u) & 0xffu) << 23u),
+    );
+    let scale = e * ray.inv_direction;
+    let offset = (node.origin - ray.origin) * ray.inv_direction;
+    let negative = ray.direction < vec3f(0.0);
+    var hits = 0u;
+    for (var half = 0u; half < 2u; half++) {
+        let meta4 = node.child_meta[half];
+        let is_inner4 = (meta4 & (meta4 << 1u)) & 0x10101010u;
+        let inner_mask4 = (is_inner4 >> 4u) * 0xffu;
+        let bit_index4 = (meta4 ^ (ray.octant_inv4 & inner_mask4)) & 0x1f1f1f1fu;
+        let child_bits4 = (meta4 >> 5u) & 0x07070707u;
+        // Near and far planes per axis: swap min and max where the direction is negative.
+        let near_x = select(node.bounds_x[half], node.bounds_x[half + 2u], negative.x);
+        let far_x = select(node.bounds_x[half + 2u], node.bounds_x[half], negative.x);
+        let near_y = select(node.bounds_y[half], node.bounds_y[half + 2u], negative.y);
+        let far_y = select(node.bounds_y[half + 2u], node.bounds_y[half], negative.y);
+        let near_z = select(node.bounds_z[half], node.bounds_z[half + 2u], negative.z);
+        let far_z = select(node.bounds_z[half + 2u], node.bounds_z[half], negative.z);
+        for (var j = 0u; j < 4u; j++) {
+            let shift = j * 8u;
+            let q_near = vec3f(f32(extractBits(near_x, shift, 8u)), f32(extractBits(near_y, shift, 8u)), f32(extractBits(near_z, shift, 8u)));
+            let q_far = vec3f(f32(extractBits(far_x, shift, 8u)), f32(extractBits(far_y, shift, 8u)), f32(extractBits(far_z, shift, 8u)));
+            let t_near = q_near * scale + offset;
+            let t_far = q_far * scale + offset;
+            let t0 = max(max(t_near.x, t_near.y), max(t_near.z, 0.0));
+            let t1 = min(min(t_far.x, t_far.y), min(t_far.z, t_max));
+            if t0 <= t1 {
+                hits |= extractBits(child_bits4, shift, 8u) << extractBits(bit_index4, shift, 8u);
+            }
+        }
+    }
+    return hits;
+}
+
+// Two-level traversal with one stack: TLAS leaves are instances; entering one saves the rest of
+// the TLAS level on the stack, notes the stack size, and continues at the BLAS root with the ray
+// in object space (t is unchanged: the direction is transformed, not normalised). When the stack
+// falls back to that size the BLAS is done and the world ray is restored.
+fn sg_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit: bool) -> Hit {
+    var hit = Hit(t_max, NO_HIT, NO_HIT, vec2f(0.0));
+    if sg_instances.tlas_node_count == 0u || !(t_max > 0.0) {
+        return hit;
+    }
+    let world_ray = sg_make_ray(world_origin, world_direction);
+    var ray = world_ray;
+    var stack: array<vec2u, SG_STACK_SIZE>;
+    var stack_size = 0u;
+    var tlas_stack_size = NO_HIT; // NO_HIT while traversing the TLAS
+    var instance = NO_HIT;
+    // A group: x = base index, y = hit bits (24-31 inner children, 0-23 primitives) | imask (0-7).
+    var node_group = vec2u(0u, 0x80000000u);
+    loop {
+        var primitive_group = vec2u(0u);
+        if (node_group.y & 0xff000000u) != 0u {
+            let hits_imask = node_group.y;
+            let child_bit = firstLeadingBit(hits_imask);
+            node_group.y &= ~(1u << child_bit);
+            if (node_group.y & 0xff000000u) != 0u && stack_size < SG_STACK_SIZE {
+                stack[stack_size] = node_group;
+                stack_size += 1u;
+            }
+            let slot = (child_bit - 24u) ^ (ray.octant_inv4 & 0xffu);
+            let node_index = node_group.x + countOneBits(hits_imask & ~(0xffffffffu << slot));
+            var node: SgNode;
+            if tlas_stack_size == NO_HIT {
+                node = sg_tlas_nodes[node_index];
+            } else {
+                node = sg_blas_nodes[node_index];
+            }
+            let hitmask = sg_intersect_node(node, ray, hit.t);
+            node_group = vec2u(node.child_base, (hitmask & 0xff000000u) | (node.exponents_imask >> 24u));
+            primitive_group = vec2u(node.primitive_base, hitmask & 0x00ffffffu);
+        } else {
+            // Only primitive groups are pushed without inner-child bits.
+            primitive_group = node_group;
+            node_group = vec2u(0u);
+        }
+        while primitive_group.y != 0u {
+            let local = firstLeadingBit(primitive_group.y);
+            primitive_group.y &= ~(1u << local);
+            let slot = primitive_group.x + local;
+            if tlas_stack_size == NO_HIT {
+                if primitive_group.y != 0u && stack_size < SG_STACK_SIZE {
+                    stack[stack_size] = primitive_group;
+                    stack_size += 1u;
+                }
+                if (node_group.y & 0xff000000u) != 0u && stack_size < SG_STACK_SIZE {
+                    stack[stack_size] = node_group;
+                    stack_size += 1u;
+                }
+                tlas_stack_size = stack_size;
+                instance = sg_tlas_instances[slot];
+                let world_to_object = sg_instances.records[instance].world_to_object;
+                let mesh = sg_meshes[sg_instances.records[instance].mesh];
+                ray = sg_make_ray((world_to_object * vec4f(world_origin, 1.0)).xyz, (world_to_object * vec4f(world_direction, 0.0)).xyz);
+                node_group = vec2u(mesh.node_offset, select(0u, 0x80000000u, mesh.node_count != 0u));
+                break;
+            }
+            let tri = sg_blas_triangles[slot];
+            let r = sg_intersect_triangle(ray, tri.v0, tri.v1, tri.v2, hit.t);
+            if r.w > 0.0 {
+                hit = Hit(r.x, instance, tri.primitive, r.yz);
+                if any_hit {
+                    return hit;
+                }
+            }
+        }
+        if (node_group.y & 0xff000000u) == 0u {
+            if stack_size == 0u {
+                break;
+            }
+            if stack_size == tlas_stack_size {
+                tlas_stack_size = NO_HIT;
+                ray = world_ray;
+            }
+            stack_size -= 1u;
+            node_group = stack[stack_size];
+        }
+    }
+    return hit;
+}
+
+// Closest hit with 0 < t < t_max (direction need not be normalised; t in units of direction).
+fn trace_closest(origin: vec3f, direction: vec3f, t_max: f32) -> Hit {
+    return sg_traverse(origin, direction, t_max, false);
+}
+
+// True if anything is hit with 0 < t < t_max; stops at the first hit (shadow rays).
+fn trace_any(origin: vec3f, direction: vec3f, t_max: f32) -> bool {
+    return sg_traverse(origin, direction, t_max, true).instance != NO_HIT;
+}
+
+fn instance_count() -> u32 {
+    return sg_instances.count;
+}
+
+// Vertex indices (into sg_vertices) of a mesh triangle.
+fn sg_triangle_vertex_indices(mesh: SgMesh, primitive: u32) -> vec3u {
+    let base = 3u * (mesh.index_offset + primitive);
+    return vec3u(sg_indices[base], sg_indices[base + 1u], sg_indices[base + 2u]) + vec3u(mesh.vertex_offset);
+}
+
+fn sg_normalize_or(v: vec3f, fallback: vec3f) -> vec3f {
+    let len2 = dot(v, v);
+    if !(len2 > 0.0) || len2 > 3.0e38 {
+        return fallback;
+    }
+    return v * inverseSqrt(len2);
+}
+
+fn sg_object_point(hit: Hit) -> vec3f {
+    let mesh = sg_meshes[sg_instances.records[hit.instance].mesh];
+    let idx = sg_triangle_vertex_indices(mesh, hit.primitive);
+    let b = hit.barycentrics;
+    return (1.0 - b.x - b.y) * sg_vertices[idx.x].position + b.x * sg_vertices[idx.y].position + b.y * sg_vertices[idx.z].position;
+}
+
+// World-space attributes of a hit. The position is the barycentric point on the triangle (not
+// origin + t * direction) so that it lies on the surface. The geometric normal follows the
+// winding (cross(v1 - v0, v2 - v0)) and is NOT flipped towards the ray; both normals go through
+// the inverse transpose of object_to_world, so they stay on the same side under mirroring.
+fn surface_point(hit: Hit, origin: vec3f, direction: vec3f) -> SurfacePoint {
+    let record = sg_instances.records[hit.instance];
+    let mesh = sg_meshes[record.mesh];
+    let idx = sg_triangle_vertex_indices(mesh, hit.primitive);
+    let v0 = sg_vertices[idx.x];
+    let v1 = sg_vertices[idx.y];
+    let v2 = sg_vertices[idx.z];
+    let b = vec3f(1.0 - hit.barycentrics.x - hit.barycentrics.y, hit.barycentrics.x, hit.barycentrics.y);
+    let object_position = b.x * v0.position + b.y * v1.position + b.z * v2.position;
+    let w2o = record.world_to_object;
+    let normal_matrix = transpose(mat3x3f(w2o[0].xyz, w2o[1].xyz, w2o[2].xyz));
+    let object_geometric = cross(v1.position - v0.position, v2.position - v0.position);
+    var p: SurfacePoint;
+    p.position = (record.object_to_world * vec4f(object_position, 1.0)).xyz;
+    p.geometric_normal = sg_normalize_or(normal_matrix * object_geometric, vec3f(0.0, 0.0, 1.0));
+    p.shading_normal = p.geometric_normal;
+    if (mesh.flags & 1u) != 0u {
+        let n = b.x * v0.normal + b.y * v1.normal + b.z * v2.normal;
+        p.shading_normal = sg_normalize_or(normal_matrix * n, p.geometric_normal);
+    }
+    p.uv = vec2f(0.0);
+    if (mesh.flags & 2u) != 0u {
+        p.uv = b.x * vec2f(v0.u, v0.v) + b.y * vec2f(v1.u, v1.v) + b.z * vec2f(v2.u, v2.v);
+    }
+    p.material = record.material;
+    return p;
+}
+
+// The hit's object-space point through last frame's transform (motion vectors).
+fn previous_world_position(hit: Hit) -> vec3f {
+    return (sg_instances.records[hit.instance].previous_object_to_world * vec4f(sg_object_point(hit), 1.0)).xyz;
+}
+
+// World-space vertices of a triangle of an instance (area-light sampling).
+fn triangle_world_vertices(instance: u32, primitive: u32) -> array<vec3f, 3> {
+    let record = sg_instances.records[instance];
+    let idx = sg_triangle_vertex_indices(sg_meshes[record.mesh], primitive);
+    let m = record.object_to_world;
+    return array<vec3f, 3>(
+        (m * vec4f(sg_vertices[idx.x].position, 1.0)).xyz,
+        (m * vec4f(sg_vertices[idx.y].position, 1.0)).xyz,
+        (m * vec4f(sg_vertices[idx.z].position, 1.0)).xyz,
+    );
+}

@@ -1,0 +1,196 @@
+//! Traversal benchmark: rays/s of the WGSL CWBVH traversal against obvhs's CPU traversal on
+//! all cores (rayon), on the same BVHs and the same rays, in one run. Plus the procedural
+//! meshes and rays it (and the tests) use.
+
+use std::time::{Duration, Instant};
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::{BvhError, RayBatch, RayQuery, SceneGeometry, SplitMix64, TraceKind};
+use crate::gpu::Gpu;
+use crate::scene::{Mesh, SceneDesc};
+
+/// Minimum wall time of each timed side; repetitions are added until it is reached.
+const MIN_TIMED: Duration = Duration::from_millis(500);
+
+#[derive(Clone, Debug)]
+pub struct TraversalBench {
+    pub adapter: String,
+    pub triangles: u64,
+    pub instances: u32,
+    pub rays: u32,
+    /// Building every BLAS and the TLAS on the CPU, plus the upload.
+    pub build_seconds: f64,
+    /// Closest-hit rays per second of the WGSL traversal, dispatch to completion (the rays are
+    /// already on the GPU; no readback in the timing).
+    pub gpu_rays_per_second: f64,
+    /// Closest-hit rays per second of obvhs's traversal on `cpu_threads` threads.
+    pub cpu_rays_per_second: f64,
+    pub cpu_threads: usize,
+    /// Fraction of rays that hit something.
+    pub hit_fraction: f64,
+    /// Fraction of rays where GPU and CPU report the same instance and primitive.
+    pub agreement: f64,
+}
+
+impl std::fmt::Display for TraversalBench {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} triangles, {} instances, {} rays: GPU {:.3} Mrays/s ({}), CPU {:.3} Mrays/s ({} threads), hits {:.1}%, GPU=CPU {:.2}%, build {:.3} s",
+            self.triangles,
+            self.instances,
+            self.rays,
+            self.gpu_rays_per_second / 1e6,
+            self.adapter,
+            self.cpu_rays_per_second / 1e6,
+            self.cpu_threads,
+            100.0 * self.hit_fraction,
+            100.0 * self.agreement,
+            self.build_seconds
+        )
+    }
+}
+
+/// Measures closest-hit traversal of `rays` random rays (origins inside the scene bounds,
+/// uniform directions; seeded) on the GPU and on the CPU, after one warm-up run each.
+pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -> Result<TraversalBench, BvhError> {
+    let start = Instant::now();
+    let geometry = SceneGeometry::new(gpu, scene)?;
+    gpu.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| BvhError::Readback { what: "scene upload".into(), reason: e.to_string() })?;
+    let build_seconds = start.elapsed().as_secs_f64();
+    let queries = random_rays(geometry.bounds(), rays as usize, 1e30, seed);
+
+    let batch = RayBatch::new(gpu, &geometry);
+    let buffers = batch.upload(gpu, &queries)?;
+    batch.dispatch(gpu, &geometry, &buffers, TraceKind::Closest)?; // warm-up (pipeline compile, caches)
+    let (reps, elapsed) = repeat_until(MIN_TIMED, || batch.dispatch(gpu, &geometry, &buffers, TraceKind::Closest))?;
+    let gpu_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
+    let gpu_hits = batch.read_closest(gpu, &buffers)?;
+
+    let cpu = geometry.cpu();
+    let trace_all = || queries.par_iter().map(|r| cpu.trace_closest(r.origin, r.direction, r.t_max)).collect::<Vec<_>>();
+    let cpu_hits = trace_all(); // warm-up
+    let (reps, elapsed) = repeat_until(MIN_TIMED, || {
+        std::hint::black_box(trace_all());
+        Ok(())
+    })?;
+    let cpu_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
+
+    let n = queries.len().max(1) as f64;
+    let hit_fraction = cpu_hits.iter().filter(|h| h.is_hit()).count() as f64 / n;
+    let agreement =
+        gpu_hits.iter().zip(&cpu_hits).filter(|(g, c)| g.instance == c.instance && g.primitive == c.primitive).count() as f64 / n;
+    Ok(TraversalBench {
+        adapter: gpu.summary.name.clone(),
+        triangles: scene.instances.iter().map(|i| scene.meshes[i.mesh as usize].indices.len() as u64).sum(),
+        instances: scene.instances.len() as u32,
+        rays,
+        build_seconds,
+        gpu_rays_per_second,
+        cpu_rays_per_second,
+        cpu_threads: rayon::current_num_threads(),
+        hit_fraction,
+        agreement,
+    })
+}
+
+fn repeat_until(min: Duration, mut f: impl FnMut() -> Result<(), BvhError>) -> Result<(u32, Duration), BvhError> {
+    let start = Instant::now();
+    let mut reps = 0;
+    while reps == 0 || start.elapsed() < min {
+        f()?;
+        reps += 1;
+    }
+    Ok((reps, start.elapsed()))
+}
+
+/// `count` rays with origins uniform in the box `bounds` grown by 10% of its diagonal, uniform
+/// directions (unit length) and the given `t_max`; the same seed gives the same rays.
+pub fn random_rays(bounds: (Vec3, Vec3), count: usize, t_max: f32, seed: u64) -> Vec<RayQuery> {
+    let mut rng = SplitMix64::new(seed);
+    let margin = Vec3::splat(0.1 * (bounds.1 - bounds.0).length().max(1e-3));
+    let (lo, hi) = (bounds.0 - margin, bounds.1 + margin);
+    (0..count)
+        .map(|_| {
+            let origin = Vec3::new(rng.range(lo.x, hi.x), rng.range(lo.y, hi.y), rng.range(lo.z, hi.z));
+            RayQuery { origin, direction: rng.unit_vector(), t_max }
+        })
+        .collect()
+}
+
+/// A unit sphere with a seeded bumpy displacement (a few random sinusoids along the normal),
+/// tessellated as a latitude-longitude grid with at least `min_triangles` triangles. Has smooth
+/// normals and uvs. `displaced_sphere(100_000, seed)` is the benchmark's 100k-triangle mesh.
+pub fn displaced_sphere(min_triangles: u32, seed: u64) -> Mesh {
+    // 2 triangles per grid cell except one per cell in the two polar rows; slices = 2 * stacks.
+    let mut stacks = 2u32;
+    while 2 * (2 * stacks) * stacks - 2 * (2 * stacks) < min_triangles {
+        stacks += 1;
+    }
+    let slices = 2 * stacks;
+    let mut rng = SplitMix64::new(seed);
+    let waves: Vec<(Vec3, f32, f32)> = (0..6).map(|_| (rng.unit_vector(), rng.range(3.0, 12.0), rng.range(0.0, std::f32::consts::TAU))).collect();
+    let radius = |d: Vec3| 1.0 + waves.iter().map(|&(k, f, phase)| 0.02 * (f * k.dot(d) + phase).sin()).sum::<f32>();
+
+    let mut positions = Vec::new();
+    let mut uvs = Vec::new();
+    for i in 0..=stacks {
+        let theta = std::f32::consts::PI * i as f32 / stacks as f32;
+        for j in 0..=slices {
+            let phi = std::f32::consts::TAU * j as f32 / slices as f32;
+            let d = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            positions.push(d * radius(d));
+            uvs.push(Vec2::new(j as f32 / slices as f32, i as f32 / stacks as f32));
+        }
+    }
+    let at = |i: u32, j: u32| i * (slices + 1) + j;
+    let mut indices = Vec::new();
+    for i in 0..stacks {
+        for j in 0..slices {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            // Counter-clockwise seen from outside.
+            if i != 0 {
+                indices.push([a, c, b]);
+            }
+            if i != stacks - 1 {
+                indices.push([a, d, c]);
+            }
+        }
+    }
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for t in &indices {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        let n = (b - a).cross(c - a);
+        for &i in t {
+            normals[i as usize] += n;
+        }
+    }
+    for n in &mut normals {
+        *n = n.normalize_or(Vec3::Y);
+    }
+    Mesh { name: format!("displaced sphere ({} triangles)", indices.len()), positions, normals, uvs, indices }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn displaced_sphere_has_the_triangles_asked_and_faces_outwards() {
+        let m = displaced_sphere(100_000, 3);
+        assert!(m.indices.len() >= 100_000 && m.indices.len() < 105_000, "{}", m.indices.len());
+        let mut outward = 0;
+        for t in &m.indices {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            if (b - a).cross(c - a).dot(a + b + c) > 0.0 {
+                outward += 1;
+            }
+        }
+        assert!(outward as f64 > 0.999 * m.indices.len() as f64, "{outward} of {}", m.indices.len());
+        assert_eq!(m.positions, displaced_sphere(100_000, 3).positions, "deterministic");
+    }
+}

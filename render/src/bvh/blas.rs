@@ -1,0 +1,80 @@
+//! Bottom-level acceleration structure: one CWBVH per mesh, in object space, built once.
+
+use std::time::Duration;
+
+use glam::{Vec3, Vec3A};
+use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh_from_tris, triangle::Triangle};
+
+use super::BvhError;
+use crate::scene::Mesh;
+
+pub struct Blas {
+    pub bvh: CwBvh,
+    /// Triangle vertices in BVH leaf order: `triangles[i]` is the mesh triangle
+    /// `bvh.primitive_indices[i]`, so traversal reads vertices without an indirection.
+    pub triangles: Vec<[Vec3; 3]>,
+    /// Object-space bounds (empty for a mesh without triangles).
+    pub bounds: Aabb,
+    /// Node levels from the root to the deepest node (0 without triangles).
+    pub depth: u32,
+}
+
+impl Blas {
+    /// Builds the CWBVH of `mesh` (`index` is only for error messages). A mesh without triangles
+    /// gives an empty BLAS that no ray hits.
+    pub fn build(index: usize, mesh: &Mesh) -> Result<Self, BvhError> {
+        let err = |reason: String| BvhError::Mesh { index, name: mesh.name.clone(), reason };
+        if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
+            return Err(err(format!("position {i} is not finite: {}", mesh.positions[i])));
+        }
+        let n = mesh.positions.len() as u32;
+        let mut tris = Vec::with_capacity(mesh.indices.len());
+        for (t, idx) in mesh.indices.iter().enumerate() {
+            if let Some(&bad) = idx.iter().find(|&&i| i >= n) {
+                return Err(err(format!("triangle {t} uses vertex {bad}, but the mesh has {n} positions")));
+            }
+            let [a, b, c] = idx.map(|i| Vec3A::from(mesh.positions[i as usize]));
+            tris.push(Triangle { v0: a, v1: b, v2: c });
+        }
+        if !mesh.normals.is_empty() && mesh.normals.len() != mesh.positions.len() {
+            return Err(err(format!("{} normals for {} positions (expected one per position, or none)", mesh.normals.len(), n)));
+        }
+        if !mesh.uvs.is_empty() && mesh.uvs.len() != mesh.positions.len() {
+            return Err(err(format!("{} uvs for {} positions (expected one per position, or none)", mesh.uvs.len(), n)));
+        }
+        if tris.is_empty() {
+            return Ok(Self { bvh: CwBvh::default(), triangles: Vec::new(), bounds: Aabb::empty(), depth: 0 });
+        }
+        let bvh = build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
+        let triangles = bvh
+            .primitive_indices
+            .iter()
+            .map(|&p| {
+                let t = &tris[p as usize];
+                [t.v0.into(), t.v1.into(), t.v2.into()]
+            })
+            .collect();
+        let depth = cwbvh_depth(&bvh);
+        Ok(Self { bounds: bvh.total_aabb, bvh, triangles, depth })
+    }
+}
+
+/// Node levels of a CWBVH: the bound on traversal stack entries one level of traversal needs.
+pub(crate) fn cwbvh_depth(bvh: &CwBvh) -> u32 {
+    if bvh.nodes.is_empty() {
+        return 0;
+    }
+    let mut deepest = 0;
+    let mut todo = vec![(0u32, 1u32)];
+    while let Some((node_index, depth)) = todo.pop() {
+        deepest = deepest.max(depth);
+        let node = &bvh.nodes[node_index as usize];
+        for child in 0..8 {
+            if !node.is_child_empty(child) && !node.is_leaf(child) {
+                todo.push((node.child_node_index(child), depth + 1));
+            }
+        }
+    }
+    deepest
+}
+

@@ -1,0 +1,85 @@
+//! Ray-tracing acceleration structures on the GPU without ray queries: obvhs compressed wide BVHs
+//! (CWBVH, Ylitie et al. 2017) in two levels, traversed in WGSL.
+//!
+//! - [`Blas`]: one CWBVH per [`Mesh`](crate::scene::Mesh), in object space, built once.
+//! - [`Tlas`]: one CWBVH over the world-space boxes of the instances, rebuilt when one moves.
+//! - [`SceneBvh`]: both levels on the CPU, with a reference traversal through obvhs's own
+//!   CWBVH traversal (the ground truth the WGSL traversal is tested against).
+//! - [`SceneGeometry`]: the same structures in storage buffers (one bind group, `@group(1)`) and
+//!   the WGSL interface `scene_geometry.wgsl` that passes concatenate before their own code.
+//! - [`RayBatch`]: a compute pass tracing a buffer of rays (tests, benchmark).
+//! - [`traversal_benchmark`]: rays/s of the WGSL traversal against obvhs on all CPU cores.
+
+mod bench;
+mod blas;
+mod cpu_traversal;
+mod ray_batch;
+mod rng;
+mod scene_geometry;
+mod tlas;
+mod triangle;
+
+pub use bench::{TraversalBench, displaced_sphere, random_rays, traversal_benchmark};
+pub use blas::Blas;
+pub use cpu_traversal::{InstanceUpdate, SceneBvh};
+pub use tlas::InstanceTransforms;
+pub use ray_batch::{RayBatch, RayBuffers, RayQuery, SurfaceRecord, TraceKind};
+pub use rng::SplitMix64;
+pub use scene_geometry::SceneGeometry;
+pub use tlas::Tlas;
+pub use triangle::{WatertightRay, intersect_triangle};
+
+use crate::gpu::GpuError;
+use glam::Vec2;
+
+/// Entries of the WGSL traversal stack (`SG_STACK_SIZE` in scene_geometry.wgsl). A two-level
+/// traversal needs at most `tlas depth + blas depth + 1` entries; [`SceneBvh`] refuses scenes
+/// that could need more, so the shader's overflow guard never drops a node group.
+pub const TRAVERSAL_STACK_SIZE: u32 = 32;
+
+/// Marks "no instance" / "no primitive" in a [`Hit`], as `NO_HIT` does in WGSL.
+pub const NO_HIT: u32 = u32::MAX;
+
+/// A ray's closest intersection, the CPU twin of WGSL's `Hit`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter in units of the ray direction; equals the ray's `t_max` on a miss.
+    pub t: f32,
+    /// Index into `SceneDesc::instances`, [`NO_HIT`] on a miss.
+    pub instance: u32,
+    /// Triangle index into the mesh's `indices`, [`NO_HIT`] on a miss.
+    pub primitive: u32,
+    /// (u, v): weights of the triangle's vertices 1 and 2.
+    pub barycentrics: Vec2,
+}
+
+impl Hit {
+    pub fn miss(t_max: f32) -> Self {
+        Self { t: t_max, instance: NO_HIT, primitive: NO_HIT, barycentrics: Vec2::ZERO }
+    }
+
+    pub fn is_hit(&self) -> bool {
+        self.instance != NO_HIT
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum BvhError {
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    #[error("mesh {index} '{name}': {reason}")]
+    Mesh { index: usize, name: String, reason: String },
+    #[error("instance {instance} refers to mesh {mesh}, but the scene has {meshes} meshes")]
+    InstanceMesh { instance: usize, mesh: u32, meshes: usize },
+    #[error("instance {instance} has a non-invertible or non-finite transform {transform}")]
+    InstanceTransform { instance: usize, transform: String },
+    #[error(
+        "BVH too deep for the GPU traversal stack: TLAS depth {tlas} + deepest BLAS depth {blas} (mesh '{mesh}') + 1 > {} entries",
+        TRAVERSAL_STACK_SIZE
+    )]
+    TooDeep { tlas: u32, blas: u32, mesh: String },
+    #[error("the adapter allows {limit} storage buffers per shader stage; the scene geometry alone needs {needed}")]
+    StorageBuffers { needed: u32, limit: u32 },
+    #[error("reading back '{what}' from the GPU failed: {reason}")]
+    Readback { what: String, reason: String },
+}

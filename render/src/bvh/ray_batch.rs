@@ -1,0 +1,272 @@
+//! A compute pass that traces a buffer of rays through [`SceneGeometry`]: the WGSL traversal
+//! made observable, for the traversal tests and the benchmark.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Vec2, Vec3};
+
+use super::{BvhError, Hit, SceneGeometry};
+use crate::gpu::Gpu;
+
+const WORKGROUP_SIZE: u32 = 64;
+
+/// One ray: `t` in units of `direction` (which need not be normalised).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayQuery {
+    pub origin: Vec3,
+    pub direction: Vec3,
+    pub t_max: f32,
+}
+
+/// What `surface_point`, `previous_world_position` and `triangle_world_vertices` returned.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceRecord {
+    pub position: Vec3,
+    pub geometric_normal: Vec3,
+    pub shading_normal: Vec3,
+    pub uv: Vec2,
+    pub material: u32,
+    pub previous_position: Vec3,
+    pub triangle: [Vec3; 3],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuRay {
+    origin: [f32; 3],
+    t_max: f32,
+    direction: [f32; 3],
+    _pad: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuHit {
+    t: f32,
+    instance: u32,
+    primitive: u32,
+    any_hit: u32,
+    barycentrics: [f32; 2],
+    _pad: [f32; 2],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuPoint {
+    position: [f32; 4],
+    geometric_normal: [f32; 4],
+    shading_normal: [f32; 4],
+    uv: [f32; 2],
+    material: u32,
+    _pad: u32,
+    previous_position: [f32; 4],
+    triangle: [[f32; 4]; 3],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct BatchParams {
+    count: u32,
+    row_pitch: u32,
+    _pad: [u32; 2],
+}
+
+/// Which kernel [`RayBatch::dispatch`] runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TraceKind {
+    Closest,
+    Any,
+    /// Attributes of the closest hits (run after `Closest`).
+    SurfacePoints,
+}
+
+pub struct RayBatch {
+    layout: wgpu::BindGroupLayout,
+    closest: wgpu::ComputePipeline,
+    any: wgpu::ComputePipeline,
+    points: wgpu::ComputePipeline,
+}
+
+/// Rays uploaded once, traced any number of times.
+pub struct RayBuffers {
+    count: u32,
+    groups: (u32, u32),
+    hits: wgpu::Buffer,
+    points: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
+impl RayBatch {
+    pub fn new(gpu: &Gpu, geometry: &SceneGeometry) -> Self {
+        let source = format!("{}\n{}", SceneGeometry::WGSL, include_str!("../../shaders/bvh_ray_batch.wgsl"));
+        let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("bvh_ray_batch.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        };
+        let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("ray batch"),
+            entries: &[
+                entry(0, wgpu::BufferBindingType::Storage { read_only: true }),
+                entry(1, wgpu::BufferBindingType::Storage { read_only: false }),
+                entry(2, wgpu::BufferBindingType::Storage { read_only: false }),
+                entry(3, wgpu::BufferBindingType::Uniform),
+            ],
+        });
+        let pipeline_layout = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("ray batch"),
+            bind_group_layouts: &[Some(&layout), Some(geometry.bind_group_layout())],
+            immediate_size: 0,
+        });
+        let pipeline = |entry_point| {
+            gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry_point),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry_point),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        Self { closest: pipeline("trace_closest_rays"), any: pipeline("trace_any_rays"), points: pipeline("surface_points"), layout }
+    }
+
+    /// Uploads the rays (refuses more than the adapter's buffers hold).
+    pub fn upload(&self, gpu: &Gpu, rays: &[RayQuery]) -> Result<RayBuffers, BvhError> {
+        let count = rays.len() as u32;
+        let n = rays.len().max(1) as u64;
+        for (what, stride) in [("ray buffer", 32u64), ("hit buffer", 32), ("surface point buffer", size_of::<GpuPoint>() as u64)] {
+            gpu.check_buffer_size(what, n * stride)?;
+        }
+        let groups_needed = count.div_ceil(WORKGROUP_SIZE).max(1);
+        let max = gpu.limits.max_compute_workgroups_per_dimension;
+        let groups_x = groups_needed.min(max);
+        let groups = (groups_x, groups_needed.div_ceil(groups_x));
+        let gpu_rays: Vec<GpuRay> = rays
+            .iter()
+            .map(|r| GpuRay { origin: r.origin.into(), t_max: r.t_max, direction: r.direction.into(), _pad: 0 })
+            .collect();
+        let buffer = |label, size: u64, usage| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+        };
+        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
+        let ray_buffer = buffer("rays", n * 32, storage);
+        gpu.queue.write_buffer(&ray_buffer, 0, bytemuck::cast_slice(&gpu_rays));
+        let hits = buffer("hits", n * 32, storage);
+        let points = buffer("surface points", n * size_of::<GpuPoint>() as u64, storage);
+        let params = buffer("ray batch params", 16, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+        let p = BatchParams { count, row_pitch: groups_x * WORKGROUP_SIZE, _pad: [0; 2] };
+        gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&p));
+        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("ray batch"),
+            layout: &self.layout,
+            entries: &[&ray_buffer, &hits, &points, &params]
+                .iter()
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+                .collect::<Vec<_>>(),
+        });
+        Ok(RayBuffers { count, groups, hits, points, bind_group })
+    }
+
+    /// Runs one kernel over all rays and waits for the GPU to finish.
+    pub fn dispatch(&self, gpu: &Gpu, geometry: &SceneGeometry, buffers: &RayBuffers, kind: TraceKind) -> Result<(), BvhError> {
+        let pipeline = match kind {
+            TraceKind::Closest => &self.closest,
+            TraceKind::Any => &self.any,
+            TraceKind::SurfacePoints => &self.points,
+        };
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ray batch") });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("ray batch"), timestamp_writes: None });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &buffers.bind_group, &[]);
+            pass.set_bind_group(1, geometry.bind_group(), &[]);
+            pass.dispatch_workgroups(buffers.groups.0, buffers.groups.1, 1);
+        }
+        let submission = gpu.queue.submit([encoder.finish()]);
+        gpu.device
+            .poll(wgpu::PollType::Wait { submission_index: Some(submission), timeout: None })
+            .map_err(|e| BvhError::Readback { what: "ray batch".into(), reason: e.to_string() })?;
+        Ok(())
+    }
+
+    /// Closest hits of the last `Closest` dispatch.
+    pub fn read_closest(&self, gpu: &Gpu, buffers: &RayBuffers) -> Result<Vec<Hit>, BvhError> {
+        let hits: Vec<GpuHit> = read(gpu, &buffers.hits, buffers.count as u64 * 32, "hits")?;
+        Ok(hits
+            .iter()
+            .map(|h| Hit { t: h.t, instance: h.instance, primitive: h.primitive, barycentrics: Vec2::from(h.barycentrics) })
+            .collect())
+    }
+
+    /// Any-hit flags of the last `Any` dispatch.
+    pub fn read_any(&self, gpu: &Gpu, buffers: &RayBuffers) -> Result<Vec<bool>, BvhError> {
+        let hits: Vec<GpuHit> = read(gpu, &buffers.hits, buffers.count as u64 * 32, "any-hit flags")?;
+        Ok(hits.iter().map(|h| h.any_hit != 0).collect())
+    }
+
+    /// Surface records of the last `SurfacePoints` dispatch (meaningless for missed rays).
+    pub fn read_surface_points(&self, gpu: &Gpu, buffers: &RayBuffers) -> Result<Vec<SurfaceRecord>, BvhError> {
+        let points: Vec<GpuPoint> = read(gpu, &buffers.points, buffers.count as u64 * size_of::<GpuPoint>() as u64, "surface points")?;
+        let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
+        Ok(points
+            .iter()
+            .map(|p| SurfaceRecord {
+                position: v3(p.position),
+                geometric_normal: v3(p.geometric_normal),
+                shading_normal: v3(p.shading_normal),
+                uv: Vec2::from(p.uv),
+                material: p.material,
+                previous_position: v3(p.previous_position),
+                triangle: p.triangle.map(v3),
+            })
+            .collect())
+    }
+
+    /// Convenience: closest hits of `rays`.
+    pub fn trace_closest(&self, gpu: &Gpu, geometry: &SceneGeometry, rays: &[RayQuery]) -> Result<Vec<Hit>, BvhError> {
+        let buffers = self.upload(gpu, rays)?;
+        self.dispatch(gpu, geometry, &buffers, TraceKind::Closest)?;
+        self.read_closest(gpu, &buffers)
+    }
+
+    /// Convenience: any-hit flags of `rays`.
+    pub fn trace_any(&self, gpu: &Gpu, geometry: &SceneGeometry, rays: &[RayQuery]) -> Result<Vec<bool>, BvhError> {
+        let buffers = self.upload(gpu, rays)?;
+        self.dispatch(gpu, geometry, &buffers, TraceKind::Any)?;
+        self.read_any(gpu, &buffers)
+    }
+}
+
+/// Copies `size` bytes of `buffer` to a mappable buffer and reads them as `T`s.
+fn read<T: Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, size: u64, what: &str) -> Result<Vec<T>, BvhError> {
+    if size == 0 {
+        return Ok(Vec::new());
+    }
+    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("ray batch readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+    gpu.queue.submit([encoder.finish()]);
+    let (tx, rx) = std::sync::mpsc::channel();
+    staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    let fail = |reason: String| BvhError::Readback { what: what.into(), reason };
+    gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| fail(e.to_string()))?;
+    rx.recv().map_err(|e| fail(e.to_string()))?.map_err(|e| fail(e.to_string()))?;
+    let view = staging.slice(..).get_mapped_range().map_err(|e| fail(e.to_string()))?;
+    let data = bytemuck::cast_slice(&view).to_vec();
+    drop(view);
+    staging.unmap();
+    Ok(data)
+}

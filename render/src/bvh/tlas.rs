@@ -1,0 +1,90 @@
+//! Top-level acceleration structure: a CWBVH over the world-space boxes of the instances.
+//! Instances move every frame, so it is rebuilt (PLOC over N boxes is cheap next to tracing).
+
+use std::time::Duration;
+
+use glam::{Mat4, Vec3, Vec3A};
+use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh};
+
+use super::{Blas, BvhError, blas::cwbvh_depth};
+use crate::scene::Instance;
+
+/// An instance as traversal and shading need it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InstanceTransforms {
+    pub object_to_world: Mat4,
+    pub world_to_object: Mat4,
+    /// Last frame's object-to-world, for motion vectors (equals the current one on frame 0).
+    pub previous_object_to_world: Mat4,
+    pub mesh: u32,
+    pub material: u32,
+}
+
+impl InstanceTransforms {
+    /// Checks the mesh index and that the transform is finite and invertible.
+    pub fn new(index: usize, instance: &Instance, mesh_count: usize) -> Result<Self, BvhError> {
+        if instance.mesh as usize >= mesh_count {
+            return Err(BvhError::InstanceMesh { instance: index, mesh: instance.mesh, meshes: mesh_count });
+        }
+        let m = instance.transform;
+        let det = m.determinant();
+        if !m.is_finite() || !det.is_finite() || det == 0.0 {
+            return Err(BvhError::InstanceTransform { instance: index, transform: format!("{m:?}") });
+        }
+        Ok(Self {
+            object_to_world: m,
+            world_to_object: m.inverse(),
+            previous_object_to_world: m,
+            mesh: instance.mesh,
+            material: instance.material,
+        })
+    }
+}
+
+pub struct Tlas {
+    /// `bvh.primitive_indices[i]` is an index into the instances (not into the boxes built over).
+    pub bvh: CwBvh,
+    /// World bounds of all instances with geometry (empty when there are none).
+    pub bounds: Aabb,
+    pub depth: u32,
+}
+
+impl Tlas {
+    /// Builds over the instances whose mesh has triangles; the others can never be hit.
+    pub fn build(instances: &[InstanceTransforms], blas: &[Blas]) -> Self {
+        let mut ids = Vec::with_capacity(instances.len());
+        let mut boxes = Vec::with_capacity(instances.len());
+        for (i, inst) in instances.iter().enumerate() {
+            let b = &blas[inst.mesh as usize];
+            if b.triangles.is_empty() {
+                continue;
+            }
+            ids.push(i as u32);
+            boxes.push(world_bounds(&inst.object_to_world, &b.bounds));
+        }
+        if boxes.is_empty() {
+            return Self { bvh: CwBvh::default(), bounds: Aabb::empty(), depth: 0 };
+        }
+        let mut bvh = build_cwbvh(&boxes, BvhBuildParams::fast_build(), &mut Duration::default());
+        for p in &mut bvh.primitive_indices {
+            *p = ids[*p as usize];
+        }
+        let bounds = boxes.iter().fold(Aabb::empty(), |acc, b| acc.union(b));
+        let depth = cwbvh_depth(&bvh);
+        Self { bvh, bounds, depth }
+    }
+}
+
+/// The world box of an object-space box: the box around its eight transformed corners.
+pub fn world_bounds(object_to_world: &Mat4, b: &Aabb) -> Aabb {
+    let mut out = Aabb::empty();
+    for corner in 0..8 {
+        let p = Vec3::new(
+            if corner & 1 == 0 { b.min.x } else { b.max.x },
+            if corner & 2 == 0 { b.min.y } else { b.max.y },
+            if corner & 4 == 0 { b.min.z } else { b.max.z },
+        );
+        out.extend(Vec3A::from(object_to_world.transform_point3(p)));
+    }
+    out
+}
