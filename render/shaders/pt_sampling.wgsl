@@ -1,6 +1,7 @@
 // Random numbers and sampling warps for the path tracer.
-// PCG hash (Jarzynski & Olano 2020, "Hash Functions for GPU Rendering") seeds a per-path PCG
-// stream from (seed, frame, pixel, sample), so any sample of any frame is reproducible alone.
+// A per-path PCG stream (PCG hash of Jarzynski & Olano 2020, "Hash Functions for GPU
+// Rendering") seeded from (seed, frame, pixel, sample), so any sample of any frame is
+// reproducible alone.
 
 const PI: f32 = 3.14159265358979;
 const TWO_PI: f32 = 6.28318530717959;
@@ -12,11 +13,23 @@ fn pcg_hash(v: u32) -> u32 {
     return (word >> 22u) ^ word;
 }
 
+// Strong 32-bit avalanche (Wellons' "lowbias32") to combine the seed inputs: chained PCG hashes
+// of small consecutive integers (seeds 3, 4, 5, ...) left visible correlations between seeds.
+fn hash_mix(v: u32) -> u32 {
+    var x = v;
+    x ^= x >> 16u;
+    x *= 0x7feb352du;
+    x ^= x >> 15u;
+    x *= 0x846ca68bu;
+    x ^= x >> 16u;
+    return x;
+}
+
 fn rng_seed(seed: vec2u, frame: u32, pixel: u32, sample: u32) -> u32 {
-    var h = pcg_hash(seed.x ^ pcg_hash(seed.y));
-    h = pcg_hash(h ^ frame);
-    h = pcg_hash(h ^ pixel);
-    return pcg_hash(h ^ sample);
+    var h = hash_mix(seed.x ^ hash_mix(seed.y ^ 0x9e3779b9u));
+    h = hash_mix(h ^ hash_mix(frame + 0x632be5abu));
+    h = hash_mix(h ^ hash_mix(pixel + 0x85ebca6bu));
+    return pcg_hash(h ^ hash_mix(sample + 0xc2b2ae35u));
 }
 
 // Uniform in [0, 1): 24 high bits of the next PCG output.
