@@ -67,7 +67,7 @@ fn default_mode(reference: &Path) -> FlipMode {
 
 /// Loads both images and measures them.
 pub fn compare_files(reference: &Path, test: &Path, mode: Option<FlipMode>, ppd: f32, eps: f32) -> anyhow::Result<Comparison> {
-    if !(ppd > 0.0) {
+    if ppd.is_nan() || ppd <= 0.0 {
         bail!("--ppd must be positive, got {ppd}");
     }
     let r = load_image(reference)?;

@@ -96,13 +96,11 @@ fn sample_bilinear(img: &Image, w: usize, h: usize, x: f32, y: f32) -> Option<[f
     let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
     let (fx, fy) = (x - x0 as f32, y - y0 as f32);
     let p = |xx: usize, yy: usize| img.rgb[yy * w + xx];
-    let mut out = [0.0; 3];
-    for c in 0..3 {
+    Some(std::array::from_fn(|c| {
         let top = p(x0, y0)[c] * (1.0 - fx) + p(x1, y0)[c] * fx;
         let bottom = p(x0, y1)[c] * (1.0 - fx) + p(x1, y1)[c] * fx;
-        out[c] = top * (1.0 - fy) + bottom * fy;
-    }
-    Some(out)
+        top * (1.0 - fy) + bottom * fy
+    }))
 }
 
 #[cfg(test)]

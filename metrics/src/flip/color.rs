@@ -30,16 +30,14 @@ fn mat_mul(m: &[[f32; 3]; 3], v: [f32; 3]) -> [f32; 3] {
 fn invert(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
     let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-    let mut inv = [[0.0; 3]; 3];
-    for r in 0..3 {
-        for c in 0..3 {
-            // Cofactor of (c, r), i.e. the adjugate's (r, c) entry.
+    // inv[r][c] = cofactor(c, r) / det; cyclic indices give the cofactor's sign for free.
+    std::array::from_fn(|r| {
+        std::array::from_fn(|c| {
             let (r1, r2) = ((c + 1) % 3, (c + 2) % 3);
             let (c1, c2) = ((r + 1) % 3, (r + 2) % 3);
-            inv[r][c] = (m[r1][c1] * m[r2][c2] - m[r1][c2] * m[r2][c1]) / det;
-        }
-    }
-    inv
+            (m[r1][c1] * m[r2][c2] - m[r1][c2] * m[r2][c1]) / det
+        })
+    })
 }
 
 impl Default for ColorSpace {
