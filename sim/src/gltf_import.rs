@@ -1,0 +1,218 @@
+//! glTF 2.0 import: meshes, node hierarchy, metallic-roughness materials with base-colour
+//! textures, emission (with KHR_materials_emissive_strength), KHR_lights_punctual and
+//! perspective cameras.
+//!
+//! Light units are taken as they are (lux for directional, candela for point and spot) and
+//! used as the renderer's linear radiometric scale.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Quat, Vec2, Vec3};
+use render::scene::{Light, Material, Mesh, Texture};
+
+use crate::components::MeshInstance;
+use crate::template::{NodeTemplate, WorldTemplate};
+use crate::transform::Transform;
+
+/// A glTF file that could not be imported: which file, which part, what was wrong.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{}: {part}: {message}", file.display())]
+pub struct GltfError {
+    pub file: PathBuf,
+    /// The part that failed, e.g. "mesh 'Foo' primitive 0" or "file".
+    pub part: String,
+    pub message: String,
+}
+
+fn label(kind: &str, name: Option<&str>, index: usize) -> String {
+    match name {
+        Some(n) if !n.is_empty() => format!("{kind} '{n}'"),
+        _ => format!("{kind} {index}"),
+    }
+}
+
+/// Converts a decoded image to RGBA8 (16-bit channels keep their high byte).
+fn to_rgba8(data: &gltf::image::Data) -> Result<Vec<u8>, String> {
+    use gltf::image::Format;
+    let (channels, bytes_per) = match data.format {
+        Format::R8 => (1, 1),
+        Format::R8G8 => (2, 1),
+        Format::R8G8B8 => (3, 1),
+        Format::R8G8B8A8 => (4, 1),
+        Format::R16 => (1, 2),
+        Format::R16G16 => (2, 2),
+        Format::R16G16B16 => (3, 2),
+        Format::R16G16B16A16 => (4, 2),
+        other => return Err(format!("pixel format {other:?} is not supported; expected 8 or 16 bits per channel")),
+    };
+    let texels = (data.width * data.height) as usize;
+    if data.pixels.len() != texels * channels * bytes_per {
+        return Err(format!("{} bytes of pixels for {}x{}", data.pixels.len(), data.width, data.height));
+    }
+    let mut out = Vec::with_capacity(texels * 4);
+    for t in 0..texels {
+        // Little-endian 16-bit: the high byte is the second one.
+        let c = |k: usize| data.pixels[(t * channels + k) * bytes_per + bytes_per - 1];
+        let (r, g, b, a) = match channels {
+            1 => (c(0), c(0), c(0), 255),
+            2 => (c(0), c(0), c(0), c(1)),
+            3 => (c(0), c(1), c(2), 255),
+            _ => (c(0), c(1), c(2), c(3)),
+        };
+        out.extend_from_slice(&[r, g, b, a]);
+    }
+    Ok(out)
+}
+
+fn node_transform(t: gltf::scene::Transform) -> Transform {
+    match t {
+        gltf::scene::Transform::Matrix { matrix } => Transform::from_matrix(Mat4::from_cols_array_2d(&matrix)),
+        gltf::scene::Transform::Decomposed { translation, rotation, scale } => Transform::from_trs(
+            Vec3::from(translation),
+            Quat::from_array(rotation).normalize(),
+            Vec3::from(scale),
+        ),
+    }
+}
+
+fn read_primitive(
+    primitive: &gltf::Primitive,
+    buffers: &[gltf::buffer::Data],
+    name: String,
+) -> Result<Mesh, String> {
+    if primitive.mode() != gltf::mesh::Mode::Triangles {
+        return Err(format!("mode {:?} is not supported; expected triangles", primitive.mode()));
+    }
+    let reader = primitive.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+    let positions: Vec<Vec3> = reader
+        .read_positions()
+        .ok_or("no POSITION attribute; expected vertex positions")?
+        .map(Vec3::from)
+        .collect();
+    let normals: Vec<Vec3> = reader.read_normals().map(|n| n.map(Vec3::from).collect()).unwrap_or_default();
+    if !normals.is_empty() && normals.len() != positions.len() {
+        return Err(format!("{} normals for {} positions", normals.len(), positions.len()));
+    }
+    let uvs: Vec<Vec2> = reader.read_tex_coords(0).map(|t| t.into_f32().map(Vec2::from).collect()).unwrap_or_default();
+    if !uvs.is_empty() && uvs.len() != positions.len() {
+        return Err(format!("{} TEXCOORD_0 for {} positions", uvs.len(), positions.len()));
+    }
+    let flat: Vec<u32> = match reader.read_indices() {
+        Some(i) => i.into_u32().collect(),
+        None => (0..positions.len() as u32).collect(),
+    };
+    if flat.len() % 3 != 0 {
+        return Err(format!("{} indices; expected a multiple of 3", flat.len()));
+    }
+    if let Some(bad) = flat.iter().find(|&&i| i as usize >= positions.len()) {
+        return Err(format!("index {bad} out of range; expected < {}", positions.len()));
+    }
+    let indices = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    Ok(Mesh { name, positions, normals, uvs, indices })
+}
+
+/// Reads `path` (a .gltf with its buffers and images, or a .glb).
+pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
+    let err = |part: &str, message: String| GltfError { file: path.to_path_buf(), part: part.to_string(), message };
+    if !path.is_file() {
+        return Err(err("file", "not found; expected a .gltf or .glb file".into()));
+    }
+    let (doc, buffers, images) = gltf::import(path).map_err(|e| err("file", format!("cannot import: {e}")))?;
+
+    let mut t = WorldTemplate::default();
+    for (i, image) in images.iter().enumerate() {
+        let name = label("image", doc.images().nth(i).and_then(|im| im.name()), i);
+        let rgba8 = to_rgba8(image).map_err(|m| err(&name, m))?;
+        t.textures.push(Texture { name: name.clone(), width: image.width, height: image.height, rgba8 });
+    }
+    for (i, m) in doc.materials().enumerate() {
+        let pbr = m.pbr_metallic_roughness();
+        let c = pbr.base_color_factor();
+        let strength = m.emissive_strength().unwrap_or(1.0);
+        let material = Material {
+            base_color: Vec3::new(c[0], c[1], c[2]),
+            base_color_texture: pbr.base_color_texture().map(|info| info.texture().source().index() as u32),
+            emission: Vec3::from(m.emissive_factor()) * strength,
+            roughness: pbr.roughness_factor(),
+            metallic: pbr.metallic_factor(),
+            ..Material::default()
+        };
+        t.add_material(m.name().unwrap_or(&format!("material{i}")), material);
+    }
+    let mut default_material = None;
+
+    // Each primitive becomes one renderer mesh (it has one material).
+    let mut primitives: Vec<Vec<MeshInstance>> = Vec::new();
+    for mesh in doc.meshes() {
+        let mesh_label = label("mesh", mesh.name(), mesh.index());
+        let mut list = Vec::new();
+        for p in mesh.primitives() {
+            let part = format!("{mesh_label} primitive {}", p.index());
+            let name = format!("{}#{}", mesh.name().unwrap_or("mesh"), p.index());
+            let geometry = read_primitive(&p, &buffers, name).map_err(|m| err(&part, m))?;
+            let material = match p.material().index() {
+                Some(i) => i as u32,
+                None => *default_material.get_or_insert_with(|| t.add_material("default", Material::default())),
+            };
+            list.push(MeshInstance { mesh: t.add_mesh(geometry), material });
+        }
+        primitives.push(list);
+    }
+
+    let scene = doc.default_scene().or_else(|| doc.scenes().next());
+    let roots: Vec<gltf::Node> = match &scene {
+        Some(s) => s.nodes().collect(),
+        None => return Err(err("scenes", "no scene; expected at least one scene with nodes".into())),
+    };
+    let mut stack: Vec<(gltf::Node, Option<usize>)> = roots.into_iter().rev().map(|n| (n, None)).collect();
+    while let Some((node, parent)) = stack.pop() {
+        let name = node.name().map(str::to_string).unwrap_or_else(|| format!("node{}", node.index()));
+        let part = label("node", node.name(), node.index());
+        let mut tn = NodeTemplate::new(name.clone(), node_transform(node.transform()));
+        tn.parent = parent;
+        let mut extra_primitives = Vec::new();
+        if let Some(mesh) = node.mesh() {
+            let list = &primitives[mesh.index()];
+            tn.mesh = list.first().copied();
+            extra_primitives.extend(list.iter().skip(1).copied());
+        }
+        if let Some(light) = node.light() {
+            let color = Vec3::from(light.color()) * light.intensity();
+            tn.light = Some(match light.kind() {
+                gltf::khr_lights_punctual::Kind::Directional => {
+                    Light::Directional { direction: Vec3::NEG_Z, irradiance: color, angular_radius: 0.0 }
+                }
+                gltf::khr_lights_punctual::Kind::Point => Light::Point { position: Vec3::ZERO, intensity: color },
+                gltf::khr_lights_punctual::Kind::Spot { inner_cone_angle, outer_cone_angle } => Light::Spot {
+                    position: Vec3::ZERO,
+                    direction: Vec3::NEG_Z,
+                    intensity: color,
+                    inner_angle: inner_cone_angle,
+                    outer_angle: outer_cone_angle,
+                },
+            });
+        }
+        if let Some(camera) = node.camera() {
+            match camera.projection() {
+                gltf::camera::Projection::Perspective(p) => tn.camera = Some(p.yfov()),
+                gltf::camera::Projection::Orthographic(_) => {
+                    return Err(err(
+                        &format!("{part} {}", label("camera", camera.name(), camera.index())),
+                        "orthographic projection is not supported; expected perspective".into(),
+                    ));
+                }
+            }
+        }
+        let index = t.add_node(tn);
+        for (k, instance) in extra_primitives.into_iter().enumerate() {
+            let mut child = NodeTemplate::new(format!("{name}#{}", k + 1), Transform::IDENTITY);
+            child.parent = Some(index);
+            child.mesh = Some(instance);
+            t.add_node(child);
+        }
+        for child in node.children().collect::<Vec<_>>().into_iter().rev() {
+            stack.push((child, Some(index)));
+        }
+    }
+    Ok(t)
+}

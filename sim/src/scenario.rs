@@ -1,0 +1,437 @@
+//! Scenario files (RON): what to load, what moves, what to render and measure.
+//!
+//! Optional fields may be written bare (`camera: (position: ..)`): the `implicit_some`
+//! extension is on. Errors carry the file, line and column and say what was expected.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use serde::{Deserialize, Deserializer, Serialize};
+
+/// Where the scene comes from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum SceneSource {
+    /// A built-in scene by name (see [`crate::scenes::names`]).
+    Builtin(#[serde(deserialize_with = "builtin_name")] String),
+    /// A glTF file; relative paths are resolved against the scenario file's folder.
+    Gltf(PathBuf),
+}
+
+fn builtin_name<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
+    let name = String::deserialize(d)?;
+    if crate::scenes::names().contains(&name.as_str()) {
+        Ok(name)
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "unknown scene '{name}'; expected one of: {}",
+            crate::scenes::names().join(", ")
+        )))
+    }
+}
+
+/// A rendering method to run on every frame.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum MethodSpec {
+    PathTracing { spp: u32 },
+}
+
+impl MethodSpec {
+    /// A short name usable as a folder name, e.g. `pt_4spp`.
+    pub fn label(&self) -> String {
+        match self {
+            MethodSpec::PathTracing { spp } => format!("pt_{spp}spp"),
+        }
+    }
+}
+
+/// Which frames get a path-traced reference.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ReferenceFrames {
+    None,
+    List(Vec<u32>),
+    /// Frames 0, n, 2n, ...
+    Every(u32),
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceSpec {
+    pub spp: u32,
+    pub frames: ReferenceFrames,
+}
+
+impl Default for ReferenceSpec {
+    fn default() -> Self {
+        Self { spp: 64, frames: ReferenceFrames::None }
+    }
+}
+
+impl ReferenceSpec {
+    /// Whether frame `frame` of a `total`-frame run needs a reference.
+    pub fn wants(&self, frame: u32, total: u32) -> bool {
+        if frame >= total || self.spp == 0 {
+            return false;
+        }
+        match &self.frames {
+            ReferenceFrames::None => false,
+            ReferenceFrames::List(list) => list.contains(&frame),
+            ReferenceFrames::Every(n) => *n > 0 && frame % n == 0,
+        }
+    }
+}
+
+/// A named rectangle of the image (pixels), for metrics over a part of the frame.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Region {
+    pub name: String,
+    pub x: u32,
+    pub y: u32,
+    #[serde(alias = "w")]
+    pub width: u32,
+    #[serde(alias = "h")]
+    pub height: u32,
+}
+
+fn default_up() -> Vec3 {
+    Vec3::Y
+}
+fn default_vfov() -> f32 {
+    45.0
+}
+
+/// A pinhole camera replacing the scene's.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraSpec {
+    pub position: Vec3,
+    pub target: Vec3,
+    #[serde(default = "default_up")]
+    pub up: Vec3,
+    #[serde(default = "default_vfov")]
+    pub vfov_degrees: f32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AxisAngle {
+    pub axis: Vec3,
+    pub degrees: f32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum WaveformSpec {
+    /// I(t) = I0 (sin 2πft + 1)
+    Sine { frequency: f32 },
+    /// On for half of each `period` seconds.
+    Square { period: f32 },
+    /// Each frame on with this probability (seeded).
+    Strobe { probability: f32 },
+}
+
+/// A transform key; missing parts keep the entity's rest pose.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeySpec {
+    pub frame: f32,
+    #[serde(default)]
+    pub translation: Option<Vec3>,
+    #[serde(default)]
+    pub rotation: Option<AxisAngle>,
+    #[serde(default)]
+    pub scale: Option<Vec3>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraKeySpec {
+    pub frame: f32,
+    pub position: Vec3,
+    pub target: Vec3,
+    #[serde(default)]
+    pub vfov_degrees: Option<f32>,
+}
+
+/// An animation attached to named entities.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum AnimationSpec {
+    /// Continuous rotation about an axis through the entity's origin.
+    Rotate { entity: String, axis: Vec3, degrees_per_second: f32 },
+    /// One rotation by `degrees` at frame `frame`.
+    RotateOnce { entity: String, axis: Vec3, degrees: f32, frame: u32 },
+    /// Intensity waveform of a light or emissive mesh.
+    Flash { entity: String, waveform: WaveformSpec },
+    /// `count` copies of the prototype's mesh flocking inside a box (the prototype hides).
+    Boids {
+        prototype: String,
+        count: u32,
+        #[serde(default)]
+        bounds_min: Option<Vec3>,
+        #[serde(default)]
+        bounds_max: Option<Vec3>,
+        #[serde(default)]
+        separation: Option<f32>,
+        #[serde(default)]
+        view_radius: Option<f32>,
+        #[serde(default)]
+        max_speed: Option<f32>,
+        #[serde(default)]
+        min_speed: Option<f32>,
+    },
+    Keyframes {
+        entity: String,
+        keys: Vec<KeySpec>,
+        #[serde(default)]
+        repeat: bool,
+    },
+    /// A path for the active camera.
+    CameraPath {
+        keys: Vec<CameraKeySpec>,
+        #[serde(default)]
+        repeat: bool,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum ActionSpec {
+    RotateLight { light: String, axis: Vec3, degrees: f32 },
+    Rotate { entity: String, axis: Vec3, degrees: f32 },
+    /// Switch a light or an emissive mesh off (or back on).
+    Toggle { entity: String },
+    MoveTo { entity: String, translation: Vec3 },
+    MoveBy { entity: String, offset: Vec3 },
+    SetMaterial {
+        material: String,
+        #[serde(default)]
+        base_color: Option<Vec3>,
+        #[serde(default)]
+        emission: Option<Vec3>,
+        #[serde(default)]
+        roughness: Option<f32>,
+        #[serde(default)]
+        metallic: Option<f32>,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EventSpec {
+    pub frame: u32,
+    pub action: ActionSpec,
+}
+
+fn default_time_step() -> f32 {
+    1.0 / 30.0
+}
+fn default_max_depth() -> u32 {
+    8
+}
+
+/// The file as written.
+#[derive(Deserialize)]
+#[serde(rename = "Scenario", deny_unknown_fields)]
+struct ScenarioFile {
+    #[serde(default)]
+    name: Option<String>,
+    scene: SceneSource,
+    #[serde(default)]
+    camera: Option<CameraSpec>,
+    #[serde(default)]
+    environment: Option<Vec3>,
+    resolution: (u32, u32),
+    frames: u32,
+    #[serde(default)]
+    warmup_frames: u32,
+    #[serde(default = "default_time_step")]
+    time_step: f32,
+    #[serde(default)]
+    seed: u64,
+    #[serde(default)]
+    output: Option<PathBuf>,
+    #[serde(default = "default_max_depth")]
+    max_depth: u32,
+    methods: Vec<MethodSpec>,
+    #[serde(default)]
+    reference: ReferenceSpec,
+    #[serde(default)]
+    regions: Vec<Region>,
+    #[serde(default)]
+    animations: Vec<AnimationSpec>,
+    #[serde(default)]
+    events: Vec<EventSpec>,
+}
+
+/// A scenario ready to play.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Scenario {
+    /// Defaults to the file's stem.
+    pub name: String,
+    /// glTF paths are already resolved against the scenario file's folder.
+    pub scene: SceneSource,
+    pub camera: Option<CameraSpec>,
+    /// Replaces the scene's environment radiance.
+    pub environment: Option<Vec3>,
+    pub resolution: (u32, u32),
+    pub frames: u32,
+    pub warmup_frames: u32,
+    /// Seconds per frame.
+    pub time_step: f32,
+    pub seed: u64,
+    /// Defaults to `runs/<name>` (relative to the working directory).
+    pub output: PathBuf,
+    pub max_depth: u32,
+    pub methods: Vec<MethodSpec>,
+    pub reference: ReferenceSpec,
+    pub regions: Vec<Region>,
+    pub animations: Vec<AnimationSpec>,
+    pub events: Vec<EventSpec>,
+    /// The RON file this came from (used in error messages).
+    pub origin: PathBuf,
+    /// The RON text, to point errors found later (unknown entity names) at a line.
+    #[serde(skip)]
+    pub source: String,
+}
+
+/// A scenario file that could not be used: "path:line:col: what was expected".
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub struct ScenarioError {
+    pub file: PathBuf,
+    /// 1-based line and column, when the problem has a place in the text.
+    pub position: Option<(usize, usize)>,
+    pub message: String,
+}
+
+impl fmt::Display for ScenarioError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.position {
+            Some((line, col)) => write!(f, "{}:{line}:{col}: {}", self.file.display(), self.message),
+            None => write!(f, "{}: {}", self.file.display(), self.message),
+        }
+    }
+}
+
+/// Line and column (1-based) of the first quoted occurrence of `needle` in `text`.
+pub fn find_quoted(text: &str, needle: &str) -> Option<(usize, usize)> {
+    let at = text.find(&format!("\"{needle}\""))?;
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+    Some((line, col))
+}
+
+fn axis_label(v: Vec3) -> String {
+    format!("({}, {}, {})", v.x, v.y, v.z)
+}
+
+impl Scenario {
+    /// Reads and checks a scenario file.
+    pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
+            file: path.to_path_buf(),
+            position: None,
+            message: format!("cannot read scenario file: {e}"),
+        })?;
+        Self::from_ron(&text, path)
+    }
+
+    /// Parses scenario text; `origin` is the file it came from (names it in errors and
+    /// anchors relative glTF paths).
+    pub fn from_ron(text: &str, origin: &Path) -> Result<Scenario, ScenarioError> {
+        let options = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+        let file: ScenarioFile = options.from_str(text).map_err(|e| ScenarioError {
+            file: origin.to_path_buf(),
+            position: Some((e.span.start.line, e.span.start.col)),
+            message: e.code.to_string(),
+        })?;
+        let invalid = |what: &str, message: String| ScenarioError {
+            file: origin.to_path_buf(),
+            position: text.find(&format!("{what}:")).map(|at| {
+                let before = &text[..at];
+                (before.matches('\n').count() + 1, before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1)
+            }),
+            message,
+        };
+        let (w, h) = file.resolution;
+        if w == 0 || h == 0 {
+            return Err(invalid("resolution", format!("resolution {w}x{h}; expected both sides > 0")));
+        }
+        if file.frames == 0 {
+            return Err(invalid("frames", "frames: 0; expected at least 1 frame".into()));
+        }
+        if !(file.time_step > 0.0 && file.time_step.is_finite()) {
+            return Err(invalid("time_step", format!("time_step {}; expected a positive number of seconds", file.time_step)));
+        }
+        if file.methods.is_empty() {
+            return Err(invalid("methods", "no methods; expected e.g. [PathTracing(spp: 4)]".into()));
+        }
+        for r in &file.regions {
+            if r.width == 0 || r.height == 0 || r.x + r.width > w || r.y + r.height > h {
+                return Err(ScenarioError {
+                    file: origin.to_path_buf(),
+                    position: find_quoted(text, &r.name),
+                    message: format!(
+                        "region '{}' ({}, {}, {}x{}) is empty or leaves the {w}x{h} image; expected a rectangle inside it",
+                        r.name, r.x, r.y, r.width, r.height
+                    ),
+                });
+            }
+        }
+        let name = file.name.unwrap_or_else(|| {
+            origin.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scenario".into())
+        });
+        let scene = match file.scene {
+            SceneSource::Gltf(p) if p.is_relative() => {
+                SceneSource::Gltf(origin.parent().unwrap_or(Path::new("")).join(p))
+            }
+            other => other,
+        };
+        let output = file.output.unwrap_or_else(|| PathBuf::from("runs").join(&name));
+        Ok(Scenario {
+            name,
+            scene,
+            camera: file.camera,
+            environment: file.environment,
+            resolution: file.resolution,
+            frames: file.frames,
+            warmup_frames: file.warmup_frames,
+            time_step: file.time_step,
+            seed: file.seed,
+            output,
+            max_depth: file.max_depth,
+            methods: file.methods,
+            reference: file.reference,
+            regions: file.regions,
+            animations: file.animations,
+            events: file.events,
+            origin: origin.to_path_buf(),
+            source: text.to_string(),
+        })
+    }
+
+    /// Discrete changes by frame, for charts: scripted events and one-shot rotations.
+    pub fn events_summary(&self) -> Vec<(u32, String)> {
+        let mut out: Vec<(u32, String)> = Vec::new();
+        for a in &self.animations {
+            if let AnimationSpec::RotateOnce { entity, degrees, frame, .. } = a {
+                out.push((*frame, format!("rotate '{entity}' by {degrees}°")));
+            }
+        }
+        for e in &self.events {
+            let text = match &e.action {
+                ActionSpec::RotateLight { light, degrees, .. } => format!("rotate light '{light}' by {degrees}°"),
+                ActionSpec::Rotate { entity, degrees, .. } => format!("rotate '{entity}' by {degrees}°"),
+                ActionSpec::Toggle { entity } => format!("toggle '{entity}'"),
+                ActionSpec::MoveTo { entity, translation } => format!("move '{entity}' to {}", axis_label(*translation)),
+                ActionSpec::MoveBy { entity, offset } => format!("move '{entity}' by {}", axis_label(*offset)),
+                ActionSpec::SetMaterial { material, .. } => format!("change material '{material}'"),
+            };
+            out.push((e.frame, text));
+        }
+        out.sort_by_key(|(f, _)| *f);
+        out
+    }
+}
