@@ -105,3 +105,25 @@ impl FrameParams {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn projection_inverts_ray_generation_and_matches_view_projection() {
+        let camera = Camera { position: Vec3::new(1.0, 2.0, 3.0), target: Vec3::new(-0.5, 0.3, 0.0), up: Vec3::Y, vfov: 0.9 };
+        let (w, h) = (64, 36);
+        let b = CameraBasis::new(&camera, w, h);
+        let clip = camera.projection(w as f32 / h as f32) * camera.view();
+        for pixel in [Vec2::new(0.5, 0.5), Vec2::new(63.5, 35.5), Vec2::new(20.25, 7.75)] {
+            let p = camera.position + b.ray_direction(pixel, w, h) * 4.2;
+            assert!(b.project(p, w, h).unwrap().abs_diff_eq(pixel, 1e-3));
+            // The same pixel through Camera::view/projection (NDC y up, image y down).
+            let ndc = clip.project_point3(p);
+            let from_matrices = Vec2::new((ndc.x + 1.0) * 0.5 * w as f32, (1.0 - ndc.y) * 0.5 * h as f32);
+            assert!(from_matrices.abs_diff_eq(pixel, 1e-3), "{from_matrices} vs {pixel}");
+        }
+        assert!(b.project(camera.position - b.forward, w, h).is_none());
+    }
+}

@@ -115,3 +115,66 @@ pub(crate) fn build_light_table(scene: &SceneDesc) -> Result<LightTable, RenderE
     }
     Ok(LightTable { lights, analytic, emitters: emitters as u32, emitter_weight: total as f32 })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Instance, Material, Mesh};
+    use glam::Mat4;
+
+    fn triangle_mesh() -> Mesh {
+        Mesh { name: "tri".into(), positions: vec![Vec3::ZERO, Vec3::X, Vec3::Z], indices: vec![[0, 1, 2]], ..Default::default() }
+    }
+
+    #[test]
+    fn emissive_triangles_are_chosen_by_power() {
+        // Two emitters: the second twice as bright and (scaled by 3 in x) three times as large.
+        let scene = SceneDesc {
+            meshes: vec![triangle_mesh()],
+            materials: vec![
+                Material { emission: Vec3::ONE, ..Default::default() },
+                Material { emission: Vec3::splat(2.0), ..Default::default() },
+                Material::default(),
+            ],
+            instances: vec![
+                Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY },
+                Instance { mesh: 0, material: 1, transform: Mat4::from_scale(Vec3::new(3.0, 1.0, 1.0)) },
+                Instance { mesh: 0, material: 2, transform: Mat4::IDENTITY },
+            ],
+            lights: vec![Light::Point { position: Vec3::Y, intensity: Vec3::ONE }],
+            ..Default::default()
+        };
+        let t = build_light_table(&scene).unwrap();
+        assert_eq!((t.analytic, t.emitters), (1, 2));
+        // W = 1 * 0.5 + 2 * 1.5
+        assert!((t.emitter_weight - 3.5).abs() < 1e-6, "{}", t.emitter_weight);
+        assert!((t.lights[1].cdf - 0.5 / 3.5).abs() < 1e-6);
+        assert_eq!(t.lights[2].cdf, 1.0);
+        // World-space vertices of the scaled instance.
+        assert_eq!(t.lights[2].p1, [3.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn sun_cone_constants_keep_precision() {
+        let r = 0.00465f32;
+        let scene = SceneDesc { lights: vec![Light::Directional { direction: Vec3::NEG_Y, irradiance: Vec3::ONE, angular_radius: r }], ..Default::default() };
+        let l = build_light_table(&scene).unwrap().lights[0];
+        let one_minus_cos = 1.0 - (r as f64).cos();
+        assert!((l.a as f64 / one_minus_cos - 1.0).abs() < 1e-5);
+        // Disk radiance x solid angle = irradiance (for the sun's tiny cone, to first order).
+        let omega = 2.0 * std::f64::consts::PI * one_minus_cos;
+        assert!((l.b as f64 * omega - 1.0).abs() < 1e-4, "{}", l.b as f64 * omega);
+    }
+
+    #[test]
+    fn dangling_indices_are_reported() {
+        let scene = SceneDesc {
+            meshes: vec![triangle_mesh()],
+            materials: vec![Material { emission: Vec3::ONE, ..Default::default() }],
+            instances: vec![Instance { mesh: 4, material: 0, transform: Mat4::IDENTITY }],
+            ..Default::default()
+        };
+        let e = build_light_table(&scene).err().unwrap().to_string();
+        assert!(e.contains("instance 0 uses mesh 4"), "{e}");
+    }
+}
