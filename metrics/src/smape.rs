@@ -17,6 +17,9 @@ pub struct SmapeResult {
     pub map: Vec<f32>,
     /// Pixels excluded because they have no valid history (always 0 for plain [`smape`]).
     pub disoccluded_count: u64,
+    /// Per-pixel exclusion mask of [`smape_reprojected`] (empty for plain [`smape`]); use it with
+    /// [`crate::Region::mean_of_valid`] for region means.
+    pub disoccluded: Vec<bool>,
 }
 
 #[inline]
@@ -50,7 +53,7 @@ pub fn smape(cur: &Image, prev: &Image, eps: f32) -> SmapeResult {
         })
         .sum();
     let n = cur.len().max(1) as f64;
-    SmapeResult { mean: sum / n, map, disoccluded_count: 0 }
+    SmapeResult { mean: sum / n, map, disoccluded_count: 0, disoccluded: Vec::new() }
 }
 
 /// SMAPE between the current frame and the previous frame reprojected by motion vectors.
@@ -65,16 +68,19 @@ pub fn smape_reprojected(cur: &Image, prev: &Image, motion: &[[f32; 2]], eps: f3
     assert_eq!(motion.len(), cur.len(), "smape_reprojected: one motion vector per pixel expected");
     let (w, h) = (cur.width as usize, cur.height as usize);
     let mut map = vec![0.0f32; cur.len()];
+    let mut disoccluded = vec![true; cur.len()];
     let (sum, valid): (f64, u64) = map
         .par_chunks_mut(w)
+        .zip(disoccluded.par_chunks_mut(w))
         .enumerate()
-        .map(|(y, out)| {
+        .map(|(y, (out, mask))| {
             let mut acc = (0.0f64, 0u64);
-            for (x, o) in out.iter_mut().enumerate() {
+            for (x, (o, m)) in out.iter_mut().zip(mask.iter_mut()).enumerate() {
                 let i = y * w + x;
                 let [mx, my] = motion[i];
                 if let Some(hist) = sample_bilinear(prev, w, h, x as f32 + mx, y as f32 + my) {
                     *o = smape_pixel(cur.rgb[i], hist, eps);
+                    *m = false;
                     acc.0 += *o as f64;
                     acc.1 += 1;
                 }
@@ -83,7 +89,7 @@ pub fn smape_reprojected(cur: &Image, prev: &Image, motion: &[[f32; 2]], eps: f3
         })
         .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
     let mean = if valid > 0 { sum / valid as f64 } else { 0.0 };
-    SmapeResult { mean, map, disoccluded_count: cur.len() as u64 - valid }
+    SmapeResult { mean, map, disoccluded_count: cur.len() as u64 - valid, disoccluded }
 }
 
 /// Bilinear sample at pixel coordinates (pixel centres at integers); `None` outside the image.
@@ -153,6 +159,8 @@ mod tests {
         let rep = smape_reprojected(&cur, &prev, &motion, 0.01);
         // Columns 0..3 read outside the previous frame.
         assert_eq!(rep.disoccluded_count, 3 * 10);
+        assert_eq!(rep.disoccluded.iter().filter(|&&d| d).count(), 30);
+        assert!(rep.disoccluded[0] && rep.disoccluded[2] && !rep.disoccluded[3]);
         assert!(rep.mean < 1e-6, "reprojected SMAPE {}", rep.mean);
         // A renderer-flagged pixel is excluded too.
         let mut flagged = motion.clone();
