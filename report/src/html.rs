@@ -33,7 +33,7 @@ const TABLE_COLUMNS: [(&str, &str); 7] = [
 
 const STYLE: &str = "body{font-family:sans-serif;margin:24px;max-width:1500px;color:#222}\
 table{border-collapse:collapse;margin:8px 0 20px}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}\
-th{background:#f3f3f3}td.m{text-align:left}.charts img{margin:4px;border:1px solid #ddd}\
+th{background:#f3f3f3}td.m{text-align:left}.charts{display:flex;flex-wrap:wrap}.charts img{margin:4px;border:1px solid #ddd;max-width:100%;height:auto}\
 figure{display:inline-block;margin:6px;vertical-align:top}figcaption{font-size:12px;text-align:center}\
 img.px{image-rendering:pixelated}pre{background:#f7f7f7;padding:10px;overflow:auto;font-size:12px}";
 

@@ -68,3 +68,23 @@ fn report_is_self_contained_with_charts_maps_and_crops() {
     assert!(svg.contains("rotate light") && svg.contains("pt_1spp") && svg.contains("cache_ema"));
     std::fs::remove_dir_all(&run).ok();
 }
+
+#[test]
+fn minimal_run_without_reference_events_or_regions() {
+    let run = std::env::temp_dir().join(format!("report-minimal-{}", std::process::id()));
+    std::fs::create_dir_all(&run).unwrap();
+    std::fs::write(run.join("manifest.json"), r#"{"scenario": "tiny", "methods": ["a"]}"#).unwrap();
+    std::fs::write(run.join("frames.csv"), "method,frame,cpu_ms,smape\na,0,1.0,\na,1,1.2,0.5\na,2,1.1,0.25\n").unwrap();
+    let html = std::fs::read_to_string(report::rebuild(&run).unwrap()).unwrap();
+    let s = read_json(&run.join("summary.json"));
+    let names: Vec<&str> = s["windows"].as_array().unwrap().iter().map(|w| w["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["overall"]);
+    assert_eq!(s["methods"][0]["means"]["overall"]["smape"].as_f64(), Some(0.375));
+    assert!(run.join("charts/frames_smape.svg").exists() && run.join("charts/speed_vs_smape.png").exists());
+    assert_eq!(html.matches("<img ").count(), 3, "smape, cpu_ms, speed vs smape");
+    // A malformed manifest is reported with its path.
+    std::fs::write(run.join("manifest.json"), "{").unwrap();
+    let err = format!("{:#}", report::rebuild(&run).unwrap_err());
+    assert!(err.contains("manifest.json"), "{err}");
+    std::fs::remove_dir_all(&run).ok();
+}
