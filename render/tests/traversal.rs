@@ -177,14 +177,31 @@ fn instanced_scene(seed: u64) -> SceneDesc {
 
 // ---------------------------------------------------------------- comparison
 
-fn rays_for(bvh: &SceneBvh, seed: u64) -> Vec<RayQuery> {
+fn rays_for(scene: &SceneDesc, bvh: &SceneBvh, seed: u64) -> Vec<RayQuery> {
     let bounds = bvh.bounds();
     let mut rays = random_rays(bounds, RAYS, 1e30, seed);
-    // A third of the rays get a finite t_max (shadow-ray style), within the scene's size.
     let mut rng = SplitMix64::new(seed ^ 0x5eed);
     let diagonal = (bounds.1 - bounds.0).length();
-    for r in rays.iter_mut().step_by(3) {
-        r.t_max = rng.range(0.0, diagonal);
+    for (i, r) in rays.iter_mut().enumerate() {
+        // Half the rays aim at a random point of a random triangle (so that many hit), with an
+        // unnormalised direction of random length (t is in units of the direction).
+        if i % 2 == 0 {
+            let instance = &bvh.instances[(rng.next_u64() % bvh.instances.len() as u64) as usize];
+            let mesh = &scene.meshes[instance.mesh as usize];
+            if !mesh.indices.is_empty() {
+                let tri = mesh.indices[(rng.next_u64() % mesh.indices.len() as u64) as usize].map(|k| mesh.positions[k as usize]);
+                let (mut u, mut v) = (rng.next_f32(), rng.next_f32());
+                if u + v > 1.0 {
+                    (u, v) = (1.0 - u, 1.0 - v);
+                }
+                let target = instance.object_to_world.transform_point3(tri[0] + u * (tri[1] - tri[0]) + v * (tri[2] - tri[0]));
+                r.direction = (target - r.origin) * rng.range(0.2, 3.0);
+            }
+        }
+        // A third of the rays get a finite t_max (shadow-ray style), within the scene's size.
+        if i % 3 == 1 {
+            r.t_max = rng.range(0.0, diagonal) / r.direction.length();
+        }
     }
     rays
 }
@@ -201,6 +218,16 @@ fn triangle_t(scene: &SceneDesc, bvh: &SceneBvh, ray: &RayQuery, instance: u32, 
     let d = inst.world_to_object.transform_vector3(ray.direction);
     let [a, b, c] = mesh.indices[primitive as usize].map(|i| mesh.positions[i as usize]);
     intersect_triangle(&WatertightRay::new(o, d), a, b, c, ray.t_max).map(|(t, _)| t)
+}
+
+/// |cos| of the angle between the ray and the triangle's plane normal, in object space (where
+/// the intersection is computed): near 0 the hit distance is ill-conditioned.
+fn grazing_cosine(scene: &SceneDesc, bvh: &SceneBvh, ray: &RayQuery, instance: u32, primitive: u32) -> f32 {
+    let inst = &bvh.instances[instance as usize];
+    let mesh = &scene.meshes[inst.mesh as usize];
+    let d = inst.world_to_object.transform_vector3(ray.direction);
+    let [a, b, c] = mesh.indices[primitive as usize].map(|i| mesh.positions[i as usize]);
+    (b - a).cross(c - a).normalize().dot(d.normalize()).abs()
 }
 
 /// Closest hit by testing every triangle of every instance (no BVH).
@@ -230,6 +257,8 @@ struct Agreement {
     ties: usize,
     /// obvhs culls node boxes that end before t = 1e-4; the WGSL does not.
     near_origin: usize,
+    /// Same triangle hit at a grazing angle (|cos| < 1e-3), where t is ill-conditioned.
+    grazing: usize,
     failures: Vec<String>,
 }
 
@@ -252,8 +281,17 @@ fn compare(label: &str, scene: &SceneDesc, bvh: &SceneBvh, rays: &[RayQuery], gp
         }
         if gpu.instance == cpu.instance && gpu.primitive == cpu.primitive {
             if cpu.is_hit() {
-                if relative_difference(gpu.t, cpu.t) > 1e-4 || (gpu.barycentrics - cpu.barycentrics).abs().max_element() > 1e-3 {
-                    a.failures.push(format!("{label} ray {i}: same triangle, GPU {gpu:?} vs CPU {cpu:?}"));
+                // Rounding differences (fused multiply-adds) in the object-space ray are
+                // amplified by 1/|cos| in t and in the barycentrics.
+                let cos = grazing_cosine(scene, bvh, ray, cpu.instance, cpu.primitive);
+                let t_ok = relative_difference(gpu.t, cpu.t) <= 1e-4;
+                let uv_ok = (gpu.barycentrics - cpu.barycentrics).abs().max_element() <= (1e-5 / cos).max(1e-3);
+                if cos < 1e-3 && !(t_ok && uv_ok) {
+                    a.grazing += 1;
+                    continue;
+                }
+                if !(t_ok && uv_ok) {
+                    a.failures.push(format!("{label} ray {i} {ray:?}: same triangle, GPU {gpu:?} vs CPU {cpu:?}, |cos| {cos}"));
                     continue;
                 }
             }
@@ -276,7 +314,7 @@ fn compare(label: &str, scene: &SceneDesc, bvh: &SceneBvh, rays: &[RayQuery], gp
 fn check(label: &str, a: &Agreement) {
     println!("{label}: {a:?}");
     assert!(a.failures.is_empty(), "{label}: {} of {} rays disagree:\n{}", a.failures.len(), a.rays, a.failures.iter().take(10).cloned().collect::<Vec<_>>().join("\n"));
-    assert!(a.ties + a.near_origin <= a.rays / 100, "{label}: too many ties/near-origin hits: {a:?}");
+    assert!(a.ties + a.near_origin + a.grazing <= a.rays / 100, "{label}: too many ties/near-origin/grazing hits: {a:?}");
     // The rays must exercise both outcomes for the comparison to mean anything.
     assert!(a.hits > a.rays / 5 && a.hits < a.rays * 19 / 20, "{label}: {} hits of {} rays", a.hits, a.rays);
 }
@@ -314,7 +352,7 @@ fn gltf_mesh_gpu_traversal_matches_obvhs() {
     assert_eq!(scene.meshes[0].indices.len(), 48 * 24 * 2);
     let gpu = gpu();
     let geometry = SceneGeometry::new(&gpu, &scene).unwrap();
-    let rays = rays_for(geometry.cpu(), 1);
+    let rays = rays_for(&scene, geometry.cpu(), 1);
     cpu_matches_brute_force("glTF torus", &scene, geometry.cpu(), &rays);
     gpu_matches_cpu("glTF torus", &gpu, &scene, &geometry, &rays);
 }
@@ -325,7 +363,7 @@ fn hairball_gpu_traversal_matches_obvhs() {
     let scene = SceneDesc { meshes: vec![mesh], instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }], ..Default::default() };
     let gpu = gpu();
     let geometry = SceneGeometry::new(&gpu, &scene).unwrap();
-    let rays = rays_for(geometry.cpu(), 2);
+    let rays = rays_for(&scene, geometry.cpu(), 2);
     cpu_matches_brute_force("hairball", &scene, geometry.cpu(), &rays[..RAYS / 3]);
     gpu_matches_cpu("hairball", &gpu, &scene, &geometry, &rays);
 }
@@ -335,7 +373,7 @@ fn transformed_instances_gpu_traversal_and_surface_points_match_cpu() {
     let scene = instanced_scene(3);
     let gpu = gpu();
     let mut geometry = SceneGeometry::new(&gpu, &scene).unwrap();
-    let rays = rays_for(geometry.cpu(), 3);
+    let rays = rays_for(&scene, geometry.cpu(), 3);
     cpu_matches_brute_force("instances", &scene, geometry.cpu(), &rays);
     gpu_matches_cpu("instances", &gpu, &scene, &geometry, &rays);
 
@@ -347,7 +385,7 @@ fn transformed_instances_gpu_traversal_and_surface_points_match_cpu() {
         inst.transform = random_transform(&mut rng, i == 4);
     }
     assert_eq!(geometry.try_update_instances(&gpu, &moved.instances).unwrap(), InstanceUpdate::Rebuilt);
-    let rays = rays_for(geometry.cpu(), 4);
+    let rays = rays_for(&moved, geometry.cpu(), 4);
     let hits = gpu_matches_cpu("moved instances", &gpu, &moved, &geometry, &rays);
     check_surface_points(&gpu, &geometry, &moved, &old, &rays, &hits);
 
@@ -363,7 +401,7 @@ fn transformed_instances_gpu_traversal_and_surface_points_match_cpu() {
         more.instances.push(Instance { mesh: i % 3, material: i, transform: random_transform(&mut rng, i % 5 == 0) });
     }
     assert_eq!(geometry.try_update_instances(&gpu, &more.instances).unwrap(), InstanceUpdate::Rebuilt);
-    let rays = rays_for(geometry.cpu(), 5);
+    let rays = rays_for(&more, geometry.cpu(), 5);
     gpu_matches_cpu("grown instances", &gpu, &more, &geometry, &rays);
 }
 
