@@ -173,16 +173,8 @@ impl PathTracer {
             bind_group_layouts: &[Some(&layout), Some(geometry.bind_group_layout())],
             immediate_size: 0,
         });
-        let source = [
-            SceneGeometry::WGSL,
-            include_str!("../shaders/pt_sampling.wgsl"),
-            include_str!("../shaders/pt_bsdf.wgsl"),
-            include_str!("../shaders/pt_lights.wgsl"),
-            include_str!("../shaders/path_tracer.wgsl"),
-        ]
-        .join("\n");
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("path_tracer.wgsl"), source: wgpu::ShaderSource::Wgsl(source.into()) });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("path_tracer.wgsl"), source: wgpu::ShaderSource::Wgsl(Self::shader_source().into()) });
         let pipeline = |entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
@@ -221,6 +213,22 @@ impl PathTracer {
             previous_camera: None,
             environment: scene.environment,
             paths_per_dispatch: PATHS_PER_DISPATCH,
+        })
+    }
+
+    /// The complete WGSL of the pass (geometry interface + path tracer): part of the key of
+    /// anything cached from its images.
+    pub fn shader_source() -> &'static str {
+        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+        SOURCE.get_or_init(|| {
+            [
+                SceneGeometry::WGSL,
+                include_str!("../shaders/pt_sampling.wgsl"),
+                include_str!("../shaders/pt_bsdf.wgsl"),
+                include_str!("../shaders/pt_lights.wgsl"),
+                include_str!("../shaders/path_tracer.wgsl"),
+            ]
+            .join("\n")
         })
     }
 
