@@ -91,6 +91,9 @@ impl SceneGeometry {
     /// before a pass's own code and bind [`Self::bind_group`] at group 1.
     pub const WGSL: &'static str = include_str!("../../shaders/scene_geometry.wgsl");
 
+    /// Storage buffers in the bind group: a pass adds its own to check the per-stage limit.
+    pub const STORAGE_BUFFERS: u32 = STORAGE_BUFFERS;
+
     /// Builds every BLAS and the TLAS and uploads them.
     pub fn new(gpu: &Gpu, scene: &SceneDesc) -> Result<Self, BvhError> {
         let limit = gpu.limits.max_storage_buffers_per_shader_stage;
