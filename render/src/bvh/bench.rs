@@ -152,11 +152,12 @@ pub fn displaced_sphere(min_triangles: u32, seed: u64) -> Mesh {
     for i in 0..stacks {
         for j in 0..slices {
             let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-            // Counter-clockwise seen from outside.
-            if i != 0 {
+            // Counter-clockwise seen from outside; in the polar rows one triangle of the cell
+            // would be degenerate (a = d at the north pole, b = c at the south pole).
+            if i != stacks - 1 {
                 indices.push([a, c, b]);
             }
-            if i != stacks - 1 {
+            if i != 0 {
                 indices.push([a, d, c]);
             }
         }
