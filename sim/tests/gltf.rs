@@ -1,0 +1,126 @@
+//! glTF import: the shipped test asset, and errors that name the file and the part.
+
+mod support;
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use render::scene::Light;
+use sim::gltf_import::import;
+
+fn asset_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/assets/test_scene.gltf")
+}
+
+fn temp_dir(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("flicker-sim-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The committed asset is exactly what the generator writes (FLICKER_REGENERATE=1 rewrites it).
+#[test]
+fn test_asset_is_generated_by_the_support_code() {
+    let text = support::test_asset::gltf_text();
+    if std::env::var_os("FLICKER_REGENERATE").is_some() {
+        std::fs::write(asset_path(), &text).unwrap();
+    }
+    let committed = std::fs::read_to_string(asset_path()).expect("scenarios/assets/test_scene.gltf exists");
+    assert!(committed == text, "test_scene.gltf is stale; run with FLICKER_REGENERATE=1");
+}
+
+#[test]
+fn test_asset_imports_with_expected_counts() {
+    use support::test_asset::*;
+    let t = import(&asset_path()).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(t.meshes.len(), MESHES);
+    assert_eq!(t.materials.materials.len(), MATERIALS);
+    assert_eq!(t.nodes.len(), NODES);
+    assert_eq!(t.textures.len(), 1);
+    let tex = &t.textures[0];
+    assert_eq!((tex.width, tex.height, tex.rgba8.len()), (4, 4, 64));
+    assert_eq!(&tex.rgba8[0..8], &[220, 30, 30, 255, 255, 255, 255, 255], "checker texels");
+
+    let cube = t.meshes.iter().find(|m| m.name.starts_with("Cube")).unwrap();
+    assert_eq!(cube.indices.len(), CUBE_TRIANGLES);
+    assert_eq!((cube.positions.len(), cube.normals.len(), cube.uvs.len()), (24, 24, 24));
+
+    let checker = t.materials.index_of("Checker").unwrap() as usize;
+    assert_eq!(t.materials.materials[checker].base_color_texture, Some(0));
+    assert!((t.materials.materials[checker].roughness - 0.7).abs() < 1e-6);
+    let glow = &t.materials.materials[t.materials.index_of("Glow").unwrap() as usize];
+    assert!((glow.emission - Vec3::new(5.0, 4.0, 3.0)).length() < 1e-5, "emissive x strength: {}", glow.emission);
+
+    // Hierarchy: Cube and Floor are children of Root.
+    let root = t.nodes.iter().position(|n| n.name == "Root").unwrap();
+    for child in ["Cube", "Floor"] {
+        assert_eq!(t.nodes.iter().find(|n| n.name == child).unwrap().parent, Some(root), "{child}'s parent");
+    }
+    // The matrix node decomposes to scale 4 x 1 x 4 and y = -0.5.
+    let floor = t.nodes.iter().find(|n| n.name == "Floor").unwrap();
+    assert!((floor.transform.scale - Vec3::new(4.0, 1.0, 4.0)).length() < 1e-5);
+    assert!((floor.transform.translation - Vec3::new(0.0, -0.5, 0.0)).length() < 1e-6);
+
+    let lights: Vec<&Light> = t.nodes.iter().filter_map(|n| n.light.as_ref()).collect();
+    assert_eq!(lights.len(), LIGHTS);
+    assert!(lights.iter().any(|l| matches!(l, Light::Directional { .. })));
+    assert!(lights.iter().any(|l| matches!(l, Light::Point { intensity, .. } if (*intensity - Vec3::splat(20.0)).length() < 1e-5)));
+    assert!(lights.iter().any(|l| matches!(l, Light::Spot { inner_angle, outer_angle, .. } if *inner_angle == 0.2 && *outer_angle == 0.5)));
+    let cameras: Vec<f32> = t.nodes.iter().filter_map(|n| n.camera).collect();
+    assert_eq!(cameras, vec![0.8]);
+}
+
+#[test]
+fn imported_lights_point_along_their_node() {
+    // SunNode turns -Z to -Y: the sun shines straight down once placed in the world.
+    let scenario = sim::Scenario::from_ron(
+        "Scenario(scene: Gltf(\"assets/test_scene.gltf\"), resolution: (8, 8), frames: 1, methods: [PathTracing(spp: 1)])",
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/inline.ron"),
+    )
+    .unwrap();
+    let mut s = sim::Simulation::new(&scenario).unwrap_or_else(|e| panic!("{e}"));
+    let scene = s.scene();
+    let sun = scene.lights.iter().find_map(|l| match l {
+        Light::Directional { direction, .. } => Some(*direction),
+        _ => None,
+    });
+    assert!((sun.unwrap() - Vec3::NEG_Y).length() < 1e-5, "{sun:?}");
+    let bulb = scene.lights.iter().find_map(|l| match l {
+        Light::Point { position, .. } => Some(*position),
+        _ => None,
+    });
+    assert!((bulb.unwrap() - Vec3::new(1.0, 2.0, 1.0)).length() < 1e-5);
+    assert!((scene.camera.position - Vec3::new(0.0, 1.0, 4.0)).length() < 1e-5);
+    assert!((scene.camera.vfov - 0.8).abs() < 1e-6);
+    // Cube sits under Root (y = 0.5).
+    assert_eq!(scene.instances.len(), 3);
+    assert!(scene.instances.iter().any(|i| (i.transform.w_axis.truncate() - Vec3::new(0.0, 0.5, 0.0)).length() < 1e-6));
+}
+
+#[test]
+fn missing_file_is_named() {
+    let path = Path::new("/nonexistent/dir/nothing.gltf");
+    let e = import(path).unwrap_err().to_string();
+    assert!(e.contains("/nonexistent/dir/nothing.gltf") && e.contains("not found"), "{e}");
+}
+
+#[test]
+fn broken_json_is_named() {
+    let dir = temp_dir("broken");
+    let path = dir.join("broken.gltf");
+    std::fs::write(&path, "{ \"asset\": { \"version\": \"2.0\" }, \"nodes\": [ {").unwrap();
+    let e = import(&path).unwrap_err().to_string();
+    assert!(e.starts_with(&path.display().to_string()), "{e}");
+    assert!(e.contains("file: cannot import"), "{e}");
+}
+
+#[test]
+fn unsupported_primitive_mode_names_mesh_and_primitive() {
+    let dir = temp_dir("lines");
+    let path = dir.join("lines.gltf");
+    let text = support::test_asset::gltf_text().replacen("\"mode\": 4", "\"mode\": 1", 1);
+    std::fs::write(&path, text).unwrap();
+    let e = import(&path).unwrap_err().to_string();
+    let expected = format!("{}: mesh 'Cube' primitive 0: mode Lines is not supported; expected triangles", path.display());
+    assert_eq!(e, expected);
+}
