@@ -52,3 +52,9 @@ pub struct Camera {
 /// Removed from rendering (e.g. the prototype of a flock) but kept for its name and mesh.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Hidden;
+
+/// Position in spawn order: extraction lists instances and lights in this order, so
+/// instance ids follow the scene file (entity ids themselves are allocated in no useful
+/// order).
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct SpawnOrder(pub u32);

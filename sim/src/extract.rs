@@ -1,14 +1,14 @@
 //! World -> `SceneDesc`: the dynamic parts (instances, lights, camera, materials,
 //! environment) are rebuilt from the ECS each frame; meshes and textures are set once.
 //!
-//! Output order is by entity id, which is fixed once the simulation is set up, so the same
-//! world always gives the same `SceneDesc`.
+//! Output order is spawn order ([`SpawnOrder`], then entity id), fixed once the simulation
+//! is set up, so the same world always gives the same `SceneDesc`.
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use render::scene::{Camera as CameraDesc, Instance, Light, SceneDesc};
 
-use crate::components::{Camera, Hidden, Intensity, LightSource, MeshInstance};
+use crate::components::{Camera, Hidden, Intensity, LightSource, MeshInstance, SpawnOrder};
 use crate::resources::{ActiveCamera, Environment, MaterialTable};
 use crate::transform::GlobalTransform;
 
@@ -52,10 +52,11 @@ pub fn extract_dynamic(world: &mut World, out: &mut SceneDesc) {
     out.materials.clear();
     out.materials.extend_from_slice(&table);
 
-    let mut instances: Vec<(Entity, Instance)> = Vec::new();
-    let mut query = world.query_filtered::<(Entity, &MeshInstance, &GlobalTransform, Option<&Intensity>), Without<Hidden>>();
-    for (entity, mesh, global, intensity) in query.iter(world) {
-        instances.push((entity, Instance { mesh: mesh.mesh, material: mesh.material, transform: global.0 }));
+    type Key = (Option<SpawnOrder>, Entity);
+    let mut instances: Vec<(Key, Instance)> = Vec::new();
+    let mut query = world.query_filtered::<(Entity, Option<&SpawnOrder>, &MeshInstance, &GlobalTransform, Option<&Intensity>), Without<Hidden>>();
+    for (entity, order, mesh, global, intensity) in query.iter(world) {
+        instances.push(((order.copied(), entity), Instance { mesh: mesh.mesh, material: mesh.material, transform: global.0 }));
         if let Some(intensity) = intensity {
             let mut own = table[mesh.material as usize];
             own.emission *= intensity.factor();
@@ -63,8 +64,8 @@ pub fn extract_dynamic(world: &mut World, out: &mut SceneDesc) {
             instances.last_mut().unwrap().1.material = (out.materials.len() - 1) as u32;
         }
     }
-    // Materials were appended in query order; renumber them in entity order.
-    instances.sort_by_key(|(e, _)| *e);
+    // Materials were appended in query order; renumber them in spawn order.
+    instances.sort_by_key(|(k, _)| *k);
     let mut derived = Vec::new();
     for (_, instance) in instances.iter_mut() {
         if instance.material as usize >= table.len() {
@@ -77,12 +78,12 @@ pub fn extract_dynamic(world: &mut World, out: &mut SceneDesc) {
     out.instances.clear();
     out.instances.extend(instances.into_iter().map(|(_, i)| i));
 
-    let mut lights: Vec<(Entity, Light)> = world
-        .query::<(Entity, &LightSource, &GlobalTransform, Option<&Intensity>)>()
+    let mut lights: Vec<(Key, Light)> = world
+        .query::<(Entity, Option<&SpawnOrder>, &LightSource, &GlobalTransform, Option<&Intensity>)>()
         .iter(world)
-        .map(|(e, l, g, i)| (e, world_light(&l.0, g, i.map_or(1.0, Intensity::factor))))
+        .map(|(e, o, l, g, i)| ((o.copied(), e), world_light(&l.0, g, i.map_or(1.0, Intensity::factor))))
         .collect();
-    lights.sort_by_key(|(e, _)| *e);
+    lights.sort_by_key(|(k, _)| *k);
     out.lights.clear();
     out.lights.extend(lights.into_iter().map(|(_, l)| l));
 

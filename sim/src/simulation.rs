@@ -9,7 +9,7 @@ use glam::{Quat, Vec3};
 use render::scene::SceneDesc;
 
 use crate::animation::{self, *};
-use crate::components::{Camera, Hidden, Intensity, LightSource, MeshInstance, Name};
+use crate::components::{Camera, Hidden, Intensity, LightSource, MeshInstance, Name, SpawnOrder};
 use crate::extract::extract_dynamic;
 use crate::gltf_import::{self, GltfError};
 use crate::resources::{ActiveCamera, Clock, Environment, MaterialTable, SimRng};
@@ -106,9 +106,13 @@ impl Simulation {
         }
 
         let mut names = Names { scenario, entities: HashMap::new(), ordered: Vec::new() };
-        let mut named: Vec<(Entity, String)> =
-            world.query::<(Entity, &Name)>().iter(&world).map(|(e, n)| (e, n.as_str().to_string())).collect();
-        named.sort_by_key(|(e, _)| *e);
+        let mut named: Vec<(Option<SpawnOrder>, Entity, String)> = world
+            .query::<(Entity, &Name, Option<&SpawnOrder>)>()
+            .iter(&world)
+            .map(|(e, n, o)| (o.copied(), e, n.as_str().to_string()))
+            .collect();
+        named.sort_by_key(|(o, e, _)| (*o, *e));
+        let named = named.into_iter().map(|(_, e, n)| (e, n));
         for (e, n) in named {
             if !names.entities.contains_key(&n) {
                 names.entities.insert(n.clone(), e);
@@ -227,10 +231,15 @@ impl Simulation {
 
     /// The entity with this name (the first one, if several share it).
     pub fn entity(&mut self, name: &str) -> Option<Entity> {
-        let mut found: Vec<(Entity, bool)> =
-            self.world.query::<(Entity, &Name)>().iter(&self.world).map(|(e, n)| (e, n.as_str() == name)).collect();
-        found.sort_by_key(|(e, _)| *e);
-        found.into_iter().find(|(_, hit)| *hit).map(|(e, _)| e)
+        let mut found: Vec<(Option<SpawnOrder>, Entity)> = self
+            .world
+            .query::<(Entity, &Name, Option<&SpawnOrder>)>()
+            .iter(&self.world)
+            .filter(|(_, n, _)| n.as_str() == name)
+            .map(|(e, _, o)| (o.copied(), e))
+            .collect();
+        found.sort();
+        found.first().map(|(_, e)| *e)
     }
 
     pub fn world(&self) -> &World {
@@ -324,6 +333,7 @@ fn attach_animation(world: &mut World, names: &Names, spec: &AnimationSpec, inde
             let scale = world.get::<Transform>(proto).map_or(Vec3::ONE, |t| t.scale);
             world.entity_mut(proto).insert((Flock { params }, Hidden));
             let mut rng = Rng::stream(seed, index);
+            let first = world.query::<&SpawnOrder>().iter(world).map(|o| o.0 + 1).max().unwrap_or(0);
             for (i, (p, v)) in initial_boids(&params, *count, &mut rng).into_iter().enumerate() {
                 world.spawn((
                     Name::new(format!("{prototype}_{i}")),
@@ -331,6 +341,7 @@ fn attach_animation(world: &mut World, names: &Names, spec: &AnimationSpec, inde
                     GlobalTransform::default(),
                     mesh,
                     Boid { flock: proto, index: i as u32, velocity: v },
+                    SpawnOrder(first + i as u32),
                 ));
             }
         }

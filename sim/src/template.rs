@@ -4,7 +4,7 @@ use bevy_ecs::prelude::*;
 use glam::Vec3;
 use render::scene::{Light, Material, Mesh, Texture};
 
-use crate::components::{Camera, Intensity, LightSource, MeshInstance, Name};
+use crate::components::{Camera, Intensity, LightSource, MeshInstance, Name, SpawnOrder};
 use crate::resources::{ActiveCamera, Environment, MaterialTable};
 use crate::transform::{GlobalTransform, Transform};
 
@@ -94,8 +94,13 @@ impl WorldTemplate {
         world.insert_resource(Environment(self.environment));
         let mut entities: Vec<Entity> = Vec::with_capacity(self.nodes.len());
         let mut active = None;
-        for node in &self.nodes {
-            let mut e = world.spawn((Name::new(node.name.clone()), node.transform, GlobalTransform::default()));
+        for (order, node) in self.nodes.iter().enumerate() {
+            let mut e = world.spawn((
+                Name::new(node.name.clone()),
+                node.transform,
+                GlobalTransform::default(),
+                SpawnOrder(order as u32),
+            ));
             if let Some(p) = node.parent {
                 e.insert(ChildOf(entities[p]));
             }
@@ -119,6 +124,7 @@ impl WorldTemplate {
                     Transform::looking_at(c.position, c.target, c.up),
                     GlobalTransform::default(),
                     Camera { vfov: c.vfov },
+                    SpawnOrder(self.nodes.len() as u32),
                 ))
                 .id()
         });

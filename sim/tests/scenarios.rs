@@ -321,3 +321,4 @@ fn same_seed_same_scene_different_seed_differs() {
         assert_ne!(run(&a, 20), run(&b, 20), "{file}: seed has no effect");
     }
 }
+
