@@ -79,11 +79,11 @@ fn bench(out: Option<PathBuf>, rays: u32, frames: u32, no_metrics: bool) -> anyh
     let mut md = systems::bench::run(&opts, |step| eprintln!("bench: {step}"))?;
     if !no_metrics {
         eprintln!("bench: image metrics at 1280x720");
-        let args = metrics::bench::BenchArgs { width: 1280, height: 720, repeats: 5, no_reference: false };
+        let args = metrics::bench::BenchArgs { width: 1280, height: 720, repeats: 5, no_reference: false, smape_only: false };
         let r = metrics::bench::bench(&args)?;
         md.push_str(&format!(
             "\n## Image metrics, {}x{} HDR pair ({} threads)\n\n| metric | ms |\n|---|---:|\n| SMAPE | {:.2} |\n| HDR-FLIP (flicker) | {:.1} |\n",
-            r.width, r.height, r.threads, r.smape_ms, r.flip_hdr_ms
+            r.width, r.height, r.threads, r.smape_ms, r.flip_hdr_ms.unwrap_or(f64::NAN)
         ));
         if let (Some(ms), Some(speedup)) = (r.reference_flip_ms, r.speedup) {
             md.push_str(&format!("| HDR-FLIP (flip-evaluator) | {ms:.1} |\n\nflip-evaluator time / flicker time: {speedup:.2}\n"));

@@ -7,7 +7,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use render::bvh::bench::{displaced_sphere, traversal_benchmark};
+use render::bvh::{displaced_sphere, traversal_benchmark};
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::{Instance, Material, SceneDesc};

@@ -119,6 +119,7 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary> {
                     spp: scenario.reference.spp,
                     seed: reference_seed(scenario.seed),
                     max_depth: scenario.max_depth,
+                    rr_start_depth: settings.rr_start_depth,
                     adapter: &gpu.summary.to_string(),
                     shader_source: PathTracer::shader_source(),
                 },

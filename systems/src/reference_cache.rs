@@ -21,6 +21,7 @@ pub struct ReferenceKey<'a> {
     pub spp: u32,
     pub seed: u64,
     pub max_depth: u32,
+    pub rr_start_depth: u32,
     pub adapter: &'a str,
     pub shader_source: &'a str,
 }
@@ -45,7 +46,7 @@ impl ReferenceCache {
     pub fn key(scene: &SceneDesc, key: &ReferenceKey) -> String {
         let mut h = Sha256::new();
         h.update(b"flicker-reference-v1");
-        h.update(format!("{}x{} spp{} seed{} depth{}", key.width, key.height, key.spp, key.seed, key.max_depth));
+        h.update(format!("{}x{} spp{} seed{} depth{} rr{}", key.width, key.height, key.spp, key.seed, key.max_depth, key.rr_start_depth));
         h.update(key.adapter.as_bytes());
         h.update(key.shader_source.as_bytes());
         hash_scene(&mut h, scene);
@@ -93,7 +94,7 @@ mod tests {
     use render::scene::{Instance, Mesh};
 
     fn key(scene: &SceneDesc, spp: u32) -> String {
-        ReferenceCache::key(scene, &ReferenceKey { width: 8, height: 4, spp, seed: 1, max_depth: 4, adapter: "a", shader_source: "s" })
+        ReferenceCache::key(scene, &ReferenceKey { width: 8, height: 4, spp, seed: 1, max_depth: 4, rr_start_depth: 3, adapter: "a", shader_source: "s" })
     }
 
     #[test]

@@ -1,0 +1,168 @@
+//! End-to-end tests of the `flicker` program: runs, determinism, the run folder, bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn flicker(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_flicker")).args(args).output().expect("flicker runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("flicker-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Runs `flicker run` expecting failure; returns stderr and checks nothing was written.
+fn run_fails(scenario: &Path, extra: &[&str], out: &Path) -> String {
+    let mut args = vec!["run", scenario.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let o = flicker(&args);
+    let stderr = text(&o.stderr);
+    assert!(!o.status.success(), "expected failure, got success; stderr: {stderr}");
+    assert!(!out.exists(), "a failed run must not create its output folder {}", out.display());
+    stderr
+}
+
+fn tiny_scenario(dir: &Path, body: &str) -> PathBuf {
+    let path = dir.join("scenario.ron");
+    std::fs::write(&path, body).unwrap();
+    path
+}
+
+#[test]
+fn malformed_ron_names_file_line_and_column() {
+    let dir = scratch("malformed");
+    let path = tiny_scenario(&dir, "Scenario(\n    scene: Builtin(\"cornell_box\"),\n    resolution: (16, 9)\n    frames: 2,\n)\n");
+    let err = run_fails(&path, &[], &dir.join("out"));
+    assert!(err.contains("scenario.ron:4:"), "error should point at line 4: {err}");
+}
+
+#[test]
+fn unknown_entity_is_an_error_before_frame_zero() {
+    let dir = scratch("entity");
+    let path = tiny_scenario(
+        &dir,
+        r#"Scenario(scene: Builtin("cornell_box"), resolution: (16, 9), frames: 2,
+            methods: [PathTracing(spp: 1)],
+            animations: [Rotate(entity: "no_such_box", axis: (0, 1, 0), degrees_per_second: 10)])"#,
+    );
+    let err = run_fails(&path, &[], &dir.join("out"));
+    assert!(err.contains("no_such_box") && err.contains("scenario.ron"), "{err}");
+}
+
+#[test]
+fn unknown_scene_and_missing_gltf_are_errors() {
+    let dir = scratch("scene");
+    let path = tiny_scenario(&dir, r#"Scenario(scene: Builtin("cornel_box"), resolution: (16, 9), frames: 2, methods: [PathTracing(spp: 1)])"#);
+    let err = run_fails(&path, &[], &dir.join("out"));
+    assert!(err.contains("cornel_box") && err.contains("cornell_box"), "should list the known scenes: {err}");
+
+    let path = tiny_scenario(&dir, r#"Scenario(scene: Gltf("assets/missing.gltf"), resolution: (16, 9), frames: 2, methods: [PathTracing(spp: 1)])"#);
+    let err = run_fails(&path, &[], &dir.join("out"));
+    assert!(err.contains("missing.gltf"), "{err}");
+}
+
+#[test]
+fn oversize_resolution_is_refused_with_the_limit() {
+    let dir = scratch("oversize");
+    let err = run_fails(Path::new("scenarios/cornell_box.ron"), &["--resolution", "100000x8"], &dir.join("out"));
+    assert!(err.contains("100000") && err.contains("limit"), "{err}");
+    let err = run_fails(Path::new("scenarios/cornell_box.ron"), &["--resolution", "160by90"], &dir.join("out"));
+    assert!(err.contains("WIDTHxHEIGHT"), "{err}");
+}
+
+#[test]
+fn two_runs_give_byte_identical_frames_and_a_complete_run_folder() {
+    let dir = scratch("determinism");
+    let cache = dir.join("cache");
+    let scenario = tiny_scenario(
+        &dir,
+        r#"Scenario(
+            scene: Builtin("cornell_box"), resolution: (32, 18), frames: 3, seed: 7, max_depth: 4,
+            methods: [PathTracing(spp: 1), PathTracing(spp: 2)],
+            reference: (spp: 8, frames: List([1])),
+            regions: [(name: "centre", x: 8, y: 4, w: 16, h: 10)],
+        )"#,
+    );
+    let mut outs = Vec::new();
+    for (i, expect_cached) in [(0, 0), (1, 1)] {
+        let out = dir.join(format!("run{i}"));
+        let o = flicker(&[
+            "run",
+            scenario.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+            "--cache-dir",
+            cache.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "run failed: {}", text(&o.stderr));
+        let stdout = text(&o.stdout);
+        assert!(stdout.contains(&format!("{expect_cached} from cache")), "{stdout}");
+        outs.push(out);
+    }
+    for method in ["pt_1spp", "pt_2spp"] {
+        for frame in 0..3 {
+            let name = format!("frames/{method}/{frame:04}.exr");
+            let a = std::fs::read(outs[0].join(&name)).unwrap();
+            let b = std::fs::read(outs[1].join(&name)).unwrap();
+            assert!(a == b, "{name} differs between two runs of the same scenario");
+            assert!(outs[0].join(format!("frames/{method}/{frame:04}.png")).exists());
+        }
+    }
+    let run = &outs[0];
+    assert!(run.join("reference/0001.exr").exists() && run.join("reference/0001.png").exists());
+    assert!(!run.join("reference/0000.exr").exists());
+    let manifest: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["seed"], 7);
+    assert_eq!(manifest["resolution"], serde_json::json!([32, 18]));
+    assert!(manifest["adapter"]["name"].as_str().is_some_and(|n| !n.is_empty()));
+    let csv = std::fs::read_to_string(run.join("frames.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 6, "one row per (method, frame)");
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name} in {header:?}"));
+    for row in &rows {
+        let frame: u32 = row[col("frame")].parse().unwrap();
+        let flip = row[col("flip")];
+        assert_eq!(flip.is_empty(), frame != 1, "FLIP exactly on the reference frame: {row:?}");
+        assert_eq!(row[col("smape")].is_empty(), frame == 0, "SMAPE from the second frame on: {row:?}");
+        if frame == 1 {
+            let f: f64 = flip.parse().unwrap();
+            assert!(f > 0.0 && f < 1.0, "{f}");
+            assert!(!row[col("centre_flip")].is_empty());
+        }
+    }
+    assert!(run.join("summary.json").exists() && run.join("report.html").exists());
+    let leftovers: Vec<_> = walk(run).into_iter().filter(|p| p.extension().is_some_and(|e| e == "tmp")).collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+}
+
+#[test]
+fn scenes_lists_every_builtin() {
+    let o = flicker(&["scenes"]);
+    assert!(o.status.success());
+    let out = text(&o.stdout);
+    for name in ["cornell_box", "corridor", "door_gap", "courtyard", "hairball", "rotating_cone"] {
+        assert!(out.contains(name), "{out}");
+    }
+}
+
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let p = entry.unwrap().path();
+        if p.is_dir() {
+            out.extend(walk(&p));
+        } else {
+            out.push(p);
+        }
+    }
+    out
+}
