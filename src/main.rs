@@ -61,6 +61,9 @@ enum Command {
         /// Skip the image-metric benchmark (FLIP against NVIDIA's flip-evaluator, SMAPE).
         #[arg(long)]
         no_metrics: bool,
+        /// Timed repetitions of each image metric (the best is reported).
+        #[arg(long, default_value_t = 3)]
+        repeats: u32,
     },
 }
 
@@ -74,12 +77,12 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-fn bench(out: Option<PathBuf>, rays: u32, frames: u32, no_metrics: bool) -> anyhow::Result<()> {
+fn bench(out: Option<PathBuf>, rays: u32, frames: u32, no_metrics: bool, repeats: u32) -> anyhow::Result<()> {
     let opts = systems::bench::BenchOptions { rays, frames, ..Default::default() };
     let mut md = systems::bench::run(&opts, |step| eprintln!("bench: {step}"))?;
     if !no_metrics {
         eprintln!("bench: image metrics at 1280x720");
-        let args = metrics::bench::BenchArgs { width: 1280, height: 720, repeats: 5, no_reference: false, smape_only: false };
+        let args = metrics::bench::BenchArgs { width: 1280, height: 720, repeats, no_reference: false, smape_only: false };
         let r = metrics::bench::bench(&args)?;
         md.push_str(&format!(
             "\n## Image metrics, {}x{} HDR pair ({} threads)\n\n| metric | ms |\n|---|---:|\n| SMAPE | {:.2} |\n| HDR-FLIP (flicker) | {:.1} |\n",
@@ -125,7 +128,7 @@ fn main() -> ExitCode {
         }
         Command::Compare(args) => metrics::compare(&args),
         Command::Report(args) => report::report(&args).map(|path| println!("wrote {}", path.display())),
-        Command::Bench { out, rays, frames, no_metrics } => bench(out, rays, frames, no_metrics),
+        Command::Bench { out, rays, frames, no_metrics, repeats } => bench(out, rays, frames, no_metrics, repeats),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

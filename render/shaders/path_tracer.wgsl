@@ -164,11 +164,14 @@ fn trace_path(pixel: vec2u, sample_index: u32) -> vec3f {
         let wo = -dir;
         let sh = orient(sp, wo);
         let le_lum = luminance(m.emission);
-        if le_lum > 0.0 {
+        // Emitters are one-sided (front face by winding, as pbrt's area lights and glTF's
+        // emissive): a two-sided light a few millimetres under a ceiling traps light between
+        // its back face and the ceiling, an unbounded-variance source of fireflies.
+        let cos_light = -dot(sp.geometric_normal, dir);
+        if le_lum > 0.0 && cos_light > 0.0 {
             var w = 1.0;
             if prev_bsdf_pdf > 0.0 && emitter_weight > 0.0 {
                 let dist = hit.t;
-                let cos_light = abs(dot(sp.geometric_normal, dir));
                 let light_pdf = select(0.0, le_lum / emitter_weight * dist * dist / cos_light, cos_light > 0.0);
                 w = power_heuristic(prev_bsdf_pdf, light_pdf);
             }

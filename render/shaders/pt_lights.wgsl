@@ -1,7 +1,8 @@
 // Light sampling for next-event estimation. One table holds the analytic lights followed by the
 // emissive triangles (area lights); triangles are chosen by power (luminance x area) through the
 // cumulative distribution in `cdf`, so the area pdf of any emissive point is luminance(Le) / W.
-// Emissive triangles emit from both faces (glTF says nothing about an emission side).
+// Emissive triangles emit from their front face only (counter-clockwise winding), as pbrt's
+// area lights do by default.
 
 const LIGHT_DIRECTIONAL: u32 = 0u;
 const LIGHT_POINT: u32 = 1u;
@@ -113,7 +114,8 @@ fn sample_emitter(first: u32, count: u32, p: vec3f, u_select: f32, u: vec2f) -> 
     }
     s.dist = sqrt(dist2);
     s.wi = d / s.dist;
-    let cos_light = abs(dot(c / double_area, s.wi));
+    // One-sided: the light emits from its front face (winding) only; wi points at the light.
+    let cos_light = -dot(c / double_area, s.wi);
     if cos_light <= 0.0 {
         return s;
     }

@@ -230,6 +230,10 @@ fn default_time_step() -> f32 {
 fn default_max_depth() -> u32 {
     8
 }
+/// ε of the SMAPE denominator, reliability-weighted-nirc.txt §4.2.
+fn default_smape_epsilon() -> f32 {
+    0.01
+}
 
 /// The file as written.
 #[derive(Deserialize)]
@@ -259,6 +263,8 @@ struct ScenarioFile {
     reference: ReferenceSpec,
     #[serde(default)]
     regions: Vec<Region>,
+    #[serde(default = "default_smape_epsilon")]
+    smape_epsilon: f32,
     #[serde(default)]
     animations: Vec<AnimationSpec>,
     #[serde(default)]
@@ -287,6 +293,8 @@ pub struct Scenario {
     pub methods: Vec<MethodSpec>,
     pub reference: ReferenceSpec,
     pub regions: Vec<Region>,
+    /// ε in SMAPE's denominator 2|a - b| / (|a| + |b| + ε).
+    pub smape_epsilon: f32,
     pub animations: Vec<AnimationSpec>,
     pub events: Vec<EventSpec>,
     /// The RON file this came from (used in error messages).
@@ -405,6 +413,7 @@ impl Scenario {
             methods: file.methods,
             reference: file.reference,
             regions: file.regions,
+            smape_epsilon: file.smape_epsilon,
             animations: file.animations,
             events: file.events,
             origin: origin.to_path_buf(),

@@ -27,10 +27,11 @@ pub fn build(scenario: &Scenario, scenario_file: &Path, gpu: &Gpu, overrides: &O
         "warmup_frames": scenario.warmup_frames,
         "methods": scenario.methods.iter().map(|m| m.label()).collect::<Vec<_>>(),
         "reference": { "spp": scenario.reference.spp, "frames": reference_frames },
-        "events": scenario.events_summary().into_iter().map(|(frame, label)| json!({"frame": frame, "label": label})).collect::<Vec<_>>(),
+        "events": scenario.events_summary().into_iter().filter(|(frame, _)| *frame < frames).map(|(frame, label)| json!({"frame": frame, "label": label})).collect::<Vec<_>>(),
         "regions": scenario.regions.iter().map(|r| json!({"name": r.name, "x": r.x, "y": r.y, "width": r.width, "height": r.height})).collect::<Vec<_>>(),
         "settings": {
             "max_depth": scenario.max_depth,
+            "smape_epsilon": scenario.smape_epsilon,
             "time_step": scenario.time_step,
             "methods": scenario.methods.iter().map(|m| json!({"label": m.label(), "spp": crate::playback::method_spp(m)})).collect::<Vec<_>>(),
             "overrides": {

@@ -24,7 +24,7 @@ impl Frame {
 
 /// Measures `current` against the method's `previous` frame and the `reference` where given.
 pub fn record(current: &Frame, previous: Option<&Frame>, reference: Option<&Frame>, scenario: &Scenario) -> FrameRecord {
-    let eps = metrics::smape::DEFAULT_EPS;
+    let eps = scenario.smape_epsilon;
     let regions: Vec<Region> = scenario
         .regions
         .iter()

@@ -68,6 +68,9 @@ pub fn load_scenario(path: &Path, o: &Overrides) -> Result<Scenario> {
     if scenario.frames == 0 {
         bail!("{}: frames must be at least 1", path.display());
     }
+    if !(scenario.smape_epsilon.is_finite() && scenario.smape_epsilon >= 0.0) {
+        bail!("{}: smape_epsilon must be a finite number >= 0, got {}", path.display(), scenario.smape_epsilon);
+    }
     if scenario.methods.is_empty() {
         bail!("{}: no methods to run; add e.g. `methods: [PathTracing(spp: 1)]`", path.display());
     }
