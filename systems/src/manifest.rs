@@ -10,13 +10,12 @@ use sim::Scenario;
 use crate::playback::Overrides;
 
 pub fn build(scenario: &Scenario, scenario_file: &Path, gpu: &Gpu, overrides: &Overrides) -> Result<Value> {
-    let text = std::fs::read_to_string(scenario_file).unwrap_or_default();
     let frames = scenario.frames;
     let reference_frames: Vec<u32> = (0..frames).filter(|&f| scenario.reference.wants(f, frames)).collect();
     Ok(json!({
         "scenario": scenario.name,
         "scenario_file": scenario_file.display().to_string(),
-        "scenario_text": text,
+        "scenario_text": scenario.source,
         "commit": commit(scenario_file),
         "flicker_version": env!("CARGO_PKG_VERSION"),
         "adapter": gpu.summary,
