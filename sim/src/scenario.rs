@@ -44,6 +44,13 @@ impl MethodSpec {
             MethodSpec::PathTracing { spp } => format!("pt_{spp}spp"),
         }
     }
+
+    /// Samples per pixel the method spends per frame.
+    pub fn spp(&self) -> u32 {
+        match self {
+            MethodSpec::PathTracing { spp } => *spp,
+        }
+    }
 }
 
 /// Which frames get a path-traced reference.

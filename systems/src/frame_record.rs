@@ -18,6 +18,8 @@ pub struct FrameRecord {
     pub psnr: Option<f64>,
     /// Per region of interest: (name, flip, smape).
     pub regions: Vec<(String, Option<f64>, Option<f64>)>,
+    /// Method-specific numbers (reliability, occupancy, shaded samples, ...).
+    pub stats: Vec<(String, f64)>,
 }
 
 /// Writes the CSV; pass columns are the union over rows, so methods with different passes share
@@ -25,7 +27,13 @@ pub struct FrameRecord {
 pub fn to_csv(rows: &[FrameRecord]) -> String {
     let mut passes: Vec<String> = Vec::new();
     let mut regions: Vec<String> = Vec::new();
+    let mut stats: Vec<String> = Vec::new();
     for row in rows {
+        for (k, _) in &row.stats {
+            if !stats.contains(k) {
+                stats.push(k.clone());
+            }
+        }
         for (p, _) in &row.passes {
             if !passes.contains(p) {
                 passes.push(p.clone());
@@ -44,6 +52,9 @@ pub fn to_csv(rows: &[FrameRecord]) -> String {
     out.push_str(",smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr");
     for r in &regions {
         write!(out, ",{r}_flip,{r}_smape").unwrap();
+    }
+    for k in &stats {
+        write!(out, ",{k}").unwrap();
     }
     out.push('\n');
     for row in rows {
@@ -76,6 +87,9 @@ pub fn to_csv(rows: &[FrameRecord]) -> String {
             let found = row.regions.iter().find(|(q, _, _)| q == r);
             write!(out, ",{},{}", cell(found.and_then(|f| f.1)), cell(found.and_then(|f| f.2))).unwrap();
         }
+        for k in &stats {
+            write!(out, ",{}", cell(row.stats.iter().find(|(q, _)| q == k).map(|s| s.1))).unwrap();
+        }
         out.push('\n');
     }
     out
@@ -97,13 +111,14 @@ mod tests {
             cpu_ms: 2.0,
             passes: vec![("trace".into(), Some(1.5))],
             smape: Some(0.25),
+            stats: vec![("occupancy".into(), 0.5)],
             ..Default::default()
         };
         let b = FrameRecord { method: "pt_4spp".into(), frame: 0, passes: vec![("shade".into(), None)], ..Default::default() };
         let csv = to_csv(&[a, b]);
         let lines: Vec<&str> = csv.lines().collect();
-        assert_eq!(lines[0], "method,frame,cpu_ms,gpu_ms_total,gpu_ms_trace,gpu_ms_shade,smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr");
-        assert_eq!(lines[1], "pt_1spp,0,2.0000,1.500000,1.500000,,0.250000,,,,,,");
-        assert_eq!(lines[2], "pt_4spp,0,0.0000,,,,,,,,,,");
+        assert_eq!(lines[0], "method,frame,cpu_ms,gpu_ms_total,gpu_ms_trace,gpu_ms_shade,smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr,occupancy");
+        assert_eq!(lines[1], "pt_1spp,0,2.0000,1.500000,1.500000,,0.250000,,,,,,,0.500000");
+        assert_eq!(lines[2], "pt_4spp,0,0.0000,,,,,,,,,,,");
     }
 }

@@ -5,6 +5,7 @@ pub mod extract;
 pub mod frame_record;
 pub mod manifest;
 pub mod measure;
+pub mod methods;
 pub mod output;
 pub mod playback;
 pub mod reference_cache;

@@ -32,7 +32,7 @@ pub fn build(scenario: &Scenario, scenario_file: &Path, gpu: &Gpu, overrides: &O
             "max_depth": scenario.max_depth,
             "smape_epsilon": scenario.smape_epsilon,
             "time_step": scenario.time_step,
-            "methods": scenario.methods.iter().map(|m| json!({"label": m.label(), "spp": crate::playback::method_spp(m)})).collect::<Vec<_>>(),
+            "methods": scenario.methods.iter().map(|m| json!({"label": m.label(), "spp": m.spp()})).collect::<Vec<_>>(),
             "overrides": {
                 "frames": overrides.frames,
                 "resolution": overrides.resolution.map(|(w, h)| format!("{w}x{h}")),

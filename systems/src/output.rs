@@ -70,6 +70,21 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[[f32; 4]], exposu
     })
 }
 
+/// Writes display-ready values in [0, 1] (false-colour maps, masks) as 8-bit sRGB-encoded PNG
+/// without tone mapping.
+pub fn write_png_linear(path: &Path, width: u32, height: u32, rgba: &[[f32; 4]]) -> Result<()> {
+    let bytes: Vec<u8> = rgba
+        .iter()
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .map(|v| (tonemap::linear_to_srgb(v.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8)
+        .collect();
+    write_atomic(path, |w| {
+        image::codecs::png::PngEncoder::new(w)
+            .write_image(&bytes, width, height, image::ExtendedColorType::Rgb8)
+            .with_context(|| format!("encoding {}", path.display()))
+    })
+}
+
 /// Reads an RGBA32F EXR written by [`write_exr`].
 pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
     let img = image::open(path).with_context(|| format!("reading {}", path.display()))?.into_rgba32f();

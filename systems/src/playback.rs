@@ -12,6 +12,7 @@ use sim::{MethodSpec, Scenario, Simulation};
 
 use crate::frame_record::{self, FrameRecord};
 use crate::measure;
+use crate::methods::{self, FrameContext, FrameMethod};
 use crate::output;
 use crate::reference_cache::{ReferenceCache, ReferenceKey};
 use crate::run_folder::RunFolder;
@@ -92,15 +93,23 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary> {
     output::write_json(&folder.manifest(), &manifest)?;
 
     let cache = ReferenceCache::new(opts.cache_dir.clone().unwrap_or_else(ReferenceCache::default_location));
-    let methods: Vec<(String, u32)> = scenario.methods.iter().map(|m| (m.label(), method_spp(m))).collect();
+    let mut methods: Vec<Box<dyn FrameMethod>> = Vec::new();
+    for spec in &scenario.methods {
+        tracer.update(&gpu, sim.scene());
+        let method = methods::build(spec, &gpu, &scenario, sim.scene())
+            .with_context(|| format!("{}: preparing method {}", opts.scenario.display(), spec.label()))?;
+        methods.push(method);
+    }
     let bar = progress_bar(opts.progress, (scenario.warmup_frames + scenario.frames) as u64);
 
     // Warm-up frames are simulated and rendered (caches learn from them) but not recorded.
     for _ in 0..scenario.warmup_frames {
         bar.set_message("warm-up");
         tracer.update(&gpu, sim.scene());
-        for (_, spp) in &methods {
-            tracer.render(&gpu, *spp, scenario.seed, sim.frame())?;
+        let frame = sim.frame();
+        for method in &mut methods {
+            let mut ctx = FrameContext { gpu: &gpu, tracer: &mut tracer, scene: sim.scene(), scenario: &scenario, frame, recorded: false };
+            method.render(&mut ctx).with_context(|| format!("{} warm-up frame {frame}", method.label()))?;
         }
         sim.step();
         bar.inc(1);
@@ -150,19 +159,32 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary> {
             None
         };
 
-        for (m, (label, spp)) in methods.iter().enumerate() {
+        for (m, method) in methods.iter_mut().enumerate() {
+            let label = method.label();
             bar.set_message(format!("{label} frame {frame:04}"));
             let start = Instant::now();
-            let out = tracer.render(&gpu, *spp, scenario.seed, global_frame)?;
+            let mut ctx =
+                FrameContext { gpu: &gpu, tracer: &mut tracer, scene: sim.scene(), scenario: &scenario, frame: global_frame, recorded: true };
+            let out = method.render(&mut ctx).with_context(|| format!("{label} frame {frame}"))?;
             let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
-            output::write_exr(&folder.frame(label, frame, "exr"), width, height, &out.radiance)?;
-            output::write_png(&folder.frame(label, frame, "png"), width, height, &out.radiance, 1.0)?;
-            let current = measure::Frame::from_radiance(width, height, &out.radiance, Some(&out.gbuffer.motion));
+            output::write_exr(&folder.frame(&label, frame, "exr"), width, height, &out.radiance)?;
+            output::write_png(&folder.frame(&label, frame, "png"), width, height, &out.radiance, 1.0)?;
+            for image in &out.images {
+                if image.hdr {
+                    output::write_exr(&folder.method_image(&label, &image.name, frame, "exr"), width, height, &image.pixels)?;
+                    output::write_png(&folder.method_image(&label, &image.name, frame, "png"), width, height, &image.pixels, 1.0)?;
+                } else {
+                    output::write_png_linear(&folder.method_image(&label, &image.name, frame, "png"), width, height, &image.pixels)?;
+                }
+            }
+            let motion = (!out.motion.is_empty()).then_some(out.motion.as_slice());
+            let current = measure::Frame::from_radiance(width, height, &out.radiance, motion);
             let mut record = measure::record(&current, previous[m].as_ref(), reference.as_ref(), &scenario);
-            record.method = label.clone();
+            record.method = label;
             record.frame = frame;
             record.cpu_ms = cpu_ms;
-            record.passes = out.timings.iter().map(|t| (t.pass.clone(), t.gpu_ms)).collect();
+            record.passes = out.passes;
+            record.stats = out.stats;
             records.push(record);
             previous[m] = Some(current);
         }
@@ -193,9 +215,3 @@ fn progress_bar(enabled: bool, len: u64) -> ProgressBar {
     bar
 }
 
-/// Samples per pixel a method spends per frame.
-pub fn method_spp(method: &MethodSpec) -> u32 {
-    match method {
-        MethodSpec::PathTracing { spp } => *spp,
-    }
-}

@@ -33,6 +33,11 @@ impl RunFolder {
         self.root.join("frames").join(method).join(format!("{frame:04}.{ext}"))
     }
 
+    /// A method's extra image, e.g. `frames/nirc_blend/preference/0003.png`.
+    pub fn method_image(&self, method: &str, name: &str, frame: u32, ext: &str) -> PathBuf {
+        self.root.join("frames").join(method).join(name).join(format!("{frame:04}.{ext}"))
+    }
+
     pub fn reference(&self, frame: u32, ext: &str) -> PathBuf {
         self.root.join("reference").join(format!("{frame:04}.{ext}"))
     }

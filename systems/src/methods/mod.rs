@@ -1,0 +1,65 @@
+//! Rendering methods as per-frame systems: the playback loop asks each method for one frame, in
+//! the scenario's order, after the scene has been updated. A method owns its own GPU state
+//! (caches, histories) and may use the shared path tracer (scene geometry, G-buffer).
+
+mod path_tracing;
+
+use anyhow::Result;
+use render::gpu::Gpu;
+use render::path_tracer::PathTracer;
+use render::scene::SceneDesc;
+use sim::{MethodSpec, Scenario};
+
+pub use path_tracing::PathTracing;
+
+/// Everything a method may read while rendering one frame.
+pub struct FrameContext<'a> {
+    pub gpu: &'a Gpu,
+    /// Shared path tracer, already updated to this frame's scene.
+    pub tracer: &'a mut PathTracer,
+    pub scene: &'a SceneDesc,
+    pub scenario: &'a Scenario,
+    /// Simulation frame (warm-up frames included), the seed of per-frame randomness.
+    pub frame: u32,
+    /// False during warm-up: the frame is rendered (caches learn) but not recorded.
+    pub recorded: bool,
+}
+
+/// One rendered frame of a method.
+#[derive(Clone, Debug, Default)]
+pub struct MethodOutput {
+    /// Linear HDR radiance, row-major, alpha = 1.
+    pub radiance: Vec<[f32; 4]>,
+    /// Per-pixel motion (pixels, current to previous), for reprojected SMAPE.
+    pub motion: Vec<[f32; 2]>,
+    /// GPU time per pass in execution order; `None` without timestamp queries.
+    pub passes: Vec<(String, Option<f64>)>,
+    /// Method-specific numbers for `frames.csv`, e.g. mean reliability or cache occupancy.
+    pub stats: Vec<(String, f64)>,
+    /// Method-specific images (linear RGB, or a false-colour map), written as
+    /// `frames/METHOD/NAME/NNNN.png` (and `.exr` when `hdr`).
+    pub images: Vec<MethodImage>,
+}
+
+#[derive(Clone, Debug)]
+pub struct MethodImage {
+    pub name: String,
+    pub pixels: Vec<[f32; 4]>,
+    /// HDR images are written as EXR too and tone-mapped for the PNG; others are written as is.
+    pub hdr: bool,
+}
+
+pub trait FrameMethod {
+    /// Folder and table name, e.g. `pt_4spp`.
+    fn label(&self) -> String;
+    /// Samples per pixel it spends per frame (for equal-budget comparisons).
+    fn spp(&self) -> u32;
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodOutput>;
+}
+
+/// Builds the method a scenario asks for.
+pub fn build(spec: &MethodSpec, _gpu: &Gpu, _scenario: &Scenario, _scene: &SceneDesc) -> Result<Box<dyn FrameMethod>> {
+    Ok(match spec {
+        MethodSpec::PathTracing { spp } => Box::new(PathTracing::new(*spp)),
+    })
+}

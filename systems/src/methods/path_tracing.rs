@@ -1,0 +1,35 @@
+//! Plain path tracing at k samples per pixel: the baseline every cache is measured against.
+
+use anyhow::Result;
+
+use super::{FrameContext, FrameMethod, MethodOutput};
+
+pub struct PathTracing {
+    spp: u32,
+}
+
+impl PathTracing {
+    pub fn new(spp: u32) -> Self {
+        Self { spp }
+    }
+}
+
+impl FrameMethod for PathTracing {
+    fn label(&self) -> String {
+        format!("pt_{}spp", self.spp)
+    }
+
+    fn spp(&self) -> u32 {
+        self.spp
+    }
+
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodOutput> {
+        let out = ctx.tracer.render(ctx.gpu, self.spp, ctx.scenario.seed, ctx.frame)?;
+        Ok(MethodOutput {
+            radiance: out.radiance,
+            motion: out.gbuffer.motion,
+            passes: out.timings.iter().map(|t| (t.pass.clone(), t.gpu_ms)).collect(),
+            ..Default::default()
+        })
+    }
+}
