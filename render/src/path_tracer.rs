@@ -112,8 +112,9 @@ pub struct PathTracer {
     timestamps: Option<PassTimestamps>,
     light_table: LightTable,
     camera: Camera,
-    /// Camera of the last `render`, for motion vectors; `None` before the first frame.
-    previous_camera: Option<Camera>,
+    /// Camera before the last `update` (motion vectors), like the instances' previous
+    /// transforms; the current camera before the first update.
+    previous_camera: Camera,
     environment: Vec3,
     paths_per_dispatch: u64,
 }
@@ -210,7 +211,7 @@ impl PathTracer {
             timestamps: PassTimestamps::new(gpu, 2),
             light_table,
             camera: scene.camera,
-            previous_camera: None,
+            previous_camera: scene.camera,
             environment: scene.environment,
             paths_per_dispatch: PATHS_PER_DISPATCH,
         })
@@ -220,16 +221,44 @@ impl PathTracer {
     /// anything cached from its images.
     pub fn shader_source() -> &'static str {
         static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+        SOURCE.get_or_init(|| [Self::library_source(), include_str!("../shaders/path_tracer.wgsl")].join("\n"))
+    }
+
+    /// The shading library without entry points: scene geometry (@group(1)), sampling, BSDFs,
+    /// lights, the scene bindings (@group(0)) and the path integrator (`next_event`,
+    /// `emitted_radiance`, `path_radiance`). Another method's pass appends its own WGSL (its
+    /// buffers in @group(2)) and binds [`Self::scene_bind_group`] and the geometry's group.
+    pub fn library_source() -> &'static str {
+        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
         SOURCE.get_or_init(|| {
             [
                 SceneGeometry::WGSL,
                 include_str!("../shaders/pt_sampling.wgsl"),
                 include_str!("../shaders/pt_bsdf.wgsl"),
                 include_str!("../shaders/pt_lights.wgsl"),
-                include_str!("../shaders/path_tracer.wgsl"),
+                include_str!("../shaders/pt_scene.wgsl"),
+                include_str!("../shaders/pt_integrator.wgsl"),
             ]
             .join("\n")
         })
+    }
+
+    /// Layout of @group(0) of [`Self::library_source`].
+    pub fn scene_bind_group_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// @group(0) of [`Self::library_source`]. It changes when `update` had to grow a buffer:
+    /// fetch it every frame, do not keep it.
+    pub fn scene_bind_group(&self) -> &wgpu::BindGroup {
+        &self.bind_group
+    }
+
+    /// Writes the frame uniform for another method's pass (camera, previous camera, lights,
+    /// `spp` and the first sample index in `size.zw`, seed, frame, max depth) exactly as this
+    /// tracer's own passes see it.
+    pub fn prepare_frame(&self, gpu: &Gpu, spp: u32, first_sample: u32, seed: u64, frame: u32) {
+        self.write_frame(gpu, &self.previous_camera, spp, first_sample, seed, frame, false);
     }
 
     pub fn settings(&self) -> PathTracerSettings {
@@ -242,7 +271,8 @@ impl PathTracer {
 
     /// Refreshes the dynamic parts: instance transforms, materials (and textures), lights
     /// (emissive triangles follow their instances), camera, environment. Meshes are fixed at
-    /// `new`. The camera of the last rendered frame is kept for motion vectors.
+    /// `new`. Call once per simulated frame: the camera and instance transforms it replaces become
+    /// the previous ones of motion vectors.
     pub fn update(&mut self, gpu: &Gpu, scene: &SceneDesc) {
         if let Err(e) = self.try_update(gpu, scene) {
             panic!("PathTracer::update: {e}");
@@ -280,6 +310,7 @@ impl PathTracer {
             );
         }
         self.light_table = light_table;
+        self.previous_camera = self.camera;
         self.camera = scene.camera;
         self.environment = scene.environment;
         Ok(())
@@ -290,7 +321,7 @@ impl PathTracer {
         if spp == 0 {
             return Err(RenderError::Settings("spp must be at least 1".into()));
         }
-        let previous = self.previous_camera.unwrap_or(self.camera);
+        let previous = self.previous_camera;
         // G-buffer pass.
         let start = Instant::now();
         self.write_frame(gpu, &previous, 0, 0, seed, frame, false);
@@ -306,18 +337,17 @@ impl PathTracer {
 
         let radiance = self.read_radiance(gpu)?;
         let gbuffer = self.read_gbuffer(gpu)?;
-        self.previous_camera = Some(self.camera);
         Ok(FrameOutput { width: self.settings.width, height: self.settings.height, radiance, gbuffer, timings: vec![gbuffer_timing, trace_timing] })
     }
 
     /// The current scene accumulated to `spp` samples per pixel in batches of at most
     /// [`PATHS_PER_DISPATCH`] paths, one submission each; `progress(done_spp, total_spp)` after
-    /// every batch. Radiance only (no G-buffer); the motion-vector camera is left untouched.
+    /// every batch. Radiance only (no G-buffer).
     pub fn render_reference(&mut self, gpu: &Gpu, spp: u32, seed: u64, frame: u32, progress: &mut dyn FnMut(u32, u32)) -> Result<Vec<[f32; 4]>, RenderError> {
         if spp == 0 {
             return Err(RenderError::Settings("reference spp must be at least 1".into()));
         }
-        let previous = self.previous_camera.unwrap_or(self.camera);
+        let previous = self.previous_camera;
         self.trace_batches(gpu, &previous, spp, seed, frame, progress)?;
         self.read_radiance(gpu)
     }

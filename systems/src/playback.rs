@@ -95,7 +95,6 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary> {
     let cache = ReferenceCache::new(opts.cache_dir.clone().unwrap_or_else(ReferenceCache::default_location));
     let mut methods: Vec<Box<dyn FrameMethod>> = Vec::new();
     for spec in &scenario.methods {
-        tracer.update(&gpu, sim.scene());
         let method = methods::build(spec, &gpu, &scenario, sim.scene())
             .with_context(|| format!("{}: preparing method {}", opts.scenario.display(), spec.label()))?;
         methods.push(method);

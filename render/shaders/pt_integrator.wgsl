@@ -1,0 +1,124 @@
+// Path integrator shared by every pass that shades: next-event estimation with MIS, emission,
+// and the path loop. Concatenated after pt_scene.wgsl.
+
+// Next-event estimation at a surface point: every analytic light, one emissive triangle, the
+// environment, each MIS-weighted (power heuristic) against the BSDF's pdf.
+fn next_event(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>) -> vec3f {
+    var radiance = vec3f(0.0);
+    let analytic_count = frame.counts.y;
+    let emitter_count = frame.counts.z;
+    for (var i = 0u; i < analytic_count; i++) {
+        let ls = sample_analytic_light(lights[i], p, rng_next2(rng));
+        if dot(ls.wi, sh.ng) <= 0.0 || max_component(ls.weight) <= 0.0 {
+            continue;
+        }
+        let f = bsdf_eval(bsdf, sh.ns, wo, ls.wi);
+        if max_component(f) <= 0.0 {
+            continue;
+        }
+        let o = offset_origin(p, sh.ng, ls.wi);
+        if trace_any(o, ls.wi, ls.dist * (1.0 - 1.0e-4)) {
+            continue;
+        }
+        var w = 1.0;
+        if ls.pdf > 0.0 {
+            w = power_heuristic(ls.pdf, bsdf_pdf(bsdf, sh.ns, wo, ls.wi));
+        }
+        radiance += f * dot(sh.ns, ls.wi) * ls.weight * w;
+    }
+    if emitter_count > 0u {
+        let u_select = rng_next(rng);
+        let ls = sample_emitter(analytic_count, emitter_count, p, u_select, rng_next2(rng));
+        if ls.pdf > 0.0 && dot(ls.wi, sh.ng) > 0.0 {
+            let f = bsdf_eval(bsdf, sh.ns, wo, ls.wi);
+            if max_component(f) > 0.0 {
+                let o = offset_origin(p, sh.ng, ls.wi);
+                if !trace_any(o, ls.wi, ls.dist * (1.0 - 1.0e-3)) {
+                    let w = power_heuristic(ls.pdf, bsdf_pdf(bsdf, sh.ns, wo, ls.wi));
+                    radiance += f * dot(sh.ns, ls.wi) * ls.weight * w;
+                }
+            }
+        }
+    }
+    let env_pdf = environment_pdf();
+    if env_pdf > 0.0 {
+        let wi = sample_uniform_sphere(rng_next2(rng));
+        if dot(wi, sh.ng) > 0.0 {
+            let f = bsdf_eval(bsdf, sh.ns, wo, wi);
+            if max_component(f) > 0.0 && !trace_any(offset_origin(p, sh.ng, wi), wi, FAR) {
+                let w = power_heuristic(env_pdf, bsdf_pdf(bsdf, sh.ns, wo, wi));
+                radiance += f * dot(sh.ns, wi) * frame.environment.xyz * (w / env_pdf);
+            }
+        }
+    }
+    return radiance;
+}
+
+// Emitted radiance seen along a ray that hit `sp` at distance `dist`, MIS-weighted against the
+// light-sampling pdf when the ray was BSDF-sampled (`prev_bsdf_pdf` > 0).
+// Emitters are one-sided (front face by winding, as pbrt's area lights and glTF's emissive):
+// a two-sided light a few millimetres under a ceiling traps light between its back face and
+// the ceiling, an unbounded-variance source of fireflies.
+fn emitted_radiance(sp: SurfacePoint, m: GpuMaterial, dir: vec3f, dist: f32, prev_bsdf_pdf: f32) -> vec3f {
+    let le_lum = luminance(m.emission);
+    let cos_light = -dot(sp.geometric_normal, dir);
+    if le_lum <= 0.0 || cos_light <= 0.0 {
+        return vec3f(0.0);
+    }
+    var w = 1.0;
+    let emitter_weight = frame.environment.w;
+    if prev_bsdf_pdf > 0.0 && emitter_weight > 0.0 {
+        let light_pdf = le_lum / emitter_weight * dist * dist / cos_light;
+        w = power_heuristic(prev_bsdf_pdf, light_pdf);
+    }
+    return m.emission * w;
+}
+
+// Radiance carried back along a path that starts with the ray (origin, dir) at vertex `depth`
+// (0 = camera ray), up to the frame's max depth. `prev_bsdf_pdf` is the pdf that chose `dir`
+// (0 for a camera ray: no MIS on what it hits). Russian roulette from frame.counts.x on.
+fn path_radiance(origin_in: vec3f, dir_in: vec3f, prev_bsdf_pdf_in: f32, depth_in: u32, rng: ptr<function, u32>) -> vec3f {
+    var origin = origin_in;
+    var dir = dir_in;
+    var throughput = vec3f(1.0);
+    var radiance = vec3f(0.0);
+    var prev_bsdf_pdf = prev_bsdf_pdf_in;
+    let max_depth = frame.seed.w;
+    for (var depth = depth_in; depth <= max_depth; depth++) {
+        let hit = trace_closest(origin, dir, FAR);
+        if hit.instance == NO_HIT {
+            radiance += throughput * escaped_radiance(dir, prev_bsdf_pdf);
+            break;
+        }
+        let sp = surface_point(hit, origin, dir);
+        let m = materials[sp.material];
+        let wo = -dir;
+        let sh = orient(sp, wo);
+        radiance += throughput * emitted_radiance(sp, m, dir, hit.t, prev_bsdf_pdf);
+        if depth == max_depth {
+            break;
+        }
+        let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);
+        let p = sp.position;
+        radiance += throughput * next_event(p, sh, bsdf, wo, rng);
+
+        // Continue the path by sampling the BSDF.
+        let u_lobe = rng_next(rng);
+        let bs = bsdf_sample(bsdf, sh.ns, wo, u_lobe, rng_next2(rng));
+        if !bs.valid || dot(bs.wi, sh.ng) <= 0.0 {
+            break;
+        }
+        throughput *= bs.f * (dot(sh.ns, bs.wi) / bs.pdf);
+        prev_bsdf_pdf = bs.pdf;
+        if depth + 1u >= frame.counts.x {
+            let survive = min(max_component(throughput), 0.95);
+            if rng_next(rng) >= survive {
+                break;
+            }
+            throughput /= survive;
+        }
+        origin = offset_origin(p, sh.ng, bs.wi);
+        dir = bs.wi;
+    }
+    return radiance;
+}

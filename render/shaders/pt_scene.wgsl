@@ -1,0 +1,140 @@
+// The scene as the path tracer's passes see it: frame uniform, materials, lights, camera, and
+// the helpers every pass that shades surfaces needs. @group(0) (layout in path_tracer.rs);
+// passes of other methods bind it too and put their own buffers in @group(2).
+
+struct CameraFrame {
+    position: vec4f,  // w: tan(vfov / 2)
+    forward: vec4f,   // w: aspect (width / height)
+    right: vec4f,
+    up: vec4f,
+}
+
+struct Frame {
+    camera: CameraFrame,
+    previous_camera: CameraFrame,
+    environment: vec4f,   // w: total emitter weight W = sum luminance(Le) * area
+    size: vec4u,          // width, height, spp of this dispatch, index of its first sample
+    seed: vec4u,          // seed low, seed high, frame, max depth
+    counts: vec4u,        // Russian-roulette start depth, analytic lights, emissive triangles, accumulate
+}
+
+struct GpuMaterial {
+    base_color: vec3f,
+    texture_offset: u32,  // first texel in `texels`, NO_TEXTURE if none
+    emission: vec3f,
+    roughness: f32,
+    metallic: f32,
+    specular: f32,
+    texture_width: u32,
+    texture_height: u32,
+}
+
+struct GBufferTexel {
+    normal: vec3f,
+    depth: f32,
+    albedo: vec3f,
+    instance: u32,
+    motion: vec2f,
+    primitive: u32,
+    pad: u32,
+}
+
+const NO_TEXTURE: u32 = 0xffffffffu;
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> materials: array<GpuMaterial>;
+@group(0) @binding(2) var<storage, read> texels: array<u32>;
+@group(0) @binding(3) var<storage, read> lights: array<GpuLight>;
+@group(0) @binding(4) var<storage, read_write> radiance_sum: array<vec4f>;
+@group(0) @binding(5) var<storage, read_write> gbuffer: array<GBufferTexel>;
+
+fn srgb_to_linear(c: vec3f) -> vec3f {
+    let lo = c / 12.92;
+    let hi = pow((c + 0.055) / 1.055, vec3f(2.4));
+    return select(hi, lo, c <= vec3f(0.04045));
+}
+
+fn texel(m: GpuMaterial, x: i32, y: i32) -> vec3f {
+    let w = i32(m.texture_width);
+    let h = i32(m.texture_height);
+    let xi = ((x % w) + w) % w;
+    let yi = ((y % h) + h) % h;
+    let packed = texels[m.texture_offset + u32(yi * w + xi)];
+    return srgb_to_linear(unpack4x8unorm(packed).rgb);
+}
+
+// Bilinear, repeat wrap, filtered in linear space (sRGB decoded per texel).
+fn base_color_at(m: GpuMaterial, uv: vec2f) -> vec3f {
+    if m.texture_offset == NO_TEXTURE || m.texture_width == 0u || m.texture_height == 0u {
+        return m.base_color;
+    }
+    let st = uv * vec2f(f32(m.texture_width), f32(m.texture_height)) - 0.5;
+    let base = floor(st);
+    let f = st - base;
+    let x = i32(base.x);
+    let y = i32(base.y);
+    let top = mix(texel(m, x, y), texel(m, x + 1, y), f.x);
+    let bottom = mix(texel(m, x, y + 1), texel(m, x + 1, y + 1), f.x);
+    return m.base_color * mix(top, bottom, f.y);
+}
+
+fn camera_ray_direction(c: CameraFrame, pixel: vec2f) -> vec3f {
+    let w = f32(frame.size.x);
+    let h = f32(frame.size.y);
+    let ndc = vec2f(2.0 * pixel.x / w - 1.0, 1.0 - 2.0 * pixel.y / h);
+    let d = c.forward.xyz + ndc.x * c.position.w * c.forward.w * c.right.xyz + ndc.y * c.position.w * c.up.xyz;
+    return normalize(d);
+}
+
+// Pixel coordinates (x right, y down, pixel centres at +0.5) of a camera-space offset `d`.
+fn project_offset(c: CameraFrame, d: vec3f) -> vec2f {
+    let z = dot(d, c.forward.xyz);
+    if z <= 0.0 {
+        return vec2f(-1.0e9);
+    }
+    let ndc = vec2f(dot(d, c.right.xyz) / (z * c.position.w * c.forward.w), dot(d, c.up.xyz) / (z * c.position.w));
+    return vec2f((0.5 * ndc.x + 0.5) * f32(frame.size.x), (0.5 - 0.5 * ndc.y) * f32(frame.size.y));
+}
+
+// Origin offset off the surface along the geometric normal, on the side `dir` leaves to.
+fn offset_origin(p: vec3f, ng: vec3f, dir: vec3f) -> vec3f {
+    let scale = 1.0e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z))));
+    return p + ng * select(-scale, scale, dot(dir, ng) >= 0.0);
+}
+
+fn environment_pdf() -> f32 {
+    return select(0.0, 1.0 / (4.0 * PI), max_component(frame.environment.xyz) > 0.0);
+}
+
+// Radiance arriving along a ray that left the scene: environment plus the disks of directional
+// lights with an angular radius, each MIS-weighted against the BSDF pdf that chose the ray
+// (`bsdf_pdf` <= 0: camera ray, no MIS).
+fn escaped_radiance(dir: vec3f, bsdf_pdf: f32) -> vec3f {
+    var l = frame.environment.xyz;
+    if bsdf_pdf > 0.0 {
+        l *= power_heuristic(bsdf_pdf, environment_pdf());
+    }
+    for (var i = 0u; i < frame.counts.y; i++) {
+        let light = lights[i];
+        if light.kind == LIGHT_DIRECTIONAL && light.a > 0.0 && 1.0 - dot(dir, -normalize(light.p1)) <= light.a {
+            var w = 1.0;
+            if bsdf_pdf > 0.0 {
+                w = power_heuristic(bsdf_pdf, 1.0 / cone_solid_angle(light.a));
+            }
+            l += light.radiance * light.b * w;
+        }
+    }
+    return l;
+}
+
+struct Shading {
+    ng: vec3f,   // geometric normal, turned towards wo
+    ns: vec3f,   // shading normal, on the same side as ng
+}
+
+fn orient(sp: SurfacePoint, wo: vec3f) -> Shading {
+    var s: Shading;
+    s.ng = select(-sp.geometric_normal, sp.geometric_normal, dot(sp.geometric_normal, wo) >= 0.0);
+    s.ns = select(-sp.shading_normal, sp.shading_normal, dot(sp.shading_normal, s.ng) >= 0.0);
+    return s;
+}
