@@ -9,16 +9,42 @@ fn trace_path(pixel: vec2u, sample_index: u32) -> vec3f {
     return path_radiance(frame.camera.position.xyz, dir, 0.0, 0u, &rng);
 }
 
+// Per-(chunk, pixel) partial sums of one dispatch; `accumulate_main` adds them up in chunk order.
+@group(0) @binding(6) var<storage, read_write> sample_partials: array<vec4f>;
+
+// One thread per pixel and chunk of at most SAMPLES_PER_THREAD samples (global id z = chunk).
+// Few samples per thread keep every invocation short: llvmpipe (Mesa 22) silently ends a shader's
+// loops after 65535 iterations in total per invocation, and real GPUs reset a device whose
+// dispatch runs too long; spreading samples over z also keeps small images parallel.
 @compute @workgroup_size(8, 8, 1)
 fn trace_main(@builtin(global_invocation_id) id: vec3u) {
     if id.x >= frame.size.x || id.y >= frame.size.y {
         return;
     }
+    let first = id.z * SAMPLES_PER_THREAD;
     var sum = vec3f(0.0);
-    for (var s = 0u; s < frame.size.z; s++) {
-        sum += trace_path(id.xy, frame.size.w + s);
+    for (var s = 0u; s < SAMPLES_PER_THREAD; s++) {
+        if first + s < frame.size.z {
+            sum += trace_path(id.xy, frame.size.w + first + s);
+        }
     }
+    let pixels = frame.size.x * frame.size.y;
+    sample_partials[id.z * pixels + id.y * frame.size.x + id.x] = vec4f(sum, 0.0);
+}
+
+// Adds a dispatch's chunks to the running sum in a fixed order (deterministic); w counts samples.
+@compute @workgroup_size(8, 8, 1)
+fn accumulate_main(@builtin(global_invocation_id) id: vec3u) {
+    if id.x >= frame.size.x || id.y >= frame.size.y {
+        return;
+    }
+    let pixels = frame.size.x * frame.size.y;
     let index = id.y * frame.size.x + id.x;
+    let chunks = (frame.size.z + SAMPLES_PER_THREAD - 1u) / SAMPLES_PER_THREAD;
+    var sum = vec3f(0.0);
+    for (var c = 0u; c < chunks; c++) {
+        sum += sample_partials[c * pixels + index].xyz;
+    }
     var previous = vec4f(0.0);
     if frame.counts.w != 0u {
         previous = radiance_sum[index];

@@ -27,13 +27,20 @@ pub const NO_HIT: u32 = u32::MAX;
 /// trip a GPU watchdog (about 2 s on desktop drivers) even on slow adapters.
 pub const PATHS_PER_DISPATCH: u64 = 1 << 20;
 
+/// Samples one invocation of the trace pass traces; a dispatch spreads its samples over
+/// workgroup z (see trace_main in path_tracer.wgsl for why invocations must stay short).
+pub const SAMPLES_PER_THREAD: u32 = 2;
+
+/// Upper bound on sample chunks (workgroups along z) per dispatch.
+const MAX_CHUNKS: u32 = 4096;
+
 /// The pass names in [`FrameOutput::timings`].
 pub const GBUFFER_PASS: &str = "gbuffer";
 pub const PATH_TRACE_PASS: &str = "path_trace";
 
 const WORKGROUP: u32 = 8;
-/// Storage buffers of group 0 (materials, texels, lights, radiance, G-buffer).
-const STORAGE_BUFFERS: u32 = 5;
+/// Storage buffers of group 0 (materials, texels, lights, radiance, G-buffer, sample partials).
+const STORAGE_BUFFERS: u32 = 6;
 /// Storage buffers of scene_geometry.wgsl (group 1).
 const GEOMETRY_STORAGE_BUFFERS: u32 = 8;
 
@@ -106,6 +113,10 @@ pub struct PathTracer {
     lights: wgpu::Buffer,
     radiance_sum: wgpu::Buffer,
     gbuffer: wgpu::Buffer,
+    /// Per-(chunk, pixel) sums of one dispatch, summed by `accumulate_main`.
+    sample_partials: wgpu::Buffer,
+    accumulate_pipeline: wgpu::ComputePipeline,
+    max_chunks: u32,
     radiance_readback: wgpu::Buffer,
     gbuffer_readback: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
@@ -166,6 +177,8 @@ impl PathTracer {
         let gbuffer = per_pixel("gbuffer", gbuffer_size, rw);
         let radiance_readback = per_pixel("radiance readback", radiance_size, readback);
         let gbuffer_readback = per_pixel("gbuffer readback", gbuffer_size, readback);
+        let max_chunks = MAX_CHUNKS.min(gpu.limits.max_compute_workgroups_per_dimension);
+        let sample_partials = Self::partials_buffer(gpu, pixels, Self::chunks_for(PATHS_PER_DISPATCH, pixels, max_chunks))?;
         let frame_buffer = per_pixel("path tracer frame", size_of::<GpuFrame>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
 
         let layout = bind_group_layout(device);
@@ -188,11 +201,12 @@ impl PathTracer {
         };
         let trace_pipeline = pipeline("trace_main");
         let gbuffer_pipeline = pipeline("gbuffer_main");
+        let accumulate_pipeline = pipeline("accumulate_main");
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Shader { pass: "path_tracer.wgsl".into(), message: e.to_string() });
         }
 
-        let bind_group = make_bind_group(device, &layout, [&frame_buffer, &materials, &texels, &lights, &radiance_sum, &gbuffer]);
+        let bind_group = make_bind_group(device, &layout, [&frame_buffer, &materials, &texels, &lights, &radiance_sum, &gbuffer, &sample_partials]);
         Ok(Self {
             settings,
             geometry,
@@ -205,6 +219,9 @@ impl PathTracer {
             lights,
             radiance_sum,
             gbuffer,
+            sample_partials,
+            accumulate_pipeline,
+            max_chunks,
             radiance_readback,
             gbuffer_readback,
             bind_group,
@@ -221,7 +238,14 @@ impl PathTracer {
     /// anything cached from its images.
     pub fn shader_source() -> &'static str {
         static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-        SOURCE.get_or_init(|| [Self::library_source(), include_str!("../shaders/path_tracer.wgsl")].join("\n"))
+        SOURCE.get_or_init(|| {
+            [
+                Self::library_source(),
+                &format!("const SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;"),
+                include_str!("../shaders/path_tracer.wgsl"),
+            ]
+            .join("\n")
+        })
     }
 
     /// The shading library without entry points: scene geometry (@group(1)), sampling, BSDFs,
@@ -306,7 +330,7 @@ impl PathTracer {
             self.bind_group = make_bind_group(
                 &gpu.device,
                 &self.layout,
-                [&self.frame_buffer, &self.materials, &self.texels, &self.lights, &self.radiance_sum, &self.gbuffer],
+                [&self.frame_buffer, &self.materials, &self.texels, &self.lights, &self.radiance_sum, &self.gbuffer, &self.sample_partials],
             );
         }
         self.light_table = light_table;
@@ -355,14 +379,41 @@ impl PathTracer {
     /// Samples per pixel in one dispatch at this resolution (at least 1).
     pub fn samples_per_dispatch(&self) -> u32 {
         let pixels = self.settings.width as u64 * self.settings.height as u64;
-        (self.paths_per_dispatch / pixels).clamp(1, u32::MAX as u64) as u32
+        Self::chunks_for(self.paths_per_dispatch, pixels, self.max_chunks) * SAMPLES_PER_THREAD
     }
 
     /// Changes the work bound of one dispatch (default [`PATHS_PER_DISPATCH`]): lower it for a
     /// slow adapter with a watchdog, raise it for a fast one. The image does not depend on it
     /// beyond float summation order.
-    pub fn set_paths_per_dispatch(&mut self, paths: u64) {
+    pub fn set_paths_per_dispatch(&mut self, gpu: &Gpu, paths: u64) -> Result<(), RenderError> {
         self.paths_per_dispatch = paths.max(1);
+        let pixels = self.settings.width as u64 * self.settings.height as u64;
+        let chunks = Self::chunks_for(self.paths_per_dispatch, pixels, self.max_chunks);
+        if self.sample_partials.size() < pixels * chunks as u64 * 16 {
+            self.sample_partials = Self::partials_buffer(gpu, pixels, chunks)?;
+            self.bind_group = make_bind_group(
+                &gpu.device,
+                &self.layout,
+                [&self.frame_buffer, &self.materials, &self.texels, &self.lights, &self.radiance_sum, &self.gbuffer, &self.sample_partials],
+            );
+        }
+        Ok(())
+    }
+
+    /// Chunks of [`SAMPLES_PER_THREAD`] samples per dispatch: at least one.
+    fn chunks_for(paths: u64, pixels: u64, max_chunks: u32) -> u32 {
+        (paths / pixels / SAMPLES_PER_THREAD as u64).clamp(1, max_chunks as u64) as u32
+    }
+
+    fn partials_buffer(gpu: &Gpu, pixels: u64, chunks: u32) -> Result<wgpu::Buffer, RenderError> {
+        let size = pixels * chunks as u64 * 16;
+        gpu.check_buffer_size("sample partials", size)?;
+        Ok(gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sample partials"),
+            size,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        }))
     }
 
     /// Traces `spp` samples into the radiance sum; returns the summed GPU time of the batches.
@@ -374,7 +425,19 @@ impl PathTracer {
             let batch = per_dispatch.min(spp - done);
             self.write_frame(gpu, previous, batch, done, seed, frame, done > 0);
             let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path trace") });
-            self.dispatch(&mut encoder, &self.trace_pipeline, PATH_TRACE_PASS, 1);
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(PATH_TRACE_PASS),
+                    timestamp_writes: self.timestamps.as_ref().map(|t| t.writes(1)),
+                });
+                let (x, y) = (self.settings.width.div_ceil(WORKGROUP), self.settings.height.div_ceil(WORKGROUP));
+                pass.set_bind_group(0, &self.bind_group, &[]);
+                pass.set_bind_group(1, self.geometry.bind_group(), &[]);
+                pass.set_pipeline(&self.trace_pipeline);
+                pass.dispatch_workgroups(x, y, batch.div_ceil(SAMPLES_PER_THREAD));
+                pass.set_pipeline(&self.accumulate_pipeline);
+                pass.dispatch_workgroups(x, y, 1);
+            }
             let t = self.submit_timed(gpu, encoder, 1)?;
             gpu_ms = gpu_ms.zip(t).map(|(a, b)| a + b);
             done += batch;
@@ -486,11 +549,12 @@ fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             buffer(3, read),
             buffer(4, write),
             buffer(5, write),
+            buffer(6, write),
         ],
     })
 }
 
-fn make_bind_group(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, buffers: [&wgpu::Buffer; 6]) -> wgpu::BindGroup {
+fn make_bind_group(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, buffers: [&wgpu::Buffer; 7]) -> wgpu::BindGroup {
     let entries: Vec<wgpu::BindGroupEntry> =
         buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
     device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("path tracer"), layout, entries: &entries })

@@ -200,6 +200,36 @@ fn furnace_albedo_one_scene_renders_the_environment() {
 }
 
 #[test]
+fn long_dispatch_keeps_every_sample() {
+    // Thousands of deep paths per pixel in ONE dispatch. llvmpipe (Mesa 22) silently ends all of
+    // an invocation's loops after 65535 iterations in total; a thread that looped over its
+    // samples returned a sum of only the first few hundred while the count said thousands, and
+    // the image came out several times too dark. The furnace must stay at 1.
+    let camera = Camera { position: Vec3::new(0.0, 1.5, 4.0), target: Vec3::new(0.0, 0.7, 0.0), up: Vec3::Y, vfov: 60f32.to_radians() };
+    let scene = SceneDesc {
+        meshes: vec![plane(3.0), sphere(24, 12)],
+        materials: vec![lambert(1.0)],
+        instances: vec![
+            Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY },
+            Instance { mesh: 1, material: 0, transform: Mat4::from_translation(Vec3::new(0.0, 1.0, 0.0)) },
+        ],
+        environment: Vec3::ONE,
+        camera,
+        ..Default::default()
+    };
+    let s = PathTracerSettings { width: 8, height: 6, max_depth: 64, rr_start_depth: 64 };
+    let mut pt = PathTracer::new(gpu(), &scene, s).unwrap();
+    let spp = 2048;
+    assert!(pt.samples_per_dispatch() >= spp, "the test needs all samples in one dispatch");
+    let mut dispatches = 0;
+    let image = pt.render_reference(gpu(), spp, 5, 0, &mut |_, _| dispatches += 1).unwrap();
+    assert_eq!(dispatches, 1);
+    let mean = image.iter().map(mean_rgb).sum::<f64>() / image.len() as f64;
+    let worst = image.iter().map(|p| (mean_rgb(p) - 1.0).abs()).fold(0.0, f64::max);
+    assert!((mean - 1.0).abs() < 0.01 && worst < 0.05, "furnace at {spp} spp in one dispatch: mean {mean}, worst pixel off by {worst}");
+}
+
+#[test]
 fn furnace_convex_object_reflects_its_albedo() {
     // A convex Lambertian object of albedo a in a constant environment L: every point sees only
     // the environment over its hemisphere, so the reflected radiance is exactly a L.
@@ -520,7 +550,7 @@ fn reference_batches_sum_the_same_samples() {
     let s = PathTracerSettings { width: 16, height: 12, max_depth: 4, rr_start_depth: 2 };
     let mut pt = PathTracer::new(gpu(), &scene, s).unwrap();
     let one = pt.render_reference(gpu(), 64, 9, 3, &mut |_, _| {}).unwrap();
-    pt.set_paths_per_dispatch(16 * 12 * 16);
+    pt.set_paths_per_dispatch(gpu(), 16 * 12 * 16).unwrap();
     assert_eq!(pt.samples_per_dispatch(), 16);
     let mut batches = 0;
     let four = pt.render_reference(gpu(), 64, 9, 3, &mut |_, _| batches += 1).unwrap();
