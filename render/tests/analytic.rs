@@ -173,12 +173,10 @@ fn ground_scene(albedo: f32, camera: Camera) -> SceneDesc {
     }
 }
 
-#[test]
-fn furnace_albedo_one_scene_renders_the_environment() {
-    // Every surface white Lambertian inside a constant environment L = 1: whatever the geometry
-    // (here a sphere resting on a plane: concave corners, many bounces), radiance is 1 everywhere.
+/// A white Lambertian sphere resting on a white plane in a constant environment L = 1.
+fn white_furnace() -> SceneDesc {
     let camera = Camera { position: Vec3::new(0.0, 1.5, 4.0), target: Vec3::new(0.0, 0.7, 0.0), up: Vec3::Y, vfov: 60f32.to_radians() };
-    let scene = SceneDesc {
+    SceneDesc {
         meshes: vec![plane(3.0), sphere(24, 12)],
         materials: vec![lambert(1.0)],
         instances: vec![
@@ -188,7 +186,14 @@ fn furnace_albedo_one_scene_renders_the_environment() {
         environment: Vec3::ONE,
         camera,
         ..Default::default()
-    };
+    }
+}
+
+#[test]
+fn furnace_albedo_one_scene_renders_the_environment() {
+    // Every surface white Lambertian inside a constant environment L = 1: whatever the geometry
+    // (here a sphere resting on a plane: concave corners, many bounces), radiance is 1 everywhere.
+    let scene = white_furnace();
     let s = PathTracerSettings { max_depth: 64, rr_start_depth: 64, ..settings(64) };
     let first = render(&scene, s, 1, 0);
     let hits = first.gbuffer.instance_id.iter().filter(|&&i| i != NO_HIT).count();
@@ -205,18 +210,7 @@ fn long_dispatch_keeps_every_sample() {
     // an invocation's loops after 65535 iterations in total; a thread that looped over its
     // samples returned a sum of only the first few hundred while the count said thousands, and
     // the image came out several times too dark. The furnace must stay at 1.
-    let camera = Camera { position: Vec3::new(0.0, 1.5, 4.0), target: Vec3::new(0.0, 0.7, 0.0), up: Vec3::Y, vfov: 60f32.to_radians() };
-    let scene = SceneDesc {
-        meshes: vec![plane(3.0), sphere(24, 12)],
-        materials: vec![lambert(1.0)],
-        instances: vec![
-            Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY },
-            Instance { mesh: 1, material: 0, transform: Mat4::from_translation(Vec3::new(0.0, 1.0, 0.0)) },
-        ],
-        environment: Vec3::ONE,
-        camera,
-        ..Default::default()
-    };
+    let scene = white_furnace();
     let s = PathTracerSettings { width: 8, height: 6, max_depth: 64, rr_start_depth: 64 };
     let mut pt = PathTracer::new(gpu(), &scene, s).unwrap();
     let spp = 2048;
