@@ -84,9 +84,26 @@ fn bsdf_pdf(b: Bsdf, n: vec3f, wo: vec3f, wi: vec3f) -> f32 {
     }
     let p_spec = specular_probability(b, n_dot_v);
     let h = normalize(wo + wi);
-    // Half-vector pdf D (n.h), mapped to wi by the reflection Jacobian 1 / (4 v.h).
-    let pdf_spec = ggx_d(b.alpha, max(dot(n, h), 0.0)) * max(dot(n, h), 0.0) / max(4.0 * dot(wo, h), 1.0e-12);
+    // Visible-normal pdf G1(v) D(h) (v.h) / (n.v), mapped to wi by the reflection Jacobian
+    // 1 / (4 v.h): G1(v) D(h) / (4 n.v) = D(h) / (2 (n.v + sqrt(a^2 + (1 - a^2)(n.v)^2))).
+    let a2 = b.alpha * b.alpha;
+    let pdf_spec = ggx_d(b.alpha, max(dot(n, h), 0.0)) / (2.0 * (n_dot_v + sqrt(a2 + (1.0 - a2) * n_dot_v * n_dot_v)));
     return p_spec * pdf_spec + (1.0 - p_spec) * n_dot_l * INV_PI;
+}
+
+// A GGX normal visible from `wo` (local frame, +z the normal), distributed as
+// G1(wo) max(0, wo.h) D(h) / wo.z: sampling visible normals keeps the specular sample weight
+// F G2 / G1(wo) <= 1, where sampling D(h) cos alone gives weights that grow without bound at
+// grazing angles (heavy-tailed noise). Spherical-cap method of Dupuy and Benyoub (2023):
+// stretch wo to the alpha = 1 configuration, sample the cap of the unit sphere above -wo, and
+// unstretch the result.
+fn sample_ggx_visible_normal(wo: vec3f, alpha: f32, u: vec2f) -> vec3f {
+    let v = normalize(vec3f(alpha * wo.x, alpha * wo.y, wo.z));
+    let phi = TWO_PI * u.x;
+    let z = (1.0 - u.y) * (1.0 + v.z) - v.z;
+    let sin_theta = sqrt(clamp(1.0 - z * z, 0.0, 1.0));
+    let h = vec3f(sin_theta * cos(phi), sin_theta * sin(phi), z) + v;
+    return normalize(vec3f(alpha * h.x, alpha * h.y, max(h.z, 0.0)));
 }
 
 fn bsdf_sample(b: Bsdf, n: vec3f, wo: vec3f, u_lobe: f32, u: vec2f) -> BsdfSample {
@@ -98,13 +115,10 @@ fn bsdf_sample(b: Bsdf, n: vec3f, wo: vec3f, u_lobe: f32, u: vec2f) -> BsdfSampl
     }
     let p_spec = specular_probability(b, n_dot_v);
     if u_lobe < p_spec {
-        // GGX half vector from D (n.h): cos^2 theta_h = (1 - u) / (1 + (a^2 - 1) u).
-        let a2 = b.alpha * b.alpha;
-        let cos2 = (1.0 - u.x) / (1.0 + (a2 - 1.0) * u.x);
-        let cos_h = sqrt(max(cos2, 0.0));
-        let sin_h = sqrt(max(1.0 - cos2, 0.0));
-        let phi = TWO_PI * u.y;
-        let h = to_world(vec3f(sin_h * cos(phi), sin_h * sin(phi), cos_h), n);
+        let t = basis_tangent(n);
+        let bt = basis_bitangent(n);
+        let wo_local = vec3f(dot(wo, t), dot(wo, bt), n_dot_v);
+        let h = to_world(sample_ggx_visible_normal(wo_local, b.alpha, u), n);
         s.wi = reflect(-wo, h);
     } else {
         s.wi = to_world(sample_cosine_hemisphere(u), n);
