@@ -60,7 +60,7 @@ pub struct SimRng {
 
 impl SimRng {
     pub fn new(seed: u64) -> Self {
-        Self { seed, rng: Rng::new(seed) }
+        Self { seed, rng: Rng::seeded(seed) }
     }
 }
 

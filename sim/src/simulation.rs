@@ -13,7 +13,6 @@ use crate::components::{Camera, Hidden, Intensity, LightSource, MeshInstance, Na
 use crate::extract::extract_dynamic;
 use crate::gltf_import::{self, GltfError};
 use crate::resources::{ActiveCamera, Clock, Environment, MaterialTable, SimRng};
-use crate::rng::Rng;
 use crate::scenario::{ActionSpec, AnimationSpec, Scenario, SceneSource, WaveformSpec, find_quoted};
 use crate::template::WorldTemplate;
 use crate::transform::{GlobalTransform, Transform, propagate_transforms};
@@ -332,7 +331,7 @@ fn attach_animation(world: &mut World, names: &Names, spec: &AnimationSpec, inde
             }
             let scale = world.get::<Transform>(proto).map_or(Vec3::ONE, |t| t.scale);
             world.entity_mut(proto).insert((Flock { params }, Hidden));
-            let mut rng = Rng::stream(seed, index);
+            let mut rng = crate::rng::stream(seed, index);
             let first = world.query::<&SpawnOrder>().iter(world).map(|o| o.0 + 1).max().unwrap_or(0);
             for (i, (p, v)) in initial_boids(&params, *count, &mut rng).into_iter().enumerate() {
                 world.spawn((

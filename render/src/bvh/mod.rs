@@ -24,7 +24,7 @@ pub use blas::Blas;
 pub use cpu_traversal::{InstanceUpdate, SceneBvh};
 pub use tlas::InstanceTransforms;
 pub use ray_batch::{RayBatch, RayBuffers, RayQuery, SurfaceRecord, TraceKind};
-pub use rng::SplitMix64;
+pub use rng::{SplitMix64, mix64};
 pub use scene_geometry::SceneGeometry;
 pub use tlas::Tlas;
 pub use triangle::{WatertightRay, intersect_triangle};

@@ -1,22 +1,34 @@
-//! SplitMix64 (Steele, Lea & Flood 2014): a tiny seeded generator for test and benchmark rays,
-//! so the same seed gives the same rays everywhere.
+//! SplitMix64 (Steele, Lea & Flood 2014): the project's one seeded CPU generator (test and
+//! benchmark rays here, every random draw of the simulation in sim::rng), so the same seed
+//! gives the same numbers everywhere.
 
-#[derive(Clone, Debug)]
+/// Finalizer of SplitMix64: a good 64-bit mixing function.
+pub fn mix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SplitMix64 {
     state: u64,
 }
 
 impl SplitMix64 {
+    /// The generator whose state starts at `seed`.
     pub fn new(seed: u64) -> Self {
         Self { state: seed }
     }
 
+    /// The generator for a user-facing seed: the seed is mixed first, so that small
+    /// consecutive seeds (1, 2, 3) start far apart.
+    pub fn seeded(seed: u64) -> Self {
+        Self::new(mix64(seed ^ 0x5851_f42d_4c95_7f2d))
+    }
+
     pub fn next_u64(&mut self) -> u64 {
         self.state = self.state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
+        mix64(self.state)
     }
 
     /// Uniform in [0, 1), from the top 24 bits (exactly representable in f32).

@@ -210,7 +210,7 @@ mod tests {
     #[test]
     fn boids_stay_in_box_and_apart_over_many_steps() {
         let params = FlockParams::default();
-        let mut rng = Rng::new(42);
+        let mut rng = Rng::seeded(42);
         let init = initial_boids(&params, 40, &mut rng);
         let mut p: Vec<Vec3> = init.iter().map(|b| b.0).collect();
         let mut v: Vec<Vec3> = init.iter().map(|b| b.1).collect();
@@ -239,7 +239,7 @@ mod tests {
     fn flocking_aligns_velocities() {
         // With alignment alone, the spread of headings shrinks.
         let params = FlockParams { separation_weight: 0.0, cohesion_weight: 0.0, alignment_weight: 4.0, view_radius: 10.0, ..Default::default() };
-        let mut rng = Rng::new(5);
+        let mut rng = Rng::seeded(5);
         let init = initial_boids(&params, 20, &mut rng);
         let mut p: Vec<Vec3> = init.iter().map(|b| b.0).collect();
         let mut v: Vec<Vec3> = init.iter().map(|b| b.1).collect();

@@ -15,7 +15,7 @@ pub const SEGMENTS: u32 = 4;
 const GEOMETRY_SEED: u64 = 0x4a11_ba11;
 
 pub fn build() -> WorldTemplate {
-    let mut rng = Rng::new(GEOMETRY_SEED);
+    let mut rng = Rng::seeded(GEOMETRY_SEED);
     let mut b = MeshBuilder::new("hairball");
     for _ in 0..STRANDS {
         // Start on an inner sphere, wander outwards with a curl.
