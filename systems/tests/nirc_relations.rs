@@ -21,10 +21,12 @@ const CACHE: &str = "cache: (
         paths: (termination_vertex: 1, train_records: 512)";
 
 fn scenario(dir: &Path, name: &str, frames: u32, warmup: u32, events: &str, reference: bool) -> PathBuf {
+    // The Cornell box: its only light is an emissive quad, whose light at the primary hits comes
+    // entirely through the cache (analytic lights would be NEE's, see cache_paths.wgsl).
     let methods: Vec<String> = ["EmaOnly", "HighLrOnly", "Blend"].iter().map(|p| format!("Nirc(spp: 1, predictor: {p}, {CACHE})")).collect();
     let reference = if reference { "(spp: 64, frames: Every(1))" } else { "(spp: 64, frames: None)" };
     let text = format!(
-        "Scenario(scene: Builtin(\"courtyard\"), resolution: (32, 18), frames: {frames}, warmup_frames: {warmup}, seed: 3, max_depth: 3,
+        "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: {frames}, warmup_frames: {warmup}, seed: 3, max_depth: 3,
     methods: [{}], reference: {reference}, events: [{events}])",
         methods.join(", ")
     );
@@ -51,7 +53,8 @@ fn play(name: &str, frames: u32, warmup: u32, events: &str, reference: bool) -> 
 fn series(records: &[FrameRecord], method: &str, f: impl Fn(&FrameRecord) -> Option<f64>) -> Vec<f64> {
     let mut rows: Vec<&FrameRecord> = records.iter().filter(|r| r.method == method).collect();
     rows.sort_by_key(|r| r.frame);
-    rows.iter().map(|r| f(r).unwrap_or_else(|| panic!("{method} frame {}: missing value", r.frame))).collect()
+    // NaN where a frame has no value (SMAPE of the first frame).
+    rows.iter().map(|r| f(r).unwrap_or(f64::NAN)).collect()
 }
 
 fn stat(r: &FrameRecord, name: &str) -> Option<f64> {
@@ -69,8 +72,15 @@ const BLEND: &str = "nirc_blend_1spp";
 #[test]
 fn blend_adapts_like_high_lr_and_flickers_like_ema() {
     // 30 warm-up frames (training, past the reliability warm-up), then 16 recorded frames; the
-    // sun turns at simulation frame 36 = recorded frame 6.
-    let records = play("light_change", 16, 30, "(frame: 36, action: RotateLight(light: \"sun\", axis: (0.0, 1.0, 0.0), degrees: 60.0))", true);
+    // ceiling light is lowered and tilted towards the green wall at simulation frame 36 =
+    // recorded frame 6.
+    let records = play(
+        "light_change",
+        16,
+        30,
+        "(frame: 36, action: MoveBy(entity: \"ceiling_light\", offset: (0.0, -0.3, 0.0))), (frame: 36, action: Rotate(entity: \"ceiling_light\", axis: (0.0, 0.0, 1.0), degrees: 60.0))",
+        true,
+    );
     let flip = |m: &str| series(&records, m, |r| r.flip);
     let smape = |m: &str| series(&records, m, |r| r.smape);
     let (f_ema, f_hlr, f_blend) = (flip(EMA), flip(HIGH_LR), flip(BLEND));
@@ -97,9 +107,9 @@ fn static_scene_reliability_rises_and_blend_prefers_ema() {
     for (name, m) in [("reliability_ema", BLEND), ("reliability_high_lr", BLEND)] {
         let r = series(&records, m, |row| stat(row, name));
         eprintln!("{name} {r:.3?}");
-        // Grid warm-up K = 16 updates = frames 0..16; compare the frames right after it with the end.
-        let (early, late) = (mean(&r[16..21]), mean(&r[35..40]));
-        assert!(late > early, "{name} must rise in a static scene: {early:.3} after warm-up, {late:.3} at the end");
+        // From an untrained cache (frames 1..5) to the end: the predictors learn the scene.
+        let (early, late) = (mean(&r[1..6]), mean(&r[35..40]));
+        assert!(late > early + 0.1, "{name} must rise in a static scene: {early:.3} at the start, {late:.3} at the end");
         assert!(late > 0.0, "{name} must end positive: {late:.3}");
     }
     let sigma = series(&records, BLEND, |row| stat(row, "blend_sigma"));
