@@ -221,6 +221,17 @@ fn saved_and_loaded_cache_renders_the_next_frames_identically() {
         images.push(cache_frame(&paths, &cache, &t, &out, frame));
     }
     assert_ne!(images[2], images[3], "the cache must be learning");
+    // The diagnostic look-up reports the σ the blend used, and the grid is past its warm-up.
+    let diag = paths.output(g).unwrap();
+    let mut encoder = g.device.create_command_encoder(&Default::default());
+    paths.encode_queries(g, &mut encoder, &t, 5, 4);
+    cache.encode_infer(g, &mut encoder, paths.queries(), paths.query_count(), &out.answers, PredictorMode::Blend).unwrap();
+    cache.encode_reliability(g, &mut encoder, paths.queries(), paths.query_count(), &diag.answers).unwrap();
+    g.queue.submit([encoder.finish()]);
+    let (blend, rel) = (paths.read_answers(g, &out).unwrap(), paths.read_answers(g, &diag).unwrap());
+    assert!(rel.iter().all(|r| r[3] == 1.0), "grid warmed up");
+    assert!(blend.iter().zip(&rel).all(|(b, r)| b[3] == r[2]), "σ of the blend = σ of the diagnostics");
+    assert!(rel.iter().any(|r| r[0] != r[1]), "the two predictors' reliabilities differ somewhere");
     let file = std::env::temp_dir().join(format!("nirc-integrator-{}.state", std::process::id()));
     cache.save(g, &file).unwrap();
     let loaded = NeuralCache::load(g, &file).unwrap();
