@@ -1,5 +1,6 @@
 // Inference (one thread per query): evaluates the predictors the mode needs, looks up the
 // query's reliability cell and answers max(0, (1 - σ) f_EMA + σ f_cur) with σ in .w.
+// Mode 4 (diagnostics, no network): (r̄_cur, r̄_EMA, σ of the blend, 1 once warmed up).
 
 @group(0) @binding(0) var<uniform> call: Call;
 @group(0) @binding(1) var<uniform> hyper: Hyper;
@@ -25,14 +26,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
 
     var f_ema = vec3<f32>(0.0);
     var f_cur = vec3<f32>(0.0);
-    if mode != 1u {
+    if mode != 1u && mode != 4u {
         load_weights(1u, lid);
         if in_range {
             encode_input(1u, pos, dir);
             f_ema = mlp_forward(1u);
         }
     }
-    if mode != 0u {
+    if mode != 0u && mode != 4u {
         load_weights(0u, lid);
         if in_range {
             encode_input(0u, pos, dir);
@@ -50,6 +51,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
         let qy = moment3(b + 3u);
         r_cur = mean_correlation(my, qy, moment3(b + MOMENTS_CUR), moment3(b + MOMENTS_CUR + 3u), moment3(b + MOMENTS_CUR + 6u));
         r_ema = mean_correlation(my, qy, moment3(b + MOMENTS_EMA), moment3(b + MOMENTS_EMA + 3u), moment3(b + MOMENTS_EMA + 6u));
+    }
+    if mode == 4u {
+        let warm = counters.grid_updates >= hyper.warmup;
+        answers[qi] = vec4<f32>(r_cur, r_ema, high_lr_weight(2u, counters.grid_updates, r_cur, r_ema), select(0.0, 1.0, warm));
+        return;
     }
     let sigma = high_lr_weight(mode, counters.grid_updates, r_cur, r_ema);
     let l = max((1.0 - sigma) * f_ema + sigma * f_cur, vec3<f32>(0.0));

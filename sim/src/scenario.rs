@@ -31,10 +31,36 @@ fn builtin_name<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
 }
 
 /// A rendering method to run on every frame.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum MethodSpec {
     PathTracing { spp: u32 },
+    /// Path tracing terminated into the neural incident radiance cache (nirc/README.md).
+    /// Methods of one scenario with equal `spp`, `cache`, `paths` and `pretrain_frames` share
+    /// one cache, its camera paths and its training; only `predictor` (inference) differs.
+    Nirc {
+        spp: u32,
+        #[serde(default)]
+        predictor: nirc::PredictorMode,
+        #[serde(default)]
+        cache: nirc::NircConfig,
+        #[serde(default)]
+        paths: nirc::CachePathSettings,
+        /// Training-only frames on the first frame's scene before anything renders (a warm
+        /// start, saved next to the reference cache and reused).
+        #[serde(default)]
+        pretrain_frames: u32,
+    },
+}
+
+/// Short name of a predictor mode in labels.
+pub fn predictor_label(mode: nirc::PredictorMode) -> &'static str {
+    match mode {
+        nirc::PredictorMode::EmaOnly => "ema",
+        nirc::PredictorMode::HighLrOnly => "highlr",
+        nirc::PredictorMode::Blend => "blend",
+        nirc::PredictorMode::Switch => "switch",
+    }
 }
 
 impl MethodSpec {
@@ -42,6 +68,7 @@ impl MethodSpec {
     pub fn label(&self) -> String {
         match self {
             MethodSpec::PathTracing { spp } => format!("pt_{spp}spp"),
+            MethodSpec::Nirc { spp, predictor, .. } => format!("nirc_{}_{spp}spp", predictor_label(*predictor)),
         }
     }
 
@@ -49,6 +76,7 @@ impl MethodSpec {
     pub fn spp(&self) -> u32 {
         match self {
             MethodSpec::PathTracing { spp } => *spp,
+            MethodSpec::Nirc { spp, .. } => *spp,
         }
     }
 }

@@ -29,6 +29,9 @@ use shaders::{CHUNK, WORKGROUP_SIZE, WeightPlacement};
 use std::path::Path;
 use wgpu::util::DeviceExt;
 
+/// `Call::mode` of the diagnostic reliability look-up (after the four `PredictorMode` codes).
+const RELIABILITY_MODE: u32 = 4;
+
 /// u32 words per reliability cell accumulator (24 sums x 3 words + count).
 const ACCUM_PER_CELL: u64 = 73;
 
@@ -396,6 +399,17 @@ impl NeuralCache {
 
     /// Records the inference of `n` queries into the caller's encoder.
     pub fn encode_infer(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: PredictorMode) -> Result<(), NircError> {
+        self.encode_infer_code(gpu, encoder, queries, n, out, mode.code())
+    }
+
+    /// Records a diagnostic look-up of the reliability grid at `n` queries (no network): each
+    /// answer is (r̄_cur, r̄_EMA, σ of the blend, 1 once the grid is past its warm-up else 0),
+    /// the signal behind preference maps and the mean reliability per frame.
+    pub fn encode_reliability(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer) -> Result<(), NircError> {
+        self.encode_infer_code(gpu, encoder, queries, n, out, RELIABILITY_MODE)
+    }
+
+    fn encode_infer_code(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: u32) -> Result<(), NircError> {
         if n == 0 {
             return Ok(());
         }
@@ -406,7 +420,7 @@ impl NeuralCache {
             return Err(NircError::Config(format!("{n} queries need {groups} workgroups, over this adapter's limit")));
         }
         let b = &self.buffers;
-        let call = Self::call_buffer(gpu, Call { n, inv_n: 1.0 / n as f32, mode: mode.code(), num_chunks: 0 });
+        let call = Self::call_buffer(gpu, Call { n, inv_n: 1.0 / n as f32, mode, num_chunks: 0 });
         let group = bind(
             gpu,
             "nirc infer",

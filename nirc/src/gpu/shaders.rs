@@ -116,3 +116,8 @@ pub fn source(config: &NircConfig, layout: &ParameterLayout, placement: WeightPl
     }
     s
 }
+
+/// Every WGSL file of the cache's passes, concatenated (part of warm-start keys).
+pub fn all_sources() -> String {
+    [COMMON, COUNTERS, FIXED_SUM, FIXED_SUM_READ, ENCODING, MLP_LAYOUT, MLP, RELIABILITY, TRAIN_FORWARD_BACKWARD, WEIGHT_GRADIENT, ADAM_EMA, RELIABILITY_ACCUMULATE, RELIABILITY_UPDATE, FINISH_STEP, INFER].join("\n")
+}

@@ -58,6 +58,30 @@ pub fn frame_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)
         .collect()
 }
 
+/// Figure 1 of reliability-weighted-nirc.txt: mean reliability per frame of the two predictors
+/// (stats columns `reliability_high_lr`, `reliability_ema` of the NIRC methods; every NIRC method
+/// of a cache reports the same values, so the first method with data is drawn).
+pub fn reliability_chart(manifest: &Manifest, frames: &Frames) -> Option<(String, Chart)> {
+    let cur = frames.column("reliability_high_lr").filter(|&c| frames.has_data(c))?;
+    let ema = frames.column("reliability_ema").filter(|&c| frames.has_data(c))?;
+    let method = frames.methods().into_iter().find(|m| frames.series(m, cur).iter().any(|p| p.1.is_finite()))?;
+    let last_frame = frames.rows.iter().map(|r| r.frame).max().unwrap_or(0) as f64;
+    let chart = Chart {
+        title: format!("Mean reliability per predictor ({method}) — {}", manifest.scenario),
+        x_label: "frame".into(),
+        y_label: "mean reliability r̄".into(),
+        kind: Kind::Lines,
+        series: vec![
+            Series { name: "High-LR".into(), points: frames.series(&method, cur) },
+            Series { name: "EMA".into(), points: frames.series(&method, ema) },
+        ],
+        events: manifest.events.iter().map(|e| (e.frame as f64, e.label.clone())).collect(),
+        pareto: vec![],
+        x_extent: vec![0.0, last_frame],
+    };
+    Some(("frames_reliability".into(), chart))
+}
+
 pub fn speed_accuracy_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)> {
     let time_col = ["gpu_ms_total", "cpu_ms"].into_iter().find(|c| frames.column(c).is_some_and(|i| frames.has_data(i)));
     let Some(time_col) = time_col else { return vec![] };
@@ -102,7 +126,7 @@ pub fn write_charts(run_dir: &Path, manifest: &Manifest, frames: &Frames) -> any
     let dir = run_dir.join("charts");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut out = Vec::new();
-    for (stem, chart) in frame_charts(manifest, frames).into_iter().chain(speed_accuracy_charts(manifest, frames)) {
+    for (stem, chart) in frame_charts(manifest, frames).into_iter().chain(reliability_chart(manifest, frames)).chain(speed_accuracy_charts(manifest, frames)) {
         let svg = svg::to_svg(&chart);
         let svg_path = dir.join(format!("{stem}.svg"));
         std::fs::write(&svg_path, &svg).with_context(|| format!("cannot write {}", svg_path.display()))?;

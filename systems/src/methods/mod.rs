@@ -2,6 +2,7 @@
 //! the scenario's order, after the scene has been updated. A method owns its own GPU state
 //! (caches, histories) and may use the shared path tracer (scene geometry, G-buffer).
 
+pub mod nirc;
 mod path_tracing;
 
 use anyhow::Result;
@@ -10,6 +11,7 @@ use render::path_tracer::PathTracer;
 use render::scene::SceneDesc;
 use sim::{MethodSpec, Scenario};
 
+pub use nirc::Nirc;
 pub use path_tracing::PathTracing;
 
 /// Everything a method may read while rendering one frame.
@@ -61,5 +63,10 @@ pub trait FrameMethod {
 pub fn build(spec: &MethodSpec, _gpu: &Gpu, _scenario: &Scenario, _scene: &SceneDesc) -> Result<Box<dyn FrameMethod>> {
     Ok(match spec {
         MethodSpec::PathTracing { spp } => Box::new(PathTracing::new(*spp)),
+        MethodSpec::Nirc { spp, predictor, cache, paths, pretrain_frames } => Box::new(Nirc::new(
+            _scenario,
+            nirc::NircSettings { spp: *spp, cache: cache.clone(), paths: paths.clone(), pretrain_frames: *pretrain_frames },
+            *predictor,
+        )?),
     })
 }

@@ -1,0 +1,295 @@
+// Cache-terminated paths (NIRC): camera paths end in a query of the incident radiance cache,
+// a sparse seeded subset of them is extended into Monte Carlo training targets, and a resolve
+// pass turns the cache's answers into the image. Appended to PathTracer::library_source();
+// the scene is @group(0), the geometry @group(1), these buffers @group(2) (integrator.rs).
+//
+// Estimator. A camera path is traced exactly as pt_integrator.wgsl's `path_radiance` (emission,
+// NEE with MIS, BSDF sampling, Russian roulette) up to the termination vertex x_k (k =
+// `termination_vertex`, 1 = the primary hit). There:
+//   L(x_k -> wo) = Le(x_k) [MIS-weighted as the path tracer]
+//                + sum over analytic lights (delta and sun-disk) of NEE, unweighted
+//                + f(wo, w) cos / pdf(w) * Lc(x_k, w),   w ~ BSDF
+// where Lc(x, w) is the radiance arriving at x along w WITHOUT the analytic lights' own
+// emission (the environment and emissive surfaces seen along w are included, unweighted).
+// The analytic lights are split off because a BSDF-sampled direction (almost) never hits a point,
+// spot or 0.27°-wide sun: the cache could not learn them, NEE handles them exactly. Emissive
+// triangles and the environment are left to the cache, so no NEE of them happens at x_k and no
+// MIS weight is needed: each light path reaches x_k's estimate through exactly one strategy.
+// The cache learns Lc from `cache_target`, an unbiased one-sample estimate: the ray (x_k, w),
+// full emission at its hit (no MIS, since NEE at x_k did not sample emitters), then
+// path_radiance from there (NEE + MIS + Russian roulette) up to the frame's max depth.
+// Replacing the cache by cache_target (the oracle) gives an estimator with the same mean as
+// the path tracer's (test: tests/integrator.rs).
+
+struct CacheParams {
+    query_count: u32,        // pixels * spp
+    record_count: u32,       // training records per frame
+    termination_vertex: u32, // k >= 1
+    spp: u32,
+}
+
+struct QueryOut {
+    position: vec4f,
+    direction: vec4f,
+}
+
+// weight.xyz: throughput * f cos / pdf of the query direction; weight.w: 1 = a query exists.
+// prefix.xyz: radiance gathered before the cache term. origin.xyz: offset ray origin of the
+// query ray; origin.w: its depth (as in path_radiance), stored as a float.
+struct QueryMeta {
+    weight: vec4f,
+    prefix: vec4f,
+    origin: vec4f,
+}
+
+struct Record {
+    position: vec4f,   // w: 1 = valid
+    direction: vec4f,
+    target_rgb: vec4f,
+}
+
+@group(2) @binding(0) var<uniform> params: CacheParams;
+@group(2) @binding(1) var<storage, read_write> queries: array<QueryOut>;
+@group(2) @binding(2) var<storage, read_write> query_meta: array<QueryMeta>;
+// [0, record_count): the compacted training records handed to the cache;
+// [record_count, 2 record_count): one candidate per record slot, before compaction.
+@group(2) @binding(3) var<storage, read_write> records: array<Record>;
+@group(2) @binding(4) var<storage, read_write> answers: array<vec4f>;
+@group(2) @binding(5) var<storage, read_write> image: array<vec4f>;
+
+// Stream of training-path random numbers: disjoint from the camera samples' (small indices).
+const TRAIN_SAMPLE_STREAM: u32 = 0x80000001u;
+const TRAIN_PICK_STREAM: u32 = 0x80000002u;
+// Candidates a training record tries before giving up (a sky pixel has no query).
+const PICK_TRIES: u32 = 16u;
+
+// NEE of the analytic lights only (point, spot, directional with or without a disk), without
+// MIS: the cache term never contains them (see the estimator above).
+fn analytic_next_event(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>) -> vec3f {
+    var radiance = vec3f(0.0);
+    for (var i = 0u; i < frame.counts.y; i++) {
+        let ls = sample_analytic_light(lights[i], p, rng_next2(rng));
+        if dot(ls.wi, sh.ng) <= 0.0 || max_component(ls.weight) <= 0.0 {
+            continue;
+        }
+        let f = bsdf_eval(bsdf, sh.ns, wo, ls.wi);
+        if max_component(f) <= 0.0 {
+            continue;
+        }
+        if trace_any(offset_origin(p, sh.ng, ls.wi), ls.wi, ls.dist * (1.0 - 1.0e-4)) {
+            continue;
+        }
+        radiance += f * dot(sh.ns, ls.wi) * ls.weight;
+    }
+    return radiance;
+}
+
+// One-sample estimate of Lc(x, dir) for the ray (origin, dir) at path depth `depth`.
+fn cache_target(origin: vec3f, dir: vec3f, depth: u32, rng: ptr<function, u32>) -> vec3f {
+    let hit = trace_closest(origin, dir, FAR);
+    if hit.instance == NO_HIT {
+        // The environment only: the analytic lights' disks are NEE's.
+        return frame.environment.xyz;
+    }
+    let sp = surface_point(hit, origin, dir);
+    let m = materials[sp.material];
+    let wo = -dir;
+    let sh = orient(sp, wo);
+    var l = emitted_radiance(sp, m, dir, hit.t, 0.0);
+    if depth >= frame.seed.w {
+        return l;
+    }
+    let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);
+    let p = sp.position;
+    l += next_event(p, sh, bsdf, wo, rng);
+    let bs = bsdf_sample(bsdf, sh.ns, wo, rng_next(rng), rng_next2(rng));
+    if !bs.valid || dot(bs.wi, sh.ng) <= 0.0 {
+        return l;
+    }
+    var throughput = bs.f * (dot(sh.ns, bs.wi) / bs.pdf);
+    if depth + 1u >= frame.counts.x {
+        let survive = min(max_component(throughput), 0.95);
+        if rng_next(rng) >= survive {
+            return l;
+        }
+        throughput /= survive;
+    }
+    return l + throughput * path_radiance(offset_origin(p, sh.ng, bs.wi), bs.wi, bs.pdf, depth + 1u, rng);
+}
+
+// One camera path up to its termination vertex; writes query q's position, direction, weight.
+fn trace_query(pixel: vec2u, sample_index: u32, q: u32) {
+    var rng = rng_seed(frame.seed.xy, frame.seed.z, pixel.y * frame.size.x + pixel.x, sample_index);
+    let jitter = rng_next2(&rng);
+    var origin = frame.camera.position.xyz;
+    var dir = camera_ray_direction(frame.camera, vec2f(pixel) + jitter);
+    var throughput = vec3f(1.0);
+    var radiance = vec3f(0.0);
+    var prev_bsdf_pdf = 0.0;
+    var result: QueryMeta;
+    result.weight = vec4f(0.0);
+    result.origin = vec4f(0.0);
+    var query: QueryOut;
+    query.position = vec4f(0.0);
+    query.direction = vec4f(0.0, 0.0, 1.0, 0.0);
+    let max_depth = frame.seed.w;
+    for (var depth = 0u; depth <= max_depth; depth++) {
+        let hit = trace_closest(origin, dir, FAR);
+        if hit.instance == NO_HIT {
+            radiance += throughput * escaped_radiance(dir, prev_bsdf_pdf);
+            break;
+        }
+        let sp = surface_point(hit, origin, dir);
+        let m = materials[sp.material];
+        let wo = -dir;
+        let sh = orient(sp, wo);
+        radiance += throughput * emitted_radiance(sp, m, dir, hit.t, prev_bsdf_pdf);
+        if depth == max_depth {
+            break;
+        }
+        let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);
+        let p = sp.position;
+        if depth + 1u >= params.termination_vertex {
+            // Termination vertex: analytic lights by NEE, everything else from the cache.
+            radiance += throughput * analytic_next_event(p, sh, bsdf, wo, &rng);
+            let bs = bsdf_sample(bsdf, sh.ns, wo, rng_next(&rng), rng_next2(&rng));
+            if bs.valid && dot(bs.wi, sh.ng) > 0.0 {
+                result.weight = vec4f(throughput * bs.f * (dot(sh.ns, bs.wi) / bs.pdf), 1.0);
+                result.origin = vec4f(offset_origin(p, sh.ng, bs.wi), f32(depth + 1u));
+                query.position = vec4f(p, 0.0);
+                query.direction = vec4f(bs.wi, 0.0);
+            }
+            break;
+        }
+        radiance += throughput * next_event(p, sh, bsdf, wo, &rng);
+        let bs = bsdf_sample(bsdf, sh.ns, wo, rng_next(&rng), rng_next2(&rng));
+        if !bs.valid || dot(bs.wi, sh.ng) <= 0.0 {
+            break;
+        }
+        throughput *= bs.f * (dot(sh.ns, bs.wi) / bs.pdf);
+        prev_bsdf_pdf = bs.pdf;
+        if depth + 1u >= frame.counts.x {
+            let survive = min(max_component(throughput), 0.95);
+            if rng_next(&rng) >= survive {
+                break;
+            }
+            throughput /= survive;
+        }
+        origin = offset_origin(p, sh.ng, bs.wi);
+        dir = bs.wi;
+    }
+    result.prefix = vec4f(radiance, 0.0);
+    query_meta[q] = result;
+    queries[q] = query;
+}
+
+// Per pixel: `spp` camera paths, queries at pixel * spp + s.
+@compute @workgroup_size(8, 8, 1)
+fn queries_main(@builtin(global_invocation_id) id: vec3u) {
+    if id.x >= frame.size.x || id.y >= frame.size.y {
+        return;
+    }
+    let pixel = id.y * frame.size.x + id.x;
+    for (var s = 0u; s < params.spp; s++) {
+        trace_query(id.xy, s, pixel * params.spp + s);
+    }
+}
+
+fn target_of(q: u32, rng: ptr<function, u32>) -> vec3f {
+    let m = query_meta[q];
+    return cache_target(m.origin.xyz, queries[q].direction.xyz, u32(m.origin.w), rng);
+}
+
+// Per training record slot: a seeded random query of this frame that exists, and the Monte
+// Carlo target of its incident radiance; written as a candidate (compacted below).
+@compute @workgroup_size(64, 1, 1)
+fn targets_main(@builtin(global_invocation_id) id: vec3u) {
+    let i = id.x;
+    if i >= params.record_count {
+        return;
+    }
+    var pick = rng_seed(frame.seed.xy, frame.seed.z, i, TRAIN_PICK_STREAM);
+    var chosen = 0xffffffffu;
+    for (var t = 0u; t < PICK_TRIES; t++) {
+        let c = min(u32(rng_next(&pick) * f32(params.query_count)), params.query_count - 1u);
+        if query_meta[c].weight.w > 0.0 {
+            chosen = c;
+            break;
+        }
+    }
+    var r: Record;
+    r.position = vec4f(0.0);
+    r.direction = vec4f(0.0, 0.0, 1.0, 0.0);
+    r.target_rgb = vec4f(0.0);
+    if chosen != 0xffffffffu {
+        var rng = rng_seed(frame.seed.xy, frame.seed.z, i, TRAIN_SAMPLE_STREAM);
+        r.position = vec4f(queries[chosen].position.xyz, 1.0);
+        r.direction = queries[chosen].direction;
+        r.target_rgb = vec4f(target_of(chosen, &rng), 0.0);
+    }
+    records[params.record_count + i] = r;
+}
+
+// One thread: the valid candidates in slot order, then repeated cyclically to fill every slot
+// (deterministic, no readback of the count). With no valid candidate at all (an empty view),
+// the slots keep zero targets at the bounds' corner.
+@compute @workgroup_size(1, 1, 1)
+fn compact_main() {
+    let n = params.record_count;
+    var count = 0u;
+    for (var i = 0u; i < n; i++) {
+        let r = records[n + i];
+        if r.position.w > 0.0 {
+            records[count] = r;
+            count++;
+        }
+    }
+    for (var j = count; j < n; j++) {
+        if count > 0u {
+            records[j] = records[j % count];
+        } else {
+            records[j] = records[n + j];
+        }
+    }
+}
+
+// Test oracle: every query answered by its own Monte Carlo target (same mean as the exact Lc).
+@compute @workgroup_size(64, 1, 1)
+fn oracle_main(@builtin(global_invocation_id) id: vec3u) {
+    let q = id.x;
+    if q >= params.query_count {
+        return;
+    }
+    var l = vec3f(0.0);
+    if query_meta[q].weight.w > 0.0 {
+        var rng = rng_seed(frame.seed.xy, frame.seed.z ^ 0x0c0ffeeu, q, TRAIN_SAMPLE_STREAM);
+        l = target_of(q, &rng);
+    }
+    answers[q] = vec4f(l, 0.0);
+}
+
+// Per pixel: mean over samples of prefix + weight * answer; and in image[pixels + pixel] the
+// mean σ (weight of the High-LR predictor) of the pixel's answered queries, w = their count.
+@compute @workgroup_size(8, 8, 1)
+fn resolve_main(@builtin(global_invocation_id) id: vec3u) {
+    if id.x >= frame.size.x || id.y >= frame.size.y {
+        return;
+    }
+    let pixel = id.y * frame.size.x + id.x;
+    var sum = vec3f(0.0);
+    var sigma = 0.0;
+    var answered = 0.0;
+    for (var s = 0u; s < params.spp; s++) {
+        let q = pixel * params.spp + s;
+        let m = query_meta[q];
+        sum += m.prefix.xyz;
+        if m.weight.w > 0.0 {
+            let a = answers[q];
+            sum += m.weight.xyz * a.xyz;
+            sigma += a.w;
+            answered += 1.0;
+        }
+    }
+    image[pixel] = vec4f(sum / f32(params.spp), 1.0);
+    image[frame.size.x * frame.size.y + pixel] = vec4f(sigma / max(answered, 1.0), 0.0, 0.0, answered);
+}

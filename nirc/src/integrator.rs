@@ -1,0 +1,325 @@
+//! Cache-terminated path tracing (NIRC): the passes of nirc/shaders/cache_paths.wgsl, which
+//! run on the path tracer's scene and geometry bind groups.
+//!
+//! Per frame: `encode_paths` traces `spp` camera paths per pixel up to the termination vertex
+//! and writes one `CacheQuery` per path (plus its weight and the radiance gathered before it),
+//! then picks `train_records` seeded queries and extends each into a Monte Carlo target
+//! (`TrainingRecord`s, compacted, in `records()`); the cache answers the queries
+//! (`NeuralCache::encode_infer`) and `encode_resolve` turns the answers into the image. Nothing
+//! is read back but what the caller asks for. The estimator is written out in the shader.
+
+use crate::error::NircError;
+use crate::records::{CacheAnswer, CacheQuery, TrainingRecord};
+use bytemuck::{Pod, Zeroable};
+use render::gpu::Gpu;
+use render::path_tracer::PathTracer;
+use serde::{Deserialize, Serialize};
+use wgpu::util::DeviceExt;
+
+/// How camera paths end in the cache and how many train it.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CachePathSettings {
+    /// Vertex k at which every camera path is terminated into the cache (1 = the primary hit,
+    /// NIRC's choice: the cache then carries all indirect light and the area lights' and sky's
+    /// direct light, and its temporal behaviour is seen undiluted in the image). Larger k traces
+    /// k - 1 bounces with full NEE + MIS first. Paths that end earlier (escape, absorption,
+    /// Russian roulette) never query.
+    pub termination_vertex: u32,
+    /// Training records per frame, picked among the frame's queries (seeded).
+    pub train_records: u32,
+}
+
+impl Default for CachePathSettings {
+    fn default() -> Self {
+        // 2048 records: about 1.5 s of training per frame on lavapipe at width 64 (README).
+        Self { termination_vertex: 1, train_records: 2048 }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct CacheParams {
+    query_count: u32,
+    record_count: u32,
+    termination_vertex: u32,
+    spp: u32,
+}
+
+/// Bytes of one `QueryMeta` (weight, prefix, origin) in the shader.
+const META_BYTES: u64 = 48;
+/// Storage buffers of this pass's own group (queries, meta, records, answers, image).
+const OWN_STORAGE_BUFFERS: u32 = 5;
+/// Storage buffers of the path tracer's scene group (materials, texels, lights, radiance, G-buffer).
+const SCENE_STORAGE_BUFFERS: u32 = 5;
+const WORKGROUP_2D: u32 = 8;
+const WORKGROUP_1D: u32 = 64;
+
+/// Where a method's answers go and where its image comes out: one per predictor mode.
+pub struct CacheOutput {
+    pub answers: wgpu::Buffer,
+    /// `pixels` radiance texels, then `pixels` texels of (mean σ, 0, 0, answered samples).
+    pub image: wgpu::Buffer,
+}
+
+pub struct CachePaths {
+    pub settings: CachePathSettings,
+    width: u32,
+    height: u32,
+    spp: u32,
+    layout: wgpu::BindGroupLayout,
+    queries_pipeline: wgpu::ComputePipeline,
+    targets_pipeline: wgpu::ComputePipeline,
+    compact_pipeline: wgpu::ComputePipeline,
+    oracle_pipeline: wgpu::ComputePipeline,
+    resolve_pipeline: wgpu::ComputePipeline,
+    params: wgpu::Buffer,
+    queries: wgpu::Buffer,
+    meta: wgpu::Buffer,
+    records: wgpu::Buffer,
+    /// Bound where a pass does not use the caller's output.
+    scratch: CacheOutput,
+}
+
+impl CachePaths {
+    /// The WGSL of the pass (part of warm-start keys).
+    pub fn shader_source() -> &'static str {
+        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+        SOURCE.get_or_init(|| [PathTracer::library_source(), include_str!("../shaders/cache_paths.wgsl")].join("\n"))
+    }
+
+    /// Passes for `tracer`'s resolution at `spp` paths per pixel.
+    pub fn new(gpu: &Gpu, tracer: &PathTracer, spp: u32, settings: CachePathSettings) -> Result<Self, NircError> {
+        if spp == 0 {
+            return Err(NircError::Config("spp must be at least 1".into()));
+        }
+        if settings.termination_vertex == 0 {
+            return Err(NircError::Config("termination_vertex must be at least 1 (1 = the primary hit)".into()));
+        }
+        if settings.train_records == 0 {
+            return Err(NircError::Config("train_records must be at least 1".into()));
+        }
+        let s = tracer.settings();
+        let (width, height) = (s.width, s.height);
+        let query_count = width as u64 * height as u64 * spp as u64;
+        if query_count > u32::MAX as u64 / 2 {
+            return Err(NircError::Config(format!("{width}x{height} at {spp} spp is {query_count} queries, too many")));
+        }
+        let needed = OWN_STORAGE_BUFFERS + SCENE_STORAGE_BUFFERS + render::bvh::SceneGeometry::STORAGE_BUFFERS;
+        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
+        if needed > limit {
+            return Err(render::gpu::GpuError::OverLimit {
+                what: "storage buffers of the NIRC cache-path pass".into(),
+                requested: needed as u64,
+                limit: limit as u64,
+                adapter: gpu.summary.name.clone(),
+            }
+            .into());
+        }
+        let groups = settings.train_records.div_ceil(WORKGROUP_1D).max(query_count.div_ceil(WORKGROUP_1D as u64) as u32);
+        if groups > gpu.limits.max_compute_workgroups_per_dimension {
+            return Err(NircError::Config(format!("{groups} workgroups in one dispatch, over this adapter's limit")));
+        }
+        // No var<workgroup> in cache_paths.wgsl.
+        gpu.check_workgroup_memory("nirc cache_paths", 0)?;
+
+        let device = &gpu.device;
+        let layout = own_layout(device);
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("nirc cache paths"),
+            bind_group_layouts: &[Some(tracer.scene_bind_group_layout()), Some(tracer.geometry().bind_group_layout()), Some(&layout)],
+            immediate_size: 0,
+        });
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("cache_paths.wgsl"), source: wgpu::ShaderSource::Wgsl(Self::shader_source().into()) });
+        let pipeline = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let queries_pipeline = pipeline("queries_main");
+        let targets_pipeline = pipeline("targets_main");
+        let compact_pipeline = pipeline("compact_main");
+        let oracle_pipeline = pipeline("oracle_main");
+        let resolve_pipeline = pipeline("resolve_main");
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(NircError::Config(format!("cache_paths.wgsl does not compile: {e}")));
+        }
+        let buffer = |label: &str, bytes: u64| -> Result<wgpu::Buffer, NircError> {
+            gpu.check_buffer_size(label, bytes)?;
+            Ok(device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(16),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }))
+        };
+        let params = CacheParams { query_count: query_count as u32, record_count: settings.train_records, termination_vertex: settings.termination_vertex, spp };
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("nirc cache params"), contents: bytemuck::bytes_of(&params), usage: wgpu::BufferUsages::UNIFORM });
+        let queries = buffer("nirc cache queries", query_count * size_of::<CacheQuery>() as u64)?;
+        let meta = buffer("nirc query weights", query_count * META_BYTES)?;
+        let records = buffer("nirc training records", 2 * settings.train_records as u64 * size_of::<TrainingRecord>() as u64)?;
+        let mut me = Self {
+            settings,
+            width,
+            height,
+            spp,
+            layout,
+            queries_pipeline,
+            targets_pipeline,
+            compact_pipeline,
+            oracle_pipeline,
+            resolve_pipeline,
+            params,
+            queries,
+            meta,
+            records,
+            scratch: CacheOutput { answers: buffer("nirc scratch", 16)?, image: buffer("nirc scratch", 16)? },
+        };
+        me.scratch = me.output(gpu)?;
+        Ok(me)
+    }
+
+    /// Answer and image buffers sized for this pass.
+    pub fn output(&self, gpu: &Gpu) -> Result<CacheOutput, NircError> {
+        let answers = self.query_count() as u64 * size_of::<CacheAnswer>() as u64;
+        let image = 2 * self.pixels() as u64 * 16;
+        gpu.check_buffer_size("nirc answers", answers)?;
+        gpu.check_buffer_size("nirc image", image)?;
+        let make = |label: &str, size: u64| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        Ok(CacheOutput { answers: make("nirc answers", answers), image: make("nirc image", image) })
+    }
+
+    pub fn pixels(&self) -> u32 {
+        self.width * self.height
+    }
+
+    pub fn spp(&self) -> u32 {
+        self.spp
+    }
+
+    /// Queries per frame: pixels x spp, query `pixel * spp + s`.
+    pub fn query_count(&self) -> u32 {
+        self.pixels() * self.spp
+    }
+
+    /// `CacheQuery[query_count]` of the last `encode_paths`.
+    pub fn queries(&self) -> &wgpu::Buffer {
+        &self.queries
+    }
+
+    /// `TrainingRecord[train_records]` of the last `encode_paths` (compacted).
+    pub fn records(&self) -> &wgpu::Buffer {
+        &self.records
+    }
+
+    pub fn record_count(&self) -> u32 {
+        self.settings.train_records
+    }
+
+    fn bind_group(&self, gpu: &Gpu, out: &CacheOutput) -> wgpu::BindGroup {
+        let entries = [
+            (0, &self.params),
+            (1, &self.queries),
+            (2, &self.meta),
+            (3, &self.records),
+            (4, &out.answers),
+            (5, &out.image),
+        ]
+        .map(|(binding, b): (u32, &wgpu::Buffer)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() });
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("nirc cache paths"), layout: &self.layout, entries: &entries })
+    }
+
+    fn pass(&self, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer, group: &wgpu::BindGroup, pipeline: &wgpu::ComputePipeline, label: &str, workgroups: (u32, u32)) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
+        pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+        pass.set_bind_group(2, group, &[]);
+        pass.dispatch_workgroups(workgroups.0, workgroups.1, 1);
+    }
+
+    fn image_groups(&self) -> (u32, u32) {
+        (self.width.div_ceil(WORKGROUP_2D), self.height.div_ceil(WORKGROUP_2D))
+    }
+
+    /// Writes the frame uniform (seed, frame) and records the camera paths into `encoder`.
+    /// The uniform is written at the next submission: submit before preparing another frame.
+    pub fn encode_queries(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer, seed: u64, frame: u32) {
+        tracer.prepare_frame(gpu, self.spp, 0, seed, frame);
+        let group = self.bind_group(gpu, &self.scratch);
+        self.pass(encoder, tracer, &group, &self.queries_pipeline, "nirc queries", self.image_groups());
+    }
+
+    /// Records the training targets of the queries of `encode_queries` (same frame uniform).
+    pub fn encode_records(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer) {
+        let group = self.bind_group(gpu, &self.scratch);
+        self.pass(encoder, tracer, &group, &self.targets_pipeline, "nirc training targets", (self.settings.train_records.div_ceil(WORKGROUP_1D), 1));
+        self.pass(encoder, tracer, &group, &self.compact_pipeline, "nirc record compaction", (1, 1));
+    }
+
+    /// Test oracle: answers every query with its own Monte Carlo target of Lc.
+    pub fn encode_oracle(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer, out: &CacheOutput) {
+        let group = self.bind_group(gpu, out);
+        self.pass(encoder, tracer, &group, &self.oracle_pipeline, "nirc oracle", (self.query_count().div_ceil(WORKGROUP_1D), 1));
+    }
+
+    /// Records the image from `out.answers` into `out.image`.
+    pub fn encode_resolve(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer, out: &CacheOutput) {
+        let group = self.bind_group(gpu, out);
+        self.pass(encoder, tracer, &group, &self.resolve_pipeline, "nirc resolve", self.image_groups());
+    }
+
+    /// Reads `out.image` back: the radiance (alpha 1) and per pixel (mean σ, answered samples).
+    pub fn read_image(&self, gpu: &Gpu, out: &CacheOutput) -> Result<(Vec<[f32; 4]>, Vec<[f32; 4]>), NircError> {
+        let bytes = crate::gpu::readback::read_bytes(gpu, &out.image, "nirc image")?;
+        let texels: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        let n = self.pixels() as usize;
+        Ok((texels[..n].to_vec(), texels[n..2 * n].to_vec()))
+    }
+
+    /// Reads `out.answers` back (e.g. after `NeuralCache::encode_reliability`).
+    pub fn read_answers(&self, gpu: &Gpu, out: &CacheOutput) -> Result<Vec<[f32; 4]>, NircError> {
+        let bytes = crate::gpu::readback::read_bytes(gpu, &out.answers, "nirc answers")?;
+        Ok(bytemuck::cast_slice::<u8, [f32; 4]>(&bytes)[..self.query_count() as usize].to_vec())
+    }
+
+    /// Per query of the last `encode_queries`: whether the path reached its termination vertex.
+    pub fn read_query_valid(&self, gpu: &Gpu) -> Result<Vec<bool>, NircError> {
+        let bytes = crate::gpu::readback::read_bytes(gpu, &self.meta, "nirc query weights")?;
+        let floats: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        Ok(floats.chunks_exact(3).take(self.query_count() as usize).map(|m| m[0][3] > 0.0).collect())
+    }
+
+    /// The training records of the last frame (tests, diagnostics).
+    pub fn read_records(&self, gpu: &Gpu) -> Result<Vec<TrainingRecord>, NircError> {
+        let bytes = crate::gpu::readback::read_bytes(gpu, &self.records, "nirc training records")?;
+        Ok(bytemuck::cast_slice::<u8, TrainingRecord>(&bytes)[..self.record_count() as usize].to_vec())
+    }
+}
+
+fn own_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    };
+    let rw = wgpu::BufferBindingType::Storage { read_only: false };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("nirc cache paths"),
+        entries: &[entry(0, wgpu::BufferBindingType::Uniform), entry(1, rw), entry(2, rw), entry(3, rw), entry(4, rw), entry(5, rw)],
+    })
+}
