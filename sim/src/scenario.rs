@@ -31,10 +31,52 @@ fn builtin_name<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
 }
 
 /// A rendering method to run on every frame.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum MethodSpec {
     PathTracing { spp: u32 },
+    /// Stable sample cache (render::sample_cache); every field defaults to the paper's value,
+    /// e.g. `SampleCache(retrace: Multi)` or `SampleCache(shading: Adaptive, shading_rate: 0.5)`.
+    SampleCache {
+        #[serde(default = "ssc_default::slots")]
+        slots: u32,
+        #[serde(default = "ssc_default::n_target")]
+        n_target: f32,
+        #[serde(default = "ssc_default::delta")]
+        delta: f32,
+        #[serde(default = "ssc_default::epsilon0")]
+        epsilon0: f32,
+        #[serde(default = "ssc_default::epsilon1")]
+        epsilon1: f32,
+        #[serde(default = "ssc_default::base_block")]
+        base_block: u32,
+        #[serde(default = "ssc_default::buckets")]
+        buckets: u32,
+        #[serde(default = "ssc_default::alpha")]
+        alpha: f32,
+        #[serde(default)]
+        retrace: render::sample_cache::Retrace,
+        #[serde(default)]
+        shading: render::sample_cache::ShadingMode,
+        #[serde(default = "ssc_default::shading_rate")]
+        shading_rate: f32,
+    },
+}
+
+// Settings are finite numbers (validated before a run), so equality is an equivalence.
+impl Eq for MethodSpec {}
+
+mod ssc_default {
+    use render::sample_cache::SampleCacheSettings as S;
+    pub fn slots() -> u32 { S::default().slots }
+    pub fn n_target() -> f32 { S::default().n_target }
+    pub fn delta() -> f32 { S::default().delta }
+    pub fn epsilon0() -> f32 { S::default().epsilon0 }
+    pub fn epsilon1() -> f32 { S::default().epsilon1 }
+    pub fn base_block() -> u32 { S::default().base_block }
+    pub fn buckets() -> u32 { S::default().buckets }
+    pub fn alpha() -> f32 { S::default().alpha }
+    pub fn shading_rate() -> f32 { S::default().shading_rate }
 }
 
 impl MethodSpec {
@@ -42,6 +84,7 @@ impl MethodSpec {
     pub fn label(&self) -> String {
         match self {
             MethodSpec::PathTracing { spp } => format!("pt_{spp}spp"),
+            MethodSpec::SampleCache { .. } => self.sample_cache_settings().map(|s| s.label()).unwrap_or_default(),
         }
     }
 
@@ -49,6 +92,18 @@ impl MethodSpec {
     pub fn spp(&self) -> u32 {
         match self {
             MethodSpec::PathTracing { spp } => *spp,
+            // One shaded path per pixel at a 100% shading rate.
+            MethodSpec::SampleCache { shading_rate, .. } => (shading_rate.ceil() as u32).max(1),
+        }
+    }
+
+    /// The sample cache's settings, `None` for other methods.
+    pub fn sample_cache_settings(&self) -> Option<render::sample_cache::SampleCacheSettings> {
+        match *self {
+            MethodSpec::SampleCache { slots, n_target, delta, epsilon0, epsilon1, base_block, buckets, alpha, retrace, shading, shading_rate } => {
+                Some(render::sample_cache::SampleCacheSettings { slots, n_target, delta, epsilon0, epsilon1, base_block, buckets, alpha, retrace, shading, shading_rate })
+            }
+            _ => None,
         }
     }
 }

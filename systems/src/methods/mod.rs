@@ -3,6 +3,7 @@
 //! (caches, histories) and may use the shared path tracer (scene geometry, G-buffer).
 
 mod path_tracing;
+mod sample_cache;
 
 use anyhow::Result;
 use render::gpu::Gpu;
@@ -11,6 +12,7 @@ use render::scene::SceneDesc;
 use sim::{MethodSpec, Scenario};
 
 pub use path_tracing::PathTracing;
+pub use sample_cache::SampleCacheMethod;
 
 /// Everything a method may read while rendering one frame.
 pub struct FrameContext<'a> {
@@ -61,5 +63,10 @@ pub trait FrameMethod {
 pub fn build(spec: &MethodSpec, _gpu: &Gpu, _scenario: &Scenario, _scene: &SceneDesc) -> Result<Box<dyn FrameMethod>> {
     Ok(match spec {
         MethodSpec::PathTracing { spp } => Box::new(PathTracing::new(*spp)),
+        MethodSpec::SampleCache { .. } => {
+            let settings = spec.sample_cache_settings().expect("a SampleCache spec");
+            settings.validate().map_err(|e| anyhow::anyhow!("{}: SampleCache: {e}", _scenario.origin.display()))?;
+            Box::new(SampleCacheMethod::new(settings))
+        }
     })
 }

@@ -1,0 +1,307 @@
+// Primary ray tracing (sections 3.2 and 3.4), one thread per pixel after reservation:
+// canonical slot order, choice of the samples to retrace (single / multi / adaptive slope test),
+// density control towards n_target ± δ over 3x3, visibility retrace, new samples for holes, and
+// (adaptive shading) the importance histogram. Each thread owns its pixel's slots and final mask;
+// neighbours are read only through the reservation atomics, which no thread writes any more.
+
+// Jitter stays this far inside the pixel so that round-off never reprojects a sample of a static
+// view into a neighbour (a sample exactly on a pixel border would flip sides).
+const SSC_JITTER_INSET: f32 = 1.0e-3;
+
+// The 4x4 block's base pixel this frame: the block position visits all b*b pixels in turn.
+fn ssc_is_base_pixel(pixel: vec2u) -> bool {
+    let b = ssc.modes.z;
+    let k = ssc.size.w % (b * b);
+    return pixel.x % b == k % b && pixel.y % b == k / b;
+}
+
+// Round-robin index of the base sample of a base pixel, among `count` candidates.
+fn ssc_base_index(count: u32) -> u32 {
+    let b = ssc.modes.z;
+    return (ssc.size.w / (b * b)) % max(count, 1u);
+}
+
+// Retrace from the eye towards the stored point (a shadow ray, section 3.2): visible when nothing
+// is hit before (1 - ε0) of the way there; a background sample is visible when its ray escapes.
+fn ssc_verify(hit: vec4u) -> bool {
+    let eye = frame.camera.position.xyz;
+    if ssc_is_background(hit) {
+        return !trace_any(eye, ssc_background_dir(hit), FAR);
+    }
+    let d = ssc_surface(hit).position - eye;
+    return !trace_any(eye, d, 1.0 - ssc.density.z);
+}
+
+fn ssc_new_sample(pixel: vec2u, rng: ptr<function, u32>) -> vec4u {
+    let jitter = mix(vec2f(SSC_JITTER_INSET), vec2f(1.0 - SSC_JITTER_INSET), rng_next2(rng));
+    let eye = frame.camera.position.xyz;
+    let dir = camera_ray_direction(frame.camera, vec2f(pixel) + jitter);
+    let hit = trace_closest(eye, dir, FAR);
+    if hit.instance == NO_HIT {
+        return ssc_pack_background(dir);
+    }
+    return ssc_pack_hit(hit);
+}
+
+fn ssc_swap_bits(bits: u32, i: u32, j: u32) -> u32 {
+    let a = (bits >> i) & 1u;
+    let b = (bits >> j) & 1u;
+    return (bits & ~((1u << i) | (1u << j))) | (a << j) | (b << i);
+}
+
+// Log-spaced bucket (M buckets) of importance w between this frame's bounds (last frame's min
+// and max): M - 1 = most important. Degenerate bounds (first frame) put everything in M - 1.
+fn ssc_bucket(w: f32) -> u32 {
+    let m = ssc.modes.w;
+    let lo = bitcast<f32>(atomicLoad(&ssc_work[SSC_WMIN]));
+    let hi = bitcast<f32>(atomicLoad(&ssc_work[SSC_WMAX]));
+    if !(lo > 0.0) || !(hi > lo) {
+        return m - 1u;
+    }
+    let f = log(w / lo) / log(hi / lo);
+    return u32(clamp(floor(f * f32(m)), 0.0, f32(m - 1u)));
+}
+
+fn ssc_importance(count: f32) -> f32 {
+    return 1.0 / (1.0 + count);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
+    if id.x >= ssc.size.x || id.y >= ssc.size.y {
+        return;
+    }
+    let width = ssc.size.x;
+    let pixels = ssc_pixels();
+    let n = ssc.size.z;
+    let full = ssc_full();
+    let p = id.y * width + id.x;
+    let eye = frame.camera.position.xyz;
+    var rng = rng_seed(frame.seed.xy, frame.seed.z, p, 0x55c0u);
+
+    // Gather the reserved slots and sort them into the canonical order (the slots a sample won
+    // depend on the race of the reservation; the order of a pixel's samples must not).
+    let m = atomicLoad(&pixel_atomics[2u * p]);
+    var hits: array<vec4u, SSC_MAX_SLOTS>;
+    var rads: array<vec4f, SSC_MAX_SLOTS>;
+    var vis = 0u;
+    var k = 0u;
+    for (var s = 0u; s < n; s++) {
+        if ((m >> s) & 1u) != 0u {
+            let slot = dst_slots[s * pixels + p];
+            hits[k] = slot.hit;
+            rads[k] = slot.radiance;
+            if ((m >> (s + n)) & 1u) != 0u {
+                vis |= 1u << k;
+            }
+            k++;
+        }
+    }
+    for (var i = 1u; i < k; i++) {
+        var j = i;
+        while j > 0u && ssc_less(hits[j], hits[j - 1u]) {
+            let h = hits[j]; hits[j] = hits[j - 1u]; hits[j - 1u] = h;
+            let r = rads[j]; rads[j] = rads[j - 1u]; rads[j - 1u] = r;
+            vis = ssc_swap_bits(vis, j, j - 1u);
+            j--;
+        }
+    }
+
+    // 3x3 neighbourhood: visible-sample density and the farthest visible depth.
+    var neighbour_visible = 0u;
+    var neighbours = 0u;
+    var t_max_bits = 0u;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = vec2i(id.xy) + vec2i(dx, dy);
+            if q.x < 0 || q.y < 0 || q.x >= i32(width) || q.y >= i32(ssc.size.y) {
+                continue;
+            }
+            let qi = u32(q.y) * width + u32(q.x);
+            let mq = atomicLoad(&pixel_atomics[2u * qi]);
+            neighbour_visible += countOneBits(mq & (mq >> n) & full);
+            neighbours++;
+            t_max_bits = max(t_max_bits, atomicLoad(&pixel_atomics[2u * qi + 1u]));
+        }
+    }
+    let density = f32(neighbour_visible) / f32(neighbours);
+
+    // 1. Which samples to retrace.
+    let all_k = (1u << k) - 1u;
+    var trace_set = 0u;
+    var flags = 0u;
+    let mode = ssc.modes.x;
+    if mode == 0u {
+        if k > 0u {
+            trace_set = 1u << (ssc.size.w % k);
+        }
+    } else if mode == 1u {
+        trace_set = all_k;
+    } else {
+        if vis == 0u {
+            flags |= SSC_FLAG_HOLE;
+        } else {
+            // t_min and its slope Δn from the pixel's own visible samples (exact; see the
+            // packing note in sample_cache/mod.rs), t_max from the 3x3 atomics.
+            var t_min = 3.0e38;
+            var slope = 0.0;
+            for (var i = 0u; i < k; i++) {
+                if ((vis >> i) & 1u) == 0u {
+                    continue;
+                }
+                var t = SSC_BACKGROUND_DEPTH;
+                var d_n = 0.0;
+                if !ssc_is_background(hits[i]) {
+                    let sp = ssc_surface(hits[i]);
+                    let d = sp.position - eye;
+                    t = length(d);
+                    d_n = ssc_slope(t, abs(dot(sp.geometric_normal, d / t)), ssc.shade.z);
+                }
+                if t < t_min {
+                    t_min = t;
+                    slope = d_n;
+                }
+            }
+            if !ssc_consistent(t_min, bitcast<f32>(t_max_bits), slope, ssc.density.w) {
+                flags |= SSC_FLAG_SLOPE;
+            }
+        }
+        if ssc_is_base_pixel(id.xy) {
+            flags |= SSC_FLAG_BASE;
+        }
+        if (flags & (SSC_FLAG_SLOPE | SSC_FLAG_HOLE)) != 0u {
+            trace_set = all_k;
+        } else if (flags & SSC_FLAG_BASE) != 0u && k > 0u {
+            trace_set = 1u << ssc_base_index(k);
+        }
+    }
+
+    // 2. Density control: purge (randomly, keeping one visible sample) or plan new samples.
+    let n_target = ssc.density.x;
+    let delta = ssc.density.y;
+    var alive = all_k;
+    var to_add = 0u;
+    var purged = 0u;
+    if density < n_target - delta {
+        to_add = u32(ceil(n_target - density));
+    } else if density > n_target + delta {
+        let to_purge = u32(max(floor(density - n_target), 1.0));
+        for (var j = 0u; j < to_purge; j++) {
+            let alive_visible = countOneBits(alive & vis);
+            var candidates = alive;
+            if alive_visible <= 1u {
+                candidates = alive & ~vis;
+            }
+            let c = countOneBits(candidates);
+            if c == 0u {
+                break;
+            }
+            let r = min(u32(rng_next(&rng) * f32(c)), c - 1u);
+            var bits = candidates;
+            for (var skip = 0u; skip < r; skip++) {
+                bits &= bits - 1u;
+            }
+            alive &= ~(1u << firstTrailingBit(bits));
+            purged++;
+        }
+    }
+
+    // 3. Retrace the chosen samples that survived.
+    var rays = 0u;
+    let verify = trace_set & alive;
+    for (var i = 0u; i < k; i++) {
+        if ((verify >> i) & 1u) != 0u {
+            rays++;
+            if ssc_verify(hits[i]) {
+                vis |= 1u << i;
+            } else {
+                vis &= ~(1u << i);
+            }
+        }
+    }
+    // At least one visible sample per pixel: a pixel left without one gets a new sample
+    // (taking the last failed sample's place when the pixel is full).
+    if (alive & vis) == 0u {
+        to_add = max(to_add, 1u);
+    }
+
+    // Compact the survivors, then add new samples in free slots or over invisible ones.
+    var out_hits: array<vec4u, SSC_MAX_SLOTS>;
+    var out_rads: array<vec4f, SSC_MAX_SLOTS>;
+    var out_vis = 0u;
+    var kf = 0u;
+    for (var i = 0u; i < k; i++) {
+        if ((alive >> i) & 1u) != 0u {
+            out_hits[kf] = hits[i];
+            out_rads[kf] = rads[i];
+            out_vis |= ((vis >> i) & 1u) << kf;
+            kf++;
+        }
+    }
+    var added = 0u;
+    for (var j = 0u; j < to_add; j++) {
+        var at = kf;
+        if kf >= n {
+            let invisible = ((1u << kf) - 1u) & ~out_vis;
+            if invisible == 0u {
+                break;
+            }
+            at = firstLeadingBit(invisible);
+        } else {
+            kf++;
+        }
+        out_hits[at] = ssc_new_sample(id.xy, &rng);
+        out_rads[at] = vec4f(0.0);
+        out_vis |= 1u << at;
+        rays++;
+        added++;
+    }
+
+    var mask = 0u;
+    for (var i = 0u; i < kf; i++) {
+        dst_slots[i * pixels + p] = SscSlot(out_hits[i], out_rads[i]);
+        mask |= 1u << i;
+    }
+    mask |= out_vis << n;
+    dst_mask[p] = mask;
+    ssc_out[p].flags = flags;
+    ssc_out[p].rays = rays;
+
+    atomicAdd(&ssc_work[SSC_RAYS], rays);
+    atomicAdd(&ssc_work[SSC_NEW], added);
+    atomicAdd(&ssc_work[SSC_PURGED], purged);
+    atomicAdd(&ssc_work[SSC_VISIBLE], countOneBits(out_vis));
+    atomicAdd(&ssc_work[SSC_OCCUPIED], kf);
+    if (flags & SSC_FLAG_SLOPE) != 0u {
+        atomicAdd(&ssc_work[SSC_FLAGGED], 1u);
+    }
+
+    // Adaptive shading: histogram of the importance of every visible sample that the base rate
+    // does not already shade.
+    if ssc.modes.y == 1u {
+        let nv = countOneBits(out_vis);
+        var base = NO_HIT;
+        if ssc_is_base_pixel(id.xy) && nv > 0u {
+            base = ssc_nth_bit(out_vis, ssc_base_index(nv));
+            atomicAdd(&ssc_work[SSC_BASE], 1u);
+        }
+        for (var i = 0u; i < kf; i++) {
+            if ((out_vis >> i) & 1u) == 0u || i == base {
+                continue;
+            }
+            let w = ssc_importance(out_rads[i].w);
+            atomicMin(&ssc_work[SSC_WMIN_ACC], bitcast<u32>(w));
+            atomicMax(&ssc_work[SSC_WMAX_ACC], bitcast<u32>(w));
+            atomicAdd(&ssc_work[SSC_HISTOGRAM + ssc_bucket(w)], 1u);
+        }
+    }
+}
+
+// Index of the r-th set bit of `bits` (r counted from 0, lowest first).
+fn ssc_nth_bit(bits: u32, r: u32) -> u32 {
+    var b = bits;
+    for (var skip = 0u; skip < r; skip++) {
+        b &= b - 1u;
+    }
+    return firstTrailingBit(b);
+}
