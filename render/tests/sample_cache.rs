@@ -267,15 +267,17 @@ fn density_stays_within_bounds_and_runs_are_deterministic() {
         let mut scene = scene(top_down(3.0), true);
         let mut rig = Rig::new(&scene, s);
         let mut images = vec![];
-        // Zoom in (samples spread out: holes) then out (they crowd), then hold still.
-        for f in 0..12 {
+        // Zoom in (samples spread out: holes) then out (they crowd), then hold still: after four
+        // still frames the density control has settled.
+        for f in 0..16 {
             let h = if f < 4 { 3.0 - 0.15 * f as f32 } else if f < 8 { 2.4 + 0.25 * (f - 4) as f32 } else { 3.4 };
             scene.camera = top_down(h);
             let out = rig.step(&scene);
             let state = rig.state();
             check_invariants(&state, s.slots);
+            let out_stats = out.stats.clone();
             images.push(out.radiance);
-            if f >= 10 {
+            if f >= 12 {
                 let vis: Vec<f32> = state.masks.iter().map(|&m| (visibility(m, s.slots) & occupancy(m, s.slots)).count_ones() as f32).collect();
                 let mut outside = 0;
                 for y in 0..H as i32 {
@@ -293,6 +295,13 @@ fn density_stays_within_bounds_and_runs_are_deterministic() {
                             outside += 1;
                         }
                     }
+                }
+                if outside > 0 {
+                    let mut hist = [0u32; 13];
+                    for &v in &vis {
+                        hist[(v as usize).min(12)] += 1;
+                    }
+                    eprintln!("frame {f}: per-pixel visible counts {hist:?}, stats {:?}", out_stats);
                 }
                 assert_eq!(outside, 0, "frame {f}: {outside} pixels outside n_target ± δ");
             }

@@ -176,16 +176,20 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
         }
     }
 
-    // 2. Density control: purge (randomly, keeping one visible sample) or plan new samples.
+    // 2. Density control: when the 3x3 density is out of n_target ± δ, the pixel moves its own
+    // visible count to n_target (at least one sample either way): purge randomly, never the last
+    // visible sample, or plan new samples. A pixel above n_target + δ purges even inside a
+    // tolerable neighbourhood (twin of density.rs, which says why).
     let n_target = ssc.density.x;
     let delta = ssc.density.y;
     var alive = all_k;
     var to_add = 0u;
     var purged = 0u;
+    let own = f32(countOneBits(vis));
     if density < n_target - delta {
-        to_add = u32(ceil(n_target - density));
-    } else if density > n_target + delta {
-        let to_purge = u32(max(floor(density - n_target), 1.0));
+        to_add = u32(max(round(n_target) - own, 1.0));
+    } else if density > n_target + delta || own > n_target + delta {
+        let to_purge = u32(max(own - round(n_target), 1.0));
         for (var j = 0u; j < to_purge; j++) {
             let alive_visible = countOneBits(alive & vis);
             var candidates = alive;
