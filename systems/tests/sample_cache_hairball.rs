@@ -68,3 +68,34 @@ fn sample_cache_on_a_moving_hairball_camera() {
     assert!(stale[2] < stale[0], "adaptive leaves {} stale visible samples vs single {}", stale[2], stale[0]);
     assert!(stale[1] <= stale[2], "multi retraces everything, yet {} stale vs adaptive {}", stale[1], stale[2]);
 }
+
+#[test]
+fn hairball_camera_scenario_plays_end_to_end() {
+    use systems::playback::{Overrides, RunOptions, run};
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/hairball_camera.ron");
+    let out = std::env::temp_dir().join(format!("flicker-ssc-{}", std::process::id()));
+    let summary = run(&RunOptions {
+        scenario,
+        overrides: Overrides { frames: Some(3), resolution: Some((32, 18)), out: Some(out.clone()), ..Default::default() },
+        cache_dir: Some(out.join("cache")),
+        progress: false,
+    })
+    .expect("run");
+    let labels: std::collections::BTreeSet<String> = summary.records.iter().map(|r| r.method.clone()).collect();
+    for label in ["pt_1spp", "pt_4spp", "ssc_single", "ssc_multi", "ssc_adaptive"] {
+        assert!(labels.contains(label), "{label} missing from {labels:?}");
+    }
+    let csv = std::fs::read_to_string(out.join("frames.csv")).expect("frames.csv");
+    for column in ["shaded_samples", "traced_rays", "occupancy"] {
+        assert!(csv.lines().next().unwrap().contains(column), "{column} not in frames.csv");
+    }
+    // The cache's counters are per frame: the adaptive cache shades one sample per pixel.
+    let shaded = summary
+        .records
+        .iter()
+        .filter(|r| r.method == "ssc_adaptive")
+        .map(|r| r.stats.iter().find(|(k, _)| k == "shaded_samples").unwrap().1)
+        .collect::<Vec<_>>();
+    assert_eq!(shaded, vec![(32 * 18) as f64; 3]);
+    let _ = std::fs::remove_dir_all(&out);
+}
