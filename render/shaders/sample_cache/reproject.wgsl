@@ -9,7 +9,7 @@
 fn ssc_try_reserve(pixel: u32, visible: bool) -> u32 {
     let n = ssc.size.z;
     let full = ssc_full();
-    var m = atomicLoad(&pixel_atomics[2u * pixel]);
+    var m = atomicLoad(&pixel_atomics[SSC_ATOMICS * pixel]);
     loop {
         var candidates = ~m & full;
         if candidates == 0u && visible {
@@ -22,7 +22,7 @@ fn ssc_try_reserve(pixel: u32, visible: bool) -> u32 {
         let o_bit = 1u << i;
         let v_bit = 1u << (i + n);
         let s_val = o_bit | select(0u, v_bit, visible);
-        let previous = atomicOr(&pixel_atomics[2u * pixel], s_val);
+        let previous = atomicOr(&pixel_atomics[SSC_ATOMICS * pixel], s_val);
         var success = (previous & o_bit) == 0u;
         if visible && !success {
             success = (previous & v_bit) == 0u;
@@ -81,7 +81,7 @@ fn reserve_main(@builtin(global_invocation_id) id: vec3u) {
     }
     dst_slots[i * ssc_pixels() + t] = slot;
     if visible {
-        atomicMax(&pixel_atomics[2u * t + 1u], bitcast<u32>(depth));
+        atomicMax(&pixel_atomics[SSC_ATOMICS * t + 1u], bitcast<u32>(depth));
     }
     atomicAdd(&ssc_work[SSC_REPROJECTED], 1u);
 }

@@ -1,8 +1,9 @@
-// Primary ray tracing (sections 3.2 and 3.4), one thread per pixel after reservation:
-// canonical slot order, choice of the samples to retrace (single / multi / adaptive slope test),
-// density control towards n_target ± δ over 3x3, visibility retrace, new samples for holes, and
-// (adaptive shading) the importance histogram. Each thread owns its pixel's slots and final mask;
-// neighbours are read only through the reservation atomics, which no thread writes any more.
+// Primary ray tracing (sections 3.2 and 3.4) after reservation, in three dispatches.
+// retrace_main (per pixel): canonical slot order, choice of the samples to retrace (single /
+// multi / adaptive slope test), density control towards n_target ± δ over 3x3, the retrace list.
+// retrace_list_main (per ray): visibility retrace. finish_main (per pixel): new samples for holes
+// and density, final mask, (adaptive shading) the importance histogram. A pixel's thread owns its
+// slots and mask; neighbours are read only through the reservation atomics, written no more.
 
 // Jitter stays this far inside the pixel so that round-off never reprojects a sample of a static
 // view into a neighbour (a sample exactly on a pixel border would flip sides).
@@ -81,7 +82,7 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
 
     // Gather the reserved slots and sort them into the canonical order (the slots a sample won
     // depend on the race of the reservation; the order of a pixel's samples must not).
-    let m = atomicLoad(&pixel_atomics[2u * p]);
+    let m = atomicLoad(&pixel_atomics[SSC_ATOMICS * p]);
     var hits: array<vec4u, SSC_MAX_SLOTS>;
     var rads: array<vec4f, SSC_MAX_SLOTS>;
     var vis = 0u;
@@ -118,10 +119,10 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
                 continue;
             }
             let qi = u32(q.y) * width + u32(q.x);
-            let mq = atomicLoad(&pixel_atomics[2u * qi]);
+            let mq = atomicLoad(&pixel_atomics[SSC_ATOMICS * qi]);
             neighbour_visible += countOneBits(mq & (mq >> n) & full);
             neighbours++;
-            t_max_bits = max(t_max_bits, atomicLoad(&pixel_atomics[2u * qi + 1u]));
+            t_max_bits = max(t_max_bits, atomicLoad(&pixel_atomics[SSC_ATOMICS * qi + 1u]));
         }
     }
     let density = f32(neighbour_visible) / f32(neighbours);
@@ -210,37 +211,72 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
         }
     }
 
-    // 3. Retrace the chosen samples that survived.
-    var rays = 0u;
-    let verify = trace_set & alive;
-    for (var i = 0u; i < k; i++) {
-        if ((verify >> i) & 1u) != 0u {
-            rays++;
-            if ssc_verify(hits[i]) {
-                vis |= 1u << i;
-            } else {
-                vis &= ~(1u << i);
-            }
-        }
-    }
-    // At least one visible sample per pixel: a pixel left without one gets a new sample
-    // (taking the last failed sample's place when the pixel is full).
-    if (alive & vis) == 0u {
-        to_add = max(to_add, 1u);
-    }
-
-    // Compact the survivors, then add new samples in free slots or over invisible ones.
-    var out_hits: array<vec4u, SSC_MAX_SLOTS>;
-    var out_rads: array<vec4f, SSC_MAX_SLOTS>;
-    var out_vis = 0u;
-    var kf = 0u;
+    // Compact the survivors into slots 0..ka and queue the chosen ones for retracing: the rays
+    // are traced by retrace_list_main, one thread per ray, so that a pixel retracing all its
+    // samples does not hold up its SIMD neighbours that retrace none.
+    var ka = 0u;
+    var alive_vis = 0u;
     for (var i = 0u; i < k; i++) {
         if ((alive >> i) & 1u) != 0u {
-            out_hits[kf] = hits[i];
-            out_rads[kf] = rads[i];
-            out_vis |= ((vis >> i) & 1u) << kf;
-            kf++;
+            dst_slots[ka * pixels + p] = SscSlot(hits[i], rads[i]);
+            alive_vis |= ((vis >> i) & 1u) << ka;
+            if ((trace_set >> i) & 1u) != 0u {
+                let at = atomicAdd(&ssc_work[SSC_RETRACE_COUNT], 1u);
+                atomicStore(&ssc_work[SSC_LIST + at], ka * pixels + p);
+            }
+            ka++;
         }
+    }
+    dst_mask[p] = ((1u << ka) - 1u) | (alive_vis << n);
+    ssc_out[p].flags = flags;
+    // Carried to finish_main: how many new samples the density control asks for.
+    ssc_out[p].rays = to_add;
+    atomicAdd(&ssc_work[SSC_PURGED], purged);
+    if (flags & SSC_FLAG_SLOPE) != 0u {
+        atomicAdd(&ssc_work[SSC_FLAGGED], 1u);
+    }
+}
+
+// 3. Retrace one queued sample: its result goes to the pixel's third atomic word.
+@compute @workgroup_size(8, 8, 1)
+fn retrace_list_main(@builtin(global_invocation_id) id: vec3u) {
+    if id.x >= ssc.size.x || id.y >= ssc.size.y || id.z >= ssc.size.z {
+        return;
+    }
+    let pixels = ssc_pixels();
+    let index = id.z * pixels + id.y * ssc.size.x + id.x;
+    if index >= atomicLoad(&ssc_work[SSC_RETRACE_COUNT]) {
+        return;
+    }
+    let entry = atomicLoad(&ssc_work[SSC_LIST + index]);
+    let p = entry % pixels;
+    let s = entry / pixels;
+    let visible = ssc_verify(dst_slots[entry].hit);
+    atomicOr(&pixel_atomics[SSC_ATOMICS * p + 2u], (1u << (s + 16u)) | select(0u, 1u << s, visible));
+}
+
+// 4. Per pixel: apply the retrace results, give a pixel without a visible sample a new one,
+// add the samples the density control asked for, write the final mask and the histogram.
+@compute @workgroup_size(8, 8, 1)
+fn finish_main(@builtin(global_invocation_id) id: vec3u) {
+    if id.x >= ssc.size.x || id.y >= ssc.size.y {
+        return;
+    }
+    let pixels = ssc_pixels();
+    let n = ssc.size.z;
+    let p = id.y * ssc.size.x + id.x;
+    var rng = rng_seed(frame.seed.xy, frame.seed.z, p, 0x55c1u);
+    let provisional = dst_mask[p];
+    var kf = countOneBits(provisional & ssc_full());
+    let results = atomicLoad(&pixel_atomics[SSC_ATOMICS * p + 2u]);
+    let traced = results >> 16u;
+    var out_vis = (((provisional >> n) & ~traced) | (results & traced)) & ((1u << kf) - 1u);
+    var rays = countOneBits(traced);
+    var to_add = ssc_out[p].rays;
+    // At least one visible sample per pixel: a pixel left without one gets a new sample
+    // (taking the last failed sample's place when the pixel is full).
+    if out_vis == 0u {
+        to_add = max(to_add, 1u);
     }
     var added = 0u;
     for (var j = 0u; j < to_add; j++) {
@@ -254,31 +290,18 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
         } else {
             kf++;
         }
-        out_hits[at] = ssc_new_sample(id.xy, &rng);
-        out_rads[at] = vec4f(0.0);
+        dst_slots[at * pixels + p] = SscSlot(ssc_new_sample(id.xy, &rng), vec4f(0.0));
         out_vis |= 1u << at;
         rays++;
         added++;
     }
-
-    var mask = 0u;
-    for (var i = 0u; i < kf; i++) {
-        dst_slots[i * pixels + p] = SscSlot(out_hits[i], out_rads[i]);
-        mask |= 1u << i;
-    }
-    mask |= out_vis << n;
-    dst_mask[p] = mask;
-    ssc_out[p].flags = flags;
+    dst_mask[p] = ((1u << kf) - 1u) | (out_vis << n);
     ssc_out[p].rays = rays;
 
     atomicAdd(&ssc_work[SSC_RAYS], rays);
     atomicAdd(&ssc_work[SSC_NEW], added);
-    atomicAdd(&ssc_work[SSC_PURGED], purged);
     atomicAdd(&ssc_work[SSC_VISIBLE], countOneBits(out_vis));
     atomicAdd(&ssc_work[SSC_OCCUPIED], kf);
-    if (flags & SSC_FLAG_SLOPE) != 0u {
-        atomicAdd(&ssc_work[SSC_FLAGGED], 1u);
-    }
 
     // Adaptive shading: histogram of the importance of every visible sample that the base rate
     // does not already shade.
@@ -293,7 +316,7 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
             if ((out_vis >> i) & 1u) == 0u || i == base {
                 continue;
             }
-            let w = ssc_importance(out_rads[i].w);
+            let w = ssc_importance(dst_slots[i * pixels + p].radiance.w);
             atomicMin(&ssc_work[SSC_WMIN_ACC], bitcast<u32>(w));
             atomicMax(&ssc_work[SSC_WMAX_ACC], bitcast<u32>(w));
             atomicAdd(&ssc_work[SSC_HISTOGRAM + ssc_bucket(w)], 1u);

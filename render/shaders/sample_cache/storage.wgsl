@@ -12,6 +12,7 @@
 // (N <= 16), bits 2N..31 always zero.
 
 const SSC_MAX_SLOTS: u32 = 16u;
+const SSC_ATOMICS: u32 = 3u;
 // Depth of a background sample in the slope test (finite: the test multiplies it).
 const SSC_BACKGROUND_DEPTH: f32 = 1.0e30;
 
@@ -54,7 +55,8 @@ const SSC_OCCUPIED: u32 = 13u;
 const SSC_BASE: u32 = 14u;
 const SSC_FLAGGED: u32 = 15u;
 const SSC_HISTOGRAM: u32 = 16u;
-const SSC_AUDIT: u32 = 32u;   // visible samples found occluded by audit_main
+const SSC_AUDIT: u32 = 32u;
+const SSC_RETRACE_COUNT: u32 = 33u; // entries of the retrace list (shares SSC_LIST with the shade list)   // visible samples found occluded by audit_main
 const SSC_LIST: u32 = 48u;
 
 const SSC_FLAG_BASE: u32 = 1u;
@@ -64,8 +66,8 @@ const SSC_FLAG_HOLE: u32 = 4u;
 @group(2) @binding(0) var<uniform> ssc: SscParams;
 @group(2) @binding(1) var<storage, read> src_mask: array<u32>;
 @group(2) @binding(2) var<storage, read> src_slots: array<SscSlot>;
-// Two words per pixel: the mask being reserved (atomicOr) and the farthest visible depth
-// (atomicMax of its float bits).
+// SSC_ATOMICS words per pixel: the mask being reserved (atomicOr), the farthest visible depth
+// (atomicMax of its float bits), and the retrace results (bits 0-15: visible, 16-31: traced).
 @group(2) @binding(3) var<storage, read_write> pixel_atomics: array<atomic<u32>>;
 @group(2) @binding(4) var<storage, read_write> dst_slots: array<SscSlot>;
 @group(2) @binding(5) var<storage, read_write> dst_mask: array<u32>;

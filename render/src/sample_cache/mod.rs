@@ -4,7 +4,7 @@
 //! sparsely, and averaged into the image. See README.md in this folder for the map and choices.
 //!
 //! Passes per frame (shaders/sample_cache/, one compute pass each, timed):
-//! `reserve` (reproject.wgsl: begin_main + reserve_main), `trace` (retrace.wgsl),
+//! `reserve` (reproject.wgsl: begin_main + reserve_main), `trace` (retrace.wgsl: retrace_main, retrace_list_main, finish_main),
 //! `shade` (shading_rate.wgsl rates_main + select_main, shade.wgsl shade_main),
 //! `reconstruct` (reconstruct.wgsl).
 //!
@@ -149,6 +149,8 @@ struct Pipelines {
     begin: wgpu::ComputePipeline,
     reserve: wgpu::ComputePipeline,
     retrace: wgpu::ComputePipeline,
+    retrace_list: wgpu::ComputePipeline,
+    finish: wgpu::ComputePipeline,
     rates: wgpu::ComputePipeline,
     select: wgpu::ComputePipeline,
     shade: wgpu::ComputePipeline,
@@ -161,7 +163,7 @@ impl SampleCache {
         settings.validate().map_err(|e| RenderError::Settings(format!("sample cache: {e}")))?;
         let (width, height) = (tracer.settings().width, tracer.settings().height);
         let n = settings.slots as u64;
-        gpu.check_resolution(width, height, 2 * 32 * n + 4 * 2 + 8 + 4 * n + 32)?;
+        gpu.check_resolution(width, height, 2 * 32 * n + 4 * 2 + 12 + 4 * n + 32)?;
         let limit = gpu.limits.max_storage_buffers_per_shader_stage;
         let needed = STORAGE_BUFFERS + 5 + 8;
         if needed > limit {
@@ -189,7 +191,7 @@ impl SampleCache {
             Cache { mask: buffer("ssc mask a", pixels * 4, rw)?, slots: buffer("ssc slots a", pixels * n * 32, rw)? },
             Cache { mask: buffer("ssc mask b", pixels * 4, rw)?, slots: buffer("ssc slots b", pixels * n * 32, rw)? },
         ];
-        let pixel_atomics = buffer("ssc pixel atomics", pixels * 8, rw)?;
+        let pixel_atomics = buffer("ssc pixel atomics", pixels * 12, rw)?;
         let work = buffer("ssc work", (HEADER_WORDS + pixels * n) * 4, rw)?;
         let out = buffer("ssc out", pixels * 32, rw)?;
         let out_readback = buffer("ssc out readback", pixels * 32, readback)?;
@@ -218,6 +220,8 @@ impl SampleCache {
             begin: pipeline("begin_main"),
             reserve: pipeline("reserve_main"),
             retrace: pipeline("retrace_main"),
+            retrace_list: pipeline("retrace_list_main"),
+            finish: pipeline("finish_main"),
             rates: pipeline("rates_main"),
             select: pipeline("select_main"),
             shade: pipeline("shade_main"),
@@ -307,7 +311,7 @@ impl SampleCache {
         let (gx, gy) = (w.div_ceil(8), h.div_ceil(8));
         let groups: [&[(&wgpu::ComputePipeline, [u32; 3])]; 4] = [
             &[(&self.pipelines.begin, [1, 1, 1]), (&self.pipelines.reserve, [gx, gy, s.slots])],
-            &[(&self.pipelines.retrace, [gx, gy, 1])],
+            &[(&self.pipelines.retrace, [gx, gy, 1]), (&self.pipelines.retrace_list, [gx, gy, s.slots]), (&self.pipelines.finish, [gx, gy, 1])],
             &[(&self.pipelines.rates, [1, 1, 1]), (&self.pipelines.select, [gx, gy, 1]), (&self.pipelines.shade, [gx, gy, s.slots])],
             &[(&self.pipelines.reconstruct, [gx, gy, 1])],
         ];
