@@ -9,4 +9,5 @@ pub mod lights;
 pub mod materials;
 pub mod path_tracer;
 pub mod readback;
+pub mod sample_cache;
 pub mod timing;

@@ -285,6 +285,11 @@ impl PathTracer {
         self.write_frame(gpu, &self.previous_camera, spp, first_sample, seed, frame, false);
     }
 
+    /// The camera of the current frame (after the last `update`).
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
     pub fn settings(&self) -> PathTracerSettings {
         self.settings
     }

@@ -51,6 +51,32 @@ pub enum MethodSpec {
         #[serde(default)]
         pretrain_frames: u32,
     },
+    /// Stable sample cache (render::sample_cache); every field defaults to the paper's value,
+    /// e.g. `SampleCache(retrace: Multi)` or `SampleCache(shading: Adaptive, shading_rate: 0.5)`.
+    SampleCache {
+        #[serde(default = "ssc_default::slots")]
+        slots: u32,
+        #[serde(default = "ssc_default::n_target")]
+        n_target: f32,
+        #[serde(default = "ssc_default::delta")]
+        delta: f32,
+        #[serde(default = "ssc_default::epsilon0")]
+        epsilon0: f32,
+        #[serde(default = "ssc_default::epsilon1")]
+        epsilon1: f32,
+        #[serde(default = "ssc_default::base_block")]
+        base_block: u32,
+        #[serde(default = "ssc_default::buckets")]
+        buckets: u32,
+        #[serde(default = "ssc_default::alpha")]
+        alpha: f32,
+        #[serde(default)]
+        retrace: render::sample_cache::Retrace,
+        #[serde(default)]
+        shading: render::sample_cache::ShadingMode,
+        #[serde(default = "ssc_default::shading_rate")]
+        shading_rate: f32,
+    },
 }
 
 /// Short name of a predictor mode in labels.
@@ -63,12 +89,26 @@ pub fn predictor_label(mode: nirc::PredictorMode) -> &'static str {
     }
 }
 
+mod ssc_default {
+    use render::sample_cache::SampleCacheSettings as S;
+    pub fn slots() -> u32 { S::default().slots }
+    pub fn n_target() -> f32 { S::default().n_target }
+    pub fn delta() -> f32 { S::default().delta }
+    pub fn epsilon0() -> f32 { S::default().epsilon0 }
+    pub fn epsilon1() -> f32 { S::default().epsilon1 }
+    pub fn base_block() -> u32 { S::default().base_block }
+    pub fn buckets() -> u32 { S::default().buckets }
+    pub fn alpha() -> f32 { S::default().alpha }
+    pub fn shading_rate() -> f32 { S::default().shading_rate }
+}
+
 impl MethodSpec {
     /// A short name usable as a folder name, e.g. `pt_4spp`.
     pub fn label(&self) -> String {
         match self {
             MethodSpec::PathTracing { spp } => format!("pt_{spp}spp"),
             MethodSpec::Nirc { spp, predictor, .. } => format!("nirc_{}_{spp}spp", predictor_label(*predictor)),
+            MethodSpec::SampleCache { .. } => self.sample_cache_settings().map(|s| s.label()).unwrap_or_default(),
         }
     }
 
@@ -77,6 +117,18 @@ impl MethodSpec {
         match self {
             MethodSpec::PathTracing { spp } => *spp,
             MethodSpec::Nirc { spp, .. } => *spp,
+            // One shaded path per pixel at a 100% shading rate.
+            MethodSpec::SampleCache { shading_rate, .. } => (shading_rate.ceil() as u32).max(1),
+        }
+    }
+
+    /// The sample cache's settings, `None` for other methods.
+    pub fn sample_cache_settings(&self) -> Option<render::sample_cache::SampleCacheSettings> {
+        match *self {
+            MethodSpec::SampleCache { slots, n_target, delta, epsilon0, epsilon1, base_block, buckets, alpha, retrace, shading, shading_rate } => {
+                Some(render::sample_cache::SampleCacheSettings { slots, n_target, delta, epsilon0, epsilon1, base_block, buckets, alpha, retrace, shading, shading_rate })
+            }
+            _ => None,
         }
     }
 }

@@ -58,6 +58,7 @@ pub fn load_scenario(path: &Path, o: &Overrides) -> Result<Scenario> {
             match m {
                 MethodSpec::PathTracing { spp: s } => *s = spp,
                 MethodSpec::Nirc { spp: s, .. } => *s = spp,
+                MethodSpec::SampleCache { .. } => {}
             }
         }
     }

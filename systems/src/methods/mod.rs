@@ -4,6 +4,7 @@
 
 pub mod nirc;
 mod path_tracing;
+mod sample_cache;
 
 use anyhow::Result;
 use render::gpu::Gpu;
@@ -13,6 +14,7 @@ use sim::{MethodSpec, Scenario};
 
 pub use nirc::Nirc;
 pub use path_tracing::PathTracing;
+pub use sample_cache::SampleCacheMethod;
 
 /// Everything a method may read while rendering one frame.
 pub struct FrameContext<'a> {
@@ -68,5 +70,10 @@ pub fn build(spec: &MethodSpec, _gpu: &Gpu, _scenario: &Scenario, _scene: &Scene
             nirc::NircSettings { spp: *spp, cache: cache.clone(), paths: paths.clone(), pretrain_frames: *pretrain_frames },
             *predictor,
         )?),
+        MethodSpec::SampleCache { .. } => {
+            let settings = spec.sample_cache_settings().expect("a SampleCache spec");
+            settings.validate().map_err(|e| anyhow::anyhow!("{}: SampleCache: {e}", _scenario.origin.display()))?;
+            Box::new(SampleCacheMethod::new(settings))
+        }
     })
 }

@@ -1,0 +1,87 @@
+// Forward reprojection (section 3.1) with slot reservation on the occupancy/visibility mask
+// (listing 2, fixed). One thread per (source pixel, slot) of last frame's cache.
+
+// Listing 2 as printed `break`s after the first try whatever its outcome; the text says a lost
+// race retries on another slot while any remain. Here the loop only ends on success or when no
+// candidate slot is left; every failed try ORs its bit into `m`, so candidates strictly shrink.
+// Candidates: unoccupied slots, and for a visible sample, when none is free, occupied slots whose
+// sample is invisible (it races to set their visibility bit). Returns the slot or NO_HIT.
+fn ssc_try_reserve(pixel: u32, visible: bool) -> u32 {
+    let n = ssc.size.z;
+    let full = ssc_full();
+    var m = atomicLoad(&pixel_atomics[SSC_ATOMICS * pixel]);
+    loop {
+        var candidates = ~m & full;
+        if candidates == 0u && visible {
+            candidates = m & ~(m >> n) & full;
+        }
+        if candidates == 0u {
+            return NO_HIT;
+        }
+        let i = firstTrailingBit(candidates);
+        let o_bit = 1u << i;
+        let v_bit = 1u << (i + n);
+        let s_val = o_bit | select(0u, v_bit, visible);
+        let previous = atomicOr(&pixel_atomics[SSC_ATOMICS * pixel], s_val);
+        var success = (previous & o_bit) == 0u;
+        if visible && !success {
+            success = (previous & v_bit) == 0u;
+        }
+        m = previous | s_val;
+        if success {
+            return i;
+        }
+    }
+    return NO_HIT;
+}
+
+// Starts the frame's importance bounds: last frame's become this frame's bucket bounds.
+@compute @workgroup_size(1, 1, 1)
+fn begin_main() {
+    atomicStore(&ssc_work[SSC_WMIN], atomicLoad(&ssc_work[SSC_WMIN_ACC]));
+    atomicStore(&ssc_work[SSC_WMAX], atomicLoad(&ssc_work[SSC_WMAX_ACC]));
+    atomicStore(&ssc_work[SSC_WMIN_ACC], 0xffffffffu);
+    atomicStore(&ssc_work[SSC_WMAX_ACC], 0u);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn reserve_main(@builtin(global_invocation_id) id: vec3u) {
+    if id.x >= ssc.size.x || id.y >= ssc.size.y || id.z >= ssc.size.z {
+        return;
+    }
+    let source = id.y * ssc.size.x + id.x;
+    let s = id.z;
+    let mask = src_mask[source];
+    if ((mask >> s) & 1u) == 0u {
+        return;
+    }
+    let visible = ((mask >> (s + ssc.size.z)) & 1u) != 0u;
+    let slot = src_slots[s * ssc_pixels() + source];
+    let eye = frame.camera.position.xyz;
+    var image: vec2f;
+    var depth = SSC_BACKGROUND_DEPTH;
+    if ssc_is_background(slot.hit) {
+        image = project_offset(frame.camera, ssc_background_dir(slot.hit));
+    } else {
+        let p = ssc_surface(slot.hit).position;
+        image = project_offset(frame.camera, p - eye);
+        depth = length(p - eye);
+    }
+    let size = vec2f(f32(ssc.size.x), f32(ssc.size.y));
+    if !(all(image >= vec2f(0.0)) && all(image < size)) {
+        atomicAdd(&ssc_work[SSC_DROPPED], 1u);
+        return;
+    }
+    let target_pixel = min(vec2u(image), ssc.size.xy - 1u);
+    let t = target_pixel.y * ssc.size.x + target_pixel.x;
+    let i = ssc_try_reserve(t, visible);
+    if i == NO_HIT {
+        atomicAdd(&ssc_work[SSC_DROPPED], 1u);
+        return;
+    }
+    dst_slots[i * ssc_pixels() + t] = slot;
+    if visible {
+        atomicMax(&pixel_atomics[SSC_ATOMICS * t + 1u], bitcast<u32>(depth));
+    }
+    atomicAdd(&ssc_work[SSC_REPROJECTED], 1u);
+}

@@ -1,0 +1,334 @@
+// Primary ray tracing (sections 3.2 and 3.4) after reservation, in three dispatches.
+// retrace_main (per pixel): canonical slot order, choice of the samples to retrace (single /
+// multi / adaptive slope test), density control towards n_target ± δ over 3x3, the retrace list.
+// retrace_list_main (per ray): visibility retrace. finish_main (per pixel): new samples for holes
+// and density, final mask, (adaptive shading) the importance histogram. A pixel's thread owns its
+// slots and mask; neighbours are read only through the reservation atomics, written no more.
+
+// Jitter stays this far inside the pixel so that round-off never reprojects a sample of a static
+// view into a neighbour (a sample exactly on a pixel border would flip sides).
+const SSC_JITTER_INSET: f32 = 1.0e-3;
+
+// The 4x4 block's base pixel this frame: the block position visits all b*b pixels in turn.
+fn ssc_is_base_pixel(pixel: vec2u) -> bool {
+    let b = ssc.modes.z;
+    let k = ssc.size.w % (b * b);
+    return pixel.x % b == k % b && pixel.y % b == k / b;
+}
+
+// Round-robin index of the base sample of a base pixel, among `count` candidates.
+fn ssc_base_index(count: u32) -> u32 {
+    let b = ssc.modes.z;
+    return (ssc.size.w / (b * b)) % max(count, 1u);
+}
+
+// Retrace from the eye towards the stored point (a shadow ray, section 3.2): visible when nothing
+// is hit before (1 - ε0) of the way there; a background sample is visible when its ray escapes.
+fn ssc_verify(hit: vec4u) -> bool {
+    let eye = frame.camera.position.xyz;
+    if ssc_is_background(hit) {
+        return !trace_any(eye, ssc_background_dir(hit), FAR);
+    }
+    let d = ssc_surface(hit).position - eye;
+    return !trace_any(eye, d, 1.0 - ssc.density.z);
+}
+
+fn ssc_new_sample(pixel: vec2u, rng: ptr<function, u32>) -> vec4u {
+    let jitter = mix(vec2f(SSC_JITTER_INSET), vec2f(1.0 - SSC_JITTER_INSET), rng_next2(rng));
+    let eye = frame.camera.position.xyz;
+    let dir = camera_ray_direction(frame.camera, vec2f(pixel) + jitter);
+    let hit = trace_closest(eye, dir, FAR);
+    if hit.instance == NO_HIT {
+        return ssc_pack_background(dir);
+    }
+    return ssc_pack_hit(hit);
+}
+
+fn ssc_swap_bits(bits: u32, i: u32, j: u32) -> u32 {
+    let a = (bits >> i) & 1u;
+    let b = (bits >> j) & 1u;
+    return (bits & ~((1u << i) | (1u << j))) | (a << j) | (b << i);
+}
+
+// Log-spaced bucket (M buckets) of importance w between this frame's bounds (last frame's min
+// and max): M - 1 = most important. Degenerate bounds (first frame) put everything in M - 1.
+fn ssc_bucket(w: f32) -> u32 {
+    let m = ssc.modes.w;
+    let lo = bitcast<f32>(atomicLoad(&ssc_work[SSC_WMIN]));
+    let hi = bitcast<f32>(atomicLoad(&ssc_work[SSC_WMAX]));
+    if !(lo > 0.0) || !(hi > lo) {
+        return m - 1u;
+    }
+    let f = log(w / lo) / log(hi / lo);
+    return u32(clamp(floor(f * f32(m)), 0.0, f32(m - 1u)));
+}
+
+fn ssc_importance(count: f32) -> f32 {
+    return 1.0 / (1.0 + count);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
+    if id.x >= ssc.size.x || id.y >= ssc.size.y {
+        return;
+    }
+    let width = ssc.size.x;
+    let pixels = ssc_pixels();
+    let n = ssc.size.z;
+    let full = ssc_full();
+    let p = id.y * width + id.x;
+    let eye = frame.camera.position.xyz;
+    var rng = rng_seed(frame.seed.xy, frame.seed.z, p, 0x55c0u);
+
+    // Gather the reserved slots and sort them into the canonical order (the slots a sample won
+    // depend on the race of the reservation; the order of a pixel's samples must not).
+    let m = atomicLoad(&pixel_atomics[SSC_ATOMICS * p]);
+    var hits: array<vec4u, SSC_MAX_SLOTS>;
+    var rads: array<vec4f, SSC_MAX_SLOTS>;
+    var vis = 0u;
+    var k = 0u;
+    for (var s = 0u; s < n; s++) {
+        if ((m >> s) & 1u) != 0u {
+            let slot = dst_slots[s * pixels + p];
+            hits[k] = slot.hit;
+            rads[k] = slot.radiance;
+            if ((m >> (s + n)) & 1u) != 0u {
+                vis |= 1u << k;
+            }
+            k++;
+        }
+    }
+    for (var i = 1u; i < k; i++) {
+        var j = i;
+        while j > 0u && ssc_less(hits[j], hits[j - 1u]) {
+            let h = hits[j]; hits[j] = hits[j - 1u]; hits[j - 1u] = h;
+            let r = rads[j]; rads[j] = rads[j - 1u]; rads[j - 1u] = r;
+            vis = ssc_swap_bits(vis, j, j - 1u);
+            j--;
+        }
+    }
+
+    // 3x3 neighbourhood: visible-sample density and the farthest visible depth.
+    var neighbour_visible = 0u;
+    var neighbours = 0u;
+    var t_max_bits = 0u;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = vec2i(id.xy) + vec2i(dx, dy);
+            if q.x < 0 || q.y < 0 || q.x >= i32(width) || q.y >= i32(ssc.size.y) {
+                continue;
+            }
+            let qi = u32(q.y) * width + u32(q.x);
+            let mq = atomicLoad(&pixel_atomics[SSC_ATOMICS * qi]);
+            neighbour_visible += countOneBits(mq & (mq >> n) & full);
+            neighbours++;
+            t_max_bits = max(t_max_bits, atomicLoad(&pixel_atomics[SSC_ATOMICS * qi + 1u]));
+        }
+    }
+    let density = f32(neighbour_visible) / f32(neighbours);
+
+    // 1. Which samples to retrace.
+    let all_k = (1u << k) - 1u;
+    var trace_set = 0u;
+    var flags = 0u;
+    let mode = ssc.modes.x;
+    if mode == 0u {
+        if k > 0u {
+            trace_set = 1u << (ssc.size.w % k);
+        }
+    } else if mode == 1u {
+        trace_set = all_k;
+    } else {
+        if vis == 0u {
+            flags |= SSC_FLAG_HOLE;
+        } else {
+            // t_min and its slope Δn from the pixel's own visible samples (exact; see the
+            // packing note in sample_cache/mod.rs), t_max from the 3x3 atomics.
+            var t_min = 3.0e38;
+            var slope = 0.0;
+            for (var i = 0u; i < k; i++) {
+                if ((vis >> i) & 1u) == 0u {
+                    continue;
+                }
+                var t = SSC_BACKGROUND_DEPTH;
+                var d_n = 0.0;
+                if !ssc_is_background(hits[i]) {
+                    let sp = ssc_surface(hits[i]);
+                    let d = sp.position - eye;
+                    t = length(d);
+                    d_n = ssc_slope(t, abs(dot(sp.geometric_normal, d / t)), ssc.shade.z);
+                }
+                if t < t_min {
+                    t_min = t;
+                    slope = d_n;
+                }
+            }
+            if !ssc_consistent(t_min, bitcast<f32>(t_max_bits), slope, ssc.density.w) {
+                flags |= SSC_FLAG_SLOPE;
+            }
+        }
+        if ssc_is_base_pixel(id.xy) {
+            flags |= SSC_FLAG_BASE;
+        }
+        if (flags & (SSC_FLAG_SLOPE | SSC_FLAG_HOLE)) != 0u {
+            trace_set = all_k;
+        } else if (flags & SSC_FLAG_BASE) != 0u && k > 0u {
+            trace_set = 1u << ssc_base_index(k);
+        }
+    }
+
+    // 2. Density control: when the 3x3 density is out of n_target ± δ, the pixel moves its own
+    // visible count to n_target (at least one sample either way): purge randomly, never the last
+    // visible sample, or plan new samples. A pixel above n_target + δ purges even inside a
+    // tolerable neighbourhood (twin of density.rs, which says why).
+    let n_target = ssc.density.x;
+    let delta = ssc.density.y;
+    var alive = all_k;
+    var to_add = 0u;
+    var purged = 0u;
+    let own = f32(countOneBits(vis));
+    if density < n_target - delta {
+        to_add = u32(max(round(n_target) - own, 1.0));
+    } else if density > n_target + delta || own > n_target + delta {
+        let to_purge = u32(max(own - round(n_target), 1.0));
+        for (var j = 0u; j < to_purge; j++) {
+            let alive_visible = countOneBits(alive & vis);
+            var candidates = alive;
+            if alive_visible <= 1u {
+                candidates = alive & ~vis;
+            }
+            let c = countOneBits(candidates);
+            if c == 0u {
+                break;
+            }
+            let r = min(u32(rng_next(&rng) * f32(c)), c - 1u);
+            var bits = candidates;
+            for (var skip = 0u; skip < r; skip++) {
+                bits &= bits - 1u;
+            }
+            alive &= ~(1u << firstTrailingBit(bits));
+            purged++;
+        }
+    }
+
+    // Compact the survivors into slots 0..ka and queue the chosen ones for retracing: the rays
+    // are traced by retrace_list_main, one thread per ray, so that a pixel retracing all its
+    // samples does not hold up its SIMD neighbours that retrace none.
+    var ka = 0u;
+    var alive_vis = 0u;
+    for (var i = 0u; i < k; i++) {
+        if ((alive >> i) & 1u) != 0u {
+            dst_slots[ka * pixels + p] = SscSlot(hits[i], rads[i]);
+            alive_vis |= ((vis >> i) & 1u) << ka;
+            if ((trace_set >> i) & 1u) != 0u {
+                let at = atomicAdd(&ssc_work[SSC_RETRACE_COUNT], 1u);
+                atomicStore(&ssc_work[SSC_LIST + at], ka * pixels + p);
+            }
+            ka++;
+        }
+    }
+    dst_mask[p] = ((1u << ka) - 1u) | (alive_vis << n);
+    ssc_out[p].flags = flags;
+    // Carried to finish_main: how many new samples the density control asks for.
+    ssc_out[p].rays = to_add;
+    atomicAdd(&ssc_work[SSC_PURGED], purged);
+    if (flags & SSC_FLAG_SLOPE) != 0u {
+        atomicAdd(&ssc_work[SSC_FLAGGED], 1u);
+    }
+}
+
+// 3. Retrace one queued sample: its result goes to the pixel's third atomic word.
+@compute @workgroup_size(8, 8, 1)
+fn retrace_list_main(@builtin(global_invocation_id) id: vec3u) {
+    if id.x >= ssc.size.x || id.y >= ssc.size.y || id.z >= ssc.size.z {
+        return;
+    }
+    let pixels = ssc_pixels();
+    let index = id.z * pixels + id.y * ssc.size.x + id.x;
+    if index >= atomicLoad(&ssc_work[SSC_RETRACE_COUNT]) {
+        return;
+    }
+    let entry = atomicLoad(&ssc_work[SSC_LIST + index]);
+    let p = entry % pixels;
+    let s = entry / pixels;
+    let visible = ssc_verify(dst_slots[entry].hit);
+    atomicOr(&pixel_atomics[SSC_ATOMICS * p + 2u], (1u << (s + 16u)) | select(0u, 1u << s, visible));
+}
+
+// 4. Per pixel: apply the retrace results, give a pixel without a visible sample a new one,
+// add the samples the density control asked for, write the final mask and the histogram.
+@compute @workgroup_size(8, 8, 1)
+fn finish_main(@builtin(global_invocation_id) id: vec3u) {
+    if id.x >= ssc.size.x || id.y >= ssc.size.y {
+        return;
+    }
+    let pixels = ssc_pixels();
+    let n = ssc.size.z;
+    let p = id.y * ssc.size.x + id.x;
+    var rng = rng_seed(frame.seed.xy, frame.seed.z, p, 0x55c1u);
+    let provisional = dst_mask[p];
+    var kf = countOneBits(provisional & ssc_full());
+    let results = atomicLoad(&pixel_atomics[SSC_ATOMICS * p + 2u]);
+    let traced = results >> 16u;
+    var out_vis = (((provisional >> n) & ~traced) | (results & traced)) & ((1u << kf) - 1u);
+    var rays = countOneBits(traced);
+    var to_add = ssc_out[p].rays;
+    // At least one visible sample per pixel: a pixel left without one gets a new sample
+    // (taking the last failed sample's place when the pixel is full).
+    if out_vis == 0u {
+        to_add = max(to_add, 1u);
+    }
+    var added = 0u;
+    for (var j = 0u; j < to_add; j++) {
+        var at = kf;
+        if kf >= n {
+            let invisible = ((1u << kf) - 1u) & ~out_vis;
+            if invisible == 0u {
+                break;
+            }
+            at = firstLeadingBit(invisible);
+        } else {
+            kf++;
+        }
+        dst_slots[at * pixels + p] = SscSlot(ssc_new_sample(id.xy, &rng), vec4f(0.0));
+        out_vis |= 1u << at;
+        rays++;
+        added++;
+    }
+    dst_mask[p] = ((1u << kf) - 1u) | (out_vis << n);
+    ssc_out[p].rays = rays;
+
+    atomicAdd(&ssc_work[SSC_RAYS], rays);
+    atomicAdd(&ssc_work[SSC_NEW], added);
+    atomicAdd(&ssc_work[SSC_VISIBLE], countOneBits(out_vis));
+    atomicAdd(&ssc_work[SSC_OCCUPIED], kf);
+
+    // Adaptive shading: histogram of the importance of every visible sample that the base rate
+    // does not already shade.
+    if ssc.modes.y == 1u {
+        let nv = countOneBits(out_vis);
+        var base = NO_HIT;
+        if ssc_is_base_pixel(id.xy) && nv > 0u {
+            base = ssc_nth_bit(out_vis, ssc_base_index(nv));
+            atomicAdd(&ssc_work[SSC_BASE], 1u);
+        }
+        for (var i = 0u; i < kf; i++) {
+            if ((out_vis >> i) & 1u) == 0u || i == base {
+                continue;
+            }
+            let w = ssc_importance(dst_slots[i * pixels + p].radiance.w);
+            atomicMin(&ssc_work[SSC_WMIN_ACC], bitcast<u32>(w));
+            atomicMax(&ssc_work[SSC_WMAX_ACC], bitcast<u32>(w));
+            atomicAdd(&ssc_work[SSC_HISTOGRAM + ssc_bucket(w)], 1u);
+        }
+    }
+}
+
+// Index of the r-th set bit of `bits` (r counted from 0, lowest first).
+fn ssc_nth_bit(bits: u32, r: u32) -> u32 {
+    var b = bits;
+    for (var skip = 0u; skip < r; skip++) {
+        b &= b - 1u;
+    }
+    return firstTrailingBit(b);
+}

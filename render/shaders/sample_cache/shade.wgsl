@@ -1,0 +1,55 @@
+// Shading of cached samples (section 3.3): one path from the sample's surface point towards the
+// current camera with the shared integrator, accumulated into the slot's radiance. The blend
+// weight is max(1 / (c_s + 1), α): a running mean that becomes an exponential average with
+// factor α once c_s >= 1/α - 1 (the paper's temporal filter, α = 0.1; α = 0 keeps the mean).
+
+fn ssc_shade(hit: vec4u, rng: ptr<function, u32>) -> vec3f {
+    let eye = frame.camera.position.xyz;
+    if ssc_is_background(hit) {
+        return escaped_radiance(ssc_background_dir(hit), 0.0);
+    }
+    let sp = ssc_surface(hit);
+    let d = sp.position - eye;
+    let dist = length(d);
+    let dir = d / dist;
+    let wo = -dir;
+    let sh = orient(sp, wo);
+    let m = materials[sp.material];
+    var radiance = emitted_radiance(sp, m, dir, dist, 0.0);
+    let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);
+    radiance += next_event(sp.position, sh, bsdf, wo, rng);
+    // Continue as path_radiance does after its camera-ray vertex.
+    let bs = bsdf_sample(bsdf, sh.ns, wo, rng_next(rng), rng_next2(rng));
+    if !bs.valid || dot(bs.wi, sh.ng) <= 0.0 || frame.seed.w == 0u {
+        return radiance;
+    }
+    var throughput = bs.f * (dot(sh.ns, bs.wi) / bs.pdf);
+    if 1u >= frame.counts.x {
+        let survive = min(max_component(throughput), 0.95);
+        if rng_next(rng) >= survive {
+            return radiance;
+        }
+        throughput /= survive;
+    }
+    return radiance + throughput * path_radiance(offset_origin(sp.position, sh.ng, bs.wi), bs.wi, bs.pdf, 1u, rng);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn shade_main(@builtin(global_invocation_id) id: vec3u) {
+    if id.x >= ssc.size.x || id.y >= ssc.size.y || id.z >= ssc.size.z {
+        return;
+    }
+    let pixels = ssc_pixels();
+    let index = id.z * pixels + id.y * ssc.size.x + id.x;
+    if index >= atomicLoad(&ssc_work[SSC_SHADE_COUNT]) {
+        return;
+    }
+    let entry = atomicLoad(&ssc_work[SSC_LIST + index]);
+    let slot = dst_slots[entry];
+    // Seeded by (pixel, slot): the list order (atomics) does not change any result.
+    var rng = rng_seed(frame.seed.xy, frame.seed.z, entry % pixels, 0x5a00u + entry / pixels);
+    let l = ssc_shade(slot.hit, &rng);
+    let c = slot.radiance.w;
+    let a = max(1.0 / (c + 1.0), ssc.shade.x);
+    dst_slots[entry].radiance = vec4f(mix(slot.radiance.rgb, l, a), c + 1.0);
+}

@@ -1,0 +1,78 @@
+// Which cached samples are shaded this frame (sections 3.3 and 3.5). Uniform: one visible sample
+// per pixel, round robin (a never-shaded sample first). Adaptive: one sample per 4x4 block as the
+// base rate, the rest of the budget by importance w = 1 / (1 + c_s) through the log histogram:
+// buckets above the threshold all, the threshold bucket by a weighted coin toss.
+// The chosen slots are appended to the shade list (compacted work for shade_main).
+
+// One thread: the threshold bucket and its coin probability from the histogram and the budget
+// (twin of sample_cache/shading_rate.rs `threshold`).
+@compute @workgroup_size(1, 1, 1)
+fn rates_main() {
+    let m = ssc.modes.w;
+    let budget = max(ssc.shade.y - f32(atomicLoad(&ssc_work[SSC_BASE])), 0.0);
+    var above = 0.0;
+    var threshold = 0u;
+    var coin = 1.0;
+    for (var i = 0u; i < m; i++) {
+        let b = m - 1u - i;
+        let c = f32(atomicLoad(&ssc_work[SSC_HISTOGRAM + b]));
+        if c > 0.0 && above + c >= budget {
+            threshold = b;
+            coin = (budget - above) / c;
+            break;
+        }
+        above += c;
+    }
+    atomicStore(&ssc_work[SSC_THRESHOLD], threshold);
+    atomicStore(&ssc_work[SSC_COIN], bitcast<u32>(coin));
+}
+
+fn ssc_push_shade(entry: u32) {
+    let at = atomicAdd(&ssc_work[SSC_SHADE_COUNT], 1u);
+    atomicStore(&ssc_work[SSC_LIST + at], entry);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn select_main(@builtin(global_invocation_id) id: vec3u) {
+    if id.x >= ssc.size.x || id.y >= ssc.size.y {
+        return;
+    }
+    let pixels = ssc_pixels();
+    let n = ssc.size.z;
+    let p = id.y * ssc.size.x + id.x;
+    let mask = dst_mask[p];
+    let vis = (mask >> n) & mask & ssc_full();
+    let nv = countOneBits(vis);
+    if nv == 0u {
+        return;
+    }
+    if ssc.modes.y == 0u {
+        var chosen = ssc_nth_bit(vis, ssc.size.w % nv);
+        for (var s = 0u; s < n; s++) {
+            if ((vis >> s) & 1u) != 0u && dst_slots[s * pixels + p].radiance.w == 0.0 {
+                chosen = s;
+                break;
+            }
+        }
+        ssc_push_shade(chosen * pixels + p);
+        return;
+    }
+    var base = NO_HIT;
+    if ssc_is_base_pixel(id.xy) {
+        base = ssc_nth_bit(vis, ssc_base_index(nv));
+        ssc_push_shade(base * pixels + p);
+    }
+    let threshold = atomicLoad(&ssc_work[SSC_THRESHOLD]);
+    let coin = bitcast<f32>(atomicLoad(&ssc_work[SSC_COIN]));
+    var rng = rng_seed(frame.seed.xy, frame.seed.z, p, 0x5e1eu);
+    for (var s = 0u; s < n; s++) {
+        if ((vis >> s) & 1u) == 0u || s == base {
+            continue;
+        }
+        let b = ssc_bucket(ssc_importance(dst_slots[s * pixels + p].radiance.w));
+        let u = rng_next(&rng);
+        if b > threshold || (b == threshold && u < coin) {
+            ssc_push_shade(s * pixels + p);
+        }
+    }
+}

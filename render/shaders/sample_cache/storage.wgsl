@@ -1,0 +1,119 @@
+// Stable sample cache (Philippi, Jensen & Frisvad 2025): storage, packing and the per-frame
+// parameters. Concatenated after PathTracer::library_source(); bindings in @group(2).
+//
+// Layout. N slots per pixel, "layered": slot s of pixel p lives at s * pixels + p (the paper's
+// array of textures, one per slot index). A slot is 32 bytes: the first hit packed into a vec4u
+// plus the shading cache (accumulated radiance, sample count c_s) in a vec4f.
+// Hit packing (fixes listing 1, which ORs 8-bit material fields over 32-bit barycentrics): plain
+// vec4u = (instance, primitive, bits(b1), bits(b2)) with full f32 barycentrics; the material is
+// the instance's (sg_instances.records[i].material), so no material bits are stored at all.
+// A background sample (its primary ray left the scene) is (NO_HIT, bits(dir.x, dir.y, dir.z)).
+// Mask: one u32 per pixel, occupancy o_s in bits 0..N-1 and visibility v_s in bits N..2N-1
+// (N <= 16), bits 2N..31 always zero.
+
+const SSC_MAX_SLOTS: u32 = 16u;
+const SSC_ATOMICS: u32 = 3u;
+// Depth of a background sample in the slope test (finite: the test multiplies it).
+const SSC_BACKGROUND_DEPTH: f32 = 1.0e30;
+
+struct SscParams {
+    size: vec4u,      // width, height, slots N, frame
+    modes: vec4u,     // retrace (0 single, 1 multi, 2 adaptive), shading (0 uniform, 1 adaptive), base block side, buckets M
+    density: vec4f,   // n_target, delta, epsilon0, epsilon1
+    shade: vec4f,     // alpha (minimum blend weight), dynamic shading budget (samples), phi (pixel diagonal angle), unused
+}
+
+struct SscSlot {
+    hit: vec4u,
+    radiance: vec4f,  // rgb: accumulated radiance L_s, w: sample count c_s
+}
+
+// Per output pixel: reconstructed radiance, motion (pixels, now -> previous frame), trace flags
+// (bit 0: base-rate pixel, bit 1: flagged by the slope test, bit 2: hole) and rays traced.
+struct SscPixel {
+    radiance: vec4f,
+    motion: vec2f,
+    flags: u32,
+    rays: u32,
+}
+
+// Words of `ssc_work` (header), then the shade list from SSC_LIST.
+const SSC_SHADE_COUNT: u32 = 0u;
+const SSC_RAYS: u32 = 1u;
+const SSC_NEW: u32 = 2u;
+const SSC_PURGED: u32 = 3u;
+const SSC_REPROJECTED: u32 = 4u;
+const SSC_DROPPED: u32 = 5u;
+const SSC_WMIN_ACC: u32 = 6u;   // importance bounds seen this frame (float bits)
+const SSC_WMAX_ACC: u32 = 7u;
+const SSC_WMIN: u32 = 8u;       // bounds of the histogram buckets this frame (last frame's)
+const SSC_WMAX: u32 = 9u;
+const SSC_THRESHOLD: u32 = 10u; // bucket crossing the budget
+const SSC_COIN: u32 = 11u;      // dispatch probability in that bucket (float bits)
+const SSC_VISIBLE: u32 = 12u;
+const SSC_OCCUPIED: u32 = 13u;
+const SSC_BASE: u32 = 14u;
+const SSC_FLAGGED: u32 = 15u;
+const SSC_HISTOGRAM: u32 = 16u;
+const SSC_AUDIT: u32 = 32u;
+const SSC_RETRACE_COUNT: u32 = 33u; // entries of the retrace list (shares SSC_LIST with the shade list)   // visible samples found occluded by audit_main
+const SSC_LIST: u32 = 48u;
+
+const SSC_FLAG_BASE: u32 = 1u;
+const SSC_FLAG_SLOPE: u32 = 2u;
+const SSC_FLAG_HOLE: u32 = 4u;
+
+@group(2) @binding(0) var<uniform> ssc: SscParams;
+@group(2) @binding(1) var<storage, read> src_mask: array<u32>;
+@group(2) @binding(2) var<storage, read> src_slots: array<SscSlot>;
+// SSC_ATOMICS words per pixel: the mask being reserved (atomicOr), the farthest visible depth
+// (atomicMax of its float bits), and the retrace results (bits 0-15: visible, 16-31: traced).
+@group(2) @binding(3) var<storage, read_write> pixel_atomics: array<atomic<u32>>;
+@group(2) @binding(4) var<storage, read_write> dst_slots: array<SscSlot>;
+@group(2) @binding(5) var<storage, read_write> dst_mask: array<u32>;
+@group(2) @binding(6) var<storage, read_write> ssc_work: array<atomic<u32>>;
+@group(2) @binding(7) var<storage, read_write> ssc_out: array<SscPixel>;
+
+fn ssc_pixels() -> u32 {
+    return ssc.size.x * ssc.size.y;
+}
+
+fn ssc_full() -> u32 {
+    return (1u << ssc.size.z) - 1u;
+}
+
+fn ssc_is_background(hit: vec4u) -> bool {
+    return hit.x == NO_HIT;
+}
+
+fn ssc_pack_hit(h: Hit) -> vec4u {
+    return vec4u(h.instance, h.primitive, bitcast<u32>(h.barycentrics.x), bitcast<u32>(h.barycentrics.y));
+}
+
+fn ssc_pack_background(dir: vec3f) -> vec4u {
+    return vec4u(NO_HIT, bitcast<vec3u>(dir));
+}
+
+fn ssc_background_dir(hit: vec4u) -> vec3f {
+    return bitcast<vec3f>(hit.yzw);
+}
+
+// The cached surface sample through the *current* instance transforms.
+fn ssc_surface(hit: vec4u) -> SurfacePoint {
+    let h = Hit(0.0, hit.x, hit.y, bitcast<vec2f>(hit.zw));
+    return surface_point(h, vec3f(0.0), vec3f(0.0, 0.0, 1.0));
+}
+
+// Where the sample was last frame (previous transforms), for motion vectors.
+fn ssc_previous_position(hit: vec4u) -> vec3f {
+    let h = Hit(0.0, hit.x, hit.y, bitcast<vec2f>(hit.zw));
+    return previous_world_position(h);
+}
+
+// Strict lexicographic order on packed hits: the canonical slot order of a pixel.
+fn ssc_less(a: vec4u, b: vec4u) -> bool {
+    if a.x != b.x { return a.x < b.x; }
+    if a.y != b.y { return a.y < b.y; }
+    if a.z != b.z { return a.z < b.z; }
+    return a.w < b.w;
+}

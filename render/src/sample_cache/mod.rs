@@ -1,0 +1,452 @@
+//! Stable sample cache (Philippi, Jensen & Frisvad 2025, "Stable Sample Caching for Interactive
+//! Stereoscopic Ray Tracing", sections 3.1-3.5): a screen-space cache of N first-hit samples per
+//! pixel, carried from frame to frame by forward reprojection, retraced sparsely, shaded
+//! sparsely, and averaged into the image. See README.md in this folder for the map and choices.
+//!
+//! Passes per frame (shaders/sample_cache/, one compute pass each, timed):
+//! `reserve` (reproject.wgsl: begin_main + reserve_main), `trace` (retrace.wgsl: retrace_main, retrace_list_main, finish_main),
+//! `shade` (shading_rate.wgsl rates_main + select_main, shade.wgsl shade_main),
+//! `reconstruct` (reconstruct.wgsl).
+//!
+//! 64-bit atomics: the paper packs (closest depth, slope Δn) into one 64-bit atomicMin during
+//! reprojection. WGSL core has only 32-bit atomics, so each pixel gets one u32 atomicMax of the
+//! farthest visible depth's float bits (positive IEEE floats order like their bit patterns), and
+//! the closest depth with its slope is recomputed exactly in the trace pass from the centre
+//! pixel's own samples, which that pass reads anyway. Same 8 bytes per pixel with the mask; no
+//! precision lost to packing; t_max of the 3x3 neighbours still costs one load each.
+
+pub mod density;
+pub mod reservation;
+pub mod settings;
+pub mod shading_rate;
+pub mod slope;
+pub mod storage;
+
+pub use settings::{Retrace, SampleCacheSettings, ShadingMode};
+pub use storage::GpuSlot;
+
+use std::time::Instant;
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::error::RenderError;
+use crate::gpu::Gpu;
+use crate::path_tracer::PathTracer;
+use crate::readback::read_buffer;
+use crate::timing::{PassTimestamps, PassTiming};
+
+/// Pass names in [`CacheFrame::timings`].
+pub const PASSES: [&str; 4] = ["reserve", "trace", "shade", "reconstruct"];
+
+const HEADER_WORDS: u64 = 48;
+const AUDIT_WORD: u64 = 32;
+const STORAGE_BUFFERS: u32 = 7;
+
+/// The WGSL of the cache passes (appended to the path tracer's library).
+pub fn shader_source() -> &'static str {
+    static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    SOURCE.get_or_init(|| {
+        [
+            PathTracer::library_source(),
+            include_str!("../../shaders/sample_cache/storage.wgsl"),
+            include_str!("../../shaders/sample_cache/slope.wgsl"),
+            include_str!("../../shaders/sample_cache/reproject.wgsl"),
+            include_str!("../../shaders/sample_cache/retrace.wgsl"),
+            include_str!("../../shaders/sample_cache/shading_rate.wgsl"),
+            include_str!("../../shaders/sample_cache/shade.wgsl"),
+            include_str!("../../shaders/sample_cache/reconstruct.wgsl"),
+        ]
+        .join("\n")
+    })
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct GpuParams {
+    size: [u32; 4],
+    modes: [u32; 4],
+    density: [f32; 4],
+    shade: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuPixel {
+    pub radiance: [f32; 4],
+    pub motion: [f32; 2],
+    /// Bit 0: base-rate pixel, bit 1: flagged by the slope test, bit 2: hole.
+    pub flags: u32,
+    pub rays: u32,
+}
+
+pub const FLAG_BASE: u32 = 1;
+pub const FLAG_SLOPE: u32 = 2;
+pub const FLAG_HOLE: u32 = 4;
+
+/// Counters of one frame (exact integers from the GPU's atomics).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct CacheStats {
+    pub shaded: u32,
+    pub rays: u32,
+    pub new_samples: u32,
+    pub purged: u32,
+    pub reprojected: u32,
+    pub dropped: u32,
+    pub visible: u32,
+    pub occupied: u32,
+    pub base_shaded: u32,
+    pub slope_flagged: u32,
+    /// Histogram of the frame (adaptive shading), and the threshold bucket and coin chosen.
+    pub histogram: Vec<u32>,
+    pub threshold: u32,
+    pub coin: f32,
+}
+
+/// One frame of the cache.
+#[derive(Clone, Debug, Default)]
+pub struct CacheFrame {
+    pub radiance: Vec<[f32; 4]>,
+    pub motion: Vec<[f32; 2]>,
+    pub flags: Vec<u32>,
+    pub stats: CacheStats,
+    pub timings: Vec<PassTiming>,
+}
+
+/// The whole cache as the last frame left it (tests, debugging).
+#[derive(Clone, Debug)]
+pub struct CacheState {
+    pub masks: Vec<u32>,
+    /// `slots * pixels`, layered: slot s of pixel p at `s * pixels + p`.
+    pub slots: Vec<GpuSlot>,
+}
+
+struct Cache {
+    mask: wgpu::Buffer,
+    slots: wgpu::Buffer,
+}
+
+pub struct SampleCache {
+    settings: SampleCacheSettings,
+    width: u32,
+    height: u32,
+    layout: wgpu::BindGroupLayout,
+    pipelines: Pipelines,
+    params: wgpu::Buffer,
+    caches: [Cache; 2],
+    pixel_atomics: wgpu::Buffer,
+    work: wgpu::Buffer,
+    out: wgpu::Buffer,
+    out_readback: wgpu::Buffer,
+    header_readback: wgpu::Buffer,
+    bind_groups: [wgpu::BindGroup; 2],
+    /// Index of the cache holding the last frame (the source of the next reprojection).
+    current: usize,
+    timestamps: Option<PassTimestamps>,
+    frames: u32,
+}
+
+struct Pipelines {
+    begin: wgpu::ComputePipeline,
+    reserve: wgpu::ComputePipeline,
+    retrace: wgpu::ComputePipeline,
+    retrace_list: wgpu::ComputePipeline,
+    finish: wgpu::ComputePipeline,
+    rates: wgpu::ComputePipeline,
+    select: wgpu::ComputePipeline,
+    shade: wgpu::ComputePipeline,
+    reconstruct: wgpu::ComputePipeline,
+    audit: wgpu::ComputePipeline,
+}
+
+impl SampleCache {
+    pub fn new(gpu: &Gpu, tracer: &PathTracer, settings: SampleCacheSettings) -> Result<Self, RenderError> {
+        settings.validate().map_err(|e| RenderError::Settings(format!("sample cache: {e}")))?;
+        let (width, height) = (tracer.settings().width, tracer.settings().height);
+        let n = settings.slots as u64;
+        gpu.check_resolution(width, height, 2 * 32 * n + 4 * 2 + 12 + 4 * n + 32)?;
+        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
+        let needed = STORAGE_BUFFERS + 5 + 8;
+        if needed > limit {
+            return Err(crate::gpu::GpuError::OverLimit {
+                what: "storage buffers of the sample cache passes".into(),
+                requested: needed as u64,
+                limit: limit as u64,
+                adapter: gpu.summary.name.clone(),
+            }
+            .into());
+        }
+        // No var<workgroup> anywhere in the cache passes.
+        for pass in PASSES {
+            gpu.check_workgroup_memory(pass, 0)?;
+        }
+        let pixels = width as u64 * height as u64;
+        let device = &gpu.device;
+        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| -> Result<wgpu::Buffer, RenderError> {
+            gpu.check_buffer_size(label, size)?;
+            Ok(device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false }))
+        };
+        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let readback = wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST;
+        let caches = [
+            Cache { mask: buffer("ssc mask a", pixels * 4, rw)?, slots: buffer("ssc slots a", pixels * n * 32, rw)? },
+            Cache { mask: buffer("ssc mask b", pixels * 4, rw)?, slots: buffer("ssc slots b", pixels * n * 32, rw)? },
+        ];
+        let pixel_atomics = buffer("ssc pixel atomics", pixels * 12, rw)?;
+        let work = buffer("ssc work", (HEADER_WORDS + pixels * n) * 4, rw)?;
+        let out = buffer("ssc out", pixels * 32, rw)?;
+        let out_readback = buffer("ssc out readback", pixels * 32, readback)?;
+        let header_readback = buffer("ssc header readback", HEADER_WORDS * 4, readback)?;
+        let params = buffer("ssc params", size_of::<GpuParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)?;
+
+        let layout = bind_group_layout(device);
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("sample cache"),
+            bind_group_layouts: &[Some(tracer.scene_bind_group_layout()), Some(tracer.geometry().bind_group_layout()), Some(&layout)],
+            immediate_size: 0,
+        });
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("sample_cache"), source: wgpu::ShaderSource::Wgsl(shader_source().into()) });
+        let pipeline = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let pipelines = Pipelines {
+            begin: pipeline("begin_main"),
+            reserve: pipeline("reserve_main"),
+            retrace: pipeline("retrace_main"),
+            retrace_list: pipeline("retrace_list_main"),
+            finish: pipeline("finish_main"),
+            rates: pipeline("rates_main"),
+            select: pipeline("select_main"),
+            shade: pipeline("shade_main"),
+            reconstruct: pipeline("reconstruct_main"),
+            audit: pipeline("audit_main"),
+        };
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(RenderError::Shader { pass: "shaders/sample_cache/*.wgsl".into(), message: e.to_string() });
+        }
+        let make = |src: &Cache, dst: &Cache| {
+            let entries: Vec<wgpu::BindGroupEntry> = [&params, &src.mask, &src.slots, &pixel_atomics, &dst.slots, &dst.mask, &work, &out]
+                .iter()
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+                .collect();
+            device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("sample cache"), layout: &layout, entries: &entries })
+        };
+        // bind_groups[i]: reproject cache i into cache 1 - i.
+        let bind_groups = [make(&caches[0], &caches[1]), make(&caches[1], &caches[0])];
+        Ok(Self {
+            settings,
+            width,
+            height,
+            layout,
+            pipelines,
+            params,
+            caches,
+            pixel_atomics,
+            work,
+            out,
+            out_readback,
+            header_readback,
+            bind_groups,
+            current: 0,
+            timestamps: PassTimestamps::new(gpu, PASSES.len() as u32),
+            frames: 0,
+        })
+    }
+
+    pub fn settings(&self) -> &SampleCacheSettings {
+        &self.settings
+    }
+
+    /// Renders one frame: call after `tracer.update` for this frame's scene. `frame` seeds the
+    /// frame's randomness (with `seed`) and drives the round robins.
+    pub fn render(&mut self, gpu: &Gpu, tracer: &PathTracer, seed: u64, frame: u32) -> Result<CacheFrame, RenderError> {
+        let (w, h) = (self.width, self.height);
+        if tracer.settings().width != w || tracer.settings().height != h {
+            return Err(RenderError::Settings(format!("sample cache is {w}x{h}, the path tracer {}x{}", tracer.settings().width, tracer.settings().height)));
+        }
+        let start = Instant::now();
+        tracer.prepare_frame(gpu, 1, 0, seed, frame);
+        let s = &self.settings;
+        let vfov = 2.0 * tracer_tan_half_fov(tracer).atan();
+        let pixels = w * h;
+        let params = GpuParams {
+            size: [w, h, s.slots, frame],
+            modes: [
+                match s.retrace {
+                    Retrace::Single => 0,
+                    Retrace::Multi => 1,
+                    Retrace::Adaptive => 2,
+                },
+                match s.shading {
+                    ShadingMode::Uniform => 0,
+                    ShadingMode::Adaptive => 1,
+                },
+                s.base_block,
+                s.buckets,
+            ],
+            density: [s.n_target, s.delta, s.epsilon0, s.epsilon1],
+            shade: [s.alpha, s.shading_rate * pixels as f32, slope::pixel_diagonal_angle(vfov, h), 0.0],
+        };
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sample cache") });
+        encoder.clear_buffer(&self.pixel_atomics, 0, None);
+        // Header words 0-5 and 10-31; 6-9 (importance bounds) carry over, begin_main moves them.
+        encoder.clear_buffer(&self.work, 0, Some(24));
+        encoder.clear_buffer(&self.work, 40, Some((HEADER_WORDS - 10) * 4));
+        if self.frames == 0 {
+            // The very first frame reprojects an empty cache.
+            encoder.clear_buffer(&self.caches[self.current].mask, 0, None);
+            encoder.clear_buffer(&self.work, 0, Some(HEADER_WORDS * 4));
+        }
+        let bind_group = &self.bind_groups[self.current];
+        let (gx, gy) = (w.div_ceil(8), h.div_ceil(8));
+        let groups: [&[(&wgpu::ComputePipeline, [u32; 3])]; 4] = [
+            &[(&self.pipelines.begin, [1, 1, 1]), (&self.pipelines.reserve, [gx, gy, s.slots])],
+            &[(&self.pipelines.retrace, [gx, gy, 1]), (&self.pipelines.retrace_list, [gx, gy, s.slots]), (&self.pipelines.finish, [gx, gy, 1])],
+            &[(&self.pipelines.rates, [1, 1, 1]), (&self.pipelines.select, [gx, gy, 1]), (&self.pipelines.shade, [gx, gy, s.slots])],
+            &[(&self.pipelines.reconstruct, [gx, gy, 1])],
+        ];
+        for (i, dispatches) in groups.iter().enumerate() {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(PASSES[i]),
+                timestamp_writes: self.timestamps.as_ref().map(|t| t.writes(i as u32)),
+            });
+            pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
+            pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+            pass.set_bind_group(2, bind_group, &[]);
+            for (pipeline, [x, y, z]) in dispatches.iter() {
+                pass.set_pipeline(pipeline);
+                pass.dispatch_workgroups(*x, *y, *z);
+            }
+        }
+        if let Some(t) = &self.timestamps {
+            t.resolve(&mut encoder);
+        }
+        encoder.copy_buffer_to_buffer(&self.out, 0, &self.out_readback, 0, self.out.size());
+        encoder.copy_buffer_to_buffer(&self.work, 0, &self.header_readback, 0, HEADER_WORDS * 4);
+        gpu.queue.submit([encoder.finish()]);
+        self.current = 1 - self.current;
+        self.frames += 1;
+
+        let out: Vec<GpuPixel> = read_buffer(gpu, &self.out_readback).map_err(|r| readback_error("sample cache output", r))?;
+        let header: Vec<u32> = read_buffer(gpu, &self.header_readback).map_err(|r| readback_error("sample cache counters", r))?;
+        let gpu_ms = match &self.timestamps {
+            Some(t) => Some(t.read(gpu).map_err(|r| readback_error("timestamps", r))?),
+            None => None,
+        };
+        let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+        let timings = PASSES
+            .iter()
+            .enumerate()
+            .map(|(i, p)| PassTiming { pass: (*p).into(), gpu_ms: gpu_ms.as_ref().map(|v| v[i]), cpu_ms: if i == 0 { cpu_ms } else { 0.0 } })
+            .collect();
+        let stats = CacheStats {
+            shaded: header[0],
+            rays: header[1],
+            new_samples: header[2],
+            purged: header[3],
+            reprojected: header[4],
+            dropped: header[5],
+            visible: header[12],
+            occupied: header[13],
+            base_shaded: header[14],
+            slope_flagged: header[15],
+            histogram: header[16..16 + s.buckets as usize].to_vec(),
+            threshold: header[10],
+            coin: f32::from_bits(header[11]),
+        };
+        Ok(CacheFrame {
+            radiance: out.iter().map(|p| p.radiance).collect(),
+            motion: out.iter().map(|p| p.motion).collect(),
+            flags: out.iter().map(|p| p.flags).collect(),
+            stats,
+            timings,
+        })
+    }
+
+    /// Reads back the cache the last frame produced.
+    pub fn read_state(&self, gpu: &Gpu) -> Result<CacheState, RenderError> {
+        let cache = &self.caches[self.current];
+        let copy = |src: &wgpu::Buffer| -> Result<wgpu::Buffer, RenderError> {
+            let dst = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("ssc state readback"),
+                size: src.size(),
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ssc state") });
+            encoder.copy_buffer_to_buffer(src, 0, &dst, 0, src.size());
+            gpu.queue.submit([encoder.finish()]);
+            Ok(dst)
+        };
+        let masks = read_buffer(gpu, &copy(&cache.mask)?).map_err(|reason| RenderError::Readback { what: "ssc masks".into(), reason })?;
+        let slots = read_buffer(gpu, &copy(&cache.slots)?).map_err(|reason| RenderError::Readback { what: "ssc slots".into(), reason })?;
+        Ok(CacheState { masks, slots })
+    }
+
+    /// Stale visibility of the last frame: how many samples the cache holds as visible that a
+    /// retrace from the current camera finds occluded (what `Multi` would correct). Traces one
+    /// ray per visible sample; for tests and diagnostics, outside the timed passes.
+    pub fn audit(&self, gpu: &Gpu, tracer: &PathTracer) -> Result<u32, RenderError> {
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ssc audit") });
+        encoder.clear_buffer(&self.work, AUDIT_WORD * 4, Some(4));
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("audit"), timestamp_writes: None });
+            pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
+            pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+            // The bind group whose destination is the cache the last frame wrote.
+            pass.set_bind_group(2, &self.bind_groups[1 - self.current], &[]);
+            pass.set_pipeline(&self.pipelines.audit);
+            pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), self.settings.slots);
+        }
+        encoder.copy_buffer_to_buffer(&self.work, 0, &self.header_readback, 0, HEADER_WORDS * 4);
+        gpu.queue.submit([encoder.finish()]);
+        let header: Vec<u32> = read_buffer(gpu, &self.header_readback).map_err(|reason| RenderError::Readback { what: "ssc audit".into(), reason })?;
+        Ok(header[AUDIT_WORD as usize])
+    }
+
+    pub fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+}
+
+fn readback_error(what: &str, reason: String) -> RenderError {
+    RenderError::Readback { what: what.into(), reason }
+}
+
+fn tracer_tan_half_fov(tracer: &PathTracer) -> f32 {
+    (0.5 * tracer.camera().vfov).tan()
+}
+
+fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let buffer = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    };
+    let read = wgpu::BufferBindingType::Storage { read_only: true };
+    let write = wgpu::BufferBindingType::Storage { read_only: false };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("sample cache"),
+        entries: &[
+            buffer(0, wgpu::BufferBindingType::Uniform),
+            buffer(1, read),
+            buffer(2, read),
+            buffer(3, write),
+            buffer(4, write),
+            buffer(5, write),
+            buffer(6, write),
+            buffer(7, write),
+        ],
+    })
+}
