@@ -9,6 +9,7 @@ use render::hash_cache::table_cpu::{CpuHashTable, check_invariants};
 use render::hash_cache::{HC_NEEDS_SAMPLE, HashCache, HashCacheLookup, HashCacheSettings};
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::{Camera, Instance, Material, Mesh, SceneDesc};
+use render::taa::{Taa, TaaSettings, resolve_cpu};
 use std::sync::OnceLock;
 
 const W: u32 = 32;
@@ -208,5 +209,32 @@ fn static_scene_flickers_less_than_1spp_and_is_deterministic() {
         if lookup == HashCacheLookup::SecondaryHit {
             assert!(a == run(), "{lookup:?}: two runs differ");
         }
+    }
+}
+
+#[test]
+fn taa_resolves_the_cache_colour() {
+    let mut scene = room_scene();
+    let mut pt = tracer(&scene, 3);
+    let settings = HashCacheSettings::default();
+    let mut plain = HashCache::new(gpu(), &pt, settings).expect("hash cache");
+    let mut under_taa = HashCache::new(gpu(), &pt, settings).expect("hash cache");
+    let mut taa = Taa::new(gpu(), &pt, TaaSettings::default()).expect("taa");
+    for frame in 0..3 {
+        scene.camera.position.x = 0.05 * frame as f32;
+        pt.update(gpu(), &scene);
+        let a = plain.render(gpu(), &pt, &scene.camera, 9, frame, None).unwrap();
+        let b = under_taa.render(gpu(), &pt, &scene.camera, 9, frame, Some(&mut taa)).unwrap();
+        let i = taa.inspect(gpu()).unwrap();
+        // TAA's input is the cache's colour and primary hits of this frame ...
+        assert_eq!(i.current, a.radiance, "frame {frame}");
+        assert_eq!(i.primary.iter().map(|p| p.motion).collect::<Vec<_>>(), a.motion);
+        assert_eq!(b.timings.last().map(|t| t.pass.as_str()), Some(render::taa::TAA_RESOLVE_PASS));
+        // ... and its output the resolve of it.
+        let expected = resolve_cpu::resolve(&taa.settings(), (W, H), i.params_history_valid, &i.current, &i.primary, &i.previous_primary, &i.history);
+        for (g, c) in b.radiance.iter().zip(&expected) {
+            assert!((0..3).all(|k| (g[k] - c[k]).abs() <= 1e-4 * (1.0 + c[k].abs())), "frame {frame}: {g:?} vs {c:?}");
+        }
+        assert_eq!(frame > 0, i.params_history_valid);
     }
 }

@@ -31,10 +31,95 @@ fn builtin_name<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
 }
 
 /// A rendering method to run on every frame.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum MethodSpec {
     PathTracing { spp: u32 },
+    /// TAA over jittered 1 spp path tracing (render::taa). Defaults: render::taa::TaaSettings.
+    Taa {
+        #[serde(default = "taa_defaults::alpha")]
+        alpha: f32,
+        #[serde(default = "taa_defaults::clamp")]
+        clamp: render::taa::TaaClamp,
+        #[serde(default = "taa_defaults::jitter_length")]
+        jitter_length: u32,
+        #[serde(default = "taa_defaults::depth_tolerance")]
+        depth_tolerance: f32,
+        #[serde(default = "taa_defaults::normal_threshold")]
+        normal_threshold: f32,
+    },
+    /// World-space hash cache (render::hash_cache), optionally under TAA (as the paper runs it).
+    /// Defaults: render::hash_cache::HashCacheSettings, no TAA.
+    HashCache {
+        #[serde(default = "hash_cache_defaults::capacity")]
+        capacity: u32,
+        #[serde(default = "hash_cache_defaults::probe_limit")]
+        probe_limit: u32,
+        #[serde(default = "hash_cache_defaults::max_age")]
+        max_age: u32,
+        #[serde(default = "hash_cache_defaults::lod_scale")]
+        lod_scale: f32,
+        #[serde(default = "hash_cache_defaults::normal_lod")]
+        normal_lod: bool,
+        #[serde(default = "hash_cache_defaults::jitter")]
+        jitter: bool,
+        #[serde(default = "hash_cache_defaults::lookup")]
+        lookup: render::hash_cache::HashCacheLookup,
+        #[serde(default = "hash_cache_defaults::max_samples")]
+        max_samples: u32,
+        #[serde(default)]
+        taa: bool,
+    },
+}
+
+mod taa_defaults {
+    use render::taa::{TaaClamp, TaaSettings};
+    pub fn alpha() -> f32 {
+        TaaSettings::default().alpha
+    }
+    pub fn clamp() -> TaaClamp {
+        TaaSettings::default().clamp
+    }
+    pub fn jitter_length() -> u32 {
+        TaaSettings::default().jitter_length
+    }
+    pub fn depth_tolerance() -> f32 {
+        TaaSettings::default().depth_tolerance
+    }
+    pub fn normal_threshold() -> f32 {
+        TaaSettings::default().normal_threshold
+    }
+}
+
+mod hash_cache_defaults {
+    use render::hash_cache::{HashCacheLookup, HashCacheSettings};
+    fn d() -> HashCacheSettings {
+        HashCacheSettings::default()
+    }
+    pub fn capacity() -> u32 {
+        d().capacity
+    }
+    pub fn probe_limit() -> u32 {
+        d().probe_limit
+    }
+    pub fn max_age() -> u32 {
+        d().max_age
+    }
+    pub fn lod_scale() -> f32 {
+        d().lod_scale
+    }
+    pub fn normal_lod() -> bool {
+        d().normal_lod
+    }
+    pub fn jitter() -> bool {
+        d().jitter
+    }
+    pub fn lookup() -> HashCacheLookup {
+        d().lookup
+    }
+    pub fn max_samples() -> u32 {
+        d().max_samples
+    }
 }
 
 impl MethodSpec {
@@ -42,6 +127,12 @@ impl MethodSpec {
     pub fn label(&self) -> String {
         match self {
             MethodSpec::PathTracing { spp } => format!("pt_{spp}spp"),
+            MethodSpec::Taa { .. } => "taa".into(),
+            MethodSpec::HashCache { lookup, taa, .. } => format!(
+                "hash_cache{}{}",
+                if *lookup == render::hash_cache::HashCacheLookup::FirstHit { "_first_hit" } else { "" },
+                if *taa { "_taa" } else { "" }
+            ),
         }
     }
 
@@ -49,6 +140,7 @@ impl MethodSpec {
     pub fn spp(&self) -> u32 {
         match self {
             MethodSpec::PathTracing { spp } => *spp,
+            MethodSpec::Taa { .. } | MethodSpec::HashCache { .. } => 1,
         }
     }
 }

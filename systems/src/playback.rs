@@ -57,6 +57,8 @@ pub fn load_scenario(path: &Path, o: &Overrides) -> Result<Scenario> {
         for m in &mut scenario.methods {
             match m {
                 MethodSpec::PathTracing { spp: s } => *s = spp,
+                // 1 spp by construction.
+                MethodSpec::Taa { .. } | MethodSpec::HashCache { .. } => {}
             }
         }
     }

@@ -12,6 +12,21 @@
 //! History colour and primary attributes are ping-ponged; [`resolve_cpu`] repeats the resolve
 //! on the CPU for tests. The resolve can also run over another method's colour
 //! ([`Taa::resolve_external`]): the hash cache uses it as the paper does.
+//!
+//! Choices and departures from the usual real-time TAA (Karis 2014, Yang et al. 2020):
+//! - the blend starts as a uniform average (weight 1 / (length + 1)) and becomes exponential at
+//!   alpha, so a still image converges to the mean instead of starting from one frame's
+//!   weight 1 - alpha; the paper's temporal weights of Philippi et al. [PFJ23] are not used;
+//! - history is sampled bilinearly (no Catmull-Rom), clamped in linear RGB (no YCoCg, no
+//!   luminance weighting), and rejected on a nearest-pixel test of instance, depth seen from
+//!   the previous camera and normal;
+//! - each sample carries its own primary hit (the jittered ray's), not the pixel-centre
+//!   G-buffer of the path tracer: motion vectors and rejection describe what was shaded;
+//! - the primary ray is traced twice (once for its attributes, once inside `path_radiance`).
+//!
+//! Cost (lavapipe on 2 shared CPU cores, courtyard 320x180, max depth 4; see
+//! `systems/examples/issue5_bench.rs`): reported by the lead's merge notes / the report of
+//! the taa-hash branch.
 
 pub mod jitter;
 pub mod resolve_cpu;

@@ -2,7 +2,9 @@
 //! the scenario's order, after the scene has been updated. A method owns its own GPU state
 //! (caches, histories) and may use the shared path tracer (scene geometry, G-buffer).
 
+mod hash_cache;
 mod path_tracing;
+mod taa;
 
 use anyhow::Result;
 use render::gpu::Gpu;
@@ -10,7 +12,9 @@ use render::path_tracer::PathTracer;
 use render::scene::SceneDesc;
 use sim::{MethodSpec, Scenario};
 
+pub use hash_cache::HashCacheMethod;
 pub use path_tracing::PathTracing;
+pub use taa::TaaMethod;
 
 /// Everything a method may read while rendering one frame.
 pub struct FrameContext<'a> {
@@ -61,5 +65,28 @@ pub trait FrameMethod {
 pub fn build(spec: &MethodSpec, _gpu: &Gpu, _scenario: &Scenario, _scene: &SceneDesc) -> Result<Box<dyn FrameMethod>> {
     Ok(match spec {
         MethodSpec::PathTracing { spp } => Box::new(PathTracing::new(*spp)),
+        MethodSpec::Taa { alpha, clamp, jitter_length, depth_tolerance, normal_threshold } => Box::new(TaaMethod::new(render::taa::TaaSettings {
+            alpha: *alpha,
+            clamp: *clamp,
+            jitter_length: *jitter_length,
+            depth_tolerance: *depth_tolerance,
+            normal_threshold: *normal_threshold,
+            ..Default::default()
+        })?),
+        MethodSpec::HashCache { capacity, probe_limit, max_age, lod_scale, normal_lod, jitter, lookup, max_samples, taa } => {
+            let settings = render::hash_cache::HashCacheSettings {
+                capacity: *capacity,
+                probe_limit: *probe_limit,
+                max_age: *max_age,
+                lod_scale: *lod_scale,
+                normal_lod: *normal_lod,
+                jitter: *jitter,
+                lookup: *lookup,
+                max_samples: *max_samples,
+                ..Default::default()
+            };
+            let taa = taa.then(render::taa::TaaSettings::default);
+            Box::new(HashCacheMethod::new(settings, taa, spec.label())?)
+        }
     })
 }
