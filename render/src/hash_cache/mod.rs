@@ -26,6 +26,15 @@
 //!   is part of the key instead, which keeps the two sides of thin walls apart.
 //! - Four passes (age, trace, update, resolve) rather than two: the claim must be complete
 //!   before the claimant is known.
+//! - Cells are not split into parent/child levels (that is the paper's Hybrid, not HashCache).
+//!
+//! Numbers (lavapipe, 2 shared CPU cores; `cargo run -p systems --example issue5_bench 320 180 5`,
+//! courtyard, camera moving, max depth 4, median GPU ms): secondary-hit lookup hc_age 5.2,
+//! hc_trace 334, hc_update 581, hc_resolve 6.2 (occupancy 0.17 of 2^18 slots, 18k update paths
+//! for 57.6k pixels); first-hit lookup 6.6 / 152 / 503 / 4.3 (occupancy 0.07); TAA trace 1034,
+//! resolve 11. fast_turn.ron at 64x36: mean frame-to-frame SMAPE 1 spp 0.46, hash cache 0.39,
+//! TAA 0.15, hash cache + TAA 0.13; relMSE at the reference frames 0.072, 0.052, 0.015-0.027,
+//! 0.010-0.023.
 
 pub mod key;
 pub mod table_cpu;
