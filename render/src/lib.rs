@@ -2,6 +2,7 @@
 
 pub mod scene;
 pub mod gpu;
+pub mod hash_cache;
 pub mod bvh;
 pub mod error;
 pub mod frame;
@@ -10,4 +11,5 @@ pub mod materials;
 pub mod path_tracer;
 pub mod readback;
 pub mod sample_cache;
+pub mod taa;
 pub mod timing;

@@ -77,6 +77,41 @@ pub enum MethodSpec {
         #[serde(default = "ssc_default::shading_rate")]
         shading_rate: f32,
     },
+    /// TAA over jittered 1 spp path tracing (render::taa). Defaults: render::taa::TaaSettings.
+    Taa {
+        #[serde(default = "taa_defaults::alpha")]
+        alpha: f32,
+        #[serde(default = "taa_defaults::clamp")]
+        clamp: render::taa::TaaClamp,
+        #[serde(default = "taa_defaults::jitter_length")]
+        jitter_length: u32,
+        #[serde(default = "taa_defaults::depth_tolerance")]
+        depth_tolerance: f32,
+        #[serde(default = "taa_defaults::normal_threshold")]
+        normal_threshold: f32,
+    },
+    /// World-space hash cache (render::hash_cache), optionally under TAA (as the paper runs it).
+    /// Defaults: render::hash_cache::HashCacheSettings, no TAA.
+    HashCache {
+        #[serde(default = "hash_cache_defaults::capacity")]
+        capacity: u32,
+        #[serde(default = "hash_cache_defaults::probe_limit")]
+        probe_limit: u32,
+        #[serde(default = "hash_cache_defaults::max_age")]
+        max_age: u32,
+        #[serde(default = "hash_cache_defaults::lod_scale")]
+        lod_scale: f32,
+        #[serde(default = "hash_cache_defaults::normal_lod")]
+        normal_lod: bool,
+        #[serde(default = "hash_cache_defaults::jitter")]
+        jitter: bool,
+        #[serde(default = "hash_cache_defaults::lookup")]
+        lookup: render::hash_cache::HashCacheLookup,
+        #[serde(default = "hash_cache_defaults::max_samples")]
+        max_samples: u32,
+        #[serde(default)]
+        taa: bool,
+    },
 }
 
 /// Short name of a predictor mode in labels.
@@ -102,6 +137,56 @@ mod ssc_default {
     pub fn shading_rate() -> f32 { S::default().shading_rate }
 }
 
+mod taa_defaults {
+    use render::taa::{TaaClamp, TaaSettings};
+    pub fn alpha() -> f32 {
+        TaaSettings::default().alpha
+    }
+    pub fn clamp() -> TaaClamp {
+        TaaSettings::default().clamp
+    }
+    pub fn jitter_length() -> u32 {
+        TaaSettings::default().jitter_length
+    }
+    pub fn depth_tolerance() -> f32 {
+        TaaSettings::default().depth_tolerance
+    }
+    pub fn normal_threshold() -> f32 {
+        TaaSettings::default().normal_threshold
+    }
+}
+
+mod hash_cache_defaults {
+    use render::hash_cache::{HashCacheLookup, HashCacheSettings};
+    fn d() -> HashCacheSettings {
+        HashCacheSettings::default()
+    }
+    pub fn capacity() -> u32 {
+        d().capacity
+    }
+    pub fn probe_limit() -> u32 {
+        d().probe_limit
+    }
+    pub fn max_age() -> u32 {
+        d().max_age
+    }
+    pub fn lod_scale() -> f32 {
+        d().lod_scale
+    }
+    pub fn normal_lod() -> bool {
+        d().normal_lod
+    }
+    pub fn jitter() -> bool {
+        d().jitter
+    }
+    pub fn lookup() -> HashCacheLookup {
+        d().lookup
+    }
+    pub fn max_samples() -> u32 {
+        d().max_samples
+    }
+}
+
 impl MethodSpec {
     /// A short name usable as a folder name, e.g. `pt_4spp`.
     pub fn label(&self) -> String {
@@ -109,6 +194,12 @@ impl MethodSpec {
             MethodSpec::PathTracing { spp } => format!("pt_{spp}spp"),
             MethodSpec::Nirc { spp, predictor, .. } => format!("nirc_{}_{spp}spp", predictor_label(*predictor)),
             MethodSpec::SampleCache { .. } => self.sample_cache_settings().map(|s| s.label()).unwrap_or_default(),
+            MethodSpec::Taa { .. } => "taa".into(),
+            MethodSpec::HashCache { lookup, taa, .. } => format!(
+                "hash_cache{}{}",
+                if *lookup == render::hash_cache::HashCacheLookup::FirstHit { "_first_hit" } else { "" },
+                if *taa { "_taa" } else { "" }
+            ),
         }
     }
 
@@ -119,6 +210,7 @@ impl MethodSpec {
             MethodSpec::Nirc { spp, .. } => *spp,
             // One shaded path per pixel at a 100% shading rate.
             MethodSpec::SampleCache { shading_rate, .. } => (shading_rate.ceil() as u32).max(1),
+            MethodSpec::Taa { .. } | MethodSpec::HashCache { .. } => 1,
         }
     }
 

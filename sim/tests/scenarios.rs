@@ -322,3 +322,18 @@ fn same_seed_same_scene_different_seed_differs() {
     }
 }
 
+
+#[test]
+fn taa_and_hash_cache_methods_take_defaults_and_overrides() {
+    let s = parse(
+        "Scenario(scene: Builtin(\"courtyard\"), resolution: (32, 18), frames: 1, methods: [Taa(), Taa(alpha: 0.2, clamp: MinMax), \
+         HashCache(), HashCache(lookup: FirstHit, taa: true, capacity: 1024)])",
+    );
+    let d = render::taa::TaaSettings::default();
+    assert_eq!(s.methods[0], sim::MethodSpec::Taa { alpha: d.alpha, clamp: d.clamp, jitter_length: d.jitter_length, depth_tolerance: d.depth_tolerance, normal_threshold: d.normal_threshold });
+    assert!(matches!(s.methods[1], sim::MethodSpec::Taa { alpha: 0.2, clamp: render::taa::TaaClamp::MinMax, .. }));
+    let labels: Vec<String> = s.methods.iter().map(|m| m.label()).collect();
+    assert_eq!(labels, ["taa", "taa", "hash_cache", "hash_cache_first_hit_taa"]);
+    assert!(s.methods.iter().all(|m| m.spp() == 1));
+    assert!(matches!(s.methods[3], sim::MethodSpec::HashCache { capacity: 1024, probe_limit: 8, .. }));
+}

@@ -59,6 +59,8 @@ pub fn load_scenario(path: &Path, o: &Overrides) -> Result<Scenario> {
                 MethodSpec::PathTracing { spp: s } => *s = spp,
                 MethodSpec::Nirc { spp: s, .. } => *s = spp,
                 MethodSpec::SampleCache { .. } => {}
+                // 1 spp by construction.
+                MethodSpec::Taa { .. } | MethodSpec::HashCache { .. } => {}
             }
         }
     }

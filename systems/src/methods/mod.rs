@@ -5,6 +5,8 @@
 pub mod nirc;
 mod path_tracing;
 mod sample_cache;
+mod hash_cache;
+mod taa;
 
 use anyhow::Result;
 use render::gpu::Gpu;
@@ -15,6 +17,8 @@ use sim::{MethodSpec, Scenario};
 pub use nirc::Nirc;
 pub use path_tracing::PathTracing;
 pub use sample_cache::SampleCacheMethod;
+pub use hash_cache::HashCacheMethod;
+pub use taa::TaaMethod;
 
 /// Everything a method may read while rendering one frame.
 pub struct FrameContext<'a> {
@@ -74,6 +78,29 @@ pub fn build(spec: &MethodSpec, _gpu: &Gpu, _scenario: &Scenario, _scene: &Scene
             let settings = spec.sample_cache_settings().expect("a SampleCache spec");
             settings.validate().map_err(|e| anyhow::anyhow!("{}: SampleCache: {e}", _scenario.origin.display()))?;
             Box::new(SampleCacheMethod::new(settings))
+        }
+        MethodSpec::Taa { alpha, clamp, jitter_length, depth_tolerance, normal_threshold } => Box::new(TaaMethod::new(render::taa::TaaSettings {
+            alpha: *alpha,
+            clamp: *clamp,
+            jitter_length: *jitter_length,
+            depth_tolerance: *depth_tolerance,
+            normal_threshold: *normal_threshold,
+            ..Default::default()
+        })?),
+        MethodSpec::HashCache { capacity, probe_limit, max_age, lod_scale, normal_lod, jitter, lookup, max_samples, taa } => {
+            let settings = render::hash_cache::HashCacheSettings {
+                capacity: *capacity,
+                probe_limit: *probe_limit,
+                max_age: *max_age,
+                lod_scale: *lod_scale,
+                normal_lod: *normal_lod,
+                jitter: *jitter,
+                lookup: *lookup,
+                max_samples: *max_samples,
+                ..Default::default()
+            };
+            let taa = taa.then(render::taa::TaaSettings::default);
+            Box::new(HashCacheMethod::new(settings, taa, spec.label())?)
         }
     })
 }

@@ -1,0 +1,32 @@
+// Primary-hit attributes of a jittered sample, written by every pass that feeds the TAA resolve
+// (taa_trace.wgsl, the hash cache). Needs the shading library (pt_scene: frame, camera helpers).
+
+// Primary-hit attributes of a jittered sample. Misses: instance NO_HIT, depth 0.
+struct TaaPrimary {
+    normal: vec3f,
+    depth: f32,
+    motion: vec2f,          // previous image position - current image position (pixels)
+    instance: u32,
+    previous_depth: f32,    // distance from the previous camera to where the point was
+}
+
+// The primary hit's attributes for the ray (origin, dir); shared with the hash cache's pass.
+fn primary_attributes(hit: Hit, origin: vec3f, dir: vec3f) -> TaaPrimary {
+    var p: TaaPrimary;
+    p.instance = hit.instance;
+    if hit.instance == NO_HIT {
+        p.depth = 0.0;
+        p.previous_depth = 0.0;
+        p.normal = vec3f(0.0);
+        p.motion = project_offset(frame.previous_camera, dir) - project_offset(frame.camera, dir);
+    } else {
+        let sp = surface_point(hit, origin, dir);
+        let sh = orient(sp, -dir);
+        let before = previous_world_position(hit) - frame.previous_camera.position.xyz;
+        p.depth = length(sp.position - origin);
+        p.previous_depth = length(before);
+        p.normal = sh.ns;
+        p.motion = project_offset(frame.previous_camera, before) - project_offset(frame.camera, sp.position - origin);
+    }
+    return p;
+}

@@ -1,0 +1,404 @@
+//! World-space hash cache: the HashCache baseline of stable-sample-caching.txt (§4, §5).
+//!
+//! What follows the paper: voxels hashed twice (home slot + checksum), linear probing (open
+//! addressing) within a bounded window, a last-access stamp per entry and eviction of entries
+//! not accessed for a while, level of detail from the camera distance and optionally the
+//! incidence angle (its Fig. 9), voxel jitter before lookup [BFK18], jittered first hits at 1 spp,
+//! one secondary path per reserved cell per frame (the pixel that reserves a cell traces, the
+//! others only look up), albedo demodulation, the cell a running mean (non-resampled temporal
+//! filtering), optional TAA on the result.
+//!
+//! Departures, and why:
+//! - `lookup`: [`HashCacheLookup::SecondaryHit`] (the default, issue 5's method) terminates the
+//!   first bounce into the cache at its hit and caches outgoing radiance there (not albedo
+//!   demodulated); [`HashCacheLookup::FirstHit`] is the paper's placement (cells at primary hits,
+//!   sub-pixel voxels, albedo demodulated).
+//! - Keys: WGSL has no 64-bit atomics, so the paper's 64-bit (last access, checksum) word becomes
+//!   a 32-bit checksum claimed by compare-exchange plus a separate last-access word every
+//!   accessor stores the same frame into; the home slot is stored for checking.
+//! - Which pixel reserves a cell: the lowest pixel index (atomicMin), not the first to arrive, so
+//!   that the one writer of each cell, and hence the image, does not depend on scheduling. The
+//!   slot a key lands in may (when home windows overlap), which changes nothing visible unless
+//!   a probe window overflows (counted in `insert_failures`; those pixels use their own sample).
+//! - Eviction is a per-slot pass at the start of the frame (entries older than `max_age`
+//!   frames), not lazy overwrite at insertion: a lookup never races an eviction.
+//! - No 2D tiling of the slots by the normal's major axis ([BMdD*23] memory coherence); the axis
+//!   is part of the key instead, which keeps the two sides of thin walls apart.
+//! - Four passes (age, trace, update, resolve) rather than two: the claim must be complete
+//!   before the claimant is known.
+//! - Cells are not split into parent/child levels (that is the paper's Hybrid, not HashCache).
+//!
+//! Numbers (lavapipe, 2 shared CPU cores; `cargo run -p systems --example issue5_bench 320 180 5`,
+//! courtyard, camera moving, max depth 4, median GPU ms): secondary-hit lookup hc_age 5.2,
+//! hc_trace 334, hc_update 581, hc_resolve 6.2 (occupancy 0.17 of 2^18 slots, 18k update paths
+//! for 57.6k pixels); first-hit lookup 6.6 / 152 / 503 / 4.3 (occupancy 0.07); TAA trace 1034,
+//! resolve 11. fast_turn.ron at 64x36: mean frame-to-frame SMAPE 1 spp 0.46, hash cache 0.39,
+//! TAA 0.15, hash cache + TAA 0.13; relMSE at the reference frames 0.072, 0.052, 0.015-0.027,
+//! 0.010-0.023.
+
+pub mod key;
+pub mod table_cpu;
+
+use crate::error::RenderError;
+use crate::gpu::Gpu;
+use crate::path_tracer::PathTracer;
+use crate::readback::read_buffer;
+use crate::scene::Camera;
+use crate::taa::{PRIMARY_WGSL, Taa, TaaPrimary, halton_jitter};
+use crate::timing::{PassTimestamps, PassTiming};
+use bytemuck::{Pod, Zeroable};
+use std::time::Instant;
+
+pub use key::KeyParams;
+pub use table_cpu::{CpuHashTable, CpuSlot};
+
+pub const HC_AGE_PASS: &str = "hc_age";
+pub const HC_TRACE_PASS: &str = "hc_trace";
+pub const HC_UPDATE_PASS: &str = "hc_update";
+pub const HC_RESOLVE_PASS: &str = "hc_resolve";
+const PASSES: [&str; 4] = [HC_AGE_PASS, HC_TRACE_PASS, HC_UPDATE_PASS, HC_RESOLVE_PASS];
+
+const LIBRARY_STORAGE_BUFFERS: u32 = 5 + 8;
+const OWN_STORAGE_BUFFERS: u32 = 6;
+
+/// Where the path terminates into the cache.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum HashCacheLookup {
+    /// The paper: cells at the primary hits, albedo demodulated, sub-pixel voxels.
+    FirstHit,
+    /// Issue 5: the first bounce ends in the cache at its hit (outgoing radiance there).
+    SecondaryHit,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct HashCacheSettings {
+    /// Slots of the table.
+    pub capacity: u32,
+    /// Slots probed from the home slot before an insertion fails.
+    pub probe_limit: u32,
+    /// Entries not accessed for more than this many frames are evicted.
+    pub max_age: u32,
+    /// Voxel size in pixel footprints at the point's camera distance (rounded up to 2^k).
+    pub lod_scale: f32,
+    /// Widen voxels at grazing incidence (the paper's distance + normal LOD).
+    pub normal_lod: bool,
+    /// Voxel jitter before lookup.
+    pub jitter: bool,
+    pub lookup: HashCacheLookup,
+    /// Running mean of a cell up to this many samples, then exponential (weight 1/max_samples).
+    pub max_samples: u32,
+    /// Halton (2, 3) cycle of the primary rays; 0 = pixel centres.
+    pub jitter_length: u32,
+}
+
+impl Default for HashCacheSettings {
+    fn default() -> Self {
+        Self {
+            capacity: 1 << 18,
+            probe_limit: 8,
+            max_age: 8,
+            lod_scale: 1.0,
+            normal_lod: true,
+            jitter: true,
+            lookup: HashCacheLookup::SecondaryHit,
+            max_samples: 32,
+            jitter_length: 8,
+        }
+    }
+}
+
+impl HashCacheSettings {
+    pub fn validate(&self) -> Result<(), RenderError> {
+        let bad = |m: String| Err(RenderError::Settings(m));
+        if self.capacity == 0 || self.capacity >= u32::MAX / 4 {
+            return bad(format!("hash cache capacity must be in 1..2^30 slots, got {}", self.capacity));
+        }
+        if self.probe_limit == 0 || self.probe_limit > self.capacity {
+            return bad(format!("hash cache probe_limit must be in 1..=capacity, got {}", self.probe_limit));
+        }
+        if self.max_samples == 0 || !(self.lod_scale > 0.0) {
+            return bad("hash cache max_samples must be at least 1 and lod_scale positive".into());
+        }
+        Ok(())
+    }
+
+    /// Key parameters for a camera and image height.
+    pub fn key_params(&self, camera: &Camera, height: u32) -> KeyParams {
+        KeyParams { capacity: self.capacity, pixel_angle: 2.0 * (0.5 * camera.vfov).tan() / height as f32, lod_scale: self.lod_scale, normal_lod: self.normal_lod, jitter: self.jitter }
+    }
+}
+
+/// WGSL `HashCacheParams`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct GpuParams {
+    capacity: u32,
+    probe_limit: u32,
+    frame: u32,
+    max_age: u32,
+    pixel_angle: f32,
+    lod_scale: f32,
+    normal_lod: u32,
+    jitter: u32,
+    lookup: u32,
+    max_samples: f32,
+    voxel_jitter_seed: u32,
+    pad: u32,
+    primary_jitter: [f32; 2],
+    pad2: [f32; 2],
+}
+
+/// WGSL `HcRecord`: a pixel's state between the passes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct HcRecord {
+    pub key_point: [f32; 3],
+    pub slot: u32,
+    pub key_normal: [f32; 3],
+    pub checksum: u32,
+    pub direct: [f32; 3],
+    pub home: u32,
+    pub modulate: [f32; 3],
+    pub rng: u32,
+    pub ray_origin: [f32; 3],
+    pub depth: u32,
+    pub ray_dir: [f32; 3],
+    pub voxel_jitter: u32,
+    pub own_sample: [f32; 3],
+    pub flags: u32,
+}
+
+pub const HC_NEEDS_SAMPLE: u32 = 1;
+
+const _: () = assert!(size_of::<GpuParams>() == 64 && size_of::<HcRecord>() == 112);
+
+/// Cache counters of one frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HashCacheStats {
+    pub capacity: u32,
+    /// Entries after this frame's insertions.
+    pub occupied: u32,
+    pub evicted: u32,
+    pub inserted: u32,
+    /// Lookups whose probe window was full (those pixels used their own sample).
+    pub insert_failures: u32,
+    /// Secondary paths traced for updates (one per reserved cell + failures).
+    pub update_paths: u32,
+}
+
+impl HashCacheStats {
+    pub fn occupancy(&self) -> f64 {
+        self.occupied as f64 / self.capacity as f64
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct HashCacheOutput {
+    /// Linear radiance (after TAA when one was given), row-major, alpha = 1.
+    pub radiance: Vec<[f32; 4]>,
+    pub motion: Vec<[f32; 2]>,
+    pub stats: HashCacheStats,
+    /// The four cache passes, then TAA's resolve when used.
+    pub timings: Vec<PassTiming>,
+}
+
+pub struct HashCache {
+    settings: HashCacheSettings,
+    width: u32,
+    height: u32,
+    params: wgpu::Buffer,
+    slots: wgpu::Buffer,
+    cells: wgpu::Buffer,
+    records: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    primary: wgpu::Buffer,
+    colour: wgpu::Buffer,
+    group: wgpu::BindGroup,
+    pipelines: [wgpu::ComputePipeline; 4],
+    timestamps: Option<PassTimestamps>,
+    /// Frames rendered so far; the stamp of the next one is `frames + 1`.
+    frames: u32,
+}
+
+impl HashCache {
+    pub fn new(gpu: &Gpu, tracer: &PathTracer, settings: HashCacheSettings) -> Result<Self, RenderError> {
+        settings.validate()?;
+        let s = tracer.settings();
+        let (width, height) = (s.width, s.height);
+        gpu.check_resolution(width, height, size_of::<HcRecord>() as u64 + 32 + 16)?;
+        let needed = LIBRARY_STORAGE_BUFFERS + OWN_STORAGE_BUFFERS;
+        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
+        if needed > limit {
+            return Err(crate::gpu::GpuError::OverLimit { what: "storage buffers of the hash cache passes".into(), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
+        }
+        gpu.check_buffer_size("hash cache slots", settings.capacity as u64 * 16)?;
+        gpu.check_buffer_size("hash cache cells", settings.capacity as u64 * 16)?;
+        // No pass declares var<workgroup>.
+        gpu.check_workgroup_memory(HC_TRACE_PASS, 0)?;
+        let device = &gpu.device;
+        let pixels = width as u64 * height as u64;
+        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false });
+        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let params = buffer("hash cache params", size_of::<GpuParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+        let slots = buffer("hash cache slots", settings.capacity as u64 * 16, rw);
+        let cells = buffer("hash cache cells", settings.capacity as u64 * 16, rw);
+        let records = buffer("hash cache records", pixels * size_of::<HcRecord>() as u64, rw);
+        let counters = buffer("hash cache counters", 32, rw);
+        let primary = buffer("hash cache primary", pixels * size_of::<TaaPrimary>() as u64, rw);
+        let colour = buffer("hash cache colour", pixels * 16, rw);
+
+        let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        };
+        let write = wgpu::BufferBindingType::Storage { read_only: false };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("hash cache"),
+            entries: &[entry(0, wgpu::BufferBindingType::Uniform), entry(1, write), entry(2, write), entry(3, write), entry(4, write), entry(5, write), entry(6, write)],
+        });
+        let bufs = [&params, &slots, &cells, &records, &counters, &primary, &colour];
+        let entries: Vec<_> = bufs.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("hash cache"), layout: &layout, entries: &entries });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("hash cache"),
+            bind_group_layouts: &[Some(tracer.scene_bind_group_layout()), Some(tracer.geometry().bind_group_layout()), Some(&layout)],
+            immediate_size: 0,
+        });
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("hash_cache.wgsl"), source: wgpu::ShaderSource::Wgsl(Self::shader_source().into()) });
+        let pipeline = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let pipelines = PASSES.map(pipeline);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(RenderError::Shader { pass: "hash_cache.wgsl".into(), message: e.to_string() });
+        }
+        Ok(Self { settings, width, height, params, slots, cells, records, counters, primary, colour, group, pipelines, timestamps: PassTimestamps::new(gpu, 4), frames: 0 })
+    }
+
+    /// The complete WGSL of the passes: shading library, TaaPrimary, keys, passes.
+    pub fn shader_source() -> &'static str {
+        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+        SOURCE.get_or_init(|| {
+            [PathTracer::library_source(), PRIMARY_WGSL, include_str!("../../shaders/hash_cache/hash_key.wgsl"), include_str!("../../shaders/hash_cache/hash_cache.wgsl")].join("\n")
+        })
+    }
+
+    pub fn settings(&self) -> HashCacheSettings {
+        self.settings
+    }
+
+    /// Frames rendered so far.
+    pub fn frames(&self) -> u32 {
+        self.frames
+    }
+
+    /// One frame; `camera` is the scene's camera of this frame (its field of view sets the LOD),
+    /// `taa` an optional resolve over the result (the paper applies TAA to HashCache).
+    pub fn render(&mut self, gpu: &Gpu, tracer: &PathTracer, camera: &Camera, seed: u64, frame: u32, taa: Option<&mut Taa>) -> Result<HashCacheOutput, RenderError> {
+        let jitter = halton_jitter(frame, self.settings.jitter_length);
+        let stamp = self.frames + 1;
+        let k = self.settings.key_params(camera, self.height);
+        let params = GpuParams {
+            capacity: self.settings.capacity,
+            probe_limit: self.settings.probe_limit,
+            frame: stamp,
+            max_age: self.settings.max_age,
+            pixel_angle: k.pixel_angle,
+            lod_scale: k.lod_scale,
+            normal_lod: k.normal_lod as u32,
+            jitter: k.jitter as u32,
+            lookup: (self.settings.lookup == HashCacheLookup::SecondaryHit) as u32,
+            max_samples: self.settings.max_samples as f32,
+            voxel_jitter_seed: (seed as u32) ^ 0x5bd1e995,
+            pad: 0,
+            primary_jitter: jitter,
+            pad2: [0.0; 2],
+        };
+        tracer.prepare_frame(gpu, 1, 0, seed, frame);
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        gpu.queue.write_buffer(&self.counters, 0, &[0u8; 32]);
+        let start = Instant::now();
+        let (radiance, taa_timings) = match taa {
+            Some(taa) => {
+                let out = taa.resolve_external(gpu, jitter, |encoder, colour, primary| {
+                    self.encode(encoder, tracer);
+                    encoder.copy_buffer_to_buffer(&self.colour, 0, colour, 0, self.colour.size());
+                    encoder.copy_buffer_to_buffer(&self.primary, 0, primary, 0, self.primary.size());
+                })?;
+                (out.radiance, out.timings)
+            }
+            None => {
+                let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hash cache") });
+                self.encode(&mut encoder, tracer);
+                gpu.queue.submit([encoder.finish()]);
+                let colour: Vec<[f32; 4]> = read(gpu, &self.colour, "hash cache colour")?;
+                (colour, vec![])
+            }
+        };
+        let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+        let gpu_ms = match &self.timestamps {
+            Some(t) => Some(t.read(gpu).map_err(|reason| RenderError::Readback { what: "hash cache timestamps".into(), reason })?),
+            None => None,
+        };
+        let mut timings: Vec<PassTiming> =
+            PASSES.iter().enumerate().map(|(i, p)| PassTiming { pass: (*p).into(), gpu_ms: gpu_ms.as_ref().map(|t| t[i]), cpu_ms: if i == 0 { cpu_ms } else { 0.0 } }).collect();
+        timings.extend(taa_timings);
+        let c: Vec<u32> = read(gpu, &self.counters, "hash cache counters")?;
+        let primary: Vec<TaaPrimary> = read(gpu, &self.primary, "hash cache primary hits")?;
+        self.frames += 1;
+        let stats = HashCacheStats { capacity: self.settings.capacity, occupied: c[0] + c[2], evicted: c[1], inserted: c[2], insert_failures: c[3], update_paths: c[4] };
+        Ok(HashCacheOutput { radiance, motion: primary.iter().map(|p| p.motion).collect(), stats, timings })
+    }
+
+    fn encode(&self, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer) {
+        for (i, pipeline) in self.pipelines.iter().enumerate() {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(PASSES[i]), timestamp_writes: self.timestamps.as_ref().map(|t| t.writes(i as u32)) });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
+            pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+            pass.set_bind_group(2, &self.group, &[]);
+            if i == 0 {
+                pass.dispatch_workgroups(self.settings.capacity.div_ceil(64), 1, 1);
+            } else {
+                pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
+            }
+        }
+        if let Some(t) = &self.timestamps {
+            t.resolve(encoder);
+        }
+    }
+
+    /// The table as stored: (checksum, last access, claim, home) per slot → [`CpuSlot`]s.
+    pub fn read_slots(&self, gpu: &Gpu) -> Result<Vec<CpuSlot>, RenderError> {
+        let raw: Vec<[u32; 4]> = read(gpu, &self.slots, "hash cache slots")?;
+        Ok(raw.into_iter().map(|s| CpuSlot { checksum: s[0], last_access: s[1], home: s[3] }).collect())
+    }
+
+    /// Each slot's radiance (rgb) and sample count (w).
+    pub fn read_cells(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, RenderError> {
+        read(gpu, &self.cells, "hash cache cells")
+    }
+
+    /// The per-pixel records of the last frame.
+    pub fn read_records(&self, gpu: &Gpu) -> Result<Vec<HcRecord>, RenderError> {
+        read(gpu, &self.records, "hash cache records")
+    }
+}
+
+fn read<T: Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<T>, RenderError> {
+    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(what), size: buffer.size(), usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
+    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
+    gpu.queue.submit([encoder.finish()]);
+    read_buffer(gpu, &staging).map_err(|reason| RenderError::Readback { what: what.into(), reason })
+}

@@ -1,0 +1,409 @@
+//! Temporal anti-aliasing (TAA) over jittered 1 spp path tracing: the baseline of issue 5.
+//!
+//! Two passes per frame:
+//! - `taa_trace` (render/shaders/taa_trace.wgsl, after the shading library): one path per pixel
+//!   through the frame's Halton (2, 3) jitter point ([`jitter`]), plus that sample's own primary
+//!   hit (depth, normal, instance, motion, depth from the previous camera);
+//! - `taa_resolve` (render/shaders/taa_resolve.wgsl): reprojection of the history by the motion
+//!   vector (bilinear), history rejection on disocclusion (instance, relative depth and normal
+//!   test at the previous position), neighbourhood clamp (3x3 min/max, or variance clipping
+//!   mean +- gamma sigma), exponential blend with weight max(alpha, 1 / (length + 1)).
+//!
+//! History colour and primary attributes are ping-ponged; [`resolve_cpu`] repeats the resolve
+//! on the CPU for tests. The resolve can also run over another method's colour
+//! ([`Taa::resolve_external`]): the hash cache uses it as the paper does.
+//!
+//! Choices and departures from the usual real-time TAA (Karis 2014, Yang et al. 2020):
+//! - the blend starts as a uniform average (weight 1 / (length + 1)) and becomes exponential at
+//!   alpha, so a still image converges to the mean instead of starting from one frame's
+//!   weight 1 - alpha; the paper's temporal weights of Philippi et al. [PFJ23] are not used;
+//! - history is sampled bilinearly (no Catmull-Rom), clamped in linear RGB (no YCoCg, no
+//!   luminance weighting), and rejected on a nearest-pixel test of instance, depth seen from
+//!   the previous camera and normal;
+//! - each sample carries its own primary hit (the jittered ray's), not the pixel-centre
+//!   G-buffer of the path tracer: motion vectors and rejection describe what was shaded;
+//! - the primary ray is traced twice (once for its attributes, once inside `path_radiance`).
+//!
+//! Cost (lavapipe on 2 shared CPU cores, courtyard 320x180, max depth 4, median GPU ms of 5
+//! frames, `cargo run -p systems --example issue5_bench 320 180 5`): taa_trace 1034,
+//! taa_resolve 11.
+
+pub mod jitter;
+pub mod resolve_cpu;
+
+use crate::error::RenderError;
+use crate::gpu::Gpu;
+use crate::path_tracer::PathTracer;
+use crate::readback::read_buffer;
+use crate::timing::{PassTimestamps, PassTiming};
+use bytemuck::{Pod, Zeroable};
+use std::time::Instant;
+
+pub use jitter::{halton, halton_jitter};
+
+pub const TAA_TRACE_PASS: &str = "taa_trace";
+pub const TAA_RESOLVE_PASS: &str = "taa_resolve";
+
+/// `TaaPrimary` and `primary_attributes` in WGSL, for every pass that feeds the resolve.
+pub const PRIMARY_WGSL: &str = include_str!("../../shaders/taa_primary.wgsl");
+
+const WORKGROUP: u32 = 8;
+/// Storage buffers of group 0 and 1 of the shading library (path_tracer.rs).
+const LIBRARY_STORAGE_BUFFERS: u32 = 5 + 8;
+
+/// How the reprojected history is limited to the current neighbourhood.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum TaaClamp {
+    /// No clamp: ghosting wherever the rejection test passes wrongly (for tests).
+    None,
+    /// Per-channel min/max of the 3x3 neighbourhood (Karis 2014).
+    MinMax,
+    /// Clip towards the 3x3 mean inside mean +- gamma * sigma (Salvi 2016).
+    Variance { gamma: f32 },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TaaSettings {
+    /// Weight of the current frame in the exponential blend.
+    pub alpha: f32,
+    pub clamp: TaaClamp,
+    /// Points of the Halton (2, 3) cycle; 0 = rays through pixel centres.
+    pub jitter_length: u32,
+    /// History rejected where the previous depth differs by more than this fraction.
+    pub depth_tolerance: f32,
+    /// History rejected where the normals' cosine is below this.
+    pub normal_threshold: f32,
+    /// Cap of the history length, the denominator of the uniform-average start.
+    pub max_history: f32,
+}
+
+impl Default for TaaSettings {
+    fn default() -> Self {
+        Self { alpha: 0.1, clamp: TaaClamp::Variance { gamma: 1.0 }, jitter_length: 8, depth_tolerance: 0.05, normal_threshold: 0.8, max_history: 256.0 }
+    }
+}
+
+impl TaaSettings {
+    pub fn validate(&self) -> Result<(), RenderError> {
+        if !(self.alpha > 0.0 && self.alpha <= 1.0) {
+            return Err(RenderError::Settings(format!("TAA alpha must be in (0, 1], got {}", self.alpha)));
+        }
+        if let TaaClamp::Variance { gamma } = self.clamp
+            && !(gamma > 0.0)
+        {
+            return Err(RenderError::Settings(format!("TAA variance clipping gamma must be positive, got {gamma}")));
+        }
+        if !(self.depth_tolerance > 0.0) || !(self.max_history >= 1.0) {
+            return Err(RenderError::Settings("TAA depth_tolerance must be positive and max_history at least 1".into()));
+        }
+        Ok(())
+    }
+
+    pub(crate) fn params(&self, width: u32, height: u32, jitter: [f32; 2], history_valid: bool) -> TaaParams {
+        let (clamp_mode, gamma) = match self.clamp {
+            TaaClamp::None => (0, 0.0),
+            TaaClamp::MinMax => (1, 0.0),
+            TaaClamp::Variance { gamma } => (2, gamma),
+        };
+        TaaParams {
+            jitter,
+            alpha: self.alpha,
+            gamma,
+            size: [width, height],
+            clamp_mode,
+            history_valid: history_valid as u32,
+            depth_tolerance: self.depth_tolerance,
+            normal_threshold: self.normal_threshold,
+            max_history: self.max_history,
+            pad: 0.0,
+        }
+    }
+}
+
+/// WGSL `TaaParams`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub(crate) struct TaaParams {
+    pub jitter: [f32; 2],
+    pub alpha: f32,
+    pub gamma: f32,
+    pub size: [u32; 2],
+    pub clamp_mode: u32,
+    pub history_valid: u32,
+    pub depth_tolerance: f32,
+    pub normal_threshold: f32,
+    pub max_history: f32,
+    pub pad: f32,
+}
+
+/// WGSL `TaaPrimary`: attributes of a jittered sample's primary hit.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct TaaPrimary {
+    pub normal: [f32; 3],
+    /// Distance from the camera; 0 on a miss.
+    pub depth: f32,
+    /// Previous image position minus current one, pixels (x right, y down).
+    pub motion: [f32; 2],
+    /// [`crate::path_tracer::NO_HIT`] on a miss.
+    pub instance: u32,
+    /// Distance from the previous camera to where the point was in the previous frame.
+    pub previous_depth: f32,
+}
+
+const _: () = assert!(size_of::<TaaParams>() == 48 && size_of::<TaaPrimary>() == 32);
+
+/// One resolved frame.
+#[derive(Clone, Debug, Default)]
+pub struct TaaOutput {
+    /// Resolved linear radiance, row-major, alpha = 1.
+    pub radiance: Vec<[f32; 4]>,
+    /// Motion of each pixel's sample (previous minus current position, pixels).
+    pub motion: Vec<[f32; 2]>,
+    /// Frames accumulated in each pixel's history (1 = rejected or first frame).
+    pub history_length: Vec<f32>,
+    /// [`TAA_TRACE_PASS`] (when traced here) and [`TAA_RESOLVE_PASS`].
+    pub timings: Vec<PassTiming>,
+}
+
+/// Everything the last resolve read and wrote, for checking it against [`resolve_cpu`].
+#[derive(Clone, Debug)]
+pub struct TaaInspection {
+    pub params_history_valid: bool,
+    pub current: Vec<[f32; 4]>,
+    pub primary: Vec<TaaPrimary>,
+    pub previous_primary: Vec<TaaPrimary>,
+    pub history: Vec<[f32; 4]>,
+    pub resolved: Vec<[f32; 4]>,
+}
+
+pub struct Taa {
+    settings: TaaSettings,
+    width: u32,
+    height: u32,
+    params: wgpu::Buffer,
+    current: wgpu::Buffer,
+    /// Ping-pong: `primary[parity]` and `history[parity]` are written this frame.
+    primary: [wgpu::Buffer; 2],
+    history: [wgpu::Buffer; 2],
+    trace_layout: wgpu::BindGroupLayout,
+    trace_pipeline: wgpu::ComputePipeline,
+    resolve_groups: [wgpu::BindGroup; 2],
+    resolve_pipeline: wgpu::ComputePipeline,
+    timestamps: Option<PassTimestamps>,
+    parity: usize,
+    history_valid: bool,
+    last_history_valid: bool,
+}
+
+impl Taa {
+    /// Passes at the tracer's resolution, bound to its scene and geometry layouts.
+    pub fn new(gpu: &Gpu, tracer: &PathTracer, settings: TaaSettings) -> Result<Self, RenderError> {
+        settings.validate()?;
+        let s = tracer.settings();
+        let (width, height) = (s.width, s.height);
+        gpu.check_resolution(width, height, 16 * 3 + 32 * 2)?;
+        let needed = LIBRARY_STORAGE_BUFFERS + 2;
+        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
+        if needed > limit {
+            return Err(crate::gpu::GpuError::OverLimit { what: "storage buffers of the TAA trace pass".into(), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
+        }
+        // Neither pass declares var<workgroup>.
+        gpu.check_workgroup_memory(TAA_RESOLVE_PASS, 0)?;
+        let device = &gpu.device;
+        let pixels = width as u64 * height as u64;
+        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false });
+        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let params = buffer("taa params", size_of::<TaaParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+        let current = buffer("taa current", pixels * 16, rw);
+        let primary = [buffer("taa primary 0", pixels * 32, rw), buffer("taa primary 1", pixels * 32, rw)];
+        let history = [buffer("taa history 0", pixels * 16, rw), buffer("taa history 1", pixels * 16, rw)];
+
+        let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        };
+        let uniform = wgpu::BufferBindingType::Uniform;
+        let read = wgpu::BufferBindingType::Storage { read_only: true };
+        let write = wgpu::BufferBindingType::Storage { read_only: false };
+        let trace_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("taa trace"), entries: &[entry(0, uniform), entry(1, write), entry(2, write)] });
+        let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("taa resolve"),
+            entries: &[entry(0, uniform), entry(1, read), entry(2, read), entry(3, read), entry(4, read), entry(5, write)],
+        });
+
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let trace_module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("taa_trace.wgsl"), source: wgpu::ShaderSource::Wgsl(Self::trace_source().into()) });
+        let resolve_module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("taa_resolve.wgsl"), source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/taa_resolve.wgsl").into()) });
+        let trace_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("taa trace"),
+            bind_group_layouts: &[Some(tracer.scene_bind_group_layout()), Some(tracer.geometry().bind_group_layout()), Some(&trace_layout)],
+            immediate_size: 0,
+        });
+        let resolve_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("taa resolve"), bind_group_layouts: &[Some(&resolve_layout)], immediate_size: 0 });
+        let pipeline = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor { label: Some(entry), layout: Some(layout), module, entry_point: Some(entry), compilation_options: Default::default(), cache: None })
+        };
+        let trace_pipeline = pipeline(&trace_pipeline_layout, &trace_module, "taa_trace");
+        let resolve_pipeline = pipeline(&resolve_pipeline_layout, &resolve_module, "taa_resolve");
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(RenderError::Shader { pass: "taa_trace.wgsl / taa_resolve.wgsl".into(), message: e.to_string() });
+        }
+        let resolve_group = |p: usize| {
+            let q = 1 - p;
+            let bufs = [&params, &current, &primary[p], &primary[q], &history[q], &history[p]];
+            let entries: Vec<_> = bufs.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
+            device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("taa resolve"), layout: &resolve_layout, entries: &entries })
+        };
+        let resolve_groups = [resolve_group(0), resolve_group(1)];
+        Ok(Self {
+            settings,
+            width,
+            height,
+            params,
+            current,
+            primary,
+            history,
+            trace_layout,
+            trace_pipeline,
+            resolve_groups,
+            resolve_pipeline,
+            timestamps: PassTimestamps::new(gpu, 2),
+            parity: 0,
+            history_valid: false,
+            last_history_valid: false,
+        })
+    }
+
+    /// The trace pass's complete WGSL (shading library + taa_trace.wgsl).
+    pub fn trace_source() -> &'static str {
+        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+        SOURCE.get_or_init(|| [PathTracer::library_source(), PRIMARY_WGSL, include_str!("../../shaders/taa_trace.wgsl")].join("\n"))
+    }
+
+    pub fn settings(&self) -> TaaSettings {
+        self.settings
+    }
+
+    /// Forgets the history: the next frame starts a new one.
+    pub fn reset(&mut self) {
+        self.history_valid = false;
+    }
+
+    /// Jittered 1 spp path tracing + resolve. `tracer` must be updated to this frame's scene.
+    pub fn render(&mut self, gpu: &Gpu, tracer: &PathTracer, seed: u64, frame: u32) -> Result<TaaOutput, RenderError> {
+        let jitter = halton_jitter(frame, self.settings.jitter_length);
+        tracer.prepare_frame(gpu, 1, 0, seed, frame);
+        self.write_params(gpu, jitter);
+        let start = Instant::now();
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("taa") });
+        {
+            let group = self.trace_group(gpu, &self.current, &self.primary[self.parity]);
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(TAA_TRACE_PASS), timestamp_writes: self.timestamps.as_ref().map(|t| t.writes(0)) });
+            pass.set_pipeline(&self.trace_pipeline);
+            pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
+            pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+            pass.set_bind_group(2, &group, &[]);
+            pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
+        }
+        self.encode_resolve(&mut encoder, 1);
+        let gpu_ms = self.submit(gpu, encoder)?;
+        let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
+        let timings = vec![
+            PassTiming { pass: TAA_TRACE_PASS.into(), gpu_ms: gpu_ms.as_ref().map(|t| t[0]), cpu_ms },
+            PassTiming { pass: TAA_RESOLVE_PASS.into(), gpu_ms: gpu_ms.as_ref().map(|t| t[1]), cpu_ms: 0.0 },
+        ];
+        self.finish(gpu, timings)
+    }
+
+    /// The bind group of the trace pass's @group(2) writing `current` and `primary`; other
+    /// passes that feed the resolve (the hash cache) bind the same layout.
+    fn trace_group(&self, gpu: &Gpu, current: &wgpu::Buffer, primary: &wgpu::Buffer) -> wgpu::BindGroup {
+        let entries = [
+            wgpu::BindGroupEntry { binding: 0, resource: self.params.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: current.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 2, resource: primary.as_entire_binding() },
+        ];
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("taa trace"), layout: &self.trace_layout, entries: &entries })
+    }
+
+    /// Resolves a colour another pass produced: `write` gets an encoder, the buffer to write the
+    /// linear colour into (vec4 per pixel) and the one for [`TaaPrimary`] texels, and records
+    /// its passes; the resolve follows in the same submission.
+    pub fn resolve_external(
+        &mut self,
+        gpu: &Gpu,
+        jitter: [f32; 2],
+        write: impl FnOnce(&mut wgpu::CommandEncoder, &wgpu::Buffer, &wgpu::Buffer),
+    ) -> Result<TaaOutput, RenderError> {
+        self.write_params(gpu, jitter);
+        let start = Instant::now();
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("taa resolve") });
+        write(&mut encoder, &self.current, &self.primary[self.parity]);
+        self.encode_resolve(&mut encoder, 1);
+        let gpu_ms = self.submit(gpu, encoder)?;
+        let timings = vec![PassTiming { pass: TAA_RESOLVE_PASS.into(), gpu_ms: gpu_ms.as_ref().map(|t| t[1]), cpu_ms: start.elapsed().as_secs_f64() * 1e3 }];
+        self.finish(gpu, timings)
+    }
+
+    fn write_params(&mut self, gpu: &Gpu, jitter: [f32; 2]) {
+        let params = self.settings.params(self.width, self.height, jitter, self.history_valid);
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        self.last_history_valid = self.history_valid;
+    }
+
+    fn encode_resolve(&self, encoder: &mut wgpu::CommandEncoder, timestamp: u32) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(TAA_RESOLVE_PASS), timestamp_writes: self.timestamps.as_ref().map(|t| t.writes(timestamp)) });
+        pass.set_pipeline(&self.resolve_pipeline);
+        pass.set_bind_group(0, &self.resolve_groups[self.parity], &[]);
+        pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
+    }
+
+    fn submit(&self, gpu: &Gpu, mut encoder: wgpu::CommandEncoder) -> Result<Option<Vec<f64>>, RenderError> {
+        if let Some(t) = &self.timestamps {
+            t.resolve(&mut encoder);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        match &self.timestamps {
+            None => Ok(None),
+            Some(t) => t.read(gpu).map(Some).map_err(|reason| RenderError::Readback { what: "TAA timestamps".into(), reason }),
+        }
+    }
+
+    /// Reads the resolved frame and motion, then swaps the ping-pong buffers.
+    fn finish(&mut self, gpu: &Gpu, timings: Vec<PassTiming>) -> Result<TaaOutput, RenderError> {
+        let resolved: Vec<[f32; 4]> = self.read(gpu, &self.history[self.parity], "TAA resolved colour")?;
+        let primary: Vec<TaaPrimary> = self.read(gpu, &self.primary[self.parity], "TAA primary hits")?;
+        self.parity = 1 - self.parity;
+        self.history_valid = true;
+        Ok(TaaOutput {
+            radiance: resolved.iter().map(|c| [c[0], c[1], c[2], 1.0]).collect(),
+            history_length: resolved.iter().map(|c| c[3]).collect(),
+            motion: primary.iter().map(|p| p.motion).collect(),
+            timings,
+        })
+    }
+
+    /// Inputs and output of the last resolve (call right after `render`).
+    pub fn inspect(&self, gpu: &Gpu) -> Result<TaaInspection, RenderError> {
+        let last = 1 - self.parity;
+        Ok(TaaInspection {
+            params_history_valid: self.last_history_valid,
+            current: self.read(gpu, &self.current, "TAA current")?,
+            primary: self.read(gpu, &self.primary[last], "TAA primary")?,
+            previous_primary: self.read(gpu, &self.primary[self.parity], "TAA previous primary")?,
+            history: self.read(gpu, &self.history[self.parity], "TAA history")?,
+            resolved: self.read(gpu, &self.history[last], "TAA resolved")?,
+        })
+    }
+
+    fn read<T: Pod>(&self, gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<T>, RenderError> {
+        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(what), size: buffer.size(), usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
+        gpu.queue.submit([encoder.finish()]);
+        read_buffer(gpu, &staging).map_err(|reason| RenderError::Readback { what: what.into(), reason })
+    }
+}

@@ -1,0 +1,240 @@
+//! The hash cache on the GPU: keys and table against the CPU reference (same keys, same
+//! contents, probing bound, no duplicates, eviction of entries older than max_age), a furnace
+//! converging to its analytic radiance through the cache, and stability against 1 spp.
+
+use glam::{Mat4, Quat, Vec3};
+use render::gpu::Gpu;
+use render::hash_cache::key::{self, NONE};
+use render::hash_cache::table_cpu::{CpuHashTable, check_invariants};
+use render::hash_cache::{HC_NEEDS_SAMPLE, HashCache, HashCacheLookup, HashCacheSettings};
+use render::path_tracer::{PathTracer, PathTracerSettings};
+use render::scene::{Camera, Instance, Material, Mesh, SceneDesc};
+use render::taa::{Taa, TaaSettings, resolve_cpu};
+use std::sync::OnceLock;
+
+const W: u32 = 32;
+const H: u32 = 18;
+
+fn gpu() -> &'static Gpu {
+    static GPU: OnceLock<Gpu> = OnceLock::new();
+    GPU.get_or_init(|| Gpu::new().expect("a wgpu adapter (lavapipe on CI)"))
+}
+
+/// Axis-aligned box [-1, 1]^3, faces wound to face outwards or inwards (emitters are one-sided).
+fn box_mesh(inward: bool) -> Mesh {
+    let mut positions = vec![];
+    let mut indices = vec![];
+    for axis in 0..3 {
+        for sign in [-1.0f32, 1.0] {
+            let n = Vec3::from_array(std::array::from_fn(|i| if i == axis { sign } else { 0.0 }));
+            let (u, v) = (Vec3::from_array(std::array::from_fn(|i| (i == (axis + 1) % 3) as u8 as f32)), Vec3::from_array(std::array::from_fn(|i| (i == (axis + 2) % 3) as u8 as f32)));
+            let base = positions.len() as u32;
+            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                positions.push(n + a * u + b * v);
+            }
+            let mut tris = [[base, base + 1, base + 2], [base, base + 2, base + 3]];
+            for t in &mut tris {
+                let (p0, p1, p2) = (positions[t[0] as usize], positions[t[1] as usize], positions[t[2] as usize]);
+                let outward = (p1 - p0).cross(p2 - p0).dot(n) > 0.0;
+                if outward == inward {
+                    t.swap(1, 2);
+                }
+            }
+            indices.extend(tris);
+        }
+    }
+    Mesh { name: "box".into(), positions, normals: vec![], uvs: vec![], indices }
+}
+
+fn plane(half: f32) -> Mesh {
+    Mesh {
+        name: "plane".into(),
+        positions: vec![Vec3::new(-half, 0.0, -half), Vec3::new(-half, 0.0, half), Vec3::new(half, 0.0, half), Vec3::new(half, 0.0, -half)],
+        normals: vec![],
+        uvs: vec![],
+        indices: vec![[0, 1, 2], [0, 2, 3]],
+    }
+}
+
+/// A closed grey room (inward walls, [-2, 2]^3) lit by a panel under the ceiling, with a red
+/// box: mostly indirect light, the case a radiance cache is for.
+fn room_scene() -> SceneDesc {
+    let grey = Material { base_color: Vec3::splat(0.6), specular: 0.0, ..Default::default() };
+    let red = Material { base_color: Vec3::new(0.7, 0.2, 0.1), specular: 0.0, ..Default::default() };
+    let light = Material { base_color: Vec3::ZERO, emission: Vec3::splat(8.0), specular: 0.0, ..Default::default() };
+    SceneDesc {
+        meshes: vec![box_mesh(true), box_mesh(false), plane(0.5)],
+        materials: vec![grey, red, light],
+        instances: vec![
+            Instance { mesh: 0, material: 0, transform: Mat4::from_scale(Vec3::splat(2.0)) },
+            Instance { mesh: 1, material: 1, transform: Mat4::from_scale_rotation_translation(Vec3::splat(0.6), Quat::from_rotation_y(0.5), Vec3::new(0.3, -1.4, -0.5)) },
+            // Facing down.
+            Instance { mesh: 2, material: 2, transform: Mat4::from_rotation_translation(Quat::from_rotation_x(std::f32::consts::PI), Vec3::new(0.0, 1.95, 0.0)) },
+        ],
+        camera: Camera { position: Vec3::new(0.0, 0.0, 1.9), target: Vec3::new(0.0, -0.6, -1.0), up: Vec3::Y, vfov: 1.1 },
+        ..Default::default()
+    }
+}
+
+fn tracer(scene: &SceneDesc, max_depth: u32) -> PathTracer {
+    PathTracer::new(gpu(), scene, PathTracerSettings { width: W, height: H, max_depth, rr_start_depth: 3 }).expect("path tracer")
+}
+
+#[test]
+fn keys_table_and_eviction_match_the_cpu_reference() {
+    for lookup in [HashCacheLookup::FirstHit, HashCacheLookup::SecondaryHit] {
+        let mut scene = room_scene();
+        let mut pt = tracer(&scene, 3);
+        // A small table (load around a quarter) so that home windows overlap, and max_age 1 so
+        // that a moving camera evicts.
+        let settings = HashCacheSettings { capacity: 4096, probe_limit: 16, max_age: 1, lookup, ..Default::default() };
+        let mut cache = HashCache::new(gpu(), &pt, settings).expect("hash cache");
+        let mut cpu = CpuHashTable::new(settings.capacity, settings.probe_limit, settings.max_age);
+        let mut evictions = 0;
+        for frame in 0..4u32 {
+            scene.camera.position.x = 0.3 * frame as f32;
+            pt.update(gpu(), &scene);
+            let out = cache.render(gpu(), &pt, &scene.camera, 3, frame, None).expect("render");
+            let stamp = frame + 1;
+            let records = cache.read_records(gpu()).unwrap();
+            let slots = cache.read_slots(gpu()).unwrap();
+            let k = settings.key_params(&scene.camera, H);
+            // Same keys as the CPU from the recorded key points (float ties at voxel borders aside).
+            let (mut keyed, mut same) = (0, 0);
+            let (occupied, evicted) = cpu.age(stamp);
+            for r in &records {
+                if r.flags & HC_NEEDS_SAMPLE == 0 {
+                    continue;
+                }
+                keyed += 1;
+                let p = Vec3::from(r.key_point);
+                let n = Vec3::from(r.key_normal);
+                let to = p - scene.camera.position;
+                let level = key::level(&k, to.length(), n.dot(to) / to.length());
+                let expected = key::key(&k, p, n, level, key::unpack2x16unorm(r.voxel_jitter));
+                same += (expected.home == r.home && expected.checksum == r.checksum) as u32;
+                assert_ne!(r.slot, NONE, "{lookup:?} frame {frame}: an insertion failed in a quarter-full table");
+                let s = slots[r.slot as usize];
+                assert_eq!((s.checksum, s.home, s.last_access), (r.checksum, r.home, stamp), "{lookup:?} frame {frame}: slot {} of a pixel", r.slot);
+                let key = key::VoxelKey { home: r.home, checksum: r.checksum };
+                cpu.find_or_insert(key, stamp).expect("cpu insertion");
+            }
+            assert!(keyed > (W * H) as usize / 2, "{lookup:?}: only {keyed} pixels have a key point");
+            assert!(same as f64 >= 0.995 * keyed as f64, "{lookup:?} frame {frame}: {same} of {keyed} GPU keys equal the CPU's");
+            check_invariants(&slots, settings.probe_limit).unwrap_or_else(|e| panic!("{lookup:?} frame {frame}: {e}"));
+            // Same contents (slots may differ: insertion order), same counters.
+            assert_eq!(CpuHashTable::contents(slots.iter().copied()), CpuHashTable::contents(cpu.slots.iter().copied()), "{lookup:?} frame {frame}");
+            let inserted = CpuHashTable::contents(cpu.slots.iter().copied()).len() as u32 - occupied;
+            assert_eq!((out.stats.evicted, out.stats.occupied, out.stats.inserted), (evicted, occupied + inserted, inserted), "{lookup:?} frame {frame}");
+            assert_eq!(out.stats.insert_failures, 0);
+            // Every live entry was accessed within max_age frames.
+            assert!(slots.iter().filter(|s| s.checksum != 0).all(|s| stamp - s.last_access <= settings.max_age));
+            evictions += evicted;
+            // One claimant per accessed cell: update paths = distinct cells accessed this frame.
+            let mut cells: Vec<u32> = records.iter().filter(|r| r.flags & HC_NEEDS_SAMPLE != 0).map(|r| r.slot).collect();
+            cells.sort_unstable();
+            cells.dedup();
+            assert_eq!(out.stats.update_paths as usize, cells.len(), "{lookup:?} frame {frame}");
+        }
+        assert!(evictions > 0, "{lookup:?}: the moving camera evicted nothing");
+    }
+}
+
+/// Inside a closed box whose walls (albedo a) all emit Le: L = Le / (1 - a) everywhere.
+fn furnace() -> (SceneDesc, f32) {
+    let (le, a) = (0.5f32, 0.5f32);
+    let wall = Material { base_color: Vec3::splat(a), emission: Vec3::splat(le), specular: 0.0, ..Default::default() };
+    let scene = SceneDesc {
+        meshes: vec![box_mesh(true)],
+        materials: vec![wall],
+        instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::from_scale(Vec3::splat(2.0)) }],
+        camera: Camera { position: Vec3::new(0.3, -0.2, 1.0), target: Vec3::new(-0.5, 0.1, -2.0), up: Vec3::Y, vfov: 1.2 },
+        ..Default::default()
+    };
+    (scene, le / (1.0 - a))
+}
+
+fn mean_relative_error(img: &[[f32; 4]], expected: f32) -> f64 {
+    img.iter().map(|c| ((c[0] + c[1] + c[2]) / 3.0 - expected).abs() as f64).sum::<f64>() / img.len() as f64 / expected as f64
+}
+
+#[test]
+fn furnace_converges_to_the_analytic_radiance_through_the_cache() {
+    let (scene, expected) = furnace();
+    let mut pt = tracer(&scene, 40);
+    let frames = 16;
+    let pt_error = (0..4).map(|f| mean_relative_error(&pt.render(gpu(), 1, 11, f).unwrap().radiance, expected)).sum::<f64>() / 4.0;
+    for lookup in [HashCacheLookup::FirstHit, HashCacheLookup::SecondaryHit] {
+        let mut cache = HashCache::new(gpu(), &pt, HashCacheSettings { lookup, ..Default::default() }).expect("hash cache");
+        let mut errors = vec![];
+        let mut last = vec![];
+        for frame in 0..frames {
+            let out = cache.render(gpu(), &pt, &scene.camera, 11, frame, None).unwrap();
+            errors.push(mean_relative_error(&out.radiance, expected));
+            last = out.radiance;
+        }
+        // Unbiased: the image mean is the analytic radiance (3 % covers the 1 spp noise).
+        let mean = last.iter().map(|c| c[0] as f64).sum::<f64>() / (W * H) as f64;
+        assert!((mean - expected as f64).abs() < 0.03 * expected as f64, "{lookup:?}: image mean {mean} expected {expected}");
+        // Converges: the per-pixel error of the last frames is below the first frame's (a
+        // one-sample cache) and below 1 spp path tracing. The secondary-hit lookup keeps the
+        // noise of next-event estimation at the primary hit, so it gains less.
+        let late = errors[frames as usize - 4..].iter().sum::<f64>() / 4.0;
+        eprintln!("{lookup:?}: per-pixel relative error {:.4} -> {late:.4}, 1 spp {pt_error:.4}", errors[0]);
+        assert!(late < errors[0] && late < pt_error, "{lookup:?}: per-pixel error by frame {errors:?}, 1 spp {pt_error}");
+    }
+}
+
+fn smape(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (0..3).map(|c| ((x[c] - y[c]).abs() / (x[c].abs() + y[c].abs() + 0.01)) as f64).sum::<f64>() / 3.0).sum::<f64>() / a.len() as f64
+}
+
+#[test]
+fn static_scene_flickers_less_than_1spp_and_is_deterministic() {
+    let scene = room_scene();
+    let mut pt = tracer(&scene, 4);
+    let frames = 12;
+    let pt_frames: Vec<_> = (0..frames).map(|f| pt.render(gpu(), 1, 5, f).unwrap().radiance).collect();
+    let flicker = |v: &[Vec<[f32; 4]>]| (6..frames as usize).map(|f| smape(&v[f], &v[f - 1])).sum::<f64>() / (frames as f64 - 6.0);
+    let pt_flicker = flicker(&pt_frames);
+    for lookup in [HashCacheLookup::FirstHit, HashCacheLookup::SecondaryHit] {
+        let run = || {
+            let mut cache = HashCache::new(gpu(), &pt, HashCacheSettings { lookup, ..Default::default() }).expect("hash cache");
+            (0..frames).map(|f| cache.render(gpu(), &pt, &scene.camera, 5, f, None).unwrap().radiance).collect::<Vec<_>>()
+        };
+        let a = run();
+        let hc_flicker = flicker(&a);
+        assert!(hc_flicker < pt_flicker, "{lookup:?}: frame-to-frame SMAPE {hc_flicker} vs 1 spp {pt_flicker}");
+        eprintln!("{lookup:?}: frame-to-frame SMAPE {hc_flicker:.4} vs 1 spp {pt_flicker:.4}");
+        if lookup == HashCacheLookup::SecondaryHit {
+            assert!(a == run(), "{lookup:?}: two runs differ");
+        }
+    }
+}
+
+#[test]
+fn taa_resolves_the_cache_colour() {
+    let mut scene = room_scene();
+    let mut pt = tracer(&scene, 3);
+    let settings = HashCacheSettings::default();
+    let mut plain = HashCache::new(gpu(), &pt, settings).expect("hash cache");
+    let mut under_taa = HashCache::new(gpu(), &pt, settings).expect("hash cache");
+    let mut taa = Taa::new(gpu(), &pt, TaaSettings::default()).expect("taa");
+    for frame in 0..3 {
+        scene.camera.position.x = 0.05 * frame as f32;
+        pt.update(gpu(), &scene);
+        let a = plain.render(gpu(), &pt, &scene.camera, 9, frame, None).unwrap();
+        let b = under_taa.render(gpu(), &pt, &scene.camera, 9, frame, Some(&mut taa)).unwrap();
+        let i = taa.inspect(gpu()).unwrap();
+        // TAA's input is the cache's colour and primary hits of this frame ...
+        assert_eq!(i.current, a.radiance, "frame {frame}");
+        assert_eq!(i.primary.iter().map(|p| p.motion).collect::<Vec<_>>(), a.motion);
+        assert_eq!(b.timings.last().map(|t| t.pass.as_str()), Some(render::taa::TAA_RESOLVE_PASS));
+        // ... and its output the resolve of it.
+        let expected = resolve_cpu::resolve(&taa.settings(), (W, H), i.params_history_valid, &i.current, &i.primary, &i.previous_primary, &i.history);
+        for (g, c) in b.radiance.iter().zip(&expected) {
+            assert!((0..3).all(|k| (g[k] - c[k]).abs() <= 1e-4 * (1.0 + c[k].abs())), "frame {frame}: {g:?} vs {c:?}");
+        }
+        assert_eq!(frame > 0, i.params_history_valid);
+    }
+}
