@@ -50,8 +50,6 @@ struct CacheParams {
 const META_BYTES: u64 = 48;
 /// Storage buffers of this pass's own group (queries, meta, records, answers, image).
 const OWN_STORAGE_BUFFERS: u32 = 5;
-/// Storage buffers of the path tracer's scene group (materials, texels, lights, radiance, G-buffer).
-const SCENE_STORAGE_BUFFERS: u32 = 5;
 const WORKGROUP_2D: u32 = 8;
 const WORKGROUP_1D: u32 = 64;
 
@@ -105,7 +103,7 @@ impl CachePaths {
         if query_count > u32::MAX as u64 / 2 {
             return Err(NircError::Config(format!("{width}x{height} at {spp} spp is {query_count} queries, too many")));
         }
-        let needed = OWN_STORAGE_BUFFERS + SCENE_STORAGE_BUFFERS + render::bvh::SceneGeometry::STORAGE_BUFFERS;
+        let needed = OWN_STORAGE_BUFFERS + render::path_tracer::LIBRARY_STORAGE_BUFFERS;
         let limit = gpu.limits.max_storage_buffers_per_shader_stage;
         if needed > limit {
             return Err(render::gpu::GpuError::OverLimit {

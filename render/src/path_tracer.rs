@@ -41,6 +41,10 @@ pub const PATH_TRACE_PASS: &str = "path_trace";
 const WORKGROUP: u32 = 8;
 /// Storage buffers of group 0 (materials, texels, lights, radiance, G-buffer, sample partials).
 const STORAGE_BUFFERS: u32 = 6;
+
+/// Storage buffers a pass built on [`PathTracer::library_source`] binds before its own:
+/// @group(0) (scene) and @group(1) (geometry). Add the pass's own to check the adapter limit.
+pub const LIBRARY_STORAGE_BUFFERS: u32 = STORAGE_BUFFERS + crate::bvh::SceneGeometry::STORAGE_BUFFERS;
 /// Storage buffers of scene_geometry.wgsl (group 1).
 const GEOMETRY_STORAGE_BUFFERS: u32 = 8;
 

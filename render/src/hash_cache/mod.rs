@@ -58,7 +58,7 @@ pub const HC_UPDATE_PASS: &str = "hc_update";
 pub const HC_RESOLVE_PASS: &str = "hc_resolve";
 const PASSES: [&str; 4] = [HC_AGE_PASS, HC_TRACE_PASS, HC_UPDATE_PASS, HC_RESOLVE_PASS];
 
-const LIBRARY_STORAGE_BUFFERS: u32 = 5 + 8;
+use crate::path_tracer::LIBRARY_STORAGE_BUFFERS;
 const OWN_STORAGE_BUFFERS: u32 = 6;
 
 /// Where the path terminates into the cache.

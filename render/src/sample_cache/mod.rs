@@ -165,7 +165,7 @@ impl SampleCache {
         let n = settings.slots as u64;
         gpu.check_resolution(width, height, 2 * 32 * n + 4 * 2 + 12 + 4 * n + 32)?;
         let limit = gpu.limits.max_storage_buffers_per_shader_stage;
-        let needed = STORAGE_BUFFERS + 5 + 8;
+        let needed = STORAGE_BUFFERS + crate::path_tracer::LIBRARY_STORAGE_BUFFERS;
         if needed > limit {
             return Err(crate::gpu::GpuError::OverLimit {
                 what: "storage buffers of the sample cache passes".into(),

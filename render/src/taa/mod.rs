@@ -48,8 +48,7 @@ pub const TAA_RESOLVE_PASS: &str = "taa_resolve";
 pub const PRIMARY_WGSL: &str = include_str!("../../shaders/taa_primary.wgsl");
 
 const WORKGROUP: u32 = 8;
-/// Storage buffers of group 0 and 1 of the shading library (path_tracer.rs).
-const LIBRARY_STORAGE_BUFFERS: u32 = 5 + 8;
+use crate::path_tracer::LIBRARY_STORAGE_BUFFERS;
 
 /// How the reprojected history is limited to the current neighbourhood.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
