@@ -34,7 +34,7 @@ enum Command {
         /// Output folder (overrides the scenario).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Folder of the reference cache [default: $FLICKER_CACHE_DIR or ~/.cache/flicker].
+        /// Cache folder: references and NIRC warm starts [default: $FLICKER_CACHE_DIR or ~/.cache/flicker].
         #[arg(long)]
         cache_dir: Option<PathBuf>,
         /// Do not draw the progress bar.

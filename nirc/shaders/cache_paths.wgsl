@@ -7,19 +7,23 @@
 // NEE with MIS, BSDF sampling, Russian roulette) up to the termination vertex x_k (k =
 // `termination_vertex`, 1 = the primary hit). There:
 //   L(x_k -> wo) = Le(x_k) [MIS-weighted as the path tracer]
-//                + sum over analytic lights (delta and sun-disk) of NEE, unweighted
+//                + NEE of every analytic light and of one emissive triangle, without MIS
 //                + f(wo, w) cos / pdf(w) * Lc(x_k, w),   w ~ BSDF
-// where Lc(x, w) is the radiance arriving at x along w WITHOUT the analytic lights' own
-// emission (the environment and emissive surfaces seen along w are included, unweighted).
-// The analytic lights are split off because a BSDF-sampled direction (almost) never hits a point,
-// spot or 0.27°-wide sun: the cache could not learn them, NEE handles them exactly. Emissive
-// triangles and the environment are left to the cache, so no NEE of them happens at x_k and no
-// MIS weight is needed: each light path reaches x_k's estimate through exactly one strategy.
+// where Lc(x, w) is the radiance arriving at x along w WITHOUT light that comes straight from an
+// emitter: no analytic light, and no emission of the surface the ray hits first. The
+// environment seen along w stays in Lc (it is a smooth function of w alone, which the cache
+// learns easily); everything scattered at least once stays in Lc.
+// Direct light is split off for two reasons. A BSDF-sampled direction (almost) never hits a
+// point, spot or 0.27°-wide sun, so the cache could not learn them. And small emissive
+// triangles (a corridor's ceiling lamps, a Cornell box's light) make the incident radiance a
+// needle in direction space that a small hash-grid MLP blurs away: the lights then reached the
+// primary hits only through that blur, and the image came out dark (measured: see README).
+// Each light path reaches x_k's estimate through exactly one strategy, so no MIS weight is
+// needed at x_k.
 // The cache learns Lc from `cache_target`, an unbiased one-sample estimate: the ray (x_k, w),
-// full emission at its hit (no MIS, since NEE at x_k did not sample emitters), then
-// path_radiance from there (NEE + MIS + Russian roulette) up to the frame's max depth.
-// Replacing the cache by cache_target (the oracle) gives an estimator with the same mean as
-// the path tracer's (test: tests/integrator.rs).
+// no emission at its hit, then NEE + MIS at the hit and path_radiance from there up to the
+// frame's max depth. Replacing the cache by cache_target (the oracle) gives an estimator with
+// the same mean as the path tracer's (test: tests/integrator.rs).
 
 struct CacheParams {
     query_count: u32,        // pixels * spp
@@ -63,27 +67,6 @@ const TRAIN_PICK_STREAM: u32 = 0x80000002u;
 // Candidates a training record tries before giving up (a sky pixel has no query).
 const PICK_TRIES: u32 = 16u;
 
-// NEE of the analytic lights only (point, spot, directional with or without a disk), without
-// MIS: the cache term never contains them (see the estimator above).
-fn analytic_next_event(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>) -> vec3f {
-    var radiance = vec3f(0.0);
-    for (var i = 0u; i < frame.counts.y; i++) {
-        let ls = sample_analytic_light(lights[i], p, rng_next2(rng));
-        if dot(ls.wi, sh.ng) <= 0.0 || max_component(ls.weight) <= 0.0 {
-            continue;
-        }
-        let f = bsdf_eval(bsdf, sh.ns, wo, ls.wi);
-        if max_component(f) <= 0.0 {
-            continue;
-        }
-        if trace_any(offset_origin(p, sh.ng, ls.wi), ls.wi, ls.dist * (1.0 - 1.0e-4)) {
-            continue;
-        }
-        radiance += f * dot(sh.ns, ls.wi) * ls.weight;
-    }
-    return radiance;
-}
-
 // One-sample estimate of Lc(x, dir) for the ray (origin, dir) at path depth `depth`.
 fn cache_target(origin: vec3f, dir: vec3f, depth: u32, rng: ptr<function, u32>) -> vec3f {
     let hit = trace_closest(origin, dir, FAR);
@@ -95,7 +78,8 @@ fn cache_target(origin: vec3f, dir: vec3f, depth: u32, rng: ptr<function, u32>) 
     let m = materials[sp.material];
     let wo = -dir;
     let sh = orient(sp, wo);
-    var l = emitted_radiance(sp, m, dir, hit.t, 0.0);
+    // The hit's own emission is direct light: NEE's at x_k, not the cache's.
+    var l = vec3f(0.0);
     if depth >= frame.seed.w {
         return l;
     }
@@ -150,8 +134,9 @@ fn trace_query(pixel: vec2u, sample_index: u32, q: u32) {
         let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);
         let p = sp.position;
         if depth + 1u >= params.termination_vertex {
-            // Termination vertex: analytic lights by NEE, everything else from the cache.
-            radiance += throughput * analytic_next_event(p, sh, bsdf, wo, &rng);
+            // Termination vertex: direct light by NEE, everything else from the cache.
+            radiance += throughput * (next_event_analytic(p, sh, bsdf, wo, &rng, false)
+                + next_event_emitter(p, sh, bsdf, wo, &rng, false));
             let bs = bsdf_sample(bsdf, sh.ns, wo, rng_next(&rng), rng_next2(&rng));
             if bs.valid && dot(bs.wi, sh.ng) > 0.0 {
                 result.weight = vec4f(throughput * bs.f * (dot(sh.ns, bs.wi) / bs.pdf), 1.0);

@@ -97,6 +97,20 @@ impl ParameterLayout {
     pub fn forward_macs(&self) -> u64 {
         self.matrices.iter().map(|m| m.rows as u64 * m.cols as u64).sum()
     }
+
+    /// An upper bound on the loop iterations one invocation of the heaviest per-query pass
+    /// runs: a training thread (encode, forward, backward, encoding gradient, scratch
+    /// clearing) or a blending inference thread (encode, two forwards), plus its share of the
+    /// workgroup weight copy. Drivers that cap it (llvmpipe) are checked against this.
+    pub fn loop_iterations_per_invocation(&self, workgroup_size: u32) -> u64 {
+        let matrix_loops = |m: &Matrix| m.rows as u64 * m.cols as u64 + m.rows.max(m.cols) as u64 + 1;
+        let forward: u64 = self.matrices.iter().map(matrix_loops).sum::<u64>() + 1;
+        let encoding = self.levels.len() as u64 * (8 * self.features_per_level as u64 + 8 + 3);
+        let copy = (2 * self.mlp_params as u64).div_ceil(workgroup_size.max(1) as u64);
+        let train = encoding * 2 + forward * 2 + (self.activation_floats() + self.delta_floats()) as u64 + 3;
+        let infer = encoding + forward * 2;
+        train.max(infer) + copy
+    }
 }
 
 /// The spatial hash of instant-ngp: coordinates times large primes, xor-ed.

@@ -304,3 +304,21 @@ fn weights_over_the_workgroup_budget_fall_back_to_storage_or_are_refused() {
         }
     }
 }
+
+#[test]
+fn networks_over_the_drivers_loop_cap_are_refused() {
+    let mut config = small_config();
+    // Forward alone: 128 x 128 x 4 + ... ~ 72k multiply-adds per query, over llvmpipe's 65535.
+    config.network = nirc::config::NetworkConfig { width: 128, hidden_layers: 5 };
+    let result = NeuralCache::new(gpu(), &config, bounds());
+    match gpu().loop_iteration_limit() {
+        Some(limit) => {
+            let err = result.err().expect("refused on a driver with a loop cap").to_string();
+            assert!(err.contains("loop iterations") && err.contains(&limit.to_string()) && err.contains("width 128"), "{err}");
+        }
+        None => assert!(result.is_ok(), "no loop cap on this adapter, yet refused"),
+    }
+    // The defaults (width 64) stay well inside the cap.
+    let default = nirc::layout::ParameterLayout::new(&nirc::NircConfig::default());
+    assert!(default.loop_iterations_per_invocation(64) < render::gpu::LLVMPIPE_LOOP_ITERATIONS / 2);
+}

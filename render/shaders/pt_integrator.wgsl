@@ -2,12 +2,19 @@
 // and the path loop. Concatenated after pt_scene.wgsl.
 
 // Next-event estimation at a surface point: every analytic light, one emissive triangle, the
-// environment, each MIS-weighted (power heuristic) against the BSDF's pdf.
+// environment, each MIS-weighted (power heuristic) against the BSDF's pdf. The three parts are
+// separate functions because a cache-terminated path (nirc) needs some of them without MIS;
+// `mis` = false gives the plain light-sampling estimate. The random numbers drawn do not
+// depend on `mis`.
 fn next_event(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>) -> vec3f {
+    return next_event_analytic(p, sh, bsdf, wo, rng, true)
+        + next_event_emitter(p, sh, bsdf, wo, rng, true)
+        + next_event_environment(p, sh, bsdf, wo, rng);
+}
+
+fn next_event_analytic(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>, mis: bool) -> vec3f {
     var radiance = vec3f(0.0);
-    let analytic_count = frame.counts.y;
-    let emitter_count = frame.counts.z;
-    for (var i = 0u; i < analytic_count; i++) {
+    for (var i = 0u; i < frame.counts.y; i++) {
         let ls = sample_analytic_light(lights[i], p, rng_next2(rng));
         if dot(ls.wi, sh.ng) <= 0.0 || max_component(ls.weight) <= 0.0 {
             continue;
@@ -21,37 +28,56 @@ fn next_event(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u
             continue;
         }
         var w = 1.0;
-        if ls.pdf > 0.0 {
+        if mis && ls.pdf > 0.0 {
             w = power_heuristic(ls.pdf, bsdf_pdf(bsdf, sh.ns, wo, ls.wi));
         }
         radiance += f * dot(sh.ns, ls.wi) * ls.weight * w;
     }
-    if emitter_count > 0u {
-        let u_select = rng_next(rng);
-        let ls = sample_emitter(analytic_count, emitter_count, p, u_select, rng_next2(rng));
-        if ls.pdf > 0.0 && dot(ls.wi, sh.ng) > 0.0 {
-            let f = bsdf_eval(bsdf, sh.ns, wo, ls.wi);
-            if max_component(f) > 0.0 {
-                let o = offset_origin(p, sh.ng, ls.wi);
-                if !trace_any(o, ls.wi, ls.dist * (1.0 - 1.0e-3)) {
-                    let w = power_heuristic(ls.pdf, bsdf_pdf(bsdf, sh.ns, wo, ls.wi));
-                    radiance += f * dot(sh.ns, ls.wi) * ls.weight * w;
-                }
-            }
-        }
-    }
-    let env_pdf = environment_pdf();
-    if env_pdf > 0.0 {
-        let wi = sample_uniform_sphere(rng_next2(rng));
-        if dot(wi, sh.ng) > 0.0 {
-            let f = bsdf_eval(bsdf, sh.ns, wo, wi);
-            if max_component(f) > 0.0 && !trace_any(offset_origin(p, sh.ng, wi), wi, FAR) {
-                let w = power_heuristic(env_pdf, bsdf_pdf(bsdf, sh.ns, wo, wi));
-                radiance += f * dot(sh.ns, wi) * frame.environment.xyz * (w / env_pdf);
-            }
-        }
-    }
     return radiance;
+}
+
+// One emissive triangle, chosen by power.
+fn next_event_emitter(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>, mis: bool) -> vec3f {
+    let emitter_count = frame.counts.z;
+    if emitter_count == 0u {
+        return vec3f(0.0);
+    }
+    let u_select = rng_next(rng);
+    let ls = sample_emitter(frame.counts.y, emitter_count, p, u_select, rng_next2(rng));
+    if ls.pdf <= 0.0 || dot(ls.wi, sh.ng) <= 0.0 {
+        return vec3f(0.0);
+    }
+    let f = bsdf_eval(bsdf, sh.ns, wo, ls.wi);
+    if max_component(f) <= 0.0 {
+        return vec3f(0.0);
+    }
+    let o = offset_origin(p, sh.ng, ls.wi);
+    if trace_any(o, ls.wi, ls.dist * (1.0 - 1.0e-3)) {
+        return vec3f(0.0);
+    }
+    var w = 1.0;
+    if mis {
+        w = power_heuristic(ls.pdf, bsdf_pdf(bsdf, sh.ns, wo, ls.wi));
+    }
+    return f * dot(sh.ns, ls.wi) * ls.weight * w;
+}
+
+// The constant environment, sampled uniformly over the sphere, always MIS-weighted.
+fn next_event_environment(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>) -> vec3f {
+    let env_pdf = environment_pdf();
+    if env_pdf <= 0.0 {
+        return vec3f(0.0);
+    }
+    let wi = sample_uniform_sphere(rng_next2(rng));
+    if dot(wi, sh.ng) <= 0.0 {
+        return vec3f(0.0);
+    }
+    let f = bsdf_eval(bsdf, sh.ns, wo, wi);
+    if max_component(f) <= 0.0 || trace_any(offset_origin(p, sh.ng, wi), wi, FAR) {
+        return vec3f(0.0);
+    }
+    let w = power_heuristic(env_pdf, bsdf_pdf(bsdf, sh.ns, wo, wi));
+    return f * dot(sh.ns, wi) * frame.environment.xyz * (w / env_pdf);
 }
 
 // Emitted radiance seen along a ray that hit `sp` at distance `dist`, MIS-weighted against the

@@ -17,6 +17,11 @@ pub enum GpuError {
     OverLimit { what: String, requested: u64, limit: u64, adapter: String },
 }
 
+/// Loop iterations one shader invocation may run in total on Mesa's llvmpipe (lavapipe):
+/// `LP_MAX_TGSI_LOOP_ITERATIONS`. Past it every loop of the invocation ends silently, so a
+/// long invocation returns wrong results without an error.
+pub const LLVMPIPE_LOOP_ITERATIONS: u64 = 65_535;
+
 /// What the adapter is, for manifests and reference-cache keys.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize, PartialEq, Eq)]
 pub struct AdapterSummary {
@@ -129,6 +134,21 @@ impl Gpu {
             return Err(self.over(&format!("workgroup memory of pass '{pass}'"), bytes as u64, limit as u64));
         }
         Ok(())
+    }
+
+    /// The total loop iterations one invocation may run before the driver cuts it short, where
+    /// known (llvmpipe); `None` on drivers without such a cap.
+    pub fn loop_iteration_limit(&self) -> Option<u64> {
+        let is_llvmpipe = |s: &str| s.to_ascii_lowercase().contains("llvmpipe");
+        (is_llvmpipe(&self.summary.name) || is_llvmpipe(&self.summary.driver)).then_some(LLVMPIPE_LOOP_ITERATIONS)
+    }
+
+    /// Refuses a pass whose invocations would run more loop iterations than the driver allows.
+    pub fn check_loop_iterations(&self, pass: &str, iterations: u64) -> Result<(), GpuError> {
+        match self.loop_iteration_limit() {
+            Some(limit) if iterations > limit => Err(self.over(&format!("loop iterations per invocation of pass '{pass}'"), iterations, limit)),
+            _ => Ok(()),
+        }
     }
 
     fn over(&self, what: &str, requested: u64, limit: u64) -> GpuError {

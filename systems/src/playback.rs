@@ -111,7 +111,7 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary> {
         tracer.update(&gpu, sim.scene());
         let frame = sim.frame();
         for method in &mut methods {
-            let mut ctx = FrameContext { gpu: &gpu, tracer: &mut tracer, scene: sim.scene(), scenario: &scenario, frame, recorded: false };
+            let mut ctx = FrameContext { gpu: &gpu, tracer: &mut tracer, scene: sim.scene(), scenario: &scenario, frame, recorded: false, cache_dir: cache.dir() };
             method.render(&mut ctx).with_context(|| format!("{} warm-up frame {frame}", method.label()))?;
         }
         sim.step();
@@ -167,7 +167,7 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary> {
             bar.set_message(format!("{label} frame {frame:04}"));
             let start = Instant::now();
             let mut ctx =
-                FrameContext { gpu: &gpu, tracer: &mut tracer, scene: sim.scene(), scenario: &scenario, frame: global_frame, recorded: true };
+                FrameContext { gpu: &gpu, tracer: &mut tracer, scene: sim.scene(), scenario: &scenario, frame: global_frame, recorded: true, cache_dir: cache.dir() };
             let out = method.render(&mut ctx).with_context(|| format!("{label} frame {frame}"))?;
             let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
             output::write_exr(&folder.frame(&label, frame, "exr"), width, height, &out.radiance)?;

@@ -31,6 +31,11 @@ impl ReferenceCache {
         Self { dir: dir.into() }
     }
 
+    /// The cache's folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
     /// `$FLICKER_CACHE_DIR`, else `$XDG_CACHE_HOME/flicker`, else `~/.cache/flicker`.
     pub fn default_location() -> PathBuf {
         if let Some(dir) = std::env::var_os("FLICKER_CACHE_DIR") {

@@ -173,6 +173,12 @@ impl NeuralCache {
         let config = state.config.clone();
         config.validate()?;
         let layout = ParameterLayout::new(&config);
+        // A network too large for the driver's per-invocation loop cap would come out wrong
+        // silently (llvmpipe); refuse it with the numbers instead.
+        gpu.check_loop_iterations(
+            &format!("nirc training/inference (width {}, {} hidden layers)", config.network.width, config.network.hidden_layers),
+            layout.loop_iterations_per_invocation(WORKGROUP_SIZE),
+        )?;
         let wg_bytes = shaders::workgroup_bytes(&layout, WeightPlacement::Workgroup);
         let placement = match placement {
             Some(WeightPlacement::Workgroup) => {

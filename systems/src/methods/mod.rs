@@ -31,6 +31,9 @@ pub struct FrameContext<'a> {
     pub frame: u32,
     /// False during warm-up: the frame is rendered (caches learn) but not recorded.
     pub recorded: bool,
+    /// The run's cache folder (`--cache-dir`): references, and state a method may reuse
+    /// across runs (NIRC warm starts).
+    pub cache_dir: &'a std::path::Path,
 }
 
 /// One rendered frame of a method.

@@ -146,7 +146,7 @@ impl SharedCache {
         cache_config.max_batch = cache_config.max_batch.max(paths.record_count());
         let mut cache = None;
         if self.settings.pretrain_frames > 0 {
-            let dir = crate::reference_cache::ReferenceCache::default_location().join("nirc");
+            let dir = ctx.cache_dir.join("nirc");
             let file = dir.join(format!("{}.nirc", self.warm_start_key(gpu, ctx.scene, ctx.scenario, ctx.tracer)));
             if file.exists() {
                 cache = Some(NeuralCache::load(gpu, &file).with_context(|| format!("loading the NIRC warm start {}", file.display()))?);
