@@ -60,6 +60,9 @@ struct Record {
 @group(2) @binding(3) var<storage, read_write> records: array<Record>;
 @group(2) @binding(4) var<storage, read_write> answers: array<vec4f>;
 @group(2) @binding(5) var<storage, read_write> image: array<vec4f>;
+// Per pixel: motion of the pixel-centre primary hit (as the path tracer's G-buffer), for SMAPE
+// with reprojection.
+@group(2) @binding(6) var<storage, read_write> motion: array<vec2f>;
 
 // Stream of training-path random numbers: disjoint from the camera samples' (small indices).
 const TRAIN_SAMPLE_STREAM: u32 = 0x80000001u;
@@ -178,6 +181,14 @@ fn queries_main(@builtin(global_invocation_id) id: vec3u) {
     for (var s = 0u; s < params.spp; s++) {
         trace_query(id.xy, s, pixel * params.spp + s);
     }
+    let origin = frame.camera.position.xyz;
+    let dir = camera_ray_direction(frame.camera, vec2f(id.xy) + 0.5);
+    let hit = trace_closest(origin, dir, FAR);
+    var hit_point = origin;
+    if hit.instance != NO_HIT {
+        hit_point = surface_point(hit, origin, dir).position;
+    }
+    motion[pixel] = primary_motion(hit, origin, dir, hit_point);
 }
 
 fn target_of(q: u32, rng: ptr<function, u32>) -> vec3f {

@@ -48,8 +48,8 @@ struct CacheParams {
 
 /// Bytes of one `QueryMeta` (weight, prefix, origin) in the shader.
 const META_BYTES: u64 = 48;
-/// Storage buffers of this pass's own group (queries, meta, records, answers, image).
-const OWN_STORAGE_BUFFERS: u32 = 5;
+/// Storage buffers of this pass's own group (queries, meta, records, answers, image, motion).
+const OWN_STORAGE_BUFFERS: u32 = 6;
 const WORKGROUP_2D: u32 = 8;
 const WORKGROUP_1D: u32 = 64;
 
@@ -75,6 +75,8 @@ pub struct CachePaths {
     queries: wgpu::Buffer,
     meta: wgpu::Buffer,
     records: wgpu::Buffer,
+    /// Per pixel motion vector of the last `encode_queries`.
+    motion: wgpu::Buffer,
     /// Bound where a pass does not use the caller's output.
     scratch: CacheOutput,
 }
@@ -162,6 +164,7 @@ impl CachePaths {
         let queries = buffer("nirc cache queries", query_count * size_of::<CacheQuery>() as u64)?;
         let meta = buffer("nirc query weights", query_count * META_BYTES)?;
         let records = buffer("nirc training records", 2 * settings.train_records as u64 * size_of::<TrainingRecord>() as u64)?;
+        let motion = buffer("nirc motion", width as u64 * height as u64 * 8)?;
         let mut me = Self {
             settings,
             width,
@@ -177,6 +180,7 @@ impl CachePaths {
             queries,
             meta,
             records,
+            motion,
             scratch: CacheOutput { answers: buffer("nirc scratch", 16)?, image: buffer("nirc scratch", 16)? },
         };
         me.scratch = me.output(gpu)?;
@@ -235,6 +239,7 @@ impl CachePaths {
             (3, &self.records),
             (4, &out.answers),
             (5, &out.image),
+            (6, &self.motion),
         ]
         .map(|(binding, b): (u32, &wgpu::Buffer)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() });
         gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("nirc cache paths"), layout: &self.layout, entries: &entries })
@@ -288,6 +293,13 @@ impl CachePaths {
         Ok((texels[..n].to_vec(), texels[n..2 * n].to_vec()))
     }
 
+    /// Per pixel motion (previous image position - current, pixels) of the last
+    /// `encode_queries`, from the pixel-centre primary hit as the path tracer's G-buffer.
+    pub fn read_motion(&self, gpu: &Gpu) -> Result<Vec<[f32; 2]>, NircError> {
+        let bytes = crate::gpu::readback::read_bytes(gpu, &self.motion, "nirc motion")?;
+        Ok(bytemuck::cast_slice::<u8, [f32; 2]>(&bytes)[..self.pixels() as usize].to_vec())
+    }
+
     /// Reads `out.answers` back (e.g. after `NeuralCache::encode_reliability`).
     pub fn read_answers(&self, gpu: &Gpu, out: &CacheOutput) -> Result<Vec<[f32; 4]>, NircError> {
         let bytes = crate::gpu::readback::read_bytes(gpu, &out.answers, "nirc answers")?;
@@ -318,6 +330,6 @@ fn own_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let rw = wgpu::BufferBindingType::Storage { read_only: false };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("nirc cache paths"),
-        entries: &[entry(0, wgpu::BufferBindingType::Uniform), entry(1, rw), entry(2, rw), entry(3, rw), entry(4, rw), entry(5, rw)],
+        entries: &[entry(0, wgpu::BufferBindingType::Uniform), entry(1, rw), entry(2, rw), entry(3, rw), entry(4, rw), entry(5, rw), entry(6, rw)],
     })
 }

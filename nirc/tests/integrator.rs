@@ -242,3 +242,27 @@ fn saved_and_loaded_cache_renders_the_next_frames_identically() {
         assert_eq!(bytemuck::cast_slice::<[f32; 4], u8>(&a), bytemuck::cast_slice::<[f32; 4], u8>(&b), "frame {frame} after save/load");
     }
 }
+
+#[test]
+fn motion_vectors_match_the_path_tracers_gbuffer() {
+    // Camera moved and an instance moved between two updates: the cache paths' per-pixel motion
+    // is the path tracer's G-buffer motion of the same frame.
+    let g = gpu();
+    let mut t = tracer(2);
+    let mut moved = scene();
+    moved.camera.position += Vec3::new(0.15, -0.05, 0.1);
+    moved.instances[1].transform = Mat4::from_translation(Vec3::new(0.1, 0.0, 0.05)) * moved.instances[1].transform;
+    t.update(g, &moved);
+    let expected = t.render(g, 1, 3, 1).unwrap().gbuffer.motion;
+    let paths = CachePaths::new(g, &t, 1, CachePathSettings::default()).unwrap();
+    let mut encoder = g.device.create_command_encoder(&Default::default());
+    paths.encode_queries(g, &mut encoder, &t, 3, 1);
+    g.queue.submit([encoder.finish()]);
+    let got = paths.read_motion(g).unwrap();
+    assert_eq!(got.len(), expected.len());
+    let moving = expected.iter().filter(|m| m[0].abs() + m[1].abs() > 0.5).count();
+    assert!(moving > expected.len() / 2, "the test needs motion: {moving} of {} pixels move", expected.len());
+    for (i, (a, b)) in got.iter().zip(&expected).enumerate() {
+        assert!((a[0] - b[0]).abs() < 1e-3 && (a[1] - b[1]).abs() < 1e-3, "pixel {i}: {a:?} vs G-buffer {b:?}");
+    }
+}

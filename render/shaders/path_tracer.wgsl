@@ -70,16 +70,14 @@ fn gbuffer_main(@builtin(global_invocation_id) id: vec3u) {
         g.depth = 0.0;
         g.normal = vec3f(0.0);
         g.albedo = vec3f(0.0);
-        g.motion = project_offset(frame.previous_camera, dir) - project_offset(frame.camera, dir);
+        g.motion = primary_motion(hit, origin, dir, origin);
     } else {
         let sp = surface_point(hit, origin, dir);
         let sh = orient(sp, -dir);
         g.depth = length(sp.position - origin);
         g.normal = sh.ns;
         g.albedo = base_color_at(materials[sp.material], sp.uv);
-        let now = project_offset(frame.camera, sp.position - origin);
-        let before = project_offset(frame.previous_camera, previous_world_position(hit) - frame.previous_camera.position.xyz);
-        g.motion = before - now;
+        g.motion = primary_motion(hit, origin, dir, sp.position);
     }
     gbuffer[id.y * frame.size.x + id.x] = g;
 }

@@ -96,6 +96,17 @@ fn project_offset(c: CameraFrame, d: vec3f) -> vec2f {
     return vec2f((0.5 * ndc.x + 0.5) * f32(frame.size.x), (0.5 - 0.5 * ndc.y) * f32(frame.size.y));
 }
 
+// Motion (previous image position - current, pixels) of what the camera ray (origin, dir) hit:
+// the hit point moved by the previous instance transforms, seen by the previous camera; a miss
+// moves like the direction at infinity.
+fn primary_motion(hit: Hit, origin: vec3f, dir: vec3f, hit_point: vec3f) -> vec2f {
+    if hit.instance == NO_HIT {
+        return project_offset(frame.previous_camera, dir) - project_offset(frame.camera, dir);
+    }
+    let before = project_offset(frame.previous_camera, previous_world_position(hit) - frame.previous_camera.position.xyz);
+    return before - project_offset(frame.camera, hit_point - origin);
+}
+
 // Origin offset off the surface along the geometric normal, on the side `dir` leaves to.
 fn offset_origin(p: vec3f, ng: vec3f, dir: vec3f) -> vec3f {
     let scale = 1.0e-4 * (1.0 + max(abs(p.x), max(abs(p.y), abs(p.z))));

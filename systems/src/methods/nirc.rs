@@ -64,6 +64,8 @@ pub struct SharedCache {
     paths_ms: f64,
     train_ms: f64,
     stats: Vec<(String, f64)>,
+    /// Motion vectors of the frame's pixel-centre primary hits (shared by every mode).
+    motion: Vec<[f32; 2]>,
     warm_start: Option<PathBuf>,
 }
 
@@ -96,6 +98,7 @@ fn shared_for(scenario: &Scenario, settings: &NircSettings, mode: PredictorMode)
                 paths_ms: 0.0,
                 train_ms: 0.0,
                 stats: Vec::new(),
+                motion: Vec::new(),
                 warm_start: None,
             }));
             list.push((key, Rc::downgrade(&rc)));
@@ -198,6 +201,7 @@ impl SharedCache {
         gpu.queue.submit([encoder.finish()]);
         wait(gpu)?;
         self.paths_ms = ms(start);
+        self.motion = g.paths.read_motion(gpu)?;
 
         self.results.clear();
         for (mode, out) in &g.outputs {
@@ -307,7 +311,7 @@ impl FrameMethod for Nirc {
         }
         Ok(MethodOutput {
             radiance: r.radiance,
-            motion: Vec::new(),
+            motion: shared.motion.clone(),
             passes: vec![
                 ("nirc_paths".into(), Some(shared.paths_ms)),
                 ("nirc_infer".into(), Some(r.infer_ms)),
