@@ -3,7 +3,7 @@
 // pass turns the cache's answers into the image. Appended to PathTracer::library_source();
 // the scene is @group(0), the geometry @group(1), these buffers @group(2) (integrator.rs).
 //
-// Estimator. A camera path is traced exactly as pt_integrator.wgsl's `path_radiance` (emission,
+// Estimator. A camera path is traced by pt_integrator.wgsl's `trace_path_prefix` (emission,
 // NEE with MIS, BSDF sampling, Russian roulette) up to the termination vertex x_k (k =
 // `termination_vertex`, 1 = the primary hit). There:
 //   L(x_k -> wo) = Le(x_k) [MIS-weighted as the path tracer]
@@ -108,63 +108,28 @@ fn cache_target(origin: vec3f, dir: vec3f, depth: u32, rng: ptr<function, u32>) 
 fn trace_query(pixel: vec2u, sample_index: u32, q: u32) {
     var rng = rng_seed(frame.seed.xy, frame.seed.z, pixel.y * frame.size.x + pixel.x, sample_index);
     let jitter = rng_next2(&rng);
-    var origin = frame.camera.position.xyz;
-    var dir = camera_ray_direction(frame.camera, vec2f(pixel) + jitter);
-    var throughput = vec3f(1.0);
-    var radiance = vec3f(0.0);
-    var prev_bsdf_pdf = 0.0;
+    let dir = camera_ray_direction(frame.camera, vec2f(pixel) + jitter);
+    let path = trace_path_prefix(frame.camera.position.xyz, dir, 0.0, 0u, params.termination_vertex - 1u, &rng);
+    var radiance = path.radiance;
     var result: QueryMeta;
     result.weight = vec4f(0.0);
     result.origin = vec4f(0.0);
     var query: QueryOut;
     query.position = vec4f(0.0);
     query.direction = vec4f(0.0, 0.0, 1.0, 0.0);
-    let max_depth = frame.seed.w;
-    for (var depth = 0u; depth <= max_depth; depth++) {
-        let hit = trace_closest(origin, dir, FAR);
-        if hit.instance == NO_HIT {
-            radiance += throughput * escaped_radiance(dir, prev_bsdf_pdf);
-            break;
+    if path.stopped {
+        // Termination vertex: direct light by NEE, everything else from the cache.
+        let p = path.p;
+        let sh = path.sh;
+        radiance += path.throughput * (next_event_analytic(p, sh, path.bsdf, path.wo, &rng, false)
+            + next_event_emitter(p, sh, path.bsdf, path.wo, &rng, false));
+        let bs = bsdf_sample(path.bsdf, sh.ns, path.wo, rng_next(&rng), rng_next2(&rng));
+        if bs.valid && dot(bs.wi, sh.ng) > 0.0 {
+            result.weight = vec4f(path.throughput * bs.f * (dot(sh.ns, bs.wi) / bs.pdf), 1.0);
+            result.origin = vec4f(offset_origin(p, sh.ng, bs.wi), f32(path.depth + 1u));
+            query.position = vec4f(p, 0.0);
+            query.direction = vec4f(bs.wi, 0.0);
         }
-        let sp = surface_point(hit, origin, dir);
-        let m = materials[sp.material];
-        let wo = -dir;
-        let sh = orient(sp, wo);
-        radiance += throughput * emitted_radiance(sp, m, dir, hit.t, prev_bsdf_pdf);
-        if depth == max_depth {
-            break;
-        }
-        let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);
-        let p = sp.position;
-        if depth + 1u >= params.termination_vertex {
-            // Termination vertex: direct light by NEE, everything else from the cache.
-            radiance += throughput * (next_event_analytic(p, sh, bsdf, wo, &rng, false)
-                + next_event_emitter(p, sh, bsdf, wo, &rng, false));
-            let bs = bsdf_sample(bsdf, sh.ns, wo, rng_next(&rng), rng_next2(&rng));
-            if bs.valid && dot(bs.wi, sh.ng) > 0.0 {
-                result.weight = vec4f(throughput * bs.f * (dot(sh.ns, bs.wi) / bs.pdf), 1.0);
-                result.origin = vec4f(offset_origin(p, sh.ng, bs.wi), f32(depth + 1u));
-                query.position = vec4f(p, 0.0);
-                query.direction = vec4f(bs.wi, 0.0);
-            }
-            break;
-        }
-        radiance += throughput * next_event(p, sh, bsdf, wo, &rng);
-        let bs = bsdf_sample(bsdf, sh.ns, wo, rng_next(&rng), rng_next2(&rng));
-        if !bs.valid || dot(bs.wi, sh.ng) <= 0.0 {
-            break;
-        }
-        throughput *= bs.f * (dot(sh.ns, bs.wi) / bs.pdf);
-        prev_bsdf_pdf = bs.pdf;
-        if depth + 1u >= frame.counts.x {
-            let survive = min(max_component(throughput), 0.95);
-            if rng_next(&rng) >= survive {
-                break;
-            }
-            throughput /= survive;
-        }
-        origin = offset_origin(p, sh.ng, bs.wi);
-        dir = bs.wi;
     }
     result.prefix = vec4f(radiance, 0.0);
     query_meta[q] = result;

@@ -100,10 +100,34 @@ fn emitted_radiance(sp: SurfacePoint, m: GpuMaterial, dir: vec3f, dist: f32, pre
     return m.emission * w;
 }
 
+// A path traced up to a vertex where its caller takes over (a cache query, nirc), or to its end.
+struct PathPrefix {
+    radiance: vec3f,    // gathered up to the stop vertex, its own (MIS-weighted) emission included
+    throughput: vec3f,  // of the path up to the stop vertex
+    stopped: bool,      // true: the path reached a surface at `stop_depth` below the max depth
+    p: vec3f,           // the stop vertex, its shading frame, BSDF and outgoing direction
+    sh: Shading,
+    bsdf: Bsdf,
+    wo: vec3f,
+    depth: u32,
+}
+
+// Never stop early: trace to the frame's max depth.
+const NO_STOP: u32 = 0xffffffffu;
+
 // Radiance carried back along a path that starts with the ray (origin, dir) at vertex `depth`
 // (0 = camera ray), up to the frame's max depth. `prev_bsdf_pdf` is the pdf that chose `dir`
 // (0 for a camera ray: no MIS on what it hits). Russian roulette from frame.counts.x on.
-fn path_radiance(origin_in: vec3f, dir_in: vec3f, prev_bsdf_pdf_in: f32, depth_in: u32, rng: ptr<function, u32>) -> vec3f {
+fn path_radiance(origin: vec3f, dir: vec3f, prev_bsdf_pdf: f32, depth: u32, rng: ptr<function, u32>) -> vec3f {
+    return trace_path_prefix(origin, dir, prev_bsdf_pdf, depth, NO_STOP, rng).radiance;
+}
+
+// The path loop of `path_radiance`, stopping at the surface vertex `stop_depth` (if the path
+// gets there below the max depth) before its NEE: the caller continues from there with the
+// same random-number stream.
+fn trace_path_prefix(origin_in: vec3f, dir_in: vec3f, prev_bsdf_pdf_in: f32, depth_in: u32, stop_depth: u32, rng: ptr<function, u32>) -> PathPrefix {
+    var out: PathPrefix;
+    out.stopped = false;
     var origin = origin_in;
     var dir = dir_in;
     var throughput = vec3f(1.0);
@@ -126,6 +150,15 @@ fn path_radiance(origin_in: vec3f, dir_in: vec3f, prev_bsdf_pdf_in: f32, depth_i
         }
         let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);
         let p = sp.position;
+        if depth == stop_depth {
+            out.stopped = true;
+            out.p = p;
+            out.sh = sh;
+            out.bsdf = bsdf;
+            out.wo = wo;
+            out.depth = depth;
+            break;
+        }
         radiance += throughput * next_event(p, sh, bsdf, wo, rng);
 
         // Continue the path by sampling the BSDF.
@@ -146,5 +179,7 @@ fn path_radiance(origin_in: vec3f, dir_in: vec3f, prev_bsdf_pdf_in: f32, depth_i
         origin = offset_origin(p, sh.ng, bs.wi);
         dir = bs.wi;
     }
-    return radiance;
+    out.radiance = radiance;
+    out.throughput = throughput;
+    return out;
 }
