@@ -59,7 +59,9 @@ fn every_shipped_scenario_loads_and_plays() {
     for f in &files {
         let scenario = Scenario::load(f).unwrap_or_else(|e| panic!("{e}"));
         assert!(scenario.resolution.0 * scenario.resolution.1 <= 160 * 90, "{}: too big for CI", f.display());
-        assert!(scenario.frames <= 60 && scenario.reference.spp <= 256, "{}: too long for CI", f.display());
+        // References are cached by scene content, so a still scene renders only a few: 1024 spp
+        // at 64x36 (a dark corridor needs it) takes minutes on lavapipe.
+        assert!(scenario.frames <= 60 && scenario.reference.spp <= 1024, "{}: too long for CI", f.display());
         assert_eq!(scenario.output, Path::new("runs").join(&scenario.name));
         let mut s = Simulation::new(&scenario).unwrap_or_else(|e| panic!("{e}"));
         assert!(!s.scene().meshes.is_empty() && !s.scene().instances.is_empty(), "{}: empty scene", f.display());
