@@ -28,13 +28,16 @@
 //!   before the claimant is known.
 //! - Cells are not split into parent/child levels (that is the paper's Hybrid, not HashCache).
 //!
-//! Numbers (lavapipe, 2 shared CPU cores; `cargo run -p systems --example issue5_bench 320 180 5`,
-//! courtyard, camera moving, max depth 4, median GPU ms): secondary-hit lookup hc_age 5.2,
+//! Numbers (lavapipe, 2 shared CPU cores; an earlier courtyard version of issue5_bench at 320x180,
+//! camera moving, max depth 4, median GPU ms): secondary-hit lookup hc_age 5.2,
 //! hc_trace 334, hc_update 581, hc_resolve 6.2 (occupancy 0.17 of 2^18 slots, 18k update paths
 //! for 57.6k pixels); first-hit lookup 6.6 / 152 / 503 / 4.3 (occupancy 0.07); TAA trace 1034,
 //! resolve 11. fast_turn.ron at 64x36: mean frame-to-frame SMAPE 1 spp 0.46, hash cache 0.39,
 //! TAA 0.15, hash cache + TAA 0.13; relMSE at the reference frames 0.072, 0.052, 0.015-0.027,
-//! 0.010-0.023.
+//! 0.010-0.023. Hairball 320x180, max depth 3 (`cargo run --release -j2 -p systems --example
+//! issue5_bench -- 320 180 12`, table in render/src/sample_cache/README.md): hc_age 5.6,
+//! hc_trace 711, hc_update 517, hc_resolve 3.8 ms; 141 027 rays and 64 211 shaded paths
+//! (57 600 pixels + update paths) per frame.
 
 pub mod key;
 pub mod table_cpu;

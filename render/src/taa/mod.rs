@@ -25,8 +25,10 @@
 //! - the primary ray is traced twice (once for its attributes, once inside `path_radiance`).
 //!
 //! Cost (lavapipe on 2 shared CPU cores, courtyard 320x180, max depth 4, median GPU ms of 5
-//! frames, `cargo run -p systems --example issue5_bench 320 180 5`): taa_trace 1034,
-//! taa_resolve 11.
+//! frames, an earlier courtyard version of issue5_bench): taa_trace 1034, taa_resolve 11.
+//! Hairball 320x180, max depth 3, mean of 10 frames (`cargo run --release -j2 -p systems
+//! --example issue5_bench -- 320 180 12`, table in render/src/sample_cache/README.md):
+//! taa_trace 1105, taa_resolve 10.8; 191 905 rays per frame (GPU counter).
 
 pub mod jitter;
 pub mod resolve_cpu;
