@@ -105,7 +105,9 @@ fn main() -> anyhow::Result<()> {
             }
         }
         sim.step();
-        eprintln!("frame {f} done");
+        // Per frame, to tell a steady cost from outliers in the means.
+        let ms = |timings: &[PassTiming], pass: &str| timings.iter().find(|t| t.pass == pass).map_or(0.0, |t| t.ms);
+        eprintln!("frame {f}: pt path_trace {:.0} ms, taa_trace {:.0} ms", ms(&pt.timings, "path_trace"), ms(&t.timings, "taa_trace"));
     }
     let n = (frames - WARM_UP) as f64;
     let clock = clock.map_or("?", |c| c.name());
