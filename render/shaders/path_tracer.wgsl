@@ -11,6 +11,8 @@ fn trace_path(pixel: vec2u, sample_index: u32) -> vec3f {
 
 // Per-(chunk, pixel) partial sums of one dispatch; `accumulate_main` adds them up in chunk order.
 @group(0) @binding(6) var<storage, read_write> sample_partials: array<vec4f>;
+// [0]: rays traced by this frame's passes (sg_rays_traced of every invocation).
+@group(0) @binding(7) var<storage, read_write> pt_counters: array<atomic<u32>>;
 
 // One thread per pixel and chunk of at most SAMPLES_PER_THREAD samples (global id z = chunk).
 // Few samples per thread keep every invocation short: llvmpipe (Mesa 22) silently ends a shader's
@@ -30,6 +32,7 @@ fn trace_main(@builtin(global_invocation_id) id: vec3u) {
     }
     let pixels = frame.size.x * frame.size.y;
     sample_partials[id.z * pixels + id.y * frame.size.x + id.x] = vec4f(sum, 0.0);
+    atomicAdd(&pt_counters[0], sg_rays_traced);
 }
 
 // Adds a dispatch's chunks to the running sum in a fixed order (deterministic); w counts samples.
@@ -80,4 +83,5 @@ fn gbuffer_main(@builtin(global_invocation_id) id: vec3u) {
         g.motion = primary_motion(hit, origin, dir, sp.position);
     }
     gbuffer[id.y * frame.size.x + id.x] = g;
+    atomicAdd(&pt_counters[0], sg_rays_traced);
 }

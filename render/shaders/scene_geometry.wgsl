@@ -288,13 +288,20 @@ fn sg_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit:
     return hit;
 }
 
+// Rays this invocation traced (trace_closest + trace_any). A pass that reports rays adds it to
+// its own atomic counter once at the end of the invocation (one atomic per invocation, not per
+// ray); passes that do not report ignore it.
+var<private> sg_rays_traced: u32 = 0u;
+
 // Closest hit with 0 < t < t_max (direction need not be normalised; t in units of direction).
 fn trace_closest(origin: vec3f, direction: vec3f, t_max: f32) -> Hit {
+    sg_rays_traced += 1u;
     return sg_traverse(origin, direction, t_max, false);
 }
 
 // True if anything is hit with 0 < t < t_max; stops at the first hit (shadow rays).
 fn trace_any(origin: vec3f, direction: vec3f, t_max: f32) -> bool {
+    sg_rays_traced += 1u;
     return sg_traverse(origin, direction, t_max, true).instance != NO_HIT;
 }
 

@@ -19,6 +19,8 @@ struct TaaParams {
 @group(2) @binding(0) var<uniform> taa: TaaParams;
 @group(2) @binding(1) var<storage, read_write> taa_current: array<vec4f>;
 @group(2) @binding(2) var<storage, read_write> taa_primary: array<TaaPrimary>;
+// [0]: rays traced by this pass (sg_rays_traced of every invocation).
+@group(2) @binding(3) var<storage, read_write> taa_counters: array<atomic<u32>>;
 
 @compute @workgroup_size(8, 8, 1)
 fn taa_trace(@builtin(global_invocation_id) id: vec3u) {
@@ -34,4 +36,5 @@ fn taa_trace(@builtin(global_invocation_id) id: vec3u) {
     let hit = trace_closest(origin, dir, FAR);
     taa_primary[index] = primary_attributes(hit, origin, dir);
     taa_current[index] = vec4f(path_radiance(origin, dir, 0.0, 0u, &rng), 1.0);
+    atomicAdd(&taa_counters[0], sg_rays_traced);
 }

@@ -14,10 +14,9 @@ use crate::lights::{LightTable, build_light_table};
 use crate::materials::pack_materials;
 use crate::readback::read_buffer;
 use crate::scene::{Camera, SceneDesc};
-use crate::timing::{PassTimestamps, PassTiming};
+use crate::timing::{PassTimer, PassTiming, merge};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use std::time::Instant;
 use wgpu::util::DeviceExt;
 
 /// `Hit::instance`/`primitive` of a pixel whose primary ray left the scene.
@@ -39,8 +38,11 @@ pub const GBUFFER_PASS: &str = "gbuffer";
 pub const PATH_TRACE_PASS: &str = "path_trace";
 
 const WORKGROUP: u32 = 8;
-/// Storage buffers of group 0 (materials, texels, lights, radiance, G-buffer, sample partials).
-const STORAGE_BUFFERS: u32 = 6;
+/// Storage buffers of group 0 (materials, texels, lights, radiance, G-buffer, sample partials,
+/// ray counter).
+const STORAGE_BUFFERS: u32 = 7;
+/// Words of the ray counter: [0] rays traced since the last clear.
+const COUNTER_WORDS: u64 = 4;
 
 /// Storage buffers a pass built on [`PathTracer::library_source`] binds before its own:
 /// @group(0) (scene) and @group(1) (geometry). Add the pass's own to check the adapter limit.
@@ -86,6 +88,11 @@ pub struct FrameOutput {
     pub gbuffer: GBuffer,
     /// One entry per pass: [`GBUFFER_PASS`], [`PATH_TRACE_PASS`] (readback excluded).
     pub timings: Vec<PassTiming>,
+    /// Rays traced by both passes (G-buffer rays + camera, shadow and bounce rays of the paths),
+    /// counted on the GPU.
+    pub rays: u64,
+    /// Paths shaded: pixels x spp.
+    pub shaded: u64,
 }
 
 #[repr(C)]
@@ -124,7 +131,10 @@ pub struct PathTracer {
     radiance_readback: wgpu::Buffer,
     gbuffer_readback: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
-    timestamps: Option<PassTimestamps>,
+    timer: PassTimer,
+    /// Rays traced (atomic, flushed once per invocation), cleared per frame.
+    counters: wgpu::Buffer,
+    counters_readback: wgpu::Buffer,
     light_table: LightTable,
     camera: Camera,
     /// Camera before the last `update` (motion vectors), like the instances' previous
@@ -184,6 +194,8 @@ impl PathTracer {
         let max_chunks = MAX_CHUNKS.min(gpu.limits.max_compute_workgroups_per_dimension);
         let sample_partials = Self::partials_buffer(gpu, pixels, Self::chunks_for(PATHS_PER_DISPATCH, pixels, max_chunks))?;
         let frame_buffer = per_pixel("path tracer frame", size_of::<GpuFrame>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+        let counters = per_pixel("path tracer ray counter", COUNTER_WORDS * 4, rw | wgpu::BufferUsages::COPY_DST);
+        let counters_readback = per_pixel("path tracer ray counter readback", COUNTER_WORDS * 4, readback);
 
         let layout = bind_group_layout(device);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -210,7 +222,7 @@ impl PathTracer {
             return Err(RenderError::Shader { pass: "path_tracer.wgsl".into(), message: e.to_string() });
         }
 
-        let bind_group = make_bind_group(device, &layout, [&frame_buffer, &materials, &texels, &lights, &radiance_sum, &gbuffer, &sample_partials]);
+        let bind_group = make_bind_group(device, &layout, [&frame_buffer, &materials, &texels, &lights, &radiance_sum, &gbuffer, &sample_partials, &counters]);
         Ok(Self {
             settings,
             geometry,
@@ -229,7 +241,9 @@ impl PathTracer {
             radiance_readback,
             gbuffer_readback,
             bind_group,
-            timestamps: PassTimestamps::new(gpu, 2),
+            timer: PassTimer::new(gpu, &[GBUFFER_PASS, PATH_TRACE_PASS]),
+            counters,
+            counters_readback,
             light_table,
             camera: scene.camera,
             previous_camera: scene.camera,
@@ -339,7 +353,7 @@ impl PathTracer {
             self.bind_group = make_bind_group(
                 &gpu.device,
                 &self.layout,
-                [&self.frame_buffer, &self.materials, &self.texels, &self.lights, &self.radiance_sum, &self.gbuffer, &self.sample_partials],
+                [&self.frame_buffer, &self.materials, &self.texels, &self.lights, &self.radiance_sum, &self.gbuffer, &self.sample_partials, &self.counters],
             );
         }
         self.light_table = light_table;
@@ -356,21 +370,25 @@ impl PathTracer {
         }
         let previous = self.previous_camera;
         // G-buffer pass.
-        let start = Instant::now();
         self.write_frame(gpu, &previous, 0, 0, seed, frame, false);
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer") });
-        self.dispatch(&mut encoder, &self.gbuffer_pipeline, GBUFFER_PASS, 0);
-        let gbuffer_gpu = self.submit_timed(gpu, encoder, 0)?;
-        let gbuffer_timing = PassTiming { pass: GBUFFER_PASS.into(), gpu_ms: gbuffer_gpu, cpu_ms: ms(start) };
+        let mut timed = self.timer.begin(gpu, "gbuffer");
+        timed.encoder().clear_buffer(&self.counters, 0, None);
+        timed.pass(0, |pass| {
+            pass.set_pipeline(&self.gbuffer_pipeline);
+            pass.set_bind_group(0, &self.bind_group, &[]);
+            pass.set_bind_group(1, self.geometry.bind_group(), &[]);
+            pass.dispatch_workgroups(self.settings.width.div_ceil(WORKGROUP), self.settings.height.div_ceil(WORKGROUP), 1);
+        })?;
+        let mut timings = timed.submit()?;
 
         // Path-trace pass, in batches of bounded work.
-        let start = Instant::now();
-        let trace_gpu = self.trace_batches(gpu, &previous, spp, seed, frame, &mut |_, _| {})?;
-        let trace_timing = PassTiming { pass: PATH_TRACE_PASS.into(), gpu_ms: trace_gpu, cpu_ms: ms(start) };
+        merge(&mut timings, self.trace_batches(gpu, &previous, spp, seed, frame, &mut |_, _| {})?);
 
         let radiance = self.read_radiance(gpu)?;
         let gbuffer = self.read_gbuffer(gpu)?;
-        Ok(FrameOutput { width: self.settings.width, height: self.settings.height, radiance, gbuffer, timings: vec![gbuffer_timing, trace_timing] })
+        let rays = self.read_rays(gpu)?;
+        let shaded = self.settings.width as u64 * self.settings.height as u64 * spp as u64;
+        Ok(FrameOutput { width: self.settings.width, height: self.settings.height, radiance, gbuffer, timings, rays, shaded })
     }
 
     /// The current scene accumulated to `spp` samples per pixel in batches of at most
@@ -403,7 +421,7 @@ impl PathTracer {
             self.bind_group = make_bind_group(
                 &gpu.device,
                 &self.layout,
-                [&self.frame_buffer, &self.materials, &self.texels, &self.lights, &self.radiance_sum, &self.gbuffer, &self.sample_partials],
+                [&self.frame_buffer, &self.materials, &self.texels, &self.lights, &self.radiance_sum, &self.gbuffer, &self.sample_partials, &self.counters],
             );
         }
         Ok(())
@@ -425,20 +443,16 @@ impl PathTracer {
         }))
     }
 
-    /// Traces `spp` samples into the radiance sum; returns the summed GPU time of the batches.
-    fn trace_batches(&self, gpu: &Gpu, previous: &Camera, spp: u32, seed: u64, frame: u32, progress: &mut dyn FnMut(u32, u32)) -> Result<Option<f64>, RenderError> {
+    /// Traces `spp` samples into the radiance sum; returns the summed time of the batches.
+    fn trace_batches(&self, gpu: &Gpu, previous: &Camera, spp: u32, seed: u64, frame: u32, progress: &mut dyn FnMut(u32, u32)) -> Result<Vec<PassTiming>, RenderError> {
         let per_dispatch = self.samples_per_dispatch();
         let mut done = 0;
-        let mut gpu_ms = Some(0.0);
+        let mut timings = Vec::new();
         while done < spp {
             let batch = per_dispatch.min(spp - done);
             self.write_frame(gpu, previous, batch, done, seed, frame, done > 0);
-            let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path trace") });
-            {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some(PATH_TRACE_PASS),
-                    timestamp_writes: self.timestamps.as_ref().map(|t| t.writes(1)),
-                });
+            let mut timed = self.timer.begin(gpu, "path trace");
+            timed.pass(1, |pass| {
                 let (x, y) = (self.settings.width.div_ceil(WORKGROUP), self.settings.height.div_ceil(WORKGROUP));
                 pass.set_bind_group(0, &self.bind_group, &[]);
                 pass.set_bind_group(1, self.geometry.bind_group(), &[]);
@@ -446,13 +460,12 @@ impl PathTracer {
                 pass.dispatch_workgroups(x, y, batch.div_ceil(SAMPLES_PER_THREAD));
                 pass.set_pipeline(&self.accumulate_pipeline);
                 pass.dispatch_workgroups(x, y, 1);
-            }
-            let t = self.submit_timed(gpu, encoder, 1)?;
-            gpu_ms = gpu_ms.zip(t).map(|(a, b)| a + b);
+            })?;
+            merge(&mut timings, timed.submit()?);
             done += batch;
             progress(done, spp);
         }
-        Ok(gpu_ms)
+        Ok(timings)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -478,35 +491,13 @@ impl PathTracer {
         gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&params.gpu()));
     }
 
-    fn dispatch(&self, encoder: &mut wgpu::CommandEncoder, pipeline: &wgpu::ComputePipeline, label: &str, pass_index: u32) {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(label),
-            timestamp_writes: self.timestamps.as_ref().map(|t| t.writes(pass_index)),
-        });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &self.bind_group, &[]);
-        pass.set_bind_group(1, self.geometry.bind_group(), &[]);
-        pass.dispatch_workgroups(self.settings.width.div_ceil(WORKGROUP), self.settings.height.div_ceil(WORKGROUP), 1);
-    }
-
-    /// Submits, waits, and returns the GPU time of pass `pass_index` where timestamps exist.
-    fn submit_timed(&self, gpu: &Gpu, mut encoder: wgpu::CommandEncoder, pass_index: u32) -> Result<Option<f64>, RenderError> {
-        if let Some(t) = &self.timestamps {
-            t.resolve(&mut encoder);
-        }
+    /// Rays the passes since the last clear traced (the frame's G-buffer and paths).
+    fn read_rays(&self, gpu: &Gpu) -> Result<u64, RenderError> {
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ray counter readback") });
+        encoder.copy_buffer_to_buffer(&self.counters, 0, &self.counters_readback, 0, COUNTER_WORDS * 4);
         gpu.queue.submit([encoder.finish()]);
-        match &self.timestamps {
-            None => {
-                gpu.device
-                    .poll(wgpu::PollType::wait_indefinitely())
-                    .map_err(|e| RenderError::Readback { what: "path tracer submission".into(), reason: e.to_string() })?;
-                Ok(None)
-            }
-            Some(t) => {
-                let ms = t.read(gpu).map_err(|reason| RenderError::Readback { what: "timestamps".into(), reason })?;
-                Ok(Some(ms[pass_index as usize]))
-            }
-        }
+        let words: Vec<u32> = read_buffer(gpu, &self.counters_readback).map_err(|reason| RenderError::Readback { what: "ray counter".into(), reason })?;
+        Ok(words[0] as u64)
     }
 
     fn read_radiance(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, RenderError> {
@@ -536,10 +527,6 @@ impl PathTracer {
     }
 }
 
-fn ms(start: Instant) -> f64 {
-    start.elapsed().as_secs_f64() * 1e3
-}
-
 fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let buffer = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
         binding,
@@ -559,11 +546,12 @@ fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
             buffer(4, write),
             buffer(5, write),
             buffer(6, write),
+            buffer(7, write),
         ],
     })
 }
 
-fn make_bind_group(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, buffers: [&wgpu::Buffer; 7]) -> wgpu::BindGroup {
+fn make_bind_group(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, buffers: [&wgpu::Buffer; 8]) -> wgpu::BindGroup {
     let entries: Vec<wgpu::BindGroupEntry> =
         buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
     device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("path tracer"), layout, entries: &entries })

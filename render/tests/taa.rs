@@ -213,3 +213,48 @@ fn same_inputs_give_identical_bytes() {
     };
     assert_eq!(run(), run());
 }
+
+/// Every primary ray escapes (the camera looks up, away from the ground): each path is exactly
+/// its camera ray, so the GPU ray counters have exact expected values.
+#[test]
+fn ray_counters_are_exact_when_every_ray_escapes() {
+    let mut scene = feature_scene(0.0);
+    scene.camera = Camera { position: Vec3::new(0.0, HEIGHT, 0.0), target: Vec3::new(0.0, 2.0 * HEIGHT, 0.0), up: Vec3::NEG_Z, vfov: VFOV };
+    let mut pt = tracer(&scene, 4);
+    pt.update(gpu(), &scene);
+    let pixels = (W * H) as u64;
+    let out = pt.render(gpu(), 3, 5, 0).expect("pt frame");
+    assert!(out.gbuffer.instance_id.iter().all(|&i| i == NO_HIT), "the view must see only sky");
+    // G-buffer ray + 3 camera rays per pixel.
+    assert_eq!((out.rays, out.shaded), (4 * pixels, 3 * pixels));
+    assert_eq!(out.timings.iter().map(|t| t.pass.as_str()).collect::<Vec<_>>(), ["gbuffer", "path_trace"]);
+    let mut taa = Taa::new(gpu(), &pt, TaaSettings::default()).expect("taa");
+    for f in 0..2 {
+        let t = taa.render(gpu(), &pt, 5, f).expect("taa frame");
+        // The primary-attribute ray + the path's camera ray, per pixel, every frame (cleared).
+        assert_eq!((t.rays, t.shaded), (2 * pixels, pixels), "frame {f}");
+        assert_eq!(t.timings.iter().map(|t| t.pass.as_str()).collect::<Vec<_>>(), ["taa_trace", "taa_resolve"]);
+    }
+    let mut cache = render::hash_cache::HashCache::new(gpu(), &pt, Default::default()).expect("hash cache");
+    let h = cache.render(gpu(), &pt, &scene.camera, 5, 0, None).expect("hash cache frame");
+    // One camera ray per pixel, no cache update path (nothing was hit).
+    assert_eq!((h.rays, h.shaded, h.stats.update_paths), (pixels, pixels, 0));
+}
+
+#[test]
+fn wall_clock_times_each_pass_on_its_own() {
+    use render::timing::{Clock, PassTimer};
+    let timer = PassTimer::wall(&["first", "second"]);
+    assert_eq!(timer.clock(), Clock::Wall);
+    let buffer = gpu().device.create_buffer(&wgpu::BufferDescriptor { label: None, size: 256, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
+    let mut frame = timer.begin(gpu(), "test");
+    frame.encoder().clear_buffer(&buffer, 0, None);
+    frame.pass(1, |_| {}).expect("pass");
+    let timings = frame.submit().expect("submit");
+    // Only the pass recorded is reported, under its own name and the wall clock.
+    assert_eq!(timings.len(), 1);
+    assert_eq!((timings[0].pass.as_str(), timings[0].clock), ("second", Clock::Wall));
+    assert!(timings[0].ms >= 0.0);
+    let gpu_timer = PassTimer::new(gpu(), &["only"]);
+    assert_eq!(gpu_timer.clock() == Clock::Gpu, gpu().has_timestamps());
+}

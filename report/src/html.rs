@@ -21,14 +21,17 @@ fn png_uri(path: &Path) -> anyhow::Result<String> {
 }
 
 /// Columns of the summary table, when present.
-const TABLE_COLUMNS: [(&str, &str); 7] = [
+const TABLE_COLUMNS: [(&str, &str); 10] = [
     ("flip", "FLIP"),
     ("smape", "SMAPE"),
     ("smape_reprojected", "SMAPE (reproj.)"),
     ("psnr", "PSNR dB"),
     ("rel_mse", "rel. MSE"),
     ("gpu_ms_total", "GPU ms"),
+    ("wall_ms_total", "pass wall ms"),
     ("cpu_ms", "CPU ms"),
+    ("rays", "rays"),
+    ("shaded", "shaded paths"),
 ];
 
 const STYLE: &str = "body{font-family:sans-serif;margin:24px;max-width:1500px;color:#222}\

@@ -7,8 +7,14 @@ pub struct FrameRecord {
     pub method: String,
     pub frame: u32,
     pub cpu_ms: f64,
-    /// GPU time per pass, in the order the passes ran; `None` without timestamp queries.
+    /// Time per pass, in the order the passes ran; `None` = not measured.
     pub passes: Vec<(String, Option<f64>)>,
+    /// The clock of `passes`: columns `gpu_ms_PASS` (timestamp queries, also when unknown) or
+    /// `wall_ms_PASS` (each pass submitted alone and waited for).
+    pub clock: Option<render::timing::Clock>,
+    /// Rays traced and paths shaded this frame (the method's GPU counters); `None` = not reported.
+    pub rays: Option<u64>,
+    pub shaded: Option<u64>,
     pub smape: Option<f64>,
     pub smape_reprojected: Option<f64>,
     pub disoccluded: Option<u64>,
@@ -22,9 +28,14 @@ pub struct FrameRecord {
     pub stats: Vec<(String, f64)>,
 }
 
+fn clock_prefix(row: &FrameRecord) -> &'static str {
+    row.clock.unwrap_or(render::timing::Clock::Gpu).name()
+}
+
 /// Writes the CSV; pass columns are the union over rows, so methods with different passes share
 /// one table. Empty cells mean "not measured".
 pub fn to_csv(rows: &[FrameRecord]) -> String {
+    let wall_total = rows.iter().any(|r| clock_prefix(r) == "wall");
     let mut passes: Vec<String> = Vec::new();
     let mut regions: Vec<String> = Vec::new();
     let mut stats: Vec<String> = Vec::new();
@@ -35,8 +46,9 @@ pub fn to_csv(rows: &[FrameRecord]) -> String {
             }
         }
         for (p, _) in &row.passes {
-            if !passes.contains(p) {
-                passes.push(p.clone());
+            let column = format!("{}_ms_{p}", clock_prefix(row));
+            if !passes.contains(&column) {
+                passes.push(column);
             }
         }
         for (r, _, _) in &row.regions {
@@ -46,10 +58,13 @@ pub fn to_csv(rows: &[FrameRecord]) -> String {
         }
     }
     let mut out = String::from("method,frame,cpu_ms,gpu_ms_total");
-    for p in &passes {
-        write!(out, ",gpu_ms_{p}").unwrap();
+    if wall_total {
+        out.push_str(",wall_ms_total");
     }
-    out.push_str(",smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr");
+    for p in &passes {
+        write!(out, ",{p}").unwrap();
+    }
+    out.push_str(",smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr,rays,shaded");
     for r in &regions {
         write!(out, ",{r}_flip,{r}_smape").unwrap();
     }
@@ -60,27 +75,33 @@ pub fn to_csv(rows: &[FrameRecord]) -> String {
     for row in rows {
         let times: Vec<Option<f64>> = passes
             .iter()
-            .map(|p| row.passes.iter().find(|(q, _)| q == p).and_then(|(_, t)| *t))
+            .map(|p| row.passes.iter().find(|(q, _)| format!("{}_ms_{q}", clock_prefix(row)) == *p).and_then(|(_, t)| *t))
             .collect();
         let total = if row.passes.iter().all(|(_, t)| t.is_some()) && !row.passes.is_empty() {
             Some(row.passes.iter().filter_map(|(_, t)| *t).sum())
         } else {
             None
         };
-        write!(out, "{},{},{:.4},{}", row.method, row.frame, row.cpu_ms, cell(total)).unwrap();
+        let wall = clock_prefix(row) == "wall";
+        write!(out, "{},{},{:.4},{}", row.method, row.frame, row.cpu_ms, cell(if wall { None } else { total })).unwrap();
+        if wall_total {
+            write!(out, ",{}", cell(if wall { total } else { None })).unwrap();
+        }
         for t in times {
             write!(out, ",{}", cell(t)).unwrap();
         }
         write!(
             out,
-            ",{},{},{},{},{},{},{}",
+            ",{},{},{},{},{},{},{},{},{}",
             cell(row.smape),
             cell(row.smape_reprojected),
             row.disoccluded.map(|d| d.to_string()).unwrap_or_default(),
             cell(row.flip),
             cell(row.mse),
             cell(row.rel_mse),
-            cell(row.psnr)
+            cell(row.psnr),
+            row.rays.map(|d| d.to_string()).unwrap_or_default(),
+            row.shaded.map(|d| d.to_string()).unwrap_or_default()
         )
         .unwrap();
         for r in &regions {
@@ -111,14 +132,32 @@ mod tests {
             cpu_ms: 2.0,
             passes: vec![("trace".into(), Some(1.5))],
             smape: Some(0.25),
+            rays: Some(120),
+            shaded: Some(40),
             stats: vec![("occupancy".into(), 0.5)],
             ..Default::default()
         };
         let b = FrameRecord { method: "pt_4spp".into(), frame: 0, passes: vec![("shade".into(), None)], ..Default::default() };
         let csv = to_csv(&[a, b]);
         let lines: Vec<&str> = csv.lines().collect();
-        assert_eq!(lines[0], "method,frame,cpu_ms,gpu_ms_total,gpu_ms_trace,gpu_ms_shade,smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr,occupancy");
-        assert_eq!(lines[1], "pt_1spp,0,2.0000,1.500000,1.500000,,0.250000,,,,,,,0.500000");
-        assert_eq!(lines[2], "pt_4spp,0,0.0000,,,,,,,,,,,");
+        assert_eq!(lines[0], "method,frame,cpu_ms,gpu_ms_total,gpu_ms_trace,gpu_ms_shade,smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr,rays,shaded,occupancy");
+        assert_eq!(lines[1], "pt_1spp,0,2.0000,1.500000,1.500000,,0.250000,,,,,,,120,40,0.500000");
+        assert_eq!(lines[2], "pt_4spp,0,0.0000,,,,,,,,,,,,,");
+    }
+
+    #[test]
+    fn wall_clock_passes_get_their_own_columns() {
+        let a = FrameRecord {
+            method: "taa".into(),
+            passes: vec![("taa_trace".into(), Some(3.0)), ("taa_resolve".into(), Some(1.0))],
+            clock: Some(render::timing::Clock::Wall),
+            ..Default::default()
+        };
+        let b = FrameRecord { method: "pt_1spp".into(), passes: vec![("path_trace".into(), Some(2.0))], clock: Some(render::timing::Clock::Gpu), ..Default::default() };
+        let csv = to_csv(&[a, b]);
+        let lines: Vec<&str> = csv.lines().collect();
+        assert!(lines[0].starts_with("method,frame,cpu_ms,gpu_ms_total,wall_ms_total,wall_ms_taa_trace,wall_ms_taa_resolve,gpu_ms_path_trace,smape"), "{}", lines[0]);
+        assert!(lines[1].starts_with("taa,0,0.0000,,4.000000,3.000000,1.000000,,"), "{}", lines[1]);
+        assert!(lines[2].starts_with("pt_1spp,0,0.0000,2.000000,,,,2.000000,"), "{}", lines[2]);
     }
 }

@@ -187,6 +187,9 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary> {
             record.frame = frame;
             record.cpu_ms = cpu_ms;
             record.passes = out.passes;
+            record.clock = out.clock;
+            record.rays = out.rays;
+            record.shaded = out.shaded;
             record.stats = out.stats;
             records.push(record);
             previous[m] = Some(current);

@@ -56,6 +56,7 @@ const HC_COUNTER_EVICTED: u32 = 1u;
 const HC_COUNTER_INSERTED: u32 = 2u;
 const HC_COUNTER_FAILED: u32 = 3u;
 const HC_COUNTER_UPDATES: u32 = 4u;
+const HC_COUNTER_RAYS: u32 = 5u;      // rays traced by hc_trace and hc_update
 
 @group(2) @binding(0) var<uniform> hc: HashCacheParams;
 @group(2) @binding(1) var<storage, read_write> slots: array<atomic<u32>>;
@@ -117,6 +118,12 @@ fn hc_find_or_insert(key: VoxelKey) -> u32 {
     return HC_NONE;
 }
 
+// Stores the pixel's record at the end of hc_trace and books the invocation's rays.
+fn hc_store_record(index: u32, r: HcRecord) {
+    records[index] = r;
+    atomicAdd(&counters[HC_COUNTER_RAYS], sg_rays_traced);
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn hc_trace(@builtin(global_invocation_id) id: vec3u) {
     if id.x >= frame.size.x || id.y >= frame.size.y {
@@ -134,7 +141,7 @@ fn hc_trace(@builtin(global_invocation_id) id: vec3u) {
     r.modulate = vec3f(0.0);
     if hit.instance == NO_HIT {
         r.direct = escaped_radiance(dir, 0.0);
-        records[index] = r;
+        hc_store_record(index, r);
         return;
     }
     let sp = surface_point(hit, origin, dir);
@@ -155,7 +162,7 @@ fn hc_trace(@builtin(global_invocation_id) id: vec3u) {
         r.direct += next_event(sp.position, sh, bsdf, -dir, &rng);
         let bs = bsdf_sample(bsdf, sh.ns, -dir, rng_next(&rng), rng_next2(&rng));
         if !bs.valid || dot(bs.wi, sh.ng) <= 0.0 {
-            records[index] = r;
+            hc_store_record(index, r);
             return;
         }
         let throughput = bs.f * (dot(sh.ns, bs.wi) / bs.pdf);
@@ -163,7 +170,7 @@ fn hc_trace(@builtin(global_invocation_id) id: vec3u) {
         let hit2 = trace_closest(o2, bs.wi, FAR);
         if hit2.instance == NO_HIT {
             r.direct += throughput * escaped_radiance(bs.wi, bs.pdf);
-            records[index] = r;
+            hc_store_record(index, r);
             return;
         }
         let sp2 = surface_point(hit2, o2, bs.wi);
@@ -192,7 +199,7 @@ fn hc_trace(@builtin(global_invocation_id) id: vec3u) {
     }
     // The update path continues this pixel's random stream.
     r.rng = hash_mix(rng ^ 0x9e3779b9u);
-    records[index] = r;
+    hc_store_record(index, r);
 }
 
 // One estimate of the radiance leaving the key point towards the ray's origin, emission
@@ -240,6 +247,7 @@ fn hc_update(@builtin(global_invocation_id) id: vec3u) {
     }
     atomicAdd(&counters[HC_COUNTER_UPDATES], 1u);
     var l = hc_sample(r);
+    atomicAdd(&counters[HC_COUNTER_RAYS], sg_rays_traced);
     if hc.lookup == 0u {
         l = hc_demodulate(l, r.modulate);
     }

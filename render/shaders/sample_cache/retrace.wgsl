@@ -252,6 +252,7 @@ fn retrace_list_main(@builtin(global_invocation_id) id: vec3u) {
     let p = entry % pixels;
     let s = entry / pixels;
     let visible = ssc_verify(dst_slots[entry].hit);
+    atomicAdd(&ssc_work[SSC_ALL_RAYS], sg_rays_traced);
     atomicOr(&pixel_atomics[SSC_ATOMICS * p + 2u], (1u << (s + 16u)) | select(0u, 1u << s, visible));
 }
 
@@ -299,6 +300,7 @@ fn finish_main(@builtin(global_invocation_id) id: vec3u) {
     ssc_out[p].rays = rays;
 
     atomicAdd(&ssc_work[SSC_RAYS], rays);
+    atomicAdd(&ssc_work[SSC_ALL_RAYS], sg_rays_traced);
     atomicAdd(&ssc_work[SSC_NEW], added);
     atomicAdd(&ssc_work[SSC_VISIBLE], countOneBits(out_vis));
     atomicAdd(&ssc_work[SSC_OCCUPIED], kf);

@@ -49,6 +49,7 @@ fn shade_main(@builtin(global_invocation_id) id: vec3u) {
     // Seeded by (pixel, slot): the list order (atomics) does not change any result.
     var rng = rng_seed(frame.seed.xy, frame.seed.z, entry % pixels, 0x5a00u + entry / pixels);
     let l = ssc_shade(slot.hit, &rng);
+    atomicAdd(&ssc_work[SSC_ALL_RAYS], sg_rays_traced);
     let c = slot.radiance.w;
     let a = max(1.0 / (c + 1.0), ssc.shade.x);
     dst_slots[entry].radiance = vec4f(mix(slot.radiance.rgb, l, a), c + 1.0);

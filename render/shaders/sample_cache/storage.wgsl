@@ -56,6 +56,7 @@ const SSC_BASE: u32 = 14u;
 const SSC_FLAGGED: u32 = 15u;
 const SSC_HISTOGRAM: u32 = 16u;
 const SSC_AUDIT: u32 = 32u;
+const SSC_ALL_RAYS: u32 = 34u;      // every ray of the frame: retraces, new samples, shading paths
 const SSC_RETRACE_COUNT: u32 = 33u; // entries of the retrace list (shares SSC_LIST with the shade list)   // visible samples found occluded by audit_main
 const SSC_LIST: u32 = 48u;
 

@@ -28,13 +28,16 @@
 //!   before the claimant is known.
 //! - Cells are not split into parent/child levels (that is the paper's Hybrid, not HashCache).
 //!
-//! Numbers (lavapipe, 2 shared CPU cores; `cargo run -p systems --example issue5_bench 320 180 5`,
-//! courtyard, camera moving, max depth 4, median GPU ms): secondary-hit lookup hc_age 5.2,
+//! Numbers (lavapipe, 2 shared CPU cores; an earlier courtyard version of issue5_bench at 320x180,
+//! camera moving, max depth 4, median GPU ms): secondary-hit lookup hc_age 5.2,
 //! hc_trace 334, hc_update 581, hc_resolve 6.2 (occupancy 0.17 of 2^18 slots, 18k update paths
 //! for 57.6k pixels); first-hit lookup 6.6 / 152 / 503 / 4.3 (occupancy 0.07); TAA trace 1034,
 //! resolve 11. fast_turn.ron at 64x36: mean frame-to-frame SMAPE 1 spp 0.46, hash cache 0.39,
 //! TAA 0.15, hash cache + TAA 0.13; relMSE at the reference frames 0.072, 0.052, 0.015-0.027,
-//! 0.010-0.023.
+//! 0.010-0.023. Hairball 320x180, max depth 3 (`cargo run --release -j2 -p systems --example
+//! issue5_bench -- 320 180 12`, table in render/src/sample_cache/README.md): hc_age 5.6,
+//! hc_trace 711, hc_update 517, hc_resolve 3.8 ms; 141 027 rays and 64 211 shaded paths
+//! (57 600 pixels + update paths) per frame.
 
 pub mod key;
 pub mod table_cpu;
@@ -45,9 +48,8 @@ use crate::path_tracer::PathTracer;
 use crate::readback::read_buffer;
 use crate::scene::Camera;
 use crate::taa::{PRIMARY_WGSL, Taa, TaaPrimary, halton_jitter};
-use crate::timing::{PassTimestamps, PassTiming};
+use crate::timing::{PassTimer, PassTiming};
 use bytemuck::{Pod, Zeroable};
-use std::time::Instant;
 
 pub use key::KeyParams;
 pub use table_cpu::{CpuHashTable, CpuSlot};
@@ -184,6 +186,8 @@ pub struct HashCacheStats {
     pub insert_failures: u32,
     /// Secondary paths traced for updates (one per reserved cell + failures).
     pub update_paths: u32,
+    /// Rays traced by hc_trace and hc_update (camera, shadow, bounce), counted on the GPU.
+    pub rays: u32,
 }
 
 impl HashCacheStats {
@@ -200,6 +204,10 @@ pub struct HashCacheOutput {
     pub stats: HashCacheStats,
     /// The four cache passes, then TAA's resolve when used.
     pub timings: Vec<PassTiming>,
+    /// Rays traced this frame ([`HashCacheStats::rays`]).
+    pub rays: u64,
+    /// Paths shaded: one per pixel (its primary hit, ended into the cache) plus the update paths.
+    pub shaded: u64,
 }
 
 pub struct HashCache {
@@ -215,7 +223,7 @@ pub struct HashCache {
     colour: wgpu::Buffer,
     group: wgpu::BindGroup,
     pipelines: [wgpu::ComputePipeline; 4],
-    timestamps: Option<PassTimestamps>,
+    timer: PassTimer,
     /// Frames rendered so far; the stamp of the next one is `frames + 1`.
     frames: u32,
 }
@@ -282,7 +290,7 @@ impl HashCache {
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(RenderError::Shader { pass: "hash_cache.wgsl".into(), message: e.to_string() });
         }
-        Ok(Self { settings, width, height, params, slots, cells, records, counters, primary, colour, group, pipelines, timestamps: PassTimestamps::new(gpu, 4), frames: 0 })
+        Ok(Self { settings, width, height, params, slots, cells, records, counters, primary, colour, group, pipelines, timer: PassTimer::new(gpu, &PASSES), frames: 0 })
     }
 
     /// The complete WGSL of the passes: shading library, TaaPrimary, keys, passes.
@@ -327,55 +335,40 @@ impl HashCache {
         tracer.prepare_frame(gpu, 1, 0, seed, frame);
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         gpu.queue.write_buffer(&self.counters, 0, &[0u8; 32]);
-        let start = Instant::now();
-        let (radiance, taa_timings) = match taa {
+        // The cache's own passes in one timed submission; TAA's resolve (its own timing) after.
+        let mut timed = self.timer.begin(gpu, "hash cache");
+        for (i, pipeline) in self.pipelines.iter().enumerate() {
+            timed.pass(i, |pass| {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
+                pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+                pass.set_bind_group(2, &self.group, &[]);
+                if i == 0 {
+                    pass.dispatch_workgroups(self.settings.capacity.div_ceil(64), 1, 1);
+                } else {
+                    pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
+                }
+            })?;
+        }
+        let mut timings = timed.submit()?;
+        let radiance = match taa {
             Some(taa) => {
                 let out = taa.resolve_external(gpu, jitter, |encoder, colour, primary| {
-                    self.encode(encoder, tracer);
                     encoder.copy_buffer_to_buffer(&self.colour, 0, colour, 0, self.colour.size());
                     encoder.copy_buffer_to_buffer(&self.primary, 0, primary, 0, self.primary.size());
                 })?;
-                (out.radiance, out.timings)
+                timings.extend(out.timings);
+                out.radiance
             }
-            None => {
-                let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hash cache") });
-                self.encode(&mut encoder, tracer);
-                gpu.queue.submit([encoder.finish()]);
-                let colour: Vec<[f32; 4]> = read(gpu, &self.colour, "hash cache colour")?;
-                (colour, vec![])
-            }
+            None => read(gpu, &self.colour, "hash cache colour")?,
         };
-        let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
-        let gpu_ms = match &self.timestamps {
-            Some(t) => Some(t.read(gpu).map_err(|reason| RenderError::Readback { what: "hash cache timestamps".into(), reason })?),
-            None => None,
-        };
-        let mut timings: Vec<PassTiming> =
-            PASSES.iter().enumerate().map(|(i, p)| PassTiming { pass: (*p).into(), gpu_ms: gpu_ms.as_ref().map(|t| t[i]), cpu_ms: if i == 0 { cpu_ms } else { 0.0 } }).collect();
-        timings.extend(taa_timings);
         let c: Vec<u32> = read(gpu, &self.counters, "hash cache counters")?;
         let primary: Vec<TaaPrimary> = read(gpu, &self.primary, "hash cache primary hits")?;
         self.frames += 1;
-        let stats = HashCacheStats { capacity: self.settings.capacity, occupied: c[0] + c[2], evicted: c[1], inserted: c[2], insert_failures: c[3], update_paths: c[4] };
-        Ok(HashCacheOutput { radiance, motion: primary.iter().map(|p| p.motion).collect(), stats, timings })
-    }
-
-    fn encode(&self, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer) {
-        for (i, pipeline) in self.pipelines.iter().enumerate() {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(PASSES[i]), timestamp_writes: self.timestamps.as_ref().map(|t| t.writes(i as u32)) });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
-            pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
-            pass.set_bind_group(2, &self.group, &[]);
-            if i == 0 {
-                pass.dispatch_workgroups(self.settings.capacity.div_ceil(64), 1, 1);
-            } else {
-                pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
-            }
-        }
-        if let Some(t) = &self.timestamps {
-            t.resolve(encoder);
-        }
+        let stats =
+            HashCacheStats { capacity: self.settings.capacity, occupied: c[0] + c[2], evicted: c[1], inserted: c[2], insert_failures: c[3], update_paths: c[4], rays: c[5] };
+        let shaded = self.width as u64 * self.height as u64 + stats.update_paths as u64;
+        Ok(HashCacheOutput { radiance, motion: primary.iter().map(|p| p.motion).collect(), stats, timings, rays: stats.rays as u64, shaded })
     }
 
     /// The table as stored: (checksum, last access, claim, home) per slot → [`CpuSlot`]s.

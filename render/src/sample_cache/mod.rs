@@ -25,18 +25,30 @@ pub mod storage;
 pub use settings::{Retrace, SampleCacheSettings, ShadingMode};
 pub use storage::GpuSlot;
 
-use std::time::Instant;
-
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::path_tracer::PathTracer;
 use crate::readback::read_buffer;
-use crate::timing::{PassTimestamps, PassTiming};
+use crate::timing::{PassTimer, PassTiming};
 
 /// Pass names in [`CacheFrame::timings`].
 pub const PASSES: [&str; 4] = ["reserve", "trace", "shade", "reconstruct"];
+
+/// The dispatches of a frame, `PASS/entry`, in order; each is timed on its own
+/// ([`CacheFrame::dispatch_timings`]) and the pass time is the sum of its dispatches'.
+pub const DISPATCHES: [&str; 9] = [
+    "reserve/begin_main",
+    "reserve/reserve_main",
+    "trace/retrace_main",
+    "trace/retrace_list_main",
+    "trace/finish_main",
+    "shade/rates_main",
+    "shade/select_main",
+    "shade/shade_main",
+    "reconstruct/reconstruct_main",
+];
 
 const HEADER_WORDS: u64 = 48;
 const AUDIT_WORD: u64 = 32;
@@ -87,7 +99,10 @@ pub const FLAG_HOLE: u32 = 4;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CacheStats {
     pub shaded: u32,
+    /// Primary-visibility rays: retraces and new samples (the rays of the paper's figure 7).
     pub rays: u32,
+    /// Every ray of the frame: `rays` + the shadow and bounce rays of the shaded paths.
+    pub all_rays: u32,
     pub new_samples: u32,
     pub purged: u32,
     pub reprojected: u32,
@@ -109,7 +124,10 @@ pub struct CacheFrame {
     pub motion: Vec<[f32; 2]>,
     pub flags: Vec<u32>,
     pub stats: CacheStats,
+    /// Per pass of [`PASSES`]: the sum of its dispatches.
     pub timings: Vec<PassTiming>,
+    /// Per dispatch of [`DISPATCHES`].
+    pub dispatch_timings: Vec<PassTiming>,
 }
 
 /// The whole cache as the last frame left it (tests, debugging).
@@ -141,7 +159,7 @@ pub struct SampleCache {
     bind_groups: [wgpu::BindGroup; 2],
     /// Index of the cache holding the last frame (the source of the next reprojection).
     current: usize,
-    timestamps: Option<PassTimestamps>,
+    timer: PassTimer,
     frames: u32,
 }
 
@@ -256,7 +274,7 @@ impl SampleCache {
             header_readback,
             bind_groups,
             current: 0,
-            timestamps: PassTimestamps::new(gpu, PASSES.len() as u32),
+            timer: PassTimer::new(gpu, &DISPATCHES),
             frames: 0,
         })
     }
@@ -272,7 +290,6 @@ impl SampleCache {
         if tracer.settings().width != w || tracer.settings().height != h {
             return Err(RenderError::Settings(format!("sample cache is {w}x{h}, the path tracer {}x{}", tracer.settings().width, tracer.settings().height)));
         }
-        let start = Instant::now();
         tracer.prepare_frame(gpu, 1, 0, seed, frame);
         let s = &self.settings;
         let vfov = 2.0 * tracer_tan_half_fov(tracer).atan();
@@ -297,7 +314,8 @@ impl SampleCache {
         };
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
 
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sample cache") });
+        let mut timed = self.timer.begin(gpu, "sample cache");
+        let encoder = timed.encoder();
         encoder.clear_buffer(&self.pixel_atomics, 0, None);
         // Header words 0-5 and 10-31; 6-9 (importance bounds) carry over, begin_main moves them.
         encoder.clear_buffer(&self.work, 0, Some(24));
@@ -309,49 +327,46 @@ impl SampleCache {
         }
         let bind_group = &self.bind_groups[self.current];
         let (gx, gy) = (w.div_ceil(8), h.div_ceil(8));
-        let groups: [&[(&wgpu::ComputePipeline, [u32; 3])]; 4] = [
-            &[(&self.pipelines.begin, [1, 1, 1]), (&self.pipelines.reserve, [gx, gy, s.slots])],
-            &[(&self.pipelines.retrace, [gx, gy, 1]), (&self.pipelines.retrace_list, [gx, gy, s.slots]), (&self.pipelines.finish, [gx, gy, 1])],
-            &[(&self.pipelines.rates, [1, 1, 1]), (&self.pipelines.select, [gx, gy, 1]), (&self.pipelines.shade, [gx, gy, s.slots])],
-            &[(&self.pipelines.reconstruct, [gx, gy, 1])],
+        let p = &self.pipelines;
+        // In the order of DISPATCHES.
+        let dispatches: [(&wgpu::ComputePipeline, [u32; 3]); 9] = [
+            (&p.begin, [1, 1, 1]),
+            (&p.reserve, [gx, gy, s.slots]),
+            (&p.retrace, [gx, gy, 1]),
+            (&p.retrace_list, [gx, gy, s.slots]),
+            (&p.finish, [gx, gy, 1]),
+            (&p.rates, [1, 1, 1]),
+            (&p.select, [gx, gy, 1]),
+            (&p.shade, [gx, gy, s.slots]),
+            (&p.reconstruct, [gx, gy, 1]),
         ];
-        for (i, dispatches) in groups.iter().enumerate() {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(PASSES[i]),
-                timestamp_writes: self.timestamps.as_ref().map(|t| t.writes(i as u32)),
-            });
-            pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
-            pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
-            pass.set_bind_group(2, bind_group, &[]);
-            for (pipeline, [x, y, z]) in dispatches.iter() {
+        for (i, (pipeline, [x, y, z])) in dispatches.into_iter().enumerate() {
+            timed.pass(i, |pass| {
+                pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
+                pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+                pass.set_bind_group(2, bind_group, &[]);
                 pass.set_pipeline(pipeline);
-                pass.dispatch_workgroups(*x, *y, *z);
-            }
+                pass.dispatch_workgroups(x, y, z);
+            })?;
         }
-        if let Some(t) = &self.timestamps {
-            t.resolve(&mut encoder);
-        }
+        let encoder = timed.encoder();
         encoder.copy_buffer_to_buffer(&self.out, 0, &self.out_readback, 0, self.out.size());
         encoder.copy_buffer_to_buffer(&self.work, 0, &self.header_readback, 0, HEADER_WORDS * 4);
-        gpu.queue.submit([encoder.finish()]);
+        let dispatch_timings = timed.submit()?;
+        let mut timings = Vec::new();
+        for t in &dispatch_timings {
+            let pass = t.pass.split('/').next().unwrap_or(&t.pass);
+            crate::timing::merge(&mut timings, vec![PassTiming { pass: pass.into(), ..t.clone() }]);
+        }
         self.current = 1 - self.current;
         self.frames += 1;
 
         let out: Vec<GpuPixel> = read_buffer(gpu, &self.out_readback).map_err(|r| readback_error("sample cache output", r))?;
         let header: Vec<u32> = read_buffer(gpu, &self.header_readback).map_err(|r| readback_error("sample cache counters", r))?;
-        let gpu_ms = match &self.timestamps {
-            Some(t) => Some(t.read(gpu).map_err(|r| readback_error("timestamps", r))?),
-            None => None,
-        };
-        let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
-        let timings = PASSES
-            .iter()
-            .enumerate()
-            .map(|(i, p)| PassTiming { pass: (*p).into(), gpu_ms: gpu_ms.as_ref().map(|v| v[i]), cpu_ms: if i == 0 { cpu_ms } else { 0.0 } })
-            .collect();
         let stats = CacheStats {
             shaded: header[0],
             rays: header[1],
+            all_rays: header[34],
             new_samples: header[2],
             purged: header[3],
             reprojected: header[4],
@@ -370,6 +385,7 @@ impl SampleCache {
             flags: out.iter().map(|p| p.flags).collect(),
             stats,
             timings,
+            dispatch_timings,
         })
     }
 

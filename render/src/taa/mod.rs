@@ -25,8 +25,10 @@
 //! - the primary ray is traced twice (once for its attributes, once inside `path_radiance`).
 //!
 //! Cost (lavapipe on 2 shared CPU cores, courtyard 320x180, max depth 4, median GPU ms of 5
-//! frames, `cargo run -p systems --example issue5_bench 320 180 5`): taa_trace 1034,
-//! taa_resolve 11.
+//! frames, an earlier courtyard version of issue5_bench): taa_trace 1034, taa_resolve 11.
+//! Hairball 320x180, max depth 3, mean of 10 frames (`cargo run --release -j2 -p systems
+//! --example issue5_bench -- 320 180 12`, table in render/src/sample_cache/README.md):
+//! taa_trace 1105, taa_resolve 10.8; 191 905 rays per frame (GPU counter).
 
 pub mod jitter;
 pub mod resolve_cpu;
@@ -35,9 +37,8 @@ use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::path_tracer::PathTracer;
 use crate::readback::read_buffer;
-use crate::timing::{PassTimestamps, PassTiming};
+use crate::timing::{PassTimer, PassTiming};
 use bytemuck::{Pod, Zeroable};
-use std::time::Instant;
 
 pub use jitter::{halton, halton_jitter};
 
@@ -163,6 +164,11 @@ pub struct TaaOutput {
     pub history_length: Vec<f32>,
     /// [`TAA_TRACE_PASS`] (when traced here) and [`TAA_RESOLVE_PASS`].
     pub timings: Vec<PassTiming>,
+    /// Rays the trace pass traced (primary-attribute ray + the path's camera, shadow and
+    /// bounce rays), counted on the GPU; 0 for [`Taa::resolve_external`].
+    pub rays: u64,
+    /// Paths shaded: one per pixel; 0 for [`Taa::resolve_external`].
+    pub shaded: u64,
 }
 
 /// Everything the last resolve read and wrote, for checking it against [`resolve_cpu`].
@@ -189,7 +195,9 @@ pub struct Taa {
     trace_pipeline: wgpu::ComputePipeline,
     resolve_groups: [wgpu::BindGroup; 2],
     resolve_pipeline: wgpu::ComputePipeline,
-    timestamps: Option<PassTimestamps>,
+    /// [0]: rays traced by the trace pass this frame.
+    counters: wgpu::Buffer,
+    timer: PassTimer,
     parity: usize,
     history_valid: bool,
     last_history_valid: bool,
@@ -202,7 +210,7 @@ impl Taa {
         let s = tracer.settings();
         let (width, height) = (s.width, s.height);
         gpu.check_resolution(width, height, 16 * 3 + 32 * 2)?;
-        let needed = LIBRARY_STORAGE_BUFFERS + 2;
+        let needed = LIBRARY_STORAGE_BUFFERS + 3;
         let limit = gpu.limits.max_storage_buffers_per_shader_stage;
         if needed > limit {
             return Err(crate::gpu::GpuError::OverLimit { what: "storage buffers of the TAA trace pass".into(), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
@@ -217,6 +225,7 @@ impl Taa {
         let current = buffer("taa current", pixels * 16, rw);
         let primary = [buffer("taa primary 0", pixels * 32, rw), buffer("taa primary 1", pixels * 32, rw)];
         let history = [buffer("taa history 0", pixels * 16, rw), buffer("taa history 1", pixels * 16, rw)];
+        let counters = buffer("taa ray counter", 16, rw);
 
         let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
             binding,
@@ -227,7 +236,7 @@ impl Taa {
         let uniform = wgpu::BufferBindingType::Uniform;
         let read = wgpu::BufferBindingType::Storage { read_only: true };
         let write = wgpu::BufferBindingType::Storage { read_only: false };
-        let trace_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("taa trace"), entries: &[entry(0, uniform), entry(1, write), entry(2, write)] });
+        let trace_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("taa trace"), entries: &[entry(0, uniform), entry(1, write), entry(2, write), entry(3, write)] });
         let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("taa resolve"),
             entries: &[entry(0, uniform), entry(1, read), entry(2, read), entry(3, read), entry(4, read), entry(5, write)],
@@ -269,7 +278,8 @@ impl Taa {
             trace_pipeline,
             resolve_groups,
             resolve_pipeline,
-            timestamps: PassTimestamps::new(gpu, 2),
+            counters,
+            timer: PassTimer::new(gpu, &[TAA_TRACE_PASS, TAA_RESOLVE_PASS]),
             parity: 0,
             history_valid: false,
             last_history_valid: false,
@@ -296,25 +306,22 @@ impl Taa {
         let jitter = halton_jitter(frame, self.settings.jitter_length);
         tracer.prepare_frame(gpu, 1, 0, seed, frame);
         self.write_params(gpu, jitter);
-        let start = Instant::now();
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("taa") });
-        {
-            let group = self.trace_group(gpu, &self.current, &self.primary[self.parity]);
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(TAA_TRACE_PASS), timestamp_writes: self.timestamps.as_ref().map(|t| t.writes(0)) });
+        let group = self.trace_group(gpu, &self.current, &self.primary[self.parity]);
+        let mut timed = self.timer.begin(gpu, "taa");
+        timed.encoder().clear_buffer(&self.counters, 0, None);
+        timed.pass(0, |pass| {
             pass.set_pipeline(&self.trace_pipeline);
             pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
             pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
             pass.set_bind_group(2, &group, &[]);
             pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
-        }
-        self.encode_resolve(&mut encoder, 1);
-        let gpu_ms = self.submit(gpu, encoder)?;
-        let cpu_ms = start.elapsed().as_secs_f64() * 1e3;
-        let timings = vec![
-            PassTiming { pass: TAA_TRACE_PASS.into(), gpu_ms: gpu_ms.as_ref().map(|t| t[0]), cpu_ms },
-            PassTiming { pass: TAA_RESOLVE_PASS.into(), gpu_ms: gpu_ms.as_ref().map(|t| t[1]), cpu_ms: 0.0 },
-        ];
-        self.finish(gpu, timings)
+        })?;
+        timed.pass(1, |pass| self.encode_resolve(pass))?;
+        let timings = timed.submit()?;
+        let mut out = self.finish(gpu, timings)?;
+        out.rays = self.read::<u32>(gpu, &self.counters, "TAA ray counter")?[0] as u64;
+        out.shaded = self.width as u64 * self.height as u64;
+        Ok(out)
     }
 
     /// The bind group of the trace pass's @group(2) writing `current` and `primary`; other
@@ -324,13 +331,15 @@ impl Taa {
             wgpu::BindGroupEntry { binding: 0, resource: self.params.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 1, resource: current.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 2, resource: primary.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 3, resource: self.counters.as_entire_binding() },
         ];
         gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("taa trace"), layout: &self.trace_layout, entries: &entries })
     }
 
     /// Resolves a colour another pass produced: `write` gets an encoder, the buffer to write the
     /// linear colour into (vec4 per pixel) and the one for [`TaaPrimary`] texels, and records
-    /// its passes; the resolve follows in the same submission.
+    /// untimed commands (copies; the producer times its own passes); the resolve follows in the
+    /// same submission.
     pub fn resolve_external(
         &mut self,
         gpu: &Gpu,
@@ -338,12 +347,10 @@ impl Taa {
         write: impl FnOnce(&mut wgpu::CommandEncoder, &wgpu::Buffer, &wgpu::Buffer),
     ) -> Result<TaaOutput, RenderError> {
         self.write_params(gpu, jitter);
-        let start = Instant::now();
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("taa resolve") });
-        write(&mut encoder, &self.current, &self.primary[self.parity]);
-        self.encode_resolve(&mut encoder, 1);
-        let gpu_ms = self.submit(gpu, encoder)?;
-        let timings = vec![PassTiming { pass: TAA_RESOLVE_PASS.into(), gpu_ms: gpu_ms.as_ref().map(|t| t[1]), cpu_ms: start.elapsed().as_secs_f64() * 1e3 }];
+        let mut timed = self.timer.begin(gpu, "taa resolve");
+        write(timed.encoder(), &self.current, &self.primary[self.parity]);
+        timed.pass(1, |pass| self.encode_resolve(pass))?;
+        let timings = timed.submit()?;
         self.finish(gpu, timings)
     }
 
@@ -353,22 +360,10 @@ impl Taa {
         self.last_history_valid = self.history_valid;
     }
 
-    fn encode_resolve(&self, encoder: &mut wgpu::CommandEncoder, timestamp: u32) {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(TAA_RESOLVE_PASS), timestamp_writes: self.timestamps.as_ref().map(|t| t.writes(timestamp)) });
+    fn encode_resolve(&self, pass: &mut wgpu::ComputePass<'_>) {
         pass.set_pipeline(&self.resolve_pipeline);
         pass.set_bind_group(0, &self.resolve_groups[self.parity], &[]);
         pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
-    }
-
-    fn submit(&self, gpu: &Gpu, mut encoder: wgpu::CommandEncoder) -> Result<Option<Vec<f64>>, RenderError> {
-        if let Some(t) = &self.timestamps {
-            t.resolve(&mut encoder);
-        }
-        gpu.queue.submit([encoder.finish()]);
-        match &self.timestamps {
-            None => Ok(None),
-            Some(t) => t.read(gpu).map(Some).map_err(|reason| RenderError::Readback { what: "TAA timestamps".into(), reason }),
-        }
     }
 
     /// Reads the resolved frame and motion, then swaps the ping-pong buffers.
@@ -382,6 +377,8 @@ impl Taa {
             history_length: resolved.iter().map(|c| c[3]).collect(),
             motion: primary.iter().map(|p| p.motion).collect(),
             timings,
+            rays: 0,
+            shaded: 0,
         })
     }
 

@@ -20,12 +20,13 @@ fn label(column: &str) -> String {
         "rel_mse" => "relative MSE".into(),
         "cpu_ms" => "CPU time (ms)".into(),
         "gpu_ms_total" => "GPU time (ms)".into(),
+        "wall_ms_total" => "wall time of the passes (ms)".into(),
         c => c.replace('_', " "),
     }
 }
 
 /// Columns charted against frame, in this order, then per-region FLIP and SMAPE.
-const FRAME_COLUMNS: [&str; 7] = ["flip", "smape", "smape_reprojected", "psnr", "rel_mse", "gpu_ms_total", "cpu_ms"];
+const FRAME_COLUMNS: [&str; 8] = ["flip", "smape", "smape_reprojected", "psnr", "rel_mse", "gpu_ms_total", "wall_ms_total", "cpu_ms"];
 
 fn mean(v: &[(f64, f64)]) -> Option<f64> {
     let f: Vec<f64> = v.iter().map(|p| p.1).filter(|x| x.is_finite()).collect();
@@ -83,7 +84,7 @@ pub fn reliability_chart(manifest: &Manifest, frames: &Frames) -> Option<(String
 }
 
 pub fn speed_accuracy_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)> {
-    let time_col = ["gpu_ms_total", "cpu_ms"].into_iter().find(|c| frames.column(c).is_some_and(|i| frames.has_data(i)));
+    let time_col = ["gpu_ms_total", "wall_ms_total", "cpu_ms"].into_iter().find(|c| frames.column(c).is_some_and(|i| frames.has_data(i)));
     let Some(time_col) = time_col else { return vec![] };
     let t = frames.column(time_col).unwrap();
     let mut out = Vec::new();

@@ -43,9 +43,6 @@ impl FrameMethod for HashCacheMethod {
         let out = cache.render(ctx.gpu, ctx.tracer, &ctx.scene.camera, ctx.scenario.seed, ctx.frame, taa.as_mut())?;
         let s = out.stats;
         Ok(MethodOutput {
-            radiance: out.radiance,
-            motion: out.motion,
-            passes: out.timings.iter().map(|t| (t.pass.clone(), t.gpu_ms)).collect(),
             stats: vec![
                 ("cache_occupancy".into(), s.occupancy()),
                 ("cache_used_cells".into(), s.occupied as f64),
@@ -54,7 +51,7 @@ impl FrameMethod for HashCacheMethod {
                 ("cache_insert_failures".into(), s.insert_failures as f64),
                 ("cache_update_paths".into(), s.update_paths as f64),
             ],
-            images: vec![],
+            ..MethodOutput::timed(out.radiance, out.motion, &out.timings, out.rays, out.shaded)
         })
     }
 }

@@ -319,6 +319,8 @@ impl FrameMethod for Nirc {
             ],
             stats,
             images,
+            // Ray and shading counters, the pass clock: not reported yet (issue 4).
+            ..Default::default()
         })
     }
 }

@@ -25,11 +25,6 @@ impl FrameMethod for PathTracing {
 
     fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodOutput> {
         let out = ctx.tracer.render(ctx.gpu, self.spp, ctx.scenario.seed, ctx.frame)?;
-        Ok(MethodOutput {
-            radiance: out.radiance,
-            motion: out.gbuffer.motion,
-            passes: out.timings.iter().map(|t| (t.pass.clone(), t.gpu_ms)).collect(),
-            ..Default::default()
-        })
+        Ok(MethodOutput::timed(out.radiance, out.gbuffer.motion, &out.timings, out.rays, out.shaded))
     }
 }

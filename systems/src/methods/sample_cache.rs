@@ -36,8 +36,7 @@ impl FrameMethod for SampleCacheMethod {
         let pixels = out.radiance.len().max(1) as f64;
         let n = self.settings.slots as f64;
         let stats = vec![
-            ("shaded_samples".to_string(), s.shaded as f64),
-            ("traced_rays".to_string(), s.rays as f64),
+            ("primary_rays".to_string(), s.rays as f64),
             ("new_samples".to_string(), s.new_samples as f64),
             ("purged_samples".to_string(), s.purged as f64),
             ("reprojected_samples".to_string(), s.reprojected as f64),
@@ -56,11 +55,9 @@ impl FrameMethod for SampleCacheMethod {
             })
             .collect();
         Ok(MethodOutput {
-            radiance: out.radiance,
-            motion: out.motion,
-            passes: out.timings.iter().map(|t| (t.pass.clone(), t.gpu_ms)).collect(),
             stats,
             images: vec![MethodImage { name: "trace_mask".into(), pixels: trace_mask, hdr: false }],
+            ..MethodOutput::timed(out.radiance, out.motion, &out.timings, s.all_rays as u64, s.shaded as u64)
         })
     }
 }

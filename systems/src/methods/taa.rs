@@ -37,11 +37,8 @@ impl FrameMethod for TaaMethod {
         let rejected = out.history_length.iter().filter(|&&l| l <= 1.0).count() as f64 / n;
         let mean_length = out.history_length.iter().map(|&l| l as f64).sum::<f64>() / n;
         Ok(MethodOutput {
-            radiance: out.radiance,
-            motion: out.motion,
-            passes: out.timings.iter().map(|t| (t.pass.clone(), t.gpu_ms)).collect(),
             stats: vec![("history_rejected".into(), rejected), ("history_length_mean".into(), mean_length)],
-            images: vec![],
+            ..MethodOutput::timed(out.radiance, out.motion, &out.timings, out.rays, out.shaded)
         })
     }
 }
