@@ -63,6 +63,9 @@ struct Record {
 // Per pixel: motion of the pixel-centre primary hit (as the path tracer's G-buffer), for SMAPE
 // with reprojection.
 @group(2) @binding(6) var<storage, read_write> motion: array<vec2f>;
+// Rays traced this frame (sg_rays_traced of every invocation): [0] camera paths (queries pass,
+// motion rays included), [1] training targets. Cleared by encode_queries.
+@group(2) @binding(7) var<storage, read_write> ray_counters: array<atomic<u32>>;
 
 // Stream of training-path random numbers: disjoint from the camera samples' (small indices).
 const TRAIN_SAMPLE_STREAM: u32 = 0x80000001u;
@@ -154,6 +157,7 @@ fn queries_main(@builtin(global_invocation_id) id: vec3u) {
         hit_point = surface_point(hit, origin, dir).position;
     }
     motion[pixel] = primary_motion(hit, origin, dir, hit_point);
+    atomicAdd(&ray_counters[0], sg_rays_traced);
 }
 
 fn target_of(q: u32, rng: ptr<function, u32>) -> vec3f {
@@ -189,6 +193,7 @@ fn targets_main(@builtin(global_invocation_id) id: vec3u) {
         r.target_rgb = vec4f(target_of(chosen, &rng), 0.0);
     }
     records[params.record_count + i] = r;
+    atomicAdd(&ray_counters[1], sg_rays_traced);
 }
 
 // One thread: the valid candidates in slot order, then repeated cyclically to fill every slot

@@ -48,8 +48,9 @@ struct CacheParams {
 
 /// Bytes of one `QueryMeta` (weight, prefix, origin) in the shader.
 const META_BYTES: u64 = 48;
-/// Storage buffers of this pass's own group (queries, meta, records, answers, image, motion).
-const OWN_STORAGE_BUFFERS: u32 = 6;
+/// Storage buffers of this pass's own group (queries, meta, records, answers, image, motion,
+/// ray counters).
+const OWN_STORAGE_BUFFERS: u32 = 7;
 const WORKGROUP_2D: u32 = 8;
 const WORKGROUP_1D: u32 = 64;
 
@@ -77,6 +78,8 @@ pub struct CachePaths {
     records: wgpu::Buffer,
     /// Per pixel motion vector of the last `encode_queries`.
     motion: wgpu::Buffer,
+    /// Rays traced since the last `encode_queries`: camera paths, training targets.
+    ray_counters: wgpu::Buffer,
     /// Bound where a pass does not use the caller's output.
     scratch: CacheOutput,
 }
@@ -165,6 +168,7 @@ impl CachePaths {
         let meta = buffer("nirc query weights", query_count * META_BYTES)?;
         let records = buffer("nirc training records", 2 * settings.train_records as u64 * size_of::<TrainingRecord>() as u64)?;
         let motion = buffer("nirc motion", width as u64 * height as u64 * 8)?;
+        let ray_counters = buffer("nirc ray counters", 8)?;
         let mut me = Self {
             settings,
             width,
@@ -181,6 +185,7 @@ impl CachePaths {
             meta,
             records,
             motion,
+            ray_counters,
             scratch: CacheOutput { answers: buffer("nirc scratch", 16)?, image: buffer("nirc scratch", 16)? },
         };
         me.scratch = me.output(gpu)?;
@@ -240,6 +245,7 @@ impl CachePaths {
             (4, &out.answers),
             (5, &out.image),
             (6, &self.motion),
+            (7, &self.ray_counters),
         ]
         .map(|(binding, b): (u32, &wgpu::Buffer)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() });
         gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("nirc cache paths"), layout: &self.layout, entries: &entries })
@@ -262,6 +268,7 @@ impl CachePaths {
     /// The uniform is written at the next submission: submit before preparing another frame.
     pub fn encode_queries(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer, seed: u64, frame: u32) {
         tracer.prepare_frame(gpu, self.spp, 0, seed, frame);
+        encoder.clear_buffer(&self.ray_counters, 0, None);
         let group = self.bind_group(gpu, &self.scratch);
         self.pass(encoder, tracer, &group, &self.queries_pipeline, "nirc queries", self.image_groups());
     }
@@ -300,6 +307,14 @@ impl CachePaths {
         Ok(bytemuck::cast_slice::<u8, [f32; 2]>(&bytes)[..self.pixels() as usize].to_vec())
     }
 
+    /// Rays traced since the last `encode_queries` (camera paths, training targets), counted on
+    /// the GPU as every other method's.
+    pub fn read_rays(&self, gpu: &Gpu) -> Result<[u64; 2], NircError> {
+        let bytes = crate::gpu::readback::read_bytes(gpu, &self.ray_counters, "nirc ray counters")?;
+        let c: &[u32] = bytemuck::cast_slice(&bytes);
+        Ok([c[0] as u64, c[1] as u64])
+    }
+
     /// Reads `out.answers` back (e.g. after `NeuralCache::encode_reliability`).
     pub fn read_answers(&self, gpu: &Gpu, out: &CacheOutput) -> Result<Vec<[f32; 4]>, NircError> {
         let bytes = crate::gpu::readback::read_bytes(gpu, &out.answers, "nirc answers")?;
@@ -330,6 +345,6 @@ fn own_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let rw = wgpu::BufferBindingType::Storage { read_only: false };
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("nirc cache paths"),
-        entries: &[entry(0, wgpu::BufferBindingType::Uniform), entry(1, rw), entry(2, rw), entry(3, rw), entry(4, rw), entry(5, rw), entry(6, rw)],
+        entries: &[entry(0, wgpu::BufferBindingType::Uniform), entry(1, rw), entry(2, rw), entry(3, rw), entry(4, rw), entry(5, rw), entry(6, rw), entry(7, rw)],
     })
 }

@@ -167,6 +167,9 @@ fn training_records_are_queries_with_finite_targets() {
     paths.encode_records(g, &mut encoder, &t);
     g.queue.submit([encoder.finish()]);
     let records = paths.read_records(g).unwrap();
+    // Camera rays, motion rays and NEE shadow rays; every training record traces at least one.
+    let [camera, training] = paths.read_rays(g).unwrap();
+    assert!(camera > 2 * (W * H) as u64 && training >= 256, "rays: camera {camera}, training {training}");
     let bytes = nirc::gpu::readback::read_bytes(g, paths.queries(), "queries").unwrap();
     let queries: &[nirc::CacheQuery] = bytemuck::cast_slice(&bytes);
     let mut distinct = std::collections::HashSet::new();
@@ -265,4 +268,23 @@ fn motion_vectors_match_the_path_tracers_gbuffer() {
     for (i, (a, b)) in got.iter().zip(&expected).enumerate() {
         assert!((a[0] - b[0]).abs() < 1e-3 && (a[1] - b[1]).abs() < 1e-3, "pixel {i}: {a:?} vs G-buffer {b:?}");
     }
+}
+
+#[test]
+fn ray_counters_count_every_ray_when_all_escape() {
+    // Looking straight up, every camera ray escapes: per pixel `spp` camera rays and one motion
+    // ray, no termination vertex, hence no query and no training ray.
+    let g = gpu();
+    let mut up = scene();
+    up.camera.target = up.camera.position + Vec3::new(0.0, 10.0, 0.01);
+    let mut t = tracer(3);
+    t.update(g, &up);
+    let spp = 2;
+    let paths = CachePaths::new(g, &t, spp, CachePathSettings { termination_vertex: 1, train_records: 64 }).unwrap();
+    let mut encoder = g.device.create_command_encoder(&Default::default());
+    paths.encode_queries(g, &mut encoder, &t, 5, 2);
+    paths.encode_records(g, &mut encoder, &t);
+    g.queue.submit([encoder.finish()]);
+    assert!(paths.read_query_valid(g).unwrap().iter().all(|v| !v), "the test needs every camera ray to escape");
+    assert_eq!(paths.read_rays(g).unwrap(), [(W * H * (spp + 1)) as u64, 0]);
 }

@@ -66,6 +66,10 @@ pub struct SharedCache {
     stats: Vec<(String, f64)>,
     /// Motion vectors of the frame's pixel-centre primary hits (shared by every mode).
     motion: Vec<[f32; 2]>,
+    /// Rays traced this frame: camera paths (with motion rays), training targets.
+    rays: [u64; 2],
+    /// Camera paths shaded this frame (pixels x spp).
+    shaded: u64,
     warm_start: Option<PathBuf>,
 }
 
@@ -99,6 +103,8 @@ fn shared_for(scenario: &Scenario, settings: &NircSettings, mode: PredictorMode)
                 train_ms: 0.0,
                 stats: Vec::new(),
                 motion: Vec::new(),
+                rays: [0; 2],
+                shaded: 0,
                 warm_start: None,
             }));
             list.push((key, Rc::downgrade(&rc)));
@@ -230,6 +236,8 @@ impl SharedCache {
         gpu.queue.submit([encoder.finish()]);
         wait(gpu)?;
         self.train_ms = ms(start);
+        self.rays = g.paths.read_rays(gpu)?;
+        self.shaded = g.paths.query_count() as u64;
 
         let counters = g.cache.counters(gpu)?;
         let loss = g.cache.last_loss(gpu, g.paths.record_count())?;
@@ -319,8 +327,11 @@ impl FrameMethod for Nirc {
             ],
             stats,
             images,
-            // Ray and shading counters, the pass clock: not reported yet (issue 4).
-            ..Default::default()
+            // Each submission timed alone to completion (nothing else runs on the device).
+            clock: Some(render::timing::Clock::Wall),
+            // Camera paths and training paths (shared by the modes: each pays them once).
+            rays: Some(shared.rays[0] + shared.rays[1]),
+            shaded: Some(shared.shaded),
         })
     }
 }
