@@ -9,6 +9,9 @@ pub enum NircError {
     Config(String),
     #[error(transparent)]
     Gpu(#[from] GpuError),
+    /// A pass built on the path tracer's shading library could not be made.
+    #[error(transparent)]
+    Render(#[from] render::error::RenderError),
     #[error("training batch of {requested} records is over the cache's max_batch of {max}")]
     BatchTooLarge { requested: u32, max: u32 },
     #[error("buffer '{what}' holds {bytes} bytes, {needed} needed for {count} items")]

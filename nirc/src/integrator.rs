@@ -48,9 +48,12 @@ struct CacheParams {
 
 /// Bytes of one `QueryMeta` (weight, prefix, origin) in the shader.
 const META_BYTES: u64 = 48;
-/// Storage buffers of this pass's own group (queries, meta, records, answers, image, motion,
-/// ray counters).
-const OWN_STORAGE_BUFFERS: u32 = 7;
+/// This pass's own @group(2): params, then queries, meta, records, answers, image, motion, ray
+/// counters.
+const OWN_GROUP: [wgpu::BufferBindingType; 8] = {
+    let rw = wgpu::BufferBindingType::Storage { read_only: false };
+    [wgpu::BufferBindingType::Uniform, rw, rw, rw, rw, rw, rw, rw]
+};
 const WORKGROUP_2D: u32 = 8;
 const WORKGROUP_1D: u32 = 64;
 
@@ -108,17 +111,6 @@ impl CachePaths {
         if query_count > u32::MAX as u64 / 2 {
             return Err(NircError::Config(format!("{width}x{height} at {spp} spp is {query_count} queries, too many")));
         }
-        let needed = OWN_STORAGE_BUFFERS + render::path_tracer::LIBRARY_STORAGE_BUFFERS;
-        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
-        if needed > limit {
-            return Err(render::gpu::GpuError::OverLimit {
-                what: "storage buffers of the NIRC cache-path pass".into(),
-                requested: needed as u64,
-                limit: limit as u64,
-                adapter: gpu.summary.name.clone(),
-            }
-            .into());
-        }
         let groups = settings.train_records.div_ceil(WORKGROUP_1D).max(query_count.div_ceil(WORKGROUP_1D as u64) as u32);
         if groups > gpu.limits.max_compute_workgroups_per_dimension {
             return Err(NircError::Config(format!("{groups} workgroups in one dispatch, over this adapter's limit")));
@@ -127,32 +119,8 @@ impl CachePaths {
         gpu.check_workgroup_memory("nirc cache_paths", 0)?;
 
         let device = &gpu.device;
-        let layout = own_layout(device);
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("nirc cache paths"),
-            bind_group_layouts: &[Some(tracer.scene_bind_group_layout()), Some(tracer.geometry().bind_group_layout()), Some(&layout)],
-            immediate_size: 0,
-        });
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("cache_paths.wgsl"), source: wgpu::ShaderSource::Wgsl(Self::shader_source().into()) });
-        let pipeline = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let queries_pipeline = pipeline("queries_main");
-        let targets_pipeline = pipeline("targets_main");
-        let compact_pipeline = pipeline("compact_main");
-        let oracle_pipeline = pipeline("oracle_main");
-        let resolve_pipeline = pipeline("resolve_main");
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(NircError::Config(format!("cache_paths.wgsl does not compile: {e}")));
-        }
+        let (layout, [queries_pipeline, targets_pipeline, compact_pipeline, oracle_pipeline, resolve_pipeline]) = tracer
+            .library_pass(gpu, "cache_paths.wgsl", Self::shader_source(), &OWN_GROUP, ["queries_main", "targets_main", "compact_main", "oracle_main", "resolve_main"])?;
         let buffer = |label: &str, bytes: u64| -> Result<wgpu::Buffer, NircError> {
             gpu.check_buffer_size(label, bytes)?;
             Ok(device.create_buffer(&wgpu::BufferDescriptor {
@@ -237,18 +205,8 @@ impl CachePaths {
     }
 
     fn bind_group(&self, gpu: &Gpu, out: &CacheOutput) -> wgpu::BindGroup {
-        let entries = [
-            (0, &self.params),
-            (1, &self.queries),
-            (2, &self.meta),
-            (3, &self.records),
-            (4, &out.answers),
-            (5, &out.image),
-            (6, &self.motion),
-            (7, &self.ray_counters),
-        ]
-        .map(|(binding, b): (u32, &wgpu::Buffer)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() });
-        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("nirc cache paths"), layout: &self.layout, entries: &entries })
+        let buffers = [&self.params, &self.queries, &self.meta, &self.records, &out.answers, &out.image, &self.motion, &self.ray_counters];
+        render::compute::buffer_group(gpu, "nirc cache paths", &self.layout, &buffers)
     }
 
     fn pass(&self, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer, group: &wgpu::BindGroup, pipeline: &wgpu::ComputePipeline, label: &str, workgroups: (u32, u32)) {
@@ -333,18 +291,4 @@ impl CachePaths {
         let bytes = crate::gpu::readback::read_bytes(gpu, &self.records, "nirc training records")?;
         Ok(bytemuck::cast_slice::<u8, TrainingRecord>(&bytes)[..self.record_count() as usize].to_vec())
     }
-}
-
-fn own_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-        count: None,
-    };
-    let rw = wgpu::BufferBindingType::Storage { read_only: false };
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("nirc cache paths"),
-        entries: &[entry(0, wgpu::BufferBindingType::Uniform), entry(1, rw), entry(2, rw), entry(3, rw), entry(4, rw), entry(5, rw), entry(6, rw), entry(7, rw)],
-    })
 }

@@ -4,6 +4,7 @@ pub mod scene;
 pub mod gpu;
 pub mod hash_cache;
 pub mod bvh;
+pub mod compute;
 pub mod error;
 pub mod frame;
 pub mod lights;

@@ -7,6 +7,7 @@
 //! radiance sum and the G-buffer.
 
 use crate::bvh::SceneGeometry;
+use crate::compute;
 use crate::error::RenderError;
 use crate::frame::{CameraBasis, FrameParams, GpuFrame};
 use crate::gpu::Gpu;
@@ -197,32 +198,11 @@ impl PathTracer {
         let counters = per_pixel("path tracer ray counter", COUNTER_WORDS * 4, rw | wgpu::BufferUsages::COPY_DST);
         let counters_readback = per_pixel("path tracer ray counter readback", COUNTER_WORDS * 4, readback);
 
-        let layout = bind_group_layout(device);
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("path tracer"),
-            bind_group_layouts: &[Some(&layout), Some(geometry.bind_group_layout())],
-            immediate_size: 0,
-        });
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("path_tracer.wgsl"), source: wgpu::ShaderSource::Wgsl(Self::shader_source().into()) });
-        let pipeline = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let trace_pipeline = pipeline("trace_main");
-        let gbuffer_pipeline = pipeline("gbuffer_main");
-        let accumulate_pipeline = pipeline("accumulate_main");
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Shader { pass: "path_tracer.wgsl".into(), message: e.to_string() });
-        }
+        let layout = bind_group_layout(gpu);
+        let [trace_pipeline, gbuffer_pipeline, accumulate_pipeline] =
+            compute::pipelines(gpu, "path_tracer.wgsl", Self::shader_source(), &[&layout, geometry.bind_group_layout()], ["trace_main", "gbuffer_main", "accumulate_main"])?;
 
-        let bind_group = make_bind_group(device, &layout, [&frame_buffer, &materials, &texels, &lights, &radiance_sum, &gbuffer, &sample_partials, &counters]);
+        let bind_group = compute::buffer_group(gpu, "path tracer", &layout, &[&frame_buffer, &materials, &texels, &lights, &radiance_sum, &gbuffer, &sample_partials, &counters]);
         Ok(Self {
             settings,
             geometry,
@@ -283,6 +263,34 @@ impl PathTracer {
             ]
             .join("\n")
         })
+    }
+
+    /// Group 0 over the current buffers, after one of them was replaced.
+    fn rebind(&mut self, gpu: &Gpu) {
+        let buffers = [&self.frame_buffer, &self.materials, &self.texels, &self.lights, &self.radiance_sum, &self.gbuffer, &self.sample_partials, &self.counters];
+        self.bind_group = compute::buffer_group(gpu, "path tracer", &self.layout, &buffers);
+    }
+
+    /// The layout of a pass's own @group(2) (buffer kinds by binding) and the pipelines of
+    /// `entries` in `source`, a WGSL module built on [`Self::library_source`] (scene @group(0),
+    /// geometry @group(1)). Refuses a pass with more storage buffers than the adapter binds.
+    pub fn library_pass<const N: usize>(
+        &self,
+        gpu: &Gpu,
+        pass: &str,
+        source: &str,
+        own: &[wgpu::BufferBindingType],
+        entries: [&str; N],
+    ) -> Result<(wgpu::BindGroupLayout, [wgpu::ComputePipeline; N]), RenderError> {
+        let own_storage = own.iter().filter(|k| matches!(k, wgpu::BufferBindingType::Storage { .. })).count() as u32;
+        let needed = LIBRARY_STORAGE_BUFFERS + own_storage;
+        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
+        if needed > limit {
+            return Err(crate::gpu::GpuError::OverLimit { what: format!("storage buffers of pass '{pass}'"), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
+        }
+        let layout = compute::buffer_layout(gpu, pass, own);
+        let pipelines = compute::pipelines(gpu, pass, source, &[&self.layout, self.geometry.bind_group_layout(), &layout], entries)?;
+        Ok((layout, pipelines))
     }
 
     /// Layout of @group(0) of [`Self::library_source`].
@@ -350,11 +358,7 @@ impl PathTracer {
             }
         }
         if rebind {
-            self.bind_group = make_bind_group(
-                &gpu.device,
-                &self.layout,
-                [&self.frame_buffer, &self.materials, &self.texels, &self.lights, &self.radiance_sum, &self.gbuffer, &self.sample_partials, &self.counters],
-            );
+            self.rebind(gpu);
         }
         self.light_table = light_table;
         self.previous_camera = self.camera;
@@ -418,11 +422,7 @@ impl PathTracer {
         let chunks = Self::chunks_for(self.paths_per_dispatch, pixels, self.max_chunks);
         if self.sample_partials.size() < pixels * chunks as u64 * 16 {
             self.sample_partials = Self::partials_buffer(gpu, pixels, chunks)?;
-            self.bind_group = make_bind_group(
-                &gpu.device,
-                &self.layout,
-                [&self.frame_buffer, &self.materials, &self.texels, &self.lights, &self.radiance_sum, &self.gbuffer, &self.sample_partials, &self.counters],
-            );
+            self.rebind(gpu);
         }
         Ok(())
     }
@@ -527,32 +527,16 @@ impl PathTracer {
     }
 }
 
-fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let buffer = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-        count: None,
-    };
+/// Group 0 of the path tracer and of every pass built on its shading library (the scene):
+/// frame uniform, materials, texels, lights, then the path tracer's own radiance sum, G-buffer,
+/// sample partials and ray counter.
+const SCENE_GROUP: [wgpu::BufferBindingType; 8] = {
     let read = wgpu::BufferBindingType::Storage { read_only: true };
     let write = wgpu::BufferBindingType::Storage { read_only: false };
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("path tracer"),
-        entries: &[
-            buffer(0, wgpu::BufferBindingType::Uniform),
-            buffer(1, read),
-            buffer(2, read),
-            buffer(3, read),
-            buffer(4, write),
-            buffer(5, write),
-            buffer(6, write),
-            buffer(7, write),
-        ],
-    })
+    [wgpu::BufferBindingType::Uniform, read, read, read, write, write, write, write]
+};
+
+fn bind_group_layout(gpu: &Gpu) -> wgpu::BindGroupLayout {
+    compute::buffer_layout(gpu, "path tracer", &SCENE_GROUP)
 }
 
-fn make_bind_group(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, buffers: [&wgpu::Buffer; 8]) -> wgpu::BindGroup {
-    let entries: Vec<wgpu::BindGroupEntry> =
-        buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("path tracer"), layout, entries: &entries })
-}

@@ -60,8 +60,6 @@ pub const HC_UPDATE_PASS: &str = "hc_update";
 pub const HC_RESOLVE_PASS: &str = "hc_resolve";
 const PASSES: [&str; 4] = [HC_AGE_PASS, HC_TRACE_PASS, HC_UPDATE_PASS, HC_RESOLVE_PASS];
 
-use crate::path_tracer::LIBRARY_STORAGE_BUFFERS;
-const OWN_STORAGE_BUFFERS: u32 = 6;
 
 /// Where the path terminates into the cache.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -234,11 +232,6 @@ impl HashCache {
         let s = tracer.settings();
         let (width, height) = (s.width, s.height);
         gpu.check_resolution(width, height, size_of::<HcRecord>() as u64 + 32 + 16)?;
-        let needed = LIBRARY_STORAGE_BUFFERS + OWN_STORAGE_BUFFERS;
-        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
-        if needed > limit {
-            return Err(crate::gpu::GpuError::OverLimit { what: "storage buffers of the hash cache passes".into(), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
-        }
         gpu.check_buffer_size("hash cache slots", settings.capacity as u64 * 16)?;
         gpu.check_buffer_size("hash cache cells", settings.capacity as u64 * 16)?;
         // No pass declares var<workgroup>.
@@ -255,41 +248,10 @@ impl HashCache {
         let primary = buffer("hash cache primary", pixels * size_of::<TaaPrimary>() as u64, rw);
         let colour = buffer("hash cache colour", pixels * 16, rw);
 
-        let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-            count: None,
-        };
         let write = wgpu::BufferBindingType::Storage { read_only: false };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("hash cache"),
-            entries: &[entry(0, wgpu::BufferBindingType::Uniform), entry(1, write), entry(2, write), entry(3, write), entry(4, write), entry(5, write), entry(6, write)],
-        });
-        let bufs = [&params, &slots, &cells, &records, &counters, &primary, &colour];
-        let entries: Vec<_> = bufs.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("hash cache"), layout: &layout, entries: &entries });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("hash cache"),
-            bind_group_layouts: &[Some(tracer.scene_bind_group_layout()), Some(tracer.geometry().bind_group_layout()), Some(&layout)],
-            immediate_size: 0,
-        });
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("hash_cache.wgsl"), source: wgpu::ShaderSource::Wgsl(Self::shader_source().into()) });
-        let pipeline = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let pipelines = PASSES.map(pipeline);
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Shader { pass: "hash_cache.wgsl".into(), message: e.to_string() });
-        }
+        let own = [wgpu::BufferBindingType::Uniform, write, write, write, write, write, write];
+        let (layout, pipelines) = tracer.library_pass(gpu, "hash_cache.wgsl", Self::shader_source(), &own, PASSES)?;
+        let group = crate::compute::buffer_group(gpu, "hash cache", &layout, &[&params, &slots, &cells, &records, &counters, &primary, &colour]);
         Ok(Self { settings, width, height, params, slots, cells, records, counters, primary, colour, group, pipelines, timer: PassTimer::new(gpu, &PASSES), frames: 0 })
     }
 

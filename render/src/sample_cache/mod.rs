@@ -52,7 +52,13 @@ pub const DISPATCHES: [&str; 9] = [
 
 const HEADER_WORDS: u64 = 48;
 const AUDIT_WORD: u64 = 32;
-const STORAGE_BUFFERS: u32 = 7;
+/// The cache's own @group(2): params, source mask and slots (read), then pixel atomics,
+/// destination slots and mask, work lists, output.
+const OWN_GROUP: [wgpu::BufferBindingType; 8] = {
+    let read = wgpu::BufferBindingType::Storage { read_only: true };
+    let write = wgpu::BufferBindingType::Storage { read_only: false };
+    [wgpu::BufferBindingType::Uniform, read, read, write, write, write, write, write]
+};
 
 /// The WGSL of the cache passes (appended to the path tracer's library).
 pub fn shader_source() -> &'static str {
@@ -182,17 +188,6 @@ impl SampleCache {
         let (width, height) = (tracer.settings().width, tracer.settings().height);
         let n = settings.slots as u64;
         gpu.check_resolution(width, height, 2 * 32 * n + 4 * 2 + 12 + 4 * n + 32)?;
-        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
-        let needed = STORAGE_BUFFERS + crate::path_tracer::LIBRARY_STORAGE_BUFFERS;
-        if needed > limit {
-            return Err(crate::gpu::GpuError::OverLimit {
-                what: "storage buffers of the sample cache passes".into(),
-                requested: needed as u64,
-                limit: limit as u64,
-                adapter: gpu.summary.name.clone(),
-            }
-            .into());
-        }
         // No var<workgroup> anywhere in the cache passes.
         for pass in PASSES {
             gpu.check_workgroup_memory(pass, 0)?;
@@ -216,46 +211,16 @@ impl SampleCache {
         let header_readback = buffer("ssc header readback", HEADER_WORDS * 4, readback)?;
         let params = buffer("ssc params", size_of::<GpuParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)?;
 
-        let layout = bind_group_layout(device);
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("sample cache"),
-            bind_group_layouts: &[Some(tracer.scene_bind_group_layout()), Some(tracer.geometry().bind_group_layout()), Some(&layout)],
-            immediate_size: 0,
-        });
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("sample_cache"), source: wgpu::ShaderSource::Wgsl(shader_source().into()) });
-        let pipeline = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let pipelines = Pipelines {
-            begin: pipeline("begin_main"),
-            reserve: pipeline("reserve_main"),
-            retrace: pipeline("retrace_main"),
-            retrace_list: pipeline("retrace_list_main"),
-            finish: pipeline("finish_main"),
-            rates: pipeline("rates_main"),
-            select: pipeline("select_main"),
-            shade: pipeline("shade_main"),
-            reconstruct: pipeline("reconstruct_main"),
-            audit: pipeline("audit_main"),
-        };
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Shader { pass: "shaders/sample_cache/*.wgsl".into(), message: e.to_string() });
-        }
+        let (layout, [begin, reserve, retrace, retrace_list, finish, rates, select, shade, reconstruct, audit]) = tracer.library_pass(
+            gpu,
+            "shaders/sample_cache/*.wgsl",
+            shader_source(),
+            &OWN_GROUP,
+            ["begin_main", "reserve_main", "retrace_main", "retrace_list_main", "finish_main", "rates_main", "select_main", "shade_main", "reconstruct_main", "audit_main"],
+        )?;
+        let pipelines = Pipelines { begin, reserve, retrace, retrace_list, finish, rates, select, shade, reconstruct, audit };
         let make = |src: &Cache, dst: &Cache| {
-            let entries: Vec<wgpu::BindGroupEntry> = [&params, &src.mask, &src.slots, &pixel_atomics, &dst.slots, &dst.mask, &work, &out]
-                .iter()
-                .enumerate()
-                .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
-                .collect();
-            device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("sample cache"), layout: &layout, entries: &entries })
+            crate::compute::buffer_group(gpu, "sample cache", &layout, &[&params, &src.mask, &src.slots, &pixel_atomics, &dst.slots, &dst.mask, &work, &out])
         };
         // bind_groups[i]: reproject cache i into cache 1 - i.
         let bind_groups = [make(&caches[0], &caches[1]), make(&caches[1], &caches[0])];
@@ -443,26 +408,3 @@ fn tracer_tan_half_fov(tracer: &PathTracer) -> f32 {
     (0.5 * tracer.camera().vfov).tan()
 }
 
-fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let buffer = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-        count: None,
-    };
-    let read = wgpu::BufferBindingType::Storage { read_only: true };
-    let write = wgpu::BufferBindingType::Storage { read_only: false };
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("sample cache"),
-        entries: &[
-            buffer(0, wgpu::BufferBindingType::Uniform),
-            buffer(1, read),
-            buffer(2, read),
-            buffer(3, write),
-            buffer(4, write),
-            buffer(5, write),
-            buffer(6, write),
-            buffer(7, write),
-        ],
-    })
-}

@@ -49,7 +49,6 @@ pub const TAA_RESOLVE_PASS: &str = "taa_resolve";
 pub const PRIMARY_WGSL: &str = include_str!("../../shaders/taa_primary.wgsl");
 
 const WORKGROUP: u32 = 8;
-use crate::path_tracer::LIBRARY_STORAGE_BUFFERS;
 
 /// How the reprojected history is limited to the current neighbourhood.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -210,11 +209,6 @@ impl Taa {
         let s = tracer.settings();
         let (width, height) = (s.width, s.height);
         gpu.check_resolution(width, height, 16 * 3 + 32 * 2)?;
-        let needed = LIBRARY_STORAGE_BUFFERS + 3;
-        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
-        if needed > limit {
-            return Err(crate::gpu::GpuError::OverLimit { what: "storage buffers of the TAA trace pass".into(), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
-        }
         // Neither pass declares var<workgroup>.
         gpu.check_workgroup_memory(TAA_RESOLVE_PASS, 0)?;
         let device = &gpu.device;
@@ -227,43 +221,15 @@ impl Taa {
         let history = [buffer("taa history 0", pixels * 16, rw), buffer("taa history 1", pixels * 16, rw)];
         let counters = buffer("taa ray counter", 16, rw);
 
-        let entry = |binding: u32, ty: wgpu::BufferBindingType| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-            count: None,
-        };
         let uniform = wgpu::BufferBindingType::Uniform;
         let read = wgpu::BufferBindingType::Storage { read_only: true };
         let write = wgpu::BufferBindingType::Storage { read_only: false };
-        let trace_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("taa trace"), entries: &[entry(0, uniform), entry(1, write), entry(2, write), entry(3, write)] });
-        let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("taa resolve"),
-            entries: &[entry(0, uniform), entry(1, read), entry(2, read), entry(3, read), entry(4, read), entry(5, write)],
-        });
-
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let trace_module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("taa_trace.wgsl"), source: wgpu::ShaderSource::Wgsl(Self::trace_source().into()) });
-        let resolve_module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("taa_resolve.wgsl"), source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/taa_resolve.wgsl").into()) });
-        let trace_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("taa trace"),
-            bind_group_layouts: &[Some(tracer.scene_bind_group_layout()), Some(tracer.geometry().bind_group_layout()), Some(&trace_layout)],
-            immediate_size: 0,
-        });
-        let resolve_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some("taa resolve"), bind_group_layouts: &[Some(&resolve_layout)], immediate_size: 0 });
-        let pipeline = |layout: &wgpu::PipelineLayout, module: &wgpu::ShaderModule, entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor { label: Some(entry), layout: Some(layout), module, entry_point: Some(entry), compilation_options: Default::default(), cache: None })
-        };
-        let trace_pipeline = pipeline(&trace_pipeline_layout, &trace_module, "taa_trace");
-        let resolve_pipeline = pipeline(&resolve_pipeline_layout, &resolve_module, "taa_resolve");
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(RenderError::Shader { pass: "taa_trace.wgsl / taa_resolve.wgsl".into(), message: e.to_string() });
-        }
+        let (trace_layout, [trace_pipeline]) = tracer.library_pass(gpu, "taa_trace.wgsl", Self::trace_source(), &[uniform, write, write, write], ["taa_trace"])?;
+        let resolve_layout = crate::compute::buffer_layout(gpu, "taa resolve", &[uniform, read, read, read, read, write]);
+        let [resolve_pipeline] = crate::compute::pipelines(gpu, "taa_resolve.wgsl", include_str!("../../shaders/taa_resolve.wgsl"), &[&resolve_layout], ["taa_resolve"])?;
         let resolve_group = |p: usize| {
             let q = 1 - p;
-            let bufs = [&params, &current, &primary[p], &primary[q], &history[q], &history[p]];
-            let entries: Vec<_> = bufs.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
-            device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("taa resolve"), layout: &resolve_layout, entries: &entries })
+            crate::compute::buffer_group(gpu, "taa resolve", &resolve_layout, &[&params, &current, &primary[p], &primary[q], &history[q], &history[p]])
         };
         let resolve_groups = [resolve_group(0), resolve_group(1)];
         Ok(Self {
@@ -327,13 +293,7 @@ impl Taa {
     /// The bind group of the trace pass's @group(2) writing `current` and `primary`; other
     /// passes that feed the resolve (the hash cache) bind the same layout.
     fn trace_group(&self, gpu: &Gpu, current: &wgpu::Buffer, primary: &wgpu::Buffer) -> wgpu::BindGroup {
-        let entries = [
-            wgpu::BindGroupEntry { binding: 0, resource: self.params.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: current.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 2, resource: primary.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 3, resource: self.counters.as_entire_binding() },
-        ];
-        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("taa trace"), layout: &self.trace_layout, entries: &entries })
+        crate::compute::buffer_group(gpu, "taa trace", &self.trace_layout, &[&self.params, current, primary, &self.counters])
     }
 
     /// Resolves a colour another pass produced: `write` gets an encoder, the buffer to write the

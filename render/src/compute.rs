@@ -1,0 +1,57 @@
+//! Compute pipelines from one WGSL module: the set-up every pass shares (bind group layout of
+//! plain buffers, pipeline layout, the module validated inside an error scope so that a WGSL
+//! error names its pass, one pipeline per entry point).
+
+use crate::error::RenderError;
+use crate::gpu::Gpu;
+
+/// A bind group layout whose binding i is a buffer of kind `kinds[i]`, visible to compute.
+pub fn buffer_layout(gpu: &Gpu, label: &str, kinds: &[wgpu::BufferBindingType]) -> wgpu::BindGroupLayout {
+    let entries: Vec<_> = kinds
+        .iter()
+        .enumerate()
+        .map(|(i, &ty)| wgpu::BindGroupLayoutEntry {
+            binding: i as u32,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        })
+        .collect();
+    gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
+}
+
+/// A bind group binding `buffers[i]` whole at binding i.
+pub fn buffer_group(gpu: &Gpu, label: &str, layout: &wgpu::BindGroupLayout, buffers: &[&wgpu::Buffer]) -> wgpu::BindGroup {
+    let entries: Vec<_> = buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+}
+
+/// The pipelines of `entries` in the WGSL `source` (named `pass` in errors), bound with
+/// `groups` as @group(0), @group(1), ...
+pub fn pipelines<const N: usize>(
+    gpu: &Gpu,
+    pass: &str,
+    source: &str,
+    groups: &[&wgpu::BindGroupLayout],
+    entries: [&str; N],
+) -> Result<[wgpu::ComputePipeline; N], RenderError> {
+    let device = &gpu.device;
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|&g| Some(g)).collect();
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(pass), bind_group_layouts: &layouts, immediate_size: 0 });
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(pass), source: wgpu::ShaderSource::Wgsl(source.into()) });
+    let made = entries.map(|entry| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(&layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    });
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(RenderError::Shader { pass: pass.into(), message: e.to_string() });
+    }
+    Ok(made)
+}
