@@ -9,7 +9,7 @@
 
 mod common;
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec3};
 use nirc::config::PredictorMode;
 use nirc::{CacheOutput, CachePathSettings, CachePaths, NeuralCache, SceneBounds};
 use render::gpu::Gpu;
@@ -30,16 +30,6 @@ fn gpu() -> &'static Gpu {
     GPU.get_or_init(|| Gpu::new().expect("a wgpu adapter (lavapipe on CI)"))
 }
 
-fn plane(half: f32) -> Mesh {
-    Mesh {
-        name: "plane".into(),
-        positions: vec![Vec3::new(-half, 0.0, -half), Vec3::new(-half, 0.0, half), Vec3::new(half, 0.0, half), Vec3::new(half, 0.0, -half)],
-        normals: vec![],
-        uvs: vec![Vec2::ZERO; 4],
-        indices: vec![[0, 1, 2], [0, 2, 3]],
-    }
-}
-
 fn cube() -> Mesh {
     let p = |x: f32, y: f32, z: f32| Vec3::new(x, y, z) * 0.5;
     let positions = vec![p(-1., -1., -1.), p(1., -1., -1.), p(1., 1., -1.), p(-1., 1., -1.), p(-1., -1., 1.), p(1., -1., 1.), p(1., 1., 1.), p(-1., 1., 1.)];
@@ -50,7 +40,7 @@ fn cube() -> Mesh {
 pub fn scene() -> SceneDesc {
     let camera = Camera { position: Vec3::new(0.0, 1.2, 3.0), target: Vec3::new(0.0, 0.6, 0.0), up: Vec3::Y, vfov: 55f32.to_radians() };
     SceneDesc {
-        meshes: vec![plane(2.0), cube(), plane(0.5)],
+        meshes: vec![Mesh::plane(2.0), cube(), Mesh::plane(0.5)],
         materials: vec![
             Material { base_color: Vec3::new(0.7, 0.6, 0.5), roughness: 0.8, ..Default::default() },
             Material { base_color: Vec3::new(0.9, 0.5, 0.2), roughness: 0.4, metallic: 1.0, ..Default::default() },

@@ -19,6 +19,20 @@ pub struct Mesh {
     pub indices: Vec<[u32; 3]>,
 }
 
+impl Mesh {
+    /// The square of side 2 * half in the y = 0 plane, facing +y (counter-clockwise seen from
+    /// above), uvs over [0, 1]^2: the floor of analytic test scenes.
+    pub fn plane(half: f32) -> Mesh {
+        Mesh {
+            name: "plane".into(),
+            positions: vec![Vec3::new(-half, 0.0, -half), Vec3::new(-half, 0.0, half), Vec3::new(half, 0.0, half), Vec3::new(half, 0.0, -half)],
+            normals: vec![],
+            uvs: vec![Vec2::new(0.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0)],
+            indices: vec![[0, 1, 2], [0, 2, 3]],
+        }
+    }
+}
+
 /// An RGBA8 texture in sRGB encoding (glTF base colour textures are sRGB).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Texture {

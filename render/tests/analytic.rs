@@ -23,17 +23,6 @@ fn gpu() -> &'static Gpu {
     GPU.get_or_init(|| Gpu::new().expect("a wgpu adapter (lavapipe on CI)"))
 }
 
-/// Square in the y = 0 plane, side 2 * half, normal +y, with uvs.
-fn plane(half: f32) -> Mesh {
-    Mesh {
-        name: "plane".into(),
-        positions: vec![Vec3::new(-half, 0.0, -half), Vec3::new(-half, 0.0, half), Vec3::new(half, 0.0, half), Vec3::new(half, 0.0, -half)],
-        normals: vec![],
-        uvs: vec![Vec2::new(0.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0)],
-        indices: vec![[0, 1, 2], [0, 2, 3]],
-    }
-}
-
 /// Flat-shaded UV sphere of radius 1 (a convex polyhedron).
 fn sphere(segments: u32, rings: u32) -> Mesh {
     let mut positions = vec![];
@@ -165,7 +154,7 @@ fn hit_ground(o: Vec3, d: Vec3) -> Vec3 {
 
 fn ground_scene(albedo: f32, camera: Camera) -> SceneDesc {
     SceneDesc {
-        meshes: vec![plane(50.0)],
+        meshes: vec![Mesh::plane(50.0)],
         materials: vec![lambert(albedo)],
         instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }],
         camera,
@@ -177,7 +166,7 @@ fn ground_scene(albedo: f32, camera: Camera) -> SceneDesc {
 fn white_furnace() -> SceneDesc {
     let camera = Camera { position: Vec3::new(0.0, 1.5, 4.0), target: Vec3::new(0.0, 0.7, 0.0), up: Vec3::Y, vfov: 60f32.to_radians() };
     SceneDesc {
-        meshes: vec![plane(3.0), sphere(24, 12)],
+        meshes: vec![Mesh::plane(3.0), sphere(24, 12)],
         materials: vec![lambert(1.0)],
         instances: vec![
             Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY },
@@ -347,7 +336,7 @@ fn emissive_rectangle_over_diffuse_plane() {
     // Camera beside the light, looking down at the plane under it.
     let camera = Camera { position: Vec3::new(0.0, 1.4, 1.6), target: Vec3::new(-0.1, 0.0, 0.0), up: Vec3::Y, vfov: 50f32.to_radians() };
     let scene = SceneDesc {
-        meshes: vec![plane(50.0), plane(1.0)],
+        meshes: vec![Mesh::plane(50.0), Mesh::plane(1.0)],
         materials: vec![lambert(albedo), Material { base_color: Vec3::ZERO, emission: Vec3::splat(le), ..lambert(0.0) }],
         instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }, Instance { mesh: 1, material: 1, transform: light_transform }],
         camera,
@@ -442,7 +431,7 @@ fn ggx_plane_under_constant_environment_matches_cpu_integral() {
     ];
     for material in materials {
         let scene = SceneDesc {
-            meshes: vec![plane(50.0)],
+            meshes: vec![Mesh::plane(50.0)],
             materials: vec![material],
             instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }],
             environment: Vec3::ONE,
@@ -475,7 +464,7 @@ fn ggx_plane_under_constant_environment_matches_cpu_integral() {
 fn small_scene() -> SceneDesc {
     let camera = Camera { position: Vec3::new(0.0, 1.2, 3.0), target: Vec3::new(0.0, 0.6, 0.0), up: Vec3::Y, vfov: 55f32.to_radians() };
     SceneDesc {
-        meshes: vec![plane(2.0), sphere(16, 8), plane(0.5)],
+        meshes: vec![Mesh::plane(2.0), sphere(16, 8), Mesh::plane(0.5)],
         materials: vec![
             Material { base_color: Vec3::new(0.7, 0.6, 0.5), roughness: 0.8, ..Default::default() },
             Material { base_color: Vec3::new(0.9, 0.5, 0.2), roughness: 0.5, metallic: 1.0, ..Default::default() },
@@ -563,7 +552,7 @@ fn gbuffer_of_a_known_plane_and_motion_of_a_moved_instance() {
     let camera = top_down_camera(2.0);
     let texture = Texture { name: "grey".into(), width: 2, height: 2, rgba8: [188u8, 188, 188, 255].repeat(4) };
     let mut scene = SceneDesc {
-        meshes: vec![plane(1.0), plane(0.25)],
+        meshes: vec![Mesh::plane(1.0), Mesh::plane(0.25)],
         textures: vec![texture],
         materials: vec![
             Material { base_color: Vec3::new(0.2, 0.4, 0.6), specular: 0.0, ..Default::default() },

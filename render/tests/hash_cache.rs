@@ -46,16 +46,6 @@ fn box_mesh(inward: bool) -> Mesh {
     Mesh { name: "box".into(), positions, normals: vec![], uvs: vec![], indices }
 }
 
-fn plane(half: f32) -> Mesh {
-    Mesh {
-        name: "plane".into(),
-        positions: vec![Vec3::new(-half, 0.0, -half), Vec3::new(-half, 0.0, half), Vec3::new(half, 0.0, half), Vec3::new(half, 0.0, -half)],
-        normals: vec![],
-        uvs: vec![],
-        indices: vec![[0, 1, 2], [0, 2, 3]],
-    }
-}
-
 /// A closed grey room (inward walls, [-2, 2]^3) lit by a panel under the ceiling, with a red
 /// box: mostly indirect light, the case a radiance cache is for.
 fn room_scene() -> SceneDesc {
@@ -63,7 +53,7 @@ fn room_scene() -> SceneDesc {
     let red = Material { base_color: Vec3::new(0.7, 0.2, 0.1), specular: 0.0, ..Default::default() };
     let light = Material { base_color: Vec3::ZERO, emission: Vec3::splat(8.0), specular: 0.0, ..Default::default() };
     SceneDesc {
-        meshes: vec![box_mesh(true), box_mesh(false), plane(0.5)],
+        meshes: vec![box_mesh(true), box_mesh(false), Mesh::plane(0.5)],
         materials: vec![grey, red, light],
         instances: vec![
             Instance { mesh: 0, material: 0, transform: Mat4::from_scale(Vec3::splat(2.0)) },

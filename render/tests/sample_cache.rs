@@ -23,16 +23,6 @@ fn gpu() -> &'static Gpu {
     GPU.get_or_init(|| Gpu::new().expect("a wgpu adapter (lavapipe on CI)"))
 }
 
-/// Square in the y = 0 plane, side 2 * half, normal +y.
-fn plane(half: f32) -> Mesh {
-    Mesh {
-        name: "plane".into(),
-        positions: vec![Vec3::new(-half, 0.0, -half), Vec3::new(-half, 0.0, half), Vec3::new(half, 0.0, half), Vec3::new(half, 0.0, -half)],
-        indices: vec![[0, 1, 2], [0, 2, 3]],
-        ..Default::default()
-    }
-}
-
 fn top_down(height: f32) -> Camera {
     Camera { position: Vec3::new(0.0, height, 0.0), target: Vec3::ZERO, up: Vec3::NEG_Z, vfov: 50f32.to_radians() }
 }
@@ -50,7 +40,7 @@ fn scene(camera: Camera, step: bool) -> SceneDesc {
         instances.push(Instance { mesh: 1, material: 1, transform: Mat4::from_translation(Vec3::new(0.0, 0.6, 0.0)) });
     }
     SceneDesc {
-        meshes: vec![plane(50.0), plane(0.5)],
+        meshes: vec![Mesh::plane(50.0), Mesh::plane(0.5)],
         materials: vec![
             Material { base_color: Vec3::splat(0.5), specular: 0.0, ..Default::default() },
             Material { base_color: Vec3::new(0.9, 0.3, 0.2), specular: 0.0, ..Default::default() },
