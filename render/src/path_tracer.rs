@@ -117,6 +117,8 @@ pub struct PathTracer {
     settings: PathTracerSettings,
     geometry: SceneGeometry,
     layout: wgpu::BindGroupLayout,
+    /// Passes built on the shading library, by (pass, source, own group, entry points).
+    shared_passes: std::sync::Mutex<std::collections::HashMap<u64, (wgpu::BindGroupLayout, Vec<wgpu::ComputePipeline>)>>,
     trace_pipeline: wgpu::ComputePipeline,
     gbuffer_pipeline: wgpu::ComputePipeline,
     frame_buffer: wgpu::Buffer,
@@ -207,6 +209,7 @@ impl PathTracer {
             settings,
             geometry,
             layout,
+            shared_passes: Default::default(),
             trace_pipeline,
             gbuffer_pipeline,
             frame_buffer,
@@ -288,8 +291,24 @@ impl PathTracer {
         if needed > limit {
             return Err(crate::gpu::GpuError::OverLimit { what: format!("storage buffers of pass '{pass}'"), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
         }
+        // Methods of one run share the pipelines of equal passes (three sample caches, two hash
+        // caches): fewer compiled shaders, and on llvmpipe a working set that stays inside its
+        // shader-variant cache, whose evictions cost seconds of recompilation per frame.
+        let key = {
+            use std::hash::{Hash, Hasher};
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            (pass, source, format!("{own:?}"), entries.as_slice()).hash(&mut h);
+            h.finish()
+        };
+        let mut shared = self.shared_passes.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((layout, pipelines)) = shared.get(&key)
+            && let Ok(pipelines) = <[wgpu::ComputePipeline; N]>::try_from(pipelines.clone())
+        {
+            return Ok((layout.clone(), pipelines));
+        }
         let layout = compute::buffer_layout(gpu, pass, own);
         let pipelines = compute::pipelines(gpu, pass, source, &[&self.layout, self.geometry.bind_group_layout(), &layout], entries)?;
+        shared.insert(key, (layout.clone(), pipelines.to_vec()));
         Ok((layout, pipelines))
     }
 

@@ -258,3 +258,20 @@ fn wall_clock_times_each_pass_on_its_own() {
     let gpu_timer = PassTimer::new(gpu(), &["only"]);
     assert_eq!(gpu_timer.clock() == Clock::Gpu, gpu().has_timestamps());
 }
+
+#[test]
+fn equal_passes_share_their_pipelines() {
+    // Two TAA instances on one tracer compile the trace pass once; another pass does not alias.
+    let t = tracer(&feature_scene(0.0), 2);
+    let write = wgpu::BufferBindingType::Storage { read_only: false };
+    let own = [wgpu::BufferBindingType::Uniform, write, write, write];
+    let (layout_a, [a]) = t.library_pass(gpu(), "taa_trace.wgsl", Taa::trace_source(), &own, ["taa_trace"]).unwrap();
+    let (layout_b, [b]) = t.library_pass(gpu(), "taa_trace.wgsl", Taa::trace_source(), &own, ["taa_trace"]).unwrap();
+    assert!(a == b && layout_a == layout_b, "the same pass was compiled twice");
+    let (_, [c]) = t.library_pass(gpu(), "taa_trace.wgsl (copy)", Taa::trace_source(), &own, ["taa_trace"]).unwrap();
+    assert!(a != c, "a pass of another name must get its own pipeline");
+    // Both TAA instances still render (they bind their own buffers to the shared pipeline).
+    let (mut one, mut two) = (Taa::new(gpu(), &t, TaaSettings::default()).unwrap(), Taa::new(gpu(), &t, TaaSettings::default()).unwrap());
+    let (x, y) = (one.render(gpu(), &t, 1, 0).unwrap(), two.render(gpu(), &t, 1, 0).unwrap());
+    assert_eq!(x.radiance, y.radiance, "the same frame through a shared pipeline");
+}
