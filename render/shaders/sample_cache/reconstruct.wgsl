@@ -10,7 +10,7 @@ fn reconstruct_main(@builtin(global_invocation_id) id: vec3u) {
     let n = ssc.size.z;
     let p = id.y * ssc.size.x + id.x;
     let mask = dst_mask[p];
-    let vis = (mask >> n) & mask & ssc_full();
+    let vis = ssc_visible_slots(mask);
     let eye = frame.camera.position.xyz;
     var sum = vec3f(0.0);
     var count = 0.0;

@@ -75,7 +75,6 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
     let width = ssc.size.x;
     let pixels = ssc_pixels();
     let n = ssc.size.z;
-    let full = ssc_full();
     let p = id.y * width + id.x;
     let eye = frame.camera.position.xyz;
     var rng = rng_seed(frame.seed.xy, frame.seed.z, p, 0x55c0u);
@@ -120,7 +119,7 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
             }
             let qi = u32(q.y) * width + u32(q.x);
             let mq = atomicLoad(&pixel_atomics[SSC_ATOMICS * qi]);
-            neighbour_visible += countOneBits(mq & (mq >> n) & full);
+            neighbour_visible += countOneBits(ssc_visible_slots(mq));
             neighbours++;
             t_max_bits = max(t_max_bits, atomicLoad(&pixel_atomics[SSC_ATOMICS * qi + 1u]));
         }

@@ -41,7 +41,7 @@ fn select_main(@builtin(global_invocation_id) id: vec3u) {
     let n = ssc.size.z;
     let p = id.y * ssc.size.x + id.x;
     let mask = dst_mask[p];
-    let vis = (mask >> n) & mask & ssc_full();
+    let vis = ssc_visible_slots(mask);
     let nv = countOneBits(vis);
     if nv == 0u {
         return;

@@ -55,9 +55,9 @@ const SSC_OCCUPIED: u32 = 13u;
 const SSC_BASE: u32 = 14u;
 const SSC_FLAGGED: u32 = 15u;
 const SSC_HISTOGRAM: u32 = 16u;
-const SSC_AUDIT: u32 = 32u;
+const SSC_AUDIT: u32 = 32u;         // visible samples found occluded by audit_main
+const SSC_RETRACE_COUNT: u32 = 33u; // entries of the retrace list (shares SSC_LIST with the shade list)
 const SSC_ALL_RAYS: u32 = 34u;      // every ray of the frame: retraces, new samples, shading paths
-const SSC_RETRACE_COUNT: u32 = 33u; // entries of the retrace list (shares SSC_LIST with the shade list)   // visible samples found occluded by audit_main
 const SSC_LIST: u32 = 48u;
 
 const SSC_FLAG_BASE: u32 = 1u;
@@ -81,6 +81,11 @@ fn ssc_pixels() -> u32 {
 
 fn ssc_full() -> u32 {
     return (1u << ssc.size.z) - 1u;
+}
+
+// Slots of a mask that are visible (visibility bits n..2n) and occupied (bits 0..n).
+fn ssc_visible_slots(mask: u32) -> u32 {
+    return (mask >> ssc.size.z) & mask & ssc_full();
 }
 
 fn ssc_is_background(hit: vec4u) -> bool {
