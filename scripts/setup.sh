@@ -12,4 +12,6 @@ if [ ${#need_apt[@]} -gt 0 ]; then
     apt-get update -qq
     apt-get install -y -qq --no-install-recommends "${need_apt[@]}" >/dev/null
 fi
-python3 -c 'import flip_evaluator' 2>/dev/null || python3 -m pip install --quiet flip-evaluator
+# The same probe the FLIP tests use (metrics::bench::reference_flip_available).
+python3 -m flip_evaluator.flip_python_api -h >/dev/null 2>&1 || python3 -m pip install --quiet flip-evaluator
+python3 -m flip_evaluator.flip_python_api -h >/dev/null

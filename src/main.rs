@@ -41,6 +41,11 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Print the frame's systems in execution order, grouped by stage, for a scenario's methods.
+    Schedule {
+        /// The scenario file (RON), e.g. scenarios/light_rotation_cornell_box.ron
+        scenario: PathBuf,
+    },
     /// List the built-in scenes.
     Scenes,
     /// Compare a test image with a reference (PNG or EXR): mean FLIP, SMAPE, PSNR, error map.
@@ -119,6 +124,9 @@ fn main() -> ExitCode {
                 );
             })
         }
+        Command::Schedule { scenario } => systems::scenario::RunSpec::load(&scenario, &Overrides::default())
+            .and_then(|spec| systems::methods::describe_schedule(&spec.methods))
+            .map(|text| print!("{text}")),
         Command::Scenes => {
             for name in sim::scenes::names() {
                 let description = sim::scenes::describe(name).unwrap_or_default();

@@ -166,3 +166,29 @@ fn walk(dir: &Path) -> Vec<PathBuf> {
     }
     out
 }
+
+#[test]
+fn schedule_lists_each_stage_and_the_methods_systems() {
+    let o = flicker(&["schedule", "scenarios/light_rotation_cornell_box.ron"]);
+    let out = text(&o.stdout);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let at = |s: &str| out.find(s).unwrap_or_else(|| panic!("'{s}' missing from:\n{out}"));
+    let stages: Vec<usize> = ["\nSimulate\n", "\nExtract\n", "\nRender\n", "\nLearn\n", "\nMeasure\n", "\nRecord\n"].iter().map(|s| at(s)).collect();
+    assert!(stages.windows(2).all(|w| w[0] < w[1]), "stages out of order:\n{out}");
+    assert!(at("nirc_blend_1spp (Nirc)") < stages[0]);
+    assert!((stages[2]..stages[3]).contains(&at("nirc::infer")), "{out}");
+    assert!((stages[3]..stages[4]).contains(&at("nirc::train")), "{out}");
+    assert!((stages[2]..stages[3]).contains(&at("path_tracing::render")), "{out}");
+    assert!(!out.contains("taa::"), "no TAA in this scenario:\n{out}");
+}
+
+#[test]
+fn duplicate_method_labels_are_refused_before_anything_is_written() {
+    let dir = scratch("duplicate");
+    let path = tiny_scenario(
+        &dir,
+        "Scenario(scene: Builtin(\"cornell_box\"), resolution: (16, 9), frames: 2,\n  methods: [PathTracing(spp: 1),\n    PathTracing(spp: 1)])",
+    );
+    let err = run_fails(&path, &[], &dir.join("out"));
+    assert!(err.contains("scenario.ron:3:5") && err.contains("scenario.ron:2:13") && err.contains("pt_1spp"), "{err}");
+}

@@ -1,6 +1,7 @@
 //! GPU side: wgpu device, BVH upload (obvhs), WGSL passes, GPU timing, readback.
 
-pub mod scene;
+/// The plain-data scene (its own crate, shared with `sim`).
+pub use ::scene;
 pub mod gpu;
 pub mod hash_cache;
 pub mod bvh;

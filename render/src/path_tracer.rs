@@ -14,6 +14,7 @@ use crate::gpu::Gpu;
 use crate::lights::{LightTable, build_light_table};
 use crate::materials::pack_materials;
 use crate::readback::read_buffer;
+use crate::scene::SceneChanges;
 use crate::scene::{Camera, SceneDesc};
 use crate::timing::{PassTimer, PassTiming, merge};
 use bytemuck::{Pod, Zeroable};
@@ -355,15 +356,27 @@ impl PathTracer {
 
     /// [`Self::update`] that reports an inconsistent scene instead of panicking.
     pub fn try_update(&mut self, gpu: &Gpu, scene: &SceneDesc) -> Result<(), RenderError> {
-        let (materials, texels) = pack_materials(scene)?;
-        let light_table = build_light_table(scene)?;
+        self.update_changed(gpu, scene, SceneChanges::ALL)
+    }
+
+    /// [`Self::try_update`] that uploads only what `changes` names: materials and texels when
+    /// materials changed, the light table when lights, instances (emissive triangles follow
+    /// them) or materials changed. Instance transforms and the camera are taken every frame:
+    /// they become the previous ones of motion vectors.
+    pub fn update_changed(&mut self, gpu: &Gpu, scene: &SceneDesc, changes: SceneChanges) -> Result<(), RenderError> {
+        let materials = (changes.materials || changes.geometry).then(|| pack_materials(scene)).transpose()?;
+        let light_table = (changes.lights || changes.instances || changes.materials || changes.geometry).then(|| build_light_table(scene)).transpose()?;
         self.geometry.try_update_instances(gpu, &scene.instances)?;
         let mut rebind = false;
-        for (buffer, label, bytes) in [
-            (&mut self.materials, "materials", bytemuck::cast_slice::<_, u8>(&materials)),
-            (&mut self.texels, "base-colour texels", bytemuck::cast_slice(&texels)),
-            (&mut self.lights, "lights", bytemuck::cast_slice(&light_table.lights)),
-        ] {
+        let mut uploads: Vec<(&mut wgpu::Buffer, &str, &[u8])> = Vec::new();
+        if let Some((materials, texels)) = &materials {
+            uploads.push((&mut self.materials, "materials", bytemuck::cast_slice::<_, u8>(materials)));
+            uploads.push((&mut self.texels, "base-colour texels", bytemuck::cast_slice(texels)));
+        }
+        if let Some(table) = &light_table {
+            uploads.push((&mut self.lights, "lights", bytemuck::cast_slice(&table.lights)));
+        }
+        for (buffer, label, bytes) in uploads {
             if buffer.size() == bytes.len() as u64 {
                 gpu.queue.write_buffer(buffer, 0, bytes);
             } else {
@@ -379,7 +392,9 @@ impl PathTracer {
         if rebind {
             self.rebind(gpu);
         }
-        self.light_table = light_table;
+        if let Some(table) = light_table {
+            self.light_table = table;
+        }
         self.previous_camera = self.camera;
         self.camera = scene.camera;
         self.environment = scene.environment;

@@ -1,7 +1,7 @@
 //! Components of the world that the renderer sees: geometry instances, lights, the camera.
 
 use bevy_ecs::prelude::*;
-use render::scene::Light;
+use scene::Light;
 
 pub use bevy_ecs::name::Name;
 

@@ -6,7 +6,7 @@
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use render::scene::{Camera as CameraDesc, Instance, Light, SceneDesc};
+use scene::{Camera as CameraDesc, Instance, Light, SceneDesc};
 
 use crate::components::{Camera, Hidden, Intensity, LightSource, MeshInstance, SpawnOrder};
 use crate::resources::{ActiveCamera, Environment, MaterialTable};

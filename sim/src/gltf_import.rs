@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec2, Vec3};
-use render::scene::{Light, Material, Mesh, Texture};
+use scene::{Light, Material, Mesh, Texture};
 
 use crate::components::MeshInstance;
 use crate::template::{NodeTemplate, WorldTemplate};

@@ -2,7 +2,7 @@
 //!
 //! A [`Scenario`] (RON) names a scene (built-in or glTF), its animations and events; a
 //! [`Simulation`] spawns it into a bevy_ecs world, steps it at a fixed time step and
-//! extracts a `render::scene::SceneDesc` per frame.
+//! extracts a `scene::SceneDesc` per frame.
 
 pub mod animation;
 pub mod components;
@@ -16,5 +16,5 @@ pub mod simulation;
 pub mod template;
 pub mod transform;
 
-pub use scenario::{MethodSpec, ReferenceFrames, ReferenceSpec, Region, Scenario, ScenarioError, SceneSource};
-pub use simulation::{SimError, Simulation};
+pub use scenario::{MethodEntry, ReferenceFrames, ReferenceSpec, Region, Scenario, ScenarioError, SceneSource};
+pub use simulation::{ExtractedScene, SimError, Simulation, advance_clock, animation_systems, extract_scene};

@@ -2,7 +2,7 @@
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use render::scene::Material;
+use scene::Material;
 
 use crate::rng::Rng;
 

@@ -3,7 +3,7 @@
 //! Everything random in the simulation goes through here so that a scenario's seed fixes
 //! every frame.
 
-pub use render::bvh::{SplitMix64 as Rng, mix64};
+pub use scene::{SplitMix64 as Rng, mix64};
 
 /// Uniform float in [0, 1) from a hash of (seed, stream, index), without state: a draw at
 /// frame N does not depend on how many draws happened before.

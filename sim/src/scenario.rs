@@ -30,198 +30,27 @@ fn builtin_name<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
     }
 }
 
-/// A rendering method to run on every frame.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub enum MethodSpec {
-    PathTracing { spp: u32 },
-    /// Path tracing terminated into the neural incident radiance cache (nirc/README.md).
-    /// Methods of one scenario with equal `spp`, `cache`, `paths` and `pretrain_frames` share
-    /// one cache, its camera paths and its training; only `predictor` (inference) differs.
-    Nirc {
-        spp: u32,
-        #[serde(default)]
-        predictor: nirc::PredictorMode,
-        #[serde(default)]
-        cache: nirc::NircConfig,
-        #[serde(default)]
-        paths: nirc::CachePathSettings,
-        /// Training-only frames on the first frame's scene before anything renders (a warm
-        /// start, saved next to the reference cache and reused).
-        #[serde(default)]
-        pretrain_frames: u32,
-    },
-    /// Stable sample cache (render::sample_cache); every field defaults to the paper's value,
-    /// e.g. `SampleCache(retrace: Multi)` or `SampleCache(shading: Adaptive, shading_rate: 0.5)`.
-    SampleCache {
-        #[serde(default = "ssc_default::slots")]
-        slots: u32,
-        #[serde(default = "ssc_default::n_target")]
-        n_target: f32,
-        #[serde(default = "ssc_default::delta")]
-        delta: f32,
-        #[serde(default = "ssc_default::epsilon0")]
-        epsilon0: f32,
-        #[serde(default = "ssc_default::epsilon1")]
-        epsilon1: f32,
-        #[serde(default = "ssc_default::base_block")]
-        base_block: u32,
-        #[serde(default = "ssc_default::buckets")]
-        buckets: u32,
-        #[serde(default = "ssc_default::alpha")]
-        alpha: f32,
-        #[serde(default)]
-        retrace: render::sample_cache::Retrace,
-        #[serde(default)]
-        shading: render::sample_cache::ShadingMode,
-        #[serde(default = "ssc_default::shading_rate")]
-        shading_rate: f32,
-    },
-    /// TAA over jittered 1 spp path tracing (render::taa). Defaults: render::taa::TaaSettings.
-    Taa {
-        #[serde(default = "taa_defaults::alpha")]
-        alpha: f32,
-        #[serde(default = "taa_defaults::clamp")]
-        clamp: render::taa::TaaClamp,
-        #[serde(default = "taa_defaults::jitter_length")]
-        jitter_length: u32,
-        #[serde(default = "taa_defaults::depth_tolerance")]
-        depth_tolerance: f32,
-        #[serde(default = "taa_defaults::normal_threshold")]
-        normal_threshold: f32,
-    },
-    /// World-space hash cache (render::hash_cache), optionally under TAA (as the paper runs it).
-    /// Defaults: render::hash_cache::HashCacheSettings, no TAA.
-    HashCache {
-        #[serde(default = "hash_cache_defaults::capacity")]
-        capacity: u32,
-        #[serde(default = "hash_cache_defaults::probe_limit")]
-        probe_limit: u32,
-        #[serde(default = "hash_cache_defaults::max_age")]
-        max_age: u32,
-        #[serde(default = "hash_cache_defaults::lod_scale")]
-        lod_scale: f32,
-        #[serde(default = "hash_cache_defaults::normal_lod")]
-        normal_lod: bool,
-        #[serde(default = "hash_cache_defaults::jitter")]
-        jitter: bool,
-        #[serde(default = "hash_cache_defaults::lookup")]
-        lookup: render::hash_cache::HashCacheLookup,
-        #[serde(default = "hash_cache_defaults::max_samples")]
-        max_samples: u32,
-        #[serde(default)]
-        taa: bool,
-    },
+/// One entry of the scenario's `methods: [...]`, as written. The world knows nothing of
+/// rendering methods (`systems` parses them, each with its own settings struct); it keeps each
+/// entry's text and its place in the file, so a method's errors point at the file's line.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct MethodEntry {
+    /// The entry's RON text, e.g. `SampleCache(retrace: Multi)`.
+    pub text: String,
+    /// 1-based line and column of the entry in the scenario file.
+    pub line: usize,
+    pub column: usize,
 }
 
-/// Short name of a predictor mode in labels.
-pub fn predictor_label(mode: nirc::PredictorMode) -> &'static str {
-    match mode {
-        nirc::PredictorMode::EmaOnly => "ema",
-        nirc::PredictorMode::HighLrOnly => "highlr",
-        nirc::PredictorMode::Blend => "blend",
-        nirc::PredictorMode::Switch => "switch",
-    }
-}
-
-mod ssc_default {
-    use render::sample_cache::SampleCacheSettings as S;
-    pub fn slots() -> u32 { S::default().slots }
-    pub fn n_target() -> f32 { S::default().n_target }
-    pub fn delta() -> f32 { S::default().delta }
-    pub fn epsilon0() -> f32 { S::default().epsilon0 }
-    pub fn epsilon1() -> f32 { S::default().epsilon1 }
-    pub fn base_block() -> u32 { S::default().base_block }
-    pub fn buckets() -> u32 { S::default().buckets }
-    pub fn alpha() -> f32 { S::default().alpha }
-    pub fn shading_rate() -> f32 { S::default().shading_rate }
-}
-
-mod taa_defaults {
-    use render::taa::{TaaClamp, TaaSettings};
-    pub fn alpha() -> f32 {
-        TaaSettings::default().alpha
-    }
-    pub fn clamp() -> TaaClamp {
-        TaaSettings::default().clamp
-    }
-    pub fn jitter_length() -> u32 {
-        TaaSettings::default().jitter_length
-    }
-    pub fn depth_tolerance() -> f32 {
-        TaaSettings::default().depth_tolerance
-    }
-    pub fn normal_threshold() -> f32 {
-        TaaSettings::default().normal_threshold
-    }
-}
-
-mod hash_cache_defaults {
-    use render::hash_cache::{HashCacheLookup, HashCacheSettings};
-    fn d() -> HashCacheSettings {
-        HashCacheSettings::default()
-    }
-    pub fn capacity() -> u32 {
-        d().capacity
-    }
-    pub fn probe_limit() -> u32 {
-        d().probe_limit
-    }
-    pub fn max_age() -> u32 {
-        d().max_age
-    }
-    pub fn lod_scale() -> f32 {
-        d().lod_scale
-    }
-    pub fn normal_lod() -> bool {
-        d().normal_lod
-    }
-    pub fn jitter() -> bool {
-        d().jitter
-    }
-    pub fn lookup() -> HashCacheLookup {
-        d().lookup
-    }
-    pub fn max_samples() -> u32 {
-        d().max_samples
-    }
-}
-
-impl MethodSpec {
-    /// A short name usable as a folder name, e.g. `pt_4spp`.
-    pub fn label(&self) -> String {
-        match self {
-            MethodSpec::PathTracing { spp } => format!("pt_{spp}spp"),
-            MethodSpec::Nirc { spp, predictor, .. } => format!("nirc_{}_{spp}spp", predictor_label(*predictor)),
-            MethodSpec::SampleCache { .. } => self.sample_cache_settings().map(|s| s.label()).unwrap_or_default(),
-            MethodSpec::Taa { .. } => "taa".into(),
-            MethodSpec::HashCache { lookup, taa, .. } => format!(
-                "hash_cache{}{}",
-                if *lookup == render::hash_cache::HashCacheLookup::FirstHit { "_first_hit" } else { "" },
-                if *taa { "_taa" } else { "" }
-            ),
-        }
+impl MethodEntry {
+    /// An entry that is not from a file (tests, tools); its place is line 1, column 1.
+    pub fn new(text: impl Into<String>) -> Self {
+        Self { text: text.into(), line: 1, column: 1 }
     }
 
-    /// Samples per pixel the method spends per frame.
-    pub fn spp(&self) -> u32 {
-        match self {
-            MethodSpec::PathTracing { spp } => *spp,
-            MethodSpec::Nirc { spp, .. } => *spp,
-            // One shaded path per pixel at a 100% shading rate.
-            MethodSpec::SampleCache { shading_rate, .. } => (shading_rate.ceil() as u32).max(1),
-            MethodSpec::Taa { .. } | MethodSpec::HashCache { .. } => 1,
-        }
-    }
-
-    /// The sample cache's settings, `None` for other methods.
-    pub fn sample_cache_settings(&self) -> Option<render::sample_cache::SampleCacheSettings> {
-        match *self {
-            MethodSpec::SampleCache { slots, n_target, delta, epsilon0, epsilon1, base_block, buckets, alpha, retrace, shading, shading_rate } => {
-                Some(render::sample_cache::SampleCacheSettings { slots, n_target, delta, epsilon0, epsilon1, base_block, buckets, alpha, retrace, shading, shading_rate })
-            }
-            _ => None,
-        }
+    /// The file position of a (1-based) line and column inside the entry's text.
+    pub fn position_in_file(&self, line: usize, column: usize) -> (usize, usize) {
+        if line <= 1 { (self.line, self.column + column.saturating_sub(1)) } else { (self.line + line - 1, column) }
     }
 }
 
@@ -437,7 +266,7 @@ struct ScenarioFile {
     output: Option<PathBuf>,
     #[serde(default = "default_max_depth")]
     max_depth: u32,
-    methods: Vec<MethodSpec>,
+    methods: Vec<Box<ron::value::RawValue>>,
     #[serde(default)]
     reference: ReferenceSpec,
     #[serde(default)]
@@ -469,7 +298,8 @@ pub struct Scenario {
     /// Defaults to `runs/<name>` (relative to the working directory).
     pub output: PathBuf,
     pub max_depth: u32,
-    pub methods: Vec<MethodSpec>,
+    /// The methods as written; `systems` parses them.
+    pub methods: Vec<MethodEntry>,
     pub reference: ReferenceSpec,
     pub regions: Vec<Region>,
     /// ε in SMAPE's denominator 2|a - b| / (|a| + |b| + ε).
@@ -499,6 +329,26 @@ impl fmt::Display for ScenarioError {
             None => write!(f, "{}: {}", self.file.display(), self.message),
         }
     }
+}
+
+/// Each method's text and where it starts: entries are found in file order after `methods:`.
+fn method_entries(text: &str, raw: &[Box<ron::value::RawValue>]) -> Vec<MethodEntry> {
+    let mut from = text.find("methods").unwrap_or(0);
+    raw.iter()
+        .map(|r| {
+            let ron = r.get_ron().trim();
+            let at = text[from..].find(ron).map_or(from, |i| from + i);
+            from = at + ron.len();
+            let (line, column) = line_col(text, at);
+            MethodEntry { text: ron.to_string(), line, column }
+        })
+        .collect()
+}
+
+/// 1-based line and column of byte offset `at`.
+pub fn line_col(text: &str, at: usize) -> (usize, usize) {
+    let before = &text[..at];
+    (before.matches('\n').count() + 1, before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1)
 }
 
 /// Line and column (1-based) of the first quoted occurrence of `needle` in `text`.
@@ -577,6 +427,7 @@ impl Scenario {
             other => other,
         };
         let output = file.output.unwrap_or_else(|| PathBuf::from("runs").join(&name));
+        let methods = method_entries(text, &file.methods);
         Ok(Scenario {
             name,
             scene,
@@ -589,7 +440,7 @@ impl Scenario {
             seed: file.seed,
             output,
             max_depth: file.max_depth,
-            methods: file.methods,
+            methods,
             reference: file.reference,
             regions: file.regions,
             smape_epsilon: file.smape_epsilon,

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::SingleThreadedExecutor;
 use glam::{Quat, Vec3};
-use render::scene::SceneDesc;
+use scene::{SceneChanges, SceneDesc};
 
 use crate::animation::{self, *};
 use crate::components::{Camera, Hidden, Intensity, LightSource, MeshInstance, Name, SpawnOrder};
@@ -76,12 +76,61 @@ impl Names<'_> {
     }
 }
 
+/// The scene of the current frame as the renderer sees it, and what changed since the last.
+/// [`extract_scene`] rewrites it (and marks it changed for ECS change detection) only when
+/// something changed.
+#[derive(Resource, Clone, Debug)]
+pub struct ExtractedScene {
+    pub scene: SceneDesc,
+    pub changes: SceneChanges,
+}
+
+/// Simulate stage: moves the clock to the next frame (before the animation systems read it).
+pub fn advance_clock(mut clock: ResMut<Clock>) {
+    clock.frame += 1;
+}
+
+/// Simulate stage, in order: animations, this frame's events, transform propagation.
+pub fn animation_systems() -> bevy_ecs::schedule::ScheduleConfigs<bevy_ecs::system::ScheduleSystem> {
+    (
+        animation::rotate,
+        animation::rotate_once,
+        animation::keyframes,
+        animation::camera_path,
+        animation::flock,
+        animation::flash,
+        animation::apply_events,
+        propagate_transforms,
+    )
+        .chain()
+}
+
+/// Extract stage: the world -> [`ExtractedScene`], with what changed since the last frame. The
+/// resource is marked changed (ECS change detection) only when something did.
+pub fn extract_scene(world: &mut World) {
+    world.resource_scope(|world, mut extracted: Mut<ExtractedScene>| {
+        let e = extracted.bypass_change_detection();
+        let s = &mut e.scene;
+        let before = (std::mem::take(&mut s.instances), std::mem::take(&mut s.lights), std::mem::take(&mut s.materials), s.camera, s.environment);
+        extract_dynamic(world, s);
+        e.changes = SceneChanges {
+            geometry: false,
+            instances: before.0 != s.instances,
+            lights: before.1 != s.lights,
+            materials: before.2 != s.materials,
+            camera: before.3 != s.camera,
+            environment: before.4 != s.environment,
+        };
+        if e.changes.any() {
+            extracted.set_changed();
+        }
+    });
+}
+
 /// The playing world of one scenario.
 pub struct Simulation {
     world: World,
     schedule: Schedule,
-    scene: SceneDesc,
-    changed: bool,
 }
 
 impl Simulation {
@@ -167,26 +216,19 @@ impl Simulation {
         }
         world.insert_resource(ScheduledEvents(events));
 
-        let mut schedule = Schedule::default();
-        schedule.set_executor(SingleThreadedExecutor::default());
-        schedule.add_systems(
-            (
-                animation::rotate,
-                animation::rotate_once,
-                animation::keyframes,
-                animation::camera_path,
-                animation::flock,
-                animation::flash,
-                animation::apply_events,
-                propagate_transforms,
-            )
-                .chain(),
-        );
-        schedule.run(&mut world);
-
+        // Frame 0: the animations at time 0, then the first extraction (everything is new).
+        let mut first = Schedule::default();
+        first.set_executor(SingleThreadedExecutor::default());
+        first.add_systems(animation_systems());
+        first.run(&mut world);
         let mut scene = SceneDesc { meshes: template.meshes, textures: template.textures, ..Default::default() };
         extract_dynamic(&mut world, &mut scene);
-        Ok(Simulation { world, schedule, scene, changed: true })
+        world.insert_resource(ExtractedScene { scene, changes: SceneChanges::ALL });
+
+        let mut schedule = Schedule::default();
+        schedule.set_executor(SingleThreadedExecutor::default());
+        schedule.add_systems((advance_clock, animation_systems(), extract_scene).chain());
+        Ok(Simulation { world, schedule })
     }
 
     /// The frame whose state the world holds (0 after `new`).
@@ -199,33 +241,31 @@ impl Simulation {
         self.world.resource::<Clock>().time()
     }
 
-    /// Advances one fixed step: animations, this frame's events, transform propagation.
+    /// Advances one fixed step: the systems of the frame's Simulate and Extract stages
+    /// ([`advance_clock`], [`animation_systems`], [`extract_scene`]).
     pub fn step(&mut self) {
-        self.world.resource_mut::<Clock>().frame += 1;
         self.schedule.run(&mut self.world);
-        let before = (
-            std::mem::take(&mut self.scene.instances),
-            std::mem::take(&mut self.scene.lights),
-            std::mem::take(&mut self.scene.materials),
-            self.scene.camera,
-            self.scene.environment,
-        );
-        extract_dynamic(&mut self.world, &mut self.scene);
-        self.changed = before.0 != self.scene.instances
-            || before.1 != self.scene.lights
-            || before.2 != self.scene.materials
-            || before.3 != self.scene.camera
-            || before.4 != self.scene.environment;
     }
 
     /// The scene of the current frame (meshes and textures never change).
-    pub fn scene(&mut self) -> &SceneDesc {
-        &self.scene
+    pub fn scene(&self) -> &SceneDesc {
+        &self.world.resource::<ExtractedScene>().scene
+    }
+
+    /// What the last step changed (everything after `new`).
+    pub fn changes(&self) -> SceneChanges {
+        self.world.resource::<ExtractedScene>().changes
     }
 
     /// Whether the last step changed anything the image depends on (true after `new`).
     pub fn changed(&self) -> bool {
-        self.changed
+        self.changes().any()
+    }
+
+    /// The world, to run the frame's own schedule on (its Simulate and Extract stages add
+    /// [`advance_clock`], [`animation_systems`] and [`extract_scene`]).
+    pub fn into_world(self) -> World {
+        self.world
     }
 
     /// The entity with this name (the first one, if several share it).

@@ -2,7 +2,7 @@
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use render::scene::{Light, Material, Mesh, Texture};
+use scene::{Light, Material, Mesh, Texture};
 
 use crate::components::{Camera, Intensity, LightSource, MeshInstance, Name, SpawnOrder};
 use crate::resources::{ActiveCamera, Environment, MaterialTable};
@@ -117,7 +117,7 @@ impl WorldTemplate {
             entities.push(e.id());
         }
         let camera = active.unwrap_or_else(|| {
-            let c = render::scene::Camera::default();
+            let c = scene::Camera::default();
             world
                 .spawn((
                     Name::new("camera"),

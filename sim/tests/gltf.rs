@@ -5,7 +5,7 @@ mod support;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use render::scene::Light;
+use scene::Light;
 use sim::gltf_import::import;
 
 fn asset_path() -> PathBuf {
@@ -78,7 +78,7 @@ fn imported_lights_point_along_their_node() {
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/inline.ron"),
     )
     .unwrap();
-    let mut s = sim::Simulation::new(&scenario).unwrap_or_else(|e| panic!("{e}"));
+    let s = sim::Simulation::new(&scenario).unwrap_or_else(|e| panic!("{e}"));
     let scene = s.scene();
     let sun = scene.lights.iter().find_map(|l| match l {
         Light::Directional { direction, .. } => Some(*direction),

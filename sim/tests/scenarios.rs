@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Quat, Vec3};
-use render::scene::{Light, SceneDesc};
+use scene::{Light, SceneChanges, SceneDesc};
 use sim::{ReferenceFrames, ReferenceSpec, Scenario, SimError, Simulation};
 
 fn scenarios_dir() -> PathBuf {
@@ -131,7 +131,6 @@ fn bad_values_are_refused() {
 
 #[test]
 fn method_labels_reference_frames_and_summary() {
-    assert_eq!(sim::MethodSpec::PathTracing { spp: 4 }.label(), "pt_4spp");
     let every = ReferenceSpec { spp: 16, frames: ReferenceFrames::Every(10) };
     let wanted: Vec<u32> = (0..30).filter(|&f| every.wants(f, 25)).collect();
     assert_eq!(wanted, vec![0, 10, 20]);
@@ -324,18 +323,38 @@ fn same_seed_same_scene_different_seed_differs() {
     }
 }
 
+#[test]
+fn method_entries_keep_their_text_and_place() {
+    let s = parse(
+        "Scenario(scene: Builtin(\"courtyard\"), resolution: (32, 18), frames: 1,\n methods: [\n  Taa(),\n    HashCache(lookup: FirstHit,\n  taa: true), Taa(alpha: 0.2)])",
+    );
+    let entries: Vec<(&str, usize, usize)> = s.methods.iter().map(|m| (m.text.as_str(), m.line, m.column)).collect();
+    assert_eq!(entries, [("Taa()", 3, 3), ("HashCache(lookup: FirstHit,\n  taa: true)", 4, 5), ("Taa(alpha: 0.2)", 5, 15)]);
+    // A place inside the second entry, as a parser of that text reports it.
+    assert_eq!(s.methods[1].position_in_file(1, 11), (4, 15));
+    assert_eq!(s.methods[1].position_in_file(2, 3), (5, 3));
+}
 
 #[test]
-fn taa_and_hash_cache_methods_take_defaults_and_overrides() {
-    let s = parse(
-        "Scenario(scene: Builtin(\"courtyard\"), resolution: (32, 18), frames: 1, methods: [Taa(), Taa(alpha: 0.2, clamp: MinMax), \
-         HashCache(), HashCache(lookup: FirstHit, taa: true, capacity: 1024)])",
+fn extraction_reports_what_each_event_changed() {
+    let s = with(
+        "cornell_box",
+        "events: [(frame: 2, action: MoveBy(entity: \"short_box\", offset: (0.1, 0, 0))),
+                  (frame: 3, action: SetMaterial(material: \"red\", base_color: (1, 0, 0))),
+                  (frame: 4, action: Toggle(entity: \"ceiling_light\"))]",
     );
-    let d = render::taa::TaaSettings::default();
-    assert_eq!(s.methods[0], sim::MethodSpec::Taa { alpha: d.alpha, clamp: d.clamp, jitter_length: d.jitter_length, depth_tolerance: d.depth_tolerance, normal_threshold: d.normal_threshold });
-    assert!(matches!(s.methods[1], sim::MethodSpec::Taa { alpha: 0.2, clamp: render::taa::TaaClamp::MinMax, .. }));
-    let labels: Vec<String> = s.methods.iter().map(|m| m.label()).collect();
-    assert_eq!(labels, ["taa", "taa", "hash_cache", "hash_cache_first_hit_taa"]);
-    assert!(s.methods.iter().all(|m| m.spp() == 1));
-    assert!(matches!(s.methods[3], sim::MethodSpec::HashCache { capacity: 1024, probe_limit: 8, .. }));
+    let mut sim = Simulation::new(&s).unwrap();
+    assert_eq!(sim.changes(), SceneChanges::ALL);
+    let mut seen = Vec::new();
+    for _ in 0..5 {
+        sim.step();
+        seen.push(sim.changes());
+    }
+    assert!(!seen[0].any());
+    assert_eq!(seen[1], SceneChanges { instances: true, ..Default::default() });
+    assert!(seen[1].moved());
+    assert_eq!(seen[2], SceneChanges { materials: true, ..Default::default() });
+    // Toggling an emissive mesh changes its own material's emission.
+    assert_eq!(seen[3], SceneChanges { materials: true, ..Default::default() });
+    assert!(!seen[4].any());
 }

@@ -40,7 +40,7 @@ pub fn builtin_scene(name: &str, resolution: (u32, u32)) -> Result<SceneDesc> {
         resolution.0, resolution.1
     );
     let scenario = Scenario::from_ron(&text, Path::new("<bench>"))?;
-    let mut sim = Simulation::new(&scenario)?;
+    let sim = Simulation::new(&scenario)?;
     Ok(sim.scene().clone())
 }
 

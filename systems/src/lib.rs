@@ -1,7 +1,8 @@
-//! Per-frame systems tying sim to render, and scenario playback.
+//! The frame as a bevy_ecs schedule (`frame`), the rendering methods as plugins (`methods`),
+//! measurement, recording, and scenario playback.
 
 pub mod bench;
-pub mod extract;
+pub mod frame;
 pub mod frame_record;
 pub mod manifest;
 pub mod measure;
@@ -10,4 +11,5 @@ pub mod output;
 pub mod playback;
 pub mod reference_cache;
 pub mod run_folder;
+pub mod scenario;
 pub mod tonemap;

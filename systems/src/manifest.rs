@@ -5,11 +5,10 @@ use std::path::Path;
 use anyhow::Result;
 use render::gpu::Gpu;
 use serde_json::{Value, json};
-use sim::Scenario;
+use crate::scenario::{Overrides, RunSpec};
 
-use crate::playback::Overrides;
-
-pub fn build(scenario: &Scenario, scenario_file: &Path, gpu: &Gpu, overrides: &Overrides) -> Result<Value> {
+pub fn build(spec: &RunSpec, scenario_file: &Path, gpu: &Gpu, overrides: &Overrides) -> Result<Value> {
+    let scenario = &spec.scenario;
     let frames = scenario.frames;
     let reference_frames: Vec<u32> = (0..frames).filter(|&f| scenario.reference.wants(f, frames)).collect();
     Ok(json!({
@@ -24,7 +23,7 @@ pub fn build(scenario: &Scenario, scenario_file: &Path, gpu: &Gpu, overrides: &O
         "resolution": [scenario.resolution.0, scenario.resolution.1],
         "frames": frames,
         "warmup_frames": scenario.warmup_frames,
-        "methods": scenario.methods.iter().map(|m| m.label()).collect::<Vec<_>>(),
+        "methods": spec.methods.iter().map(|m| m.label()).collect::<Vec<_>>(),
         "reference": { "spp": scenario.reference.spp, "frames": reference_frames },
         "events": scenario.events_summary().into_iter().filter(|(frame, _)| *frame < frames).map(|(frame, label)| json!({"frame": frame, "label": label})).collect::<Vec<_>>(),
         "regions": scenario.regions.iter().map(|r| json!({"name": r.name, "x": r.x, "y": r.y, "width": r.width, "height": r.height})).collect::<Vec<_>>(),
@@ -32,7 +31,7 @@ pub fn build(scenario: &Scenario, scenario_file: &Path, gpu: &Gpu, overrides: &O
             "max_depth": scenario.max_depth,
             "smape_epsilon": scenario.smape_epsilon,
             "time_step": scenario.time_step,
-            "methods": scenario.methods.iter().map(|m| json!({"label": m.label(), "spp": m.spp()})).collect::<Vec<_>>(),
+            "methods": spec.methods.iter().map(|m| json!({"label": m.label(), "spp": m.spec.spp(), "spec": m.spec})).collect::<Vec<_>>(),
             "overrides": {
                 "frames": overrides.frames,
                 "resolution": overrides.resolution.map(|(w, h)| format!("{w}x{h}")),

@@ -22,39 +22,51 @@ impl Frame {
     }
 }
 
-/// Measures `current` against the method's `previous` frame and the `reference` where given.
-pub fn record(current: &Frame, previous: Option<&Frame>, reference: Option<&Frame>, scenario: &Scenario) -> FrameRecord {
-    let eps = scenario.smape_epsilon;
-    let regions: Vec<Region> = scenario
-        .regions
-        .iter()
-        .map(|r| Region { name: r.name.clone(), x: r.x, y: r.y, width: r.width, height: r.height })
-        .collect();
-    let width = current.image.width;
-    let mut rec = FrameRecord::default();
-    let smape = previous.map(|prev| metrics::smape(&current.image, &prev.image, eps));
-    if let Some(s) = &smape {
-        rec.smape = Some(s.mean);
-    }
-    if let (Some(prev), Some(motion)) = (previous, &current.motion) {
+/// Flicker: SMAPE of `current` against the method's `previous` frame, plain and reprojected
+/// along `current`'s motion. Returns the per-pixel map (for regions).
+pub fn smape_vs_previous(rec: &mut FrameRecord, current: &Frame, previous: Option<&Frame>, eps: f32) -> Option<Vec<f32>> {
+    let prev = previous?;
+    let smape = metrics::smape(&current.image, &prev.image, eps);
+    rec.smape = Some(smape.mean);
+    if let Some(motion) = &current.motion {
         let s = metrics::smape_reprojected(&current.image, &prev.image, motion, eps);
         rec.smape_reprojected = Some(s.mean);
         rec.disoccluded = Some(s.disoccluded_count);
     }
-    let flip = reference.map(|r| {
-        rec.mse = Some(metrics::mse(&r.image, &current.image));
-        rec.rel_mse = Some(metrics::relative_mse(&r.image, &current.image));
-        rec.psnr = Some(metrics::psnr(&r.image, &current.image));
-        metrics::flip_hdr(&r.image, &current.image, metrics::DEFAULT_PPD)
-    });
-    rec.flip = flip.as_ref().map(|f| f.mean);
-    rec.regions = regions
+    Some(smape.map)
+}
+
+/// Error against the reference: HDR-FLIP, MSE, relative MSE, PSNR. Returns the FLIP map.
+pub fn error_vs_reference(rec: &mut FrameRecord, current: &Frame, reference: Option<&Frame>) -> Option<Vec<f32>> {
+    let r = reference?;
+    rec.mse = Some(metrics::mse(&r.image, &current.image));
+    rec.rel_mse = Some(metrics::relative_mse(&r.image, &current.image));
+    rec.psnr = Some(metrics::psnr(&r.image, &current.image));
+    let flip = metrics::flip_hdr(&r.image, &current.image, metrics::DEFAULT_PPD);
+    rec.flip = Some(flip.mean);
+    Some(flip.map)
+}
+
+/// Per region of interest: the means of the FLIP and SMAPE maps inside it.
+pub fn regions(rec: &mut FrameRecord, scenario: &Scenario, width: u32, flip: Option<&[f32]>, smape: Option<&[f32]>) {
+    rec.regions = scenario
+        .regions
         .iter()
         .map(|r| {
-            let f = flip.as_ref().and_then(|f| r.mean_of(&f.map, width));
-            let s = smape.as_ref().and_then(|s| r.mean_of(&s.map, width));
+            let r = Region { name: r.name.clone(), x: r.x, y: r.y, width: r.width, height: r.height };
+            let f = flip.and_then(|f| r.mean_of(f, width));
+            let s = smape.and_then(|s| r.mean_of(s, width));
             (r.name.clone(), f, s)
         })
         .collect();
+}
+
+/// Every measurement of `current` at once: [`smape_vs_previous`], [`error_vs_reference`],
+/// [`regions`] (the frame's Measure stage runs them as separate systems).
+pub fn record(current: &Frame, previous: Option<&Frame>, reference: Option<&Frame>, scenario: &Scenario) -> FrameRecord {
+    let mut rec = FrameRecord::default();
+    let smape = smape_vs_previous(&mut rec, current, previous, scenario.smape_epsilon);
+    let flip = error_vs_reference(&mut rec, current, reference);
+    regions(&mut rec, scenario, current.image.width, flip.as_deref(), smape.as_deref());
     rec
 }

@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 
+#[derive(Clone, Debug)]
 pub struct RunFolder {
     pub root: PathBuf,
 }

@@ -70,7 +70,9 @@ pub enum HashCacheLookup {
     SecondaryHit,
 }
 
+/// The `HashCache(...)` method's scenario settings; every field defaults to [`Default`]'s value.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct HashCacheSettings {
     /// Slots of the table.
     pub capacity: u32,
@@ -89,6 +91,8 @@ pub struct HashCacheSettings {
     pub max_samples: u32,
     /// Halton (2, 3) cycle of the primary rays; 0 = pixel centres.
     pub jitter_length: u32,
+    /// Resolve the cache's image under TAA (default settings), as the paper runs it.
+    pub taa: bool,
 }
 
 impl Default for HashCacheSettings {
@@ -103,6 +107,7 @@ impl Default for HashCacheSettings {
             lookup: HashCacheLookup::SecondaryHit,
             max_samples: 32,
             jitter_length: 8,
+            taa: false,
         }
     }
 }
@@ -275,6 +280,13 @@ impl HashCache {
     /// One frame; `camera` is the scene's camera of this frame (its field of view sets the LOD),
     /// `taa` an optional resolve over the result (the paper applies TAA to HashCache).
     pub fn render(&mut self, gpu: &Gpu, tracer: &PathTracer, camera: &Camera, seed: u64, frame: u32, taa: Option<&mut Taa>) -> Result<HashCacheOutput, RenderError> {
+        let (timings, jitter) = self.update(gpu, tracer, camera, seed, frame)?;
+        self.resolve(gpu, taa, timings, jitter)
+    }
+
+    /// The cache's own passes in one timed submission: age (eviction), then the frame's lookups
+    /// and updates. Returns their times and the frame's primary jitter (for [`Self::resolve`]).
+    pub fn update(&mut self, gpu: &Gpu, tracer: &PathTracer, camera: &Camera, seed: u64, frame: u32) -> Result<(Vec<PassTiming>, [f32; 2]), RenderError> {
         let jitter = halton_jitter(frame, self.settings.jitter_length);
         let stamp = self.frames + 1;
         let k = self.settings.key_params(camera, self.height);
@@ -312,7 +324,11 @@ impl HashCache {
                 }
             })?;
         }
-        let mut timings = timed.submit()?;
+        Ok((timed.submit()?, jitter))
+    }
+
+    /// The frame's image after [`Self::update`]: the cache's colour, or `taa`'s resolve of it.
+    pub fn resolve(&mut self, gpu: &Gpu, taa: Option<&mut Taa>, mut timings: Vec<PassTiming>, jitter: [f32; 2]) -> Result<HashCacheOutput, RenderError> {
         let radiance = match taa {
             Some(taa) => {
                 let out = taa.resolve_external(gpu, jitter, |encoder, colour, primary| {

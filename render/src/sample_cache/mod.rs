@@ -33,8 +33,12 @@ use crate::path_tracer::PathTracer;
 use crate::readback::read_buffer;
 use crate::timing::{PassTimer, PassTiming};
 
-/// Pass names in [`CacheFrame::timings`].
+/// Pass names in [`CacheFrame::timings`]: the stages of a frame, each one submission
+/// ([`SampleCache::stage`]); the frame's systems run them in this order.
 pub const PASSES: [&str; 4] = ["reserve", "trace", "shade", "reconstruct"];
+
+/// The dispatches (indices into [`DISPATCHES`]) of each of [`PASSES`].
+const STAGE_DISPATCHES: [std::ops::Range<usize>; 4] = [0..2, 2..5, 5..8, 8..9];
 
 /// The dispatches of a frame, `PASS/entry`, in order; each is timed on its own
 /// ([`CacheFrame::dispatch_timings`]) and the pass time is the sum of its dispatches'.
@@ -165,8 +169,11 @@ pub struct SampleCache {
     bind_groups: [wgpu::BindGroup; 2],
     /// Index of the cache holding the last frame (the source of the next reprojection).
     current: usize,
-    timer: PassTimer,
+    /// One timer per stage of [`PASSES`] (each stage is its own submission).
+    timers: Vec<PassTimer>,
     frames: u32,
+    /// The frame under way: its seed and number, and the dispatch times of its stages so far.
+    pending: Option<(u64, u32, Vec<PassTiming>)>,
 }
 
 struct Pipelines {
@@ -239,8 +246,9 @@ impl SampleCache {
             header_readback,
             bind_groups,
             current: 0,
-            timer: PassTimer::new(gpu, &DISPATCHES),
+            timers: STAGE_DISPATCHES.iter().map(|r| PassTimer::new(gpu, &DISPATCHES[r.clone()])).collect(),
             frames: 0,
+            pending: None,
         })
     }
 
@@ -249,46 +257,70 @@ impl SampleCache {
     }
 
     /// Renders one frame: call after `tracer.update` for this frame's scene. `frame` seeds the
-    /// frame's randomness (with `seed`) and drives the round robins.
+    /// frame's randomness (with `seed`) and drives the round robins. The four stages of
+    /// [`PASSES`] in order; the frame's systems call [`Self::stage`] one by one instead.
     pub fn render(&mut self, gpu: &Gpu, tracer: &PathTracer, seed: u64, frame: u32) -> Result<CacheFrame, RenderError> {
+        self.begin_frame(seed, frame);
+        for stage in 0..PASSES.len() {
+            self.stage(gpu, tracer, stage)?;
+        }
+        self.finish_frame(gpu)
+    }
+
+    /// Starts frame `frame`; then [`Self::stage`] 0 to 3, then [`Self::finish_frame`].
+    pub fn begin_frame(&mut self, seed: u64, frame: u32) {
+        self.pending = Some((seed, frame, Vec::new()));
+    }
+
+    /// Stage `stage` of [`PASSES`] (reserve = reprojection, trace, shade, reconstruct) as one
+    /// timed submission. Each stage sets the tracer's frame uniform itself, so other methods may
+    /// run between stages.
+    pub fn stage(&mut self, gpu: &Gpu, tracer: &PathTracer, stage: usize) -> Result<(), RenderError> {
         let (w, h) = (self.width, self.height);
         if tracer.settings().width != w || tracer.settings().height != h {
             return Err(RenderError::Settings(format!("sample cache is {w}x{h}, the path tracer {}x{}", tracer.settings().width, tracer.settings().height)));
         }
+        let Some((seed, frame, _)) = self.pending else {
+            return Err(RenderError::Settings("sample cache: stage before begin_frame".into()));
+        };
         tracer.prepare_frame(gpu, 1, 0, seed, frame);
         let s = &self.settings;
-        let vfov = 2.0 * tracer_tan_half_fov(tracer).atan();
-        let pixels = w * h;
-        let params = GpuParams {
-            size: [w, h, s.slots, frame],
-            modes: [
-                match s.retrace {
-                    Retrace::Single => 0,
-                    Retrace::Multi => 1,
-                    Retrace::Adaptive => 2,
-                },
-                match s.shading {
-                    ShadingMode::Uniform => 0,
-                    ShadingMode::Adaptive => 1,
-                },
-                s.base_block,
-                s.buckets,
-            ],
-            density: [s.n_target, s.delta, s.epsilon0, s.epsilon1],
-            shade: [s.alpha, s.shading_rate * pixels as f32, slope::pixel_diagonal_angle(vfov, h), 0.0],
-        };
-        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        if stage == 0 {
+            let vfov = 2.0 * tracer_tan_half_fov(tracer).atan();
+            let pixels = w * h;
+            let params = GpuParams {
+                size: [w, h, s.slots, frame],
+                modes: [
+                    match s.retrace {
+                        Retrace::Single => 0,
+                        Retrace::Multi => 1,
+                        Retrace::Adaptive => 2,
+                    },
+                    match s.shading {
+                        ShadingMode::Uniform => 0,
+                        ShadingMode::Adaptive => 1,
+                    },
+                    s.base_block,
+                    s.buckets,
+                ],
+                density: [s.n_target, s.delta, s.epsilon0, s.epsilon1],
+                shade: [s.alpha, s.shading_rate * pixels as f32, slope::pixel_diagonal_angle(vfov, h), 0.0],
+            };
+            gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        }
 
-        let mut timed = self.timer.begin(gpu, "sample cache");
-        let encoder = timed.encoder();
-        encoder.clear_buffer(&self.pixel_atomics, 0, None);
-        // Header words 0-5 and 10-31; 6-9 (importance bounds) carry over, begin_main moves them.
-        encoder.clear_buffer(&self.work, 0, Some(24));
-        encoder.clear_buffer(&self.work, 40, Some((HEADER_WORDS - 10) * 4));
-        if self.frames == 0 {
-            // The very first frame reprojects an empty cache.
-            encoder.clear_buffer(&self.caches[self.current].mask, 0, None);
-            encoder.clear_buffer(&self.work, 0, Some(HEADER_WORDS * 4));
+        let mut timed = self.timers[stage].begin(gpu, PASSES[stage]);
+        if stage == 0 {
+            let encoder = timed.encoder();
+            encoder.clear_buffer(&self.pixel_atomics, 0, None);
+            // Header words 0-5 and 10-31; 6-9 (importance bounds) carry over, begin_main moves them.
+            encoder.clear_buffer(&self.work, 0, Some(24));
+            encoder.clear_buffer(&self.work, 40, Some((HEADER_WORDS - 10) * 4));
+            if self.frames == 0 {
+                // The very first frame reprojects an empty cache.
+                encoder.clear_buffer(&self.caches[self.current].mask, 0, None);
+                encoder.clear_buffer(&self.work, 0, Some(HEADER_WORDS * 4));
+            }
         }
         let bind_group = &self.bind_groups[self.current];
         let (gx, gy) = (w.div_ceil(8), h.div_ceil(8));
@@ -305,7 +337,8 @@ impl SampleCache {
             (&p.shade, [gx, gy, s.slots]),
             (&p.reconstruct, [gx, gy, 1]),
         ];
-        for (i, (pipeline, [x, y, z])) in dispatches.into_iter().enumerate() {
+        for (i, d) in STAGE_DISPATCHES[stage].clone().enumerate() {
+            let (pipeline, [x, y, z]) = dispatches[d];
             timed.pass(i, |pass| {
                 pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
                 pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
@@ -314,10 +347,24 @@ impl SampleCache {
                 pass.dispatch_workgroups(x, y, z);
             })?;
         }
-        let encoder = timed.encoder();
-        encoder.copy_buffer_to_buffer(&self.out, 0, &self.out_readback, 0, self.out.size());
-        encoder.copy_buffer_to_buffer(&self.work, 0, &self.header_readback, 0, HEADER_WORDS * 4);
-        let dispatch_timings = timed.submit()?;
+        if stage == PASSES.len() - 1 {
+            let encoder = timed.encoder();
+            encoder.copy_buffer_to_buffer(&self.out, 0, &self.out_readback, 0, self.out.size());
+            encoder.copy_buffer_to_buffer(&self.work, 0, &self.header_readback, 0, HEADER_WORDS * 4);
+        }
+        let times = timed.submit()?;
+        if let Some((_, _, all)) = &mut self.pending {
+            all.extend(times);
+        }
+        Ok(())
+    }
+
+    /// Ends the frame after its four stages: swaps the caches and reads the image and counters.
+    pub fn finish_frame(&mut self, gpu: &Gpu) -> Result<CacheFrame, RenderError> {
+        let Some((_, _, dispatch_timings)) = self.pending.take() else {
+            return Err(RenderError::Settings("sample cache: finish_frame before begin_frame".into()));
+        };
+        let s = &self.settings;
         let mut timings = Vec::new();
         for t in &dispatch_timings {
             let pass = t.pass.split('/').next().unwrap_or(&t.pass);

@@ -61,7 +61,9 @@ pub enum TaaClamp {
     Variance { gamma: f32 },
 }
 
+/// The `Taa(...)` method's scenario settings; every field defaults to [`Default`]'s value.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct TaaSettings {
     /// Weight of the current frame in the exponential blend.
     pub alpha: f32,
@@ -196,7 +198,9 @@ pub struct Taa {
     resolve_pipeline: wgpu::ComputePipeline,
     /// [0]: rays traced by the trace pass this frame.
     counters: wgpu::Buffer,
+    /// The trace pass's timer, and the resolve's (each pass is its own submission).
     timer: PassTimer,
+    resolve_timer: PassTimer,
     parity: usize,
     history_valid: bool,
     last_history_valid: bool,
@@ -245,7 +249,8 @@ impl Taa {
             resolve_groups,
             resolve_pipeline,
             counters,
-            timer: PassTimer::new(gpu, &[TAA_TRACE_PASS, TAA_RESOLVE_PASS]),
+            timer: PassTimer::new(gpu, &[TAA_TRACE_PASS]),
+            resolve_timer: PassTimer::new(gpu, &[TAA_RESOLVE_PASS]),
             parity: 0,
             history_valid: false,
             last_history_valid: false,
@@ -269,11 +274,17 @@ impl Taa {
 
     /// Jittered 1 spp path tracing + resolve. `tracer` must be updated to this frame's scene.
     pub fn render(&mut self, gpu: &Gpu, tracer: &PathTracer, seed: u64, frame: u32) -> Result<TaaOutput, RenderError> {
+        let trace = self.trace(gpu, tracer, seed, frame)?;
+        self.resolve(gpu, trace)
+    }
+
+    /// The trace pass (its own submission): jittered 1 spp path tracing into the current colour.
+    pub fn trace(&mut self, gpu: &Gpu, tracer: &PathTracer, seed: u64, frame: u32) -> Result<Vec<PassTiming>, RenderError> {
         let jitter = halton_jitter(frame, self.settings.jitter_length);
         tracer.prepare_frame(gpu, 1, 0, seed, frame);
         self.write_params(gpu, jitter);
         let group = self.trace_group(gpu, &self.current, &self.primary[self.parity]);
-        let mut timed = self.timer.begin(gpu, "taa");
+        let mut timed = self.timer.begin(gpu, "taa trace");
         timed.encoder().clear_buffer(&self.counters, 0, None);
         timed.pass(0, |pass| {
             pass.set_pipeline(&self.trace_pipeline);
@@ -282,8 +293,16 @@ impl Taa {
             pass.set_bind_group(2, &group, &[]);
             pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
         })?;
-        timed.pass(1, |pass| self.encode_resolve(pass))?;
-        let timings = timed.submit()?;
+        timed.submit()
+    }
+
+    /// The resolve pass after [`Self::trace`] (its own submission): reprojection, clamp, blend;
+    /// `trace` is what `trace` returned, reported first in the output's timings.
+    pub fn resolve(&mut self, gpu: &Gpu, trace: Vec<PassTiming>) -> Result<TaaOutput, RenderError> {
+        let mut timed = self.resolve_timer.begin(gpu, "taa resolve");
+        timed.pass(0, |pass| self.encode_resolve(pass))?;
+        let mut timings = trace;
+        timings.extend(timed.submit()?);
         let mut out = self.finish(gpu, timings)?;
         out.rays = self.read::<u32>(gpu, &self.counters, "TAA ray counter")?[0] as u64;
         out.shaded = self.width as u64 * self.height as u64;
@@ -307,9 +326,9 @@ impl Taa {
         write: impl FnOnce(&mut wgpu::CommandEncoder, &wgpu::Buffer, &wgpu::Buffer),
     ) -> Result<TaaOutput, RenderError> {
         self.write_params(gpu, jitter);
-        let mut timed = self.timer.begin(gpu, "taa resolve");
+        let mut timed = self.resolve_timer.begin(gpu, "taa resolve");
         write(timed.encoder(), &self.current, &self.primary[self.parity]);
-        timed.pass(1, |pass| self.encode_resolve(pass))?;
+        timed.pass(0, |pass| self.encode_resolve(pass))?;
         let timings = timed.submit()?;
         self.finish(gpu, timings)
     }

@@ -2,7 +2,7 @@
 //! 2 m cube open towards the camera at +Z.
 
 use glam::{Quat, Vec3};
-use render::scene::Material;
+use scene::Material;
 
 use super::geometry::{unit_cube, unit_quad};
 use crate::template::WorldTemplate;

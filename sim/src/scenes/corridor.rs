@@ -2,7 +2,7 @@
 //! visible pixel near the camera is reached after several bounces.
 
 use glam::{IVec2, Vec3};
-use render::scene::Material;
+use scene::Material;
 
 use super::geometry::MeshBuilder;
 use crate::template::WorldTemplate;

@@ -2,7 +2,7 @@
 //! prototype of the boids scenario), under a dominant sun and a dim sky.
 
 use glam::{Quat, Vec2, Vec3};
-use render::scene::{Light, Material};
+use scene::{Light, Material};
 
 use super::geometry::{MeshBuilder, unit_cube, unit_quad};
 use crate::template::WorldTemplate;
@@ -12,7 +12,7 @@ use crate::transform::Transform;
 pub const SUN_ELEVATION: f32 = 40.0;
 
 /// A small arrow-shaped "bird" pointing along -Z (boids turn -Z into their heading).
-fn bird_mesh() -> render::scene::Mesh {
+fn bird_mesh() -> scene::Mesh {
     let mut b = MeshBuilder::new("bird");
     let nose = Vec3::new(0.0, 0.0, -0.15);
     let tail = [Vec3::new(-0.12, 0.0, 0.1), Vec3::new(0.12, 0.0, 0.1), Vec3::new(0.0, 0.05, 0.08)];

@@ -2,7 +2,7 @@
 //! dark room (camera) is lit only through a narrow gap by a lamp in the other room.
 
 use glam::{Quat, Vec3};
-use render::scene::{Light, Material};
+use scene::{Light, Material};
 
 use super::geometry::unit_cube;
 use crate::template::{NodeTemplate, WorldTemplate};

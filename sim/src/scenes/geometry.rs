@@ -2,7 +2,7 @@
 //! from the side their normal points to.
 
 use glam::{Vec2, Vec3};
-use render::scene::Mesh;
+use scene::Mesh;
 
 /// Accumulates vertices and triangles of one mesh.
 pub struct MeshBuilder {

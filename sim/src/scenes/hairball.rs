@@ -2,7 +2,7 @@
 //! stress test for traversal of thin, overlapping geometry.
 
 use glam::Vec3;
-use render::scene::{Light, Material};
+use scene::{Light, Material};
 
 use super::geometry::{MeshBuilder, unit_quad};
 use crate::rng::Rng;

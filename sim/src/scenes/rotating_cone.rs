@@ -2,7 +2,7 @@
 //! its shadow and silhouette.
 
 use glam::{Quat, Vec3};
-use render::scene::{Light, Material};
+use scene::{Light, Material};
 
 use super::geometry::{MeshBuilder, unit_quad};
 use crate::components::MeshInstance;

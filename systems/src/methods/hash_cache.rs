@@ -1,48 +1,86 @@
-//! World-space hash cache (render::hash_cache), optionally under TAA as the paper runs it.
+//! World-space hash cache (render::hash_cache), optionally under TAA as the paper runs it. Two
+//! systems: the cache's passes (age = eviction, then lookups and updates), then the resolve of
+//! the image (TAA's, or the cache's colour as is).
 
-use anyhow::Result;
-use render::hash_cache::{HashCache, HashCacheSettings};
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use bevy_ecs::prelude::*;
+use render::hash_cache::{HashCache, HashCacheLookup};
 use render::taa::{Taa, TaaSettings};
+use render::timing::PassTiming;
 
-use super::{FrameContext, FrameMethod, MethodOutput};
+pub use render::hash_cache::HashCacheSettings;
 
-pub struct HashCacheMethod {
-    settings: HashCacheSettings,
-    taa: Option<TaaSettings>,
-    label: String,
-    /// Built on the first frame: the passes bind the shared tracer's layouts.
-    state: Option<(HashCache, Option<Taa>)>,
+use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
+use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, failed};
+
+/// `hash_cache`, `hash_cache_first_hit`, `hash_cache_taa`, ...
+pub fn label(s: &HashCacheSettings) -> String {
+    format!("hash_cache{}{}", if s.lookup == HashCacheLookup::FirstHit { "_first_hit" } else { "" }, if s.taa { "_taa" } else { "" })
 }
 
-impl HashCacheMethod {
-    pub fn new(settings: HashCacheSettings, taa: Option<TaaSettings>, label: String) -> Result<Self> {
+#[derive(Component)]
+pub struct HashCacheState {
+    cache: HashCache,
+    taa: Option<Taa>,
+    /// This frame's pass times and primary jitter, from `age_and_update` to `resolve`.
+    updated: Option<(Vec<PassTiming>, [f32; 2])>,
+}
+
+pub struct Plugin;
+pub static PLUGIN: Plugin = Plugin;
+
+impl MethodPlugin for Plugin {
+    fn name(&self) -> &'static str {
+        "HashCache"
+    }
+
+    fn add_systems(&self, schedule: &mut Schedule) {
+        schedule.add_systems((age_and_update, resolve).chain().in_set(Stage::Render));
+    }
+
+    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
+        let MethodSpec::HashCache(settings) = &method.spec else { bail!("not a HashCache method") };
         settings.validate()?;
-        if let Some(t) = &taa {
-            t.validate()?;
-        }
-        Ok(Self { settings, taa, label, state: None })
+        let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
+        let cache = HashCache::new(gpu, tracer, *settings)?;
+        let taa = settings.taa.then(|| Taa::new(gpu, tracer, TaaSettings::default())).transpose()?;
+        world.entity_mut(entity).insert(HashCacheState { cache, taa, updated: None });
+        Ok(())
     }
 }
 
-impl FrameMethod for HashCacheMethod {
-    fn label(&self) -> String {
-        self.label.clone()
+/// The cache's passes: age (eviction), trace, update, resolve into its colour.
+pub fn age_and_update(
+    gpu: Res<GpuDevice>,
+    tracer: Res<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    scene: Res<sim::ExtractedScene>,
+    mut methods: Query<(&mut HashCacheState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
+    for (mut state, info, mut frame) in &mut methods {
+        let start = Instant::now();
+        let updated = state
+            .cache
+            .update(&gpu.0, &tracer.0, &scene.scene.camera, run.scenario.seed, clock.global)
+            .map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
+        state.updated = Some(updated);
+        frame.add_cpu(start);
     }
+    Ok(())
+}
 
-    fn spp(&self) -> u32 {
-        1
-    }
-
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodOutput> {
-        if self.state.is_none() {
-            let cache = HashCache::new(ctx.gpu, ctx.tracer, self.settings)?;
-            let taa = self.taa.map(|s| Taa::new(ctx.gpu, ctx.tracer, s)).transpose()?;
-            self.state = Some((cache, taa));
-        }
-        let (cache, taa) = self.state.as_mut().expect("built above");
-        let out = cache.render(ctx.gpu, ctx.tracer, &ctx.scene.camera, ctx.scenario.seed, ctx.frame, taa.as_mut())?;
+/// The frame's image: TAA's resolve over the cache's colour, or the colour itself.
+pub fn resolve(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut methods: Query<(&mut HashCacheState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+    for (mut state, info, mut frame) in &mut methods {
+        let start = Instant::now();
+        let state = &mut *state;
+        let (timings, jitter) = state.updated.take().unwrap_or_default();
+        let out = state.cache.resolve(&gpu.0, state.taa.as_mut(), timings, jitter).map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
         let s = out.stats;
-        Ok(MethodOutput {
+        frame.output = Some(MethodOutput {
             stats: vec![
                 ("cache_occupancy".into(), s.occupancy()),
                 ("cache_used_cells".into(), s.occupied as f64),
@@ -52,6 +90,8 @@ impl FrameMethod for HashCacheMethod {
                 ("cache_update_paths".into(), s.update_paths as f64),
             ],
             ..MethodOutput::timed(out.radiance, out.motion, &out.timings, out.rays, out.shaded)
-        })
+        });
+        frame.add_cpu(start);
     }
+    Ok(())
 }

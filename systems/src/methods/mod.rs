@@ -1,132 +1,156 @@
-//! Rendering methods as per-frame systems: the playback loop asks each method for one frame, in
-//! the scenario's order, after the scene has been updated. A method owns its own GPU state
-//! (caches, histories) and may use the shared path tracer (scene geometry, G-buffer).
+//! Rendering methods. Each is a plugin ([`MethodPlugin`]): it adds its systems to the frame's
+//! stages (`crate::frame::Stage`) and builds each instance, GPU state included, up front on the
+//! instance's entity. Its scenario settings are its own serde struct, wrapped by
+//! [`MethodSpec`]. Adding a method: its passes (render/ or its own crate), one file here with
+//! its settings, components, systems and plugin, and one variant + registry line in `spec.rs`.
 
+pub mod hash_cache;
 pub mod nirc;
-mod path_tracing;
-mod sample_cache;
-mod hash_cache;
-mod taa;
+pub mod path_tracing;
+pub mod sample_cache;
+pub mod spec;
+pub mod taa;
 
 use anyhow::Result;
-use render::gpu::Gpu;
-use render::path_tracer::PathTracer;
-use render::scene::SceneDesc;
-use sim::{MethodSpec, Scenario};
+use bevy_ecs::prelude::*;
 
-pub use nirc::Nirc;
-pub use path_tracing::PathTracing;
-pub use sample_cache::SampleCacheMethod;
-pub use hash_cache::HashCacheMethod;
-pub use taa::TaaMethod;
+pub use spec::{check_labels, parse_methods};
 
-/// Everything a method may read while rendering one frame.
-pub struct FrameContext<'a> {
-    pub gpu: &'a Gpu,
-    /// Shared path tracer, already updated to this frame's scene.
-    pub tracer: &'a mut PathTracer,
-    pub scene: &'a SceneDesc,
-    pub scenario: &'a Scenario,
-    /// Simulation frame (warm-up frames included), the seed of per-frame randomness.
-    pub frame: u32,
-    /// False during warm-up: the frame is rendered (caches learn) but not recorded.
-    pub recorded: bool,
-    /// The run's cache folder (`--cache-dir`): references, and state a method may reuse
-    /// across runs (NIRC warm starts).
-    pub cache_dir: &'a std::path::Path,
+use hash_cache::HashCacheSettings;
+use nirc::NircSettings;
+use path_tracing::PathTracingSettings;
+use sample_cache::SampleCacheSettings;
+use serde::{Deserialize, Serialize};
+use sim::MethodEntry;
+use taa::TaaSettings;
+
+/// A method family: its systems and how to build one instance.
+pub trait MethodPlugin: Sync {
+    /// The scenario's name of the method, e.g. `SampleCache`.
+    fn name(&self) -> &'static str;
+    /// Adds the method's systems to the frame's stages (once per run, whatever the number of
+    /// instances; each system serves every instance).
+    fn add_systems(&self, schedule: &mut Schedule);
+    /// Builds one instance on `entity` (which already has its `MethodInfo` and `MethodFrame`):
+    /// its GPU state, from the world's `GpuDevice` and `Tracer`.
+    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()>;
 }
 
-/// One rendered frame of a method.
-#[derive(Clone, Debug, Default)]
-pub struct MethodOutput {
-    /// Linear HDR radiance, row-major, alpha = 1.
-    pub radiance: Vec<[f32; 4]>,
-    /// Per-pixel motion (pixels, current to previous), for reprojected SMAPE.
-    pub motion: Vec<[f32; 2]>,
-    /// Time per pass in execution order; `None` = not measured. Fill it with [`Self::timed`]
-    /// from the passes' [`render::timing::PassTiming`]s.
-    pub passes: Vec<(String, Option<f64>)>,
-    /// The clock of `passes` (GPU timestamps or per-pass wall time); `None` = unknown.
-    pub clock: Option<render::timing::Clock>,
-    /// Rays traced this frame (camera + shadow + bounce, counted on the GPU); `None` = not
-    /// reported.
-    pub rays: Option<u64>,
-    /// Paths shaded this frame; `None` = not reported.
-    pub shaded: Option<u64>,
-    /// Method-specific numbers for `frames.csv`, e.g. mean reliability or cache occupancy.
-    pub stats: Vec<(String, f64)>,
-    /// Method-specific images (linear RGB, or a false-colour map), written as
-    /// `frames/METHOD/NAME/NNNN.png` (and `.exr` when `hdr`).
-    pub images: Vec<MethodImage>,
+pub use crate::frame::{MethodImage, MethodOutput};
+
+/// A rendering method and its settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum MethodSpec {
+    /// NEE + MIS path tracing at `spp` samples per pixel.
+    PathTracing(PathTracingSettings),
+    /// Path tracing terminated into the neural incident radiance cache (nirc/README.md).
+    Nirc(NircSettings),
+    /// Stable sample cache (render::sample_cache).
+    SampleCache(SampleCacheSettings),
+    /// TAA over jittered 1 spp path tracing (render::taa).
+    Taa(TaaSettings),
+    /// World-space hash cache (render::hash_cache), optionally under TAA.
+    HashCache(HashCacheSettings),
 }
 
-impl MethodOutput {
-    /// The common part of every method's output: image, motion, pass times and the counters.
-    pub fn timed(radiance: Vec<[f32; 4]>, motion: Vec<[f32; 2]>, timings: &[render::timing::PassTiming], rays: u64, shaded: u64) -> Self {
-        Self {
-            radiance,
-            motion,
-            passes: timings.iter().map(|t| (t.pass.clone(), Some(t.ms))).collect(),
-            clock: timings.first().map(|t| t.clock),
-            rays: Some(rays),
-            shaded: Some(shaded),
-            ..Default::default()
+impl MethodSpec {
+    /// The method's plugin: the registry of methods, one line each.
+    pub fn plugin(&self) -> &'static dyn MethodPlugin {
+        match self {
+            MethodSpec::PathTracing(_) => &path_tracing::PLUGIN,
+            MethodSpec::Nirc(_) => &nirc::PLUGIN,
+            MethodSpec::SampleCache(_) => &sample_cache::PLUGIN,
+            MethodSpec::Taa(_) => &taa::PLUGIN,
+            MethodSpec::HashCache(_) => &hash_cache::PLUGIN,
+        }
+    }
+
+    /// The label of an unnamed method, e.g. `pt_4spp`.
+    pub fn default_label(&self) -> String {
+        match self {
+            MethodSpec::PathTracing(s) => s.label(),
+            MethodSpec::Nirc(s) => s.label(),
+            MethodSpec::SampleCache(s) => s.label(),
+            MethodSpec::Taa(_) => "taa".into(),
+            MethodSpec::HashCache(s) => hash_cache::label(s),
+        }
+    }
+
+    /// Samples per pixel the method spends per frame.
+    pub fn spp(&self) -> u32 {
+        match self {
+            MethodSpec::PathTracing(s) => s.spp,
+            MethodSpec::Nirc(s) => s.spp,
+            // One shaded path per pixel at a 100% shading rate.
+            MethodSpec::SampleCache(s) => (s.shading_rate.ceil() as u32).max(1),
+            MethodSpec::Taa(_) | MethodSpec::HashCache(_) => 1,
+        }
+    }
+
+    /// `--spp N`: methods whose cost is a sample count take it; the others are 1 spp by
+    /// construction.
+    pub fn set_spp(&mut self, spp: u32) {
+        match self {
+            MethodSpec::PathTracing(s) => s.spp = spp,
+            MethodSpec::Nirc(s) => s.spp = spp,
+            MethodSpec::SampleCache(_) | MethodSpec::Taa(_) | MethodSpec::HashCache(_) => {}
         }
     }
 }
 
-#[derive(Clone, Debug)]
-pub struct MethodImage {
-    pub name: String,
-    pub pixels: Vec<[f32; 4]>,
-    /// HDR images are written as EXR too and tone-mapped for the PNG; others are written as is.
-    pub hdr: bool,
+/// One method of a run: its settings, its label and where the scenario wrote it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Method {
+    pub spec: MethodSpec,
+    /// `name: "..."` of the entry, if any.
+    pub name: Option<String>,
+    pub entry: MethodEntry,
 }
 
-pub trait FrameMethod {
-    /// Folder and table name, e.g. `pt_4spp`.
-    fn label(&self) -> String;
-    /// Samples per pixel it spends per frame (for equal-budget comparisons).
-    fn spp(&self) -> u32;
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodOutput>;
+impl Method {
+    /// Folder and table name: the entry's `name`, else the method's default label.
+    pub fn label(&self) -> String {
+        self.name.clone().unwrap_or_else(|| self.spec.default_label())
+    }
+
+    /// A method from RON text alone (tests, tools).
+    pub fn parse(text: &str) -> Result<Method, String> {
+        spec::parse_one(text)
+    }
 }
 
-/// Builds the method a scenario asks for.
-pub fn build(spec: &MethodSpec, _gpu: &Gpu, _scenario: &Scenario, _scene: &SceneDesc) -> Result<Box<dyn FrameMethod>> {
-    Ok(match spec {
-        MethodSpec::PathTracing { spp } => Box::new(PathTracing::new(*spp)),
-        MethodSpec::Nirc { spp, predictor, cache, paths, pretrain_frames } => Box::new(Nirc::new(
-            _scenario,
-            nirc::NircSettings { spp: *spp, cache: cache.clone(), paths: paths.clone(), pretrain_frames: *pretrain_frames },
-            *predictor,
-        )?),
-        MethodSpec::SampleCache { .. } => {
-            let settings = spec.sample_cache_settings().expect("a SampleCache spec");
-            settings.validate().map_err(|e| anyhow::anyhow!("{}: SampleCache: {e}", _scenario.origin.display()))?;
-            Box::new(SampleCacheMethod::new(settings))
+
+/// The plugins of `methods`, each once, in order of first use.
+pub fn plugins(methods: &[Method]) -> Vec<&'static dyn MethodPlugin> {
+    let mut out: Vec<&'static dyn MethodPlugin> = Vec::new();
+    for m in methods {
+        let p = m.spec.plugin();
+        if !out.iter().any(|q| q.name() == p.name()) {
+            out.push(p);
         }
-        MethodSpec::Taa { alpha, clamp, jitter_length, depth_tolerance, normal_threshold } => Box::new(TaaMethod::new(render::taa::TaaSettings {
-            alpha: *alpha,
-            clamp: *clamp,
-            jitter_length: *jitter_length,
-            depth_tolerance: *depth_tolerance,
-            normal_threshold: *normal_threshold,
-            ..Default::default()
-        })?),
-        MethodSpec::HashCache { capacity, probe_limit, max_age, lod_scale, normal_lod, jitter, lookup, max_samples, taa } => {
-            let settings = render::hash_cache::HashCacheSettings {
-                capacity: *capacity,
-                probe_limit: *probe_limit,
-                max_age: *max_age,
-                lod_scale: *lod_scale,
-                normal_lod: *normal_lod,
-                jitter: *jitter,
-                lookup: *lookup,
-                max_samples: *max_samples,
-                ..Default::default()
-            };
-            let taa = taa.then(render::taa::TaaSettings::default);
-            Box::new(HashCacheMethod::new(settings, taa, spec.label())?)
-        }
-    })
+    }
+    out
+}
+
+/// The frame's schedule for `methods`: the core systems and each used method's systems.
+pub fn schedule_for(methods: &[Method]) -> Schedule {
+    let mut schedule = crate::frame::new_schedule();
+    crate::frame::add_core_systems(&mut schedule);
+    for plugin in plugins(methods) {
+        plugin.add_systems(&mut schedule);
+    }
+    schedule
+}
+
+/// What `flicker schedule` prints: the methods, then the frame's systems by stage in execution
+/// order. Fails if a system is in no stage or out of stage order.
+pub fn describe_schedule(methods: &[Method]) -> Result<String> {
+    let mut schedule = schedule_for(methods);
+    let listing = crate::frame::listing(&mut schedule, &mut World::new()).map_err(|e| anyhow::anyhow!(e))?;
+    let mut text = String::from("methods\n");
+    for m in methods {
+        text += &format!("  {} ({})\n", m.label(), m.spec.plugin().name());
+    }
+    text += &crate::frame::describe(&listing);
+    Ok(text)
 }

@@ -1,41 +1,103 @@
 //! Path tracing terminated into the neural incident radiance cache (reliability-weighted NIRC,
 //! ../shared/seeds/reliability-weighted-nirc.txt). The cache, its camera paths and its training
-//! are shared by every NIRC method of a run with the same cache settings (`SharedCache`): as in
-//! the paper, EMA-only, High-LR, blend and switch see identical training and identical path
-//! samples, and differ only in how queries are answered. Per frame, whichever of them renders
-//! first does the shared work:
+//! are shared by every NIRC method of a run with the same cache settings (one [`NircCache`]
+//! entity): as in the paper, EMA-only, High-LR, blend and switch see identical training and
+//! identical path samples, and differ only in how queries are answered. Per frame:
 //!
-//! 1. camera paths up to the termination vertex -> queries       (`nirc_paths`)
-//! 2. per predictor mode: cache inference + resolve into an image (`nirc_infer`)
-//! 3. training records from a seeded subset of the queries + one training step (`nirc_train`)
+//! Render  `camera_paths`  camera paths up to the termination vertex -> queries, motion
+//!         `infer`         per predictor mode: cache inference + resolve into an image
+//! Learn   `reliability`   reliability grid at this frame's queries (before training)
+//!         `train`         training records from a seeded subset of the queries, one training
+//!                         step: Adam on the High-LR weights, then their EMA (one pass today)
+//!         `frame_output`  each method's frame: image, motion, pass times, statistics
 //!
 //! Inference uses the cache as trained up to the previous frame (NRC's order). Pass times are
 //! wall times of each submission to completion (nothing else runs on the device meanwhile);
 //! a method's frame time is paths + its own inference + training.
 
-use std::cell::RefCell;
-use std::collections::HashMap;
 use std::path::PathBuf;
-use std::rc::{Rc, Weak};
 use std::time::Instant;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
+use bevy_ecs::error::BevyError;
+use bevy_ecs::prelude::{Component, Entity, IntoScheduleConfigs, Query, Res, Schedule, World};
 use nirc::{CacheOutput, CachePathSettings, CachePaths, NeuralCache, NircConfig, PredictorMode, SceneBounds};
 use render::gpu::Gpu;
 use render::path_tracer::PathTracer;
-use render::scene::SceneDesc;
+use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
-use sim::Scenario;
 
-use super::{FrameContext, FrameMethod, MethodImage, MethodOutput};
+use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
+use crate::frame::{FrameClock, GpuDevice, MethodFrame, Run, Stage, Tracer, failed};
 
-/// What one shared cache is keyed by within a run.
-#[derive(Clone, Debug, PartialEq)]
+/// `Nirc(spp: 1, predictor: Blend, cache: (...), paths: (...), pretrain_frames: 0)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct NircSettings {
     pub spp: u32,
+    /// How queries are answered (inference only; training is the same for every mode).
+    #[serde(default)]
+    pub predictor: PredictorMode,
+    #[serde(default)]
     pub cache: NircConfig,
+    #[serde(default)]
     pub paths: CachePathSettings,
+    /// Training-only frames on the first frame's scene before anything renders (a warm start,
+    /// saved next to the reference cache and reused).
+    #[serde(default)]
     pub pretrain_frames: u32,
+}
+
+impl NircSettings {
+    pub fn label(&self) -> String {
+        format!("nirc_{}_{}spp", predictor_label(self.predictor), self.spp)
+    }
+
+    /// Methods with equal keys share one cache: everything but the predictor.
+    fn shared_key(&self) -> String {
+        format!("{}|{}|{}", self.spp, serde_json::to_string(&(&self.cache, &self.paths)).expect("settings serialise"), self.pretrain_frames)
+    }
+}
+
+/// Short name of a predictor mode in labels.
+pub fn predictor_label(mode: PredictorMode) -> &'static str {
+    match mode {
+        PredictorMode::EmaOnly => "ema",
+        PredictorMode::HighLrOnly => "highlr",
+        PredictorMode::Blend => "blend",
+        PredictorMode::Switch => "switch",
+    }
+}
+
+/// One cache, its camera paths and training, shared by the NIRC methods of equal settings.
+#[derive(Component)]
+pub struct NircCache {
+    key: String,
+    settings: NircSettings,
+    paths: CachePaths,
+    cache: NeuralCache,
+    /// One answer buffer per predictor mode in use, and one for the reliability diagnostics.
+    outputs: Vec<(PredictorMode, CacheOutput)>,
+    diagnostics: CacheOutput,
+    paths_ms: f64,
+    train_ms: f64,
+    stats: Vec<(String, f64)>,
+    /// Motion vectors of the frame's pixel-centre primary hits (shared by every mode).
+    motion: Vec<[f32; 2]>,
+    /// Rays traced this frame: camera paths (with motion rays), training targets.
+    rays: [u64; 2],
+    /// Camera paths shaded this frame (pixels x spp).
+    shaded: u64,
+    /// The warm-start file the cache was loaded from or saved to, if any.
+    pub warm_start: Option<PathBuf>,
+}
+
+/// One NIRC method: its predictor mode, its cache, and this frame's inference.
+#[derive(Component)]
+pub struct NircMethod {
+    mode: PredictorMode,
+    cache: Entity,
+    inferred: Option<ModeFrame>,
 }
 
 /// One frame's result for one predictor mode.
@@ -47,74 +109,42 @@ struct ModeFrame {
     infer_ms: f64,
 }
 
-struct Gpuside {
-    paths: CachePaths,
-    cache: NeuralCache,
-    outputs: Vec<(PredictorMode, CacheOutput)>,
-    diagnostics: CacheOutput,
-}
+pub struct Plugin;
+pub static PLUGIN: Plugin = Plugin;
 
-/// Cache, paths and per-frame results shared by the NIRC methods of one run.
-pub struct SharedCache {
-    settings: NircSettings,
-    modes: Vec<PredictorMode>,
-    gpu: Option<Gpuside>,
-    frame: Option<u32>,
-    results: HashMap<PredictorMode, ModeFrame>,
-    paths_ms: f64,
-    train_ms: f64,
-    stats: Vec<(String, f64)>,
-    /// Motion vectors of the frame's pixel-centre primary hits (shared by every mode).
-    motion: Vec<[f32; 2]>,
-    /// Rays traced this frame: camera paths (with motion rays), training targets.
-    rays: [u64; 2],
-    /// Camera paths shaded this frame (pixels x spp).
-    shaded: u64,
-    warm_start: Option<PathBuf>,
-}
+impl MethodPlugin for Plugin {
+    fn name(&self) -> &'static str {
+        "Nirc"
+    }
 
-thread_local! {
-    /// Shared caches of the methods alive on this thread, by (scenario, settings). Weak: a
-    /// run's caches go away with its methods.
-    static SHARED: RefCell<Vec<(String, Weak<RefCell<SharedCache>>)>> = const { RefCell::new(Vec::new()) };
-}
+    fn add_systems(&self, schedule: &mut Schedule) {
+        schedule.add_systems((camera_paths, infer).chain().in_set(Stage::Render));
+        schedule.add_systems((reliability, train, frame_output).chain().in_set(Stage::Learn));
+    }
 
-fn shared_for(scenario: &Scenario, settings: &NircSettings, mode: PredictorMode) -> Rc<RefCell<SharedCache>> {
-    let key = format!(
-        "{}|{}|{}|{}|{}",
-        scenario.origin.display(),
-        scenario.name,
-        settings.spp,
-        serde_json::to_string(&(&settings.cache, &settings.paths)).expect("settings serialise"),
-        settings.pretrain_frames
-    );
-    SHARED.with(|s| {
-        let mut list = s.borrow_mut();
-        list.retain(|(_, w)| w.strong_count() > 0);
-        let found = list.iter().find(|(k, _)| *k == key).and_then(|(_, w)| w.upgrade());
-        let shared = found.unwrap_or_else(|| {
-            let rc = Rc::new(RefCell::new(SharedCache {
-                settings: settings.clone(),
-                modes: Vec::new(),
-                gpu: None,
-                frame: None,
-                results: HashMap::new(),
-                paths_ms: 0.0,
-                train_ms: 0.0,
-                stats: Vec::new(),
-                motion: Vec::new(),
-                rays: [0; 2],
-                shaded: 0,
-                warm_start: None,
-            }));
-            list.push((key, Rc::downgrade(&rc)));
-            rc
-        });
-        if !shared.borrow().modes.contains(&mode) {
-            shared.borrow_mut().modes.push(mode);
+    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
+        let MethodSpec::Nirc(settings) = &method.spec else { bail!("not a Nirc method") };
+        settings.cache.validate()?;
+        if settings.spp == 0 {
+            bail!("Nirc: spp 0; expected at least 1 path per pixel");
         }
-        shared
-    })
+        let key = settings.shared_key();
+        let existing = world.query::<(Entity, &NircCache)>().iter(world).find(|(_, c)| c.key == key).map(|(e, _)| e);
+        let cache = match existing {
+            Some(e) => e,
+            None => {
+                let c = NircCache::build(world, settings, key)?;
+                world.spawn(c).id()
+            }
+        };
+        let c = world.get::<NircCache>(cache).expect("a cache entity");
+        if !c.outputs.iter().any(|(m, _)| *m == settings.predictor) {
+            let out = c.paths.output(&world.resource::<GpuDevice>().0)?;
+            world.get_mut::<NircCache>(cache).expect("a cache entity").outputs.push((settings.predictor, out));
+        }
+        world.entity_mut(entity).insert(NircMethod { mode: settings.predictor, cache, inferred: None });
+        Ok(())
+    }
 }
 
 fn wait(gpu: &Gpu) -> Result<()> {
@@ -134,39 +164,45 @@ fn scene_bounds(tracer: &PathTracer) -> SceneBounds {
     SceneBounds::new((lo - pad).to_array(), (hi + pad).to_array())
 }
 
-impl SharedCache {
+impl NircCache {
     /// Key of a warm start: everything that affects the pre-trained state.
-    fn warm_start_key(&self, gpu: &Gpu, scene: &SceneDesc, scenario: &Scenario, tracer: &PathTracer) -> String {
+    fn warm_start_key(settings: &NircSettings, gpu: &Gpu, scene: &scene::SceneDesc, run: &Run, tracer: &PathTracer) -> String {
         let mut h = Sha256::new();
         h.update(format!("{scene:?}").as_bytes());
-        h.update(serde_json::to_string(&(&self.settings.cache, &self.settings.paths)).unwrap().as_bytes());
-        h.update(format!("{:?}|{}|{}|{}", tracer.settings(), self.settings.spp, self.settings.pretrain_frames, scenario.seed).as_bytes());
+        h.update(serde_json::to_string(&(&settings.cache, &settings.paths)).unwrap().as_bytes());
+        h.update(format!("{:?}|{}|{}|{}", tracer.settings(), settings.spp, settings.pretrain_frames, run.scenario.seed).as_bytes());
         h.update(CachePaths::shader_source().as_bytes());
         h.update(nirc::gpu::shaders::all_sources().as_bytes());
         h.update(gpu.summary.to_string().as_bytes());
         h.finalize().iter().map(|b| format!("{b:02x}")).collect()
     }
 
-    fn init(&mut self, ctx: &FrameContext) -> Result<()> {
-        let gpu = ctx.gpu;
-        let paths = CachePaths::new(gpu, ctx.tracer, self.settings.spp, self.settings.paths.clone())?;
-        let bounds = scene_bounds(ctx.tracer);
-        let mut cache_config = self.settings.cache.clone();
+    /// The cache on the first frame's scene: fresh, or pre-trained (loaded from the warm-start
+    /// file when one exists, else trained and saved).
+    fn build(world: &World, settings: &NircSettings, key: String) -> Result<Self> {
+        let gpu = &world.resource::<GpuDevice>().0;
+        let tracer = &world.resource::<Tracer>().0;
+        let run = world.resource::<Run>();
+        let scene = &world.resource::<sim::ExtractedScene>().scene;
+        let paths = CachePaths::new(gpu, tracer, settings.spp, settings.paths.clone())?;
+        let bounds = scene_bounds(tracer);
+        let mut cache_config = settings.cache.clone();
         cache_config.max_batch = cache_config.max_batch.max(paths.record_count());
         let mut cache = None;
-        if self.settings.pretrain_frames > 0 {
-            let dir = ctx.cache_dir.join("nirc");
-            let file = dir.join(format!("{}.nirc", self.warm_start_key(gpu, ctx.scene, ctx.scenario, ctx.tracer)));
+        let mut warm_start = None;
+        if settings.pretrain_frames > 0 {
+            let dir = run.cache_dir.join("nirc");
+            let file = dir.join(format!("{}.nirc", Self::warm_start_key(settings, gpu, scene, run, tracer)));
             if file.exists() {
                 cache = Some(NeuralCache::load(gpu, &file).with_context(|| format!("loading the NIRC warm start {}", file.display()))?);
             } else {
                 let fresh = NeuralCache::new(gpu, &cache_config, bounds)?;
-                for k in 0..self.settings.pretrain_frames {
+                for k in 0..settings.pretrain_frames {
                     // Frame numbers of their own, so pre-training samples differ from the run's.
                     let frame = u32::MAX - k;
                     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                    paths.encode_queries(gpu, &mut encoder, ctx.tracer, ctx.scenario.seed, frame);
-                    paths.encode_records(gpu, &mut encoder, ctx.tracer);
+                    paths.encode_queries(gpu, &mut encoder, tracer, run.scenario.seed, frame);
+                    paths.encode_records(gpu, &mut encoder, tracer);
                     fresh.encode_train(gpu, &mut encoder, paths.records(), paths.record_count())?;
                     gpu.queue.submit([encoder.finish()]);
                     wait(gpu)?;
@@ -177,76 +213,151 @@ impl SharedCache {
                 std::fs::rename(&tmp, &file).with_context(|| format!("writing {}", file.display()))?;
                 cache = Some(fresh);
             }
-            self.warm_start = Some(file);
+            warm_start = Some(file);
         }
         let cache = match cache {
             Some(c) => c,
             None => NeuralCache::new(gpu, &cache_config, bounds)?,
         };
-        let mut outputs = Vec::new();
-        for &m in &self.modes {
-            outputs.push((m, paths.output(gpu)?));
-        }
         let diagnostics = paths.output(gpu)?;
-        self.gpu = Some(Gpuside { paths, cache, outputs, diagnostics });
-        Ok(())
+        Ok(Self {
+            key,
+            settings: settings.clone(),
+            paths,
+            cache,
+            outputs: Vec::new(),
+            diagnostics,
+            paths_ms: 0.0,
+            train_ms: 0.0,
+            stats: Vec::new(),
+            motion: Vec::new(),
+            rays: [0; 2],
+            shaded: 0,
+            warm_start,
+        })
     }
 
-    /// The shared work of frame `ctx.frame`: paths, inference of every mode, training.
-    fn render_frame(&mut self, ctx: &FrameContext) -> Result<()> {
-        if self.gpu.is_none() {
-            self.init(ctx)?;
-        }
-        let g = self.gpu.as_ref().expect("initialised");
-        let gpu = ctx.gpu;
-        let tracer = &*ctx.tracer;
-
-        let start = Instant::now();
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        g.paths.encode_queries(gpu, &mut encoder, tracer, ctx.scenario.seed, ctx.frame);
-        gpu.queue.submit([encoder.finish()]);
-        wait(gpu)?;
-        self.paths_ms = ms(start);
-        self.motion = g.paths.read_motion(gpu)?;
-
-        self.results.clear();
-        for (mode, out) in &g.outputs {
-            let start = Instant::now();
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            g.cache.encode_infer(gpu, &mut encoder, g.paths.queries(), g.paths.query_count(), &out.answers, *mode)?;
-            g.paths.encode_resolve(gpu, &mut encoder, tracer, out);
-            gpu.queue.submit([encoder.finish()]);
-            wait(gpu)?;
-            let infer_ms = ms(start);
-            let (radiance, sigma) = g.paths.read_image(gpu, out)?;
-            self.results.insert(*mode, ModeFrame { radiance, sigma, infer_ms });
-        }
-
-        // Reliability at this frame's queries, before the frame's training step.
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        g.cache.encode_reliability(gpu, &mut encoder, g.paths.queries(), g.paths.query_count(), &g.diagnostics.answers)?;
-        gpu.queue.submit([encoder.finish()]);
-        let diag = g.paths.read_answers(gpu, &g.diagnostics)?;
-        let valid = g.paths.read_query_valid(gpu)?;
-
-        let start = Instant::now();
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        g.paths.encode_records(gpu, &mut encoder, tracer);
-        g.cache.encode_train(gpu, &mut encoder, g.paths.records(), g.paths.record_count())?;
-        gpu.queue.submit([encoder.finish()]);
-        wait(gpu)?;
-        self.train_ms = ms(start);
-        self.rays = g.paths.read_rays(gpu)?;
-        self.shaded = g.paths.query_count() as u64;
-
-        let counters = g.cache.counters(gpu)?;
-        let loss = g.cache.last_loss(gpu, g.paths.record_count())?;
-        self.stats = reliability_stats(&diag, &valid);
-        self.stats.push(("train_loss".into(), loss));
-        self.stats.push(("rejected_steps".into(), counters.rejected_steps as f64));
-        self.frame = Some(ctx.frame);
-        Ok(())
+    /// The frame uniform of this cache's camera paths (set again by each system that traces or
+    /// resolves: other methods' passes may have run in between).
+    fn prepare(&self, gpu: &Gpu, tracer: &PathTracer, seed: u64, frame: u32) {
+        tracer.prepare_frame(gpu, self.settings.spp, 0, seed, frame);
     }
+}
+
+fn frame_error(clock: &FrameClock) -> impl Fn(anyhow::Error) -> BevyError + '_ {
+    move |e| failed(e.context(format!("NIRC frame {}", clock.global)))
+}
+
+/// Camera paths up to the termination vertex: the frame's cache queries and motion vectors.
+pub fn camera_paths(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut caches: Query<&mut NircCache>) -> Result<(), BevyError> {
+    let gpu = &gpu.0;
+    for mut c in &mut caches {
+        let start = Instant::now();
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        c.paths.encode_queries(gpu, &mut encoder, &tracer.0, run.scenario.seed, clock.global);
+        gpu.queue.submit([encoder.finish()]);
+        wait(gpu).map_err(frame_error(&clock))?;
+        c.paths_ms = ms(start);
+        c.motion = c.paths.read_motion(gpu).map_err(|e| frame_error(&clock)(e.into()))?;
+    }
+    Ok(())
+}
+
+/// Each method's inference (its predictor mode) and the resolve of its answers into an image.
+pub fn infer(
+    gpu: Res<GpuDevice>,
+    tracer: Res<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    caches: Query<&NircCache>,
+    mut methods: Query<(&mut NircMethod, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
+    let gpu = &gpu.0;
+    let err = frame_error(&clock);
+    for (mut m, mut frame) in &mut methods {
+        let start = Instant::now();
+        let c = caches.get(m.cache).map_err(|e| err(anyhow::anyhow!("{e}")))?;
+        let out = &c.outputs.iter().find(|(mode, _)| *mode == m.mode).ok_or_else(|| err(anyhow::anyhow!("predictor mode without answers")))?.1;
+        c.prepare(gpu, &tracer.0, run.scenario.seed, clock.global);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        c.cache.encode_infer(gpu, &mut encoder, c.paths.queries(), c.paths.query_count(), &out.answers, m.mode).map_err(|e| err(e.into()))?;
+        c.paths.encode_resolve(gpu, &mut encoder, &tracer.0, out);
+        gpu.queue.submit([encoder.finish()]);
+        wait(gpu).map_err(&err)?;
+        let infer_ms = ms(start);
+        let (radiance, sigma) = c.paths.read_image(gpu, out).map_err(|e| err(e.into()))?;
+        m.inferred = Some(ModeFrame { radiance, sigma, infer_ms });
+        frame.add_cpu(start);
+    }
+    Ok(())
+}
+
+/// The reliability grid at this frame's queries, before the frame's training step: r̄_cur,
+/// r̄_EMA, the blend's σ (frames.csv statistics, preference maps).
+pub fn reliability(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut caches: Query<&mut NircCache>) -> Result<(), BevyError> {
+    let gpu = &gpu.0;
+    let err = frame_error(&clock);
+    for mut c in &mut caches {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        c.cache.encode_reliability(gpu, &mut encoder, c.paths.queries(), c.paths.query_count(), &c.diagnostics.answers).map_err(|e| err(e.into()))?;
+        gpu.queue.submit([encoder.finish()]);
+        let diag = c.paths.read_answers(gpu, &c.diagnostics).map_err(|e| err(e.into()))?;
+        let valid = c.paths.read_query_valid(gpu).map_err(|e| err(e.into()))?;
+        c.stats = reliability_stats(&diag, &valid);
+    }
+    Ok(())
+}
+
+/// Training records from the frame's paths and one training step (Adam on the High-LR weights,
+/// their EMA, the reliability grid's update), with its loss and rejected steps.
+pub fn train(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut caches: Query<&mut NircCache>) -> Result<(), BevyError> {
+    let gpu = &gpu.0;
+    let err = frame_error(&clock);
+    for mut c in &mut caches {
+        let start = Instant::now();
+        c.prepare(gpu, &tracer.0, run.scenario.seed, clock.global);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        c.paths.encode_records(gpu, &mut encoder, &tracer.0);
+        c.cache.encode_train(gpu, &mut encoder, c.paths.records(), c.paths.record_count()).map_err(|e| err(e.into()))?;
+        gpu.queue.submit([encoder.finish()]);
+        wait(gpu).map_err(&err)?;
+        c.train_ms = ms(start);
+        c.rays = c.paths.read_rays(gpu).map_err(|e| err(e.into()))?;
+        c.shaded = c.paths.query_count() as u64;
+        let counters = c.cache.counters(gpu).map_err(|e| err(e.into()))?;
+        let loss = c.cache.last_loss(gpu, c.paths.record_count()).map_err(|e| err(e.into()))?;
+        c.stats.push(("train_loss".into(), loss));
+        c.stats.push(("rejected_steps".into(), counters.rejected_steps as f64));
+    }
+    Ok(())
+}
+
+/// Each NIRC method's frame: its image, the shared motion, paths + its inference + training
+/// times, the cache's statistics, and the preference map of blend and switch.
+pub fn frame_output(caches: Query<&NircCache>, mut methods: Query<(&mut NircMethod, &mut MethodFrame)>) -> Result<(), BevyError> {
+    for (mut m, mut frame) in &mut methods {
+        let c = caches.get(m.cache).map_err(|e| failed(anyhow::anyhow!("{e}")))?;
+        let Some(r) = m.inferred.take() else { continue };
+        let mut stats = c.stats.clone();
+        stats.push(("nirc_ms".into(), c.paths_ms + r.infer_ms + c.train_ms));
+        let mut images = Vec::new();
+        if matches!(m.mode, PredictorMode::Blend | PredictorMode::Switch) {
+            images.push(MethodImage { name: "preference".into(), pixels: preference_map(&r.sigma), hdr: false });
+        }
+        frame.output = Some(MethodOutput {
+            radiance: r.radiance,
+            motion: c.motion.clone(),
+            passes: vec![("nirc_paths".into(), Some(c.paths_ms)), ("nirc_infer".into(), Some(r.infer_ms)), ("nirc_train".into(), Some(c.train_ms))],
+            stats,
+            images,
+            // Each submission timed alone to completion (nothing else runs on the device).
+            clock: Some(render::timing::Clock::Wall),
+            // Camera paths and training paths (shared by the modes: each pays them once).
+            rays: Some(c.rays[0] + c.rays[1]),
+            shaded: Some(c.shaded),
+        });
+    }
+    Ok(())
 }
 
 /// Means over the frame's answered queries of r̄_cur, r̄_EMA, the blend's σ, and the share of
@@ -278,60 +389,3 @@ pub fn preference_map(sigma: &[[f32; 4]]) -> Vec<[f32; 4]> {
     sigma.iter().map(|s| if s[3] > 0.0 { [1.0 - s[0], s[0], 0.0, 1.0] } else { [0.0, 0.0, 0.0, 1.0] }).collect()
 }
 
-pub struct Nirc {
-    spp: u32,
-    mode: PredictorMode,
-    shared: Rc<RefCell<SharedCache>>,
-}
-
-impl Nirc {
-    pub fn new(scenario: &Scenario, settings: NircSettings, mode: PredictorMode) -> Result<Self> {
-        settings.cache.validate()?;
-        Ok(Self { spp: settings.spp, mode, shared: shared_for(scenario, &settings, mode) })
-    }
-
-    /// The warm-start file this method's cache was loaded from or saved to, if any.
-    pub fn warm_start(&self) -> Option<PathBuf> {
-        self.shared.borrow().warm_start.clone()
-    }
-}
-
-impl FrameMethod for Nirc {
-    fn label(&self) -> String {
-        format!("nirc_{}_{}spp", sim::scenario::predictor_label(self.mode), self.spp)
-    }
-
-    fn spp(&self) -> u32 {
-        self.spp
-    }
-
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodOutput> {
-        let mut shared = self.shared.borrow_mut();
-        if shared.frame != Some(ctx.frame) {
-            shared.render_frame(ctx)?;
-        }
-        let r = shared.results.get(&self.mode).cloned().context("this predictor mode was not rendered")?;
-        let mut stats = shared.stats.clone();
-        stats.push(("nirc_ms".into(), shared.paths_ms + r.infer_ms + shared.train_ms));
-        let mut images = Vec::new();
-        if matches!(self.mode, PredictorMode::Blend | PredictorMode::Switch) {
-            images.push(MethodImage { name: "preference".into(), pixels: preference_map(&r.sigma), hdr: false });
-        }
-        Ok(MethodOutput {
-            radiance: r.radiance,
-            motion: shared.motion.clone(),
-            passes: vec![
-                ("nirc_paths".into(), Some(shared.paths_ms)),
-                ("nirc_infer".into(), Some(r.infer_ms)),
-                ("nirc_train".into(), Some(shared.train_ms)),
-            ],
-            stats,
-            images,
-            // Each submission timed alone to completion (nothing else runs on the device).
-            clock: Some(render::timing::Clock::Wall),
-            // Camera paths and training paths (shared by the modes: each pays them once).
-            rays: Some(shared.rays[0] + shared.rays[1]),
-            shaded: Some(shared.shaded),
-        })
-    }
-}

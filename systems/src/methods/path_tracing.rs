@@ -1,30 +1,61 @@
 //! Plain path tracing at k samples per pixel: the baseline every cache is measured against.
 
-use anyhow::Result;
+use std::time::Instant;
 
-use super::{FrameContext, FrameMethod, MethodOutput};
+use anyhow::{Result, bail};
+use bevy_ecs::prelude::*;
+use serde::{Deserialize, Serialize};
 
+use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
+use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, failed};
+
+/// `PathTracing(spp: 4)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PathTracingSettings {
+    pub spp: u32,
+}
+
+impl PathTracingSettings {
+    pub fn label(&self) -> String {
+        format!("pt_{}spp", self.spp)
+    }
+}
+
+#[derive(Component)]
 pub struct PathTracing {
     spp: u32,
 }
 
-impl PathTracing {
-    pub fn new(spp: u32) -> Self {
-        Self { spp }
+pub struct Plugin;
+pub static PLUGIN: Plugin = Plugin;
+
+impl MethodPlugin for Plugin {
+    fn name(&self) -> &'static str {
+        "PathTracing"
+    }
+
+    fn add_systems(&self, schedule: &mut Schedule) {
+        schedule.add_systems(render.in_set(Stage::Render));
+    }
+
+    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
+        let MethodSpec::PathTracing(s) = &method.spec else { bail!("not a PathTracing method") };
+        if s.spp == 0 {
+            bail!("PathTracing: spp 0; expected at least 1 sample per pixel");
+        }
+        world.entity_mut(entity).insert(PathTracing { spp: s.spp });
+        Ok(())
     }
 }
 
-impl FrameMethod for PathTracing {
-    fn label(&self) -> String {
-        format!("pt_{}spp", self.spp)
+/// G-buffer and `spp` paths per pixel.
+pub fn render(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&PathTracing, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+    for (pt, info, mut frame) in &mut methods {
+        let start = Instant::now();
+        let out = tracer.0.render(&gpu.0, pt.spp, run.scenario.seed, clock.global).map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
+        frame.output = Some(MethodOutput::timed(out.radiance, out.gbuffer.motion, &out.timings, out.rays, out.shaded));
+        frame.add_cpu(start);
     }
-
-    fn spp(&self) -> u32 {
-        self.spp
-    }
-
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodOutput> {
-        let out = ctx.tracer.render(ctx.gpu, self.spp, ctx.scenario.seed, ctx.frame)?;
-        Ok(MethodOutput::timed(out.radiance, out.gbuffer.motion, &out.timings, out.rays, out.shaded))
-    }
+    Ok(())
 }

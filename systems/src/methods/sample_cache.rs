@@ -1,40 +1,78 @@
-//! The stable sample cache as a frame method (render::sample_cache): its GPU state is created on
-//! the first frame from the shared path tracer, then carried from frame to frame.
+//! The stable sample cache (render::sample_cache) as four systems, one per stage of the paper's
+//! frame: reproject (forward reprojection and slot reservation), retrace, shade, reconstruct.
 
-use anyhow::Result;
-use render::sample_cache::{SampleCache, SampleCacheSettings};
+use std::time::Instant;
 
-use super::{FrameContext, FrameMethod, MethodImage, MethodOutput};
+use anyhow::{Result, bail};
+use bevy_ecs::prelude::*;
+use render::sample_cache::SampleCache;
 
-pub struct SampleCacheMethod {
-    settings: SampleCacheSettings,
-    cache: Option<SampleCache>,
-}
+pub use render::sample_cache::SampleCacheSettings;
 
-impl SampleCacheMethod {
-    pub fn new(settings: SampleCacheSettings) -> Self {
-        Self { settings, cache: None }
+use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
+use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, failed};
+
+#[derive(Component)]
+pub struct SampleCacheState(SampleCache);
+
+pub struct Plugin;
+pub static PLUGIN: Plugin = Plugin;
+
+impl MethodPlugin for Plugin {
+    fn name(&self) -> &'static str {
+        "SampleCache"
+    }
+
+    fn add_systems(&self, schedule: &mut Schedule) {
+        schedule.add_systems((reproject, retrace, shade, reconstruct).chain().in_set(Stage::Render));
+    }
+
+    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
+        let MethodSpec::SampleCache(settings) = &method.spec else { bail!("not a SampleCache method") };
+        settings.validate().map_err(|e| anyhow::anyhow!("SampleCache: {e}"))?;
+        let cache = SampleCache::new(&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0, *settings)?;
+        world.entity_mut(entity).insert(SampleCacheState(cache));
+        Ok(())
     }
 }
 
-impl FrameMethod for SampleCacheMethod {
-    fn label(&self) -> String {
-        self.settings.label()
-    }
-
-    fn spp(&self) -> u32 {
-        (self.settings.shading_rate.ceil() as u32).max(1)
-    }
-
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodOutput> {
-        if self.cache.is_none() {
-            self.cache = Some(SampleCache::new(ctx.gpu, ctx.tracer, self.settings)?);
+/// Runs stage `stage` of every sample cache.
+fn stage(stage: usize, gpu: &GpuDevice, tracer: &Tracer, seed: u64, clock: &FrameClock, methods: &mut Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+    for (mut state, info, mut frame) in methods.iter_mut() {
+        let start = Instant::now();
+        if stage == 0 {
+            state.0.begin_frame(seed, clock.global);
         }
-        let cache = self.cache.as_mut().expect("created above");
-        let out = cache.render(ctx.gpu, ctx.tracer, ctx.scenario.seed, ctx.frame)?;
+        state.0.stage(&gpu.0, &tracer.0, stage).map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
+        frame.add_cpu(start);
+    }
+    Ok(())
+}
+
+/// Forward reprojection of last frame's samples and reservation of their slots.
+pub fn reproject(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+    stage(0, &gpu, &tracer, run.scenario.seed, &clock, &mut methods)
+}
+
+/// Retracing: holes, the slope test's pixels and the base rate (single, multi or adaptive).
+pub fn retrace(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+    stage(1, &gpu, &tracer, run.scenario.seed, &clock, &mut methods)
+}
+
+/// Shading of the selected samples (uniform or adaptive rate).
+pub fn shade(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+    stage(2, &gpu, &tracer, run.scenario.seed, &clock, &mut methods)
+}
+
+/// The image: each pixel's visible samples averaged; counters and the trace mask.
+pub fn reconstruct(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+    stage(3, &gpu, &tracer, run.scenario.seed, &clock, &mut methods)?;
+    for (mut state, info, mut frame) in &mut methods {
+        let start = Instant::now();
+        let slots = state.0.settings().slots as f64;
+        let out = state.0.finish_frame(&gpu.0).map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
         let s = &out.stats;
         let pixels = out.radiance.len().max(1) as f64;
-        let n = self.settings.slots as f64;
         let stats = vec![
             ("primary_rays".to_string(), s.rays as f64),
             ("new_samples".to_string(), s.new_samples as f64),
@@ -42,7 +80,7 @@ impl FrameMethod for SampleCacheMethod {
             ("reprojected_samples".to_string(), s.reprojected as f64),
             ("dropped_samples".to_string(), s.dropped as f64),
             ("visible_per_pixel".to_string(), s.visible as f64 / pixels),
-            ("occupancy".to_string(), s.occupied as f64 / (pixels * n)),
+            ("occupancy".to_string(), s.occupied as f64 / (pixels * slots)),
             ("slope_flagged_pixels".to_string(), s.slope_flagged as f64),
         ];
         // Trace mask (red: slope test, green: base rate, blue: hole), as the paper's figure 4.
@@ -54,10 +92,12 @@ impl FrameMethod for SampleCacheMethod {
                 [on(render::sample_cache::FLAG_SLOPE), on(render::sample_cache::FLAG_BASE), on(render::sample_cache::FLAG_HOLE), 1.0]
             })
             .collect();
-        Ok(MethodOutput {
+        frame.output = Some(MethodOutput {
             stats,
             images: vec![MethodImage { name: "trace_mask".into(), pixels: trace_mask, hdr: false }],
             ..MethodOutput::timed(out.radiance, out.motion, &out.timings, s.all_rays as u64, s.shaded as u64)
-        })
+        });
+        frame.add_cpu(start);
     }
+    Ok(())
 }

@@ -1,44 +1,71 @@
-//! TAA over jittered 1 spp path tracing (render::taa): the temporal baseline of issue 5.
+//! TAA over jittered 1 spp path tracing (render::taa): the temporal baseline of issue 5. Two
+//! systems: the jittered trace, then the resolve (reprojection, clamp, blend).
 
-use anyhow::Result;
-use render::taa::{Taa, TaaSettings};
+use std::time::Instant;
 
-use super::{FrameContext, FrameMethod, MethodOutput};
+use anyhow::{Result, bail};
+use bevy_ecs::prelude::*;
+use render::taa::Taa;
+use render::timing::PassTiming;
 
-pub struct TaaMethod {
-    settings: TaaSettings,
-    /// Built on the first frame: its passes bind the shared tracer's layouts.
-    taa: Option<Taa>,
+pub use render::taa::TaaSettings;
+
+use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
+use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, failed};
+
+#[derive(Component)]
+pub struct TaaState {
+    taa: Taa,
+    /// The trace pass's time this frame, until the resolve reports it.
+    traced: Option<Vec<PassTiming>>,
 }
 
-impl TaaMethod {
-    pub fn new(settings: TaaSettings) -> Result<Self> {
+pub struct Plugin;
+pub static PLUGIN: Plugin = Plugin;
+
+impl MethodPlugin for Plugin {
+    fn name(&self) -> &'static str {
+        "Taa"
+    }
+
+    fn add_systems(&self, schedule: &mut Schedule) {
+        schedule.add_systems((trace, resolve).chain().in_set(Stage::Render));
+    }
+
+    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
+        let MethodSpec::Taa(settings) = &method.spec else { bail!("not a Taa method") };
         settings.validate()?;
-        Ok(Self { settings, taa: None })
+        let taa = Taa::new(&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0, *settings)?;
+        world.entity_mut(entity).insert(TaaState { taa, traced: None });
+        Ok(())
     }
 }
 
-impl FrameMethod for TaaMethod {
-    fn label(&self) -> String {
-        "taa".into()
+/// Jittered 1 spp path tracing into the current colour.
+pub fn trace(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&mut TaaState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+    for (mut state, info, mut frame) in &mut methods {
+        let start = Instant::now();
+        let t = state.taa.trace(&gpu.0, &tracer.0, run.scenario.seed, clock.global).map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
+        state.traced = Some(t);
+        frame.add_cpu(start);
     }
+    Ok(())
+}
 
-    fn spp(&self) -> u32 {
-        1
-    }
-
-    fn render(&mut self, ctx: &mut FrameContext) -> Result<MethodOutput> {
-        if self.taa.is_none() {
-            self.taa = Some(Taa::new(ctx.gpu, ctx.tracer, self.settings)?);
-        }
-        let taa = self.taa.as_mut().expect("built above");
-        let out = taa.render(ctx.gpu, ctx.tracer, ctx.scenario.seed, ctx.frame)?;
+/// Reprojection of the history, neighbourhood clamp, exponential blend.
+pub fn resolve(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut methods: Query<(&mut TaaState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+    for (mut state, info, mut frame) in &mut methods {
+        let start = Instant::now();
+        let traced = state.traced.take().unwrap_or_default();
+        let out = state.taa.resolve(&gpu.0, traced).map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
         let n = out.history_length.len().max(1) as f64;
         let rejected = out.history_length.iter().filter(|&&l| l <= 1.0).count() as f64 / n;
         let mean_length = out.history_length.iter().map(|&l| l as f64).sum::<f64>() / n;
-        Ok(MethodOutput {
+        frame.output = Some(MethodOutput {
             stats: vec![("history_rejected".into(), rejected), ("history_length_mean".into(), mean_length)],
             ..MethodOutput::timed(out.radiance, out.motion, &out.timings, out.rays, out.shaded)
-        })
+        });
+        frame.add_cpu(start);
     }
+    Ok(())
 }

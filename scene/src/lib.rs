@@ -1,8 +1,13 @@
 //! The scene as the renderer sees it: plain data, no ECS.
 //!
-//! `sim` builds these from its world (glTF import, built-in scenes) and `systems::extract`
-//! refreshes the dynamic parts (instances, lights, camera, materials) every frame.
+//! `sim` builds these from its world (glTF import, built-in scenes) and refreshes the dynamic
+//! parts (instances, lights, camera, materials) every frame; `render` draws them. Its own crate so
+//! that neither depends on the other.
 //! Units: metres, radians; radiance in W/(sr m^2) on a linear RGB scale.
+
+pub mod rng;
+
+pub use rng::{SplitMix64, mix64};
 
 use glam::{Mat4, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
@@ -138,4 +143,45 @@ pub struct SceneDesc {
     /// Constant environment radiance seen by rays that leave the scene.
     pub environment: Vec3,
     pub camera: Camera,
+}
+
+/// Which parts of the scene differ between two consecutive frames, so the renderer uploads only
+/// what changed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SceneChanges {
+    /// Meshes or textures (only on the first frame: geometry is static during a run).
+    pub geometry: bool,
+    /// Instance transforms, meshes or material indices: the TLAS needs a refit or rebuild.
+    pub instances: bool,
+    pub materials: bool,
+    pub lights: bool,
+    pub camera: bool,
+    pub environment: bool,
+}
+
+impl SceneChanges {
+    /// Everything changed (a first frame).
+    pub const ALL: SceneChanges =
+        SceneChanges { geometry: true, instances: true, materials: true, lights: true, camera: true, environment: true };
+
+    /// Compares the dynamic parts; geometry is compared by counts only (it is static).
+    pub fn between(previous: &SceneDesc, next: &SceneDesc) -> SceneChanges {
+        SceneChanges {
+            geometry: previous.meshes.len() != next.meshes.len() || previous.textures.len() != next.textures.len(),
+            instances: previous.instances != next.instances,
+            materials: previous.materials != next.materials,
+            lights: previous.lights != next.lights,
+            camera: previous.camera != next.camera,
+            environment: previous.environment != next.environment,
+        }
+    }
+
+    pub fn any(&self) -> bool {
+        *self != SceneChanges::default()
+    }
+
+    /// Did the world-space geometry move (TLAS refit/rebuild)?
+    pub fn moved(&self) -> bool {
+        self.geometry || self.instances
+    }
 }

@@ -1,0 +1,60 @@
+#!/usr/bin/env python3
+"""Compares two folders written by `scripts/same_results.sh run`: every EXR byte for byte, and
+frames.csv without its timing columns. Prints each difference; exit 1 if there is any."""
+import csv
+import pathlib
+import sys
+
+TIMING = ("cpu_ms", "nirc_ms")
+TIMING_PREFIXES = ("gpu_ms_", "wall_ms_")
+
+
+def metric_rows(path):
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    keep = lambda c: c not in TIMING and not c.startswith(TIMING_PREFIXES)
+    return [{k: v for k, v in r.items() if keep(k)} for r in rows]
+
+
+def main(a, b):
+    a, b = pathlib.Path(a), pathlib.Path(b)
+    problems = []
+    for failed in (a / "failed.txt", b / "failed.txt"):
+        if failed.exists():
+            problems.append(f"{failed}: runs failed: {failed.read_text().split()}")
+    runs_a = sorted(p.name for p in (a / "runs").iterdir()) if (a / "runs").exists() else []
+    runs_b = sorted(p.name for p in (b / "runs").iterdir()) if (b / "runs").exists() else []
+    if runs_a != runs_b:
+        problems.append(f"different runs: {sorted(set(runs_a) ^ set(runs_b))}")
+    compared = 0
+    for run in sorted(set(runs_a) & set(runs_b)):
+        ra, rb = a / "runs" / run, b / "runs" / run
+        exr_a = sorted(p.relative_to(ra) for p in ra.rglob("*.exr"))
+        exr_b = sorted(p.relative_to(rb) for p in rb.rglob("*.exr"))
+        if exr_a != exr_b:
+            problems.append(f"{run}: different EXR files: {sorted(map(str, set(exr_a) ^ set(exr_b)))}")
+        for rel in sorted(set(exr_a) & set(exr_b)):
+            compared += 1
+            if (ra / rel).read_bytes() != (rb / rel).read_bytes():
+                problems.append(f"{run}/{rel}: bytes differ")
+        csv_a, csv_b = ra / "frames.csv", rb / "frames.csv"
+        if not (csv_a.exists() and csv_b.exists()):
+            problems.append(f"{run}: frames.csv missing")
+            continue
+        rows_a, rows_b = metric_rows(csv_a), metric_rows(csv_b)
+        if len(rows_a) != len(rows_b):
+            problems.append(f"{run}/frames.csv: {len(rows_a)} vs {len(rows_b)} rows")
+        for i, (x, y) in enumerate(zip(rows_a, rows_b)):
+            if x != y:
+                diff = {k: (x.get(k), y.get(k)) for k in set(x) | set(y) if x.get(k) != y.get(k)}
+                problems.append(f"{run}/frames.csv row {i + 2}: {diff}")
+    for p in problems:
+        print(p)
+    print(f"{len(set(runs_a) & set(runs_b))} runs, {compared} EXRs compared, {len(problems)} differences")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3:
+        sys.exit("usage: same_results_compare.py OUT_A OUT_B")
+    sys.exit(main(sys.argv[1], sys.argv[2]))

@@ -1,0 +1,46 @@
+//! The frame as a bevy_ecs schedule. Its stages (Simulate, Extract, Render, Learn, Measure,
+//! Record) are ordered system sets; the simulation's animation systems, the upload of the
+//! scene, each method's systems (added by its plugin from `crate::methods`, which builds on this
+//! module; this module knows no method), the metrics and the
+//! recording are systems in them. `flicker schedule` prints what runs.
+
+pub mod extract;
+pub mod measure;
+pub mod method_output;
+pub mod record;
+pub mod reference;
+pub mod resources;
+pub mod stage;
+
+use bevy_ecs::prelude::*;
+
+pub use method_output::{MethodImage, MethodOutput};
+pub use resources::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Progress, References, Run, RunOutput, Tracer};
+pub use stage::{Stage, catch_failures, describe, failed, listing, new_schedule, take_failure};
+
+
+fn started(clock: Res<FrameClock>) -> bool {
+    clock.started
+}
+
+fn recorded(clock: Res<FrameClock>) -> bool {
+    clock.recorded
+}
+
+/// The systems every frame has, whatever its methods.
+pub fn add_core_systems(schedule: &mut Schedule) {
+    schedule.add_systems((sim::advance_clock, sim::animation_systems()).chain().run_if(started).in_set(Stage::Simulate));
+    schedule.add_systems((sim::extract_scene.run_if(started), extract::frame_number, extract::upload_scene).chain().in_set(Stage::Extract));
+    schedule.add_systems(reference::render_reference.in_set(Stage::Render));
+    schedule.add_systems(
+        (measure::prepare, measure::smape_vs_previous, measure::flip_vs_reference, measure::regions).chain().run_if(recorded).in_set(Stage::Measure),
+    );
+    schedule.add_systems(
+        (
+            (record::write_reference, record::write_method_images, record::write_frames_csv).chain().run_if(recorded),
+            record::end_frame,
+        )
+            .chain()
+            .in_set(Stage::Record),
+    );
+}

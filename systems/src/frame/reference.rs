@@ -1,0 +1,71 @@
+//! The path-traced reference of a frame where the scenario asks for one: from the reference
+//! cache, else rendered (and cached).
+
+use bevy_ecs::prelude::*;
+
+use super::resources::{FrameClock, GpuDevice, Progress, References, Run, Tracer};
+use super::stage::failed;
+use crate::measure;
+use crate::reference_cache::{ReferenceCache, ReferenceKey};
+use render::path_tracer::PathTracer;
+
+/// References use their own random sequence, so they never share noise with a method.
+pub fn reference_seed(seed: u64) -> u64 {
+    seed ^ 0x5eed_0f_4e_fe_4e_9ce
+}
+
+/// Render stage: this frame's reference into [`References::current`] (or `None`).
+pub fn render_reference(
+    gpu: Res<GpuDevice>,
+    mut tracer: ResMut<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    scene: Res<sim::ExtractedScene>,
+    progress: Res<Progress>,
+    mut references: ResMut<References>,
+) -> Result {
+    references.current = None;
+    let scenario = &run.scenario;
+    if !clock.recorded || !scenario.reference.wants(clock.frame, scenario.frames) {
+        return Ok(());
+    }
+    let (width, height) = (run.width, run.height);
+    let settings = tracer.0.settings();
+    let key = ReferenceCache::key(
+        &scene.scene,
+        &ReferenceKey {
+            width,
+            height,
+            spp: scenario.reference.spp,
+            seed: reference_seed(scenario.seed),
+            max_depth: scenario.max_depth,
+            rr_start_depth: settings.rr_start_depth,
+            adapter: &gpu.0.summary.to_string(),
+            shader_source: PathTracer::shader_source(),
+        },
+    );
+    let frame = clock.frame;
+    let pixels = match references.cache.load(&key, width, height) {
+        Some(px) => {
+            references.cached += 1;
+            px
+        }
+        None => {
+            let bar = &progress.0;
+            bar.set_message(format!("reference {frame:04}"));
+            let spp = scenario.reference.spp;
+            let px = tracer
+                .0
+                .render_reference(&gpu.0, spp, reference_seed(scenario.seed), clock.global, &mut |done, total| {
+                    bar.set_message(format!("reference {frame:04}: {done}/{total} spp"));
+                })
+                .map_err(|e| failed(anyhow::anyhow!("reference of frame {frame}: {e}")))?;
+            references.cache.store(&key, width, height, &px).map_err(failed)?;
+            references.rendered += 1;
+            px
+        }
+    };
+    let measured = measure::Frame::from_radiance(width, height, &pixels, None);
+    references.current = Some((pixels, measured));
+    Ok(())
+}

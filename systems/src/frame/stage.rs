@@ -1,0 +1,144 @@
+//! The frame's stages as ordered system sets, and what ran: every system of the frame belongs to
+//! exactly one stage, and the stages run in order (../shared/DESIGN.md, "One frame").
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+
+use bevy_ecs::error::{BevyError, ErrorContext, FallbackErrorHandler};
+use bevy_ecs::prelude::*;
+use bevy_ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
+
+/// The stages of one frame, in execution order.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Stage {
+    /// Animation systems: rotations, flashes, boids, keyframes, scripted events.
+    Simulate,
+    /// World -> scene description -> GPU (only what changed).
+    Extract,
+    /// Each method's passes that make its image; the reference where one is wanted.
+    Render,
+    /// Training, weight averages, reliability statistics, cache upkeep after the image.
+    Learn,
+    /// SMAPE against the previous frame, FLIP against the reference.
+    Measure,
+    /// Images, frames.csv, progress.
+    Record,
+}
+
+impl Stage {
+    pub const ALL: [Stage; 6] = [Stage::Simulate, Stage::Extract, Stage::Render, Stage::Learn, Stage::Measure, Stage::Record];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Simulate => "Simulate",
+            Stage::Extract => "Extract",
+            Stage::Render => "Render",
+            Stage::Learn => "Learn",
+            Stage::Measure => "Measure",
+            Stage::Record => "Record",
+        }
+    }
+}
+
+/// The label of the frame's schedule.
+#[derive(ScheduleLabel, Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Frame;
+
+/// An empty frame: the stages chained in order, stopped after a failed system. Single threaded:
+/// the systems share one GPU queue, and their order makes runs deterministic.
+pub fn new_schedule() -> Schedule {
+    let mut schedule = Schedule::new(Frame);
+    schedule.set_executor(SingleThreadedExecutor::default());
+    schedule.configure_sets((Stage::Simulate, Stage::Extract, Stage::Render, Stage::Learn, Stage::Measure, Stage::Record).chain());
+    // Each stage checks on its own, so a failure stops the stages after it.
+    for stage in Stage::ALL {
+        schedule.configure_sets(stage.run_if(no_failure));
+    }
+    schedule
+}
+
+thread_local! {
+    /// The first failure of the frame being run on this thread (the executor is single threaded,
+    /// so systems and the error handler run on the caller's thread).
+    static FAILURE: RefCell<Option<String>> = const { RefCell::new(None) };
+}
+
+fn record_failure(error: BevyError, context: ErrorContext) {
+    FAILURE.with(|f| {
+        let mut f = f.borrow_mut();
+        if f.is_none() {
+            *f = Some(format!("{}: {error}", context.name()));
+        }
+    });
+}
+
+fn no_failure() -> bool {
+    FAILURE.with(|f| f.borrow().is_none())
+}
+
+/// Makes failed systems stop the frame (later stages are skipped) instead of panicking; the
+/// error is then [`take_failure`]'s.
+pub fn catch_failures(world: &mut World) {
+    world.insert_resource(FallbackErrorHandler(record_failure));
+    let _ = take_failure();
+}
+
+/// The failure of the last frame run on this thread, if any (and clears it).
+pub fn take_failure() -> Option<String> {
+    FAILURE.with(|f| f.borrow_mut().take())
+}
+
+/// A system's error: the whole anyhow chain in one message.
+pub fn failed(e: anyhow::Error) -> BevyError {
+    BevyError::from(format!("{e:#}"))
+}
+
+/// The frame's systems in execution order with their stage. An error names a system that is in
+/// no stage, or one that would run before a system of an earlier stage.
+pub fn listing(schedule: &mut Schedule, world: &mut World) -> Result<Vec<(Stage, String)>, String> {
+    schedule.initialize(world).map_err(|e| format!("the frame's schedule does not build: {e}"))?;
+    let mut stage_of = HashMap::new();
+    for stage in Stage::ALL {
+        if let Ok(keys) = schedule.graph().systems_in_set(stage.intern()) {
+            for key in keys {
+                stage_of.insert(*key, stage);
+            }
+        }
+    }
+    let systems = schedule.systems().map_err(|e| format!("{e}"))?;
+    let mut out: Vec<(Stage, String)> = Vec::new();
+    for (key, system) in systems {
+        let name = short_name(&system.name().to_string());
+        let Some(&stage) = stage_of.get(&key) else {
+            return Err(format!("system {name} is in no stage of the frame"));
+        };
+        if let Some((last, last_name)) = out.last()
+            && *last > stage
+        {
+            return Err(format!("system {name} ({}) runs after {last_name} ({})", stage.name(), last.name()));
+        }
+        out.push((stage, name));
+    }
+    Ok(out)
+}
+
+/// `systems::methods::taa::resolve` -> `taa::resolve`: the module and the function.
+fn short_name(full: &str) -> String {
+    let parts: Vec<&str> = full.split("::").collect();
+    match parts.len() {
+        0 | 1 => full.to_string(),
+        n => format!("{}::{}", parts[n - 2], parts[n - 1]),
+    }
+}
+
+/// The listing as text, grouped by stage: what `flicker schedule` prints.
+pub fn describe(listing: &[(Stage, String)]) -> String {
+    let mut text = String::new();
+    for stage in Stage::ALL {
+        text += &format!("{}\n", stage.name());
+        for (_, name) in listing.iter().filter(|(s, _)| *s == stage) {
+            text += &format!("  {name}\n");
+        }
+    }
+    text
+}
