@@ -60,11 +60,18 @@ case "${1:-}" in
             sha="$(git -C "$repo" rev-parse --short "$commit")"
             tree="$work/src-$sha"
             [ -d "$tree" ] || git -C "$repo" worktree add --detach "$tree" "$commit" >/dev/null
-            # One target folder: dependencies build once for both commits.
-            CARGO_TARGET_DIR="$repo/target/same_results_build" cargo build --release --locked --manifest-path "$tree/Cargo.toml" --bin flicker >&2
-            cp "$repo/target/same_results_build/release/flicker" "$work/flicker-$sha"
-            rm -rf "$work/out-$sha"
-            run_all "$work/flicker-$sha" "$work/out-$sha" "$tree/scenarios"
+            # A commit's binary and runs are kept (by commit hash): a second comparison against
+            # the same commit reuses them.
+            if [ ! -x "$work/flicker-$sha" ]; then
+                # One target folder: dependencies build once for both commits.
+                CARGO_TARGET_DIR="$repo/target/same_results_build" cargo build --release --locked --manifest-path "$tree/Cargo.toml" --bin flicker >&2
+                cp "$repo/target/same_results_build/release/flicker" "$work/flicker-$sha"
+            fi
+            if [ ! -e "$work/out-$sha/done" ]; then
+                rm -rf "$work/out-$sha"
+                run_all "$work/flicker-$sha" "$work/out-$sha" "$tree/scenarios"
+                touch "$work/out-$sha/done"
+            fi
         done
         compare "$work/out-$(git -C "$repo" rev-parse --short "$1")" "$work/out-$(git -C "$repo" rev-parse --short "$2")"
         ;;
