@@ -13,6 +13,7 @@ use crate::records::{CacheAnswer, CacheQuery, TrainingRecord};
 use bytemuck::{Pod, Zeroable};
 use render::gpu::Gpu;
 use render::path_tracer::PathTracer;
+use render::timing::TimedFrame;
 use serde::{Deserialize, Serialize};
 use wgpu::util::DeviceExt;
 
@@ -216,6 +217,41 @@ impl CachePaths {
         pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
         pass.set_bind_group(2, group, &[]);
         pass.dispatch_workgroups(workgroups.0, workgroups.1, 1);
+    }
+
+    /// One timed pass (pass `index` of `timed`) of `pipelines`, in order, each over its workgroups.
+    fn timed_pass(&self, timed: &mut TimedFrame, index: usize, tracer: &PathTracer, group: &wgpu::BindGroup, pipelines: &[(&wgpu::ComputePipeline, (u32, u32))]) -> Result<(), NircError> {
+        timed.pass(index, |pass| {
+            pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
+            pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+            pass.set_bind_group(2, group, &[]);
+            for (pipeline, groups) in pipelines {
+                pass.set_pipeline(pipeline);
+                pass.dispatch_workgroups(groups.0, groups.1, 1);
+            }
+        })?;
+        Ok(())
+    }
+
+    /// [`Self::encode_queries`] as pass `index` of a timed frame.
+    pub fn queries_timed(&self, gpu: &Gpu, timed: &mut TimedFrame, index: usize, tracer: &PathTracer, seed: u64, frame: u32) -> Result<(), NircError> {
+        tracer.prepare_frame(gpu, self.spp, 0, seed, frame);
+        timed.encoder().clear_buffer(&self.ray_counters, 0, None);
+        let group = self.bind_group(gpu, &self.scratch);
+        self.timed_pass(timed, index, tracer, &group, &[(&self.queries_pipeline, self.image_groups())])
+    }
+
+    /// [`Self::encode_records`] (targets, then compaction) as pass `index` of a timed frame.
+    pub fn records_timed(&self, gpu: &Gpu, timed: &mut TimedFrame, index: usize, tracer: &PathTracer) -> Result<(), NircError> {
+        let group = self.bind_group(gpu, &self.scratch);
+        let targets = (self.settings.train_records.div_ceil(WORKGROUP_1D), 1);
+        self.timed_pass(timed, index, tracer, &group, &[(&self.targets_pipeline, targets), (&self.compact_pipeline, (1, 1))])
+    }
+
+    /// [`Self::encode_resolve`] as pass `index` of a timed frame.
+    pub fn resolve_timed(&self, gpu: &Gpu, timed: &mut TimedFrame, index: usize, tracer: &PathTracer, out: &CacheOutput) -> Result<(), NircError> {
+        let group = self.bind_group(gpu, out);
+        self.timed_pass(timed, index, tracer, &group, &[(&self.resolve_pipeline, self.image_groups())])
     }
 
     fn image_groups(&self) -> (u32, u32) {

@@ -1,6 +1,6 @@
 // The scene as the path tracer's passes see it: frame uniform, materials, lights, camera, and
-// the helpers every pass that shades surfaces needs. @group(0) (layout in path_tracer.rs);
-// passes of other methods bind it too and put their own buffers in @group(2).
+// the helpers every pass that shades surfaces needs. @group(0), read only (layout in
+// scene_bindings.rs); every pass binds it and puts its own buffers in @group(2).
 
 struct CameraFrame {
     position: vec4f,  // w: tan(vfov / 2)
@@ -29,24 +29,12 @@ struct GpuMaterial {
     texture_height: u32,
 }
 
-struct GBufferTexel {
-    normal: vec3f,
-    depth: f32,
-    albedo: vec3f,
-    instance: u32,
-    motion: vec2f,
-    primitive: u32,
-    pad: u32,
-}
-
 const NO_TEXTURE: u32 = 0xffffffffu;
 
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var<storage, read> materials: array<GpuMaterial>;
 @group(0) @binding(2) var<storage, read> texels: array<u32>;
 @group(0) @binding(3) var<storage, read> lights: array<GpuLight>;
-@group(0) @binding(4) var<storage, read_write> radiance_sum: array<vec4f>;
-@group(0) @binding(5) var<storage, read_write> gbuffer: array<GBufferTexel>;
 
 fn srgb_to_linear(c: vec3f) -> vec3f {
     let lo = c / 12.92;

@@ -38,12 +38,24 @@ pub fn pipelines<const N: usize>(
     let device = &gpu.device;
     let layouts: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|&g| Some(g)).collect();
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(pass), bind_group_layouts: &layouts, immediate_size: 0 });
+    validated(gpu, pass, source, Some(&layout), entries)
+}
+
+/// [`pipelines`] whose bind group layouts are derived from the shader (each entry point's own
+/// @group(0), fetched with `get_bind_group_layout`): for passes whose entry points bind
+/// different subsets of one module's buffers.
+pub fn pipelines_auto_layout<const N: usize>(gpu: &Gpu, pass: &str, source: &str, entries: [&str; N]) -> Result<[wgpu::ComputePipeline; N], RenderError> {
+    validated(gpu, pass, source, None, entries)
+}
+
+fn validated<const N: usize>(gpu: &Gpu, pass: &str, source: &str, layout: Option<&wgpu::PipelineLayout>, entries: [&str; N]) -> Result<[wgpu::ComputePipeline; N], RenderError> {
+    let device = &gpu.device;
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(pass), source: wgpu::ShaderSource::Wgsl(source.into()) });
     let made = entries.map(|entry| {
         device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(entry),
-            layout: Some(&layout),
+            layout,
             module: &module,
             entry_point: Some(entry),
             compilation_options: Default::default(),

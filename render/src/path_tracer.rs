@@ -1,25 +1,21 @@
 //! The WGSL path tracer: per frame, HDR radiance and a primary-hit G-buffer read back to the
 //! CPU, GPU time per pass; and converged references accumulated in bounded batches.
 //!
-//! Shaders: render/shaders/path_tracer.wgsl (+ pt_sampling, pt_bsdf, pt_lights), concatenated
-//! after the scene geometry interface (`SceneGeometry::WGSL`, bind group 1). This pass's own
-//! bindings are group 0: the `Frame` uniform, materials, texture atlas, light table, the
-//! radiance sum and the G-buffer.
+//! Three parts: the scene bindings (`SceneBindings`: @group(0) frame uniform, materials, texels,
+//! lights, read only; @group(1) geometry), the pass library (`PassLibrary`: the shading library's
+//! WGSL and the run's shared pipelines) and the path tracer's own outputs (@group(2) of
+//! render/shaders/path_tracer.wgsl: radiance sum, G-buffer, sample partials, ray counter).
 
 use crate::bvh::SceneGeometry;
 use crate::compute;
 use crate::error::RenderError;
-use crate::frame::{CameraBasis, FrameParams, GpuFrame};
 use crate::gpu::Gpu;
-use crate::lights::{LightTable, build_light_table};
-use crate::materials::pack_materials;
+use crate::pass_library::PassLibrary;
 use crate::readback::read_buffer;
-use crate::scene::SceneChanges;
-use crate::scene::{Camera, SceneDesc};
+use crate::scene::{Camera, SceneChanges, SceneDesc};
+use crate::scene_bindings::SceneBindings;
 use crate::timing::{PassTimer, PassTiming, merge};
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
-use wgpu::util::DeviceExt;
 
 /// `Hit::instance`/`primitive` of a pixel whose primary ray left the scene.
 pub const NO_HIT: u32 = u32::MAX;
@@ -40,17 +36,13 @@ pub const GBUFFER_PASS: &str = "gbuffer";
 pub const PATH_TRACE_PASS: &str = "path_trace";
 
 const WORKGROUP: u32 = 8;
-/// Storage buffers of group 0 (materials, texels, lights, radiance, G-buffer, sample partials,
-/// ray counter).
-const STORAGE_BUFFERS: u32 = 7;
+/// Storage buffers of the path tracer's own @group(2) (radiance, G-buffer, sample partials, ray
+/// counter).
+const OWN_STORAGE_BUFFERS: u32 = 4;
 /// Words of the ray counter: [0] rays traced since the last clear.
 const COUNTER_WORDS: u64 = 4;
 
-/// Storage buffers a pass built on [`PathTracer::library_source`] binds before its own:
-/// @group(0) (scene) and @group(1) (geometry). Add the pass's own to check the adapter limit.
-pub const LIBRARY_STORAGE_BUFFERS: u32 = STORAGE_BUFFERS + crate::bvh::SceneGeometry::STORAGE_BUFFERS;
-/// Storage buffers of scene_geometry.wgsl (group 1).
-const GEOMETRY_STORAGE_BUFFERS: u32 = 8;
+pub use crate::pass_library::LIBRARY_STORAGE_BUFFERS;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct PathTracerSettings {
@@ -116,16 +108,13 @@ const BYTES_PER_PIXEL: u64 = 16 + size_of::<GpuGBufferTexel>() as u64;
 
 pub struct PathTracer {
     settings: PathTracerSettings,
-    geometry: SceneGeometry,
+    scene: SceneBindings,
+    library: PassLibrary,
+    /// The path tracer's own @group(2) and its buffers.
     layout: wgpu::BindGroupLayout,
-    /// Passes built on the shading library, by (pass, source, own group, entry points).
-    shared_passes: std::sync::Mutex<std::collections::HashMap<u64, (wgpu::BindGroupLayout, Vec<wgpu::ComputePipeline>)>>,
+    bind_group: wgpu::BindGroup,
     trace_pipeline: wgpu::ComputePipeline,
     gbuffer_pipeline: wgpu::ComputePipeline,
-    frame_buffer: wgpu::Buffer,
-    materials: wgpu::Buffer,
-    texels: wgpu::Buffer,
-    lights: wgpu::Buffer,
     radiance_sum: wgpu::Buffer,
     gbuffer: wgpu::Buffer,
     /// Per-(chunk, pixel) sums of one dispatch, summed by `accumulate_main`.
@@ -134,17 +123,10 @@ pub struct PathTracer {
     max_chunks: u32,
     radiance_readback: wgpu::Buffer,
     gbuffer_readback: wgpu::Buffer,
-    bind_group: wgpu::BindGroup,
     timer: PassTimer,
     /// Rays traced (atomic, flushed once per invocation), cleared per frame.
     counters: wgpu::Buffer,
     counters_readback: wgpu::Buffer,
-    light_table: LightTable,
-    camera: Camera,
-    /// Camera before the last `update` (motion vectors), like the instances' previous
-    /// transforms; the current camera before the first update.
-    previous_camera: Camera,
-    environment: Vec3,
     paths_per_dispatch: u64,
 }
 
@@ -154,7 +136,7 @@ impl PathTracer {
             return Err(RenderError::Settings("max_depth must be at least 1 (1 = direct lighting)".into()));
         }
         gpu.check_resolution(settings.width, settings.height, BYTES_PER_PIXEL)?;
-        let needed = STORAGE_BUFFERS + GEOMETRY_STORAGE_BUFFERS;
+        let needed = LIBRARY_STORAGE_BUFFERS + OWN_STORAGE_BUFFERS;
         let limit = gpu.limits.max_storage_buffers_per_shader_stage;
         if needed > limit {
             return Err(crate::gpu::GpuError::OverLimit {
@@ -168,21 +150,8 @@ impl PathTracer {
         // No workgroup memory is declared (var<workgroup>): nothing to check against the budget.
         gpu.check_workgroup_memory("path_trace", 0)?;
 
-        let geometry = SceneGeometry::new(gpu, scene)?;
-        let (materials, texels) = pack_materials(scene)?;
-        let light_table = build_light_table(scene)?;
+        let scene = SceneBindings::new(gpu, scene, settings)?;
         let device = &gpu.device;
-        let storage = |label: &str, contents: &[u8]| -> Result<wgpu::Buffer, RenderError> {
-            gpu.check_buffer_size(label, contents.len() as u64)?;
-            Ok(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            }))
-        };
-        let materials = storage("materials", bytemuck::cast_slice(&materials))?;
-        let texels = storage("base-colour texels", bytemuck::cast_slice(&texels))?;
-        let lights = storage("lights", bytemuck::cast_slice(&light_table.lights))?;
         let pixels = settings.width as u64 * settings.height as u64;
         let per_pixel = |label: &str, size: u64, usage: wgpu::BufferUsages| {
             device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
@@ -197,26 +166,26 @@ impl PathTracer {
         let gbuffer_readback = per_pixel("gbuffer readback", gbuffer_size, readback);
         let max_chunks = MAX_CHUNKS.min(gpu.limits.max_compute_workgroups_per_dimension);
         let sample_partials = Self::partials_buffer(gpu, pixels, Self::chunks_for(PATHS_PER_DISPATCH, pixels, max_chunks))?;
-        let frame_buffer = per_pixel("path tracer frame", size_of::<GpuFrame>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
         let counters = per_pixel("path tracer ray counter", COUNTER_WORDS * 4, rw | wgpu::BufferUsages::COPY_DST);
         let counters_readback = per_pixel("path tracer ray counter readback", COUNTER_WORDS * 4, readback);
 
-        let layout = bind_group_layout(gpu);
-        let [trace_pipeline, gbuffer_pipeline, accumulate_pipeline] =
-            compute::pipelines(gpu, "path_tracer.wgsl", Self::shader_source(), &[&layout, geometry.bind_group_layout()], ["trace_main", "gbuffer_main", "accumulate_main"])?;
-
-        let bind_group = compute::buffer_group(gpu, "path tracer", &layout, &[&frame_buffer, &materials, &texels, &lights, &radiance_sum, &gbuffer, &sample_partials, &counters]);
+        let layout = compute::buffer_layout(gpu, "path tracer", &OWN_GROUP);
+        let [trace_pipeline, gbuffer_pipeline, accumulate_pipeline] = compute::pipelines(
+            gpu,
+            "path_tracer.wgsl",
+            Self::shader_source(),
+            &[scene.layout(), scene.geometry().bind_group_layout(), &layout],
+            ["trace_main", "gbuffer_main", "accumulate_main"],
+        )?;
+        let bind_group = compute::buffer_group(gpu, "path tracer", &layout, &[&radiance_sum, &gbuffer, &sample_partials, &counters]);
         Ok(Self {
             settings,
-            geometry,
+            scene,
+            library: PassLibrary::default(),
             layout,
-            shared_passes: Default::default(),
+            bind_group,
             trace_pipeline,
             gbuffer_pipeline,
-            frame_buffer,
-            materials,
-            texels,
-            lights,
             radiance_sum,
             gbuffer,
             sample_partials,
@@ -224,16 +193,21 @@ impl PathTracer {
             max_chunks,
             radiance_readback,
             gbuffer_readback,
-            bind_group,
             timer: PassTimer::new(gpu, &[GBUFFER_PASS, PATH_TRACE_PASS]),
             counters,
             counters_readback,
-            light_table,
-            camera: scene.camera,
-            previous_camera: scene.camera,
-            environment: scene.environment,
             paths_per_dispatch: PATHS_PER_DISPATCH,
         })
+    }
+
+    /// The scene bindings (@group(0) and the geometry's @group(1)) every method's passes bind.
+    pub fn scene(&self) -> &SceneBindings {
+        &self.scene
+    }
+
+    /// The pass library: the shading library's source and the run's shared pipelines.
+    pub fn library(&self) -> &PassLibrary {
+        &self.library
     }
 
     /// The complete WGSL of the pass (geometry interface + path tracer): part of the key of
@@ -250,34 +224,17 @@ impl PathTracer {
         })
     }
 
-    /// The shading library without entry points: scene geometry (@group(1)), sampling, BSDFs,
-    /// lights, the scene bindings (@group(0)) and the path integrator (`next_event`,
-    /// `emitted_radiance`, `path_radiance`). Another method's pass appends its own WGSL (its
-    /// buffers in @group(2)) and binds [`Self::scene_bind_group`] and the geometry's group.
+    /// The shading library's WGSL ([`PassLibrary::source`]).
     pub fn library_source() -> &'static str {
-        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-        SOURCE.get_or_init(|| {
-            [
-                SceneGeometry::WGSL,
-                include_str!("../shaders/pt_sampling.wgsl"),
-                include_str!("../shaders/pt_bsdf.wgsl"),
-                include_str!("../shaders/pt_lights.wgsl"),
-                include_str!("../shaders/pt_scene.wgsl"),
-                include_str!("../shaders/pt_integrator.wgsl"),
-            ]
-            .join("\n")
-        })
+        PassLibrary::source()
     }
 
-    /// Group 0 over the current buffers, after one of them was replaced.
+    /// Group 2 over the current buffers, after one of them was replaced.
     fn rebind(&mut self, gpu: &Gpu) {
-        let buffers = [&self.frame_buffer, &self.materials, &self.texels, &self.lights, &self.radiance_sum, &self.gbuffer, &self.sample_partials, &self.counters];
-        self.bind_group = compute::buffer_group(gpu, "path tracer", &self.layout, &buffers);
+        self.bind_group = compute::buffer_group(gpu, "path tracer", &self.layout, &[&self.radiance_sum, &self.gbuffer, &self.sample_partials, &self.counters]);
     }
 
-    /// The layout of a pass's own @group(2) (buffer kinds by binding) and the pipelines of
-    /// `entries` in `source`, a WGSL module built on [`Self::library_source`] (scene @group(0),
-    /// geometry @group(1)). Refuses a pass with more storage buffers than the adapter binds.
+    /// [`PassLibrary::pass`] on this run's scene bindings.
     pub fn library_pass<const N: usize>(
         &self,
         gpu: &Gpu,
@@ -286,54 +243,27 @@ impl PathTracer {
         own: &[wgpu::BufferBindingType],
         entries: [&str; N],
     ) -> Result<(wgpu::BindGroupLayout, [wgpu::ComputePipeline; N]), RenderError> {
-        let own_storage = own.iter().filter(|k| matches!(k, wgpu::BufferBindingType::Storage { .. })).count() as u32;
-        let needed = LIBRARY_STORAGE_BUFFERS + own_storage;
-        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
-        if needed > limit {
-            return Err(crate::gpu::GpuError::OverLimit { what: format!("storage buffers of pass '{pass}'"), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
-        }
-        // Methods of one run share the pipelines of equal passes (three sample caches, two hash
-        // caches): fewer compiled shaders, and on llvmpipe a working set that stays inside its
-        // shader-variant cache, whose evictions cost seconds of recompilation per frame.
-        let key = {
-            use std::hash::{Hash, Hasher};
-            let mut h = std::collections::hash_map::DefaultHasher::new();
-            (pass, source, format!("{own:?}"), entries.as_slice()).hash(&mut h);
-            h.finish()
-        };
-        let mut shared = self.shared_passes.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((layout, pipelines)) = shared.get(&key)
-            && let Ok(pipelines) = <[wgpu::ComputePipeline; N]>::try_from(pipelines.clone())
-        {
-            return Ok((layout.clone(), pipelines));
-        }
-        let layout = compute::buffer_layout(gpu, pass, own);
-        let pipelines = compute::pipelines(gpu, pass, source, &[&self.layout, self.geometry.bind_group_layout(), &layout], entries)?;
-        shared.insert(key, (layout.clone(), pipelines.to_vec()));
-        Ok((layout, pipelines))
+        self.library.pass(gpu, &self.scene, pass, source, own, entries)
     }
 
     /// Layout of @group(0) of [`Self::library_source`].
     pub fn scene_bind_group_layout(&self) -> &wgpu::BindGroupLayout {
-        &self.layout
+        self.scene.layout()
     }
 
-    /// @group(0) of [`Self::library_source`]. It changes when `update` had to grow a buffer:
-    /// fetch it every frame, do not keep it.
+    /// @group(0) of [`Self::library_source`] ([`SceneBindings::bind_group`]).
     pub fn scene_bind_group(&self) -> &wgpu::BindGroup {
-        &self.bind_group
+        self.scene.bind_group()
     }
 
-    /// Writes the frame uniform for another method's pass (camera, previous camera, lights,
-    /// `spp` and the first sample index in `size.zw`, seed, frame, max depth) exactly as this
-    /// tracer's own passes see it.
+    /// [`SceneBindings::prepare_frame`].
     pub fn prepare_frame(&self, gpu: &Gpu, spp: u32, first_sample: u32, seed: u64, frame: u32) {
-        self.write_frame(gpu, &self.previous_camera, spp, first_sample, seed, frame, false);
+        self.scene.prepare_frame(gpu, spp, first_sample, seed, frame);
     }
 
     /// The camera of the current frame (after the last `update`).
     pub fn camera(&self) -> &Camera {
-        &self.camera
+        self.scene.camera()
     }
 
     pub fn settings(&self) -> PathTracerSettings {
@@ -341,7 +271,7 @@ impl PathTracer {
     }
 
     pub fn geometry(&self) -> &SceneGeometry {
-        &self.geometry
+        self.scene.geometry()
     }
 
     /// Refreshes the dynamic parts: instance transforms, materials (and textures), lights
@@ -356,49 +286,12 @@ impl PathTracer {
 
     /// [`Self::update`] that reports an inconsistent scene instead of panicking.
     pub fn try_update(&mut self, gpu: &Gpu, scene: &SceneDesc) -> Result<(), RenderError> {
-        self.update_changed(gpu, scene, SceneChanges::ALL)
+        self.scene.update_changed(gpu, scene, SceneChanges::ALL)
     }
 
-    /// [`Self::try_update`] that uploads only what `changes` names: materials and texels when
-    /// materials changed, the light table when lights, instances (emissive triangles follow
-    /// them) or materials changed. Instance transforms and the camera are taken every frame:
-    /// they become the previous ones of motion vectors.
+    /// [`Self::try_update`] uploading only what `changes` names ([`SceneBindings::update_changed`]).
     pub fn update_changed(&mut self, gpu: &Gpu, scene: &SceneDesc, changes: SceneChanges) -> Result<(), RenderError> {
-        let materials = (changes.materials || changes.geometry).then(|| pack_materials(scene)).transpose()?;
-        let light_table = (changes.lights || changes.instances || changes.materials || changes.geometry).then(|| build_light_table(scene)).transpose()?;
-        self.geometry.try_update_instances(gpu, &scene.instances)?;
-        let mut rebind = false;
-        let mut uploads: Vec<(&mut wgpu::Buffer, &str, &[u8])> = Vec::new();
-        if let Some((materials, texels)) = &materials {
-            uploads.push((&mut self.materials, "materials", bytemuck::cast_slice::<_, u8>(materials)));
-            uploads.push((&mut self.texels, "base-colour texels", bytemuck::cast_slice(texels)));
-        }
-        if let Some(table) = &light_table {
-            uploads.push((&mut self.lights, "lights", bytemuck::cast_slice(&table.lights)));
-        }
-        for (buffer, label, bytes) in uploads {
-            if buffer.size() == bytes.len() as u64 {
-                gpu.queue.write_buffer(buffer, 0, bytes);
-            } else {
-                gpu.check_buffer_size(label, bytes.len() as u64)?;
-                *buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents: bytes,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                });
-                rebind = true;
-            }
-        }
-        if rebind {
-            self.rebind(gpu);
-        }
-        if let Some(table) = light_table {
-            self.light_table = table;
-        }
-        self.previous_camera = self.camera;
-        self.camera = scene.camera;
-        self.environment = scene.environment;
-        Ok(())
+        self.scene.update_changed(gpu, scene, changes)
     }
 
     /// One frame: G-buffer of the pixel-centre rays, then `spp` jittered paths per pixel.
@@ -406,21 +299,21 @@ impl PathTracer {
         if spp == 0 {
             return Err(RenderError::Settings("spp must be at least 1".into()));
         }
-        let previous = self.previous_camera;
         // G-buffer pass.
-        self.write_frame(gpu, &previous, 0, 0, seed, frame, false);
+        self.scene.write_frame(gpu, 0, 0, seed, frame, false);
         let mut timed = self.timer.begin(gpu, "gbuffer");
         timed.encoder().clear_buffer(&self.counters, 0, None);
         timed.pass(0, |pass| {
             pass.set_pipeline(&self.gbuffer_pipeline);
-            pass.set_bind_group(0, &self.bind_group, &[]);
-            pass.set_bind_group(1, self.geometry.bind_group(), &[]);
+            pass.set_bind_group(0, self.scene.bind_group(), &[]);
+            pass.set_bind_group(1, self.scene.geometry().bind_group(), &[]);
+            pass.set_bind_group(2, &self.bind_group, &[]);
             pass.dispatch_workgroups(self.settings.width.div_ceil(WORKGROUP), self.settings.height.div_ceil(WORKGROUP), 1);
         })?;
         let mut timings = timed.submit()?;
 
         // Path-trace pass, in batches of bounded work.
-        merge(&mut timings, self.trace_batches(gpu, &previous, spp, seed, frame, &mut |_, _| {})?);
+        merge(&mut timings, self.trace_batches(gpu, spp, seed, frame, &mut |_, _| {})?);
 
         let radiance = self.read_radiance(gpu)?;
         let gbuffer = self.read_gbuffer(gpu)?;
@@ -436,8 +329,7 @@ impl PathTracer {
         if spp == 0 {
             return Err(RenderError::Settings("reference spp must be at least 1".into()));
         }
-        let previous = self.previous_camera;
-        self.trace_batches(gpu, &previous, spp, seed, frame, progress)?;
+        self.trace_batches(gpu, spp, seed, frame, progress)?;
         self.read_radiance(gpu)
     }
 
@@ -478,18 +370,19 @@ impl PathTracer {
     }
 
     /// Traces `spp` samples into the radiance sum; returns the summed time of the batches.
-    fn trace_batches(&self, gpu: &Gpu, previous: &Camera, spp: u32, seed: u64, frame: u32, progress: &mut dyn FnMut(u32, u32)) -> Result<Vec<PassTiming>, RenderError> {
+    fn trace_batches(&self, gpu: &Gpu, spp: u32, seed: u64, frame: u32, progress: &mut dyn FnMut(u32, u32)) -> Result<Vec<PassTiming>, RenderError> {
         let per_dispatch = self.samples_per_dispatch();
         let mut done = 0;
         let mut timings = Vec::new();
         while done < spp {
             let batch = per_dispatch.min(spp - done);
-            self.write_frame(gpu, previous, batch, done, seed, frame, done > 0);
+            self.scene.write_frame(gpu, batch, done, seed, frame, done > 0);
             let mut timed = self.timer.begin(gpu, "path trace");
             timed.pass(1, |pass| {
                 let (x, y) = (self.settings.width.div_ceil(WORKGROUP), self.settings.height.div_ceil(WORKGROUP));
-                pass.set_bind_group(0, &self.bind_group, &[]);
-                pass.set_bind_group(1, self.geometry.bind_group(), &[]);
+                pass.set_bind_group(0, self.scene.bind_group(), &[]);
+                pass.set_bind_group(1, self.scene.geometry().bind_group(), &[]);
+                pass.set_bind_group(2, &self.bind_group, &[]);
                 pass.set_pipeline(&self.trace_pipeline);
                 pass.dispatch_workgroups(x, y, batch.div_ceil(SAMPLES_PER_THREAD));
                 pass.set_pipeline(&self.accumulate_pipeline);
@@ -500,29 +393,6 @@ impl PathTracer {
             progress(done, spp);
         }
         Ok(timings)
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn write_frame(&self, gpu: &Gpu, previous: &Camera, spp: u32, first_sample: u32, seed: u64, frame: u32, accumulate: bool) {
-        let (w, h) = (self.settings.width, self.settings.height);
-        let params = FrameParams {
-            camera: CameraBasis::new(&self.camera, w, h),
-            previous_camera: CameraBasis::new(previous, w, h),
-            environment: self.environment,
-            emitter_weight: self.light_table.emitter_weight,
-            width: w,
-            height: h,
-            spp,
-            first_sample,
-            seed,
-            frame,
-            max_depth: self.settings.max_depth,
-            rr_start_depth: self.settings.rr_start_depth,
-            analytic_lights: self.light_table.analytic,
-            emitters: self.light_table.emitters,
-            accumulate,
-        };
-        gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&params.gpu()));
     }
 
     /// Rays the passes since the last clear traced (the frame's G-buffer and paths).
@@ -561,16 +431,8 @@ impl PathTracer {
     }
 }
 
-/// Group 0 of the path tracer and of every pass built on its shading library (the scene):
-/// frame uniform, materials, texels, lights, then the path tracer's own radiance sum, G-buffer,
-/// sample partials and ray counter.
-const SCENE_GROUP: [wgpu::BufferBindingType; 8] = {
-    let read = wgpu::BufferBindingType::Storage { read_only: true };
+/// The path tracer's own @group(2): radiance sum, G-buffer, sample partials, ray counter.
+const OWN_GROUP: [wgpu::BufferBindingType; 4] = {
     let write = wgpu::BufferBindingType::Storage { read_only: false };
-    [wgpu::BufferBindingType::Uniform, read, read, read, write, write, write, write]
+    [write, write, write, write]
 };
-
-fn bind_group_layout(gpu: &Gpu) -> wgpu::BindGroupLayout {
-    compute::buffer_layout(gpu, "path tracer", &SCENE_GROUP)
-}
-

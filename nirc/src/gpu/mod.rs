@@ -25,6 +25,7 @@ use crate::reliability::{MOMENTS_PER_CELL, cell_count};
 use crate::state::CacheState;
 use bytemuck::{Pod, Zeroable};
 use render::gpu::Gpu;
+use render::timing::TimedFrame;
 use shaders::{CHUNK, WORKGROUP_SIZE, WeightPlacement};
 use std::path::Path;
 use wgpu::util::DeviceExt;
@@ -90,6 +91,19 @@ struct Buffers {
     reliability_accum: wgpu::Buffer,
     moments: wgpu::Buffer,
     counters: wgpu::Buffer,
+}
+
+/// The bind groups of one training step.
+struct TrainStep {
+    n: u32,
+    num_chunks: u32,
+    fb: wgpu::BindGroup,
+    accumulate: wgpu::BindGroup,
+    partial: wgpu::BindGroup,
+    reduce: wgpu::BindGroup,
+    check: wgpu::BindGroup,
+    apply: wgpu::BindGroup,
+    finish: wgpu::BindGroup,
 }
 
 /// Bind groups that depend on neither the caller's buffers nor the call's uniforms.
@@ -192,47 +206,38 @@ impl NeuralCache {
         if config.max_batch.div_ceil(WORKGROUP_SIZE) > gpu.limits.max_compute_workgroups_per_dimension {
             return Err(NircError::Config(format!("max_batch {} needs more workgroups than this adapter dispatches", config.max_batch)));
         }
-        let pipelines = Self::pipelines(gpu, &config, &layout, placement);
+        let pipelines = Self::pipelines(gpu, &config, &layout, placement)?;
         let buffers = Self::buffers(gpu, &config, &layout, state)?;
         let groups = Self::fixed_groups(gpu, &pipelines, &buffers);
         Ok(Self { bounds: state.bounds, config, layout, placement, pipelines, buffers, groups })
     }
 
-    fn pipelines(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, placement: WeightPlacement) -> Pipelines {
-        let module = |pass: &str| {
-            gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(pass),
-                source: wgpu::ShaderSource::Wgsl(shaders::source(config, layout, placement, pass).into()),
+    /// Every pass's pipelines, validated (render::compute): a shader the driver refuses is an
+    /// error naming the pass.
+    fn pipelines(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, placement: WeightPlacement) -> Result<Pipelines, NircError> {
+        let build = |pass: &str, entries: &[&str]| -> Result<Vec<wgpu::ComputePipeline>, NircError> {
+            let source = shaders::source(config, layout, placement, pass);
+            let label = format!("nirc {pass}");
+            Ok(match entries {
+                [a] => render::compute::pipelines_auto_layout(gpu, &label, &source, [*a])?.to_vec(),
+                [a, b] => render::compute::pipelines_auto_layout(gpu, &label, &source, [*a, *b])?.to_vec(),
+                _ => unreachable!("one or two entry points per module"),
             })
         };
-        let pipeline = |m: &wgpu::ShaderModule, label: &str, entry: &str| {
-            gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(label),
-                layout: None,
-                module: m,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let fb = module("train_forward_backward");
-        let wgrad = module("weight_gradient");
-        let adam = module("adam_ema");
-        let acc = module("reliability_accumulate");
-        let upd = module("reliability_update");
-        let fin = module("finish_step");
-        let inf = module("infer");
-        Pipelines {
-            train_forward_backward: pipeline(&fb, "nirc train_forward_backward", "main"),
-            weight_partial: pipeline(&wgrad, "nirc weight_gradient partial", "partial_sums"),
-            weight_reduce: pipeline(&wgrad, "nirc weight_gradient reduce", "reduce"),
-            adam_check: pipeline(&adam, "nirc adam check", "check"),
-            adam_apply: pipeline(&adam, "nirc adam apply", "apply"),
-            reliability_accumulate: pipeline(&acc, "nirc reliability_accumulate", "main"),
-            reliability_update: pipeline(&upd, "nirc reliability_update", "main"),
-            finish_step: pipeline(&fin, "nirc finish_step", "main"),
-            infer: pipeline(&inf, "nirc infer", "main"),
-        }
+        let one = |pass: &str| -> Result<wgpu::ComputePipeline, NircError> { Ok(build(pass, &["main"])?.remove(0)) };
+        let [weight_partial, weight_reduce] = <[wgpu::ComputePipeline; 2]>::try_from(build("weight_gradient", &["partial_sums", "reduce"])?).expect("two pipelines");
+        let [adam_check, adam_apply] = <[wgpu::ComputePipeline; 2]>::try_from(build("adam_ema", &["check", "apply"])?).expect("two pipelines");
+        Ok(Pipelines {
+            train_forward_backward: one("train_forward_backward")?,
+            weight_partial,
+            weight_reduce,
+            adam_check,
+            adam_apply,
+            reliability_accumulate: one("reliability_accumulate")?,
+            reliability_update: one("reliability_update")?,
+            finish_step: one("finish_step")?,
+            infer: one("infer")?,
+        })
     }
 
     fn hyper(config: &NircConfig, bounds: &SceneBounds) -> Hyper {
@@ -330,8 +335,26 @@ impl NeuralCache {
     /// Records one training step into the caller's encoder (e.g. after the path tracer's pass
     /// that wrote `records`). Steps recorded in order run in order.
     pub fn encode_train(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, records: &wgpu::Buffer, n: u32) -> Result<(), NircError> {
+        let Some(step) = self.train_step(gpu, records, n)? else { return Ok(()) };
+        self.clear_train(encoder);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc train"), timestamp_writes: None });
+        self.dispatch_train(&mut pass, &step);
+        Ok(())
+    }
+
+    /// [`Self::encode_train`] as pass `index` of a timed frame (GPU timestamps where the
+    /// adapter has them).
+    pub fn train_timed(&self, gpu: &Gpu, timed: &mut TimedFrame, index: usize, records: &wgpu::Buffer, n: u32) -> Result<(), NircError> {
+        let Some(step) = self.train_step(gpu, records, n)? else { return Ok(()) };
+        self.clear_train(timed.encoder());
+        timed.pass(index, |pass| self.dispatch_train(pass, &step))?;
+        Ok(())
+    }
+
+    /// The bind groups and sizes of one training step on `n` records; `None` for no records.
+    fn train_step(&self, gpu: &Gpu, records: &wgpu::Buffer, n: u32) -> Result<Option<TrainStep>, NircError> {
         if n == 0 {
-            return Ok(());
+            return Ok(None);
         }
         if n > self.config.max_batch {
             return Err(NircError::BatchTooLarge { requested: n, max: self.config.max_batch });
@@ -355,19 +378,25 @@ impl NeuralCache {
         let check = bind(gpu, "nirc adam check", &p.adam_check, adam_entries);
         let apply = bind(gpu, "nirc adam apply", &p.adam_apply, adam_entries);
         let finish = bind(gpu, "nirc finish", &p.finish_step, &[(0, &call), (1, &b.hyper), (2, &b.counters)]);
-        encoder.clear_buffer(&b.grid_accum, 0, None);
-        encoder.clear_buffer(&b.reliability_accum, 0, None);
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc train"), timestamp_writes: None });
-        dispatch(&mut pass, &p.train_forward_backward, &fb, n.div_ceil(WORKGROUP_SIZE));
-        dispatch(&mut pass, &p.reliability_accumulate, &accumulate, groups_for(n as u64));
-        dispatch(&mut pass, &p.weight_partial, &partial, groups_for(self.layout.mlp_params as u64 * num_chunks as u64));
-        dispatch(&mut pass, &p.weight_reduce, &reduce, groups_for(self.layout.mlp_params as u64));
+        Ok(Some(TrainStep { n, num_chunks, fb, accumulate, partial, reduce, check, apply, finish }))
+    }
+
+    fn clear_train(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.clear_buffer(&self.buffers.grid_accum, 0, None);
+        encoder.clear_buffer(&self.buffers.reliability_accum, 0, None);
+    }
+
+    fn dispatch_train(&self, pass: &mut wgpu::ComputePass, s: &TrainStep) {
+        let p = &self.pipelines;
+        dispatch(pass, &p.train_forward_backward, &s.fb, s.n.div_ceil(WORKGROUP_SIZE));
+        dispatch(pass, &p.reliability_accumulate, &s.accumulate, groups_for(s.n as u64));
+        dispatch(pass, &p.weight_partial, &s.partial, groups_for(self.layout.mlp_params as u64 * s.num_chunks as u64));
+        dispatch(pass, &p.weight_reduce, &s.reduce, groups_for(self.layout.mlp_params as u64));
         let all = groups_for(self.layout.total_params as u64);
-        dispatch(&mut pass, &p.adam_check, &check, all);
-        dispatch(&mut pass, &p.adam_apply, &apply, all);
-        dispatch(&mut pass, &p.reliability_update, &self.groups.reliability_update, groups_for(cell_count(&self.config.reliability) as u64));
-        dispatch(&mut pass, &p.finish_step, &finish, 1);
-        Ok(())
+        dispatch(pass, &p.adam_check, &s.check, all);
+        dispatch(pass, &p.adam_apply, &s.apply, all);
+        dispatch(pass, &p.reliability_update, &self.groups.reliability_update, groups_for(cell_count(&self.config.reliability) as u64));
+        dispatch(pass, &p.finish_step, &s.finish, 1);
     }
 
     /// One update of the reliability grid from explicit samples (no training): what a training
@@ -403,6 +432,13 @@ impl NeuralCache {
         Ok(())
     }
 
+    /// [`Self::encode_infer`] as pass `index` of a timed frame.
+    pub fn infer_timed(&self, gpu: &Gpu, timed: &mut TimedFrame, index: usize, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: PredictorMode) -> Result<(), NircError> {
+        let Some(group) = self.infer_group(gpu, queries, n, out, mode.code())? else { return Ok(()) };
+        timed.pass(index, |pass| dispatch(pass, &self.pipelines.infer, &group, n.div_ceil(WORKGROUP_SIZE)))?;
+        Ok(())
+    }
+
     /// Records the inference of `n` queries into the caller's encoder.
     pub fn encode_infer(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: PredictorMode) -> Result<(), NircError> {
         self.encode_infer_code(gpu, encoder, queries, n, out, mode.code())
@@ -416,8 +452,16 @@ impl NeuralCache {
     }
 
     fn encode_infer_code(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: u32) -> Result<(), NircError> {
+        let Some(group) = self.infer_group(gpu, queries, n, out, mode)? else { return Ok(()) };
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc infer"), timestamp_writes: None });
+        dispatch(&mut pass, &self.pipelines.infer, &group, n.div_ceil(WORKGROUP_SIZE));
+        Ok(())
+    }
+
+    /// The bind group of an inference of `n` queries; `None` for no queries.
+    fn infer_group(&self, gpu: &Gpu, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: u32) -> Result<Option<wgpu::BindGroup>, NircError> {
         if n == 0 {
-            return Ok(());
+            return Ok(None);
         }
         Self::check_items("cache queries", queries, n, std::mem::size_of::<CacheQuery>() as u64)?;
         Self::check_items("cache answers", out, n, std::mem::size_of::<CacheAnswer>() as u64)?;
@@ -427,15 +471,12 @@ impl NeuralCache {
         }
         let b = &self.buffers;
         let call = Self::call_buffer(gpu, Call { n, inv_n: 1.0 / n as f32, mode, num_chunks: 0 });
-        let group = bind(
+        Ok(Some(bind(
             gpu,
             "nirc infer",
             &self.pipelines.infer,
             &[(0, &call), (1, &b.hyper), (2, queries), (3, &b.params), (4, &b.ema), (5, &b.moments), (6, &b.counters), (7, out)],
-        );
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc infer"), timestamp_writes: None });
-        dispatch(&mut pass, &self.pipelines.infer, &group, groups);
-        Ok(())
+        )))
     }
 
     pub fn counters(&self, gpu: &Gpu) -> Result<Counters, NircError> {

@@ -11,9 +11,10 @@
 //!                         step: Adam on the High-LR weights, then their EMA (one pass today)
 //!         `frame_output`  each method's frame: image, motion, pass times, statistics
 //!
-//! Inference uses the cache as trained up to the previous frame (NRC's order). Pass times are
-//! wall times of each submission to completion (nothing else runs on the device meanwhile);
-//! a method's frame time is paths + its own inference + training.
+//! Inference uses the cache as trained up to the previous frame (NRC's order). Pass times come
+//! from render::timing::PassTimer (GPU timestamps where the adapter has them): nirc_paths,
+//! nirc_infer and nirc_resolve (the method's own), nirc_records and nirc_train (shared: every
+//! mode reports them, as each would pay them alone).
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -24,6 +25,7 @@ use bevy_ecs::prelude::{Component, Entity, IntoScheduleConfigs, Query, Res, Sche
 use nirc::{CacheOutput, CachePathSettings, CachePaths, NeuralCache, NircConfig, PredictorMode, SceneBounds};
 use render::gpu::Gpu;
 use render::path_tracer::PathTracer;
+use render::timing::{PassTimer, PassTiming};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
@@ -79,8 +81,11 @@ pub struct NircCache {
     /// One answer buffer per predictor mode in use, and one for the reliability diagnostics.
     outputs: Vec<(PredictorMode, CacheOutput)>,
     diagnostics: CacheOutput,
-    paths_ms: f64,
-    train_ms: f64,
+    paths_timer: PassTimer,
+    infer_timer: PassTimer,
+    train_timer: PassTimer,
+    paths_times: Vec<PassTiming>,
+    train_times: Vec<PassTiming>,
     stats: Vec<(String, f64)>,
     /// Motion vectors of the frame's pixel-centre primary hits (shared by every mode).
     motion: Vec<[f32; 2]>,
@@ -106,7 +111,8 @@ struct ModeFrame {
     radiance: Vec<[f32; 4]>,
     /// Per pixel mean σ (weight of High-LR) and answered samples.
     sigma: Vec<[f32; 4]>,
-    infer_ms: f64,
+    /// nirc_infer and nirc_resolve.
+    times: Vec<PassTiming>,
 }
 
 pub struct Plugin;
@@ -150,10 +156,6 @@ impl MethodPlugin for Plugin {
 fn wait(gpu: &Gpu) -> Result<()> {
     nirc::gpu::readback::wait_idle(gpu)?;
     Ok(())
-}
-
-fn ms(start: Instant) -> f64 {
-    start.elapsed().as_secs_f64() * 1e3
 }
 
 /// Scene bounds of the cache's grids, padded a little so that points on the box faces stay
@@ -227,8 +229,11 @@ impl NircCache {
             cache,
             outputs: Vec::new(),
             diagnostics,
-            paths_ms: 0.0,
-            train_ms: 0.0,
+            paths_timer: PassTimer::new(gpu, &["nirc_paths"]),
+            infer_timer: PassTimer::new(gpu, &["nirc_infer", "nirc_resolve"]),
+            train_timer: PassTimer::new(gpu, &["nirc_records", "nirc_train"]),
+            paths_times: Vec::new(),
+            train_times: Vec::new(),
             stats: Vec::new(),
             motion: Vec::new(),
             rays: [0; 2],
@@ -251,14 +256,13 @@ fn frame_error(clock: &FrameClock) -> impl Fn(anyhow::Error) -> BevyError + '_ {
 /// Camera paths up to the termination vertex: the frame's cache queries and motion vectors.
 pub fn camera_paths(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut caches: Query<&mut NircCache>) -> Result<(), BevyError> {
     let gpu = &gpu.0;
+    let err = frame_error(&clock);
     for mut c in &mut caches {
-        let start = Instant::now();
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        c.paths.encode_queries(gpu, &mut encoder, &tracer.0, run.scenario.seed, clock.global);
-        gpu.queue.submit([encoder.finish()]);
-        wait(gpu).map_err(frame_error(&clock))?;
-        c.paths_ms = ms(start);
-        c.motion = c.paths.read_motion(gpu).map_err(|e| frame_error(&clock)(e.into()))?;
+        let c = &mut *c;
+        let mut timed = c.paths_timer.begin(gpu, "nirc paths");
+        c.paths.queries_timed(gpu, &mut timed, 0, &tracer.0, run.scenario.seed, clock.global).map_err(|e| err(e.into()))?;
+        c.paths_times = timed.submit().map_err(|e| err(e.into()))?;
+        c.motion = c.paths.read_motion(gpu).map_err(|e| err(e.into()))?;
     }
     Ok(())
 }
@@ -279,14 +283,12 @@ pub fn infer(
         let c = caches.get(m.cache).map_err(|e| err(anyhow::anyhow!("{e}")))?;
         let out = &c.outputs.iter().find(|(mode, _)| *mode == m.mode).ok_or_else(|| err(anyhow::anyhow!("predictor mode without answers")))?.1;
         c.prepare(gpu, &tracer.0, run.scenario.seed, clock.global);
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        c.cache.encode_infer(gpu, &mut encoder, c.paths.queries(), c.paths.query_count(), &out.answers, m.mode).map_err(|e| err(e.into()))?;
-        c.paths.encode_resolve(gpu, &mut encoder, &tracer.0, out);
-        gpu.queue.submit([encoder.finish()]);
-        wait(gpu).map_err(&err)?;
-        let infer_ms = ms(start);
+        let mut timed = c.infer_timer.begin(gpu, "nirc infer");
+        c.cache.infer_timed(gpu, &mut timed, 0, c.paths.queries(), c.paths.query_count(), &out.answers, m.mode).map_err(|e| err(e.into()))?;
+        c.paths.resolve_timed(gpu, &mut timed, 1, &tracer.0, out).map_err(|e| err(e.into()))?;
+        let times = timed.submit().map_err(|e| err(e.into()))?;
         let (radiance, sigma) = c.paths.read_image(gpu, out).map_err(|e| err(e.into()))?;
-        m.inferred = Some(ModeFrame { radiance, sigma, infer_ms });
+        m.inferred = Some(ModeFrame { radiance, sigma, times });
         frame.add_cpu(start);
     }
     Ok(())
@@ -314,14 +316,12 @@ pub fn train(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res
     let gpu = &gpu.0;
     let err = frame_error(&clock);
     for mut c in &mut caches {
-        let start = Instant::now();
+        let c = &mut *c;
         c.prepare(gpu, &tracer.0, run.scenario.seed, clock.global);
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        c.paths.encode_records(gpu, &mut encoder, &tracer.0);
-        c.cache.encode_train(gpu, &mut encoder, c.paths.records(), c.paths.record_count()).map_err(|e| err(e.into()))?;
-        gpu.queue.submit([encoder.finish()]);
-        wait(gpu).map_err(&err)?;
-        c.train_ms = ms(start);
+        let mut timed = c.train_timer.begin(gpu, "nirc train");
+        c.paths.records_timed(gpu, &mut timed, 0, &tracer.0).map_err(|e| err(e.into()))?;
+        c.cache.train_timed(gpu, &mut timed, 1, c.paths.records(), c.paths.record_count()).map_err(|e| err(e.into()))?;
+        c.train_times = timed.submit().map_err(|e| err(e.into()))?;
         c.rays = c.paths.read_rays(gpu).map_err(|e| err(e.into()))?;
         c.shaded = c.paths.query_count() as u64;
         let counters = c.cache.counters(gpu).map_err(|e| err(e.into()))?;
@@ -338,8 +338,9 @@ pub fn frame_output(caches: Query<&NircCache>, mut methods: Query<(&mut NircMeth
     for (mut m, mut frame) in &mut methods {
         let c = caches.get(m.cache).map_err(|e| failed(anyhow::anyhow!("{e}")))?;
         let Some(r) = m.inferred.take() else { continue };
+        let times: Vec<&PassTiming> = c.paths_times.iter().chain(&r.times).chain(&c.train_times).collect();
         let mut stats = c.stats.clone();
-        stats.push(("nirc_ms".into(), c.paths_ms + r.infer_ms + c.train_ms));
+        stats.push(("nirc_ms".into(), times.iter().map(|t| t.ms).sum()));
         let mut images = Vec::new();
         if matches!(m.mode, PredictorMode::Blend | PredictorMode::Switch) {
             images.push(MethodImage { name: "preference".into(), pixels: preference_map(&r.sigma), hdr: false });
@@ -347,11 +348,10 @@ pub fn frame_output(caches: Query<&NircCache>, mut methods: Query<(&mut NircMeth
         frame.output = Some(MethodOutput {
             radiance: r.radiance,
             motion: c.motion.clone(),
-            passes: vec![("nirc_paths".into(), Some(c.paths_ms)), ("nirc_infer".into(), Some(r.infer_ms)), ("nirc_train".into(), Some(c.train_ms))],
+            passes: times.iter().map(|t| (t.pass.clone(), Some(t.ms))).collect(),
+            clock: times.first().map(|t| t.clock),
             stats,
             images,
-            // Each submission timed alone to completion (nothing else runs on the device).
-            clock: Some(render::timing::Clock::Wall),
             // Camera paths and training paths (shared by the modes: each pays them once).
             rays: Some(c.rays[0] + c.rays[1]),
             shaded: Some(c.shaded),

@@ -1,0 +1,82 @@
+//! The shading library every method's passes are built on: its WGSL (scene geometry, sampling,
+//! BSDFs, lights, the scene's @group(0) and the path integrator, without entry points) and the
+//! run's cache of compiled passes, so that methods with equal passes share their pipelines.
+
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+use crate::bvh::SceneGeometry;
+use crate::compute;
+use crate::error::RenderError;
+use crate::gpu::Gpu;
+use crate::scene_bindings::SceneBindings;
+
+/// Storage buffers a pass built on the library binds before its own: @group(0) (scene) and
+/// @group(1) (geometry). Add the pass's own to check the adapter limit.
+pub const LIBRARY_STORAGE_BUFFERS: u32 = crate::scene_bindings::STORAGE_BUFFERS + SceneGeometry::STORAGE_BUFFERS;
+
+type Compiled = (wgpu::BindGroupLayout, Vec<wgpu::ComputePipeline>);
+
+#[derive(Default)]
+pub struct PassLibrary {
+    /// Passes built so far, by (pass, source, own group, entry points).
+    compiled: Mutex<HashMap<u64, Compiled>>,
+}
+
+impl PassLibrary {
+    /// The library's WGSL; a pass appends its own (its buffers in @group(2)) and binds the
+    /// scene's @group(0) and the geometry's @group(1).
+    pub fn source() -> &'static str {
+        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+        SOURCE.get_or_init(|| {
+            [
+                SceneGeometry::WGSL,
+                include_str!("../shaders/pt_sampling.wgsl"),
+                include_str!("../shaders/pt_bsdf.wgsl"),
+                include_str!("../shaders/pt_lights.wgsl"),
+                include_str!("../shaders/pt_scene.wgsl"),
+                include_str!("../shaders/pt_integrator.wgsl"),
+            ]
+            .join("\n")
+        })
+    }
+
+    /// The layout of a pass's own @group(2) (buffer kinds by binding) and the pipelines of
+    /// `entries` in `source`, a WGSL module built on [`Self::source`]. Refuses a pass with more
+    /// storage buffers than the adapter binds. Equal passes are compiled once per run.
+    pub fn pass<const N: usize>(
+        &self,
+        gpu: &Gpu,
+        scene: &SceneBindings,
+        pass: &str,
+        source: &str,
+        own: &[wgpu::BufferBindingType],
+        entries: [&str; N],
+    ) -> Result<(wgpu::BindGroupLayout, [wgpu::ComputePipeline; N]), RenderError> {
+        let own_storage = own.iter().filter(|k| matches!(k, wgpu::BufferBindingType::Storage { .. })).count() as u32;
+        let needed = LIBRARY_STORAGE_BUFFERS + own_storage;
+        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
+        if needed > limit {
+            return Err(crate::gpu::GpuError::OverLimit { what: format!("storage buffers of pass '{pass}'"), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
+        }
+        // Methods of one run share the pipelines of equal passes (three sample caches, two hash
+        // caches): fewer compiled shaders, and on llvmpipe a working set that stays inside its
+        // shader-variant cache, whose evictions cost seconds of recompilation per frame.
+        let key = {
+            use std::hash::{Hash, Hasher};
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            (pass, source, format!("{own:?}"), entries.as_slice()).hash(&mut h);
+            h.finish()
+        };
+        let mut compiled = self.compiled.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((layout, pipelines)) = compiled.get(&key)
+            && let Ok(pipelines) = <[wgpu::ComputePipeline; N]>::try_from(pipelines.clone())
+        {
+            return Ok((layout.clone(), pipelines));
+        }
+        let layout = compute::buffer_layout(gpu, pass, own);
+        let pipelines = compute::pipelines(gpu, pass, source, &[scene.layout(), scene.geometry().bind_group_layout(), &layout], entries)?;
+        compiled.insert(key, (layout.clone(), pipelines.to_vec()));
+        Ok((layout, pipelines))
+    }
+}

@@ -1,0 +1,179 @@
+//! The scene as every pass built on the shading library binds it: @group(0) holds the `Frame`
+//! uniform (camera, previous camera, lights, seed, spp, depth), materials, the texture atlas and
+//! the light table, all read only; @group(1) is the geometry (BLAS, TLAS, instances). One per
+//! run, updated once per frame; methods read it and never write it.
+
+use crate::bvh::SceneGeometry;
+use crate::compute;
+use crate::error::RenderError;
+use crate::frame::{CameraBasis, FrameParams, GpuFrame};
+use crate::gpu::Gpu;
+use crate::lights::{LightTable, build_light_table};
+use crate::materials::pack_materials;
+use crate::path_tracer::PathTracerSettings;
+use crate::scene::{Camera, SceneChanges, SceneDesc};
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+/// Storage buffers of @group(0): materials, texels, lights.
+pub const STORAGE_BUFFERS: u32 = 3;
+
+/// @group(0): frame uniform, materials, texels, lights.
+const GROUP: [wgpu::BufferBindingType; 4] = {
+    let read = wgpu::BufferBindingType::Storage { read_only: true };
+    [wgpu::BufferBindingType::Uniform, read, read, read]
+};
+
+pub struct SceneBindings {
+    settings: PathTracerSettings,
+    geometry: SceneGeometry,
+    layout: wgpu::BindGroupLayout,
+    bind_group: wgpu::BindGroup,
+    frame_buffer: wgpu::Buffer,
+    materials: wgpu::Buffer,
+    texels: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    light_table: LightTable,
+    camera: Camera,
+    /// Camera before the last `update` (motion vectors), like the instances' previous
+    /// transforms; the current camera before the first update.
+    previous_camera: Camera,
+    environment: Vec3,
+}
+
+impl SceneBindings {
+    pub fn new(gpu: &Gpu, scene: &SceneDesc, settings: PathTracerSettings) -> Result<Self, RenderError> {
+        let geometry = SceneGeometry::new(gpu, scene)?;
+        let (materials, texels) = pack_materials(scene)?;
+        let light_table = build_light_table(scene)?;
+        let device = &gpu.device;
+        let storage = |label: &str, contents: &[u8]| -> Result<wgpu::Buffer, RenderError> {
+            gpu.check_buffer_size(label, contents.len() as u64)?;
+            Ok(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            }))
+        };
+        let materials = storage("materials", bytemuck::cast_slice(&materials))?;
+        let texels = storage("base-colour texels", bytemuck::cast_slice(&texels))?;
+        let lights = storage("lights", bytemuck::cast_slice(&light_table.lights))?;
+        let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame uniform"),
+            size: size_of::<GpuFrame>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let layout = compute::buffer_layout(gpu, "scene", &GROUP);
+        let bind_group = compute::buffer_group(gpu, "scene", &layout, &[&frame_buffer, &materials, &texels, &lights]);
+        Ok(Self {
+            settings,
+            geometry,
+            layout,
+            bind_group,
+            frame_buffer,
+            materials,
+            texels,
+            lights,
+            light_table,
+            camera: scene.camera,
+            previous_camera: scene.camera,
+            environment: scene.environment,
+        })
+    }
+
+    /// Uploads what `changes` names: materials and texels when materials changed, the light
+    /// table when lights, instances (emissive triangles follow them) or materials changed.
+    /// Instance transforms and the camera are taken every frame: they become the previous ones
+    /// of motion vectors.
+    pub fn update_changed(&mut self, gpu: &Gpu, scene: &SceneDesc, changes: SceneChanges) -> Result<(), RenderError> {
+        let materials = (changes.materials || changes.geometry).then(|| pack_materials(scene)).transpose()?;
+        let light_table = (changes.lights || changes.instances || changes.materials || changes.geometry).then(|| build_light_table(scene)).transpose()?;
+        self.geometry.try_update_instances(gpu, &scene.instances)?;
+        let mut rebind = false;
+        let mut uploads: Vec<(&mut wgpu::Buffer, &str, &[u8])> = Vec::new();
+        if let Some((materials, texels)) = &materials {
+            uploads.push((&mut self.materials, "materials", bytemuck::cast_slice::<_, u8>(materials)));
+            uploads.push((&mut self.texels, "base-colour texels", bytemuck::cast_slice(texels)));
+        }
+        if let Some(table) = &light_table {
+            uploads.push((&mut self.lights, "lights", bytemuck::cast_slice(&table.lights)));
+        }
+        for (buffer, label, bytes) in uploads {
+            if buffer.size() == bytes.len() as u64 {
+                gpu.queue.write_buffer(buffer, 0, bytes);
+            } else {
+                gpu.check_buffer_size(label, bytes.len() as u64)?;
+                *buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: bytes,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                });
+                rebind = true;
+            }
+        }
+        if rebind {
+            self.bind_group = compute::buffer_group(gpu, "scene", &self.layout, &[&self.frame_buffer, &self.materials, &self.texels, &self.lights]);
+        }
+        if let Some(table) = light_table {
+            self.light_table = table;
+        }
+        self.previous_camera = self.camera;
+        self.camera = scene.camera;
+        self.environment = scene.environment;
+        Ok(())
+    }
+
+    /// Writes the frame uniform for a pass (camera, previous camera, lights, `spp` and the first
+    /// sample index, seed, frame, max depth), as the path tracer's own passes see it.
+    pub fn prepare_frame(&self, gpu: &Gpu, spp: u32, first_sample: u32, seed: u64, frame: u32) {
+        self.write_frame(gpu, spp, first_sample, seed, frame, false);
+    }
+
+    /// [`Self::prepare_frame`] with `accumulate`: the path tracer's later batches add to the
+    /// radiance sum instead of replacing it.
+    pub(crate) fn write_frame(&self, gpu: &Gpu, spp: u32, first_sample: u32, seed: u64, frame: u32, accumulate: bool) {
+        let (w, h) = (self.settings.width, self.settings.height);
+        let params = FrameParams {
+            camera: CameraBasis::new(&self.camera, w, h),
+            previous_camera: CameraBasis::new(&self.previous_camera, w, h),
+            environment: self.environment,
+            emitter_weight: self.light_table.emitter_weight,
+            width: w,
+            height: h,
+            spp,
+            first_sample,
+            seed,
+            frame,
+            max_depth: self.settings.max_depth,
+            rr_start_depth: self.settings.rr_start_depth,
+            analytic_lights: self.light_table.analytic,
+            emitters: self.light_table.emitters,
+            accumulate,
+        };
+        gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&params.gpu()));
+    }
+
+    /// @group(0). It changes when an update had to grow a buffer: fetch it every frame.
+    pub fn bind_group(&self) -> &wgpu::BindGroup {
+        &self.bind_group
+    }
+
+    pub fn layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    /// @group(1) and the scene's bounds.
+    pub fn geometry(&self) -> &SceneGeometry {
+        &self.geometry
+    }
+
+    /// The camera of the current frame (after the last update).
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    pub fn settings(&self) -> PathTracerSettings {
+        self.settings
+    }
+}
