@@ -56,8 +56,11 @@ case "${1:-}" in
         [ $# -ge 2 ] || { echo "usage: $0 BEFORE AFTER [WORK]" >&2; exit 2; }
         work="${3:-$repo/target/same_results}"
         mkdir -p "$work"
-        for commit in "$1" "$2"; do
-            sha="$(git -C "$repo" rev-parse --short "$commit")"
+        # Resolved once: a commit made while this runs must not change what is compared.
+        before="$(git -C "$repo" rev-parse --short "$1^{commit}")"
+        after="$(git -C "$repo" rev-parse --short "$2^{commit}")"
+        for sha in "$before" "$after"; do
+            commit="$sha"
             tree="$work/src-$sha"
             [ -d "$tree" ] || git -C "$repo" worktree add --detach "$tree" "$commit" >/dev/null
             # A commit's binary and runs are kept (by commit hash): a second comparison against
@@ -73,6 +76,6 @@ case "${1:-}" in
                 touch "$work/out-$sha/done"
             fi
         done
-        compare "$work/out-$(git -C "$repo" rev-parse --short "$1")" "$work/out-$(git -C "$repo" rev-parse --short "$2")"
+        compare "$work/out-$before" "$work/out-$after"
         ;;
 esac

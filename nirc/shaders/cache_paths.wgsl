@@ -78,7 +78,7 @@ fn cache_target(origin: vec3f, dir: vec3f, depth: u32, rng: ptr<function, u32>) 
     let hit = trace_closest(origin, dir, FAR);
     if hit.instance == NO_HIT {
         // The environment only: the analytic lights' disks are NEE's.
-        return frame.environment.xyz;
+        return frame.environment;
     }
     let sp = surface_point(hit, origin, dir);
     let m = materials[sp.material];
@@ -86,7 +86,7 @@ fn cache_target(origin: vec3f, dir: vec3f, depth: u32, rng: ptr<function, u32>) 
     let sh = orient(sp, wo);
     // The hit's own emission is direct light: NEE's at x_k, not the cache's.
     var l = vec3f(0.0);
-    if depth >= frame.seed.w {
+    if depth >= frame.max_depth {
         return l;
     }
     let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);
@@ -97,7 +97,7 @@ fn cache_target(origin: vec3f, dir: vec3f, depth: u32, rng: ptr<function, u32>) 
         return l;
     }
     var throughput = bs.f * (dot(sh.ns, bs.wi) / bs.pdf);
-    if depth + 1u >= frame.counts.x {
+    if depth + 1u >= frame.rr_start_depth {
         let survive = min(max_component(throughput), 0.95);
         if rng_next(rng) >= survive {
             return l;
@@ -109,10 +109,10 @@ fn cache_target(origin: vec3f, dir: vec3f, depth: u32, rng: ptr<function, u32>) 
 
 // One camera path up to its termination vertex; writes query q's position, direction, weight.
 fn trace_query(pixel: vec2u, sample_index: u32, q: u32) {
-    var rng = rng_seed(frame.seed.xy, frame.seed.z, pixel.y * frame.size.x + pixel.x, sample_index);
+    var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, pixel.y * frame.width + pixel.x, sample_index);
     let jitter = rng_next2(&rng);
     let dir = camera_ray_direction(frame.camera, vec2f(pixel) + jitter);
-    let path = trace_path_prefix(frame.camera.position.xyz, dir, 0.0, 0u, params.termination_vertex - 1u, &rng);
+    let path = trace_path_prefix(frame.camera.position, dir, 0.0, 0u, params.termination_vertex - 1u, &rng);
     var radiance = path.radiance;
     var result: QueryMeta;
     result.weight = vec4f(0.0);
@@ -142,14 +142,14 @@ fn trace_query(pixel: vec2u, sample_index: u32, q: u32) {
 // Per pixel: `spp` camera paths, queries at pixel * spp + s.
 @compute @workgroup_size(8, 8, 1)
 fn queries_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.size.x || id.y >= frame.size.y {
+    if id.x >= frame.width || id.y >= frame.height {
         return;
     }
-    let pixel = id.y * frame.size.x + id.x;
+    let pixel = id.y * frame.width + id.x;
     for (var s = 0u; s < params.spp; s++) {
         trace_query(id.xy, s, pixel * params.spp + s);
     }
-    let origin = frame.camera.position.xyz;
+    let origin = frame.camera.position;
     let dir = camera_ray_direction(frame.camera, vec2f(id.xy) + 0.5);
     let hit = trace_closest(origin, dir, FAR);
     var hit_point = origin;
@@ -173,7 +173,7 @@ fn targets_main(@builtin(global_invocation_id) id: vec3u) {
     if i >= params.record_count {
         return;
     }
-    var pick = rng_seed(frame.seed.xy, frame.seed.z, i, TRAIN_PICK_STREAM);
+    var pick = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, i, TRAIN_PICK_STREAM);
     var chosen = 0xffffffffu;
     for (var t = 0u; t < PICK_TRIES; t++) {
         let c = min(u32(rng_next(&pick) * f32(params.query_count)), params.query_count - 1u);
@@ -187,7 +187,7 @@ fn targets_main(@builtin(global_invocation_id) id: vec3u) {
     r.direction = vec4f(0.0, 0.0, 1.0, 0.0);
     r.target_rgb = vec4f(0.0);
     if chosen != 0xffffffffu {
-        var rng = rng_seed(frame.seed.xy, frame.seed.z, i, TRAIN_SAMPLE_STREAM);
+        var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, i, TRAIN_SAMPLE_STREAM);
         r.position = vec4f(queries[chosen].position.xyz, 1.0);
         r.direction = queries[chosen].direction;
         r.target_rgb = vec4f(target_of(chosen, &rng), 0.0);
@@ -228,7 +228,7 @@ fn oracle_main(@builtin(global_invocation_id) id: vec3u) {
     }
     var l = vec3f(0.0);
     if query_meta[q].weight.w > 0.0 {
-        var rng = rng_seed(frame.seed.xy, frame.seed.z ^ 0x0c0ffeeu, q, TRAIN_SAMPLE_STREAM);
+        var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame ^ 0x0c0ffeeu, q, TRAIN_SAMPLE_STREAM);
         l = target_of(q, &rng);
     }
     answers[q] = vec4f(l, 0.0);
@@ -238,10 +238,10 @@ fn oracle_main(@builtin(global_invocation_id) id: vec3u) {
 // mean σ (weight of the High-LR predictor) of the pixel's answered queries, w = their count.
 @compute @workgroup_size(8, 8, 1)
 fn resolve_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.size.x || id.y >= frame.size.y {
+    if id.x >= frame.width || id.y >= frame.height {
         return;
     }
-    let pixel = id.y * frame.size.x + id.x;
+    let pixel = id.y * frame.width + id.x;
     var sum = vec3f(0.0);
     var sigma = 0.0;
     var answered = 0.0;
@@ -257,5 +257,5 @@ fn resolve_main(@builtin(global_invocation_id) id: vec3u) {
         }
     }
     image[pixel] = vec4f(sum / f32(params.spp), 1.0);
-    image[frame.size.x * frame.size.y + pixel] = vec4f(sigma / max(answered, 1.0), 0.0, 0.0, answered);
+    image[frame.width * frame.height + pixel] = vec4f(sigma / max(answered, 1.0), 0.0, 0.0, answered);
 }

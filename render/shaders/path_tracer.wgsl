@@ -3,10 +3,10 @@
 // (PathTracer::library_source).
 
 fn trace_path(pixel: vec2u, sample_index: u32) -> vec3f {
-    var rng = rng_seed(frame.seed.xy, frame.seed.z, pixel.y * frame.size.x + pixel.x, sample_index);
+    var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, pixel.y * frame.width + pixel.x, sample_index);
     let jitter = rng_next2(&rng);
     let dir = camera_ray_direction(frame.camera, vec2f(pixel) + jitter);
-    return path_radiance(frame.camera.position.xyz, dir, 0.0, 0u, &rng);
+    return path_radiance(frame.camera.position, dir, 0.0, 0u, &rng);
 }
 
 struct GBufferTexel {
@@ -33,50 +33,50 @@ struct GBufferTexel {
 // dispatch runs too long; spreading samples over z also keeps small images parallel.
 @compute @workgroup_size(8, 8, 1)
 fn trace_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.size.x || id.y >= frame.size.y {
+    if id.x >= frame.width || id.y >= frame.height {
         return;
     }
     let first = id.z * SAMPLES_PER_THREAD;
     var sum = vec3f(0.0);
     for (var s = 0u; s < SAMPLES_PER_THREAD; s++) {
-        if first + s < frame.size.z {
-            sum += trace_path(id.xy, frame.size.w + first + s);
+        if first + s < frame.spp {
+            sum += trace_path(id.xy, frame.first_sample + first + s);
         }
     }
-    let pixels = frame.size.x * frame.size.y;
-    sample_partials[id.z * pixels + id.y * frame.size.x + id.x] = vec4f(sum, 0.0);
+    let pixels = frame.width * frame.height;
+    sample_partials[id.z * pixels + id.y * frame.width + id.x] = vec4f(sum, 0.0);
     atomicAdd(&pt_counters[0], sg_rays_traced);
 }
 
 // Adds a dispatch's chunks to the running sum in a fixed order (deterministic); w counts samples.
 @compute @workgroup_size(8, 8, 1)
 fn accumulate_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.size.x || id.y >= frame.size.y {
+    if id.x >= frame.width || id.y >= frame.height {
         return;
     }
-    let pixels = frame.size.x * frame.size.y;
-    let index = id.y * frame.size.x + id.x;
-    let chunks = (frame.size.z + SAMPLES_PER_THREAD - 1u) / SAMPLES_PER_THREAD;
+    let pixels = frame.width * frame.height;
+    let index = id.y * frame.width + id.x;
+    let chunks = (frame.spp + SAMPLES_PER_THREAD - 1u) / SAMPLES_PER_THREAD;
     var sum = vec3f(0.0);
     for (var c = 0u; c < chunks; c++) {
         sum += sample_partials[c * pixels + index].xyz;
     }
     var previous = vec4f(0.0);
-    if frame.counts.w != 0u {
+    if frame.accumulate != 0u {
         previous = radiance_sum[index];
     }
-    radiance_sum[index] = previous + vec4f(sum, f32(frame.size.z));
+    radiance_sum[index] = previous + vec4f(sum, f32(frame.spp));
 }
 
 // Primary-hit G-buffer from the pixel-centre ray. Misses: depth 0 (the CPU turns it into +inf),
 // zero normal and albedo, NO_HIT ids, motion of the direction at infinity.
 @compute @workgroup_size(8, 8, 1)
 fn gbuffer_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.size.x || id.y >= frame.size.y {
+    if id.x >= frame.width || id.y >= frame.height {
         return;
     }
     let centre = vec2f(id.xy) + 0.5;
-    let origin = frame.camera.position.xyz;
+    let origin = frame.camera.position;
     let dir = camera_ray_direction(frame.camera, centre);
     let hit = trace_closest(origin, dir, FAR);
     var g: GBufferTexel;
@@ -95,6 +95,6 @@ fn gbuffer_main(@builtin(global_invocation_id) id: vec3u) {
         g.albedo = base_color_at(materials[sp.material], sp.uv);
         g.motion = primary_motion(hit, origin, dir, sp.position);
     }
-    gbuffer[id.y * frame.size.x + id.x] = g;
+    gbuffer[id.y * frame.width + id.x] = g;
     atomicAdd(&pt_counters[0], sg_rays_traced);
 }

@@ -14,7 +14,7 @@ fn next_event(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u
 
 fn next_event_analytic(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>, mis: bool) -> vec3f {
     var radiance = vec3f(0.0);
-    for (var i = 0u; i < frame.counts.y; i++) {
+    for (var i = 0u; i < frame.analytic_lights; i++) {
         let ls = sample_analytic_light(lights[i], p, rng_next2(rng));
         if dot(ls.wi, sh.ng) <= 0.0 || max_component(ls.weight) <= 0.0 {
             continue;
@@ -38,12 +38,12 @@ fn next_event_analytic(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<fu
 
 // One emissive triangle, chosen by power.
 fn next_event_emitter(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>, mis: bool) -> vec3f {
-    let emitter_count = frame.counts.z;
+    let emitter_count = frame.emitters;
     if emitter_count == 0u {
         return vec3f(0.0);
     }
     let u_select = rng_next(rng);
-    let ls = sample_emitter(frame.counts.y, emitter_count, p, u_select, rng_next2(rng));
+    let ls = sample_emitter(frame.analytic_lights, emitter_count, p, u_select, rng_next2(rng));
     if ls.pdf <= 0.0 || dot(ls.wi, sh.ng) <= 0.0 {
         return vec3f(0.0);
     }
@@ -77,7 +77,7 @@ fn next_event_environment(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr
         return vec3f(0.0);
     }
     let w = power_heuristic(env_pdf, bsdf_pdf(bsdf, sh.ns, wo, wi));
-    return f * dot(sh.ns, wi) * frame.environment.xyz * (w / env_pdf);
+    return f * dot(sh.ns, wi) * frame.environment * (w / env_pdf);
 }
 
 // Emitted radiance seen along a ray that hit `sp` at distance `dist`, MIS-weighted against the
@@ -92,7 +92,7 @@ fn emitted_radiance(sp: SurfacePoint, m: GpuMaterial, dir: vec3f, dist: f32, pre
         return vec3f(0.0);
     }
     var w = 1.0;
-    let emitter_weight = frame.environment.w;
+    let emitter_weight = frame.emitter_weight;
     if prev_bsdf_pdf > 0.0 && emitter_weight > 0.0 {
         let light_pdf = le_lum / emitter_weight * dist * dist / cos_light;
         w = power_heuristic(prev_bsdf_pdf, light_pdf);
@@ -117,7 +117,7 @@ const NO_STOP: u32 = 0xffffffffu;
 
 // Radiance carried back along a path that starts with the ray (origin, dir) at vertex `depth`
 // (0 = camera ray), up to the frame's max depth. `prev_bsdf_pdf` is the pdf that chose `dir`
-// (0 for a camera ray: no MIS on what it hits). Russian roulette from frame.counts.x on.
+// (0 for a camera ray: no MIS on what it hits). Russian roulette from frame.rr_start_depth on.
 fn path_radiance(origin: vec3f, dir: vec3f, prev_bsdf_pdf: f32, depth: u32, rng: ptr<function, u32>) -> vec3f {
     return trace_path_prefix(origin, dir, prev_bsdf_pdf, depth, NO_STOP, rng).radiance;
 }
@@ -133,7 +133,7 @@ fn trace_path_prefix(origin_in: vec3f, dir_in: vec3f, prev_bsdf_pdf_in: f32, dep
     var throughput = vec3f(1.0);
     var radiance = vec3f(0.0);
     var prev_bsdf_pdf = prev_bsdf_pdf_in;
-    let max_depth = frame.seed.w;
+    let max_depth = frame.max_depth;
     for (var depth = depth_in; depth <= max_depth; depth++) {
         let hit = trace_closest(origin, dir, FAR);
         if hit.instance == NO_HIT {
@@ -169,7 +169,7 @@ fn trace_path_prefix(origin_in: vec3f, dir_in: vec3f, prev_bsdf_pdf_in: f32, dep
         }
         throughput *= bs.f * (dot(sh.ns, bs.wi) / bs.pdf);
         prev_bsdf_pdf = bs.pdf;
-        if depth + 1u >= frame.counts.x {
+        if depth + 1u >= frame.rr_start_depth {
             let survive = min(max_component(throughput), 0.95);
             if rng_next(rng) >= survive {
                 break;

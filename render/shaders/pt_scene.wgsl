@@ -1,33 +1,8 @@
 // The scene as the path tracer's passes see it: frame uniform, materials, lights, camera, and
 // the helpers every pass that shades surfaces needs. @group(0), read only (layout in
-// scene_bindings.rs); every pass binds it and puts its own buffers in @group(2).
-
-struct CameraFrame {
-    position: vec4f,  // w: tan(vfov / 2)
-    forward: vec4f,   // w: aspect (width / height)
-    right: vec4f,
-    up: vec4f,
-}
-
-struct Frame {
-    camera: CameraFrame,
-    previous_camera: CameraFrame,
-    environment: vec4f,   // w: total emitter weight W = sum luminance(Le) * area
-    size: vec4u,          // width, height, spp of this dispatch, index of its first sample
-    seed: vec4u,          // seed low, seed high, frame, max depth
-    counts: vec4u,        // Russian-roulette start depth, analytic lights, emissive triangles, accumulate
-}
-
-struct GpuMaterial {
-    base_color: vec3f,
-    texture_offset: u32,  // first texel in `texels`, NO_TEXTURE if none
-    emission: vec3f,
-    roughness: f32,
-    metallic: f32,
-    specular: f32,
-    texture_width: u32,
-    texture_height: u32,
-}
+// scene_bindings.rs); every pass binds it and puts its own buffers in @group(2). The structs
+// Frame, CameraFrame and GpuMaterial are declared once in Rust (render/src/frame.rs,
+// materials.rs: gpu_struct!) and prepended by PassLibrary::source.
 
 const NO_TEXTURE: u32 = 0xffffffffu;
 
@@ -67,21 +42,21 @@ fn base_color_at(m: GpuMaterial, uv: vec2f) -> vec3f {
 }
 
 fn camera_ray_direction(c: CameraFrame, pixel: vec2f) -> vec3f {
-    let w = f32(frame.size.x);
-    let h = f32(frame.size.y);
+    let w = f32(frame.width);
+    let h = f32(frame.height);
     let ndc = vec2f(2.0 * pixel.x / w - 1.0, 1.0 - 2.0 * pixel.y / h);
-    let d = c.forward.xyz + ndc.x * c.position.w * c.forward.w * c.right.xyz + ndc.y * c.position.w * c.up.xyz;
+    let d = c.forward + ndc.x * c.tan_half_fov * c.aspect * c.right + ndc.y * c.tan_half_fov * c.up;
     return normalize(d);
 }
 
 // Pixel coordinates (x right, y down, pixel centres at +0.5) of a camera-space offset `d`.
 fn project_offset(c: CameraFrame, d: vec3f) -> vec2f {
-    let z = dot(d, c.forward.xyz);
+    let z = dot(d, c.forward);
     if z <= 0.0 {
         return vec2f(-1.0e9);
     }
-    let ndc = vec2f(dot(d, c.right.xyz) / (z * c.position.w * c.forward.w), dot(d, c.up.xyz) / (z * c.position.w));
-    return vec2f((0.5 * ndc.x + 0.5) * f32(frame.size.x), (0.5 - 0.5 * ndc.y) * f32(frame.size.y));
+    let ndc = vec2f(dot(d, c.right) / (z * c.tan_half_fov * c.aspect), dot(d, c.up) / (z * c.tan_half_fov));
+    return vec2f((0.5 * ndc.x + 0.5) * f32(frame.width), (0.5 - 0.5 * ndc.y) * f32(frame.height));
 }
 
 // Motion (previous image position - current, pixels) of what the camera ray (origin, dir) hit:
@@ -91,7 +66,7 @@ fn primary_motion(hit: Hit, origin: vec3f, dir: vec3f, hit_point: vec3f) -> vec2
     if hit.instance == NO_HIT {
         return project_offset(frame.previous_camera, dir) - project_offset(frame.camera, dir);
     }
-    let before = project_offset(frame.previous_camera, previous_world_position(hit) - frame.previous_camera.position.xyz);
+    let before = project_offset(frame.previous_camera, previous_world_position(hit) - frame.previous_camera.position);
     return before - project_offset(frame.camera, hit_point - origin);
 }
 
@@ -102,18 +77,18 @@ fn offset_origin(p: vec3f, ng: vec3f, dir: vec3f) -> vec3f {
 }
 
 fn environment_pdf() -> f32 {
-    return select(0.0, 1.0 / (4.0 * PI), max_component(frame.environment.xyz) > 0.0);
+    return select(0.0, 1.0 / (4.0 * PI), max_component(frame.environment) > 0.0);
 }
 
 // Radiance arriving along a ray that left the scene: environment plus the disks of directional
 // lights with an angular radius, each MIS-weighted against the BSDF pdf that chose the ray
 // (`bsdf_pdf` <= 0: camera ray, no MIS).
 fn escaped_radiance(dir: vec3f, bsdf_pdf: f32) -> vec3f {
-    var l = frame.environment.xyz;
+    var l = frame.environment;
     if bsdf_pdf > 0.0 {
         l *= power_heuristic(bsdf_pdf, environment_pdf());
     }
-    for (var i = 0u; i < frame.counts.y; i++) {
+    for (var i = 0u; i < frame.analytic_lights; i++) {
         let light = lights[i];
         if light.kind == LIGHT_DIRECTIONAL && light.a > 0.0 && 1.0 - dot(dir, -normalize(light.p1)) <= light.a {
             var w = 1.0;

@@ -22,7 +22,7 @@ fn primary_attributes(hit: Hit, origin: vec3f, dir: vec3f) -> TaaPrimary {
     } else {
         let sp = surface_point(hit, origin, dir);
         let sh = orient(sp, -dir);
-        let before = previous_world_position(hit) - frame.previous_camera.position.xyz;
+        let before = previous_world_position(hit) - frame.previous_camera.position;
         p.depth = length(sp.position - origin);
         p.previous_depth = length(before);
         p.normal = sh.ns;

@@ -6,19 +6,6 @@
 // fresh history averages uniformly until it reaches the exponential regime.
 // Mirrored on the CPU by render/src/taa/resolve_cpu.rs (keep them in step).
 
-struct TaaParams {
-    jitter: vec2f,
-    alpha: f32,
-    gamma: f32,
-    size: vec2u,
-    clamp_mode: u32,
-    history_valid: u32,
-    depth_tolerance: f32,
-    normal_threshold: f32,
-    max_history: f32,
-    pad: f32,
-}
-
 struct TaaPrimary {
     normal: vec3f,
     depth: f32,

@@ -3,19 +3,6 @@
 // Concatenated after PathTracer::library_source() and taa_primary.wgsl; buffers in @group(2)
 // (layout in render/src/taa/mod.rs).
 
-struct TaaParams {
-    jitter: vec2f,          // position of the primary ray inside its pixel, [0, 1)^2
-    alpha: f32,             // exponential blend weight of the current frame
-    gamma: f32,             // variance clipping: box = mean +- gamma * sigma
-    size: vec2u,
-    clamp_mode: u32,        // 0 none, 1 min/max, 2 variance clipping
-    history_valid: u32,     // 0 on the first frame: everything is rejected
-    depth_tolerance: f32,   // relative
-    normal_threshold: f32,  // minimum cosine between current and history normals
-    max_history: f32,       // cap of the history length (frames)
-    pad: f32,
-}
-
 @group(2) @binding(0) var<uniform> taa: TaaParams;
 @group(2) @binding(1) var<storage, read_write> taa_current: array<vec4f>;
 @group(2) @binding(2) var<storage, read_write> taa_primary: array<TaaPrimary>;
@@ -24,12 +11,12 @@ struct TaaParams {
 
 @compute @workgroup_size(8, 8, 1)
 fn taa_trace(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.size.x || id.y >= frame.size.y {
+    if id.x >= frame.width || id.y >= frame.height {
         return;
     }
-    let index = id.y * frame.size.x + id.x;
-    var rng = rng_seed(frame.seed.xy, frame.seed.z, index, frame.size.w);
-    let origin = frame.camera.position.xyz;
+    let index = id.y * frame.width + id.x;
+    var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, index, frame.first_sample);
+    let origin = frame.camera.position;
     let dir = camera_ray_direction(frame.camera, vec2f(id.xy) + taa.jitter);
     // The primary ray is traced twice (here and in path_radiance): one ray of a whole path,
     // for keeping the shared integrator untouched.

@@ -2,7 +2,6 @@
 //! model it uses, with the same math on the CPU for tests and motion-vector checks.
 
 use crate::scene::Camera;
-use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
 /// Orthonormal pinhole camera basis, as the shader sees it.
@@ -41,38 +40,65 @@ impl CameraBasis {
         Some(Vec2::new((0.5 * ndc.x + 0.5) * width as f32, (0.5 - 0.5 * ndc.y) * height as f32))
     }
 
-    fn gpu(&self) -> GpuCamera {
-        GpuCamera {
-            position: self.position.extend(self.tan_half_fov).to_array(),
-            forward: self.forward.extend(self.aspect).to_array(),
-            right: self.right.extend(0.0).to_array(),
-            up: self.up.extend(0.0).to_array(),
+    fn gpu(&self) -> CameraFrame {
+        CameraFrame {
+            position: self.position.to_array(),
+            tan_half_fov: self.tan_half_fov,
+            forward: self.forward.to_array(),
+            aspect: self.aspect,
+            right: self.right.to_array(),
+            pad0: 0.0,
+            up: self.up.to_array(),
+            pad1: 0.0,
         }
     }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub(crate) struct GpuCamera {
-    position: [f32; 4],
-    forward: [f32; 4],
-    right: [f32; 4],
-    up: [f32; 4],
+crate::gpu_struct! {
+    /// A pinhole camera as the shaders see it ([`CameraBasis`]).
+    pub struct CameraFrame {
+        pub position: [f32; 3] => "vec3f",
+        pub tan_half_fov: f32 => "f32",
+        pub forward: [f32; 3] => "vec3f",
+        /// Width / height.
+        pub aspect: f32 => "f32",
+        pub right: [f32; 3] => "vec3f",
+        pub pad0: f32 => "f32",
+        pub up: [f32; 3] => "vec3f",
+        pub pad1: f32 => "f32",
+    }
 }
 
-/// WGSL `Frame` (path_tracer.wgsl).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub(crate) struct GpuFrame {
-    camera: GpuCamera,
-    previous_camera: GpuCamera,
-    environment: [f32; 4],
-    size: [u32; 4],
-    seed: [u32; 4],
-    counts: [u32; 4],
+crate::gpu_struct! {
+    /// The `frame` uniform of every pass built on the shading library (@group(0) binding 0).
+    pub struct Frame {
+        pub camera: CameraFrame => "CameraFrame",
+        pub previous_camera: CameraFrame => "CameraFrame",
+        /// Constant environment radiance.
+        pub environment: [f32; 3] => "vec3f",
+        /// Total emitter weight W = sum of luminance(Le) * area over emissive triangles.
+        pub emitter_weight: f32 => "f32",
+        pub width: u32 => "u32",
+        pub height: u32 => "u32",
+        /// Samples per pixel of this dispatch.
+        pub spp: u32 => "u32",
+        /// Index of the dispatch's first sample.
+        pub first_sample: u32 => "u32",
+        pub seed_lo: u32 => "u32",
+        pub seed_hi: u32 => "u32",
+        pub frame: u32 => "u32",
+        pub max_depth: u32 => "u32",
+        /// Russian roulette applies from this depth on.
+        pub rr_start_depth: u32 => "u32",
+        pub analytic_lights: u32 => "u32",
+        /// Emissive triangles in the light table.
+        pub emitters: u32 => "u32",
+        /// 1: add to the radiance sum, 0: replace it.
+        pub accumulate: u32 => "u32",
+    }
 }
 
-const _: () = assert!(size_of::<GpuFrame>() == 192);
+const _: () = assert!(size_of::<Frame>() == 192);
 
 /// Everything that changes between dispatches.
 pub(crate) struct FrameParams {
@@ -94,14 +120,24 @@ pub(crate) struct FrameParams {
 }
 
 impl FrameParams {
-    pub fn gpu(&self) -> GpuFrame {
-        GpuFrame {
+    pub fn gpu(&self) -> Frame {
+        Frame {
             camera: self.camera.gpu(),
             previous_camera: self.previous_camera.gpu(),
-            environment: self.environment.extend(self.emitter_weight).to_array(),
-            size: [self.width, self.height, self.spp, self.first_sample],
-            seed: [self.seed as u32, (self.seed >> 32) as u32, self.frame, self.max_depth],
-            counts: [self.rr_start_depth, self.analytic_lights, self.emitters, self.accumulate as u32],
+            environment: self.environment.to_array(),
+            emitter_weight: self.emitter_weight,
+            width: self.width,
+            height: self.height,
+            spp: self.spp,
+            first_sample: self.first_sample,
+            seed_lo: self.seed as u32,
+            seed_hi: (self.seed >> 32) as u32,
+            frame: self.frame,
+            max_depth: self.max_depth,
+            rr_start_depth: self.rr_start_depth,
+            analytic_lights: self.analytic_lights,
+            emitters: self.emitters,
+            accumulate: self.accumulate as u32,
         }
     }
 }

@@ -3,6 +3,7 @@
 /// The plain-data scene (its own crate, shared with `sim`).
 pub use ::scene;
 pub mod gpu;
+pub mod gpu_struct;
 pub mod hash_cache;
 pub mod bvh;
 pub mod compute;

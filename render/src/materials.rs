@@ -3,21 +3,23 @@
 
 use crate::error::RenderError;
 use crate::scene::SceneDesc;
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Zeroable;
 
 pub(crate) const NO_TEXTURE: u32 = u32::MAX;
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub(crate) struct GpuMaterial {
-    base_color: [f32; 3],
-    texture_offset: u32,
-    emission: [f32; 3],
-    roughness: f32,
-    metallic: f32,
-    specular: f32,
-    texture_width: u32,
-    texture_height: u32,
+crate::gpu_struct! {
+    /// One scene material as the shaders read it (`materials`, @group(0) binding 1).
+    pub struct GpuMaterial {
+        pub base_color: [f32; 3] => "vec3f",
+        /// First texel in `texels`, NO_TEXTURE if none.
+        pub texture_offset: u32 => "u32",
+        pub emission: [f32; 3] => "vec3f",
+        pub roughness: f32 => "f32",
+        pub metallic: f32 => "f32",
+        pub specular: f32 => "f32",
+        pub texture_width: u32 => "u32",
+        pub texture_height: u32 => "u32",
+    }
 }
 
 const _: () = assert!(size_of::<GpuMaterial>() == 48);

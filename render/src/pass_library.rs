@@ -7,6 +7,9 @@ use std::sync::Mutex;
 
 use crate::bvh::SceneGeometry;
 use crate::compute;
+use crate::frame::{CameraFrame, Frame};
+use crate::gpu_struct::GpuStruct;
+use crate::materials::GpuMaterial;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::scene_bindings::SceneBindings;
@@ -30,6 +33,9 @@ impl PassLibrary {
         static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
         SOURCE.get_or_init(|| {
             [
+                CameraFrame::WGSL,
+                Frame::WGSL,
+                GpuMaterial::WGSL,
                 SceneGeometry::WGSL,
                 include_str!("../shaders/pt_sampling.wgsl"),
                 include_str!("../shaders/pt_bsdf.wgsl"),

@@ -6,7 +6,7 @@
 use crate::bvh::SceneGeometry;
 use crate::compute;
 use crate::error::RenderError;
-use crate::frame::{CameraBasis, FrameParams, GpuFrame};
+use crate::frame::{CameraBasis, Frame, FrameParams};
 use crate::gpu::Gpu;
 use crate::lights::{LightTable, build_light_table};
 use crate::materials::pack_materials;
@@ -60,7 +60,7 @@ impl SceneBindings {
         let lights = storage("lights", bytemuck::cast_slice(&light_table.lights))?;
         let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame uniform"),
-            size: size_of::<GpuFrame>() as u64,
+            size: size_of::<Frame>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });

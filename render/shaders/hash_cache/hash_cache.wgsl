@@ -126,12 +126,12 @@ fn hc_store_record(index: u32, r: HcRecord) {
 
 @compute @workgroup_size(8, 8, 1)
 fn hc_trace(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.size.x || id.y >= frame.size.y {
+    if id.x >= frame.width || id.y >= frame.height {
         return;
     }
-    let index = id.y * frame.size.x + id.x;
-    var rng = rng_seed(frame.seed.xy, frame.seed.z, index, frame.size.w);
-    let origin = frame.camera.position.xyz;
+    let index = id.y * frame.width + id.x;
+    var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, index, frame.first_sample);
+    let origin = frame.camera.position;
     let dir = camera_ray_direction(frame.camera, vec2f(id.xy) + hc.primary_jitter);
     let hit = trace_closest(origin, dir, FAR);
     primary_out[index] = primary_attributes(hit, origin, dir);
@@ -184,7 +184,7 @@ fn hc_trace(@builtin(global_invocation_id) id: vec3u) {
     }
     r.flags = HC_NEEDS_SAMPLE;
     // Voxel jitter, quantised to 16 bits so that the CPU reference sees the same value.
-    var jrng = rng_seed(vec2u(hc.voxel_jitter_seed, frame.seed.y), frame.seed.z, index, 0x7a3du);
+    var jrng = rng_seed(vec2u(hc.voxel_jitter_seed, frame.seed_hi), frame.frame, index, 0x7a3du);
     r.voxel_jitter = pack2x16unorm(rng_next2(&jrng));
     let to_point = r.key_point - origin;
     let distance = length(to_point);
@@ -216,7 +216,7 @@ fn hc_sample(r: HcRecord) -> vec3f {
     let sh = orient(sp, wo);
     let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);
     var l = next_event(sp.position, sh, bsdf, wo, &rng);
-    if r.depth + 1u <= frame.seed.w {
+    if r.depth + 1u <= frame.max_depth {
         let bs = bsdf_sample(bsdf, sh.ns, wo, rng_next(&rng), rng_next2(&rng));
         if bs.valid && dot(bs.wi, sh.ng) > 0.0 {
             let throughput = bs.f * (dot(sh.ns, bs.wi) / bs.pdf);
@@ -233,10 +233,10 @@ fn hc_demodulate(l: vec3f, albedo: vec3f) -> vec3f {
 
 @compute @workgroup_size(8, 8, 1)
 fn hc_update(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.size.x || id.y >= frame.size.y {
+    if id.x >= frame.width || id.y >= frame.height {
         return;
     }
-    let index = id.y * frame.size.x + id.x;
+    let index = id.y * frame.width + id.x;
     let r = records[index];
     if (r.flags & HC_NEEDS_SAMPLE) == 0u {
         return;
@@ -263,10 +263,10 @@ fn hc_update(@builtin(global_invocation_id) id: vec3u) {
 
 @compute @workgroup_size(8, 8, 1)
 fn hc_resolve(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.size.x || id.y >= frame.size.y {
+    if id.x >= frame.width || id.y >= frame.height {
         return;
     }
-    let index = id.y * frame.size.x + id.x;
+    let index = id.y * frame.width + id.x;
     let r = records[index];
     var c = r.direct;
     if (r.flags & HC_NEEDS_SAMPLE) != 0u {

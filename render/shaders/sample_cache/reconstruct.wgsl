@@ -3,15 +3,15 @@
 
 @compute @workgroup_size(8, 8, 1)
 fn reconstruct_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.size.x || id.y >= ssc.size.y {
+    if id.x >= ssc.width || id.y >= ssc.height {
         return;
     }
     let pixels = ssc_pixels();
-    let n = ssc.size.z;
-    let p = id.y * ssc.size.x + id.x;
+    let n = ssc.slots;
+    let p = id.y * ssc.width + id.x;
     let mask = dst_mask[p];
     let vis = ssc_visible_slots(mask);
-    let eye = frame.camera.position.xyz;
+    let eye = frame.camera.position;
     var sum = vec3f(0.0);
     var count = 0.0;
     var closest = 3.0e38;
@@ -34,7 +34,7 @@ fn reconstruct_main(@builtin(global_invocation_id) id: vec3u) {
         } else {
             let now = ssc_surface(slot.hit).position;
             t = length(now - eye);
-            let before = project_offset(frame.previous_camera, ssc_previous_position(slot.hit) - frame.previous_camera.position.xyz);
+            let before = project_offset(frame.previous_camera, ssc_previous_position(slot.hit) - frame.previous_camera.position);
             m = before - project_offset(frame.camera, now - eye);
         }
         if t < closest {
@@ -42,7 +42,7 @@ fn reconstruct_main(@builtin(global_invocation_id) id: vec3u) {
             motion = m;
         }
     }
-    var radiance = frame.environment.xyz;
+    var radiance = frame.environment;
     if count > 0.0 {
         radiance = sum / count;
     }
@@ -54,12 +54,12 @@ fn reconstruct_main(@builtin(global_invocation_id) id: vec3u) {
 // visible that a retrace finds occluded: stale visibility, the ghosting of section 5.
 @compute @workgroup_size(8, 8, 1)
 fn audit_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.size.x || id.y >= ssc.size.y || id.z >= ssc.size.z {
+    if id.x >= ssc.width || id.y >= ssc.height || id.z >= ssc.slots {
         return;
     }
-    let p = id.y * ssc.size.x + id.x;
+    let p = id.y * ssc.width + id.x;
     let mask = dst_mask[p];
-    if ((mask >> (id.z + ssc.size.z)) & 1u) == 0u {
+    if ((mask >> (id.z + ssc.slots)) & 1u) == 0u {
         return;
     }
     if !ssc_verify(dst_slots[id.z * ssc_pixels() + p].hit) {

@@ -7,7 +7,7 @@
 // Candidates: unoccupied slots, and for a visible sample, when none is free, occupied slots whose
 // sample is invisible (it races to set their visibility bit). Returns the slot or NO_HIT.
 fn ssc_try_reserve(pixel: u32, visible: bool) -> u32 {
-    let n = ssc.size.z;
+    let n = ssc.slots;
     let full = ssc_full();
     var m = atomicLoad(&pixel_atomics[SSC_ATOMICS * pixel]);
     loop {
@@ -46,18 +46,18 @@ fn begin_main() {
 
 @compute @workgroup_size(8, 8, 1)
 fn reserve_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.size.x || id.y >= ssc.size.y || id.z >= ssc.size.z {
+    if id.x >= ssc.width || id.y >= ssc.height || id.z >= ssc.slots {
         return;
     }
-    let source = id.y * ssc.size.x + id.x;
+    let source = id.y * ssc.width + id.x;
     let s = id.z;
     let mask = src_mask[source];
     if ((mask >> s) & 1u) == 0u {
         return;
     }
-    let visible = ((mask >> (s + ssc.size.z)) & 1u) != 0u;
+    let visible = ((mask >> (s + ssc.slots)) & 1u) != 0u;
     let slot = src_slots[s * ssc_pixels() + source];
-    let eye = frame.camera.position.xyz;
+    let eye = frame.camera.position;
     var image: vec2f;
     var depth = SSC_BACKGROUND_DEPTH;
     if ssc_is_background(slot.hit) {
@@ -67,13 +67,13 @@ fn reserve_main(@builtin(global_invocation_id) id: vec3u) {
         image = project_offset(frame.camera, p - eye);
         depth = length(p - eye);
     }
-    let size = vec2f(f32(ssc.size.x), f32(ssc.size.y));
+    let size = vec2f(f32(ssc.width), f32(ssc.height));
     if !(all(image >= vec2f(0.0)) && all(image < size)) {
         atomicAdd(&ssc_work[SSC_DROPPED], 1u);
         return;
     }
-    let target_pixel = min(vec2u(image), ssc.size.xy - 1u);
-    let t = target_pixel.y * ssc.size.x + target_pixel.x;
+    let target_pixel = min(vec2u(image), vec2u(ssc.width, ssc.height) - 1u);
+    let t = target_pixel.y * ssc.width + target_pixel.x;
     let i = ssc_try_reserve(t, visible);
     if i == NO_HIT {
         atomicAdd(&ssc_work[SSC_DROPPED], 1u);

@@ -11,31 +11,31 @@ const SSC_JITTER_INSET: f32 = 1.0e-3;
 
 // The 4x4 block's base pixel this frame: the block position visits all b*b pixels in turn.
 fn ssc_is_base_pixel(pixel: vec2u) -> bool {
-    let b = ssc.modes.z;
-    let k = ssc.size.w % (b * b);
+    let b = ssc.base_block;
+    let k = ssc.frame % (b * b);
     return pixel.x % b == k % b && pixel.y % b == k / b;
 }
 
 // Round-robin index of the base sample of a base pixel, among `count` candidates.
 fn ssc_base_index(count: u32) -> u32 {
-    let b = ssc.modes.z;
-    return (ssc.size.w / (b * b)) % max(count, 1u);
+    let b = ssc.base_block;
+    return (ssc.frame / (b * b)) % max(count, 1u);
 }
 
 // Retrace from the eye towards the stored point (a shadow ray, section 3.2): visible when nothing
 // is hit before (1 - ε0) of the way there; a background sample is visible when its ray escapes.
 fn ssc_verify(hit: vec4u) -> bool {
-    let eye = frame.camera.position.xyz;
+    let eye = frame.camera.position;
     if ssc_is_background(hit) {
         return !trace_any(eye, ssc_background_dir(hit), FAR);
     }
     let d = ssc_surface(hit).position - eye;
-    return !trace_any(eye, d, 1.0 - ssc.density.z);
+    return !trace_any(eye, d, 1.0 - ssc.epsilon0);
 }
 
 fn ssc_new_sample(pixel: vec2u, rng: ptr<function, u32>) -> vec4u {
     let jitter = mix(vec2f(SSC_JITTER_INSET), vec2f(1.0 - SSC_JITTER_INSET), rng_next2(rng));
-    let eye = frame.camera.position.xyz;
+    let eye = frame.camera.position;
     let dir = camera_ray_direction(frame.camera, vec2f(pixel) + jitter);
     let hit = trace_closest(eye, dir, FAR);
     if hit.instance == NO_HIT {
@@ -53,7 +53,7 @@ fn ssc_swap_bits(bits: u32, i: u32, j: u32) -> u32 {
 // Log-spaced bucket (M buckets) of importance w between this frame's bounds (last frame's min
 // and max): M - 1 = most important. Degenerate bounds (first frame) put everything in M - 1.
 fn ssc_bucket(w: f32) -> u32 {
-    let m = ssc.modes.w;
+    let m = ssc.buckets;
     let lo = bitcast<f32>(atomicLoad(&ssc_work[SSC_WMIN]));
     let hi = bitcast<f32>(atomicLoad(&ssc_work[SSC_WMAX]));
     if !(lo > 0.0) || !(hi > lo) {
@@ -69,15 +69,15 @@ fn ssc_importance(count: f32) -> f32 {
 
 @compute @workgroup_size(8, 8, 1)
 fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.size.x || id.y >= ssc.size.y {
+    if id.x >= ssc.width || id.y >= ssc.height {
         return;
     }
-    let width = ssc.size.x;
+    let width = ssc.width;
     let pixels = ssc_pixels();
-    let n = ssc.size.z;
+    let n = ssc.slots;
     let p = id.y * width + id.x;
-    let eye = frame.camera.position.xyz;
-    var rng = rng_seed(frame.seed.xy, frame.seed.z, p, 0x55c0u);
+    let eye = frame.camera.position;
+    var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, p, 0x55c0u);
 
     // Gather the reserved slots and sort them into the canonical order (the slots a sample won
     // depend on the race of the reservation; the order of a pixel's samples must not).
@@ -114,7 +114,7 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
     for (var dy = -1; dy <= 1; dy++) {
         for (var dx = -1; dx <= 1; dx++) {
             let q = vec2i(id.xy) + vec2i(dx, dy);
-            if q.x < 0 || q.y < 0 || q.x >= i32(width) || q.y >= i32(ssc.size.y) {
+            if q.x < 0 || q.y < 0 || q.x >= i32(width) || q.y >= i32(ssc.height) {
                 continue;
             }
             let qi = u32(q.y) * width + u32(q.x);
@@ -130,10 +130,10 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
     let all_k = (1u << k) - 1u;
     var trace_set = 0u;
     var flags = 0u;
-    let mode = ssc.modes.x;
+    let mode = ssc.retrace;
     if mode == 0u {
         if k > 0u {
-            trace_set = 1u << (ssc.size.w % k);
+            trace_set = 1u << (ssc.frame % k);
         }
     } else if mode == 1u {
         trace_set = all_k;
@@ -155,14 +155,14 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
                     let sp = ssc_surface(hits[i]);
                     let d = sp.position - eye;
                     t = length(d);
-                    d_n = ssc_slope(t, abs(dot(sp.geometric_normal, d / t)), ssc.shade.z);
+                    d_n = ssc_slope(t, abs(dot(sp.geometric_normal, d / t)), ssc.pixel_diagonal_angle);
                 }
                 if t < t_min {
                     t_min = t;
                     slope = d_n;
                 }
             }
-            if !ssc_consistent(t_min, bitcast<f32>(t_max_bits), slope, ssc.density.w) {
+            if !ssc_consistent(t_min, bitcast<f32>(t_max_bits), slope, ssc.epsilon1) {
                 flags |= SSC_FLAG_SLOPE;
             }
         }
@@ -180,8 +180,8 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
     // visible count to n_target (at least one sample either way): purge randomly, never the last
     // visible sample, or plan new samples. A pixel above n_target + δ purges even inside a
     // tolerable neighbourhood (twin of density.rs, which says why).
-    let n_target = ssc.density.x;
-    let delta = ssc.density.y;
+    let n_target = ssc.n_target;
+    let delta = ssc.delta;
     var alive = all_k;
     var to_add = 0u;
     var purged = 0u;
@@ -239,11 +239,11 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
 // 3. Retrace one queued sample: its result goes to the pixel's third atomic word.
 @compute @workgroup_size(8, 8, 1)
 fn retrace_list_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.size.x || id.y >= ssc.size.y || id.z >= ssc.size.z {
+    if id.x >= ssc.width || id.y >= ssc.height || id.z >= ssc.slots {
         return;
     }
     let pixels = ssc_pixels();
-    let index = id.z * pixels + id.y * ssc.size.x + id.x;
+    let index = id.z * pixels + id.y * ssc.width + id.x;
     if index >= atomicLoad(&ssc_work[SSC_RETRACE_COUNT]) {
         return;
     }
@@ -259,13 +259,13 @@ fn retrace_list_main(@builtin(global_invocation_id) id: vec3u) {
 // add the samples the density control asked for, write the final mask and the histogram.
 @compute @workgroup_size(8, 8, 1)
 fn finish_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.size.x || id.y >= ssc.size.y {
+    if id.x >= ssc.width || id.y >= ssc.height {
         return;
     }
     let pixels = ssc_pixels();
-    let n = ssc.size.z;
-    let p = id.y * ssc.size.x + id.x;
-    var rng = rng_seed(frame.seed.xy, frame.seed.z, p, 0x55c1u);
+    let n = ssc.slots;
+    let p = id.y * ssc.width + id.x;
+    var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, p, 0x55c1u);
     let provisional = dst_mask[p];
     var kf = countOneBits(provisional & ssc_full());
     let results = atomicLoad(&pixel_atomics[SSC_ATOMICS * p + 2u]);
@@ -306,7 +306,7 @@ fn finish_main(@builtin(global_invocation_id) id: vec3u) {
 
     // Adaptive shading: histogram of the importance of every visible sample that the base rate
     // does not already shade.
-    if ssc.modes.y == 1u {
+    if ssc.shading == 1u {
         let nv = countOneBits(out_vis);
         var base = NO_HIT;
         if ssc_is_base_pixel(id.xy) && nv > 0u {

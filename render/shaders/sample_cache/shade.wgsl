@@ -4,7 +4,7 @@
 // factor α once c_s >= 1/α - 1 (the paper's temporal filter, α = 0.1; α = 0 keeps the mean).
 
 fn ssc_shade(hit: vec4u, rng: ptr<function, u32>) -> vec3f {
-    let eye = frame.camera.position.xyz;
+    let eye = frame.camera.position;
     if ssc_is_background(hit) {
         return escaped_radiance(ssc_background_dir(hit), 0.0);
     }
@@ -20,11 +20,11 @@ fn ssc_shade(hit: vec4u, rng: ptr<function, u32>) -> vec3f {
     radiance += next_event(sp.position, sh, bsdf, wo, rng);
     // Continue as path_radiance does after its camera-ray vertex.
     let bs = bsdf_sample(bsdf, sh.ns, wo, rng_next(rng), rng_next2(rng));
-    if !bs.valid || dot(bs.wi, sh.ng) <= 0.0 || frame.seed.w == 0u {
+    if !bs.valid || dot(bs.wi, sh.ng) <= 0.0 || frame.max_depth == 0u {
         return radiance;
     }
     var throughput = bs.f * (dot(sh.ns, bs.wi) / bs.pdf);
-    if 1u >= frame.counts.x {
+    if 1u >= frame.rr_start_depth {
         let survive = min(max_component(throughput), 0.95);
         if rng_next(rng) >= survive {
             return radiance;
@@ -36,21 +36,21 @@ fn ssc_shade(hit: vec4u, rng: ptr<function, u32>) -> vec3f {
 
 @compute @workgroup_size(8, 8, 1)
 fn shade_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.size.x || id.y >= ssc.size.y || id.z >= ssc.size.z {
+    if id.x >= ssc.width || id.y >= ssc.height || id.z >= ssc.slots {
         return;
     }
     let pixels = ssc_pixels();
-    let index = id.z * pixels + id.y * ssc.size.x + id.x;
+    let index = id.z * pixels + id.y * ssc.width + id.x;
     if index >= atomicLoad(&ssc_work[SSC_SHADE_COUNT]) {
         return;
     }
     let entry = atomicLoad(&ssc_work[SSC_LIST + index]);
     let slot = dst_slots[entry];
     // Seeded by (pixel, slot): the list order (atomics) does not change any result.
-    var rng = rng_seed(frame.seed.xy, frame.seed.z, entry % pixels, 0x5a00u + entry / pixels);
+    var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, entry % pixels, 0x5a00u + entry / pixels);
     let l = ssc_shade(slot.hit, &rng);
     atomicAdd(&ssc_work[SSC_ALL_RAYS], sg_rays_traced);
     let c = slot.radiance.w;
-    let a = max(1.0 / (c + 1.0), ssc.shade.x);
+    let a = max(1.0 / (c + 1.0), ssc.alpha);
     dst_slots[entry].radiance = vec4f(mix(slot.radiance.rgb, l, a), c + 1.0);
 }

@@ -8,8 +8,8 @@
 // (twin of sample_cache/shading_rate.rs `threshold`).
 @compute @workgroup_size(1, 1, 1)
 fn rates_main() {
-    let m = ssc.modes.w;
-    let budget = max(ssc.shade.y - f32(atomicLoad(&ssc_work[SSC_BASE])), 0.0);
+    let m = ssc.buckets;
+    let budget = max(ssc.shading_budget - f32(atomicLoad(&ssc_work[SSC_BASE])), 0.0);
     var above = 0.0;
     var threshold = 0u;
     var coin = 1.0;
@@ -34,20 +34,20 @@ fn ssc_push_shade(entry: u32) {
 
 @compute @workgroup_size(8, 8, 1)
 fn select_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.size.x || id.y >= ssc.size.y {
+    if id.x >= ssc.width || id.y >= ssc.height {
         return;
     }
     let pixels = ssc_pixels();
-    let n = ssc.size.z;
-    let p = id.y * ssc.size.x + id.x;
+    let n = ssc.slots;
+    let p = id.y * ssc.width + id.x;
     let mask = dst_mask[p];
     let vis = ssc_visible_slots(mask);
     let nv = countOneBits(vis);
     if nv == 0u {
         return;
     }
-    if ssc.modes.y == 0u {
-        var chosen = ssc_nth_bit(vis, ssc.size.w % nv);
+    if ssc.shading == 0u {
+        var chosen = ssc_nth_bit(vis, ssc.frame % nv);
         for (var s = 0u; s < n; s++) {
             if ((vis >> s) & 1u) != 0u && dst_slots[s * pixels + p].radiance.w == 0.0 {
                 chosen = s;
@@ -64,7 +64,7 @@ fn select_main(@builtin(global_invocation_id) id: vec3u) {
     }
     let threshold = atomicLoad(&ssc_work[SSC_THRESHOLD]);
     let coin = bitcast<f32>(atomicLoad(&ssc_work[SSC_COIN]));
-    var rng = rng_seed(frame.seed.xy, frame.seed.z, p, 0x5e1eu);
+    var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, p, 0x5e1eu);
     for (var s = 0u; s < n; s++) {
         if ((vis >> s) & 1u) == 0u || s == base {
             continue;

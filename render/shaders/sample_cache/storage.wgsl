@@ -16,13 +16,6 @@ const SSC_ATOMICS: u32 = 3u;
 // Depth of a background sample in the slope test (finite: the test multiplies it).
 const SSC_BACKGROUND_DEPTH: f32 = 1.0e30;
 
-struct SscParams {
-    size: vec4u,      // width, height, slots N, frame
-    modes: vec4u,     // retrace (0 single, 1 multi, 2 adaptive), shading (0 uniform, 1 adaptive), base block side, buckets M
-    density: vec4f,   // n_target, delta, epsilon0, epsilon1
-    shade: vec4f,     // alpha (minimum blend weight), dynamic shading budget (samples), phi (pixel diagonal angle), unused
-}
-
 struct SscSlot {
     hit: vec4u,
     radiance: vec4f,  // rgb: accumulated radiance L_s, w: sample count c_s
@@ -76,16 +69,16 @@ const SSC_FLAG_HOLE: u32 = 4u;
 @group(2) @binding(7) var<storage, read_write> ssc_out: array<SscPixel>;
 
 fn ssc_pixels() -> u32 {
-    return ssc.size.x * ssc.size.y;
+    return ssc.width * ssc.height;
 }
 
 fn ssc_full() -> u32 {
-    return (1u << ssc.size.z) - 1u;
+    return (1u << ssc.slots) - 1u;
 }
 
 // Slots of a mask that are visible (visibility bits n..2n) and occupied (bits 0..n).
 fn ssc_visible_slots(mask: u32) -> u32 {
-    return (mask >> ssc.size.z) & mask & ssc_full();
+    return (mask >> ssc.slots) & mask & ssc_full();
 }
 
 fn ssc_is_background(hit: vec4u) -> bool {

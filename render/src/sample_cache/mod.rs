@@ -29,6 +29,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::error::RenderError;
 use crate::gpu::Gpu;
+use crate::gpu_struct::GpuStruct;
 use crate::path_tracer::PathTracer;
 use crate::readback::read_buffer;
 use crate::timing::{PassTimer, PassTiming};
@@ -70,6 +71,7 @@ pub fn shader_source() -> &'static str {
     SOURCE.get_or_init(|| {
         [
             PathTracer::library_source(),
+            SscParams::WGSL,
             include_str!("../../shaders/sample_cache/storage.wgsl"),
             include_str!("../../shaders/sample_cache/slope.wgsl"),
             include_str!("../../shaders/sample_cache/reproject.wgsl"),
@@ -82,13 +84,34 @@ pub fn shader_source() -> &'static str {
     })
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct GpuParams {
-    size: [u32; 4],
-    modes: [u32; 4],
-    density: [f32; 4],
-    shade: [f32; 4],
+crate::gpu_struct! {
+    /// The cache's uniform (`ssc`, @group(2) binding 0).
+    pub struct SscParams {
+        pub width: u32 => "u32",
+        pub height: u32 => "u32",
+        /// N, slots per pixel.
+        pub slots: u32 => "u32",
+        pub frame: u32 => "u32",
+        /// 0 single, 1 multi, 2 adaptive.
+        pub retrace: u32 => "u32",
+        /// 0 uniform, 1 adaptive.
+        pub shading: u32 => "u32",
+        /// Side of the base-rate block, pixels.
+        pub base_block: u32 => "u32",
+        /// M, buckets of the importance histogram.
+        pub buckets: u32 => "u32",
+        pub n_target: f32 => "f32",
+        pub delta: f32 => "f32",
+        pub epsilon0: f32 => "f32",
+        pub epsilon1: f32 => "f32",
+        /// Minimum blend weight.
+        pub alpha: f32 => "f32",
+        /// Dynamic shading budget, samples.
+        pub shading_budget: f32 => "f32",
+        /// φ, the angle of a pixel's diagonal.
+        pub pixel_diagonal_angle: f32 => "f32",
+        pub pad: f32 => "f32",
+    }
 }
 
 #[repr(C)]
@@ -216,7 +239,7 @@ impl SampleCache {
         let out = buffer("ssc out", pixels * 32, rw)?;
         let out_readback = buffer("ssc out readback", pixels * 32, readback)?;
         let header_readback = buffer("ssc header readback", HEADER_WORDS * 4, readback)?;
-        let params = buffer("ssc params", size_of::<GpuParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)?;
+        let params = buffer("ssc params", size_of::<SscParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)?;
 
         let (layout, [begin, reserve, retrace, retrace_list, finish, rates, select, shade, reconstruct, audit]) = tracer.library_pass(
             gpu,
@@ -288,23 +311,30 @@ impl SampleCache {
         if stage == 0 {
             let vfov = 2.0 * tracer_tan_half_fov(tracer).atan();
             let pixels = w * h;
-            let params = GpuParams {
-                size: [w, h, s.slots, frame],
-                modes: [
-                    match s.retrace {
-                        Retrace::Single => 0,
-                        Retrace::Multi => 1,
-                        Retrace::Adaptive => 2,
-                    },
-                    match s.shading {
-                        ShadingMode::Uniform => 0,
-                        ShadingMode::Adaptive => 1,
-                    },
-                    s.base_block,
-                    s.buckets,
-                ],
-                density: [s.n_target, s.delta, s.epsilon0, s.epsilon1],
-                shade: [s.alpha, s.shading_rate * pixels as f32, slope::pixel_diagonal_angle(vfov, h), 0.0],
+            let params = SscParams {
+                width: w,
+                height: h,
+                slots: s.slots,
+                frame,
+                retrace: match s.retrace {
+                    Retrace::Single => 0,
+                    Retrace::Multi => 1,
+                    Retrace::Adaptive => 2,
+                },
+                shading: match s.shading {
+                    ShadingMode::Uniform => 0,
+                    ShadingMode::Adaptive => 1,
+                },
+                base_block: s.base_block,
+                buckets: s.buckets,
+                n_target: s.n_target,
+                delta: s.delta,
+                epsilon0: s.epsilon0,
+                epsilon1: s.epsilon1,
+                alpha: s.alpha,
+                shading_budget: s.shading_rate * pixels as f32,
+                pixel_diagonal_angle: slope::pixel_diagonal_angle(vfov, h),
+                pad: 0.0,
             };
             gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         }

@@ -35,6 +35,7 @@ pub mod resolve_cpu;
 
 use crate::error::RenderError;
 use crate::gpu::Gpu;
+use crate::gpu_struct::GpuStruct;
 use crate::path_tracer::PathTracer;
 use crate::readback::read_buffer;
 use crate::timing::{PassTimer, PassTiming};
@@ -121,20 +122,28 @@ impl TaaSettings {
     }
 }
 
-/// WGSL `TaaParams`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub(crate) struct TaaParams {
-    pub jitter: [f32; 2],
-    pub alpha: f32,
-    pub gamma: f32,
-    pub size: [u32; 2],
-    pub clamp_mode: u32,
-    pub history_valid: u32,
-    pub depth_tolerance: f32,
-    pub normal_threshold: f32,
-    pub max_history: f32,
-    pub pad: f32,
+crate::gpu_struct! {
+    /// TAA's uniform, shared by its trace and resolve passes (and the hash cache's).
+    pub struct TaaParams {
+        /// Position of the primary ray inside its pixel, [0, 1)^2.
+        pub jitter: [f32; 2] => "vec2f",
+        /// Exponential blend weight of the current frame.
+        pub alpha: f32 => "f32",
+        /// Variance clipping: box = mean +- gamma * sigma.
+        pub gamma: f32 => "f32",
+        pub size: [u32; 2] => "vec2u",
+        /// 0 none, 1 min/max, 2 variance clipping.
+        pub clamp_mode: u32 => "u32",
+        /// 0 on the first frame: everything is rejected.
+        pub history_valid: u32 => "u32",
+        /// Relative.
+        pub depth_tolerance: f32 => "f32",
+        /// Minimum cosine between current and history normals.
+        pub normal_threshold: f32 => "f32",
+        /// Cap of the history length (frames).
+        pub max_history: f32 => "f32",
+        pub pad: f32 => "f32",
+    }
 }
 
 /// WGSL `TaaPrimary`: attributes of a jittered sample's primary hit.
@@ -230,7 +239,7 @@ impl Taa {
         let write = wgpu::BufferBindingType::Storage { read_only: false };
         let (trace_layout, [trace_pipeline]) = tracer.library_pass(gpu, "taa_trace.wgsl", Self::trace_source(), &[uniform, write, write, write], ["taa_trace"])?;
         let resolve_layout = crate::compute::buffer_layout(gpu, "taa resolve", &[uniform, read, read, read, read, write]);
-        let [resolve_pipeline] = crate::compute::pipelines(gpu, "taa_resolve.wgsl", include_str!("../../shaders/taa_resolve.wgsl"), &[&resolve_layout], ["taa_resolve"])?;
+        let [resolve_pipeline] = crate::compute::pipelines(gpu, "taa_resolve.wgsl", &Self::resolve_source(), &[&resolve_layout], ["taa_resolve"])?;
         let resolve_group = |p: usize| {
             let q = 1 - p;
             crate::compute::buffer_group(gpu, "taa resolve", &resolve_layout, &[&params, &current, &primary[p], &primary[q], &history[q], &history[p]])
@@ -257,10 +266,15 @@ impl Taa {
         })
     }
 
+    /// The resolve pass's complete WGSL (TaaParams + taa_resolve.wgsl).
+    fn resolve_source() -> String {
+        [TaaParams::WGSL, include_str!("../../shaders/taa_resolve.wgsl")].join("\n")
+    }
+
     /// The trace pass's complete WGSL (shading library + taa_trace.wgsl).
     pub fn trace_source() -> &'static str {
         static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-        SOURCE.get_or_init(|| [PathTracer::library_source(), PRIMARY_WGSL, include_str!("../../shaders/taa_trace.wgsl")].join("\n"))
+        SOURCE.get_or_init(|| [PathTracer::library_source(), TaaParams::WGSL, PRIMARY_WGSL, include_str!("../../shaders/taa_trace.wgsl")].join("\n"))
     }
 
     pub fn settings(&self) -> TaaSettings {

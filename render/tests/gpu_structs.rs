@@ -1,0 +1,74 @@
+//! Every struct shared by Rust and WGSL (gpu_struct!) has each field at the same byte offset and
+//! the same size on both sides, as naga lays the WGSL declaration out.
+
+use render::frame::{CameraFrame, Frame};
+use render::gpu_struct::GpuStruct;
+use render::materials::GpuMaterial;
+use render::sample_cache::SscParams;
+use render::taa::TaaParams;
+
+/// The differences between `T`'s Rust layout and its WGSL declaration's (after `deps`, the
+/// declarations it uses).
+fn mismatches<T: GpuStruct>(deps: &str) -> Vec<String> {
+    let source = format!("{deps}\n{}", T::WGSL);
+    let module = naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{}\n{source}", e.emit_to_string(&source)));
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).expect("layout");
+    let name = T::WGSL.split_whitespace().nth(1).expect("struct NAME");
+    let (_, ty) = module.types.iter().find(|(_, t)| t.name.as_deref() == Some(name)).unwrap_or_else(|| panic!("{name} not declared"));
+    let naga::TypeInner::Struct { members, span } = &ty.inner else { panic!("{name} is not a struct") };
+    let rust = T::offsets();
+    let mut out = Vec::new();
+    if members.len() != rust.len() {
+        out.push(format!("{name}: {} WGSL fields, {} Rust fields", members.len(), rust.len()));
+    }
+    for (m, (field, offset)) in members.iter().zip(&rust) {
+        if m.name.as_deref() != Some(*field) || m.offset as usize != *offset {
+            out.push(format!("{name}.{field}: Rust offset {offset}, WGSL {:?} at {}", m.name, m.offset));
+        }
+    }
+    if *span as usize != size_of::<T>() {
+        out.push(format!("{name}: Rust size {}, WGSL {span}", size_of::<T>()));
+    }
+    out
+}
+
+#[test]
+fn shared_structs_have_one_layout() {
+    let camera = CameraFrame::WGSL;
+    for (name, found) in [
+        ("CameraFrame", mismatches::<CameraFrame>("")),
+        ("Frame", mismatches::<Frame>(camera)),
+        ("GpuMaterial", mismatches::<GpuMaterial>("")),
+        ("TaaParams", mismatches::<TaaParams>("")),
+        ("SscParams", mismatches::<SscParams>("")),
+    ] {
+        assert!(found.is_empty(), "{name}: {found:?}");
+    }
+}
+
+render::gpu_struct! {
+    /// WGSL aligns vec3f to 16 bytes, Rust's [f32; 3] to 4: `b` sits at 16 there, 12 here.
+    struct Misaligned {
+        a: [f32; 3] => "vec3f",
+        b: [f32; 3] => "vec3f",
+    }
+}
+
+#[test]
+fn a_layout_mismatch_is_found() {
+    let found = mismatches::<Misaligned>("");
+    assert!(found.iter().any(|m| m.contains("Misaligned.b") && m.contains("offset 12")), "{found:?}");
+    let _ = Misaligned { a: [0.0; 3], b: [0.0; 3] };
+}
+
+#[test]
+fn declarations_name_every_field() {
+    assert_eq!(
+        Frame::WGSL.lines().filter(|l| l.trim_end().ends_with(',')).count(),
+        Frame::offsets().len(),
+        "{}",
+        Frame::WGSL
+    );
+    assert!(Frame::WGSL.contains("    max_depth: u32,") && Frame::WGSL.contains("    rr_start_depth: u32,"));
+}
