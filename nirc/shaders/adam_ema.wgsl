@@ -1,7 +1,9 @@
 // Training pass 3: Adam on every parameter, then the debiased EMA
 // w̄_t = (α w̄_{t-1} (1 - α^{t-1}) + (1 - α) w_t) / (1 - α^t) (CPU mirror: src/cpu/optimizer.rs).
 // `check` computes every update without writing and raises the flag on any non-finite value;
-// `apply` recomputes and writes only if no pass raised it, so a bad step leaves no trace.
+// `apply` recomputes and writes the Adam step (w, m, v) only if no pass raised it, and `ema`
+// then moves the EMA towards the new weights (its own dispatch, the frame's `nirc::ema`
+// system); a bad step leaves no trace.
 
 @group(0) @binding(0) var<uniform> call: Call;
 @group(0) @binding(1) var<uniform> hyper: Hyper;
@@ -31,7 +33,6 @@ fn update(i: u32) -> Update {
     }
     let b1t = counters.beta1_pow * hyper.beta1;
     let b2t = counters.beta2_pow * hyper.beta2;
-    let at = counters.alpha_pow * hyper.alpha;
     let m1 = hyper.beta1 * adam_m[i] + (1.0 - hyper.beta1) * g;
     let v1 = hyper.beta2 * adam_v[i] + (1.0 - hyper.beta2) * (g * g);
     let m_hat = m1 / (1.0 - b1t);
@@ -39,12 +40,18 @@ fn update(i: u32) -> Update {
     let w1 = params[i] - hyper.learning_rate * m_hat / (sqrt(v_hat) + hyper.adam_epsilon);
     // Debiased EMA as the convex combination w̄ + β_t (w - w̄), β_t = (1 - α) / (1 - α^t)
     // (same as the notes' formula, exact on constants); at t = 1 it is w_1.
+    return Update(w1, m1, v1, ema_of(i, w1), g);
+}
+
+/// The EMA of parameter `i` once the weights are `w1`.
+fn ema_of(i: u32, w1: f32) -> f32 {
     var e1 = w1;
     if counters.alpha_pow != 1.0 {
+        let at = counters.alpha_pow * hyper.alpha;
         let beta = (1.0 - hyper.alpha) / (1.0 - at);
         e1 = ema[i] + beta * (w1 - ema[i]);
     }
-    return Update(w1, m1, v1, e1, g);
+    return e1;
 }
 
 @compute @workgroup_size(64)
@@ -69,6 +76,15 @@ fn apply(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups)
         params[i] = u.w;
         adam_m[i] = u.m;
         adam_v[i] = u.v;
-        ema[i] = u.e;
+    }
+}
+
+@compute @workgroup_size(64)
+fn ema_update(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    if atomicLoad(&counters.flag) != 0u {
+        return;
+    }
+    for (var i = gid.x; i < TOTAL_PARAMS; i += groups.x * 64u) {
+        ema[i] = ema_of(i, params[i]);
     }
 }

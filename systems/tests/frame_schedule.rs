@@ -63,7 +63,7 @@ fn every_method_system_runs_in_its_stage_in_order() {
     ] {
         assert!(render.contains(&name.to_string()), "{name} not in Render: {render:?}");
     }
-    assert_eq!(in_stage(&l, Stage::Learn), ["nirc::reliability", "nirc::train", "nirc::frame_output"]);
+    assert_eq!(in_stage(&l, Stage::Learn), ["nirc::reliability", "nirc::train", "nirc::ema", "nirc::reliability_update", "nirc::frame_output"]);
     assert_eq!(in_stage(&l, Stage::Measure), ["measure::prepare", "measure::smape_vs_previous", "measure::flip_vs_reference", "measure::regions"]);
     assert_eq!(in_stage(&l, Stage::Record), ["record::write_reference", "record::write_method_images", "record::write_frames_csv", "record::end_frame"]);
 
@@ -76,6 +76,8 @@ fn every_method_system_runs_in_its_stage_in_order() {
         ("hash_cache::age_and_update", "hash_cache::resolve"),
         ("nirc::camera_paths", "nirc::infer"),
         ("nirc::infer", "nirc::train"),
+        ("nirc::train", "nirc::ema"),
+        ("nirc::ema", "nirc::reliability_update"),
     ] {
         assert!(position(&l, pair.0) < position(&l, pair.1), "{} should run before {}", pair.0, pair.1);
     }

@@ -6,8 +6,8 @@
 //!                            exact fixed-point sums; reliability samples (y, f_cur, f_ema)
 //! 2. reliability_accumulate  per sample: fixed-point sums per reliability cell
 //! 3. weight_gradient         per weight and chunk of records, then over chunks (no atomics)
-//! 4. adam_ema check, apply   Adam + debiased EMA; any non-finite value raises a flag and
-//!                            nothing is written
+//! 4. adam_ema check, apply   Adam; any non-finite value raises a flag and nothing is written
+//!    adam_ema ema_update     debiased EMA of the new weights (skipped on a flagged step)
 //! 5. reliability_update      per cell: EMA of the moments towards the batch means
 //! 6. finish_step             commit the counters, or count the rolled-back step
 //! Every sum has a fixed order or is exact, so a step is deterministic.
@@ -70,6 +70,7 @@ struct Pipelines {
     weight_reduce: wgpu::ComputePipeline,
     adam_check: wgpu::ComputePipeline,
     adam_apply: wgpu::ComputePipeline,
+    ema_update: wgpu::ComputePipeline,
     reliability_accumulate: wgpu::ComputePipeline,
     reliability_update: wgpu::ComputePipeline,
     finish_step: wgpu::ComputePipeline,
@@ -93,8 +94,8 @@ struct Buffers {
     counters: wgpu::Buffer,
 }
 
-/// The bind groups of one training step.
-struct TrainStep {
+/// The bind groups of one training step ([`NeuralCache::prepare_step`]).
+pub struct TrainStep {
     n: u32,
     num_chunks: u32,
     fb: wgpu::BindGroup,
@@ -103,6 +104,7 @@ struct TrainStep {
     reduce: wgpu::BindGroup,
     check: wgpu::BindGroup,
     apply: wgpu::BindGroup,
+    ema: wgpu::BindGroup,
     finish: wgpu::BindGroup,
 }
 
@@ -221,18 +223,20 @@ impl NeuralCache {
             Ok(match entries {
                 [a] => render::compute::pipelines_auto_layout(gpu, &label, &source, [*a])?.to_vec(),
                 [a, b] => render::compute::pipelines_auto_layout(gpu, &label, &source, [*a, *b])?.to_vec(),
-                _ => unreachable!("one or two entry points per module"),
+                [a, b, c] => render::compute::pipelines_auto_layout(gpu, &label, &source, [*a, *b, *c])?.to_vec(),
+                _ => unreachable!("one to three entry points per module"),
             })
         };
         let one = |pass: &str| -> Result<wgpu::ComputePipeline, NircError> { Ok(build(pass, &["main"])?.remove(0)) };
         let [weight_partial, weight_reduce] = <[wgpu::ComputePipeline; 2]>::try_from(build("weight_gradient", &["partial_sums", "reduce"])?).expect("two pipelines");
-        let [adam_check, adam_apply] = <[wgpu::ComputePipeline; 2]>::try_from(build("adam_ema", &["check", "apply"])?).expect("two pipelines");
+        let [adam_check, adam_apply, ema_update] = <[wgpu::ComputePipeline; 3]>::try_from(build("adam_ema", &["check", "apply", "ema_update"])?).expect("three pipelines");
         Ok(Pipelines {
             train_forward_backward: one("train_forward_backward")?,
             weight_partial,
             weight_reduce,
             adam_check,
             adam_apply,
+            ema_update,
             reliability_accumulate: one("reliability_accumulate")?,
             reliability_update: one("reliability_update")?,
             finish_step: one("finish_step")?,
@@ -333,26 +337,23 @@ impl NeuralCache {
     }
 
     /// Records one training step into the caller's encoder (e.g. after the path tracer's pass
-    /// that wrote `records`). Steps recorded in order run in order.
+    /// that wrote `records`): Adam, the EMA of the weights, the reliability grid, the step's
+    /// commit. Steps recorded in order run in order.
     pub fn encode_train(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, records: &wgpu::Buffer, n: u32) -> Result<(), NircError> {
-        let Some(step) = self.train_step(gpu, records, n)? else { return Ok(()) };
-        self.clear_train(encoder);
+        let Some(step) = self.prepare_step(gpu, records, n)? else { return Ok(()) };
+        self.clear_step(encoder);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc train"), timestamp_writes: None });
-        self.dispatch_train(&mut pass, &step);
+        self.dispatch_adam(&mut pass, &step);
+        self.dispatch_ema(&mut pass, &step);
+        self.dispatch_reliability(&mut pass, &step);
         Ok(())
     }
 
-    /// [`Self::encode_train`] as pass `index` of a timed frame (GPU timestamps where the
-    /// adapter has them).
-    pub fn train_timed(&self, gpu: &Gpu, timed: &mut TimedFrame, index: usize, records: &wgpu::Buffer, n: u32) -> Result<(), NircError> {
-        let Some(step) = self.train_step(gpu, records, n)? else { return Ok(()) };
-        self.clear_train(timed.encoder());
-        timed.pass(index, |pass| self.dispatch_train(pass, &step))?;
-        Ok(())
-    }
-
-    /// The bind groups and sizes of one training step on `n` records; `None` for no records.
-    fn train_step(&self, gpu: &Gpu, records: &wgpu::Buffer, n: u32) -> Result<Option<TrainStep>, NircError> {
+    /// The bind groups and sizes of one training step on the first `n` of `records`; `None` for
+    /// no records. Then [`Self::adam_timed`], [`Self::ema_timed`], [`Self::reliability_timed`]
+    /// in this order, each its own pass (the frame's `nirc::train`, `nirc::ema` and
+    /// `nirc::reliability_update` systems).
+    pub fn prepare_step(&self, gpu: &Gpu, records: &wgpu::Buffer, n: u32) -> Result<Option<TrainStep>, NircError> {
         if n == 0 {
             return Ok(None);
         }
@@ -377,16 +378,38 @@ impl NeuralCache {
             &[(0, &call), (1, &b.hyper), (2, &b.params), (3, &b.ema), (4, &b.adam_m), (5, &b.adam_v), (6, &b.grad), (7, &b.grid_accum), (8, &b.counters)];
         let check = bind(gpu, "nirc adam check", &p.adam_check, adam_entries);
         let apply = bind(gpu, "nirc adam apply", &p.adam_apply, adam_entries);
+        let ema = bind(gpu, "nirc ema update", &p.ema_update, &[(1, &b.hyper), (2, &b.params), (3, &b.ema), (8, &b.counters)]);
         let finish = bind(gpu, "nirc finish", &p.finish_step, &[(0, &call), (1, &b.hyper), (2, &b.counters)]);
-        Ok(Some(TrainStep { n, num_chunks, fb, accumulate, partial, reduce, check, apply, finish }))
+        Ok(Some(TrainStep { n, num_chunks, fb, accumulate, partial, reduce, check, apply, ema, finish }))
     }
 
-    fn clear_train(&self, encoder: &mut wgpu::CommandEncoder) {
+    /// Forward and backward passes, gradients and the Adam step of the High-LR weights (with the
+    /// step's reliability samples accumulated), as pass `index` of a timed frame.
+    pub fn adam_timed(&self, timed: &mut TimedFrame, index: usize, step: &TrainStep) -> Result<(), NircError> {
+        self.clear_step(timed.encoder());
+        timed.pass(index, |pass| self.dispatch_adam(pass, step))?;
+        Ok(())
+    }
+
+    /// The debiased EMA of the weights after the Adam step, as pass `index` of a timed frame.
+    pub fn ema_timed(&self, timed: &mut TimedFrame, index: usize, step: &TrainStep) -> Result<(), NircError> {
+        timed.pass(index, |pass| self.dispatch_ema(pass, step))?;
+        Ok(())
+    }
+
+    /// The reliability grid's moments from the step's samples, then the step's commit (or
+    /// roll-back count), as pass `index` of a timed frame.
+    pub fn reliability_timed(&self, timed: &mut TimedFrame, index: usize, step: &TrainStep) -> Result<(), NircError> {
+        timed.pass(index, |pass| self.dispatch_reliability(pass, step))?;
+        Ok(())
+    }
+
+    fn clear_step(&self, encoder: &mut wgpu::CommandEncoder) {
         encoder.clear_buffer(&self.buffers.grid_accum, 0, None);
         encoder.clear_buffer(&self.buffers.reliability_accum, 0, None);
     }
 
-    fn dispatch_train(&self, pass: &mut wgpu::ComputePass, s: &TrainStep) {
+    fn dispatch_adam(&self, pass: &mut wgpu::ComputePass, s: &TrainStep) {
         let p = &self.pipelines;
         dispatch(pass, &p.train_forward_backward, &s.fb, s.n.div_ceil(WORKGROUP_SIZE));
         dispatch(pass, &p.reliability_accumulate, &s.accumulate, groups_for(s.n as u64));
@@ -395,6 +418,14 @@ impl NeuralCache {
         let all = groups_for(self.layout.total_params as u64);
         dispatch(pass, &p.adam_check, &s.check, all);
         dispatch(pass, &p.adam_apply, &s.apply, all);
+    }
+
+    fn dispatch_ema(&self, pass: &mut wgpu::ComputePass, s: &TrainStep) {
+        dispatch(pass, &self.pipelines.ema_update, &s.ema, groups_for(self.layout.total_params as u64));
+    }
+
+    fn dispatch_reliability(&self, pass: &mut wgpu::ComputePass, s: &TrainStep) {
+        let p = &self.pipelines;
         dispatch(pass, &p.reliability_update, &self.groups.reliability_update, groups_for(cell_count(&self.config.reliability) as u64));
         dispatch(pass, &p.finish_step, &s.finish, 1);
     }

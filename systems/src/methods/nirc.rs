@@ -7,14 +7,17 @@
 //! Render  `camera_paths`  camera paths up to the termination vertex -> queries, motion
 //!         `infer`         per predictor mode: cache inference + resolve into an image
 //! Learn   `reliability`   reliability grid at this frame's queries (before training)
-//!         `train`         training records from a seeded subset of the queries, one training
-//!                         step: Adam on the High-LR weights, then their EMA (one pass today)
+//!         `train`         training records from a seeded subset of the queries, one Adam
+//!                         step on the High-LR weights
+//!         `ema`           the debiased EMA of the weights after the step
+//!         `reliability_update`  the reliability grid's moments from the step's samples, the
+//!                         step's commit, loss and rejected steps
 //!         `frame_output`  each method's frame: image, motion, pass times, statistics
 //!
 //! Inference uses the cache as trained up to the previous frame (NRC's order). Pass times come
 //! from render::timing::PassTimer (GPU timestamps where the adapter has them): nirc_paths,
-//! nirc_infer and nirc_resolve (the method's own), nirc_records and nirc_train (shared: every
-//! mode reports them, as each would pay them alone).
+//! nirc_infer and nirc_resolve (the method's own), nirc_records, nirc_train, nirc_ema and
+//! nirc_reliability (shared: every mode reports them, as each would pay them alone).
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -84,8 +87,13 @@ pub struct NircCache {
     paths_timer: PassTimer,
     infer_timer: PassTimer,
     train_timer: PassTimer,
+    ema_timer: PassTimer,
+    reliability_timer: PassTimer,
     paths_times: Vec<PassTiming>,
+    /// nirc_records, nirc_train, nirc_ema, nirc_reliability of this frame.
     train_times: Vec<PassTiming>,
+    /// This frame's training step, from `train` to `reliability_update`.
+    step: Option<nirc::gpu::TrainStep>,
     stats: Vec<(String, f64)>,
     /// Motion vectors of the frame's pixel-centre primary hits (shared by every mode).
     motion: Vec<[f32; 2]>,
@@ -125,7 +133,7 @@ impl MethodPlugin for Plugin {
 
     fn add_systems(&self, schedule: &mut Schedule) {
         schedule.add_systems((camera_paths, infer).chain().in_set(Stage::Render));
-        schedule.add_systems((reliability, train, frame_output).chain().in_set(Stage::Learn));
+        schedule.add_systems((reliability, train, ema, reliability_update, frame_output).chain().in_set(Stage::Learn));
     }
 
     fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
@@ -232,8 +240,11 @@ impl NircCache {
             paths_timer: PassTimer::new(gpu, &["nirc_paths"]),
             infer_timer: PassTimer::new(gpu, &["nirc_infer", "nirc_resolve"]),
             train_timer: PassTimer::new(gpu, &["nirc_records", "nirc_train"]),
+            ema_timer: PassTimer::new(gpu, &["nirc_ema"]),
+            reliability_timer: PassTimer::new(gpu, &["nirc_reliability"]),
             paths_times: Vec::new(),
             train_times: Vec::new(),
+            step: None,
             stats: Vec::new(),
             motion: Vec::new(),
             rays: [0; 2],
@@ -310,8 +321,7 @@ pub fn reliability(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut caches: Quer
     Ok(())
 }
 
-/// Training records from the frame's paths and one training step (Adam on the High-LR weights,
-/// their EMA, the reliability grid's update), with its loss and rejected steps.
+/// Training records from the frame's paths and the Adam step of the High-LR weights.
 pub fn train(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut caches: Query<&mut NircCache>) -> Result<(), BevyError> {
     let gpu = &gpu.0;
     let err = frame_error(&clock);
@@ -320,10 +330,43 @@ pub fn train(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res
         c.prepare(gpu, &tracer.0, run.scenario.seed, clock.global);
         let mut timed = c.train_timer.begin(gpu, "nirc train");
         c.paths.records_timed(gpu, &mut timed, 0, &tracer.0).map_err(|e| err(e.into()))?;
-        c.cache.train_timed(gpu, &mut timed, 1, c.paths.records(), c.paths.record_count()).map_err(|e| err(e.into()))?;
+        c.step = c.cache.prepare_step(gpu, c.paths.records(), c.paths.record_count()).map_err(|e| err(e.into()))?;
+        if let Some(step) = &c.step {
+            c.cache.adam_timed(&mut timed, 1, step).map_err(|e| err(e.into()))?;
+        }
         c.train_times = timed.submit().map_err(|e| err(e.into()))?;
         c.rays = c.paths.read_rays(gpu).map_err(|e| err(e.into()))?;
         c.shaded = c.paths.query_count() as u64;
+    }
+    Ok(())
+}
+
+/// The debiased EMA of the weights after this frame's Adam step (nothing on a rejected step).
+pub fn ema(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut caches: Query<&mut NircCache>) -> Result<(), BevyError> {
+    let gpu = &gpu.0;
+    let err = frame_error(&clock);
+    for mut c in &mut caches {
+        let c = &mut *c;
+        let Some(step) = &c.step else { continue };
+        let mut timed = c.ema_timer.begin(gpu, "nirc ema");
+        c.cache.ema_timed(&mut timed, 0, step).map_err(|e| err(e.into()))?;
+        c.train_times.extend(timed.submit().map_err(|e| err(e.into()))?);
+    }
+    Ok(())
+}
+
+/// The reliability grid's moments from the step's samples and the step's commit; then the
+/// step's loss and the count of rejected steps.
+pub fn reliability_update(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut caches: Query<&mut NircCache>) -> Result<(), BevyError> {
+    let gpu = &gpu.0;
+    let err = frame_error(&clock);
+    for mut c in &mut caches {
+        let c = &mut *c;
+        if let Some(step) = c.step.take() {
+            let mut timed = c.reliability_timer.begin(gpu, "nirc reliability");
+            c.cache.reliability_timed(&mut timed, 0, &step).map_err(|e| err(e.into()))?;
+            c.train_times.extend(timed.submit().map_err(|e| err(e.into()))?);
+        }
         let counters = c.cache.counters(gpu).map_err(|e| err(e.into()))?;
         let loss = c.cache.last_loss(gpu, c.paths.record_count()).map_err(|e| err(e.into()))?;
         c.stats.push(("train_loss".into(), loss));
