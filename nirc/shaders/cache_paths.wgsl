@@ -52,20 +52,6 @@ struct Record {
     target_rgb: vec4f,
 }
 
-@group(2) @binding(0) var<uniform> params: CacheParams;
-@group(2) @binding(1) var<storage, read_write> queries: array<QueryOut>;
-@group(2) @binding(2) var<storage, read_write> query_meta: array<QueryMeta>;
-// [0, record_count): the compacted training records handed to the cache;
-// [record_count, 2 record_count): one candidate per record slot, before compaction.
-@group(2) @binding(3) var<storage, read_write> records: array<Record>;
-@group(2) @binding(4) var<storage, read_write> answers: array<vec4f>;
-@group(2) @binding(5) var<storage, read_write> image: array<vec4f>;
-// Per pixel: motion of the pixel-centre primary hit (as the path tracer's G-buffer), for SMAPE
-// with reprojection.
-@group(2) @binding(6) var<storage, read_write> motion: array<vec2f>;
-// Rays traced this frame (sg_rays_traced of every invocation): [0] camera paths (queries pass,
-// motion rays included), [1] training targets. Cleared by encode_queries.
-@group(2) @binding(7) var<storage, read_write> ray_counters: array<atomic<u32>>;
 
 // Stream of training-path random numbers: disjoint from the camera samples' (small indices).
 const TRAIN_SAMPLE_STREAM: u32 = 0x80000001u;

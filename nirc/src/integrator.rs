@@ -11,6 +11,7 @@
 use crate::error::NircError;
 use crate::records::{CacheAnswer, CacheQuery, TrainingRecord};
 use bytemuck::{Pod, Zeroable};
+use render::compute::BufferBinding;
 use render::gpu::Gpu;
 use render::path_tracer::PathTracer;
 use render::timing::TimedFrame;
@@ -51,10 +52,22 @@ struct CacheParams {
 const META_BYTES: u64 = 48;
 /// This pass's own @group(2): params, then queries, meta, records, answers, image, motion, ray
 /// counters.
-const OWN_GROUP: [wgpu::BufferBindingType; 8] = {
-    let rw = wgpu::BufferBindingType::Storage { read_only: false };
-    [wgpu::BufferBindingType::Uniform, rw, rw, rw, rw, rw, rw, rw]
-};
+const OWN_GROUP: [BufferBinding; 8] = [
+    BufferBinding::uniform("params", "CacheParams"),
+    BufferBinding::read_write("queries", "array<QueryOut>"),
+    BufferBinding::read_write("query_meta", "array<QueryMeta>"),
+    // [0, record_count): the compacted training records handed to the cache;
+    // [record_count, 2 record_count): one candidate per record slot, before compaction.
+    BufferBinding::read_write("records", "array<Record>"),
+    BufferBinding::read_write("answers", "array<vec4f>"),
+    BufferBinding::read_write("image", "array<vec4f>"),
+    // Per pixel: motion of the pixel-centre primary hit (as the path tracer's G-buffer), for
+    // SMAPE with reprojection.
+    BufferBinding::read_write("motion", "array<vec2f>"),
+    // Rays traced this frame (sg_rays_traced of every invocation): [0] camera paths (queries
+    // pass, motion rays included), [1] training targets. Cleared with the queries.
+    BufferBinding::read_write("ray_counters", "array<atomic<u32>>"),
+];
 const WORKGROUP_2D: u32 = 8;
 const WORKGROUP_1D: u32 = 64;
 

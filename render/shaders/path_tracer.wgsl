@@ -19,13 +19,6 @@ struct GBufferTexel {
     pad: u32,
 }
 
-// The path tracer's own outputs (@group(2)): the radiance sum (w: samples) and the G-buffer.
-@group(2) @binding(0) var<storage, read_write> radiance_sum: array<vec4f>;
-@group(2) @binding(1) var<storage, read_write> gbuffer: array<GBufferTexel>;
-// Per-(chunk, pixel) partial sums of one dispatch; `accumulate_main` adds them up in chunk order.
-@group(2) @binding(2) var<storage, read_write> sample_partials: array<vec4f>;
-// [0]: rays traced by this frame's passes (sg_rays_traced of every invocation).
-@group(2) @binding(3) var<storage, read_write> pt_counters: array<atomic<u32>>;
 
 // One thread per pixel and chunk of at most SAMPLES_PER_THREAD samples (global id z = chunk).
 // Few samples per thread keep every invocation short: llvmpipe (Mesa 22) silently ends a shader's

@@ -6,10 +6,6 @@
 
 const NO_TEXTURE: u32 = 0xffffffffu;
 
-@group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<storage, read> materials: array<GpuMaterial>;
-@group(0) @binding(2) var<storage, read> texels: array<u32>;
-@group(0) @binding(3) var<storage, read> lights: array<GpuLight>;
 
 fn srgb_to_linear(c: vec3f) -> vec3f {
     let lo = c / 12.92;

@@ -16,12 +16,6 @@ struct TaaPrimary {
 
 const NO_HIT: u32 = 0xffffffffu;
 
-@group(0) @binding(0) var<uniform> taa: TaaParams;
-@group(0) @binding(1) var<storage, read> current: array<vec4f>;
-@group(0) @binding(2) var<storage, read> primary: array<TaaPrimary>;
-@group(0) @binding(3) var<storage, read> previous_primary: array<TaaPrimary>;
-@group(0) @binding(4) var<storage, read> history: array<vec4f>;
-@group(0) @binding(5) var<storage, read_write> resolved: array<vec4f>;
 
 fn pixel_index(q: vec2i) -> u32 {
     return u32(q.y) * taa.size.x + u32(q.x);

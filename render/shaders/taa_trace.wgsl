@@ -1,13 +1,8 @@
 // TAA input: one path per pixel through the frame's Halton jitter point, with the attributes of
 // its own primary hit (taa_primary.wgsl) for the history test of taa_resolve.wgsl.
-// Concatenated after PathTracer::library_source() and taa_primary.wgsl; buffers in @group(2)
-// (layout in render/src/taa/mod.rs).
+// Concatenated after PathTracer::library_source() and taa_primary.wgsl; its buffers in @group(2)
+// are declared in render/src/taa/mod.rs (TRACE_GROUP).
 
-@group(2) @binding(0) var<uniform> taa: TaaParams;
-@group(2) @binding(1) var<storage, read_write> taa_current: array<vec4f>;
-@group(2) @binding(2) var<storage, read_write> taa_primary: array<TaaPrimary>;
-// [0]: rays traced by this pass (sg_rays_traced of every invocation).
-@group(2) @binding(3) var<storage, read_write> taa_counters: array<atomic<u32>>;
 
 @compute @workgroup_size(8, 8, 1)
 fn taa_trace(@builtin(global_invocation_id) id: vec3u) {

@@ -5,6 +5,67 @@
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 
+/// How a pass may access a buffer of its bind group.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Access {
+    Uniform,
+    Read,
+    ReadWrite,
+}
+
+/// One buffer of a bind group, declared once: its WGSL `var` ([`declare`]) and its layout entry
+/// ([`binding_layout`]) both come from it, so the shader and the Rust side cannot disagree.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BufferBinding {
+    pub name: &'static str,
+    pub access: Access,
+    /// The WGSL type, e.g. `array<vec4f>` or `SscParams`.
+    pub wgsl_type: &'static str,
+}
+
+impl BufferBinding {
+    pub const fn uniform(name: &'static str, wgsl_type: &'static str) -> Self {
+        Self { name, access: Access::Uniform, wgsl_type }
+    }
+
+    pub const fn read(name: &'static str, wgsl_type: &'static str) -> Self {
+        Self { name, access: Access::Read, wgsl_type }
+    }
+
+    pub const fn read_write(name: &'static str, wgsl_type: &'static str) -> Self {
+        Self { name, access: Access::ReadWrite, wgsl_type }
+    }
+
+    pub const fn kind(&self) -> wgpu::BufferBindingType {
+        match self.access {
+            Access::Uniform => wgpu::BufferBindingType::Uniform,
+            Access::Read => wgpu::BufferBindingType::Storage { read_only: true },
+            Access::ReadWrite => wgpu::BufferBindingType::Storage { read_only: false },
+        }
+    }
+}
+
+/// The WGSL declarations of `bindings` as @group(`group`), binding i = `bindings[i]`.
+pub fn declare(group: u32, bindings: &[BufferBinding]) -> String {
+    bindings
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let space = match b.access {
+                Access::Uniform => "<uniform>",
+                Access::Read => "<storage, read>",
+                Access::ReadWrite => "<storage, read_write>",
+            };
+            format!("@group({group}) @binding({i}) var{space} {}: {};\n", b.name, b.wgsl_type)
+        })
+        .collect()
+}
+
+/// The layout of `bindings` ([`buffer_layout`] of their kinds).
+pub fn binding_layout(gpu: &Gpu, label: &str, bindings: &[BufferBinding]) -> wgpu::BindGroupLayout {
+    buffer_layout(gpu, label, &bindings.iter().map(BufferBinding::kind).collect::<Vec<_>>())
+}
+
 /// A bind group layout whose binding i is a buffer of kind `kinds[i]`, visible to compute.
 pub fn buffer_layout(gpu: &Gpu, label: &str, kinds: &[wgpu::BufferBindingType]) -> wgpu::BindGroupLayout {
     let entries: Vec<_> = kinds

@@ -6,7 +6,7 @@ use std::collections::HashMap;
 use std::sync::Mutex;
 
 use crate::bvh::SceneGeometry;
-use crate::compute;
+use crate::compute::{self, BufferBinding};
 use crate::frame::{CameraFrame, Frame};
 use crate::gpu_struct::GpuStruct;
 use crate::materials::GpuMaterial;
@@ -36,6 +36,7 @@ impl PassLibrary {
                 CameraFrame::WGSL,
                 Frame::WGSL,
                 GpuMaterial::WGSL,
+                &compute::declare(0, &crate::scene_bindings::GROUP),
                 SceneGeometry::WGSL,
                 include_str!("../shaders/pt_sampling.wgsl"),
                 include_str!("../shaders/pt_bsdf.wgsl"),
@@ -47,19 +48,20 @@ impl PassLibrary {
         })
     }
 
-    /// The layout of a pass's own @group(2) (buffer kinds by binding) and the pipelines of
-    /// `entries` in `source`, a WGSL module built on [`Self::source`]. Refuses a pass with more
-    /// storage buffers than the adapter binds. Equal passes are compiled once per run.
+    /// The layout of a pass's own @group(2) and the pipelines of `entries` in `source`, a WGSL
+    /// module built on [`Self::source`]; the declarations of `own` (binding i = `own[i]`) are
+    /// appended to it, so a pass states its buffers once. Refuses a pass with more storage
+    /// buffers than the adapter binds. Equal passes are compiled once per run.
     pub fn pass<const N: usize>(
         &self,
         gpu: &Gpu,
         scene: &SceneBindings,
         pass: &str,
         source: &str,
-        own: &[wgpu::BufferBindingType],
+        own: &[BufferBinding],
         entries: [&str; N],
     ) -> Result<(wgpu::BindGroupLayout, [wgpu::ComputePipeline; N]), RenderError> {
-        let own_storage = own.iter().filter(|k| matches!(k, wgpu::BufferBindingType::Storage { .. })).count() as u32;
+        let own_storage = own.iter().filter(|b| b.access != compute::Access::Uniform).count() as u32;
         let needed = LIBRARY_STORAGE_BUFFERS + own_storage;
         let limit = gpu.limits.max_storage_buffers_per_shader_stage;
         if needed > limit {
@@ -80,8 +82,9 @@ impl PassLibrary {
         {
             return Ok((layout.clone(), pipelines));
         }
-        let layout = compute::buffer_layout(gpu, pass, own);
-        let pipelines = compute::pipelines(gpu, pass, source, &[scene.layout(), scene.geometry().bind_group_layout(), &layout], entries)?;
+        let layout = compute::binding_layout(gpu, pass, own);
+        let source = format!("{source}\n{}", compute::declare(2, own));
+        let pipelines = compute::pipelines(gpu, pass, &source, &[scene.layout(), scene.geometry().bind_group_layout(), &layout], entries)?;
         compiled.insert(key, (layout.clone(), pipelines.to_vec()));
         Ok((layout, pipelines))
     }

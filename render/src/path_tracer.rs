@@ -7,7 +7,7 @@
 //! render/shaders/path_tracer.wgsl: radiance sum, G-buffer, sample partials, ray counter).
 
 use crate::bvh::SceneGeometry;
-use crate::compute;
+use crate::compute::{self, BufferBinding};
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::pass_library::PassLibrary;
@@ -169,7 +169,7 @@ impl PathTracer {
         let counters = per_pixel("path tracer ray counter", COUNTER_WORDS * 4, rw | wgpu::BufferUsages::COPY_DST);
         let counters_readback = per_pixel("path tracer ray counter readback", COUNTER_WORDS * 4, readback);
 
-        let layout = compute::buffer_layout(gpu, "path tracer", &OWN_GROUP);
+        let layout = compute::binding_layout(gpu, "path tracer", &OWN_GROUP);
         let [trace_pipeline, gbuffer_pipeline, accumulate_pipeline] = compute::pipelines(
             gpu,
             "path_tracer.wgsl",
@@ -217,6 +217,7 @@ impl PathTracer {
         SOURCE.get_or_init(|| {
             [
                 Self::library_source(),
+                &compute::declare(2, &OWN_GROUP),
                 &format!("const SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;"),
                 include_str!("../shaders/path_tracer.wgsl"),
             ]
@@ -240,7 +241,7 @@ impl PathTracer {
         gpu: &Gpu,
         pass: &str,
         source: &str,
-        own: &[wgpu::BufferBindingType],
+        own: &[BufferBinding],
         entries: [&str; N],
     ) -> Result<(wgpu::BindGroupLayout, [wgpu::ComputePipeline; N]), RenderError> {
         self.library.pass(gpu, &self.scene, pass, source, own, entries)
@@ -431,8 +432,12 @@ impl PathTracer {
     }
 }
 
-/// The path tracer's own @group(2): radiance sum, G-buffer, sample partials, ray counter.
-const OWN_GROUP: [wgpu::BufferBindingType; 4] = {
-    let write = wgpu::BufferBindingType::Storage { read_only: false };
-    [write, write, write, write]
-};
+/// The path tracer's own @group(2), declared into its WGSL: the radiance sum (w: samples), the
+/// G-buffer, per-(chunk, pixel) partial sums of one dispatch (`accumulate_main` adds them up in
+/// chunk order), and [0] = rays traced by this frame's passes.
+const OWN_GROUP: [BufferBinding; 4] = [
+    BufferBinding::read_write("radiance_sum", "array<vec4f>"),
+    BufferBinding::read_write("gbuffer", "array<GBufferTexel>"),
+    BufferBinding::read_write("sample_partials", "array<vec4f>"),
+    BufferBinding::read_write("pt_counters", "array<atomic<u32>>"),
+];

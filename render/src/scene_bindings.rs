@@ -4,7 +4,7 @@
 //! run, updated once per frame; methods read it and never write it.
 
 use crate::bvh::SceneGeometry;
-use crate::compute;
+use crate::compute::{self, BufferBinding};
 use crate::error::RenderError;
 use crate::frame::{CameraBasis, Frame, FrameParams};
 use crate::gpu::Gpu;
@@ -18,11 +18,13 @@ use wgpu::util::DeviceExt;
 /// Storage buffers of @group(0): materials, texels, lights.
 pub const STORAGE_BUFFERS: u32 = 3;
 
-/// @group(0): frame uniform, materials, texels, lights.
-const GROUP: [wgpu::BufferBindingType; 4] = {
-    let read = wgpu::BufferBindingType::Storage { read_only: true };
-    [wgpu::BufferBindingType::Uniform, read, read, read]
-};
+/// @group(0): frame uniform, materials, texels, lights (declared into the library's WGSL).
+pub const GROUP: [BufferBinding; 4] = [
+    BufferBinding::uniform("frame", "Frame"),
+    BufferBinding::read("materials", "array<GpuMaterial>"),
+    BufferBinding::read("texels", "array<u32>"),
+    BufferBinding::read("lights", "array<GpuLight>"),
+];
 
 pub struct SceneBindings {
     settings: PathTracerSettings,
@@ -64,7 +66,7 @@ impl SceneBindings {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let layout = compute::buffer_layout(gpu, "scene", &GROUP);
+        let layout = compute::binding_layout(gpu, "scene", &GROUP);
         let bind_group = compute::buffer_group(gpu, "scene", &layout, &[&frame_buffer, &materials, &texels, &lights]);
         Ok(Self {
             settings,

@@ -263,8 +263,13 @@ fn wall_clock_times_each_pass_on_its_own() {
 fn equal_passes_share_their_pipelines() {
     // Two TAA instances on one tracer compile the trace pass once; another pass does not alias.
     let t = tracer(&feature_scene(0.0), 2);
-    let write = wgpu::BufferBindingType::Storage { read_only: false };
-    let own = [wgpu::BufferBindingType::Uniform, write, write, write];
+    use render::compute::BufferBinding;
+    let own = [
+        BufferBinding::uniform("taa", "TaaParams"),
+        BufferBinding::read_write("taa_current", "array<vec4f>"),
+        BufferBinding::read_write("taa_primary", "array<TaaPrimary>"),
+        BufferBinding::read_write("taa_counters", "array<atomic<u32>>"),
+    ];
     let (layout_a, [a]) = t.library_pass(gpu(), "taa_trace.wgsl", Taa::trace_source(), &own, ["taa_trace"]).unwrap();
     let (layout_b, [b]) = t.library_pass(gpu(), "taa_trace.wgsl", Taa::trace_source(), &own, ["taa_trace"]).unwrap();
     assert!(a == b && layout_a == layout_b, "the same pass was compiled twice");

@@ -58,13 +58,6 @@ const HC_COUNTER_FAILED: u32 = 3u;
 const HC_COUNTER_UPDATES: u32 = 4u;
 const HC_COUNTER_RAYS: u32 = 5u;      // rays traced by hc_trace and hc_update
 
-@group(2) @binding(0) var<uniform> hc: HashCacheParams;
-@group(2) @binding(1) var<storage, read_write> slots: array<atomic<u32>>;
-@group(2) @binding(2) var<storage, read_write> cell_radiance: array<vec4f>;   // rgb mean, w samples
-@group(2) @binding(3) var<storage, read_write> records: array<HcRecord>;
-@group(2) @binding(4) var<storage, read_write> counters: array<atomic<u32>>;
-@group(2) @binding(5) var<storage, read_write> primary_out: array<TaaPrimary>;
-@group(2) @binding(6) var<storage, read_write> colour_out: array<vec4f>;
 
 @compute @workgroup_size(64, 1, 1)
 fn hc_age(@builtin(global_invocation_id) id: vec3u) {

@@ -57,16 +57,6 @@ const SSC_FLAG_BASE: u32 = 1u;
 const SSC_FLAG_SLOPE: u32 = 2u;
 const SSC_FLAG_HOLE: u32 = 4u;
 
-@group(2) @binding(0) var<uniform> ssc: SscParams;
-@group(2) @binding(1) var<storage, read> src_mask: array<u32>;
-@group(2) @binding(2) var<storage, read> src_slots: array<SscSlot>;
-// SSC_ATOMICS words per pixel: the mask being reserved (atomicOr), the farthest visible depth
-// (atomicMax of its float bits), and the retrace results (bits 0-15: visible, 16-31: traced).
-@group(2) @binding(3) var<storage, read_write> pixel_atomics: array<atomic<u32>>;
-@group(2) @binding(4) var<storage, read_write> dst_slots: array<SscSlot>;
-@group(2) @binding(5) var<storage, read_write> dst_mask: array<u32>;
-@group(2) @binding(6) var<storage, read_write> ssc_work: array<atomic<u32>>;
-@group(2) @binding(7) var<storage, read_write> ssc_out: array<SscPixel>;
 
 fn ssc_pixels() -> u32 {
     return ssc.width * ssc.height;

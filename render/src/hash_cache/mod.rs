@@ -42,6 +42,7 @@
 pub mod key;
 pub mod table_cpu;
 
+use crate::compute::BufferBinding;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::path_tracer::PathTracer;
@@ -58,6 +59,18 @@ pub const HC_AGE_PASS: &str = "hc_age";
 pub const HC_TRACE_PASS: &str = "hc_trace";
 pub const HC_UPDATE_PASS: &str = "hc_update";
 pub const HC_RESOLVE_PASS: &str = "hc_resolve";
+/// The cache's own @group(2) (declared into its WGSL).
+const OWN_GROUP: [BufferBinding; 7] = [
+    BufferBinding::uniform("hc", "HashCacheParams"),
+    BufferBinding::read_write("slots", "array<atomic<u32>>"),
+    // rgb mean, w samples.
+    BufferBinding::read_write("cell_radiance", "array<vec4f>"),
+    BufferBinding::read_write("records", "array<HcRecord>"),
+    BufferBinding::read_write("counters", "array<atomic<u32>>"),
+    BufferBinding::read_write("primary_out", "array<TaaPrimary>"),
+    BufferBinding::read_write("colour_out", "array<vec4f>"),
+];
+
 const PASSES: [&str; 4] = [HC_AGE_PASS, HC_TRACE_PASS, HC_UPDATE_PASS, HC_RESOLVE_PASS];
 
 
@@ -253,8 +266,7 @@ impl HashCache {
         let primary = buffer("hash cache primary", pixels * size_of::<TaaPrimary>() as u64, rw);
         let colour = buffer("hash cache colour", pixels * 16, rw);
 
-        let write = wgpu::BufferBindingType::Storage { read_only: false };
-        let own = [wgpu::BufferBindingType::Uniform, write, write, write, write, write, write];
+        let own = OWN_GROUP;
         let (layout, pipelines) = tracer.library_pass(gpu, "hash_cache.wgsl", Self::shader_source(), &own, PASSES)?;
         let group = crate::compute::buffer_group(gpu, "hash cache", &layout, &[&params, &slots, &cells, &records, &counters, &primary, &colour]);
         Ok(Self { settings, width, height, params, slots, cells, records, counters, primary, colour, group, pipelines, timer: PassTimer::new(gpu, &PASSES), frames: 0 })

@@ -27,6 +27,7 @@ pub use storage::GpuSlot;
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::compute::BufferBinding;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
@@ -57,13 +58,20 @@ pub const DISPATCHES: [&str; 9] = [
 
 const HEADER_WORDS: u64 = 48;
 const AUDIT_WORD: u64 = 32;
-/// The cache's own @group(2): params, source mask and slots (read), then pixel atomics,
-/// destination slots and mask, work lists, output.
-const OWN_GROUP: [wgpu::BufferBindingType; 8] = {
-    let read = wgpu::BufferBindingType::Storage { read_only: true };
-    let write = wgpu::BufferBindingType::Storage { read_only: false };
-    [wgpu::BufferBindingType::Uniform, read, read, write, write, write, write, write]
-};
+/// The cache's own @group(2), declared into its WGSL: params, source mask and slots (read),
+/// then pixel atomics, destination slots and mask, work lists, output.
+const OWN_GROUP: [BufferBinding; 8] = [
+    BufferBinding::uniform("ssc", "SscParams"),
+    BufferBinding::read("src_mask", "array<u32>"),
+    BufferBinding::read("src_slots", "array<SscSlot>"),
+    // SSC_ATOMICS words per pixel: the mask being reserved (atomicOr), the farthest visible depth
+    // (atomicMax of its float bits), and the retrace results (bits 0-15: visible, 16-31: traced).
+    BufferBinding::read_write("pixel_atomics", "array<atomic<u32>>"),
+    BufferBinding::read_write("dst_slots", "array<SscSlot>"),
+    BufferBinding::read_write("dst_mask", "array<u32>"),
+    BufferBinding::read_write("ssc_work", "array<atomic<u32>>"),
+    BufferBinding::read_write("ssc_out", "array<SscPixel>"),
+];
 
 /// The WGSL of the cache passes (appended to the path tracer's library).
 pub fn shader_source() -> &'static str {

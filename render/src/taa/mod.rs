@@ -33,6 +33,7 @@
 pub mod jitter;
 pub mod resolve_cpu;
 
+use crate::compute::BufferBinding;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
@@ -121,6 +122,25 @@ impl TaaSettings {
         }
     }
 }
+
+/// The trace pass's own @group(2) (declared into its WGSL).
+const TRACE_GROUP: [BufferBinding; 4] = [
+    BufferBinding::uniform("taa", "TaaParams"),
+    BufferBinding::read_write("taa_current", "array<vec4f>"),
+    BufferBinding::read_write("taa_primary", "array<TaaPrimary>"),
+    // [0]: rays traced by this pass (sg_rays_traced of every invocation).
+    BufferBinding::read_write("taa_counters", "array<atomic<u32>>"),
+];
+
+/// The resolve pass's @group(0) (declared into its WGSL).
+const RESOLVE_GROUP: [BufferBinding; 6] = [
+    BufferBinding::uniform("taa", "TaaParams"),
+    BufferBinding::read("current", "array<vec4f>"),
+    BufferBinding::read("primary", "array<TaaPrimary>"),
+    BufferBinding::read("previous_primary", "array<TaaPrimary>"),
+    BufferBinding::read("history", "array<vec4f>"),
+    BufferBinding::read_write("resolved", "array<vec4f>"),
+];
 
 crate::gpu_struct! {
     /// TAA's uniform, shared by its trace and resolve passes (and the hash cache's).
@@ -234,11 +254,8 @@ impl Taa {
         let history = [buffer("taa history 0", pixels * 16, rw), buffer("taa history 1", pixels * 16, rw)];
         let counters = buffer("taa ray counter", 16, rw);
 
-        let uniform = wgpu::BufferBindingType::Uniform;
-        let read = wgpu::BufferBindingType::Storage { read_only: true };
-        let write = wgpu::BufferBindingType::Storage { read_only: false };
-        let (trace_layout, [trace_pipeline]) = tracer.library_pass(gpu, "taa_trace.wgsl", Self::trace_source(), &[uniform, write, write, write], ["taa_trace"])?;
-        let resolve_layout = crate::compute::buffer_layout(gpu, "taa resolve", &[uniform, read, read, read, read, write]);
+        let (trace_layout, [trace_pipeline]) = tracer.library_pass(gpu, "taa_trace.wgsl", Self::trace_source(), &TRACE_GROUP, ["taa_trace"])?;
+        let resolve_layout = crate::compute::binding_layout(gpu, "taa resolve", &RESOLVE_GROUP);
         let [resolve_pipeline] = crate::compute::pipelines(gpu, "taa_resolve.wgsl", &Self::resolve_source(), &[&resolve_layout], ["taa_resolve"])?;
         let resolve_group = |p: usize| {
             let q = 1 - p;
@@ -266,9 +283,9 @@ impl Taa {
         })
     }
 
-    /// The resolve pass's complete WGSL (TaaParams + taa_resolve.wgsl).
+    /// The resolve pass's complete WGSL (TaaParams, its bindings, taa_resolve.wgsl).
     fn resolve_source() -> String {
-        [TaaParams::WGSL, include_str!("../../shaders/taa_resolve.wgsl")].join("\n")
+        [TaaParams::WGSL, &crate::compute::declare(0, &RESOLVE_GROUP), include_str!("../../shaders/taa_resolve.wgsl")].join("\n")
     }
 
     /// The trace pass's complete WGSL (shading library + taa_trace.wgsl).
