@@ -44,15 +44,7 @@ const COUNTER_WORDS: u64 = 4;
 
 pub use crate::pass_library::LIBRARY_STORAGE_BUFFERS;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub struct PathTracerSettings {
-    pub width: u32,
-    pub height: u32,
-    /// Maximum number of scattering events: 1 = direct lighting only.
-    pub max_depth: u32,
-    /// Russian roulette applies to bounces from this depth on (1 = after the first bounce).
-    pub rr_start_depth: u32,
-}
+pub use crate::scene_bindings::PathTracerSettings;
 
 /// Primary-hit attributes of the pixel-centre ray, row-major, `width * height` each.
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -10,7 +10,6 @@ use crate::frame::{CameraBasis, Frame, FrameParams};
 use crate::gpu::Gpu;
 use crate::lights::{LightTable, build_light_table};
 use crate::materials::pack_materials;
-use crate::path_tracer::PathTracerSettings;
 use crate::scene::{Camera, SceneChanges, SceneDesc};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
@@ -25,6 +24,18 @@ pub const GROUP: [BufferBinding; 4] = [
     BufferBinding::read("texels", "array<u32>"),
     BufferBinding::read("lights", "array<GpuLight>"),
 ];
+
+/// Image size and path depth: what every pass's frame uniform carries besides the scene (the
+/// path tracer's settings; `render::path_tracer` re-exports it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct PathTracerSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Maximum number of scattering events: 1 = direct lighting only.
+    pub max_depth: u32,
+    /// Russian roulette applies to bounces from this depth on (1 = after the first bounce).
+    pub rr_start_depth: u32,
+}
 
 pub struct SceneBindings {
     settings: PathTracerSettings,
