@@ -9,16 +9,6 @@ fn trace_path(pixel: vec2u, sample_index: u32) -> vec3f {
     return path_radiance(frame.camera.position, dir, 0.0, 0u, &rng);
 }
 
-struct GBufferTexel {
-    normal: vec3f,
-    depth: f32,
-    albedo: vec3f,
-    instance: u32,
-    motion: vec2f,
-    primitive: u32,
-    pad: u32,
-}
-
 
 // One thread per pixel and chunk of at most SAMPLES_PER_THREAD samples (global id z = chunk).
 // Few samples per thread keep every invocation short: llvmpipe (Mesa 22) silently ends a shader's

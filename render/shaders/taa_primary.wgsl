@@ -1,15 +1,6 @@
 // Primary-hit attributes of a jittered sample, written by every pass that feeds the TAA resolve
 // (taa_trace.wgsl, the hash cache). Needs the shading library (pt_scene: frame, camera helpers).
 
-// Primary-hit attributes of a jittered sample. Misses: instance NO_HIT, depth 0.
-struct TaaPrimary {
-    normal: vec3f,
-    depth: f32,
-    motion: vec2f,          // previous image position - current image position (pixels)
-    instance: u32,
-    previous_depth: f32,    // distance from the previous camera to where the point was
-}
-
 // The primary hit's attributes for the ray (origin, dir); shared with the hash cache's pass.
 fn primary_attributes(hit: Hit, origin: vec3f, dir: vec3f) -> TaaPrimary {
     var p: TaaPrimary;

@@ -6,14 +6,6 @@
 // fresh history averages uniformly until it reaches the exponential regime.
 // Mirrored on the CPU by render/src/taa/resolve_cpu.rs (keep them in step).
 
-struct TaaPrimary {
-    normal: vec3f,
-    depth: f32,
-    motion: vec2f,
-    instance: u32,
-    previous_depth: f32,
-}
-
 const NO_HIT: u32 = 0xffffffffu;
 
 

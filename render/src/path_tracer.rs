@@ -10,12 +10,12 @@ use crate::bvh::SceneGeometry;
 use crate::compute::{self, BufferBinding};
 use crate::error::RenderError;
 use crate::gpu::Gpu;
+use crate::gpu_struct::GpuStruct;
 use crate::pass_library::PassLibrary;
 use crate::readback::read_buffer;
 use crate::scene::{Camera, SceneChanges, SceneDesc};
 use crate::scene_bindings::SceneBindings;
 use crate::timing::{PassTimer, PassTiming, merge};
-use bytemuck::{Pod, Zeroable};
 
 /// `Hit::instance`/`primitive` of a pixel whose primary ray left the scene.
 pub const NO_HIT: u32 = u32::MAX;
@@ -81,22 +81,23 @@ pub struct FrameOutput {
     pub shaded: u64,
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct GpuGBufferTexel {
-    normal: [f32; 3],
-    depth: f32,
-    albedo: [f32; 3],
-    instance: u32,
-    motion: [f32; 2],
-    primitive: u32,
-    _pad: u32,
+crate::gpu_struct! {
+    /// One pixel of the path tracer's G-buffer (its @group(2) `gbuffer`).
+    pub struct GBufferTexel {
+        pub normal: [f32; 3] => "vec3f",
+        pub depth: f32 => "f32",
+        pub albedo: [f32; 3] => "vec3f",
+        pub instance: u32 => "u32",
+        pub motion: [f32; 2] => "vec2f",
+        pub primitive: u32 => "u32",
+        pub pad: u32 => "u32",
+    }
 }
 
-const _: () = assert!(size_of::<GpuGBufferTexel>() == 48);
+const _: () = assert!(size_of::<GBufferTexel>() == 48);
 
 /// Bytes per pixel of the per-pixel buffers (radiance sum and G-buffer texel).
-const BYTES_PER_PIXEL: u64 = 16 + size_of::<GpuGBufferTexel>() as u64;
+const BYTES_PER_PIXEL: u64 = 16 + size_of::<GBufferTexel>() as u64;
 
 pub struct PathTracer {
     settings: PathTracerSettings,
@@ -151,7 +152,7 @@ impl PathTracer {
         let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
         let readback = wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST;
         let radiance_size = pixels * 16;
-        let gbuffer_size = pixels * size_of::<GpuGBufferTexel>() as u64;
+        let gbuffer_size = pixels * size_of::<GBufferTexel>() as u64;
         let radiance_sum = per_pixel("radiance sum", radiance_size, rw);
         let gbuffer = per_pixel("gbuffer", gbuffer_size, rw);
         let radiance_readback = per_pixel("radiance readback", radiance_size, readback);
@@ -209,6 +210,7 @@ impl PathTracer {
         SOURCE.get_or_init(|| {
             [
                 Self::library_source(),
+                GBufferTexel::WGSL,
                 &compute::declare(2, &OWN_GROUP),
                 &format!("const SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;"),
                 include_str!("../shaders/path_tracer.wgsl"),
@@ -410,7 +412,7 @@ impl PathTracer {
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer readback") });
         encoder.copy_buffer_to_buffer(&self.gbuffer, 0, &self.gbuffer_readback, 0, self.gbuffer.size());
         gpu.queue.submit([encoder.finish()]);
-        let texels: Vec<GpuGBufferTexel> = read_buffer(gpu, &self.gbuffer_readback).map_err(|reason| RenderError::Readback { what: "gbuffer".into(), reason })?;
+        let texels: Vec<GBufferTexel> = read_buffer(gpu, &self.gbuffer_readback).map_err(|reason| RenderError::Readback { what: "gbuffer".into(), reason })?;
         let mut g = GBuffer::default();
         for t in texels {
             g.depth.push(if t.instance == NO_HIT { f32::INFINITY } else { t.depth });

@@ -2,10 +2,12 @@
 //! the same size on both sides, as naga lays the WGSL declaration out.
 
 use render::frame::{CameraFrame, Frame};
+use render::hash_cache::{HashCacheParams, HcRecord};
+use render::path_tracer::GBufferTexel;
 use render::gpu_struct::GpuStruct;
 use render::materials::GpuMaterial;
 use render::sample_cache::SscParams;
-use render::taa::TaaParams;
+use render::taa::{TaaParams, TaaPrimary};
 
 /// The differences between `T`'s Rust layout and its WGSL declaration's (after `deps`, the
 /// declarations it uses).
@@ -42,6 +44,10 @@ fn shared_structs_have_one_layout() {
         ("GpuMaterial", mismatches::<GpuMaterial>("")),
         ("TaaParams", mismatches::<TaaParams>("")),
         ("SscParams", mismatches::<SscParams>("")),
+        ("TaaPrimary", mismatches::<TaaPrimary>("")),
+        ("HashCacheParams", mismatches::<HashCacheParams>("")),
+        ("HcRecord", mismatches::<HcRecord>("")),
+        ("GBufferTexel", mismatches::<GBufferTexel>("")),
     ] {
         assert!(found.is_empty(), "{name}: {found:?}");
     }

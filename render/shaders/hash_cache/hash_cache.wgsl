@@ -15,41 +15,6 @@
 // WGSL has no 64-bit atomics: the checksum alone is claimed by compare-exchange, last access is
 // a separate word every accessor stores the same value into.
 
-struct HashCacheParams {
-    capacity: u32,
-    probe_limit: u32,
-    frame: u32,            // frame + 1 (0 marks never accessed)
-    max_age: u32,
-    pixel_angle: f32,      // 2 tan(vfov / 2) / height: pixel footprint per unit distance
-    lod_scale: f32,
-    normal_lod: u32,
-    jitter: u32,
-    lookup: u32,           // 0 first hit (the paper), 1 first secondary hit
-    max_samples: f32,
-    voxel_jitter_seed: u32,
-    pad: u32,
-    primary_jitter: vec2f,
-    pad2: vec2f,
-}
-
-// Per-pixel state between the passes.
-struct HcRecord {
-    key_point: vec3f,
-    slot: u32,             // HC_NONE: no key point, or insertion failed
-    key_normal: vec3f,
-    checksum: u32,
-    direct: vec3f,
-    home: u32,
-    modulate: vec3f,
-    rng: u32,
-    ray_origin: vec3f,
-    depth: u32,            // path vertex index of the key point
-    ray_dir: vec3f,
-    voxel_jitter: u32,     // pack2x16unorm
-    own_sample: vec3f,     // the pixel's own update sample when it has no cell
-    flags: u32,            // HC_NEEDS_SAMPLE
-}
-
 const HC_NEEDS_SAMPLE: u32 = 1u;
 const HC_COUNTER_OCCUPIED: u32 = 0u;
 const HC_COUNTER_EVICTED: u32 = 1u;

@@ -45,12 +45,13 @@ pub mod table_cpu;
 use crate::compute::BufferBinding;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
+use crate::gpu_struct::GpuStruct;
 use crate::path_tracer::PathTracer;
 use crate::readback::read_buffer;
 use crate::scene::Camera;
 use crate::taa::{PRIMARY_WGSL, Taa, TaaPrimary, halton_jitter};
 use crate::timing::{PassTimer, PassTiming};
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Pod;
 
 pub use key::KeyParams;
 pub use table_cpu::{CpuHashTable, CpuSlot};
@@ -146,49 +147,58 @@ impl HashCacheSettings {
     }
 }
 
-/// WGSL `HashCacheParams`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct GpuParams {
-    capacity: u32,
-    probe_limit: u32,
-    frame: u32,
-    max_age: u32,
-    pixel_angle: f32,
-    lod_scale: f32,
-    normal_lod: u32,
-    jitter: u32,
-    lookup: u32,
-    max_samples: f32,
-    voxel_jitter_seed: u32,
-    pad: u32,
-    primary_jitter: [f32; 2],
-    pad2: [f32; 2],
+crate::gpu_struct! {
+    /// The cache's uniform (`hc`, its @group(2) binding 0).
+    pub struct HashCacheParams {
+        pub capacity: u32 => "u32",
+        pub probe_limit: u32 => "u32",
+        /// Frame + 1 (0 marks never accessed).
+        pub frame: u32 => "u32",
+        pub max_age: u32 => "u32",
+        /// 2 tan(vfov / 2) / height: pixel footprint per unit distance.
+        pub pixel_angle: f32 => "f32",
+        pub lod_scale: f32 => "f32",
+        pub normal_lod: u32 => "u32",
+        pub jitter: u32 => "u32",
+        /// 0 first hit (the paper), 1 first secondary hit.
+        pub lookup: u32 => "u32",
+        pub max_samples: f32 => "f32",
+        pub voxel_jitter_seed: u32 => "u32",
+        pub pad: u32 => "u32",
+        pub primary_jitter: [f32; 2] => "vec2f",
+        pub pad2: [f32; 2] => "vec2f",
+    }
 }
 
-/// WGSL `HcRecord`: a pixel's state between the passes.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct HcRecord {
-    pub key_point: [f32; 3],
-    pub slot: u32,
-    pub key_normal: [f32; 3],
-    pub checksum: u32,
-    pub direct: [f32; 3],
-    pub home: u32,
-    pub modulate: [f32; 3],
-    pub rng: u32,
-    pub ray_origin: [f32; 3],
-    pub depth: u32,
-    pub ray_dir: [f32; 3],
-    pub voxel_jitter: u32,
-    pub own_sample: [f32; 3],
-    pub flags: u32,
+crate::gpu_struct! {
+    /// A pixel's state between the passes.
+    #[derive(Default, PartialEq)]
+    pub struct HcRecord {
+        pub key_point: [f32; 3] => "vec3f",
+        /// HC_NONE: no key point, or insertion failed.
+        pub slot: u32 => "u32",
+        pub key_normal: [f32; 3] => "vec3f",
+        pub checksum: u32 => "u32",
+        pub direct: [f32; 3] => "vec3f",
+        pub home: u32 => "u32",
+        pub modulate: [f32; 3] => "vec3f",
+        pub rng: u32 => "u32",
+        pub ray_origin: [f32; 3] => "vec3f",
+        /// Path vertex index of the key point.
+        pub depth: u32 => "u32",
+        pub ray_dir: [f32; 3] => "vec3f",
+        /// pack2x16unorm.
+        pub voxel_jitter: u32 => "u32",
+        /// The pixel's own update sample when it has no cell.
+        pub own_sample: [f32; 3] => "vec3f",
+        /// HC_NEEDS_SAMPLE.
+        pub flags: u32 => "u32",
+    }
 }
 
 pub const HC_NEEDS_SAMPLE: u32 = 1;
 
-const _: () = assert!(size_of::<GpuParams>() == 64 && size_of::<HcRecord>() == 112);
+const _: () = assert!(size_of::<HashCacheParams>() == 64 && size_of::<HcRecord>() == 112);
 
 /// Cache counters of one frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -258,7 +268,7 @@ impl HashCache {
         let pixels = width as u64 * height as u64;
         let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false });
         let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let params = buffer("hash cache params", size_of::<GpuParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+        let params = buffer("hash cache params", size_of::<HashCacheParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
         let slots = buffer("hash cache slots", settings.capacity as u64 * 16, rw);
         let cells = buffer("hash cache cells", settings.capacity as u64 * 16, rw);
         let records = buffer("hash cache records", pixels * size_of::<HcRecord>() as u64, rw);
@@ -276,7 +286,16 @@ impl HashCache {
     pub fn shader_source() -> &'static str {
         static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
         SOURCE.get_or_init(|| {
-            [PathTracer::library_source(), PRIMARY_WGSL, include_str!("../../shaders/hash_cache/hash_key.wgsl"), include_str!("../../shaders/hash_cache/hash_cache.wgsl")].join("\n")
+            [
+                PathTracer::library_source(),
+                TaaPrimary::WGSL,
+                PRIMARY_WGSL,
+                HashCacheParams::WGSL,
+                HcRecord::WGSL,
+                include_str!("../../shaders/hash_cache/hash_key.wgsl"),
+                include_str!("../../shaders/hash_cache/hash_cache.wgsl"),
+            ]
+            .join("\n")
         })
     }
 
@@ -302,7 +321,7 @@ impl HashCache {
         let jitter = halton_jitter(frame, self.settings.jitter_length);
         let stamp = self.frames + 1;
         let k = self.settings.key_params(camera, self.height);
-        let params = GpuParams {
+        let params = HashCacheParams {
             capacity: self.settings.capacity,
             probe_limit: self.settings.probe_limit,
             frame: stamp,

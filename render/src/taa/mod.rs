@@ -40,7 +40,7 @@ use crate::gpu_struct::GpuStruct;
 use crate::path_tracer::PathTracer;
 use crate::readback::read_buffer;
 use crate::timing::{PassTimer, PassTiming};
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Pod;
 
 pub use jitter::{halton, halton_jitter};
 
@@ -166,19 +166,20 @@ crate::gpu_struct! {
     }
 }
 
-/// WGSL `TaaPrimary`: attributes of a jittered sample's primary hit.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct TaaPrimary {
-    pub normal: [f32; 3],
-    /// Distance from the camera; 0 on a miss.
-    pub depth: f32,
-    /// Previous image position minus current one, pixels (x right, y down).
-    pub motion: [f32; 2],
-    /// [`crate::path_tracer::NO_HIT`] on a miss.
-    pub instance: u32,
-    /// Distance from the previous camera to where the point was in the previous frame.
-    pub previous_depth: f32,
+crate::gpu_struct! {
+    /// The attributes of a jittered sample's primary hit (TAA's trace, the hash cache).
+    #[derive(Default, PartialEq)]
+    pub struct TaaPrimary {
+        pub normal: [f32; 3] => "vec3f",
+        /// Distance from the camera; 0 on a miss.
+        pub depth: f32 => "f32",
+        /// Previous image position minus current one, pixels (x right, y down).
+        pub motion: [f32; 2] => "vec2f",
+        /// [`crate::path_tracer::NO_HIT`] on a miss.
+        pub instance: u32 => "u32",
+        /// Distance from the previous camera to where the point was in the previous frame.
+        pub previous_depth: f32 => "f32",
+    }
 }
 
 const _: () = assert!(size_of::<TaaParams>() == 48 && size_of::<TaaPrimary>() == 32);
@@ -285,13 +286,13 @@ impl Taa {
 
     /// The resolve pass's complete WGSL (TaaParams, its bindings, taa_resolve.wgsl).
     fn resolve_source() -> String {
-        [TaaParams::WGSL, &crate::compute::declare(0, &RESOLVE_GROUP), include_str!("../../shaders/taa_resolve.wgsl")].join("\n")
+        [TaaParams::WGSL, TaaPrimary::WGSL, &crate::compute::declare(0, &RESOLVE_GROUP), include_str!("../../shaders/taa_resolve.wgsl")].join("\n")
     }
 
     /// The trace pass's complete WGSL (shading library + taa_trace.wgsl).
     pub fn trace_source() -> &'static str {
         static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-        SOURCE.get_or_init(|| [PathTracer::library_source(), TaaParams::WGSL, PRIMARY_WGSL, include_str!("../../shaders/taa_trace.wgsl")].join("\n"))
+        SOURCE.get_or_init(|| [PathTracer::library_source(), TaaParams::WGSL, TaaPrimary::WGSL, PRIMARY_WGSL, include_str!("../../shaders/taa_trace.wgsl")].join("\n"))
     }
 
     pub fn settings(&self) -> TaaSettings {
