@@ -14,17 +14,6 @@ const LIGHT_TRIANGLE: u32 = 3u;
 // Point: p0 = position, radiance = intensity. Spot: p0 = position, p1 = axis, radiance =
 //   intensity, a = cos(outer angle), b = cos(inner angle).
 // Triangle: p0, p1, p2 = world vertices, radiance = emitted radiance, cdf = inclusive CDF.
-struct GpuLight {
-    p0: vec3f,
-    kind: u32,
-    p1: vec3f,
-    cdf: f32,
-    p2: vec3f,
-    a: f32,
-    radiance: vec3f,
-    b: f32,
-}
-
 struct LightSample {
     wi: vec3f,
     dist: f32,

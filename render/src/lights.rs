@@ -4,7 +4,7 @@
 
 use crate::error::RenderError;
 use crate::scene::{Light, SceneDesc};
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Zeroable;
 use glam::Vec3;
 
 const DIRECTIONAL: u32 = 0;
@@ -12,17 +12,19 @@ const POINT: u32 = 1;
 const SPOT: u32 = 2;
 const TRIANGLE: u32 = 3;
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub(crate) struct GpuLight {
-    p0: [f32; 3],
-    kind: u32,
-    p1: [f32; 3],
-    cdf: f32,
-    p2: [f32; 3],
-    a: f32,
-    radiance: [f32; 3],
-    b: f32,
+crate::gpu_struct! {
+    /// One entry of the light table (`lights`, @group(0) binding 3); the meaning of p0, p1, p2,
+    /// a and b depends on `kind` (see pt_lights.wgsl).
+    pub struct GpuLight {
+        pub p0: [f32; 3] => "vec3f",
+        pub kind: u32 => "u32",
+        pub p1: [f32; 3] => "vec3f",
+        pub cdf: f32 => "f32",
+        pub p2: [f32; 3] => "vec3f",
+        pub a: f32 => "f32",
+        pub radiance: [f32; 3] => "vec3f",
+        pub b: f32 => "f32",
+    }
 }
 
 const _: () = assert!(size_of::<GpuLight>() == 64);

@@ -9,6 +9,7 @@ use crate::bvh::SceneGeometry;
 use crate::compute::{self, BufferBinding};
 use crate::frame::{CameraFrame, Frame};
 use crate::gpu_struct::GpuStruct;
+use crate::lights::GpuLight;
 use crate::materials::GpuMaterial;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
@@ -36,6 +37,7 @@ impl PassLibrary {
                 CameraFrame::WGSL,
                 Frame::WGSL,
                 GpuMaterial::WGSL,
+                GpuLight::WGSL,
                 &compute::declare(0, &crate::scene_bindings::GROUP),
                 SceneGeometry::WGSL,
                 include_str!("../shaders/pt_sampling.wgsl"),

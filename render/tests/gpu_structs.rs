@@ -6,7 +6,8 @@ use render::hash_cache::{HashCacheParams, HcRecord};
 use render::path_tracer::GBufferTexel;
 use render::gpu_struct::GpuStruct;
 use render::materials::GpuMaterial;
-use render::sample_cache::SscParams;
+use render::lights::GpuLight;
+use render::sample_cache::{SscParams, SscPixel, SscSlot};
 use render::taa::{TaaParams, TaaPrimary};
 
 /// The differences between `T`'s Rust layout and its WGSL declaration's (after `deps`, the
@@ -48,6 +49,9 @@ fn shared_structs_have_one_layout() {
         ("HashCacheParams", mismatches::<HashCacheParams>("")),
         ("HcRecord", mismatches::<HcRecord>("")),
         ("GBufferTexel", mismatches::<GBufferTexel>("")),
+        ("GpuLight", mismatches::<GpuLight>("")),
+        ("SscSlot", mismatches::<SscSlot>("")),
+        ("SscPixel", mismatches::<SscPixel>("")),
     ] {
         assert!(found.is_empty(), "{name}: {found:?}");
     }

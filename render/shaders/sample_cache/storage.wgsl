@@ -16,20 +16,6 @@ const SSC_ATOMICS: u32 = 3u;
 // Depth of a background sample in the slope test (finite: the test multiplies it).
 const SSC_BACKGROUND_DEPTH: f32 = 1.0e30;
 
-struct SscSlot {
-    hit: vec4u,
-    radiance: vec4f,  // rgb: accumulated radiance L_s, w: sample count c_s
-}
-
-// Per output pixel: reconstructed radiance, motion (pixels, now -> previous frame), trace flags
-// (bit 0: base-rate pixel, bit 1: flagged by the slope test, bit 2: hole) and rays traced.
-struct SscPixel {
-    radiance: vec4f,
-    motion: vec2f,
-    flags: u32,
-    rays: u32,
-}
-
 // Words of `ssc_work` (header), then the shade list from SSC_LIST.
 const SSC_SHADE_COUNT: u32 = 0u;
 const SSC_RAYS: u32 = 1u;

@@ -23,9 +23,8 @@ pub mod slope;
 pub mod storage;
 
 pub use settings::{Retrace, SampleCacheSettings, ShadingMode};
-pub use storage::GpuSlot;
+pub use storage::{GpuSlot, SscSlot};
 
-use bytemuck::{Pod, Zeroable};
 
 use crate::compute::BufferBinding;
 use crate::error::RenderError;
@@ -80,6 +79,8 @@ pub fn shader_source() -> &'static str {
         [
             PathTracer::library_source(),
             SscParams::WGSL,
+            storage::SscSlot::WGSL,
+            SscPixel::WGSL,
             include_str!("../../shaders/sample_cache/storage.wgsl"),
             include_str!("../../shaders/sample_cache/slope.wgsl"),
             include_str!("../../shaders/sample_cache/reproject.wgsl"),
@@ -122,15 +123,21 @@ crate::gpu_struct! {
     }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct GpuPixel {
-    pub radiance: [f32; 4],
-    pub motion: [f32; 2],
-    /// Bit 0: base-rate pixel, bit 1: flagged by the slope test, bit 2: hole.
-    pub flags: u32,
-    pub rays: u32,
+crate::gpu_struct! {
+    /// Per output pixel: reconstructed radiance, motion (pixels, now -> previous frame), trace
+    /// flags and rays traced.
+    #[derive(Default)]
+    pub struct SscPixel {
+        pub radiance: [f32; 4] => "vec4f",
+        pub motion: [f32; 2] => "vec2f",
+        /// Bit 0: base-rate pixel, bit 1: flagged by the slope test, bit 2: hole.
+        pub flags: u32 => "u32",
+        pub rays: u32 => "u32",
+    }
 }
+
+/// The former name of [`SscPixel`].
+pub type GpuPixel = SscPixel;
 
 pub const FLAG_BASE: u32 = 1;
 pub const FLAG_SLOPE: u32 = 2;

@@ -8,19 +8,24 @@
 //! (it is the instance's). A background sample is `[NO_HIT, bits(dir.xyz)]`.
 //! The mask holds occupancy in bits 0..N and visibility in bits N..2N.
 
-use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
 use crate::path_tracer::NO_HIT;
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct GpuSlot {
-    pub hit: [u32; 4],
-    pub radiance: [f32; 4],
+crate::gpu_struct! {
+    /// One cached sample: its hit (see the accessors) and rgb: accumulated radiance L_s, w:
+    /// sample count c_s.
+    #[derive(Default, PartialEq)]
+    pub struct SscSlot {
+        pub hit: [u32; 4] => "vec4u",
+        pub radiance: [f32; 4] => "vec4f",
+    }
 }
 
-const _: () = assert!(size_of::<GpuSlot>() == 32);
+/// The former name of [`SscSlot`].
+pub type GpuSlot = SscSlot;
+
+const _: () = assert!(size_of::<SscSlot>() == 32);
 
 /// A decoded cached sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,7 +34,7 @@ pub enum CachedHit {
     Background { direction: Vec3 },
 }
 
-impl GpuSlot {
+impl SscSlot {
     pub fn decode(&self) -> CachedHit {
         let h = self.hit;
         if h[0] == NO_HIT {
