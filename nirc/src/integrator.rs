@@ -225,24 +225,12 @@ impl CachePaths {
 
     fn pass(&self, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer, group: &wgpu::BindGroup, pipeline: &wgpu::ComputePipeline, label: &str, workgroups: (u32, u32)) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
-        pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
-        pass.set_bind_group(2, group, &[]);
-        pass.dispatch_workgroups(workgroups.0, workgroups.1, 1);
+        record(&mut pass, tracer, group, &[(pipeline, workgroups)]);
     }
 
     /// One timed pass (pass `index` of `timed`) of `pipelines`, in order, each over its workgroups.
     fn timed_pass(&self, timed: &mut TimedFrame, index: usize, tracer: &PathTracer, group: &wgpu::BindGroup, pipelines: &[(&wgpu::ComputePipeline, (u32, u32))]) -> Result<(), NircError> {
-        timed.pass(index, |pass| {
-            pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
-            pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
-            pass.set_bind_group(2, group, &[]);
-            for (pipeline, groups) in pipelines {
-                pass.set_pipeline(pipeline);
-                pass.dispatch_workgroups(groups.0, groups.1, 1);
-            }
-        })?;
+        timed.pass(index, |pass| record(pass, tracer, group, pipelines))?;
         Ok(())
     }
 
@@ -339,5 +327,17 @@ impl CachePaths {
     pub fn read_records(&self, gpu: &Gpu) -> Result<Vec<TrainingRecord>, NircError> {
         let bytes = crate::gpu::readback::read_bytes(gpu, &self.records, "nirc training records")?;
         Ok(bytemuck::cast_slice::<u8, TrainingRecord>(&bytes)[..self.record_count() as usize].to_vec())
+    }
+}
+
+/// Binds the scene (@group(0)), the geometry (@group(1)) and `group` (@group(2)), then dispatches
+/// each of `pipelines` over its workgroups.
+fn record(pass: &mut wgpu::ComputePass, tracer: &PathTracer, group: &wgpu::BindGroup, pipelines: &[(&wgpu::ComputePipeline, (u32, u32))]) {
+    pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
+    pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+    pass.set_bind_group(2, group, &[]);
+    for (pipeline, groups) in pipelines {
+        pass.set_pipeline(pipeline);
+        pass.dispatch_workgroups(groups.0, groups.1, 1);
     }
 }

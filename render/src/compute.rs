@@ -45,6 +45,19 @@ impl BufferBinding {
     }
 }
 
+/// Storage buffers among `bindings` (what counts against the adapter's per-stage limit).
+pub const fn storage_buffers(bindings: &[BufferBinding]) -> u32 {
+    let mut n = 0;
+    let mut i = 0;
+    while i < bindings.len() {
+        if !matches!(bindings[i].access, Access::Uniform) {
+            n += 1;
+        }
+        i += 1;
+    }
+    n
+}
+
 /// The WGSL declarations of `bindings` as @group(`group`), binding i = `bindings[i]`.
 pub fn declare(group: u32, bindings: &[BufferBinding]) -> String {
     bindings

@@ -63,8 +63,7 @@ impl PassLibrary {
         own: &[BufferBinding],
         entries: [&str; N],
     ) -> Result<(wgpu::BindGroupLayout, [wgpu::ComputePipeline; N]), RenderError> {
-        let own_storage = own.iter().filter(|b| b.access != compute::Access::Uniform).count() as u32;
-        let needed = LIBRARY_STORAGE_BUFFERS + own_storage;
+        let needed = LIBRARY_STORAGE_BUFFERS + compute::storage_buffers(own);
         let limit = gpu.limits.max_storage_buffers_per_shader_stage;
         if needed > limit {
             return Err(crate::gpu::GpuError::OverLimit { what: format!("storage buffers of pass '{pass}'"), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());

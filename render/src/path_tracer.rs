@@ -36,9 +36,6 @@ pub const GBUFFER_PASS: &str = "gbuffer";
 pub const PATH_TRACE_PASS: &str = "path_trace";
 
 const WORKGROUP: u32 = 8;
-/// Storage buffers of the path tracer's own @group(2) (radiance, G-buffer, sample partials, ray
-/// counter).
-const OWN_STORAGE_BUFFERS: u32 = 4;
 /// Words of the ray counter: [0] rays traced since the last clear.
 const COUNTER_WORDS: u64 = 4;
 
@@ -129,7 +126,7 @@ impl PathTracer {
             return Err(RenderError::Settings("max_depth must be at least 1 (1 = direct lighting)".into()));
         }
         gpu.check_resolution(settings.width, settings.height, BYTES_PER_PIXEL)?;
-        let needed = LIBRARY_STORAGE_BUFFERS + OWN_STORAGE_BUFFERS;
+        let needed = LIBRARY_STORAGE_BUFFERS + compute::storage_buffers(&OWN_GROUP);
         let limit = gpu.limits.max_storage_buffers_per_shader_stage;
         if needed > limit {
             return Err(crate::gpu::GpuError::OverLimit {

@@ -14,8 +14,6 @@ use crate::scene::{Camera, SceneChanges, SceneDesc};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-/// Storage buffers of @group(0): materials, texels, lights.
-pub const STORAGE_BUFFERS: u32 = 3;
 
 /// @group(0): frame uniform, materials, texels, lights (declared into the library's WGSL).
 pub const GROUP: [BufferBinding; 4] = [
@@ -24,6 +22,9 @@ pub const GROUP: [BufferBinding; 4] = [
     BufferBinding::read("texels", "array<u32>"),
     BufferBinding::read("lights", "array<GpuLight>"),
 ];
+
+/// Storage buffers of @group(0).
+pub const STORAGE_BUFFERS: u32 = compute::storage_buffers(&GROUP);
 
 /// Image size and path depth: what every pass's frame uniform carries besides the scene (the
 /// path tracer's settings; `render::path_tracer` re-exports it).

@@ -111,16 +111,17 @@ pub fn extract_scene(world: &mut World) {
     world.resource_scope(|world, mut extracted: Mut<ExtractedScene>| {
         let e = extracted.bypass_change_detection();
         let s = &mut e.scene;
-        let before = (std::mem::take(&mut s.instances), std::mem::take(&mut s.lights), std::mem::take(&mut s.materials), s.camera, s.environment);
-        extract_dynamic(world, s);
-        e.changes = SceneChanges {
-            geometry: false,
-            instances: before.0 != s.instances,
-            lights: before.1 != s.lights,
-            materials: before.2 != s.materials,
-            camera: before.3 != s.camera,
-            environment: before.4 != s.environment,
+        // The dynamic parts of the last frame (meshes and textures are static: not copied).
+        let before = SceneDesc {
+            instances: std::mem::take(&mut s.instances),
+            lights: std::mem::take(&mut s.lights),
+            materials: std::mem::take(&mut s.materials),
+            camera: s.camera,
+            environment: s.environment,
+            ..Default::default()
         };
+        extract_dynamic(world, s);
+        e.changes = SceneChanges { geometry: false, ..SceneChanges::between(&before, s) };
         if e.changes.any() {
             extracted.set_changed();
         }

@@ -16,7 +16,7 @@ use bevy_ecs::prelude::*;
 
 pub use method_output::{MethodImage, MethodOutput};
 pub use resources::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Progress, References, Run, RunOutput, Tracer};
-pub use stage::{Stage, catch_failures, describe, failed, listing, new_schedule, take_failure};
+pub use stage::{Stage, catch_failures, describe, failed, listing, method_failed, new_schedule, take_failure};
 
 
 fn started(clock: Res<FrameClock>) -> bool {

@@ -93,6 +93,11 @@ pub fn failed(e: anyhow::Error) -> BevyError {
     BevyError::from(format!("{e:#}"))
 }
 
+/// A method system's error: the method's label, the frame, then `e`.
+pub fn method_failed(label: &str, frame: u32, e: impl std::fmt::Display) -> BevyError {
+    BevyError::from(format!("{label} frame {frame}: {e}"))
+}
+
 /// The frame's systems in execution order with their stage. An error names a system that is in
 /// no stage, or one that would run before a system of an earlier stage.
 pub fn listing(schedule: &mut Schedule, world: &mut World) -> Result<Vec<(Stage, String)>, String> {

@@ -13,7 +13,7 @@ use render::timing::PassTiming;
 pub use render::hash_cache::HashCacheSettings;
 
 use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
-use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, failed};
+use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
 
 /// `hash_cache`, `hash_cache_first_hit`, `hash_cache_taa`, ...
 pub fn label(s: &HashCacheSettings) -> String {
@@ -65,7 +65,7 @@ pub fn age_and_update(
         let updated = state
             .cache
             .update(&gpu.0, &tracer.0, &scene.scene.camera, run.scenario.seed, clock.global)
-            .map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
+            .map_err(|e| method_failed(&info.label, clock.global, e))?;
         state.updated = Some(updated);
         frame.add_cpu(start);
     }
@@ -78,7 +78,7 @@ pub fn resolve(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut methods: Query<(
         let start = Instant::now();
         let state = &mut *state;
         let (timings, jitter) = state.updated.take().unwrap_or_default();
-        let out = state.cache.resolve(&gpu.0, state.taa.as_mut(), timings, jitter).map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
+        let out = state.cache.resolve(&gpu.0, state.taa.as_mut(), timings, jitter).map_err(|e| method_failed(&info.label, clock.global, e))?;
         let s = out.stats;
         frame.output = Some(MethodOutput {
             stats: vec![

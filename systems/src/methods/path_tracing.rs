@@ -7,7 +7,7 @@ use bevy_ecs::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
-use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, failed};
+use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
 
 /// `PathTracing(spp: 4)`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -53,7 +53,7 @@ impl MethodPlugin for Plugin {
 pub fn render(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&PathTracing, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
     for (pt, info, mut frame) in &mut methods {
         let start = Instant::now();
-        let out = tracer.0.render(&gpu.0, pt.spp, run.scenario.seed, clock.global).map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
+        let out = tracer.0.render(&gpu.0, pt.spp, run.scenario.seed, clock.global).map_err(|e| method_failed(&info.label, clock.global, e))?;
         frame.output = Some(MethodOutput::timed(out.radiance, out.gbuffer.motion, &out.timings, out.rays, out.shaded));
         frame.add_cpu(start);
     }

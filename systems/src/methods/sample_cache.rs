@@ -10,7 +10,7 @@ use render::sample_cache::SampleCache;
 pub use render::sample_cache::SampleCacheSettings;
 
 use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
-use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, failed};
+use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
 
 #[derive(Component)]
 pub struct SampleCacheState(SampleCache);
@@ -43,7 +43,7 @@ fn stage(stage: usize, gpu: &GpuDevice, tracer: &Tracer, seed: u64, clock: &Fram
         if stage == 0 {
             state.0.begin_frame(seed, clock.global);
         }
-        state.0.stage(&gpu.0, &tracer.0, stage).map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
+        state.0.stage(&gpu.0, &tracer.0, stage).map_err(|e| method_failed(&info.label, clock.global, e))?;
         frame.add_cpu(start);
     }
     Ok(())
@@ -70,7 +70,7 @@ pub fn reconstruct(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, cloc
     for (mut state, info, mut frame) in &mut methods {
         let start = Instant::now();
         let slots = state.0.settings().slots as f64;
-        let out = state.0.finish_frame(&gpu.0).map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
+        let out = state.0.finish_frame(&gpu.0).map_err(|e| method_failed(&info.label, clock.global, e))?;
         let s = &out.stats;
         let pixels = out.radiance.len().max(1) as f64;
         let stats = vec![

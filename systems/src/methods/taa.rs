@@ -11,7 +11,7 @@ use render::timing::PassTiming;
 pub use render::taa::TaaSettings;
 
 use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
-use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, failed};
+use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
 
 #[derive(Component)]
 pub struct TaaState {
@@ -45,7 +45,7 @@ impl MethodPlugin for Plugin {
 pub fn trace(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&mut TaaState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
     for (mut state, info, mut frame) in &mut methods {
         let start = Instant::now();
-        let t = state.taa.trace(&gpu.0, &tracer.0, run.scenario.seed, clock.global).map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
+        let t = state.taa.trace(&gpu.0, &tracer.0, run.scenario.seed, clock.global).map_err(|e| method_failed(&info.label, clock.global, e))?;
         state.traced = Some(t);
         frame.add_cpu(start);
     }
@@ -57,7 +57,7 @@ pub fn resolve(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut methods: Query<(
     for (mut state, info, mut frame) in &mut methods {
         let start = Instant::now();
         let traced = state.traced.take().unwrap_or_default();
-        let out = state.taa.resolve(&gpu.0, traced).map_err(|e| failed(anyhow::anyhow!("{} frame {}: {e}", info.label, clock.global)))?;
+        let out = state.taa.resolve(&gpu.0, traced).map_err(|e| method_failed(&info.label, clock.global, e))?;
         let n = out.history_length.len().max(1) as f64;
         let rejected = out.history_length.iter().filter(|&&l| l <= 1.0).count() as f64 / n;
         let mean_length = out.history_length.iter().map(|&l| l as f64).sum::<f64>() / n;
