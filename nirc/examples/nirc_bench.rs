@@ -11,7 +11,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let reps = args.get(2).copied().unwrap_or(3);
     let gpu = render::gpu::Gpu::new()?;
     let config = NircConfig::default();
-    for placement in [WeightPlacement::Workgroup, WeightPlacement::Storage] {
+    for placement in [WeightPlacement::Tiled, WeightPlacement::Storage] {
         let r = nirc::bench::run(&gpu, &config, Some(placement), batch, queries, reps)?;
         println!("{r:#?}");
     }

@@ -1,6 +1,6 @@
 // Input encoding (CPU mirror: src/cpu/encoding.rs): multi-resolution hash grid of the position
 // with trilinear interpolation, then the direction (identity or real spherical harmonics).
-// Needs from the pass: `hyper`, `fn table(net, i) -> f32` and the private `acts` array.
+// Needs from the pass: `hyper` and `fn table(net, i) -> f32`.
 
 struct Corners {
     index: array<u32, 8>,
@@ -37,44 +37,30 @@ fn level_corners(level: u32, p: vec3<f32>) -> Corners {
     return out;
 }
 
-fn encode_direction(d: vec3<f32>) {
-    let x = d.x;
-    let y = d.y;
-    let z = d.z;
-    let b = LEVELS * FEATURES;
+// Feature i (< DIR_DIMS) of the direction encoding.
+fn direction_feature(d: vec3<f32>, i: u32) -> f32 {
     if DIR_KIND == 1u {
-        acts[b] = x;
-        acts[b + 1u] = y;
-        acts[b + 2u] = z;
-    } else if DIR_KIND == 2u {
-        acts[b] = 0.2820948;
-        if DIR_BANDS >= 2u {
-            acts[b + 1u] = -0.48860252 * y;
-            acts[b + 2u] = 0.48860252 * z;
-            acts[b + 3u] = -0.48860252 * x;
-        }
-        if DIR_BANDS >= 3u {
-            acts[b + 4u] = 1.0925484 * x * y;
-            acts[b + 5u] = -1.0925484 * y * z;
-            acts[b + 6u] = 0.9461747 * z * z - 0.31539157;
-            acts[b + 7u] = -1.0925484 * x * z;
-            acts[b + 8u] = 0.5462742 * (x * x - y * y);
-        }
+        return d[i];
+    }
+    switch i {
+        case 0u: { return 0.2820948; }
+        case 1u: { return -0.48860252 * d.y; }
+        case 2u: { return 0.48860252 * d.z; }
+        case 3u: { return -0.48860252 * d.x; }
+        case 4u: { return 1.0925484 * d.x * d.y; }
+        case 5u: { return -1.0925484 * d.y * d.z; }
+        case 6u: { return 0.9461747 * d.z * d.z - 0.31539157; }
+        case 7u: { return -1.0925484 * d.x * d.z; }
+        case 8u: { return 0.5462742 * (d.x * d.x - d.y * d.y); }
+        default: { return 0.0; }
     }
 }
 
-// Writes the network input of predictor `net` (0 = High-LR, 1 = EMA) into acts[0..IN_DIMS).
-fn encode_input(net: u32, position: vec3<f32>, direction: vec3<f32>) {
-    let p = normalize_to_bounds(hyper, position);
-    for (var l = 0u; l < LEVELS; l++) {
-        let corners = level_corners(l, p);
-        for (var k = 0u; k < FEATURES; k++) {
-            var acc = 0.0;
-            for (var c = 0u; c < 8u; c++) {
-                acc += corners.weight[c] * table(net, corners.index[c] + k);
-            }
-            acts[l * FEATURES + k] = acc;
-        }
+// Feature k of one level from predictor `net`'s table: the trilinear sum over the corners.
+fn corner_sum(net: u32, corners: Corners, k: u32) -> f32 {
+    var acc = 0.0;
+    for (var c = 0u; c < 8u; c++) {
+        acc += corners.weight[c] * table(net, corners.index[c] + k);
     }
-    encode_direction(direction);
+    return acc;
 }

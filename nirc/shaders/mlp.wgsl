@@ -1,6 +1,6 @@
-// The tiny MLP (CPU mirror: src/cpu/mlp.rs): no biases, ReLU hidden layers, linear RGB output.
-// Activations stay in private arrays; `fn weight(net, i) -> f32` comes from the pass (workgroup
-// copy of the weights when they fit, else the storage buffer).
+// The tiny MLP, one invocation per record (CPU mirror: src/cpu/mlp.rs): no biases, ReLU hidden
+// layers, linear RGB output. Activations stay in private arrays, weights come from storage
+// (weights.wgsl). The fallback for networks the tiled passes (mlp_tile.wgsl) do not take.
 
 var<private> acts: array<f32, ACT_FLOATS>;
 var<private> deltas: array<f32, DELTA_FLOATS>;
@@ -54,4 +54,22 @@ fn mlp_backward(d_out: vec3<f32>) {
             }
         }
     }
+}
+
+fn encode_direction(d: vec3<f32>) {
+    for (var i = 0u; i < DIR_DIMS; i++) {
+        acts[LEVELS * FEATURES + i] = direction_feature(d, i);
+    }
+}
+
+// Writes the network input of predictor `net` (0 = High-LR, 1 = EMA) into acts[0..IN_DIMS).
+fn encode_input(net: u32, position: vec3<f32>, direction: vec3<f32>) {
+    let p = normalize_to_bounds(hyper, position);
+    for (var l = 0u; l < LEVELS; l++) {
+        let corners = level_corners(l, p);
+        for (var k = 0u; k < FEATURES; k++) {
+            acts[l * FEATURES + k] = corner_sum(net, corners, k);
+        }
+    }
+    encode_direction(direction);
 }

@@ -3,17 +3,6 @@
 // for the weight-gradient pass, scatters the hash-grid gradients into exact fixed-point sums
 // (order-independent), and the (y, f_cur, f_ema) sample for the reliability grid.
 
-@group(0) @binding(0) var<uniform> call: Call;
-@group(0) @binding(1) var<uniform> hyper: Hyper;
-@group(0) @binding(2) var<storage, read> records: array<TrainingRecord>;
-@group(0) @binding(3) var<storage, read> params: array<f32>;
-@group(0) @binding(4) var<storage, read> ema: array<f32>;
-@group(0) @binding(5) var<storage, read_write> scratch: array<f32>;
-@group(0) @binding(6) var<storage, read_write> accum: array<atomic<u32>>;
-@group(0) @binding(7) var<storage, read_write> samples: array<ReliabilitySample>;
-@group(0) @binding(8) var<storage, read_write> losses: array<f32>;
-@group(0) @binding(9) var<storage, read_write> counters: CountersAtomic;
-
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let r = gid.x;
@@ -22,13 +11,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
     let pos = rec.position.xyz;
     let dir = rec.direction.xyz;
 
-    load_weights(1u, lid);
     var f_ema = vec3<f32>(0.0);
     if in_range {
         encode_input(1u, pos, dir);
         f_ema = mlp_forward(1u);
     }
-    load_weights(0u, lid);
     if !in_range {
         return;
     }
@@ -36,22 +23,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
     let f = mlp_forward(0u);
     let y = rec.target_rgb.xyz;
 
-    // Relative L2, denominators under stop-gradient.
-    var den: vec3<f32>;
-    if hyper.loss_luminance == 1u {
-        let l = 0.2126 * f.x + 0.7152 * f.y + 0.0722 * f.z;
-        den = vec3<f32>(l * l + hyper.loss_epsilon);
-    } else {
-        den = f * f + vec3<f32>(hyper.loss_epsilon);
-    }
-    var loss = 0.0;
-    var d_out = vec3<f32>(0.0);
-    for (var c = 0u; c < 3u; c++) {
-        let diff = f[c] - y[c];
-        loss += diff * diff / den[c];
-        d_out[c] = (2.0 / 3.0) * diff / den[c];
-    }
-    loss = loss / 3.0;
+    let l2 = relative_l2(f, y);
+    let loss = l2.w;
+    let d_out = l2.xyz;
     losses[r] = loss;
     var ok = is_finite(loss);
 

@@ -38,7 +38,7 @@ fn forward_matches_cpu_in_both_weight_placements() {
     let cpu = CpuCache::new(state.clone());
     let mut rng = Rng(4);
     let queries: Vec<_> = records(&mut rng, 200).iter().map(|r| r.query()).collect();
-    for placement in [WeightPlacement::Workgroup, WeightPlacement::Storage] {
+    for placement in [WeightPlacement::Tiled, WeightPlacement::Storage] {
         let cache = NeuralCache::from_state(gpu(), &state, Some(placement)).unwrap();
         for mode in [PredictorMode::HighLrOnly, PredictorMode::EmaOnly] {
             let got = cache.infer_queries(gpu(), &queries, mode).unwrap();
@@ -61,12 +61,12 @@ fn one_training_step_matches_cpu() {
     let config = small_config();
     let state = randomized_state(&config, 33);
     let mut rng = Rng(6);
-    // 300 records: two weight-gradient chunks, one partial.
+    // 300 records: four full weight-gradient chunks (training tiles of 64) and a partial one.
     let batch = records(&mut rng, 300);
     let mut cpu = CpuCache::new(state.clone());
     let report = cpu.train_step(&batch);
     assert!(report.committed);
-    for placement in [WeightPlacement::Workgroup, WeightPlacement::Storage] {
+    for placement in [WeightPlacement::Tiled, WeightPlacement::Storage] {
         let cache = NeuralCache::from_state(gpu(), &state, Some(placement)).unwrap();
         cache.train_records(gpu(), &batch).unwrap();
         let got = cache.download_state(gpu()).unwrap();
@@ -83,6 +83,38 @@ fn one_training_step_matches_cpu() {
         // The step really moved the weights.
         let moved = got.params.iter().zip(&state.params).filter(|(a, b)| (*a - *b).abs() > 0.5 * lr).count();
         assert!(moved > got.params.len() / 10, "only {moved} parameters moved");
+    }
+}
+
+#[test]
+fn twelve_steps_keep_weights_ema_and_blend_on_the_cpu_reference() {
+    // Step 1's debiased EMA equals the weights; only later steps test the average itself.
+    let config = small_config();
+    let state = randomized_state(&config, 51);
+    let mut rng = Rng(52);
+    let mut cpu = CpuCache::new(state.clone());
+    let cache = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Tiled)).unwrap();
+    for _ in 0..12 {
+        let batch = records(&mut rng, 130);
+        assert!(cpu.train_step(&batch).committed);
+        cache.train_records(gpu(), &batch).unwrap();
+    }
+    let got = cache.download_state(gpu()).unwrap();
+    assert_eq!(got.counters, cpu.state.counters);
+    let lr = config.optimizer.learning_rate;
+    // Twelve Adam steps of about lr each: round-off compounds, the bound is still far below lr.
+    assert_vec_close("params", &got.params, &cpu.state.params, 1e-4, 2e-2 * lr);
+    assert_vec_close("ema", &got.ema, &cpu.state.ema, 1e-4, 2e-2 * lr);
+    let apart = got.ema.iter().zip(&got.params).filter(|(e, p)| (*e - *p).abs() > lr).count();
+    assert!(apart > got.ema.len() / 10, "after 12 steps the EMA must lag the weights ({apart} apart)");
+    let q: Vec<_> = records(&mut rng, 100).iter().map(|r| r.query()).collect();
+    for mode in [PredictorMode::EmaOnly, PredictorMode::Blend] {
+        for (g, w) in cache.infer_queries(gpu(), &q, mode).unwrap().iter().zip(cpu.infer(&q, mode)) {
+            assert!(close(g.sigma, w.sigma, 1e-3, 1e-4), "{mode:?}: σ {} vs {}", g.sigma, w.sigma);
+            for c in 0..3 {
+                assert!(close(g.radiance[c], w.radiance[c], 1e-3, 1e-4), "{mode:?}: {:?} vs {:?}", g.radiance, w.radiance);
+            }
+        }
     }
 }
 
@@ -283,17 +315,19 @@ fn gpu_training_converges_like_the_cpu_reference() {
 }
 
 #[test]
-fn weights_over_the_workgroup_budget_fall_back_to_storage_or_are_refused() {
+fn networks_the_tiled_mlp_does_not_take_fall_back_to_storage_or_are_refused() {
     let small = NeuralCache::new(gpu(), &small_config(), bounds()).unwrap();
-    assert_eq!(small.placement, WeightPlacement::Workgroup);
+    assert_eq!(small.placement, WeightPlacement::Tiled);
+    assert!(nirc::gpu::shaders::workgroup_bytes(&small.layout) <= 32768);
+    let default = nirc::layout::ParameterLayout::new(&nirc::NircConfig::default());
+    assert_eq!(nirc::gpu::shaders::workgroup_bytes(&default), 32768, "width 64: two 16 KiB tiles");
     let mut config = small_config();
-    // 21 + 128 x 128 + ... floats: 80 KiB of weights, over 32 KiB.
     config.network = nirc::config::NetworkConfig { width: 128, hidden_layers: 2 };
     let big = NeuralCache::new(gpu(), &config, bounds()).unwrap();
     assert_eq!(big.placement, WeightPlacement::Storage);
     let state = CacheState::initial(&config, bounds()).unwrap();
-    let err = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Workgroup)).err().expect("refused").to_string();
-    assert!(err.contains("workgroup memory") && err.contains("32768"), "{err}");
+    let err = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Tiled)).err().expect("refused").to_string();
+    assert!(err.contains("tiled MLP") && err.contains("width 128"), "{err}");
     // The fallback computes the same thing.
     let cpu = CpuCache::new(state);
     let q: Vec<_> = records(&mut Rng(9), 32).iter().map(|r| r.query()).collect();

@@ -15,7 +15,7 @@ use crate::reliability::{self, MOMENTS_PER_CELL};
 use crate::state::CacheState;
 
 /// Records per partial sum of the MLP weight gradient (the GPU's chunk).
-pub const GRADIENT_CHUNK: usize = 256;
+pub const GRADIENT_CHUNK: usize = 64;
 
 /// What a training step did.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -65,8 +65,10 @@ struct Call {
 }
 
 struct Pipelines {
-    train_forward_backward: wgpu::ComputePipeline,
-    weight_partial: wgpu::ComputePipeline,
+    /// train_tile (tiled: forward, backward and the tile's weight-gradient sums) or
+    /// train_forward_backward (per record, then `weight_partial`).
+    train: wgpu::ComputePipeline,
+    weight_partial: Option<wgpu::ComputePipeline>,
     weight_reduce: wgpu::ComputePipeline,
     adam_check: wgpu::ComputePipeline,
     adam_apply: wgpu::ComputePipeline,
@@ -100,7 +102,7 @@ pub struct TrainStep {
     num_chunks: u32,
     fb: wgpu::BindGroup,
     accumulate: wgpu::BindGroup,
-    partial: wgpu::BindGroup,
+    partial: Option<wgpu::BindGroup>,
     reduce: wgpu::BindGroup,
     check: wgpu::BindGroup,
     apply: wgpu::BindGroup,
@@ -183,28 +185,36 @@ impl NeuralCache {
         Self::from_state(gpu, &CacheState::initial(config, scene_bounds)?, None)
     }
 
-    /// Uploads a whole state. `placement` None chooses workgroup memory when one predictor's
-    /// weights fit the adapter's workgroup memory budget, else the storage buffer.
+    /// Uploads a whole state. `placement` None chooses the tiled MLP where the network and the
+    /// adapter's workgroup memory allow it, else the per-record passes.
     pub fn from_state(gpu: &Gpu, state: &CacheState, placement: Option<WeightPlacement>) -> Result<Self, NircError> {
         let config = state.config.clone();
         config.validate()?;
         let layout = ParameterLayout::new(&config);
-        // A network too large for the driver's per-invocation loop cap would come out wrong
-        // silently (llvmpipe); refuse it with the numbers instead.
-        gpu.check_loop_iterations(
-            &format!("nirc training/inference (width {}, {} hidden layers)", config.network.width, config.network.hidden_layers),
-            layout.loop_iterations_per_invocation(WORKGROUP_SIZE),
-        )?;
-        let wg_bytes = shaders::workgroup_bytes(&layout, WeightPlacement::Workgroup);
+        let wg_bytes = shaders::workgroup_bytes(&layout);
+        let tiled = || -> Result<(), NircError> {
+            if let Some(why) = shaders::tiled_unsupported(&layout) {
+                return Err(NircError::Config(format!("the tiled MLP cannot run this network: {why}")));
+            }
+            Ok(gpu.check_workgroup_memory("nirc tiled MLP (tiles in workgroup memory)", wg_bytes)?)
+        };
         let placement = match placement {
-            Some(WeightPlacement::Workgroup) => {
-                gpu.check_workgroup_memory("nirc forward (MLP weights in workgroup memory)", wg_bytes)?;
-                WeightPlacement::Workgroup
+            Some(WeightPlacement::Tiled) => {
+                tiled()?;
+                WeightPlacement::Tiled
             }
             Some(WeightPlacement::Storage) => WeightPlacement::Storage,
-            None if gpu.check_workgroup_memory("nirc forward", wg_bytes).is_ok() => WeightPlacement::Workgroup,
+            None if tiled().is_ok() => WeightPlacement::Tiled,
             None => WeightPlacement::Storage,
         };
+        if placement == WeightPlacement::Storage {
+            // A network too large for the driver's per-invocation loop cap would come out wrong
+            // silently (llvmpipe); refuse it with the numbers instead.
+            gpu.check_loop_iterations(
+                &format!("nirc training/inference (width {}, {} hidden layers)", config.network.width, config.network.hidden_layers),
+                layout.loop_iterations_per_invocation(WORKGROUP_SIZE),
+            )?;
+        }
         if config.max_batch.div_ceil(WORKGROUP_SIZE) > gpu.limits.max_compute_workgroups_per_dimension {
             return Err(NircError::Config(format!("max_batch {} needs more workgroups than this adapter dispatches", config.max_batch)));
         }
@@ -218,7 +228,7 @@ impl NeuralCache {
     /// error naming the pass.
     fn pipelines(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, placement: WeightPlacement) -> Result<Pipelines, NircError> {
         let build = |pass: &str, entries: &[&str]| -> Result<Vec<wgpu::ComputePipeline>, NircError> {
-            let source = shaders::source(config, layout, placement, pass);
+            let source = shaders::source(config, layout, pass);
             let label = format!("nirc {pass}");
             Ok(match entries {
                 [a] => render::compute::pipelines_auto_layout(gpu, &label, &source, [*a])?.to_vec(),
@@ -230,9 +240,10 @@ impl NeuralCache {
         let one = |pass: &str| -> Result<wgpu::ComputePipeline, NircError> { Ok(build(pass, &["main"])?.remove(0)) };
         let [weight_partial, weight_reduce] = <[wgpu::ComputePipeline; 2]>::try_from(build("weight_gradient", &["partial_sums", "reduce"])?).expect("two pipelines");
         let [adam_check, adam_apply, ema_update] = <[wgpu::ComputePipeline; 3]>::try_from(build("adam_ema", &["check", "apply", "ema_update"])?).expect("three pipelines");
+        let tiled = placement == WeightPlacement::Tiled;
         Ok(Pipelines {
-            train_forward_backward: one("train_forward_backward")?,
-            weight_partial,
+            train: one(if tiled { "train_tile" } else { "train_forward_backward" })?,
+            weight_partial: (!tiled).then_some(weight_partial),
             weight_reduce,
             adam_check,
             adam_apply,
@@ -240,7 +251,7 @@ impl NeuralCache {
             reliability_accumulate: one("reliability_accumulate")?,
             reliability_update: one("reliability_update")?,
             finish_step: one("finish_step")?,
-            infer: one("infer")?,
+            infer: one(if tiled { "infer_tile" } else { "infer" })?,
         })
     }
 
@@ -365,14 +376,14 @@ impl NeuralCache {
         let p = &self.pipelines;
         let num_chunks = n.div_ceil(CHUNK);
         let call = Self::call_buffer(gpu, Call { n, inv_n: 1.0 / n as f32, mode: 0, num_chunks });
-        let fb = bind(
-            gpu,
-            "nirc train_forward_backward",
-            &p.train_forward_backward,
-            &[(0, &call), (1, &b.hyper), (2, records), (3, &b.params), (4, &b.ema), (5, &b.scratch), (6, &b.grid_accum), (7, &b.samples), (8, &b.losses), (9, &b.counters)],
-        );
+        let mut fb_entries: Vec<(u32, &wgpu::Buffer)> =
+            vec![(0, &call), (1, &b.hyper), (2, records), (3, &b.params), (4, &b.ema), (5, &b.scratch), (6, &b.grid_accum), (7, &b.samples), (8, &b.losses), (9, &b.counters)];
+        if self.placement == WeightPlacement::Tiled {
+            fb_entries.push((10, &b.partials));
+        }
+        let fb = bind(gpu, "nirc train", &p.train, &fb_entries);
         let accumulate = bind(gpu, "nirc reliability accumulate", &p.reliability_accumulate, &[(0, &call), (1, &b.hyper), (2, &b.samples), (3, &b.reliability_accum), (4, &b.counters)]);
-        let partial = bind(gpu, "nirc weight partial", &p.weight_partial, &[(0, &call), (1, &b.scratch), (2, &b.partials)]);
+        let partial = p.weight_partial.as_ref().map(|wp| bind(gpu, "nirc weight partial", wp, &[(0, &call), (1, &b.scratch), (2, &b.partials)]));
         let reduce = bind(gpu, "nirc weight reduce", &p.weight_reduce, &[(0, &call), (2, &b.partials), (3, &b.grad)]);
         let adam_entries: &[(u32, &wgpu::Buffer)] =
             &[(0, &call), (1, &b.hyper), (2, &b.params), (3, &b.ema), (4, &b.adam_m), (5, &b.adam_v), (6, &b.grad), (7, &b.grid_accum), (8, &b.counters)];
@@ -411,9 +422,11 @@ impl NeuralCache {
 
     fn dispatch_adam(&self, pass: &mut wgpu::ComputePass, s: &TrainStep) {
         let p = &self.pipelines;
-        dispatch(pass, &p.train_forward_backward, &s.fb, s.n.div_ceil(WORKGROUP_SIZE));
+        dispatch(pass, &p.train, &s.fb, s.n.div_ceil(WORKGROUP_SIZE));
         dispatch(pass, &p.reliability_accumulate, &s.accumulate, groups_for(s.n as u64));
-        dispatch(pass, &p.weight_partial, &s.partial, groups_for(self.layout.mlp_params as u64 * s.num_chunks as u64));
+        if let (Some(pipeline), Some(group)) = (&p.weight_partial, &s.partial) {
+            dispatch(pass, pipeline, group, groups_for(self.layout.mlp_params as u64 * s.num_chunks as u64));
+        }
         dispatch(pass, &p.weight_reduce, &s.reduce, groups_for(self.layout.mlp_params as u64));
         let all = groups_for(self.layout.total_params as u64);
         dispatch(pass, &p.adam_check, &s.check, all);
@@ -466,7 +479,7 @@ impl NeuralCache {
     /// [`Self::encode_infer`] as pass `index` of a timed frame.
     pub fn infer_timed(&self, gpu: &Gpu, timed: &mut TimedFrame, index: usize, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: PredictorMode) -> Result<(), NircError> {
         let Some(group) = self.infer_group(gpu, queries, n, out, mode.code())? else { return Ok(()) };
-        timed.pass(index, |pass| dispatch(pass, &self.pipelines.infer, &group, n.div_ceil(WORKGROUP_SIZE)))?;
+        timed.pass(index, |pass| dispatch(pass, &self.pipelines.infer, &group, self.infer_groups(n)))?;
         Ok(())
     }
 
@@ -485,8 +498,16 @@ impl NeuralCache {
     fn encode_infer_code(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: u32) -> Result<(), NircError> {
         let Some(group) = self.infer_group(gpu, queries, n, out, mode)? else { return Ok(()) };
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc infer"), timestamp_writes: None });
-        dispatch(&mut pass, &self.pipelines.infer, &group, n.div_ceil(WORKGROUP_SIZE));
+        dispatch(&mut pass, &self.pipelines.infer, &group, self.infer_groups(n));
         Ok(())
+    }
+
+    /// Workgroups of an inference of `n` queries.
+    fn infer_groups(&self, n: u32) -> u32 {
+        match self.placement {
+            WeightPlacement::Tiled => n.div_ceil(shaders::INFER_TILE_QUERIES),
+            WeightPlacement::Storage => n.div_ceil(WORKGROUP_SIZE),
+        }
     }
 
     /// The bind group of an inference of `n` queries; `None` for no queries.
@@ -496,7 +517,7 @@ impl NeuralCache {
         }
         Self::check_items("cache queries", queries, n, std::mem::size_of::<CacheQuery>() as u64)?;
         Self::check_items("cache answers", out, n, std::mem::size_of::<CacheAnswer>() as u64)?;
-        let groups = n.div_ceil(WORKGROUP_SIZE);
+        let groups = self.infer_groups(n);
         if groups > gpu.limits.max_compute_workgroups_per_dimension {
             return Err(NircError::Config(format!("{n} queries need {groups} workgroups, over this adapter's limit")));
         }

@@ -1,5 +1,5 @@
-//! Assembles the WGSL of each pass: generated constants (sizes, level tables), the shared files
-//! of nirc/shaders/, the weight-access chunk (workgroup copy or storage), then the pass itself.
+//! Assembles the WGSL of each pass: generated constants (sizes, level tables, tile shapes), the
+//! shared files of nirc/shaders/, then the pass itself.
 
 use crate::config::NircConfig;
 use crate::layout::ParameterLayout;
@@ -14,6 +14,12 @@ const FIXED_SUM_READ: &str = include_str!("../../shaders/fixed_sum_read.wgsl");
 const ENCODING: &str = include_str!("../../shaders/encoding.wgsl");
 const MLP_LAYOUT: &str = include_str!("../../shaders/mlp_layout.wgsl");
 const MLP: &str = include_str!("../../shaders/mlp.wgsl");
+const MLP_TILE: &str = include_str!("../../shaders/mlp_tile.wgsl");
+const ANSWER: &str = include_str!("../../shaders/answer.wgsl");
+const WEIGHTS: &str = include_str!("../../shaders/weights.wgsl");
+const LOSS: &str = include_str!("../../shaders/loss.wgsl");
+const TRAIN_BINDINGS: &str = include_str!("../../shaders/train_bindings.wgsl");
+const INFER_BINDINGS: &str = include_str!("../../shaders/infer_bindings.wgsl");
 const RELIABILITY: &str = include_str!("../../shaders/reliability.wgsl");
 pub const TRAIN_FORWARD_BACKWARD: &str = include_str!("../../shaders/train_forward_backward.wgsl");
 pub const WEIGHT_GRADIENT: &str = include_str!("../../shaders/weight_gradient.wgsl");
@@ -22,17 +28,67 @@ pub const RELIABILITY_ACCUMULATE: &str = include_str!("../../shaders/reliability
 pub const RELIABILITY_UPDATE: &str = include_str!("../../shaders/reliability_update.wgsl");
 pub const FINISH_STEP: &str = include_str!("../../shaders/finish_step.wgsl");
 pub const INFER: &str = include_str!("../../shaders/infer.wgsl");
+pub const TRAIN_TILE: &str = include_str!("../../shaders/train_tile.wgsl");
+pub const INFER_TILE: &str = include_str!("../../shaders/infer_tile.wgsl");
 
-/// Records per partial sum of the weight gradient (`cpu::cache::GRADIENT_CHUNK`).
+/// Records per partial sum of the weight gradient (`cpu::cache::GRADIENT_CHUNK`): one training
+/// tile.
 pub const CHUNK: u32 = crate::cpu::cache::GRADIENT_CHUNK as u32;
 
-/// Where the forward/backward passes read the MLP weights from.
+/// Records per workgroup of the tiled training pass, queries per workgroup of the tiled
+/// inference (smaller, so that the second predictor's inputs fit beside the tiles).
+pub const TRAIN_TILE_RECORDS: u32 = 64;
+pub const INFER_TILE_QUERIES: u32 = 32;
+const _: () = assert!(TRAIN_TILE_RECORDS == CHUNK);
+
+/// How the MLP passes are written.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum WeightPlacement {
-    /// Each workgroup copies one predictor's weights into workgroup memory (fits in budget).
-    Workgroup,
-    /// Straight from the storage buffer (weights larger than the workgroup memory budget).
+    /// Tiled matrix products in workgroup memory (mlp_tile.wgsl): widths 32 and 64, at most 64
+    /// inputs.
+    Tiled,
+    /// One invocation per record, weights read from the storage buffer (any network).
     Storage,
+}
+
+/// Invocation (rq, oq) of a tile computes 4 records x OPT outputs: RQ = tile / 4 record quads,
+/// 64 / RQ output blocks.
+struct TileShape {
+    tile: u32,
+    rq: u32,
+    opt: u32,
+}
+
+fn tile_shape(layout: &ParameterLayout, tile: u32) -> TileShape {
+    let rq = tile / 4;
+    TileShape { tile, rq, opt: layout.width / (WORKGROUP_SIZE / rq) }
+}
+
+fn block_stride(n: u32, opt: u32) -> u32 {
+    n.div_ceil(opt) * (opt / 4)
+}
+
+/// vec4s of tile_w a pass needs: the largest W^T, W, or (training) activation tile.
+fn tile_w_vec4(layout: &ParameterLayout, shape: &TileShape, training: bool) -> u32 {
+    let mut need = 0;
+    for m in &layout.matrices {
+        need = need.max(block_stride(m.rows, shape.opt) * m.cols);
+        if training {
+            need = need.max(block_stride(m.cols, shape.opt) * m.rows).max(shape.tile * block_stride(m.cols, shape.opt));
+        }
+    }
+    need
+}
+
+/// Why the tiled passes cannot run this network, if they cannot.
+pub fn tiled_unsupported(layout: &ParameterLayout) -> Option<String> {
+    if !(layout.width == 32 || layout.width == 64) {
+        return Some(format!("width {} (the tiled MLP takes 32 or 64)", layout.width));
+    }
+    if layout.input_dims > 64 {
+        return Some(format!("{} network inputs (the tiled MLP takes at most 64)", layout.input_dims));
+    }
+    None
 }
 
 fn prelude(config: &NircConfig, layout: &ParameterLayout) -> String {
@@ -54,6 +110,7 @@ fn prelude(config: &NircConfig, layout: &ParameterLayout) -> String {
     c("CELL_COUNT", cell_count(&config.reliability));
     c("CHUNK", CHUNK);
     c("WG_SIZE", WORKGROUP_SIZE);
+    c("DIR_DIMS", layout.direction_dims);
     let table = |name: &str, f: &dyn Fn(&crate::layout::GridLevel) -> u32| {
         let values: Vec<String> = layout.levels.iter().map(|l| format!("{}u", f(l))).collect();
         format!("var<private> {name}: array<u32, LEVELS> = array<u32, LEVELS>({});\n", values.join(", "))
@@ -65,51 +122,51 @@ fn prelude(config: &NircConfig, layout: &ParameterLayout) -> String {
     s
 }
 
-fn weights_chunk(placement: WeightPlacement) -> &'static str {
-    match placement {
-        WeightPlacement::Workgroup => {
-            "fn table(net: u32, i: u32) -> f32 { if net == 0u { return params[i]; } return ema[i]; }
-var<workgroup> wg_weights: array<f32, MLP_PARAMS>;
-fn weight(net: u32, i: u32) -> f32 { return wg_weights[i]; }
-// Copies predictor `net`'s MLP weights into workgroup memory (barriers on both sides: the
-// previous predictor may still be in use). Call from uniform control flow.
-fn load_weights(net: u32, lid: u32) {
-    workgroupBarrier();
-    for (var i = lid; i < MLP_PARAMS; i += WG_SIZE) { wg_weights[i] = table(net, i); }
-    workgroupBarrier();
-}
-"
-        }
-        WeightPlacement::Storage => {
-            "fn table(net: u32, i: u32) -> f32 { if net == 0u { return params[i]; } return ema[i]; }
-fn weight(net: u32, i: u32) -> f32 { return table(net, i); }
-fn load_weights(net: u32, lid: u32) {}
-"
-        }
+fn tile_constants(layout: &ParameterLayout, shape: &TileShape, training: bool) -> String {
+    let mut s = String::new();
+    for (name, v) in [
+        ("TILE", shape.tile),
+        ("RQ", shape.rq),
+        ("OPT", shape.opt),
+        ("TILE_A_VEC4", 64 * shape.rq),
+        ("TILE_W_VEC4", tile_w_vec4(layout, shape, training)),
+        ("STASH_VEC4", layout.input_dims * shape.rq),
+    ] {
+        s.push_str(&format!("const {name}: u32 = {v}u;\n"));
     }
+    s
 }
 
-/// Bytes of workgroup memory the forward passes declare with this placement.
-pub fn workgroup_bytes(layout: &ParameterLayout, placement: WeightPlacement) -> u32 {
-    match placement {
-        WeightPlacement::Workgroup => layout.mlp_params * 4,
-        WeightPlacement::Storage => 0,
-    }
+/// Bytes of workgroup memory the tiled training and inference passes declare (the larger).
+pub fn workgroup_bytes(layout: &ParameterLayout) -> u32 {
+    let train = tile_shape(layout, TRAIN_TILE_RECORDS);
+    let infer = tile_shape(layout, INFER_TILE_QUERIES);
+    let train_bytes = (64 * train.rq + tile_w_vec4(layout, &train, true)) * 16;
+    let infer_bytes = (64 * infer.rq + tile_w_vec4(layout, &infer, false) + layout.input_dims * infer.rq) * 16;
+    train_bytes.max(infer_bytes)
 }
 
 /// The full source of one pass.
-pub fn source(config: &NircConfig, layout: &ParameterLayout, placement: WeightPlacement, pass: &str) -> String {
+pub fn source(config: &NircConfig, layout: &ParameterLayout, pass: &str) -> String {
+    let mut s = prelude(config, layout);
     let parts: Vec<&str> = match pass {
-        "train_forward_backward" => vec![COMMON, COUNTERS, MLP_LAYOUT, MLP, ENCODING, FIXED_SUM, weights_chunk(placement), TRAIN_FORWARD_BACKWARD],
+        "train_tile" => {
+            s.push_str(&tile_constants(layout, &tile_shape(layout, TRAIN_TILE_RECORDS), true));
+            vec![COMMON, COUNTERS, TRAIN_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP_TILE, ENCODING, FIXED_SUM, LOSS, TRAIN_TILE]
+        }
+        "infer_tile" => {
+            s.push_str(&tile_constants(layout, &tile_shape(layout, INFER_TILE_QUERIES), false));
+            vec![COMMON, COUNTERS, INFER_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP_TILE, ENCODING, RELIABILITY, ANSWER, INFER_TILE]
+        }
+        "train_forward_backward" => vec![COMMON, COUNTERS, TRAIN_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP, ENCODING, FIXED_SUM, LOSS, TRAIN_FORWARD_BACKWARD],
         "weight_gradient" => vec![COMMON, MLP_LAYOUT, WEIGHT_GRADIENT],
         "adam_ema" => vec![COMMON, COUNTERS, FIXED_SUM_READ, ADAM_EMA],
         "reliability_accumulate" => vec![COMMON, COUNTERS, RELIABILITY, FIXED_SUM, RELIABILITY_ACCUMULATE],
         "reliability_update" => vec![COMMON, COUNTERS, RELIABILITY, FIXED_SUM_READ, RELIABILITY_UPDATE],
         "finish_step" => vec![COMMON, COUNTERS, FINISH_STEP],
-        "infer" => vec![COMMON, COUNTERS, MLP_LAYOUT, MLP, ENCODING, RELIABILITY, weights_chunk(placement), INFER],
+        "infer" => vec![COMMON, COUNTERS, INFER_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP, ENCODING, RELIABILITY, ANSWER, INFER],
         other => panic!("unknown NIRC pass '{other}'"),
     };
-    let mut s = prelude(config, layout);
     for p in parts {
         s.push('\n');
         s.push_str(p);
@@ -119,5 +176,9 @@ pub fn source(config: &NircConfig, layout: &ParameterLayout, placement: WeightPl
 
 /// Every WGSL file of the cache's passes, concatenated (part of warm-start keys).
 pub fn all_sources() -> String {
-    [COMMON, COUNTERS, FIXED_SUM, FIXED_SUM_READ, ENCODING, MLP_LAYOUT, MLP, RELIABILITY, TRAIN_FORWARD_BACKWARD, WEIGHT_GRADIENT, ADAM_EMA, RELIABILITY_ACCUMULATE, RELIABILITY_UPDATE, FINISH_STEP, INFER].join("\n")
+    [
+        COMMON, COUNTERS, TRAIN_BINDINGS, INFER_BINDINGS, WEIGHTS, LOSS, FIXED_SUM, FIXED_SUM_READ, ENCODING, MLP_LAYOUT, MLP, MLP_TILE, ANSWER, RELIABILITY, TRAIN_FORWARD_BACKWARD, TRAIN_TILE, WEIGHT_GRADIENT, ADAM_EMA, RELIABILITY_ACCUMULATE,
+        RELIABILITY_UPDATE, FINISH_STEP, INFER, INFER_TILE,
+    ]
+    .join("\n")
 }

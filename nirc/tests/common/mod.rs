@@ -30,7 +30,7 @@ pub fn small_config() -> NircConfig {
     NircConfig {
         encoding: HashGridConfig { levels: 4, features_per_level: 2, log2_table_size: 10, base_resolution: 4, growth_factor: 1.5, init_scale: 1e-4 },
         direction: DirectionEncoding::SphericalHarmonics { bands: 3 },
-        network: NetworkConfig { width: 16, hidden_layers: 2 },
+        network: NetworkConfig { width: 32, hidden_layers: 2 },
         reliability: ReliabilityConfig { resolution: 8, log2_cells: 8, warmup: 2, ..Default::default() },
         max_batch: 512,
         ..Default::default()

@@ -1,0 +1,27 @@
+// The cache's answer to one query (CPU mirror: CpuCache::infer): σ from the query's
+// reliability cell, then max(0, (1 - σ) f_EMA + σ f_cur) with σ in .w. Mode 4 (diagnostics)
+// answers (r̄_cur, r̄_EMA, σ of the blend, 1 once warmed up). Needs the pass's `hyper`,
+// `moments`, `counters` and `answers`.
+
+fn moment3(base: u32) -> vec3<f32> {
+    return vec3<f32>(moments[base], moments[base + 1u], moments[base + 2u]);
+}
+
+fn write_answer(qi: u32, pos: vec3<f32>, mode: u32, f_ema: vec3<f32>, f_cur: vec3<f32>) {
+    var r_cur = 0.0;
+    var r_ema = 0.0;
+    if mode >= 2u {
+        let b = cell_index(pos) * MOMENTS_PER_CELL;
+        let my = moment3(b);
+        let qy = moment3(b + 3u);
+        r_cur = mean_correlation(my, qy, moment3(b + MOMENTS_CUR), moment3(b + MOMENTS_CUR + 3u), moment3(b + MOMENTS_CUR + 6u));
+        r_ema = mean_correlation(my, qy, moment3(b + MOMENTS_EMA), moment3(b + MOMENTS_EMA + 3u), moment3(b + MOMENTS_EMA + 6u));
+    }
+    if mode == 4u {
+        let warm = counters.grid_updates >= hyper.warmup;
+        answers[qi] = vec4<f32>(r_cur, r_ema, high_lr_weight(2u, counters.grid_updates, r_cur, r_ema), select(0.0, 1.0, warm));
+        return;
+    }
+    let sigma = high_lr_weight(mode, counters.grid_updates, r_cur, r_ema);
+    answers[qi] = vec4<f32>(max((1.0 - sigma) * f_ema + sigma * f_cur, vec3<f32>(0.0)), sigma);
+}

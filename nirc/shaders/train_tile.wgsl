@@ -1,0 +1,217 @@
+// Training, tiled (mlp_tile.wgsl): one workgroup per TILE records does everything a step needs
+// per record. Encoding of both predictors (the hash-grid corners found once), forward of the
+// EMA and High-LR predictors, relative L2 loss, backward of the High-LR predictor, hash-grid
+// gradients as exact fixed-point sums (order-independent), the reliability samples
+// (y, f_cur, f_EMA), and this tile's partial sums of the MLP weight gradients, records summed
+// in order; `reduce` (weight_gradient.wgsl) then sums the tiles in order. Activations and
+// pre-activation gradients go through `scratch` (record-major, as the per-record pass).
+
+@group(0) @binding(10) var<storage, read_write> partials: array<f32>;
+
+var<private> tile_first: u32;
+
+// Scratch offset of value `v` of record 4 rq + c of this tile; records past the batch have none.
+fn record_slot(rq: u32, c: u32) -> u32 {
+    return (tile_first + 4u * rq + c) * SCRATCH_STRIDE;
+}
+fn record_valid(rq: u32, c: u32) -> bool {
+    return tile_first + 4u * rq + c < call.n;
+}
+
+// Saves the High-LR predictor's hidden activations (inputs of matrix `layer`).
+fn keep_activation(layer: u32, rq: u32, o0: u32, block: Block) {
+    for (var c = 0u; c < 4u; c++) {
+        if record_valid(rq, c) {
+            let b = record_slot(rq, c) + act_base(layer) + o0;
+            for (var j = 0u; j < OPT; j++) {
+                if o0 + j < WIDTH {
+                    scratch[b + j] = block[j][c];
+                }
+            }
+        }
+    }
+}
+
+// Gradient of the pre-activation of matrix m - 1 from that of matrix m's input: ReLU passes it
+// where the activation (saved by this invocation in the forward pass) was positive.
+fn relu_backward(g: Block, m: u32, rq: u32, o0: u32) -> Block {
+    var out = g;
+    for (var c = 0u; c < 4u; c++) {
+        let valid = record_valid(rq, c);
+        let b = select(0u, record_slot(rq, c) + act_base(m) + o0, valid);
+        for (var j = 0u; j < OPT; j++) {
+            var keep = false;
+            if valid && o0 + j < WIDTH {
+                keep = scratch[b + j] > 0.0;
+            }
+            out[j][c] = select(0.0, g[j][c], keep);
+        }
+    }
+    return out;
+}
+
+fn keep_delta(m: u32, rq: u32, o0: u32, block: Block, count: u32) {
+    for (var c = 0u; c < 4u; c++) {
+        if record_valid(rq, c) {
+            let b = record_slot(rq, c) + ACT_FLOATS + delta_base(m) + o0;
+            for (var j = 0u; j < OPT; j++) {
+                if o0 + j < count {
+                    scratch[b + j] = block[j][c];
+                }
+            }
+        }
+    }
+}
+
+@compute @workgroup_size(64)
+fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    tile_first = wid.x * TILE;
+    let r = tile_first + lid;
+    let in_range = r < call.n;
+    let rec = records[min(r, call.n - 1u)];
+    let rq = lid % RQ;
+    let o0 = (lid / RQ) * OPT;
+    let p = normalize_to_bounds(hyper, rec.position.xyz);
+
+    // 1. Inputs: the EMA predictor's into tile_a, the High-LR predictor's into the scratch.
+    for (var l = 0u; l < LEVELS; l++) {
+        let corners = level_corners(l, p);
+        for (var k = 0u; k < FEATURES; k++) {
+            tile_a[(l * FEATURES + k) * RQ + lid / 4u][lid % 4u] = corner_sum(1u, corners, k);
+            if in_range {
+                scratch[r * SCRATCH_STRIDE + l * FEATURES + k] = corner_sum(0u, corners, k);
+            }
+        }
+    }
+    for (var i = 0u; i < DIR_DIMS; i++) {
+        let d = direction_feature(rec.direction.xyz, i);
+        tile_a[(LEVELS * FEATURES + i) * RQ + lid / 4u][lid % 4u] = d;
+        if in_range {
+            scratch[r * SCRATCH_STRIDE + LEVELS * FEATURES + i] = d;
+        }
+    }
+
+    // 2. Both forwards; output block 0 (o0 == 0) holds f of records 4 rq .. 4 rq + 3.
+    let fe = mlp_forward_tile(1u, lid, false);
+    let f_ema = array<vec4<f32>, 3>(fe[0], fe[1], fe[2]);
+    workgroupBarrier();
+    for (var i = 0u; i < IN_DIMS; i++) {
+        var v = 0.0;
+        if in_range {
+            v = scratch[r * SCRATCH_STRIDE + i];
+        }
+        tile_a[i * RQ + lid / 4u][lid % 4u] = v;
+    }
+    let fc = mlp_forward_tile(0u, lid, true);
+
+    // 3. Relative L2 loss (denominators under stop-gradient) and dL/df.
+    var ok = true;
+    var d_out = array<vec4<f32>, 3>(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
+    if o0 == 0u {
+        for (var c = 0u; c < 4u; c++) {
+            if record_valid(rq, c) {
+                let rr = tile_first + 4u * rq + c;
+                let record = records[rr];
+                let f = vec3<f32>(fc[0][c], fc[1][c], fc[2][c]);
+                let y = record.target_rgb.xyz;
+                let l2 = relative_l2(f, y);
+                let loss = l2.w;
+                for (var ch = 0u; ch < 3u; ch++) {
+                    d_out[ch][c] = l2[ch];
+                    scratch[rr * SCRATCH_STRIDE + ACT_FLOATS + delta_base(HIDDEN) + ch] = l2[ch];
+                }
+                losses[rr] = loss;
+                ok = is_finite(loss) && ok;
+                let fe3 = vec3<f32>(f_ema[0][c], f_ema[1][c], f_ema[2][c]);
+                samples[rr] = ReliabilitySample(record.position, record.target_rgb, vec4<f32>(f, 0.0), vec4<f32>(fe3, 0.0));
+            }
+        }
+    }
+
+    // 4. Backward of the High-LR predictor, matrix by matrix from the output; tile_a holds the
+    //    pre-activation gradient of the matrix being passed (k-major), then dL/d(input).
+    workgroupBarrier();
+    if o0 == 0u {
+        for (var ch = 0u; ch < 3u; ch++) {
+            tile_a[ch * RQ + rq] = d_out[ch];
+        }
+    }
+    for (var mm = 0u; mm <= HIDDEN; mm++) {
+        let m = HIDDEN - mm;
+        workgroupBarrier();
+        load_matrix(0u, m, lid, false);
+        workgroupBarrier();
+        let cols = mat_cols(m);
+        var g = Block();
+        if o0 < cols {
+            g = tile_matmul(mat_rows(m), block_stride(cols), o0, rq);
+            if m > 0u {
+                g = relu_backward(g, m, rq, o0);
+                keep_delta(m - 1u, rq, o0, g, cols);
+            }
+        }
+        workgroupBarrier();
+        store_block(g, cols, o0, rq);
+    }
+    workgroupBarrier();
+
+    // 5. Hash-grid gradients, per record.
+    if in_range {
+        for (var l = 0u; l < LEVELS; l++) {
+            let corners = level_corners(l, p);
+            for (var k = 0u; k < FEATURES; k++) {
+                let d = tile_a[(l * FEATURES + k) * RQ + lid / 4u][lid % 4u];
+                for (var c = 0u; c < 8u; c++) {
+                    ok = fixed_add(3u * (corners.index[c] + k - MLP_PARAMS), corners.weight[c] * d) && ok;
+                }
+            }
+        }
+    }
+    if !ok {
+        atomicOr(&counters.flag, 1u);
+    }
+
+    // 6. This tile's weight-gradient partial sums: dW_m[i][j] = sum over its records of
+    //    delta_m[r][i] a_m[r][j]. Deltas (k = record, quads of i) into tile_a, activations into
+    //    tile_w; invocation (rq, oq) sums rows 4 rq .. 4 rq + 3, columns o0 .. o0 + OPT - 1.
+    storageBarrier();
+    for (var m = 0u; m <= HIDDEN; m++) {
+        let rows = mat_rows(m);
+        let cols = mat_cols(m);
+        let s = block_stride(cols);
+        workgroupBarrier();
+        for (var e = lid; e < TILE * RQ * 4u; e += WG_SIZE) {
+            let rl = e / (RQ * 4u);
+            let i = e % (RQ * 4u);
+            var v = 0.0;
+            if i < rows && tile_first + rl < call.n {
+                v = scratch[(tile_first + rl) * SCRATCH_STRIDE + ACT_FLOATS + delta_base(m) + i];
+            }
+            tile_a[e / 4u][e % 4u] = v;
+        }
+        for (var e = lid; e < TILE * s * 4u; e += WG_SIZE) {
+            let rl = e / (s * 4u);
+            let j = e % (s * 4u);
+            var v = 0.0;
+            if j < cols && tile_first + rl < call.n {
+                v = scratch[(tile_first + rl) * SCRATCH_STRIDE + act_base(m) + j];
+            }
+            tile_w[e / 4u][e % 4u] = v;
+        }
+        workgroupBarrier();
+        if 4u * rq < rows && o0 < cols {
+            let acc = tile_matmul(TILE, s, o0, rq);
+            let off = mat_offset(m);
+            for (var c = 0u; c < 4u; c++) {
+                let i = 4u * rq + c;
+                if i < rows {
+                    for (var j = 0u; j < OPT; j++) {
+                        if o0 + j < cols {
+                            partials[wid.x * MLP_PARAMS + off + i * cols + o0 + j] = acc[j][c];
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
