@@ -69,6 +69,19 @@ enum Command {
         /// Timed repetitions of each image metric (the best is reported).
         #[arg(long, default_value_t = 3)]
         repeats: u32,
+        /// Measure the neural incident radiance cache instead: training and inference GFLOP/s
+        /// against this adapter's FMA ceiling, and the blend's overhead.
+        #[arg(long)]
+        nirc: bool,
+        /// With --nirc: training records per step.
+        #[arg(long, default_value_t = 4096)]
+        nirc_batch: u32,
+        /// With --nirc: queries per inference.
+        #[arg(long, default_value_t = 16384)]
+        nirc_queries: u32,
+        /// With --nirc: also write the numbers as JSON to this file.
+        #[arg(long)]
+        json: Option<PathBuf>,
     },
 }
 
@@ -80,6 +93,31 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
         return Err(format!("width and height must be at least 1, got '{s}'"));
     }
     Ok((w, h))
+}
+
+/// `flicker bench --nirc`: the cache's throughput (nirc::bench) as a table, and as JSON.
+fn bench_nirc(out: Option<PathBuf>, json: Option<PathBuf>, batch: u32, queries: u32, repeats: u32) -> anyhow::Result<()> {
+    let gpu = render::gpu::Gpu::new()?;
+    eprintln!("bench: NIRC at width 64, {batch} training records, {queries} queries, {repeats} repetitions");
+    let r = nirc::bench::run(&gpu, &nirc::NircConfig::default(), None, batch, queries, repeats)?;
+    let md = format!(
+        "Adapter: {}; MLP form: {:?} (width {}, {} hidden layers)\n\n| measure | value |\n|---|---:|\n\
+         | FMA ceiling (GFLOP/s) | {:.1} |\n| training (records/s) | {:.0} |\n| training (GFLOP/s, % of ceiling) | {:.2} ({:.1}%) |\n\
+         | EMA-only inference (queries/s) | {:.0} |\n| inference (GFLOP/s, % of ceiling) | {:.2} ({:.1}%) |\n| blend (queries/s) | {:.0} |\n\
+         | blend overhead (% of a NIRC frame) | {:.1} |\n| blend overhead (% of EMA-only inference) | {:.1} |\n\
+         | one 64x64 layer, 4x16 blocks (GFLOP/s) | {:.2} |\n| one 64x64 layer, 16x16 blocks (GFLOP/s) | {:.2} |\n",
+        r.adapter, r.placement, r.width, r.hidden_layers, r.peak_gflops, r.train_records_per_s, r.train_gflops, r.train_percent_of_peak,
+        r.ema_only_queries_per_s, r.infer_gflops, r.infer_percent_of_peak, r.blend_queries_per_s, r.blend_overhead_frame_percent,
+        r.blend_overhead_infer_percent, r.layer_probe_4x16_gflops, r.layer_probe_16x16_gflops
+    );
+    print!("{md}");
+    if let Some(path) = out {
+        systems::output::write_text(&path, &md)?;
+    }
+    if let Some(path) = json {
+        systems::output::write_text(&path, &serde_json::to_string_pretty(&r)?)?;
+    }
+    Ok(())
 }
 
 fn bench(out: Option<PathBuf>, rays: u32, frames: u32, no_metrics: bool, repeats: u32) -> anyhow::Result<()> {
@@ -136,7 +174,9 @@ fn main() -> ExitCode {
         }
         Command::Compare(args) => metrics::compare(&args),
         Command::Report(args) => report::report(&args).map(|path| println!("wrote {}", path.display())),
-        Command::Bench { out, rays, frames, no_metrics, repeats } => bench(out, rays, frames, no_metrics, repeats),
+        Command::Bench { out, repeats, nirc: true, nirc_batch, nirc_queries, json, .. } => bench_nirc(out, json, nirc_batch, nirc_queries, repeats),
+        Command::Bench { json: Some(_), .. } => Err(anyhow::anyhow!("bench --json writes the NIRC numbers: use it with --nirc")),
+        Command::Bench { out, rays, frames, no_metrics, repeats, .. } => bench(out, rays, frames, no_metrics, repeats),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

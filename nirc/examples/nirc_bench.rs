@@ -1,5 +1,6 @@
-//! Throughput of the GPU cache at width 64 on this adapter:
-//! `cargo run --release -p nirc --example nirc_bench [batch] [queries] [reps]`.
+//! Throughput of the GPU cache at width 64 on this adapter, both MLP forms:
+//! `cargo run --release -p nirc --example nirc_bench [batch] [queries] [reps]`
+//! (`flicker bench --nirc` runs the default form and writes JSON).
 
 use nirc::NircConfig;
 use nirc::gpu::shaders::WeightPlacement;
@@ -13,7 +14,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let config = NircConfig::default();
     for placement in [WeightPlacement::Tiled, WeightPlacement::Storage] {
         let r = nirc::bench::run(&gpu, &config, Some(placement), batch, queries, reps)?;
-        println!("{r:#?}");
+        println!("{}", serde_json::to_string_pretty(&r)?);
     }
     Ok(())
 }

@@ -1,5 +1,6 @@
 // The cache's answer to one query (CPU mirror: CpuCache::infer): σ from the query's
-// reliability cell, then max(0, (1 - σ) f_EMA + σ f_cur) with σ in .w. Mode 4 (diagnostics)
+// reliability cell (mode 5: the call's fixed σ), then max(0, (1 - σ) f_EMA + σ f_cur) with σ
+// in .w. Mode 4 (diagnostics)
 // answers (r̄_cur, r̄_EMA, σ of the blend, 1 once warmed up). Needs the pass's `hyper`,
 // `moments`, `counters` and `answers`.
 
@@ -10,7 +11,7 @@ fn moment3(base: u32) -> vec3<f32> {
 fn write_answer(qi: u32, pos: vec3<f32>, mode: u32, f_ema: vec3<f32>, f_cur: vec3<f32>) {
     var r_cur = 0.0;
     var r_ema = 0.0;
-    if mode >= 2u {
+    if mode == 2u || mode == 3u || mode == 4u {
         let b = cell_index(pos) * MOMENTS_PER_CELL;
         let my = moment3(b);
         let qy = moment3(b + 3u);
@@ -22,6 +23,9 @@ fn write_answer(qi: u32, pos: vec3<f32>, mode: u32, f_ema: vec3<f32>, f_cur: vec
         answers[qi] = vec4<f32>(r_cur, r_ema, high_lr_weight(2u, counters.grid_updates, r_cur, r_ema), select(0.0, 1.0, warm));
         return;
     }
-    let sigma = high_lr_weight(mode, counters.grid_updates, r_cur, r_ema);
+    var sigma = high_lr_weight(mode, counters.grid_updates, r_cur, r_ema);
+    if mode == 5u {
+        sigma = call.fixed_sigma;
+    }
     answers[qi] = vec4<f32>(max((1.0 - sigma) * f_ema + sigma * f_cur, vec3<f32>(0.0)), sigma);
 }

@@ -17,6 +17,11 @@ struct Hyper {
     warmup: u32,
     reliability_resolution: u32,
     loss_luminance: u32,
+    // 1: the moments move once per sample (the paper), 0: once per step towards the batch mean.
+    moments_per_sample: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 // What one train/infer call works on.
@@ -25,6 +30,11 @@ struct Call {
     inv_n: f32,
     mode: u32,
     num_chunks: u32,
+    // σ of the fixed blend (mode 5).
+    fixed_sigma: f32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 struct TrainingRecord {

@@ -40,23 +40,10 @@ fn load_matrix(net: u32, m: u32, lid: u32, transposed: bool) {
     }
 }
 
-// out[o0 + j][record 4 rq + c] = sum over k < reduce_len of tile_a[k][4 rq + c] * tile_w[k][o0 + j].
-fn tile_matmul(reduce_len: u32, stride: u32, o0: u32, rq: u32) -> Block {
-    var acc: Block;
-    let wb = o0 / 4u;
-    for (var k = 0u; k < reduce_len; k++) {
-        let a = tile_a[k * RQ + rq];
-        let row = k * stride + wb;
-        for (var q = 0u; q < OPT / 4u; q++) {
-            let w = tile_w[row + q];
-            acc[4u * q] += a * w.x;
-            acc[4u * q + 1u] += a * w.y;
-            acc[4u * q + 2u] += a * w.z;
-            acc[4u * q + 3u] += a * w.w;
-        }
-    }
-    return acc;
-}
+// tile_matmul(reduce_len, stride, o0, rq) -> Block: out[o0 + j][record 4 rq + c] = sum over
+// k < reduce_len of tile_a[k][4 rq + c] * tile_w[k][o0 + j], k in order. Generated for the
+// pass's OPT (src/gpu/shaders.rs) with one named accumulator per output: an accumulator array
+// indexed in a loop would live in memory on lavapipe.
 
 // Writes a block into rows o0.. of tile_a (rows below `rows` only). Call after a barrier.
 fn store_block(block: Block, rows: u32, o0: u32, rq: u32) {

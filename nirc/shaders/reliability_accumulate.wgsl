@@ -1,12 +1,15 @@
-// Reliability grid, step 1 of an update (one thread per sample): adds the sample's 24
-// quantities (y, y^2, f, f^2, y f per predictor, per channel) to its cell's exact fixed-point
-// sums and counts it. Order-independent, hence deterministic.
+// Reliability grid, step 1 of an update (one invocation per sample): finds the sample's cell
+// and counts it. Per sample (the paper's rule) the cell's first sample in record order is made
+// its owner (an atomic max of ~index: order-independent), which replays the cell's samples in
+// order (reliability_walk.wgsl). Per batch, the sample's 24 quantities (y, y^2, f, f^2, y f per
+// predictor, per channel) are added to the cell's exact fixed-point sums. Deterministic.
 
 @group(0) @binding(0) var<uniform> call: Call;
 @group(0) @binding(1) var<uniform> hyper: Hyper;
 @group(0) @binding(2) var<storage, read> samples: array<ReliabilitySample>;
 @group(0) @binding(3) var<storage, read_write> accum: array<atomic<u32>>;
 @group(0) @binding(4) var<storage, read_write> counters: CountersAtomic;
+@group(0) @binding(5) var<storage, read_write> sample_cells: array<u32>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
@@ -15,7 +18,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let sample = samples[s];
         let cell = cell_index(sample.position.xyz);
         let base = cell * ACCUM_PER_CELL;
-        atomicAdd(&accum[base + 72u], 1u);
+        atomicAdd(&accum[base + ACCUM_COUNT], 1u);
+        if hyper.moments_per_sample == 1u {
+            sample_cells[s] = cell;
+            atomicMax(&accum[base + ACCUM_OWNER], ~s);
+            for (var c = 0u; c < 3u; c++) {
+                ok = ok && is_finite(sample.target_rgb[c]) && is_finite(sample.f_cur[c]) && is_finite(sample.f_ema[c]);
+            }
+            continue;
+        }
         for (var c = 0u; c < 3u; c++) {
             let y = sample.target_rgb[c];
             let fc = sample.f_cur[c];

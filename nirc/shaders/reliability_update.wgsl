@@ -1,6 +1,6 @@
-// Reliability grid, step 2 of an update (one thread per cell): every cell that received samples
-// moves each moment once towards the batch mean, X <- λ X + (1 - λ) mean. Skipped when the step
-// is being rolled back.
+// Reliability grid, last step of an update (one thread per cell that received samples): per
+// sample, the moments staged by reliability_walk.wgsl; per batch, one move towards the batch
+// mean, X <- λ X + (1 - λ) mean. Skipped when the step is being rolled back.
 
 @group(0) @binding(1) var<uniform> hyper: Hyper;
 @group(0) @binding(2) var<storage, read> accum: array<u32>;
@@ -14,14 +14,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     for (var cell = gid.x; cell < CELL_COUNT; cell += groups.x * 64u) {
         let base = cell * ACCUM_PER_CELL;
-        let count = accum[base + 72u];
+        let count = accum[base + ACCUM_COUNT];
         if count == 0u {
             continue;
         }
         for (var q = 0u; q < MOMENTS_PER_CELL; q++) {
-            let mean = fixed_to_f32(accum[base + 3u * q], accum[base + 3u * q + 1u], accum[base + 3u * q + 2u]) / f32(count);
             let i = cell * MOMENTS_PER_CELL + q;
-            moments[i] = hyper.lambda * moments[i] + (1.0 - hyper.lambda) * mean;
+            if hyper.moments_per_sample == 1u {
+                moments[i] = bitcast<f32>(accum[base + q]);
+            } else {
+                let mean = fixed_to_f32(accum[base + 3u * q], accum[base + 3u * q + 1u], accum[base + 3u * q + 2u]) / f32(count);
+                moments[i] = hyper.lambda * moments[i] + (1.0 - hyper.lambda) * mean;
+            }
         }
     }
 }

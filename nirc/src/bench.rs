@@ -1,5 +1,6 @@
-//! Throughput benchmark of the GPU cache (not a test): training and inference queries per
-//! second and GFLOP/s, and the cost of evaluating both predictors + blend over EMA-only.
+//! Throughput benchmark of the GPU cache (not a test): training and inference per second and in
+//! GFLOP/s against the adapter's FMA ceiling measured in the same run, and the cost of
+//! evaluating both predictors + blend over EMA-only.
 
 use crate::config::{NircConfig, PredictorMode};
 use crate::error::NircError;
@@ -11,7 +12,7 @@ use crate::bounds::SceneBounds;
 use render::gpu::Gpu;
 use std::time::Instant;
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize)]
 pub struct BenchReport {
     pub adapter: String,
     pub placement: WeightPlacement,
@@ -19,16 +20,28 @@ pub struct BenchReport {
     pub hidden_layers: u32,
     pub batch: u32,
     pub queries: u32,
+    /// The adapter's FMA ceiling (fma_peak.wgsl), measured in the same run.
+    pub peak_gflops: f64,
     pub train_records_per_s: f64,
-    /// MLP FLOPs of training counted as 3 forwards (forward, backward, weight gradient) of the
-    /// High-LR predictor + 1 forward of the EMA predictor, per record.
+    /// Useful MLP FLOPs of training per second: 2 x the multiply-adds of the High-LR forward,
+    /// backward and weight gradient (3 x a forward) per record; the EMA forward that feeds the
+    /// reliability samples, the encoding, Adam and the grid are not counted but are timed.
     pub train_gflops: f64,
+    pub train_percent_of_peak: f64,
     pub ema_only_queries_per_s: f64,
     pub blend_queries_per_s: f64,
-    pub ema_only_gflops: f64,
-    pub blend_gflops: f64,
-    /// Extra time of blend over EMA-only, in percent of EMA-only.
-    pub blend_overhead_percent: f64,
+    /// EMA-only inference: 2 x the forward's multiply-adds per query.
+    pub infer_gflops: f64,
+    pub infer_percent_of_peak: f64,
+    /// Extra time of the blend over EMA-only inference, in percent of a NIRC frame of this
+    /// bench: one training step of `batch` records plus EMA-only inference of `queries`.
+    pub blend_overhead_frame_percent: f64,
+    /// Extra time of the blend over EMA-only inference, in percent of EMA-only inference.
+    pub blend_overhead_infer_percent: f64,
+    /// One 64x64 layer as a tiled product, 4 records x 16 outputs per invocation (the
+    /// training pass's shape) and 16 x 16 (tile_layer.wgsl).
+    pub layer_probe_4x16_gflops: f64,
+    pub layer_probe_16x16_gflops: f64,
 }
 
 fn records(n: u32) -> Vec<TrainingRecord> {
@@ -75,7 +88,10 @@ pub fn run(gpu: &Gpu, config: &NircConfig, placement: Option<WeightPlacement>, b
     let out = answer_buffer(gpu, queries);
     let ema_s = time(gpu, reps, || cache.infer(gpu, &qbuf, queries, &out, PredictorMode::EmaOnly))?;
     let blend_s = time(gpu, reps, || cache.infer(gpu, &qbuf, queries, &out, PredictorMode::Blend))?;
+    let probes = probes(gpu, reps)?;
     let flops = 2.0 * cache.layout.forward_macs() as f64;
+    let train_gflops = batch as f64 * 3.0 * flops / train_s / 1e9;
+    let infer_gflops = queries as f64 * flops / ema_s / 1e9;
     Ok(BenchReport {
         adapter: gpu.summary.to_string(),
         placement: cache.placement,
@@ -83,12 +99,91 @@ pub fn run(gpu: &Gpu, config: &NircConfig, placement: Option<WeightPlacement>, b
         hidden_layers: config.network.hidden_layers,
         batch,
         queries,
+        peak_gflops: probes.fma_gflops,
         train_records_per_s: batch as f64 / train_s,
-        train_gflops: batch as f64 * 4.0 * flops / train_s / 1e9,
+        train_gflops,
+        train_percent_of_peak: 100.0 * train_gflops / probes.fma_gflops,
         ema_only_queries_per_s: queries as f64 / ema_s,
         blend_queries_per_s: queries as f64 / blend_s,
-        ema_only_gflops: queries as f64 * flops / ema_s / 1e9,
-        blend_gflops: queries as f64 * 2.0 * flops / blend_s / 1e9,
-        blend_overhead_percent: 100.0 * (blend_s - ema_s) / ema_s,
+        infer_gflops,
+        infer_percent_of_peak: 100.0 * infer_gflops / probes.fma_gflops,
+        blend_overhead_frame_percent: 100.0 * (blend_s - ema_s) / (train_s + ema_s),
+        blend_overhead_infer_percent: 100.0 * (blend_s - ema_s) / ema_s,
+        layer_probe_4x16_gflops: probes.layer_4x16_gflops,
+        layer_probe_16x16_gflops: probes.layer_16x16_gflops,
+    })
+}
+
+/// GFLOP/s of the probe kernels.
+pub struct Probes {
+    pub fma_gflops: f64,
+    pub layer_4x16_gflops: f64,
+    pub layer_16x16_gflops: f64,
+}
+
+fn dispatch_timed(gpu: &Gpu, reps: u32, pipeline: &wgpu::ComputePipeline, entries: &[(u32, &wgpu::Buffer)], groups: u32) -> Result<f64, NircError> {
+    let entries: Vec<wgpu::BindGroupEntry> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
+    let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("nirc probe"), layout: &pipeline.get_bind_group_layout(0), entries: &entries });
+    time(gpu, reps, || {
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc probe") });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc probe"), timestamp_writes: None });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups(groups, 1, 1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    })
+}
+
+/// Entry point `block{r}x{o}` of tile_layer.wgsl: r records x o outputs per invocation.
+fn tile_layer_probe(r: u32, o: u32) -> String {
+    let (rq, oq) = (r / 4, o / 4);
+    let mut s = format!(
+        "@compute @workgroup_size({inv})\nfn block{r}x{o}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {{\n    load_tiles(wid.x, lid, {inv}u);\n    let rb = (lid % {per}u) * {rq}u;\n    let ob = (lid / {per}u) * {oq}u;\n",
+        inv = (64 / r) * (64 / o),
+        per = 64 / r
+    );
+    let accs: Vec<String> = (0..rq).flat_map(|a| (0..o).map(move |j| format!("c{a}_{j}"))).collect();
+    for acc in &accs {
+        s.push_str(&format!("    var {acc} = vec4<f32>(0.0);\n"));
+    }
+    s.push_str("    for (var k = 0u; k < 64u; k++) {\n");
+    for a in 0..rq {
+        s.push_str(&format!("        let a{a} = ta[k * 16u + rb + {a}u];\n"));
+    }
+    for q in 0..oq {
+        s.push_str(&format!("        let w{q} = tw[k * 16u + ob + {q}u];\n"));
+    }
+    for a in 0..rq {
+        for j in 0..o {
+            s.push_str(&format!("        c{a}_{j} += a{a} * w{}.{};\n", j / 4, ["x", "y", "z", "w"][j as usize % 4]));
+        }
+    }
+    s.push_str(&format!("    }}\n    out[wid.x * 64u + lid] = {};\n}}\n", accs.join(" + ")));
+    s
+}
+
+/// The FMA ceiling (`shaders/bench/fma_peak.wgsl`) and one 64x64 layer as a tiled product in two
+/// block shapes (`shaders/bench/tile_layer.wgsl`).
+pub fn probes(gpu: &Gpu, reps: u32) -> Result<Probes, NircError> {
+    const ITERATIONS: u32 = 4096;
+    let invocations = 64 * 256u32;
+    let out = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some("nirc probe out"), size: invocations as u64 * 16, usage: wgpu::BufferUsages::STORAGE, mapped_at_creation: false });
+    let fma_src = format!("const ITERATIONS: u32 = {ITERATIONS}u;\n{}", include_str!("../shaders/bench/fma_peak.wgsl"));
+    let [fma] = render::compute::pipelines_auto_layout(gpu, "fma peak", &fma_src, ["main"])?;
+    let fma_s = dispatch_timed(gpu, reps, &fma, &[(0, &out)], invocations / 64)?;
+    let layer_src = format!("{}\n{}\n{}", include_str!("../shaders/bench/tile_layer.wgsl"), tile_layer_probe(4, 16), tile_layer_probe(16, 16));
+    let [block4x16, block16x16] = render::compute::pipelines_auto_layout(gpu, "tile layer", &layer_src, ["block4x16", "block16x16"])?;
+    let tiles = 256u32;
+    let input = upload(gpu, "probe input", &vec![0.01f32; tiles as usize * 4096]);
+    let weights = upload(gpu, "probe weights", &vec![0.02f32; 4096]);
+    let layer_flops = tiles as f64 * 2.0 * 64f64.powi(3);
+    let layer = |p: &wgpu::ComputePipeline| dispatch_timed(gpu, reps, p, &[(0, &input), (1, &weights), (2, &out)], tiles).map(|s| layer_flops / s / 1e9);
+    Ok(Probes {
+        fma_gflops: invocations as f64 * ITERATIONS as f64 * 8.0 * 4.0 * 2.0 / fma_s / 1e9,
+        layer_4x16_gflops: layer(&block4x16)?,
+        layer_16x16_gflops: layer(&block16x16)?,
     })
 }

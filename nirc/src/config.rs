@@ -195,17 +195,31 @@ pub struct ReliabilityConfig {
     pub kappa: f32,
     /// ε added to both variances in r = c / sqrt((s^y + ε)(s^f + ε)).
     pub epsilon: f32,
+    /// How a training step's samples move the moments.
+    pub update: MomentUpdate,
+}
+
+/// How the reliability moments follow the training samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]
+pub enum MomentUpdate {
+    /// The paper's rule: X <- λ X + (1 - λ) x once per sample, in record order, in the sample's
+    /// cell (a memory of about 1 / (1 - λ) = 10 samples).
+    #[default]
+    PerSample,
+    /// One step per training step towards the mean of the step's samples in the cell (a memory
+    /// of about 10 steps): the lab's earlier rule, kept for comparison.
+    BatchMean,
 }
 
 impl Default for ReliabilityConfig {
     fn default() -> Self {
         // λ ≈ 0.9, K = 128, κ = 4 from the paper; resolution, table size and ε are ours.
-        Self { resolution: 32, log2_cells: 16, lambda: 0.9, warmup: 128, kappa: 4.0, epsilon: 1e-4 }
+        Self { resolution: 32, log2_cells: 16, lambda: 0.9, warmup: 128, kappa: 4.0, epsilon: 1e-4, update: MomentUpdate::PerSample }
     }
 }
 
 /// Which predictor(s) answer a query.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Default)]
 pub enum PredictorMode {
     /// The EMA weights only (NRC's inference).
     EmaOnly,
@@ -216,6 +230,21 @@ pub enum PredictorMode {
     Blend,
     /// The predictor of higher reliability r̄ (ties go to EMA).
     Switch,
+    /// L = (1 - σ) f_EMA + σ f_cur with a constant σ in [0, 1] (a control for the blend: the
+    /// same two predictors without the reliability grid, warm-up included).
+    Fixed(f32),
+}
+
+// σ of `Fixed` is compared and hashed by its bits (methods with equal settings share a cache).
+impl Eq for PredictorMode {}
+
+impl std::hash::Hash for PredictorMode {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.code().hash(state);
+        if let PredictorMode::Fixed(sigma) = self {
+            sigma.to_bits().hash(state);
+        }
+    }
 }
 
 impl PredictorMode {
@@ -225,6 +254,15 @@ impl PredictorMode {
             PredictorMode::HighLrOnly => 1,
             PredictorMode::Blend => 2,
             PredictorMode::Switch => 3,
+            PredictorMode::Fixed(_) => 5,
+        }
+    }
+
+    /// σ of `Fixed`, 0 for the others (unused by them).
+    pub(crate) fn fixed_sigma(self) -> f32 {
+        match self {
+            PredictorMode::Fixed(sigma) => sigma,
+            _ => 0.0,
         }
     }
 }

@@ -5,14 +5,16 @@
 //! ignored. Each cell keeps, per colour channel, EMAs (parameter λ) of the target moments
 //! M^y, Q^y (shared) and, per predictor (High-LR "cur" and EMA), M^f, Q^f, C^{y,f}.
 //!
-//! One *update of the grid* is one committed training step: every cell that received training
-//! samples in that batch moves its moments once towards the batch means of the samples that fell
-//! into it (X <- λ X + (1 - λ) mean); cells without samples are unchanged. Averaging within the
-//! batch (instead of one EMA step per sample) makes the result independent of the order in which
-//! GPU threads see the samples. The warm-up K counts these updates for the whole grid.
+//! One *update of the grid* is one committed training step. By default (`MomentUpdate::PerSample`,
+//! the paper's rule) every sample moves its cell's moments, X <- λ X + (1 - λ) x, in record
+//! order; on the GPU one invocation per cell (the owner: its first sample) replays the cell's
+//! samples in that order, so the result does not depend on thread order.
+//! `MomentUpdate::BatchMean` instead moves each cell once towards the mean of its samples in the
+//! step (exact fixed-point sums). Cells without samples are unchanged. The warm-up K counts grid
+//! updates (committed steps) for the whole grid.
 
 use crate::bounds::SceneBounds;
-use crate::config::{PredictorMode, ReliabilityConfig};
+use crate::config::{MomentUpdate, PredictorMode, ReliabilityConfig};
 use crate::fixed_sum::FixedSum;
 use crate::layout::spatial_hash;
 use crate::records::ReliabilitySample;
@@ -51,11 +53,24 @@ pub fn sample_quantities(s: &ReliabilitySample) -> [f32; MOMENTS_PER_CELL] {
     q
 }
 
-/// One grid update from a batch of samples. Returns false (and changes nothing) if a sample is
-/// not finite.
+/// One grid update from a batch of samples, as the GPU computes it (see the module docs).
+/// Returns false (and changes nothing) if a sample is not finite.
 pub fn update(config: &ReliabilityConfig, bounds: &SceneBounds, moments: &mut [f32], samples: &[ReliabilitySample]) -> bool {
     let cells = cell_count(config) as usize;
     assert_eq!(moments.len(), cells * MOMENTS_PER_CELL, "reliability moments sized for another grid");
+    if config.update == MomentUpdate::PerSample {
+        let finite = samples.iter().all(|s| (0..3).all(|c| s.target[c].is_finite() && s.f_cur[c].is_finite() && s.f_ema[c].is_finite()));
+        if finite {
+            for s in samples {
+                let cell = cell_index(config, bounds, [s.position[0], s.position[1], s.position[2]]) as usize;
+                for (k, q) in sample_quantities(s).into_iter().enumerate() {
+                    let i = cell * MOMENTS_PER_CELL + k;
+                    moments[i] = ema_step(config.lambda, moments[i], q);
+                }
+            }
+        }
+        return finite;
+    }
     let mut sums = vec![FixedSum::default(); cells * MOMENTS_PER_CELL];
     let mut counts = vec![0u32; cells];
     for s in samples {
@@ -107,6 +122,7 @@ pub fn high_lr_weight(config: &ReliabilityConfig, mode: PredictorMode, grid_upda
     match mode {
         PredictorMode::EmaOnly => 0.0,
         PredictorMode::HighLrOnly => 1.0,
+        PredictorMode::Fixed(sigma) => sigma,
         // During warm-up the markers are disabled: the EMA baseline answers.
         _ if grid_updates < config.warmup => 0.0,
         PredictorMode::Blend => {
@@ -223,6 +239,32 @@ mod tests {
         same.copy_within(CUR..CUR + 9, EMA);
         assert!((high_lr_weight(&cfg, PredictorMode::Blend, 1000, &same) - 0.5).abs() < 1e-6, "{rc} {re}");
         assert_eq!(combine(0.25, [4.0, 0.0, -8.0], [0.0, 4.0, -8.0]), [1.0, 3.0, 0.0]);
+    }
+
+    #[test]
+    fn per_sample_and_batch_mean_rules_differ_as_their_memories_say() {
+        // 50 samples of targets 0..49 in one cell, in one step, from zero moments.
+        let cfg = config();
+        let bounds = SceneBounds::new([0.0; 3], [1.0; 3]);
+        let cells = cell_count(&cfg) as usize * MOMENTS_PER_CELL;
+        let batch: Vec<ReliabilitySample> = (0..50)
+            .map(|i| ReliabilitySample { position: [0.1, 0.1, 0.1, 0.0], target: [i as f32, 0.0, 0.0, 0.0], f_cur: [0.0; 4], f_ema: [0.0; 4] })
+            .collect();
+        let (mut per_sample, mut batch_mean) = (vec![0.0f32; cells], vec![0.0f32; cells]);
+        assert!(update(&cfg, &bounds, &mut per_sample, &batch));
+        assert!(update(&ReliabilityConfig { update: MomentUpdate::BatchMean, ..cfg.clone() }, &bounds, &mut batch_mean, &batch));
+        let cell = cell_index(&cfg, &bounds, [0.1, 0.1, 0.1]) as usize * MOMENTS_PER_CELL;
+        // Per sample, the last ~10 samples dominate: 49 - λ/(1 - λ) (1 - λ^49) = 40.05.
+        let expected = 49.0 - 0.9 / 0.1 * (1.0 - 0.9f32.powi(49));
+        assert!((per_sample[cell] - expected).abs() < 1e-3, "{} vs {expected}", per_sample[cell]);
+        // Per batch, one step of 10% towards the mean 24.5.
+        assert!((batch_mean[cell] - 2.45).abs() < 1e-4, "{}", batch_mean[cell]);
+        // A non-finite sample changes nothing.
+        let mut bad = batch.clone();
+        bad[7].f_ema[1] = f32::NAN;
+        let mut untouched = per_sample.clone();
+        assert!(!update(&cfg, &bounds, &mut untouched, &bad));
+        assert_eq!(untouched, per_sample);
     }
 
     #[test]

@@ -120,8 +120,17 @@ fn twelve_steps_keep_weights_ema_and_blend_on_the_cpu_reference() {
 
 #[test]
 fn reliability_grid_matches_cpu_on_a_random_stream() {
+    reliability_stream(nirc::config::MomentUpdate::PerSample);
+    reliability_stream(nirc::config::MomentUpdate::BatchMean);
+}
+
+fn reliability_stream(rule: nirc::config::MomentUpdate) {
     let mut config = small_config();
     config.reliability.warmup = 3;
+    // 64 cells for 400 samples a step: ~6 samples per cell, spread over several 64-sample chunks.
+    config.reliability.resolution = 4;
+    config.reliability.log2_cells = 6;
+    config.reliability.update = rule;
     let state = CacheState::initial(&config, bounds()).unwrap();
     let cache = NeuralCache::from_state(gpu(), &state, None).unwrap();
     let mut moments = state.reliability.clone();
@@ -141,7 +150,7 @@ fn reliability_grid_matches_cpu_on_a_random_stream() {
         assert!(nirc::reliability::update(&config.reliability, &b, &mut moments, &samples));
         cache.update_reliability(gpu(), &upload(gpu(), "samples", &samples), samples.len() as u32).unwrap();
         let got = cache.download_state(gpu()).unwrap();
-        assert_vec_close(&format!("moments after update {update}"), &got.reliability, &moments, 1e-5, 1e-7);
+        assert_vec_close(&format!("{rule:?} moments after update {update}"), &got.reliability, &moments, 1e-5, 1e-7);
         assert_eq!(got.counters.grid_updates, update + 1);
     }
     // Blend and switch answers follow the CPU reliabilities (warm-up over).
@@ -156,6 +165,14 @@ fn reliability_grid_matches_cpu_on_a_random_stream() {
             off_half += ((w.sigma - 0.5).abs() > 0.2) as usize;
         }
         assert!(off_half > 100, "{mode:?}: the reliabilities must decide ({off_half})");
+    }
+    // The fixed blend ignores the grid: σ is the setting, the radiance the blend of both.
+    let fixed = PredictorMode::Fixed(0.3);
+    for (g, w) in cache.infer_queries(gpu(), &queries, fixed).unwrap().iter().zip(cpu.infer(&queries, fixed)) {
+        assert_eq!((g.sigma, w.sigma), (0.3, 0.3));
+        for c in 0..3 {
+            assert!(close(g.radiance[c], w.radiance[c], 1e-4, 1e-6), "{:?} vs {:?}", g.radiance, w.radiance);
+        }
     }
 }
 

@@ -4,11 +4,13 @@
 //! A training step is one submission of these passes (nirc/shaders/):
 //! 1. train_forward_backward  per record: both forwards, loss, backward; hash-grid gradients as
 //!                            exact fixed-point sums; reliability samples (y, f_cur, f_ema)
-//! 2. reliability_accumulate  per sample: fixed-point sums per reliability cell
+//! 2. reliability_accumulate  per sample: its reliability cell, the cell's count and owner (per
+//!                            sample) or fixed-point sums (per batch)
 //! 3. weight_gradient         per weight and chunk of records, then over chunks (no atomics)
 //! 4. adam_ema check, apply   Adam; any non-finite value raises a flag and nothing is written
 //!    adam_ema ema_update     debiased EMA of the new weights (skipped on a flagged step)
-//! 5. reliability_update      per cell: EMA of the moments towards the batch means
+//! 5. reliability_walk        per cell (its owner): the per-sample EMAs of the moments in order
+//!    reliability_update      per cell: keep the new moments (or the batch-mean step)
 //! 6. finish_step             commit the counters, or count the rolled-back step
 //! Every sum has a fixed order or is exact, so a step is deterministic.
 
@@ -53,6 +55,8 @@ struct Hyper {
     warmup: u32,
     reliability_resolution: u32,
     loss_luminance: u32,
+    moments_per_sample: u32,
+    pad: [u32; 3],
 }
 
 #[repr(C)]
@@ -62,6 +66,14 @@ struct Call {
     inv_n: f32,
     mode: u32,
     num_chunks: u32,
+    fixed_sigma: f32,
+    pad: [u32; 3],
+}
+
+impl Call {
+    fn new(n: u32, mode: u32, num_chunks: u32) -> Self {
+        Self { n, inv_n: 1.0 / n as f32, mode, num_chunks, fixed_sigma: 0.0, pad: [0; 3] }
+    }
 }
 
 struct Pipelines {
@@ -75,6 +87,7 @@ struct Pipelines {
     ema_update: wgpu::ComputePipeline,
     reliability_accumulate: wgpu::ComputePipeline,
     reliability_update: wgpu::ComputePipeline,
+    reliability_walk: wgpu::ComputePipeline,
     finish_step: wgpu::ComputePipeline,
     infer: wgpu::ComputePipeline,
 }
@@ -90,6 +103,7 @@ struct Buffers {
     scratch: wgpu::Buffer,
     grid_accum: wgpu::Buffer,
     samples: wgpu::Buffer,
+    sample_cells: wgpu::Buffer,
     losses: wgpu::Buffer,
     reliability_accum: wgpu::Buffer,
     moments: wgpu::Buffer,
@@ -102,6 +116,7 @@ pub struct TrainStep {
     num_chunks: u32,
     fb: wgpu::BindGroup,
     accumulate: wgpu::BindGroup,
+    walk: wgpu::BindGroup,
     partial: Option<wgpu::BindGroup>,
     reduce: wgpu::BindGroup,
     check: wgpu::BindGroup,
@@ -250,6 +265,7 @@ impl NeuralCache {
             ema_update,
             reliability_accumulate: one("reliability_accumulate")?,
             reliability_update: one("reliability_update")?,
+            reliability_walk: one("reliability_walk")?,
             finish_step: one("finish_step")?,
             infer: one(if tiled { "infer_tile" } else { "infer" })?,
         })
@@ -272,6 +288,8 @@ impl NeuralCache {
             warmup: config.reliability.warmup,
             reliability_resolution: config.reliability.resolution,
             loss_luminance: (config.loss.normalization == crate::config::LossNormalization::Luminance) as u32,
+            moments_per_sample: (config.reliability.update == crate::config::MomentUpdate::PerSample) as u32,
+            pad: [0; 3],
         }
     }
 
@@ -310,6 +328,7 @@ impl NeuralCache {
             scratch: storage(gpu, "nirc training scratch", max_batch * (layout.activation_floats() + layout.delta_floats()) as u64 * 4)?,
             grid_accum: storage(gpu, "nirc hash-grid gradient sums", layout.grid_params() as u64 * 12)?,
             samples: storage(gpu, "nirc reliability samples", max_batch * std::mem::size_of::<ReliabilitySample>() as u64)?,
+            sample_cells: storage(gpu, "nirc reliability sample cells", max_batch * 4)?,
             losses: storage(gpu, "nirc losses", max_batch * 4)?,
             reliability_accum: storage(gpu, "nirc reliability sums", cell_count(&config.reliability) as u64 * ACCUM_PER_CELL * 4)?,
             moments: storage_init(gpu, "nirc reliability moments", bytemuck::cast_slice(&state.reliability))?,
@@ -375,14 +394,14 @@ impl NeuralCache {
         let b = &self.buffers;
         let p = &self.pipelines;
         let num_chunks = n.div_ceil(CHUNK);
-        let call = Self::call_buffer(gpu, Call { n, inv_n: 1.0 / n as f32, mode: 0, num_chunks });
+        let call = Self::call_buffer(gpu, Call::new(n, 0, num_chunks));
         let mut fb_entries: Vec<(u32, &wgpu::Buffer)> =
             vec![(0, &call), (1, &b.hyper), (2, records), (3, &b.params), (4, &b.ema), (5, &b.scratch), (6, &b.grid_accum), (7, &b.samples), (8, &b.losses), (9, &b.counters)];
         if self.placement == WeightPlacement::Tiled {
             fb_entries.push((10, &b.partials));
         }
         let fb = bind(gpu, "nirc train", &p.train, &fb_entries);
-        let accumulate = bind(gpu, "nirc reliability accumulate", &p.reliability_accumulate, &[(0, &call), (1, &b.hyper), (2, &b.samples), (3, &b.reliability_accum), (4, &b.counters)]);
+        let (accumulate, walk) = self.reliability_groups(gpu, &call, &b.samples);
         let partial = p.weight_partial.as_ref().map(|wp| bind(gpu, "nirc weight partial", wp, &[(0, &call), (1, &b.scratch), (2, &b.partials)]));
         let reduce = bind(gpu, "nirc weight reduce", &p.weight_reduce, &[(0, &call), (2, &b.partials), (3, &b.grad)]);
         let adam_entries: &[(u32, &wgpu::Buffer)] =
@@ -391,7 +410,7 @@ impl NeuralCache {
         let apply = bind(gpu, "nirc adam apply", &p.adam_apply, adam_entries);
         let ema = bind(gpu, "nirc ema update", &p.ema_update, &[(1, &b.hyper), (2, &b.params), (3, &b.ema), (8, &b.counters)]);
         let finish = bind(gpu, "nirc finish", &p.finish_step, &[(0, &call), (1, &b.hyper), (2, &b.counters)]);
-        Ok(Some(TrainStep { n, num_chunks, fb, accumulate, partial, reduce, check, apply, ema, finish }))
+        Ok(Some(TrainStep { n, num_chunks, fb, accumulate, walk, partial, reduce, check, apply, ema, finish }))
     }
 
     /// Forward and backward passes, gradients and the Adam step of the High-LR weights (with the
@@ -439,8 +458,25 @@ impl NeuralCache {
 
     fn dispatch_reliability(&self, pass: &mut wgpu::ComputePass, s: &TrainStep) {
         let p = &self.pipelines;
+        self.dispatch_walk(pass, &s.walk, s.n);
         dispatch(pass, &p.reliability_update, &self.groups.reliability_update, groups_for(cell_count(&self.config.reliability) as u64));
         dispatch(pass, &p.finish_step, &s.finish, 1);
+    }
+
+    /// The bind groups of the reliability accumulation and walk over `samples`.
+    fn reliability_groups(&self, gpu: &Gpu, call: &wgpu::Buffer, samples: &wgpu::Buffer) -> (wgpu::BindGroup, wgpu::BindGroup) {
+        let b = &self.buffers;
+        let p = &self.pipelines;
+        let accumulate = bind(gpu, "nirc reliability accumulate", &p.reliability_accumulate, &[(0, call), (1, &b.hyper), (2, samples), (3, &b.reliability_accum), (4, &b.counters), (5, &b.sample_cells)]);
+        let walk = bind(gpu, "nirc reliability walk", &p.reliability_walk, &[(0, call), (1, &b.hyper), (2, samples), (3, &b.reliability_accum), (4, &b.moments), (5, &b.sample_cells)]);
+        (accumulate, walk)
+    }
+
+    /// The per-sample moment updates (nothing to do for the batch-mean rule).
+    fn dispatch_walk(&self, pass: &mut wgpu::ComputePass, walk: &wgpu::BindGroup, n: u32) {
+        if self.config.reliability.update == crate::config::MomentUpdate::PerSample {
+            dispatch(pass, &self.pipelines.reliability_walk, walk, groups_for(n as u64));
+        }
     }
 
     /// One update of the reliability grid from explicit samples (no training): what a training
@@ -450,16 +486,20 @@ impl NeuralCache {
             return Ok(());
         }
         Self::check_items("reliability samples", samples, n, std::mem::size_of::<ReliabilitySample>() as u64)?;
+        if n > self.config.max_batch {
+            return Err(NircError::BatchTooLarge { requested: n, max: self.config.max_batch });
+        }
         let b = &self.buffers;
         let p = &self.pipelines;
-        let call = Self::call_buffer(gpu, Call { n, inv_n: 1.0 / n as f32, mode: 1, num_chunks: 0 });
-        let acc = bind(gpu, "nirc reliability accumulate", &p.reliability_accumulate, &[(0, &call), (1, &b.hyper), (2, samples), (3, &b.reliability_accum), (4, &b.counters)]);
+        let call = Self::call_buffer(gpu, Call::new(n, 1, 0));
+        let (acc, walk) = self.reliability_groups(gpu, &call, samples);
         let finish = bind(gpu, "nirc finish", &p.finish_step, &[(0, &call), (1, &b.hyper), (2, &b.counters)]);
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc reliability") });
         encoder.clear_buffer(&b.reliability_accum, 0, None);
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc reliability"), timestamp_writes: None });
             dispatch(&mut pass, &p.reliability_accumulate, &acc, groups_for(n as u64));
+            self.dispatch_walk(&mut pass, &walk, n);
             dispatch(&mut pass, &p.reliability_update, &self.groups.reliability_update, groups_for(cell_count(&self.config.reliability) as u64));
             dispatch(&mut pass, &p.finish_step, &finish, 1);
         }
@@ -478,24 +518,24 @@ impl NeuralCache {
 
     /// [`Self::encode_infer`] as pass `index` of a timed frame.
     pub fn infer_timed(&self, gpu: &Gpu, timed: &mut TimedFrame, index: usize, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: PredictorMode) -> Result<(), NircError> {
-        let Some(group) = self.infer_group(gpu, queries, n, out, mode.code())? else { return Ok(()) };
+        let Some(group) = self.infer_group(gpu, queries, n, out, (mode.code(), mode.fixed_sigma()))? else { return Ok(()) };
         timed.pass(index, |pass| dispatch(pass, &self.pipelines.infer, &group, self.infer_groups(n)))?;
         Ok(())
     }
 
     /// Records the inference of `n` queries into the caller's encoder.
     pub fn encode_infer(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: PredictorMode) -> Result<(), NircError> {
-        self.encode_infer_code(gpu, encoder, queries, n, out, mode.code())
+        self.encode_infer_code(gpu, encoder, queries, n, out, (mode.code(), mode.fixed_sigma()))
     }
 
     /// Records a diagnostic look-up of the reliability grid at `n` queries (no network): each
     /// answer is (r̄_cur, r̄_EMA, σ of the blend, 1 once the grid is past its warm-up else 0),
     /// the signal behind preference maps and the mean reliability per frame.
     pub fn encode_reliability(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer) -> Result<(), NircError> {
-        self.encode_infer_code(gpu, encoder, queries, n, out, RELIABILITY_MODE)
+        self.encode_infer_code(gpu, encoder, queries, n, out, (RELIABILITY_MODE, 0.0))
     }
 
-    fn encode_infer_code(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: u32) -> Result<(), NircError> {
+    fn encode_infer_code(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: (u32, f32)) -> Result<(), NircError> {
         let Some(group) = self.infer_group(gpu, queries, n, out, mode)? else { return Ok(()) };
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc infer"), timestamp_writes: None });
         dispatch(&mut pass, &self.pipelines.infer, &group, self.infer_groups(n));
@@ -511,7 +551,7 @@ impl NeuralCache {
     }
 
     /// The bind group of an inference of `n` queries; `None` for no queries.
-    fn infer_group(&self, gpu: &Gpu, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: u32) -> Result<Option<wgpu::BindGroup>, NircError> {
+    fn infer_group(&self, gpu: &Gpu, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: (u32, f32)) -> Result<Option<wgpu::BindGroup>, NircError> {
         if n == 0 {
             return Ok(None);
         }
@@ -522,7 +562,7 @@ impl NeuralCache {
             return Err(NircError::Config(format!("{n} queries need {groups} workgroups, over this adapter's limit")));
         }
         let b = &self.buffers;
-        let call = Self::call_buffer(gpu, Call { n, inv_n: 1.0 / n as f32, mode, num_chunks: 0 });
+        let call = Self::call_buffer(gpu, Call { fixed_sigma: mode.1, ..Call::new(n, mode.0, 0) });
         Ok(Some(bind(
             gpu,
             "nirc infer",

@@ -26,6 +26,7 @@ pub const WEIGHT_GRADIENT: &str = include_str!("../../shaders/weight_gradient.wg
 pub const ADAM_EMA: &str = include_str!("../../shaders/adam_ema.wgsl");
 pub const RELIABILITY_ACCUMULATE: &str = include_str!("../../shaders/reliability_accumulate.wgsl");
 pub const RELIABILITY_UPDATE: &str = include_str!("../../shaders/reliability_update.wgsl");
+pub const RELIABILITY_WALK: &str = include_str!("../../shaders/reliability_walk.wgsl");
 pub const FINISH_STEP: &str = include_str!("../../shaders/finish_step.wgsl");
 pub const INFER: &str = include_str!("../../shaders/infer.wgsl");
 pub const TRAIN_TILE: &str = include_str!("../../shaders/train_tile.wgsl");
@@ -42,7 +43,7 @@ pub const INFER_TILE_QUERIES: u32 = 32;
 const _: () = assert!(TRAIN_TILE_RECORDS == CHUNK);
 
 /// How the MLP passes are written.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub enum WeightPlacement {
     /// Tiled matrix products in workgroup memory (mlp_tile.wgsl): widths 32 and 64, at most 64
     /// inputs.
@@ -134,6 +135,25 @@ fn tile_constants(layout: &ParameterLayout, shape: &TileShape, training: bool) -
     ] {
         s.push_str(&format!("const {name}: u32 = {v}u;\n"));
     }
+    s.push_str(&tile_matmul(shape.opt));
+    s
+}
+
+/// The tiled matrix product of mlp_tile.wgsl, unrolled over the OPT outputs of a block.
+fn tile_matmul(opt: u32) -> String {
+    let mut s = String::from("fn tile_matmul(reduce_len: u32, stride: u32, o0: u32, rq: u32) -> Block {\n");
+    for j in 0..opt {
+        s.push_str(&format!("    var acc{j} = vec4<f32>(0.0);\n"));
+    }
+    s.push_str("    let wb = o0 / 4u;\n    for (var k = 0u; k < reduce_len; k++) {\n        let a = tile_a[k * RQ + rq];\n        let row = k * stride + wb;\n");
+    for q in 0..opt / 4 {
+        s.push_str(&format!("        let w{q} = tile_w[row + {q}u];\n"));
+        for (c, comp) in ["x", "y", "z", "w"].iter().enumerate() {
+            s.push_str(&format!("        acc{j} += a * w{q}.{comp};\n", j = 4 * q + c as u32));
+        }
+    }
+    let accs: Vec<String> = (0..opt).map(|j| format!("acc{j}")).collect();
+    s.push_str(&format!("    }}\n    return Block({});\n}}\n", accs.join(", ")));
     s
 }
 
@@ -163,6 +183,7 @@ pub fn source(config: &NircConfig, layout: &ParameterLayout, pass: &str) -> Stri
         "adam_ema" => vec![COMMON, COUNTERS, FIXED_SUM_READ, ADAM_EMA],
         "reliability_accumulate" => vec![COMMON, COUNTERS, RELIABILITY, FIXED_SUM, RELIABILITY_ACCUMULATE],
         "reliability_update" => vec![COMMON, COUNTERS, RELIABILITY, FIXED_SUM_READ, RELIABILITY_UPDATE],
+        "reliability_walk" => vec![COMMON, RELIABILITY, RELIABILITY_WALK],
         "finish_step" => vec![COMMON, COUNTERS, FINISH_STEP],
         "infer" => vec![COMMON, COUNTERS, INFER_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP, ENCODING, RELIABILITY, ANSWER, INFER],
         other => panic!("unknown NIRC pass '{other}'"),
@@ -178,7 +199,7 @@ pub fn source(config: &NircConfig, layout: &ParameterLayout, pass: &str) -> Stri
 pub fn all_sources() -> String {
     [
         COMMON, COUNTERS, TRAIN_BINDINGS, INFER_BINDINGS, WEIGHTS, LOSS, FIXED_SUM, FIXED_SUM_READ, ENCODING, MLP_LAYOUT, MLP, MLP_TILE, ANSWER, RELIABILITY, TRAIN_FORWARD_BACKWARD, TRAIN_TILE, WEIGHT_GRADIENT, ADAM_EMA, RELIABILITY_ACCUMULATE,
-        RELIABILITY_UPDATE, FINISH_STEP, INFER, INFER_TILE,
+        RELIABILITY_UPDATE, RELIABILITY_WALK, FINISH_STEP, INFER, INFER_TILE,
     ]
     .join("\n")
 }

@@ -64,13 +64,14 @@ impl NircSettings {
     }
 }
 
-/// Short name of a predictor mode in labels.
-pub fn predictor_label(mode: PredictorMode) -> &'static str {
+/// Short name of a predictor mode in labels (`Fixed(0.5)` is `fixed50`).
+pub fn predictor_label(mode: PredictorMode) -> String {
     match mode {
-        PredictorMode::EmaOnly => "ema",
-        PredictorMode::HighLrOnly => "highlr",
-        PredictorMode::Blend => "blend",
-        PredictorMode::Switch => "switch",
+        PredictorMode::EmaOnly => "ema".into(),
+        PredictorMode::HighLrOnly => "highlr".into(),
+        PredictorMode::Blend => "blend".into(),
+        PredictorMode::Switch => "switch".into(),
+        PredictorMode::Fixed(sigma) => format!("fixed{}", (sigma * 100.0).round()),
     }
 }
 
@@ -141,6 +142,11 @@ impl MethodPlugin for Plugin {
         settings.cache.validate()?;
         if settings.spp == 0 {
             bail!("Nirc: spp 0; expected at least 1 path per pixel");
+        }
+        if let PredictorMode::Fixed(sigma) = settings.predictor
+            && !(0.0..=1.0).contains(&sigma)
+        {
+            bail!("Nirc: predictor Fixed({sigma}); expected a weight of the High-LR predictor in [0, 1]");
         }
         let key = settings.shared_key();
         let existing = world.query::<(Entity, &NircCache)>().iter(world).find(|(_, c)| c.key == key).map(|(e, _)| e);
