@@ -11,13 +11,17 @@ def f(x):
 def mean(v):
     v = [x for x in v if not math.isnan(x)]
     return sum(v) / len(v) if v else float('nan')
-print(f"{'method':18} {'ms/frame':>9} {'paths':>7} {'infer':>7} {'train':>7} {'FLIP<':>6} {'FLIP>':>6} {'SMAPE<':>7} {'SMAPE>':>7}")
+print(f"{'method':18} {'cpu ms':>9} {'paths':>7} {'infer':>7} {'train':>7} {'FLIP<':>6} {'FLIP>':>6} {'SMAPE<':>7} {'SMAPE>':>7}")
 for m, rs in by.items():
     rs.sort(key=lambda r: int(r['frame']))
     pre = [r for r in rs if change is None or int(r['frame']) < change]
     post = [r for r in rs if change is not None and change + 2 <= int(r['frame'])]
-    col = lambda rr, k: mean([f(r.get(k, '')) for r in rr])
-    print(f"{m:18} {col(rs,'gpu_ms_total'):9.1f} {col(rs,'gpu_ms_nirc_paths'):7.1f} {col(rs,'gpu_ms_nirc_infer'):7.1f} {col(rs,'gpu_ms_nirc_train'):7.1f} {col(pre,'flip'):6.3f} {col(post,'flip'):6.3f} {col(pre,'smape'):7.3f} {col(post,'smape'):7.3f}")
+    # Pass times: gpu_ms_PASS where the adapter has timestamp queries, else wall_ms_PASS.
+    def col(rr, k):
+        if k.startswith('gpu_ms_') and k not in rr[0]:
+            k = 'wall_ms_' + k[len('gpu_ms_'):]
+        return mean([f(r.get(k, '')) for r in rr])
+    print(f"{m:18} {col(rs,'cpu_ms'):9.1f} {col(rs,'gpu_ms_nirc_paths'):7.1f} {col(rs,'gpu_ms_nirc_infer'):7.1f} {col(rs,'gpu_ms_nirc_train'):7.1f} {col(pre,'flip'):6.3f} {col(post,'flip'):6.3f} {col(pre,'smape'):7.3f} {col(post,'smape'):7.3f}")
 m = next((m for m in by if m.startswith('nirc_blend')), None)
 if m:
     rs = sorted(by[m], key=lambda r: int(r['frame']))

@@ -28,14 +28,17 @@ pub struct CachePathSettings {
     /// k - 1 bounces with full NEE + MIS first. Paths that end earlier (escape, absorption,
     /// Russian roulette) never query.
     pub termination_vertex: u32,
-    /// Training records per frame, picked among the frame's queries (seeded).
+    /// Training records per step, picked among the frame's queries (seeded).
     pub train_records: u32,
+    /// Training steps per frame, each on its own `train_records` picks and targets (public NRC:
+    /// 4 steps of 16384 records).
+    pub train_steps: u32,
 }
 
 impl Default for CachePathSettings {
     fn default() -> Self {
         // 2048 records: about 1.5 s of training per frame on lavapipe at width 64 (README).
-        Self { termination_vertex: 1, train_records: 2048 }
+        Self { termination_vertex: 1, train_records: 2048, train_steps: 1 }
     }
 }
 
@@ -116,8 +119,8 @@ impl CachePaths {
         if settings.termination_vertex == 0 {
             return Err(NircError::Config("termination_vertex must be at least 1 (1 = the primary hit)".into()));
         }
-        if settings.train_records == 0 {
-            return Err(NircError::Config("train_records must be at least 1".into()));
+        if settings.train_records == 0 || settings.train_steps == 0 {
+            return Err(NircError::Config(format!("train_records ({}) and train_steps ({}) must be at least 1", settings.train_records, settings.train_steps)));
         }
         let s = tracer.settings();
         let (width, height) = (s.width, s.height);

@@ -108,7 +108,7 @@ enum Answer {
 
 fn cache_images(tracer: &PathTracer, termination_vertex: u32, answer: Answer) -> Vec<Vec<[f32; 4]>> {
     let g = gpu();
-    let paths = CachePaths::new(g, tracer, SPP, CachePathSettings { termination_vertex, train_records: 64 }).expect("cache paths");
+    let paths = CachePaths::new(g, tracer, SPP, CachePathSettings { termination_vertex, train_records: 64, train_steps: 1 }).expect("cache paths");
     let out = paths.output(g).unwrap();
     (0..SEEDS)
         .map(|seed| {
@@ -151,7 +151,7 @@ fn oracle_answers_reproduce_the_path_tracer() {
 fn training_records_are_queries_with_finite_targets() {
     let g = gpu();
     let t = tracer(4);
-    let paths = CachePaths::new(g, &t, 1, CachePathSettings { termination_vertex: 1, train_records: 256 }).unwrap();
+    let paths = CachePaths::new(g, &t, 1, CachePathSettings { termination_vertex: 1, train_records: 256, train_steps: 1 }).unwrap();
     let mut encoder = g.device.create_command_encoder(&Default::default());
     paths.encode_queries(g, &mut encoder, &t, 7, 3);
     paths.encode_records(g, &mut encoder, &t);
@@ -205,7 +205,7 @@ fn saved_and_loaded_cache_renders_the_next_frames_identically() {
     let t = tracer(3);
     let (lo, hi) = t.geometry().bounds();
     let config = common::small_config();
-    let paths = CachePaths::new(g, &t, 1, CachePathSettings { termination_vertex: 1, train_records: 256 }).unwrap();
+    let paths = CachePaths::new(g, &t, 1, CachePathSettings { termination_vertex: 1, train_records: 256, train_steps: 1 }).unwrap();
     let out = paths.output(g).unwrap();
     let cache = NeuralCache::new(g, &config, SceneBounds::new(lo.to_array(), hi.to_array())).unwrap();
     // Past the reliability warm-up (2 updates in small_config), so the blend uses the grid.
@@ -270,7 +270,7 @@ fn ray_counters_count_every_ray_when_all_escape() {
     let mut t = tracer(3);
     t.update(g, &up);
     let spp = 2;
-    let paths = CachePaths::new(g, &t, spp, CachePathSettings { termination_vertex: 1, train_records: 64 }).unwrap();
+    let paths = CachePaths::new(g, &t, spp, CachePathSettings { termination_vertex: 1, train_records: 64, train_steps: 1 }).unwrap();
     let mut encoder = g.device.create_command_encoder(&Default::default());
     paths.encode_queries(g, &mut encoder, &t, 5, 2);
     paths.encode_records(g, &mut encoder, &t);

@@ -104,6 +104,8 @@ pub struct NircCache {
     shaded: u64,
     /// The warm-start file the cache was loaded from or saved to, if any.
     pub warm_start: Option<PathBuf>,
+    /// Wall time of the frame's training steps before the last (train_steps > 1).
+    steps_wall_ms: Option<f64>,
 }
 
 /// One NIRC method: its predictor mode, its cache, and this frame's inference.
@@ -218,9 +220,14 @@ impl NircCache {
                     let frame = u32::MAX - k;
                     let mut encoder = gpu.device.create_command_encoder(&Default::default());
                     paths.encode_queries(gpu, &mut encoder, tracer, run.scenario.seed, frame);
-                    paths.encode_records(gpu, &mut encoder, tracer);
-                    fresh.encode_train(gpu, &mut encoder, paths.records(), paths.record_count())?;
                     gpu.queue.submit([encoder.finish()]);
+                    for step in 0..settings.paths.train_steps {
+                        tracer.prepare_frame(gpu, settings.spp, 0, step_seed(run.scenario.seed, step), frame);
+                        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                        paths.encode_records(gpu, &mut encoder, tracer);
+                        fresh.encode_train(gpu, &mut encoder, paths.records(), paths.record_count())?;
+                        gpu.queue.submit([encoder.finish()]);
+                    }
                     wait(gpu)?;
                 }
                 std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
@@ -256,6 +263,7 @@ impl NircCache {
             rays: [0; 2],
             shaded: 0,
             warm_start,
+            steps_wall_ms: None,
         })
     }
 
@@ -327,12 +335,34 @@ pub fn reliability(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut caches: Quer
     Ok(())
 }
 
-/// Training records from the frame's paths and the Adam step of the High-LR weights.
+/// The seed of training step `step` of a frame (step 0 uses the run's seed, as with one step).
+fn step_seed(seed: u64, step: u32) -> u64 {
+    seed ^ 0x9E37_79B9_7F4A_7C15u64.wrapping_mul(step as u64)
+}
+
+/// Training records from the frame's paths and the Adam step of the High-LR weights. With
+/// `train_steps` > 1 the earlier steps (records, Adam, EMA, reliability) run first, their wall
+/// time in the statistic `nirc_steps_wall_ms`; the last step is split over this system, `ema` and
+/// `reliability_update` as with one step.
 pub fn train(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut caches: Query<&mut NircCache>) -> Result<(), BevyError> {
     let gpu = &gpu.0;
     let err = frame_error(&clock);
     for mut c in &mut caches {
         let c = &mut *c;
+        let steps = c.settings.paths.train_steps;
+        c.steps_wall_ms = None;
+        if steps > 1 {
+            let start = Instant::now();
+            for step in 1..steps {
+                c.prepare(gpu, &tracer.0, step_seed(run.scenario.seed, step), clock.global);
+                let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                c.paths.encode_records(gpu, &mut encoder, &tracer.0);
+                c.cache.encode_train(gpu, &mut encoder, c.paths.records(), c.paths.record_count()).map_err(|e| err(e.into()))?;
+                gpu.queue.submit([encoder.finish()]);
+            }
+            wait(gpu).map_err(|e| err(e))?;
+            c.steps_wall_ms = Some(start.elapsed().as_secs_f64() * 1e3);
+        }
         c.prepare(gpu, &tracer.0, run.scenario.seed, clock.global);
         let mut timed = c.train_timer.begin(gpu, "nirc train");
         c.paths.records_timed(gpu, &mut timed, 0, &tracer.0).map_err(|e| err(e.into()))?;
@@ -389,7 +419,10 @@ pub fn frame_output(caches: Query<&NircCache>, mut methods: Query<(&mut NircMeth
         let Some(r) = m.inferred.take() else { continue };
         let times: Vec<&PassTiming> = c.paths_times.iter().chain(&r.times).chain(&c.train_times).collect();
         let mut stats = c.stats.clone();
-        stats.push(("nirc_ms".into(), times.iter().map(|t| t.ms).sum()));
+        stats.push(("nirc_ms".into(), times.iter().map(|t| t.ms).sum::<f64>() + c.steps_wall_ms.unwrap_or(0.0)));
+        if let Some(ms) = c.steps_wall_ms {
+            stats.push(("nirc_steps_wall_ms".into(), ms));
+        }
         let mut images = Vec::new();
         if matches!(m.mode, PredictorMode::Blend | PredictorMode::Switch) {
             images.push(MethodImage { name: "preference".into(), pixels: preference_map(&r.sigma), hdr: false });
