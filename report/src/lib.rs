@@ -9,6 +9,8 @@ pub mod html;
 pub mod images;
 pub mod run;
 pub mod summary;
+pub mod table;
+pub mod viewer;
 
 use std::path::{Path, PathBuf};
 

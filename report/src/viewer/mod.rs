@@ -1,0 +1,179 @@
+//! The viewer at the top of report.html: every method beside the reference, one frame at a
+//! time, with a frame slider, play/pause at the scenario's frame rate, exposure on HDR data,
+//! FLIP and SMAPE maps, synchronised zoom/pan and the pixel values under the pointer.
+//!
+//! Frames travel as RGBE planes ([`rgbe`]) in one `flickerFrame(frame, {label: base64})` call per
+//! frame: inline in the page while all frames together stay under [`EMBED_LIMIT_BYTES`], else
+//! in `RUN/viewer/NNNN.js`, which the page loads on demand (a script loads from file://, where
+//! the browser refuses fetch()).
+
+pub mod rgbe;
+
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use anyhow::{Context, bail};
+use metrics::{Image, load_image};
+use rayon::prelude::*;
+use serde_json::json;
+
+use crate::base64;
+use crate::html::esc;
+use crate::run::{Frames, Manifest, frame_file};
+
+/// Encoded frames (base64 text) embedded in report.html up to this size; a larger run's frames
+/// are linked from `RUN/viewer/`, so the page stays quick to open.
+pub const EMBED_LIMIT_BYTES: usize = 48 << 20;
+
+/// The subfolder of the run with the linked frames.
+pub const LINKED_DIR: &str = "viewer";
+
+/// Width of a panel at the fitted zoom, in CSS pixels.
+const PANEL_WIDTH: f64 = 360.0;
+
+const SCRIPT: &str = include_str!("viewer.js");
+pub const STYLE: &str = include_str!("viewer.css");
+
+/// The viewer's part of the page.
+pub struct Viewer {
+    /// Markup, data and script, to be placed at the top of the body.
+    pub html: String,
+    /// Total size of the encoded frames (base64).
+    pub encoded_bytes: usize,
+    pub linked: bool,
+}
+
+/// Where the page finds its frames.
+fn chunk_js(frame: u32, entries: &[(String, String)]) -> String {
+    let map: serde_json::Map<String, serde_json::Value> = entries.iter().map(|(k, v)| (k.clone(), json!(v))).collect();
+    format!("flickerFrame({frame},{});\n", serde_json::Value::Object(map))
+}
+
+/// The radiance of a frame: EXR when present, else the PNG made linear.
+fn load(run_dir: &Path, method: Option<&str>, frame: u32) -> anyhow::Result<Option<Image>> {
+    for ext in ["exr", "png"] {
+        let p = frame_file(run_dir, method, frame, ext);
+        if p.exists() {
+            return load_image(&p).map(Some);
+        }
+    }
+    Ok(None)
+}
+
+/// Builds the viewer of a run, or `None` when the run has no frames on disk. `flip_maps` holds
+/// the FLIP map of (frame, method) where a reference exists.
+pub fn build(run_dir: &Path, manifest: &Manifest, frames: &Frames, methods: &[String], flip_maps: &HashMap<(u32, String), Vec<f32>>) -> anyhow::Result<Option<Viewer>> {
+    let frame_count = frames.rows.iter().map(|r| r.frame + 1).max().unwrap_or(0).max(manifest.frames.unwrap_or(0));
+    let labels: Vec<Option<&str>> = std::iter::once(None).chain(methods.iter().map(|m| Some(m.as_str()))).collect();
+    let size = std::sync::Mutex::new(None::<(u32, u32)>);
+    let chunks: Vec<Option<String>> = (0..frame_count)
+        .into_par_iter()
+        .map(|f| {
+            let mut entries = Vec::new();
+            for label in &labels {
+                let Some(img) = load(run_dir, *label, f)? else { continue };
+                let mut s = size.lock().unwrap();
+                match *s {
+                    None => *s = Some((img.width, img.height)),
+                    Some(wh) if wh != (img.width, img.height) => {
+                        bail!("{}: frame {f} of {} is {}x{}, other frames are {}x{}", run_dir.display(), label.unwrap_or("the reference"), img.width, img.height, wh.0, wh.1)
+                    }
+                    Some(_) => {}
+                }
+                drop(s);
+                entries.push((label.unwrap_or("reference").to_string(), base64::encode(&rgbe::encode(&img))));
+            }
+            for m in methods {
+                if let Some(map) = flip_maps.get(&(f, m.clone())) {
+                    entries.push((format!("flip:{m}"), base64::encode(&rgbe::encode_map(map))));
+                }
+            }
+            Ok((!entries.is_empty()).then(|| chunk_js(f, &entries)))
+        })
+        .collect::<anyhow::Result<_>>()?;
+    let Some((width, height)) = size.into_inner().unwrap() else { return Ok(None) };
+    let encoded_bytes: usize = chunks.iter().flatten().map(String::len).sum();
+    let linked = encoded_bytes > EMBED_LIMIT_BYTES;
+    let dir = run_dir.join(LINKED_DIR);
+    if dir.exists() {
+        std::fs::remove_dir_all(&dir).with_context(|| format!("cannot remove {}", dir.display()))?;
+    }
+    if linked {
+        std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        for (f, js) in chunks.iter().enumerate() {
+            if let Some(js) = js {
+                let p = dir.join(format!("{f:04}.js"));
+                std::fs::write(&p, js).with_context(|| format!("cannot write {}", p.display()))?;
+            }
+        }
+    }
+
+    let settings = manifest.raw.get("settings");
+    let time_step = settings.and_then(|s| s.get("time_step")).and_then(|v| v.as_f64()).filter(|&t| t > 0.0);
+    let fps = time_step.map(|t| 1.0 / t).unwrap_or(30.0);
+    let smape_epsilon = settings.and_then(|s| s.get("smape_epsilon").or(s.get("smape_eps"))).and_then(|v| v.as_f64()).unwrap_or(0.01);
+    let magma: Vec<u8> = (0..256).flat_map(|i| metrics::magma(i as f32 / 255.0)).collect();
+    let mut names = vec!["reference".to_string()];
+    names.extend(methods.iter().cloned());
+    let config = json!({
+        "width": width, "height": height, "frames": frame_count, "fps": fps, "labels": names,
+        "smape_epsilon": smape_epsilon, "linked": linked.then(|| format!("{LINKED_DIR}/")), "magma": magma,
+    });
+
+    let mut h = String::new();
+    h.push_str("<section id=\"viewer\">\n<div class=\"controls\">");
+    h.push_str("<button id=\"play\" type=\"button\">play</button>");
+    let _ = write!(h, "<div class=\"timeline\"><input type=\"range\" id=\"frame-slider\" min=\"0\" max=\"{}\" value=\"0\" step=\"1\" aria-label=\"frame\">", frame_count.saturating_sub(1));
+    let pos = |f: u32| 100.0 * f as f64 / frame_count.saturating_sub(1).max(1) as f64;
+    for e in &manifest.events {
+        let _ = write!(h, "<span class=\"event-mark\" data-frame=\"{}\" style=\"left:{:.3}%\" title=\"frame {}: {}\">▼</span>", e.frame, pos(e.frame), e.frame, esc(&e.label));
+    }
+    for &f in &manifest.reference.frames {
+        let _ = write!(h, "<span class=\"reference-mark\" style=\"left:{:.3}%\" title=\"reference at frame {f}\"></span>", pos(f));
+    }
+    h.push_str("</div><span id=\"frame-label\">frame 0</span>");
+    h.push_str("<label>exposure <input type=\"range\" id=\"exposure\" min=\"-10\" max=\"10\" step=\"0.25\" value=\"0\"></label><span id=\"exposure-label\">0 EV</span>");
+    h.push_str("<span class=\"modes\"><button type=\"button\" data-mode=\"image\" class=\"on\">image</button>");
+    if !flip_maps.is_empty() {
+        h.push_str("<button type=\"button\" data-mode=\"flip\">FLIP map</button>");
+    }
+    h.push_str("<button type=\"button\" data-mode=\"smape\">SMAPE to previous frame</button></span>");
+    h.push_str("<button id=\"fit\" type=\"button\">fit</button></div>\n<div id=\"panels\">");
+    let scale = if (width as f64) < PANEL_WIDTH { (PANEL_WIDTH / width as f64).floor() } else { PANEL_WIDTH / width as f64 };
+    let (vw, vh) = ((width as f64 * scale).round(), (height as f64 * scale).round());
+    for name in &names {
+        let _ = write!(
+            h,
+            "<figure class=\"panel\" data-label=\"{n}\"><div class=\"view\" style=\"width:{vw}px;height:{vh}px\"><canvas width=\"{width}\" height=\"{height}\" style=\"width:{width}px;height:{height}px\"></canvas></div><figcaption>{n}<span class=\"value\"></span></figcaption></figure>",
+            n = esc(name)
+        );
+    }
+    h.push_str("</div>\n<p id=\"pixel-label\"></p>\n");
+    let mb = |b: usize| b as f64 / (1 << 20) as f64;
+    let _ = writeln!(
+        h,
+        "<p class=\"note\">Plays at {fps:.3} frames/s (the scenario's time step). Wheel: zoom, drag: pan, double-click: fit; space: play/pause, arrows: step. \
+         Frames are decoded from RGBE (HDR) in the page; the exposure scales radiance before sRGB. SMAPE maps are computed in the page against the previous frame (ε = {smape_epsilon}); \
+         FLIP maps exist at reference frames (grey ticks on the slider), scripted events are marked ▼. This run records no motion vectors. \
+         Frames: {:.1} MB, {} (frames are embedded up to {:.0} MB, linked from <code>{LINKED_DIR}/</code> beyond).</p>",
+        mb(encoded_bytes),
+        if linked { format!("linked from <code>{LINKED_DIR}/</code>: keep the folder next to report.html") } else { "embedded in this file".into() },
+        mb(EMBED_LIMIT_BYTES),
+    );
+    // `</` would end the script element early.
+    let _ = writeln!(h, "<script type=\"application/json\" id=\"flicker-config\">{}</script>", config.to_string().replace("</", "<\\/"));
+    h.push_str("<script>window.flickerChunks={};function flickerFrame(f,d){window.flickerChunks[f]=d;}</script>\n");
+    if !linked {
+        for js in chunks.iter().flatten() {
+            let _ = writeln!(h, "<script>{js}</script>");
+        }
+    }
+    let _ = writeln!(h, "</section>");
+    Ok(Some(Viewer { html: h, encoded_bytes, linked }))
+}
+
+/// The viewer's script, placed after everything it drives (panels and charts).
+pub fn script() -> String {
+    format!("<script>{SCRIPT}</script>\n")
+}
