@@ -117,7 +117,7 @@
     p.ctx.putImageData(img, 0, 0);
   }
 
-  let token = 0, waiters = [];
+  let token = 0, done = -1, waiters = [];
   async function show(f) {
     f = Math.max(0, Math.min(N - 1, f | 0));
     state.frame = f;
@@ -129,6 +129,7 @@
     if (mine !== token) return; // a later request superseded this one
     panels.forEach((p, i) => { p.data = data[i]; paint(p); });
     state.shown = f;
+    done = mine;
     readout();
     if (state.playing) decoded((f + 1) % N, panels[panels.length - 1].label); // warm the next frame
     const w = waiters;
@@ -213,7 +214,7 @@
     playButton.textContent = on ? 'pause' : 'play';
     clearInterval(timer);
     // One step per frame period; a frame still decoding is not skipped, the next tick waits.
-    if (on) timer = setInterval(() => { if (state.shown === state.frame) show((state.frame + 1) % N); }, 1000 / C.fps);
+    if (on) timer = setInterval(() => { if (done === token) show((state.frame + 1) % N); }, 1000 / C.fps);
   }
   playButton.addEventListener('click', () => play(!state.playing));
   $('fit').addEventListener('click', fit);
@@ -236,7 +237,7 @@
     state, labels: panels.map(p => p.label), show, pixelAt, valueAt: (i, x, y) => valueAt(panels[i], x, y),
     canvas: i => panels[i].canvas, view: i => panels[i].view,
     // Resolves once the requested frame is on screen.
-    whenShown: () => (state.shown === state.frame && token > 0 ? Promise.resolve() : new Promise(r => waiters.push(r))),
+    whenShown: () => (done === token ? Promise.resolve() : new Promise(r => waiters.push(r))),
   };
   fit();
   const start = /frame=(\d+)/.exec(location.hash);
