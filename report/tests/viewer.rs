@@ -245,3 +245,72 @@ fn screenshots_differ_where_the_scene_changes_and_only_there() {
     }
     std::fs::remove_dir_all(&run).ok();
 }
+
+/// A page that says when the viewer first showed a frame (the load event alone comes earlier).
+const FIRST_FRAME: &str = r#"<script>
+window.addEventListener('load', async () => {
+  await window.flickerViewer.whenShown();
+  // The frames' scripts go before the dump: printing tens of MB of DOM would be timed too.
+  document.querySelectorAll('script').forEach(s => s.remove());
+  const d = document.createElement('pre');
+  d.id = 'first-frame';
+  d.textContent = 'shown ' + window.flickerViewer.state.shown + ' empty ' + document.querySelectorAll('#panels .view.empty').length + ' errors ' + window.__errors.length;
+  document.body.appendChild(d);
+});
+</script>"#;
+
+/// Wall time of headless Chromium from start to the dump of `page` (file path).
+fn open_seconds(bin: &Path, work: &Path, page: &Path) -> (f64, String) {
+    let t = std::time::Instant::now();
+    let out = browser(bin, work, &["--dump-dom".into()], &file_url(page));
+    (t.elapsed().as_secs_f64(), String::from_utf8_lossy(&out.stdout).into_owned())
+}
+
+/// The size named in the issue: 320x180, 60 frames, 6 methods. Opening it (browser start to the
+/// first frame on screen, less the browser's start on an empty page) stays under 3 s.
+#[test]
+fn a_320x180_60_frame_6_method_report_opens_in_under_3_s() {
+    let bin = chromium();
+    let spec = FakeRun {
+        width: 320,
+        height: 180,
+        frames: 60,
+        event: 30,
+        methods: (0..6).map(|m| format!("method_{m}")).collect(),
+        reference_frames: vec![0, 30, 59],
+        static_noise: false,
+        time_step: Some(1.0 / 30.0),
+    };
+    let run = fake_run_with("large", &spec);
+    let t = std::time::Instant::now();
+    report::rebuild(&run).unwrap();
+    let build_s = t.elapsed().as_secs_f64();
+    let html = std::fs::read_to_string(run.join("report.html")).unwrap();
+    let page = run.join("timed.html");
+    std::fs::write(&page, html.replacen("<head>", &format!("<head>{ERROR_HOOK}"), 1).replacen("</body>", &format!("{FIRST_FRAME}</body>"), 1)).unwrap();
+    let blank = run.join("blank.html");
+    std::fs::write(&blank, "<!DOCTYPE html><html><body><pre id=\"first-frame\">blank</pre></body></html>").unwrap();
+    let size = |p: &Path| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
+    let linked: u64 = std::fs::read_dir(run.join("viewer")).map(|d| d.map(|e| size(&e.unwrap().path())).sum()).unwrap_or(0);
+    // Best of three of each: the machine may be busy with other work.
+    let mut times = Vec::new();
+    for _ in 0..3 {
+        let (blank_s, _) = open_seconds(&bin, &run, &blank);
+        let (page_s, dom) = open_seconds(&bin, &run, &page);
+        assert_eq!(element_text(&dom, "first-frame").as_deref(), Some("shown 0 empty 0 errors 0"), "the first frame was not shown in every panel");
+        times.push((page_s - blank_s, page_s, blank_s));
+    }
+    let (open, page_s, blank_s) = times.into_iter().min_by(|a, b| a.0.total_cmp(&b.0)).unwrap();
+    let mb = |b: u64| b as f64 / (1u64 << 20) as f64;
+    eprintln!(
+        "320x180, 60 frames, 6 methods: report.html {:.1} MB, linked frames {:.1} MB ({}), report built in {build_s:.1} s; \
+         opened (first frame shown) in {open:.2} s = {page_s:.2} s less {blank_s:.2} s for an empty page",
+        mb(size(&run.join("report.html"))),
+        mb(linked),
+        if linked > 0 { "linked" } else { "embedded" },
+    );
+    assert!(open < 3.0, "opening took {open:.2} s");
+    // This run is past the embedding threshold: its frames came from RUN/viewer/.
+    assert!(linked > report::viewer::EMBED_LIMIT_BYTES as u64 && size(&run.join("report.html")) < 2 << 20);
+    std::fs::remove_dir_all(&run).ok();
+}

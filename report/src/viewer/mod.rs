@@ -24,7 +24,7 @@ use crate::run::{Frames, Manifest, frame_file};
 
 /// Encoded frames (base64 text) embedded in report.html up to this size; a larger run's frames
 /// are linked from `RUN/viewer/`, so the page stays quick to open.
-pub const EMBED_LIMIT_BYTES: usize = 48 << 20;
+pub const EMBED_LIMIT_BYTES: usize = 32 << 20;
 
 /// The subfolder of the run with the linked frames.
 pub const LINKED_DIR: &str = "viewer";
