@@ -25,9 +25,9 @@ fn png_uri(path: &Path) -> anyhow::Result<String> {
     Ok(data_uri("image/png", &bytes))
 }
 
-const STYLE: &str = "body{font-family:sans-serif;margin:24px;max-width:1600px;color:#222}\
+pub const STYLE: &str = "body{font-family:sans-serif;margin:24px;max-width:1600px;color:#222}\
 table{border-collapse:collapse;margin:8px 0 20px}td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}\
-th{background:#f3f3f3}td.m{text-align:left}td.best{font-weight:bold;background:#e3f1e3}\
+th{background:#f3f3f3}td.m{text-align:left}td.best{font-weight:bold;background:#e3f1e3}td.better{background:#e3f1e3}td.worse{background:#f8e0e0}\
 .charts{display:grid;grid-template-columns:repeat(auto-fill,minmax(520px,1fr));gap:8px}\
 .chart{position:relative;margin:0}.chart img{display:block;width:100%;height:auto;border:1px solid #ddd}\
 .chart .cursor{position:absolute;top:0;bottom:0;border-left:2px solid rgba(0,0,0,.55);pointer-events:none}\
@@ -60,7 +60,9 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
     let frame_images = write_frame_images(run_dir, &manifest, &methods)?;
     let flip_maps: HashMap<(u32, String), Vec<f32>> =
         frame_images.iter().flat_map(|fi| fi.methods.iter().map(move |m| ((fi.frame, m.method.clone()), m.flip.clone()))).collect();
-    let viewer = viewer::build(run_dir, &manifest, &frames, &methods, &flip_maps)?;
+    let frame_count = frames.frame_count(&manifest);
+    let out = viewer::Output { dir: run_dir, linked_dir: viewer::LINKED_DIR };
+    let viewer = viewer::build(&out, &viewer::Panel::of_run(run_dir, &methods), frame_count, &manifest, &flip_maps)?;
 
     let mut h = String::new();
     let title = format!("flicker run: {}", manifest.scenario);

@@ -132,6 +132,11 @@ impl Frames {
         s
     }
 
+    /// Frames of the run: those in frames.csv, or the manifest's count if larger.
+    pub fn frame_count(&self, manifest: &Manifest) -> u32 {
+        self.rows.iter().map(|r| r.frame + 1).max().unwrap_or(0).max(manifest.frames.unwrap_or(0))
+    }
+
     /// Whether a column has at least one finite value.
     pub fn has_data(&self, column: usize) -> bool {
         self.rows.iter().any(|r| r.values[column].is_some_and(f64::is_finite))

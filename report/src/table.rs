@@ -73,6 +73,30 @@ pub fn html(summary: &Summary, frames: &Frames) -> String {
     h
 }
 
+/// Two runs side by side: per method present in both, the overall mean of each column in A and
+/// in B, and B − A (relative, in %), coloured by whether B is better.
+pub fn differences_html(a: &Summary, b: &Summary, frames_a: &Frames, frames_b: &Frames) -> String {
+    let has = |f: &Frames, c: &str| f.column(c).is_some_and(|i| f.has_data(i));
+    let cols: Vec<_> = COLUMNS.iter().copied().filter(|(c, ..)| has(frames_a, c) && has(frames_b, c)).collect();
+    let overall = |s: &Summary, method: &str, c: &str| s.methods.iter().find(|m| m.method == method).and_then(|m| m.means.get("overall")?.get(c).copied());
+    let mut h = String::from("<table id=\"differences\"><tr><th>method</th><th>column</th><th>A</th><th>B</th><th>B − A</th><th>change</th></tr>\n");
+    for m in a.methods.iter().filter(|m| b.methods.iter().any(|n| n.method == m.method)) {
+        for (c, name, better) in &cols {
+            let (Some(va), Some(vb)) = (overall(a, &m.method, c), overall(b, &m.method, c)) else { continue };
+            let d = vb - va;
+            let class = match (better, d.partial_cmp(&0.0)) {
+                (Better::Lower, Some(std::cmp::Ordering::Less)) | (Better::Higher, Some(std::cmp::Ordering::Greater)) => " class=\"better\"",
+                (Better::Lower, Some(std::cmp::Ordering::Greater)) | (Better::Higher, Some(std::cmp::Ordering::Less)) => " class=\"worse\"",
+                _ => "",
+            };
+            let rel = if va != 0.0 { format!("{:+.1} %", 100.0 * d / va.abs()) } else { String::new() };
+            let _ = writeln!(h, "<tr><td class=\"m\">{}</td><td class=\"m\">{name}</td><td>{va:.4}</td><td>{vb:.4}</td><td{class}>{d:+.4}</td><td{class}>{rel}</td></tr>", esc(&m.method));
+        }
+    }
+    h.push_str("</table>\n");
+    h
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -314,3 +314,49 @@ fn a_320x180_60_frame_6_method_report_opens_in_under_3_s() {
     assert!(linked > report::viewer::EMBED_LIMIT_BYTES as u64 && size(&run.join("report.html")) < 2 << 20);
     std::fs::remove_dir_all(&run).ok();
 }
+
+#[test]
+fn compare_puts_two_runs_in_one_viewer_with_a_table_of_differences() {
+    let bin = chromium();
+    let a = fake_run_with("compare-a", &FakeRun::default());
+    // B: the same scene with noise that holds still from frame to frame (less flicker).
+    let b = fake_run_with("compare-b", &FakeRun { static_noise: true, ..FakeRun::default() });
+    let args = report::ReportArgs { run_dir: None, compare: Some(vec![a.clone(), b.clone()]), out: None };
+    let page = report::report(&args).unwrap();
+    assert_eq!(page, b.join("compare.html"));
+    let html = std::fs::read_to_string(&page).unwrap();
+    let labels: Vec<&str> = html.split("data-label=\"").skip(1).map(|s| s.split('"').next().unwrap()).collect();
+    assert_eq!(labels, ["reference", "A: pt_1spp", "B: pt_1spp", "A: cache_ema", "B: cache_ema"]);
+    assert_eq!(html.matches("<script>flickerFrame(").count(), FRAMES as usize);
+    assert_eq!(html.matches("\"flip:B: cache_ema\"").count(), 2, "FLIP maps of B at both reference frames");
+
+    // Differences: the overall SMAPE of each run, from its frames.csv; B flickers less.
+    let frames = |dir: &Path| report::run::Frames::load(dir).unwrap();
+    let mean_smape = |dir: &Path, method: &str| {
+        let f = frames(dir);
+        let v: Vec<f64> = f.series(method, f.column("smape").unwrap()).into_iter().map(|p| p.1).collect();
+        v.iter().sum::<f64>() / v.len() as f64
+    };
+    let row = |method: &str, column: &str| -> Vec<String> {
+        let start = format!("<tr><td class=\"m\">{method}</td><td class=\"m\">{column}</td>");
+        let r = html.split(&start).nth(1).unwrap_or_else(|| panic!("no row {method} {column}")).split("</tr>").next().unwrap();
+        r.split("<td").skip(1).map(|c| c.to_string()).collect()
+    };
+    for method in METHODS {
+        let (sa, sb) = (mean_smape(&a, method), mean_smape(&b, method));
+        let cells = row(method, "SMAPE");
+        let num = |c: &str| c.split('>').nth(1).unwrap().split('<').next().unwrap().parse::<f64>().unwrap();
+        assert!((num(&cells[0]) - sa).abs() < 1e-4 && (num(&cells[1]) - sb).abs() < 1e-4, "{method}: {cells:?} vs {sa} {sb}");
+        assert!(sb < sa && cells[2].starts_with(" class=\"better\""), "{method}: {cells:?}");
+        // GPU time is the same in both runs: no colour.
+        assert!(row(method, "GPU ms")[2].starts_with(">+0.0000"));
+    }
+
+    // In the browser: every panel shows frame 0.
+    let timed = b.join("compare-check.html");
+    std::fs::write(&timed, html.replacen("<head>", &format!("<head>{ERROR_HOOK}"), 1).replacen("</body>", &format!("{FIRST_FRAME}</body>"), 1)).unwrap();
+    let (_, dom) = open_seconds(&bin, &b, &timed);
+    assert_eq!(element_text(&dom, "first-frame").as_deref(), Some("shown 0 empty 0 errors 0"));
+    std::fs::remove_dir_all(&a).ok();
+    std::fs::remove_dir_all(&b).ok();
+}

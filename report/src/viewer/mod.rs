@@ -11,7 +11,7 @@ pub mod rgbe;
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use metrics::{Image, load_image};
@@ -20,13 +20,13 @@ use serde_json::json;
 
 use crate::base64;
 use crate::html::esc;
-use crate::run::{Frames, Manifest, frame_file};
+use crate::run::{Manifest, frame_file};
 
 /// Encoded frames (base64 text) embedded in report.html up to this size; a larger run's frames
 /// are linked from `RUN/viewer/`, so the page stays quick to open.
 pub const EMBED_LIMIT_BYTES: usize = 32 << 20;
 
-/// The subfolder of the run with the linked frames.
+/// The folder, next to report.html, with the linked frames.
 pub const LINKED_DIR: &str = "viewer";
 
 /// Width of a panel at the fitted zoom, in CSS pixels.
@@ -44,7 +44,30 @@ pub struct Viewer {
     pub linked: bool,
 }
 
-/// Where the page finds its frames.
+/// One panel of the viewer: its caption and where its frames are.
+#[derive(Clone, Debug)]
+pub struct Panel {
+    pub label: String,
+    pub run_dir: PathBuf,
+    /// The method's frames, or the reference's when `None`.
+    pub method: Option<String>,
+}
+
+impl Panel {
+    /// The reference, then every method, of one run.
+    pub fn of_run(run_dir: &Path, methods: &[String]) -> Vec<Panel> {
+        let reference = Panel { label: "reference".into(), run_dir: run_dir.to_path_buf(), method: None };
+        std::iter::once(reference).chain(methods.iter().map(|m| Panel { label: m.clone(), run_dir: run_dir.to_path_buf(), method: Some(m.clone()) })).collect()
+    }
+}
+
+/// Where the viewer's page goes: its folder, and the name of the linked frames' subfolder.
+pub struct Output<'a> {
+    pub dir: &'a Path,
+    pub linked_dir: &'a str,
+}
+
+/// One frame's data, as the page receives it.
 fn chunk_js(frame: u32, entries: &[(String, String)]) -> String {
     let map: serde_json::Map<String, serde_json::Value> = entries.iter().map(|(k, v)| (k.clone(), json!(v))).collect();
     format!("flickerFrame({frame},{});\n", serde_json::Value::Object(map))
@@ -61,32 +84,29 @@ fn load(run_dir: &Path, method: Option<&str>, frame: u32) -> anyhow::Result<Opti
     Ok(None)
 }
 
-/// Builds the viewer of a run, or `None` when the run has no frames on disk. `flip_maps` holds
-/// the FLIP map of (frame, method) where a reference exists.
-pub fn build(run_dir: &Path, manifest: &Manifest, frames: &Frames, methods: &[String], flip_maps: &HashMap<(u32, String), Vec<f32>>) -> anyhow::Result<Option<Viewer>> {
-    let frame_count = frames.rows.iter().map(|r| r.frame + 1).max().unwrap_or(0).max(manifest.frames.unwrap_or(0));
-    let labels: Vec<Option<&str>> = std::iter::once(None).chain(methods.iter().map(|m| Some(m.as_str()))).collect();
+/// Builds a viewer of `frame_count` frames over `panels`, or `None` when no frame is on disk.
+/// `flip_maps` holds the FLIP map of (frame, panel label) where a reference exists; `manifest`
+/// gives the events, reference frames and settings (frame rate, SMAPE's epsilon).
+pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manifest, flip_maps: &HashMap<(u32, String), Vec<f32>>) -> anyhow::Result<Option<Viewer>> {
     let size = std::sync::Mutex::new(None::<(u32, u32)>);
     let chunks: Vec<Option<String>> = (0..frame_count)
         .into_par_iter()
         .map(|f| {
             let mut entries = Vec::new();
-            for label in &labels {
-                let Some(img) = load(run_dir, *label, f)? else { continue };
+            for p in panels {
+                let Some(img) = load(&p.run_dir, p.method.as_deref(), f)? else { continue };
                 let mut s = size.lock().unwrap();
                 match *s {
                     None => *s = Some((img.width, img.height)),
                     Some(wh) if wh != (img.width, img.height) => {
-                        bail!("{}: frame {f} of {} is {}x{}, other frames are {}x{}", run_dir.display(), label.unwrap_or("the reference"), img.width, img.height, wh.0, wh.1)
+                        bail!("{}: frame {f} of {} is {}x{}, other frames are {}x{}", p.run_dir.display(), p.label, img.width, img.height, wh.0, wh.1)
                     }
                     Some(_) => {}
                 }
                 drop(s);
-                entries.push((label.unwrap_or("reference").to_string(), base64::encode(&rgbe::encode(&img))));
-            }
-            for m in methods {
-                if let Some(map) = flip_maps.get(&(f, m.clone())) {
-                    entries.push((format!("flip:{m}"), base64::encode(&rgbe::encode_map(map))));
+                entries.push((p.label.clone(), base64::encode(&rgbe::encode(&img))));
+                if let Some(map) = flip_maps.get(&(f, p.label.clone())) {
+                    entries.push((format!("flip:{}", p.label), base64::encode(&rgbe::encode_map(map))));
                 }
             }
             Ok((!entries.is_empty()).then(|| chunk_js(f, &entries)))
@@ -95,7 +115,7 @@ pub fn build(run_dir: &Path, manifest: &Manifest, frames: &Frames, methods: &[St
     let Some((width, height)) = size.into_inner().unwrap() else { return Ok(None) };
     let encoded_bytes: usize = chunks.iter().flatten().map(String::len).sum();
     let linked = encoded_bytes > EMBED_LIMIT_BYTES;
-    let dir = run_dir.join(LINKED_DIR);
+    let dir = out.dir.join(out.linked_dir);
     if dir.exists() {
         std::fs::remove_dir_all(&dir).with_context(|| format!("cannot remove {}", dir.display()))?;
     }
@@ -114,11 +134,10 @@ pub fn build(run_dir: &Path, manifest: &Manifest, frames: &Frames, methods: &[St
     let fps = time_step.map(|t| 1.0 / t).unwrap_or(30.0);
     let smape_epsilon = settings.and_then(|s| s.get("smape_epsilon").or(s.get("smape_eps"))).and_then(|v| v.as_f64()).unwrap_or(0.01);
     let magma: Vec<u8> = (0..256).flat_map(|i| metrics::magma(i as f32 / 255.0)).collect();
-    let mut names = vec!["reference".to_string()];
-    names.extend(methods.iter().cloned());
+    let names: Vec<&str> = panels.iter().map(|p| p.label.as_str()).collect();
     let config = json!({
         "width": width, "height": height, "frames": frame_count, "fps": fps, "labels": names,
-        "smape_epsilon": smape_epsilon, "linked": linked.then(|| format!("{LINKED_DIR}/")), "magma": magma,
+        "smape_epsilon": smape_epsilon, "linked": linked.then(|| format!("{}/", out.linked_dir)), "magma": magma,
     });
 
     let mut h = String::new();
@@ -142,11 +161,12 @@ pub fn build(run_dir: &Path, manifest: &Manifest, frames: &Frames, methods: &[St
     h.push_str("<button id=\"fit\" type=\"button\">fit</button></div>\n<div id=\"panels\">");
     let scale = if (width as f64) < PANEL_WIDTH { (PANEL_WIDTH / width as f64).floor() } else { PANEL_WIDTH / width as f64 };
     let (vw, vh) = ((width as f64 * scale).round(), (height as f64 * scale).round());
-    for name in &names {
+    for p in panels {
         let _ = write!(
             h,
-            "<figure class=\"panel\" data-label=\"{n}\"><div class=\"view\" style=\"width:{vw}px;height:{vh}px\"><canvas width=\"{width}\" height=\"{height}\" style=\"width:{width}px;height:{height}px\"></canvas></div><figcaption>{n}<span class=\"value\"></span></figcaption></figure>",
-            n = esc(name)
+            "<figure class=\"panel\" data-label=\"{n}\" data-reference=\"{r}\"><div class=\"view\" style=\"width:{vw}px;height:{vh}px\"><canvas width=\"{width}\" height=\"{height}\" style=\"width:{width}px;height:{height}px\"></canvas></div><figcaption>{n}<span class=\"value\"></span></figcaption></figure>",
+            n = esc(&p.label),
+            r = p.method.is_none()
         );
     }
     h.push_str("</div>\n<p id=\"pixel-label\"></p>\n");
@@ -156,10 +176,11 @@ pub fn build(run_dir: &Path, manifest: &Manifest, frames: &Frames, methods: &[St
         "<p class=\"note\">Plays at {fps:.3} frames/s (the scenario's time step). Wheel: zoom, drag: pan, double-click: fit; space: play/pause, arrows: step. \
          Frames are decoded from RGBE (HDR) in the page; the exposure scales radiance before sRGB. SMAPE maps are computed in the page against the previous frame (ε = {smape_epsilon}); \
          FLIP maps exist at reference frames (grey ticks on the slider), scripted events are marked ▼. This run records no motion vectors. \
-         Frames: {:.1} MB, {} (frames are embedded up to {:.0} MB, linked from <code>{LINKED_DIR}/</code> beyond).</p>",
+         Frames: {:.1} MB, {} (frames are embedded up to {:.0} MB, linked from <code>{}/</code> beyond).</p>",
         mb(encoded_bytes),
-        if linked { format!("linked from <code>{LINKED_DIR}/</code>: keep the folder next to report.html") } else { "embedded in this file".into() },
+        if linked { format!("linked from <code>{}/</code>: keep the folder next to this page", out.linked_dir) } else { "embedded in this file".into() },
         mb(EMBED_LIMIT_BYTES),
+        out.linked_dir,
     );
     // `</` would end the script element early.
     let _ = writeln!(h, "<script type=\"application/json\" id=\"flicker-config\">{}</script>", config.to_string().replace("</", "<\\/"));

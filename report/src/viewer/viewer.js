@@ -9,6 +9,7 @@
   const slider = $('frame-slider'), exposure = $('exposure'), playButton = $('play');
   const panels = Array.from(document.querySelectorAll('#panels .panel')).map(fig => ({
     label: fig.dataset.label,
+    reference: fig.dataset.reference === 'true',
     view: fig.querySelector('.view'),
     canvas: fig.querySelector('canvas'),
     ctx: fig.querySelector('canvas').getContext('2d'),
@@ -73,7 +74,7 @@
     return out;
   }
   async function content(p, f) {
-    if (state.mode === 'flip' && p.label !== 'reference') {
+    if (state.mode === 'flip' && !p.reference) {
       const m = await decoded(f, 'flip:' + p.label);
       return m && { kind: 'map', scale: 1, values: Float32Array.from(m, v => v / 255) };
     }
