@@ -103,7 +103,7 @@ pub fn speed_accuracy_charts(manifest: &Manifest, frames: &Frames) -> Vec<(Strin
         out.push((
             format!("speed_vs_{metric}"),
             Chart {
-                title: format!("Speed vs accuracy: {} — {}", label(metric), manifest.scenario),
+                title: format!("Speed vs accuracy ({}) — {}", metric.to_uppercase(), manifest.scenario),
                 x_label: format!("mean {}", label(time_col)),
                 y_label: format!("mean {}", label(metric)),
                 kind: Kind::Scatter,

@@ -53,8 +53,10 @@ fn rgb(i: usize) -> RGBColor {
 fn draw<DB: DrawingBackend>(chart: &Chart, root: &DrawingArea<DB, Shift>) -> Result<XMap, DrawingAreaErrorKind<DB::ErrorType>> {
     let f = Frame::of(chart);
     root.fill(&WHITE)?;
+    // Long titles get a smaller font rather than being clipped (a glyph is about half an em wide).
+    let caption_size = 21.0f64.min((WIDTH - LEGEND_WIDTH) as f64 / (0.5 * chart.title.chars().count().max(1) as f64));
     let mut cc = ChartBuilder::on(root)
-        .caption(&chart.title, (FONT, 21))
+        .caption(&chart.title, (FONT, caption_size))
         .margin(12)
         .margin_right(LEGEND_WIDTH)
         .x_label_area_size(42)

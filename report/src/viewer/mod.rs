@@ -171,10 +171,13 @@ pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manife
     }
     h.push_str("</div>\n<p id=\"pixel-label\"></p>\n");
     let mb = |b: usize| b as f64 / (1 << 20) as f64;
+    // Settings are f32 in the scenario: print 30 and 0.01, not 29.999998 and 0.009999999776482582.
+    let short = |v: f64| format!("{}", (v * 1e4).round() / 1e4);
+    let (fps_text, eps_text) = (short(fps), short(smape_epsilon));
     let _ = writeln!(
         h,
-        "<p class=\"note\">Plays at {fps:.3} frames/s (the scenario's time step). Wheel: zoom, drag: pan, double-click: fit; space: play/pause, arrows: step. \
-         Frames are decoded from RGBE (HDR) in the page; the exposure scales radiance before sRGB. SMAPE maps are computed in the page against the previous frame (ε = {smape_epsilon}); \
+        "<p class=\"note\">Plays at {fps_text} frames/s (the scenario's time step). Wheel: zoom, drag: pan, double-click: fit; space: play/pause, arrows: step. \
+         Frames are decoded from RGBE (HDR) in the page; the exposure scales radiance before sRGB. SMAPE maps are computed in the page against the previous frame (ε = {eps_text}); \
          FLIP maps exist at reference frames (grey ticks on the slider), scripted events are marked ▼. This run records no motion vectors. \
          Frames: {:.1} MB, {} (frames are embedded up to {:.0} MB, linked from <code>{}/</code> beyond).</p>",
         mb(encoded_bytes),
