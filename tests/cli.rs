@@ -114,6 +114,9 @@ fn two_runs_give_byte_identical_frames_and_a_complete_run_folder() {
             let b = std::fs::read(outs[1].join(&name)).unwrap();
             assert!(a == b, "{name} differs between two runs of the same scenario");
             assert!(outs[0].join(format!("frames/{method}/{frame:04}.png")).exists());
+            // A still camera: its motion vectors, recorded for the report's viewer, are zero.
+            let motion = metrics::load_image(outs[0].join(format!("frames/{method}/motion/{frame:04}.exr"))).unwrap();
+            assert!(motion.rgb.iter().all(|p| p[0] == 0.0 && p[1] == 0.0), "{method} frame {frame}: non-zero motion");
         }
     }
     let run = &outs[0];

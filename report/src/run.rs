@@ -157,6 +157,9 @@ impl Frames {
     }
 }
 
+/// The folder of a method's motion vectors, `frames/METHOD/motion/` (as systems::run_folder).
+pub const MOTION: &str = "motion";
+
 pub fn frame_file(run_dir: &Path, method: Option<&str>, frame: u32, ext: &str) -> PathBuf {
     match method {
         Some(m) => run_dir.join("frames").join(m).join(format!("{frame:04}.{ext}")),

@@ -67,6 +67,7 @@ fn report_is_self_contained_with_charts_maps_and_crops() {
     assert_eq!(html.matches("\"flip:pt_1spp\"").count(), 2);
     assert_eq!(html.matches("class=\"event-mark\"").count(), 1);
     assert!(!run.join("viewer").exists(), "a small run's frames are embedded, not linked");
+    assert!(!html.contains("data-mode=\"motion\"") && html.contains("records no motion vectors"), "no motion toggle without motion vectors");
     // The best method of each column is marked, once per column and window with data.
     // 3 windows (before, after the event, overall) x 6 columns with data (FLIP, SMAPE, PSNR,
     // rel. MSE, GPU ms, CPU ms): no ties in this run.

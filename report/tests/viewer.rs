@@ -15,7 +15,7 @@ use serde_json::Value;
 const FPS: f64 = 20.0;
 
 fn viewer_run(name: &str) -> (FakeRun, std::path::PathBuf) {
-    let spec = FakeRun { static_noise: true, time_step: Some(1.0 / FPS), ..FakeRun::default() };
+    let spec = FakeRun { static_noise: true, time_step: Some(1.0 / FPS), motion: true, ..FakeRun::default() };
     let dir = fake_run_with(name, &spec);
     report::rebuild(&dir).unwrap();
     (spec, dir)
@@ -83,6 +83,10 @@ window.addEventListener('load', async () => {
     document.querySelector('[data-mode=smape]').click();
     await V.whenShown();
     out.smape21 = { value: V.valueAt(1, 40, 12), empty: V.view(1).classList.contains('empty') };
+    document.querySelector('[data-mode=motion]').click();
+    await V.whenShown();
+    out.motion21 = { value: V.valueAt(1, 6, 12), empty: V.view(1).classList.contains('empty'), otherEmpty: V.view(2).classList.contains('empty'),
+      pixel: pixels(1).slice(4 * (12 * V.canvas(1).width + 6), 4 * (12 * V.canvas(1).width + 6) + 3) };
     document.querySelector('[data-mode=image]').click();
 
     // Events on the slider; chart cursors follow the frame.
@@ -189,6 +193,13 @@ fn slider_play_exposure_zoom_maps_and_pixel_values() {
     assert_eq!(out["smape21"]["empty"], false);
     assert!((f(&out["smape21"]["value"][0]) - s).abs() < 0.02, "SMAPE {} vs {s}", out["smape21"]["value"]);
 
+    // Motion vectors of the method that records them, as written (1/8 pixel steps), coloured.
+    let [dx, dy] = motion(6, 12, 21);
+    assert_eq!(out["motion21"]["empty"], false);
+    assert!((f(&out["motion21"]["value"][0]) - dx as f64).abs() <= 1.0 / 16.0 && (f(&out["motion21"]["value"][1]) - dy as f64).abs() <= 1.0 / 16.0, "{}", out["motion21"]);
+    assert!(out["motion21"]["pixel"].as_array().unwrap().iter().any(|c| f(c) > 20.0), "motion drawn black: {}", out["motion21"]);
+    assert_eq!(out["motion21"]["otherEmpty"], true, "cache_ema records no motion");
+
     // The event is marked on the slider at its frame.
     let marks = out["marks"].as_array().unwrap();
     assert_eq!(marks.len(), 1);
@@ -280,6 +291,7 @@ fn a_320x180_60_frame_6_method_report_opens_in_under_3_s() {
         reference_frames: vec![0, 30, 59],
         static_noise: false,
         time_step: Some(1.0 / 30.0),
+        motion: false,
     };
     let run = fake_run_with("large", &spec);
     let t = std::time::Instant::now();

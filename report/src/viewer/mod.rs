@@ -20,7 +20,7 @@ use serde_json::json;
 
 use crate::base64;
 use crate::html::esc;
-use crate::run::{Manifest, frame_file};
+use crate::run::{MOTION, Manifest, frame_file};
 
 /// Encoded frames (base64 text) embedded in report.html up to this size; a larger run's frames
 /// are linked from `RUN/viewer/`, so the page stays quick to open.
@@ -89,6 +89,7 @@ fn load(run_dir: &Path, method: Option<&str>, frame: u32) -> anyhow::Result<Opti
 /// gives the events, reference frames and settings (frame rate, SMAPE's epsilon).
 pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manifest, flip_maps: &HashMap<(u32, String), Vec<f32>>) -> anyhow::Result<Option<Viewer>> {
     let size = std::sync::Mutex::new(None::<(u32, u32)>);
+    let any_motion = std::sync::atomic::AtomicBool::new(false);
     let chunks: Vec<Option<String>> = (0..frame_count)
         .into_par_iter()
         .map(|f| {
@@ -105,6 +106,13 @@ pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manife
                 }
                 drop(s);
                 entries.push((p.label.clone(), base64::encode(&rgbe::encode(&img))));
+                if let Some(m) = &p.method {
+                    let motion = p.run_dir.join("frames").join(m).join(MOTION).join(format!("{f:04}.exr"));
+                    if motion.exists() {
+                        entries.push((format!("motion:{}", p.label), base64::encode(&rgbe::encode_motion(&load_image(&motion)?))));
+                        any_motion.store(true, std::sync::atomic::Ordering::Relaxed);
+                    }
+                }
                 if let Some(map) = flip_maps.get(&(f, p.label.clone())) {
                     entries.push((format!("flip:{}", p.label), base64::encode(&rgbe::encode_map(map))));
                 }
@@ -137,7 +145,7 @@ pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manife
     let names: Vec<&str> = panels.iter().map(|p| p.label.as_str()).collect();
     let config = json!({
         "width": width, "height": height, "frames": frame_count, "fps": fps, "labels": names,
-        "smape_epsilon": smape_epsilon, "linked": linked.then(|| format!("{}/", out.linked_dir)), "magma": magma,
+        "smape_epsilon": smape_epsilon, "motion_steps": rgbe::MOTION_STEPS, "linked": linked.then(|| format!("{}/", out.linked_dir)), "magma": magma,
     });
 
     let mut h = String::new();
@@ -157,7 +165,12 @@ pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manife
     if !flip_maps.is_empty() {
         h.push_str("<button type=\"button\" data-mode=\"flip\">FLIP map</button>");
     }
-    h.push_str("<button type=\"button\" data-mode=\"smape\">SMAPE to previous frame</button></span>");
+    h.push_str("<button type=\"button\" data-mode=\"smape\">SMAPE to previous frame</button>");
+    let any_motion = any_motion.into_inner();
+    if any_motion {
+        h.push_str("<button type=\"button\" data-mode=\"motion\">motion vectors</button>");
+    }
+    h.push_str("</span>");
     h.push_str("<button id=\"fit\" type=\"button\">fit</button></div>\n<div id=\"panels\">");
     let scale = if (width as f64) < PANEL_WIDTH { (PANEL_WIDTH / width as f64).floor() } else { PANEL_WIDTH / width as f64 };
     let (vw, vh) = ((width as f64 * scale).round(), (height as f64 * scale).round());
@@ -178,8 +191,9 @@ pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manife
         h,
         "<p class=\"note\">Plays at {fps_text} frames/s (the scenario's time step). Wheel: zoom, drag: pan, double-click: fit; space: play/pause, arrows: step. \
          Frames are decoded from RGBE (HDR) in the page; the exposure scales radiance before sRGB. SMAPE maps are computed in the page against the previous frame (ε = {eps_text}); \
-         FLIP maps exist at reference frames (grey ticks on the slider), scripted events are marked ▼. This run records no motion vectors. \
+         FLIP maps exist at reference frames (grey ticks on the slider), scripted events are marked ▼. {} \
          Frames: {:.1} MB, {} (frames are embedded up to {:.0} MB, linked from <code>{}/</code> beyond).</p>",
+        if any_motion { "Motion vectors: hue gives the direction, brightness the length (brightest = the longest of the panel), values in pixels to the previous frame." } else { "This run records no motion vectors." },
         mb(encoded_bytes),
         if linked { format!("linked from <code>{}/</code>: keep the folder next to this page", out.linked_dir) } else { "embedded in this file".into() },
         mb(EMBED_LIMIT_BYTES),

@@ -48,6 +48,16 @@ pub fn encode_map(map: &[f32]) -> Vec<u8> {
     zlib(&bytes)
 }
 
+/// Steps of a pixel in which motion vectors are stored: eight per pixel, up to ±4095 pixels.
+pub const MOTION_STEPS: f32 = 8.0;
+
+/// Motion vectors (pixels) as zlib-compressed little-endian i16 planes dx, dy in 1/8 pixel.
+pub fn encode_motion(img: &Image) -> Vec<u8> {
+    let q = |v: f32| if v.is_finite() { (v * MOTION_STEPS).round().clamp(-32767.0, 32767.0) as i16 } else { 0 };
+    let bytes: Vec<u8> = (0..2).flat_map(|c| img.rgb.iter().flat_map(move |p| q(p[c]).to_le_bytes())).collect();
+    zlib(&bytes)
+}
+
 fn zlib(bytes: &[u8]) -> Vec<u8> {
     // Level 6: most of level 9's ratio on noisy radiance at a fraction of its time.
     miniz_oxide::deflate::compress_to_vec_zlib(bytes, 6)
@@ -81,5 +91,9 @@ mod tests {
         assert_eq!(px(7), encode_pixel(img.rgb[7]));
         let map = miniz_oxide::inflate::decompress_to_vec_zlib(&encode_map(&[0.0, 0.5, 1.0, 2.0])).unwrap();
         assert_eq!(map, [0, 128, 255, 255]);
+        let motion = Image::new(2, 1, vec![[1.5, -0.25, 0.0], [-3.0, 10000.0, 0.0]]);
+        let m = miniz_oxide::inflate::decompress_to_vec_zlib(&encode_motion(&motion)).unwrap();
+        let i16s: Vec<i16> = m.chunks(2).map(|b| i16::from_le_bytes([b[0], b[1]])).collect();
+        assert_eq!(i16s, [12, -24, -2, 32767]);
     }
 }

@@ -49,12 +49,19 @@
     }
     return out;
   }
+  // Motion: planes dx, dy of little-endian i16 in 1/motion_steps pixel (viewer/rgbe.rs).
+  function motionToFloat(b) {
+    const v = new DataView(b.buffer, b.byteOffset, b.byteLength), out = new Float32Array(2 * NPX);
+    for (let i = 0; i < 2 * NPX; i++) out[i] = v.getInt16(2 * i, true) / C.motion_steps;
+    return out;
+  }
   const cache = new Map();
   const CACHE_SIZE = 12 * (panels.length + 1);
   function decoded(f, key) {
     const k = f + '/' + key;
     if (!cache.has(k)) {
-      cache.set(k, chunk(f).then(c => (c && c[key] ? inflate(c[key]) : null)).then(b => (b && !key.startsWith('flip:') ? rgbeToFloat(b) : b)));
+      const decode = key.startsWith('flip:') ? b => b : key.startsWith('motion:') ? motionToFloat : rgbeToFloat;
+      cache.set(k, chunk(f).then(c => (c && c[key] ? inflate(c[key]) : null)).then(b => b && decode(b)));
       if (cache.size > CACHE_SIZE) cache.delete(cache.keys().next().value);
     }
     return cache.get(k);
@@ -77,6 +84,13 @@
     if (state.mode === 'flip' && !p.reference) {
       const m = await decoded(f, 'flip:' + p.label);
       return m && { kind: 'map', scale: 1, values: Float32Array.from(m, v => v / 255) };
+    }
+    if (state.mode === 'motion' && !p.reference) {
+      const m = await decoded(f, 'motion:' + p.label);
+      if (!m) return null;
+      let max = 0;
+      for (let i = 0; i < NPX; i++) max = Math.max(max, Math.hypot(m[i], m[NPX + i]));
+      return { kind: 'motion', max, values: m };
     }
     const cur = await decoded(f, p.label);
     if (state.mode === 'smape' && cur) {
@@ -104,6 +118,15 @@
       const k = Math.pow(2, state.exposure) * 4095;
       for (let i = 0; i < NPX; i++) {
         for (let c = 0; c < 3; c++) px[4 * i + c] = SRGB[Math.min(4095, Math.max(0, d.values[3 * i + c] * k)) | 0];
+        px[4 * i + 3] = 255;
+      }
+    } else if (d.kind === 'motion') {
+      // Hue = direction, value = length relative to the panel's longest vector.
+      for (let i = 0; i < NPX; i++) {
+        const dx = d.values[i], dy = d.values[NPX + i], v = d.max > 0 ? Math.hypot(dx, dy) / d.max : 0;
+        const h = ((Math.atan2(dy, dx) / (2 * Math.PI) + 1) % 1) * 6;
+        const rgb = [5, 3, 1].map(n => { const k = (n + h) % 6; return v * (1 - Math.max(0, Math.min(k, 4 - k, 1))); });
+        for (let c = 0; c < 3; c++) px[4 * i + c] = 255 * rgb[c];
         px[4 * i + 3] = 255;
       }
     } else {
@@ -159,7 +182,8 @@
     const d = p.data;
     if (!d || x < 0 || y < 0 || x >= W || y >= H) return null;
     const i = y * W + x;
-    return d.kind === 'rgb' ? [d.values[3 * i], d.values[3 * i + 1], d.values[3 * i + 2]] : [d.values[i]];
+    if (d.kind === 'rgb') return [d.values[3 * i], d.values[3 * i + 1], d.values[3 * i + 2]];
+    return d.kind === 'motion' ? [d.values[i], d.values[NPX + i]] : [d.values[i]];
   }
   function readout() {
     const at = state.pointer;

@@ -31,6 +31,13 @@ pub struct FakeRun {
     pub static_noise: bool,
     /// Seconds per frame, written to the manifest's settings (the viewer plays at 1 / this).
     pub time_step: Option<f64>,
+    /// Whether the first method records motion vectors ([`motion`]).
+    pub motion: bool,
+}
+
+/// The motion vectors the first method records when `FakeRun::motion` is set (pixels).
+pub fn motion(x: u32, _y: u32, f: u32) -> [f32; 2] {
+    [(x as f32 - 32.0) / 8.0 + 0.125 * f as f32, 0.75]
 }
 
 impl Default for FakeRun {
@@ -44,6 +51,7 @@ impl Default for FakeRun {
             reference_frames: vec![0, EVENT],
             static_noise: false,
             time_step: None,
+            motion: false,
         }
     }
 }
@@ -108,6 +116,14 @@ pub fn fake_run_with(name: &str, run: &FakeRun) -> PathBuf {
             let img = render(run, m, f);
             write_exr(&img, dir.join(format!("frames/{method}/{f:04}.exr"))).unwrap();
             write_png_srgb(&img, dir.join(format!("frames/{method}/{f:04}.png"))).unwrap();
+            if run.motion && m == 0 {
+                std::fs::create_dir_all(dir.join(format!("frames/{method}/motion"))).unwrap();
+                let mv = Image::from_fn(w, h, |x, y| {
+                    let [dx, dy] = motion(x, y, f);
+                    [dx, dy, 0.0]
+                });
+                write_exr(&mv, dir.join(format!("frames/{method}/motion/{f:04}.exr"))).unwrap();
+            }
             let s = prev.as_ref().map(|p| smape(&img, p, 0.01));
             let gpu = [1.0, 2.5, 1.5, 4.0, 0.7, 3.0][m % 6] + 0.01 * f as f64;
             write!(csv, "{method},{f},{:.3},{gpu:.4},{gpu:.4},", gpu + 0.5).unwrap();
