@@ -1,13 +1,13 @@
 //! The viewer at the top of report.html: every method beside the reference, one frame at a
 //! time, with a frame slider, play/pause at the scenario's frame rate, exposure on HDR data,
-//! FLIP and SMAPE maps, synchronised zoom/pan and the pixel values under the pointer.
+//! FLIP and SMAPE maps, motion vectors, synchronised zoom/pan and the pixel values under the pointer.
 //!
-//! Frames travel as RGBE planes ([`rgbe`]) in one `flickerFrame(frame, {label: base64})` call per
+//! Frames travel as RGBE planes ([`encoding`]) in one `flickerFrame(frame, {label: base64})` call per
 //! frame: inline in the page while all frames together stay under [`EMBED_LIMIT_BYTES`], else
 //! in `RUN/viewer/NNNN.js`, which the page loads on demand (a script loads from file://, where
 //! the browser refuses fetch()).
 
-pub mod rgbe;
+pub mod encoding;
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -105,16 +105,16 @@ pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manife
                     Some(_) => {}
                 }
                 drop(s);
-                entries.push((p.label.clone(), base64::encode(&rgbe::encode(&img))));
+                entries.push((p.label.clone(), base64::encode(&encoding::encode(&img))));
                 if let Some(m) = &p.method {
                     let motion = p.run_dir.join("frames").join(m).join(MOTION).join(format!("{f:04}.exr"));
                     if motion.exists() {
-                        entries.push((format!("motion:{}", p.label), base64::encode(&rgbe::encode_motion(&load_image(&motion)?))));
+                        entries.push((format!("motion:{}", p.label), base64::encode(&encoding::encode_motion(&load_image(&motion)?))));
                         any_motion.store(true, std::sync::atomic::Ordering::Relaxed);
                     }
                 }
                 if let Some(map) = flip_maps.get(&(f, p.label.clone())) {
-                    entries.push((format!("flip:{}", p.label), base64::encode(&rgbe::encode_map(map))));
+                    entries.push((format!("flip:{}", p.label), base64::encode(&encoding::encode_map(map))));
                 }
             }
             Ok((!entries.is_empty()).then(|| chunk_js(f, &entries)))
@@ -145,7 +145,7 @@ pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manife
     let names: Vec<&str> = panels.iter().map(|p| p.label.as_str()).collect();
     let config = json!({
         "width": width, "height": height, "frames": frame_count, "fps": fps, "labels": names,
-        "smape_epsilon": smape_epsilon, "motion_steps": rgbe::MOTION_STEPS, "linked": linked.then(|| format!("{}/", out.linked_dir)), "magma": magma,
+        "smape_epsilon": smape_epsilon, "motion_steps": encoding::MOTION_STEPS, "linked": linked.then(|| format!("{}/", out.linked_dir)), "magma": magma,
     });
 
     let mut h = String::new();

@@ -1,5 +1,5 @@
 // flicker's viewer: every method beside the reference, one frame at a time. Frames arrive as
-// RGBE planes (see viewer/rgbe.rs) through flickerFrame(); they are decoded to floats here so
+// RGBE planes (see viewer/encoding.rs) through flickerFrame(); they are decoded to floats here so
 // that exposure, pixel values and the SMAPE map work on radiance, not on 8-bit PNGs.
 (() => {
   'use strict';
@@ -49,7 +49,7 @@
     }
     return out;
   }
-  // Motion: planes dx, dy of little-endian i16 in 1/motion_steps pixel (viewer/rgbe.rs).
+  // Motion: planes dx, dy of little-endian i16 in 1/motion_steps pixel (viewer/encoding.rs).
   function motionToFloat(b) {
     const v = new DataView(b.buffer, b.byteOffset, b.byteLength), out = new Float32Array(2 * NPX);
     for (let i = 0; i < 2 * NPX; i++) out[i] = v.getInt16(2 * i, true) / C.motion_steps;

@@ -1,7 +1,9 @@
-//! Frames for the viewer as RGBE (Ward's shared-exponent format from the Radiance system): HDR
-//! in 4 bytes per pixel, which the page decodes back to floats for its exposure control. The four
-//! byte planes (R, G, B, E) are stored one after the other and zlib-compressed: planes compress
-//! better than interleaved bytes, and browsers inflate zlib natively (`DecompressionStream`).
+//! What the viewer's page receives, as zlib-compressed byte planes (planes compress better than
+//! interleaved bytes, and browsers inflate zlib natively with `DecompressionStream`):
+//! - radiance as RGBE (Ward's shared-exponent format from the Radiance system): HDR in 4 bytes
+//!   per pixel, decoded back to floats in the page for its exposure control;
+//! - maps in [0, 1] (FLIP) as one byte per pixel;
+//! - motion vectors as two i16 planes in 1/8 pixel.
 
 use metrics::Image;
 
