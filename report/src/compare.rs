@@ -19,6 +19,7 @@ fn methods(manifest: &Manifest, frames: &Frames) -> Vec<String> {
 }
 
 /// Writes the comparison page to `out` (its linked frames, if any, to `<stem>_viewer/` beside it).
+/// Each run's FLIP maps and crops are (re)written to its `charts/`, as `flicker report` does.
 pub fn write_comparison(run_a: &Path, run_b: &Path, out: &Path) -> anyhow::Result<PathBuf> {
     let (ma, mb) = (Manifest::load(run_a)?, Manifest::load(run_b)?);
     let (fa, fb) = (Frames::load(run_a)?, Frames::load(run_b)?);

@@ -9,7 +9,6 @@ use std::sync::Once;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
-use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::{Chart, Frame, HEIGHT, Kind, WIDTH, color};
 
@@ -80,6 +79,8 @@ fn draw<DB: DrawingBackend>(chart: &Chart, root: &DrawingArea<DB, Shift>) -> Res
     if chart.pareto.len() > 1 {
         cc.draw_series(DashedLineSeries::new(chart.pareto.iter().copied(), 3, 3, BLACK.stroke_width(1)))?;
     }
+    // Scatter points' names: (marker's pixel, name), placed once all are known.
+    let mut labels: Vec<((i32, i32), String, RGBColor)> = Vec::new();
     for (i, series) in chart.series.iter().enumerate() {
         let c = rgb(i);
         let pts: Vec<(f64, f64)> = series.points.iter().copied().filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
@@ -91,19 +92,12 @@ fn draw<DB: DrawingBackend>(chart: &Chart, root: &DrawingArea<DB, Shift>) -> Res
                 cc.draw_series(LineSeries::new(pts, c.stroke_width(2)))?;
             }
             Kind::Scatter => {
-                // The name beside its marker, on the side facing the plot's centre, so it is not clipped.
-                let (mx, my) = ((f.x.min + f.x.max) / 2.0, f.y.min + 0.85 * (f.y.max - f.y.min));
-                let name = series.name.clone();
-                cc.draw_series(pts.into_iter().map(move |p| {
-                    let h = if p.0 > mx { HPos::Right } else { HPos::Left };
-                    let v = if p.1 > my { VPos::Top } else { VPos::Bottom };
-                    let offset = (if p.0 > mx { -9 } else { 9 }, if p.1 > my { 7 } else { -7 });
-                    let style = (FONT, 15).into_font().into_text_style(root).pos(Pos::new(h, v));
-                    EmptyElement::at(p) + Circle::new((0, 0), 6, c.filled()) + Text::new(name.clone(), offset, style)
-                }))?;
+                cc.draw_series(pts.iter().map(|&p| Circle::new(p, 6, c.filled())))?;
+                labels.extend(pts.iter().map(|p| (cc.backend_coord(p), series.name.clone(), c)));
             }
         }
     }
+    place_labels(root, &labels, cc.plotting_area().get_pixel_range())?;
     // The legend, in its own column: a swatch and the name of each series, then the front.
     let x = (WIDTH - LEGEND_WIDTH + 16) as i32;
     let font = (FONT, 15).into_font();
@@ -120,6 +114,34 @@ fn draw<DB: DrawingBackend>(chart: &Chart, root: &DrawingArea<DB, Shift>) -> Res
     let (x0, x1) = (cc.backend_coord(&(f.x.min, f.y.min)).0, cc.backend_coord(&(f.x.max, f.y.min)).0);
     root.present()?;
     Ok(XMap { v0: f.x.min, v1: f.x.max, x0, x1 })
+}
+
+/// Height of a label line and the width of a glyph, in pixels (15 px DejaVu Sans, roughly).
+const LABEL_HEIGHT: i32 = 17;
+const GLYPH_WIDTH: f64 = 8.5;
+
+/// Writes each name beside its marker, in its colour, on the side facing the plot's centre (so it is not
+/// clipped), moving a label to the nearest line where it overlaps none placed before (methods
+/// with near-equal results).
+fn place_labels<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, labels: &[((i32, i32), String, RGBColor)], area: (std::ops::Range<i32>, std::ops::Range<i32>)) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let mid_x = (area.0.start + area.0.end) / 2;
+    let mut order: Vec<&((i32, i32), String, RGBColor)> = labels.iter().collect();
+    order.sort_by_key(|((x, y), ..)| (*y, *x));
+    let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+    for ((x, y), name, color) in order {
+        let w = (GLYPH_WIDTH * name.chars().count() as f64) as i32;
+        let x0 = if *x > mid_x { x - 10 - w } else { x + 10 };
+        let start = (y - 8 - LABEL_HEIGHT).max(area.1.start);
+        let free = |y0: i32| !placed.iter().any(|&(a, b, c, d)| x0 < c && a < x0 + w && y0 < d && b < y0 + LABEL_HEIGHT);
+        let inside = |y0: i32| y0 >= area.1.start && y0 + LABEL_HEIGHT <= area.1.end;
+        // Nearest free line: below, above, two below, ...; inside the plot when possible.
+        let tries = (0..labels.len() as i32 * 2 + 1).map(|k| start + LABEL_HEIGHT * if k % 2 == 1 { (k + 1) / 2 } else { -(k / 2) });
+        let y0 = tries.clone().find(|&t| inside(t) && free(t)).or_else(|| tries.clone().find(|&t| free(t))).unwrap_or(start);
+        placed.push((x0, y0, x0 + w, y0 + LABEL_HEIGHT));
+        // In the series' colour, so a displaced name still points to its marker.
+        root.draw(&Text::new(name.clone(), (x0, y0), (FONT, 15).into_font().color(color)))?;
+    }
+    Ok(())
 }
 
 /// The chart as an SVG document, and where its x axis lies.
@@ -226,5 +248,28 @@ mod tests {
         let texts = svg_texts(&svg);
         let count = |name: &str| texts.iter().filter(|t| *t == name).count();
         assert_eq!((count("taa"), count("pt_4spp"), count("Pareto front")), (2, 2, 1), "{texts:?}");
+    }
+
+    #[test]
+    fn names_of_coinciding_points_do_not_overlap() {
+        let series = ["nirc_ema", "nirc_blend", "nirc_switch"].map(|n| Series { name: n.into(), points: vec![(2.0, 0.3)] }).to_vec();
+        let c = Chart { title: "t".into(), x_label: "x".into(), y_label: "y".into(), kind: Kind::Scatter, series, events: vec![], pareto: vec![], x_extent: vec![] };
+        let (svg, _) = to_svg(&c).unwrap();
+        // The y of each label beside the markers (the legend's copies sit right of the plot).
+        let ys: Vec<f64> = svg
+            .split("<text")
+            .skip(1)
+            .filter(|t| t.contains(">nirc_") || t.contains("\nnirc_"))
+            .filter_map(|t| {
+                let num = |k: &str| t.split(&format!("{k}=\"")).nth(1)?.split('"').next()?.parse::<f64>().ok();
+                (num("x")? < (WIDTH - LEGEND_WIDTH) as f64).then(|| num("y")).flatten()
+            })
+            .collect();
+        assert_eq!(ys.len(), 3, "{svg}");
+        for (i, a) in ys.iter().enumerate() {
+            for b in &ys[i + 1..] {
+                assert!((a - b).abs() >= LABEL_HEIGHT as f64, "labels at y {ys:?} overlap");
+            }
+        }
     }
 }

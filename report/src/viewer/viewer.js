@@ -244,7 +244,8 @@
   playButton.addEventListener('click', () => play(!state.playing));
   $('fit').addEventListener('click', fit);
   document.addEventListener('keydown', e => {
-    if (e.target.tagName === 'INPUT' && e.target.type !== 'range') return;
+    // Controls handle their own keys (a focused slider already steps, a button already clicks).
+    if (['INPUT', 'BUTTON', 'SELECT', 'TEXTAREA'].includes(e.target.tagName)) return;
     if (e.key === ' ') { e.preventDefault(); play(!state.playing); }
     if (e.key === 'ArrowRight') show(state.frame + 1);
     if (e.key === 'ArrowLeft') show(state.frame - 1);
