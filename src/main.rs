@@ -1,5 +1,7 @@
 //! `flicker`: play scenarios of dynamic scenes, measure how light-transport caches behave.
 
+mod runtime_dir;
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -143,6 +145,7 @@ fn bench(out: Option<PathBuf>, rays: u32, frames: u32, no_metrics: bool, repeats
 }
 
 fn main() -> ExitCode {
+    runtime_dir::ensure();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run { scenario, frames, resolution, spp, seed, out, cache_dir, quiet } => {

@@ -114,6 +114,9 @@ fn two_runs_give_byte_identical_frames_and_a_complete_run_folder() {
             let b = std::fs::read(outs[1].join(&name)).unwrap();
             assert!(a == b, "{name} differs between two runs of the same scenario");
             assert!(outs[0].join(format!("frames/{method}/{frame:04}.png")).exists());
+            // A still camera: its motion vectors, recorded for the report's viewer, are zero.
+            let motion = metrics::load_image(outs[0].join(format!("frames/{method}/motion/{frame:04}.exr"))).unwrap();
+            assert!(motion.rgb.iter().all(|p| p[0] == 0.0 && p[1] == 0.0), "{method} frame {frame}: non-zero motion");
         }
     }
     let run = &outs[0];
@@ -191,4 +194,31 @@ fn duplicate_method_labels_are_refused_before_anything_is_written() {
     );
     let err = run_fails(&path, &[], &dir.join("out"));
     assert!(err.contains("scenario.ron:3:5") && err.contains("scenario.ron:2:13") && err.contains("pt_1spp"), "{err}");
+}
+
+#[test]
+fn no_xdg_runtime_dir_message_when_it_is_unset_or_invalid() {
+    let dir = scratch("xdg");
+    let scenario = tiny_scenario(
+        &dir,
+        r#"Scenario(scene: Builtin("cornell_box"), resolution: (16, 9), frames: 1, seed: 1, max_depth: 2,
+            methods: [PathTracing(spp: 1)], reference: (spp: 4, frames: List([])))"#,
+    );
+    let run = |value: Option<&str>, name: &str| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_flicker"));
+        let out = dir.join(name);
+        cmd.args(["run", scenario.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap(), "--cache-dir", dir.join("cache").to_str().unwrap()]);
+        match value {
+            Some(v) => cmd.env("XDG_RUNTIME_DIR", v),
+            None => cmd.env_remove("XDG_RUNTIME_DIR"),
+        };
+        let o = cmd.output().expect("flicker runs");
+        assert!(o.status.success(), "run failed: {}", text(&o.stderr));
+        text(&o.stderr)
+    };
+    for (value, name) in [(None, "unset"), (Some("relative/dir"), "relative"), (Some(""), "empty")] {
+        let stderr = run(value, name);
+        assert!(!stderr.contains("XDG_RUNTIME_DIR"), "XDG_RUNTIME_DIR {value:?}: {stderr}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }

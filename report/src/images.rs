@@ -15,6 +15,8 @@ pub struct MethodImage {
     /// The method's frame for display (PNG).
     pub image: PathBuf,
     pub flip_map: PathBuf,
+    /// The FLIP map's values, row by row.
+    pub flip: Vec<f32>,
     pub flip_mean: f64,
 }
 
@@ -96,7 +98,7 @@ pub fn write_frame_images(run_dir: &Path, manifest: &Manifest, methods: &[String
             let flip = if hdr && ref_hdr { flip_hdr(&reference, &img, DEFAULT_PPD) } else { flip_ldr(&reference, &img, DEFAULT_PPD) };
             let map_path = charts.join(format!("flip_{method}_{frame:04}.png"));
             metrics::write_map_png(&flip.map, img.width, img.height, &map_path)?;
-            entries.push(MethodImage { method: method.clone(), image: shown, flip_map: map_path, flip_mean: flip.mean });
+            entries.push(MethodImage { method: method.clone(), image: shown, flip_map: map_path, flip: flip.map.clone(), flip_mean: flip.mean });
             loaded.push((img, flip.map));
         }
         let full = Region { name: "full".into(), x: 0, y: 0, width: reference.width, height: reference.height };

@@ -51,9 +51,23 @@ impl Manifest {
         let mut m: Manifest = serde_json::from_value(raw.clone())
             .with_context(|| format!("{}: expected the run manifest (scenario, methods, events, regions, ...)", path.display()))?;
         m.raw = raw;
-        m.events.sort_by_key(|e| e.frame);
+        m.events = merge_events(m.events);
         Ok(m)
     }
+}
+
+/// Events sorted by frame, those of one frame merged into one ("a + b"): windows, chart markers
+/// and slider marks are per frame.
+pub fn merge_events(mut events: Vec<Event>) -> Vec<Event> {
+    events.sort_by_key(|e| e.frame);
+    let mut out: Vec<Event> = Vec::new();
+    for e in events {
+        match out.last_mut() {
+            Some(last) if last.frame == e.frame => last.label = format!("{} + {}", last.label, e.label),
+            _ => out.push(e),
+        }
+    }
+    out
 }
 
 /// One row of frames.csv.
@@ -132,11 +146,19 @@ impl Frames {
         s
     }
 
+    /// Frames of the run: those in frames.csv, or the manifest's count if larger.
+    pub fn frame_count(&self, manifest: &Manifest) -> u32 {
+        self.rows.iter().map(|r| r.frame + 1).max().unwrap_or(0).max(manifest.frames.unwrap_or(0))
+    }
+
     /// Whether a column has at least one finite value.
     pub fn has_data(&self, column: usize) -> bool {
         self.rows.iter().any(|r| r.values[column].is_some_and(f64::is_finite))
     }
 }
+
+/// The folder of a method's motion vectors, `frames/METHOD/motion/` (as systems::run_folder).
+pub const MOTION: &str = "motion";
 
 pub fn frame_file(run_dir: &Path, method: Option<&str>, frame: u32, ext: &str) -> PathBuf {
     match method {
@@ -148,6 +170,14 @@ pub fn frame_file(run_dir: &Path, method: Option<&str>, frame: u32, ext: &str) -
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn events_of_one_frame_become_one() {
+        let ev = |frame, label: &str| Event { frame, label: label.into() };
+        let merged = merge_events(vec![ev(20, "rotate"), ev(5, "flash"), ev(20, "move")]);
+        let got: Vec<(u32, &str)> = merged.iter().map(|e| (e.frame, e.label.as_str())).collect();
+        assert_eq!(got, [(5, "flash"), (20, "rotate + move")]);
+    }
 
     #[test]
     fn parses_empty_cells_and_reports_bad_lines() {

@@ -62,7 +62,7 @@ pub fn windows(manifest: &Manifest, frame_count: u32, n: u32) -> Vec<Window> {
 }
 
 pub fn summarize(manifest: &Manifest, frames: &Frames, n: u32) -> Summary {
-    let frame_count = frames.rows.iter().map(|r| r.frame + 1).max().unwrap_or(0).max(manifest.frames.unwrap_or(0));
+    let frame_count = frames.frame_count(manifest);
     let windows = windows(manifest, frame_count, n);
     let methods = frames
         .methods()

@@ -61,11 +61,36 @@ fn report_is_self_contained_with_charts_maps_and_crops() {
     // Every image is inlined.
     let imgs = html.matches("<img ").count();
     assert_eq!(imgs, html.matches("src=\"data:image/").count());
-    assert_eq!(imgs, 12 + 2 * (1 + 2 + 2 + 2), "12 charts (7 metrics, 2 regions x 2, 2 speed); per reference frame: reference, 2 frames, 2 maps, 2 crops");
+    assert_eq!(imgs, 12 + 2 * 2, "12 charts (7 metrics, 2 regions x 2, 2 speed); 2 region crops per reference frame");
+    // The viewer carries every frame once, FLIP maps where a reference exists.
+    assert_eq!(html.matches("<script>flickerFrame(").count(), FRAMES as usize);
+    assert_eq!(html.matches("\"flip:pt_1spp\"").count(), 2);
+    assert_eq!(html.matches("class=\"event-mark\"").count(), 1);
+    assert!(!run.join("viewer").exists(), "a small run's frames are embedded, not linked");
+    assert!(!html.contains("data-mode=\"motion\"") && html.contains("records no motion vectors"), "no motion toggle without motion vectors");
+    // The best method of each column is marked, once per column and window with data.
+    // 3 windows (before, after the event, overall) x 6 columns with data (FLIP, SMAPE, PSNR,
+    // rel. MSE, GPU ms, CPU ms): no ties in this run.
+    assert_eq!(html.matches("class=\"best\"").count(), 3 * 6);
+    // The cheaper method (1 ms against 2.5 ms) is marked in the GPU column of every window.
+    let rows: Vec<&str> = html.split("<tr>").filter(|r| r.contains("<td class=\"m\">pt_1spp</td>")).collect();
+    assert_eq!(rows.len(), 3);
+    for r in rows {
+        let cells: Vec<&str> = r.split("<td").collect();
+        // window, frames, method, FLIP, SMAPE, PSNR, rel. MSE, GPU ms
+        assert!(cells[8].starts_with(" class=\"best\""), "GPU ms cell of pt_1spp not marked: {r}");
+    }
+    // The Pareto chart comes before the summary table, the table before the frame charts.
+    let at = |s: &str| html.find(s).unwrap_or_else(|| panic!("{s} missing"));
+    assert!(at("id=\"viewer\"") < at("Speed vs accuracy") && at("Speed vs accuracy") < at("id=\"summary\"") && at("id=\"summary\"") < at("<h2>Charts"));
     assert!(html.contains("id=\"summary\"") && html.contains("rotate light"));
     // The event is drawn on the frame charts.
     let svg = std::fs::read_to_string(run.join("charts/frames_flip.svg")).unwrap();
     assert!(svg.contains("rotate light") && svg.contains("pt_1spp") && svg.contains("cache_ema"));
+    if let Some(keep) = std::env::var_os("FLICKER_KEEP_REPORT") {
+        std::fs::rename(&run, keep).unwrap();
+        return;
+    }
     std::fs::remove_dir_all(&run).ok();
 }
 

@@ -4,6 +4,7 @@
 //! RUN/manifest.json              scenario, commit, adapter, seed, settings, events, regions
 //! RUN/frames.csv                 one row per (method, frame): timings and metrics
 //! RUN/frames/METHOD/NNNN.exr     linear HDR radiance, and NNNN.png tone-mapped
+//! RUN/frames/METHOD/motion/NNNN.exr  motion vectors (R, G: pixels to the previous frame)
 //! RUN/reference/NNNN.exr         path-traced reference of frame NNNN, and NNNN.png
 //! RUN/summary.json, RUN/report.html, RUN/charts/
 //! ```
@@ -11,6 +12,9 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
+
+/// The name of a method's motion-vector images (`frames/METHOD/motion/NNNN.exr`).
+pub const MOTION: &str = "motion";
 
 #[derive(Clone, Debug)]
 pub struct RunFolder {

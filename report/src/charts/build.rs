@@ -5,7 +5,8 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::{Chart, Kind, Series, pareto_front, raster, svg};
+use super::plot::{self, XMap};
+use super::{Chart, Kind, Series, pareto_front};
 use crate::run::{Frames, Manifest};
 
 /// Human-readable names of the known columns.
@@ -102,7 +103,7 @@ pub fn speed_accuracy_charts(manifest: &Manifest, frames: &Frames) -> Vec<(Strin
         out.push((
             format!("speed_vs_{metric}"),
             Chart {
-                title: format!("Speed vs accuracy: {} — {}", label(metric), manifest.scenario),
+                title: format!("Speed vs accuracy ({}) — {}", metric.to_uppercase(), manifest.scenario),
                 x_label: format!("mean {}", label(time_col)),
                 y_label: format!("mean {}", label(metric)),
                 kind: Kind::Scatter,
@@ -121,6 +122,8 @@ pub struct WrittenChart {
     pub stem: String,
     pub title: String,
     pub svg: String,
+    /// Where frames lie along x, for charts drawn against frame.
+    pub frame_axis: Option<XMap>,
 }
 
 pub fn write_charts(run_dir: &Path, manifest: &Manifest, frames: &Frames) -> anyhow::Result<Vec<WrittenChart>> {
@@ -128,12 +131,13 @@ pub fn write_charts(run_dir: &Path, manifest: &Manifest, frames: &Frames) -> any
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut out = Vec::new();
     for (stem, chart) in frame_charts(manifest, frames).into_iter().chain(reliability_chart(manifest, frames)).chain(speed_accuracy_charts(manifest, frames)) {
-        let svg = svg::to_svg(&chart);
+        let (svg, map) = plot::to_svg(&chart)?;
         let svg_path = dir.join(format!("{stem}.svg"));
         std::fs::write(&svg_path, &svg).with_context(|| format!("cannot write {}", svg_path.display()))?;
         let png_path = dir.join(format!("{stem}.png"));
-        std::fs::write(&png_path, raster::to_png(&chart)).with_context(|| format!("cannot write {}", png_path.display()))?;
-        out.push(WrittenChart { stem, title: chart.title, svg });
+        std::fs::write(&png_path, plot::to_png(&chart)?).with_context(|| format!("cannot write {}", png_path.display()))?;
+        let frame_axis = (chart.kind == Kind::Lines && chart.x_label == "frame").then_some(map);
+        out.push(WrittenChart { stem, title: chart.title, svg, frame_axis });
     }
     Ok(out)
 }

@@ -1,15 +1,12 @@
-//! Charts drawn by the tool: a small plot model rendered to SVG (with text) and to PNG (text-free,
-//! so no font library is needed; the SVG carries titles, axes labels and the legend).
+//! Charts of a run: a small plot model (series, events, Pareto front) drawn by plotters to SVG
+//! and PNG (`plot`), both with title, axis labels and legend.
 
 pub mod build;
-pub mod raster;
-pub mod svg;
+pub mod plot;
 
 /// Plot size in pixels (both renderers).
 pub const WIDTH: u32 = 720;
 pub const HEIGHT: u32 = 400;
-/// Plot area margins: left, right, top, bottom.
-pub const MARGIN: [f64; 4] = [70.0, 170.0, 40.0, 50.0];
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
@@ -95,7 +92,7 @@ impl Axis {
     }
 }
 
-/// Maps data coordinates to pixel coordinates of the plot area.
+/// The axes' ranges of a chart.
 #[derive(Clone, Debug)]
 pub struct Frame {
     pub x: Axis,
@@ -109,16 +106,6 @@ impl Frame {
         let x = Axis::fit(xs, chart.kind == Kind::Scatter);
         let y = Axis::fit(pts().map(|p| p.1), true);
         Self { x, y }
-    }
-
-    pub fn px(&self, x: f64) -> f64 {
-        let [l, r, _, _] = MARGIN;
-        l + (x - self.x.min) / (self.x.max - self.x.min) * (WIDTH as f64 - l - r)
-    }
-
-    pub fn py(&self, y: f64) -> f64 {
-        let [_, _, t, b] = MARGIN;
-        HEIGHT as f64 - b - (y - self.y.min) / (self.y.max - self.y.min) * (HEIGHT as f64 - t - b)
     }
 }
 

@@ -5,6 +5,7 @@ use bevy_ecs::prelude::*;
 
 use super::resources::{FrameClock, MethodFrame, MethodInfo, Progress, References, Run, RunOutput};
 use super::stage::failed;
+use crate::run_folder::MOTION;
 use crate::{frame_record, output};
 
 /// The reference's EXR and PNG.
@@ -16,7 +17,9 @@ pub fn write_reference(run: Res<Run>, clock: Res<FrameClock>, out: Res<RunOutput
     Ok(())
 }
 
-/// Each method's EXR and PNG, and its extra images (`frames/METHOD/NAME/NNNN.png`).
+/// Each method's EXR and PNG, its motion vectors (`frames/METHOD/motion/NNNN.exr`: R, G = pixels
+/// from this frame to the previous, for the report's viewer) and its extra images
+/// (`frames/METHOD/NAME/NNNN.png`).
 pub fn write_method_images(run: Res<Run>, clock: Res<FrameClock>, out: Res<RunOutput>, methods: Query<(&MethodInfo, &MethodFrame)>) -> Result {
     let (w, h, frame) = (run.width, run.height, clock.frame);
     let folder = &out.folder;
@@ -25,6 +28,10 @@ pub fn write_method_images(run: Res<Run>, clock: Res<FrameClock>, out: Res<RunOu
         let label = &info.label;
         output::write_exr(&folder.frame(label, frame, "exr"), w, h, &o.radiance).map_err(failed)?;
         output::write_png(&folder.frame(label, frame, "png"), w, h, &o.radiance, 1.0).map_err(failed)?;
+        if !o.motion.is_empty() {
+            let motion: Vec<[f32; 4]> = o.motion.iter().map(|&[dx, dy]| [dx, dy, 0.0, 1.0]).collect();
+            output::write_exr(&folder.method_image(label, MOTION, frame, "exr"), w, h, &motion).map_err(failed)?;
+        }
         for image in &o.images {
             if image.hdr {
                 output::write_exr(&folder.method_image(label, &image.name, frame, "exr"), w, h, &image.pixels).map_err(failed)?;
