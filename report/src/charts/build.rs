@@ -84,6 +84,31 @@ pub fn reliability_chart(manifest: &Manifest, frames: &Frames) -> Option<(String
     Some(("frames_reliability".into(), chart))
 }
 
+/// What σ does (issue 10): the blend rule's mean σ per frame and the share of queries with
+/// σ > 0.5 (stats `blend_sigma`, `prefer_high_lr`; shared by the NIRC methods of a cache), with
+/// the even mixture σ = 0.5 as a reference line.
+pub fn sigma_chart(manifest: &Manifest, frames: &Frames) -> Option<(String, Chart)> {
+    let sigma = frames.column("blend_sigma").filter(|&c| frames.has_data(c))?;
+    let method = frames.methods().into_iter().find(|m| frames.series(m, sigma).iter().any(|p| p.1.is_finite()))?;
+    let last_frame = frames.rows.iter().map(|r| r.frame).max().unwrap_or(0) as f64;
+    let mut series = vec![Series { name: "mean σ (blend rule)".into(), points: frames.series(&method, sigma) }];
+    if let Some(prefer) = frames.column("prefer_high_lr").filter(|&c| frames.has_data(c)) {
+        series.push(Series { name: "share of queries with σ > 0.5".into(), points: frames.series(&method, prefer) });
+    }
+    series.push(Series { name: "σ = 0.5 (even mixture)".into(), points: vec![(0.0, 0.5), (last_frame, 0.5)] });
+    let chart = Chart {
+        title: format!("Weight σ of the High-LR predictor ({method}) — {}", manifest.scenario),
+        x_label: "frame".into(),
+        y_label: "σ".into(),
+        kind: Kind::Lines,
+        series,
+        events: manifest.events.iter().map(|e| (e.frame as f64, e.label.clone())).collect(),
+        pareto: vec![],
+        x_extent: vec![0.0, last_frame],
+    };
+    Some(("frames_sigma".into(), chart))
+}
+
 pub fn speed_accuracy_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)> {
     let time_col = ["gpu_ms_total", "wall_ms_total", "cpu_ms"].into_iter().find(|c| frames.column(c).is_some_and(|i| frames.has_data(i)));
     let Some(time_col) = time_col else { return vec![] };
@@ -130,7 +155,7 @@ pub fn write_charts(run_dir: &Path, manifest: &Manifest, frames: &Frames) -> any
     let dir = run_dir.join("charts");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut out = Vec::new();
-    for (stem, chart) in frame_charts(manifest, frames).into_iter().chain(reliability_chart(manifest, frames)).chain(speed_accuracy_charts(manifest, frames)) {
+    for (stem, chart) in frame_charts(manifest, frames).into_iter().chain(reliability_chart(manifest, frames)).chain(sigma_chart(manifest, frames)).chain(speed_accuracy_charts(manifest, frames)) {
         let (svg, map) = plot::to_svg(&chart)?;
         let svg_path = dir.join(format!("{stem}.svg"));
         std::fs::write(&svg_path, &svg).with_context(|| format!("cannot write {}", svg_path.display()))?;
@@ -140,4 +165,28 @@ pub fn write_charts(run_dir: &Path, manifest: &Manifest, frames: &Frames) -> any
         out.push(WrittenChart { stem, title: chart.title, svg, frame_axis });
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sigma_and_reliability_charts_follow_the_nirc_columns() {
+        let csv = "method,frame,cpu_ms,reliability_high_lr,reliability_ema,blend_sigma,prefer_high_lr\n\
+                   pt_1spp,0,1,,,,\nnirc_blend_1spp,0,2,0.5,0.6,0.45,0.2\nnirc_blend_1spp,1,2,0.4,0.3,0.55,0.7\n";
+        let frames = Frames::parse(csv, Path::new("frames.csv")).unwrap();
+        let manifest: Manifest = serde_json::from_str(r#"{"scenario": "s", "frames": 2}"#).unwrap();
+        let (stem, chart) = sigma_chart(&manifest, &frames).expect("a σ chart");
+        assert_eq!(stem, "frames_sigma");
+        assert!(chart.title.contains("nirc_blend_1spp"));
+        assert_eq!(chart.series[0].points, vec![(0.0, 0.45), (1.0, 0.55)]);
+        assert_eq!(chart.series[1].points, vec![(0.0, 0.2), (1.0, 0.7)]);
+        assert_eq!(chart.series[2].points, vec![(0.0, 0.5), (1.0, 0.5)]);
+        let (_, r) = reliability_chart(&manifest, &frames).expect("a reliability chart");
+        assert_eq!(r.series[1].points, vec![(0.0, 0.6), (1.0, 0.3)]);
+        // A run without NIRC methods has neither chart.
+        let plain = Frames::parse("method,frame,cpu_ms\npt_1spp,0,1\n", Path::new("frames.csv")).unwrap();
+        assert!(sigma_chart(&manifest, &plain).is_none() && reliability_chart(&manifest, &plain).is_none());
+    }
 }
