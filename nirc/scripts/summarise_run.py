@@ -1,5 +1,5 @@
 # Summary of a NIRC run folder: per method mean FLIP / SMAPE before and after the change,
-# mean ms per pass, reliability stats. Usage: python3 summarise.py RUN [change_frame]
+# mean ms per frame (all passes) and per pass, reliability stats. Usage: python3 summarise.py RUN [change_frame]
 import csv, collections, sys, math
 run = sys.argv[1]; change = int(sys.argv[2]) if len(sys.argv) > 2 else None
 rows = list(csv.DictReader(open(run + '/frames.csv')))
@@ -11,7 +11,7 @@ def f(x):
 def mean(v):
     v = [x for x in v if not math.isnan(x)]
     return sum(v) / len(v) if v else float('nan')
-print(f"{'method':18} {'cpu ms':>9} {'paths':>7} {'infer':>7} {'train':>7} {'FLIP<':>6} {'FLIP>':>6} {'SMAPE<':>7} {'SMAPE>':>7}")
+print(f"{'method':18} {'ms/frame':>9} {'paths':>7} {'infer':>7} {'train':>7} {'FLIP<':>6} {'FLIP>':>6} {'SMAPE<':>7} {'SMAPE>':>7}")
 for m, rs in by.items():
     rs.sort(key=lambda r: int(r['frame']))
     pre = [r for r in rs if change is None or int(r['frame']) < change]
@@ -21,7 +21,7 @@ for m, rs in by.items():
         if k.startswith('gpu_ms_') and k not in rr[0]:
             k = 'wall_ms_' + k[len('gpu_ms_'):]
         return mean([f(r.get(k, '')) for r in rr])
-    print(f"{m:18} {col(rs,'cpu_ms'):9.1f} {col(rs,'gpu_ms_nirc_paths'):7.1f} {col(rs,'gpu_ms_nirc_infer'):7.1f} {col(rs,'gpu_ms_nirc_train'):7.1f} {col(pre,'flip'):6.3f} {col(post,'flip'):6.3f} {col(pre,'smape'):7.3f} {col(post,'smape'):7.3f}")
+    print(f"{m:18} {col(rs,'gpu_ms_total'):9.1f} {col(rs,'gpu_ms_nirc_paths'):7.1f} {col(rs,'gpu_ms_nirc_infer'):7.1f} {col(rs,'gpu_ms_nirc_train'):7.1f} {col(pre,'flip'):6.3f} {col(post,'flip'):6.3f} {col(pre,'smape'):7.3f} {col(post,'smape'):7.3f}")
 m = next((m for m in by if m.startswith('nirc_blend')), None)
 if m:
     rs = sorted(by[m], key=lambda r: int(r['frame']))
