@@ -170,3 +170,24 @@ fn method_errors_point_into_the_file() {
     let e = Method::parse("Taa(name: \"a/b\")").unwrap_err();
     assert!(e.contains("a/b"), "{e}");
 }
+
+#[test]
+fn paper_scale_scenarios_parse_with_the_controls_and_the_nrc_batch() {
+    // scenarios/paper/ is for GPUs (CI never plays it): check here that each file and its methods
+    // parse, with the six methods of issue 10 and NRC's batch.
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper");
+    let mut count = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let spec = RunSpec::load(&path, &Default::default()).unwrap_or_else(|e| panic!("{}: {e:#}", path.display()));
+        let labels: Vec<String> = spec.methods.iter().map(|m| m.label()).collect();
+        assert_eq!(labels, ["nirc_ema_1spp", "nirc_highlr_1spp", "nirc_blend_1spp", "nirc_switch_1spp", "nirc_fixed50_1spp", "pt_1spp"], "{}", path.display());
+        for m in &spec.methods {
+            if let MethodSpec::Nirc(n) = &m.spec {
+                assert_eq!((n.pretrain_frames, n.paths.train_records), (5000, 16384), "{}", path.display());
+            }
+        }
+        count += 1;
+    }
+    assert_eq!(count, 3);
+}
