@@ -1,59 +1,7 @@
-// Types shared by every NIRC pass. The Rust side prepends the sizes as constants (IN_DIMS,
-// WIDTH, HIDDEN, LEVELS, FEATURES, MLP_PARAMS, ...) and appends the level tables.
-
-// Settings that do not change during a cache's life (see gpu/mod.rs `Hyper`).
-struct Hyper {
-    bounds_min: vec4<f32>,
-    inv_extent: vec4<f32>,
-    learning_rate: f32,
-    beta1: f32,
-    beta2: f32,
-    adam_epsilon: f32,
-    alpha: f32,
-    loss_epsilon: f32,
-    lambda: f32,
-    reliability_epsilon: f32,
-    kappa: f32,
-    warmup: u32,
-    reliability_resolution: u32,
-    loss_luminance: u32,
-    // 1: the moments move once per sample (the paper), 0: once per step towards the batch mean.
-    moments_per_sample: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
-}
-
-// What one train/infer call works on.
-struct Call {
-    n: u32,
-    inv_n: f32,
-    mode: u32,
-    num_chunks: u32,
-    // σ of the fixed blend (mode 5).
-    fixed_sigma: f32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
-}
-
-struct TrainingRecord {
-    position: vec4<f32>,
-    direction: vec4<f32>,
-    target_rgb: vec4<f32>,
-}
-
-struct CacheQuery {
-    position: vec4<f32>,
-    direction: vec4<f32>,
-}
-
-struct ReliabilitySample {
-    position: vec4<f32>,
-    target_rgb: vec4<f32>,
-    f_cur: vec4<f32>,
-    f_ema: vec4<f32>,
-}
+// Helpers shared by every NIRC pass. The Rust side prepends the sizes as constants (IN_DIMS,
+// WIDTH, HIDDEN, LEVELS, FEATURES, MLP_PARAMS, ...), the level tables and the structs declared
+// once for Rust and WGSL (Hyper, Call, TrainingRecord, CacheQuery, ReliabilitySample,
+// Counters, CountersAtomic: gpu/mod.rs, records.rs, cpu/optimizer.rs).
 
 // A value whose exponent bits are all ones is an Inf or a NaN. Checked on the bits because
 // shader compilers may assume floats are finite.

@@ -25,18 +25,6 @@
 // frame's max depth. Replacing the cache by cache_target (the oracle) gives an estimator with
 // the same mean as the path tracer's (test: tests/integrator.rs).
 
-struct CacheParams {
-    query_count: u32,        // pixels * spp
-    record_count: u32,       // training records per frame
-    termination_vertex: u32, // k >= 1
-    spp: u32,
-}
-
-struct QueryOut {
-    position: vec4f,
-    direction: vec4f,
-}
-
 // weight.xyz: throughput * f cos / pdf of the query direction; weight.w: 1 = a query exists.
 // prefix.xyz: radiance gathered before the cache term. origin.xyz: offset ray origin of the
 // query ray; origin.w: its depth (as in path_radiance), stored as a float.
@@ -46,11 +34,8 @@ struct QueryMeta {
     origin: vec4f,
 }
 
-struct Record {
-    position: vec4f,   // w: 1 = valid
-    direction: vec4f,
-    target_rgb: vec4f,
-}
+// CacheParams, CacheQuery and TrainingRecord (position.w: 1 = valid) are declared once for Rust
+// and WGSL (src/integrator.rs, src/records.rs).
 
 
 // Stream of training-path random numbers: disjoint from the camera samples' (small indices).
@@ -103,7 +88,7 @@ fn trace_query(pixel: vec2u, sample_index: u32, q: u32) {
     var result: QueryMeta;
     result.weight = vec4f(0.0);
     result.origin = vec4f(0.0);
-    var query: QueryOut;
+    var query: CacheQuery;
     query.position = vec4f(0.0);
     query.direction = vec4f(0.0, 0.0, 1.0, 0.0);
     if path.stopped {
@@ -168,7 +153,7 @@ fn targets_main(@builtin(global_invocation_id) id: vec3u) {
             break;
         }
     }
-    var r: Record;
+    var r: TrainingRecord;
     r.position = vec4f(0.0);
     r.direction = vec4f(0.0, 0.0, 1.0, 0.0);
     r.target_rgb = vec4f(0.0);

@@ -10,7 +10,7 @@
 
 use crate::error::NircError;
 use crate::records::{CacheAnswer, CacheQuery, TrainingRecord};
-use bytemuck::{Pod, Zeroable};
+use render::gpu_struct::GpuStruct;
 use render::compute::BufferBinding;
 use render::gpu::Gpu;
 use render::path_tracer::PathTracer;
@@ -42,13 +42,17 @@ impl Default for CachePathSettings {
     }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct CacheParams {
-    query_count: u32,
-    record_count: u32,
-    termination_vertex: u32,
-    spp: u32,
+render::gpu_struct! {
+    /// The cache-paths passes' uniform.
+    pub struct CacheParams {
+        /// Pixels x spp.
+        pub query_count: u32 => "u32",
+        /// Training records per step.
+        pub record_count: u32 => "u32",
+        /// k >= 1.
+        pub termination_vertex: u32 => "u32",
+        pub spp: u32 => "u32",
+    }
 }
 
 /// Bytes of one `QueryMeta` (weight, prefix, origin) in the shader.
@@ -57,11 +61,11 @@ const META_BYTES: u64 = 48;
 /// counters.
 const OWN_GROUP: [BufferBinding; 8] = [
     BufferBinding::uniform("params", "CacheParams"),
-    BufferBinding::read_write("queries", "array<QueryOut>"),
+    BufferBinding::read_write("queries", "array<CacheQuery>"),
     BufferBinding::read_write("query_meta", "array<QueryMeta>"),
     // [0, record_count): the compacted training records handed to the cache;
     // [record_count, 2 record_count): one candidate per record slot, before compaction.
-    BufferBinding::read_write("records", "array<Record>"),
+    BufferBinding::read_write("records", "array<TrainingRecord>"),
     BufferBinding::read_write("answers", "array<vec4f>"),
     BufferBinding::read_write("image", "array<vec4f>"),
     // Per pixel: motion of the pixel-centre primary hit (as the path tracer's G-buffer), for
@@ -108,7 +112,7 @@ impl CachePaths {
     /// The WGSL of the pass (part of warm-start keys).
     pub fn shader_source() -> &'static str {
         static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-        SOURCE.get_or_init(|| [PathTracer::library_source(), include_str!("../shaders/cache_paths.wgsl")].join("\n"))
+        SOURCE.get_or_init(|| [PathTracer::library_source(), CacheParams::WGSL, &crate::records::wgsl(), include_str!("../shaders/cache_paths.wgsl")].join("\n"))
     }
 
     /// Passes for `tracer`'s resolution at `spp` paths per pixel.

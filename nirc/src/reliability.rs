@@ -40,7 +40,7 @@ pub fn cell_index(config: &ReliabilityConfig, bounds: &SceneBounds, position: [f
 pub fn sample_quantities(s: &ReliabilitySample) -> [f32; MOMENTS_PER_CELL] {
     let mut q = [0.0; MOMENTS_PER_CELL];
     for c in 0..3 {
-        let (y, fc, fe) = (s.target[c], s.f_cur[c], s.f_ema[c]);
+        let (y, fc, fe) = (s.target_rgb[c], s.f_cur[c], s.f_ema[c]);
         q[c] = y;
         q[3 + c] = y * y;
         q[CUR + c] = fc;
@@ -59,7 +59,7 @@ pub fn update(config: &ReliabilityConfig, bounds: &SceneBounds, moments: &mut [f
     let cells = cell_count(config) as usize;
     assert_eq!(moments.len(), cells * MOMENTS_PER_CELL, "reliability moments sized for another grid");
     if config.update == MomentUpdate::PerSample {
-        let finite = samples.iter().all(|s| (0..3).all(|c| s.target[c].is_finite() && s.f_cur[c].is_finite() && s.f_ema[c].is_finite()));
+        let finite = samples.iter().all(|s| (0..3).all(|c| s.target_rgb[c].is_finite() && s.f_cur[c].is_finite() && s.f_ema[c].is_finite()));
         if finite {
             for s in samples {
                 let cell = cell_index(config, bounds, [s.position[0], s.position[1], s.position[2]]) as usize;
@@ -163,7 +163,7 @@ mod tests {
             let (y, fc, fe) = sample(t);
             let s = ReliabilitySample {
                 position: [0.1, 0.1, 0.1, 0.0],
-                target: [y[0], y[1], y[2], 0.0],
+                target_rgb: [y[0], y[1], y[2], 0.0],
                 f_cur: [fc[0], fc[1], fc[2], 0.0],
                 f_ema: [fe[0], fe[1], fe[2], 0.0],
             };
@@ -248,7 +248,7 @@ mod tests {
         let bounds = SceneBounds::new([0.0; 3], [1.0; 3]);
         let cells = cell_count(&cfg) as usize * MOMENTS_PER_CELL;
         let batch: Vec<ReliabilitySample> = (0..50)
-            .map(|i| ReliabilitySample { position: [0.1, 0.1, 0.1, 0.0], target: [i as f32, 0.0, 0.0, 0.0], f_cur: [0.0; 4], f_ema: [0.0; 4] })
+            .map(|i| ReliabilitySample { position: [0.1, 0.1, 0.1, 0.0], target_rgb: [i as f32, 0.0, 0.0, 0.0], f_cur: [0.0; 4], f_ema: [0.0; 4] })
             .collect();
         let (mut per_sample, mut batch_mean) = (vec![0.0f32; cells], vec![0.0f32; cells]);
         assert!(update(&cfg, &bounds, &mut per_sample, &batch));

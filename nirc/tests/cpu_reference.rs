@@ -72,7 +72,7 @@ fn regression_on_a_smooth_function_converges() {
         test.iter()
             .map(|r| {
                 let f = c.predict(&r.query(), ema);
-                (0..3).map(|k| (f[k] - r.target[k]).abs() / r.target[k]).sum::<f32>() / 3.0
+                (0..3).map(|k| (f[k] - r.target_rgb[k]).abs() / r.target_rgb[k]).sum::<f32>() / 3.0
             })
             .sum::<f32>()
             / test.len() as f32
@@ -92,7 +92,7 @@ fn non_finite_target_rolls_the_step_back() {
     cache.train_step(&records(&mut rng, 64));
     let before = cache.state.clone();
     let mut bad = records(&mut rng, 64);
-    bad[17].target[1] = f32::NAN;
+    bad[17].target_rgb[1] = f32::NAN;
     let report = cache.train_step(&bad);
     assert!(!report.committed && report.loss.is_nan());
     assert_eq!(cache.state.params, before.params);
@@ -100,7 +100,7 @@ fn non_finite_target_rolls_the_step_back() {
     assert_eq!(cache.state.reliability, before.reliability);
     assert_eq!(cache.state.counters.rejected_steps, 1);
     assert_eq!(cache.state.counters.step, before.counters.step);
-    bad[17].target[1] = f32::INFINITY;
+    bad[17].target_rgb[1] = f32::INFINITY;
     assert!(!cache.train_step(&bad).committed);
     assert_eq!(cache.state.counters.rejected_steps, 2);
     assert!(cache.train_step(&records(&mut rng, 64)).committed);

@@ -144,7 +144,7 @@ fn reliability_stream(rule: nirc::config::MomentUpdate) {
                 // cur tracks y, ema lags with noise: distinct correlations per cell.
                 let fc = y.map(|v| 0.9 * v + 0.1);
                 let fe = [rng.range(0.0, 3.0), y[1] * 0.5, rng.range(0.0, 0.1)];
-                ReliabilitySample { position: [p[0], p[1], p[2], 0.0], target: [y[0], y[1], y[2], 0.0], f_cur: [fc[0], fc[1], fc[2], 0.0], f_ema: [fe[0], fe[1], fe[2], 0.0] }
+                ReliabilitySample { position: [p[0], p[1], p[2], 0.0], target_rgb: [y[0], y[1], y[2], 0.0], f_cur: [fc[0], fc[1], fc[2], 0.0], f_ema: [fe[0], fe[1], fe[2], 0.0] }
             })
             .collect();
         assert!(nirc::reliability::update(&config.reliability, &b, &mut moments, &samples));
@@ -217,7 +217,7 @@ fn nan_target_rolls_the_step_back_and_is_counted() {
     cache.train_records(gpu(), &records(&mut rng, 128)).unwrap();
     let before = cache.download_state(gpu()).unwrap();
     let mut bad = records(&mut rng, 128);
-    bad[77].target[2] = f32::NAN;
+    bad[77].target_rgb[2] = f32::NAN;
     cache.train_records(gpu(), &bad).unwrap();
     let after = cache.download_state(gpu()).unwrap();
     assert_eq!(after.params, before.params);

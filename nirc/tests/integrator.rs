@@ -167,7 +167,7 @@ fn training_records_are_queries_with_finite_targets() {
         assert_eq!(r.position[3], 1.0, "every slot holds a valid record: {r:?}");
         let d = r.direction;
         assert!(((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() - 1.0).abs() < 1e-4, "unit direction: {r:?}");
-        assert!(r.target[..3].iter().all(|v| v.is_finite() && *v >= 0.0), "finite non-negative target: {r:?}");
+        assert!(r.target_rgb[..3].iter().all(|v| v.is_finite() && *v >= 0.0), "finite non-negative target: {r:?}");
         assert!(
             queries.iter().any(|q| q.position[..3] == r.position[..3] && q.direction[..3] == r.direction[..3]),
             "a record must be one of the frame's queries: {r:?}"

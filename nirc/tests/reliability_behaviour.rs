@@ -16,7 +16,7 @@ fn noisy(rng: &mut Rng, n: usize) -> Vec<TrainingRecord> {
     for r in &mut recs {
         let k = 0.7 + 0.6 * rng.f32();
         for c in 0..3 {
-            r.target[c] *= k;
+            r.target_rgb[c] *= k;
         }
     }
     recs

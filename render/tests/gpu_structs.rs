@@ -10,30 +10,8 @@ use render::lights::GpuLight;
 use render::sample_cache::{SscParams, SscPixel, SscSlot};
 use render::taa::{TaaParams, TaaPrimary};
 
-/// The differences between `T`'s Rust layout and its WGSL declaration's (after `deps`, the
-/// declarations it uses).
 fn mismatches<T: GpuStruct>(deps: &str) -> Vec<String> {
-    let source = format!("{deps}\n{}", T::WGSL);
-    let module = naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{}\n{source}", e.emit_to_string(&source)));
-    let mut layouter = naga::proc::Layouter::default();
-    layouter.update(module.to_ctx()).expect("layout");
-    let name = T::WGSL.split_whitespace().nth(1).expect("struct NAME");
-    let (_, ty) = module.types.iter().find(|(_, t)| t.name.as_deref() == Some(name)).unwrap_or_else(|| panic!("{name} not declared"));
-    let naga::TypeInner::Struct { members, span } = &ty.inner else { panic!("{name} is not a struct") };
-    let rust = T::offsets();
-    let mut out = Vec::new();
-    if members.len() != rust.len() {
-        out.push(format!("{name}: {} WGSL fields, {} Rust fields", members.len(), rust.len()));
-    }
-    for (m, (field, offset)) in members.iter().zip(&rust) {
-        if m.name.as_deref() != Some(*field) || m.offset as usize != *offset {
-            out.push(format!("{name}.{field}: Rust offset {offset}, WGSL {:?} at {}", m.name, m.offset));
-        }
-    }
-    if *span as usize != size_of::<T>() {
-        out.push(format!("{name}: Rust size {}, WGSL {span}", size_of::<T>()));
-    }
-    out
+    render::gpu_struct::layout_mismatches::<T>(deps)
 }
 
 #[test]

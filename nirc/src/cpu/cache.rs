@@ -79,7 +79,7 @@ impl CpuCache {
         for (r, rec) in records.iter().enumerate() {
             let (f, acts, corners) = predict(cfg, &self.layout, params, &self.state, &rec.query());
             let den = frozen.map(|d| d[r]).unwrap_or_else(|| denominators(&cfg.loss, f));
-            let (loss, d_out) = relative_l2(f, xyz(rec.target).map(T::from_f32), den);
+            let (loss, d_out) = relative_l2(f, xyz(rec.target_rgb).map(T::from_f32), den);
             total += loss * inv_n;
             let (deltas, d_input) = backward(&self.layout, params, &acts, d_out.map(|d| d * inv_n));
             for (k, m) in self.layout.matrices.iter().enumerate() {
@@ -125,13 +125,13 @@ impl CpuCache {
             let q = rec.query();
             let (f, acts, corners) = predict(&cfg, layout, &self.state.params, &self.state, &q);
             let f_ema = self.predict(&q, true);
-            let y = xyz(rec.target);
+            let y = xyz(rec.target_rgb);
             let (loss, d_out) = relative_l2(f, y, denominators(&cfg.loss, f));
             finite &= loss.is_finite();
             loss_sum += loss as f64;
             let (deltas, d_input) = backward(layout, &self.state.params, &acts, d_out);
             self.scatter_grid(&corners, &d_input, |index, g| finite &= grid_sums[index - grid_base].add(g));
-            samples.push(ReliabilitySample { position: rec.position, target: rec.target, f_cur: [f[0], f[1], f[2], 0.0], f_ema: [f_ema[0], f_ema[1], f_ema[2], 0.0] });
+            samples.push(ReliabilitySample { position: rec.position, target_rgb: rec.target_rgb, f_cur: [f[0], f[1], f[2], 0.0], f_ema: [f_ema[0], f_ema[1], f_ema[2], 0.0] });
             acts_all.push(acts);
             deltas_all.push(deltas);
         }

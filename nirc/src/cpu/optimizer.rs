@@ -5,22 +5,30 @@
 use crate::config::{AdamConfig, EmaConfig};
 use serde::{Deserialize, Serialize};
 
-/// Step counters, laid out as the GPU's `Counters` buffer.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct Counters {
-    /// Committed training steps t.
-    pub step: u32,
-    /// Steps rolled back because a loss, gradient or weight was not finite.
-    pub rejected_steps: u32,
-    /// Updates of the reliability grid (one per committed step that carried samples).
-    pub grid_updates: u32,
-    /// Scratch of the step in flight on the GPU (non-finite flag); always 0 at rest.
-    pub flag: u32,
-    pub beta1_pow: f32,
-    pub beta2_pow: f32,
-    pub alpha_pow: f32,
-    pub _pad: u32,
+render::gpu_struct! {
+    /// Step counters, the GPU's `Counters` buffer (passes that raise `flag` see it as
+    /// `CountersAtomic`, see `counters_atomic_wgsl`).
+    #[derive(PartialEq, Serialize, Deserialize)]
+    pub struct Counters {
+        /// Committed training steps t.
+        pub step: u32 => "u32",
+        /// Steps rolled back because a loss, gradient or weight was not finite.
+        pub rejected_steps: u32 => "u32",
+        /// Updates of the reliability grid (one per committed step that carried samples).
+        pub grid_updates: u32 => "u32",
+        /// Scratch of the step in flight on the GPU (non-finite flag); always 0 at rest.
+        pub flag: u32 => "u32",
+        pub beta1_pow: f32 => "f32",
+        pub beta2_pow: f32 => "f32",
+        pub alpha_pow: f32 => "f32",
+        pub _pad: u32 => "u32",
+    }
+}
+
+/// `Counters` with an atomic `flag`, for the passes that raise it (the same layout).
+pub fn counters_atomic_wgsl() -> String {
+    use render::gpu_struct::GpuStruct;
+    Counters::WGSL.replacen("struct Counters", "struct CountersAtomic", 1).replacen("flag: u32", "flag: atomic<u32>", 1)
 }
 
 impl Default for Counters {

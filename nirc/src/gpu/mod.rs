@@ -25,7 +25,7 @@ use crate::layout::ParameterLayout;
 use crate::records::{CacheAnswer, CacheQuery, ReliabilitySample, TrainingRecord};
 use crate::reliability::{MOMENTS_PER_CELL, cell_count};
 use crate::state::CacheState;
-use bytemuck::{Pod, Zeroable};
+use bytemuck::Pod;
 use render::gpu::Gpu;
 use render::timing::TimedFrame;
 use shaders::{CHUNK, WORKGROUP_SIZE, WeightPlacement};
@@ -38,41 +38,49 @@ const RELIABILITY_MODE: u32 = 4;
 /// u32 words per reliability cell accumulator (24 sums x 3 words + count).
 const ACCUM_PER_CELL: u64 = 73;
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct Hyper {
-    bounds_min: [f32; 4],
-    inv_extent: [f32; 4],
-    learning_rate: f32,
-    beta1: f32,
-    beta2: f32,
-    adam_epsilon: f32,
-    alpha: f32,
-    loss_epsilon: f32,
-    lambda: f32,
-    reliability_epsilon: f32,
-    kappa: f32,
-    warmup: u32,
-    reliability_resolution: u32,
-    loss_luminance: u32,
-    moments_per_sample: u32,
-    pad: [u32; 3],
+render::gpu_struct! {
+    /// Settings that do not change during a cache's life (a uniform of every pass).
+    pub struct Hyper {
+        pub bounds_min: [f32; 4] => "vec4<f32>",
+        pub inv_extent: [f32; 4] => "vec4<f32>",
+        pub learning_rate: f32 => "f32",
+        pub beta1: f32 => "f32",
+        pub beta2: f32 => "f32",
+        pub adam_epsilon: f32 => "f32",
+        pub alpha: f32 => "f32",
+        pub loss_epsilon: f32 => "f32",
+        pub lambda: f32 => "f32",
+        pub reliability_epsilon: f32 => "f32",
+        pub kappa: f32 => "f32",
+        pub warmup: u32 => "u32",
+        pub reliability_resolution: u32 => "u32",
+        pub loss_luminance: u32 => "u32",
+        /// 1: the moments move once per sample (the paper), 0: once per step (batch mean).
+        pub moments_per_sample: u32 => "u32",
+        pub pad0: u32 => "u32",
+        pub pad1: u32 => "u32",
+        pub pad2: u32 => "u32",
+    }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct Call {
-    n: u32,
-    inv_n: f32,
-    mode: u32,
-    num_chunks: u32,
-    fixed_sigma: f32,
-    pad: [u32; 3],
+render::gpu_struct! {
+    /// What one train/infer call works on (its own small uniform buffer).
+    pub struct Call {
+        pub n: u32 => "u32",
+        pub inv_n: f32 => "f32",
+        pub mode: u32 => "u32",
+        pub num_chunks: u32 => "u32",
+        /// σ of the fixed blend (mode 5).
+        pub fixed_sigma: f32 => "f32",
+        pub pad0: u32 => "u32",
+        pub pad1: u32 => "u32",
+        pub pad2: u32 => "u32",
+    }
 }
 
 impl Call {
     fn new(n: u32, mode: u32, num_chunks: u32) -> Self {
-        Self { n, inv_n: 1.0 / n as f32, mode, num_chunks, fixed_sigma: 0.0, pad: [0; 3] }
+        Self { n, inv_n: 1.0 / n as f32, mode, num_chunks, fixed_sigma: 0.0, pad0: 0, pad1: 0, pad2: 0 }
     }
 }
 
@@ -289,7 +297,9 @@ impl NeuralCache {
             reliability_resolution: config.reliability.resolution,
             loss_luminance: (config.loss.normalization == crate::config::LossNormalization::Luminance) as u32,
             moments_per_sample: (config.reliability.update == crate::config::MomentUpdate::PerSample) as u32,
-            pad: [0; 3],
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
         }
     }
 

@@ -8,7 +8,6 @@ use crate::reliability::cell_count;
 pub const WORKGROUP_SIZE: u32 = 64;
 
 const COMMON: &str = include_str!("../../shaders/bindings_common.wgsl");
-const COUNTERS: &str = include_str!("../../shaders/counters.wgsl");
 const FIXED_SUM: &str = include_str!("../../shaders/fixed_sum.wgsl");
 const FIXED_SUM_READ: &str = include_str!("../../shaders/fixed_sum_read.wgsl");
 const ENCODING: &str = include_str!("../../shaders/encoding.wgsl");
@@ -92,9 +91,15 @@ pub fn tiled_unsupported(layout: &ParameterLayout) -> Option<String> {
     None
 }
 
+/// The structs declared once for Rust and WGSL (`render::gpu_struct!`) that the passes use.
+pub fn structs() -> String {
+    use render::gpu_struct::GpuStruct;
+    [super::Hyper::WGSL.to_string(), super::Call::WGSL.to_string(), crate::records::wgsl(), crate::cpu::optimizer::Counters::WGSL.to_string(), crate::cpu::optimizer::counters_atomic_wgsl()].concat()
+}
+
 fn prelude(config: &NircConfig, layout: &ParameterLayout) -> String {
     let (dir_kind, dir_bands) = config.direction.code();
-    let mut s = String::new();
+    let mut s = structs();
     let mut c = |name: &str, v: u32| s.push_str(&format!("const {name}: u32 = {v}u;\n"));
     c("IN_DIMS", layout.input_dims);
     c("WIDTH", layout.width);
@@ -172,20 +177,20 @@ pub fn source(config: &NircConfig, layout: &ParameterLayout, pass: &str) -> Stri
     let parts: Vec<&str> = match pass {
         "train_tile" => {
             s.push_str(&tile_constants(layout, &tile_shape(layout, TRAIN_TILE_RECORDS), true));
-            vec![COMMON, COUNTERS, TRAIN_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP_TILE, ENCODING, FIXED_SUM, LOSS, TRAIN_TILE]
+            vec![COMMON, TRAIN_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP_TILE, ENCODING, FIXED_SUM, LOSS, TRAIN_TILE]
         }
         "infer_tile" => {
             s.push_str(&tile_constants(layout, &tile_shape(layout, INFER_TILE_QUERIES), false));
-            vec![COMMON, COUNTERS, INFER_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP_TILE, ENCODING, RELIABILITY, ANSWER, INFER_TILE]
+            vec![COMMON, INFER_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP_TILE, ENCODING, RELIABILITY, ANSWER, INFER_TILE]
         }
-        "train_forward_backward" => vec![COMMON, COUNTERS, TRAIN_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP, ENCODING, FIXED_SUM, LOSS, TRAIN_FORWARD_BACKWARD],
+        "train_forward_backward" => vec![COMMON, TRAIN_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP, ENCODING, FIXED_SUM, LOSS, TRAIN_FORWARD_BACKWARD],
         "weight_gradient" => vec![COMMON, MLP_LAYOUT, WEIGHT_GRADIENT],
-        "adam_ema" => vec![COMMON, COUNTERS, FIXED_SUM_READ, ADAM_EMA],
-        "reliability_accumulate" => vec![COMMON, COUNTERS, RELIABILITY, FIXED_SUM, RELIABILITY_ACCUMULATE],
-        "reliability_update" => vec![COMMON, COUNTERS, RELIABILITY, FIXED_SUM_READ, RELIABILITY_UPDATE],
+        "adam_ema" => vec![COMMON, FIXED_SUM_READ, ADAM_EMA],
+        "reliability_accumulate" => vec![COMMON, RELIABILITY, FIXED_SUM, RELIABILITY_ACCUMULATE],
+        "reliability_update" => vec![COMMON, RELIABILITY, FIXED_SUM_READ, RELIABILITY_UPDATE],
         "reliability_walk" => vec![COMMON, RELIABILITY, RELIABILITY_WALK],
-        "finish_step" => vec![COMMON, COUNTERS, FINISH_STEP],
-        "infer" => vec![COMMON, COUNTERS, INFER_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP, ENCODING, RELIABILITY, ANSWER, INFER],
+        "finish_step" => vec![COMMON, FINISH_STEP],
+        "infer" => vec![COMMON, INFER_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP, ENCODING, RELIABILITY, ANSWER, INFER],
         other => panic!("unknown NIRC pass '{other}'"),
     };
     for p in parts {
@@ -198,7 +203,8 @@ pub fn source(config: &NircConfig, layout: &ParameterLayout, pass: &str) -> Stri
 /// Every WGSL file of the cache's passes, concatenated (part of warm-start keys).
 pub fn all_sources() -> String {
     [
-        COMMON, COUNTERS, TRAIN_BINDINGS, INFER_BINDINGS, WEIGHTS, LOSS, FIXED_SUM, FIXED_SUM_READ, ENCODING, MLP_LAYOUT, MLP, MLP_TILE, ANSWER, RELIABILITY, TRAIN_FORWARD_BACKWARD, TRAIN_TILE, WEIGHT_GRADIENT, ADAM_EMA, RELIABILITY_ACCUMULATE,
+        &structs(),
+        COMMON, TRAIN_BINDINGS, INFER_BINDINGS, WEIGHTS, LOSS, FIXED_SUM, FIXED_SUM_READ, ENCODING, MLP_LAYOUT, MLP, MLP_TILE, ANSWER, RELIABILITY, TRAIN_FORWARD_BACKWARD, TRAIN_TILE, WEIGHT_GRADIENT, ADAM_EMA, RELIABILITY_ACCUMULATE,
         RELIABILITY_UPDATE, RELIABILITY_WALK, FINISH_STEP, INFER, INFER_TILE,
     ]
     .join("\n")
