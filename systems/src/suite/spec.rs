@@ -71,7 +71,7 @@ impl Gate {
     pub fn describe(&self) -> String {
         let bound = match self.bound {
             Bound::Absolute { limit } => format!("{} {limit}", if self.metric.higher_is_better() { ">=" } else { "<=" }),
-            Bound::Relative { tolerance } => format!("within {}% of baseline", tolerance * 100.0),
+            Bound::Relative { tolerance } => format!("within {:.1}% of baseline", tolerance * 100.0),
         };
         format!("{} {} {bound}", self.metric.name(), self.window.name())
     }
