@@ -54,6 +54,11 @@ enum Command {
     Compare(metrics::CompareArgs),
     /// Rebuild summary.json, the charts and report.html of a run folder.
     Report(report::ReportArgs),
+    /// Regression suites: play cases over seeds and judge gates against a blessed baseline.
+    Suite {
+        #[command(subcommand)]
+        action: SuiteAction,
+    },
     /// Measure speed: BVH traversal (WGSL vs obvhs CPU), frame time per pass, FLIP and SMAPE.
     Bench {
         /// Also write the Markdown table to this file.
@@ -85,6 +90,62 @@ enum Command {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+}
+
+#[derive(Subcommand)]
+enum SuiteAction {
+    /// Play the suite and judge its gates; exit code 0 when all pass, 1 when one fails, 2 when
+    /// the suite could not be played (bad file, missing baseline).
+    Run(SuiteArgs),
+    /// Play the suite and record its measurements as this adapter's baseline.
+    Bless(SuiteArgs),
+}
+
+#[derive(clap::Args)]
+struct SuiteArgs {
+    /// The suite file (RON), e.g. suites/smoke.ron
+    suite: PathBuf,
+    /// Output folder: each case's run folders, summary.md, junit.xml [default: runs/suite_NAME].
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Cache folder for references [default: $FLICKER_CACHE_DIR or ~/.cache/flicker].
+    #[arg(long)]
+    cache_dir: Option<PathBuf>,
+    /// Baseline file [default: baselines/NAME.json next to the suite file].
+    #[arg(long)]
+    baselines: Option<PathBuf>,
+    /// Do not draw progress bars.
+    #[arg(long)]
+    quiet: bool,
+}
+
+impl SuiteArgs {
+    fn options(self) -> systems::suite::SuiteOptions {
+        systems::suite::SuiteOptions { suite: self.suite, out: self.out, cache_dir: self.cache_dir, baselines: self.baselines, progress: !self.quiet }
+    }
+}
+
+/// `flicker suite`: its own exit codes (1 = a gate failed, 2 = could not run).
+fn suite(action: SuiteAction) -> ExitCode {
+    let result = match action {
+        SuiteAction::Run(args) => systems::suite::run(&args.options()).map(|outcome| {
+            print!("{}", outcome.markdown);
+            println!("\nwrote {} and {}", outcome.summary.display(), outcome.junit.display());
+            outcome.passed()
+        }),
+        SuiteAction::Bless(args) => systems::suite::bless(&args.options()).map(|file| {
+            println!("wrote {}", file.display());
+            true
+        }),
+    };
+    match result {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(1),
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -148,6 +209,7 @@ fn main() -> ExitCode {
     runtime_dir::ensure();
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Suite { action } => return suite(action),
         Command::Run { scenario, frames, resolution, spp, seed, out, cache_dir, quiet } => {
             let opts = RunOptions {
                 scenario,

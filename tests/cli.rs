@@ -222,3 +222,33 @@ fn no_xdg_runtime_dir_message_when_it_is_unset_or_invalid() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn suite_exit_codes_summary_and_junit() {
+    let dir = scratch("suite");
+    tiny_scenario(
+        &dir,
+        "Scenario(scene: Builtin(\"cornell_box\"), resolution: (16, 9), frames: 3, max_depth: 2, methods: [PathTracing(spp: 1)], reference: (spp: 8, frames: Every(1)))",
+    );
+    // One gate every image passes, one none can (FLIP is never below 0): exit code 1.
+    let suite = dir.join("tiny.ron");
+    std::fs::write(
+        &suite,
+        "Suite(\n  cases: [(name: \"box\", scenario: \"scenario.ron\", seeds: [1, 2])],\n  gates: [\n    (metric: Flip, window: Overall, bound: Absolute(limit: 1.0)),\n    (metric: Flip, window: Overall, bound: Absolute(limit: -0.1)),\n  ],\n)\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let o = flicker(&["suite", "run", suite.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap(), "--cache-dir", dir.join("cache").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(1), "stdout: {}\nstderr: {}", text(&o.stdout), text(&o.stderr));
+    let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(summary.contains("1 of 2 checks failed") && summary.contains("**FAIL** | box | pt_1spp | flip overall <= -0.1"), "{summary}");
+    let junit = std::fs::read_to_string(out.join("junit.xml")).unwrap();
+    assert!(junit.contains("tests=\"2\" failures=\"1\" errors=\"0\""), "{junit}");
+    assert!(out.join("box/seed_1/frames.csv").exists() && out.join("box/seed_2/report.html").exists());
+    // A bad suite file: exit code 2, the error at file:line.
+    std::fs::write(&suite, "Suite(\n  cases: [],\n  gates: [(metric: Flip, window: Overall, bound: Absolute(limit: 1.0))],\n  extra: 1,\n)\n").unwrap();
+    let o = flicker(&["suite", "run", suite.to_str().unwrap(), "--quiet"]);
+    let stderr = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("tiny.ron:4:"), "{stderr}");
+}

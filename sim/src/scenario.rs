@@ -331,9 +331,11 @@ impl fmt::Display for ScenarioError {
     }
 }
 
-/// Each method's text and where it starts: entries are found in file order after `methods:`.
-fn method_entries(text: &str, raw: &[Box<ron::value::RawValue>]) -> Vec<MethodEntry> {
-    let mut from = text.find("methods").unwrap_or(0);
+/// Each entry's text and where it starts: entries of a list kept as raw RON (`methods`, a
+/// suite's `cases` and `gates`) are found in file order after `key`, so that errors found when
+/// an entry is parsed later point at the file's line.
+pub fn raw_entries(text: &str, key: &str, raw: &[Box<ron::value::RawValue>]) -> Vec<MethodEntry> {
+    let mut from = text.find(key).unwrap_or(0);
     raw.iter()
         .map(|r| {
             let ron = r.get_ron().trim();
@@ -427,7 +429,7 @@ impl Scenario {
             other => other,
         };
         let output = file.output.unwrap_or_else(|| PathBuf::from("runs").join(&name));
-        let methods = method_entries(text, &file.methods);
+        let methods = raw_entries(text, "methods", &file.methods);
         Ok(Scenario {
             name,
             scene,

@@ -12,4 +12,5 @@ pub mod playback;
 pub mod reference_cache;
 pub mod run_folder;
 pub mod scenario;
+pub mod suite;
 pub mod tonemap;

@@ -45,7 +45,7 @@ pub fn build(spec: &RunSpec, scenario_file: &Path, gpu: &Gpu, overrides: &Overri
 
 /// The commit of the checkout the tool runs from, with `-dirty` when it has local changes;
 /// "unknown" outside a git checkout.
-fn commit(scenario_file: &Path) -> String {
+pub fn commit(scenario_file: &Path) -> String {
     let dir = scenario_file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let git = |args: &[&str]| {
         std::process::Command::new("git")

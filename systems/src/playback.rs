@@ -94,13 +94,19 @@ impl FrameWorld {
 
 pub fn run(opts: &RunOptions) -> Result<RunSummary> {
     let spec = RunSpec::load(&opts.scenario, &opts.overrides)?;
+    run_spec(&spec, opts)
+}
+
+/// [`run`] of a scenario already loaded, with `opts.overrides` applied (a suite keeps only some
+/// of its methods first); `opts.scenario` names the file in the manifest.
+pub fn run_spec(spec: &RunSpec, opts: &RunOptions) -> Result<RunSummary> {
     let scenario = &spec.scenario;
     let gpu = Gpu::new()?;
     let folder = RunFolder::new(&scenario.output);
-    let manifest = crate::manifest::build(&spec, &opts.scenario, &gpu, &opts.overrides)?;
+    let manifest = crate::manifest::build(spec, &opts.scenario, &gpu, &opts.overrides)?;
     let cache_dir = opts.cache_dir.clone().unwrap_or_else(ReferenceCache::default_location);
     let bar = progress_bar(opts.progress, (scenario.warmup_frames + scenario.frames) as u64);
-    let mut frames = FrameWorld::build(&spec, gpu, cache_dir, folder.clone(), bar.clone())?;
+    let mut frames = FrameWorld::build(spec, gpu, cache_dir, folder.clone(), bar.clone())?;
     folder.prepare()?;
     output::write_json(&folder.manifest(), &manifest)?;
 

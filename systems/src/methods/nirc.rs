@@ -51,6 +51,12 @@ pub struct NircSettings {
     /// saved next to the reference cache and reused).
     #[serde(default)]
     pub pretrain_frames: u32,
+    /// TEST ONLY: never update the EMA weights, so that EMA-only (and the blend's EMA side)
+    /// answer from the initial network. A deliberately broken method for the test that the
+    /// smoke suite catches a regression (systems/tests/suite.rs); never set it in a scenario
+    /// meant for results.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub test_skip_ema: bool,
 }
 
 impl NircSettings {
@@ -60,7 +66,9 @@ impl NircSettings {
 
     /// Methods with equal keys share one cache: everything but the predictor.
     fn shared_key(&self) -> String {
-        format!("{}|{}|{}", self.spp, serde_json::to_string(&(&self.cache, &self.paths)).expect("settings serialise"), self.pretrain_frames)
+        let key = format!("{}|{}|{}", self.spp, serde_json::to_string(&(&self.cache, &self.paths)).expect("settings serialise"), self.pretrain_frames);
+        // The test-only switch never shares a cache with a working method.
+        if self.test_skip_ema { key + "|test_skip_ema" } else { key }
     }
 }
 
@@ -384,6 +392,9 @@ pub fn ema(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut caches: Query<&mut N
     for mut c in &mut caches {
         let c = &mut *c;
         let Some(step) = &c.step else { continue };
+        if c.settings.test_skip_ema {
+            continue;
+        }
         let mut timed = c.ema_timer.begin(gpu, "nirc ema");
         c.cache.ema_timed(&mut timed, 0, step).map_err(|e| err(e.into()))?;
         c.train_times.extend(timed.submit().map_err(|e| err(e.into()))?);

@@ -1,0 +1,49 @@
+//! The per-frame numbers a gate can judge, read from a run's frame records.
+
+use serde::{Deserialize, Serialize};
+
+use crate::frame_record::FrameRecord;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum Metric {
+    /// Mean FLIP against the reference (frames with a reference only).
+    Flip,
+    /// SMAPE against the previous frame: the flicker.
+    Smape,
+    /// SMAPE against the motion-reprojected previous frame.
+    SmapeReprojected,
+    Mse,
+    RelMse,
+    Psnr,
+}
+
+impl Metric {
+    pub const ALL: [Metric; 6] = [Metric::Flip, Metric::Smape, Metric::SmapeReprojected, Metric::Mse, Metric::RelMse, Metric::Psnr];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::Flip => "flip",
+            Metric::Smape => "smape",
+            Metric::SmapeReprojected => "smape_reprojected",
+            Metric::Mse => "mse",
+            Metric::RelMse => "rel_mse",
+            Metric::Psnr => "psnr",
+        }
+    }
+
+    /// Errors get worse upwards, PSNR downwards.
+    pub fn higher_is_better(self) -> bool {
+        self == Metric::Psnr
+    }
+
+    pub fn of(self, r: &FrameRecord) -> Option<f64> {
+        match self {
+            Metric::Flip => r.flip,
+            Metric::Smape => r.smape,
+            Metric::SmapeReprojected => r.smape_reprojected,
+            Metric::Mse => r.mse,
+            Metric::RelMse => r.rel_mse,
+            Metric::Psnr => r.psnr,
+        }
+    }
+}

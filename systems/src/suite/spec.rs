@@ -1,0 +1,177 @@
+//! Suite files (RON): cases to play over seeds and gates their metrics must pass. Errors carry
+//! the file, line and column, as scenario files' do (sim::scenario): `cases` and `gates` are
+//! kept as raw entries with their place in the file and parsed one by one.
+
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use sim::scenario::{MethodEntry, ScenarioError, raw_entries};
+
+use super::metric::Metric;
+use super::window::Window;
+
+/// One scenario played once per seed.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    pub name: String,
+    /// Relative paths are resolved against the suite file's folder.
+    pub scenario: PathBuf,
+    pub seeds: Vec<u64>,
+    #[serde(default)]
+    pub frames: Option<u32>,
+    #[serde(default)]
+    pub resolution: Option<(u32, u32)>,
+    #[serde(default)]
+    pub spp: Option<u32>,
+    /// Only these method labels of the scenario (after `spp`); all when absent.
+    #[serde(default)]
+    pub methods: Option<Vec<String>>,
+    #[serde(skip)]
+    pub entry: Option<MethodEntry>,
+}
+
+/// How a gate's per-seed values are judged.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Bound {
+    /// `Absolute(limit: 0.5)`: the mean over seeds must not be worse than `limit` (above it, or
+    /// below it for PSNR).
+    Absolute { limit: f64 },
+    /// `Relative(tolerance: 0.05)`: fails when the new mean is worse than the baseline mean by more
+    /// than `tolerance` times the baseline mean, with the gate's confidence (Welch's one-sided
+    /// t-test).
+    Relative { tolerance: f64 },
+}
+
+fn default_confidence() -> f64 {
+    0.95
+}
+
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Gate {
+    pub metric: Metric,
+    pub window: Window,
+    pub bound: Bound,
+    #[serde(default = "default_confidence")]
+    pub confidence: f64,
+    /// Only these cases / method labels; all when absent.
+    #[serde(default)]
+    pub cases: Option<Vec<String>>,
+    #[serde(default)]
+    pub methods: Option<Vec<String>>,
+    #[serde(skip)]
+    pub entry: Option<MethodEntry>,
+}
+
+impl Gate {
+    /// A short name: `flip after_event_0(2) relative 10%`.
+    pub fn describe(&self) -> String {
+        let bound = match self.bound {
+            Bound::Absolute { limit } => format!("{} {limit}", if self.metric.higher_is_better() { ">=" } else { "<=" }),
+            Bound::Relative { tolerance } => format!("within {:.1}% of baseline", tolerance * 100.0),
+        };
+        format!("{} {} {bound}", self.metric.name(), self.window.name())
+    }
+
+    pub fn applies_to(&self, case: &str, method: &str) -> bool {
+        self.cases.as_ref().is_none_or(|c| c.iter().any(|n| n == case)) && self.methods.as_ref().is_none_or(|m| m.iter().any(|n| n == method))
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Suite", deny_unknown_fields)]
+struct SuiteFile {
+    #[serde(default)]
+    name: Option<String>,
+    cases: Vec<Box<ron::value::RawValue>>,
+    gates: Vec<Box<ron::value::RawValue>>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Suite {
+    /// Defaults to the file's stem; names the baseline file.
+    pub name: String,
+    pub cases: Vec<Case>,
+    pub gates: Vec<Gate>,
+    pub origin: PathBuf,
+}
+
+fn options() -> ron::Options {
+    ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+}
+
+impl Suite {
+    pub fn load(path: &Path) -> Result<Suite, ScenarioError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| ScenarioError { file: path.to_path_buf(), position: None, message: format!("cannot read suite file: {e}") })?;
+        Self::from_ron(&text, path)
+    }
+
+    pub fn from_ron(text: &str, origin: &Path) -> Result<Suite, ScenarioError> {
+        let error = |position: Option<(usize, usize)>, message: String| ScenarioError { file: origin.to_path_buf(), position, message };
+        let file: SuiteFile = options().from_str(text).map_err(|e| error(Some((e.span.start.line, e.span.start.col)), e.code.to_string()))?;
+        // An entry's own errors: positions inside the entry moved to the file's.
+        fn parse<T: serde::de::DeserializeOwned>(entry: &MethodEntry) -> Result<T, ((usize, usize), String)> {
+            options().from_str(&entry.text).map_err(|e| (entry.position_in_file(e.span.start.line, e.span.start.col), e.code.to_string()))
+        }
+        let at = |entry: &MethodEntry| Some((entry.line, entry.column));
+        let folder = origin.parent().unwrap_or(Path::new(""));
+        let mut cases = Vec::new();
+        for entry in raw_entries(text, "cases", &file.cases) {
+            let mut case: Case = parse(&entry).map_err(|(pos, m)| error(Some(pos), m))?;
+            if case.seeds.is_empty() {
+                return Err(error(at(&entry), format!("case '{}' has no seeds; expected e.g. seeds: [1, 2, 3]", case.name)));
+            }
+            if let Some(dup) = case.seeds.iter().enumerate().find(|(i, s)| case.seeds[..*i].contains(s)) {
+                return Err(error(at(&entry), format!("case '{}' lists seed {} twice; expected distinct seeds", case.name, dup.1)));
+            }
+            if cases.iter().any(|c: &Case| c.name == case.name) {
+                return Err(error(at(&entry), format!("two cases are named '{}'; expected distinct names (they name run folders and baselines)", case.name)));
+            }
+            if case.scenario.is_relative() {
+                case.scenario = folder.join(&case.scenario);
+            }
+            case.entry = Some(entry);
+            cases.push(case);
+        }
+        if cases.is_empty() {
+            return Err(error(None, "no cases; expected e.g. cases: [(name: \"cornell\", scenario: \"scenarios/cornell_box.ron\", seeds: [1, 2])]".into()));
+        }
+        let names: BTreeSet<&str> = cases.iter().map(|c| c.name.as_str()).collect();
+        let mut gates = Vec::new();
+        for entry in raw_entries(text, "gates", &file.gates) {
+            let mut gate: Gate = parse(&entry).map_err(|(pos, m)| error(Some(pos), m))?;
+            if !(gate.confidence > 0.5 && gate.confidence < 1.0) {
+                return Err(error(at(&entry), format!("confidence {}; expected a probability between 0.5 and 1, e.g. 0.95", gate.confidence)));
+            }
+            match gate.bound {
+                Bound::Relative { tolerance: t } if !(t.is_finite() && t >= 0.0) => return Err(error(at(&entry), format!("tolerance {t}; expected a fraction >= 0, e.g. 0.05 for 5%"))),
+                Bound::Absolute { limit: l } if !l.is_finite() => return Err(error(at(&entry), format!("limit {l}; expected a finite number"))),
+                _ => {}
+            }
+            if let Some(unknown) = gate.cases.iter().flatten().find(|c| !names.contains(c.as_str())) {
+                return Err(error(at(&entry), format!("gate names case '{unknown}'; the suite's cases are: {}", names.iter().copied().collect::<Vec<_>>().join(", "))));
+            }
+            if matches!(gate.bound, Bound::Relative { .. })
+                && let Some(case) = cases.iter().find(|c| c.seeds.len() < 2 && gate.cases.as_ref().is_none_or(|g| g.contains(&c.name)))
+            {
+                return Err(error(at(&entry), format!("a relative gate needs the spread over seeds, but case '{}' has one seed; expected at least 2", case.name)));
+            }
+            gate.entry = Some(entry);
+            gates.push(gate);
+        }
+        if gates.is_empty() {
+            return Err(error(None, "no gates; expected e.g. gates: [(metric: Flip, window: Overall, bound: Relative(tolerance: 0.05))]".into()));
+        }
+        let name = file.name.unwrap_or_else(|| origin.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "suite".into()));
+        Ok(Suite { name, cases, gates, origin: origin.to_path_buf() })
+    }
+
+    /// Where baselines of this suite live: `baselines/NAME.json` next to the suite file.
+    pub fn baseline_file(&self) -> PathBuf {
+        self.origin.parent().unwrap_or(Path::new("")).join("baselines").join(format!("{}.json", self.name))
+    }
+}
