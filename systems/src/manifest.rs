@@ -7,6 +7,16 @@ use render::gpu::Gpu;
 use serde_json::{Value, json};
 use crate::scenario::{Overrides, RunSpec};
 
+/// The scenario's events in recorded frames (frames.csv's `frame`): simulation frame minus the
+/// warm-up frames; events during the warm-up or after the last recorded frame are left out.
+pub fn recorded_events(scenario: &sim::Scenario) -> Vec<(u32, String)> {
+    scenario
+        .events_summary()
+        .into_iter()
+        .filter_map(|(frame, label)| frame.checked_sub(scenario.warmup_frames).filter(|f| *f < scenario.frames).map(|f| (f, label)))
+        .collect()
+}
+
 pub fn build(spec: &RunSpec, scenario_file: &Path, gpu: &Gpu, overrides: &Overrides) -> Result<Value> {
     let scenario = &spec.scenario;
     let frames = scenario.frames;
@@ -25,7 +35,7 @@ pub fn build(spec: &RunSpec, scenario_file: &Path, gpu: &Gpu, overrides: &Overri
         "warmup_frames": scenario.warmup_frames,
         "methods": spec.methods.iter().map(|m| m.label()).collect::<Vec<_>>(),
         "reference": { "spp": scenario.reference.spp, "frames": reference_frames },
-        "events": scenario.events_summary().into_iter().filter(|(frame, _)| *frame < frames).map(|(frame, label)| json!({"frame": frame, "label": label})).collect::<Vec<_>>(),
+        "events": recorded_events(scenario).into_iter().map(|(frame, label)| json!({"frame": frame, "label": label})).collect::<Vec<_>>(),
         "regions": scenario.regions.iter().map(|r| json!({"name": r.name, "x": r.x, "y": r.y, "width": r.width, "height": r.height})).collect::<Vec<_>>(),
         "settings": {
             "max_depth": scenario.max_depth,
@@ -62,5 +72,26 @@ pub fn commit(scenario_file: &Path) -> String {
             if dirty { format!("{hash}-dirty") } else { hash }
         }
         None => "unknown".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn events_are_placed_on_recorded_frames() {
+        let dir = std::env::temp_dir().join(format!("manifest-events-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("warm.ron");
+        std::fs::write(
+            &path,
+            "Scenario(scene: Builtin(\"cornell_box\"), resolution: (8, 8), frames: 8, warmup_frames: 8, methods: [PathTracing(spp: 1)],
+    events: [(frame: 3, action: Toggle(entity: \"ceiling_light\")), (frame: 12, action: Toggle(entity: \"ceiling_light\")), (frame: 16, action: Toggle(entity: \"ceiling_light\"))])",
+        )
+        .unwrap();
+        let scenario = sim::Scenario::load(&path).unwrap();
+        // Simulation frame 12 is recorded frame 4; 3 falls in the warm-up, 16 after the last frame.
+        let frames: Vec<u32> = super::recorded_events(&scenario).into_iter().map(|e| e.0).collect();
+        assert_eq!(frames, [4]);
+        std::fs::remove_dir_all(&dir).ok();
     }
 }
