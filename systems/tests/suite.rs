@@ -108,3 +108,31 @@ fn bad_suite_files_are_reported_at_file_line() {
     assert_eq!(ok.cases[0].scenario, Path::new("dir/s.ron"));
     assert_eq!(ok.baseline_file(), Path::new("dir/baselines/bad.json"));
 }
+
+#[test]
+fn papers_suite_parses_with_relation_gates_and_existing_scenarios() {
+    // suites/papers.ron is for users (minutes per seed): here only that it loads, that its
+    // scenarios exist and that its relation gates name methods of those scenarios.
+    let suite = Suite::load(&root().join("suites/papers.ron")).unwrap_or_else(|e| panic!("{e}"));
+    let relations: Vec<&str> = suite
+        .gates
+        .iter()
+        .filter_map(|g| match &g.bound {
+            systems::suite::spec::Bound::Better { than } => Some(than.as_str()),
+            _ => None,
+        })
+        .collect();
+    assert!(relations.len() >= 3, "{relations:?}");
+    for case in &suite.cases {
+        let spec = systems::scenario::RunSpec::load(&case.scenario, &Default::default()).unwrap_or_else(|e| panic!("{}: {e:#}", case.scenario.display()));
+        let labels: Vec<String> = spec.methods.iter().map(|m| m.label()).collect();
+        for than in &relations {
+            assert!(labels.iter().any(|l| l == than), "{than} is not a method of {}: {labels:?}", case.scenario.display());
+        }
+        for gate in &suite.gates {
+            for m in gate.methods.iter().flatten() {
+                assert!(labels.contains(m), "{m} is not a method of {}", case.scenario.display());
+            }
+        }
+    }
+}

@@ -87,3 +87,46 @@ fn false_failures_match_the_stated_confidence() {
     assert!((0.035..=0.065).contains(&ten), "false-failure rate {ten} at 95% confidence, 10 seeds");
     assert!(three <= 0.05, "false-failure rate {three} at 95% confidence, 3 seeds");
 }
+
+/// One case whose methods "a" and "b" have FLIP `a[i]` and `b[i]` for seed i.
+fn two_methods(a: &[f64], b: &[f64]) -> CaseRuns {
+    let seeds = a
+        .iter()
+        .zip(b)
+        .enumerate()
+        .map(|(i, (&x, &y))| {
+            let one = |v: f64| BTreeMap::from([(Metric::Flip.name().to_string(), vec![Some(v)])]);
+            SeedRun { seed: i as u64, methods: BTreeMap::from([("a".to_string(), one(x)), ("b".to_string(), one(y))]) }
+        })
+        .collect();
+    CaseRuns { frames: 1, events: Vec::new(), seeds }
+}
+
+#[test]
+fn relation_gates_pass_only_when_the_method_is_better_with_confidence() {
+    let gate = Gate { bound: Bound::Better { than: "b".into() }, ..gate(0.95) };
+    // Per seed, a is clearly below b (lower FLIP is better), with a spread.
+    let better = two_methods(&[0.30, 0.31, 0.29, 0.305], &[0.35, 0.37, 0.34, 0.36]);
+    assert!(judge(&gate, "case", "a", &better, None).passed());
+    // Equal on average, or worse: not shown, so the gate fails.
+    let mixed = two_methods(&[0.30, 0.36, 0.29, 0.37], &[0.33, 0.33, 0.33, 0.33]);
+    assert!(!judge(&gate, "case", "a", &mixed, None).passed());
+    assert!(!judge(&gate, "case", "b", &better, None).passed());
+    // Synthetic runs: a true paired advantage of 3 σ of a seed's difference, 6 seeds, is shown
+    // in at least 95% of 200 runs; no advantage passes in at most 5% + noise.
+    let mut rng = Normal(SplitMix64::new(17));
+    let mut rate = |shift: f64| {
+        let passed = (0..RUNS)
+            .filter(|_| {
+                let b: Vec<f64> = (0..6).map(|_| rng.sample(0.3, 0.02)).collect();
+                let a: Vec<f64> = b.iter().map(|v| v - shift * 0.02 + rng.sample(0.0, 0.02)).collect();
+                judge(&gate, "case", "a", &two_methods(&a, &b), None).passed()
+            })
+            .count();
+        passed as f64 / RUNS as f64
+    };
+    let (caught, false_pass) = (rate(3.0), rate(0.0));
+    eprintln!("relation gate: a true 3σ advantage shown in {caught:.3} of runs, no advantage passes in {false_pass:.3}");
+    assert!(caught >= 0.95, "{caught}");
+    assert!(false_pass <= 0.08, "{false_pass}");
+}

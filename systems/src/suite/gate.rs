@@ -1,5 +1,6 @@
 //! Judging one gate for one (case, method): the per-seed window means of the new runs against
-//! an absolute limit, or against the baseline's with Welch's one-sided test.
+//! an absolute limit, against the baseline's with Welch's one-sided test, or against another
+//! method of the same runs with a paired one-sided t test.
 
 use super::measurement::CaseRuns;
 use super::spec::{Bound, Gate};
@@ -58,13 +59,42 @@ pub fn judge(gate: &Gate, case: &str, method: &str, new: &CaseRuns, baseline: Op
     result.new = Some(sample);
     // Both bounds are judged on "how much worse": positive = worse, whatever the metric's direction.
     let sign = if gate.metric.higher_is_better() { -1.0 } else { 1.0 };
-    match gate.bound {
+    match &gate.bound {
+        Bound::Better { than } => {
+            let other = match new.per_seed(than, gate.metric, &gate.window) {
+                Ok(v) => v,
+                Err(e) => {
+                    result.verdict = Verdict::Error(format!("{than}: {e}"));
+                    result.detail = format!("{than}: {e}");
+                    return result;
+                }
+            };
+            // Paired by seed: positive differences = the gate's method is worse.
+            let diffs: Vec<f64> = values.iter().zip(&other).map(|(a, b)| sign * (a - b)).collect();
+            let d = Sample::of(&diffs);
+            let se = d.standard_error();
+            let df = (d.n.max(2) - 1) as f64;
+            // P(mean difference >= 0) under the t model; no spread: the sign decides.
+            let p_value = if se > 0.0 { 1.0 - super::student_t::cdf(-d.mean / se, df) } else if d.mean < 0.0 { 0.0 } else { 1.0 };
+            result.p_value = Some(p_value);
+            result.verdict = if p_value < 1.0 - gate.confidence { Verdict::Pass } else { Verdict::Fail };
+            result.detail = format!(
+                "{method} {:.5} vs {than} {:.5}; paired difference {:+.5} ± {se:.5} (standard error, {} seeds), p = {p_value:.4} (pass below {:.2})",
+                sample.mean,
+                Sample::of(&other).mean,
+                sign * d.mean,
+                d.n,
+                1.0 - gate.confidence
+            );
+        }
         Bound::Absolute { limit } => {
+            let limit = *limit;
             let worse = sign * (sample.mean - limit) > 0.0;
             result.verdict = if worse { Verdict::Fail } else { Verdict::Pass };
             result.detail = format!("mean {:.5} over {} seeds, limit {limit}", sample.mean, sample.n);
         }
         Bound::Relative { tolerance } => {
+            let tolerance = *tolerance;
             let base = match baseline.map(|b| b.per_seed(method, gate.metric, &gate.window)) {
                 Some(Ok(v)) => Sample::of(&v),
                 Some(Err(e)) => {

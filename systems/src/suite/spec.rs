@@ -43,6 +43,11 @@ pub enum Bound {
     /// than `tolerance` times the baseline mean, with the gate's confidence (Welch's one-sided
     /// t-test).
     Relative { tolerance: f64 },
+    /// `Better(than: "nirc_ema_1spp")`: a relation between methods of the same runs (a paper's
+    /// claim). Passes only when the gate's method is better than `than` with the gate's
+    /// confidence: the paired per-seed differences' one-sided Student t test, so the margin
+    /// comes from the spread across seeds. Needs no baseline.
+    Better { than: String },
 }
 
 fn default_confidence() -> f64 {
@@ -72,6 +77,7 @@ impl Gate {
         let bound = match self.bound {
             Bound::Absolute { limit } => format!("{} {limit}", if self.metric.higher_is_better() { ">=" } else { "<=" }),
             Bound::Relative { tolerance } => format!("within {:.1}% of baseline", tolerance * 100.0),
+            Bound::Better { ref than } => format!("better than {than}"),
         };
         format!("{} {} {bound}", self.metric.name(), self.window.name())
     }
@@ -155,10 +161,10 @@ impl Suite {
             if let Some(unknown) = gate.cases.iter().flatten().find(|c| !names.contains(c.as_str())) {
                 return Err(error(at(&entry), format!("gate names case '{unknown}'; the suite's cases are: {}", names.iter().copied().collect::<Vec<_>>().join(", "))));
             }
-            if matches!(gate.bound, Bound::Relative { .. })
+            if matches!(gate.bound, Bound::Relative { .. } | Bound::Better { .. })
                 && let Some(case) = cases.iter().find(|c| c.seeds.len() < 2 && gate.cases.as_ref().is_none_or(|g| g.contains(&c.name)))
             {
-                return Err(error(at(&entry), format!("a relative gate needs the spread over seeds, but case '{}' has one seed; expected at least 2", case.name)));
+                return Err(error(at(&entry), format!("a relative or relation gate needs the spread over seeds, but case '{}' has one seed; expected at least 2", case.name)));
             }
             gate.entry = Some(entry);
             gates.push(gate);
