@@ -164,7 +164,8 @@ impl Suite {
             if matches!(gate.bound, Bound::Relative { .. } | Bound::Better { .. })
                 && let Some(case) = cases.iter().find(|c| c.seeds.len() < 2 && gate.cases.as_ref().is_none_or(|g| g.contains(&c.name)))
             {
-                return Err(error(at(&entry), format!("a relative or relation gate needs the spread over seeds, but case '{}' has one seed; expected at least 2", case.name)));
+                let kind = if matches!(gate.bound, Bound::Better { .. }) { "relation" } else { "relative" };
+                return Err(error(at(&entry), format!("a {kind} gate needs the spread over seeds, but case '{}' has one seed; expected at least 2", case.name)));
             }
             gate.entry = Some(entry);
             gates.push(gate);
