@@ -18,18 +18,24 @@ fn record_valid(rq: u32, c: u32) -> bool {
     return tile_first + 4u * rq + c < call.n;
 }
 
-// Saves the High-LR predictor's hidden activations (inputs of matrix `layer`).
-fn keep_activation(layer: u32, rq: u32, o0: u32, block: Block) {
+// Saves this invocation's block (records 4 rq .., values o0 .. below `count`) at `offset` in each
+// valid record's scratch slot.
+fn keep_block(offset: u32, rq: u32, o0: u32, block: Block, count: u32) {
     for (var c = 0u; c < 4u; c++) {
         if record_valid(rq, c) {
-            let b = record_slot(rq, c) + act_base(layer) + o0;
+            let b = record_slot(rq, c) + offset + o0;
             for (var j = 0u; j < OPT; j++) {
-                if o0 + j < WIDTH {
+                if o0 + j < count {
                     scratch[b + j] = block[j][c];
                 }
             }
         }
     }
+}
+
+// Saves the High-LR predictor's hidden activations (inputs of matrix `layer`).
+fn keep_activation(layer: u32, rq: u32, o0: u32, block: Block) {
+    keep_block(act_base(layer), rq, o0, block, WIDTH);
 }
 
 // Gradient of the pre-activation of matrix m - 1 from that of matrix m's input: ReLU passes it
@@ -48,19 +54,6 @@ fn relu_backward(g: Block, m: u32, rq: u32, o0: u32) -> Block {
         }
     }
     return out;
-}
-
-fn keep_delta(m: u32, rq: u32, o0: u32, block: Block, count: u32) {
-    for (var c = 0u; c < 4u; c++) {
-        if record_valid(rq, c) {
-            let b = record_slot(rq, c) + ACT_FLOATS + delta_base(m) + o0;
-            for (var j = 0u; j < OPT; j++) {
-                if o0 + j < count {
-                    scratch[b + j] = block[j][c];
-                }
-            }
-        }
-    }
 }
 
 @compute @workgroup_size(64)
@@ -147,7 +140,7 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
             g = tile_matmul(mat_rows(m), block_stride(cols), o0, rq);
             if m > 0u {
                 g = relu_backward(g, m, rq, o0);
-                keep_delta(m - 1u, rq, o0, g, cols);
+                keep_block(ACT_FLOATS + delta_base(m - 1u), rq, o0, g, cols);
             }
         }
         workgroupBarrier();

@@ -230,11 +230,7 @@ impl NircCache {
                     paths.encode_queries(gpu, &mut encoder, tracer, run.scenario.seed, frame);
                     gpu.queue.submit([encoder.finish()]);
                     for step in 0..settings.paths.train_steps {
-                        tracer.prepare_frame(gpu, settings.spp, 0, step_seed(run.scenario.seed, step), frame);
-                        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                        paths.encode_records(gpu, &mut encoder, tracer);
-                        fresh.encode_train(gpu, &mut encoder, paths.records(), paths.record_count())?;
-                        gpu.queue.submit([encoder.finish()]);
+                        submit_step(gpu, tracer, &paths, &fresh, settings.spp, step_seed(run.scenario.seed, step), frame)?;
                     }
                     wait(gpu)?;
                 }
@@ -348,6 +344,17 @@ fn step_seed(seed: u64, step: u32) -> u64 {
     seed ^ 0x9E37_79B9_7F4A_7C15u64.wrapping_mul(step as u64)
 }
 
+/// One whole training step (records from the frame's queries, Adam, EMA, reliability, commit)
+/// with `seed` for the record picks and targets, submitted untimed.
+fn submit_step(gpu: &Gpu, tracer: &PathTracer, paths: &CachePaths, cache: &NeuralCache, spp: u32, seed: u64, frame: u32) -> Result<(), nirc::NircError> {
+    tracer.prepare_frame(gpu, spp, 0, seed, frame);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    paths.encode_records(gpu, &mut encoder, tracer);
+    cache.encode_train(gpu, &mut encoder, paths.records(), paths.record_count())?;
+    gpu.queue.submit([encoder.finish()]);
+    Ok(())
+}
+
 /// Training records from the frame's paths and the Adam step of the High-LR weights. With
 /// `train_steps` > 1 the earlier steps (records, Adam, EMA, reliability) run first, their wall
 /// time in the statistic `nirc_steps_wall_ms`; the last step is split over this system, `ema` and
@@ -362,11 +369,7 @@ pub fn train(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res
         if steps > 1 {
             let start = Instant::now();
             for step in 1..steps {
-                c.prepare(gpu, &tracer.0, step_seed(run.scenario.seed, step), clock.global);
-                let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                c.paths.encode_records(gpu, &mut encoder, &tracer.0);
-                c.cache.encode_train(gpu, &mut encoder, c.paths.records(), c.paths.record_count()).map_err(|e| err(e.into()))?;
-                gpu.queue.submit([encoder.finish()]);
+                submit_step(gpu, &tracer.0, &c.paths, &c.cache, c.settings.spp, step_seed(run.scenario.seed, step), clock.global).map_err(|e| err(e.into()))?;
             }
             wait(gpu).map_err(|e| err(e))?;
             c.steps_wall_ms = Some(start.elapsed().as_secs_f64() * 1e3);
