@@ -1,7 +1,10 @@
 // Scene geometry: two-level CWBVH traversal (Ylitie, Karras & Laine 2017, "Efficient Incoherent
 // Ray Traversal on GPUs Through Compressed Wide BVHs") and hit attributes.
-// Concatenate before a pass's own WGSL (SceneGeometry::WGSL). All bindings are in @group(1);
-// internal names start with `sg_`.
+// A pass imports it (SceneGeometry::modules) and binds the geometry at @group(1); internal names
+// start with `sg_`.
+
+import package::scene_geometry_types::{SgNode, SgTriangle, SgMesh, SgVertex, SgInstance};
+import package::scene_geometry_bindings::{sg_blas_nodes, sg_blas_triangles, sg_meshes, sg_vertices, sg_indices, sg_tlas_nodes, sg_tlas_instances, sg_instances};
 
 const NO_HIT: u32 = 0xffffffffu;
 
@@ -16,58 +19,8 @@ struct SurfacePoint {
     material: u32,
 }
 
-// obvhs's CwBvhNode, 80 bytes.
-struct SgNode {
-    origin: vec3f,          // min corner of the node's child grid
-    exponents_imask: u32,   // bytes: exponent x, y, z of the grid scale (2^(e-127)), imask
-    child_base: u32,        // first child node (children are contiguous)
-    primitive_base: u32,    // first leaf primitive slot
-    child_meta: vec2u,      // one byte per child slot: leaf = count (unary, bits 5-7) | offset; inner = 24 + slot
-    bounds_x: vec4u,        // .xy: quantized child minima (one byte per child), .zw: maxima
-    bounds_y: vec4u,
-    bounds_z: vec4u,
-}
-
-// A BLAS triangle in leaf order, object space.
-struct SgTriangle { v0: vec3f, primitive: u32, v1: vec3f, sg_pad1: u32, v2: vec3f, sg_pad2: u32 }
-
-struct SgMesh {
-    node_offset: u32,       // root of this mesh's BLAS in sg_blas_nodes
-    node_count: u32,
-    triangle_offset: u32,   // first slot in sg_blas_triangles
-    triangle_count: u32,
-    vertex_offset: u32,     // first vertex in sg_vertices
-    index_offset: u32,      // first triangle in sg_indices (3 indices each)
-    flags: u32,             // bit 0: has shading normals, bit 1: has uvs
-    sg_pad: u32,
-}
-
-struct SgVertex { position: vec3f, u: f32, normal: vec3f, v: f32 }
-
-struct SgInstance {
-    object_to_world: mat4x4f,
-    world_to_object: mat4x4f,
-    previous_object_to_world: mat4x4f,
-    mesh: u32,
-    material: u32,
-    sg_pad: vec2u,
-}
-
-struct SgInstanceTable {
-    count: u32,
-    tlas_node_count: u32,
-    sg_pad: vec2u,
-    records: array<SgInstance>,
-}
-
-@group(1) @binding(0) var<storage, read> sg_blas_nodes: array<SgNode>;
-@group(1) @binding(1) var<storage, read> sg_blas_triangles: array<SgTriangle>;
-@group(1) @binding(2) var<storage, read> sg_meshes: array<SgMesh>;
-@group(1) @binding(3) var<storage, read> sg_vertices: array<SgVertex>;
-@group(1) @binding(4) var<storage, read> sg_indices: array<u32>;
-@group(1) @binding(5) var<storage, read> sg_tlas_nodes: array<SgNode>;
-@group(1) @binding(6) var<storage, read> sg_tlas_instances: array<u32>;
-@group(1) @binding(7) var<storage, read> sg_instances: SgInstanceTable;
+// The node, triangle, mesh, vertex and instance structs and the @group(1) bindings are declared
+// once with their Rust twins (src/bvh/scene_geometry.rs).
 
 // Node groups on the traversal stack (TRAVERSAL_STACK_SIZE on the Rust side). The scene is
 // refused on the CPU if TLAS depth + BLAS depth + 1 could exceed it; were it ever exceeded, the
@@ -206,7 +159,7 @@ fn sg_intersect_node(node: SgNode, ray: SgRay, t_max: f32) -> u32 {
 // falls back to that size the BLAS is done and the world ray is restored.
 fn sg_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit: bool) -> Hit {
     var hit = Hit(t_max, NO_HIT, NO_HIT, vec2f(0.0));
-    if sg_instances.tlas_node_count == 0u || !(t_max > 0.0) {
+    if sg_instances.header.tlas_node_count == 0u || !(t_max > 0.0) {
         return hit;
     }
     let world_ray = sg_make_ray(world_origin, world_direction);
@@ -306,7 +259,7 @@ fn trace_any(origin: vec3f, direction: vec3f, t_max: f32) -> bool {
 }
 
 fn instance_count() -> u32 {
-    return sg_instances.count;
+    return sg_instances.header.count;
 }
 
 // Vertex indices (into sg_vertices) of a mesh triangle.

@@ -37,16 +37,16 @@ impl PassLibrary {
         MODULES.get_or_init(|| {
             let types = Module::generated("package::scene_types", &[CameraFrame::WGSL, Frame::WGSL, GpuMaterial::WGSL, GpuLight::WGSL]);
             let bindings = compute::group_module("package::scene_bindings", 0, &crate::scene_bindings::GROUP, &[&types]);
-            vec![
-                types,
-                bindings,
-                SceneGeometry::module(),
+            let mut modules = vec![types, bindings];
+            modules.extend(SceneGeometry::modules());
+            modules.extend([
                 crate::wgsl_file!("pt_sampling.wgsl"),
                 crate::wgsl_file!("pt_bsdf.wgsl"),
                 crate::wgsl_file!("pt_lights.wgsl"),
                 crate::wgsl_file!("pt_scene.wgsl"),
                 crate::wgsl_file!("pt_integrator.wgsl"),
-            ]
+            ]);
+            modules
         })
     }
 

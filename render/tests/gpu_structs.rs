@@ -1,6 +1,7 @@
 //! Every struct shared by Rust and WGSL (gpu_struct!) has each field at the same byte offset and
 //! the same size on both sides, as naga lays the WGSL declaration out.
 
+use render::bvh::{SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTriangle, SgVertex};
 use render::frame::{CameraFrame, Frame};
 use render::hash_cache::{HashCacheParams, HcRecord};
 use render::path_tracer::GBufferTexel;
@@ -30,6 +31,12 @@ fn shared_structs_have_one_layout() {
         ("GpuLight", mismatches::<GpuLight>("")),
         ("SscSlot", mismatches::<SscSlot>("")),
         ("SscPixel", mismatches::<SscPixel>("")),
+        ("SgNode", mismatches::<SgNode>("")),
+        ("SgTriangle", mismatches::<SgTriangle>("")),
+        ("SgMesh", mismatches::<SgMesh>("")),
+        ("SgVertex", mismatches::<SgVertex>("")),
+        ("SgInstance", mismatches::<SgInstance>("")),
+        ("SgInstanceHeader", mismatches::<SgInstanceHeader>("")),
     ] {
         assert!(found.is_empty(), "{name}: {found:?}");
     }

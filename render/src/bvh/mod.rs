@@ -24,7 +24,7 @@ pub use cpu_traversal::{InstanceUpdate, SceneBvh};
 pub use tlas::InstanceTransforms;
 pub use ray_batch::{RayBatch, RayBuffers, RayQuery, SurfaceRecord, TraceKind};
 pub use scene::rng::{SplitMix64, mix64};
-pub use scene_geometry::SceneGeometry;
+pub use scene_geometry::{SceneGeometry, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTriangle, SgVertex};
 pub use tlas::Tlas;
 pub use triangle::{WatertightRay, intersect_triangle};
 

@@ -112,7 +112,7 @@ impl RayBatch {
                 entry(3, wgpu::BufferBindingType::Uniform),
             ],
         });
-        let program = crate::shader::Program::new(vec![SceneGeometry::module()]).entry(crate::wgsl_file!("bvh_ray_batch.wgsl"));
+        let program = crate::shader::Program::new(SceneGeometry::modules()).entry(crate::wgsl_file!("bvh_ray_batch.wgsl"));
         let [closest, any, points] = crate::compute::pipelines(gpu, "bvh_ray_batch.wgsl", &program, &[&layout, geometry.bind_group_layout()], ["trace_closest_rays", "trace_any_rays", "surface_points"])
             .unwrap_or_else(|e| panic!("the ray batch's WGSL: {e}"));
         Self { closest, any, points, layout }

@@ -1,76 +1,126 @@
 //! The scene's geometry on the GPU: both BVH levels, triangles and instances in storage buffers
 //! of one bind group (`@group(1)` of scene_geometry.wgsl).
 
-use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
 use super::cpu_traversal::InstanceUpdate;
 use super::tlas::InstanceTransforms;
 use super::{BvhError, SceneBvh};
+use crate::compute::BufferBinding;
 use crate::gpu::Gpu;
+use crate::gpu_struct::GpuStruct;
+use crate::shader::Module;
 use crate::scene::{Instance, SceneDesc};
 
 /// Storage buffers the bind group holds (a pass adds its own to the per-stage count).
 pub const STORAGE_BUFFERS: u32 = 8;
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct GpuTriangle {
-    v0: [f32; 3],
-    primitive: u32,
-    v1: [f32; 3],
-    _pad1: u32,
-    v2: [f32; 3],
-    _pad2: u32,
+crate::gpu_struct! {
+    /// obvhs's `CwBvhNode` as the traversal reads it: the same 80 bytes (uploaded by a cast), its
+    /// byte fields read as words.
+    pub struct SgNode {
+        /// Min corner of the node's child grid (`p`).
+        pub origin: [f32; 3] => "vec3f",
+        /// Bytes: exponents x, y, z of the grid scale (2^(e-127)), then `imask`.
+        pub exponents_imask: u32 => "u32",
+        /// First child node (children are contiguous).
+        pub child_base: u32 => "u32",
+        /// First leaf primitive slot.
+        pub primitive_base: u32 => "u32",
+        /// One byte per child slot: leaf = count (unary, bits 5-7) | offset; inner = 24 + slot.
+        pub child_meta: [u32; 2] => "vec2u",
+        /// .xy: quantized child minima (one byte per child), .zw: maxima.
+        pub bounds_x: [u32; 4] => "vec4u",
+        pub bounds_y: [u32; 4] => "vec4u",
+        pub bounds_z: [u32; 4] => "vec4u",
+    }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct GpuMesh {
-    node_offset: u32,
-    node_count: u32,
-    triangle_offset: u32,
-    triangle_count: u32,
-    vertex_offset: u32,
-    index_offset: u32,
-    flags: u32,
-    _pad: u32,
+// SgNode is CwBvhNode's bytes: same size, and each word where obvhs keeps its field.
+const _: () = {
+    use obvhs::cwbvh::node::CwBvhNode as N;
+    use std::mem::offset_of;
+    assert!(size_of::<N>() == size_of::<SgNode>());
+    assert!(offset_of!(N, p) == offset_of!(SgNode, origin) && offset_of!(N, e) == offset_of!(SgNode, exponents_imask) && offset_of!(N, imask) == offset_of!(SgNode, exponents_imask) + 3);
+    assert!(offset_of!(N, child_base_idx) == offset_of!(SgNode, child_base) && offset_of!(N, primitive_base_idx) == offset_of!(SgNode, primitive_base));
+    assert!(offset_of!(N, child_meta) == offset_of!(SgNode, child_meta) && offset_of!(N, child_min_x) == offset_of!(SgNode, bounds_x));
+    assert!(offset_of!(N, child_min_y) == offset_of!(SgNode, bounds_y) && offset_of!(N, child_min_z) == offset_of!(SgNode, bounds_z));
+};
+
+crate::gpu_struct! {
+    /// A BLAS triangle in leaf order, object space.
+    pub struct SgTriangle {
+        pub v0: [f32; 3] => "vec3f",
+        pub primitive: u32 => "u32",
+        pub v1: [f32; 3] => "vec3f",
+        pub pad1: u32 => "u32",
+        pub v2: [f32; 3] => "vec3f",
+        pub pad2: u32 => "u32",
+    }
+}
+
+crate::gpu_struct! {
+    pub struct SgMesh {
+        /// Root of this mesh's BLAS in sg_blas_nodes.
+        pub node_offset: u32 => "u32",
+        pub node_count: u32 => "u32",
+        /// First slot in sg_blas_triangles.
+        pub triangle_offset: u32 => "u32",
+        pub triangle_count: u32 => "u32",
+        /// First vertex in sg_vertices.
+        pub vertex_offset: u32 => "u32",
+        /// First triangle in sg_indices (3 indices each).
+        pub index_offset: u32 => "u32",
+        /// Bit 0: has shading normals, bit 1: has uvs.
+        pub flags: u32 => "u32",
+        pub pad: u32 => "u32",
+    }
 }
 
 const HAS_NORMALS: u32 = 1;
 const HAS_UVS: u32 = 2;
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct GpuVertex {
-    position: [f32; 3],
-    u: f32,
-    normal: [f32; 3],
-    v: f32,
+crate::gpu_struct! {
+    pub struct SgVertex {
+        pub position: [f32; 3] => "vec3f",
+        pub u: f32 => "f32",
+        pub normal: [f32; 3] => "vec3f",
+        pub v: f32 => "f32",
+    }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct GpuInstance {
-    object_to_world: [f32; 16],
-    world_to_object: [f32; 16],
-    previous_object_to_world: [f32; 16],
-    mesh: u32,
-    material: u32,
-    _pad: [u32; 2],
+crate::gpu_struct! {
+    pub struct SgInstance {
+        pub object_to_world: [f32; 16] => "mat4x4f",
+        pub world_to_object: [f32; 16] => "mat4x4f",
+        pub previous_object_to_world: [f32; 16] => "mat4x4f",
+        pub mesh: u32 => "u32",
+        pub material: u32 => "u32",
+        pub pad: [u32; 2] => "vec2u",
+    }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct InstanceTableHeader {
-    count: u32,
-    tlas_node_count: u32,
-    _pad: [u32; 2],
+crate::gpu_struct! {
+    /// The head of the instance table (its records follow at byte 16).
+    pub struct SgInstanceHeader {
+        pub count: u32 => "u32",
+        pub tlas_node_count: u32 => "u32",
+        pub pad: [u32; 2] => "vec2u",
+    }
 }
 
-const _: () = assert!(size_of::<obvhs::cwbvh::node::CwBvhNode>() == 80);
-const _: () = assert!(size_of::<GpuTriangle>() == 48);
-const _: () = assert!(size_of::<GpuInstance>() == 208);
+/// The geometry's @group(1), declared once (its WGSL and its layout).
+pub const GROUP: [BufferBinding; 8] = [
+    BufferBinding::read("sg_blas_nodes", "array<SgNode>"),
+    BufferBinding::read("sg_blas_triangles", "array<SgTriangle>"),
+    BufferBinding::read("sg_meshes", "array<SgMesh>"),
+    BufferBinding::read("sg_vertices", "array<SgVertex>"),
+    BufferBinding::read("sg_indices", "array<u32>"),
+    BufferBinding::read("sg_tlas_nodes", "array<SgNode>"),
+    BufferBinding::read("sg_tlas_instances", "array<u32>"),
+    BufferBinding::read("sg_instances", "SgInstanceTable"),
+];
+const _: () = assert!(crate::compute::storage_buffers(&GROUP) == STORAGE_BUFFERS);
 
 pub struct SceneGeometry {
     bvh: SceneBvh,
@@ -87,10 +137,17 @@ pub struct SceneGeometry {
 }
 
 impl SceneGeometry {
-    /// The WGSL interface (`trace_closest`, `trace_any`, `surface_point`, ...), importable as
-    /// `flicker::scene_geometry`; a pass that imports it binds [`Self::bind_group`] at group 1.
-    pub fn module() -> crate::shader::Module {
-        crate::wgsl_file!("scene_geometry.wgsl")
+    /// The WGSL interface: its structs (`package::scene_geometry_types`), its @group(1)
+    /// (`package::scene_geometry_bindings`) and `package::scene_geometry` (`trace_closest`,
+    /// `trace_any`, `surface_point`, ...); a pass that imports them binds [`Self::bind_group`] at
+    /// group 1.
+    pub fn modules() -> Vec<Module> {
+        let types = Module::generated(
+            "package::scene_geometry_types",
+            &[SgNode::WGSL, SgTriangle::WGSL, SgMesh::WGSL, SgVertex::WGSL, SgInstance::WGSL, SgInstanceHeader::WGSL, "struct SgInstanceTable { header: SgInstanceHeader, records: array<SgInstance> }\n"],
+        );
+        let bindings = crate::compute::group_module("package::scene_geometry_bindings", 1, &GROUP, &[&types]);
+        vec![types, bindings, crate::wgsl_file!("scene_geometry.wgsl")]
     }
 
     /// Storage buffers in the bind group: a pass adds its own to check the per-stage limit.
@@ -119,16 +176,16 @@ impl SceneGeometry {
                 n.primitive_base_idx = n.primitive_base_idx.wrapping_add(triangle_offset);
                 n
             }));
-            triangles.extend(blas.triangles.iter().zip(&blas.bvh.primitive_indices).map(|(t, &p)| GpuTriangle {
+            triangles.extend(blas.triangles.iter().zip(&blas.bvh.primitive_indices).map(|(t, &p)| SgTriangle {
                 v0: t[0].into(),
                 primitive: p,
                 v1: t[1].into(),
-                _pad1: 0,
+                pad1: 0,
                 v2: t[2].into(),
-                _pad2: 0,
+                pad2: 0,
             }));
             let flags = if mesh.normals.is_empty() { 0 } else { HAS_NORMALS } | if mesh.uvs.is_empty() { 0 } else { HAS_UVS };
-            meshes.push(GpuMesh {
+            meshes.push(SgMesh {
                 node_offset,
                 node_count: blas.bvh.nodes.len() as u32,
                 triangle_offset,
@@ -136,12 +193,12 @@ impl SceneGeometry {
                 vertex_offset: vertices.len() as u32,
                 index_offset: (indices.len() / 3) as u32,
                 flags,
-                _pad: 0,
+                pad: 0,
             });
             vertices.extend(mesh.positions.iter().enumerate().map(|(i, p)| {
                 let n = mesh.normals.get(i).copied().unwrap_or(Vec3::ZERO);
                 let uv = mesh.uvs.get(i).copied().unwrap_or_default();
-                GpuVertex { position: (*p).into(), u: uv.x, normal: n.into(), v: uv.y }
+                SgVertex { position: (*p).into(), u: uv.x, normal: n.into(), v: uv.y }
             }));
             indices.extend(mesh.indices.iter().flatten().copied());
         }
@@ -153,21 +210,7 @@ impl SceneGeometry {
         let indices = storage(gpu, "triangle indices", bytemuck::cast_slice(&indices), 4)?;
         let (tlas_nodes, tlas_instances, instances) = Self::instance_buffers(gpu, &bvh)?;
 
-        let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("scene geometry"),
-            entries: &(0..STORAGE_BUFFERS)
-                .map(|binding| wgpu::BindGroupLayoutEntry {
-                    binding,
-                    visibility: wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                })
-                .collect::<Vec<_>>(),
-        });
+        let layout = crate::compute::binding_layout(gpu, "scene geometry", &GROUP);
         let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene geometry"),
             layout: &layout,
@@ -276,17 +319,17 @@ fn tlas_nodes(bvh: &SceneBvh) -> Vec<u8> {
 }
 
 fn instance_table(bvh: &SceneBvh) -> Vec<u8> {
-    let header = InstanceTableHeader { count: bvh.instances.len() as u32, tlas_node_count: bvh.tlas.bvh.nodes.len() as u32, _pad: [0; 2] };
+    let header = SgInstanceHeader { count: bvh.instances.len() as u32, tlas_node_count: bvh.tlas.bvh.nodes.len() as u32, pad: [0; 2] };
     let mut bytes = bytemuck::bytes_of(&header).to_vec();
     let m = |m: &Mat4| m.to_cols_array();
     for i in &bvh.instances {
-        let record = GpuInstance {
+        let record = SgInstance {
             object_to_world: m(&i.object_to_world),
             world_to_object: m(&i.world_to_object),
             previous_object_to_world: m(&i.previous_object_to_world),
             mesh: i.mesh,
             material: i.material,
-            _pad: [0; 2],
+            pad: [0; 2],
         };
         bytes.extend_from_slice(bytemuck::bytes_of(&record));
     }
