@@ -5,6 +5,11 @@
 // then moves the EMA towards the new weights (its own dispatch, the frame's `nirc::ema`
 // system); a bad step leaves no trace.
 
+import package::nirc::types::{Call, CountersAtomic, Hyper};
+import package::nirc::config::{MLP_PARAMS, TOTAL_PARAMS};
+import package::nirc::bindings_common::{is_finite};
+import package::nirc::fixed_sum_read::{fixed_to_f32};
+
 @group(0) @binding(0) var<uniform> call: Call;
 @group(0) @binding(1) var<uniform> hyper: Hyper;
 @group(0) @binding(2) var<storage, read_write> params: array<f32>;

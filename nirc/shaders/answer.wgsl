@@ -1,8 +1,11 @@
 // The cache's answer to one query (CPU mirror: CpuCache::infer): σ from the query's
 // reliability cell (mode 5: the call's fixed σ), then max(0, (1 - σ) f_EMA + σ f_cur) with σ
 // in .w. Mode 4 (diagnostics)
-// answers (r̄_cur, r̄_EMA, σ of the blend, 1 once warmed up). Needs the pass's `hyper`,
-// `moments`, `counters` and `answers`.
+// answers (r̄_cur, r̄_EMA, σ of the blend, 1 once warmed up). Reads the pass's `hyper`,
+// `moments`, `counters` and `answers` (package::nirc::bindings).
+
+import package::nirc::bindings::{answers, call, counters, hyper, moments};
+import package::nirc::reliability::{MOMENTS_CUR, MOMENTS_EMA, MOMENTS_PER_CELL, cell_index, high_lr_weight, mean_correlation};
 
 fn moment3(base: u32) -> vec3<f32> {
     return vec3<f32>(moments[base], moments[base + 1u], moments[base + 2u]);

@@ -1,7 +1,10 @@
-// Helpers shared by every NIRC pass. The Rust side prepends the sizes as constants (IN_DIMS,
-// WIDTH, HIDDEN, LEVELS, FEATURES, MLP_PARAMS, ...), the level tables and the structs declared
-// once for Rust and WGSL (Hyper, Call, TrainingRecord, CacheQuery, ReliabilitySample,
-// Counters, CountersAtomic: gpu/mod.rs, records.rs, cpu/optimizer.rs).
+// Helpers shared by every NIRC pass. The sizes (IN_DIMS, WIDTH, HIDDEN, LEVELS, FEATURES,
+// MLP_PARAMS, ...) and level tables are generated as package::nirc::config, the structs declared
+// once for Rust and WGSL (Hyper, Call, TrainingRecord, CacheQuery, ReliabilitySample, Counters,
+// CountersAtomic: gpu/mod.rs, records.rs, cpu/optimizer.rs) as package::nirc::types
+// (src/gpu/shaders.rs).
+
+import package::nirc::types::{Hyper};
 
 // A value whose exponent bits are all ones is an Inf or a NaN. Checked on the bits because
 // shader compilers may assume floats are finite.

@@ -2,6 +2,10 @@
 // with trilinear interpolation, then the direction (identity or real spherical harmonics).
 // Needs from the pass: `hyper` and `fn table(net, i) -> f32`.
 
+import package::nirc::config::{DIR_KIND, FEATURES, level_dense, level_offset, level_resolution, level_table_size};
+import package::nirc::bindings_common::{spatial_hash};
+import package::nirc::weights::{table, weight};
+
 struct Corners {
     index: array<u32, 8>,
     weight: array<f32, 8>,

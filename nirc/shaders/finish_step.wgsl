@@ -1,6 +1,8 @@
 // Last pass of a training step or grid update (one thread): commits the counters, or counts a
 // rolled-back step, and lowers the flag. call.mode: 0 = training step, 1 = grid update only.
 
+import package::nirc::types::{Call, Counters, Hyper};
+
 @group(0) @binding(0) var<uniform> call: Call;
 @group(0) @binding(1) var<uniform> hyper: Hyper;
 @group(0) @binding(2) var<storage, read_write> counters: Counters;

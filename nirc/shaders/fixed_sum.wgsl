@@ -1,7 +1,11 @@
 // Order-independent sums of f32 (CPU mirror: src/fixed_sum.rs). A value is converted exactly to
 // a 96-bit two's-complement integer with 48 fractional bits and added word by word with
 // atomicAdd, carrying by hand: integer addition is associative, so the total does not depend on
-// the order the threads run in. The pass declares `accum: array<atomic<u32>>` (lo, mid, hi).
+// the order the threads run in. The pass's bindings (package::nirc::bindings) declare
+// `accum: array<atomic<u32>>` (lo, mid, hi).
+
+import package::nirc::bindings::{accum};
+import package::nirc::bindings_common::{is_finite};
 
 // |x| >= 2^32 is refused; 2^15 such values cannot overflow the 96 bits.
 const FIXED_MAX_EXPONENT: u32 = 158u;

@@ -1,6 +1,10 @@
 // Inference, one invocation per query (the fallback for networks the tiled pass does not
 // take, see infer_tile.wgsl): evaluates the predictors the mode needs, then answer.wgsl.
 
+import package::nirc::bindings::{call, queries};
+import package::nirc::answer::{write_answer};
+import package::nirc::mlp::{encode_input, mlp_forward};
+
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let qi = gid.x;

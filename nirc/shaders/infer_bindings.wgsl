@@ -1,6 +1,8 @@
 // Bindings of an inference pass (infer_tile.wgsl, and infer.wgsl for networks the tiled pass
 // does not take).
 
+import package::nirc::types::{CacheQuery, Call, Counters, Hyper};
+
 @group(0) @binding(0) var<uniform> call: Call;
 @group(0) @binding(1) var<uniform> hyper: Hyper;
 @group(0) @binding(2) var<storage, read> queries: array<CacheQuery>;

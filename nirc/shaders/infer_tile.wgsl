@@ -2,9 +2,15 @@
 // query are found once and both predictors' tables are read from them; the first predictor the
 // mode needs runs from tile_a while the other's inputs wait in `stash`. Then answer.wgsl.
 
-var<workgroup> stash: array<vec4<f32>, STASH_VEC4>;
+import package::nirc::config::{DIR_DIMS, FEATURES, LEVELS, WG_SIZE};
+import package::nirc::bindings::{call, hyper, queries};
+import package::nirc::tile::{RQ, STASH_VEC4, TILE, tile_a};
+import package::nirc::bindings_common::{normalize_to_bounds};
+import package::nirc::encoding::{corner_sum, direction_feature, level_corners};
+import package::nirc::answer::{write_answer};
+import package::nirc::mlp_tile::{mlp_forward_tile};
 
-fn keep_activation(layer: u32, rq: u32, o0: u32, block: Block) {}
+var<workgroup> stash: array<vec4<f32>, STASH_VEC4>;
 
 // Input row `row` of query t: into tile_a for the first predictor, into the stash for the second.
 fn put_input(row: u32, t: u32, first: f32, second: f32, both: bool) {

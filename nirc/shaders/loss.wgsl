@@ -1,6 +1,9 @@
 // Relative L2 loss (CPU mirror: src/cpu/loss.rs): mean over RGB of (f - y)^2 / (sg(f)^2 + ε),
 // the denominators under stop-gradient, per channel or by luminance. Returns dL/df in .xyz and
 // the loss in .w.
+
+import package::nirc::bindings::{hyper};
+
 fn relative_l2(f: vec3<f32>, y: vec3<f32>) -> vec4<f32> {
     var den: vec3<f32>;
     if hyper.loss_luminance == 1u {

@@ -2,6 +2,13 @@
 // layers, linear RGB output. Activations stay in private arrays, weights come from storage
 // (weights.wgsl). The fallback for networks the tiled passes (mlp_tile.wgsl) do not take.
 
+import package::nirc::config::{ACT_FLOATS, DELTA_FLOATS, DIR_DIMS, FEATURES, HIDDEN, IN_DIMS, LEVELS};
+import package::nirc::bindings::{hyper};
+import package::nirc::bindings_common::{normalize_to_bounds};
+import package::nirc::weights::{weight};
+import package::nirc::mlp_layout::{act_base, delta_base, mat_cols, mat_offset, mat_rows};
+import package::nirc::encoding::{corner_sum, direction_feature, level_corners};
+
 var<private> acts: array<f32, ACT_FLOATS>;
 var<private> deltas: array<f32, DELTA_FLOATS>;
 var<private> d_input: array<f32, IN_DIMS>;

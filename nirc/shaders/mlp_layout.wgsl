@@ -1,6 +1,8 @@
 // Shapes and offsets of the MLP matrices and of the per-record training scratch
 // (CPU mirror: src/layout.rs).
 
+import package::nirc::config::{HIDDEN, IN_DIMS, WIDTH};
+
 fn mat_rows(k: u32) -> u32 {
     return select(WIDTH, 3u, k == HIDDEN);
 }

@@ -5,13 +5,15 @@
 // (rq = lid % RQ, oq = lid / RQ) computes 4 records x OPT outputs, so each vec4 read from
 // tile_a feeds 4 * OPT multiply-adds and no per-invocation array is indexed at run time
 // (lavapipe turns that into scattered memory traffic). Every sum runs over k in order, as the
-// CPU reference does. Needs from the pass: TILE, RQ, OPT, TILE_A_VEC4, TILE_W_VEC4 (prelude),
-// weights.wgsl and `fn keep_activation(layer, rq, o0, block)`.
+// CPU reference does. The tiles, `Block` and `tile_matmul` are generated per network
+// (package::nirc::tile, src/gpu/shaders.rs); `keep_activation` is the pass's hook
+// (train_keep.wgsl or keep_none.wgsl as package::nirc::keep).
 
-var<workgroup> tile_a: array<vec4<f32>, TILE_A_VEC4>;
-var<workgroup> tile_w: array<vec4<f32>, TILE_W_VEC4>;
-
-alias Block = array<vec4<f32>, OPT>;
+import package::nirc::config::{HIDDEN, WG_SIZE};
+import package::nirc::tile::{Block, OPT, RQ, tile_a, tile_matmul, tile_w};
+import package::nirc::weights::{weight};
+import package::nirc::mlp_layout::{mat_cols, mat_offset, mat_rows};
+import package::nirc::keep::{keep_activation};
 
 // vec4s per row of tile_w when n outputs are split into blocks of OPT (zero padded, so an
 // invocation whose block starts inside the row never reads past it).

@@ -1,6 +1,10 @@
 // Reliability grid lookups (CPU mirror: src/reliability.rs): the hashed voxel cell of a
 // position, eq. 3 averaged over RGB, and the blend weight of the High-LR predictor.
 
+import package::nirc::config::{CELL_COUNT};
+import package::nirc::bindings::{hyper};
+import package::nirc::bindings_common::{normalize_to_bounds, spatial_hash};
+
 // Per cell: [M^y, Q^y, M^f_cur, Q^f_cur, C_cur, M^f_ema, Q^f_ema, C_ema] x RGB.
 const MOMENTS_PER_CELL: u32 = 24u;
 // Per cell accumulator: 24 fixed-point sums of 3 words (per batch) or 24 staged moments (per

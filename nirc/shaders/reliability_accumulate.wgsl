@@ -4,12 +4,10 @@
 // order (reliability_walk.wgsl). Per batch, the sample's 24 quantities (y, y^2, f, f^2, y f per
 // predictor, per channel) are added to the cell's exact fixed-point sums. Deterministic.
 
-@group(0) @binding(0) var<uniform> call: Call;
-@group(0) @binding(1) var<uniform> hyper: Hyper;
-@group(0) @binding(2) var<storage, read> samples: array<ReliabilitySample>;
-@group(0) @binding(3) var<storage, read_write> accum: array<atomic<u32>>;
-@group(0) @binding(4) var<storage, read_write> counters: CountersAtomic;
-@group(0) @binding(5) var<storage, read_write> sample_cells: array<u32>;
+import package::nirc::bindings::{accum, call, counters, hyper, sample_cells, samples};
+import package::nirc::bindings_common::{is_finite};
+import package::nirc::fixed_sum::{fixed_add_clamped};
+import package::nirc::reliability::{ACCUM_COUNT, ACCUM_OWNER, ACCUM_PER_CELL, MOMENTS_CUR, MOMENTS_EMA, cell_index};
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {

@@ -2,10 +2,10 @@
 // sample, the moments staged by reliability_walk.wgsl; per batch, one move towards the batch
 // mean, X <- λ X + (1 - λ) mean. Skipped when the step is being rolled back.
 
-@group(0) @binding(1) var<uniform> hyper: Hyper;
-@group(0) @binding(2) var<storage, read> accum: array<u32>;
-@group(0) @binding(3) var<storage, read_write> moments: array<f32>;
-@group(0) @binding(4) var<storage, read_write> counters: CountersAtomic;
+import package::nirc::config::{CELL_COUNT};
+import package::nirc::bindings::{accum, counters, hyper, moments};
+import package::nirc::fixed_sum_read::{fixed_to_f32};
+import package::nirc::reliability::{ACCUM_COUNT, ACCUM_PER_CELL, MOMENTS_PER_CELL};
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {

@@ -4,12 +4,8 @@
 // words for reliability_update.wgsl (which keeps them unless the step is rolled back). One
 // invocation does a cell's whole sequence: deterministic, and the CPU's exact operations.
 
-@group(0) @binding(0) var<uniform> call: Call;
-@group(0) @binding(1) var<uniform> hyper: Hyper;
-@group(0) @binding(2) var<storage, read> samples: array<ReliabilitySample>;
-@group(0) @binding(3) var<storage, read_write> accum: array<u32>;
-@group(0) @binding(4) var<storage, read> moments: array<f32>;
-@group(0) @binding(5) var<storage, read> sample_cells: array<u32>;
+import package::nirc::bindings::{accum, call, hyper, moments, sample_cells, samples};
+import package::nirc::reliability::{ACCUM_COUNT, ACCUM_OWNER, ACCUM_PER_CELL, MOMENTS_CUR, MOMENTS_EMA, MOMENTS_PER_CELL};
 
 fn moment_at(base: u32) -> vec3<f32> {
     return vec3<f32>(moments[base], moments[base + 1u], moments[base + 2u]);

@@ -1,6 +1,8 @@
 // Bindings of a training pass (train_tile.wgsl, and train_forward_backward.wgsl for networks
 // the tiled pass does not take).
 
+import package::nirc::types::{Call, CountersAtomic, Hyper, ReliabilitySample, TrainingRecord};
+
 @group(0) @binding(0) var<uniform> call: Call;
 @group(0) @binding(1) var<uniform> hyper: Hyper;
 @group(0) @binding(2) var<storage, read> records: array<TrainingRecord>;

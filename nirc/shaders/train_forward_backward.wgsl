@@ -3,6 +3,15 @@
 // for the weight-gradient pass, scatters the hash-grid gradients into exact fixed-point sums
 // (order-independent), and the (y, f_cur, f_ema) sample for the reliability grid.
 
+import package::nirc::types::{ReliabilitySample};
+import package::nirc::config::{ACT_FLOATS, DELTA_FLOATS, FEATURES, LEVELS, MLP_PARAMS, SCRATCH_STRIDE};
+import package::nirc::bindings::{call, counters, hyper, losses, records, samples, scratch};
+import package::nirc::bindings_common::{is_finite, normalize_to_bounds};
+import package::nirc::fixed_sum::{fixed_add};
+import package::nirc::loss::{relative_l2};
+import package::nirc::encoding::{level_corners};
+import package::nirc::mlp::{acts, d_input, deltas, encode_input, mlp_backward, mlp_forward};
+
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let r = gid.x;

@@ -6,37 +6,19 @@
 // in order; `reduce` (weight_gradient.wgsl) then sums the tiles in order. Activations and
 // pre-activation gradients go through `scratch` (record-major, as the per-record pass).
 
+import package::nirc::types::{ReliabilitySample};
+import package::nirc::config::{ACT_FLOATS, DIR_DIMS, FEATURES, HIDDEN, IN_DIMS, LEVELS, MLP_PARAMS, SCRATCH_STRIDE, WG_SIZE, WIDTH};
+import package::nirc::bindings::{call, counters, hyper, losses, records, samples, scratch};
+import package::nirc::tile::{Block, OPT, RQ, TILE, tile_a, tile_matmul, tile_w};
+import package::nirc::bindings_common::{is_finite, normalize_to_bounds};
+import package::nirc::mlp_layout::{act_base, delta_base, mat_cols, mat_offset, mat_rows};
+import package::nirc::fixed_sum::{fixed_add};
+import package::nirc::loss::{relative_l2};
+import package::nirc::encoding::{corner_sum, direction_feature, level_corners};
+import package::nirc::keep::{keep_block, record_slot, record_valid, tile_first};
+import package::nirc::mlp_tile::{block_stride, load_matrix, mlp_forward_tile, store_block};
+
 @group(0) @binding(10) var<storage, read_write> partials: array<f32>;
-
-var<private> tile_first: u32;
-
-// Scratch offset of value `v` of record 4 rq + c of this tile; records past the batch have none.
-fn record_slot(rq: u32, c: u32) -> u32 {
-    return (tile_first + 4u * rq + c) * SCRATCH_STRIDE;
-}
-fn record_valid(rq: u32, c: u32) -> bool {
-    return tile_first + 4u * rq + c < call.n;
-}
-
-// Saves this invocation's block (records 4 rq .., values o0 .. below `count`) at `offset` in each
-// valid record's scratch slot.
-fn keep_block(offset: u32, rq: u32, o0: u32, block: Block, count: u32) {
-    for (var c = 0u; c < 4u; c++) {
-        if record_valid(rq, c) {
-            let b = record_slot(rq, c) + offset + o0;
-            for (var j = 0u; j < OPT; j++) {
-                if o0 + j < count {
-                    scratch[b + j] = block[j][c];
-                }
-            }
-        }
-    }
-}
-
-// Saves the High-LR predictor's hidden activations (inputs of matrix `layer`).
-fn keep_activation(layer: u32, rq: u32, o0: u32, block: Block) {
-    keep_block(act_base(layer), rq, o0, block, WIDTH);
-}
 
 // Gradient of the pre-activation of matrix m - 1 from that of matrix m's input: ReLU passes it
 // where the activation (saved by this invocation in the forward pass) was positive.

@@ -3,6 +3,10 @@
 // weight and chunk), `reduce` sums the chunks in chunk order and divides by the batch size.
 // Deterministic, and the CPU reference sums in the same order.
 
+import package::nirc::types::{Call};
+import package::nirc::config::{ACT_FLOATS, CHUNK, HIDDEN, MLP_PARAMS, SCRATCH_STRIDE};
+import package::nirc::mlp_layout::{act_base, delta_base, mat_cols, mat_offset};
+
 @group(0) @binding(0) var<uniform> call: Call;
 @group(0) @binding(1) var<storage, read> scratch: array<f32>;
 @group(0) @binding(2) var<storage, read_write> partials: array<f32>;

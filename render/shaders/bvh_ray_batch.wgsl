@@ -1,4 +1,4 @@
-// Traces a buffer of rays through the scene geometry (scene_geometry.wgsl is prepended):
+// Traces a buffer of rays through the scene geometry (imported from scene_geometry.wgsl):
 // closest hits, any-hit flags and hit attributes, for tests and the traversal benchmark.
 
 import package::scene_geometry::{Hit, NO_HIT, previous_world_position, surface_point, trace_any, trace_closest, triangle_world_vertices};

@@ -1,5 +1,5 @@
 // Path integrator shared by every pass that shades: next-event estimation with MIS, emission,
-// and the path loop. Concatenated after pt_scene.wgsl.
+// and the path loop.
 
 import package::scene_types::{GpuMaterial};
 import package::scene_bindings::{frame, lights, materials};

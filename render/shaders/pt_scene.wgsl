@@ -2,7 +2,7 @@
 // the helpers every pass that shades surfaces needs. @group(0), read only (layout in
 // scene_bindings.rs); every pass binds it and puts its own buffers in @group(2). The structs
 // Frame, CameraFrame and GpuMaterial are declared once in Rust (render/src/frame.rs,
-// materials.rs: gpu_struct!) and prepended by PassLibrary::source.
+// materials.rs: gpu_struct!) as package::scene_types (PassLibrary::modules).
 
 import package::scene_types::{CameraFrame, GpuMaterial};
 import package::scene_bindings::{frame, lights, texels};

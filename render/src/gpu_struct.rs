@@ -1,7 +1,7 @@
 //! GPU structs defined once for Rust and WGSL. [`gpu_struct!`](crate::gpu_struct) declares a
 //! `#[repr(C)]` Pod struct with named fields and, from the same field list, its WGSL
-//! declaration ([`GpuStruct::WGSL`]); shaders get the declaration prepended instead of
-//! declaring the struct themselves. `render/tests/gpu_structs.rs` checks with naga that every
+//! declaration ([`GpuStruct::WGSL`]); shaders import it from a generated module
+//! (`shader::Module::generated`) instead of declaring the struct themselves. `render/tests/gpu_structs.rs` checks with naga that every
 //! field sits at the same byte offset on both sides (WGSL's alignment rules differ from Rust's,
 //! e.g. for `vec3f`), so a layout mismatch fails a test instead of corrupting a pass.
 

@@ -40,6 +40,13 @@ impl Module {
         Self { path: Cow::Owned(path.to_string()), file: Cow::Borrowed("generated"), source: Cow::Owned(parts.join("\n")) }
     }
 
+    /// This module under another path: a file that plays a role each program fills with its own
+    /// (e.g. the pass's bindings).
+    pub fn at(mut self, path: &str) -> Self {
+        self.path = Cow::Owned(path.to_string());
+        self
+    }
+
     /// Whether it declares `struct NAME`.
     pub fn declares_struct(&self, name: &str) -> bool {
         self.source.lines().any(|l| l.trim_start().strip_prefix("struct ").and_then(|r| r.strip_prefix(name)).is_some_and(|r| r.starts_with([' ', '{'])))

@@ -4,32 +4,9 @@
 use crate::config::NircConfig;
 use crate::layout::ParameterLayout;
 use crate::reliability::cell_count;
+use render::shader::{Module, Program};
 
 pub const WORKGROUP_SIZE: u32 = 64;
-
-const COMMON: &str = include_str!("../../shaders/bindings_common.wgsl");
-const FIXED_SUM: &str = include_str!("../../shaders/fixed_sum.wgsl");
-const FIXED_SUM_READ: &str = include_str!("../../shaders/fixed_sum_read.wgsl");
-const ENCODING: &str = include_str!("../../shaders/encoding.wgsl");
-const MLP_LAYOUT: &str = include_str!("../../shaders/mlp_layout.wgsl");
-const MLP: &str = include_str!("../../shaders/mlp.wgsl");
-const MLP_TILE: &str = include_str!("../../shaders/mlp_tile.wgsl");
-const ANSWER: &str = include_str!("../../shaders/answer.wgsl");
-const WEIGHTS: &str = include_str!("../../shaders/weights.wgsl");
-const LOSS: &str = include_str!("../../shaders/loss.wgsl");
-const TRAIN_BINDINGS: &str = include_str!("../../shaders/train_bindings.wgsl");
-const INFER_BINDINGS: &str = include_str!("../../shaders/infer_bindings.wgsl");
-const RELIABILITY: &str = include_str!("../../shaders/reliability.wgsl");
-pub const TRAIN_FORWARD_BACKWARD: &str = include_str!("../../shaders/train_forward_backward.wgsl");
-pub const WEIGHT_GRADIENT: &str = include_str!("../../shaders/weight_gradient.wgsl");
-pub const ADAM_EMA: &str = include_str!("../../shaders/adam_ema.wgsl");
-pub const RELIABILITY_ACCUMULATE: &str = include_str!("../../shaders/reliability_accumulate.wgsl");
-pub const RELIABILITY_UPDATE: &str = include_str!("../../shaders/reliability_update.wgsl");
-pub const RELIABILITY_WALK: &str = include_str!("../../shaders/reliability_walk.wgsl");
-pub const FINISH_STEP: &str = include_str!("../../shaders/finish_step.wgsl");
-pub const INFER: &str = include_str!("../../shaders/infer.wgsl");
-pub const TRAIN_TILE: &str = include_str!("../../shaders/train_tile.wgsl");
-pub const INFER_TILE: &str = include_str!("../../shaders/infer_tile.wgsl");
 
 /// Records per partial sum of the weight gradient (`cpu::cache::GRADIENT_CHUNK`): one training
 /// tile.
@@ -97,9 +74,10 @@ pub fn structs() -> String {
     [super::Hyper::WGSL.to_string(), super::Call::WGSL.to_string(), crate::records::wgsl(), crate::cpu::optimizer::Counters::WGSL.to_string(), crate::cpu::optimizer::counters_atomic_wgsl()].concat()
 }
 
-fn prelude(config: &NircConfig, layout: &ParameterLayout) -> String {
+/// The network's sizes, level tables and grid constants (`package::nirc::config`).
+fn config_constants(config: &NircConfig, layout: &ParameterLayout) -> String {
     let (dir_kind, dir_bands) = config.direction.code();
-    let mut s = structs();
+    let mut s = String::new();
     let mut c = |name: &str, v: u32| s.push_str(&format!("const {name}: u32 = {v}u;\n"));
     c("IN_DIMS", layout.input_dims);
     c("WIDTH", layout.width);
@@ -140,6 +118,8 @@ fn tile_constants(layout: &ParameterLayout, shape: &TileShape, training: bool) -
     ] {
         s.push_str(&format!("const {name}: u32 = {v}u;\n"));
     }
+    // The tiles of mlp_tile.wgsl, sized for this network.
+    s.push_str("var<workgroup> tile_a: array<vec4<f32>, TILE_A_VEC4>;\nvar<workgroup> tile_w: array<vec4<f32>, TILE_W_VEC4>;\nalias Block = array<vec4<f32>, OPT>;\n");
     s.push_str(&tile_matmul(shape.opt));
     s
 }
@@ -171,41 +151,68 @@ pub fn workgroup_bytes(layout: &ParameterLayout) -> u32 {
     train_bytes.max(infer_bytes)
 }
 
-/// The full source of one pass.
-pub fn source(config: &NircConfig, layout: &ParameterLayout, pass: &str) -> String {
-    let mut s = prelude(config, layout);
-    let parts: Vec<&str> = match pass {
-        "train_tile" => {
-            s.push_str(&tile_constants(layout, &tile_shape(layout, TRAIN_TILE_RECORDS), true));
-            vec![COMMON, TRAIN_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP_TILE, ENCODING, FIXED_SUM, LOSS, TRAIN_TILE]
-        }
-        "infer_tile" => {
-            s.push_str(&tile_constants(layout, &tile_shape(layout, INFER_TILE_QUERIES), false));
-            vec![COMMON, INFER_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP_TILE, ENCODING, RELIABILITY, ANSWER, INFER_TILE]
-        }
-        "train_forward_backward" => vec![COMMON, TRAIN_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP, ENCODING, FIXED_SUM, LOSS, TRAIN_FORWARD_BACKWARD],
-        "weight_gradient" => vec![COMMON, MLP_LAYOUT, WEIGHT_GRADIENT],
-        "adam_ema" => vec![COMMON, FIXED_SUM_READ, ADAM_EMA],
-        "reliability_accumulate" => vec![COMMON, RELIABILITY, FIXED_SUM, RELIABILITY_ACCUMULATE],
-        "reliability_update" => vec![COMMON, RELIABILITY, FIXED_SUM_READ, RELIABILITY_UPDATE],
-        "reliability_walk" => vec![COMMON, RELIABILITY, RELIABILITY_WALK],
-        "finish_step" => vec![COMMON, FINISH_STEP],
-        "infer" => vec![COMMON, INFER_BINDINGS, WEIGHTS, MLP_LAYOUT, MLP, ENCODING, RELIABILITY, ANSWER, INFER],
-        other => panic!("unknown NIRC pass '{other}'"),
+/// A file of nirc/shaders/ as a module.
+macro_rules! nirc_file {
+    ($name:literal) => {
+        render::wgsl_file!($name)
     };
-    for p in parts {
-        s.push('\n');
-        s.push_str(p);
-    }
-    s
 }
 
-/// Every WGSL file of the cache's passes, concatenated (part of warm-start keys).
-pub fn all_sources() -> String {
+/// The program of one pass: generated structs (`package::nirc::types`) and constants
+/// (`package::nirc::config`, and `package::nirc::tile` for the tiled passes), the pass's bindings
+/// as `package::nirc::bindings` and, for the tiled passes, its activation hook as
+/// `package::nirc::keep` (the shared files import both by those names), the shared files, and
+/// the pass's entry-point file.
+pub fn program(config: &NircConfig, layout: &ParameterLayout, pass: &str) -> Program {
+    let mut modules = vec![Module::generated("package::nirc::types", &[&structs()]), Module::generated("package::nirc::config", &[&config_constants(config, layout)])];
+    let tile = |records: u32, training: bool| Module::generated("package::nirc::tile", &[&tile_constants(layout, &tile_shape(layout, records), training)]);
+    let bindings = |m: Module| m.at("package::nirc::bindings");
+    let keep = |m: Module| m.at("package::nirc::keep");
+    let (own, entry): (Vec<Module>, Module) = match pass {
+        "train_tile" => (vec![bindings(nirc_file!("train_bindings.wgsl")), tile(TRAIN_TILE_RECORDS, true), keep(nirc_file!("train_keep.wgsl"))], nirc_file!("train_tile.wgsl")),
+        "infer_tile" => (vec![bindings(nirc_file!("infer_bindings.wgsl")), tile(INFER_TILE_QUERIES, false), keep(nirc_file!("keep_none.wgsl"))], nirc_file!("infer_tile.wgsl")),
+        "train_forward_backward" => (vec![bindings(nirc_file!("train_bindings.wgsl"))], nirc_file!("train_forward_backward.wgsl")),
+        "infer" => (vec![bindings(nirc_file!("infer_bindings.wgsl"))], nirc_file!("infer.wgsl")),
+        "reliability_accumulate" => (vec![bindings(nirc_file!("reliability_accumulate_bindings.wgsl"))], nirc_file!("reliability_accumulate.wgsl")),
+        "reliability_update" => (vec![bindings(nirc_file!("reliability_update_bindings.wgsl"))], nirc_file!("reliability_update.wgsl")),
+        "reliability_walk" => (vec![bindings(nirc_file!("reliability_walk_bindings.wgsl"))], nirc_file!("reliability_walk.wgsl")),
+        "weight_gradient" => (vec![], nirc_file!("weight_gradient.wgsl")),
+        "adam_ema" => (vec![], nirc_file!("adam_ema.wgsl")),
+        "finish_step" => (vec![], nirc_file!("finish_step.wgsl")),
+        other => panic!("unknown NIRC pass '{other}'"),
+    };
+    modules.extend(own);
+    modules.extend(shared_files());
+    Program::new(modules).entry(entry)
+}
+
+/// The files the passes share (each pass's program lists them all; a pass links what it imports).
+fn shared_files() -> [Module; 11] {
     [
-        &structs(),
-        COMMON, TRAIN_BINDINGS, INFER_BINDINGS, WEIGHTS, LOSS, FIXED_SUM, FIXED_SUM_READ, ENCODING, MLP_LAYOUT, MLP, MLP_TILE, ANSWER, RELIABILITY, TRAIN_FORWARD_BACKWARD, TRAIN_TILE, WEIGHT_GRADIENT, ADAM_EMA, RELIABILITY_ACCUMULATE,
-        RELIABILITY_UPDATE, RELIABILITY_WALK, FINISH_STEP, INFER, INFER_TILE,
+        nirc_file!("bindings_common.wgsl"),
+        nirc_file!("weights.wgsl"),
+        nirc_file!("mlp_layout.wgsl"),
+        nirc_file!("mlp.wgsl"),
+        nirc_file!("mlp_tile.wgsl"),
+        nirc_file!("encoding.wgsl"),
+        nirc_file!("fixed_sum.wgsl"),
+        nirc_file!("fixed_sum_read.wgsl"),
+        nirc_file!("loss.wgsl"),
+        nirc_file!("reliability.wgsl"),
+        nirc_file!("answer.wgsl"),
     ]
-    .join("\n")
+}
+
+/// Every WGSL file of the cache's passes and its generated structs (part of warm-start keys).
+pub fn all_sources() -> String {
+    let passes = ["train_tile", "infer_tile", "train_forward_backward", "infer", "reliability_accumulate", "reliability_update", "reliability_walk", "weight_gradient", "adam_ema", "finish_step"];
+    let mut files: Vec<Module> = vec![Module::generated("package::nirc::types", &[&structs()])];
+    files.extend(shared_files());
+    for pass in passes {
+        // Generated constants depend on the network; its files do not.
+        let program = program(&NircConfig::default(), &ParameterLayout::new(&NircConfig::default()), pass);
+        files.extend(program.modules.into_iter().chain(program.entry_files).filter(|m| m.file != "generated"));
+    }
+    files.dedup_by(|a, b| a.file == b.file && a.path == b.path);
+    Program::new(files).fingerprint()
 }

@@ -6,7 +6,7 @@
 //! - [`SceneBvh`]: both levels on the CPU, with a reference traversal through obvhs's own
 //!   CWBVH traversal (the ground truth the WGSL traversal is tested against).
 //! - [`SceneGeometry`]: the same structures in storage buffers (one bind group, `@group(1)`) and
-//!   the WGSL interface `scene_geometry.wgsl` that passes concatenate before their own code.
+//!   the WGSL interface `scene_geometry.wgsl` that passes import (`SceneGeometry::modules`).
 //! - [`RayBatch`]: a compute pass tracing a buffer of rays (tests, benchmark).
 //! - [`traversal_benchmark`]: rays/s of the WGSL traversal against obvhs on all CPU cores.
 

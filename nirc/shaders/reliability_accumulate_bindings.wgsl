@@ -1,0 +1,11 @@
+// The bindings of reliability_accumulate.wgsl (shader-derived layout), a module so that reliability.wgsl and
+// fixed_sum.wgsl read them.
+
+import package::nirc::types::{Call, CountersAtomic, Hyper, ReliabilitySample};
+
+@group(0) @binding(0) var<uniform> call: Call;
+@group(0) @binding(1) var<uniform> hyper: Hyper;
+@group(0) @binding(2) var<storage, read> samples: array<ReliabilitySample>;
+@group(0) @binding(3) var<storage, read_write> accum: array<atomic<u32>>;
+@group(0) @binding(4) var<storage, read_write> counters: CountersAtomic;
+@group(0) @binding(5) var<storage, read_write> sample_cells: array<u32>;
