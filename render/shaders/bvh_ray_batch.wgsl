@@ -1,36 +1,8 @@
 // Traces a buffer of rays through the scene geometry (imported from scene_geometry.wgsl):
 // closest hits, any-hit flags and hit attributes, for tests and the traversal benchmark.
 
+import package::ray_batch_bindings::{rays, hits, points, params};
 import package::scene_geometry::{Hit, NO_HIT, previous_world_position, surface_point, trace_any, trace_closest, triangle_world_vertices};
-
-struct RayQuery { origin: vec3f, t_max: f32, direction: vec3f, sg_pad: u32 }
-
-struct HitRecord {
-    t: f32,
-    instance: u32,
-    primitive: u32,
-    any_hit: u32,
-    barycentrics: vec2f,
-    sg_pad: vec2f,
-}
-
-struct PointRecord {
-    position: vec4f,
-    geometric_normal: vec4f,
-    shading_normal: vec4f,
-    uv: vec2f,
-    material: u32,
-    sg_pad: u32,
-    previous_position: vec4f,
-    triangle: array<vec4f, 3>,  // triangle_world_vertices
-}
-
-struct BatchParams { count: u32, row_pitch: u32, sg_pad: vec2u }
-
-@group(0) @binding(0) var<storage, read> rays: array<RayQuery>;
-@group(0) @binding(1) var<storage, read_write> hits: array<HitRecord>;
-@group(0) @binding(2) var<storage, read_write> points: array<PointRecord>;
-@group(0) @binding(3) var<uniform> params: BatchParams;
 
 fn ray_index(id: vec3u) -> u32 {
     return id.x + id.y * params.row_pitch;

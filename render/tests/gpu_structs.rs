@@ -40,6 +40,8 @@ fn shared_structs_have_one_layout() {
     ] {
         assert!(found.is_empty(), "{name}: {found:?}");
     }
+    let ray_batch = render::bvh::ray_batch_struct_mismatches();
+    assert!(ray_batch.is_empty(), "ray batch: {ray_batch:?}");
 }
 
 render::gpu_struct! {

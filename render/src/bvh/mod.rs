@@ -22,7 +22,7 @@ pub use bench::{TraversalBench, displaced_sphere, random_rays, traversal_benchma
 pub use blas::Blas;
 pub use cpu_traversal::{InstanceUpdate, SceneBvh};
 pub use tlas::InstanceTransforms;
-pub use ray_batch::{RayBatch, RayBuffers, RayQuery, SurfaceRecord, TraceKind};
+pub use ray_batch::{RayBatch, RayBuffers, RayQuery, SurfaceRecord, TraceKind, struct_layout_mismatches as ray_batch_struct_mismatches};
 pub use scene::rng::{SplitMix64, mix64};
 pub use scene_geometry::{SceneGeometry, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTriangle, SgVertex};
 pub use tlas::Tlas;

@@ -1,11 +1,13 @@
 //! A compute pass that traces a buffer of rays through [`SceneGeometry`]: the WGSL traversal
 //! made observable, for the traversal tests and the benchmark.
 
-use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
 use super::{BvhError, Hit, SceneGeometry};
+use crate::compute::BufferBinding;
 use crate::gpu::Gpu;
+use crate::gpu_struct::GpuStruct;
+use crate::shader::Module;
 
 const WORKGROUP_SIZE: u32 = 64;
 
@@ -29,45 +31,60 @@ pub struct SurfaceRecord {
     pub triangle: [Vec3; 3],
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct GpuRay {
-    origin: [f32; 3],
-    t_max: f32,
-    direction: [f32; 3],
-    _pad: u32,
+crate::gpu_struct! {
+    struct GpuRay {
+        origin: [f32; 3] => "vec3f",
+        t_max: f32 => "f32",
+        direction: [f32; 3] => "vec3f",
+        pad: u32 => "u32",
+    }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct GpuHit {
-    t: f32,
-    instance: u32,
-    primitive: u32,
-    any_hit: u32,
-    barycentrics: [f32; 2],
-    _pad: [f32; 2],
+crate::gpu_struct! {
+    struct GpuHit {
+        t: f32 => "f32",
+        instance: u32 => "u32",
+        primitive: u32 => "u32",
+        any_hit: u32 => "u32",
+        barycentrics: [f32; 2] => "vec2f",
+        pad: [f32; 2] => "vec2f",
+    }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct GpuPoint {
-    position: [f32; 4],
-    geometric_normal: [f32; 4],
-    shading_normal: [f32; 4],
-    uv: [f32; 2],
-    material: u32,
-    _pad: u32,
-    previous_position: [f32; 4],
-    triangle: [[f32; 4]; 3],
+crate::gpu_struct! {
+    struct GpuPoint {
+        position: [f32; 4] => "vec4f",
+        geometric_normal: [f32; 4] => "vec4f",
+        shading_normal: [f32; 4] => "vec4f",
+        uv: [f32; 2] => "vec2f",
+        material: u32 => "u32",
+        pad: u32 => "u32",
+        previous_position: [f32; 4] => "vec4f",
+        /// triangle_world_vertices
+        triangle: [[f32; 4]; 3] => "array<vec4f, 3>",
+    }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Pod, Zeroable)]
-struct BatchParams {
-    count: u32,
-    row_pitch: u32,
-    _pad: [u32; 2],
+crate::gpu_struct! {
+    struct BatchParams {
+        count: u32 => "u32",
+        row_pitch: u32 => "u32",
+        pad: [u32; 2] => "vec2u",
+    }
+}
+
+/// The pass's @group(0) (its geometry is @group(1)).
+const GROUP: [BufferBinding; 4] = [
+    BufferBinding::read("rays", "array<GpuRay>"),
+    BufferBinding::read_write("hits", "array<GpuHit>"),
+    BufferBinding::read_write("points", "array<GpuPoint>"),
+    BufferBinding::uniform("params", "BatchParams"),
+];
+
+/// The structs of the pass, for the layout test.
+pub fn struct_layout_mismatches() -> Vec<String> {
+    use crate::gpu_struct::layout_mismatches;
+    [layout_mismatches::<GpuRay>(""), layout_mismatches::<GpuHit>(""), layout_mismatches::<GpuPoint>(""), layout_mismatches::<BatchParams>("")].concat()
 }
 
 /// Which kernel [`RayBatch::dispatch`] runs.
@@ -97,22 +114,10 @@ pub struct RayBuffers {
 
 impl RayBatch {
     pub fn new(gpu: &Gpu, geometry: &SceneGeometry) -> Self {
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-            count: None,
-        };
-        let layout = gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("ray batch"),
-            entries: &[
-                entry(0, wgpu::BufferBindingType::Storage { read_only: true }),
-                entry(1, wgpu::BufferBindingType::Storage { read_only: false }),
-                entry(2, wgpu::BufferBindingType::Storage { read_only: false }),
-                entry(3, wgpu::BufferBindingType::Uniform),
-            ],
-        });
-        let program = crate::shader::Program::new(SceneGeometry::modules()).entry(crate::wgsl_file!("bvh_ray_batch.wgsl"));
+        let layout = crate::compute::binding_layout(gpu, "ray batch", &GROUP);
+        let types = Module::generated("package::ray_batch_types", &[GpuRay::WGSL, GpuHit::WGSL, GpuPoint::WGSL, BatchParams::WGSL]);
+        let bindings = crate::compute::group_module("package::ray_batch_bindings", 0, &GROUP, &[&types]);
+        let program = crate::shader::Program::new(SceneGeometry::modules()).with([types, bindings]).entry(crate::wgsl_file!("bvh_ray_batch.wgsl"));
         let [closest, any, points] = crate::compute::pipelines(gpu, "bvh_ray_batch.wgsl", &program, &[&layout, geometry.bind_group_layout()], ["trace_closest_rays", "trace_any_rays", "surface_points"])
             .unwrap_or_else(|e| panic!("the ray batch's WGSL: {e}"));
         Self { closest, any, points, layout }
@@ -131,7 +136,7 @@ impl RayBatch {
         let groups = (groups_x, groups_needed.div_ceil(groups_x));
         let gpu_rays: Vec<GpuRay> = rays
             .iter()
-            .map(|r| GpuRay { origin: r.origin.into(), t_max: r.t_max, direction: r.direction.into(), _pad: 0 })
+            .map(|r| GpuRay { origin: r.origin.into(), t_max: r.t_max, direction: r.direction.into(), pad: 0 })
             .collect();
         let buffer = |label, size: u64, usage| {
             gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
@@ -142,7 +147,7 @@ impl RayBatch {
         let hits = buffer("hits", n * 32, storage);
         let points = buffer("surface points", n * size_of::<GpuPoint>() as u64, storage);
         let params = buffer("ray batch params", 16, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
-        let p = BatchParams { count, row_pitch: groups_x * WORKGROUP_SIZE, _pad: [0; 2] };
+        let p = BatchParams { count, row_pitch: groups_x * WORKGROUP_SIZE, pad: [0; 2] };
         gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&p));
         let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("ray batch"),
@@ -227,7 +232,7 @@ impl RayBatch {
 }
 
 /// Copies `size` bytes of `buffer` to a mappable buffer and reads them as `T`s.
-fn read<T: Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, size: u64, what: &str) -> Result<Vec<T>, BvhError> {
+fn read<T: bytemuck::Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, size: u64, what: &str) -> Result<Vec<T>, BvhError> {
     if size == 0 {
         return Ok(Vec::new());
     }
