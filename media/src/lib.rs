@@ -9,6 +9,7 @@
 //! MIS weights (`mis`) and the 1-D stratified sampling of Sec. 4.1 (`stratified`).
 
 pub mod dda;
+pub mod gpu;
 pub mod density;
 pub mod jackknife;
 pub mod majorant_tracking;

@@ -87,7 +87,7 @@ pub fn estimate(
 ) -> u32 {
     *out = [0.0; MAX_ESTIMATES];
     // I_k: the CDF at each estimate's next sample, divided by F_Δ; unused estimates never win.
-    let mut i_next = [f32::INFINITY; MAX_ESTIMATES];
+    let mut i_next = [f32::MAX; MAX_ESTIMATES];
     for i in i_next.iter_mut().take(count) {
         *i = rng.next_f32();
     }
@@ -157,6 +157,7 @@ fn arg_min(values: &[f32; MAX_ESTIMATES]) -> usize {
 /// times `multiplier` (the paper doubles it for biased ray marching).
 pub fn kettunen_sample_count(control_optical_depth: f32, multiplier: f32) -> u32 {
     let x = control_optical_depth;
-    let n_cmf = ((x + 0.015) * (x + 0.65) * (x + 60.3)).cbrt().ceil();
+    // powf(1/3), not cbrt: the WGSL twin has only pow, and the ceil must agree.
+    let n_cmf = ((x + 0.015) * (x + 0.65) * (x + 60.3)).powf(1.0 / 3.0).ceil();
     ((multiplier * n_cmf / (1.0 + 0.31945)).round() as u32).max(1)
 }

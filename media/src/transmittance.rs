@@ -47,3 +47,17 @@ impl Estimator {
         }
     }
 }
+
+impl Estimator {
+    /// (id, samples, multiplier) of the WGSL `estimate_transmittance` (media_estimators.wgsl).
+    pub fn gpu_settings(&self) -> (u32, u32, f32) {
+        match *self {
+            Estimator::TrackLength => (0, 0, 0.0),
+            Estimator::RatioTracking => (1, 0, 0.0),
+            Estimator::BiasedRayMarching { multiplier } => (2, 0, multiplier),
+            Estimator::UnbiasedRayMarching { multiplier } => (3, 0, multiplier),
+            Estimator::Naive { samples } => (4, samples, 0.0),
+            Estimator::Jackknife { samples } => (5, samples, 0.0),
+        }
+    }
+}
