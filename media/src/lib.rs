@@ -10,6 +10,7 @@
 
 pub mod dda;
 pub mod gpu;
+pub mod image;
 pub mod density;
 pub mod jackknife;
 pub mod majorant_tracking;

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::Moments;
+use common::{Moments, all_estimators};
 use glam::{UVec3, Vec3};
 use media::regular_tracking::optical_depth;
 use media::stratified::{iid_uniform, stratified_jittered};
@@ -38,17 +38,6 @@ fn mean_of(est: Estimator, medium: &Medium, seg: &Segment, trials: usize, seed: 
         m.add(f64::from(est.estimate(medium, seg, &mut rng).value));
     }
     m
-}
-
-fn all_estimators() -> [Estimator; 6] {
-    [
-        Estimator::TrackLength,
-        Estimator::RatioTracking,
-        Estimator::BiasedRayMarching { multiplier: 2.0 },
-        Estimator::UnbiasedRayMarching { multiplier: 1.0 },
-        Estimator::Naive { samples: 16 },
-        Estimator::Jackknife { samples: 8 },
-    ]
 }
 
 #[test]

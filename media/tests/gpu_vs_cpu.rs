@@ -3,11 +3,13 @@
 //! agree to f32 rounding. Differences in transcendental rounding may flip a rare comparison
 //! (an accept/reject or a ceil), so up to 1% of estimates may differ; none may be NaN.
 
+mod common;
+
 use std::sync::OnceLock;
 
 use glam::{UVec3, Vec3};
 use media::gpu::{EstimatorPass, GpuMedium, MediumParams, RaySegment};
-use media::{DensityGrid, DensityKind, Estimator, Medium, Pcg, Segment};
+use media::{DensityGrid, DensityKind, Medium, Pcg, Segment};
 use render::gpu::Gpu;
 use render::gpu_struct::layout_mismatches;
 
@@ -43,14 +45,7 @@ fn struct_layouts_match() {
 
 #[test]
 fn every_estimator_matches_the_cpu_reference_on_the_same_random_numbers() {
-    let estimators = [
-        Estimator::TrackLength,
-        Estimator::RatioTracking,
-        Estimator::BiasedRayMarching { multiplier: 2.0 },
-        Estimator::UnbiasedRayMarching { multiplier: 1.0 },
-        Estimator::Naive { samples: 16 },
-        Estimator::Jackknife { samples: 8 },
-    ];
+    let estimators = common::all_estimators();
     let gpu = gpu();
     for kind in [DensityKind::Cloud { octaves: 4, frequency: 3.0, seed: 7 }, DensityKind::Explosion { frequency: 12.0, seed: 3 }] {
         let m = medium(kind.clone());

@@ -3,9 +3,11 @@
 //! (`EstimatorPass`, what the GPU-vs-CPU tests run).
 
 mod estimator_pass;
+mod image_pass;
 mod medium;
 mod shaders;
 
 pub use estimator_pass::{EstimatorPass, RayResult};
+pub use image_pass::{ImagePass, ImageParams, PASS};
 pub use medium::{GpuMedium, MediumParams, RaySegment};
 pub use shaders::library;

@@ -1,7 +1,7 @@
 //! Shared by the media tests: seeded normal samples, a running mean/variance, complex numbers.
 #![allow(dead_code)]
 
-use media::Pcg;
+use media::{Estimator, Pcg};
 
 /// A standard normal sample (Box–Muller on two PCG uniforms, in f64).
 pub fn normal(rng: &mut Pcg) -> f64 {
@@ -80,4 +80,16 @@ impl C {
     pub fn sinh(self) -> C {
         self.exp().add(self.scale(-1.0).exp().scale(-1.0)).scale(0.5)
     }
+}
+
+/// Every estimator, with the settings the tests use.
+pub fn all_estimators() -> [Estimator; 6] {
+    [
+        Estimator::TrackLength,
+        Estimator::RatioTracking,
+        Estimator::BiasedRayMarching { multiplier: 2.0 },
+        Estimator::UnbiasedRayMarching { multiplier: 1.0 },
+        Estimator::Naive { samples: 16 },
+        Estimator::Jackknife { samples: 8 },
+    ]
 }
