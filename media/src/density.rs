@@ -7,20 +7,8 @@
 
 use glam::{UVec3, Vec3};
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
-use serde::{Deserialize, Serialize};
 
-/// The procedural field a medium is baked from (its `kind` in a scenario).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum DensityKind {
-    /// μ = `sigma_t` everywhere in the box.
-    Homogeneous,
-    /// A round cloud: fBm (Perlin, `octaves`, base frequency `frequency` per box) eroding a
-    /// sphere, scaled to peak `sigma_t`.
-    Cloud { octaves: usize, frequency: f64, seed: u32 },
-    /// The paper's failure case: a thin shell of sparse, high-frequency blobs (most voxels
-    /// empty, the rest at `sigma_t`), so that few samples along a ray see any density.
-    Explosion { frequency: f64, seed: u32 },
-}
+pub use scene::DensityKind;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct DensityGrid {
@@ -109,5 +97,13 @@ impl Field {
                 if n > 0.35 { 1.0 } else { 0.0 }
             }
         }
+    }
+}
+
+impl DensityGrid {
+    /// A scenario's medium, baked.
+    pub fn from_desc(desc: &scene::MediumDesc) -> Self {
+        let (x, y, z) = desc.resolution;
+        Self::bake(&desc.kind, UVec3::new(x, y, z), desc.sigma_t, desc.box_min, desc.box_max)
     }
 }
