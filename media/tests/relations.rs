@@ -56,6 +56,9 @@ fn setup() -> &'static Setup {
 }
 
 fn image(est: Estimator, seed: u32, spp: u32) -> PixelStats {
+    // One pass at a time: the pass's timestamp buffer is mapped after each run.
+    static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _one = LOCK.lock().unwrap_or_else(|e| e.into_inner());
     let s = setup();
     let (e, _) = s.pass.run(gpu(), &s.gpu_medium, s.camera.position, &s.dirs, W, est, ImageKey { seed, frame: 0, spp }).expect("image");
     reduce(&e, spp)
@@ -78,7 +81,7 @@ fn mean_se(v: &[f64]) -> (f64, f64) {
 #[test]
 fn jackknife_bias_is_at_most_half_the_naive_bias_at_equal_mn() {
     let s = setup();
-    let spp = 256;
+    let spp = 4096;
     let margins: Vec<f64> = SEEDS
         .iter()
         .map(|&seed| {
@@ -95,7 +98,7 @@ fn jackknife_bias_is_at_most_half_the_naive_bias_at_equal_mn() {
 #[test]
 fn track_length_variance_is_one_minus_t_times_t() {
     let s = setup();
-    let spp = 256;
+    let spp = 1024;
     let diffs: Vec<f64> = SEEDS
         .iter()
         .map(|&seed| {
@@ -106,7 +109,8 @@ fn track_length_variance_is_one_minus_t_times_t() {
     let mean_var = s.exact.iter().map(|&t| f64::from((1.0 - t) * t)).sum::<f64>() / s.exact.len() as f64;
     let (m, se) = mean_se(&diffs);
     println!("mean (s² − (1−T)T) {m:.6} ± {se:.6}; mean (1−T)T {mean_var:.4}");
-    assert!(mean_var > 0.05, "the cloud must have pixels of intermediate transmittance");
+    let partial = s.exact.iter().filter(|&&t| (0.1..0.9).contains(&t)).count();
+    assert!(partial >= 20, "the cloud must have pixels of intermediate transmittance: {partial}");
     assert!(m.abs() <= T_TWO_SIDED_99 * se, "track-length variance differs from (1−T)T by {m} ± {se} over seeds {diffs:?}");
 }
 
