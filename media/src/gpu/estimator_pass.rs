@@ -43,7 +43,8 @@ impl EstimatorPass {
         use render::gpu_struct::GpuStruct;
         let layout = binding_layout(gpu, "media rays", &BINDINGS);
         let source = format!("{}{}{}{}", RayParams::WGSL, super::library(), render::compute::declare(1, &BINDINGS), include_str!("../../shaders/media_rays.wgsl"));
-        let [pipeline] = pipelines(gpu, "media rays", &source, &[&medium.layout, &layout], ["estimate_rays"])?;
+        let program = render::shader::Program::single("package::media::rays", &source);
+        let [pipeline] = pipelines(gpu, "media rays", &program, &[&medium.layout, &layout], ["estimate_rays"])?;
         Ok(Self { layout, pipeline })
     }
 

@@ -50,7 +50,8 @@ impl ImagePass {
     pub fn new(gpu: &Gpu, medium: &GpuMedium) -> Result<Self, RenderError> {
         let layout = binding_layout(gpu, "media image", &BINDINGS);
         let source = format!("{}{}{}{}", ImageParams::WGSL, super::library(), render::compute::declare(1, &BINDINGS), include_str!("../../shaders/media_image.wgsl"));
-        let [pipeline] = pipelines(gpu, "media image", &source, &[&medium.layout, &layout], ["transmittance_image"])?;
+        let program = render::shader::Program::single("package::media::image", &source);
+        let [pipeline] = pipelines(gpu, "media image", &program, &[&medium.layout, &layout], ["transmittance_image"])?;
         Ok(Self { timer: PassTimer::new(gpu, &[PASS]), layout, pipeline })
     }
 
