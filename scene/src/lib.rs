@@ -9,6 +9,9 @@ pub mod rng;
 
 pub use rng::{SplitMix64, mix64};
 
+pub mod medium;
+pub use medium::{DensityKind, MediumDesc};
+
 use glam::{Mat4, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 

@@ -277,6 +277,8 @@ struct ScenarioFile {
     animations: Vec<AnimationSpec>,
     #[serde(default)]
     events: Vec<EventSpec>,
+    #[serde(default)]
+    media: Vec<scene::MediumDesc>,
 }
 
 /// A scenario ready to play.
@@ -306,6 +308,10 @@ pub struct Scenario {
     pub smape_epsilon: f32,
     pub animations: Vec<AnimationSpec>,
     pub events: Vec<EventSpec>,
+    /// Participating media (scene::medium); none by default, and then nothing is paid for them
+    /// (not even a key in the manifest).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub media: Vec<scene::MediumDesc>,
     /// The RON file this came from (used in error messages).
     pub origin: PathBuf,
     /// The RON text, to point errors found later (unknown entity names) at a line.
@@ -419,6 +425,14 @@ impl Scenario {
                 });
             }
         }
+        for m in &file.media {
+            if let Some(message) = m.problem() {
+                return Err(ScenarioError { file: origin.to_path_buf(), position: find_quoted(text, &m.name).or_else(|| invalid("media", String::new()).position), message });
+            }
+            if file.media.iter().filter(|o| o.name == m.name).count() > 1 {
+                return Err(ScenarioError { file: origin.to_path_buf(), position: find_quoted(text, &m.name), message: format!("two media named '{}'; expected unique names", m.name) });
+            }
+        }
         let name = file.name.unwrap_or_else(|| {
             origin.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scenario".into())
         });
@@ -448,6 +462,7 @@ impl Scenario {
             smape_epsilon: file.smape_epsilon,
             animations: file.animations,
             events: file.events,
+            media: file.media,
             origin: origin.to_path_buf(),
             source: text.to_string(),
         })

@@ -10,6 +10,7 @@ pub mod path_tracing;
 pub mod sample_cache;
 pub mod spec;
 pub mod taa;
+pub mod volume;
 
 use anyhow::Result;
 use bevy_ecs::prelude::*;
@@ -23,6 +24,7 @@ use sample_cache::SampleCacheSettings;
 use serde::{Deserialize, Serialize};
 use sim::MethodEntry;
 use taa::TaaSettings;
+use volume::VolumeSettings;
 
 /// A method family: its systems and how to build one instance.
 pub trait MethodPlugin: Sync {
@@ -51,6 +53,8 @@ pub enum MethodSpec {
     Taa(TaaSettings),
     /// World-space hash cache (render::hash_cache), optionally under TAA.
     HashCache(HashCacheSettings),
+    /// Primary-ray transmittance images of a medium with one estimator (media crate).
+    VolumeTransmittance(VolumeSettings),
 }
 
 impl MethodSpec {
@@ -62,6 +66,7 @@ impl MethodSpec {
             MethodSpec::SampleCache(_) => &sample_cache::PLUGIN,
             MethodSpec::Taa(_) => &taa::PLUGIN,
             MethodSpec::HashCache(_) => &hash_cache::PLUGIN,
+            MethodSpec::VolumeTransmittance(_) => &volume::PLUGIN,
         }
     }
 
@@ -73,6 +78,7 @@ impl MethodSpec {
             MethodSpec::SampleCache(s) => s.label(),
             MethodSpec::Taa(_) => "taa".into(),
             MethodSpec::HashCache(s) => hash_cache::label(s),
+            MethodSpec::VolumeTransmittance(s) => s.label(),
         }
     }
 
@@ -84,6 +90,7 @@ impl MethodSpec {
             // One shaded path per pixel at a 100% shading rate.
             MethodSpec::SampleCache(s) => (s.shading_rate.ceil() as u32).max(1),
             MethodSpec::Taa(_) | MethodSpec::HashCache(_) => 1,
+            MethodSpec::VolumeTransmittance(s) => s.spp,
         }
     }
 
@@ -93,6 +100,7 @@ impl MethodSpec {
         match self {
             MethodSpec::PathTracing(s) => s.spp = spp,
             MethodSpec::Nirc(s) => s.spp = spp,
+            MethodSpec::VolumeTransmittance(s) => s.spp = spp,
             MethodSpec::SampleCache(_) | MethodSpec::Taa(_) | MethodSpec::HashCache(_) => {}
         }
     }

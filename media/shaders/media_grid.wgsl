@@ -1,0 +1,53 @@
+// A medium's voxel densities (nearest neighbour) and super-voxels (16³ voxels: min, max, mean,
+// RMS of μ − μ_min), in texel space with the ray parameter t in world units (media::medium).
+// Needs the generated structs MediumParams and RaySegment and `medium: MediumParams`, `density: array<f32>`, `super_voxels: array<vec4f>`.
+
+const SUPER_VOXEL: u32 = 16u;
+// Relative floor of the variance-aware importance in non-empty super-voxels (IMPORTANCE_FLOOR).
+const IMPORTANCE_FLOOR: f32 = 1e-3;
+const BIG: f32 = 3.4e38;
+
+// High-resolution density lookups of this invocation (what the paper counts).
+var<private> media_lookups: u32;
+
+fn seg_at(s: RaySegment, t: f32) -> vec3f {
+    return s.origin + s.dir * t;
+}
+
+// The part of the world ray (origin, unit dir) in [0, t_max] inside the box; t0 >= t1 on a miss.
+fn medium_segment(origin: vec3f, dir: vec3f, t_max: f32) -> RaySegment {
+    let voxel = (medium.box_max - medium.box_min) / vec3f(medium.res);
+    let o = (origin - medium.box_min) / voxel;
+    let d = dir / voxel;
+    let inv = 1.0 / d;
+    let a = -o * inv;
+    let b = (vec3f(medium.res) - o) * inv;
+    let lo = min(a, b);
+    let hi = max(a, b);
+    let t0 = max(max(max(lo.x, lo.y), lo.z), 0.0);
+    let t1 = min(min(min(hi.x, hi.y), hi.z), t_max);
+    return RaySegment(o, t0, d, t1);
+}
+
+fn super_voxel(c: vec3i) -> vec4f {
+    let u = vec3u(c);
+    return super_voxels[u.x + medium.dims.x * (u.y + medium.dims.y * u.z)];
+}
+
+// μ at t inside super-voxel `cell` (the voxel clamped into it, as media::Medium::mu).
+fn mu_at(s: RaySegment, t: f32, cell: vec3i) -> f32 {
+    media_lookups += 1u;
+    let lo = vec3u(cell) * SUPER_VOXEL;
+    let hi = min(lo + vec3u(SUPER_VOXEL - 1u), medium.res - vec3u(1u));
+    let v = clamp(vec3u(max(floor(seg_at(s, t)), vec3f(0.0))), lo, hi);
+    return density[v.x + medium.res.x * (v.y + medium.res.y * v.z)];
+}
+
+// (P, μ_min) of a super-voxel: Kettunen's mean (variance_aware false) or Eq. 5 with the floor.
+fn importance(sv: vec4f, variance_aware: bool) -> vec2f {
+    if !variance_aware {
+        return vec2f(sv.z, 0.0);
+    }
+    let p = select(0.0, max(sv.w, IMPORTANCE_FLOOR * sv.y), sv.y > 0.0);
+    return vec2f(p, sv.x);
+}

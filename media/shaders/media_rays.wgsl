@@ -1,0 +1,14 @@
+// One estimate per segment with the segment's own seed (media::gpu::EstimatorPass): what the
+// GPU-vs-CPU tests compare, estimate by estimate.
+
+@compute @workgroup_size(64)
+fn estimate_rays(@builtin(global_invocation_id) id: vec3u) {
+    let i = id.x;
+    if i >= ray_params.count {
+        return;
+    }
+    var rng = seeds[i];
+    media_lookups = 0u;
+    let v = estimate_transmittance(rays[i], ray_params.kind, ray_params.samples, ray_params.multiplier, &rng);
+    results[i] = vec2u(bitcast<u32>(v), media_lookups);
+}

@@ -1,0 +1,57 @@
+// Track-length and ratio tracking against the super-voxel majorants (media::track_length,
+// media::ratio_tracking, media::majorant_tracking).
+
+const MAX_COLLISIONS: u32 = 1024u;
+
+// The next tentative collision after t, or t = BIG when the segment ends first; .y = majorant.
+fn next_collision(s: RaySegment, dda: ptr<function, Dda>, t_start: f32, rng: ptr<function, u32>) -> vec2f {
+    var target_depth = -log(1.0 - media_rand(rng));
+    var t = t_start;
+    let bound = u32((*dda).dims.x + (*dda).dims.y + (*dda).dims.z) + 1u;
+    for (var i = 0u; i < bound; i++) {
+        let majorant = super_voxel((*dda).cell).y;
+        let exit = dda_exit(*dda);
+        let depth = (exit - t) * majorant;
+        if depth > target_depth {
+            return vec2f(t + target_depth / majorant, majorant);
+        }
+        target_depth -= depth;
+        t = exit;
+        if !dda_advance(dda) {
+            break;
+        }
+    }
+    return vec2f(BIG, 0.0);
+}
+
+fn track_length(s: RaySegment, rng: ptr<function, u32>) -> f32 {
+    var dda = dda_new(s, medium.dims, f32(SUPER_VOXEL));
+    var t = s.t0;
+    for (var n = 0u; n < MAX_COLLISIONS; n++) {
+        let c = next_collision(s, &dda, t, rng);
+        if c.x == BIG {
+            break;
+        }
+        let mu = mu_at(s, c.x, dda.cell);
+        if media_rand(rng) < mu / c.y {
+            return 0.0;
+        }
+        t = c.x;
+    }
+    return 1.0;
+}
+
+fn ratio_tracking(s: RaySegment, rng: ptr<function, u32>) -> f32 {
+    var dda = dda_new(s, medium.dims, f32(SUPER_VOXEL));
+    var t = s.t0;
+    var value = 1.0;
+    for (var n = 0u; n < MAX_COLLISIONS; n++) {
+        let c = next_collision(s, &dda, t, rng);
+        if c.x == BIG {
+            break;
+        }
+        value *= 1.0 - mu_at(s, c.x, dda.cell) / c.y;
+        t = c.x;
+    }
+    return value;
+}

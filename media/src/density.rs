@@ -1,0 +1,109 @@
+//! Voxel density grids (extinction μ per world unit, one value per voxel, looked up with
+//! nearest-neighbour interpolation) and the procedural fields they are baked from.
+//!
+//! Departure from the paper: it jitters each lookup stochastically (stochastic texture
+//! filtering); we use nearest-neighbour lookups, so a voxel's extinction is piecewise constant
+//! and regular tracking gives exact optical depths (the reference of the bias maps and tests).
+
+use glam::{UVec3, Vec3};
+use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
+
+pub use scene::DensityKind;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct DensityGrid {
+    pub res: UVec3,
+    /// μ per voxel, x fastest.
+    pub data: Vec<f32>,
+    pub box_min: Vec3,
+    pub box_max: Vec3,
+}
+
+impl DensityGrid {
+    /// Bakes `kind` at the voxel centres of a `res` grid filling [box_min, box_max], peak
+    /// extinction `sigma_t`.
+    pub fn bake(kind: &DensityKind, res: UVec3, sigma_t: f32, box_min: Vec3, box_max: Vec3) -> Self {
+        let mut data = Vec::with_capacity((res.x * res.y * res.z) as usize);
+        let field = Field::new(kind);
+        for z in 0..res.z {
+            for y in 0..res.y {
+                for x in 0..res.x {
+                    let p = (UVec3::new(x, y, z).as_vec3() + 0.5) / res.as_vec3();
+                    data.push(sigma_t * field.unit_density(p));
+                }
+            }
+        }
+        Self { res, data, box_min, box_max }
+    }
+
+    pub fn voxel_size(&self) -> Vec3 {
+        (self.box_max - self.box_min) / self.res.as_vec3()
+    }
+
+    pub fn index(&self, v: UVec3) -> usize {
+        (v.x + self.res.x * (v.y + self.res.y * v.z)) as usize
+    }
+
+    pub fn at(&self, v: UVec3) -> f32 {
+        self.data[self.index(v)]
+    }
+
+    /// μ at texel-space point `p`, its voxel clamped into [lo, hi] (the voxels of the
+    /// super-voxel the caller is in, so that a point on a boundary never reads a neighbour whose
+    /// value lies outside that super-voxel's bounds).
+    pub fn lookup(&self, p: Vec3, lo: UVec3, hi: UVec3) -> f32 {
+        let v = p.floor().max(Vec3::ZERO).as_uvec3().clamp(lo, hi);
+        self.at(v)
+    }
+
+    pub fn max(&self) -> f32 {
+        self.data.iter().copied().fold(0.0, f32::max)
+    }
+}
+
+/// A procedural field on the unit cube with values in [0, 1].
+enum Field {
+    Constant,
+    Cloud(Fbm<Perlin>),
+    Explosion(Perlin, f64),
+}
+
+impl Field {
+    fn new(kind: &DensityKind) -> Self {
+        match *kind {
+            DensityKind::Homogeneous => Field::Constant,
+            DensityKind::Cloud { octaves, frequency, seed } => Field::Cloud(Fbm::<Perlin>::new(seed).set_octaves(octaves).set_frequency(frequency)),
+            DensityKind::Explosion { frequency, seed } => Field::Explosion(Perlin::new(seed), frequency),
+        }
+    }
+
+    fn unit_density(&self, p: Vec3) -> f32 {
+        let r = (p - Vec3::splat(0.5)).length() * 2.0; // 0 at the centre, 1 at the faces
+        let q = [p.x as f64, p.y as f64, p.z as f64];
+        match self {
+            Field::Constant => 1.0,
+            Field::Cloud(fbm) => {
+                // Sphere of radius 0.8 with a soft edge, eroded by the noise.
+                let shape = 1.0 - r / 0.8;
+                let n = fbm.get(q) as f32;
+                (1.6 * shape + 0.9 * n).clamp(0.0, 1.0)
+            }
+            Field::Explosion(perlin, frequency) => {
+                // Shell 0.5 < r < 0.8; inside it only the crests of high-frequency noise.
+                if !(0.5..0.8).contains(&r) {
+                    return 0.0;
+                }
+                let n = perlin.get(q.map(|c| c * frequency)) as f32;
+                if n > 0.35 { 1.0 } else { 0.0 }
+            }
+        }
+    }
+}
+
+impl DensityGrid {
+    /// A scenario's medium, baked.
+    pub fn from_desc(desc: &scene::MediumDesc) -> Self {
+        let (x, y, z) = desc.resolution;
+        Self::bake(&desc.kind, UVec3::new(x, y, z), desc.sigma_t, desc.box_min, desc.box_max)
+    }
+}

@@ -1,0 +1,33 @@
+//! Participating media for flicker: the paper "Jackknife Transmittance and MIS Weight
+//! Estimation" (../shared/seeds/jackknife-transmittance.txt) and the estimators it compares.
+//!
+//! CPU reference (this crate's modules, f32 like the WGSL, the same PCG stream): densities
+//! (`density`), super-voxels (`supervoxel`), grid traversal (`dda`), the segment of a ray in a
+//! medium (`medium`), exact optical depth (`regular_tracking`), track-length, ratio tracking,
+//! ray marching (Alg. 1 and 2: `optical_depth`), naive and Kettunen's biased exp(−X)
+//! (`ray_marching`), unbiased ray marching, the jackknife, their selection (`transmittance`),
+//! MIS weights (`mis`) and the 1-D stratified sampling of Sec. 4.1 (`stratified`).
+
+pub mod dda;
+pub mod gpu;
+pub mod image;
+pub mod density;
+pub mod jackknife;
+pub mod majorant_tracking;
+pub mod medium;
+pub mod mis;
+pub mod optical_depth;
+pub mod ratio_tracking;
+pub mod ray_marching;
+pub mod regular_tracking;
+pub mod rng;
+pub mod stratified;
+pub mod supervoxel;
+pub mod track_length;
+pub mod transmittance;
+pub mod unbiased_ray_marching;
+
+pub use density::{DensityGrid, DensityKind};
+pub use medium::{Estimate, Medium, Segment};
+pub use rng::Pcg;
+pub use transmittance::Estimator;

@@ -1,0 +1,95 @@
+//! Shared by the media tests: seeded normal samples, a running mean/variance, complex numbers.
+#![allow(dead_code)]
+
+use media::{Estimator, Pcg};
+
+/// A standard normal sample (Box–Muller on two PCG uniforms, in f64).
+pub fn normal(rng: &mut Pcg) -> f64 {
+    let u1 = 1.0 - f64::from(rng.next_f32()); // (0, 1]
+    let u2 = f64::from(rng.next_f32());
+    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+}
+
+/// Mean, variance and the standard errors of both, from sums of powers.
+#[derive(Default, Clone, Copy, Debug)]
+pub struct Moments {
+    n: f64,
+    s1: f64,
+    s2: f64,
+    s3: f64,
+    s4: f64,
+}
+
+impl Moments {
+    pub fn add(&mut self, x: f64) {
+        self.n += 1.0;
+        self.s1 += x;
+        self.s2 += x * x;
+        self.s3 += x * x * x;
+        self.s4 += x * x * x * x;
+    }
+    pub fn mean(&self) -> f64 {
+        self.s1 / self.n
+    }
+    pub fn var(&self) -> f64 {
+        (self.s2 / self.n - self.mean().powi(2)) * self.n / (self.n - 1.0)
+    }
+    pub fn std(&self) -> f64 {
+        self.var().sqrt()
+    }
+    /// Standard error of the mean.
+    pub fn se(&self) -> f64 {
+        (self.var() / self.n).sqrt()
+    }
+    /// Standard error of the variance: sqrt((m4 − σ⁴) / n) with the central fourth moment m4.
+    pub fn var_se(&self) -> f64 {
+        let m = self.mean();
+        let n = self.n;
+        let m4 = self.s4 / n - 4.0 * m * self.s3 / n + 6.0 * m * m * self.s2 / n - 3.0 * m.powi(4);
+        ((m4 - self.var().powi(2)) / n).sqrt()
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct C {
+    pub re: f64,
+    pub im: f64,
+}
+
+impl C {
+    pub fn new(re: f64, im: f64) -> Self {
+        Self { re, im }
+    }
+    pub fn mul(self, o: C) -> C {
+        C::new(self.re * o.re - self.im * o.im, self.re * o.im + self.im * o.re)
+    }
+    pub fn div(self, o: C) -> C {
+        let d = o.re * o.re + o.im * o.im;
+        C::new((self.re * o.re + self.im * o.im) / d, (self.im * o.re - self.re * o.im) / d)
+    }
+    pub fn exp(self) -> C {
+        let e = self.re.exp();
+        C::new(e * self.im.cos(), e * self.im.sin())
+    }
+    pub fn scale(self, k: f64) -> C {
+        C::new(self.re * k, self.im * k)
+    }
+    pub fn add(self, o: C) -> C {
+        C::new(self.re + o.re, self.im + o.im)
+    }
+    pub fn sinh(self) -> C {
+        self.exp().add(self.scale(-1.0).exp().scale(-1.0)).scale(0.5)
+    }
+}
+
+/// Every estimator, with the settings the tests use.
+pub fn all_estimators() -> [Estimator; 6] {
+    [
+        Estimator::TrackLength,
+        Estimator::RatioTracking,
+        Estimator::BiasedRayMarching { multiplier: 2.0 },
+        Estimator::UnbiasedRayMarching { multiplier: 1.0 },
+        Estimator::Naive { samples: 16 },
+        Estimator::Jackknife { samples: 8 },
+    ]
+}
