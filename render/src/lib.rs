@@ -17,4 +17,5 @@ pub mod readback;
 pub mod sample_cache;
 pub mod scene_bindings;
 pub mod taa;
+pub mod termination;
 pub mod timing;
