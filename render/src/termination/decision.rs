@@ -30,7 +30,9 @@ impl LocalStats {
     /// Local variance of continuing under Russian roulette of survival `q`: a killed segment
     /// estimates 0, a surviving one Y/q, so E[Y'²] = E[Y²]/q while E[Y'|y] = E[Y|y].
     pub fn variance_with_roulette(&self, q: f64) -> f64 {
-        ((self.variance + self.marginal) / q - self.marginal).max(0.0)
+        // (variance + marginal) / q − marginal, written without the cancellation of the two
+        // large terms (f32 on the GPU).
+        (self.variance / q + self.marginal * (1.0 / q - 1.0)).max(0.0)
     }
 }
 

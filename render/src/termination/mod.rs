@@ -6,6 +6,7 @@
 //! paper's discrete sampling trees of Figs. 4 and 5 in closed form (`sampling_tree`).
 
 pub mod decision;
+pub mod gpu_decision;
 pub mod moments;
 pub mod rule;
 pub mod sampling_tree;
