@@ -9,6 +9,7 @@ use render::materials::GpuMaterial;
 use render::lights::GpuLight;
 use render::sample_cache::{SscParams, SscPixel, SscSlot};
 use render::taa::{TaaParams, TaaPrimary};
+use render::termination::cache::{TcParams, TcRecord, TcVertex};
 
 fn mismatches<T: GpuStruct>(deps: &str) -> Vec<String> {
     render::gpu_struct::layout_mismatches::<T>(deps)
@@ -30,6 +31,9 @@ fn shared_structs_have_one_layout() {
         ("GpuLight", mismatches::<GpuLight>("")),
         ("SscSlot", mismatches::<SscSlot>("")),
         ("SscPixel", mismatches::<SscPixel>("")),
+        ("TcParams", mismatches::<TcParams>("")),
+        ("TcRecord", mismatches::<TcRecord>("")),
+        ("TcVertex", mismatches::<TcVertex>("")),
     ] {
         assert!(found.is_empty(), "{name}: {found:?}");
     }

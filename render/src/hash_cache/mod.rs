@@ -397,7 +397,8 @@ impl HashCache {
     }
 }
 
-fn read<T: Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<T>, RenderError> {
+/// A copy of `buffer` read back (other methods' state readers use it too).
+pub(crate) fn read<T: Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<T>, RenderError> {
     let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(what), size: buffer.size(), usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
     let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
