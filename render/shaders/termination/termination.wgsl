@@ -28,6 +28,7 @@ const TC_COUNTER_FAILED: u32 = 4u;
 const TC_COUNTER_STORED: u32 = 5u;
 const TC_COUNTER_UNKNOWN: u32 = 6u;    // decisions at a vertex without a filled record
 const TC_COUNTER_PROPAGATED: u32 = 7u; // stored vertices propagated
+const TC_COUNTER_FILLED: u32 = 9u;     // records holding moments after the fold
 const TC_COUNTER_INCOMPLETE: u32 = 8u; // propagated vertices left out: a sample hit no filled record
 
 fn tc_rule() -> TcRule {
@@ -196,6 +197,9 @@ fn tc_fold(@builtin(global_invocation_id) id: vec3u) {
         }
     }
     records[slot] = r;
+    if r.vertices > 0.0 {
+        atomicAdd(&counters[TC_COUNTER_FILLED], 1u);
+    }
 }
 
 @compute @workgroup_size(8, 8, 1)

@@ -23,7 +23,7 @@ pub const TC_STORE_PASS: &str = "tc_store";
 /// iteration from an empty cache, and its early, darker values must not linger.
 const WARMUP_MAX_VERTICES: u32 = 4;
 /// Words of `counters` (termination.wgsl's TC_COUNTER_*).
-const COUNTERS: u64 = 9;
+const COUNTERS: u64 = 10;
 const PASSES: [&str; 4] = [TC_PROPAGATE_PASS, TC_FOLD_PASS, TC_TRACE_PASS, TC_STORE_PASS];
 
 const OWN_GROUP: [BufferBinding; 9] = [
@@ -112,6 +112,8 @@ pub struct TerminationStats {
     /// Stored vertices propagated with a sample that read no filled record (they only start
     /// empty records).
     pub incomplete: u32,
+    /// Records holding moments after this frame's fold.
+    pub filled: u32,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -224,7 +226,7 @@ impl TerminationCache {
         let primary: Vec<TaaPrimary> = read(gpu, &self.primary, "termination primary hits")?;
         let path_length: Vec<f32> = read(gpu, &self.path_length, "termination path length")?;
         let c: Vec<u32> = read(gpu, &self.counters, "termination counters")?;
-        let stats = TerminationStats { path_vertices: c[0], trace_rays: c[1], propagate_rays: c[2], inserted: c[3], insert_failures: c[4], stored: c[5], unknown: c[6], propagated: c[7], incomplete: c[8] };
+        let stats = TerminationStats { path_vertices: c[0], trace_rays: c[1], propagate_rays: c[2], inserted: c[3], insert_failures: c[4], stored: c[5], unknown: c[6], propagated: c[7], incomplete: c[8], filled: c[9] };
         let pixels = self.width as u64 * self.height as u64;
         Ok(TerminationOutput {
             radiance,

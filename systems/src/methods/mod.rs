@@ -10,6 +10,7 @@ pub mod path_tracing;
 pub mod sample_cache;
 pub mod spec;
 pub mod taa;
+pub mod termination;
 
 use anyhow::Result;
 use bevy_ecs::prelude::*;
@@ -23,6 +24,7 @@ use sample_cache::SampleCacheSettings;
 use serde::{Deserialize, Serialize};
 use sim::MethodEntry;
 use taa::TaaSettings;
+use termination::TerminationSettings;
 
 /// A method family: its systems and how to build one instance.
 pub trait MethodPlugin: Sync {
@@ -51,6 +53,9 @@ pub enum MethodSpec {
     Taa(TaaSettings),
     /// World-space hash cache (render::hash_cache), optionally under TAA.
     HashCache(HashCacheSettings),
+    /// Path tracing terminated into a hashed radiance cache by variance trading
+    /// (render::termination): `Termination(rule: VarianceBounding(t: 0.1))`.
+    Termination(TerminationSettings),
 }
 
 impl MethodSpec {
@@ -62,6 +67,7 @@ impl MethodSpec {
             MethodSpec::SampleCache(_) => &sample_cache::PLUGIN,
             MethodSpec::Taa(_) => &taa::PLUGIN,
             MethodSpec::HashCache(_) => &hash_cache::PLUGIN,
+            MethodSpec::Termination(_) => &termination::PLUGIN,
         }
     }
 
@@ -73,6 +79,7 @@ impl MethodSpec {
             MethodSpec::SampleCache(s) => s.label(),
             MethodSpec::Taa(_) => "taa".into(),
             MethodSpec::HashCache(s) => hash_cache::label(s),
+            MethodSpec::Termination(s) => termination::label(s),
         }
     }
 
@@ -83,7 +90,7 @@ impl MethodSpec {
             MethodSpec::Nirc(s) => s.spp,
             // One shaded path per pixel at a 100% shading rate.
             MethodSpec::SampleCache(s) => (s.shading_rate.ceil() as u32).max(1),
-            MethodSpec::Taa(_) | MethodSpec::HashCache(_) => 1,
+            MethodSpec::Taa(_) | MethodSpec::HashCache(_) | MethodSpec::Termination(_) => 1,
         }
     }
 
@@ -93,7 +100,7 @@ impl MethodSpec {
         match self {
             MethodSpec::PathTracing(s) => s.spp = spp,
             MethodSpec::Nirc(s) => s.spp = spp,
-            MethodSpec::SampleCache(_) | MethodSpec::Taa(_) | MethodSpec::HashCache(_) => {}
+            MethodSpec::SampleCache(_) | MethodSpec::Taa(_) | MethodSpec::HashCache(_) | MethodSpec::Termination(_) => {}
         }
     }
 }
