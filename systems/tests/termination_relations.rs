@@ -26,20 +26,12 @@ use systems::methods::MethodSpec;
 use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};
 
+mod common;
+use common::assert_positive;
+
 const SEEDS: [u64; 3] = [3, 4, 5];
-/// One-sided 95% t quantile for 2 degrees of freedom (three seeds).
-const T95_DF2: f64 = 2.920;
 /// Two-sided 95% t quantile for 2 degrees of freedom.
 const T975_DF2: f64 = 4.303;
-
-fn assert_positive(what: &str, d: &[f64]) {
-    let n = d.len() as f64;
-    let m = d.iter().sum::<f64>() / n;
-    let sd = (d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)).sqrt();
-    let lower = m - T95_DF2 * sd / n.sqrt();
-    eprintln!("{what}: per seed {d:.4?}, mean {m:.4}, lower 95% bound {lower:.4}");
-    assert!(lower > 0.0, "{what}: per-seed differences {d:.4?}, mean {m:.4}, one-sided 95% lower bound {lower:.4} is not above 0");
-}
 
 /// The scenario's methods named in `keep`, one recorded frame at 32x18: (method, path length,
 /// FLIP) per seed.
