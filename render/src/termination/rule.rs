@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 /// Where a path ends into the cache.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum TerminationRule {
     /// §4.2: the longest prefix whose path variance Σ P_j stays within t; the overshooting vertex
     /// is blended with α (eq. 5). `relative`: t times the squared cache value at the first hit

@@ -75,3 +75,22 @@ pub fn render(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::Method;
+    use render::termination::TerminationRule;
+
+    #[test]
+    fn scenario_text_parses_with_the_paper_defaults_and_refuses_unknown_fields() {
+        let m = Method::parse("Termination(rule: MseMinimisation(s: 100.0))").unwrap();
+        assert_eq!(m.label(), "termination_mse_100");
+        let super::super::MethodSpec::Termination(s) = m.spec else { panic!("not Termination") };
+        assert_eq!(s.rule, TerminationRule::MseMinimisation { s: 100.0, margin: 1.1, bias_clamp: 0.1 });
+        assert_eq!((s.store_probability, s.survival), (0.01, 1.0));
+        let e = Method::parse("Termination(rule: VarianceBounding(t: 0.1, tt: 1.0))").unwrap_err();
+        assert!(e.contains("tt"), "{e}");
+        let e = Method::parse("Termination(rule: VarianceBounding(t: 0.1), samples: 4)").unwrap_err();
+        assert!(e.contains("samples"), "{e}");
+    }
+}
