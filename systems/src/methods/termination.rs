@@ -2,7 +2,8 @@
 //! (render::termination, ../shared/seeds/variance-trading-termination.txt): one system per
 //! frame runs the cache's passes (propagation, fold, the tracer with the rule's decision, the
 //! vertex store) and reports the image, the pass times (tc_trace and tc_propagate separately)
-//! and the mean path length (`path_length`, vertices per path counted on the GPU).
+//! and the mean path length (`path_length`, vertices per path counted on the GPU), with the
+//! per-pixel path length as the image `path_length` (the paper's Fig. 11).
 
 use std::time::Instant;
 
@@ -12,7 +13,7 @@ use render::termination::TerminationCache;
 
 pub use render::termination::TerminationSettings;
 
-use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
+use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
 use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
 
 /// `termination_vb_0.1`, `termination_mse_100`, ...
@@ -69,6 +70,9 @@ pub fn render(
                 ("cache_propagated_vertices".into(), s.propagated as f64),
                 ("cache_insert_failures".into(), s.insert_failures as f64),
             ],
+            // The paper's Fig. 11: vertices of each pixel's path (grey value = path length; the
+            // EXR holds the exact values).
+            images: vec![MethodImage { name: "path_length".into(), pixels: out.path_length.iter().map(|&l| [l, l, l, 1.0]).collect(), hdr: true }],
             ..MethodOutput::timed(out.radiance, out.motion, &out.timings, out.rays, out.shaded)
         });
         frame.add_cpu(start);
