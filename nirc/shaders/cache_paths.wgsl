@@ -1,7 +1,7 @@
 // Cache-terminated paths (NIRC): camera paths end in a query of the incident radiance cache,
 // a sparse seeded subset of them is extended into Monte Carlo training targets, and a resolve
-// pass turns the cache's answers into the image. Appended to PathTracer::library_source();
-// the scene is @group(0), the geometry @group(1), these buffers @group(2) (integrator.rs).
+// pass turns the cache's answers into the image. Built on the pass library's modules; the scene
+// is @group(0), the geometry @group(1), these buffers @group(2) (integrator.rs).
 //
 // Estimator. A camera path is traced by pt_integrator.wgsl's `trace_path_prefix` (emission,
 // NEE with MIS, BSDF sampling, Russian roulette) up to the termination vertex x_k (k =
@@ -25,18 +25,19 @@
 // frame's max depth. Replacing the cache by cache_target (the oracle) gives an estimator with
 // the same mean as the path tracer's (test: tests/integrator.rs).
 
-// weight.xyz: throughput * f cos / pdf of the query direction; weight.w: 1 = a query exists.
-// prefix.xyz: radiance gathered before the cache term. origin.xyz: offset ray origin of the
-// query ray; origin.w: its depth (as in path_radiance), stored as a float.
-struct QueryMeta {
-    weight: vec4f,
-    prefix: vec4f,
-    origin: vec4f,
-}
+import package::scene_bindings::{frame, materials};
+import package::scene_geometry::{NO_HIT, sg_rays_traced, surface_point, trace_closest};
+import package::pt_sampling::{max_component, rng_next, rng_next2, rng_seed};
+import package::pt_bsdf::{bsdf_sample, make_bsdf};
+import package::pt_lights::{FAR};
+import package::pt_scene::{base_color_at, camera_ray_direction, offset_origin, orient, primary_motion};
+import package::pt_integrator::{next_event, next_event_analytic, next_event_emitter, path_radiance, trace_path_prefix};
+import package::nirc::cache_path_types::{CacheQuery, TrainingRecord};
+import package::nirc::query_meta::{QueryMeta};
+import package::nirc::cache_path_bindings::{answers, image, motion, params, queries, query_meta, ray_counters, records};
 
 // CacheParams, CacheQuery and TrainingRecord (position.w: 1 = valid) are declared once for Rust
 // and WGSL (src/integrator.rs, src/records.rs).
-
 
 // Stream of training-path random numbers: disjoint from the camera samples' (small indices).
 const TRAIN_SAMPLE_STREAM: u32 = 0x80000001u;

@@ -172,10 +172,10 @@ pub fn probes(gpu: &Gpu, reps: u32) -> Result<Probes, NircError> {
     let invocations = 64 * 256u32;
     let out = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some("nirc probe out"), size: invocations as u64 * 16, usage: wgpu::BufferUsages::STORAGE, mapped_at_creation: false });
     let fma_src = format!("const ITERATIONS: u32 = {ITERATIONS}u;\n{}", include_str!("../shaders/bench/fma_peak.wgsl"));
-    let [fma] = render::compute::pipelines_auto_layout(gpu, "fma peak", &fma_src, ["main"])?;
+    let [fma] = render::compute::pipelines_auto_layout(gpu, "fma peak", &render::shader::Program::single("package::nirc::fma_peak", &fma_src), ["main"])?;
     let fma_s = dispatch_timed(gpu, reps, &fma, &[(0, &out)], invocations / 64)?;
     let layer_src = format!("{}\n{}\n{}", include_str!("../shaders/bench/tile_layer.wgsl"), tile_layer_probe(4, 16), tile_layer_probe(16, 16));
-    let [block4x16, block16x16] = render::compute::pipelines_auto_layout(gpu, "tile layer", &layer_src, ["block4x16", "block16x16"])?;
+    let [block4x16, block16x16] = render::compute::pipelines_auto_layout(gpu, "tile layer", &render::shader::Program::single("package::nirc::tile_layer", &layer_src), ["block4x16", "block16x16"])?;
     let tiles = 256u32;
     let input = upload(gpu, "probe input", &vec![0.01f32; tiles as usize * 4096]);
     let weights = upload(gpu, "probe weights", &vec![0.02f32; 4096]);

@@ -13,7 +13,9 @@ use crate::records::{CacheAnswer, CacheQuery, TrainingRecord};
 use render::gpu_struct::GpuStruct;
 use render::compute::BufferBinding;
 use render::gpu::Gpu;
+use render::pass_library::PassLibrary;
 use render::path_tracer::PathTracer;
+use render::shader::{Module, Program};
 use render::timing::TimedFrame;
 use serde::{Deserialize, Serialize};
 use wgpu::util::DeviceExt;
@@ -109,10 +111,21 @@ pub struct CachePaths {
 }
 
 impl CachePaths {
-    /// The WGSL of the pass (part of warm-start keys).
+    /// The pass's program: the pass library, its structs and @group(2), cache_paths.wgsl.
+    pub fn program() -> &'static Program {
+        static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
+        PROGRAM.get_or_init(|| {
+            let types = Module::generated("package::nirc::cache_path_types", &[CacheParams::WGSL, &crate::records::wgsl()]);
+            let meta = render::wgsl_file!("query_meta.wgsl");
+            let bindings = render::compute::group_module("package::nirc::cache_path_bindings", 2, &OWN_GROUP, &[&types, &meta]);
+            PassLibrary::program([types, meta, bindings], [render::wgsl_file!("cache_paths.wgsl")])
+        })
+    }
+
+    /// Every WGSL source of the pass (part of warm-start keys).
     pub fn shader_source() -> &'static str {
         static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-        SOURCE.get_or_init(|| [PathTracer::library_source(), CacheParams::WGSL, &crate::records::wgsl(), include_str!("../shaders/cache_paths.wgsl")].join("\n"))
+        SOURCE.get_or_init(|| Self::program().fingerprint())
     }
 
     /// Passes for `tracer`'s resolution at `spp` paths per pixel.
@@ -141,7 +154,7 @@ impl CachePaths {
 
         let device = &gpu.device;
         let (layout, [queries_pipeline, targets_pipeline, compact_pipeline, oracle_pipeline, resolve_pipeline]) = tracer
-            .library_pass(gpu, "cache_paths.wgsl", Self::shader_source(), &OWN_GROUP, ["queries_main", "targets_main", "compact_main", "oracle_main", "resolve_main"])?;
+            .library_pass(gpu, "cache_paths.wgsl", Self::program(), &OWN_GROUP, ["queries_main", "targets_main", "compact_main", "oracle_main", "resolve_main"])?;
         let buffer = |label: &str, bytes: u64| -> Result<wgpu::Buffer, NircError> {
             gpu.check_buffer_size(label, bytes)?;
             Ok(device.create_buffer(&wgpu::BufferDescriptor {

@@ -1,6 +1,8 @@
 // Traces a buffer of rays through the scene geometry (scene_geometry.wgsl is prepended):
 // closest hits, any-hit flags and hit attributes, for tests and the traversal benchmark.
 
+import package::scene_geometry::{Hit, NO_HIT, previous_world_position, surface_point, trace_any, trace_closest, triangle_world_vertices};
+
 struct RayQuery { origin: vec3f, t_max: f32, direction: vec3f, sg_pad: u32 }
 
 struct HitRecord {

@@ -1,6 +1,14 @@
 // Megakernel path tracer: one thread per pixel, `spp` paths per dispatch, and a separate G-buffer
-// entry point that traces the un-jittered pixel-centre ray. Concatenated after the library
-// (PathTracer::library_source).
+// entry point that traces the un-jittered pixel-centre ray.
+
+import package::scene_bindings::{frame, materials};
+import package::scene_geometry::{NO_HIT, sg_rays_traced, surface_point, trace_closest};
+import package::pt_sampling::{rng_next2, rng_seed};
+import package::pt_lights::{FAR};
+import package::pt_scene::{base_color_at, camera_ray_direction, orient, primary_motion};
+import package::pt_integrator::{path_radiance};
+import package::path_tracer_types::{GBufferTexel, SAMPLES_PER_THREAD};
+import package::path_tracer_bindings::{gbuffer, pt_counters, radiance_sum, sample_partials};
 
 fn trace_path(pixel: vec2u, sample_index: u32) -> vec3f {
     var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, pixel.y * frame.width + pixel.x, sample_index);
@@ -8,7 +16,6 @@ fn trace_path(pixel: vec2u, sample_index: u32) -> vec3f {
     let dir = camera_ray_direction(frame.camera, vec2f(pixel) + jitter);
     return path_radiance(frame.camera.position, dir, 0.0, 0u, &rng);
 }
-
 
 // One thread per pixel and chunk of at most SAMPLES_PER_THREAD samples (global id z = chunk).
 // Few samples per thread keep every invocation short: llvmpipe (Mesa 22) silently ends a shader's

@@ -4,6 +4,8 @@
 // scales the dielectric Fresnel (0 = pure Lambertian). All directions are world space, unit, and
 // `n` is the shading normal turned towards `wo`.
 
+import package::pt_sampling::{INV_PI, PI, TWO_PI, basis_bitangent, basis_tangent, max_component, sample_cosine_hemisphere, to_world};
+
 struct Bsdf {
     c_diff: vec3f,
     alpha: f32,

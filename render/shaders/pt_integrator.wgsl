@@ -1,6 +1,14 @@
 // Path integrator shared by every pass that shades: next-event estimation with MIS, emission,
 // and the path loop. Concatenated after pt_scene.wgsl.
 
+import package::scene_types::{GpuMaterial};
+import package::scene_bindings::{frame, lights, materials};
+import package::scene_geometry::{NO_HIT, SurfacePoint, surface_point, trace_any, trace_closest};
+import package::pt_sampling::{luminance, max_component, power_heuristic, rng_next, rng_next2, sample_uniform_sphere};
+import package::pt_bsdf::{Bsdf, bsdf_eval, bsdf_pdf, bsdf_sample, make_bsdf};
+import package::pt_lights::{FAR, sample_analytic_light, sample_emitter};
+import package::pt_scene::{Shading, base_color_at, environment_pdf, escaped_radiance, offset_origin, orient};
+
 // Next-event estimation at a surface point: every analytic light, one emissive triangle, the
 // environment, each MIS-weighted (power heuristic) against the BSDF's pdf. The three parts are
 // separate functions because a cache-terminated path (nirc) needs some of them without MIS;

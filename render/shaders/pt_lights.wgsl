@@ -4,6 +4,10 @@
 // Emissive triangles emit from their front face only (counter-clockwise winding), as pbrt's
 // area lights do by default.
 
+import package::scene_types::{GpuLight};
+import package::scene_bindings::{lights};
+import package::pt_sampling::{TWO_PI, sample_triangle, sample_uniform_cone, to_world};
+
 const LIGHT_DIRECTIONAL: u32 = 0u;
 const LIGHT_POINT: u32 = 1u;
 const LIGHT_SPOT: u32 = 2u;

@@ -4,8 +4,14 @@
 // Frame, CameraFrame and GpuMaterial are declared once in Rust (render/src/frame.rs,
 // materials.rs: gpu_struct!) and prepended by PassLibrary::source.
 
-const NO_TEXTURE: u32 = 0xffffffffu;
+import package::scene_types::{CameraFrame, GpuMaterial};
+import package::scene_bindings::{frame, lights, texels};
+import package::scene_geometry::{Hit, NO_HIT, SurfacePoint, previous_world_position};
+import package::pt_sampling::{PI, max_component, power_heuristic};
+import package::pt_bsdf::{bsdf_pdf};
+import package::pt_lights::{LIGHT_DIRECTIONAL, cone_solid_angle};
 
+const NO_TEXTURE: u32 = 0xffffffffu;
 
 fn srgb_to_linear(c: vec3f) -> vec3f {
     let lo = c / 12.92;

@@ -1,6 +1,11 @@
 // Primary-hit attributes of a jittered sample, written by every pass that feeds the TAA resolve
 // (taa_trace.wgsl, the hash cache). Needs the shading library (pt_scene: frame, camera helpers).
 
+import package::scene_bindings::{frame};
+import package::scene_geometry::{Hit, NO_HIT, previous_world_position, surface_point};
+import package::pt_scene::{orient, project_offset};
+import package::taa_types::{TaaPrimary};
+
 // The primary hit's attributes for the ray (origin, dir); shared with the hash cache's pass.
 fn primary_attributes(hit: Hit, origin: vec3f, dir: vec3f) -> TaaPrimary {
     var p: TaaPrimary;

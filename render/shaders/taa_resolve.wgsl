@@ -6,8 +6,10 @@
 // fresh history averages uniformly until it reaches the exponential regime.
 // Mirrored on the CPU by render/src/taa/resolve_cpu.rs (keep them in step).
 
-const NO_HIT: u32 = 0xffffffffu;
+import package::taa_types::{TaaPrimary};
+import package::taa_resolve_bindings::{current, history, previous_primary, primary, resolved, taa};
 
+const NO_HIT: u32 = 0xffffffffu;
 
 fn pixel_index(q: vec2i) -> u32 {
     return u32(q.y) * taa.size.x + u32(q.x);

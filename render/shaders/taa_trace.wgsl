@@ -3,6 +3,14 @@
 // Concatenated after PathTracer::library_source() and taa_primary.wgsl; its buffers in @group(2)
 // are declared in render/src/taa/mod.rs (TRACE_GROUP).
 
+import package::scene_bindings::{frame};
+import package::scene_geometry::{sg_rays_traced, trace_closest};
+import package::pt_sampling::{rng_seed};
+import package::pt_lights::{FAR};
+import package::pt_scene::{camera_ray_direction};
+import package::pt_integrator::{path_radiance};
+import package::taa_primary::{primary_attributes};
+import package::taa_trace_bindings::{taa, taa_counters, taa_current, taa_primary};
 
 @compute @workgroup_size(8, 8, 1)
 fn taa_trace(@builtin(global_invocation_id) id: vec3u) {

@@ -4,6 +4,7 @@
 
 use crate::error::RenderError;
 use crate::gpu::Gpu;
+use crate::shader::{Module, Program};
 
 /// How a pass may access a buffer of its bind group.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -74,6 +75,29 @@ pub fn declare(group: u32, bindings: &[BufferBinding]) -> String {
         .collect()
 }
 
+/// A module importable as `path` that declares `bindings` as @group(`group`) ([`declare`]),
+/// importing each struct type they name from the module of `types` that declares it.
+pub fn group_module(path: &str, group: u32, bindings: &[BufferBinding], types: &[&Module]) -> Module {
+    let mut imports: Vec<(String, Vec<String>)> = Vec::new();
+    for b in bindings {
+        // `array<atomic<u32>>`, `array<SscSlot>`, `SscParams`: the struct names start upper case.
+        for name in b.wgsl_type.split(|c: char| !c.is_alphanumeric() && c != '_').filter(|w| w.starts_with(|c: char| c.is_ascii_uppercase())) {
+            let module = types
+                .iter()
+                .find(|m| m.declares_struct(name))
+                .unwrap_or_else(|| panic!("binding {} of {path}: no module among its types declares struct {name}", b.name));
+            let from = &*module.path;
+            match imports.iter_mut().find(|(p, _)| p == from) {
+                Some((_, names)) if names.iter().any(|n| n == name) => {}
+                Some((_, names)) => names.push(name.to_string()),
+                None => imports.push((from.to_string(), vec![name.to_string()])),
+            }
+        }
+    }
+    let imports: String = imports.iter().map(|(p, names)| format!("import {p}::{{{}}};\n", names.join(", "))).collect();
+    Module::generated(path, &[&imports, &declare(group, bindings)])
+}
+
 /// The layout of `bindings` ([`buffer_layout`] of their kinds).
 pub fn binding_layout(gpu: &Gpu, label: &str, bindings: &[BufferBinding]) -> wgpu::BindGroupLayout {
     buffer_layout(gpu, label, &bindings.iter().map(BufferBinding::kind).collect::<Vec<_>>())
@@ -100,37 +124,53 @@ pub fn buffer_group(gpu: &Gpu, label: &str, layout: &wgpu::BindGroupLayout, buff
     gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
 }
 
-/// The pipelines of `entries` in the WGSL `source` (named `pass` in errors), bound with
-/// `groups` as @group(0), @group(1), ...
+/// The pipelines of `entries` in `program`'s entry-point files (named `pass` in errors), bound
+/// with `groups` as @group(0), @group(1), ...
 pub fn pipelines<const N: usize>(
     gpu: &Gpu,
     pass: &str,
-    source: &str,
+    program: &Program,
     groups: &[&wgpu::BindGroupLayout],
     entries: [&str; N],
 ) -> Result<[wgpu::ComputePipeline; N], RenderError> {
     let device = &gpu.device;
     let layouts: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|&g| Some(g)).collect();
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(pass), bind_group_layouts: &layouts, immediate_size: 0 });
-    validated(gpu, pass, source, Some(&layout), entries)
+    validated(gpu, pass, program, Some(&layout), entries)
 }
 
 /// [`pipelines`] whose bind group layouts are derived from the shader (each entry point's own
 /// @group(0), fetched with `get_bind_group_layout`): for passes whose entry points bind
 /// different subsets of one module's buffers.
-pub fn pipelines_auto_layout<const N: usize>(gpu: &Gpu, pass: &str, source: &str, entries: [&str; N]) -> Result<[wgpu::ComputePipeline; N], RenderError> {
-    validated(gpu, pass, source, None, entries)
+pub fn pipelines_auto_layout<const N: usize>(gpu: &Gpu, pass: &str, program: &Program, entries: [&str; N]) -> Result<[wgpu::ComputePipeline; N], RenderError> {
+    validated(gpu, pass, program, None, entries)
 }
 
-fn validated<const N: usize>(gpu: &Gpu, pass: &str, source: &str, layout: Option<&wgpu::PipelineLayout>, entries: [&str; N]) -> Result<[wgpu::ComputePipeline; N], RenderError> {
+fn validated<const N: usize>(gpu: &Gpu, pass: &str, program: &Program, layout: Option<&wgpu::PipelineLayout>, entries: [&str; N]) -> Result<[wgpu::ComputePipeline; N], RenderError> {
+    let linked = program.compose()?;
+    // The file of each entry point.
+    let mut file_of = [0usize; N];
+    for (slot, entry) in file_of.iter_mut().zip(entries) {
+        *slot = linked
+            .iter()
+            .position(|wgsl| wgsl.contains(&format!("fn {entry}(")))
+            .ok_or_else(|| RenderError::Shader { pass: pass.into(), message: format!("no entry point '{entry}' in {:?}", program.entry_files.iter().map(|m| &m.file).collect::<Vec<_>>()) })?;
+    }
     let device = &gpu.device;
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(pass), source: wgpu::ShaderSource::Wgsl(source.into()) });
+    let modules: Vec<wgpu::ShaderModule> = linked
+        .into_iter()
+        .zip(&program.entry_files)
+        .map(|(wgsl, file)| device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(&file.file), source: wgpu::ShaderSource::Wgsl(wgsl.into()) }))
+        .collect();
+    let mut i = 0;
     let made = entries.map(|entry| {
+        let module = &modules[file_of[i]];
+        i += 1;
         device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(entry),
             layout,
-            module: &module,
+            module,
             entry_point: Some(entry),
             compilation_options: Default::default(),
             cache: None,

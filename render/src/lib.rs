@@ -15,6 +15,7 @@ pub mod pass_library;
 pub mod path_tracer;
 pub mod readback;
 pub mod sample_cache;
+pub mod shader;
 pub mod scene_bindings;
 pub mod taa;
 pub mod termination;

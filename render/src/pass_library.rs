@@ -1,5 +1,5 @@
-//! The shading library every method's passes are built on: its WGSL (scene geometry, sampling,
-//! BSDFs, lights, the scene's @group(0) and the path integrator, without entry points) and the
+//! The shading library every method's passes are built on: its WGSL modules (scene geometry,
+//! sampling, BSDFs, lights, the scene's @group(0) and the path integrator, without entry points) and the
 //! run's cache of compiled passes, so that methods with equal passes share their pipelines.
 
 use std::collections::HashMap;
@@ -14,6 +14,7 @@ use crate::materials::GpuMaterial;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::scene_bindings::SceneBindings;
+use crate::shader::{Module, Program};
 
 /// Storage buffers a pass built on the library binds before its own: @group(0) (scene) and
 /// @group(1) (geometry). Add the pass's own to check the adapter limit.
@@ -28,38 +29,45 @@ pub struct PassLibrary {
 }
 
 impl PassLibrary {
-    /// The library's WGSL; a pass appends its own (its buffers in @group(2)) and binds the
-    /// scene's @group(0) and the geometry's @group(1).
-    pub fn source() -> &'static str {
-        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-        SOURCE.get_or_init(|| {
-            [
-                CameraFrame::WGSL,
-                Frame::WGSL,
-                GpuMaterial::WGSL,
-                GpuLight::WGSL,
-                &compute::declare(0, &crate::scene_bindings::GROUP),
-                SceneGeometry::WGSL,
-                include_str!("../shaders/pt_sampling.wgsl"),
-                include_str!("../shaders/pt_bsdf.wgsl"),
-                include_str!("../shaders/pt_lights.wgsl"),
-                include_str!("../shaders/pt_scene.wgsl"),
-                include_str!("../shaders/pt_integrator.wgsl"),
+    /// The library's modules, each after those it imports: the scene's structs and its
+    /// @group(0) (generated), the geometry's @group(1) and traversal, sampling, BSDFs, lights,
+    /// the scene's shading helpers and the path integrator. A pass's program starts with them.
+    pub fn modules() -> &'static [Module] {
+        static MODULES: std::sync::OnceLock<Vec<Module>> = std::sync::OnceLock::new();
+        MODULES.get_or_init(|| {
+            let types = Module::generated("package::scene_types", &[CameraFrame::WGSL, Frame::WGSL, GpuMaterial::WGSL, GpuLight::WGSL]);
+            let bindings = compute::group_module("package::scene_bindings", 0, &crate::scene_bindings::GROUP, &[&types]);
+            vec![
+                types,
+                bindings,
+                SceneGeometry::module(),
+                crate::wgsl_file!("pt_sampling.wgsl"),
+                crate::wgsl_file!("pt_bsdf.wgsl"),
+                crate::wgsl_file!("pt_lights.wgsl"),
+                crate::wgsl_file!("pt_scene.wgsl"),
+                crate::wgsl_file!("pt_integrator.wgsl"),
             ]
-            .join("\n")
         })
     }
 
-    /// The layout of a pass's own @group(2) and the pipelines of `entries` in `source`, a WGSL
-    /// module built on [`Self::source`]; the declarations of `own` (binding i = `own[i]`) are
-    /// appended to it, so a pass states its buffers once. Refuses a pass with more storage
-    /// buffers than the adapter binds. Equal passes are compiled once per run.
+    /// A program on the library: its modules, then `own` (the pass's structs, bindings and
+    /// files it imports), with the pass's entry-point files.
+    pub fn program(own: impl IntoIterator<Item = Module>, entry_files: impl IntoIterator<Item = Module>) -> Program {
+        let mut program = Program::new(Self::modules().to_vec()).with(own);
+        program.entry_files.extend(entry_files);
+        program
+    }
+
+    /// The layout of a pass's own @group(2) and the pipelines of `entries` in `program` (a
+    /// [`Self::program`] whose own modules include `compute::group_module(.., 2, own, ..)`, so a
+    /// pass states its buffers once). Refuses a pass with more storage buffers than the adapter
+    /// binds. Equal passes are compiled once per run.
     pub fn pass<const N: usize>(
         &self,
         gpu: &Gpu,
         scene: &SceneBindings,
         pass: &str,
-        source: &str,
+        program: &Program,
         own: &[BufferBinding],
         entries: [&str; N],
     ) -> Result<(wgpu::BindGroupLayout, [wgpu::ComputePipeline; N]), RenderError> {
@@ -74,7 +82,7 @@ impl PassLibrary {
         let key = {
             use std::hash::{Hash, Hasher};
             let mut h = std::collections::hash_map::DefaultHasher::new();
-            (pass, source, format!("{own:?}"), entries.as_slice()).hash(&mut h);
+            (pass, program, format!("{own:?}"), entries.as_slice()).hash(&mut h);
             h.finish()
         };
         let mut compiled = self.compiled.lock().unwrap_or_else(|e| e.into_inner());
@@ -84,8 +92,7 @@ impl PassLibrary {
             return Ok((layout.clone(), pipelines));
         }
         let layout = compute::binding_layout(gpu, pass, own);
-        let source = format!("{source}\n{}", compute::declare(2, own));
-        let pipelines = compute::pipelines(gpu, pass, &source, &[scene.layout(), scene.geometry().bind_group_layout(), &layout], entries)?;
+        let pipelines = compute::pipelines(gpu, pass, program, &[scene.layout(), scene.geometry().bind_group_layout(), &layout], entries)?;
         compiled.insert(key, (layout.clone(), pipelines.to_vec()));
         Ok((layout, pipelines))
     }

@@ -15,6 +15,7 @@ use crate::pass_library::PassLibrary;
 use crate::readback::read_buffer;
 use crate::scene::{Camera, SceneChanges, SceneDesc};
 use crate::scene_bindings::SceneBindings;
+use crate::shader::{Module, Program};
 use crate::timing::{PassTimer, PassTiming, merge};
 
 /// `Hit::instance`/`primitive` of a pixel whose primary ray left the scene.
@@ -163,7 +164,7 @@ impl PathTracer {
         let [trace_pipeline, gbuffer_pipeline, accumulate_pipeline] = compute::pipelines(
             gpu,
             "path_tracer.wgsl",
-            Self::shader_source(),
+            Self::program(),
             &[scene.layout(), scene.geometry().bind_group_layout(), &layout],
             ["trace_main", "gbuffer_main", "accumulate_main"],
         )?;
@@ -200,25 +201,20 @@ impl PathTracer {
         &self.library
     }
 
-    /// The complete WGSL of the pass (geometry interface + path tracer): part of the key of
-    /// anything cached from its images.
-    pub fn shader_source() -> &'static str {
-        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-        SOURCE.get_or_init(|| {
-            [
-                Self::library_source(),
-                GBufferTexel::WGSL,
-                &compute::declare(2, &OWN_GROUP),
-                &format!("const SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;"),
-                include_str!("../shaders/path_tracer.wgsl"),
-            ]
-            .join("\n")
+    /// The path tracer's program: the library, its own structs and @group(2), path_tracer.wgsl.
+    pub fn program() -> &'static Program {
+        static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
+        PROGRAM.get_or_init(|| {
+            let types = Module::generated("package::path_tracer_types", &[GBufferTexel::WGSL, &format!("const SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;")]);
+            let bindings = compute::group_module("package::path_tracer_bindings", 2, &OWN_GROUP, &[&types]);
+            PassLibrary::program([types, bindings], [crate::wgsl_file!("path_tracer.wgsl")])
         })
     }
 
-    /// The shading library's WGSL ([`PassLibrary::source`]).
-    pub fn library_source() -> &'static str {
-        PassLibrary::source()
+    /// Every WGSL source of the pass: part of the key of anything cached from its images.
+    pub fn shader_source() -> &'static str {
+        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+        SOURCE.get_or_init(|| Self::program().fingerprint())
     }
 
     /// Group 2 over the current buffers, after one of them was replaced.
@@ -231,11 +227,11 @@ impl PathTracer {
         &self,
         gpu: &Gpu,
         pass: &str,
-        source: &str,
+        program: &Program,
         own: &[BufferBinding],
         entries: [&str; N],
     ) -> Result<(wgpu::BindGroupLayout, [wgpu::ComputePipeline; N]), RenderError> {
-        self.library.pass(gpu, &self.scene, pass, source, own, entries)
+        self.library.pass(gpu, &self.scene, pass, program, own, entries)
     }
 
     /// Layout of @group(0) of [`Self::library_source`].

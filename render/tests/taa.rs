@@ -270,10 +270,10 @@ fn equal_passes_share_their_pipelines() {
         BufferBinding::read_write("taa_primary", "array<TaaPrimary>"),
         BufferBinding::read_write("taa_counters", "array<atomic<u32>>"),
     ];
-    let (layout_a, [a]) = t.library_pass(gpu(), "taa_trace.wgsl", Taa::trace_source(), &own, ["taa_trace"]).unwrap();
-    let (layout_b, [b]) = t.library_pass(gpu(), "taa_trace.wgsl", Taa::trace_source(), &own, ["taa_trace"]).unwrap();
+    let (layout_a, [a]) = t.library_pass(gpu(), "taa_trace.wgsl", Taa::trace_program(), &own, ["taa_trace"]).unwrap();
+    let (layout_b, [b]) = t.library_pass(gpu(), "taa_trace.wgsl", Taa::trace_program(), &own, ["taa_trace"]).unwrap();
     assert!(a == b && layout_a == layout_b, "the same pass was compiled twice");
-    let (_, [c]) = t.library_pass(gpu(), "taa_trace.wgsl (copy)", Taa::trace_source(), &own, ["taa_trace"]).unwrap();
+    let (_, [c]) = t.library_pass(gpu(), "taa_trace.wgsl (copy)", Taa::trace_program(), &own, ["taa_trace"]).unwrap();
     assert!(a != c, "a pass of another name must get its own pipeline");
     // Both TAA instances still render (they bind their own buffers to the shared pipeline).
     let (mut one, mut two) = (Taa::new(gpu(), &t, TaaSettings::default()).unwrap(), Taa::new(gpu(), &t, TaaSettings::default()).unwrap());

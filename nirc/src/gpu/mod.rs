@@ -251,7 +251,7 @@ impl NeuralCache {
     /// error naming the pass.
     fn pipelines(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, placement: WeightPlacement) -> Result<Pipelines, NircError> {
         let build = |pass: &str, entries: &[&str]| -> Result<Vec<wgpu::ComputePipeline>, NircError> {
-            let source = shaders::source(config, layout, pass);
+            let source = render::shader::Program::single(&format!("package::nirc::{pass}"), &shaders::source(config, layout, pass));
             let label = format!("nirc {pass}");
             Ok(match entries {
                 [a] => render::compute::pipelines_auto_layout(gpu, &label, &source, [*a])?.to_vec(),

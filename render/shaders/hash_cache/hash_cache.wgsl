@@ -15,6 +15,18 @@
 // WGSL has no 64-bit atomics: the checksum alone is claimed by compare-exchange, last access is
 // a separate word every accessor stores the same value into.
 
+import package::scene_bindings::{frame, materials};
+import package::scene_geometry::{NO_HIT, sg_rays_traced, surface_point, trace_closest};
+import package::pt_sampling::{hash_mix, rng_next, rng_next2, rng_seed};
+import package::pt_bsdf::{bsdf_sample, make_bsdf};
+import package::pt_lights::{FAR};
+import package::pt_scene::{base_color_at, camera_ray_direction, escaped_radiance, offset_origin, orient};
+import package::pt_integrator::{emitted_radiance, next_event, path_radiance};
+import package::taa_primary::{primary_attributes};
+import package::hash_cache_types::{HcRecord};
+import package::hash_cache_bindings::{cell_radiance, colour_out, counters, hc, primary_out, records, slots};
+import package::hash_cache::hash_key::{HC_EMPTY, HC_NONE, VoxelKey, hc_key, hc_level};
+
 const HC_NEEDS_SAMPLE: u32 = 1u;
 const HC_COUNTER_OCCUPIED: u32 = 0u;
 const HC_COUNTER_EVICTED: u32 = 1u;
@@ -22,7 +34,6 @@ const HC_COUNTER_INSERTED: u32 = 2u;
 const HC_COUNTER_FAILED: u32 = 3u;
 const HC_COUNTER_UPDATES: u32 = 4u;
 const HC_COUNTER_RAYS: u32 = 5u;      // rays traced by hc_trace and hc_update
-
 
 @compute @workgroup_size(64, 1, 1)
 fn hc_age(@builtin(global_invocation_id) id: vec3u) {

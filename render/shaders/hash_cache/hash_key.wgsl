@@ -3,6 +3,9 @@
 // normal's major axis, and two hashes of the voxel (home slot, checksum).
 // Mirrored bit for bit by render/src/hash_cache/key.rs.
 
+import package::pt_sampling::{basis_bitangent, basis_tangent, hash_mix, pcg_hash};
+import package::hash_cache_bindings::{hc};
+
 const HC_EMPTY: u32 = 0u;
 const HC_NONE: u32 = 0xffffffffu;
 const HC_LEVEL_BIAS: i32 = 64;

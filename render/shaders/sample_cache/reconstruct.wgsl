@@ -1,6 +1,12 @@
 // Reconstruction (section 3.3): the mean radiance of the pixel's visible, shaded samples; motion
 // from the closest visible sample (where it was last frame), for reprojected metrics.
 
+import package::scene_bindings::{frame};
+import package::pt_scene::{project_offset};
+import package::sample_cache_bindings::{dst_mask, dst_slots, ssc, ssc_out, ssc_work};
+import package::sample_cache::storage::{SSC_AUDIT, SSC_BACKGROUND_DEPTH, ssc_background_dir, ssc_is_background, ssc_pixels, ssc_previous_position, ssc_surface, ssc_visible_slots};
+import package::sample_cache::selection::{ssc_verify};
+
 @compute @workgroup_size(8, 8, 1)
 fn reconstruct_main(@builtin(global_invocation_id) id: vec3u) {
     if id.x >= ssc.width || id.y >= ssc.height {

@@ -1,6 +1,12 @@
 // Forward reprojection (section 3.1) with slot reservation on the occupancy/visibility mask
 // (listing 2, fixed). One thread per (source pixel, slot) of last frame's cache.
 
+import package::scene_bindings::{frame};
+import package::scene_geometry::{NO_HIT};
+import package::pt_scene::{project_offset};
+import package::sample_cache_bindings::{dst_slots, pixel_atomics, src_mask, src_slots, ssc, ssc_work};
+import package::sample_cache::storage::{SSC_ATOMICS, SSC_BACKGROUND_DEPTH, SSC_DROPPED, SSC_REPROJECTED, SSC_WMAX, SSC_WMAX_ACC, SSC_WMIN, SSC_WMIN_ACC, ssc_background_dir, ssc_full, ssc_is_background, ssc_pixels, ssc_surface};
+
 // Listing 2 as printed `break`s after the first try whatever its outcome; the text says a lost
 // race retries on another slot while any remain. Here the loop only ends on success or when no
 // candidate slot is left; every failed try ORs its bit into `m`, so candidates strictly shrink.

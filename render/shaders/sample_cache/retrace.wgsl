@@ -5,33 +5,20 @@
 // and density, final mask, (adaptive shading) the importance histogram. A pixel's thread owns its
 // slots and mask; neighbours are read only through the reservation atomics, written no more.
 
+import package::scene_bindings::{frame};
+import package::scene_geometry::{NO_HIT, sg_rays_traced, trace_closest};
+import package::pt_sampling::{rng_next, rng_next2, rng_seed};
+import package::pt_lights::{FAR};
+import package::pt_scene::{camera_ray_direction};
+import package::sample_cache_types::{SscSlot};
+import package::sample_cache_bindings::{dst_mask, dst_slots, pixel_atomics, ssc, ssc_out, ssc_work};
+import package::sample_cache::storage::{SSC_ALL_RAYS, SSC_ATOMICS, SSC_BACKGROUND_DEPTH, SSC_BASE, SSC_FLAGGED, SSC_FLAG_BASE, SSC_FLAG_HOLE, SSC_FLAG_SLOPE, SSC_HISTOGRAM, SSC_LIST, SSC_MAX_SLOTS, SSC_NEW, SSC_OCCUPIED, SSC_PURGED, SSC_RAYS, SSC_RETRACE_COUNT, SSC_VISIBLE, SSC_WMAX_ACC, SSC_WMIN_ACC, ssc_full, ssc_is_background, ssc_less, ssc_pack_background, ssc_pack_hit, ssc_pixels, ssc_surface, ssc_visible_slots};
+import package::sample_cache::slope::{ssc_consistent, ssc_slope};
+import package::sample_cache::selection::{ssc_base_index, ssc_bucket, ssc_importance, ssc_is_base_pixel, ssc_nth_bit, ssc_verify};
+
 // Jitter stays this far inside the pixel so that round-off never reprojects a sample of a static
 // view into a neighbour (a sample exactly on a pixel border would flip sides).
 const SSC_JITTER_INSET: f32 = 1.0e-3;
-
-// The 4x4 block's base pixel this frame: the block position visits all b*b pixels in turn.
-fn ssc_is_base_pixel(pixel: vec2u) -> bool {
-    let b = ssc.base_block;
-    let k = ssc.frame % (b * b);
-    return pixel.x % b == k % b && pixel.y % b == k / b;
-}
-
-// Round-robin index of the base sample of a base pixel, among `count` candidates.
-fn ssc_base_index(count: u32) -> u32 {
-    let b = ssc.base_block;
-    return (ssc.frame / (b * b)) % max(count, 1u);
-}
-
-// Retrace from the eye towards the stored point (a shadow ray, section 3.2): visible when nothing
-// is hit before (1 - ε0) of the way there; a background sample is visible when its ray escapes.
-fn ssc_verify(hit: vec4u) -> bool {
-    let eye = frame.camera.position;
-    if ssc_is_background(hit) {
-        return !trace_any(eye, ssc_background_dir(hit), FAR);
-    }
-    let d = ssc_surface(hit).position - eye;
-    return !trace_any(eye, d, 1.0 - ssc.epsilon0);
-}
 
 fn ssc_new_sample(pixel: vec2u, rng: ptr<function, u32>) -> vec4u {
     let jitter = mix(vec2f(SSC_JITTER_INSET), vec2f(1.0 - SSC_JITTER_INSET), rng_next2(rng));
@@ -48,23 +35,6 @@ fn ssc_swap_bits(bits: u32, i: u32, j: u32) -> u32 {
     let a = (bits >> i) & 1u;
     let b = (bits >> j) & 1u;
     return (bits & ~((1u << i) | (1u << j))) | (a << j) | (b << i);
-}
-
-// Log-spaced bucket (M buckets) of importance w between this frame's bounds (last frame's min
-// and max): M - 1 = most important. Degenerate bounds (first frame) put everything in M - 1.
-fn ssc_bucket(w: f32) -> u32 {
-    let m = ssc.buckets;
-    let lo = bitcast<f32>(atomicLoad(&ssc_work[SSC_WMIN]));
-    let hi = bitcast<f32>(atomicLoad(&ssc_work[SSC_WMAX]));
-    if !(lo > 0.0) || !(hi > lo) {
-        return m - 1u;
-    }
-    let f = log(w / lo) / log(hi / lo);
-    return u32(clamp(floor(f * f32(m)), 0.0, f32(m - 1u)));
-}
-
-fn ssc_importance(count: f32) -> f32 {
-    return 1.0 / (1.0 + count);
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -323,13 +293,4 @@ fn finish_main(@builtin(global_invocation_id) id: vec3u) {
             atomicAdd(&ssc_work[SSC_HISTOGRAM + ssc_bucket(w)], 1u);
         }
     }
-}
-
-// Index of the r-th set bit of `bits` (r counted from 0, lowest first).
-fn ssc_nth_bit(bits: u32, r: u32) -> u32 {
-    var b = bits;
-    for (var skip = 0u; skip < r; skip++) {
-        b &= b - 1u;
-    }
-    return firstTrailingBit(b);
 }

@@ -3,6 +3,15 @@
 // weight is max(1 / (c_s + 1), α): a running mean that becomes an exponential average with
 // factor α once c_s >= 1/α - 1 (the paper's temporal filter, α = 0.1; α = 0 keeps the mean).
 
+import package::scene_bindings::{frame, materials};
+import package::scene_geometry::{sg_rays_traced};
+import package::pt_sampling::{max_component, rng_next, rng_next2, rng_seed};
+import package::pt_bsdf::{bsdf_sample, make_bsdf};
+import package::pt_scene::{base_color_at, escaped_radiance, offset_origin, orient};
+import package::pt_integrator::{emitted_radiance, next_event, path_radiance};
+import package::sample_cache_bindings::{dst_slots, ssc, ssc_work};
+import package::sample_cache::storage::{SSC_ALL_RAYS, SSC_LIST, SSC_SHADE_COUNT, ssc_background_dir, ssc_is_background, ssc_pixels, ssc_surface};
+
 fn ssc_shade(hit: vec4u, rng: ptr<function, u32>) -> vec3f {
     let eye = frame.camera.position;
     if ssc_is_background(hit) {

@@ -4,6 +4,13 @@
 // buckets above the threshold all, the threshold bucket by a weighted coin toss.
 // The chosen slots are appended to the shade list (compacted work for shade_main).
 
+import package::scene_bindings::{frame};
+import package::scene_geometry::{NO_HIT};
+import package::pt_sampling::{rng_next, rng_seed};
+import package::sample_cache_bindings::{dst_mask, dst_slots, ssc, ssc_work};
+import package::sample_cache::storage::{SSC_BASE, SSC_COIN, SSC_HISTOGRAM, SSC_LIST, SSC_SHADE_COUNT, SSC_THRESHOLD, ssc_pixels, ssc_visible_slots};
+import package::sample_cache::selection::{ssc_base_index, ssc_bucket, ssc_importance, ssc_is_base_pixel, ssc_nth_bit};
+
 // One thread: the threshold bucket and its coin probability from the histogram and the budget
 // (twin of sample_cache/shading_rate.rs `threshold`).
 @compute @workgroup_size(1, 1, 1)

@@ -11,6 +11,9 @@
 // Mask: one u32 per pixel, occupancy o_s in bits 0..N-1 and visibility v_s in bits N..2N-1
 // (N <= 16), bits 2N..31 always zero.
 
+import package::scene_geometry::{Hit, NO_HIT, SurfacePoint, previous_world_position, surface_point};
+import package::sample_cache_bindings::{ssc};
+
 const SSC_MAX_SLOTS: u32 = 16u;
 const SSC_ATOMICS: u32 = 3u;
 // Depth of a background sample in the slope test (finite: the test multiplies it).
@@ -42,7 +45,6 @@ const SSC_LIST: u32 = 48u;
 const SSC_FLAG_BASE: u32 = 1u;
 const SSC_FLAG_SLOPE: u32 = 2u;
 const SSC_FLAG_HOLE: u32 = 4u;
-
 
 fn ssc_pixels() -> u32 {
     return ssc.width * ssc.height;

@@ -97,11 +97,6 @@ pub struct RayBuffers {
 
 impl RayBatch {
     pub fn new(gpu: &Gpu, geometry: &SceneGeometry) -> Self {
-        let source = format!("{}\n{}", SceneGeometry::WGSL, include_str!("../../shaders/bvh_ray_batch.wgsl"));
-        let module = gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("bvh_ray_batch.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -117,22 +112,10 @@ impl RayBatch {
                 entry(3, wgpu::BufferBindingType::Uniform),
             ],
         });
-        let pipeline_layout = gpu.device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("ray batch"),
-            bind_group_layouts: &[Some(&layout), Some(geometry.bind_group_layout())],
-            immediate_size: 0,
-        });
-        let pipeline = |entry_point| {
-            gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry_point),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry_point),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        Self { closest: pipeline("trace_closest_rays"), any: pipeline("trace_any_rays"), points: pipeline("surface_points"), layout }
+        let program = crate::shader::Program::new(vec![SceneGeometry::module()]).entry(crate::wgsl_file!("bvh_ray_batch.wgsl"));
+        let [closest, any, points] = crate::compute::pipelines(gpu, "bvh_ray_batch.wgsl", &program, &[&layout, geometry.bind_group_layout()], ["trace_closest_rays", "trace_any_rays", "surface_points"])
+            .unwrap_or_else(|e| panic!("the ray batch's WGSL: {e}"));
+        Self { closest, any, points, layout }
     }
 
     /// Uploads the rays (refuses more than the adapter's buffers hold).

@@ -87,9 +87,11 @@ pub struct SceneGeometry {
 }
 
 impl SceneGeometry {
-    /// The WGSL interface (`trace_closest`, `trace_any`, `surface_point`, ...); concatenate it
-    /// before a pass's own code and bind [`Self::bind_group`] at group 1.
-    pub const WGSL: &'static str = include_str!("../../shaders/scene_geometry.wgsl");
+    /// The WGSL interface (`trace_closest`, `trace_any`, `surface_point`, ...), importable as
+    /// `flicker::scene_geometry`; a pass that imports it binds [`Self::bind_group`] at group 1.
+    pub fn module() -> crate::shader::Module {
+        crate::wgsl_file!("scene_geometry.wgsl")
+    }
 
     /// Storage buffers in the bind group: a pass adds its own to check the per-stage limit.
     pub const STORAGE_BUFFERS: u32 = STORAGE_BUFFERS;

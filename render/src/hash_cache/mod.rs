@@ -49,7 +49,9 @@ use crate::gpu_struct::GpuStruct;
 use crate::path_tracer::PathTracer;
 use crate::readback::read_buffer;
 use crate::scene::Camera;
-use crate::taa::{PRIMARY_WGSL, Taa, TaaPrimary, halton_jitter};
+use crate::pass_library::PassLibrary;
+use crate::shader::{Module, Program};
+use crate::taa::{Taa, TaaPrimary, halton_jitter};
 use crate::timing::{PassTimer, PassTiming};
 use bytemuck::Pod;
 
@@ -277,25 +279,20 @@ impl HashCache {
         let colour = buffer("hash cache colour", pixels * 16, rw);
 
         let own = OWN_GROUP;
-        let (layout, pipelines) = tracer.library_pass(gpu, "hash_cache.wgsl", Self::shader_source(), &own, PASSES)?;
+        let (layout, pipelines) = tracer.library_pass(gpu, "hash_cache.wgsl", Self::program(), &own, PASSES)?;
         let group = crate::compute::buffer_group(gpu, "hash cache", &layout, &[&params, &slots, &cells, &records, &counters, &primary, &colour]);
         Ok(Self { settings, width, height, params, slots, cells, records, counters, primary, colour, group, pipelines, timer: PassTimer::new(gpu, &PASSES), frames: 0 })
     }
 
-    /// The complete WGSL of the passes: shading library, TaaPrimary, keys, passes.
-    pub fn shader_source() -> &'static str {
-        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-        SOURCE.get_or_init(|| {
-            [
-                PathTracer::library_source(),
-                TaaPrimary::WGSL,
-                PRIMARY_WGSL,
-                HashCacheParams::WGSL,
-                HcRecord::WGSL,
-                include_str!("../../shaders/hash_cache/hash_key.wgsl"),
-                include_str!("../../shaders/hash_cache/hash_cache.wgsl"),
-            ]
-            .join("\n")
+    /// The passes' program: the shading library, TAA's structs and primary attributes, the
+    /// cache's structs and @group(2), its keys, hash_cache.wgsl.
+    pub fn program() -> &'static Program {
+        static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
+        PROGRAM.get_or_init(|| {
+            let taa_types = crate::taa::types_module();
+            let types = Module::generated("package::hash_cache_types", &[HashCacheParams::WGSL, HcRecord::WGSL]);
+            let bindings = crate::compute::group_module("package::hash_cache_bindings", 2, &OWN_GROUP, &[&taa_types, &types]);
+            PassLibrary::program([taa_types, crate::taa::primary_module(), types, bindings, crate::wgsl_file!("hash_cache/hash_key.wgsl")], [crate::wgsl_file!("hash_cache/hash_cache.wgsl")])
         })
     }
 

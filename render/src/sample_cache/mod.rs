@@ -30,7 +30,9 @@ use crate::compute::BufferBinding;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
+use crate::pass_library::PassLibrary;
 use crate::path_tracer::PathTracer;
+use crate::shader::{Module, Program};
 use crate::readback::read_buffer;
 use crate::timing::{PassTimer, PassTiming};
 
@@ -72,24 +74,23 @@ const OWN_GROUP: [BufferBinding; 8] = [
     BufferBinding::read_write("ssc_out", "array<SscPixel>"),
 ];
 
-/// The WGSL of the cache passes (appended to the path tracer's library).
-pub fn shader_source() -> &'static str {
-    static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-    SOURCE.get_or_init(|| {
-        [
-            PathTracer::library_source(),
-            SscParams::WGSL,
-            storage::SscSlot::WGSL,
-            SscPixel::WGSL,
-            include_str!("../../shaders/sample_cache/storage.wgsl"),
-            include_str!("../../shaders/sample_cache/slope.wgsl"),
-            include_str!("../../shaders/sample_cache/reproject.wgsl"),
-            include_str!("../../shaders/sample_cache/retrace.wgsl"),
-            include_str!("../../shaders/sample_cache/shading_rate.wgsl"),
-            include_str!("../../shaders/sample_cache/shade.wgsl"),
-            include_str!("../../shaders/sample_cache/reconstruct.wgsl"),
-        ]
-        .join("\n")
+/// The cache passes' program: the shading library, the cache's structs and @group(2), its
+/// storage, slope and selection modules, and one entry-point file per stage's passes.
+pub fn program() -> &'static Program {
+    static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
+    PROGRAM.get_or_init(|| {
+        let types = Module::generated("package::sample_cache_types", &[SscParams::WGSL, storage::SscSlot::WGSL, SscPixel::WGSL]);
+        let bindings = crate::compute::group_module("package::sample_cache_bindings", 2, &OWN_GROUP, &[&types]);
+        PassLibrary::program(
+            [types, bindings, crate::wgsl_file!("sample_cache/storage.wgsl"), crate::wgsl_file!("sample_cache/slope.wgsl"), crate::wgsl_file!("sample_cache/selection.wgsl")],
+            [
+                crate::wgsl_file!("sample_cache/reproject.wgsl"),
+                crate::wgsl_file!("sample_cache/retrace.wgsl"),
+                crate::wgsl_file!("sample_cache/shading_rate.wgsl"),
+                crate::wgsl_file!("sample_cache/shade.wgsl"),
+                crate::wgsl_file!("sample_cache/reconstruct.wgsl"),
+            ],
+        )
     })
 }
 
@@ -259,7 +260,7 @@ impl SampleCache {
         let (layout, [begin, reserve, retrace, retrace_list, finish, rates, select, shade, reconstruct, audit]) = tracer.library_pass(
             gpu,
             "shaders/sample_cache/*.wgsl",
-            shader_source(),
+            program(),
             &OWN_GROUP,
             ["begin_main", "reserve_main", "retrace_main", "retrace_list_main", "finish_main", "rates_main", "select_main", "shade_main", "reconstruct_main", "audit_main"],
         )?;

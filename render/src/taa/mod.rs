@@ -37,7 +37,9 @@ use crate::compute::BufferBinding;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
+use crate::pass_library::PassLibrary;
 use crate::path_tracer::PathTracer;
+use crate::shader::{Module, Program};
 use crate::readback::read_buffer;
 use crate::timing::{PassTimer, PassTiming};
 use bytemuck::Pod;
@@ -47,8 +49,15 @@ pub use jitter::{halton, halton_jitter};
 pub const TAA_TRACE_PASS: &str = "taa_trace";
 pub const TAA_RESOLVE_PASS: &str = "taa_resolve";
 
-/// `TaaPrimary` and `primary_attributes` in WGSL, for every pass that feeds the resolve.
-pub const PRIMARY_WGSL: &str = include_str!("../../shaders/taa_primary.wgsl");
+/// TAA's structs (`TaaParams`, `TaaPrimary`), importable as `flicker::taa_types`.
+pub fn types_module() -> Module {
+    Module::generated("package::taa_types", &[TaaParams::WGSL, TaaPrimary::WGSL])
+}
+
+/// The primary-hit attributes shared by TAA and the hash cache (`flicker::taa_primary`).
+pub fn primary_module() -> Module {
+    crate::wgsl_file!("taa_primary.wgsl")
+}
 
 const WORKGROUP: u32 = 8;
 
@@ -255,9 +264,9 @@ impl Taa {
         let history = [buffer("taa history 0", pixels * 16, rw), buffer("taa history 1", pixels * 16, rw)];
         let counters = buffer("taa ray counter", 16, rw);
 
-        let (trace_layout, [trace_pipeline]) = tracer.library_pass(gpu, "taa_trace.wgsl", Self::trace_source(), &TRACE_GROUP, ["taa_trace"])?;
+        let (trace_layout, [trace_pipeline]) = tracer.library_pass(gpu, "taa_trace.wgsl", Self::trace_program(), &TRACE_GROUP, ["taa_trace"])?;
         let resolve_layout = crate::compute::binding_layout(gpu, "taa resolve", &RESOLVE_GROUP);
-        let [resolve_pipeline] = crate::compute::pipelines(gpu, "taa_resolve.wgsl", &Self::resolve_source(), &[&resolve_layout], ["taa_resolve"])?;
+        let [resolve_pipeline] = crate::compute::pipelines(gpu, "taa_resolve.wgsl", &Self::resolve_program(), &[&resolve_layout], ["taa_resolve"])?;
         let resolve_group = |p: usize| {
             let q = 1 - p;
             crate::compute::buffer_group(gpu, "taa resolve", &resolve_layout, &[&params, &current, &primary[p], &primary[q], &history[q], &history[p]])
@@ -284,15 +293,22 @@ impl Taa {
         })
     }
 
-    /// The resolve pass's complete WGSL (TaaParams, its bindings, taa_resolve.wgsl).
-    fn resolve_source() -> String {
-        [TaaParams::WGSL, TaaPrimary::WGSL, &crate::compute::declare(0, &RESOLVE_GROUP), include_str!("../../shaders/taa_resolve.wgsl")].join("\n")
+    /// The resolve pass's program: TAA's structs, its @group(0), taa_resolve.wgsl.
+    fn resolve_program() -> Program {
+        let types = types_module();
+        let bindings = crate::compute::group_module("package::taa_resolve_bindings", 0, &RESOLVE_GROUP, &[&types]);
+        Program::new(vec![types, bindings]).entry(crate::wgsl_file!("taa_resolve.wgsl"))
     }
 
-    /// The trace pass's complete WGSL (shading library + taa_trace.wgsl).
-    pub fn trace_source() -> &'static str {
-        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-        SOURCE.get_or_init(|| [PathTracer::library_source(), TaaParams::WGSL, TaaPrimary::WGSL, PRIMARY_WGSL, include_str!("../../shaders/taa_trace.wgsl")].join("\n"))
+    /// The trace pass's program: the shading library, TAA's structs, the primary attributes, its
+    /// @group(2), taa_trace.wgsl.
+    pub fn trace_program() -> &'static Program {
+        static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
+        PROGRAM.get_or_init(|| {
+            let types = types_module();
+            let bindings = crate::compute::group_module("package::taa_trace_bindings", 2, &TRACE_GROUP, &[&types]);
+            PassLibrary::program([types, primary_module(), bindings], [crate::wgsl_file!("taa_trace.wgsl")])
+        })
     }
 
     pub fn settings(&self) -> TaaSettings {
