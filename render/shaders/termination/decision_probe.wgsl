@@ -1,7 +1,9 @@
 // Runs tc_decide on a batch of cases (render::termination::gpu_decision, the GPU-vs-CPU test).
-// Concatenated after decision.wgsl. A case is 6 vec4f: rule (kind, relative, param, margin),
+// A case is 6 vec4f: rule (kind, relative, param, margin),
 // (bias_clamp, survival, -, -), state (throughput2, path_variance, threshold, spread_sqrt),
 // (spread0, vertex, -, -), stats (radiance, variance, marginal, bias2), (deferred_bias2, -, -, -).
+
+import package::termination::decision::{TcLocalStats, TcPathState, TcRule, tc_decide};
 
 @group(0) @binding(0) var<storage, read> cases: array<vec4f>;
 @group(0) @binding(1) var<storage, read_write> decisions: array<vec4f>;

@@ -1,6 +1,6 @@
 // Hashed radiance cache with variance-trading termination (variance-trading-termination.txt):
-// the passes of one frame. Concatenated after the shading library, taa_primary (TaaPrimary),
-// hash_key.wgsl (the voxel keys of the hash cache, through its `hc` uniform) and decision.wgsl.
+// the passes of one frame. The voxel keys are the hash cache's (hash_key.wgsl, through its `hc`
+// uniform, binding 0 of this pass's @group(2) too); the decision is decision.wgsl.
 //
 //   tc_propagate  per stored vertex (4 per record): K one-segment samples at the vertex (NEE +
 //                 one BSDF sample ending in the cache at its hit) -> the vertex's mean, mean of
@@ -16,6 +16,20 @@
 // stored so far, unused. `records` holds the records' moments, then the per-vertex estimates of
 // this frame; `vertices` the stored vertices, then the candidates (pixels, then propagation).
 // Records are never evicted (static scenes, the cache in equilibrium as in the paper's §6).
+
+import package::scene_bindings::{frame, materials};
+import package::scene_geometry::{NO_HIT, sg_rays_traced, surface_point, trace_closest};
+import package::pt_sampling::{luminance, rng_next, rng_next2, rng_seed};
+import package::pt_bsdf::{bsdf_sample, make_bsdf};
+import package::pt_lights::{FAR};
+import package::pt_scene::{base_color_at, camera_ray_direction, escaped_radiance, offset_origin, orient};
+import package::pt_integrator::{emitted_radiance, next_event};
+import package::taa_primary::{primary_attributes};
+import package::termination_types::{TcRecord, TcVertex};
+import package::termination_bindings::{colour_out, counters, path_length, primary_out, records, slots, tc, vertices};
+import package::hash_cache_bindings::{hc};
+import package::hash_cache::hash_key::{HC_EMPTY, HC_NONE, VoxelKey, hc_key, hc_level};
+import package::termination::decision::{TC_PATH_TRACING, TcLocalStats, TcPathState, TcRule, tc_arrive_area_spread, tc_decide, tc_threshold};
 
 const TC_COUNTER_VERTICES: u32 = 0u;   // path vertices of the tracer's paths, x TC_LENGTH_SCALE
 // Path length is counted in 1/256 vertex: the vertex after a blend counts alpha (the paper's

@@ -2,16 +2,18 @@
 //! records, the propagation dispatch, the tracer with the termination decision, and the vertex
 //! store. One frame = propagate, fold, trace, store, each its own timed pass.
 
-use super::gpu_decision::{DECISION_WGSL, rule_words};
+use super::gpu_decision::{decision_module, rule_words};
 use super::settings::{BYTES_PER_RECORD, TerminationSettings, VERTICES_PER_RECORD};
-use crate::compute::BufferBinding;
+use crate::compute::{self, BufferBinding};
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
 use crate::hash_cache::{HashCacheParams, HashCacheSettings};
+use crate::pass_library::PassLibrary;
 use crate::path_tracer::PathTracer;
+use crate::shader::{Module, Program};
 use crate::scene::Camera;
-use crate::taa::{PRIMARY_WGSL, TaaPrimary};
+use crate::taa::TaaPrimary;
 use crate::timing::{PassTimer, PassTiming};
 use crate::hash_cache::read;
 
@@ -179,28 +181,27 @@ impl TerminationCache {
         let primary = buffer("termination primary", pixels * size_of::<TaaPrimary>() as u64, rw);
         let colour = buffer("termination colour", pixels * 16, rw);
         let path_length = buffer("termination path length", pixels * 4, rw);
-        let (layout, pipelines) = tracer.library_pass(gpu, "termination.wgsl", Self::shader_source(), &OWN_GROUP, PASSES)?;
+        let (layout, pipelines) = tracer.library_pass(gpu, "termination.wgsl", Self::program(), &OWN_GROUP, PASSES)?;
         let group = crate::compute::buffer_group(gpu, "termination", &layout, &[&hc, &tc, &slots, &records, &vertices, &counters, &primary, &colour, &path_length]);
         Ok(Self { settings, width, height, hc, tc, slots, records, counters, primary, colour, path_length, group, pipelines, timer: PassTimer::new(gpu, &PASSES), frames: 0 })
     }
 
-    /// The complete WGSL of the passes.
-    pub fn shader_source() -> &'static str {
-        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-        SOURCE.get_or_init(|| {
-            [
-                PathTracer::library_source(),
-                TaaPrimary::WGSL,
-                PRIMARY_WGSL,
-                HashCacheParams::WGSL,
-                TcParams::WGSL,
-                TcRecord::WGSL,
-                TcVertex::WGSL,
-                include_str!("../../shaders/hash_cache/hash_key.wgsl"),
-                DECISION_WGSL,
-                include_str!("../../shaders/termination/termination.wgsl"),
-            ]
-            .join("\n")
+    /// The passes' program: the shading library, TAA's primary attributes, the hash cache's
+    /// keys and its `hc` uniform (binding 0 of this @group(2), its own module because
+    /// hash_key.wgsl imports it from there), this cache's structs and other bindings, the
+    /// decision, termination.wgsl.
+    pub fn program() -> &'static Program {
+        static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
+        PROGRAM.get_or_init(|| {
+            let taa_types = crate::taa::types_module();
+            let hc_types = crate::hash_cache::types_module();
+            let types = Module::generated("package::termination_types", &[TcParams::WGSL, TcRecord::WGSL, TcVertex::WGSL]);
+            let hc = compute::group_module_range("package::hash_cache_bindings", 2, &OWN_GROUP, 0..1, &[&hc_types]);
+            let bindings = compute::group_module_range("package::termination_bindings", 2, &OWN_GROUP, 1..OWN_GROUP.len(), &[&taa_types, &types]);
+            PassLibrary::program(
+                [taa_types, crate::taa::primary_module(), hc_types, hc, types, bindings, crate::wgsl_file!("hash_cache/hash_key.wgsl"), decision_module()],
+                [crate::wgsl_file!("termination/termination.wgsl")],
+            )
         })
     }
 

@@ -6,9 +6,13 @@ use super::rule::TerminationRule;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::readback::read_buffer;
+use crate::shader::{Module, Program};
 use wgpu::util::DeviceExt;
 
-pub const DECISION_WGSL: &str = include_str!("../../shaders/termination/decision.wgsl");
+/// `package::termination::decision`: the decision, imported by the cache's passes and the probe.
+pub fn decision_module() -> Module {
+    crate::wgsl_file!("termination/decision.wgsl")
+}
 
 /// The rule as the shader's `TcRule` fields: (kind, relative, param, margin, bias_clamp).
 pub fn rule_words(rule: &TerminationRule) -> (u32, u32, f32, f32, f32) {
@@ -44,8 +48,8 @@ pub fn decide_on_gpu(gpu: &Gpu, cases: &[DecisionCase]) -> Result<Vec<[f32; 2]>,
         words.push([st.deferred_bias2 as f32, 0.0, 0.0, 0.0]);
     }
     let device = &gpu.device;
-    let source = [DECISION_WGSL, include_str!("../../shaders/termination/decision_probe.wgsl")].join("\n");
-    let [pipeline] = crate::compute::pipelines_auto_layout(gpu, "tc_decide_probe", &source, ["tc_decide_probe"])?;
+    let program = Program::new(vec![decision_module()]).entry(crate::wgsl_file!("termination/decision_probe.wgsl"));
+    let [pipeline] = crate::compute::pipelines_auto_layout(gpu, "tc_decide_probe", &program, ["tc_decide_probe"])?;
     let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("decision cases"), contents: bytemuck::cast_slice(&words), usage: wgpu::BufferUsages::STORAGE });
     let size = (cases.len().max(1) * 16) as u64;
     let output = device.create_buffer(&wgpu::BufferDescriptor { label: Some("decisions"), size, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
