@@ -61,9 +61,15 @@ pub const fn storage_buffers(bindings: &[BufferBinding]) -> u32 {
 
 /// The WGSL declarations of `bindings` as @group(`group`), binding i = `bindings[i]`.
 pub fn declare(group: u32, bindings: &[BufferBinding]) -> String {
+    declare_range(group, bindings, 0..bindings.len())
+}
+
+/// [`declare`] of `bindings[range]` only, each at its index in `bindings`.
+pub fn declare_range(group: u32, bindings: &[BufferBinding], range: std::ops::Range<usize>) -> String {
     bindings
         .iter()
         .enumerate()
+        .filter(|(i, _)| range.contains(i))
         .map(|(i, b)| {
             let space = match b.access {
                 Access::Uniform => "<uniform>",
@@ -78,8 +84,14 @@ pub fn declare(group: u32, bindings: &[BufferBinding]) -> String {
 /// A module importable as `path` that declares `bindings` as @group(`group`) ([`declare`]),
 /// importing each struct type they name from the module of `types` that declares it.
 pub fn group_module(path: &str, group: u32, bindings: &[BufferBinding], types: &[&Module]) -> Module {
+    group_module_range(path, group, bindings, 0..bindings.len(), types)
+}
+
+/// [`group_module`] of `bindings[range]` only, each at its index in `bindings`: a group split
+/// over two modules (a pass that shares another pass's uniform and the functions importing it).
+pub fn group_module_range(path: &str, group: u32, bindings: &[BufferBinding], range: std::ops::Range<usize>, types: &[&Module]) -> Module {
     let mut imports: Vec<(String, Vec<String>)> = Vec::new();
-    for b in bindings {
+    for b in &bindings[range.clone()] {
         // `array<atomic<u32>>`, `array<SscSlot>`, `SscParams`: the struct names start upper case.
         for name in b.wgsl_type.split(|c: char| !c.is_alphanumeric() && c != '_').filter(|w| w.starts_with(|c: char| c.is_ascii_uppercase())) {
             let module = types
@@ -95,7 +107,7 @@ pub fn group_module(path: &str, group: u32, bindings: &[BufferBinding], types: &
         }
     }
     let imports: String = imports.iter().map(|(p, names)| format!("import {p}::{{{}}};\n", names.join(", "))).collect();
-    Module::generated(path, &[&imports, &declare(group, bindings)])
+    Module::generated(path, &[&imports, &declare_range(group, bindings, range)])
 }
 
 /// The layout of `bindings` ([`buffer_layout`] of their kinds).

@@ -18,4 +18,5 @@ pub mod sample_cache;
 pub mod shader;
 pub mod scene_bindings;
 pub mod taa;
+pub mod termination;
 pub mod timing;

@@ -10,6 +10,7 @@ use render::materials::GpuMaterial;
 use render::lights::GpuLight;
 use render::sample_cache::{SscParams, SscPixel, SscSlot};
 use render::taa::{TaaParams, TaaPrimary};
+use render::termination::cache::{TcParams, TcRecord, TcVertex};
 
 fn mismatches<T: GpuStruct>(deps: &str) -> Vec<String> {
     render::gpu_struct::layout_mismatches::<T>(deps)
@@ -37,6 +38,9 @@ fn shared_structs_have_one_layout() {
         ("SgVertex", mismatches::<SgVertex>("")),
         ("SgInstance", mismatches::<SgInstance>("")),
         ("SgInstanceHeader", mismatches::<SgInstanceHeader>("")),
+        ("TcParams", mismatches::<TcParams>("")),
+        ("TcRecord", mismatches::<TcRecord>("")),
+        ("TcVertex", mismatches::<TcVertex>("")),
     ] {
         assert!(found.is_empty(), "{name}: {found:?}");
     }

@@ -2,69 +2,16 @@
 //! contents, probing bound, no duplicates, eviction of entries older than max_age), a furnace
 //! converging to its analytic radiance through the cache, and stability against 1 spp.
 
-use glam::{Mat4, Quat, Vec3};
-use render::gpu::Gpu;
+use glam::Vec3;
 use render::hash_cache::key::{self, NONE};
 use render::hash_cache::table_cpu::{CpuHashTable, check_invariants};
 use render::hash_cache::{HC_NEEDS_SAMPLE, HashCache, HashCacheLookup, HashCacheSettings};
 use render::path_tracer::{PathTracer, PathTracerSettings};
-use render::scene::{Camera, Instance, Material, Mesh, SceneDesc};
+use render::scene::SceneDesc;
 use render::taa::{Taa, TaaSettings, resolve_cpu};
-use std::sync::OnceLock;
 
-const W: u32 = 32;
-const H: u32 = 18;
-
-fn gpu() -> &'static Gpu {
-    static GPU: OnceLock<Gpu> = OnceLock::new();
-    GPU.get_or_init(|| Gpu::new().expect("a wgpu adapter (lavapipe on CI)"))
-}
-
-/// Axis-aligned box [-1, 1]^3, faces wound to face outwards or inwards (emitters are one-sided).
-fn box_mesh(inward: bool) -> Mesh {
-    let mut positions = vec![];
-    let mut indices = vec![];
-    for axis in 0..3 {
-        for sign in [-1.0f32, 1.0] {
-            let n = Vec3::from_array(std::array::from_fn(|i| if i == axis { sign } else { 0.0 }));
-            let (u, v) = (Vec3::from_array(std::array::from_fn(|i| (i == (axis + 1) % 3) as u8 as f32)), Vec3::from_array(std::array::from_fn(|i| (i == (axis + 2) % 3) as u8 as f32)));
-            let base = positions.len() as u32;
-            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                positions.push(n + a * u + b * v);
-            }
-            let mut tris = [[base, base + 1, base + 2], [base, base + 2, base + 3]];
-            for t in &mut tris {
-                let (p0, p1, p2) = (positions[t[0] as usize], positions[t[1] as usize], positions[t[2] as usize]);
-                let outward = (p1 - p0).cross(p2 - p0).dot(n) > 0.0;
-                if outward == inward {
-                    t.swap(1, 2);
-                }
-            }
-            indices.extend(tris);
-        }
-    }
-    Mesh { name: "box".into(), positions, normals: vec![], uvs: vec![], indices }
-}
-
-/// A closed grey room (inward walls, [-2, 2]^3) lit by a panel under the ceiling, with a red
-/// box: mostly indirect light, the case a radiance cache is for.
-fn room_scene() -> SceneDesc {
-    let grey = Material { base_color: Vec3::splat(0.6), specular: 0.0, ..Default::default() };
-    let red = Material { base_color: Vec3::new(0.7, 0.2, 0.1), specular: 0.0, ..Default::default() };
-    let light = Material { base_color: Vec3::ZERO, emission: Vec3::splat(8.0), specular: 0.0, ..Default::default() };
-    SceneDesc {
-        meshes: vec![box_mesh(true), box_mesh(false), Mesh::plane(0.5)],
-        materials: vec![grey, red, light],
-        instances: vec![
-            Instance { mesh: 0, material: 0, transform: Mat4::from_scale(Vec3::splat(2.0)) },
-            Instance { mesh: 1, material: 1, transform: Mat4::from_scale_rotation_translation(Vec3::splat(0.6), Quat::from_rotation_y(0.5), Vec3::new(0.3, -1.4, -0.5)) },
-            // Facing down.
-            Instance { mesh: 2, material: 2, transform: Mat4::from_rotation_translation(Quat::from_rotation_x(std::f32::consts::PI), Vec3::new(0.0, 1.95, 0.0)) },
-        ],
-        camera: Camera { position: Vec3::new(0.0, 0.0, 1.9), target: Vec3::new(0.0, -0.6, -1.0), up: Vec3::Y, vfov: 1.1 },
-        ..Default::default()
-    }
-}
+mod common;
+use common::{H, W, furnace, gpu, room_scene};
 
 fn tracer(scene: &SceneDesc, max_depth: u32) -> PathTracer {
     PathTracer::new(gpu(), scene, PathTracerSettings { width: W, height: H, max_depth, rr_start_depth: 3 }).expect("path tracer")
@@ -128,20 +75,6 @@ fn keys_table_and_eviction_match_the_cpu_reference() {
         }
         assert!(evictions > 0, "{lookup:?}: the moving camera evicted nothing");
     }
-}
-
-/// Inside a closed box whose walls (albedo a) all emit Le: L = Le / (1 - a) everywhere.
-fn furnace() -> (SceneDesc, f32) {
-    let (le, a) = (0.5f32, 0.5f32);
-    let wall = Material { base_color: Vec3::splat(a), emission: Vec3::splat(le), specular: 0.0, ..Default::default() };
-    let scene = SceneDesc {
-        meshes: vec![box_mesh(true)],
-        materials: vec![wall],
-        instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::from_scale(Vec3::splat(2.0)) }],
-        camera: Camera { position: Vec3::new(0.3, -0.2, 1.0), target: Vec3::new(-0.5, 0.1, -2.0), up: Vec3::Y, vfov: 1.2 },
-        ..Default::default()
-    };
-    (scene, le / (1.0 - a))
 }
 
 fn mean_relative_error(img: &[[f32; 4]], expected: f32) -> f64 {

@@ -16,6 +16,9 @@ use std::path::{Path, PathBuf};
 use systems::frame_record::FrameRecord;
 use systems::playback::{Overrides, RunOptions, run};
 
+mod common;
+use common::assert_positive;
+
 const CACHE: &str = "cache: (
             encoding: (levels: 8, features_per_level: 2, log2_table_size: 12, base_resolution: 4, growth_factor: 1.5),
             network: (width: 32, hidden_layers: 1),
@@ -25,19 +28,6 @@ const CACHE: &str = "cache: (
         paths: (termination_vertex: 1, train_records: 512)";
 
 const SEEDS: [u64; 3] = [3, 4, 5];
-
-/// One-sided 95% t quantile for 2 degrees of freedom (three seeds).
-const T95_DF2: f64 = 2.920;
-
-/// Asserts that the mean of per-seed differences `d` is above zero with 95% confidence.
-fn assert_positive(what: &str, d: &[f64]) {
-    let n = d.len() as f64;
-    let m = d.iter().sum::<f64>() / n;
-    let sd = (d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)).sqrt();
-    let lower = m - T95_DF2 * sd / n.sqrt();
-    eprintln!("{what}: per seed {d:.4?}, mean {m:.4}, lower 95% bound {lower:.4}");
-    assert!(lower > 0.0, "{what}: per-seed differences {d:.4?}, mean {m:.4}, one-sided 95% lower bound {lower:.4} is not above 0");
-}
 
 fn scenario(dir: &Path, name: &str, seed: u64, frames: u32, warmup: u32, pretrain: u32, events: &str, reference: bool) -> PathBuf {
     // The Cornell box: its only light is an emissive quad. Its direct light is NEE's at the

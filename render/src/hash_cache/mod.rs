@@ -290,7 +290,7 @@ impl HashCache {
         static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
         PROGRAM.get_or_init(|| {
             let taa_types = crate::taa::types_module();
-            let types = Module::generated("package::hash_cache_types", &[HashCacheParams::WGSL, HcRecord::WGSL]);
+            let types = types_module();
             let bindings = crate::compute::group_module("package::hash_cache_bindings", 2, &OWN_GROUP, &[&taa_types, &types]);
             PassLibrary::program([taa_types, crate::taa::primary_module(), types, bindings, crate::wgsl_file!("hash_cache/hash_key.wgsl")], [crate::wgsl_file!("hash_cache/hash_cache.wgsl")])
         })
@@ -394,10 +394,17 @@ impl HashCache {
     }
 }
 
-fn read<T: Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<T>, RenderError> {
+/// A copy of `buffer` read back (other methods' state readers use it too).
+pub(crate) fn read<T: Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<T>, RenderError> {
     let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(what), size: buffer.size(), usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
     let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
     gpu.queue.submit([encoder.finish()]);
     read_buffer(gpu, &staging).map_err(|reason| RenderError::Readback { what: what.into(), reason })
+}
+
+/// The cache's structs (`package::hash_cache_types`), also imported by the termination cache,
+/// which keys its records with hash_key.wgsl.
+pub fn types_module() -> Module {
+    Module::generated("package::hash_cache_types", &[HashCacheParams::WGSL, HcRecord::WGSL])
 }

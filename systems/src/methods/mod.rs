@@ -11,6 +11,7 @@ pub mod sample_cache;
 pub mod spec;
 pub mod taa;
 pub mod volume;
+pub mod termination;
 
 use anyhow::Result;
 use bevy_ecs::prelude::*;
@@ -25,6 +26,7 @@ use serde::{Deserialize, Serialize};
 use sim::MethodEntry;
 use taa::TaaSettings;
 use volume::VolumeSettings;
+use termination::TerminationSettings;
 
 /// A method family: its systems and how to build one instance.
 pub trait MethodPlugin: Sync {
@@ -55,6 +57,9 @@ pub enum MethodSpec {
     HashCache(HashCacheSettings),
     /// Primary-ray transmittance images of a medium with one estimator (media crate).
     VolumeTransmittance(VolumeSettings),
+    /// Path tracing terminated into a hashed radiance cache by variance trading
+    /// (render::termination): `Termination(rule: VarianceBounding(t: 0.1))`.
+    Termination(TerminationSettings),
 }
 
 impl MethodSpec {
@@ -67,6 +72,7 @@ impl MethodSpec {
             MethodSpec::Taa(_) => &taa::PLUGIN,
             MethodSpec::HashCache(_) => &hash_cache::PLUGIN,
             MethodSpec::VolumeTransmittance(_) => &volume::PLUGIN,
+            MethodSpec::Termination(_) => &termination::PLUGIN,
         }
     }
 
@@ -79,6 +85,7 @@ impl MethodSpec {
             MethodSpec::Taa(_) => "taa".into(),
             MethodSpec::HashCache(s) => hash_cache::label(s),
             MethodSpec::VolumeTransmittance(s) => s.label(),
+            MethodSpec::Termination(s) => termination::label(s),
         }
     }
 
@@ -89,7 +96,7 @@ impl MethodSpec {
             MethodSpec::Nirc(s) => s.spp,
             // One shaded path per pixel at a 100% shading rate.
             MethodSpec::SampleCache(s) => (s.shading_rate.ceil() as u32).max(1),
-            MethodSpec::Taa(_) | MethodSpec::HashCache(_) => 1,
+            MethodSpec::Taa(_) | MethodSpec::HashCache(_) | MethodSpec::Termination(_) => 1,
             MethodSpec::VolumeTransmittance(s) => s.spp,
         }
     }
@@ -101,7 +108,7 @@ impl MethodSpec {
             MethodSpec::PathTracing(s) => s.spp = spp,
             MethodSpec::Nirc(s) => s.spp = spp,
             MethodSpec::VolumeTransmittance(s) => s.spp = spp,
-            MethodSpec::SampleCache(_) | MethodSpec::Taa(_) | MethodSpec::HashCache(_) => {}
+            MethodSpec::SampleCache(_) | MethodSpec::Taa(_) | MethodSpec::HashCache(_) | MethodSpec::Termination(_) => {}
         }
     }
 }

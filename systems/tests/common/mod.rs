@@ -1,0 +1,15 @@
+//! Statistics shared by the relation tests that play a scenario over three seeds.
+#![allow(dead_code)]
+
+/// One-sided 95% t quantile for 2 degrees of freedom (three seeds).
+pub const T95_DF2: f64 = 2.920;
+
+/// Asserts that the mean of per-seed differences `d` is above zero with 95% confidence.
+pub fn assert_positive(what: &str, d: &[f64]) {
+    let n = d.len() as f64;
+    let m = d.iter().sum::<f64>() / n;
+    let sd = (d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)).sqrt();
+    let lower = m - T95_DF2 * sd / n.sqrt();
+    eprintln!("{what}: per seed {d:.4?}, mean {m:.4}, lower 95% bound {lower:.4}");
+    assert!(lower > 0.0, "{what}: per-seed differences {d:.4?}, mean {m:.4}, one-sided 95% lower bound {lower:.4} is not above 0");
+}

@@ -1,0 +1,118 @@
+//! The relations of variance-trading-termination.txt's Table 1 and Fig. 10, played end to end
+//! through `flicker run`'s playback on the shipped scenarios (scenarios/termination_*.ron) at
+//! 32x18, one recorded frame after the cache's warm-up, over three seeds:
+//!
+//! - mean path length grows with the variance threshold t (relative thresholds; the absolute
+//!   ones of Table 1 exceed every path's variance in these scenes and saturate at max depth):
+//!   in every seed, and in the log ratio over t = 0.01 .. 1 with a margin from the seeds;
+//! - MSE minimisation's mean path length is below variance bounding's at t = 0.01 (Table 1);
+//! - at equal samples, variance bounding (relative t = 1, as in Fig. 10) has lower FLIP than
+//!   area spread at c = 0.01 in the door scene: NOT reproduced here; the test asserts the
+//!   measured relation (no difference within the seeds' 95% interval).
+//!
+//! At 32x18 the paper's 1% of primary vertices is 6 stored vertices a frame, too few to fill
+//! the cache in its warm-up (a seed then measures an empty cache: zero-variance records let
+//! variance bounding run every path to max depth). The test therefore stores 10% and warms up
+//! for 24 frames; everything else is the shipped scenario's.
+//!
+//! Each relation holds over the seeds: the one-sided 95% bound (Student t, 2 degrees of freedom)
+//! of the mean per-seed difference must lie above zero, so the margin comes from the spread
+//! across seeds, not from one run.
+
+use std::path::{Path, PathBuf};
+
+use systems::frame_record::FrameRecord;
+use systems::methods::MethodSpec;
+use systems::playback::{RunOptions, run_spec};
+use systems::scenario::{Overrides, RunSpec};
+
+mod common;
+use common::assert_positive;
+
+const SEEDS: [u64; 3] = [3, 4, 5];
+/// Two-sided 95% t quantile for 2 degrees of freedom.
+const T975_DF2: f64 = 4.303;
+
+/// The scenario's methods named in `keep`, one recorded frame at 32x18: (method, path length,
+/// FLIP) per seed.
+fn play(scenario: &str, keep: &[&str], seed: u64) -> Vec<FrameRecord> {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("scenarios").join(scenario);
+    let dir = std::env::temp_dir().join(format!("termination-relations-{}-{scenario}-{seed}", std::process::id()));
+    let overrides = Overrides { frames: Some(1), resolution: Some((32, 18)), seed: Some(seed), out: Some(dir.join("run")), ..Default::default() };
+    let mut spec = RunSpec::load(&file, &overrides).expect("scenario");
+    spec.methods.retain(|m| keep.contains(&m.label().as_str()));
+    for m in &mut spec.methods {
+        if let MethodSpec::Termination(t) = &mut m.spec {
+            t.store_probability = 0.1;
+            t.warmup_frames = 24;
+        }
+    }
+    assert_eq!(spec.methods.len(), keep.len(), "{scenario}: methods {keep:?}");
+    let opts = RunOptions { scenario: PathBuf::from(&file), overrides, cache_dir: Some(std::env::temp_dir().join("termination-relations-references")), progress: false };
+    let summary = run_spec(&spec, &opts).expect("run");
+    std::fs::remove_dir_all(&dir).ok();
+    summary.records
+}
+
+fn value(records: &[FrameRecord], method: &str, f: impl Fn(&FrameRecord) -> Option<f64>) -> f64 {
+    let row = records.iter().find(|r| r.method == method).unwrap_or_else(|| panic!("no row of {method}"));
+    f(row).unwrap_or_else(|| panic!("{method}: value missing"))
+}
+
+fn path_length(r: &FrameRecord) -> Option<f64> {
+    r.stats.iter().find(|(k, _)| k == "path_length").map(|s| s.1)
+}
+
+fn path_length_relations(scenario: &str, runs: &[Vec<FrameRecord>]) {
+    let pl = |m: &str| runs.iter().map(|r| value(r, m, path_length)).collect::<Vec<f64>>();
+    let (r001, r01, r1) = (pl("vb_rel_0.01"), pl("vb_rel_0.1"), pl("vb_rel_1"));
+    // Grows with t in every seed: 6 of 6 paired comparisons (probability 1/64 if the order
+    // were a coin toss).
+    for s in 0..runs.len() {
+        assert!(r001[s] < r01[s] && r01[s] < r1[s], "{scenario} seed {}: path length by relative t 0.01, 0.1, 1: {} {} {}", SEEDS[s], r001[s], r01[s], r1[s]);
+    }
+    // Across the decade range, by a margin from the spread over seeds: the path length grows
+    // multiplicatively, and the seeds' caches differ in scale, so the log ratio.
+    let log_ratio: Vec<f64> = r1.iter().zip(&r001).map(|(a, b)| (a / b).ln()).collect();
+    assert_positive(&format!("{scenario}: ln(path length at relative t 1 / at 0.01)"), &log_ratio);
+    // Table 1: MSE minimisation (s = 100) ends paths earlier than variance bounding at t = 0.01
+    // (absolute; here it runs nearly every path to max depth).
+    let d: Vec<f64> = pl("vb_0.01").iter().zip(pl("mse_100")).map(|(a, b)| a - b).collect();
+    assert_positive(&format!("{scenario}: path length, variance bounding t 0.01 - MSE s 100"), &d);
+}
+
+#[test]
+fn door_relations() {
+    let keep = ["vb_0.01", "vb_rel_0.01", "vb_rel_0.1", "vb_rel_1", "mse_100", "spread_0.01"];
+    let runs: Vec<_> = SEEDS.iter().map(|&s| play("termination_door_gap.ron", &keep, s)).collect();
+    for (seed, r) in SEEDS.iter().zip(&runs) {
+        for m in keep {
+            eprintln!("door seed {seed} {m}: path length {:.3} FLIP {:.4}", value(r, m, path_length), value(r, m, |r| r.flip));
+        }
+    }
+    path_length_relations("door", &runs);
+    // The paper's Fig. 10 relation (variance bounding at relative t = 1 below area spread at
+    // c = 0.01 in FLIP) does not reproduce at this size: the per-seed differences change sign
+    // (README "Termination relations"). What is measured, and asserted: the two are not
+    // distinguishable, the two-sided 95% interval of the mean difference contains zero.
+    let flip = |m: &str| runs.iter().map(|r| value(r, m, |r| r.flip)).collect::<Vec<f64>>();
+    let d: Vec<f64> = flip("spread_0.01").iter().zip(flip("vb_rel_1")).map(|(a, b)| a - b).collect();
+    let n = d.len() as f64;
+    let m = d.iter().sum::<f64>() / n;
+    let sd = (d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)).sqrt();
+    let half = T975_DF2 * sd / n.sqrt();
+    eprintln!("door: FLIP area spread c 0.01 - variance bounding relative t 1: per seed {d:.4?}, 95% interval [{:.4}, {:.4}]", m - half, m + half);
+    assert!(m - half < 0.0 && m + half > 0.0, "door: FLIP difference {d:.4?}: interval [{:.4}, {:.4}] no longer contains 0; update the README and this test", m - half, m + half);
+}
+
+#[test]
+fn corridor_relations() {
+    let keep = ["vb_0.01", "vb_rel_0.01", "vb_rel_0.1", "vb_rel_1", "mse_100"];
+    let runs: Vec<_> = SEEDS.iter().map(|&s| play("termination_corridor.ron", &keep, s)).collect();
+    for (seed, r) in SEEDS.iter().zip(&runs) {
+        for m in keep {
+            eprintln!("corridor seed {seed} {m}: path length {:.3}", value(r, m, path_length));
+        }
+    }
+    path_length_relations("corridor", &runs);
+}
