@@ -1,6 +1,9 @@
 // Grid traversal along a segment (Amanatides & Woo), the twin of media::dda::Dda: one axis per
 // step, ties broken x, y, z. A segment crosses at most dims.x + dims.y + dims.z cells.
 
+import package::media::types::{RaySegment};
+import package::media::media_grid::{BIG, seg_at};
+
 struct Dda {
     cell: vec3i,
     dims: vec3i,

@@ -1,6 +1,11 @@
 // The transmittance estimators by id (media::transmittance::Estimator::gpu_id): naive and
 // Kettunen's biased exp(−X), unbiased ray marching (power series, degree ≤ 8), the jackknife.
 
+import package::media::types::{RaySegment};
+import package::media::media_rng::{media_rand};
+import package::media::media_tracking::{ratio_tracking, track_length};
+import package::media::media_optical_depth::{kettunen_sample_count, od_estimate, od_prepare, od_x};
+
 const EST_TRACK_LENGTH: u32 = 0u;
 const EST_RATIO_TRACKING: u32 = 1u;
 const EST_BIASED_RAY_MARCHING: u32 = 2u;

@@ -2,6 +2,9 @@
 // RMS of μ − μ_min), in texel space with the ray parameter t in world units (media::medium).
 // Needs the generated structs MediumParams and RaySegment and `medium: MediumParams`, `density: array<f32>`, `super_voxels: array<vec4f>`.
 
+import package::media::types::{RaySegment};
+import package::media::medium_bindings::{density, medium, super_voxels};
+
 const SUPER_VOXEL: u32 = 16u;
 // Relative floor of the variance-aware importance in non-empty super-voxels (IMPORTANCE_FLOOR).
 const IMPORTANCE_FLOOR: f32 = 1e-3;

@@ -1,6 +1,11 @@
 // Primary-ray transmittance images (media::gpu::ImagePass): one invocation per (pixel, sample),
 // the camera ray clipped to the medium's box on the GPU, one estimate with its own stream.
 
+import package::media::media_rng::{media_image_seed};
+import package::media::media_grid::{media_lookups, medium_segment};
+import package::media::media_estimators::{estimate_transmittance};
+import package::media::image_bindings::{directions, image, results};
+
 @compute @workgroup_size(64)
 fn transmittance_image(@builtin(global_invocation_id) id: vec3u) {
     // Dispatches wider than 65535 workgroups of 64 continue in y.

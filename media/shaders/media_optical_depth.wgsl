@@ -2,6 +2,12 @@
 // `count` i.i.d. optical depths of N samples each into od_x, with floor(I_j) + 1 + rand()
 // (erratum of Alg. 1's ceil(I_j) + rand()).
 
+import package::media::types::{RaySegment};
+import package::media::medium_bindings::{medium};
+import package::media::media_rng::{media_rand};
+import package::media::media_grid::{BIG, SUPER_VOXEL, importance, mu_at, super_voxel};
+import package::media::media_dda::{dda_advance, dda_exit, dda_new};
+
 const MAX_ESTIMATES: u32 = 9u;
 
 // x: F, y: t'_min, z: t'_max.

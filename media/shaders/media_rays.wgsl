@@ -1,6 +1,10 @@
 // One estimate per segment with the segment's own seed (media::gpu::EstimatorPass): what the
 // GPU-vs-CPU tests compare, estimate by estimate.
 
+import package::media::media_grid::{media_lookups};
+import package::media::media_estimators::{estimate_transmittance};
+import package::media::rays_bindings::{ray_params, rays, results, seeds};
+
 @compute @workgroup_size(64)
 fn estimate_rays(@builtin(global_invocation_id) id: vec3u) {
     let i = id.x;

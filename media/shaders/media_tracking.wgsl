@@ -1,6 +1,12 @@
 // Track-length and ratio tracking against the super-voxel majorants (media::track_length,
 // media::ratio_tracking, media::majorant_tracking).
 
+import package::media::types::{RaySegment};
+import package::media::medium_bindings::{medium};
+import package::media::media_rng::{media_rand};
+import package::media::media_grid::{BIG, SUPER_VOXEL, mu_at, super_voxel};
+import package::media::media_dda::{Dda, dda_advance, dda_exit, dda_new};
+
 const MAX_COLLISIONS: u32 = 1024u;
 
 // The next tentative collision after t, or t = BIG when the segment ends first; .y = majorant.

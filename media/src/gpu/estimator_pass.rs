@@ -42,8 +42,7 @@ impl EstimatorPass {
     pub fn new(gpu: &Gpu, medium: &GpuMedium) -> Result<Self, RenderError> {
         use render::gpu_struct::GpuStruct;
         let layout = binding_layout(gpu, "media rays", &BINDINGS);
-        let source = format!("{}{}{}{}", RayParams::WGSL, super::library(), render::compute::declare(1, &BINDINGS), include_str!("../../shaders/media_rays.wgsl"));
-        let program = render::shader::Program::single("package::media::rays", &source);
+        let program = super::shaders::program("rays", RayParams::WGSL, &BINDINGS, render::wgsl_file!("media_rays.wgsl"));
         let [pipeline] = pipelines(gpu, "media rays", &program, &[&medium.layout, &layout], ["estimate_rays"])?;
         Ok(Self { layout, pipeline })
     }

@@ -49,8 +49,7 @@ pub struct ImagePass {
 impl ImagePass {
     pub fn new(gpu: &Gpu, medium: &GpuMedium) -> Result<Self, RenderError> {
         let layout = binding_layout(gpu, "media image", &BINDINGS);
-        let source = format!("{}{}{}{}", ImageParams::WGSL, super::library(), render::compute::declare(1, &BINDINGS), include_str!("../../shaders/media_image.wgsl"));
-        let program = render::shader::Program::single("package::media::image", &source);
+        let program = super::shaders::program("image", ImageParams::WGSL, &BINDINGS, render::wgsl_file!("media_image.wgsl"));
         let [pipeline] = pipelines(gpu, "media image", &program, &[&medium.layout, &layout], ["transmittance_image"])?;
         Ok(Self { timer: PassTimer::new(gpu, &[PASS]), layout, pipeline })
     }

@@ -10,4 +10,4 @@ mod shaders;
 pub use estimator_pass::{EstimatorPass, RayResult};
 pub use image_pass::{ImagePass, ImageParams, PASS};
 pub use medium::{GpuMedium, MediumParams, RaySegment};
-pub use shaders::library;
+pub use shaders::{modules, program};

@@ -1,27 +1,33 @@
-//! The media shader library: the generated structs, then the estimator files in dependency
-//! order; a pass appends its bindings and entry points.
+//! The media shader library as WESL modules: the generated structs and the medium's @group(0),
+//! then the estimator files (each imports what it uses); a pass adds its own structs, its
+//! @group(1) and its entry-point file.
 
+use render::compute::BufferBinding;
 use render::gpu_struct::GpuStruct;
+use render::shader::{Module, Program};
 
 use super::medium::{MediumParams, RaySegment};
 
-const FILES: [&str; 6] = [
-    include_str!("../../shaders/media_rng.wgsl"),
-    include_str!("../../shaders/media_grid.wgsl"),
-    include_str!("../../shaders/media_dda.wgsl"),
-    include_str!("../../shaders/media_tracking.wgsl"),
-    include_str!("../../shaders/media_optical_depth.wgsl"),
-    include_str!("../../shaders/media_estimators.wgsl"),
-];
+/// The library's modules: structs, the medium's bindings, the estimator files.
+pub fn modules() -> Vec<Module> {
+    let types = Module::generated("package::media::types", &[MediumParams::WGSL, RaySegment::WGSL]);
+    let bindings = render::compute::group_module("package::media::medium_bindings", 0, &super::medium::BINDINGS, &[&types]);
+    vec![
+        types,
+        bindings,
+        render::wgsl_file!("media_rng.wgsl"),
+        render::wgsl_file!("media_grid.wgsl"),
+        render::wgsl_file!("media_dda.wgsl"),
+        render::wgsl_file!("media_tracking.wgsl"),
+        render::wgsl_file!("media_optical_depth.wgsl"),
+        render::wgsl_file!("media_estimators.wgsl"),
+    ]
+}
 
-/// Structs, the medium's @group(0) declarations, the estimator library.
-pub fn library() -> String {
-    let mut s = String::new();
-    s.push_str(MediumParams::WGSL);
-    s.push_str(RaySegment::WGSL);
-    s.push_str(&render::compute::declare(0, &super::medium::BINDINGS));
-    for f in FILES {
-        s.push_str(f);
-    }
-    s
+/// A pass's program: the library, the pass's struct `params_wgsl` (`package::media::NAME_types`),
+/// its @group(1) (`package::media::NAME_bindings`) and its entry-point file.
+pub fn program(name: &str, params_wgsl: &str, own: &[BufferBinding], entry: Module) -> Program {
+    let types = Module::generated(&format!("package::media::{name}_types"), &[params_wgsl]);
+    let bindings = render::compute::group_module(&format!("package::media::{name}_bindings"), 1, own, &[&types]);
+    Program::new(modules()).with([types, bindings]).entry(entry)
 }
