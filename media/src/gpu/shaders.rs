@@ -27,7 +27,9 @@ pub fn modules() -> Vec<Module> {
 /// A pass's program: the library, the pass's struct `params_wgsl` (`package::media::NAME_types`),
 /// its @group(1) (`package::media::NAME_bindings`) and its entry-point file.
 pub fn program(name: &str, params_wgsl: &str, own: &[BufferBinding], entry: Module) -> Program {
+    let library = modules();
     let types = Module::generated(&format!("package::media::{name}_types"), &[params_wgsl]);
-    let bindings = render::compute::group_module(&format!("package::media::{name}_bindings"), 1, own, &[&types]);
-    Program::new(modules()).with([types, bindings]).entry(entry)
+    // Its bindings may name the library's structs too (`array<RaySegment>`).
+    let bindings = render::compute::group_module(&format!("package::media::{name}_bindings"), 1, own, &[&types, &library[0]]);
+    Program::new(library).with([types, bindings]).entry(entry)
 }
