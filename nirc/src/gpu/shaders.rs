@@ -165,12 +165,31 @@ macro_rules! nirc_file {
 /// the pass's entry-point file.
 pub fn program(config: &NircConfig, layout: &ParameterLayout, pass: &str) -> Program {
     let mut modules = vec![Module::generated("package::nirc::types", &[&structs()]), Module::generated("package::nirc::config", &[&config_constants(config, layout)])];
-    let tile = |records: u32, training: bool| Module::generated("package::nirc::tile", &[&tile_constants(layout, &tile_shape(layout, records), training)]);
+    let tile = match pass {
+        "train_tile" => Some((TRAIN_TILE_RECORDS, true)),
+        "infer_tile" => Some((INFER_TILE_QUERIES, false)),
+        _ => None,
+    };
+    if let Some((records, training)) = tile {
+        modules.push(Module::generated("package::nirc::tile", &[&tile_constants(layout, &tile_shape(layout, records), training)]));
+    }
+    let (own, entry) = pass_files(pass);
+    modules.extend(own);
+    modules.extend(shared_files());
+    Program::new(modules).entry(entry)
+}
+
+/// The passes, by name.
+const PASSES: [&str; 10] = ["train_tile", "infer_tile", "train_forward_backward", "infer", "reliability_accumulate", "reliability_update", "reliability_walk", "weight_gradient", "adam_ema", "finish_step"];
+
+/// A pass's own files: its bindings (`package::nirc::bindings`), the tiled passes' activation hook
+/// (`package::nirc::keep`), and its entry-point file.
+fn pass_files(pass: &str) -> (Vec<Module>, Module) {
     let bindings = |m: Module| m.at("package::nirc::bindings");
     let keep = |m: Module| m.at("package::nirc::keep");
-    let (own, entry): (Vec<Module>, Module) = match pass {
-        "train_tile" => (vec![bindings(nirc_file!("train_bindings.wgsl")), tile(TRAIN_TILE_RECORDS, true), keep(nirc_file!("train_keep.wgsl"))], nirc_file!("train_tile.wgsl")),
-        "infer_tile" => (vec![bindings(nirc_file!("infer_bindings.wgsl")), tile(INFER_TILE_QUERIES, false), keep(nirc_file!("keep_none.wgsl"))], nirc_file!("infer_tile.wgsl")),
+    match pass {
+        "train_tile" => (vec![bindings(nirc_file!("train_bindings.wgsl")), keep(nirc_file!("train_keep.wgsl"))], nirc_file!("train_tile.wgsl")),
+        "infer_tile" => (vec![bindings(nirc_file!("infer_bindings.wgsl")), keep(nirc_file!("keep_none.wgsl"))], nirc_file!("infer_tile.wgsl")),
         "train_forward_backward" => (vec![bindings(nirc_file!("train_bindings.wgsl"))], nirc_file!("train_forward_backward.wgsl")),
         "infer" => (vec![bindings(nirc_file!("infer_bindings.wgsl"))], nirc_file!("infer.wgsl")),
         "reliability_accumulate" => (vec![bindings(nirc_file!("reliability_accumulate_bindings.wgsl"))], nirc_file!("reliability_accumulate.wgsl")),
@@ -180,10 +199,7 @@ pub fn program(config: &NircConfig, layout: &ParameterLayout, pass: &str) -> Pro
         "adam_ema" => (vec![], nirc_file!("adam_ema.wgsl")),
         "finish_step" => (vec![], nirc_file!("finish_step.wgsl")),
         other => panic!("unknown NIRC pass '{other}'"),
-    };
-    modules.extend(own);
-    modules.extend(shared_files());
-    Program::new(modules).entry(entry)
+    }
 }
 
 /// The files the passes share (each pass's program lists them all; a pass links what it imports).
@@ -203,16 +219,18 @@ fn shared_files() -> [Module; 11] {
     ]
 }
 
-/// Every WGSL file of the cache's passes and its generated structs (part of warm-start keys).
+/// Every WGSL file of the cache's passes, each once, and its generated structs (part of
+/// warm-start keys; the generated constants follow from the key's configuration).
 pub fn all_sources() -> String {
-    let passes = ["train_tile", "infer_tile", "train_forward_backward", "infer", "reliability_accumulate", "reliability_update", "reliability_walk", "weight_gradient", "adam_ema", "finish_step"];
     let mut files: Vec<Module> = vec![Module::generated("package::nirc::types", &[&structs()])];
     files.extend(shared_files());
-    for pass in passes {
-        // Generated constants depend on the network; its files do not.
-        let program = program(&NircConfig::default(), &ParameterLayout::new(&NircConfig::default()), pass);
-        files.extend(program.modules.into_iter().chain(program.entry_files).filter(|m| m.file != "generated"));
+    for pass in PASSES {
+        let (own, entry) = pass_files(pass);
+        for m in own.into_iter().chain([entry]) {
+            if !files.iter().any(|f| f.file == m.file) {
+                files.push(m);
+            }
+        }
     }
-    files.dedup_by(|a, b| a.file == b.file && a.path == b.path);
     Program::new(files).fingerprint()
 }
