@@ -74,6 +74,20 @@ fn plan_is_deterministic() {
 }
 
 #[test]
+fn shipped_sweeps_plan() {
+    let dir = scratch("shipped");
+    let sweeps = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&sweeps).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "ron")).collect();
+    files.sort();
+    assert!(files.len() >= 2, "{files:?}");
+    for f in files {
+        let out = dir.join(f.file_stem().unwrap());
+        ok(&flicker(&["sweep", "plan", f.to_str().unwrap(), "--out", out.to_str().unwrap()]), &format!("sweep plan {}", f.display()));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn bad_sweep_files_name_file_and_line() {
     let dir = scratch("bad");
     let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("suites/scenarios/smoke_cornell.ron");
