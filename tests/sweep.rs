@@ -199,7 +199,8 @@ impl Cluster {
         );
         cluster.wait_for("munged's socket", || dir.join("munge/munge.sock").exists());
         cluster.spawn("slurmctld", "slurmctld", &["-D", "-i"]);
-        cluster.spawn("slurmd", "slurmd", &["-D"]);
+        // -N: the node's name as slurm.conf has it, whatever `hostname` would resolve to.
+        cluster.spawn("slurmd", "slurmd", &["-D", "-N", &host]);
         let conf = cluster.conf.clone();
         cluster.wait_for("the node to be idle", || {
             Command::new("sinfo").env("SLURM_CONF", &conf).args(["-h", "-o", "%T"]).output().is_ok_and(|o| text(&o.stdout).trim() == "idle")
