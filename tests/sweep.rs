@@ -148,6 +148,9 @@ impl Cluster {
 
     fn spawn(&mut self, name: &'static str, program: &str, args: &[&str]) {
         let stderr = std::fs::File::create(self.dir.join(format!("{name}.stderr"))).unwrap();
+        // The daemons live in /usr/sbin, which a non-login PATH may lack.
+        let program = ["/usr/sbin", "/sbin"].iter().map(|d| Path::new(d).join(program)).find(|p| p.exists()).unwrap_or_else(|| PathBuf::from(program));
+        let program = program.to_str().unwrap();
         let mut c = self.slurm(program);
         c.args(args).stdin(Stdio::null()).stdout(stderr.try_clone().unwrap()).stderr(stderr);
         match c.spawn() {
