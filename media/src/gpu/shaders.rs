@@ -20,6 +20,8 @@ pub fn modules() -> Vec<Module> {
         render::wgsl_file!("media_dda.wgsl"),
         render::wgsl_file!("media_tracking.wgsl"),
         render::wgsl_file!("media_optical_depth.wgsl"),
+        render::wgsl_file!("media_jackknife.wgsl"),
+        render::wgsl_file!("media_mis.wgsl"),
         render::wgsl_file!("media_estimators.wgsl"),
     ]
 }
