@@ -7,9 +7,11 @@ mod image_pass;
 mod medium;
 mod mis_pass;
 mod shaders;
+mod volume_path_pass;
 
 pub use estimator_pass::{EstimatorPass, RayResult};
 pub use image_pass::{ImagePass, ImageParams, PASS};
 pub use mis_pass::{MisParams, MisPass};
 pub use medium::{GpuMedium, MediumParams, RaySegment};
-pub use shaders::{modules, program};
+pub use shaders::{modules, modules_at, program};
+pub use volume_path_pass::{Combination, MisWeight, ShadowTransmittance, VolumeImage, VolumePathParams, VolumePathPass, VolumePathSettings};
