@@ -23,12 +23,22 @@ impl DensityGrid {
     /// Bakes `kind` at the voxel centres of a `res` grid filling [box_min, box_max], peak
     /// extinction `sigma_t`.
     pub fn bake(kind: &DensityKind, res: UVec3, sigma_t: f32, box_min: Vec3, box_max: Vec3) -> Self {
+        Self::bake_spun(kind, res, sigma_t, box_min, box_max, 0.0)
+    }
+
+    /// [`Self::bake`] with the field turned by `spin` radians about the box's vertical axis
+    /// (an animated medium; the field is looked up at the voxel centre turned back).
+    pub fn bake_spun(kind: &DensityKind, res: UVec3, sigma_t: f32, box_min: Vec3, box_max: Vec3, spin: f32) -> Self {
         let mut data = Vec::with_capacity((res.x * res.y * res.z) as usize);
         let field = Field::new(kind);
+        let turn = glam::Quat::from_rotation_y(-spin);
         for z in 0..res.z {
             for y in 0..res.y {
                 for x in 0..res.x {
-                    let p = (UVec3::new(x, y, z).as_vec3() + 0.5) / res.as_vec3();
+                    let mut p = (UVec3::new(x, y, z).as_vec3() + 0.5) / res.as_vec3();
+                    if spin != 0.0 {
+                        p = turn * (p - Vec3::splat(0.5)) + Vec3::splat(0.5);
+                    }
                     data.push(sigma_t * field.unit_density(p));
                 }
             }
@@ -105,5 +115,11 @@ impl DensityGrid {
     pub fn from_desc(desc: &scene::MediumDesc) -> Self {
         let (x, y, z) = desc.resolution;
         Self::bake(&desc.kind, UVec3::new(x, y, z), desc.sigma_t, desc.box_min, desc.box_max)
+    }
+
+    /// An animated medium at one of its states (`MediumDesc::at`).
+    pub fn from_state(desc: &scene::MediumDesc, s: &scene::MediumState) -> Self {
+        let (x, y, z) = desc.resolution;
+        Self::bake_spun(&desc.kind, UVec3::new(x, y, z), s.sigma_t, s.box_min, s.box_max, s.spin)
     }
 }

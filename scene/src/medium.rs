@@ -37,6 +37,39 @@ pub struct MediumDesc {
     /// Emitted radiance per unit extinction, if any.
     #[serde(default)]
     pub emission: Option<Vec3>,
+    /// How the medium moves and changes over time (none by default).
+    #[serde(default, skip_serializing_if = "MediumMotion::is_still")]
+    pub motion: MediumMotion,
+}
+
+/// A medium's animation, a function of the simulated time t (seconds): its box moves at
+/// `velocity` and scales about its centre by 1 + `scale_per_second` t, its density field turns
+/// about the box's vertical axis at `spin_degrees_per_second` (the field is rebaked turned inside
+/// the fixed box: a shear where the box is not square in x and z), and its extinction pulses as
+/// sigma_t (1 + `pulse_amplitude` sin(2π t / `pulse_period`)).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MediumMotion {
+    pub velocity: Vec3,
+    pub scale_per_second: f32,
+    pub spin_degrees_per_second: f32,
+    pub pulse_amplitude: f32,
+    pub pulse_period: f32,
+}
+
+impl MediumMotion {
+    pub fn is_still(&self) -> bool {
+        *self == Self::default()
+    }
+}
+
+/// A medium at one time: its box, peak extinction and field rotation (radians about y).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MediumState {
+    pub box_min: Vec3,
+    pub box_max: Vec3,
+    pub sigma_t: f32,
+    pub spin: f32,
 }
 
 fn default_resolution() -> (u32, u32, u32) {
@@ -66,11 +99,34 @@ impl MediumDesc {
         if !(self.albedo.cmpge(Vec3::ZERO).all() && self.albedo.cmple(Vec3::ONE).all()) {
             return Some(format!("medium '{}': albedo {} must lie in [0, 1]", self.name, self.albedo));
         }
+        let m = &self.motion;
+        if !(m.velocity.is_finite() && m.scale_per_second.is_finite() && m.spin_degrees_per_second.is_finite()) {
+            return Some(format!("medium '{}': motion velocity, scale_per_second and spin_degrees_per_second must be finite", self.name));
+        }
+        if !(0.0..1.0).contains(&m.pulse_amplitude) || (m.pulse_amplitude > 0.0 && !(m.pulse_period.is_finite() && m.pulse_period > 0.0)) {
+            return Some(format!(
+                "medium '{}': motion pulse_amplitude {} must lie in [0, 1) and pulse_period {} must be > 0 where it pulses",
+                self.name, m.pulse_amplitude, m.pulse_period
+            ));
+        }
         if let Some(e) = self.emission {
             if !(e.is_finite() && e.cmpge(Vec3::ZERO).all()) {
                 return Some(format!("medium '{}': emission {e} must be finite and >= 0", self.name));
             }
         }
         None
+    }
+
+    /// The medium at simulated time `t` (seconds); a still medium is its declaration.
+    pub fn at(&self, t: f32) -> MediumState {
+        let m = &self.motion;
+        let centre = 0.5 * (self.box_min + self.box_max) + m.velocity * t;
+        // Never inverted or collapsed: a shrinking box stops at 1% of its size.
+        let half = 0.5 * (self.box_max - self.box_min) * (1.0 + m.scale_per_second * t).max(0.01);
+        let pulse = if m.pulse_amplitude > 0.0 { 1.0 + m.pulse_amplitude * (std::f32::consts::TAU * t / m.pulse_period).sin() } else { 1.0 };
+        if m.is_still() {
+            return MediumState { box_min: self.box_min, box_max: self.box_max, sigma_t: self.sigma_t, spin: 0.0 };
+        }
+        MediumState { box_min: centre - half, box_max: centre + half, sigma_t: self.sigma_t * pulse, spin: m.spin_degrees_per_second.to_radians() * t }
     }
 }

@@ -35,6 +35,9 @@ fn bad_media_name_the_file_and_line() {
         (r#"(name: "big", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0, resolution: (0, 8, 8))"#, "resolution"),
         (r#"(name: "bright", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0, albedo: (2, 0, 0))"#, "albedo"),
         (r#"(name: "x", kind: Smoke, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0)"#, "Smoke"),
+        (r#"(name: "p", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0, motion: (pulse_amplitude: 1.5, pulse_period: 2))"#, "pulse_amplitude"),
+        (r#"(name: "q", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0, motion: (pulse_amplitude: 0.5))"#, "pulse_period"),
+        (r#"(name: "r", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0, motion: (spin: 3))"#, "spin"),
     ];
     for (medium, word) in cases {
         let e = parse(&scenario(medium)).unwrap_err();
@@ -42,4 +45,22 @@ fn bad_media_name_the_file_and_line() {
         assert!(text.starts_with("volume.ron:4:"), "{text}");
         assert!(text.contains(word), "{text}");
     }
+}
+
+#[test]
+fn an_animated_medium_moves_scales_spins_and_pulses_in_closed_form() {
+    let s = parse(&scenario(
+        r#"(name: "m", kind: Homogeneous, box_min: (0, 0, 0), box_max: (2, 2, 2), sigma_t: 2.0,
+            motion: (velocity: (1, 0, 0), scale_per_second: 0.5, spin_degrees_per_second: 90, pulse_amplitude: 0.25, pulse_period: 4))"#,
+    ))
+    .unwrap();
+    let m = &s.media[0];
+    let a = m.at(1.0);
+    // Centre (1, 1, 1) + (1, 0, 0); half size 1 · 1.5; σ 2 (1 + 0.25 sin(π/2)); 90° = π/2.
+    assert!((a.box_min - glam::Vec3::new(0.5, -0.5, -0.5)).length() < 1e-6 && (a.box_max - glam::Vec3::new(3.5, 2.5, 2.5)).length() < 1e-6, "{a:?}");
+    assert!((a.sigma_t - 2.5).abs() < 1e-6 && (a.spin - std::f32::consts::FRAC_PI_2).abs() < 1e-6, "{a:?}");
+    // A still medium is its declaration at any time.
+    let still = parse(&scenario(r#"(name: "s", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0)"#)).unwrap();
+    let st = still.media[0].at(7.0);
+    assert_eq!((st.box_min, st.box_max, st.sigma_t, st.spin), (still.media[0].box_min, still.media[0].box_max, 1.0, 0.0));
 }

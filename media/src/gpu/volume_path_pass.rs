@@ -11,7 +11,8 @@ use render::gpu_struct::GpuStruct;
 use render::pass_library::PassLibrary;
 use render::path_tracer::PathTracer;
 use render::readback::read_buffer;
-use render::shader::Module;
+use render::shader::{Module, Program};
+use render::timing::{PassTimer, PassTiming, merge};
 use serde::{Deserialize, Serialize};
 use wgpu::util::DeviceExt;
 
@@ -92,24 +93,44 @@ pub struct VolumeImage {
     pub height: u32,
     pub mean: Vec<[f32; 3]>,
     pub var_of_mean: Vec<f64>,
+    /// GPU (or wall) time of pass `volume_path`, all batches.
+    pub timings: Vec<PassTiming>,
+    /// Paths traced.
+    pub paths: u64,
 }
+
+/// The pass's name in timings.
+pub const VOLUME_PATH_PASS: &str = "volume_path";
 
 pub struct VolumePathPass {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
+    timer: PassTimer,
 }
 
 impl VolumePathPass {
-    pub fn new(gpu: &Gpu, tracer: &PathTracer, medium: &GpuMedium) -> Result<Self, RenderError> {
-        let layout = binding_layout(gpu, "media volume path", &BINDINGS);
+    /// The pass's program: the path tracer's library, the media library with the medium as
+    /// @group(3), its own @group(2), media_path.wgsl.
+    pub fn program() -> Program {
         let types = Module::generated("package::media::volume_path_types", &[VolumePathParams::WGSL]);
         let bindings = render::compute::group_module("package::media::volume_path_bindings", 2, &BINDINGS, &[&types]);
         let mut own = super::shaders::modules_at(3);
         own.extend([types, bindings, render::wgsl_file!("media_path.wgsl")]);
-        let program = PassLibrary::program(own, [render::wgsl_file!("media_volume_path.wgsl")]);
+        PassLibrary::program(own, [render::wgsl_file!("media_volume_path.wgsl")])
+    }
+
+    /// Every WGSL source of the pass: part of the key of cached references.
+    pub fn shader_source() -> &'static str {
+        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+        SOURCE.get_or_init(|| Self::program().fingerprint())
+    }
+
+    pub fn new(gpu: &Gpu, tracer: &PathTracer, medium: &GpuMedium) -> Result<Self, RenderError> {
+        let layout = binding_layout(gpu, "media volume path", &BINDINGS);
+        let program = Self::program();
         let scene = tracer.scene();
         let [pipeline] = pipelines(gpu, "media volume path", &program, &[scene.layout(), scene.geometry().bind_group_layout(), &layout, &medium.layout], ["volume_path"])?;
-        Ok(Self { layout, pipeline })
+        Ok(Self { layout, pipeline, timer: PassTimer::new(gpu, &[VOLUME_PATH_PASS]) })
     }
 
     /// `spp` paths per pixel of the tracer's current scene and camera (seed and frame as the path
@@ -126,6 +147,7 @@ impl VolumePathPass {
         let mut sum = vec![[0f64; 3]; pixels as usize];
         let mut lum = vec![(0f64, 0f64); pixels as usize];
         let mut first = 0;
+        let mut timings = Vec::new();
         while first < spp {
             let n = batch.min(spp - first);
             let params = VolumePathParams {
@@ -143,19 +165,20 @@ impl VolumePathPass {
             let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("volume path params"), contents: bytemuck::bytes_of(&params), usage: wgpu::BufferUsages::UNIFORM });
             tracer.prepare_frame(gpu, spp, 0, seed, frame);
             let group = buffer_group(gpu, "media volume path", &self.layout, &[&params, &samples]);
-            let mut enc = device.create_command_encoder(&Default::default());
-            {
-                let mut pass = enc.begin_compute_pass(&Default::default());
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, tracer.scene().bind_group(), &[]);
-                pass.set_bind_group(1, tracer.scene().geometry().bind_group(), &[]);
-                pass.set_bind_group(2, &group, &[]);
-                pass.set_bind_group(3, &medium.group, &[]);
-                let groups = (pixels * n).div_ceil(64);
-                pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
-            }
-            enc.copy_buffer_to_buffer(&samples, 0, &staging, 0, size);
-            gpu.queue.submit([enc.finish()]);
+            let mut timed = self.timer.begin(gpu, VOLUME_PATH_PASS);
+            timed
+                .pass(0, |pass| {
+                    pass.set_pipeline(&self.pipeline);
+                    pass.set_bind_group(0, tracer.scene().bind_group(), &[]);
+                    pass.set_bind_group(1, tracer.scene().geometry().bind_group(), &[]);
+                    pass.set_bind_group(2, &group, &[]);
+                    pass.set_bind_group(3, &medium.group, &[]);
+                    let groups = (pixels * n).div_ceil(64);
+                    pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+                })
+                .map_err(|e| e.to_string())?;
+            timed.encoder().copy_buffer_to_buffer(&samples, 0, &staging, 0, size);
+            merge(&mut timings, timed.submit().map_err(|e| e.to_string())?);
             let raw: Vec<[f32; 4]> = read_buffer(gpu, &staging)?;
             for (i, v) in raw.iter().take((pixels * n) as usize).enumerate() {
                 let p = i / n as usize;
@@ -171,6 +194,6 @@ impl VolumePathPass {
         let k = f64::from(spp);
         let mean = sum.iter().map(|s| s.map(|c| (c / k) as f32)).collect();
         let var_of_mean = lum.iter().map(|&(s1, s2)| ((s2 / k - (s1 / k).powi(2)) * k / (k - 1.0).max(1.0)).max(0.0) / k).collect();
-        Ok(VolumeImage { width, height, mean, var_of_mean })
+        Ok(VolumeImage { width, height, mean, var_of_mean, timings, paths: u64::from(pixels) * u64::from(spp) })
     }
 }
