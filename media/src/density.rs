@@ -76,6 +76,7 @@ enum Field {
     Constant,
     Cloud(Fbm<Perlin>),
     Explosion(Perlin, f64),
+    Grid(scene::RawGrid),
 }
 
 impl Field {
@@ -84,6 +85,8 @@ impl Field {
             DensityKind::Homogeneous => Field::Constant,
             DensityKind::Cloud { octaves, frequency, seed } => Field::Cloud(Fbm::<Perlin>::new(seed).set_octaves(octaves).set_frequency(frequency)),
             DensityKind::Explosion { frequency, seed } => Field::Explosion(Perlin::new(seed), frequency),
+            // Checked when the scenario loaded (sim::Scenario, errors at the grid file's line).
+            DensityKind::Grid { ref file } => Field::Grid(scene::RawGrid::load(file).unwrap_or_else(|e| panic!("{e}"))),
         }
     }
 
@@ -92,6 +95,7 @@ impl Field {
         let q = [p.x as f64, p.y as f64, p.z as f64];
         match self {
             Field::Constant => 1.0,
+            Field::Grid(g) => g.at_unit(p.to_array()),
             Field::Cloud(fbm) => {
                 // Sphere of radius 0.8 with a soft edge, eroded by the noise.
                 let shape = 1.0 - r / 0.8;

@@ -16,6 +16,78 @@ pub enum DensityKind {
     /// The paper's failure case: a thin shell of sparse, high-frequency blobs (most voxels
     /// empty, the rest at `sigma_t`), so that few samples along a ray see any density.
     Explosion { frequency: f64, seed: u32 },
+    /// A raw density grid file ([`RawGrid`]; a relative path is resolved against the scenario's
+    /// folder), looked up nearest-neighbour and scaled to peak `sigma_t`.
+    Grid { file: std::path::PathBuf },
+}
+
+/// A raw density grid file, text so that a bad value has a line:
+///
+/// ```text
+/// # comments start with '#'
+/// density_grid NX NY NZ
+/// v v v ...      NX·NY·NZ values in [0, 1], x fastest, then y, then z, any number per line
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct RawGrid {
+    pub res: (u32, u32, u32),
+    pub data: Vec<f32>,
+}
+
+impl RawGrid {
+    /// The largest grid a file may hold per axis.
+    pub const MAX_RES: u32 = 256;
+
+    pub fn load(path: &std::path::Path) -> Result<RawGrid, String> {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: cannot read the density grid: {e}", path.display()))?;
+        Self::parse(&text, &path.display().to_string())
+    }
+
+    /// Parses `text`; errors read `FILE:LINE: what was found, what was expected`.
+    pub fn parse(text: &str, file: &str) -> Result<RawGrid, String> {
+        let mut res = None;
+        let mut data = Vec::new();
+        let mut last_line = 0;
+        for (i, line) in text.lines().enumerate() {
+            let n = i + 1;
+            last_line = n;
+            let line = line.split('#').next().unwrap_or("").trim();
+            if line.is_empty() {
+                continue;
+            }
+            let Some((x, y, z)) = res else {
+                let words: Vec<&str> = line.split_whitespace().collect();
+                let dims: Vec<Option<u32>> = words.iter().skip(1).map(|w| w.parse().ok()).collect();
+                match (words.first(), dims.as_slice()) {
+                    (Some(&"density_grid"), [Some(x), Some(y), Some(z)]) if [*x, *y, *z].iter().all(|&r| (1..=Self::MAX_RES).contains(&r)) => res = Some((*x, *y, *z)),
+                    _ => return Err(format!("{file}:{n}: found '{line}'; expected the header 'density_grid NX NY NZ' with each size 1 to {}", Self::MAX_RES)),
+                }
+                continue;
+            };
+            for word in line.split_whitespace() {
+                match word.parse::<f32>() {
+                    Ok(v) if v.is_finite() && (0.0..=1.0).contains(&v) => data.push(v),
+                    _ => return Err(format!("{file}:{n}: found '{word}'; expected a density in [0, 1]")),
+                }
+                if data.len() as u64 > u64::from(x) * u64::from(y) * u64::from(z) {
+                    return Err(format!("{file}:{n}: more than the {x}x{y}x{z} = {} values of the header", x * y * z));
+                }
+            }
+        }
+        let Some((x, y, z)) = res else { return Err(format!("{file}:{}: no header; expected 'density_grid NX NY NZ'", last_line.max(1))) };
+        if data.len() as u64 != u64::from(x) * u64::from(y) * u64::from(z) {
+            return Err(format!("{file}:{last_line}: {} values; expected {x}x{y}x{z} = {}", data.len(), x * y * z));
+        }
+        Ok(RawGrid { res: (x, y, z), data })
+    }
+
+    /// The value of the voxel holding unit-cube point `p` (nearest neighbour).
+    pub fn at_unit(&self, p: [f32; 3]) -> f32 {
+        let (x, y, z) = self.res;
+        let i = |c: f32, r: u32| ((c * r as f32).floor().max(0.0) as u32).min(r - 1);
+        let (a, b, c) = (i(p[0], x), i(p[1], y), i(p[2], z));
+        self.data[(a + x * (b + y * c)) as usize]
+    }
 }
 
 /// One medium of a scenario.

@@ -64,3 +64,31 @@ fn an_animated_medium_moves_scales_spins_and_pulses_in_closed_form() {
     let st = still.media[0].at(7.0);
     assert_eq!((st.box_min, st.box_max, st.sigma_t, st.spin), (still.media[0].box_min, still.media[0].box_max, 1.0, 0.0));
 }
+
+#[test]
+fn a_raw_density_grid_loads_relative_to_the_scenario_and_bad_files_name_their_line() {
+    let dir = std::env::temp_dir().join(format!("flicker_grid_{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("assets")).unwrap();
+    let grid = |name: &str, text: &str| std::fs::write(dir.join("assets").join(name), text).unwrap();
+    grid("ok.density", "# a 2x1x1 grid\ndensity_grid 2 1 1\n0.25\n1\n");
+    grid("header.density", "# no header\n0.5 0.5\n");
+    grid("value.density", "density_grid 2 1 1\n0.5\n1.5\n");
+    grid("short.density", "density_grid 2 2 1\n0.5 0.5\n0.5\n");
+    let load = |file: &str| {
+        let text = scenario(&format!(r#"(name: "g", kind: Grid(file: "assets/{file}"), box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 2.0)"#));
+        Scenario::from_ron(&text, &dir.join("volume.ron"))
+    };
+    let s = load("ok.density").unwrap();
+    let DensityKind::Grid { file } = &s.media[0].kind else { panic!("{:?}", s.media[0].kind) };
+    assert_eq!(scene::RawGrid::load(file).unwrap(), scene::RawGrid { res: (2, 1, 1), data: vec![0.25, 1.0] });
+    for (file, line, word) in [("header.density", 2, "density_grid NX NY NZ"), ("value.density", 3, "'1.5'"), ("short.density", 3, "3 values; expected 2x2x1 = 4")] {
+        let e = load(file).unwrap_err().to_string();
+        assert!(e.contains(&format!("{file}:{line}:")) && e.contains(word), "{e}");
+        assert!(e.contains("volume.ron:4:"), "{e}");
+    }
+    assert!(load("missing.density").unwrap_err().to_string().contains("cannot read"));
+    // The shipped grid parses.
+    let shipped = scene::RawGrid::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/assets/smoke_ring.density")).unwrap();
+    assert_eq!(shipped.res, (16, 16, 16));
+    let _ = std::fs::remove_dir_all(&dir);
+}
