@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs what flicker needs on a fresh Debian machine without a GPU (run as root):
 # Mesa's lavapipe (CPU Vulkan) for wgpu, Chromium to test the HTML report, Slurm and MUNGE
-# (tests/sweep.rs starts a one-node cluster of its own), and NVIDIA's FLIP reference
+# (tests/sweep.rs starts a one-node cluster of its own), GNU parallel (the same test runs a
+# sweep's job file through it), and NVIDIA's FLIP reference
 # implementation (PyPI `flip-evaluator`) that the FLIP tests compare against.
 set -euo pipefail
 need_apt=()
@@ -10,6 +11,7 @@ ldconfig -p | grep -q 'libvulkan.so.1' || need_apt+=(libvulkan1)
 command -v chromium >/dev/null || need_apt+=(chromium)
 command -v slurmctld >/dev/null && command -v slurmd >/dev/null && command -v sbatch >/dev/null || need_apt+=(slurm-wlm)
 command -v munged >/dev/null || need_apt+=(munge)
+command -v parallel >/dev/null || need_apt+=(parallel)
 if [ ${#need_apt[@]} -gt 0 ]; then
     export DEBIAN_FRONTEND=noninteractive
     # The packages' own services (munge, slurmctld, slurmd) must not start: the sweep test runs

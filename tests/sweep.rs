@@ -1,9 +1,9 @@
 //! Sweeps end to end through the `flicker` program: a deterministic plan, bad sweep files at
 //! file:line, and one 8-job sweep (sweeps/taa_alpha.ron) run by the local executor and as an
 //! 8-task Slurm array on a one-node cluster this test starts on localhost (munged, slurmctld,
-//! slurmd; Debian's `slurm-wlm` and `munge`, installed by scripts/setup.sh). The two merged
-//! summaries must agree in every number but the timings. If the cluster does not come up the
-//! test fails with the daemons' logs.
+//! slurmd; Debian's `slurm-wlm` and `munge`, installed by scripts/setup.sh), and through GNU
+//! parallel reading the plan's job file. The merged summaries must agree in every number but
+//! the timings. If the cluster does not come up the test fails with the daemons' logs.
 
 use std::net::TcpListener;
 use std::path::{Path, PathBuf};
@@ -273,6 +273,15 @@ fn sweep_runs_locally_and_on_slurm_with_identical_numbers() {
 
     let slurm_numbers = numbers(&slurm);
     assert_eq!(slurm_numbers, local_numbers, "local and Slurm runs of one sweep merged to different numbers");
+
+    // GNU parallel: the plan's job file, one shell command per line, two at a time.
+    let par = dir.join("parallel");
+    ok(&flicker(&["sweep", "plan", sweep.to_str().unwrap(), "--out", par.to_str().unwrap()]), "sweep plan (parallel)");
+    let jobs = std::fs::File::open(par.join("jobs.txt")).unwrap();
+    let o = Command::new("parallel").args(["--jobs", "2", "--halt", "now,fail=1"]).stdin(jobs).output().expect("GNU parallel runs (scripts/setup.sh installs it)");
+    ok(&o, "parallel < jobs.txt");
+    ok(&flicker(&["sweep", "merge", par.to_str().unwrap()]), "sweep merge (parallel)");
+    assert_eq!(numbers(&par), local_numbers, "local and GNU parallel runs of one sweep merged to different numbers");
     // The summary holds what the sweep asked for: 4 configurations of 2 seeds, FLIP in (0, 1).
     let configs = slurm_numbers["configurations"].as_array().unwrap();
     assert_eq!(configs.len(), 4);
