@@ -173,6 +173,11 @@ fn bench_nirc(out: Option<PathBuf>, json: Option<PathBuf>, batch: u32, queries: 
         r.ema_only_queries_per_s, r.infer_gflops, r.infer_percent_of_peak, r.blend_queries_per_s, r.blend_overhead_frame_percent,
         r.blend_overhead_infer_percent, r.layer_probe_4x16_gflops, r.layer_probe_16x16_gflops
     );
+    let mut md = md;
+    md.push_str("\n| training step, stage by stage (each submitted alone) | ms |\n|---|---:|\n");
+    for (name, ms) in &r.train_stages_ms {
+        md.push_str(&format!("| {name} | {ms:.2} |\n"));
+    }
     print!("{md}");
     if let Some(path) = out {
         systems::output::write_text(&path, &md)?;

@@ -42,6 +42,8 @@ pub struct BenchReport {
     /// training pass's shape) and 16 x 16 (tile_layer.wgsl).
     pub layer_probe_4x16_gflops: f64,
     pub layer_probe_16x16_gflops: f64,
+    /// Milliseconds per stage of one training step, each stage submitted alone.
+    pub train_stages_ms: Vec<(String, f64)>,
 }
 
 fn records(n: u32) -> Vec<TrainingRecord> {
@@ -83,6 +85,7 @@ pub fn run(gpu: &Gpu, config: &NircConfig, placement: Option<WeightPlacement>, b
     let cache = NeuralCache::from_state(gpu, &state, placement)?;
     let recs = upload(gpu, "bench records", &records(batch));
     let train_s = time(gpu, reps, || cache.train(gpu, &recs, batch))?;
+    let train_stages_ms = cache.train_stage_seconds(gpu, &recs, batch, reps)?.into_iter().map(|(n, s)| (n.to_string(), 1e3 * s)).collect();
     let q: Vec<CacheQuery> = records(queries).iter().map(|r| r.query()).collect();
     let qbuf = upload(gpu, "bench queries", &q);
     let out = answer_buffer(gpu, queries);
@@ -111,6 +114,7 @@ pub fn run(gpu: &Gpu, config: &NircConfig, placement: Option<WeightPlacement>, b
         blend_overhead_infer_percent: 100.0 * (blend_s - ema_s) / ema_s,
         layer_probe_4x16_gflops: probes.layer_4x16_gflops,
         layer_probe_16x16_gflops: probes.layer_16x16_gflops,
+        train_stages_ms,
     })
 }
 

@@ -373,3 +373,27 @@ fn networks_over_the_drivers_loop_cap_are_refused() {
     let default = nirc::layout::ParameterLayout::new(&nirc::NircConfig::default());
     assert!(default.loop_iterations_per_invocation(64) < render::gpu::LLVMPIPE_LOOP_ITERATIONS / 2);
 }
+
+/// `flicker bench --nirc` profiles a training step stage by stage: every dispatch of the step is
+/// named once, in the step's order, in both weight placements (the tiled train pass writes the
+/// gradient partials itself; the per-record form has a pass for them), and each stage runs alone without error.
+#[test]
+fn training_profile_names_every_stage_of_a_step_once() {
+    let config = small_config();
+    let state = randomized_state(&config, 5);
+    let recs = records(&mut Rng(9), 128);
+    let buf = upload(gpu(), "profile records", &recs);
+    for placement in [WeightPlacement::Tiled, WeightPlacement::Storage] {
+        let cache = NeuralCache::from_state(gpu(), &state, Some(placement)).unwrap();
+        let stages = cache.train_stage_seconds(gpu(), &buf, recs.len() as u32, 1).unwrap();
+        let names: Vec<&str> = stages.iter().map(|s| s.0).collect();
+        let mut expected = vec!["train (forward, backward)", "reliability accumulate"];
+        if placement == WeightPlacement::Storage {
+            expected.push("weight gradient partials");
+        }
+        expected.extend(["weight gradient reduce", "adam check (every parameter)", "adam apply (every parameter)", "ema update (every parameter)"]);
+        expected.extend(["reliability walk", "reliability update", "clear the step's accumulators"]);
+        assert_eq!(names, expected, "{placement:?}");
+        assert!(stages.iter().all(|s| s.1.is_finite() && s.1 >= 0.0), "{stages:?}");
+    }
+}

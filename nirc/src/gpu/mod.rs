@@ -462,6 +462,53 @@ impl NeuralCache {
         dispatch(pass, &p.adam_apply, &s.apply, all);
     }
 
+    /// Seconds per dispatch of one training step on `n` of `records`, each stage submitted and
+    /// waited for alone, `reps` times after a warm-up: the profile `flicker bench --nirc` prints.
+    pub fn train_stage_seconds(&self, gpu: &Gpu, records: &wgpu::Buffer, n: u32, reps: u32) -> Result<Vec<(&'static str, f64)>, NircError> {
+        let Some(s) = self.prepare_step(gpu, records, n)? else { return Ok(Vec::new()) };
+        let p = &self.pipelines;
+        let all = groups_for(self.layout.total_params as u64);
+        let mut stages: Vec<(&'static str, &wgpu::ComputePipeline, &wgpu::BindGroup, u32)> = vec![
+            ("train (forward, backward)", &p.train, &s.fb, s.n.div_ceil(WORKGROUP_SIZE)),
+            ("reliability accumulate", &p.reliability_accumulate, &s.accumulate, groups_for(s.n as u64)),
+        ];
+        if let (Some(pipeline), Some(group)) = (&p.weight_partial, &s.partial) {
+            stages.push(("weight gradient partials", pipeline, group, groups_for(self.layout.mlp_params as u64 * s.num_chunks as u64)));
+        }
+        stages.push(("weight gradient reduce", &p.weight_reduce, &s.reduce, groups_for(self.layout.mlp_params as u64)));
+        stages.push(("adam check (every parameter)", &p.adam_check, &s.check, all));
+        stages.push(("adam apply (every parameter)", &p.adam_apply, &s.apply, all));
+        stages.push(("ema update (every parameter)", &p.ema_update, &s.ema, all));
+        if self.config.reliability.update == crate::config::MomentUpdate::PerSample {
+            stages.push(("reliability walk", &p.reliability_walk, &s.walk, groups_for(s.n as u64)));
+        }
+        stages.push(("reliability update", &p.reliability_update, &self.groups.reliability_update, groups_for(cell_count(&self.config.reliability) as u64)));
+        let timed = |name: &'static str, record: &dyn Fn(&mut wgpu::CommandEncoder)| -> Result<f64, NircError> {
+            let run = || {
+                let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(name) });
+                record(&mut encoder);
+                gpu.queue.submit([encoder.finish()]);
+                readback::wait_idle(gpu)
+            };
+            run()?;
+            let t = std::time::Instant::now();
+            for _ in 0..reps {
+                run()?;
+            }
+            Ok(t.elapsed().as_secs_f64() / reps.max(1) as f64)
+        };
+        let mut out = Vec::new();
+        for (name, pipeline, group, workgroups) in stages {
+            let seconds = timed(name, &|encoder| {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(name), timestamp_writes: None });
+                dispatch(&mut pass, pipeline, group, workgroups);
+            })?;
+            out.push((name, seconds));
+        }
+        out.push(("clear the step's accumulators", timed("clear", &|encoder| self.clear_step(encoder))?));
+        Ok(out)
+    }
+
     fn dispatch_ema(&self, pass: &mut wgpu::ComputePass, s: &TrainStep) {
         dispatch(pass, &self.pipelines.ema_update, &s.ema, groups_for(self.layout.total_params as u64));
     }
