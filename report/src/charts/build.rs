@@ -117,6 +117,33 @@ pub fn sigma_chart(manifest: &Manifest, frames: &Frames) -> Option<(String, Char
     Some(("frames_sigma".into(), chart))
 }
 
+/// Why σ stays near 0.5 or not (issue 10): per frame, the 10th, 50th and 90th percentiles over
+/// the queries of d = r̄_cur − r̄_EMA, the difference σ = 1 / (1 + e^(−κd)) is a function of
+/// (stats `reliability_diff_p10/p50/p90`), and the share of queries with |σ − 0.5| > 0.1.
+pub fn reliability_spread_chart(manifest: &Manifest, frames: &Frames) -> Option<(String, Chart)> {
+    let p50 = frames.column("reliability_diff_p50").filter(|&c| frames.has_data(c))?;
+    let method = frames.methods().into_iter().find(|m| frames.series(m, p50).iter().any(|p| p.1.is_finite()))?;
+    let last_frame = frames.rows.iter().map(|r| r.frame).max().unwrap_or(0) as f64;
+    let mut series = Vec::new();
+    for (col, name) in [("reliability_diff_p10", "10th percentile of r̄_cur − r̄_EMA"), ("reliability_diff_p50", "median"), ("reliability_diff_p90", "90th percentile"), ("sigma_far_from_even", "share of queries with |σ − 0.5| > 0.1")] {
+        if let Some(c) = frames.column(col).filter(|&c| frames.has_data(c)) {
+            series.push(Series { name: name.into(), points: frames.series(&method, c) });
+        }
+    }
+    series.push(Series { name: "0".into(), points: vec![(0.0, 0.0), (last_frame, 0.0)] });
+    let chart = Chart {
+        title: format!("Spread of the reliability difference ({method}) — {}", manifest.scenario),
+        x_label: "frame".into(),
+        y_label: "r̄_cur − r̄_EMA; share".into(),
+        kind: Kind::Lines,
+        series,
+        events: manifest.events.iter().map(|e| (e.frame as f64, e.label.clone())).collect(),
+        pareto: vec![],
+        x_extent: vec![0.0, last_frame],
+    };
+    Some(("frames_reliability_spread".into(), chart))
+}
+
 pub fn speed_accuracy_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)> {
     let time_col = ["gpu_ms_total", "wall_ms_total", "cpu_ms"].into_iter().find(|c| frames.column(c).is_some_and(|i| frames.has_data(i)));
     let Some(time_col) = time_col else { return vec![] };
@@ -184,7 +211,7 @@ pub fn write_charts(run_dir: &Path, manifest: &Manifest, frames: &Frames) -> any
     let dir = run_dir.join("charts");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut out = Vec::new();
-    for (stem, chart) in frame_charts(manifest, frames).into_iter().chain(reliability_chart(manifest, frames)).chain(sigma_chart(manifest, frames)).chain(speed_accuracy_charts(manifest, frames)) {
+    for (stem, chart) in frame_charts(manifest, frames).into_iter().chain(reliability_chart(manifest, frames)).chain(sigma_chart(manifest, frames)).chain(reliability_spread_chart(manifest, frames)).chain(speed_accuracy_charts(manifest, frames)) {
         let (svg, map) = plot::to_svg(&chart)?;
         let svg_path = dir.join(format!("{stem}.svg"));
         std::fs::write(&svg_path, &svg).with_context(|| format!("cannot write {}", svg_path.display()))?;
@@ -214,6 +241,15 @@ mod tests {
         assert_eq!(chart.series[2].points, vec![(0.0, 0.5), (1.0, 0.5)]);
         let (_, r) = reliability_chart(&manifest, &frames).expect("a reliability chart");
         assert_eq!(r.series[1].points, vec![(0.0, 0.6), (1.0, 0.3)]);
+        assert!(reliability_spread_chart(&manifest, &frames).is_none(), "no spread columns, no chart");
+        let spread = "method,frame,cpu_ms,reliability_diff_p10,reliability_diff_p50,reliability_diff_p90,sigma_far_from_even\n\
+                      pt_1spp,0,1,,,,\nnirc_blend_1spp,0,2,-0.1,0.0,0.2,0.3\nnirc_blend_1spp,1,2,-0.2,0.1,0.3,0.4\n";
+        let spread = Frames::parse(spread, Path::new("frames.csv")).unwrap();
+        let (stem, chart) = reliability_spread_chart(&manifest, &spread).expect("a spread chart");
+        assert_eq!(stem, "frames_reliability_spread");
+        assert_eq!(chart.series[0].points, vec![(0.0, -0.1), (1.0, -0.2)]);
+        assert_eq!(chart.series[2].points, vec![(0.0, 0.2), (1.0, 0.3)]);
+        assert_eq!(chart.series[3].points, vec![(0.0, 0.3), (1.0, 0.4)]);
         // A run without NIRC methods has neither chart.
         let plain = Frames::parse("method,frame,cpu_ms\npt_1spp,0,1\n", Path::new("frames.csv")).unwrap();
         assert!(sigma_chart(&manifest, &plain).is_none() && reliability_chart(&manifest, &plain).is_none());

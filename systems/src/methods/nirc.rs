@@ -457,9 +457,14 @@ pub fn frame_output(caches: Query<&NircCache>, mut methods: Query<(&mut NircMeth
 }
 
 /// Means over the frame's answered queries of r̄_cur, r̄_EMA, the blend's σ, and the share of
-/// queries whose cell prefers High-LR (σ > 0.5); σ is 0 during the grid's warm-up.
+/// queries whose cell prefers High-LR (σ > 0.5); σ is 0 during the grid's warm-up. Also the
+/// spread of what σ is a function of, d = r̄_cur − r̄_EMA (10th, 50th and 90th percentiles over
+/// the queries, so over cells weighted by the pixels that see them), and the share of queries
+/// whose σ is more than 0.1 from the even mixture (|d| > ln(1.5)/κ ≈ 0.1 at κ = 4): how much of
+/// the image the reliability weighting actually moves.
 fn reliability_stats(diag: &[[f32; 4]], valid: &[bool]) -> Vec<(String, f64)> {
-    let (mut n, mut r_cur, mut r_ema, mut sigma, mut prefer) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mut n, mut r_cur, mut r_ema, mut sigma, mut prefer, mut far) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let mut diff = Vec::new();
     for (d, &v) in diag.iter().zip(valid) {
         if !v || !d.iter().all(|x| x.is_finite()) {
             continue;
@@ -469,14 +474,28 @@ fn reliability_stats(diag: &[[f32; 4]], valid: &[bool]) -> Vec<(String, f64)> {
         r_ema += d[1] as f64;
         sigma += d[2] as f64;
         prefer += (d[2] > 0.5) as u32 as f64;
+        // During the warm-up (d[3] = 0) σ is 0 by rule, not by the statistics.
+        if d[3] > 0.0 {
+            far += ((d[2] - 0.5).abs() > 0.1) as u32 as f64;
+            diff.push(d[0] as f64 - d[1] as f64);
+        }
     }
     let n = f64::max(n, 1.0);
-    vec![
+    let mut stats = vec![
         ("reliability_high_lr".into(), r_cur / n),
         ("reliability_ema".into(), r_ema / n),
         ("blend_sigma".into(), sigma / n),
         ("prefer_high_lr".into(), prefer / n),
-    ]
+    ];
+    if !diff.is_empty() {
+        diff.sort_by(f64::total_cmp);
+        let quantile = |q: f64| diff[(q * (diff.len() - 1) as f64).round() as usize];
+        stats.push(("reliability_diff_p10".into(), quantile(0.1)));
+        stats.push(("reliability_diff_p50".into(), quantile(0.5)));
+        stats.push(("reliability_diff_p90".into(), quantile(0.9)));
+        stats.push(("sigma_far_from_even".into(), far / diff.len() as f64));
+    }
+    stats
 }
 
 /// Figure 3's colours: green where High-LR is preferred (σ), red where EMA is (1 - σ); black
@@ -485,3 +504,29 @@ pub fn preference_map(sigma: &[[f32; 4]]) -> Vec<[f32; 4]> {
     sigma.iter().map(|s| if s[3] > 0.0 { [1.0 - s[0], s[0], 0.0, 1.0] } else { [0.0, 0.0, 0.0, 1.0] }).collect()
 }
 
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The spread of d = r̄_cur − r̄_EMA and the share of σ away from 0.5 count only answered
+    /// queries past the grid's warm-up.
+    #[test]
+    fn reliability_stats_give_the_spread_of_the_difference_past_warm_up() {
+        // (r̄_cur, r̄_EMA, σ, past warm-up)
+        let mut diag: Vec<[f32; 4]> = (0..11).map(|i| [0.5 + 0.01 * i as f32, 0.5, 0.5, 1.0]).collect();
+        diag[10][2] = 0.7; // one query far from the even mixture
+        diag.push([0.9, 0.1, 0.0, 0.0]); // in warm-up: no difference counted
+        diag.push([0.9, 0.1, 0.9, 1.0]); // not answered
+        let mut valid = vec![true; diag.len()];
+        *valid.last_mut().unwrap() = false;
+        let stats = reliability_stats(&diag, &valid);
+        let get = |k: &str| stats.iter().find(|s| s.0 == k).unwrap().1;
+        assert!((get("reliability_diff_p10") - 0.01).abs() < 1e-6, "{stats:?}");
+        assert!((get("reliability_diff_p50") - 0.05).abs() < 1e-6, "{stats:?}");
+        assert!((get("reliability_diff_p90") - 0.09).abs() < 1e-6, "{stats:?}");
+        assert!((get("sigma_far_from_even") - 1.0 / 11.0).abs() < 1e-9, "{stats:?}");
+        // All in warm-up: the spread is not reported at all.
+        let warm: Vec<[f32; 4]> = diag.iter().map(|d| [d[0], d[1], 0.0, 0.0]).collect();
+        assert!(reliability_stats(&warm, &valid).iter().all(|s| !s.0.starts_with("reliability_diff") && s.0 != "sigma_far_from_even"));
+    }
+}
