@@ -3,6 +3,7 @@
 
 import package::media::types::{RaySegment};
 import package::media::media_rng::{media_rand};
+import package::media::media_jackknife::{jackknife};
 import package::media::media_tracking::{ratio_tracking, track_length};
 import package::media::media_optical_depth::{kettunen_sample_count, od_estimate, od_prepare, od_x};
 
@@ -13,10 +14,6 @@ const EST_UNBIASED_RAY_MARCHING: u32 = 3u;
 const EST_NAIVE: u32 = 4u;
 const EST_JACKKNIFE: u32 = 5u;
 const MAX_DEGREE: u32 = 8u;
-
-fn jackknife(x0: f32, x1: f32) -> f32 {
-    return cos(0.5 * abs(x0 - x1)) * exp(-0.5 * (x0 + x1));
-}
 
 var<private> urm_prob: array<f32, 9>;
 

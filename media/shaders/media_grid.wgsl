@@ -46,6 +46,12 @@ fn mu_at(s: RaySegment, t: f32, cell: vec3i) -> f32 {
     return density[v.x + medium.res.x * (v.y + medium.res.y * v.z)];
 }
 
+// μ at t anywhere on the segment (its super-voxel found from the point).
+fn mu_point(s: RaySegment, t: f32) -> f32 {
+    let cell = clamp(vec3i(floor(seg_at(s, t) / f32(SUPER_VOXEL))), vec3i(0), vec3i(medium.dims) - vec3i(1));
+    return mu_at(s, t, cell);
+}
+
 // (P, μ_min) of a super-voxel: Kettunen's mean (variance_aware false) or Eq. 5 with the floor.
 fn importance(sv: vec4f, variance_aware: bool) -> vec2f {
     if !variance_aware {

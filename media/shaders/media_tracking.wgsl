@@ -30,21 +30,9 @@ fn next_collision(s: RaySegment, dda: ptr<function, Dda>, t_start: f32, rng: ptr
     return vec2f(BIG, 0.0);
 }
 
+// The track-length estimate: 1 when delta tracking leaves the segment without a real collision.
 fn track_length(s: RaySegment, rng: ptr<function, u32>) -> f32 {
-    var dda = dda_new(s, medium.dims, f32(SUPER_VOXEL));
-    var t = s.t0;
-    for (var n = 0u; n < MAX_COLLISIONS; n++) {
-        let c = next_collision(s, &dda, t, rng);
-        if c.x == BIG {
-            break;
-        }
-        let mu = mu_at(s, c.x, dda.cell);
-        if media_rand(rng) < mu / c.y {
-            return 0.0;
-        }
-        t = c.x;
-    }
-    return 1.0;
+    return select(0.0, 1.0, delta_tracking(s, rng) == BIG);
 }
 
 fn ratio_tracking(s: RaySegment, rng: ptr<function, u32>) -> f32 {
@@ -60,4 +48,23 @@ fn ratio_tracking(s: RaySegment, rng: ptr<function, u32>) -> f32 {
         t = c.x;
     }
     return value;
+}
+
+// Delta tracking (free-flight sampling, density T(t) μ(t)): the parameter of the first real
+// collision on the segment, or BIG when the ray leaves it. The same walk as track_length.
+fn delta_tracking(s: RaySegment, rng: ptr<function, u32>) -> f32 {
+    var dda = dda_new(s, medium.dims, f32(SUPER_VOXEL));
+    var t = s.t0;
+    for (var n = 0u; n < MAX_COLLISIONS; n++) {
+        let c = next_collision(s, &dda, t, rng);
+        if c.x == BIG {
+            break;
+        }
+        let mu = mu_at(s, c.x, dda.cell);
+        if media_rand(rng) < mu / c.y {
+            return c.x;
+        }
+        t = c.x;
+    }
+    return BIG;
 }

@@ -23,12 +23,22 @@ impl DensityGrid {
     /// Bakes `kind` at the voxel centres of a `res` grid filling [box_min, box_max], peak
     /// extinction `sigma_t`.
     pub fn bake(kind: &DensityKind, res: UVec3, sigma_t: f32, box_min: Vec3, box_max: Vec3) -> Self {
+        Self::bake_spun(kind, res, sigma_t, box_min, box_max, 0.0)
+    }
+
+    /// [`Self::bake`] with the field turned by `spin` radians about the box's vertical axis
+    /// (an animated medium; the field is looked up at the voxel centre turned back).
+    pub fn bake_spun(kind: &DensityKind, res: UVec3, sigma_t: f32, box_min: Vec3, box_max: Vec3, spin: f32) -> Self {
         let mut data = Vec::with_capacity((res.x * res.y * res.z) as usize);
         let field = Field::new(kind);
+        let turn = glam::Quat::from_rotation_y(-spin);
         for z in 0..res.z {
             for y in 0..res.y {
                 for x in 0..res.x {
-                    let p = (UVec3::new(x, y, z).as_vec3() + 0.5) / res.as_vec3();
+                    let mut p = (UVec3::new(x, y, z).as_vec3() + 0.5) / res.as_vec3();
+                    if spin != 0.0 {
+                        p = turn * (p - Vec3::splat(0.5)) + Vec3::splat(0.5);
+                    }
                     data.push(sigma_t * field.unit_density(p));
                 }
             }
@@ -66,6 +76,7 @@ enum Field {
     Constant,
     Cloud(Fbm<Perlin>),
     Explosion(Perlin, f64),
+    Grid(scene::RawGrid),
 }
 
 impl Field {
@@ -74,6 +85,8 @@ impl Field {
             DensityKind::Homogeneous => Field::Constant,
             DensityKind::Cloud { octaves, frequency, seed } => Field::Cloud(Fbm::<Perlin>::new(seed).set_octaves(octaves).set_frequency(frequency)),
             DensityKind::Explosion { frequency, seed } => Field::Explosion(Perlin::new(seed), frequency),
+            // Checked when the scenario loaded (sim::Scenario, errors at the grid file's line).
+            DensityKind::Grid { ref file } => Field::Grid(scene::RawGrid::load(file).unwrap_or_else(|e| panic!("{e}"))),
         }
     }
 
@@ -82,6 +95,7 @@ impl Field {
         let q = [p.x as f64, p.y as f64, p.z as f64];
         match self {
             Field::Constant => 1.0,
+            Field::Grid(g) => g.at_unit(p.to_array()),
             Field::Cloud(fbm) => {
                 // Sphere of radius 0.8 with a soft edge, eroded by the noise.
                 let shape = 1.0 - r / 0.8;
@@ -105,5 +119,11 @@ impl DensityGrid {
     pub fn from_desc(desc: &scene::MediumDesc) -> Self {
         let (x, y, z) = desc.resolution;
         Self::bake(&desc.kind, UVec3::new(x, y, z), desc.sigma_t, desc.box_min, desc.box_max)
+    }
+
+    /// An animated medium at one of its states (`MediumDesc::at`).
+    pub fn from_state(desc: &scene::MediumDesc, s: &scene::MediumState) -> Self {
+        let (x, y, z) = desc.resolution;
+        Self::bake_spun(&desc.kind, UVec3::new(x, y, z), s.sigma_t, s.box_min, s.box_max, s.spin)
     }
 }

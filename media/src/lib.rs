@@ -6,16 +6,19 @@
 //! medium (`medium`), exact optical depth (`regular_tracking`), track-length, ratio tracking,
 //! ray marching (Alg. 1 and 2: `optical_depth`), naive and Kettunen's biased exp(−X)
 //! (`ray_marching`), unbiased ray marching, the jackknife, their selection (`transmittance`),
-//! MIS weights (`mis`) and the 1-D stratified sampling of Sec. 4.1 (`stratified`).
+//! MIS weights (`mis`), equiangular sampling (`equiangular`), the closed-form MIS setting of
+//! Eqs. 9/10 (`mis_trial`) and the 1-D stratified sampling of Sec. 4.1 (`stratified`).
 
 pub mod dda;
 pub mod gpu;
 pub mod image;
 pub mod density;
+pub mod equiangular;
 pub mod jackknife;
 pub mod majorant_tracking;
 pub mod medium;
 pub mod mis;
+pub mod mis_trial;
 pub mod optical_depth;
 pub mod ratio_tracking;
 pub mod ray_marching;

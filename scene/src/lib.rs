@@ -10,7 +10,7 @@ pub mod rng;
 pub use rng::{SplitMix64, mix64};
 
 pub mod medium;
-pub use medium::{DensityKind, MediumDesc};
+pub use medium::{DensityKind, MediumDesc, MediumMotion, MediumState, RawGrid};
 
 use glam::{Mat4, Vec2, Vec3};
 use serde::{Deserialize, Serialize};

@@ -4,6 +4,7 @@
 //! extension is on. Errors carry the file, line and column and say what was expected.
 
 use std::fmt;
+use scene::DensityKind;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
@@ -387,7 +388,7 @@ impl Scenario {
     /// anchors relative glTF paths).
     pub fn from_ron(text: &str, origin: &Path) -> Result<Scenario, ScenarioError> {
         let options = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
-        let file: ScenarioFile = options.from_str(text).map_err(|e| ScenarioError {
+        let mut file: ScenarioFile = options.from_str(text).map_err(|e| ScenarioError {
             file: origin.to_path_buf(),
             position: Some((e.span.start.line, e.span.start.col)),
             message: e.code.to_string(),
@@ -423,6 +424,16 @@ impl Scenario {
                         r.name, r.x, r.y, r.width, r.height
                     ),
                 });
+            }
+        }
+        for m in &mut file.media {
+            if let DensityKind::Grid { file: grid } = &mut m.kind {
+                if grid.is_relative() {
+                    *grid = origin.parent().unwrap_or(Path::new("")).join(&*grid);
+                }
+                if let Err(e) = scene::RawGrid::load(grid) {
+                    return Err(ScenarioError { file: origin.to_path_buf(), position: find_quoted(text, &m.name), message: format!("medium '{}': {e}", m.name) });
+                }
             }
         }
         for m in &file.media {

@@ -35,6 +35,9 @@ fn bad_media_name_the_file_and_line() {
         (r#"(name: "big", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0, resolution: (0, 8, 8))"#, "resolution"),
         (r#"(name: "bright", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0, albedo: (2, 0, 0))"#, "albedo"),
         (r#"(name: "x", kind: Smoke, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0)"#, "Smoke"),
+        (r#"(name: "p", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0, motion: (pulse_amplitude: 1.5, pulse_period: 2))"#, "pulse_amplitude"),
+        (r#"(name: "q", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0, motion: (pulse_amplitude: 0.5))"#, "pulse_period"),
+        (r#"(name: "r", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0, motion: (spin: 3))"#, "spin"),
     ];
     for (medium, word) in cases {
         let e = parse(&scenario(medium)).unwrap_err();
@@ -42,4 +45,50 @@ fn bad_media_name_the_file_and_line() {
         assert!(text.starts_with("volume.ron:4:"), "{text}");
         assert!(text.contains(word), "{text}");
     }
+}
+
+#[test]
+fn an_animated_medium_moves_scales_spins_and_pulses_in_closed_form() {
+    let s = parse(&scenario(
+        r#"(name: "m", kind: Homogeneous, box_min: (0, 0, 0), box_max: (2, 2, 2), sigma_t: 2.0,
+            motion: (velocity: (1, 0, 0), scale_per_second: 0.5, spin_degrees_per_second: 90, pulse_amplitude: 0.25, pulse_period: 4))"#,
+    ))
+    .unwrap();
+    let m = &s.media[0];
+    let a = m.at(1.0);
+    // Centre (1, 1, 1) + (1, 0, 0); half size 1 · 1.5; σ 2 (1 + 0.25 sin(π/2)); 90° = π/2.
+    assert!((a.box_min - glam::Vec3::new(0.5, -0.5, -0.5)).length() < 1e-6 && (a.box_max - glam::Vec3::new(3.5, 2.5, 2.5)).length() < 1e-6, "{a:?}");
+    assert!((a.sigma_t - 2.5).abs() < 1e-6 && (a.spin - std::f32::consts::FRAC_PI_2).abs() < 1e-6, "{a:?}");
+    // A still medium is its declaration at any time.
+    let still = parse(&scenario(r#"(name: "s", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0)"#)).unwrap();
+    let st = still.media[0].at(7.0);
+    assert_eq!((st.box_min, st.box_max, st.sigma_t, st.spin), (still.media[0].box_min, still.media[0].box_max, 1.0, 0.0));
+}
+
+#[test]
+fn a_raw_density_grid_loads_relative_to_the_scenario_and_bad_files_name_their_line() {
+    let dir = std::env::temp_dir().join(format!("flicker_grid_{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("assets")).unwrap();
+    let grid = |name: &str, text: &str| std::fs::write(dir.join("assets").join(name), text).unwrap();
+    grid("ok.density", "# a 2x1x1 grid\ndensity_grid 2 1 1\n0.25\n1\n");
+    grid("header.density", "# no header\n0.5 0.5\n");
+    grid("value.density", "density_grid 2 1 1\n0.5\n1.5\n");
+    grid("short.density", "density_grid 2 2 1\n0.5 0.5\n0.5\n");
+    let load = |file: &str| {
+        let text = scenario(&format!(r#"(name: "g", kind: Grid(file: "assets/{file}"), box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 2.0)"#));
+        Scenario::from_ron(&text, &dir.join("volume.ron"))
+    };
+    let s = load("ok.density").unwrap();
+    let DensityKind::Grid { file } = &s.media[0].kind else { panic!("{:?}", s.media[0].kind) };
+    assert_eq!(scene::RawGrid::load(file).unwrap(), scene::RawGrid { res: (2, 1, 1), data: vec![0.25, 1.0] });
+    for (file, line, word) in [("header.density", 2, "density_grid NX NY NZ"), ("value.density", 3, "'1.5'"), ("short.density", 3, "3 values; expected 2x2x1 = 4")] {
+        let e = load(file).unwrap_err().to_string();
+        assert!(e.contains(&format!("{file}:{line}:")) && e.contains(word), "{e}");
+        assert!(e.contains("volume.ron:4:"), "{e}");
+    }
+    assert!(load("missing.density").unwrap_err().to_string().contains("cannot read"));
+    // The shipped grid parses.
+    let shipped = scene::RawGrid::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/assets/smoke_ring.density")).unwrap();
+    assert_eq!(shipped.res, (16, 16, 16));
+    let _ = std::fs::remove_dir_all(&dir);
 }

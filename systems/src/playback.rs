@@ -59,6 +59,12 @@ impl FrameWorld {
         world.insert_resource(RunOutput { folder, records: Vec::new() });
         world.insert_resource(References { cache: ReferenceCache::new(cache_dir), current: None, rendered: 0, cached: 0 });
         world.insert_resource(Progress(progress));
+        // The path tracer renders one medium: the first declared (media/README.md).
+        if let Some(desc) = scenario.media.first() {
+            let gpu = &world.resource::<GpuDevice>().0;
+            let medium = frame::media::SceneMedium::new(gpu, desc);
+            world.insert_resource(medium);
+        }
         frame::catch_failures(&mut world);
 
         for (index, method) in spec.methods.iter().enumerate() {

@@ -44,7 +44,7 @@ fn every_method_system_runs_in_its_stage_in_order() {
     for name in ["rotate::rotate", "flash::flash", "boids::flock", "events::apply_events", "transform::propagate_transforms"] {
         assert!(simulate.contains(&name.to_string()), "{name} not in Simulate: {simulate:?}");
     }
-    assert_eq!(in_stage(&l, Stage::Extract), ["simulation::extract_scene", "extract::frame_number", "extract::upload_scene"]);
+    assert_eq!(in_stage(&l, Stage::Extract), ["simulation::extract_scene", "extract::frame_number", "extract::upload_scene", "media::upload_medium"]);
 
     let render = in_stage(&l, Stage::Render);
     for name in [

@@ -1,13 +1,17 @@
 //! The media estimators in WGSL (media/shaders/) and their GPU state: a medium's buffers
 //! (`GpuMedium`) and the pass that runs one estimator on a list of segments with given seeds
-//! (`EstimatorPass`, what the GPU-vs-CPU tests run).
+//! (`EstimatorPass`, what the GPU-vs-CPU tests run); the closed-form MIS trials (`MisPass`).
 
 mod estimator_pass;
 mod image_pass;
 mod medium;
+mod mis_pass;
 mod shaders;
+mod volume_path_pass;
 
 pub use estimator_pass::{EstimatorPass, RayResult};
 pub use image_pass::{ImagePass, ImageParams, PASS};
+pub use mis_pass::{MisParams, MisPass};
 pub use medium::{GpuMedium, MediumParams, RaySegment};
-pub use shaders::{modules, program};
+pub use shaders::{modules, modules_at, program};
+pub use volume_path_pass::{Combination, MisWeight, ShadowTransmittance, VolumeImage, VolumePathParams, VolumePathPass, VolumePathSettings, VOLUME_PATH_PASS};

@@ -10,8 +10,14 @@ use super::medium::{MediumParams, RaySegment};
 
 /// The library's modules: structs, the medium's bindings, the estimator files.
 pub fn modules() -> Vec<Module> {
+    modules_at(0)
+}
+
+/// [`modules`] with the medium bound as @group(`group`) (3 in passes on the path tracer's
+/// scene, which holds groups 0 and 1).
+pub fn modules_at(group: u32) -> Vec<Module> {
     let types = Module::generated("package::media::types", &[MediumParams::WGSL, RaySegment::WGSL]);
-    let bindings = render::compute::group_module("package::media::medium_bindings", 0, &super::medium::BINDINGS, &[&types]);
+    let bindings = render::compute::group_module("package::media::medium_bindings", group, &super::medium::BINDINGS, &[&types]);
     vec![
         types,
         bindings,
@@ -20,6 +26,8 @@ pub fn modules() -> Vec<Module> {
         render::wgsl_file!("media_dda.wgsl"),
         render::wgsl_file!("media_tracking.wgsl"),
         render::wgsl_file!("media_optical_depth.wgsl"),
+        render::wgsl_file!("media_jackknife.wgsl"),
+        render::wgsl_file!("media_mis.wgsl"),
         render::wgsl_file!("media_estimators.wgsl"),
     ]
 }

@@ -5,6 +5,7 @@
 //! recording are systems in them. `flicker schedule` prints what runs.
 
 pub mod extract;
+pub mod media;
 pub mod measure;
 pub mod method_output;
 pub mod record;
@@ -30,7 +31,7 @@ fn recorded(clock: Res<FrameClock>) -> bool {
 /// The systems every frame has, whatever its methods.
 pub fn add_core_systems(schedule: &mut Schedule) {
     schedule.add_systems((sim::advance_clock, sim::animation_systems()).chain().run_if(started).in_set(Stage::Simulate));
-    schedule.add_systems((sim::extract_scene.run_if(started), extract::frame_number, extract::upload_scene).chain().in_set(Stage::Extract));
+    schedule.add_systems((sim::extract_scene.run_if(started), extract::frame_number, extract::upload_scene, media::upload_medium).chain().in_set(Stage::Extract));
     schedule.add_systems(reference::render_reference.in_set(Stage::Render));
     schedule.add_systems(
         (measure::prepare, measure::smape_vs_previous, measure::flip_vs_reference, measure::regions).chain().run_if(recorded).in_set(Stage::Measure),

@@ -23,6 +23,7 @@ pub fn render_reference(
     scene: Res<sim::ExtractedScene>,
     progress: Res<Progress>,
     mut references: ResMut<References>,
+    mut medium: Option<ResMut<super::media::SceneMedium>>,
 ) -> Result {
     references.current = None;
     let scenario = &run.scenario;
@@ -31,6 +32,12 @@ pub fn render_reference(
     }
     let (width, height) = (run.width, run.height);
     let settings = tracer.0.settings();
+    // With a medium the volumetric path tracer renders the reference: its shaders, the medium
+    // and its state are part of the key.
+    let shader_source = match &medium {
+        Some(m) => format!("{}\n{}\n{}", PathTracer::shader_source(), media::gpu::VolumePathPass::shader_source(), m.cache_key()),
+        None => PathTracer::shader_source().to_string(),
+    };
     let key = ReferenceCache::key(
         &scene.scene,
         &ReferenceKey {
@@ -41,7 +48,7 @@ pub fn render_reference(
             max_depth: scenario.max_depth,
             rr_start_depth: settings.rr_start_depth,
             adapter: &gpu.0.summary.to_string(),
-            shader_source: PathTracer::shader_source(),
+            shader_source: &shader_source,
         },
     );
     let frame = clock.frame;
@@ -54,12 +61,17 @@ pub fn render_reference(
             let bar = &progress.0;
             bar.set_message(format!("reference {frame:04}"));
             let spp = scenario.reference.spp;
-            let px = tracer
+            let px = match medium.as_deref_mut() {
+                Some(m) => super::media::render_volume(&gpu.0, &tracer, m, &super::media::REFERENCE_SETTINGS, spp, reference_seed(scenario.seed), clock.global)
+                    .map(|(px, _, _)| px)
+                    .map_err(|e| failed(anyhow::anyhow!("reference of frame {frame}: {e}")))?,
+                None => tracer
                 .0
                 .render_reference(&gpu.0, spp, reference_seed(scenario.seed), clock.global, &mut |done, total| {
                     bar.set_message(format!("reference {frame:04}: {done}/{total} spp"));
                 })
-                .map_err(|e| failed(anyhow::anyhow!("reference of frame {frame}: {e}")))?;
+                .map_err(|e| failed(anyhow::anyhow!("reference of frame {frame}: {e}")))?,
+            };
             references.cache.store(&key, width, height, &px).map_err(failed)?;
             references.rendered += 1;
             px

@@ -11,6 +11,7 @@ pub mod sample_cache;
 pub mod spec;
 pub mod taa;
 pub mod volume;
+pub mod volume_path;
 pub mod termination;
 
 use anyhow::Result;
@@ -26,6 +27,7 @@ use serde::{Deserialize, Serialize};
 use sim::MethodEntry;
 use taa::TaaSettings;
 use volume::VolumeSettings;
+use volume_path::VolumePathMethod;
 use termination::TerminationSettings;
 
 /// A method family: its systems and how to build one instance.
@@ -57,6 +59,9 @@ pub enum MethodSpec {
     HashCache(HashCacheSettings),
     /// Primary-ray transmittance images of a medium with one estimator (media crate).
     VolumeTransmittance(VolumeSettings),
+    /// Volumetric path tracing of the scenario's medium (media::gpu::VolumePathPass), with MIS
+    /// of equiangular and free-flight sampling by the paper's weights.
+    VolumePath(VolumePathMethod),
     /// Path tracing terminated into a hashed radiance cache by variance trading
     /// (render::termination): `Termination(rule: VarianceBounding(t: 0.1))`.
     Termination(TerminationSettings),
@@ -72,6 +77,7 @@ impl MethodSpec {
             MethodSpec::Taa(_) => &taa::PLUGIN,
             MethodSpec::HashCache(_) => &hash_cache::PLUGIN,
             MethodSpec::VolumeTransmittance(_) => &volume::PLUGIN,
+            MethodSpec::VolumePath(_) => &volume_path::PLUGIN,
             MethodSpec::Termination(_) => &termination::PLUGIN,
         }
     }
@@ -85,6 +91,7 @@ impl MethodSpec {
             MethodSpec::Taa(_) => "taa".into(),
             MethodSpec::HashCache(s) => hash_cache::label(s),
             MethodSpec::VolumeTransmittance(s) => s.label(),
+            MethodSpec::VolumePath(s) => s.label(),
             MethodSpec::Termination(s) => termination::label(s),
         }
     }
@@ -98,6 +105,7 @@ impl MethodSpec {
             MethodSpec::SampleCache(s) => (s.shading_rate.ceil() as u32).max(1),
             MethodSpec::Taa(_) | MethodSpec::HashCache(_) | MethodSpec::Termination(_) => 1,
             MethodSpec::VolumeTransmittance(s) => s.spp,
+            MethodSpec::VolumePath(s) => s.spp,
         }
     }
 
@@ -108,6 +116,7 @@ impl MethodSpec {
             MethodSpec::PathTracing(s) => s.spp = spp,
             MethodSpec::Nirc(s) => s.spp = spp,
             MethodSpec::VolumeTransmittance(s) => s.spp = spp,
+            MethodSpec::VolumePath(s) => s.spp = spp,
             MethodSpec::SampleCache(_) | MethodSpec::Taa(_) | MethodSpec::HashCache(_) | MethodSpec::Termination(_) => {}
         }
     }

@@ -1,0 +1,199 @@
+//! Volumetric path tracing on the path tracer's scene (media/shaders/media_path.wgsl): unbiased
+//! references of a scene with one medium. Groups: 0 and 1 the path tracer's scene and geometry,
+//! 2 this pass's parameters and per-sample radiance, 3 the medium (`GpuMedium`). A scene
+//! without media never builds this pass: the path tracer and its shaders are unchanged.
+
+use glam::Vec3;
+use render::compute::{BufferBinding, binding_layout, buffer_group, pipelines};
+use render::error::RenderError;
+use render::gpu::Gpu;
+use render::gpu_struct::GpuStruct;
+use render::pass_library::PassLibrary;
+use render::path_tracer::PathTracer;
+use render::readback::read_buffer;
+use render::shader::{Module, Program};
+use render::timing::{PassTimer, PassTiming, merge};
+use serde::{Deserialize, Serialize};
+use wgpu::util::DeviceExt;
+
+use super::medium::GpuMedium;
+
+/// The MIS weight of free-flight sampling against equiangular sampling of positional lights
+/// (Sec. 5.2); `None`: free-flight (delta tracking) only.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum MisWeight {
+    #[default]
+    None,
+    /// g(X̄).
+    Naive,
+    /// Re g(X̄ + iS) (Eq. 12, Appendix F).
+    Jackknife,
+    /// Miller et al. 2019's ratio-tracking weight.
+    Miller,
+}
+
+/// How the equiangular sample is weighted: Eq. 9 (unbiased, a separate ratio-tracking T̃(t0)) or
+/// Eq. 10 (the weight estimate carries the transmittance; slightly biased).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Combination {
+    #[default]
+    Eq9,
+    Eq10,
+}
+
+/// The transmittance estimate of shadow rays.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum ShadowTransmittance {
+    #[default]
+    RatioTracking,
+    TrackLength,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct VolumePathSettings {
+    pub mis: MisWeight,
+    pub combination: Combination,
+    pub shadow: ShadowTransmittance,
+    /// Samples N of each of the two optical-depth estimates of a naive or jackknife weight.
+    pub samples: u32,
+}
+
+impl Default for VolumePathSettings {
+    fn default() -> Self {
+        Self { mis: MisWeight::None, combination: Combination::Eq9, shadow: ShadowTransmittance::RatioTracking, samples: 4 }
+    }
+}
+
+render::gpu_struct! {
+    pub struct VolumePathParams {
+        pub albedo: [f32; 3] => "vec3f",
+        pub mis: u32 => "u32",
+        pub eq10: u32 => "u32",
+        pub shadow: u32 => "u32",
+        pub samples: u32 => "u32",
+        /// Samples per pixel in this dispatch, from `first_sample` on.
+        pub spp: u32 => "u32",
+        pub first_sample: u32 => "u32",
+        pub _pad0: u32 => "u32",
+        pub _pad1: u32 => "u32",
+        pub _pad2: u32 => "u32",
+    }
+}
+
+const BINDINGS: [BufferBinding; 2] = [BufferBinding::uniform("vp", "VolumePathParams"), BufferBinding::read_write("samples", "array<vec4f>")];
+
+/// Paths per dispatch: short invocations (llvmpipe's loop limit, GPU watchdogs) and a bounded
+/// sample buffer.
+const PATHS_PER_DISPATCH: u32 = 1 << 18;
+
+/// Per pixel: the mean radiance and the variance of that mean's luminance (from the samples).
+pub struct VolumeImage {
+    pub width: u32,
+    pub height: u32,
+    pub mean: Vec<[f32; 3]>,
+    pub var_of_mean: Vec<f64>,
+    /// GPU (or wall) time of pass `volume_path`, all batches.
+    pub timings: Vec<PassTiming>,
+    /// Paths traced.
+    pub paths: u64,
+}
+
+/// The pass's name in timings.
+pub const VOLUME_PATH_PASS: &str = "volume_path";
+
+pub struct VolumePathPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::ComputePipeline,
+    timer: PassTimer,
+}
+
+impl VolumePathPass {
+    /// The pass's program: the path tracer's library, the media library with the medium as
+    /// @group(3), its own @group(2), media_path.wgsl.
+    pub fn program() -> Program {
+        let types = Module::generated("package::media::volume_path_types", &[VolumePathParams::WGSL]);
+        let bindings = render::compute::group_module("package::media::volume_path_bindings", 2, &BINDINGS, &[&types]);
+        let mut own = super::shaders::modules_at(3);
+        own.extend([types, bindings, render::wgsl_file!("media_path.wgsl")]);
+        PassLibrary::program(own, [render::wgsl_file!("media_volume_path.wgsl")])
+    }
+
+    /// Every WGSL source of the pass: part of the key of cached references.
+    pub fn shader_source() -> &'static str {
+        static SOURCE: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+        SOURCE.get_or_init(|| Self::program().fingerprint())
+    }
+
+    pub fn new(gpu: &Gpu, tracer: &PathTracer, medium: &GpuMedium) -> Result<Self, RenderError> {
+        let layout = binding_layout(gpu, "media volume path", &BINDINGS);
+        let program = Self::program();
+        let scene = tracer.scene();
+        let [pipeline] = pipelines(gpu, "media volume path", &program, &[scene.layout(), scene.geometry().bind_group_layout(), &layout, &medium.layout], ["volume_path"])?;
+        Ok(Self { layout, pipeline, timer: PassTimer::new(gpu, &[VOLUME_PATH_PASS]) })
+    }
+
+    /// `spp` paths per pixel of the tracer's current scene and camera (seed and frame as the path
+    /// tracer's), in a medium of albedo `albedo`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render(&self, gpu: &Gpu, tracer: &PathTracer, medium: &GpuMedium, albedo: Vec3, settings: &VolumePathSettings, spp: u32, seed: u64, frame: u32) -> Result<VolumeImage, String> {
+        let (width, height) = { let s = tracer.settings(); (s.width, s.height) };
+        let pixels = width * height;
+        let batch = (PATHS_PER_DISPATCH / pixels).clamp(1, spp.max(1));
+        let device = &gpu.device;
+        let size = u64::from(pixels * batch) * 16;
+        let samples = device.create_buffer(&wgpu::BufferDescriptor { label: Some("volume path samples"), size, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
+        let staging = device.create_buffer(&wgpu::BufferDescriptor { label: Some("volume path staging"), size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
+        let mut sum = vec![[0f64; 3]; pixels as usize];
+        let mut lum = vec![(0f64, 0f64); pixels as usize];
+        let mut first = 0;
+        let mut timings = Vec::new();
+        while first < spp {
+            let n = batch.min(spp - first);
+            let params = VolumePathParams {
+                albedo: albedo.into(),
+                mis: settings.mis as u32,
+                eq10: u32::from(settings.combination == Combination::Eq10),
+                shadow: settings.shadow as u32,
+                samples: settings.samples,
+                spp: n,
+                first_sample: first,
+                _pad0: 0,
+                _pad1: 0,
+                _pad2: 0,
+            };
+            let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("volume path params"), contents: bytemuck::bytes_of(&params), usage: wgpu::BufferUsages::UNIFORM });
+            tracer.prepare_frame(gpu, spp, 0, seed, frame);
+            let group = buffer_group(gpu, "media volume path", &self.layout, &[&params, &samples]);
+            let mut timed = self.timer.begin(gpu, VOLUME_PATH_PASS);
+            timed
+                .pass(0, |pass| {
+                    pass.set_pipeline(&self.pipeline);
+                    pass.set_bind_group(0, tracer.scene().bind_group(), &[]);
+                    pass.set_bind_group(1, tracer.scene().geometry().bind_group(), &[]);
+                    pass.set_bind_group(2, &group, &[]);
+                    pass.set_bind_group(3, &medium.group, &[]);
+                    let groups = (pixels * n).div_ceil(64);
+                    pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
+                })
+                .map_err(|e| e.to_string())?;
+            timed.encoder().copy_buffer_to_buffer(&samples, 0, &staging, 0, size);
+            merge(&mut timings, timed.submit().map_err(|e| e.to_string())?);
+            let raw: Vec<[f32; 4]> = read_buffer(gpu, &staging)?;
+            for (i, v) in raw.iter().take((pixels * n) as usize).enumerate() {
+                let p = i / n as usize;
+                for c in 0..3 {
+                    sum[p][c] += f64::from(v[c]);
+                }
+                let l = 0.2126 * f64::from(v[0]) + 0.7152 * f64::from(v[1]) + 0.0722 * f64::from(v[2]);
+                lum[p].0 += l;
+                lum[p].1 += l * l;
+            }
+            first += n;
+        }
+        let k = f64::from(spp);
+        let mean = sum.iter().map(|s| s.map(|c| (c / k) as f32)).collect();
+        let var_of_mean = lum.iter().map(|&(s1, s2)| ((s2 / k - (s1 / k).powi(2)) * k / (k - 1.0).max(1.0)).max(0.0) / k).collect();
+        Ok(VolumeImage { width, height, mean, var_of_mean, timings, paths: u64::from(pixels) * u64::from(spp) })
+    }
+}

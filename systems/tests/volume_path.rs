@@ -1,0 +1,56 @@
+//! The VolumePath method and media references in playback: volume_mis.ron plays one row per
+//! weight with FLIP and relative MSE against the volumetric reference; volume_moving_light.ron's
+//! animated cloud is rebaked per frame (its references change frame to frame, its frames are
+//! measured for flicker); a scenario without media refuses the method by name. Small overrides
+//! (32x18, 2 spp, 16 spp references, 2 frames of the moving light) keep it to seconds on lavapipe.
+
+use std::path::Path;
+
+use systems::playback::{RunOptions, RunSummary, run_spec};
+use systems::scenario::{Overrides, RunSpec};
+
+fn play(scenario: &str, frames: Option<u32>, out: &Path) -> RunSummary {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios").join(scenario);
+    let overrides = Overrides { resolution: Some((32, 18)), spp: Some(2), frames, out: Some(out.to_path_buf()), ..Default::default() };
+    let mut spec = RunSpec::load(&path, &overrides).unwrap_or_else(|e| panic!("{e:#}"));
+    spec.scenario.reference.spp = 16;
+    run_spec(&spec, &RunOptions { scenario: path, overrides, cache_dir: Some(out.join("cache")), progress: false }).unwrap_or_else(|e| panic!("{e:#}"))
+}
+
+#[test]
+fn volume_mis_plays_every_weight_against_the_volumetric_reference() {
+    let out = std::env::temp_dir().join(format!("flicker_volume_mis_{}", std::process::id()));
+    let summary = play("volume_mis.ron", None, &out);
+    assert_eq!(summary.records.len(), 6, "one row per weight and combination");
+    assert_eq!(summary.references_rendered, 1);
+    for r in &summary.records {
+        let flip = r.flip.unwrap_or_else(|| panic!("{}: no FLIP against the reference", r.method));
+        assert!(flip.is_finite() && flip > 0.0 && flip < 1.0, "{}: FLIP {flip}", r.method);
+        assert!(r.passes.iter().any(|(p, ms)| p == media::gpu::VOLUME_PATH_PASS && ms.is_some()), "{}: no pass time", r.method);
+        println!("{}: FLIP {flip:.4}, rel MSE {:?}", r.method, r.rel_mse);
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn the_moving_light_scenario_rebakes_its_cloud_and_measures_flicker() {
+    let out = std::env::temp_dir().join(format!("flicker_volume_moving_{}", std::process::id()));
+    let summary = play("volume_moving_light.ron", Some(2), &out);
+    // The lamp moves and the cloud turns and pulses: no frame's reference is another's.
+    assert_eq!(summary.references_rendered, 2, "cached {}", summary.references_cached);
+    assert_eq!(summary.records.len(), 6);
+    for r in summary.records.iter().filter(|r| r.frame > 0) {
+        assert!(r.smape.is_some_and(|s| s.is_finite()) && r.flip.is_some_and(|f| f.is_finite()), "{} frame {}: {:?} {:?}", r.method, r.frame, r.smape, r.flip);
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn a_scenario_without_media_refuses_volume_path() {
+    let text = "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, methods: [VolumePath(spp: 1)])";
+    let scenario = sim::Scenario::from_ron(text, Path::new("inline.ron")).unwrap();
+    let out = std::env::temp_dir().join(format!("flicker_volume_path_none_{}", std::process::id()));
+    let spec = RunSpec::from_scenario(scenario, &Overrides { out: Some(out.clone()), ..Default::default() }).unwrap();
+    let e = run_spec(&spec, &RunOptions { scenario: "inline.ron".into(), overrides: Overrides::default(), cache_dir: Some(out.join("cache")), progress: false }).err().expect("refused");
+    assert!(format!("{e:#}").contains("declares no media"), "{e:#}");
+}
