@@ -1,16 +1,26 @@
 #!/usr/bin/env bash
 # Installs what flicker needs on a fresh Debian machine without a GPU (run as root):
-# Mesa's lavapipe (CPU Vulkan) for wgpu, Chromium to test the HTML report, and NVIDIA's
-# FLIP reference implementation (PyPI `flip-evaluator`) that the FLIP tests compare against.
+# Mesa's lavapipe (CPU Vulkan) for wgpu, Chromium to test the HTML report, Slurm and MUNGE
+# (tests/sweep.rs starts a one-node cluster of its own), and NVIDIA's FLIP reference
+# implementation (PyPI `flip-evaluator`) that the FLIP tests compare against.
 set -euo pipefail
 need_apt=()
 [ -e /usr/share/vulkan/icd.d/lvp_icd.x86_64.json ] || [ -e /usr/share/vulkan/icd.d/lvp_icd.json ] || need_apt+=(mesa-vulkan-drivers)
 ldconfig -p | grep -q 'libvulkan.so.1' || need_apt+=(libvulkan1)
 command -v chromium >/dev/null || need_apt+=(chromium)
+command -v slurmctld >/dev/null && command -v slurmd >/dev/null && command -v sbatch >/dev/null || need_apt+=(slurm-wlm)
+command -v munged >/dev/null || need_apt+=(munge)
 if [ ${#need_apt[@]} -gt 0 ]; then
     export DEBIAN_FRONTEND=noninteractive
+    # The packages' own services (munge, slurmctld, slurmd) must not start: the sweep test runs
+    # its daemons with its own configuration. policy-rc.d 101 = "action forbidden".
+    own_policy=0
+    if [ ! -e /usr/sbin/policy-rc.d ]; then
+        printf '#!/bin/sh\nexit 101\n' > /usr/sbin/policy-rc.d && chmod +x /usr/sbin/policy-rc.d && own_policy=1
+    fi
     apt-get update -qq
     apt-get install -y -qq --no-install-recommends "${need_apt[@]}" >/dev/null
+    if [ $own_policy = 1 ]; then rm -f /usr/sbin/policy-rc.d; fi
 fi
 # The same probe the FLIP tests use (metrics::bench::reference_flip_available).
 python3 -m flip_evaluator.flip_python_api -h >/dev/null 2>&1 || python3 -m pip install --quiet flip-evaluator

@@ -59,6 +59,12 @@ enum Command {
         #[command(subcommand)]
         action: SuiteAction,
     },
+    /// Parameter sweeps: a grid or list over method parameters, cases and seeds, one run folder
+    /// per job, run here, with GNU parallel or as a Slurm array, merged into one summary.
+    Sweep {
+        #[command(subcommand)]
+        action: SweepAction,
+    },
     /// Measure speed: BVH traversal (WGSL vs obvhs CPU), frame time per pass, FLIP and SMAPE.
     Bench {
         /// Also write the Markdown table to this file.
@@ -138,6 +144,113 @@ fn suite(action: SuiteAction) -> ExitCode {
             true
         }),
     };
+    exit_code(result)
+}
+
+#[derive(Subcommand)]
+enum SweepAction {
+    /// Plan, run every job on this machine and merge: `flicker sweep run SWEEP.ron --out DIR`.
+    Run {
+        /// The sweep file (RON), e.g. sweeps/nirc_kappa.ron
+        sweep: PathBuf,
+        /// The sweep's folder: plan.json, runs/, done/, logs/, summary.json, chart, report.md.
+        #[arg(long)]
+        out: PathBuf,
+        /// Jobs at a time [default: the number of cores].
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Reference cache of the jobs [default: DIR/cache].
+        #[arg(long)]
+        cache_dir: Option<PathBuf>,
+    },
+    /// Write the job list DIR/plan.json (deterministic), DIR/jobs.txt (GNU parallel) and
+    /// DIR/sweep.sbatch (Slurm array, task i = job i).
+    Plan {
+        /// The sweep file (RON).
+        sweep: PathBuf,
+        /// The sweep's folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Reference cache of the jobs [default: DIR/cache].
+        #[arg(long)]
+        cache_dir: Option<PathBuf>,
+    },
+    /// Run one job of a planned sweep (what every executor runs; reruns a failed job alone).
+    Job {
+        /// The sweep's folder.
+        dir: PathBuf,
+        /// The job's index in DIR/plan.json.
+        #[arg(long)]
+        index: usize,
+        /// Do not draw the progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// The `local` executor: run the planned jobs that have not finished, N at a time.
+    Local {
+        /// The sweep's folder.
+        dir: PathBuf,
+        /// Jobs at a time [default: the number of cores].
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Run every job again, finished or not.
+        #[arg(long)]
+        again: bool,
+    },
+    /// Gather the finished jobs into DIR/summary.json, the speed-vs-accuracy chart and DIR/report.md.
+    Merge {
+        /// The sweep's folder.
+        dir: PathBuf,
+    },
+}
+
+/// `flicker sweep`: exit code 1 when a job failed, 2 when the sweep could not be run.
+fn sweep(action: SweepAction) -> ExitCode {
+    use systems::sweep;
+    let cores = || std::thread::available_parallelism().map_or(1, |n| n.get());
+    let result = (|| -> anyhow::Result<bool> {
+        let exe = std::env::current_exe()?;
+        let local = |dir: &std::path::Path, jobs: Option<usize>, again: bool| -> anyhow::Result<bool> {
+            let outcome = sweep::run_local(dir, &exe, jobs.unwrap_or_else(cores), again)?;
+            if !outcome.failed.is_empty() {
+                let list = outcome.failed.iter().map(usize::to_string).collect::<Vec<_>>().join(", ");
+                eprintln!("error: jobs {list} failed (logs in {}/logs/); rerun them with `flicker sweep local {}`", dir.display(), dir.display());
+            }
+            Ok(outcome.failed.is_empty())
+        };
+        let merged = |dir: &std::path::Path| -> anyhow::Result<()> {
+            let m = sweep::merge(dir)?;
+            println!("wrote {}, {} and {}", m.summary_file.display(), m.chart.display(), m.report.display());
+            Ok(())
+        };
+        match action {
+            SweepAction::Plan { sweep, out, cache_dir } => {
+                let plan = sweep::plan(&sweep, &out, cache_dir, &exe)?;
+                println!("planned {} jobs in {}", plan.jobs.len(), out.display());
+                Ok(true)
+            }
+            SweepAction::Job { dir, index, quiet } => {
+                let record = sweep::run_job(&dir, index, !quiet)?;
+                println!("job {index} done in {:.1} s", record.wall_s);
+                Ok(true)
+            }
+            SweepAction::Local { dir, jobs, again } => local(&dir, jobs, again),
+            SweepAction::Merge { dir } => merged(&dir).map(|_| true),
+            SweepAction::Run { sweep, out, jobs, cache_dir } => {
+                let plan = sweep::plan(&sweep, &out, cache_dir, &exe)?;
+                println!("planned {} jobs in {}", plan.jobs.len(), out.display());
+                if !local(&out, jobs, false)? {
+                    return Ok(false);
+                }
+                merged(&out).map(|_| true)
+            }
+        }
+    })();
+    exit_code(result)
+}
+
+/// 0 when it passed, 1 when it ran and failed (a gate, a job), 2 when it could not run.
+fn exit_code(result: anyhow::Result<bool>) -> ExitCode {
     match result {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
@@ -215,6 +328,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Suite { action } => return suite(action),
+        Command::Sweep { action } => return sweep(action),
         Command::Run { scenario, frames, resolution, spp, seed, out, cache_dir, quiet } => {
             let opts = RunOptions {
                 scenario,

@@ -13,4 +13,5 @@ pub mod reference_cache;
 pub mod run_folder;
 pub mod scenario;
 pub mod suite;
+pub mod sweep;
 pub mod tonemap;

@@ -33,8 +33,9 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()
 }
 
 fn tmp_path(path: &Path) -> PathBuf {
+    // Per process: sweep jobs running side by side may store the same reference-cache entry.
     let mut name = path.file_name().unwrap_or_default().to_os_string();
-    name.push(".tmp");
+    name.push(format!(".tmp{}", std::process::id()));
     path.with_file_name(name)
 }
 

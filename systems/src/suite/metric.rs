@@ -15,10 +15,17 @@ pub enum Metric {
     Mse,
     RelMse,
     Psnr,
+    /// Mean path length in vertices (the termination method's `path_length` stat). Shorter is
+    /// "better": `Better(than: M)` on it says the method's paths are shorter than M's.
+    PathLength,
+    /// Mean |bias| of the transmittance image against the exact one (the VolumeTransmittance
+    /// method's `mean_abs_bias` stat).
+    MeanAbsBias,
 }
 
 impl Metric {
-    pub const ALL: [Metric; 6] = [Metric::Flip, Metric::Smape, Metric::SmapeReprojected, Metric::Mse, Metric::RelMse, Metric::Psnr];
+    pub const ALL: [Metric; 8] =
+        [Metric::Flip, Metric::Smape, Metric::SmapeReprojected, Metric::Mse, Metric::RelMse, Metric::Psnr, Metric::PathLength, Metric::MeanAbsBias];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -28,6 +35,8 @@ impl Metric {
             Metric::Mse => "mse",
             Metric::RelMse => "rel_mse",
             Metric::Psnr => "psnr",
+            Metric::PathLength => "path_length",
+            Metric::MeanAbsBias => "mean_abs_bias",
         }
     }
 
@@ -44,6 +53,8 @@ impl Metric {
             Metric::Mse => r.mse,
             Metric::RelMse => r.rel_mse,
             Metric::Psnr => r.psnr,
+            // Method stats, by the name the method reports them under.
+            Metric::PathLength | Metric::MeanAbsBias => r.stats.iter().find(|(n, _)| n == self.name()).map(|s| s.1),
         }
     }
 }

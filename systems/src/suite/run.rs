@@ -57,10 +57,11 @@ fn prepare(opts: &SuiteOptions) -> Result<Prepared> {
     Ok(Prepared { suite, folder, baselines, adapter })
 }
 
-/// A case's run at one seed, its methods filtered; input errors point at the case's line.
-fn case_spec(suite: &Suite, case: &Case, seed: u64, out: &Path) -> Result<(RunSpec, Overrides)> {
+/// A case's run at one seed, its methods filtered; input errors point at the case's line in
+/// `origin` (the suite or sweep file).
+pub(crate) fn case_spec(origin: &Path, case: &Case, seed: u64, out: &Path) -> Result<(RunSpec, Overrides)> {
     let (line, column) = case.entry.as_ref().map_or((1, 1), |e| (e.line, e.column));
-    let at = format!("{}:{line}:{column}: case '{}'", suite.origin.display(), case.name);
+    let at = format!("{}:{line}:{column}: case '{}'", origin.display(), case.name);
     let overrides = Overrides { frames: case.frames, resolution: case.resolution, spp: case.spp, seed: Some(seed), out: Some(out.to_path_buf()) };
     let scenario = sim::Scenario::load(&case.scenario).map_err(|e| anyhow!("{at}: {e}"))?;
     let mut spec = RunSpec::from_scenario(scenario, &overrides).map_err(|e| anyhow!("{at}: {e}"))?;
@@ -90,7 +91,7 @@ fn play(p: &Prepared, opts: &SuiteOptions) -> Result<BTreeMap<String, CaseRuns>>
     for case in &p.suite.cases {
         for &seed in &case.seeds {
             let out = p.folder.join(&case.name).join(format!("seed_{seed}"));
-            let (spec, overrides) = case_spec(&p.suite, case, seed, &out)?;
+            let (spec, overrides) = case_spec(&p.suite.origin, case, seed, &out)?;
             specs.push((case, seed, spec, overrides));
         }
     }

@@ -109,6 +109,36 @@ fn options() -> ron::Options {
     ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
 }
 
+/// The `cases` of a suite or sweep file: each parsed at its place in the file, seeds checked,
+/// names distinct, scenario paths resolved against the file's folder.
+pub(crate) fn parse_cases(text: &str, raw: &[Box<ron::value::RawValue>], origin: &Path) -> Result<Vec<Case>, ScenarioError> {
+    let error = |position: Option<(usize, usize)>, message: String| ScenarioError { file: origin.to_path_buf(), position, message };
+    let at = |entry: &MethodEntry| Some((entry.line, entry.column));
+    let folder = origin.parent().unwrap_or(Path::new(""));
+    let mut cases: Vec<Case> = Vec::new();
+    for entry in raw_entries(text, "cases", raw) {
+        let mut case: Case = options().from_str(&entry.text).map_err(|e| error(Some(entry.position_in_file(e.span.start.line, e.span.start.col)), e.code.to_string()))?;
+        if case.seeds.is_empty() {
+            return Err(error(at(&entry), format!("case '{}' has no seeds; expected e.g. seeds: [1, 2, 3]", case.name)));
+        }
+        if let Some(dup) = case.seeds.iter().enumerate().find(|(i, s)| case.seeds[..*i].contains(s)) {
+            return Err(error(at(&entry), format!("case '{}' lists seed {} twice; expected distinct seeds", case.name, dup.1)));
+        }
+        if cases.iter().any(|c| c.name == case.name) {
+            return Err(error(at(&entry), format!("two cases are named '{}'; expected distinct names (they name run folders and baselines)", case.name)));
+        }
+        if case.scenario.is_relative() {
+            case.scenario = folder.join(&case.scenario);
+        }
+        case.entry = Some(entry);
+        cases.push(case);
+    }
+    if cases.is_empty() {
+        return Err(error(None, "no cases; expected e.g. cases: [(name: \"cornell\", scenario: \"scenarios/cornell_box.ron\", seeds: [1, 2])]".into()));
+    }
+    Ok(cases)
+}
+
 impl Suite {
     pub fn load(path: &Path) -> Result<Suite, ScenarioError> {
         let text = std::fs::read_to_string(path)
@@ -124,28 +154,7 @@ impl Suite {
             options().from_str(&entry.text).map_err(|e| (entry.position_in_file(e.span.start.line, e.span.start.col), e.code.to_string()))
         }
         let at = |entry: &MethodEntry| Some((entry.line, entry.column));
-        let folder = origin.parent().unwrap_or(Path::new(""));
-        let mut cases = Vec::new();
-        for entry in raw_entries(text, "cases", &file.cases) {
-            let mut case: Case = parse(&entry).map_err(|(pos, m)| error(Some(pos), m))?;
-            if case.seeds.is_empty() {
-                return Err(error(at(&entry), format!("case '{}' has no seeds; expected e.g. seeds: [1, 2, 3]", case.name)));
-            }
-            if let Some(dup) = case.seeds.iter().enumerate().find(|(i, s)| case.seeds[..*i].contains(s)) {
-                return Err(error(at(&entry), format!("case '{}' lists seed {} twice; expected distinct seeds", case.name, dup.1)));
-            }
-            if cases.iter().any(|c: &Case| c.name == case.name) {
-                return Err(error(at(&entry), format!("two cases are named '{}'; expected distinct names (they name run folders and baselines)", case.name)));
-            }
-            if case.scenario.is_relative() {
-                case.scenario = folder.join(&case.scenario);
-            }
-            case.entry = Some(entry);
-            cases.push(case);
-        }
-        if cases.is_empty() {
-            return Err(error(None, "no cases; expected e.g. cases: [(name: \"cornell\", scenario: \"scenarios/cornell_box.ron\", seeds: [1, 2])]".into()));
-        }
+        let cases = parse_cases(text, &file.cases, origin)?;
         let names: BTreeSet<&str> = cases.iter().map(|c| c.name.as_str()).collect();
         let mut gates = Vec::new();
         for entry in raw_entries(text, "gates", &file.gates) {
