@@ -16,6 +16,9 @@ use crate::scene::Camera;
 use crate::taa::TaaPrimary;
 use crate::timing::{PassTimer, PassTiming};
 use crate::hash_cache::read;
+use crate::lights::luminance;
+use super::moments::RecordMoments;
+use glam::Vec3;
 
 pub const TC_PROPAGATE_PASS: &str = "tc_propagate";
 pub const TC_FOLD_PASS: &str = "tc_fold";
@@ -118,6 +121,35 @@ pub struct TerminationStats {
     pub filled: u32,
 }
 
+/// Means over the filled records (luminance) of the statistics the rules read: how fast the
+/// cache follows a change in the scene, and why termination moves meanwhile.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CacheStatistics {
+    /// E[Y]: the cache value.
+    pub mean: f64,
+    /// E[Y²] − E[E[Y|y]²]: average variance of one more segment.
+    pub variance: f64,
+    /// E[E[Y|y]²] − E[Y]²: average squared bias of terminating into the record.
+    pub bias2: f64,
+}
+
+impl CacheStatistics {
+    /// Over the records holding moments; zeros for an empty cache.
+    pub fn of(records: &[TcRecord]) -> Self {
+        let filled: Vec<RecordMoments> = records
+            .iter()
+            .filter(|r| r.vertices > 0.0)
+            .map(|r| RecordMoments { vertices: r.vertices as f64, mean: luminance(Vec3::from(r.mean)) as f64, second: r.second as f64, marginal: r.marginal as f64 })
+            .collect();
+        let n = filled.len().max(1) as f64;
+        Self {
+            mean: filled.iter().map(|m| m.mean).sum::<f64>() / n,
+            variance: filled.iter().map(|m| m.average_variance()).sum::<f64>() / n,
+            bias2: filled.iter().map(|m| m.squared_bias()).sum::<f64>() / n,
+        }
+    }
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct TerminationOutput {
     pub radiance: Vec<[f32; 4]>,
@@ -128,6 +160,8 @@ pub struct TerminationOutput {
     /// Mean vertices per path.
     pub mean_path_length: f64,
     pub stats: TerminationStats,
+    /// The records after this frame's passes.
+    pub cache: CacheStatistics,
     pub timings: Vec<PassTiming>,
     pub rays: u64,
     /// One path per pixel plus the propagated vertices.
@@ -235,6 +269,7 @@ impl TerminationCache {
             path_length,
             mean_path_length: stats.path_vertices as f64 / 256.0 / pixels as f64,
             stats,
+            cache: CacheStatistics::of(&self.read_records(gpu)?),
             timings,
             rays: stats.trace_rays as u64 + stats.propagate_rays as u64,
             shaded: pixels + stats.propagated as u64 + stats.incomplete as u64,

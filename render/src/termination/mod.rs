@@ -18,4 +18,4 @@ pub use moments::{RecordMoments, vertex_estimates};
 pub use rule::TerminationRule;
 pub use sampling_tree::{Moments, SamplingTree};
 pub use settings::TerminationSettings;
-pub use cache::{TerminationCache, TerminationOutput, TerminationStats};
+pub use cache::{CacheStatistics, TerminationCache, TerminationOutput, TerminationStats};

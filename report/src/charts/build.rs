@@ -22,12 +22,20 @@ fn label(column: &str) -> String {
         "cpu_ms" => "CPU time (ms)".into(),
         "gpu_ms_total" => "GPU time (ms)".into(),
         "wall_ms_total" => "wall time of the passes (ms)".into(),
+        "path_length" => "mean path length (vertices)".into(),
+        "cache_mean" => "cache: mean record luminance E[Y]".into(),
+        "cache_variance" => "cache: mean record variance".into(),
+        "cache_bias2" => "cache: mean record squared bias".into(),
         c => c.replace('_', " "),
     }
 }
 
-/// Columns charted against frame, in this order, then per-region FLIP and SMAPE.
-const FRAME_COLUMNS: [&str; 8] = ["flip", "smape", "smape_reprojected", "psnr", "rel_mse", "gpu_ms_total", "wall_ms_total", "cpu_ms"];
+/// Columns charted against frame, in this order, then per-region FLIP and SMAPE. The last four
+/// are the termination cache's (render::termination): how termination and the records'
+/// statistics move around an event.
+const FRAME_COLUMNS: [&str; 12] = [
+    "flip", "smape", "smape_reprojected", "psnr", "rel_mse", "gpu_ms_total", "wall_ms_total", "cpu_ms", "path_length", "cache_mean", "cache_variance", "cache_bias2",
+];
 
 fn mean(v: &[(f64, f64)]) -> Option<f64> {
     let f: Vec<f64> = v.iter().map(|p| p.1).filter(|x| x.is_finite()).collect();
@@ -140,6 +148,23 @@ pub fn speed_accuracy_charts(manifest: &Manifest, frames: &Frames) -> Vec<(Strin
     let time_col = ["gpu_ms_total", "wall_ms_total", "cpu_ms"].into_iter().find(|c| frames.column(c).is_some_and(|i| frames.has_data(i)));
     let Some(time_col) = time_col else { return vec![] };
     let t = frames.column(time_col).unwrap();
+    let mut out = scatter_charts(manifest, frames, "", &format!("mean {}", label(time_col)), |method| mean(&frames.series(method, t)));
+    // variance-trading-termination.txt's Table 1 separates the tracer from the cache's
+    // propagation: their sum is the cost a termination rule trades against accuracy (the
+    // record fold and the vertex store are per record, the same for every rule).
+    let trace = frames.column("gpu_ms_tc_trace").filter(|&c| frames.has_data(c));
+    let propagate = frames.column("gpu_ms_tc_propagate").filter(|&c| frames.has_data(c));
+    if let (Some(trace), Some(propagate)) = (trace, propagate) {
+        out.extend(scatter_charts(manifest, frames, "_tracer_propagation", "mean tracer + propagation GPU time (ms)", |method| {
+            Some(mean(&frames.series(method, trace))? + mean(&frames.series(method, propagate))?)
+        }));
+    }
+    out
+}
+
+/// One scatter chart per accuracy metric: every method with a cost (`cost`, the x axis) and
+/// the metric's mean, and the Pareto front of those points.
+fn scatter_charts(manifest: &Manifest, frames: &Frames, suffix: &str, x_label: &str, cost: impl Fn(&str) -> Option<f64>) -> Vec<(String, Chart)> {
     let mut out = Vec::new();
     for metric in ["flip", "smape"] {
         let Some(m) = frames.column(metric).filter(|&m| frames.has_data(m)) else { continue };
@@ -147,16 +172,20 @@ pub fn speed_accuracy_charts(manifest: &Manifest, frames: &Frames) -> Vec<(Strin
             .methods()
             .into_iter()
             .filter_map(|method| {
-                let (x, y) = (mean(&frames.series(&method, t))?, mean(&frames.series(&method, m))?);
+                let (x, y) = (cost(&method)?, mean(&frames.series(&method, m))?);
                 Some(Series { name: method, points: vec![(x, y)] })
             })
             .collect();
+        if series.is_empty() {
+            continue;
+        }
         let pts: Vec<(f64, f64)> = series.iter().map(|s| s.points[0]).collect();
+        let what = if suffix.is_empty() { String::new() } else { format!(", {x_label}") };
         out.push((
-            format!("speed_vs_{metric}"),
+            format!("speed_vs_{metric}{suffix}"),
             Chart {
-                title: format!("Speed vs accuracy ({}) — {}", metric.to_uppercase(), manifest.scenario),
-                x_label: format!("mean {}", label(time_col)),
+                title: format!("Speed vs accuracy ({}{what}) — {}", metric.to_uppercase(), manifest.scenario),
+                x_label: x_label.into(),
                 y_label: format!("mean {}", label(metric)),
                 kind: Kind::Scatter,
                 pareto: pareto_front(&pts),
@@ -224,5 +253,29 @@ mod tests {
         // A run without NIRC methods has neither chart.
         let plain = Frames::parse("method,frame,cpu_ms\npt_1spp,0,1\n", Path::new("frames.csv")).unwrap();
         assert!(sigma_chart(&manifest, &plain).is_none() && reliability_chart(&manifest, &plain).is_none());
+    }
+
+    #[test]
+    fn termination_runs_chart_tracer_plus_propagation_time_with_its_pareto_front() {
+        // Three rules and a path tracer without the cache's passes: the termination chart's x is
+        // the mean of tc_trace plus the mean of tc_propagate; the path tracer is left out of it.
+        let csv = "method,frame,gpu_ms_total,gpu_ms_tc_trace,gpu_ms_tc_propagate,gpu_ms_pt,flip,smape\n\
+                   vb,0,9,2,5,,0.5,\nvb,1,9,4,5,,,0.2\n\
+                   mse,0,9,1,5,,0.6,\nmse,1,9,1,5,,,0.1\n\
+                   spread,0,1,4,4,,0.7,\nspread,1,1,4,4,,,0.3\n\
+                   pt,0,3,,,3,0.4,\npt,1,3,,,3,,0.4\n";
+        let frames = Frames::parse(csv, Path::new("frames.csv")).unwrap();
+        let manifest: Manifest = serde_json::from_str(r#"{"scenario": "s", "frames": 2}"#).unwrap();
+        let charts = speed_accuracy_charts(&manifest, &frames);
+        let stems: Vec<&str> = charts.iter().map(|c| c.0.as_str()).collect();
+        assert_eq!(stems, ["speed_vs_flip", "speed_vs_smape", "speed_vs_flip_tracer_propagation", "speed_vs_smape_tracer_propagation"]);
+        let flip = &charts[2].1;
+        let pts: Vec<(&str, (f64, f64))> = flip.series.iter().map(|s| (s.name.as_str(), s.points[0])).collect();
+        assert_eq!(pts, [("vb", (8.0, 0.5)), ("mse", (6.0, 0.6)), ("spread", (8.0, 0.7))]);
+        // spread costs as much as vb with a larger error: dominated.
+        assert_eq!(flip.pareto, vec![(6.0, 0.6), (8.0, 0.5)]);
+        assert_eq!(charts[3].1.pareto, vec![(6.0, 0.1)]);
+        // The total-time chart keeps every method (spread is fastest there).
+        assert_eq!(charts[0].1.pareto, vec![(1.0, 0.7), (3.0, 0.4)]);
     }
 }

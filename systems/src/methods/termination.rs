@@ -65,6 +65,9 @@ pub fn render(
             stats: vec![
                 ("path_length".into(), out.mean_path_length),
                 ("cache_records".into(), s.filled as f64),
+                ("cache_mean".into(), out.cache.mean),
+                ("cache_variance".into(), out.cache.variance),
+                ("cache_bias2".into(), out.cache.bias2),
                 ("cache_bytes".into(), state.cache.cache_bytes() as f64),
                 ("cache_unknown_vertices".into(), s.unknown as f64),
                 ("cache_propagated_vertices".into(), s.propagated as f64),
