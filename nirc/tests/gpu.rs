@@ -392,7 +392,7 @@ fn training_profile_names_every_stage_of_a_step_once() {
             expected.push("weight gradient partials");
         }
         expected.extend(["weight gradient reduce", "adam check (every parameter)", "adam apply (every parameter)", "ema update (every parameter)"]);
-        expected.extend(["reliability walk", "reliability update", "clear the step's accumulators"]);
+        expected.extend(["reliability walk", "reliability update", "finish step", "clear the step's accumulators"]);
         assert_eq!(names, expected, "{placement:?}");
         assert!(stages.iter().all(|s| s.1.is_finite() && s.1 >= 0.0), "{stages:?}");
     }

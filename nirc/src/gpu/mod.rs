@@ -133,6 +133,9 @@ pub struct TrainStep {
     finish: wgpu::BindGroup,
 }
 
+/// One dispatch of a training step: name (for the profile), pipeline, bind group, workgroups.
+type Stage<'a> = (&'static str, &'a wgpu::ComputePipeline, &'a wgpu::BindGroup, u32);
+
 /// Bind groups that depend on neither the caller's buffers nor the call's uniforms.
 struct FixedBindGroups {
     reliability_update: wgpu::BindGroup,
@@ -449,26 +452,12 @@ impl NeuralCache {
         encoder.clear_buffer(&self.buffers.reliability_accum, 0, None);
     }
 
-    fn dispatch_adam(&self, pass: &mut wgpu::ComputePass, s: &TrainStep) {
-        let p = &self.pipelines;
-        dispatch(pass, &p.train, &s.fb, s.n.div_ceil(WORKGROUP_SIZE));
-        dispatch(pass, &p.reliability_accumulate, &s.accumulate, groups_for(s.n as u64));
-        if let (Some(pipeline), Some(group)) = (&p.weight_partial, &s.partial) {
-            dispatch(pass, pipeline, group, groups_for(self.layout.mlp_params as u64 * s.num_chunks as u64));
-        }
-        dispatch(pass, &p.weight_reduce, &s.reduce, groups_for(self.layout.mlp_params as u64));
-        let all = groups_for(self.layout.total_params as u64);
-        dispatch(pass, &p.adam_check, &s.check, all);
-        dispatch(pass, &p.adam_apply, &s.apply, all);
-    }
-
-    /// Seconds per dispatch of one training step on `n` of `records`, each stage submitted and
-    /// waited for alone, `reps` times after a warm-up: the profile `flicker bench --nirc` prints.
-    pub fn train_stage_seconds(&self, gpu: &Gpu, records: &wgpu::Buffer, n: u32, reps: u32) -> Result<Vec<(&'static str, f64)>, NircError> {
-        let Some(s) = self.prepare_step(gpu, records, n)? else { return Ok(Vec::new()) };
+    /// The dispatches of a step's `nirc::train` part in order: forward and backward passes,
+    /// gradients, the Adam step (name, pipeline, bind group, workgroups).
+    fn adam_stages<'a>(&'a self, s: &'a TrainStep) -> Vec<Stage<'a>> {
         let p = &self.pipelines;
         let all = groups_for(self.layout.total_params as u64);
-        let mut stages: Vec<(&'static str, &wgpu::ComputePipeline, &wgpu::BindGroup, u32)> = vec![
+        let mut stages: Vec<Stage> = vec![
             ("train (forward, backward)", &p.train, &s.fb, s.n.div_ceil(WORKGROUP_SIZE)),
             ("reliability accumulate", &p.reliability_accumulate, &s.accumulate, groups_for(s.n as u64)),
         ];
@@ -478,11 +467,41 @@ impl NeuralCache {
         stages.push(("weight gradient reduce", &p.weight_reduce, &s.reduce, groups_for(self.layout.mlp_params as u64)));
         stages.push(("adam check (every parameter)", &p.adam_check, &s.check, all));
         stages.push(("adam apply (every parameter)", &p.adam_apply, &s.apply, all));
-        stages.push(("ema update (every parameter)", &p.ema_update, &s.ema, all));
+        stages
+    }
+
+    /// The `nirc::ema` part: the debiased EMA of every parameter.
+    fn ema_stages<'a>(&'a self, s: &'a TrainStep) -> Vec<Stage<'a>> {
+        vec![("ema update (every parameter)", &self.pipelines.ema_update, &s.ema, groups_for(self.layout.total_params as u64))]
+    }
+
+    /// The `nirc::reliability_update` part: the per-sample moment walk (not for the batch-mean
+    /// rule), the grid's update, the step's commit.
+    fn reliability_stages<'a>(&'a self, s: &'a TrainStep) -> Vec<Stage<'a>> {
+        let p = &self.pipelines;
+        let mut stages: Vec<Stage> = Vec::new();
         if self.config.reliability.update == crate::config::MomentUpdate::PerSample {
             stages.push(("reliability walk", &p.reliability_walk, &s.walk, groups_for(s.n as u64)));
         }
         stages.push(("reliability update", &p.reliability_update, &self.groups.reliability_update, groups_for(cell_count(&self.config.reliability) as u64)));
+        stages.push(("finish step", &p.finish_step, &s.finish, 1));
+        stages
+    }
+
+    fn dispatch_stages(pass: &mut wgpu::ComputePass, stages: &[Stage]) {
+        for &(_, pipeline, group, workgroups) in stages {
+            dispatch(pass, pipeline, group, workgroups);
+        }
+    }
+
+    fn dispatch_adam(&self, pass: &mut wgpu::ComputePass, s: &TrainStep) {
+        Self::dispatch_stages(pass, &self.adam_stages(s));
+    }
+
+    /// Seconds per dispatch of one training step on `n` of `records`, each stage submitted and
+    /// waited for alone, `reps` times after a warm-up: the profile `flicker bench --nirc` prints.
+    pub fn train_stage_seconds(&self, gpu: &Gpu, records: &wgpu::Buffer, n: u32, reps: u32) -> Result<Vec<(&'static str, f64)>, NircError> {
+        let Some(s) = self.prepare_step(gpu, records, n)? else { return Ok(Vec::new()) };
         let timed = |name: &'static str, record: &dyn Fn(&mut wgpu::CommandEncoder)| -> Result<f64, NircError> {
             let run = || {
                 let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(name) });
@@ -498,26 +517,23 @@ impl NeuralCache {
             Ok(t.elapsed().as_secs_f64() / reps.max(1) as f64)
         };
         let mut out = Vec::new();
-        for (name, pipeline, group, workgroups) in stages {
-            let seconds = timed(name, &|encoder| {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(name), timestamp_writes: None });
-                dispatch(&mut pass, pipeline, group, workgroups);
+        for stage in self.adam_stages(&s).into_iter().chain(self.ema_stages(&s)).chain(self.reliability_stages(&s)) {
+            let seconds = timed(stage.0, &|encoder| {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(stage.0), timestamp_writes: None });
+                Self::dispatch_stages(&mut pass, &[stage]);
             })?;
-            out.push((name, seconds));
+            out.push((stage.0, seconds));
         }
         out.push(("clear the step's accumulators", timed("clear", &|encoder| self.clear_step(encoder))?));
         Ok(out)
     }
 
     fn dispatch_ema(&self, pass: &mut wgpu::ComputePass, s: &TrainStep) {
-        dispatch(pass, &self.pipelines.ema_update, &s.ema, groups_for(self.layout.total_params as u64));
+        Self::dispatch_stages(pass, &self.ema_stages(s));
     }
 
     fn dispatch_reliability(&self, pass: &mut wgpu::ComputePass, s: &TrainStep) {
-        let p = &self.pipelines;
-        self.dispatch_walk(pass, &s.walk, s.n);
-        dispatch(pass, &p.reliability_update, &self.groups.reliability_update, groups_for(cell_count(&self.config.reliability) as u64));
-        dispatch(pass, &p.finish_step, &s.finish, 1);
+        Self::dispatch_stages(pass, &self.reliability_stages(s));
     }
 
     /// The bind groups of the reliability accumulation and walk over `samples`.
