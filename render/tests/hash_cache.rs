@@ -161,3 +161,29 @@ fn taa_resolves_the_cache_colour() {
         assert_eq!(frame > 0, i.params_history_valid);
     }
 }
+
+/// Ray count of one frame on a lit plane filling the view (first-hit lookup, max_depth 1, no
+/// Russian roulette): hc_trace traces one camera ray per pixel; each update path one shadow ray
+/// and one continuation that escapes. The update starts from the hit hc_trace found: a third
+/// ray per update path (the key ray traced again) is a defect.
+#[test]
+fn update_paths_start_at_the_traced_key_point() {
+    use glam::{Mat4, Vec3};
+    use render::scene::{Camera, Instance, Light, Material, Mesh};
+    let scene = SceneDesc {
+        meshes: vec![Mesh::plane(50.0)],
+        materials: vec![Material { base_color: Vec3::splat(0.5), specular: 0.0, ..Default::default() }],
+        instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }],
+        lights: vec![Light::Directional { direction: Vec3::new(-0.3, -1.0, -0.2).normalize(), irradiance: Vec3::splat(3.0), angular_radius: 0.0 }],
+        environment: Vec3::ZERO,
+        camera: Camera { position: Vec3::new(0.0, 3.0, 0.0), target: Vec3::ZERO, up: Vec3::NEG_Z, vfov: 50f32.to_radians() },
+        ..Default::default()
+    };
+    let pt = tracer(&scene, 1);
+    let mut cache = HashCache::new(gpu(), &pt, HashCacheSettings { lookup: HashCacheLookup::FirstHit, ..Default::default() }).expect("hash cache");
+    for frame in 0..2 {
+        let s = cache.render(gpu(), &pt, &scene.camera, 3, frame, None).unwrap().stats;
+        assert!(s.update_paths > 0);
+        assert_eq!(s.rays, W * H + 2 * s.update_paths, "frame {frame}: {s:?}");
+    }
+}

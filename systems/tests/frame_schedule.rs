@@ -129,7 +129,7 @@ fn methods_take_their_settings_defaults_and_names() {
     assert_eq!((t.alpha, t.clamp, t.jitter_length), (0.2, render::taa::TaaClamp::MinMax, d.jitter_length));
     let labels: Vec<String> = s.methods.iter().map(|m| m.label()).collect();
     assert_eq!(labels, ["taa", "taa_fast", "hash_cache", "hash_cache_first_hit_taa", "ssc_multi"]);
-    assert!(s.methods[..4].iter().all(|m| m.spec.spp() == 1));
+    assert!(s.methods[..4].iter().all(|m| m.spec.spp() == 1.0));
     let MethodSpec::HashCache(h) = &s.methods[3].spec else { panic!() };
     assert_eq!((h.capacity, h.probe_limit, h.taa), (1024, 8, true));
 }

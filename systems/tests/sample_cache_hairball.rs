@@ -87,7 +87,8 @@ fn sample_cache_on_a_moving_hairball_camera() {
     }
     assert!(rays[2] as f64 <= 0.6 * rays[1] as f64, "adaptive traces {} rays vs multi {}", rays[2], rays[1]);
     assert!(stale[2] < stale[0], "adaptive leaves {} stale visible samples vs single {}", stale[2], stale[0]);
-    assert!(stale[1] <= stale[2], "multi retraces everything, yet {} stale vs adaptive {}", stale[1], stale[2]);
+    // Multi retraces every sample every frame, so none can be stale after its trace pass.
+    assert_eq!(stale[1], 0, "multi retraces everything, yet leaves {} stale visible samples", stale[1]);
 }
 
 #[test]

@@ -16,7 +16,7 @@
 // a separate word every accessor stores the same value into.
 
 import package::scene_bindings::{frame, materials};
-import package::scene_geometry::{NO_HIT, sg_rays_traced, surface_point, trace_closest};
+import package::scene_geometry::{Hit, NO_HIT, sg_rays_traced, surface_point, trace_closest};
 import package::pt_sampling::{hash_mix, rng_next, rng_next2, rng_seed};
 import package::pt_bsdf::{bsdf_sample, make_bsdf};
 import package::pt_lights::{FAR};
@@ -119,6 +119,7 @@ fn hc_trace(@builtin(global_invocation_id) id: vec3u) {
     r.direct = emitted_radiance(sp, m, dir, hit.t, 0.0);
     if hc.lookup == 0u {
         // The paper's HashCache: the first hit's outgoing radiance, albedo demodulated.
+        r.key_hit = hc_pack_hit(hit);
         r.key_point = sp.position;
         r.key_normal = sh.ns;
         r.modulate = base_color_at(m, sp.uv);
@@ -144,6 +145,7 @@ fn hc_trace(@builtin(global_invocation_id) id: vec3u) {
         }
         let sp2 = surface_point(hit2, o2, bs.wi);
         r.direct += throughput * emitted_radiance(sp2, materials[sp2.material], bs.wi, hit2.t, bs.pdf);
+        r.key_hit = hc_pack_hit(hit2);
         r.key_point = sp2.position;
         r.key_normal = orient(sp2, -bs.wi).ns;
         r.modulate = throughput;
@@ -171,15 +173,22 @@ fn hc_trace(@builtin(global_invocation_id) id: vec3u) {
     hc_store_record(index, r);
 }
 
+// The key point's hit as stored in the record (t is not needed: surface_point rebuilds the
+// point from the barycentrics).
+fn hc_pack_hit(hit: Hit) -> vec4u {
+    return vec4u(hit.instance, hit.primitive, bitcast<vec2u>(hit.barycentrics));
+}
+
+fn hc_unpack_hit(h: vec4u) -> Hit {
+    return Hit(0.0, h.x, h.y, bitcast<vec2f>(h.zw));
+}
+
 // One estimate of the radiance leaving the key point towards the ray's origin, emission
-// excluded (the pixel adds it): next-event estimation + one BSDF-sampled continuation.
+// excluded (the pixel adds it): next-event estimation + one BSDF-sampled continuation. Starts
+// from the hit hc_trace found (no second trace of the key ray).
 fn hc_sample(r: HcRecord) -> vec3f {
     var rng = r.rng;
-    let hit = trace_closest(r.ray_origin, r.ray_dir, FAR);
-    if hit.instance == NO_HIT {
-        return vec3f(0.0);
-    }
-    let sp = surface_point(hit, r.ray_origin, r.ray_dir);
+    let sp = surface_point(hc_unpack_hit(r.key_hit), r.ray_origin, r.ray_dir);
     let m = materials[sp.material];
     let wo = -r.ray_dir;
     let sh = orient(sp, wo);

@@ -176,6 +176,9 @@ crate::gpu_struct! {
     /// A pixel's state between the passes.
     #[derive(Default, PartialEq)]
     pub struct HcRecord {
+        /// The key point's hit (instance, primitive, bits of the barycentrics), so that the
+        /// update starts from it instead of tracing the key ray again.
+        pub key_hit: [u32; 4] => "vec4u",
         pub key_point: [f32; 3] => "vec3f",
         /// HC_NONE: no key point, or insertion failed.
         pub slot: u32 => "u32",
@@ -200,7 +203,7 @@ crate::gpu_struct! {
 
 pub const HC_NEEDS_SAMPLE: u32 = 1;
 
-const _: () = assert!(size_of::<HashCacheParams>() == 64 && size_of::<HcRecord>() == 112);
+const _: () = assert!(size_of::<HashCacheParams>() == 64 && size_of::<HcRecord>() == 128);
 
 /// Cache counters of one frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -45,7 +45,8 @@ pub struct SampleCacheSettings {
     pub alpha: f32,
     pub retrace: Retrace,
     pub shading: ShadingMode,
-    /// Shading invocations per frame as a fraction of the pixel count (1 = 100%).
+    /// Shading invocations per frame as a fraction of the pixel count (1 = 100%); only adaptive
+    /// shading takes another rate than 1.
     pub shading_rate: f32,
 }
 
@@ -96,6 +97,11 @@ impl SampleCacheSettings {
         if !(self.shading_rate >= 0.0 && self.shading_rate <= self.slots as f32) {
             return Err(format!("shading_rate must be in [0, slots], got {}", self.shading_rate));
         }
+        // Uniform shading shades one visible sample per pixel by construction (section 3.3); a
+        // rate there would be ignored and the reported samples per pixel would be wrong.
+        if self.shading == ShadingMode::Uniform && self.shading_rate != 1.0 {
+            return Err(format!("shading_rate {} needs shading: Adaptive (Uniform shades one sample per pixel: rate 1)", self.shading_rate));
+        }
         Ok(())
     }
 
@@ -110,5 +116,19 @@ impl SampleCacheSettings {
             ShadingMode::Uniform => format!("ssc_{retrace}"),
             ShadingMode::Adaptive => format!("ssc_{retrace}_as"),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shading_rate_needs_adaptive_shading() {
+        let uniform = SampleCacheSettings { shading_rate: 0.7, ..Default::default() };
+        let e = uniform.validate().unwrap_err();
+        assert!(e.contains("shading_rate 0.7 needs shading: Adaptive"), "{e}");
+        assert!(SampleCacheSettings { shading: ShadingMode::Adaptive, ..uniform }.validate().is_ok());
+        assert!(SampleCacheSettings::default().validate().is_ok());
     }
 }

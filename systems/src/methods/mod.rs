@@ -96,16 +96,18 @@ impl MethodSpec {
         }
     }
 
-    /// Samples per pixel the method spends per frame.
-    pub fn spp(&self) -> u32 {
+    /// Samples (shaded paths) per pixel the method spends per frame: fractional for the sample
+    /// cache's adaptive shading (its budget is shading_rate x pixels).
+    pub fn spp(&self) -> f64 {
         match self {
-            MethodSpec::PathTracing(s) => s.spp,
-            MethodSpec::Nirc(s) => s.spp,
-            // One shaded path per pixel at a 100% shading rate.
-            MethodSpec::SampleCache(s) => (s.shading_rate.ceil() as u32).max(1),
-            MethodSpec::Taa(_) | MethodSpec::HashCache(_) | MethodSpec::Termination(_) => 1,
-            MethodSpec::VolumeTransmittance(s) => s.spp,
-            MethodSpec::VolumePath(s) => s.spp,
+            MethodSpec::PathTracing(s) => s.spp as f64,
+            MethodSpec::Nirc(s) => s.spp as f64,
+            // Uniform shading: one path per pixel (validate refuses another rate); adaptive:
+            // the budget's rate.
+            MethodSpec::SampleCache(s) => s.shading_rate as f64,
+            MethodSpec::Taa(_) | MethodSpec::HashCache(_) | MethodSpec::Termination(_) => 1.0,
+            MethodSpec::VolumeTransmittance(s) => s.spp as f64,
+            MethodSpec::VolumePath(s) => s.spp as f64,
         }
     }
 
@@ -177,4 +179,18 @@ pub fn describe_schedule(methods: &[Method]) -> Result<String> {
     }
     text += &crate::frame::describe(&listing);
     Ok(text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The manifest's samples per pixel are the paths the method shades: adaptive shading at a
+    /// 70% budget spends 0.7, uniform shading one.
+    #[test]
+    fn sample_cache_spp_is_its_shading_rate() {
+        let adaptive = Method::parse("SampleCache(shading: Adaptive, shading_rate: 0.7)").unwrap();
+        assert!((adaptive.spec.spp() - 0.7).abs() < 1e-6, "{}", adaptive.spec.spp());
+        assert_eq!(Method::parse("SampleCache()").unwrap().spec.spp(), 1.0);
+    }
 }
