@@ -303,17 +303,42 @@ fn density_stays_within_bounds_and_runs_are_deterministic() {
     assert!(a == b, "two runs with the same seed differ");
 }
 
+/// Visible (or all occupied) samples of pixel p: (hit, c_s).
+fn samples(state: &CacheState, p: usize, n: u32, visible_only: bool) -> Vec<([u32; 4], f32)> {
+    let pixels = state.masks.len();
+    let mut set = occupancy(state.masks[p], n);
+    if visible_only {
+        set &= visibility(state.masks[p], n);
+    }
+    (0..n).filter(|s| set >> s & 1 == 1).map(|s| state.slots[s as usize * pixels + p]).map(|slot| (slot.hit, slot.radiance[3])).collect()
+}
+
+fn visible_samples(state: &CacheState, p: usize, n: u32) -> Vec<([u32; 4], f32)> {
+    samples(state, p, n, true)
+}
+
+/// Adaptive shading (section 3.5) on a still view at a 50% budget: the GPU's threshold is the
+/// CPU's on the same histogram, the dispatch count is the budget up to the coin tosses' spread,
+/// every pixel ends the frame with a shaded visible sample (else it would reconstruct nothing),
+/// and the budget goes to the samples with the fewest shades: each sample's bucket is computed
+/// here on the CPU from its c_s before the frame with the paper's importance 1 / (1 + c_s), and
+/// every sample above the GPU's threshold bucket must have been shaded, none below it.
 #[test]
-fn adaptive_shading_dispatches_the_budget() {
+fn adaptive_shading_dispatches_the_budget_to_low_counts_first() {
     let scene = scene(oblique(), true);
     let s = SampleCacheSettings { shading: ShadingMode::Adaptive, shading_rate: 0.5, ..Default::default() };
     let mut rig = Rig::new(&scene, s);
-    let budget = s.shading_rate * (W * H) as f32;
+    let pixels = (W * H) as usize;
+    let budget = s.shading_rate * pixels as f32;
     let mut total_dev = 0.0f64;
     let mut total_var = 0.0f64;
+    let mut before: Option<CacheState> = None;
+    // Mean c_s before the frame of the samples the budget shaded and of those it left.
+    let (mut shaded_c, mut left_c) = ((0.0f64, 0u32), (0.0f64, 0u32));
     for f in 0..8 {
         let out = rig.step(&scene);
         let st = &out.stats;
+        let after = rig.state();
         // The GPU's threshold is the CPU's on the same histogram.
         let dynamic = (budget - st.base_shaded as f32).max(0.0);
         let (t, coin) = shading_rate::threshold(&st.histogram, dynamic);
@@ -331,6 +356,37 @@ fn adaptive_shading_dispatches_the_budget() {
         total_var += n_t * coin as f64 * (1.0 - coin as f64);
         let sigma = (n_t * coin as f64 * (1.0 - coin as f64)).sqrt();
         assert!((st.shaded as f64 - expected as f64).abs() <= 5.0 * sigma + 1.0, "frame {f}: shaded {} expected {expected} σ {sigma}", st.shaded);
+        for p in 0..pixels {
+            let now = visible_samples(&after, p, s.slots);
+            assert!(now.iter().any(|v| v.1 > 0.0), "frame {f} pixel {p}: no shaded visible sample among {now:?}");
+        }
+        if let Some(prev) = &before {
+            let (lo, hi) = st.importance_bounds;
+            for p in 0..pixels {
+                let old = samples(prev, p, s.slots, false);
+                let c_before: Vec<f32> = visible_samples(&after, p, s.slots).iter().map(|(hit, _)| old.iter().find(|o| o.0 == *hit).map_or(0.0, |o| o.1)).collect();
+                // Pixels with a sample shaded outside the budget: the base pixel, and a pixel
+                // whose visible samples were all unshaded.
+                if out.flags[p] & FLAG_BASE != 0 || c_before.iter().all(|&c| c == 0.0) {
+                    continue;
+                }
+                for (&(_, c_after), &c) in visible_samples(&after, p, s.slots).iter().zip(&c_before) {
+                    let shaded = c_after == c + 1.0;
+                    assert!(shaded || c_after == c, "frame {f} pixel {p}: c_s {c} -> {c_after}");
+                    // The bucket, either side of a float's worth from a bucket border.
+                    let w = 1.0 / (1.0 + c);
+                    let (b0, b1) = (shading_rate::bucket(w * (1.0 - 1e-5), lo, hi, s.buckets), shading_rate::bucket(w * (1.0 + 1e-5), lo, hi, s.buckets));
+                    assert!(if b0 > t { shaded } else if b1 < t { !shaded } else { true }, "frame {f} pixel {p}: c_s {c} (bucket {b0}..={b1}, threshold {t}) shaded {shaded}");
+                    let acc = if shaded { &mut shaded_c } else { &mut left_c };
+                    acc.0 += c as f64;
+                    acc.1 += 1;
+                }
+            }
+        }
+        before = Some(after);
     }
     assert!(total_dev.abs() <= 4.0 * total_var.sqrt() + 1.0, "bias {total_dev} over 8 frames, σ {}", total_var.sqrt());
+    let (ms, ml) = (shaded_c.0 / shaded_c.1 as f64, left_c.0 / left_c.1 as f64);
+    eprintln!("mean c_s before the frame: shaded {ms:.2} ({} samples), left {ml:.2} ({})", shaded_c.1, left_c.1);
+    assert!(shaded_c.1 > 100 && left_c.1 > 100 && ms < ml, "shaded {shaded_c:?} left {left_c:?}");
 }

@@ -14,7 +14,7 @@ import package::sample_cache_types::{SscSlot};
 import package::sample_cache_bindings::{dst_mask, dst_slots, pixel_atomics, ssc, ssc_out, ssc_work};
 import package::sample_cache::storage::{SSC_ALL_RAYS, SSC_ATOMICS, SSC_BACKGROUND_DEPTH, SSC_BASE, SSC_FLAGGED, SSC_FLAG_BASE, SSC_FLAG_HOLE, SSC_FLAG_SLOPE, SSC_HISTOGRAM, SSC_LIST, SSC_MAX_SLOTS, SSC_NEW, SSC_OCCUPIED, SSC_PURGED, SSC_RAYS, SSC_RETRACE_COUNT, SSC_VISIBLE, SSC_WMAX_ACC, SSC_WMIN_ACC, ssc_full, ssc_is_background, ssc_less, ssc_pack_background, ssc_pack_hit, ssc_pixels, ssc_surface, ssc_visible_slots};
 import package::sample_cache::slope::{ssc_consistent, ssc_slope};
-import package::sample_cache::selection::{ssc_base_index, ssc_bucket, ssc_importance, ssc_is_base_pixel, ssc_nth_bit, ssc_verify};
+import package::sample_cache::selection::{ssc_base_index, ssc_bucket, ssc_forced_shade, ssc_importance, ssc_is_base_pixel, ssc_nth_bit, ssc_verify};
 
 // Jitter stays this far inside the pixel so that round-off never reprojects a sample of a static
 // view into a neighbour (a sample exactly on a pixel border would flip sides).
@@ -275,12 +275,10 @@ fn finish_main(@builtin(global_invocation_id) id: vec3u) {
     atomicAdd(&ssc_work[SSC_OCCUPIED], kf);
 
     // Adaptive shading: histogram of the importance of every visible sample that the base rate
-    // does not already shade.
+    // (or the first shade of a pixel with no shaded visible sample) does not already shade.
     if ssc.shading == 1u {
-        let nv = countOneBits(out_vis);
-        var base = NO_HIT;
-        if ssc_is_base_pixel(id.xy) && nv > 0u {
-            base = ssc_nth_bit(out_vis, ssc_base_index(nv));
+        let base = ssc_forced_shade(id.xy, p, out_vis);
+        if base != NO_HIT {
             atomicAdd(&ssc_work[SSC_BASE], 1u);
         }
         for (var i = 0u; i < kf; i++) {

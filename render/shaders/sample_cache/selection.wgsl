@@ -2,10 +2,10 @@
 // visibility check of a stored sample, importance and its log-spaced buckets, bit selection.
 
 import package::scene_bindings::{frame};
-import package::scene_geometry::{trace_any};
+import package::scene_geometry::{NO_HIT, trace_any};
 import package::pt_lights::{FAR};
-import package::sample_cache_bindings::{ssc, ssc_work};
-import package::sample_cache::storage::{SSC_WMAX, SSC_WMIN, ssc_background_dir, ssc_is_background, ssc_surface};
+import package::sample_cache_bindings::{dst_slots, ssc, ssc_work};
+import package::sample_cache::storage::{SSC_WMAX, SSC_WMIN, ssc_background_dir, ssc_is_background, ssc_pixels, ssc_surface};
 
 // The 4x4 block's base pixel this frame: the block position visits all b*b pixels in turn.
 fn ssc_is_base_pixel(pixel: vec2u) -> bool {
@@ -18,6 +18,29 @@ fn ssc_is_base_pixel(pixel: vec2u) -> bool {
 fn ssc_base_index(count: u32) -> u32 {
     let b = ssc.base_block;
     return (ssc.frame / (b * b)) % max(count, 1u);
+}
+
+// Adaptive shading's sample of pixel p (visible slots `vis`) that is shaded outside the
+// importance budget, or NO_HIT: the base rate's round-robin sample on the block's base pixel,
+// else the first visible sample when none of them has been shaded yet, so that every pixel with
+// a visible sample reconstructs from a shaded one (a pixel of only new samples would otherwise
+// show nothing: a new sample's c_s = 0 is the top bucket, but the coin toss there may skip it).
+// Read by the trace pass (histogram, count) and by select_main on the same state.
+fn ssc_forced_shade(pixel: vec2u, p: u32, vis: u32) -> u32 {
+    let nv = countOneBits(vis);
+    if nv == 0u {
+        return NO_HIT;
+    }
+    if ssc_is_base_pixel(pixel) {
+        return ssc_nth_bit(vis, ssc_base_index(nv));
+    }
+    let pixels = ssc_pixels();
+    for (var s = 0u; s < ssc.slots; s++) {
+        if ((vis >> s) & 1u) != 0u && dst_slots[s * pixels + p].radiance.w > 0.0 {
+            return NO_HIT;
+        }
+    }
+    return firstTrailingBit(vis);
 }
 
 // Retrace from the eye towards the stored point (a shadow ray, section 3.2): visible when nothing

@@ -1,6 +1,6 @@
 // Which cached samples are shaded this frame (sections 3.3 and 3.5). Uniform: one visible sample
 // per pixel, round robin (a never-shaded sample first). Adaptive: one sample per 4x4 block as the
-// base rate, the rest of the budget by importance w = 1 / (1 + c_s) through the log histogram:
+// base rate and one of each pixel with no shaded visible sample (ssc_forced_shade), the rest of the budget by importance w = 1 / (1 + c_s) through the log histogram:
 // buckets above the threshold all, the threshold bucket by a weighted coin toss.
 // The chosen slots are appended to the shade list (compacted work for shade_main).
 
@@ -9,7 +9,7 @@ import package::scene_geometry::{NO_HIT};
 import package::pt_sampling::{rng_next, rng_seed};
 import package::sample_cache_bindings::{dst_mask, dst_slots, ssc, ssc_work};
 import package::sample_cache::storage::{SSC_BASE, SSC_COIN, SSC_HISTOGRAM, SSC_LIST, SSC_SHADE_COUNT, SSC_THRESHOLD, ssc_pixels, ssc_visible_slots};
-import package::sample_cache::selection::{ssc_base_index, ssc_bucket, ssc_importance, ssc_is_base_pixel, ssc_nth_bit};
+import package::sample_cache::selection::{ssc_bucket, ssc_forced_shade, ssc_importance, ssc_nth_bit};
 
 // One thread: the threshold bucket and its coin probability from the histogram and the budget
 // (twin of sample_cache/shading_rate.rs `threshold`).
@@ -64,9 +64,8 @@ fn select_main(@builtin(global_invocation_id) id: vec3u) {
         ssc_push_shade(chosen * pixels + p);
         return;
     }
-    var base = NO_HIT;
-    if ssc_is_base_pixel(id.xy) {
-        base = ssc_nth_bit(vis, ssc_base_index(nv));
+    let base = ssc_forced_shade(id.xy, p, vis);
+    if base != NO_HIT {
         ssc_push_shade(base * pixels + p);
     }
     let threshold = atomicLoad(&ssc_work[SSC_THRESHOLD]);

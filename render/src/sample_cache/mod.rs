@@ -158,8 +158,12 @@ pub struct CacheStats {
     pub dropped: u32,
     pub visible: u32,
     pub occupied: u32,
+    /// Adaptive shading's samples shaded outside the importance budget: the base rate's, and
+    /// the first of each pixel with no shaded visible sample.
     pub base_shaded: u32,
     pub slope_flagged: u32,
+    /// Importance bounds (w_min, w_max) of this frame's histogram buckets (last frame's).
+    pub importance_bounds: (f32, f32),
     /// Histogram of the frame (adaptive shading), and the threshold bucket and coin chosen.
     pub histogram: Vec<u32>,
     pub threshold: u32,
@@ -433,6 +437,7 @@ impl SampleCache {
             occupied: header[13],
             base_shaded: header[14],
             slope_flagged: header[15],
+            importance_bounds: (f32::from_bits(header[8]), f32::from_bits(header[9])),
             histogram: header[16..16 + s.buckets as usize].to_vec(),
             threshold: header[10],
             coin: f32::from_bits(header[11]),
