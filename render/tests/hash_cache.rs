@@ -87,24 +87,34 @@ fn furnace_converges_to_the_analytic_radiance_through_the_cache() {
     let mut pt = tracer(&scene, 40);
     let frames = 16;
     let pt_error = (0..4).map(|f| mean_relative_error(&pt.render(gpu(), 1, 11, f).unwrap().radiance, expected)).sum::<f64>() / 4.0;
-    for lookup in [HashCacheLookup::FirstHit, HashCacheLookup::SecondaryHit] {
-        let mut cache = HashCache::new(gpu(), &pt, HashCacheSettings { lookup, ..Default::default() }).expect("hash cache");
-        let mut errors = vec![];
-        let mut last = vec![];
-        for frame in 0..frames {
-            let out = cache.render(gpu(), &pt, &scene.camera, 11, frame, None).unwrap();
-            errors.push(mean_relative_error(&out.radiance, expected));
-            last = out.radiance;
+    for (lookup, seeds) in [(HashCacheLookup::FirstHit, &[11u64, 12, 13][..]), (HashCacheLookup::SecondaryHit, &[11][..])] {
+        let mut ratios = vec![];
+        for &seed in seeds {
+            let mut cache = HashCache::new(gpu(), &pt, HashCacheSettings { lookup, ..Default::default() }).expect("hash cache");
+            let mut errors = vec![];
+            let mut last = vec![];
+            for frame in 0..frames {
+                let out = cache.render(gpu(), &pt, &scene.camera, seed, frame, None).unwrap();
+                errors.push(mean_relative_error(&out.radiance, expected));
+                last = out.radiance;
+            }
+            // Unbiased: the image mean is the analytic radiance (3 % covers the 1 spp noise).
+            let mean = last.iter().map(|c| c[0] as f64).sum::<f64>() / (W * H) as f64;
+            assert!((mean - expected as f64).abs() < 0.03 * expected as f64, "{lookup:?} seed {seed}: image mean {mean} expected {expected}");
+            let late = errors[frames as usize - 4..].iter().sum::<f64>() / 4.0;
+            eprintln!("{lookup:?} seed {seed}: per-pixel relative error {:.4} -> {:.4} (last 4 frames {late:.4}), 1 spp {pt_error:.4}", errors[0], errors[15]);
+            assert!(late < errors[0] && late < pt_error, "{lookup:?}: per-pixel error by frame {errors:?}, 1 spp {pt_error}");
+            ratios.push(errors[15] / errors[0]);
         }
-        // Unbiased: the image mean is the analytic radiance (3 % covers the 1 spp noise).
-        let mean = last.iter().map(|c| c[0] as f64).sum::<f64>() / (W * H) as f64;
-        assert!((mean - expected as f64).abs() < 0.03 * expected as f64, "{lookup:?}: image mean {mean} expected {expected}");
-        // Converges: the per-pixel error of the last frames is below the first frame's (a
-        // one-sample cache) and below 1 spp path tracing. The secondary-hit lookup keeps the
-        // noise of next-event estimation at the primary hit, so it gains less.
-        let late = errors[frames as usize - 4..].iter().sum::<f64>() / 4.0;
-        eprintln!("{lookup:?}: per-pixel relative error {:.4} -> {late:.4}, 1 spp {pt_error:.4}", errors[0]);
-        assert!(late < errors[0] && late < pt_error, "{lookup:?}: per-pixel error by frame {errors:?}, 1 spp {pt_error}");
+        // The paper's first-hit lookup: the error of frame 15 is under half of frame 0's (one
+        // sample per cell), bound over the seeds. The secondary-hit lookup keeps next-event
+        // estimation at the primary hit uncached (fresh noise every frame), so it gains less:
+        // 0.1285 -> 0.1042 (ratio 0.81) at seed 11, so only the ordering above is asserted for it.
+        if lookup == HashCacheLookup::FirstHit {
+            let bound = common::upper_bound_of_mean(&ratios);
+            eprintln!("{lookup:?}: errors[15] / errors[0] per seed {ratios:.3?}, 95% bound of the mean {bound:.3}");
+            assert!(bound < 0.5, "{lookup:?}: errors[15] / errors[0] per seed {ratios:?}, bound {bound}");
+        }
     }
 }
 
@@ -185,5 +195,40 @@ fn update_paths_start_at_the_traced_key_point() {
         let s = cache.render(gpu(), &pt, &scene.camera, 3, frame, None).unwrap().stats;
         assert!(s.update_paths > 0);
         assert_eq!(s.rays, W * H + 2 * s.update_paths, "frame {frame}: {s:?}");
+    }
+}
+
+/// Radiance against the reference, the hash cache's twin of the sample cache's test: on a still
+/// view of the room (max depth 3) the paper's first-hit cache converges towards the path-traced
+/// reference (1024 spp): mean HDR-FLIP falls from frames 2 and 8 to frame 32, bound over 3
+/// seeds (one-sided Student-t of the per-seed differences).
+#[test]
+fn still_view_converges_to_the_path_traced_reference() {
+    let scene = room_scene();
+    let mut pt = tracer(&scene, 3);
+    let image = |rgba: &[[f32; 4]]| metrics::Image::new(W, H, rgba.iter().map(|p| [p[0], p[1], p[2]]).collect());
+    let flip = |reference: &metrics::Image, rgba: &[[f32; 4]]| metrics::flip_hdr(reference, &image(rgba), metrics::DEFAULT_PPD).mean;
+    let reference = image(&pt.render(gpu(), 1024, 1, 0).expect("reference").radiance);
+    let checkpoints = [2usize, 8, 32];
+    let mut per_seed: Vec<[f64; 3]> = vec![];
+    for seed in [3u64, 4, 5] {
+        let mut cache = HashCache::new(gpu(), &pt, HashCacheSettings::default()).expect("hash cache");
+        let mut at = [0.0; 3];
+        for f in 0..32u32 {
+            let out = cache.render(gpu(), &pt, &scene.camera, seed, f, None).unwrap();
+            if let Some(i) = checkpoints.iter().position(|&c| c == f as usize + 1) {
+                at[i] = flip(&reference, &out.radiance);
+            }
+        }
+        per_seed.push(at);
+    }
+    eprintln!("hash cache mean FLIP vs 1024 spp at frames {checkpoints:?} per seed: {per_seed:.4?}");
+    // Frame 2 to 8 is not asserted: measured +0.0027, -0.0123, -0.0196 (seeds 3-5), the bound of
+    // the mean is above 0 (a cell's first samples and the jittered first hits' voxel noise
+    // dominate early); from 8 to 32 and from 2 to 32 the error falls at every seed.
+    for (a, b) in [(1, 2), (0, 2)] {
+        let d: Vec<f64> = per_seed.iter().map(|x| x[b] - x[a]).collect();
+        let bound = common::upper_bound_of_mean(&d);
+        assert!(bound < 0.0, "FLIP from frame {} to {}: differences {d:?}, bound {bound}", checkpoints[a], checkpoints[b]);
     }
 }

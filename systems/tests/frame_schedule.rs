@@ -122,13 +122,13 @@ fn describe_groups_systems_by_stage() {
 
 #[test]
 fn methods_take_their_settings_defaults_and_names() {
-    let s = spec("Taa(), Taa(name: \"taa_fast\", alpha: 0.2, clamp: MinMax), HashCache(), HashCache(lookup: FirstHit, taa: true, capacity: 1024), SampleCache(retrace: Multi)");
+    let s = spec("Taa(), Taa(name: \"taa_fast\", alpha: 0.2, clamp: MinMax), HashCache(), HashCache(lookup: SecondaryHit, taa: true, capacity: 1024), SampleCache(retrace: Multi)");
     let d = render::taa::TaaSettings::default();
     assert_eq!(s.methods[0].spec, MethodSpec::Taa(d));
     let MethodSpec::Taa(t) = &s.methods[1].spec else { panic!("{:?}", s.methods[1]) };
     assert_eq!((t.alpha, t.clamp, t.jitter_length), (0.2, render::taa::TaaClamp::MinMax, d.jitter_length));
     let labels: Vec<String> = s.methods.iter().map(|m| m.label()).collect();
-    assert_eq!(labels, ["taa", "taa_fast", "hash_cache", "hash_cache_first_hit_taa", "ssc_multi"]);
+    assert_eq!(labels, ["taa", "taa_fast", "hash_cache", "hash_cache_secondary_hit_taa", "ssc_multi"]);
     assert!(s.methods[..4].iter().all(|m| m.spec.spp() == 1.0));
     let MethodSpec::HashCache(h) = &s.methods[3].spec else { panic!() };
     assert_eq!((h.capacity, h.probe_limit, h.taa), (1024, 8, true));

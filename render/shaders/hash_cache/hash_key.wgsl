@@ -28,14 +28,15 @@ fn hc_normal_axis(n: vec3f) -> u32 {
     return select(5u, 4u, n.z >= 0.0);
 }
 
-// Voxel size exponent: the smallest power of two >= lod_scale x pixel footprint at `distance`,
-// widened at grazing incidence (1 / max(|cos|, HC_MIN_COSINE)) when normal_lod is on.
+// Voxel size exponent: the largest power of two <= lod_scale x pixel footprint at `distance`
+// (sub-pixel voxels at lod_scale 1, the paper's choice), widened at grazing incidence
+// (1 / max(|cos|, HC_MIN_COSINE)) when normal_lod is on.
 fn hc_level(distance: f32, cos_incidence: f32) -> i32 {
     var footprint = distance * hc.pixel_angle * hc.lod_scale;
     if hc.normal_lod != 0u {
         footprint /= max(abs(cos_incidence), HC_MIN_COSINE);
     }
-    return clamp(i32(ceil(log2(max(footprint, 1.0e-30)))), -HC_LEVEL_BIAS, HC_LEVEL_BIAS - 1);
+    return clamp(i32(floor(log2(max(footprint, 1.0e-30)))), -HC_LEVEL_BIAS, HC_LEVEL_BIAS - 1);
 }
 
 fn hc_key(p: vec3f, n: vec3f, level: i32, jitter: vec2f) -> VoxelKey {

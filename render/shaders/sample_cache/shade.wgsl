@@ -1,7 +1,8 @@
 // Shading of cached samples (section 3.3): one path from the sample's surface point towards the
 // current camera with the shared integrator, accumulated into the slot's radiance. The blend
-// weight is max(1 / (c_s + 1), α): a running mean that becomes an exponential average with
-// factor α once c_s >= 1/α - 1 (the paper's temporal filter, α = 0.1; α = 0 keeps the mean).
+// weight is max(1 / (c_s + 1), α_min): a running mean that becomes an exponential average with
+// factor α_min once c_s >= 1/α_min - 1 (α_min = `alpha`, or App. C's roughness-dependent one;
+// α = 0 keeps the mean).
 
 import package::scene_bindings::{frame, materials};
 import package::scene_geometry::{sg_rays_traced};
@@ -43,6 +44,17 @@ fn ssc_shade(hit: vec4u, rng: ptr<function, u32>) -> vec3f {
     return radiance + throughput * path_radiance(offset_origin(sp.position, sh.ng, bs.wi), bs.wi, bs.pdf, 1u, rng);
 }
 
+// Minimum blend weight: `alpha`, or App. C's α_min = (1 − α_GGX)·0.5 + α_GGX·0.1 from the
+// material's GGX α (make_bsdf's roughness²), so that glossy samples follow the view faster.
+fn ssc_alpha_min(hit: vec4u) -> f32 {
+    if ssc.roughness_alpha == 0u || ssc_is_background(hit) {
+        return ssc.alpha;
+    }
+    let m = materials[ssc_surface(hit).material];
+    let a_ggx = make_bsdf(vec3f(0.0), m.metallic, m.roughness, m.specular).alpha;
+    return mix(0.5, 0.1, a_ggx);
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn shade_main(@builtin(global_invocation_id) id: vec3u) {
     if id.x >= ssc.width || id.y >= ssc.height || id.z >= ssc.slots {
@@ -60,6 +72,6 @@ fn shade_main(@builtin(global_invocation_id) id: vec3u) {
     let l = ssc_shade(slot.hit, &rng);
     atomicAdd(&ssc_work[SSC_ALL_RAYS], sg_rays_traced);
     let c = slot.radiance.w;
-    let a = max(1.0 / (c + 1.0), ssc.alpha);
+    let a = max(1.0 / (c + 1.0), ssc_alpha_min(slot.hit));
     dst_slots[entry].radiance = vec4f(mix(slot.radiance.rgb, l, a), c + 1.0);
 }

@@ -73,14 +73,15 @@ pub fn normal_axis(n: Vec3) -> u32 {
     if n.z >= 0.0 { 4 } else { 5 }
 }
 
-/// Voxel size exponent: the smallest power of two not below lod_scale x the pixel footprint at
-/// `distance`, divided by max(|cos|, MIN_COSINE) with the normal-based LOD.
+/// Voxel size exponent: the largest power of two not above lod_scale x the pixel footprint at
+/// `distance`, divided by max(|cos|, MIN_COSINE) with the normal-based LOD. At lod_scale 1 a
+/// voxel is smaller than a pixel (in (1/2, 1] footprints), as the paper chooses (§5).
 pub fn level(p: &KeyParams, distance: f32, cos_incidence: f32) -> i32 {
     let mut footprint = distance * p.pixel_angle * p.lod_scale;
     if p.normal_lod {
         footprint /= cos_incidence.abs().max(MIN_COSINE);
     }
-    (footprint.max(1.0e-30).log2().ceil() as i32).clamp(-LEVEL_BIAS, LEVEL_BIAS - 1)
+    (footprint.max(1.0e-30).log2().floor() as i32).clamp(-LEVEL_BIAS, LEVEL_BIAS - 1)
 }
 
 /// Integer voxel of point `x` (jittered in the tangent plane by `jitter` in [0, 1]^2).
@@ -124,13 +125,18 @@ mod tests {
     #[test]
     fn level_grows_with_distance_and_grazing_incidence() {
         let p = params();
-        // Footprint 0.01 at distance 1: 2^-7 = 0.0078 < 0.01 <= 2^-6.
-        assert_eq!(level(&p, 1.0, 1.0), -6);
-        assert_eq!(level(&p, 2.0, 1.0), -5);
-        assert_eq!(level(&p, 1.0, 0.5), -5);
+        // Footprint 0.01 at distance 1: 2^-7 = 0.0078 <= 0.01 < 2^-6 (sub-pixel voxels).
+        assert_eq!(level(&p, 1.0, 1.0), -7);
+        assert_eq!(level(&p, 2.0, 1.0), -6);
+        assert_eq!(level(&p, 1.0, 0.5), -6);
         // Grazing angles stop widening at MIN_COSINE.
         assert_eq!(level(&p, 1.0, 0.01), level(&p, 1.0, MIN_COSINE));
-        assert_eq!(level(&KeyParams { normal_lod: false, ..p }, 1.0, 0.01), -6);
+        assert_eq!(level(&KeyParams { normal_lod: false, ..p }, 1.0, 0.01), -7);
+        // Never larger than the footprint, never smaller than half of it.
+        for d in [0.3f32, 1.0, 1.7, 5.0, 40.0] {
+            let size = (level(&p, d, 1.0) as f32).exp2();
+            assert!(size <= d * 0.01 && size > 0.5 * d * 0.01, "distance {d}: voxel {size}");
+        }
     }
 
     #[test]

@@ -9,10 +9,13 @@
 //! filtering), optional TAA on the result.
 //!
 //! Departures, and why:
-//! - `lookup`: [`HashCacheLookup::SecondaryHit`] (the default, issue 5's method) terminates the
-//!   first bounce into the cache at its hit and caches outgoing radiance there (not albedo
-//!   demodulated); [`HashCacheLookup::FirstHit`] is the paper's placement (cells at primary hits,
-//!   sub-pixel voxels, albedo demodulated).
+//! - `lookup`: [`HashCacheLookup::FirstHit`] (the default) is the paper's placement (cells at
+//!   primary hits, albedo demodulated; with lod_scale 1 voxels are the largest power of two not
+//!   above the pixel footprint, i.e. smaller than a pixel, as its §5 chooses), and the paper runs
+//!   it under TAA (`taa: true`, what the reprojection scenarios run as `hash_cache_taa`).
+//!   [`HashCacheLookup::SecondaryHit`] (issue 5's variant, label `hash_cache_secondary_hit`)
+//!   terminates the first bounce into the cache at its hit and caches outgoing radiance there
+//!   (not albedo demodulated).
 //! - Keys: WGSL has no 64-bit atomics, so the paper's 64-bit (last access, checksum) word becomes
 //!   a 32-bit checksum claimed by compare-exchange plus a separate last-access word every
 //!   accessor stores the same frame into; the home slot is stored for checking.
@@ -80,7 +83,7 @@ const PASSES: [&str; 4] = [HC_AGE_PASS, HC_TRACE_PASS, HC_UPDATE_PASS, HC_RESOLV
 /// Where the path terminates into the cache.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum HashCacheLookup {
-    /// The paper: cells at the primary hits, albedo demodulated, sub-pixel voxels.
+    /// The paper (the default): cells at the primary hits, albedo demodulated, sub-pixel voxels.
     FirstHit,
     /// Issue 5: the first bounce ends in the cache at its hit (outgoing radiance there).
     SecondaryHit,
@@ -96,7 +99,8 @@ pub struct HashCacheSettings {
     pub probe_limit: u32,
     /// Entries not accessed for more than this many frames are evicted.
     pub max_age: u32,
-    /// Voxel size in pixel footprints at the point's camera distance (rounded up to 2^k).
+    /// Voxel size in pixel footprints at the point's camera distance (rounded down to 2^k: at 1,
+    /// voxels smaller than a pixel).
     pub lod_scale: f32,
     /// Widen voxels at grazing incidence (the paper's distance + normal LOD).
     pub normal_lod: bool,
@@ -120,7 +124,7 @@ impl Default for HashCacheSettings {
             lod_scale: 1.0,
             normal_lod: true,
             jitter: true,
-            lookup: HashCacheLookup::SecondaryHit,
+            lookup: HashCacheLookup::FirstHit,
             max_samples: 32,
             jitter_length: 8,
             taa: false,

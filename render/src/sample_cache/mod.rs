@@ -120,7 +120,8 @@ crate::gpu_struct! {
         pub shading_budget: f32 => "f32",
         /// φ, the angle of a pixel's diagonal.
         pub pixel_diagonal_angle: f32 => "f32",
-        pub pad: f32 => "f32",
+        /// 1: App. C's α_min from the material's roughness instead of `alpha`.
+        pub roughness_alpha: u32 => "u32",
     }
 }
 
@@ -354,7 +355,7 @@ impl SampleCache {
                 alpha: s.alpha,
                 shading_budget: s.shading_rate * pixels as f32,
                 pixel_diagonal_angle: slope::pixel_diagonal_angle(vfov, h),
-                pad: 0.0,
+                roughness_alpha: s.roughness_alpha as u32,
             };
             gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         }

@@ -41,8 +41,12 @@ pub struct SampleCacheSettings {
     pub base_block: u32,
     /// M, buckets of the log importance histogram.
     pub buckets: u32,
-    /// Minimum blend weight of a new radiance sample (temporal filter).
+    /// Minimum blend weight of a new radiance sample (temporal filter). 0.1 is the value of the
+    /// paper's glossy stereo test (§5.2); its main results state none.
     pub alpha: f32,
+    /// App. C: the minimum blend weight of a surface sample from its material's GGX roughness,
+    /// α_min = (1 − α_GGX)·0.5 + α_GGX·0.1 (view-dependent effects), instead of `alpha`.
+    pub roughness_alpha: bool,
     pub retrace: Retrace,
     pub shading: ShadingMode,
     /// Shading invocations per frame as a fraction of the pixel count (1 = 100%); only adaptive
@@ -61,6 +65,7 @@ impl Default for SampleCacheSettings {
             base_block: 4,
             buckets: 13,
             alpha: 0.1,
+            roughness_alpha: false,
             retrace: Retrace::Adaptive,
             shading: ShadingMode::Uniform,
             shading_rate: 1.0,

@@ -278,7 +278,10 @@ impl TerminationCache {
 
     fn passes(&mut self, gpu: &Gpu, tracer: &PathTracer, camera: &Camera, seed: u64, frame: u32, max_vertices: u32) -> Result<Vec<PassTiming>, RenderError> {
         let s = &self.settings;
-        let keys = HashCacheSettings { capacity: s.capacity, probe_limit: s.probe_limit, lod_scale: s.lod_scale, jitter: s.jitter, ..Default::default() }.key_params(camera, self.height);
+        // The hash cache's keys round the voxel down to a power of two (sub-pixel voxels, the
+        // paper's HashCache); twice the scale keeps this cache's rounding up (voxels of at least
+        // lod_scale footprints), as it was tuned.
+        let keys = HashCacheSettings { capacity: s.capacity, probe_limit: s.probe_limit, lod_scale: 2.0 * s.lod_scale, jitter: s.jitter, ..Default::default() }.key_params(camera, self.height);
         let hc = HashCacheParams {
             capacity: s.capacity,
             probe_limit: s.probe_limit,

@@ -76,3 +76,12 @@ pub fn furnace() -> (SceneDesc, f32) {
     (scene, le / (1.0 - a))
 }
 
+
+/// One-sided 95% Student-t upper bound of the mean of `x` (n - 1 degrees of freedom, n <= 6).
+pub fn upper_bound_of_mean(x: &[f64]) -> f64 {
+    const T95: [f64; 5] = [6.314, 2.920, 2.353, 2.132, 2.015];
+    let n = x.len() as f64;
+    let mean = x.iter().sum::<f64>() / n;
+    let sd = (x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    mean + T95[x.len() - 2] * sd / n.sqrt()
+}

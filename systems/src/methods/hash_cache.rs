@@ -15,9 +15,10 @@ pub use render::hash_cache::HashCacheSettings;
 use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
 use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
 
-/// `hash_cache`, `hash_cache_first_hit`, `hash_cache_taa`, ...
+/// `hash_cache` (the paper's first-hit lookup), `hash_cache_taa` (under TAA, as the paper runs
+/// it), `hash_cache_secondary_hit`, `hash_cache_secondary_hit_taa`.
 pub fn label(s: &HashCacheSettings) -> String {
-    format!("hash_cache{}{}", if s.lookup == HashCacheLookup::FirstHit { "_first_hit" } else { "" }, if s.taa { "_taa" } else { "" })
+    format!("hash_cache{}{}", if s.lookup == HashCacheLookup::SecondaryHit { "_secondary_hit" } else { "" }, if s.taa { "_taa" } else { "" })
 }
 
 #[derive(Component)]
