@@ -78,6 +78,7 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
     let gpu = Gpu::new()?;
     let mut md = String::new();
     let mut traversal_json = Vec::new();
+    let mut frames_json = Vec::new();
     writeln!(md, "Adapter: {}; CPU threads: {}\n", gpu.summary, rayon_threads())?;
     log("warm-up");
     warm_up(&gpu)?;
@@ -145,9 +146,11 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
             tracer.update(&gpu, &scene);
             tracer.render(&gpu, 1, 1, 0)?;
             let mut gpu_ms: Vec<(String, f64, u32)> = Vec::new();
+            let mut rays = 0u64;
             let start = Instant::now();
             for f in 0..opts.frames {
                 let out = tracer.render(&gpu, 1, 1, f + 1)?;
+                rays += out.rays;
                 for t in &out.timings {
                     let entry = match gpu_ms.iter_mut().find(|(p, _, _)| *p == t.pass) {
                         Some(e) => e,
@@ -166,7 +169,32 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
                 let g = if *n > 0 { format!("{:.2}{}", sum / *n as f64, if gpu.has_timestamps() { "" } else { " (wall)" }) } else { "n/a".into() };
                 writeln!(md, "| {name} | {w}x{h} | {pass} | {g} | {cpu_ms:.2} |")?;
             }
+            let frame_ms: f64 = gpu_ms.iter().map(|(_, sum, n)| sum / (*n).max(1) as f64).sum();
+            let rays_per_frame = rays as f64 / opts.frames as f64;
+            frames_json.push(serde_json::json!({
+                "scene": name, "width": w, "height": h,
+                "gpu_ms": gpu_ms.iter().map(|(p, sum, n)| (p.clone(), serde_json::json!(sum / (*n).max(1) as f64))).collect::<serde_json::Map<_, _>>(),
+                "rays_per_frame": rays_per_frame, "frame_mrays_per_s": rays_per_frame / frame_ms / 1e3,
+            }));
         }
+    }
+    // Traversal's share of a frame, to first order: the frame's rays at the traversal-only rate
+    // of the same scene (random rays, like the bounces' rays) against the frame's time.
+    writeln!(md, "\n| scene | resolution | rays per frame | Mrays/s within the frame | traversal-only Mrays/s | frame rate / traversal-only rate |")?;
+    writeln!(md, "|---|---|---:|---:|---:|---:|")?;
+    for f in &frames_json {
+        let scene = f["scene"].as_str().unwrap_or_default();
+        let alone = traversal_json.iter().find(|t| t["scene"] == scene).and_then(|t| t["wgsl_mrays_per_s"].as_f64());
+        let rate = f["frame_mrays_per_s"].as_f64().unwrap_or(f64::NAN);
+        writeln!(
+            md,
+            "| {scene} | {}x{} | {:.0} | {rate:.3} | {} | {} |",
+            f["width"],
+            f["height"],
+            f["rays_per_frame"].as_f64().unwrap_or(f64::NAN),
+            alone.map_or("n/a".into(), |a| format!("{a:.3}")),
+            alone.map_or("n/a".into(), |a| format!("{:.2}", rate / a))
+        )?;
     }
     let json = serde_json::json!({
         "adapter": gpu.summary,
@@ -180,6 +208,7 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         "mitsuba_threads": reference.mitsuba.as_ref().map(|m| m.threads),
         "mitsuba_mean_rgb": reference.mitsuba.as_ref().map(|m| m.mean_rgb),
         "reference_paths_ratio_vs_mitsuba": mitsuba_ratio,
+        "frames": frames_json,
     });
     Ok(BenchReport { markdown: md, json })
 }
