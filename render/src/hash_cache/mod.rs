@@ -31,6 +31,10 @@
 //!   before the claimant is known.
 //! - Cells are not split into parent/child levels (that is the paper's Hybrid, not HashCache).
 //!
+//! Numbers below predate issue 15 (voxels then rounded up to a power of two, secondary-hit
+//! default); not rerun since. Issue 15's convergence numbers are in
+//! render/src/sample_cache/README.md.
+//!
 //! Numbers (lavapipe, 2 shared CPU cores; an earlier courtyard version of issue5_bench at 320x180,
 //! camera moving, max depth 4, median GPU ms): secondary-hit lookup hc_age 5.2,
 //! hc_trace 334, hc_update 581, hc_resolve 6.2 (occupancy 0.17 of 2^18 slots, 18k update paths
