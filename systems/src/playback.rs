@@ -78,6 +78,7 @@ impl FrameWorld {
     pub fn build(spec: &RunSpec, gpu: Gpu, cache_dir: PathBuf, folder: RunFolder, progress: ProgressBar) -> Result<FrameWorld> {
         let scenario = &spec.scenario;
         let origin = scenario.origin.display().to_string();
+        check_media_support(spec, &origin)?;
         let sim = Simulation::new(scenario)?;
         let (width, height) = scenario.resolution;
         let settings = PathTracerSettings { width, height, max_depth: scenario.max_depth, rr_start_depth: 3 };
@@ -99,7 +100,6 @@ impl FrameWorld {
         }
         frame::catch_failures(&mut world);
 
-        check_media_support(spec, &origin)?;
         for (index, method) in spec.methods.iter().enumerate() {
             let label = method.label();
             let entity = world.spawn((MethodInfo { index, label: label.clone() }, MethodFrame::default())).id();
