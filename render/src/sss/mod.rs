@@ -5,12 +5,14 @@
 //! README inside.
 
 pub mod control_variates;
+pub mod evaluation;
 pub mod gpu;
 pub mod inverse;
 pub mod profile;
 pub mod sampling;
 pub mod screen_pass;
 pub mod spvg;
+pub mod synthetic;
 
 pub use control_variates::EmCovariance;
 pub use profile::BurleyProfile;
