@@ -18,8 +18,9 @@ fn frame() -> SssFrame {
             let (x, y) = ((i % W) as f32, (i / W) as f32);
             let lit = if x + 0.5 * y < 11.0 { 1.0 } else { 0.15 };
             let fall = 1.0 - 0.03 * y;
-            let mask = if x >= 16.0 && y < 4.0 { 0.0 } else { 1.0 };
-            [lit * fall, 0.8 * lit * fall, 0.6 * lit, mask]
+            // w: pixels per unit of d, varying as depth would; 0 off the SSS mask.
+            let scale = if x >= 16.0 && y < 4.0 { 0.0 } else { 0.8 + 0.03 * x };
+            [lit * fall, 0.8 * lit * fall, 0.6 * lit, scale]
         })
         .collect();
     SssFrame { width: W, height: H, irradiance, d_px: [1.5, 0.8, 0.4] }

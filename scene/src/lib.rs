@@ -66,6 +66,19 @@ pub struct Material {
     /// 0 leaves a pure Lambertian diffuse (furnace tests); glTF's default is 1.
     #[serde(default = "one")]
     pub specular: f32,
+    /// Screen-space subsurface scattering (render::sss): set by a scenario's material override.
+    /// The path tracer shades the surface as its diffuse base; the SSS method scatters the
+    /// demodulated diffuse irradiance of its pixels.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub subsurface: Option<Subsurface>,
+}
+
+/// Burley's profile parameters of a material (realtime-sss-thesis.txt, eq. 2.44 Θ3): the diffuse
+/// mean free path per channel in scene units; the albedo is the base colour.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Subsurface {
+    pub dmfp: Vec3,
 }
 
 fn one() -> f32 {
@@ -81,6 +94,7 @@ impl Default for Material {
             roughness: 1.0,
             metallic: 0.0,
             specular: 1.0,
+            subsurface: None,
         }
     }
 }

@@ -18,7 +18,7 @@ fn texel(i: i32, j: i32, centre: vec3f) -> vec3f {
     let x = clamp(i, 0, i32(params.width) - 1);
     let y = clamp(j, 0, i32(params.height) - 1);
     let t = irradiance[u32(y) * params.width + u32(x)];
-    if t.w > 0.5 {
+    if t.w > 0.0 {
         return t.xyz;
     }
     return centre;
@@ -45,7 +45,7 @@ fn sss_scatter(@builtin(global_invocation_id) id: vec3u) {
     }
     let pixel = id.y * params.width + id.x;
     let t = irradiance[pixel];
-    if t.w <= 0.5 {
+    if t.w <= 0.0 {
         scattered[pixel] = vec4f(t.xyz, 0.0);
         history_out[pixel] = vec4f(0.0);
         cv_out[pixel] = vec4f(0.0);
@@ -57,7 +57,9 @@ fn sss_scatter(@builtin(global_invocation_id) id: vec3u) {
     if params.variant != 0u {
         n = spvg_sample_count(st, sp);
     }
-    let ds = params.d_px.w;
+    // w: pixels per unit of d here (the SSS pixel's depth sets it).
+    let ds = params.d_px.w * t.w;
+    let dc = params.d_px.xyz * t.w;
     let offset = sss_pixel_offset(params.seed, params.frame, pixel);
     let centre_pos = vec2f(f32(id.x) + 0.5, f32(id.y) + 0.5);
     var sum = vec3f(0.0);
@@ -68,7 +70,7 @@ fn sss_scatter(@builtin(global_invocation_id) id: vec3u) {
         let phi = 6.2831855 * u.y;
         let l = fetch(centre_pos + r * vec2f(cos(phi), sin(phi)), t.xyz);
         let ps = sss_radial_pdf(r, ds);
-        let w = vec3f(sss_radial_pdf(r, params.d_px.x), sss_radial_pdf(r, params.d_px.y), sss_radial_pdf(r, params.d_px.z)) / ps;
+        let w = vec3f(sss_radial_pdf(r, dc.x), sss_radial_pdf(r, dc.y), sss_radial_pdf(r, dc.z)) / ps;
         sum += l * w;
     }
     let rgb = sum / f32(n);

@@ -21,7 +21,7 @@ pub struct RunMeasures {
 pub fn psnr(result: &[PixelResult], reference: &[[f32; 3]], frame: &SssFrame, peak: f64) -> f64 {
     let (mut se, mut n) = (0.0f64, 0usize);
     for ((r, f), t) in result.iter().zip(reference).zip(&frame.irradiance) {
-        if t[3] > 0.5 {
+        if t[3] > 0.0 {
             let e = luminance(r.rgb) as f64 - luminance(*f) as f64;
             se += e * e;
             n += 1;
@@ -35,7 +35,7 @@ pub fn psnr(result: &[PixelResult], reference: &[[f32; 3]], frame: &SssFrame, pe
 pub fn smape(a: &[PixelResult], b: &[PixelResult], frame: &SssFrame) -> f64 {
     let (mut s, mut n) = (0.0f64, 0usize);
     for ((a, b), t) in a.iter().zip(b).zip(&frame.irradiance) {
-        if t[3] > 0.5 {
+        if t[3] > 0.0 {
             let (x, y) = (luminance(a.rgb) as f64, luminance(b.rgb) as f64);
             s += 2.0 * (x - y).abs() / (x.abs() + y.abs() + 1e-4);
             n += 1;
@@ -64,7 +64,7 @@ impl Accumulator {
         }
         for ((r, t), c) in result.iter().zip(&frame.irradiance).zip(&mut self.counts) {
             *c += r.count as f64;
-            if t[3] > 0.5 {
+            if t[3] > 0.0 {
                 self.spp_sum += r.count as f64;
                 self.spp_n += 1;
             }

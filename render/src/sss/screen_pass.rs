@@ -52,8 +52,9 @@ impl Default for SssSettings {
     }
 }
 
-/// One frame's input: demodulated diffuse irradiance (rgb) and the SSS mask (w: 1 or 0) per
-/// pixel, row-major, and the profile's d per channel in pixels.
+/// One frame's input, row-major: per pixel the demodulated diffuse irradiance (rgb) and w, the
+/// pixels per unit of d at that pixel (0: not an SSS pixel; 1 when d is given in pixels); and
+/// the profile's d per channel (in pixels where w = 1).
 #[derive(Clone, Debug)]
 pub struct SssFrame {
     pub width: u32,
@@ -92,7 +93,7 @@ fn fetch(frame: &SssFrame, q: [f32; 2], centre: [f32; 3]) -> [f32; 3] {
     let (fx, fy) = (x - x0, y - y0);
     let texel = |i: i32, j: i32| {
         let t = frame.irradiance[(j.clamp(0, h - 1) * w + i.clamp(0, w - 1)) as usize];
-        if t[3] > 0.5 { [t[0], t[1], t[2]] } else { centre }
+        if t[3] > 0.0 { [t[0], t[1], t[2]] } else { centre }
     };
     // Clamp before the cast: radii in the far tail are huge.
     let (xi, yi) = (x0.clamp(-2.0, w as f32 + 1.0) as i32, y0.clamp(-2.0, h as f32 + 1.0) as i32);
@@ -105,7 +106,8 @@ pub fn scatter(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x: u3
     let pixel = y * frame.width + x;
     let t = frame.irradiance[pixel as usize];
     let centre = [t[0], t[1], t[2]];
-    let ds = frame.d_sample();
+    let ds = frame.d_sample() * t[3];
+    let d = frame.d_px.map(|d| d * t[3]);
     let offset = pixel_offset(settings.seed, frame_index, pixel);
     let mut sum = [0.0f32; 3];
     for j in 0..n {
@@ -116,7 +118,7 @@ pub fn scatter(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x: u3
         let l = fetch(frame, q, centre);
         let ps = radial_pdf(r, ds);
         for c in 0..3 {
-            sum[c] += l[c] * (radial_pdf(r, frame.d_px[c]) / ps);
+            sum[c] += l[c] * (radial_pdf(r, d[c]) / ps);
         }
     }
     sum.map(|s| s / n as f32)
@@ -125,7 +127,7 @@ pub fn scatter(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x: u3
 /// One pixel's step: count, samples, histories.
 pub fn pixel_step(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x: u32, y: u32, prev: &PixelHistory) -> (PixelResult, PixelHistory) {
     let t = frame.irradiance[(y * frame.width + x) as usize];
-    if t[3] <= 0.5 {
+    if t[3] <= 0.0 {
         return (PixelResult { rgb: [t[0], t[1], t[2]], count: 0 }, PixelHistory::default());
     }
     let st = spvg::state(&prev.spvg, &settings.spvg);
