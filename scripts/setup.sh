@@ -27,3 +27,7 @@ fi
 # The same probe the FLIP tests use (metrics::bench::reference_flip_available).
 python3 -m flip_evaluator.flip_python_api -h >/dev/null 2>&1 || python3 -m pip install --quiet flip-evaluator
 python3 -m flip_evaluator.flip_python_api -h >/dev/null
+# Mitsuba 3's scalar CPU path tracer: the independent renderer of systems/tests/mitsuba_agreement.rs and
+# the reference that `flicker bench` measures the WGSL path tracer against.
+python3 -c "import mitsuba" 2>/dev/null || python3 -m pip install --quiet mitsuba==3.9.1
+python3 -c "import mitsuba"

@@ -92,7 +92,7 @@ enum Command {
         /// With --nirc: queries per inference.
         #[arg(long, default_value_t = 16384)]
         nirc_queries: u32,
-        /// With --nirc: also write the numbers as JSON to this file.
+        /// Also write the numbers as JSON to this file (with --nirc: the neural cache's).
         #[arg(long)]
         json: Option<PathBuf>,
     },
@@ -301,9 +301,10 @@ fn bench_nirc(out: Option<PathBuf>, json: Option<PathBuf>, batch: u32, queries: 
     Ok(())
 }
 
-fn bench(out: Option<PathBuf>, rays: u32, frames: u32, no_metrics: bool, repeats: u32) -> anyhow::Result<()> {
+fn bench(out: Option<PathBuf>, json: Option<PathBuf>, rays: u32, frames: u32, no_metrics: bool, repeats: u32) -> anyhow::Result<()> {
     let opts = systems::bench::BenchOptions { rays, frames, ..Default::default() };
-    let mut md = systems::bench::run(&opts, |step| eprintln!("bench: {step}"))?;
+    let report = systems::bench::run(&opts, |step| eprintln!("bench: {step}"))?;
+    let mut md = report.markdown;
     if !no_metrics {
         eprintln!("bench: image metrics at 1280x720");
         let args = metrics::bench::BenchArgs { width: 1280, height: 720, repeats, no_reference: false, smape_only: false };
@@ -319,6 +320,9 @@ fn bench(out: Option<PathBuf>, rays: u32, frames: u32, no_metrics: bool, repeats
     print!("{md}");
     if let Some(path) = out {
         systems::output::write_text(&path, &md)?;
+    }
+    if let Some(path) = json {
+        systems::output::write_text(&path, &serde_json::to_string_pretty(&report.json)?)?;
     }
     Ok(())
 }
@@ -359,8 +363,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => metrics::compare(&args),
         Command::Report(args) => report::report(&args).map(|path| println!("wrote {}", path.display())),
         Command::Bench { out, repeats, nirc: true, nirc_batch, nirc_queries, json, .. } => bench_nirc(out, json, nirc_batch, nirc_queries, repeats),
-        Command::Bench { json: Some(_), .. } => Err(anyhow::anyhow!("bench --json writes the NIRC numbers: use it with --nirc")),
-        Command::Bench { out, rays, frames, no_metrics, repeats, .. } => bench(out, rays, frames, no_metrics, repeats),
+        Command::Bench { out, rays, frames, no_metrics, repeats, json, .. } => bench(out, json, rays, frames, no_metrics, repeats),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

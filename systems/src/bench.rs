@@ -16,6 +16,8 @@ use sim::{Scenario, Simulation};
 pub struct BenchOptions {
     /// Rays per traversal measurement.
     pub rays: u32,
+    /// Samples per pixel of the reference path-tracing measurement (64x64 Cornell box).
+    pub reference_spp: u32,
     /// Timed frames per (scene, resolution).
     pub frames: u32,
     pub resolutions: Vec<(u32, u32)>,
@@ -26,6 +28,7 @@ impl Default for BenchOptions {
     fn default() -> Self {
         Self {
             rays: 1 << 18,
+            reference_spp: 256,
             frames: 5,
             resolutions: vec![(160, 90), (320, 180)],
             frame_scenes: vec!["cornell_box".into(), "courtyard".into()],
@@ -44,6 +47,17 @@ pub fn builtin_scene(name: &str, resolution: (u32, u32)) -> Result<SceneDesc> {
     Ok(sim.scene().clone())
 }
 
+/// The built-in Cornell box with every material Lambertian (specular 0): the scene both our
+/// path tracer and Mitsuba's `diffuse` BSDF render exactly (the bench's reference measurement
+/// and systems/tests/mitsuba_agreement.rs).
+pub fn lambertian_cornell_box(resolution: (u32, u32)) -> Result<SceneDesc> {
+    let mut scene = builtin_scene("cornell_box", resolution)?;
+    for m in &mut scene.materials {
+        m.specular = 0.0;
+    }
+    Ok(scene)
+}
+
 fn mesh_scene(mesh: render::scene::Mesh) -> SceneDesc {
     SceneDesc {
         meshes: vec![mesh],
@@ -54,10 +68,20 @@ fn mesh_scene(mesh: render::scene::Mesh) -> SceneDesc {
     }
 }
 
-pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<String> {
+/// The bench's Markdown table and the same numbers as JSON (`flicker bench --json`).
+pub struct BenchReport {
+    pub markdown: String,
+    pub json: serde_json::Value,
+}
+
+pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport> {
     let gpu = Gpu::new()?;
     let mut md = String::new();
+    let mut traversal_json = Vec::new();
+    let mut frames_json = Vec::new();
     writeln!(md, "Adapter: {}; CPU threads: {}\n", gpu.summary, rayon_threads())?;
+    log("warm-up");
+    warm_up(&gpu)?;
 
     writeln!(md, "## BVH traversal (closest hit, {} random rays)\n", opts.rays)?;
     writeln!(md, "| scene | triangles | instances | WGSL Mrays/s | obvhs CPU Mrays/s | WGSL / CPU | hits | WGSL = CPU |")?;
@@ -81,6 +105,33 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<String> {
             100.0 * b.hit_fraction,
             100.0 * b.agreement
         )?;
+        traversal_json.push(serde_json::json!({
+            "scene": name, "triangles": b.triangles, "wgsl_mrays_per_s": b.gpu_rays_per_second / 1e6,
+            "cpu_mrays_per_s": b.cpu_rays_per_second / 1e6, "traversal_ratio_vs_obvhs": b.gpu_rays_per_second / b.cpu_rays_per_second,
+        }));
+    }
+
+    log("reference path tracing");
+    let reference = reference_paths(&gpu, opts.reference_spp)?;
+    writeln!(
+        md,
+        "\n## Reference path tracing (Lambertian Cornell box {0}x{0}, {1} spp, unlimited depth, Russian roulette from depth {2})\n",
+        REFERENCE_SIZE, opts.reference_spp, REFERENCE_INTEGRATOR.rr_depth
+    )?;
+    writeln!(md, "| renderer | M paths/s | mean radiance (RGB) | ratio to Mitsuba |\n|---|---:|---|---:|")?;
+    let mean = |m: [f64; 3]| format!("{:.4} {:.4} {:.4}", m[0], m[1], m[2]);
+    let mitsuba_ratio = reference.mitsuba.as_ref().map(|m| reference.paths_per_s / m.paths_per_second());
+    writeln!(
+        md,
+        "| flicker WGSL ({}) | {:.3} | {} | {} |",
+        gpu.summary,
+        reference.paths_per_s / 1e6,
+        mean(reference.mean_rgb),
+        mitsuba_ratio.map_or("n/a".into(), |r| format!("{r:.2}"))
+    )?;
+    match &reference.mitsuba {
+        Some(m) => writeln!(md, "| Mitsuba {} scalar_rgb ({} threads) | {:.3} | {} | 1.00 |", m.version, m.threads, m.paths_per_second() / 1e6, mean(m.mean_rgb))?,
+        None => writeln!(md, "\nMitsuba 3 not measured: {}", reference.mitsuba_missing.as_deref().unwrap_or("?"))?,
     }
 
     writeln!(md, "\n## Path tracer frame time ({} frames after one warm-up, 1 spp, max depth 8)\n", opts.frames)?;
@@ -95,9 +146,11 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<String> {
             tracer.update(&gpu, &scene);
             tracer.render(&gpu, 1, 1, 0)?;
             let mut gpu_ms: Vec<(String, f64, u32)> = Vec::new();
+            let mut rays = 0u64;
             let start = Instant::now();
             for f in 0..opts.frames {
                 let out = tracer.render(&gpu, 1, 1, f + 1)?;
+                rays += out.rays;
                 for t in &out.timings {
                     let entry = match gpu_ms.iter_mut().find(|(p, _, _)| *p == t.pass) {
                         Some(e) => e,
@@ -116,9 +169,106 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<String> {
                 let g = if *n > 0 { format!("{:.2}{}", sum / *n as f64, if gpu.has_timestamps() { "" } else { " (wall)" }) } else { "n/a".into() };
                 writeln!(md, "| {name} | {w}x{h} | {pass} | {g} | {cpu_ms:.2} |")?;
             }
+            let frame_ms: f64 = gpu_ms.iter().map(|(_, sum, n)| sum / (*n).max(1) as f64).sum();
+            let rays_per_frame = rays as f64 / opts.frames as f64;
+            frames_json.push(serde_json::json!({
+                "scene": name, "width": w, "height": h,
+                "gpu_ms": gpu_ms.iter().map(|(p, sum, n)| (p.clone(), serde_json::json!(sum / (*n).max(1) as f64))).collect::<serde_json::Map<_, _>>(),
+                "rays_per_frame": rays_per_frame, "frame_mrays_per_s": rays_per_frame / frame_ms / 1e3,
+            }));
         }
     }
-    Ok(md)
+    // Traversal's share of a frame, to first order: the frame's rays at the traversal-only rate
+    // of the same scene (random rays, like the bounces' rays) against the frame's time.
+    writeln!(md, "\n| scene | resolution | rays per frame | Mrays/s within the frame | traversal-only Mrays/s | frame rate / traversal-only rate |")?;
+    writeln!(md, "|---|---|---:|---:|---:|---:|")?;
+    for f in &frames_json {
+        let scene = f["scene"].as_str().unwrap_or_default();
+        let alone = traversal_json.iter().find(|t| t["scene"] == scene).and_then(|t| t["wgsl_mrays_per_s"].as_f64());
+        let rate = f["frame_mrays_per_s"].as_f64().unwrap_or(f64::NAN);
+        writeln!(
+            md,
+            "| {scene} | {}x{} | {:.0} | {rate:.3} | {} | {} |",
+            f["width"],
+            f["height"],
+            f["rays_per_frame"].as_f64().unwrap_or(f64::NAN),
+            alone.map_or("n/a".into(), |a| format!("{a:.3}")),
+            alone.map_or("n/a".into(), |a| format!("{:.2}", rate / a))
+        )?;
+    }
+    let json = serde_json::json!({
+        "adapter": gpu.summary,
+        "cpu_threads": rayon_threads(),
+        "traversal": traversal_json,
+        "traversal_ratio_vs_obvhs": traversal_json.iter().map(|t| (t["scene"].as_str().unwrap_or_default().to_string(), t["traversal_ratio_vs_obvhs"].clone())).collect::<serde_json::Map<_, _>>(),
+        "reference_paths_per_s": reference.paths_per_s,
+        "reference_spp": opts.reference_spp,
+        "reference_mean_rgb": reference.mean_rgb,
+        "mitsuba_paths_per_s": reference.mitsuba.as_ref().map(|m| m.paths_per_second()),
+        "mitsuba_threads": reference.mitsuba.as_ref().map(|m| m.threads),
+        "mitsuba_mean_rgb": reference.mitsuba.as_ref().map(|m| m.mean_rgb),
+        "reference_paths_ratio_vs_mitsuba": mitsuba_ratio,
+        "frames": frames_json,
+    });
+    Ok(BenchReport { markdown: md, json })
+}
+
+const REFERENCE_SIZE: u32 = 64;
+/// "Unlimited" depth on our side is a bound no Cornell-box path reaches under roulette (a path
+/// survives 1000 white bounces with probability below 0.73^997).
+const REFERENCE_INTEGRATOR: crate::mitsuba::Integrator = crate::mitsuba::Integrator { max_depth: None, rr_depth: 3 };
+const REFERENCE_MAX_DEPTH: u32 = 1000;
+
+struct ReferenceBench {
+    paths_per_s: f64,
+    mean_rgb: [f64; 3],
+    mitsuba: Option<crate::mitsuba::MitsubaRun>,
+    mitsuba_missing: Option<String>,
+}
+
+/// Paths per second of a converging reference (the Cornell box at 64x64, unlimited depth with
+/// Russian roulette), and the same scene exported to Mitsuba 3 and rendered by its scalar CPU
+/// path tracer in this run, when Python has Mitsuba.
+fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
+    let size = REFERENCE_SIZE;
+    let scene = lambertian_cornell_box((size, size))?;
+    let settings = PathTracerSettings { width: size, height: size, max_depth: REFERENCE_MAX_DEPTH, rr_start_depth: REFERENCE_INTEGRATOR.rr_depth };
+    let mut tracer = PathTracer::new(gpu, &scene, settings)?;
+    tracer.update(gpu, &scene);
+    tracer.render_reference(gpu, 1, 1, 0, &mut |_, _| {})?;
+    let start = Instant::now();
+    let image = tracer.render_reference(gpu, spp, 1, 0, &mut |_, _| {})?;
+    let seconds = start.elapsed().as_secs_f64();
+    let paths_per_s = (size * size) as f64 * spp as f64 / seconds;
+    let n = image.len() as f64;
+    let mean_rgb = [0, 1, 2].map(|c| image.iter().map(|p| p[c] as f64).sum::<f64>() / n);
+    let (mitsuba, mitsuba_missing) = match crate::mitsuba::python() {
+        None => (None, Some("no Python with the mitsuba package (pip install mitsuba; FLICKER_PYTHON picks the interpreter)".to_string())),
+        Some(python) => {
+            let dir = std::env::temp_dir().join(format!("flicker_bench_mitsuba_{}", std::process::id()));
+            let xml = crate::mitsuba::write_scene(&scene, (size, size), &REFERENCE_INTEGRATOR, &dir)?;
+            let run = crate::mitsuba::render(&python, &xml, spp, &dir.join("mitsuba.exr"))?;
+            let _ = std::fs::remove_dir_all(&dir);
+            (Some(run), None)
+        }
+    };
+    Ok(ReferenceBench { paths_per_s, mean_rgb, mitsuba, mitsuba_missing })
+}
+
+/// A GPU fresh from idle runs at a fraction of its clock for a while (an H200 started at 345 of
+/// 1980 MHz and made the first path-tracer frames 5x slower): render untimed frames for a second,
+/// so that every timed section starts at working clocks.
+fn warm_up(gpu: &Gpu) -> Result<()> {
+    let scene = builtin_scene("cornell_box", (320, 180))?;
+    let mut tracer = PathTracer::new(gpu, &scene, PathTracerSettings { width: 320, height: 180, max_depth: 8, rr_start_depth: 3 })?;
+    tracer.update(gpu, &scene);
+    let start = Instant::now();
+    let mut frame = 0;
+    while frame < 2 || start.elapsed().as_secs_f64() < 1.0 {
+        tracer.render(gpu, 1, 1, frame)?;
+        frame += 1;
+    }
+    Ok(())
 }
 
 fn rayon_threads() -> usize {

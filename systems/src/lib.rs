@@ -7,6 +7,7 @@ pub mod frame_record;
 pub mod manifest;
 pub mod measure;
 pub mod methods;
+pub mod mitsuba;
 pub mod output;
 pub mod playback;
 pub mod reference_cache;
