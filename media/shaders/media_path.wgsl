@@ -6,7 +6,9 @@
 // are also sampled by equiangular sampling on every segment in the medium, combined with the
 // free-flight sample by MIS (Sec. 5.2): weights naive g(X̄), jackknife Re g(X̄ + iS) or
 // Miller et al.'s, combined by Eq. 9 (unbiased) or Eq. 10. vp.mis = none: delta tracking only.
-// Medium emission is not rendered.
+// Medium emission (vp.emission, radiance per unit extinction: the source term σ_t(x) ε) is
+// collected at every real collision of delta tracking, whose density is T(t) σ_t(t): an unbiased
+// estimate of ∫ T σ_t ε dt.
 
 import package::scene_types::{GpuMaterial};
 import package::scene_bindings::{frame, lights, materials};
@@ -214,6 +216,8 @@ fn volume_path_radiance(origin_in: vec3f, dir_in: vec3f, rng: ptr<function, u32>
         }
         var v: Vertex;
         if t_collision < BIG {
+            // Emission at the collision, before its scattering weight (ε per unit extinction).
+            radiance += throughput * vp.emission;
             if depth == max_depth {
                 break;
             }

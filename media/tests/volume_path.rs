@@ -10,11 +10,17 @@
 //!   track-length estimate (delta tracking) agree in expectation; so do free-flight sampling
 //!   alone and its MIS with equiangular sampling by Eq. 9 with the naive, jackknife and Miller
 //!   weights (all unbiased).
+//! - The MIS variants' order in MSE over three seeds, in the cloud (N = 4) and a sparse
+//!   explosion field (N = 1), as measured (see the test's comment and media/README.md).
+//! - Medium emission (ε per unit extinction, source term σ_t ε): a non-scattering emissive slab
+//!   over a black ground gives ε (1 − exp(−σ_t ℓ)) per pixel; an emissive scattering medium
+//!   filling the scene (every path collides D + 1 times, escape has probability e^{−80}) gives
+//!   ε Σ_{k ≤ D} albedo^k per channel at max depth D.
 
 use std::sync::OnceLock;
 
 use glam::{Mat4, UVec3, Vec2, Vec3};
-use media::gpu::{Combination, GpuMedium, MisWeight, ShadowTransmittance, VolumeImage, VolumePathPass, VolumePathSettings};
+use media::gpu::{Combination, GpuMedium, MediumOptics, MisWeight, ShadowTransmittance, VolumeImage, VolumePathPass, VolumePathSettings};
 use media::{DensityGrid, DensityKind, Medium};
 use render::frame::CameraBasis;
 use render::gpu::Gpu;
@@ -42,6 +48,25 @@ fn ground(camera: Camera, lights: Vec<Light>) -> SceneDesc {
 
 fn medium(kind: DensityKind, res: u32, sigma_t: f32, lo: Vec3, hi: Vec3) -> GpuMedium {
     GpuMedium::new(gpu(), &Medium::new(DensityGrid::bake(&kind, UVec3::splat(res), sigma_t, lo, hi)))
+}
+
+/// ε (1 − exp(−σ ℓ)) over each pixel's footprint (16 x 16 points), ℓ = `chord` / |d.y|.
+fn slab_image(camera: &Camera, sigma: f64, chord: f64, scale: f64) -> Vec<f64> {
+    let basis = CameraBasis::new(camera, W, H);
+    let k = 16;
+    (0..W * H)
+        .map(|i| {
+            let (x, y) = (i % W, i / W);
+            let mut sum = 0.0;
+            for j in 0..k {
+                for s in 0..k {
+                    let p = Vec2::new(x as f32 + (s as f32 + 0.5) / k as f32, y as f32 + (j as f32 + 0.5) / k as f32);
+                    sum += (-sigma * chord / f64::from(basis.ray_direction(p, W, H).y.abs())).exp();
+                }
+            }
+            scale * sum / f64::from(k * k)
+        })
+        .collect()
 }
 
 fn lum(c: &[f32; 3]) -> f64 {
@@ -72,30 +97,54 @@ fn absorbing_slab_attenuates_the_path_tracer_image_by_its_closed_form() {
     let mut tracer = PathTracer::new(gpu(), &scene, settings).expect("path tracer");
     let plain = tracer.render(gpu(), 4, 3, 0).expect("render").radiance;
     let slab = medium(DensityKind::Homogeneous, 8, sigma, Vec3::new(-60.0, 1.0, -60.0), Vec3::new(60.0, 2.0, 60.0));
-    let pass = VolumePathPass::new(gpu(), &tracer, &slab).expect("volume path pass compiles");
-    let image = pass.render(gpu(), &tracer, &slab, Vec3::ZERO, &VolumePathSettings::default(), 128, 5, 0).expect("render");
-    // exp(−σ ℓ) over each pixel's footprint (16 x 16 points), ℓ = 1 / |d.y| through the slab.
-    let basis = CameraBasis::new(&camera, W, H);
-    let k = 16;
-    let expected: Vec<f64> = (0..W * H)
-        .map(|i| {
-            let (x, y) = (i % W, i / W);
-            let mut sum = 0.0;
-            for j in 0..k {
-                for s in 0..k {
-                    let p = Vec2::new(x as f32 + (s as f32 + 0.5) / k as f32, y as f32 + (j as f32 + 0.5) / k as f32);
-                    sum += (-f64::from(sigma) / f64::from(basis.ray_direction(p, W, H).y.abs())).exp();
-                }
-            }
-            let plain = lum(&[plain[i as usize][0], plain[i as usize][1], plain[i as usize][2]]);
-            plain * (-f64::from(sigma)).exp() * sum / f64::from(k * k)
-        })
+    let setup = cloud_setup();
+    let image = setup.pass.render(gpu(), &tracer, &slab, MediumOptics::scattering(Vec3::ZERO), &VolumePathSettings::default(), 128, 5, 0).expect("render");
+    // exp(−σ ℓ) over each pixel's footprint, ℓ = 1 / |d.y| through the slab; the sun's chord is 1.
+    let expected: Vec<f64> = slab_image(&camera, f64::from(sigma), 1.0, (-f64::from(sigma)).exp())
+        .iter()
+        .zip(&plain)
+        .map(|(t, p)| t * lum(&[p[0], p[1], p[2]]))
         .collect();
     let (z, worst) = compare(&image, &expected, &vec![0.0; expected.len()]);
     let mean = image.mean.iter().map(lum).sum::<f64>() / expected.len() as f64;
     let want = expected.iter().sum::<f64>() / expected.len() as f64;
     println!("absorbing slab: mean {mean:.5} expected {want:.5}, z = {z:.2}, worst pixel {worst:.2} SE");
     assert!(z.abs() <= 4.5 && worst <= 6.0, "absorbing slab: z = {z}, worst pixel {worst} SE");
+}
+
+#[test]
+fn medium_emission_matches_its_closed_forms() {
+    let camera = Camera { position: Vec3::new(0.0, 4.0, 0.0), target: Vec3::ZERO, up: Vec3::NEG_Z, vfov: 50f32.to_radians() };
+    // No lights, no environment, a black ground: all light is the medium's emission.
+    let mut scene = ground(camera, vec![]);
+    scene.materials[0].base_color = Vec3::ZERO;
+    let depth = 3;
+    let tracer = PathTracer::new(gpu(), &scene, PathTracerSettings { width: W, height: H, max_depth: depth, rr_start_depth: 8 }).expect("path tracer");
+    let emission = Vec3::new(1.5, 1.0, 0.5);
+
+    let sigma = 0.8;
+    let slab = medium(DensityKind::Homogeneous, 8, sigma, Vec3::new(-60.0, 1.0, -60.0), Vec3::new(60.0, 2.0, 60.0));
+    let setup = cloud_setup();
+    let pass = &setup.pass;
+    let optics = MediumOptics { albedo: Vec3::ZERO, emission };
+    let image = pass.render(gpu(), &tracer, &slab, optics, &VolumePathSettings::default(), 128, 7, 0).expect("render");
+    let transmitted = slab_image(&camera, f64::from(sigma), 1.0, 1.0);
+    let expected: Vec<f64> = transmitted.iter().map(|t| lum(&emission.to_array()) * (1.0 - t)).collect();
+    let (z, worst) = compare(&image, &expected, &vec![0.0; expected.len()]);
+    let mean = image.mean.iter().map(lum).sum::<f64>() / expected.len() as f64;
+    let want = expected.iter().sum::<f64>() / expected.len() as f64;
+    println!("emissive absorbing slab: mean {mean:.5} expected {want:.5}, z = {z:.2}, worst pixel {worst:.2} SE");
+    assert!(z.abs() <= 4.5 && worst <= 6.0, "emissive slab: z = {z}, worst pixel {worst} SE");
+
+    // σ_t = 20 in a box around everything: the ground, 4 units away, is reached with e^{−80}.
+    let fog = medium(DensityKind::Homogeneous, 8, 20.0, Vec3::splat(-1000.0), Vec3::splat(1000.0));
+    let albedo = Vec3::new(0.5, 0.25, 0.8);
+    let image = pass.render(gpu(), &tracer, &fog, MediumOptics { albedo, emission }, &VolumePathSettings::default(), 4, 7, 0).expect("render");
+    let want = emission * (0..=depth).map(|k| albedo.powf(k as f32)).fold(Vec3::ZERO, |a, b| a + b);
+    let got = image.mean.iter().fold(Vec3::ZERO, |a, m| a + Vec3::from_array(*m)) / image.mean.len() as f32;
+    let worst = image.mean.iter().map(|m| (Vec3::from_array(*m) - want).abs().max_element()).fold(0f32, f32::max);
+    println!("emissive scattering fog, depth {depth}: mean {got} expected {want}, worst pixel off by {worst:.2e}");
+    assert!(worst <= 1e-4 * want.max_element(), "emissive fog: mean {got}, expected {want}, worst pixel off by {worst}");
 }
 
 /// A point light inside a cloud over the ground, just above the view (no camera ray passes
@@ -108,8 +157,39 @@ fn cloud_scene() -> (SceneDesc, GpuMedium) {
     (ground(camera, vec![light]), cloud)
 }
 
+/// The cloud scene's tracer (direct light, max depth 1: single scattering in the medium and the
+/// lit ground, each shadow ray through the cloud; deeper paths start segments next to the light,
+/// whose estimates are heavy-tailed for every strategy), two media in the same box (the cloud
+/// and a sparse explosion field) and the pass, compiled once (~24 s on lavapipe) and used by
+/// every test with its own tracer and medium (their layouts are the same). Tests take turns
+/// (the pass's timestamp readback, a tracer's frame uniform).
+struct CloudSetup {
+    tracer: PathTracer,
+    pass: VolumePathPass,
+    cloud: GpuMedium,
+    explosion: GpuMedium,
+}
+
+fn cloud_setup() -> std::sync::MutexGuard<'static, CloudSetup> {
+    static SETUP: OnceLock<std::sync::Mutex<CloudSetup>> = OnceLock::new();
+    SETUP
+        .get_or_init(|| {
+            let (scene, cloud) = cloud_scene();
+            let tracer = PathTracer::new(gpu(), &scene, PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 2 }).expect("path tracer");
+            let pass = VolumePathPass::new(gpu(), &tracer, &cloud).expect("volume path pass compiles");
+            let explosion = medium(DensityKind::Explosion { frequency: 8.0, seed: 3 }, 48, 8.0, Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 3.0, 1.0));
+            std::sync::Mutex::new(CloudSetup { tracer, pass, cloud, explosion })
+        })
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
 fn render_cloud(tracer: &PathTracer, pass: &VolumePathPass, cloud: &GpuMedium, s: VolumePathSettings, seed: u64) -> VolumeImage {
-    pass.render(gpu(), tracer, cloud, Vec3::splat(0.8), &s, 256, seed, 0).expect("render")
+    render_spp(tracer, pass, cloud, s, 256, seed)
+}
+
+fn render_spp(tracer: &PathTracer, pass: &VolumePathPass, medium: &GpuMedium, s: VolumePathSettings, spp: u32, seed: u64) -> VolumeImage {
+    pass.render(gpu(), tracer, medium, MediumOptics::scattering(Vec3::splat(0.8)), &s, spp, seed, 0).expect("render")
 }
 
 fn agree(what: &str, a: &VolumeImage, b: &VolumeImage) {
@@ -121,21 +201,126 @@ fn agree(what: &str, a: &VolumeImage, b: &VolumeImage) {
 
 #[test]
 fn shadow_ratio_tracking_equals_delta_tracking_and_mis_is_unbiased_in_a_cloud() {
-    let (scene, cloud) = cloud_scene();
-    // Direct light (max depth 1): single scattering in the medium and the lit ground, each shadow
-    // ray through the cloud; deeper paths start segments next to the light, whose estimates are
-    // heavy-tailed for every strategy.
-    let tracer = PathTracer::new(gpu(), &scene, PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 2 }).expect("path tracer");
-    let pass = VolumePathPass::new(gpu(), &tracer, &cloud).expect("volume path pass compiles");
+    let setup = cloud_setup();
+    let (tracer, pass, cloud) = (&setup.tracer, &setup.pass, &setup.cloud);
     let base = VolumePathSettings::default();
-    let ratio = render_cloud(&tracer, &pass, &cloud, base, 11);
-    let track = render_cloud(&tracer, &pass, &cloud, VolumePathSettings { shadow: ShadowTransmittance::TrackLength, ..base }, 12);
+    let ratio = render_cloud(tracer, pass, cloud, base, 11);
+    let track = render_cloud(tracer, pass, cloud, VolumePathSettings { shadow: ShadowTransmittance::TrackLength, ..base }, 12);
     agree("shadow rays: ratio tracking vs track-length", &ratio, &track);
     let mean_var = |im: &VolumeImage| im.var_of_mean.iter().sum::<f64>() / im.var_of_mean.len() as f64;
     println!("mean variance of a pixel's mean: free-flight only {:.3e}", mean_var(&ratio));
     for mis in [MisWeight::Naive, MisWeight::Jackknife, MisWeight::Miller] {
-        let im = render_cloud(&tracer, &pass, &cloud, VolumePathSettings { mis, combination: Combination::Eq9, ..base }, 13);
+        let im = render_cloud(tracer, pass, cloud, VolumePathSettings { mis, combination: Combination::Eq9, ..base }, 13);
         println!("{mis:?} Eq. 9: mean variance {:.3e}", mean_var(&im));
         agree(&format!("{mis:?} Eq. 9 vs free-flight only"), &im, &ratio);
     }
+}
+
+/// The MIS variants, as (label, weight, combination); free-flight alone first.
+const VARIANTS: [(&str, MisWeight, Combination); 6] = [
+    ("free-flight only", MisWeight::None, Combination::Eq9),
+    ("naive, Eq. 9", MisWeight::Naive, Combination::Eq9),
+    ("jackknife, Eq. 9", MisWeight::Jackknife, Combination::Eq9),
+    ("Miller, Eq. 9", MisWeight::Miller, Combination::Eq9),
+    ("naive, Eq. 10", MisWeight::Naive, Combination::Eq10),
+    ("jackknife, Eq. 10", MisWeight::Jackknife, Combination::Eq10),
+];
+const SEEDS: [u64; 3] = [1, 2, 3];
+/// Quantiles of Student's t with 2 degrees of freedom (3 seeds): one-sided and two-sided 95%.
+const T_ONE_SIDED_95: f64 = 2.920;
+const T_TWO_SIDED_95: f64 = 4.303;
+
+/// Per variant and seed: the MSE of the image's luminance against a 1024-spp reference (Eq. 9,
+/// jackknife weights: unbiased), less the reference's own mean variance (so an unbiased
+/// estimate of the MSE against the truth); and the relative bias of the image's mean.
+fn mis_errors(setup: &CloudSetup, medium: &GpuMedium, samples: u32, spp: u32) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+    let (tracer, pass) = (&setup.tracer, &setup.pass);
+    let base = VolumePathSettings { samples, ..VolumePathSettings::default() };
+    let reference = render_spp(tracer, pass, medium, VolumePathSettings { mis: MisWeight::Jackknife, ..base }, 1024, 1000);
+    let truth: Vec<f64> = reference.mean.iter().map(lum).collect();
+    let n = truth.len() as f64;
+    let ref_var = reference.var_of_mean.iter().sum::<f64>() / n;
+    let ref_mean = truth.iter().sum::<f64>() / n;
+    let (mut mse, mut bias) = (Vec::new(), Vec::new());
+    for &(_, mis, combination) in &VARIANTS {
+        let (mut m, mut b) = (Vec::new(), Vec::new());
+        for &seed in &SEEDS {
+            let im = render_spp(tracer, pass, medium, VolumePathSettings { mis, combination, ..base }, spp, seed);
+            m.push(im.mean.iter().zip(&truth).map(|(x, t)| (lum(x) - t).powi(2)).sum::<f64>() / n - ref_var);
+            b.push(im.mean.iter().map(lum).sum::<f64>() / n / ref_mean - 1.0);
+        }
+        mse.push(m);
+        bias.push(b);
+    }
+    (mse, bias)
+}
+
+/// Mean and standard deviation of per-seed values.
+fn mean_sd(d: &[f64]) -> (f64, f64) {
+    let n = d.len() as f64;
+    let mean = d.iter().sum::<f64>() / n;
+    (mean, (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt())
+}
+
+/// Per seed, the relative MSE difference (a − b) / b.
+fn relative(mse: &[Vec<f64>], a: usize, b: usize) -> Vec<f64> {
+    (0..SEEDS.len()).map(|s| (mse[a][s] - mse[b][s]) / mse[b][s]).collect()
+}
+
+const FREE: usize = 0;
+const NAIVE_9: usize = 1;
+const JACKKNIFE_9: usize = 2;
+const MILLER_9: usize = 3;
+const NAIVE_10: usize = 4;
+const JACKKNIFE_10: usize = 5;
+
+/// The MIS variants' order in MSE, as measured in two settings (not the paper's, see
+/// media/README.md): variant a is below b when the one-sided 95% Student t upper bound of the
+/// mean per-seed relative difference (a − b) / b is below zero; "alike" when the two-sided 95%
+/// interval lies within ±5%.
+/// - the cloud with N = 4 stratified samples per optical-depth estimate (S ≈ 0): Eq. 10 below
+///   Eq. 9 (both weights) and below Miller et al.'s; naive and jackknife weights alike.
+/// - the explosion field with N = 1 (S large): Eq. 10 below Eq. 9 (both weights); Miller et
+///   al.'s worst of Eq. 9; free-flight alone below Eq. 9 with jackknife weights; naive below
+///   jackknife weights in both combinations (the paper's Fig. 11 has the opposite; at 64 spp the
+///   jackknife's extra variance outweighs the naive weights' bias).
+#[test]
+fn mis_variants_keep_their_measured_order_over_seeds() {
+    let setup = cloud_setup();
+    let mut failures: Vec<String> = Vec::new();
+    let settings: [(&str, &GpuMedium, u32, &[(usize, usize)], &[(usize, usize)]); 2] = [
+        ("cloud, N = 4", &setup.cloud, 4, &[(NAIVE_10, NAIVE_9), (JACKKNIFE_10, JACKKNIFE_9), (JACKKNIFE_10, MILLER_9)], &[(NAIVE_9, JACKKNIFE_9), (NAIVE_10, JACKKNIFE_10)]),
+        (
+            "explosion, N = 1",
+            &setup.explosion,
+            1,
+            &[(NAIVE_10, NAIVE_9), (JACKKNIFE_10, JACKKNIFE_9), (NAIVE_9, MILLER_9), (JACKKNIFE_9, MILLER_9), (FREE, JACKKNIFE_9), (NAIVE_9, JACKKNIFE_9), (NAIVE_10, JACKKNIFE_10)],
+            &[],
+        ),
+    ];
+    for (name, medium, samples, below, alike) in settings {
+        let (mse, bias) = mis_errors(&setup, medium, samples, 64);
+        println!("{name}: 64 spp against a 1024-spp reference (Eq. 9, jackknife), seeds {SEEDS:?}");
+        for (v, (label, _, _)) in VARIANTS.iter().enumerate() {
+            let ((m, ms), (b, bs)) = (mean_sd(&mse[v]), mean_sd(&bias[v]));
+            println!("  {label:>18}: MSE {m:.3e} ± {ms:.1e}, relative bias {b:+.4} ± {bs:.4}");
+        }
+        for &(a, b) in below {
+            let (mean, sd) = mean_sd(&relative(&mse, a, b));
+            let bound = mean + T_ONE_SIDED_95 * sd / (SEEDS.len() as f64).sqrt();
+            println!("  {} below {}: relative difference {mean:+.3}, upper bound {bound:+.3}", VARIANTS[a].0, VARIANTS[b].0);
+            if bound >= 0.0 {
+                failures.push(format!("{name}: {} not below {} (relative difference {mean:+.3}, bound {bound:+.3})", VARIANTS[a].0, VARIANTS[b].0));
+            }
+        }
+        for &(a, b) in alike {
+            let (mean, sd) = mean_sd(&relative(&mse, a, b));
+            let half = T_TWO_SIDED_95 * sd / (SEEDS.len() as f64).sqrt();
+            println!("  {} alike {}: relative difference {mean:+.4} ± {half:.4}", VARIANTS[a].0, VARIANTS[b].0);
+            if mean.abs() + half >= 0.05 {
+                failures.push(format!("{name}: {} and {} differ (relative difference {mean:+.4} ± {half:.4})", VARIANTS[a].0, VARIANTS[b].0));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
 }

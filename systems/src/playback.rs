@@ -12,6 +12,7 @@ use sim::Simulation;
 
 use crate::frame::{self, FrameClock, GpuDevice, MethodFrame, MethodInfo, Progress, References, Run, RunOutput, Tracer};
 use crate::frame_record::FrameRecord;
+use crate::methods::MethodSpec;
 use crate::output;
 use crate::reference_cache::ReferenceCache;
 use crate::run_folder::RunFolder;
@@ -40,12 +41,44 @@ pub struct FrameWorld {
     pub schedule: Schedule,
 }
 
+/// A scenario with media refuses what would silently leave them out: methods that do not
+/// render media, and a second medium where the volumetric path tracer (references, VolumePath)
+/// renders only the first (media/README.md).
+fn check_media_support(spec: &RunSpec, origin: &str) -> Result<()> {
+    let scenario = &spec.scenario;
+    if scenario.media.is_empty() {
+        return Ok(());
+    }
+    for method in &spec.methods {
+        let plugin = method.spec.plugin();
+        if !plugin.sees_media() {
+            anyhow::bail!(
+                "{origin}:{}:{}: method {} does not render participating media and the scenario declares media ('{}'); expected only VolumePath or VolumeTransmittance methods in a scenario with media (media/README.md)",
+                method.entry.line,
+                method.entry.column,
+                method.label(),
+                scenario.media[0].name
+            );
+        }
+    }
+    let references = (0..scenario.frames).any(|f| scenario.reference.wants(f, scenario.frames));
+    let volume_path = spec.methods.iter().any(|m| matches!(m.spec, MethodSpec::VolumePath(_)));
+    if let (Some(second), true) = (scenario.media.get(1), references || volume_path) {
+        anyhow::bail!(
+            "{origin}: medium '{}': the volumetric path tracer (references, VolumePath) renders one medium; expected a single medium, or more only with VolumeTransmittance methods and no references",
+            second.name
+        );
+    }
+    Ok(())
+}
+
 impl FrameWorld {
     /// Everything a run needs before its first frame; input errors (names, sizes over the
     /// adapter's limits) surface here, before anything is written.
     pub fn build(spec: &RunSpec, gpu: Gpu, cache_dir: PathBuf, folder: RunFolder, progress: ProgressBar) -> Result<FrameWorld> {
         let scenario = &spec.scenario;
         let origin = scenario.origin.display().to_string();
+        check_media_support(spec, &origin)?;
         let sim = Simulation::new(scenario)?;
         let (width, height) = scenario.resolution;
         let settings = PathTracerSettings { width, height, max_depth: scenario.max_depth, rr_start_depth: 3 };

@@ -1,7 +1,9 @@
 //! The VolumePath method and media references in playback: volume_mis.ron plays one row per
 //! weight with FLIP and relative MSE against the volumetric reference; volume_moving_light.ron's
 //! animated cloud is rebaked per frame (its references change frame to frame, its frames are
-//! measured for flicker); a scenario without media refuses the method by name. Small overrides
+//! measured for flicker); a scenario without media refuses the method by name; a scenario with
+//! media refuses methods that would render it without them, and a second medium where the
+//! volumetric path tracer renders one. Small overrides
 //! (32x18, 2 spp, 16 spp references, 2 frames of the moving light) keep it to seconds on lavapipe.
 
 use std::path::Path;
@@ -45,12 +47,28 @@ fn the_moving_light_scenario_rebakes_its_cloud_and_measures_flicker() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
-#[test]
-fn a_scenario_without_media_refuses_volume_path() {
-    let text = "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, methods: [VolumePath(spp: 1)])";
+/// The error of running an inline scenario (refused before any frame).
+fn refusal(text: &str, name: &str) -> String {
     let scenario = sim::Scenario::from_ron(text, Path::new("inline.ron")).unwrap();
-    let out = std::env::temp_dir().join(format!("flicker_volume_path_none_{}", std::process::id()));
+    let out = std::env::temp_dir().join(format!("flicker_volume_path_{name}_{}", std::process::id()));
     let spec = RunSpec::from_scenario(scenario, &Overrides { out: Some(out.clone()), ..Default::default() }).unwrap();
     let e = run_spec(&spec, &RunOptions { scenario: "inline.ron".into(), overrides: Overrides::default(), cache_dir: Some(out.join("cache")), progress: false }).err().expect("refused");
-    assert!(format!("{e:#}").contains("declares no media"), "{e:#}");
+    let _ = std::fs::remove_dir_all(&out);
+    format!("{e:#}")
+}
+
+#[test]
+fn a_scenario_without_media_refuses_volume_path() {
+    let e = refusal("Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, methods: [VolumePath(spp: 1)])", "none");
+    assert!(e.contains("declares no media"), "{e}");
+}
+
+#[test]
+fn a_scenario_with_media_refuses_what_would_leave_them_out() {
+    let fog = "(name: \"fog\", kind: Homogeneous, box_min: (-1, -1, -1), box_max: (1, 1, 1), sigma_t: 1.0, resolution: (8, 8, 8))";
+    let haze = "(name: \"haze\", kind: Homogeneous, box_min: (-1, -1, -1), box_max: (1, 1, 1), sigma_t: 1.0, resolution: (8, 8, 8))";
+    let e = refusal(&format!("Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1,\n methods: [VolumePath(spp: 1), PathTracing(spp: 1)], media: [{fog}])"), "pt");
+    assert!(e.contains("inline.ron:2:") && e.contains("does not render participating media") && e.contains("'fog'"), "{e}");
+    let e = refusal(&format!("Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, methods: [VolumePath(spp: 1)], media: [{fog}, {haze}])"), "two");
+    assert!(e.contains("medium 'haze'") && e.contains("renders one medium"), "{e}");
 }

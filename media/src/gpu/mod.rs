@@ -14,4 +14,4 @@ pub use image_pass::{ImagePass, ImageParams, PASS};
 pub use mis_pass::{MisParams, MisPass};
 pub use medium::{GpuMedium, MediumParams, RaySegment};
 pub use shaders::{modules, modules_at, program};
-pub use volume_path_pass::{Combination, MisWeight, ShadowTransmittance, VolumeImage, VolumePathParams, VolumePathPass, VolumePathSettings, VOLUME_PATH_PASS};
+pub use volume_path_pass::{Combination, MediumOptics, MisWeight, ShadowTransmittance, VolumeImage, VolumePathParams, VolumePathPass, VolumePathSettings, VOLUME_PATH_PASS};

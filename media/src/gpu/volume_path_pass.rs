@@ -18,6 +18,21 @@ use wgpu::util::DeviceExt;
 
 use super::medium::GpuMedium;
 
+/// What a medium does to light beside extinction: single-scattering albedo σ_s/σ_t per channel,
+/// and emitted radiance per unit extinction (the source term σ_t(x) ε; zero: none).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MediumOptics {
+    pub albedo: Vec3,
+    pub emission: Vec3,
+}
+
+impl MediumOptics {
+    /// A medium that scatters with `albedo` and emits nothing.
+    pub fn scattering(albedo: Vec3) -> Self {
+        Self { albedo, emission: Vec3::ZERO }
+    }
+}
+
 /// The MIS weight of free-flight sampling against equiangular sampling of positional lights
 /// (Sec. 5.2); `None`: free-flight (delta tracking) only.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -78,6 +93,9 @@ render::gpu_struct! {
         pub _pad0: u32 => "u32",
         pub _pad1: u32 => "u32",
         pub _pad2: u32 => "u32",
+        /// Emitted radiance per unit extinction (zero: none).
+        pub emission: [f32; 3] => "vec3f",
+        pub _pad3: u32 => "u32",
     }
 }
 
@@ -134,9 +152,9 @@ impl VolumePathPass {
     }
 
     /// `spp` paths per pixel of the tracer's current scene and camera (seed and frame as the path
-    /// tracer's), in a medium of albedo `albedo`.
+    /// tracer's), in a medium of the given albedo and emission.
     #[allow(clippy::too_many_arguments)]
-    pub fn render(&self, gpu: &Gpu, tracer: &PathTracer, medium: &GpuMedium, albedo: Vec3, settings: &VolumePathSettings, spp: u32, seed: u64, frame: u32) -> Result<VolumeImage, String> {
+    pub fn render(&self, gpu: &Gpu, tracer: &PathTracer, medium: &GpuMedium, optics: MediumOptics, settings: &VolumePathSettings, spp: u32, seed: u64, frame: u32) -> Result<VolumeImage, String> {
         let (width, height) = { let s = tracer.settings(); (s.width, s.height) };
         let pixels = width * height;
         let batch = (PATHS_PER_DISPATCH / pixels).clamp(1, spp.max(1));
@@ -151,7 +169,7 @@ impl VolumePathPass {
         while first < spp {
             let n = batch.min(spp - first);
             let params = VolumePathParams {
-                albedo: albedo.into(),
+                albedo: optics.albedo.into(),
                 mis: settings.mis as u32,
                 eq10: u32::from(settings.combination == Combination::Eq10),
                 shadow: settings.shadow as u32,
@@ -161,6 +179,8 @@ impl VolumePathPass {
                 _pad0: 0,
                 _pad1: 0,
                 _pad2: 0,
+                emission: optics.emission.into(),
+                _pad3: 0,
             };
             let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("volume path params"), contents: bytemuck::bytes_of(&params), usage: wgpu::BufferUsages::UNIFORM });
             tracer.prepare_frame(gpu, spp, 0, seed, frame);

@@ -7,7 +7,7 @@
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use media::gpu::{GpuMedium, MisWeight, VolumePathPass, VolumePathSettings};
+use media::gpu::{GpuMedium, MediumOptics, MisWeight, VolumePathPass, VolumePathSettings};
 use media::{DensityGrid, Medium};
 use scene::{MediumDesc, MediumState};
 
@@ -40,8 +40,9 @@ impl SceneMedium {
         Self { desc: desc.clone(), state, gpu: GpuMedium::new(gpu, &medium), pass: None }
     }
 
-    pub fn albedo(&self) -> Vec3 {
-        self.desc.albedo
+    /// Albedo and emission (none: zero) of the declared medium.
+    pub fn optics(&self) -> MediumOptics {
+        MediumOptics { albedo: self.desc.albedo, emission: self.desc.emission.unwrap_or(Vec3::ZERO) }
     }
 
     /// The volumetric path tracing pass, compiled on first use.
@@ -83,9 +84,9 @@ pub fn render_volume(
     seed: u64,
     frame: u32,
 ) -> anyhow::Result<(Vec<[f32; 4]>, Vec<render::timing::PassTiming>, u64)> {
-    let albedo = medium.albedo();
+    let optics = medium.optics();
     medium.pass(gpu, &tracer.0)?;
     let pass = medium.pass.as_ref().expect("built above");
-    let image = pass.render(gpu, &tracer.0, &medium.gpu, albedo, settings, spp, seed, frame).map_err(|e| anyhow::anyhow!(e))?;
+    let image = pass.render(gpu, &tracer.0, &medium.gpu, optics, settings, spp, seed, frame).map_err(|e| anyhow::anyhow!(e))?;
     Ok((image.mean.iter().map(|c| [c[0], c[1], c[2], 1.0]).collect(), image.timings, image.paths))
 }

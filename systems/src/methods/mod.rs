@@ -42,6 +42,11 @@ pub trait MethodPlugin: Sync {
     /// Builds one instance on `entity` (which already has its `MethodInfo` and `MethodFrame`):
     /// its GPU state, from the world's `GpuDevice` and `Tracer`.
     fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()>;
+    /// Whether the method renders the scenario's participating media (issue 13); the others
+    /// would render a scene with media as if it had none, so such scenarios refuse them.
+    fn sees_media(&self) -> bool {
+        false
+    }
 }
 
 pub use crate::frame::{MethodImage, MethodOutput};

@@ -58,6 +58,10 @@ impl MethodPlugin for Plugin {
         "VolumeTransmittance"
     }
 
+    fn sees_media(&self) -> bool {
+        true
+    }
+
     fn add_systems(&self, schedule: &mut Schedule) {
         schedule.add_systems(render.in_set(Stage::Render));
     }

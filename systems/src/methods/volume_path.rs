@@ -60,6 +60,10 @@ impl MethodPlugin for Plugin {
         "VolumePath"
     }
 
+    fn sees_media(&self) -> bool {
+        true
+    }
+
     fn add_systems(&self, schedule: &mut Schedule) {
         schedule.add_systems(render.in_set(Stage::Render));
     }
