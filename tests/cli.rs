@@ -152,7 +152,7 @@ fn scenes_lists_every_builtin() {
     let o = flicker(&["scenes"]);
     assert!(o.status.success());
     let out = text(&o.stdout);
-    for name in ["cornell_box", "corridor", "door_gap", "courtyard", "hairball", "rotating_cone"] {
+    for name in ["cornell_box", "corridor", "door_gap", "courtyard", "hairball", "rotating_cone", "sss_sphere"] {
         assert!(out.contains(name), "{out}");
     }
 }

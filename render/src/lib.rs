@@ -17,6 +17,7 @@ pub mod readback;
 pub mod sample_cache;
 pub mod shader;
 pub mod scene_bindings;
+pub mod sss;
 pub mod taa;
 pub mod termination;
 pub mod timing;

@@ -41,6 +41,7 @@ fn shared_structs_have_one_layout() {
         ("TcParams", mismatches::<TcParams>("")),
         ("TcRecord", mismatches::<TcRecord>("")),
         ("TcVertex", mismatches::<TcVertex>("")),
+        ("SssParams", mismatches::<render::sss::gpu::SssParams>("")),
     ] {
         assert!(found.is_empty(), "{name}: {found:?}");
     }

@@ -51,7 +51,7 @@ pub struct Texture {
 }
 
 /// glTF metallic-roughness material.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Material {
     /// Linear base colour (multiplied by the texture when there is one).
     pub base_color: Vec3,
@@ -66,10 +66,41 @@ pub struct Material {
     /// 0 leaves a pure Lambertian diffuse (furnace tests); glTF's default is 1.
     #[serde(default = "one")]
     pub specular: f32,
+    /// Screen-space subsurface scattering (render::sss): set by a scenario's material override.
+    /// The path tracer shades the surface as its diffuse base; the SSS method scatters the
+    /// demodulated diffuse irradiance of its pixels.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub subsurface: Option<Subsurface>,
+}
+
+/// Burley's profile parameters of a material (realtime-sss-thesis.txt, eq. 2.44 Θ3): the diffuse
+/// mean free path per channel in scene units; the albedo is the base colour.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Subsurface {
+    pub dmfp: Vec3,
 }
 
 fn one() -> f32 {
     1.0
+}
+
+/// As derived, but `subsurface` only when set: the reference cache hashes materials by their
+/// `Debug` form, and a field that is always `None` must not change the keys of existing scenes.
+impl std::fmt::Debug for Material {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut d = f.debug_struct("Material");
+        d.field("base_color", &self.base_color)
+            .field("base_color_texture", &self.base_color_texture)
+            .field("emission", &self.emission)
+            .field("roughness", &self.roughness)
+            .field("metallic", &self.metallic)
+            .field("specular", &self.specular);
+        if let Some(s) = &self.subsurface {
+            d.field("subsurface", s);
+        }
+        d.finish()
+    }
 }
 
 impl Default for Material {
@@ -81,6 +112,7 @@ impl Default for Material {
             roughness: 1.0,
             metallic: 0.0,
             specular: 1.0,
+            subsurface: None,
         }
     }
 }
@@ -186,5 +218,20 @@ impl SceneChanges {
     /// Did the world-space geometry move (TLAS refit/rebuild)?
     pub fn moved(&self) -> bool {
         self.geometry || self.instances
+    }
+}
+
+#[cfg(test)]
+mod material_debug_tests {
+    use super::*;
+
+    /// The reference cache hashes `format!("{:?}", materials)`: the form without subsurface is
+    /// the derived one of the fields before it was added.
+    #[test]
+    fn debug_form_without_subsurface_is_unchanged() {
+        let m = Material::default();
+        assert_eq!(format!("{m:?}"), "Material { base_color: Vec3(0.8, 0.8, 0.8), base_color_texture: None, emission: Vec3(0.0, 0.0, 0.0), roughness: 1.0, metallic: 0.0, specular: 1.0 }");
+        let s = Material { subsurface: Some(Subsurface { dmfp: Vec3::ONE }), ..m };
+        assert!(format!("{s:?}").contains("subsurface: Subsurface { dmfp: Vec3(1.0, 1.0, 1.0) }"));
     }
 }

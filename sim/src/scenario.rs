@@ -280,6 +280,19 @@ struct ScenarioFile {
     events: Vec<EventSpec>,
     #[serde(default)]
     media: Vec<scene::MediumDesc>,
+    #[serde(default)]
+    materials: Vec<MaterialOverride>,
+}
+
+/// A scenario's change to one of the scene's materials, by name:
+/// `(material: "skin", subsurface: (dmfp: (0.3, 0.12, 0.06)))`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialOverride {
+    pub material: String,
+    /// Makes the material a subsurface material (render::sss).
+    #[serde(default)]
+    pub subsurface: Option<scene::Subsurface>,
 }
 
 /// A scenario ready to play.
@@ -313,6 +326,9 @@ pub struct Scenario {
     /// (not even a key in the manifest).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub media: Vec<scene::MediumDesc>,
+    /// Material overrides (subsurface parameters), applied when the scene is spawned.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub materials: Vec<MaterialOverride>,
     /// The RON file this came from (used in error messages).
     pub origin: PathBuf,
     /// The RON text, to point errors found later (unknown entity names) at a line.
@@ -444,6 +460,18 @@ impl Scenario {
                 return Err(ScenarioError { file: origin.to_path_buf(), position: find_quoted(text, &m.name), message: format!("two media named '{}'; expected unique names", m.name) });
             }
         }
+        for m in &file.materials {
+            if let Some(sss) = &m.subsurface {
+                let d = sss.dmfp;
+                if !(d.min_element() > 0.0 && d.is_finite()) {
+                    return Err(ScenarioError {
+                        file: origin.to_path_buf(),
+                        position: find_quoted(text, &m.material).or_else(|| invalid("materials", String::new()).position),
+                        message: format!("material '{}': subsurface dmfp ({}, {}, {}); expected three positive diffuse mean free paths in scene units", m.material, d.x, d.y, d.z),
+                    });
+                }
+            }
+        }
         let name = file.name.unwrap_or_else(|| {
             origin.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scenario".into())
         });
@@ -474,6 +502,7 @@ impl Scenario {
             animations: file.animations,
             events: file.events,
             media: file.media,
+            materials: file.materials,
             origin: origin.to_path_buf(),
             source: text.to_string(),
         })

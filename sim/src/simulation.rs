@@ -177,6 +177,11 @@ impl Simulation {
             world.get_mut::<Camera>(camera).unwrap().vfov = c.vfov_degrees.to_radians();
         }
 
+        for o in &scenario.materials {
+            let index = names.material(&world, &o.material)? as usize;
+            world.resource_mut::<MaterialTable>().materials[index].subsurface = o.subsurface;
+        }
+
         for (index, spec) in scenario.animations.iter().enumerate() {
             attach_animation(&mut world, &names, spec, index as u64, scenario.seed)?;
         }

@@ -52,7 +52,7 @@ fn every_shipped_scenario_loads_and_plays() {
         .collect();
     files.sort();
     let required = ["cornell_box", "corridor", "door_gap", "courtyard", "hairball", "rotating_cone", "flash_sine",
-        "flash_square", "strobe", "boids", "keyframes", "camera_path", "events"];
+        "flash_square", "strobe", "boids", "keyframes", "camera_path", "events", "sss_flash", "sss_toggle", "sss_boids"];
     for r in required {
         assert!(files.iter().any(|f| f.file_stem().unwrap() == r), "scenarios/{r}.ron is missing");
     }

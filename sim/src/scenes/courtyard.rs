@@ -12,7 +12,7 @@ use crate::transform::Transform;
 pub const SUN_ELEVATION: f32 = 40.0;
 
 /// A small arrow-shaped "bird" pointing along -Z (boids turn -Z into their heading).
-fn bird_mesh() -> scene::Mesh {
+pub(crate) fn bird_mesh() -> scene::Mesh {
     let mut b = MeshBuilder::new("bird");
     let nose = Vec3::new(0.0, 0.0, -0.15);
     let tail = [Vec3::new(-0.12, 0.0, 0.1), Vec3::new(0.12, 0.0, 0.1), Vec3::new(0.0, 0.05, 0.08)];

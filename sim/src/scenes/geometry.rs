@@ -54,6 +54,33 @@ impl MeshBuilder {
         }
     }
 
+    /// UV sphere of radius `radius` centred at the origin, outward faces.
+    pub fn sphere(&mut self, radius: f32, segments: u32, rings: u32) {
+        let point = |k: u32, j: u32| {
+            let (phi, theta) = (std::f32::consts::TAU * k as f32 / segments as f32, std::f32::consts::PI * j as f32 / rings as f32);
+            Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
+        };
+        let mut index = vec![0u32; ((segments + 1) * (rings + 1)) as usize];
+        for j in 0..=rings {
+            for k in 0..=segments {
+                let n = point(k, j);
+                index[(j * (segments + 1) + k) as usize] = self.vertex(radius * n, n, Vec2::new(k as f32 / segments as f32, j as f32 / rings as f32));
+            }
+        }
+        let at = |k: u32, j: u32| index[(j * (segments + 1) + k) as usize];
+        for j in 0..rings {
+            for k in 0..segments {
+                let facing = point(k, j) + point(k + 1, j + 1);
+                if j > 0 {
+                    self.triangle(at(k, j), at(k + 1, j), at(k + 1, j + 1), facing);
+                }
+                if j + 1 < rings {
+                    self.triangle(at(k, j), at(k + 1, j + 1), at(k, j + 1), facing);
+                }
+            }
+        }
+    }
+
     /// Cone with its base disc at y = 0 (radius `radius`) and apex at y = `height`.
     pub fn cone(&mut self, radius: f32, height: f32, segments: u32) {
         let apex = Vec3::new(0.0, height, 0.0);

@@ -8,6 +8,7 @@ pub mod door_gap;
 pub mod geometry;
 pub mod hairball;
 pub mod rotating_cone;
+pub mod sss_sphere;
 
 use crate::template::WorldTemplate;
 
@@ -48,6 +49,11 @@ pub const SCENES: &[BuiltinScene] = &[
         name: "rotating_cone",
         description: "A cone lying on a floor on a turntable, lit by a point light",
         build: rotating_cone::build,
+    },
+    BuiltinScene {
+        name: "sss_sphere",
+        description: "A skin sphere under a point light with a bar's shadow edge and two candles (subsurface tests)",
+        build: sss_sphere::build,
     },
 ];
 

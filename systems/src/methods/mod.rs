@@ -9,6 +9,7 @@ pub mod nirc;
 pub mod path_tracing;
 pub mod sample_cache;
 pub mod spec;
+pub mod sss;
 pub mod taa;
 pub mod volume;
 pub mod volume_path;
@@ -23,6 +24,7 @@ use hash_cache::HashCacheSettings;
 use nirc::NircSettings;
 use path_tracing::PathTracingSettings;
 use sample_cache::SampleCacheSettings;
+use sss::SssMethodSettings;
 use serde::{Deserialize, Serialize};
 use sim::MethodEntry;
 use taa::TaaSettings;
@@ -70,6 +72,9 @@ pub enum MethodSpec {
     /// Path tracing terminated into a hashed radiance cache by variance trading
     /// (render::termination): `Termination(rule: VarianceBounding(t: 0.1))`.
     Termination(TerminationSettings),
+    /// Screen-space subsurface scattering of the path tracer's image (render::sss):
+    /// `Sss(variant: OnlineCv)`.
+    Sss(SssMethodSettings),
 }
 
 impl MethodSpec {
@@ -84,6 +89,7 @@ impl MethodSpec {
             MethodSpec::VolumeTransmittance(_) => &volume::PLUGIN,
             MethodSpec::VolumePath(_) => &volume_path::PLUGIN,
             MethodSpec::Termination(_) => &termination::PLUGIN,
+            MethodSpec::Sss(_) => &sss::PLUGIN,
         }
     }
 
@@ -98,6 +104,7 @@ impl MethodSpec {
             MethodSpec::VolumeTransmittance(s) => s.label(),
             MethodSpec::VolumePath(s) => s.label(),
             MethodSpec::Termination(s) => termination::label(s),
+            MethodSpec::Sss(s) => s.label(),
         }
     }
 
@@ -113,6 +120,7 @@ impl MethodSpec {
             MethodSpec::Taa(_) | MethodSpec::HashCache(_) | MethodSpec::Termination(_) => 1.0,
             MethodSpec::VolumeTransmittance(s) => s.spp as f64,
             MethodSpec::VolumePath(s) => s.spp as f64,
+            MethodSpec::Sss(s) => s.spp as f64,
         }
     }
 
@@ -124,6 +132,7 @@ impl MethodSpec {
             MethodSpec::Nirc(s) => s.spp = spp,
             MethodSpec::VolumeTransmittance(s) => s.spp = spp,
             MethodSpec::VolumePath(s) => s.spp = spp,
+            MethodSpec::Sss(s) => s.spp = spp,
             MethodSpec::SampleCache(_) | MethodSpec::Taa(_) | MethodSpec::HashCache(_) | MethodSpec::Termination(_) => {}
         }
     }

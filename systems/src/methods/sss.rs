@@ -1,0 +1,165 @@
+//! Screen-space subsurface scattering (render::sss, issue 14, realtime-sss-thesis.txt): the path
+//! tracer's image, demodulated by the G-buffer albedo on the pixels of the scene's subsurface
+//! material, is scattered by the thesis's pass (Burley sampling with SPVG counts and control
+//! variates, or a fixed count) and modulated back. `Sss(variant: OnlineCv)`.
+
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use render::path_tracer::NO_HIT;
+use render::sss::gpu::SssPass;
+use render::sss::profile::scaling_from_dmfp;
+use render::sss::{SpvgSettings, SssFrame, SssSettings, SssVariant};
+use serde::{Deserialize, Serialize};
+
+use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
+use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+
+/// `Sss(variant: Adaptive, spp: 1)`; the thesis's parameters by default.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SssMethodSettings {
+    /// Adaptive (AS), OnlineCv (AS+OCV), ConstantCv (AS+CCV) or Fixed(count: N).
+    pub variant: SssVariant,
+    /// Path-traced samples per pixel of the irradiance the pass scatters.
+    pub spp: u32,
+    /// Radii from g(ξ) (eq. 5.6) rather than the analytic inverse.
+    pub fast_inverse: bool,
+    pub spvg: SpvgSettings,
+    pub eps_a: f32,
+    pub a0: f32,
+    pub a_cv: f32,
+}
+
+impl Default for SssMethodSettings {
+    fn default() -> Self {
+        let s = SssSettings::default();
+        Self { variant: s.variant, spp: 1, fast_inverse: s.fast_inverse, spvg: s.spvg, eps_a: s.eps_a, a0: s.a0, a_cv: s.a_cv }
+    }
+}
+
+impl SssMethodSettings {
+    pub fn label(&self) -> String {
+        match self.variant {
+            SssVariant::Fixed { count } => format!("sss_fixed{count}"),
+            SssVariant::Adaptive => "sss_as".into(),
+            SssVariant::OnlineCv => "sss_ocv".into(),
+            SssVariant::ConstantCv => "sss_ccv".into(),
+        }
+    }
+
+    fn pass_settings(&self, seed: u64) -> SssSettings {
+        SssSettings { variant: self.variant, spvg: self.spvg, fast_inverse: self.fast_inverse, eps_a: self.eps_a, a0: self.a0, a_cv: self.a_cv, seed: seed as u32 }
+    }
+}
+
+#[derive(Component)]
+pub struct SssState {
+    settings: SssMethodSettings,
+    pass: SssPass,
+    /// Burley's d per channel in scene units (Θ3 of eq. 2.44 from dmfp and the base colour).
+    d: [f32; 3],
+    /// The subsurface material's index in `SceneDesc::materials`.
+    material: u32,
+}
+
+pub struct Plugin;
+pub static PLUGIN: Plugin = Plugin;
+
+impl MethodPlugin for Plugin {
+    fn name(&self) -> &'static str {
+        "Sss"
+    }
+
+    fn add_systems(&self, schedule: &mut Schedule) {
+        schedule.add_systems(render.in_set(Stage::Render));
+    }
+
+    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
+        let MethodSpec::Sss(s) = &method.spec else { bail!("not an Sss method") };
+        if s.spp == 0 {
+            bail!("Sss: spp 0; expected at least 1 path-traced sample per pixel");
+        }
+        s.spvg.validate().map_err(|e| anyhow::anyhow!("Sss: {e}"))?;
+        if let SssVariant::Fixed { count } = s.variant
+            && !(1..=render::sss::gpu::MAX_COUNT).contains(&count)
+        {
+            bail!("Sss: Fixed count {count}; expected 1 to {}", render::sss::gpu::MAX_COUNT);
+        }
+        let scene = &world.resource::<sim::ExtractedScene>().scene;
+        let subsurface: Vec<(u32, scene::Material)> = scene.materials.iter().enumerate().filter(|(_, m)| m.subsurface.is_some()).map(|(i, m)| (i as u32, *m)).collect();
+        let Some(&(material, m)) = subsurface.first() else {
+            bail!("Sss: the scene has no subsurface material; expected a material override in the scenario, e.g. materials: [(material: \"skin\", subsurface: (dmfp: (0.3, 0.12, 0.06)))]");
+        };
+        if subsurface.len() > 1 {
+            bail!("Sss: {} subsurface materials; the pass scatters one profile per image, expected one", subsurface.len());
+        }
+        let dmfp = m.subsurface.expect("filtered").dmfp;
+        let albedo = m.base_color;
+        let d = [0, 1, 2].map(|c| (dmfp[c] as f64 / scaling_from_dmfp(albedo[c] as f64)) as f32);
+        let (width, height) = {
+            let run = world.resource::<Run>();
+            (run.width, run.height)
+        };
+        let pass = SssPass::new(&world.resource::<GpuDevice>().0, width, height)?;
+        world.entity_mut(entity).insert(SssState { settings: s.clone(), pass, d, material });
+        Ok(())
+    }
+}
+
+/// Path tracing, demodulation, the SSS pass, modulation.
+pub fn render(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, run: Res<Run>, clock: Res<FrameClock>, scene: Res<sim::ExtractedScene>, mut methods: Query<(&mut SssState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+    for (mut state, info, mut frame) in &mut methods {
+        let start = Instant::now();
+        let fail = |e: &dyn std::fmt::Display| method_failed(&info.label, clock.global, e);
+        let out = tracer.0.render(&gpu.0, state.settings.spp, run.scenario.seed, clock.global).map_err(|e| fail(&e))?;
+        // Pixels per scene unit at distance t: height / (2 t tan(vfov / 2)) (on the axis).
+        let focal = out.height as f32 / (2.0 * (0.5 * tracer.0.camera().vfov).tan());
+        let g = &out.gbuffer;
+        let material = state.material;
+        let is_sss = |i: usize| {
+            let inst = g.instance_id[i];
+            inst != NO_HIT && scene.scene.instances.get(inst as usize).is_some_and(|x| x.material == material)
+        };
+        let irradiance: Vec<[f32; 4]> = (0..out.radiance.len())
+            .map(|i| {
+                let l = out.radiance[i];
+                if !is_sss(i) {
+                    return [l[0], l[1], l[2], 0.0];
+                }
+                let a = Vec3::from(g.albedo[i]).max(Vec3::splat(1e-4));
+                [l[0] / a.x, l[1] / a.y, l[2] / a.z, focal / g.depth[i].max(1e-6)]
+            })
+            .collect();
+        let sss_frame = SssFrame { width: out.width, height: out.height, irradiance, d_px: state.d };
+        let settings = state.settings.pass_settings(run.scenario.seed);
+        let mut timings = out.timings.clone();
+        timings.extend(state.pass.dispatch(&gpu.0, &sss_frame, &settings, clock.global).map_err(|e| fail(&e))?);
+        let results = state.pass.results(&gpu.0).map_err(|e| fail(&e))?;
+        let (mut count_sum, mut sss_pixels) = (0u64, 0u64);
+        let radiance: Vec<[f32; 4]> = results
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                if !is_sss(i) {
+                    return out.radiance[i];
+                }
+                count_sum += r.count as u64;
+                sss_pixels += 1;
+                let a = g.albedo[i];
+                [r.rgb[0] * a[0], r.rgb[1] * a[1], r.rgb[2] * a[2], 1.0]
+            })
+            .collect();
+        let counts: Vec<[f32; 4]> = results.iter().map(|r| { let v = r.count as f32 / 64.0; [v, v, v, 1.0] }).collect();
+        let mean_spp = count_sum as f64 / sss_pixels.max(1) as f64;
+        frame.output = Some(MethodOutput {
+            stats: vec![("sss_mean_spp".into(), mean_spp), ("sss_pixels".into(), sss_pixels as f64)],
+            images: vec![MethodImage { name: "sample_count".into(), pixels: counts, hdr: false }],
+            ..MethodOutput::timed(radiance, out.gbuffer.motion.clone(), &timings, out.rays, out.shaded)
+        });
+        frame.add_cpu(start);
+    }
+    Ok(())
+}
