@@ -74,11 +74,34 @@ pub struct BenchReport {
     pub json: serde_json::Value,
 }
 
+/// One traversal measurement (a row of the table and of the JSON's `traversal`).
+#[derive(serde::Serialize)]
+struct TraversalRow {
+    scene: String,
+    triangles: u64,
+    wgsl_mrays_per_s: f64,
+    cpu_mrays_per_s: f64,
+    traversal_ratio_vs_obvhs: f64,
+}
+
+/// One path-tracer frame measurement (the JSON's `frames`).
+#[derive(serde::Serialize)]
+struct FrameRow {
+    scene: String,
+    width: u32,
+    height: u32,
+    /// Mean GPU ms per pass.
+    gpu_ms: std::collections::BTreeMap<String, f64>,
+    rays_per_frame: f64,
+    /// The frame's rays over its GPU time (all passes).
+    frame_mrays_per_s: f64,
+}
+
 pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport> {
     let gpu = Gpu::new()?;
     let mut md = String::new();
-    let mut traversal_json = Vec::new();
-    let mut frames_json = Vec::new();
+    let mut traversal_rows: Vec<TraversalRow> = Vec::new();
+    let mut frame_rows: Vec<FrameRow> = Vec::new();
     writeln!(md, "Adapter: {}; CPU threads: {}\n", gpu.summary, rayon_threads())?;
     log("warm-up");
     warm_up(&gpu)?;
@@ -105,10 +128,13 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
             100.0 * b.hit_fraction,
             100.0 * b.agreement
         )?;
-        traversal_json.push(serde_json::json!({
-            "scene": name, "triangles": b.triangles, "wgsl_mrays_per_s": b.gpu_rays_per_second / 1e6,
-            "cpu_mrays_per_s": b.cpu_rays_per_second / 1e6, "traversal_ratio_vs_obvhs": b.gpu_rays_per_second / b.cpu_rays_per_second,
-        }));
+        traversal_rows.push(TraversalRow {
+            scene: name.clone(),
+            triangles: b.triangles,
+            wgsl_mrays_per_s: b.gpu_rays_per_second / 1e6,
+            cpu_mrays_per_s: b.cpu_rays_per_second / 1e6,
+            traversal_ratio_vs_obvhs: b.gpu_rays_per_second / b.cpu_rays_per_second,
+        });
     }
 
     log("reference path tracing");
@@ -169,29 +195,33 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
                 let g = if *n > 0 { format!("{:.2}{}", sum / *n as f64, if gpu.has_timestamps() { "" } else { " (wall)" }) } else { "n/a".into() };
                 writeln!(md, "| {name} | {w}x{h} | {pass} | {g} | {cpu_ms:.2} |")?;
             }
-            let frame_ms: f64 = gpu_ms.iter().map(|(_, sum, n)| sum / (*n).max(1) as f64).sum();
+            let mean_ms: std::collections::BTreeMap<String, f64> = gpu_ms.iter().map(|(p, sum, n)| (p.clone(), sum / (*n).max(1) as f64)).collect();
+            let frame_ms: f64 = mean_ms.values().sum();
             let rays_per_frame = rays as f64 / opts.frames as f64;
-            frames_json.push(serde_json::json!({
-                "scene": name, "width": w, "height": h,
-                "gpu_ms": gpu_ms.iter().map(|(p, sum, n)| (p.clone(), serde_json::json!(sum / (*n).max(1) as f64))).collect::<serde_json::Map<_, _>>(),
-                "rays_per_frame": rays_per_frame, "frame_mrays_per_s": rays_per_frame / frame_ms / 1e3,
-            }));
+            frame_rows.push(FrameRow {
+                scene: name.clone(),
+                width: w,
+                height: h,
+                gpu_ms: mean_ms,
+                rays_per_frame,
+                frame_mrays_per_s: rays_per_frame / frame_ms / 1e3,
+            });
         }
     }
     // Traversal's share of a frame, to first order: the frame's rays at the traversal-only rate
     // of the same scene (random rays, like the bounces' rays) against the frame's time.
     writeln!(md, "\n| scene | resolution | rays per frame | Mrays/s within the frame | traversal-only Mrays/s | frame rate / traversal-only rate |")?;
     writeln!(md, "|---|---|---:|---:|---:|---:|")?;
-    for f in &frames_json {
-        let scene = f["scene"].as_str().unwrap_or_default();
-        let alone = traversal_json.iter().find(|t| t["scene"] == scene).and_then(|t| t["wgsl_mrays_per_s"].as_f64());
-        let rate = f["frame_mrays_per_s"].as_f64().unwrap_or(f64::NAN);
+    for f in &frame_rows {
+        let alone = traversal_rows.iter().find(|t| t.scene == f.scene).map(|t| t.wgsl_mrays_per_s);
+        let rate = f.frame_mrays_per_s;
         writeln!(
             md,
-            "| {scene} | {}x{} | {:.0} | {rate:.3} | {} | {} |",
-            f["width"],
-            f["height"],
-            f["rays_per_frame"].as_f64().unwrap_or(f64::NAN),
+            "| {} | {}x{} | {:.0} | {rate:.3} | {} | {} |",
+            f.scene,
+            f.width,
+            f.height,
+            f.rays_per_frame,
             alone.map_or("n/a".into(), |a| format!("{a:.3}")),
             alone.map_or("n/a".into(), |a| format!("{:.2}", rate / a))
         )?;
@@ -199,8 +229,8 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
     let json = serde_json::json!({
         "adapter": gpu.summary,
         "cpu_threads": rayon_threads(),
-        "traversal": traversal_json,
-        "traversal_ratio_vs_obvhs": traversal_json.iter().map(|t| (t["scene"].as_str().unwrap_or_default().to_string(), t["traversal_ratio_vs_obvhs"].clone())).collect::<serde_json::Map<_, _>>(),
+        "traversal_ratio_vs_obvhs": traversal_rows.iter().map(|t| (t.scene.clone(), serde_json::json!(t.traversal_ratio_vs_obvhs))).collect::<serde_json::Map<_, _>>(),
+        "traversal": traversal_rows,
         "reference_paths_per_s": reference.paths_per_s,
         "reference_spp": opts.reference_spp,
         "reference_mean_rgb": reference.mean_rgb,
@@ -208,7 +238,7 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         "mitsuba_threads": reference.mitsuba.as_ref().map(|m| m.threads),
         "mitsuba_mean_rgb": reference.mitsuba.as_ref().map(|m| m.mean_rgb),
         "reference_paths_ratio_vs_mitsuba": mitsuba_ratio,
-        "frames": frames_json,
+        "frames": frame_rows,
     });
     Ok(BenchReport { markdown: md, json })
 }
