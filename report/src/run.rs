@@ -21,6 +21,23 @@ pub struct ReferenceInfo {
     pub frames: Vec<u32>,
 }
 
+/// One method's entry of the manifest's `settings.methods`, as far as the report reads it.
+#[derive(Clone, Debug, Default, Deserialize)]
+pub struct MethodSettings {
+    #[serde(default)]
+    pub label: String,
+    /// Effective temporal window, frames (systems::methods::temporal_window); absent in runs
+    /// before issue 15 and for methods that state none.
+    #[serde(default)]
+    pub temporal_window: Option<f64>,
+}
+
+#[derive(Clone, Debug, Default, Deserialize)]
+pub struct Settings {
+    #[serde(default)]
+    pub methods: Vec<MethodSettings>,
+}
+
 /// The fields of manifest.json the report uses; the whole JSON is kept in `raw`.
 #[derive(Clone, Debug, Deserialize)]
 pub struct Manifest {
@@ -38,6 +55,8 @@ pub struct Manifest {
     pub events: Vec<Event>,
     #[serde(default)]
     pub regions: Vec<Region>,
+    #[serde(default)]
+    pub settings: Settings,
     #[serde(skip)]
     pub raw: serde_json::Value,
 }

@@ -28,6 +28,9 @@ pub struct MethodSummary {
     pub method: String,
     /// window name -> column -> mean over the window's measured frames.
     pub means: BTreeMap<String, BTreeMap<String, f64>>,
+    /// Effective temporal window, frames, from the manifest (absent where the run states none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub temporal_window: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -85,7 +88,8 @@ pub fn summarize(manifest: &Manifest, frames: &Frames, n: u32) -> Summary {
                     (w.name.clone(), cols)
                 })
                 .collect();
-            MethodSummary { method, means }
+            let temporal_window = manifest.settings.methods.iter().find(|m| m.label == method).and_then(|m| m.temporal_window);
+            MethodSummary { method, means, temporal_window }
         })
         .collect();
     Summary { scenario: manifest.scenario.clone(), window_frames: n, windows, methods }
@@ -102,4 +106,34 @@ pub fn write_summary_with_window(run_dir: &Path, n: u32) -> anyhow::Result<()> {
     let summary = summarize(&manifest, &frames, n);
     let path = run_dir.join("summary.json");
     std::fs::write(&path, serde_json::to_string_pretty(&summary)?).with_context(|| format!("cannot write {}", path.display()))
+}
+
+#[cfg(test)]
+mod temporal_window_tests {
+    use super::*;
+
+    /// Issue 15: each method's effective temporal window goes from the manifest into the
+    /// summary and the summary table; runs that state none show no column.
+    #[test]
+    fn the_manifest_temporal_windows_reach_the_summary_table() {
+        let frames = Frames::parse("method,frame,flip\ntaa,0,0.2\nssc,0,0.1\npt,0,0.3\n", Path::new("frames.csv")).unwrap();
+        let manifest: Manifest = serde_json::from_str(
+            r#"{"scenario": "s", "methods": ["taa", "ssc", "pt"], "settings": {"methods": [
+                {"label": "taa", "temporal_window": 19.0}, {"label": "ssc", "temporal_window": 76.0}, {"label": "pt"}]}}"#,
+        )
+        .unwrap();
+        let summary = summarize(&manifest, &frames, DEFAULT_WINDOW);
+        let windows: Vec<_> = summary.methods.iter().map(|m| (m.method.as_str(), m.temporal_window)).collect();
+        assert_eq!(windows, [("taa", Some(19.0)), ("ssc", Some(76.0)), ("pt", None)]);
+        let html = crate::table::html(&summary, &frames);
+        assert!(html.contains("temporal window (frames)</th>"), "{html}");
+        assert!(html.contains(">ssc</td><td>76.0</td>") && html.contains(">pt</td><td></td>"), "{html}");
+        let json = serde_json::to_value(&summary).unwrap();
+        assert_eq!(json["methods"][1]["temporal_window"], 76.0);
+        assert!(json["methods"][2].get("temporal_window").is_none());
+
+        let old: Manifest = serde_json::from_str(r#"{"scenario": "s", "methods": ["taa", "ssc", "pt"]}"#).unwrap();
+        let html = crate::table::html(&summarize(&old, &frames, DEFAULT_WINDOW), &frames);
+        assert!(!html.contains("temporal window"), "{html}");
+    }
 }

@@ -43,6 +43,11 @@ pub fn best(values: &[Option<f64>], better: Better) -> Option<usize> {
 pub fn html(summary: &Summary, frames: &Frames) -> String {
     let cols: Vec<_> = COLUMNS.iter().copied().filter(|(c, ..)| frames.column(c).is_some_and(|i| frames.has_data(i))).collect();
     let mut h = String::from("<table id=\"summary\"><tr><th>window</th><th>frames</th><th>method</th>");
+    // Each method's effective temporal window (issue 15): compare flicker at equal windows.
+    let temporal = summary.methods.iter().any(|m| m.temporal_window.is_some());
+    if temporal {
+        h.push_str("<th title=\"box-filter frames of equal noise variance, nominal (systems::methods::temporal_window)\">temporal window (frames)</th>");
+    }
     for (_, name, better) in &cols {
         let hint = match better {
             Better::Lower => " ↓",
@@ -58,6 +63,9 @@ pub fn html(summary: &Summary, frames: &Frames) -> String {
             cols.iter().map(|(c, _, better)| best(&(0..summary.methods.len()).map(|m| value(m, c)).collect::<Vec<_>>(), *better)).collect();
         for (mi, m) in summary.methods.iter().enumerate() {
             let _ = write!(h, "<tr><td class=\"m\">{}</td><td>{}–{}</td><td class=\"m\">{}</td>", esc(&w.name), w.first, w.last, esc(&m.method));
+            if temporal {
+                let _ = write!(h, "<td>{}</td>", m.temporal_window.map(|v| format!("{v:.1}")).unwrap_or_default());
+            }
             for (ci, (c, ..)) in cols.iter().enumerate() {
                 let text = value(mi, c).map(|v| format!("{v:.4}")).unwrap_or_default();
                 if bests[ci] == Some(mi) {

@@ -41,7 +41,7 @@ pub fn build(spec: &RunSpec, scenario_file: &Path, gpu: &Gpu, overrides: &Overri
             "max_depth": scenario.max_depth,
             "smape_epsilon": scenario.smape_epsilon,
             "time_step": scenario.time_step,
-            "methods": spec.methods.iter().map(|m| json!({"label": m.label(), "spp": m.spec.spp(), "spec": m.spec})).collect::<Vec<_>>(),
+            "methods": spec.methods.iter().map(|m| json!({"label": m.label(), "spp": m.spec.spp(), "temporal_window": m.spec.temporal_window(), "spec": m.spec})).collect::<Vec<_>>(),
             "overrides": {
                 "frames": overrides.frames,
                 "resolution": overrides.resolution.map(|(w, h)| format!("{w}x{h}")),

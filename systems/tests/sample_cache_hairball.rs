@@ -104,9 +104,25 @@ fn hairball_camera_scenario_plays_end_to_end() {
     })
     .expect("run");
     let labels: std::collections::BTreeSet<String> = summary.records.iter().map(|r| r.method.clone()).collect();
-    for label in ["pt_1spp", "pt_4spp", "ssc_single", "ssc_multi", "ssc_adaptive"] {
+    for label in ["pt_1spp", "pt_4spp", "ssc_single", "ssc_multi", "ssc_adaptive", "ssc_adaptive_taa", "hash_cache_taa"] {
         assert!(labels.contains(label), "{label} missing from {labels:?}");
     }
+    // Each method's effective temporal window is in the manifest (issue 15): TAA's exponential
+    // blend (α 0.1: 19 frames), the cache's n_target · 19 shades at one per pixel and frame, and
+    // TAA over the cache longer than either.
+    let manifest: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).expect("manifest.json")).expect("manifest JSON");
+    let window = |label: &str| {
+        let methods = manifest["settings"]["methods"].as_array().expect("settings.methods");
+        methods.iter().find(|m| m["label"] == label).and_then(|m| m["temporal_window"].as_f64()).unwrap_or_else(|| panic!("{label}: no temporal window"))
+    };
+    // (α is an f32: 19 up to its rounding.)
+    for (label, expected) in [("pt_1spp", 1.0), ("taa", 19.0), ("ssc_adaptive", 76.0)] {
+        assert!((window(label) - expected).abs() < 1e-5 * expected, "{label}: {} frames, expected {expected}", window(label));
+    }
+    assert!(window("ssc_adaptive_taa") > 76.0 && window("hash_cache_taa") > window("hash_cache_secondary_hit"));
+    // TAA over the cache: the resolve's pass follows the cache's four.
+    let taa_rows: Vec<_> = summary.records.iter().filter(|r| r.method == "ssc_adaptive_taa").collect();
+    assert!(taa_rows.iter().all(|r| r.passes.iter().any(|(p, _)| p == "taa_resolve")), "{:?}", taa_rows.first().map(|r| &r.passes));
     let csv = std::fs::read_to_string(out.join("frames.csv")).expect("frames.csv");
     for column in ["shaded", "rays", "primary_rays", "occupancy", "gpu_ms_reserve"] {
         assert!(csv.lines().next().unwrap().contains(column), "{column} not in frames.csv");

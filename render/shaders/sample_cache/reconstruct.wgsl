@@ -1,10 +1,14 @@
 // Reconstruction (section 3.3): the mean radiance of the pixel's visible, shaded samples; motion
-// from the closest visible sample (where it was last frame), for reprojected metrics.
+// from the closest visible sample (where it was last frame), for reprojected metrics. The same
+// colour and that sample's primary attributes (taa_primary.wgsl) also go to ssc_colour and
+// ssc_primary, the inputs of a TAA resolve over the cache.
 
 import package::scene_bindings::{frame};
-import package::pt_scene::{project_offset};
-import package::sample_cache_bindings::{dst_mask, dst_slots, ssc, ssc_out, ssc_work};
-import package::sample_cache::storage::{SSC_AUDIT, SSC_BACKGROUND_DEPTH, ssc_background_dir, ssc_is_background, ssc_pixels, ssc_previous_position, ssc_surface, ssc_visible_slots};
+import package::scene_geometry::{Hit, NO_HIT};
+import package::taa_types::{TaaPrimary};
+import package::taa_primary::{primary_attributes};
+import package::sample_cache_bindings::{dst_mask, dst_slots, ssc, ssc_colour, ssc_out, ssc_primary, ssc_work};
+import package::sample_cache::storage::{SSC_AUDIT, SSC_BACKGROUND_DEPTH, ssc_background_dir, ssc_hit, ssc_is_background, ssc_pixels, ssc_surface, ssc_visible_slots};
 import package::sample_cache::selection::{ssc_verify};
 
 @compute @workgroup_size(8, 8, 1)
@@ -21,8 +25,8 @@ fn reconstruct_main(@builtin(global_invocation_id) id: vec3u) {
     var sum = vec3f(0.0);
     var count = 0.0;
     var closest = 3.0e38;
-    var motion = vec2f(0.0);
-    let centre = vec2f(id.xy) + 0.5;
+    var closest_hit = vec4u(0u);
+    var any_visible = false;
     for (var s = 0u; s < n; s++) {
         if ((vis >> s) & 1u) == 0u {
             continue;
@@ -33,19 +37,23 @@ fn reconstruct_main(@builtin(global_invocation_id) id: vec3u) {
             count += 1.0;
         }
         var t = SSC_BACKGROUND_DEPTH;
-        var m = vec2f(0.0);
-        if ssc_is_background(slot.hit) {
-            let dir = ssc_background_dir(slot.hit);
-            m = project_offset(frame.previous_camera, dir) - project_offset(frame.camera, dir);
-        } else {
-            let now = ssc_surface(slot.hit).position;
-            t = length(now - eye);
-            let before = project_offset(frame.previous_camera, ssc_previous_position(slot.hit) - frame.previous_camera.position);
-            m = before - project_offset(frame.camera, now - eye);
+        if !ssc_is_background(slot.hit) {
+            t = length(ssc_surface(slot.hit).position - eye);
         }
         if t < closest {
             closest = t;
-            motion = m;
+            closest_hit = slot.hit;
+            any_visible = true;
+        }
+    }
+    // The closest visible sample's primary attributes (motion: where it was last frame); a
+    // pixel without visible samples has no motion and no surface.
+    var primary = TaaPrimary(vec3f(0.0), 0.0, vec2f(0.0), NO_HIT, 0.0);
+    if any_visible {
+        if ssc_is_background(closest_hit) {
+            primary = primary_attributes(Hit(0.0, NO_HIT, 0u, vec2f(0.0)), eye, ssc_background_dir(closest_hit));
+        } else {
+            primary = primary_attributes(ssc_hit(closest_hit), eye, normalize(ssc_surface(closest_hit).position - eye));
         }
     }
     var radiance = frame.environment;
@@ -53,7 +61,9 @@ fn reconstruct_main(@builtin(global_invocation_id) id: vec3u) {
         radiance = sum / count;
     }
     ssc_out[p].radiance = vec4f(radiance, 1.0);
-    ssc_out[p].motion = motion;
+    ssc_out[p].motion = primary.motion;
+    ssc_colour[p] = vec4f(radiance, 1.0);
+    ssc_primary[p] = primary;
 }
 
 // Audit (tests and diagnostics, not part of a frame): counts the samples the cache holds as

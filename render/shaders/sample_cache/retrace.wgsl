@@ -12,7 +12,7 @@ import package::pt_lights::{FAR};
 import package::pt_scene::{camera_ray_direction};
 import package::sample_cache_types::{SscSlot};
 import package::sample_cache_bindings::{dst_mask, dst_slots, pixel_atomics, ssc, ssc_out, ssc_work};
-import package::sample_cache::storage::{SSC_ALL_RAYS, SSC_ATOMICS, SSC_BACKGROUND_DEPTH, SSC_BASE, SSC_FLAGGED, SSC_FLAG_BASE, SSC_FLAG_HOLE, SSC_FLAG_SLOPE, SSC_HISTOGRAM, SSC_LIST, SSC_MAX_SLOTS, SSC_NEW, SSC_OCCUPIED, SSC_PURGED, SSC_RAYS, SSC_RETRACE_COUNT, SSC_VISIBLE, SSC_WMAX_ACC, SSC_WMIN_ACC, ssc_full, ssc_is_background, ssc_less, ssc_pack_background, ssc_pack_hit, ssc_pixels, ssc_surface, ssc_visible_slots};
+import package::sample_cache::storage::{SSC_ALL_RAYS, SSC_ATOMICS, SSC_BACKGROUND_DEPTH, SSC_BASE, SSC_FLAGGED, SSC_FLAG_BASE, SSC_FLAG_HOLE, SSC_FLAG_SLOPE, SSC_HISTOGRAM, SSC_LIST, SSC_MAX_SLOTS, SSC_NEW, SSC_OCCUPIED, SSC_PURGED, SSC_RAYS, SSC_RETRACE_COUNT, SSC_VISIBLE, SSC_WMAX_ACC, SSC_WMIN_ACC, ssc_full, ssc_is_background, ssc_less, ssc_list_index, ssc_pack_background, ssc_pack_hit, ssc_pixels, ssc_surface, ssc_visible_slots};
 import package::sample_cache::slope::{ssc_consistent, ssc_slope};
 import package::sample_cache::selection::{ssc_base_index, ssc_bucket, ssc_forced_shade, ssc_importance, ssc_is_base_pixel, ssc_nth_bit, ssc_verify};
 
@@ -207,13 +207,11 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
 }
 
 // 3. Retrace one queued sample: its result goes to the pixel's third atomic word.
-@compute @workgroup_size(8, 8, 1)
-fn retrace_list_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.width || id.y >= ssc.height || id.z >= ssc.slots {
-        return;
-    }
+// One thread per entry: dispatched indirectly with the list's length (list_dispatch.wgsl).
+@compute @workgroup_size(64, 1, 1)
+fn retrace_list_main(@builtin(global_invocation_id) id: vec3u, @builtin(num_workgroups) groups: vec3u) {
     let pixels = ssc_pixels();
-    let index = id.z * pixels + id.y * ssc.width + id.x;
+    let index = ssc_list_index(id, groups);
     if index >= atomicLoad(&ssc_work[SSC_RETRACE_COUNT]) {
         return;
     }

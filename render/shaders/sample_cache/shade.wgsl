@@ -11,7 +11,7 @@ import package::pt_bsdf::{bsdf_sample, make_bsdf};
 import package::pt_scene::{base_color_at, escaped_radiance, offset_origin, orient};
 import package::pt_integrator::{emitted_radiance, next_event, path_radiance};
 import package::sample_cache_bindings::{dst_slots, ssc, ssc_work};
-import package::sample_cache::storage::{SSC_ALL_RAYS, SSC_LIST, SSC_SHADE_COUNT, ssc_background_dir, ssc_is_background, ssc_pixels, ssc_surface};
+import package::sample_cache::storage::{SSC_ALL_RAYS, SSC_LIST, SSC_SHADE_COUNT, ssc_background_dir, ssc_is_background, ssc_list_index, ssc_pixels, ssc_surface};
 
 fn ssc_shade(hit: vec4u, rng: ptr<function, u32>) -> vec3f {
     let eye = frame.camera.position;
@@ -55,13 +55,11 @@ fn ssc_alpha_min(hit: vec4u) -> f32 {
     return mix(0.5, 0.1, a_ggx);
 }
 
-@compute @workgroup_size(8, 8, 1)
-fn shade_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.width || id.y >= ssc.height || id.z >= ssc.slots {
-        return;
-    }
+// One thread per entry: dispatched indirectly with the list's length (list_dispatch.wgsl).
+@compute @workgroup_size(64, 1, 1)
+fn shade_main(@builtin(global_invocation_id) id: vec3u, @builtin(num_workgroups) groups: vec3u) {
     let pixels = ssc_pixels();
-    let index = id.z * pixels + id.y * ssc.width + id.x;
+    let index = ssc_list_index(id, groups);
     if index >= atomicLoad(&ssc_work[SSC_SHADE_COUNT]) {
         return;
     }

@@ -11,7 +11,7 @@
 // Mask: one u32 per pixel, occupancy o_s in bits 0..N-1 and visibility v_s in bits N..2N-1
 // (N <= 16), bits 2N..31 always zero.
 
-import package::scene_geometry::{Hit, NO_HIT, SurfacePoint, previous_world_position, surface_point};
+import package::scene_geometry::{Hit, NO_HIT, SurfacePoint, surface_point};
 import package::sample_cache_bindings::{ssc};
 
 const SSC_MAX_SLOTS: u32 = 16u;
@@ -40,11 +40,24 @@ const SSC_HISTOGRAM: u32 = 16u;
 const SSC_AUDIT: u32 = 32u;         // visible samples found occluded by audit_main
 const SSC_RETRACE_COUNT: u32 = 33u; // entries of the retrace list (shares SSC_LIST with the shade list)
 const SSC_ALL_RAYS: u32 = 34u;      // every ray of the frame: retraces, new samples, shading paths
+const SSC_RETRACE_ARGS: u32 = 35u;  // 3 words: indirect dispatch of retrace_list_main
+const SSC_SHADE_ARGS: u32 = 38u;    // 3 words: indirect dispatch of shade_main
 const SSC_LIST: u32 = 48u;
+
+// The list passes (retrace_list_main, shade_main) run one thread per list entry in 1-D workgroups
+// over an x·y grid of them (SampleCache::list_dispatch on the CPU, list_dispatch.wgsl on the GPU).
+const SSC_LIST_WORKGROUP: u32 = 64u;
+// WebGPU's guaranteed minimum of max_compute_workgroups_per_dimension: every adapter takes it.
+const SSC_MAX_GROUPS_X: u32 = 65535u;
 
 const SSC_FLAG_BASE: u32 = 1u;
 const SSC_FLAG_SLOPE: u32 = 2u;
 const SSC_FLAG_HOLE: u32 = 4u;
+
+// The list entry of a thread of a list pass (global id, workgroups of the dispatch).
+fn ssc_list_index(id: vec3u, groups: vec3u) -> u32 {
+    return id.y * groups.x * SSC_LIST_WORKGROUP + id.x;
+}
 
 fn ssc_pixels() -> u32 {
     return ssc.width * ssc.height;
@@ -77,14 +90,12 @@ fn ssc_background_dir(hit: vec4u) -> vec3f {
 
 // The cached surface sample through the *current* instance transforms.
 fn ssc_surface(hit: vec4u) -> SurfacePoint {
-    let h = Hit(0.0, hit.x, hit.y, bitcast<vec2f>(hit.zw));
-    return surface_point(h, vec3f(0.0), vec3f(0.0, 0.0, 1.0));
+    return surface_point(ssc_hit(hit), vec3f(0.0), vec3f(0.0, 0.0, 1.0));
 }
 
-// Where the sample was last frame (previous transforms), for motion vectors.
-fn ssc_previous_position(hit: vec4u) -> vec3f {
-    let h = Hit(0.0, hit.x, hit.y, bitcast<vec2f>(hit.zw));
-    return previous_world_position(h);
+// A packed surface hit as the geometry's Hit (t unknown: 0).
+fn ssc_hit(hit: vec4u) -> Hit {
+    return Hit(0.0, hit.x, hit.y, bitcast<vec2f>(hit.zw));
 }
 
 // Strict lexicographic order on packed hits: the canonical slot order of a pixel.

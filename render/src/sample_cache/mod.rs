@@ -4,9 +4,15 @@
 //! sparsely, and averaged into the image. See README.md in this folder for the map and choices.
 //!
 //! Passes per frame (shaders/sample_cache/, one compute pass each, timed):
-//! `reserve` (reproject.wgsl: begin_main + reserve_main), `trace` (retrace.wgsl: retrace_main, retrace_list_main, finish_main),
-//! `shade` (shading_rate.wgsl rates_main + select_main, shade.wgsl shade_main),
-//! `reconstruct` (reconstruct.wgsl).
+//! `reserve` (reproject.wgsl: begin_main + reserve_main), `trace` (retrace.wgsl: retrace_main,
+//! list_dispatch.wgsl retrace_args_main, retrace.wgsl retrace_list_main, finish_main),
+//! `shade` (shading_rate.wgsl rates_main + select_main, list_dispatch.wgsl shade_args_main,
+//! shade.wgsl shade_main), `reconstruct` (reconstruct.wgsl).
+//!
+//! The two list passes (retrace_list_main, shade_main) are dispatched indirectly: one thread
+//! per list entry, the workgroup counts written on the GPU by the args passes and copied into
+//! an indirect buffer ([`SampleCache::set_indirect`] turns it off for comparisons: then N ·
+//! pixels threads launch and those past the list's end exit).
 //!
 //! 64-bit atomics: the paper packs (closest depth, slope Δn) into one 64-bit atomicMin during
 //! reprojection. WGSL core has only 32-bit atomics, so each pixel gets one u32 atomicMax of the
@@ -41,27 +47,49 @@ use crate::timing::{PassTimer, PassTiming};
 pub const PASSES: [&str; 4] = ["reserve", "trace", "shade", "reconstruct"];
 
 /// The dispatches (indices into [`DISPATCHES`]) of each of [`PASSES`].
-const STAGE_DISPATCHES: [std::ops::Range<usize>; 4] = [0..2, 2..5, 5..8, 8..9];
+const STAGE_DISPATCHES: [std::ops::Range<usize>; 4] = [0..2, 2..6, 6..10, 10..11];
 
 /// The dispatches of a frame, `PASS/entry`, in order; each is timed on its own
 /// ([`CacheFrame::dispatch_timings`]) and the pass time is the sum of its dispatches'.
-pub const DISPATCHES: [&str; 9] = [
+pub const DISPATCHES: [&str; 11] = [
     "reserve/begin_main",
     "reserve/reserve_main",
     "trace/retrace_main",
+    "trace/retrace_args_main",
     "trace/retrace_list_main",
     "trace/finish_main",
     "shade/rates_main",
     "shade/select_main",
+    "shade/shade_args_main",
     "shade/shade_main",
     "reconstruct/reconstruct_main",
 ];
 
+/// Threads per workgroup of the list passes (`SSC_LIST_WORKGROUP` in storage.wgsl).
+pub const LIST_WORKGROUP: u32 = 64;
+/// WebGPU's guaranteed minimum of `max_compute_workgroups_per_dimension` (`SSC_MAX_GROUPS_X`).
+pub const MAX_GROUPS_X: u32 = 65_535;
+
+/// Workgroups `[x, y, 1]` of a list pass over `count` entries: x · y · LIST_WORKGROUP >= count
+/// with x within every adapter's limit. The GPU's twin (list_dispatch.wgsl) writes the indirect
+/// arguments; on the CPU this is the direct dispatch's worst case.
+pub fn list_dispatch(count: u32) -> [u32; 3] {
+    let groups = count.div_ceil(LIST_WORKGROUP);
+    let x = groups.min(MAX_GROUPS_X);
+    let y = if x > 0 { groups.div_ceil(x) } else { 0 };
+    [x, y, 1]
+}
+
+/// Header words of the indirect arguments (`SSC_RETRACE_ARGS`, `SSC_SHADE_ARGS`).
+const RETRACE_ARGS_WORD: u64 = 35;
+const SHADE_ARGS_WORD: u64 = 38;
+
 const HEADER_WORDS: u64 = 48;
 const AUDIT_WORD: u64 = 32;
 /// The cache's own @group(2), declared into its WGSL: params, source mask and slots (read),
-/// then pixel atomics, destination slots and mask, work lists, output.
-const OWN_GROUP: [BufferBinding; 8] = [
+/// then pixel atomics, destination slots and mask, work lists, output, and the inputs of a TAA
+/// resolve over the image (colour, closest visible sample's primary attributes).
+const OWN_GROUP: [BufferBinding; 10] = [
     BufferBinding::uniform("ssc", "SscParams"),
     BufferBinding::read("src_mask", "array<u32>"),
     BufferBinding::read("src_slots", "array<SscSlot>"),
@@ -72,6 +100,9 @@ const OWN_GROUP: [BufferBinding; 8] = [
     BufferBinding::read_write("dst_mask", "array<u32>"),
     BufferBinding::read_write("ssc_work", "array<atomic<u32>>"),
     BufferBinding::read_write("ssc_out", "array<SscPixel>"),
+    // The reconstruction again in the layouts `Taa::resolve_external` copies from.
+    BufferBinding::read_write("ssc_colour", "array<vec4f>"),
+    BufferBinding::read_write("ssc_primary", "array<TaaPrimary>"),
 ];
 
 /// The cache passes' program: the shading library, the cache's structs and @group(2), its
@@ -80,14 +111,16 @@ pub fn program() -> &'static Program {
     static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
     PROGRAM.get_or_init(|| {
         let types = Module::generated("package::sample_cache_types", &[SscParams::WGSL, storage::SscSlot::WGSL, SscPixel::WGSL]);
-        let bindings = crate::compute::group_module("package::sample_cache_bindings", 2, &OWN_GROUP, &[&types]);
+        let taa_types = crate::taa::types_module();
+        let bindings = crate::compute::group_module("package::sample_cache_bindings", 2, &OWN_GROUP, &[&types, &taa_types]);
         PassLibrary::program(
-            [types, bindings, crate::wgsl_file!("sample_cache/storage.wgsl"), crate::wgsl_file!("sample_cache/slope.wgsl"), crate::wgsl_file!("sample_cache/selection.wgsl")],
+            [types, taa_types, crate::taa::primary_module(), bindings, crate::wgsl_file!("sample_cache/storage.wgsl"), crate::wgsl_file!("sample_cache/slope.wgsl"), crate::wgsl_file!("sample_cache/selection.wgsl")],
             [
                 crate::wgsl_file!("sample_cache/reproject.wgsl"),
                 crate::wgsl_file!("sample_cache/retrace.wgsl"),
                 crate::wgsl_file!("sample_cache/shading_rate.wgsl"),
                 crate::wgsl_file!("sample_cache/shade.wgsl"),
+                crate::wgsl_file!("sample_cache/list_dispatch.wgsl"),
                 crate::wgsl_file!("sample_cache/reconstruct.wgsl"),
             ],
         )
@@ -163,6 +196,10 @@ pub struct CacheStats {
     /// the first of each pixel with no shaded visible sample.
     pub base_shaded: u32,
     pub slope_flagged: u32,
+    /// Entries of the retrace list.
+    pub retrace_listed: u32,
+    /// The workgroups the GPU computed for the retrace and shade lists (indirect arguments).
+    pub list_args: [[u32; 3]; 2],
     /// Importance bounds (w_min, w_max) of this frame's histogram buckets (last frame's).
     pub importance_bounds: (f32, f32),
     /// Histogram of the frame (adaptive shading), and the threshold bucket and coin chosen.
@@ -207,7 +244,15 @@ pub struct SampleCache {
     caches: [Cache; 2],
     pixel_atomics: wgpu::Buffer,
     work: wgpu::Buffer,
+    /// Indirect arguments of the retrace list (bytes 0-11) and the shade list (12-23), copied
+    /// from `work`'s header (a buffer bound as storage cannot be a dispatch's indirect buffer).
+    list_args: wgpu::Buffer,
+    /// Whether the list passes are dispatched indirectly (the default) or over N · pixels.
+    indirect: bool,
     out: wgpu::Buffer,
+    /// The image and its primary attributes for a TAA resolve ([`Self::taa_inputs`]).
+    colour: wgpu::Buffer,
+    primary: wgpu::Buffer,
     out_readback: wgpu::Buffer,
     header_readback: wgpu::Buffer,
     bind_groups: [wgpu::BindGroup; 2],
@@ -224,10 +269,12 @@ struct Pipelines {
     begin: wgpu::ComputePipeline,
     reserve: wgpu::ComputePipeline,
     retrace: wgpu::ComputePipeline,
+    retrace_args: wgpu::ComputePipeline,
     retrace_list: wgpu::ComputePipeline,
     finish: wgpu::ComputePipeline,
     rates: wgpu::ComputePipeline,
     select: wgpu::ComputePipeline,
+    shade_args: wgpu::ComputePipeline,
     shade: wgpu::ComputePipeline,
     reconstruct: wgpu::ComputePipeline,
     audit: wgpu::ComputePipeline,
@@ -238,7 +285,7 @@ impl SampleCache {
         settings.validate().map_err(|e| RenderError::Settings(format!("sample cache: {e}")))?;
         let (width, height) = (tracer.settings().width, tracer.settings().height);
         let n = settings.slots as u64;
-        gpu.check_resolution(width, height, 2 * 32 * n + 4 * 2 + 12 + 4 * n + 32)?;
+        gpu.check_resolution(width, height, 2 * 32 * n + 4 * 2 + 12 + 4 * n + 32 + 16 + 32)?;
         // No var<workgroup> anywhere in the cache passes.
         for pass in PASSES {
             gpu.check_workgroup_memory(pass, 0)?;
@@ -257,21 +304,37 @@ impl SampleCache {
         ];
         let pixel_atomics = buffer("ssc pixel atomics", pixels * 12, rw)?;
         let work = buffer("ssc work", (HEADER_WORDS + pixels * n) * 4, rw)?;
+        let list_args = buffer("ssc list dispatch", 24, wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST)?;
         let out = buffer("ssc out", pixels * 32, rw)?;
+        let colour = buffer("ssc colour", pixels * 16, rw)?;
+        let primary = buffer("ssc primary", pixels * size_of::<crate::taa::TaaPrimary>() as u64, rw)?;
         let out_readback = buffer("ssc out readback", pixels * 32, readback)?;
         let header_readback = buffer("ssc header readback", HEADER_WORDS * 4, readback)?;
         let params = buffer("ssc params", size_of::<SscParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)?;
 
-        let (layout, [begin, reserve, retrace, retrace_list, finish, rates, select, shade, reconstruct, audit]) = tracer.library_pass(
+        let (layout, [begin, reserve, retrace, retrace_args, retrace_list, finish, rates, select, shade_args, shade, reconstruct, audit]) = tracer.library_pass(
             gpu,
             "shaders/sample_cache/*.wgsl",
             program(),
             &OWN_GROUP,
-            ["begin_main", "reserve_main", "retrace_main", "retrace_list_main", "finish_main", "rates_main", "select_main", "shade_main", "reconstruct_main", "audit_main"],
+            [
+                "begin_main",
+                "reserve_main",
+                "retrace_main",
+                "retrace_args_main",
+                "retrace_list_main",
+                "finish_main",
+                "rates_main",
+                "select_main",
+                "shade_args_main",
+                "shade_main",
+                "reconstruct_main",
+                "audit_main",
+            ],
         )?;
-        let pipelines = Pipelines { begin, reserve, retrace, retrace_list, finish, rates, select, shade, reconstruct, audit };
+        let pipelines = Pipelines { begin, reserve, retrace, retrace_args, retrace_list, finish, rates, select, shade_args, shade, reconstruct, audit };
         let make = |src: &Cache, dst: &Cache| {
-            crate::compute::buffer_group(gpu, "sample cache", &layout, &[&params, &src.mask, &src.slots, &pixel_atomics, &dst.slots, &dst.mask, &work, &out])
+            crate::compute::buffer_group(gpu, "sample cache", &layout, &[&params, &src.mask, &src.slots, &pixel_atomics, &dst.slots, &dst.mask, &work, &out, &colour, &primary])
         };
         // bind_groups[i]: reproject cache i into cache 1 - i.
         let bind_groups = [make(&caches[0], &caches[1]), make(&caches[1], &caches[0])];
@@ -285,7 +348,11 @@ impl SampleCache {
             caches,
             pixel_atomics,
             work,
+            list_args,
+            indirect: true,
             out,
+            colour,
+            primary,
             out_readback,
             header_readback,
             bind_groups,
@@ -298,6 +365,12 @@ impl SampleCache {
 
     pub fn settings(&self) -> &SampleCacheSettings {
         &self.settings
+    }
+
+    /// Dispatch the list passes indirectly (default: one thread per entry) or directly over N ·
+    /// pixels threads (the former way; for comparisons and benchmarks). Same results either way.
+    pub fn set_indirect(&mut self, indirect: bool) {
+        self.indirect = indirect;
     }
 
     /// Renders one frame: call after `tracer.update` for this frame's scene. `frame` seeds the
@@ -376,26 +449,38 @@ impl SampleCache {
         let bind_group = &self.bind_groups[self.current];
         let (gx, gy) = (w.div_ceil(8), h.div_ceil(8));
         let p = &self.pipelines;
-        // In the order of DISPATCHES.
-        let dispatches: [(&wgpu::ComputePipeline, [u32; 3]); 9] = [
-            (&p.begin, [1, 1, 1]),
-            (&p.reserve, [gx, gy, s.slots]),
-            (&p.retrace, [gx, gy, 1]),
-            (&p.retrace_list, [gx, gy, s.slots]),
-            (&p.finish, [gx, gy, 1]),
-            (&p.rates, [1, 1, 1]),
-            (&p.select, [gx, gy, 1]),
-            (&p.shade, [gx, gy, s.slots]),
-            (&p.reconstruct, [gx, gy, 1]),
+        // A list pass: its indirect arguments' offset in `list_args` and header word in `work`.
+        let list = |l: u64| Some((12 * l, [RETRACE_ARGS_WORD, SHADE_ARGS_WORD][l as usize]));
+        let whole_list = list_dispatch(s.slots * w * h);
+        // In the order of DISPATCHES: pipeline, direct workgroups, list.
+        let dispatches: [(&wgpu::ComputePipeline, [u32; 3], Option<(u64, u64)>); 11] = [
+            (&p.begin, [1, 1, 1], None),
+            (&p.reserve, [gx, gy, s.slots], None),
+            (&p.retrace, [gx, gy, 1], None),
+            (&p.retrace_args, [1, 1, 1], None),
+            (&p.retrace_list, whole_list, list(0)),
+            (&p.finish, [gx, gy, 1], None),
+            (&p.rates, [1, 1, 1], None),
+            (&p.select, [gx, gy, 1], None),
+            (&p.shade_args, [1, 1, 1], None),
+            (&p.shade, whole_list, list(1)),
+            (&p.reconstruct, [gx, gy, 1], None),
         ];
         for (i, d) in STAGE_DISPATCHES[stage].clone().enumerate() {
-            let (pipeline, [x, y, z]) = dispatches[d];
+            let (pipeline, [x, y, z], list) = dispatches[d];
+            let indirect = list.filter(|_| self.indirect);
+            if let Some((offset, word)) = indirect {
+                timed.encoder().copy_buffer_to_buffer(&self.work, word * 4, &self.list_args, offset, 12);
+            }
             timed.pass(i, |pass| {
                 pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
                 pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
                 pass.set_bind_group(2, bind_group, &[]);
                 pass.set_pipeline(pipeline);
-                pass.dispatch_workgroups(x, y, z);
+                match indirect {
+                    Some((offset, _)) => pass.dispatch_workgroups_indirect(&self.list_args, offset),
+                    None => pass.dispatch_workgroups(x, y, z),
+                }
             })?;
         }
         if stage == PASSES.len() - 1 {
@@ -438,6 +523,11 @@ impl SampleCache {
             occupied: header[13],
             base_shaded: header[14],
             slope_flagged: header[15],
+            retrace_listed: header[33],
+            list_args: [0, 1].map(|l| {
+                let at = [RETRACE_ARGS_WORD, SHADE_ARGS_WORD][l] as usize;
+                [header[at], header[at + 1], header[at + 2]]
+            }),
             importance_bounds: (f32::from_bits(header[8]), f32::from_bits(header[9])),
             histogram: header[16..16 + s.buckets as usize].to_vec(),
             threshold: header[10],
@@ -492,6 +582,18 @@ impl SampleCache {
         gpu.queue.submit([encoder.finish()]);
         let header: Vec<u32> = read_buffer(gpu, &self.header_readback).map_err(|reason| RenderError::Readback { what: "ssc audit".into(), reason })?;
         Ok(header[AUDIT_WORD as usize])
+    }
+
+    /// TAA's resolve (`taa`, its own submission) over the last frame's image, with each pixel's
+    /// closest visible sample's primary attributes (reconstruct.wgsl) for its reprojection and
+    /// history rejection: the paper applies TAA to every method for its error figures. The
+    /// resolve reads no jitter: the cache's samples lie anywhere in their pixels.
+    pub fn resolve_taa(&self, gpu: &Gpu, taa: &mut crate::taa::Taa) -> Result<crate::taa::TaaOutput, RenderError> {
+        let (colour, primary) = (&self.colour, &self.primary);
+        taa.resolve_external(gpu, [0.5; 2], |encoder, current, taa_primary| {
+            encoder.copy_buffer_to_buffer(colour, 0, current, 0, colour.size());
+            encoder.copy_buffer_to_buffer(primary, 0, taa_primary, 0, primary.size());
+        })
     }
 
     pub fn layout(&self) -> &wgpu::BindGroupLayout {

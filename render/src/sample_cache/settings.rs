@@ -52,6 +52,10 @@ pub struct SampleCacheSettings {
     /// Shading invocations per frame as a fraction of the pixel count (1 = 100%); only adaptive
     /// shading takes another rate than 1.
     pub shading_rate: f32,
+    /// The image resolved by TAA (`render::taa`) over the cache's reconstruction and its closest
+    /// visible samples' primary attributes: the paper applies TAA to every method for its error
+    /// figures. The cache itself is unchanged; `systems` runs the resolve.
+    pub taa: bool,
 }
 
 impl Default for SampleCacheSettings {
@@ -69,6 +73,7 @@ impl Default for SampleCacheSettings {
             retrace: Retrace::Adaptive,
             shading: ShadingMode::Uniform,
             shading_rate: 1.0,
+            taa: false,
         }
     }
 }
@@ -110,17 +115,18 @@ impl SampleCacheSettings {
         Ok(())
     }
 
-    /// Short name, e.g. `ssc_adaptive` or `ssc_multi_as` (adaptive shading).
+    /// Short name, e.g. `ssc_adaptive`, `ssc_multi_as` (adaptive shading), `ssc_adaptive_taa`.
     pub fn label(&self) -> String {
         let retrace = match self.retrace {
             Retrace::Single => "single",
             Retrace::Multi => "multi",
             Retrace::Adaptive => "adaptive",
         };
-        match self.shading {
-            ShadingMode::Uniform => format!("ssc_{retrace}"),
-            ShadingMode::Adaptive => format!("ssc_{retrace}_as"),
-        }
+        let shading = match self.shading {
+            ShadingMode::Uniform => "",
+            ShadingMode::Adaptive => "_as",
+        };
+        format!("ssc_{retrace}{shading}{}", if self.taa { "_taa" } else { "" })
     }
 }
 

@@ -11,6 +11,7 @@ pub mod sample_cache;
 pub mod spec;
 pub mod sss;
 pub mod taa;
+pub mod temporal_window;
 pub mod volume;
 pub mod volume_path;
 pub mod termination;
@@ -121,6 +122,24 @@ impl MethodSpec {
             MethodSpec::VolumeTransmittance(s) => s.spp as f64,
             MethodSpec::VolumePath(s) => s.spp as f64,
             MethodSpec::Sss(s) => s.spp as f64,
+        }
+    }
+
+    /// The method's effective temporal window in frames ([`temporal_window`]: the box-filter
+    /// length of equal noise variance, nominal); `None` where it is not stated: NIRC and the
+    /// termination cache learn over time with no fixed blend.
+    pub fn temporal_window(&self) -> Option<f64> {
+        let taa = |window: f64, under: bool| if under { temporal_window::in_series(window, temporal_window::exponential(TaaSettings::default().alpha as f64)) } else { window };
+        match self {
+            MethodSpec::PathTracing(_) | MethodSpec::VolumeTransmittance(_) | MethodSpec::VolumePath(_) | MethodSpec::Sss(_) => Some(1.0),
+            MethodSpec::Taa(s) => Some(temporal_window::exponential(s.alpha as f64)),
+            MethodSpec::HashCache(s) => Some(taa(temporal_window::exponential(1.0 / s.max_samples as f64), s.taa)),
+            MethodSpec::SampleCache(s) => {
+                let alpha = if s.roughness_alpha { 0.1 } else { s.alpha as f64 };
+                let shades = s.n_target as f64 * temporal_window::exponential(alpha);
+                Some(taa(shades / s.shading_rate as f64, s.taa))
+            }
+            MethodSpec::Nirc(_) | MethodSpec::Termination(_) => None,
         }
     }
 

@@ -1,11 +1,14 @@
 //! The stable sample cache (render::sample_cache) as four systems, one per stage of the paper's
-//! frame: reproject (forward reprojection and slot reservation), retrace, shade, reconstruct.
+//! frame: reproject (forward reprojection and slot reservation), retrace, shade, reconstruct;
+//! with `taa: true` the reconstruction is resolved by TAA (render::taa), as the paper's error
+//! figures run every method.
 
 use std::time::Instant;
 
 use anyhow::{Result, bail};
 use bevy_ecs::prelude::*;
 use render::sample_cache::SampleCache;
+use render::taa::{Taa, TaaSettings};
 
 pub use render::sample_cache::SampleCacheSettings;
 
@@ -13,7 +16,7 @@ use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
 use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
 
 #[derive(Component)]
-pub struct SampleCacheState(SampleCache);
+pub struct SampleCacheState(SampleCache, Option<Taa>);
 
 pub struct Plugin;
 pub static PLUGIN: Plugin = Plugin;
@@ -30,8 +33,10 @@ impl MethodPlugin for Plugin {
     fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
         let MethodSpec::SampleCache(settings) = &method.spec else { bail!("not a SampleCache method") };
         settings.validate().map_err(|e| anyhow::anyhow!("SampleCache: {e}"))?;
-        let cache = SampleCache::new(&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0, *settings)?;
-        world.entity_mut(entity).insert(SampleCacheState(cache));
+        let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
+        let cache = SampleCache::new(gpu, tracer, *settings)?;
+        let taa = settings.taa.then(|| Taa::new(gpu, tracer, TaaSettings::default())).transpose()?;
+        world.entity_mut(entity).insert(SampleCacheState(cache, taa));
         Ok(())
     }
 }
@@ -70,7 +75,13 @@ pub fn reconstruct(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, cloc
     for (mut state, info, mut frame) in &mut methods {
         let start = Instant::now();
         let slots = state.0.settings().slots as f64;
-        let out = state.0.finish_frame(&gpu.0).map_err(|e| method_failed(&info.label, clock.global, e))?;
+        let mut out = state.0.finish_frame(&gpu.0).map_err(|e| method_failed(&info.label, clock.global, e))?;
+        let SampleCacheState(cache, taa) = &mut *state;
+        if let Some(taa) = taa {
+            let resolved = cache.resolve_taa(&gpu.0, taa).map_err(|e| method_failed(&info.label, clock.global, e))?;
+            out.radiance = resolved.radiance;
+            out.timings.extend(resolved.timings);
+        }
         let s = &out.stats;
         let pixels = out.radiance.len().max(1) as f64;
         let stats = vec![
