@@ -91,7 +91,7 @@ fn taa_after_the_pass_lowers_flicker_and_separable_runs() {
     const FRAMES: u32 = 8;
     let mut gaps = vec![];
     for seed in 1..=3u64 {
-        let methods = "Sss(variant: Adaptive, name: \"as\"), Sss(variant: Adaptive, taa: Some((alpha: 0.1)), name: \"as_taa\"), Sss(variant: Separable(taps: 25), name: \"separable\")";
+        let methods = "Sss(variant: Adaptive, name: \"as\"), Sss(variant: Adaptive, taa: (alpha: 0.1), name: \"as_taa\"), Sss(variant: Separable(taps: 25), name: \"separable\")";
         let (records, dir) = play_inline("taa", seed, FRAMES, methods);
         let image = |m: &str, f: u32| systems::output::read_exr(&dir.join(format!("run/frames/{m}/{f:04}.exr"))).unwrap().2;
         assert_eq!(image("as", 0), image("as_taa", 0), "seed {seed}: frame 0 has no history");

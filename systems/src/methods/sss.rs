@@ -3,7 +3,7 @@
 //! material, is scattered by the thesis's pass (Burley sampling with SPVG counts and control
 //! variates, or a fixed count, or the separable baseline) and modulated back; with `taa` set,
 //! render::taa's resolve runs over the result, as the thesis's TAA after the pass.
-//! `Sss(variant: OnlineCv, taa: Some((alpha: 0.1)))`.
+//! `Sss(variant: OnlineCv, taa: (alpha: 0.1))`.
 
 use std::time::Instant;
 
