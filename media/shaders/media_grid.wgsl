@@ -1,14 +1,31 @@
 // A medium's voxel densities (nearest neighbour) and super-voxels (16³ voxels: min, max, mean,
 // RMS of μ − μ_min), in texel space with the ray parameter t in world units (media::medium).
-// Needs the generated structs MediumParams and RaySegment and `medium: MediumParams`, `density: array<f32>`, `super_voxels: array<vec4f>`.
+// Several media may be bound (`media`, their voxels and super-voxels concatenated): every
+// function here reads the one `media_index` selects (select_medium), the first by default.
 
 import package::media::types::{RaySegment};
-import package::media::medium_bindings::{density, medium, super_voxels};
+import package::media::medium_bindings::{density, media, super_voxels};
 
 const SUPER_VOXEL: u32 = 16u;
 // Relative floor of the variance-aware importance in non-empty super-voxels (IMPORTANCE_FLOOR).
 const IMPORTANCE_FLOOR: f32 = 1e-3;
 const BIG: f32 = 3.4e38;
+
+// The medium the functions below read (private, so 0 unless a pass selects another).
+var<private> media_index: u32;
+
+fn select_medium(i: u32) {
+    media_index = i;
+}
+
+// Super-voxels per axis of the selected medium.
+fn media_dims() -> vec3u {
+    return media[media_index].dims;
+}
+
+fn media_count() -> u32 {
+    return media[0].count;
+}
 
 // High-resolution density lookups of this invocation (what the paper counts).
 var<private> media_lookups: u32;
@@ -19,6 +36,7 @@ fn seg_at(s: RaySegment, t: f32) -> vec3f {
 
 // The part of the world ray (origin, unit dir) in [0, t_max] inside the box; t0 >= t1 on a miss.
 fn medium_segment(origin: vec3f, dir: vec3f, t_max: f32) -> RaySegment {
+    let medium = media[media_index];
     let voxel = (medium.box_max - medium.box_min) / vec3f(medium.res);
     let o = (origin - medium.box_min) / voxel;
     let d = dir / voxel;
@@ -34,21 +52,23 @@ fn medium_segment(origin: vec3f, dir: vec3f, t_max: f32) -> RaySegment {
 
 fn super_voxel(c: vec3i) -> vec4f {
     let u = vec3u(c);
-    return super_voxels[u.x + medium.dims.x * (u.y + medium.dims.y * u.z)];
+    let medium = media[media_index];
+    return super_voxels[medium.super_voxel_offset + u.x + medium.dims.x * (u.y + medium.dims.y * u.z)];
 }
 
 // μ at t inside super-voxel `cell` (the voxel clamped into it, as media::Medium::mu).
 fn mu_at(s: RaySegment, t: f32, cell: vec3i) -> f32 {
     media_lookups += 1u;
+    let medium = media[media_index];
     let lo = vec3u(cell) * SUPER_VOXEL;
     let hi = min(lo + vec3u(SUPER_VOXEL - 1u), medium.res - vec3u(1u));
     let v = clamp(vec3u(max(floor(seg_at(s, t)), vec3f(0.0))), lo, hi);
-    return density[v.x + medium.res.x * (v.y + medium.res.y * v.z)];
+    return density[medium.density_offset + v.x + medium.res.x * (v.y + medium.res.y * v.z)];
 }
 
 // μ at t anywhere on the segment (its super-voxel found from the point).
 fn mu_point(s: RaySegment, t: f32) -> f32 {
-    let cell = clamp(vec3i(floor(seg_at(s, t) / f32(SUPER_VOXEL))), vec3i(0), vec3i(medium.dims) - vec3i(1));
+    let cell = clamp(vec3i(floor(seg_at(s, t) / f32(SUPER_VOXEL))), vec3i(0), vec3i(media[media_index].dims) - vec3i(1));
     return mu_at(s, t, cell);
 }
 

@@ -3,19 +3,18 @@
 // (erratum of Alg. 1's ceil(I_j) + rand()).
 
 import package::media::types::{RaySegment};
-import package::media::medium_bindings::{medium};
 import package::media::media_rng::{media_rand};
-import package::media::media_grid::{BIG, SUPER_VOXEL, importance, mu_at, super_voxel};
+import package::media::media_grid::{media_dims, BIG, SUPER_VOXEL, importance, mu_at, super_voxel};
 import package::media::media_dda::{dda_advance, dda_exit, dda_new};
 
 const MAX_ESTIMATES: u32 = 9u;
 
 // x: F, y: t'_min, z: t'_max.
 fn od_prepare(s: RaySegment, variance_aware: bool) -> vec3f {
-    var dda = dda_new(s, medium.dims, f32(SUPER_VOXEL));
+    var dda = dda_new(s, media_dims(), f32(SUPER_VOXEL));
     var out = vec3f(0.0, s.t1, s.t0);
     var t = s.t0;
-    let bound = medium.dims.x + medium.dims.y + medium.dims.z + 1u;
+    let bound = media_dims().x + media_dims().y + media_dims().z + 1u;
     for (var i = 0u; i < bound; i++) {
         let p = importance(super_voxel(dda.cell), variance_aware).x;
         let exit = dda_exit(dda);
@@ -58,14 +57,14 @@ fn od_estimate(s: RaySegment, prep: vec3f, count: u32, samples: u32, variance_aw
     }
     let f_delta = prep.x / f32(samples);
     let tight = RaySegment(s.origin, prep.y, s.dir, prep.z);
-    var dda = dda_new(tight, medium.dims, f32(SUPER_VOXEL));
+    var dda = dda_new(tight, media_dims(), f32(SUPER_VOXEL));
     var imp = importance(super_voxel(dda.cell), variance_aware);
     var t_exit = dda_exit(dda);
     var f = (t_exit - tight.t0) * imp.x;
     var tau_c = (t_exit - tight.t0) * imp.y;
     var exhausted = false;
     var j = od_arg_min(&i_next);
-    let dims = medium.dims;
+    let dims = media_dims();
     let bound = count * samples + dims.x + dims.y + dims.z + 2u;
     for (var n = 0u; n < bound; n++) {
         if f_delta * i_next[j] >= f && exhausted {

@@ -2,9 +2,8 @@
 // media::ratio_tracking, media::majorant_tracking).
 
 import package::media::types::{RaySegment};
-import package::media::medium_bindings::{medium};
 import package::media::media_rng::{media_rand};
-import package::media::media_grid::{BIG, SUPER_VOXEL, mu_at, super_voxel};
+import package::media::media_grid::{media_dims, BIG, SUPER_VOXEL, mu_at, super_voxel};
 import package::media::media_dda::{Dda, dda_advance, dda_exit, dda_new};
 
 const MAX_COLLISIONS: u32 = 1024u;
@@ -36,7 +35,7 @@ fn track_length(s: RaySegment, rng: ptr<function, u32>) -> f32 {
 }
 
 fn ratio_tracking(s: RaySegment, rng: ptr<function, u32>) -> f32 {
-    var dda = dda_new(s, medium.dims, f32(SUPER_VOXEL));
+    var dda = dda_new(s, media_dims(), f32(SUPER_VOXEL));
     var t = s.t0;
     var value = 1.0;
     for (var n = 0u; n < MAX_COLLISIONS; n++) {
@@ -53,7 +52,7 @@ fn ratio_tracking(s: RaySegment, rng: ptr<function, u32>) -> f32 {
 // Delta tracking (free-flight sampling, density T(t) μ(t)): the parameter of the first real
 // collision on the segment, or BIG when the ray leaves it. The same walk as track_length.
 fn delta_tracking(s: RaySegment, rng: ptr<function, u32>) -> f32 {
-    var dda = dda_new(s, medium.dims, f32(SUPER_VOXEL));
+    var dda = dda_new(s, media_dims(), f32(SUPER_VOXEL));
     var t = s.t0;
     for (var n = 0u; n < MAX_COLLISIONS; n++) {
         let c = next_collision(s, &dda, t, rng);

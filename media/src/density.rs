@@ -8,6 +8,8 @@
 use glam::{UVec3, Vec3};
 use noise::{Fbm, MultiFractal, NoiseFn, Perlin};
 
+use crate::mesh_inside::MeshInside;
+
 pub use scene::DensityKind;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -29,6 +31,13 @@ impl DensityGrid {
     /// [`Self::bake`] with the field turned by `spin` radians about the box's vertical axis
     /// (an animated medium; the field is looked up at the voxel centre turned back).
     pub fn bake_spun(kind: &DensityKind, res: UVec3, sigma_t: f32, box_min: Vec3, box_max: Vec3, spin: f32) -> Self {
+        Self::bake_bounded(kind, None, res, sigma_t, box_min, box_max, spin)
+    }
+
+    /// [`Self::bake_spun`] clipped to a closed mesh in the box's unit coordinates: a voxel whose
+    /// centre lies outside it is empty (so the boundary is resolved to a voxel; the super-voxel
+    /// grid then skips what lies outside). The mesh turns with the field.
+    pub fn bake_bounded(kind: &DensityKind, bound: Option<&MeshInside>, res: UVec3, sigma_t: f32, box_min: Vec3, box_max: Vec3, spin: f32) -> Self {
         let mut data = Vec::with_capacity((res.x * res.y * res.z) as usize);
         let field = Field::new(kind);
         let turn = glam::Quat::from_rotation_y(-spin);
@@ -39,7 +48,8 @@ impl DensityGrid {
                     if spin != 0.0 {
                         p = turn * (p - Vec3::splat(0.5)) + Vec3::splat(0.5);
                     }
-                    data.push(sigma_t * field.unit_density(p));
+                    let inside = bound.is_none_or(|m| m.contains(p));
+                    data.push(if inside { sigma_t * field.unit_density(p) } else { 0.0 });
                 }
             }
         }
@@ -117,13 +127,15 @@ impl Field {
 impl DensityGrid {
     /// A scenario's medium, baked.
     pub fn from_desc(desc: &scene::MediumDesc) -> Self {
-        let (x, y, z) = desc.resolution;
-        Self::bake(&desc.kind, UVec3::new(x, y, z), desc.sigma_t, desc.box_min, desc.box_max)
+        Self::from_state(desc, &scene::MediumState { box_min: desc.box_min, box_max: desc.box_max, sigma_t: desc.sigma_t, spin: 0.0 })
     }
 
-    /// An animated medium at one of its states (`MediumDesc::at`).
+    /// An animated medium at one of its states (`MediumDesc::at`), clipped to its bound.
     pub fn from_state(desc: &scene::MediumDesc, s: &scene::MediumState) -> Self {
         let (x, y, z) = desc.resolution;
-        Self::bake_spun(&desc.kind, UVec3::new(x, y, z), s.sigma_t, s.box_min, s.box_max, s.spin)
+        // Checked when the scenario loaded (sim::Scenario, errors at the mesh file's line).
+        let mesh = desc.bound.mesh(desc.box_min, desc.box_max).unwrap_or_else(|e| panic!("medium '{}': {e}", desc.name));
+        let inside = mesh.as_ref().map(MeshInside::new);
+        Self::bake_bounded(&desc.kind, inside.as_ref(), UVec3::new(x, y, z), s.sigma_t, s.box_min, s.box_max, s.spin)
     }
 }

@@ -9,6 +9,7 @@
 //! MIS weights (`mis`), equiangular sampling (`equiangular`), the closed-form MIS setting of
 //! Eqs. 9/10 (`mis_trial`) and the 1-D stratified sampling of Sec. 4.1 (`stratified`).
 
+pub mod closed_form;
 pub mod dda;
 pub mod gpu;
 pub mod image;
@@ -17,6 +18,7 @@ pub mod equiangular;
 pub mod jackknife;
 pub mod majorant_tracking;
 pub mod medium;
+pub mod mesh_inside;
 pub mod mis;
 pub mod mis_trial;
 pub mod optical_depth;
@@ -32,5 +34,6 @@ pub mod unbiased_ray_marching;
 
 pub use density::{DensityGrid, DensityKind};
 pub use medium::{Estimate, Medium, Segment};
+pub use mesh_inside::MeshInside;
 pub use rng::Pcg;
 pub use transmittance::Estimator;

@@ -16,6 +16,11 @@
 //!   over a black ground gives ε (1 − exp(−σ_t ℓ)) per pixel; an emissive scattering medium
 //!   filling the scene (every path collides D + 1 times, escape has probability e^{−80}) gives
 //!   ε Σ_{k ≤ D} albedo^k per channel at max depth D.
+//! - Several media (extinctions add): two disjoint absorbing slabs give the path tracer's image
+//!   times the product of their transmittances; two media in one box render as the one medium
+//!   of the summed extinction (its albedo and emission the extinction-weighted means), with
+//!   free-flight sampling and with MIS (jackknife weights on the summed optical depth), over
+//!   three seeds.
 
 use std::sync::OnceLock;
 
@@ -98,7 +103,7 @@ fn absorbing_slab_attenuates_the_path_tracer_image_by_its_closed_form() {
     let plain = tracer.render(gpu(), 4, 3, 0).expect("render").radiance;
     let slab = medium(DensityKind::Homogeneous, 8, sigma, Vec3::new(-60.0, 1.0, -60.0), Vec3::new(60.0, 2.0, 60.0));
     let setup = cloud_setup();
-    let image = setup.pass.render(gpu(), &tracer, &slab, MediumOptics::scattering(Vec3::ZERO), &VolumePathSettings::default(), 128, 5, 0).expect("render");
+    let image = setup.pass.render(gpu(), &tracer, &slab, &[MediumOptics::scattering(Vec3::ZERO)], &VolumePathSettings::default(), 128, 5, 0).expect("render");
     // exp(−σ ℓ) over each pixel's footprint, ℓ = 1 / |d.y| through the slab; the sun's chord is 1.
     let expected: Vec<f64> = slab_image(&camera, f64::from(sigma), 1.0, (-f64::from(sigma)).exp())
         .iter()
@@ -127,7 +132,7 @@ fn medium_emission_matches_its_closed_forms() {
     let setup = cloud_setup();
     let pass = &setup.pass;
     let optics = MediumOptics { albedo: Vec3::ZERO, emission };
-    let image = pass.render(gpu(), &tracer, &slab, optics, &VolumePathSettings::default(), 128, 7, 0).expect("render");
+    let image = pass.render(gpu(), &tracer, &slab, &[optics], &VolumePathSettings::default(), 128, 7, 0).expect("render");
     let transmitted = slab_image(&camera, f64::from(sigma), 1.0, 1.0);
     let expected: Vec<f64> = transmitted.iter().map(|t| lum(&emission.to_array()) * (1.0 - t)).collect();
     let (z, worst) = compare(&image, &expected, &vec![0.0; expected.len()]);
@@ -139,7 +144,7 @@ fn medium_emission_matches_its_closed_forms() {
     // σ_t = 20 in a box around everything: the ground, 4 units away, is reached with e^{−80}.
     let fog = medium(DensityKind::Homogeneous, 8, 20.0, Vec3::splat(-1000.0), Vec3::splat(1000.0));
     let albedo = Vec3::new(0.5, 0.25, 0.8);
-    let image = pass.render(gpu(), &tracer, &fog, MediumOptics { albedo, emission }, &VolumePathSettings::default(), 4, 7, 0).expect("render");
+    let image = pass.render(gpu(), &tracer, &fog, &[MediumOptics { albedo, emission }], &VolumePathSettings::default(), 4, 7, 0).expect("render");
     let want = emission * (0..=depth).map(|k| albedo.powf(k as f32)).fold(Vec3::ZERO, |a, b| a + b);
     let got = image.mean.iter().fold(Vec3::ZERO, |a, m| a + Vec3::from_array(*m)) / image.mean.len() as f32;
     let worst = image.mean.iter().map(|m| (Vec3::from_array(*m) - want).abs().max_element()).fold(0f32, f32::max);
@@ -189,7 +194,7 @@ fn render_cloud(tracer: &PathTracer, pass: &VolumePathPass, cloud: &GpuMedium, s
 }
 
 fn render_spp(tracer: &PathTracer, pass: &VolumePathPass, medium: &GpuMedium, s: VolumePathSettings, spp: u32, seed: u64) -> VolumeImage {
-    pass.render(gpu(), tracer, medium, MediumOptics::scattering(Vec3::splat(0.8)), &s, spp, seed, 0).expect("render")
+    pass.render(gpu(), tracer, medium, &[MediumOptics::scattering(Vec3::splat(0.8))], &s, spp, seed, 0).expect("render")
 }
 
 fn agree(what: &str, a: &VolumeImage, b: &VolumeImage) {
@@ -323,4 +328,73 @@ fn mis_variants_keep_their_measured_order_over_seeds() {
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn two_disjoint_absorbing_slabs_multiply_their_transmittances() {
+    let camera = Camera { position: Vec3::new(0.0, 4.0, 0.0), target: Vec3::ZERO, up: Vec3::NEG_Z, vfov: 50f32.to_radians() };
+    let sun = Light::Directional { direction: Vec3::NEG_Y, irradiance: Vec3::splat(2.0), angular_radius: 0.0 };
+    let scene = ground(camera, vec![sun]);
+    let mut tracer = PathTracer::new(gpu(), &scene, PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 8 }).expect("path tracer");
+    let plain = tracer.render(gpu(), 4, 3, 0).expect("render").radiance;
+    // σ 0.5 in y ∈ [1, 1.4] and σ 1.0 in y ∈ [1.6, 2]: optical depth (0.2 + 0.4) / |d.y| along a
+    // camera ray, 0.6 along the sun's.
+    let bake = |sigma: f32, y0: f32, y1: f32| Medium::new(DensityGrid::bake(&DensityKind::Homogeneous, UVec3::splat(8), sigma, Vec3::new(-60.0, y0, -60.0), Vec3::new(60.0, y1, 60.0)));
+    let (low, high) = (bake(0.5, 1.0, 1.4), bake(1.0, 1.6, 2.0));
+    let both = GpuMedium::several(gpu(), &[&low, &high]);
+    let setup = cloud_setup();
+    let absorbing = MediumOptics::scattering(Vec3::ZERO);
+    let image = setup.pass.render(gpu(), &tracer, &both, &[absorbing, absorbing], &VolumePathSettings::default(), 128, 5, 0).expect("render");
+    let expected: Vec<f64> = slab_image(&camera, 1.0, 0.6, (-0.6f64).exp()).iter().zip(&plain).map(|(t, p)| t * lum(&[p[0], p[1], p[2]])).collect();
+    let (z, worst) = compare(&image, &expected, &vec![0.0; expected.len()]);
+    let mean = image.mean.iter().map(lum).sum::<f64>() / expected.len() as f64;
+    let want = expected.iter().sum::<f64>() / expected.len() as f64;
+    println!("two absorbing slabs: mean {mean:.5} expected {want:.5}, z = {z:.2}, worst pixel {worst:.2} SE");
+    assert!(z.abs() <= 4.5 && worst <= 6.0, "two slabs: z = {z}, worst pixel {worst} SE");
+    assert!(setup.pass.render(gpu(), &tracer, &both, &[absorbing], &VolumePathSettings::default(), 1, 5, 0).is_err(), "one optics for two media is refused");
+}
+
+#[test]
+fn two_media_in_one_box_render_as_the_medium_of_their_summed_extinction() {
+    let setup = cloud_setup();
+    let (tracer, pass) = (&setup.tracer, &setup.pass);
+    let (lo, hi) = (Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 3.0, 1.0));
+    let bake = |kind: &DensityKind, sigma: f32| DensityGrid::bake(kind, UVec3::splat(32), sigma, lo, hi);
+    let sum = |a: &DensityGrid, b: &DensityGrid| DensityGrid { data: a.data.iter().zip(&b.data).map(|(x, y)| x + y).collect(), ..a.clone() };
+    let cases = {
+        // Two homogeneous media of different albedo and emission: the one medium has σ 1 + 2,
+        // albedo (0.9 · 1 + 0.3 · 2) / 3 and emission (1 ε1 + 2 ε2) / 3 (source terms σ ε add).
+        let (a, b) = (bake(&DensityKind::Homogeneous, 1.0), bake(&DensityKind::Homogeneous, 2.0));
+        let (e1, e2) = (Vec3::new(0.3, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.6));
+        let homogeneous = (
+            "homogeneous σ 1 + 2",
+            vec![(a.clone(), MediumOptics { albedo: Vec3::splat(0.9), emission: e1 }), (b.clone(), MediumOptics { albedo: Vec3::splat(0.3), emission: e2 })],
+            (sum(&a, &b), MediumOptics { albedo: Vec3::splat(0.5), emission: (e1 + 2.0 * e2) / 3.0 }),
+        );
+        // A cloud and a thin homogeneous haze: the one medium is their voxel sum.
+        let (c, h) = (bake(&DensityKind::Cloud { octaves: 3, frequency: 2.0, seed: 5 }, 3.0), bake(&DensityKind::Homogeneous, 0.5));
+        let grey = MediumOptics::scattering(Vec3::splat(0.8));
+        let cloud = ("cloud σ 3 + haze σ 0.5", vec![(c.clone(), grey), (h.clone(), grey)], (sum(&c, &h), grey));
+        [homogeneous, cloud]
+    };
+    for (what, parts, (one, one_optics)) in cases {
+        let media: Vec<Medium> = parts.iter().map(|(g, _)| Medium::new(g.clone())).collect();
+        let several = GpuMedium::several(gpu(), &media.iter().collect::<Vec<_>>());
+        let optics: Vec<MediumOptics> = parts.iter().map(|(_, o)| *o).collect();
+        let single = GpuMedium::new(gpu(), &Medium::new(one));
+        for mis in [MisWeight::None, MisWeight::Jackknife] {
+            let s = VolumePathSettings { mis, ..VolumePathSettings::default() };
+            let mut zs = Vec::new();
+            for seed in [1u64, 2, 3] {
+                let a = pass.render(gpu(), tracer, &several, &optics, &s, 64, 100 + seed, 0).expect("render");
+                let b = pass.render(gpu(), tracer, &single, &[one_optics], &s, 64, 200 + seed, 0).expect("render");
+                agree(&format!("{what}, {mis:?}, seed {seed}: two media vs one"), &a, &b);
+                zs.push(compare(&a, &b.mean.iter().map(lum).collect::<Vec<_>>(), &b.var_of_mean).0);
+            }
+            // Over the seeds: independent z, so their sum / √3 is standard normal too.
+            let z = zs.iter().sum::<f64>() / 3f64.sqrt();
+            println!("{what}, {mis:?}: z over three seeds {z:.2}");
+            assert!(z.abs() <= 4.5, "{what}, {mis:?}: z over three seeds {z}");
+        }
+    }
 }

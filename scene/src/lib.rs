@@ -10,7 +10,9 @@ pub mod rng;
 pub use rng::{SplitMix64, mix64};
 
 pub mod medium;
+pub mod medium_bound;
 pub use medium::{DensityKind, MediumDesc, MediumMotion, MediumState, RawGrid};
+pub use medium_bound::{ClosedMesh, MediumBound};
 
 use glam::{Mat4, Vec2, Vec3};
 use serde::{Deserialize, Serialize};

@@ -91,13 +91,17 @@ impl RawGrid {
 }
 
 /// One medium of a scenario.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MediumDesc {
     pub name: String,
     pub kind: DensityKind,
     pub box_min: Vec3,
     pub box_max: Vec3,
+    /// A closed mesh the medium is clipped to inside its box (`MediumBound::Box`, none, by
+    /// default).
+    #[serde(default, skip_serializing_if = "is_box")]
+    pub bound: crate::MediumBound,
     /// Peak extinction per world unit.
     pub sigma_t: f32,
     /// Voxels along each axis of the box.
@@ -142,6 +146,28 @@ pub struct MediumState {
     pub box_max: Vec3,
     pub sigma_t: f32,
     pub spin: f32,
+}
+
+fn is_box(b: &crate::MediumBound) -> bool {
+    *b == crate::MediumBound::Box
+}
+
+/// As derived, but `bound` only when it is not the box: the reference cache hashes a medium by
+/// its `Debug` form, and the field must not change the keys of media declared before it.
+impl std::fmt::Debug for MediumDesc {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut d = f.debug_struct("MediumDesc");
+        d.field("name", &self.name).field("kind", &self.kind).field("box_min", &self.box_min).field("box_max", &self.box_max);
+        if !is_box(&self.bound) {
+            d.field("bound", &self.bound);
+        }
+        d.field("sigma_t", &self.sigma_t)
+            .field("resolution", &self.resolution)
+            .field("albedo", &self.albedo)
+            .field("emission", &self.emission)
+            .field("motion", &self.motion)
+            .finish()
+    }
 }
 
 fn default_resolution() -> (u32, u32, u32) {

@@ -452,6 +452,12 @@ impl Scenario {
                 }
             }
         }
+        for m in &mut file.media {
+            m.bound.resolve(origin.parent().unwrap_or(Path::new("")));
+            if let Err(e) = m.bound.mesh(m.box_min, m.box_max) {
+                return Err(ScenarioError { file: origin.to_path_buf(), position: find_quoted(text, &m.name), message: format!("medium '{}': bound: {e}", m.name) });
+            }
+        }
         for m in &file.media {
             if let Some(message) = m.problem() {
                 return Err(ScenarioError { file: origin.to_path_buf(), position: find_quoted(text, &m.name).or_else(|| invalid("media", String::new()).position), message });

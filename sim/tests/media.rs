@@ -92,3 +92,57 @@ fn a_raw_density_grid_loads_relative_to_the_scenario_and_bad_files_name_their_li
     assert_eq!(shipped.res, (16, 16, 16));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_mesh_bound_loads_relative_to_the_scenario_and_bad_meshes_name_their_line() {
+    let dir = std::env::temp_dir().join(format!("flicker_mesh_bound_{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("assets")).unwrap();
+    let obj = |name: &str, text: &str| std::fs::write(dir.join("assets").join(name), text).unwrap();
+    // An octahedron, outward-facing; variants with one face missing, one flipped, a bad index.
+    let vertices = "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n";
+    let faces = ["f 1 3 5", "f 3 2 5", "f 2 4 5", "f 4 1 5", "f 3 1 6", "f 2 3 6", "f 4 2 6", "f 1 4 6"];
+    obj("ok.obj", &format!("# octahedron\n{vertices}{}\n", faces.join("\n")));
+    obj("open.obj", &format!("{vertices}{}\n", faces[..7].join("\n")));
+    obj("flipped.obj", &format!("{vertices}{}\nf 5 3 1\n", faces[1..].join("\n")));
+    obj("index.obj", &format!("{vertices}f 1 3 7\n"));
+    obj("vertex.obj", "v 1 0\n");
+    let load = |bound: &str| {
+        let text = scenario(&format!(r#"(name: "m", kind: Homogeneous, box_min: (-1, -1, -1), box_max: (1, 1, 1), bound: {bound}, sigma_t: 2.0)"#));
+        Scenario::from_ron(&text, &dir.join("volume.ron"))
+    };
+    let s = load(r#"Obj(file: "assets/ok.obj")"#).unwrap();
+    let mesh = s.media[0].bound.mesh(s.media[0].box_min, s.media[0].box_max).unwrap().unwrap();
+    assert_eq!(mesh.triangles.len(), 8);
+    // In the box's unit coordinates.
+    assert_eq!(mesh.positions[0], glam::Vec3::new(1.0, 0.5, 0.5));
+    for (file, line, word) in [
+        // The first face (in file order) with an open edge: the one beside the missing face.
+        ("open.obj", 10, "no face on its other side"),
+        ("flipped.obj", 14, "same direction"),
+        ("index.obj", 7, "'7'; expected a vertex index 1 to 6"),
+        ("vertex.obj", 1, "expected a vertex 'v X Y Z'"),
+    ] {
+        let e = load(&format!(r#"Obj(file: "assets/{file}")"#)).unwrap_err().to_string();
+        assert!(e.contains(&format!("{file}:{line}:")) && e.contains(word), "{e}");
+        assert!(e.contains("volume.ron:4:"), "{e}");
+    }
+    assert!(load(r#"Obj(file: "assets/missing.obj")"#).unwrap_err().to_string().contains("cannot read the OBJ mesh"));
+    assert!(load("Sphere(segments: 7)").unwrap_err().to_string().contains("expected an even number from 4 to 256"));
+    assert_eq!(load("Sphere(segments: 16)").unwrap().media[0].bound, scene::MediumBound::Sphere { segments: 16 });
+    // The shipped torus is closed.
+    let torus = scene::ClosedMesh::load_obj(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/assets/torus.obj")).unwrap();
+    assert_eq!(torus.triangles.len(), 2 * 24 * 12);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_medium_without_a_bound_keeps_its_debug_form() {
+    // The reference cache keys a medium by its Debug form: the bound appears only when set.
+    let s = parse(&scenario(r#"(name: "b", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0)"#)).unwrap();
+    assert_eq!(
+        format!("{:?}", s.media[0]),
+        "MediumDesc { name: \"b\", kind: Homogeneous, box_min: Vec3(0.0, 0.0, 0.0), box_max: Vec3(1.0, 1.0, 1.0), sigma_t: 1.0, resolution: (64, 64, 64), albedo: Vec3(0.8, 0.8, 0.8), emission: None, motion: MediumMotion { velocity: Vec3(0.0, 0.0, 0.0), scale_per_second: 0.0, spin_degrees_per_second: 0.0, pulse_amplitude: 0.0, pulse_period: 0.0 } }"
+    );
+    let b = parse(&scenario(r#"(name: "b", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), bound: Sphere(segments: 8), sigma_t: 1.0)"#)).unwrap();
+    assert!(format!("{:?}", b.media[0]).contains("bound: Sphere { segments: 8 }"));
+}

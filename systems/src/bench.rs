@@ -82,6 +82,11 @@ struct TraversalRow {
     wgsl_mrays_per_s: f64,
     cpu_mrays_per_s: f64,
     traversal_ratio_vs_obvhs: f64,
+    /// The same rays sorted for coherence (render::bvh::ray_order).
+    wgsl_sorted_mrays_per_s: f64,
+    cpu_sorted_mrays_per_s: f64,
+    /// WGSL on sorted rays over WGSL on the same rays in random order.
+    wgsl_sorted_speedup: f64,
 }
 
 /// One path-tracer frame measurement (the JSON's `frames`).
@@ -107,8 +112,11 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
     warm_up(&gpu)?;
 
     writeln!(md, "## BVH traversal (closest hit, {} random rays)\n", opts.rays)?;
-    writeln!(md, "| scene | triangles | instances | WGSL Mrays/s | obvhs CPU Mrays/s | WGSL / CPU | hits | WGSL = CPU |")?;
-    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|")?;
+    writeln!(
+        md,
+        "| scene | triangles | instances | WGSL Mrays/s | obvhs CPU Mrays/s | WGSL / CPU | sorted: WGSL Mrays/s | sorted: CPU Mrays/s | sorted / random, WGSL | hits | WGSL = CPU |"
+    )?;
+    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
     let scenes: Vec<(String, SceneDesc)> = vec![
         ("cornell_box".into(), builtin_scene("cornell_box", (64, 36))?),
         ("hairball".into(), builtin_scene("hairball", (64, 36))?),
@@ -119,12 +127,15 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         let b = traversal_benchmark(&gpu, scene, opts.rays, 1).with_context(|| format!("traversal benchmark on {name}"))?;
         writeln!(
             md,
-            "| {name} | {} | {} | {:.3} | {:.3} | {:.2} | {:.1}% | {:.2}% |",
+            "| {name} | {} | {} | {:.3} | {:.3} | {:.2} | {:.3} | {:.3} | {:.2} | {:.1}% | {:.2}% |",
             b.triangles,
             b.instances,
             b.gpu_rays_per_second / 1e6,
             b.cpu_rays_per_second / 1e6,
             b.gpu_rays_per_second / b.cpu_rays_per_second,
+            b.gpu_sorted_rays_per_second / 1e6,
+            b.cpu_sorted_rays_per_second / 1e6,
+            b.gpu_sorted_rays_per_second / b.gpu_rays_per_second,
             100.0 * b.hit_fraction,
             100.0 * b.agreement
         )?;
@@ -134,6 +145,9 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
             wgsl_mrays_per_s: b.gpu_rays_per_second / 1e6,
             cpu_mrays_per_s: b.cpu_rays_per_second / 1e6,
             traversal_ratio_vs_obvhs: b.gpu_rays_per_second / b.cpu_rays_per_second,
+            wgsl_sorted_mrays_per_s: b.gpu_sorted_rays_per_second / 1e6,
+            cpu_sorted_mrays_per_s: b.cpu_sorted_rays_per_second / 1e6,
+            wgsl_sorted_speedup: b.gpu_sorted_rays_per_second / b.gpu_rays_per_second,
         });
     }
 

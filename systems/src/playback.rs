@@ -63,10 +63,11 @@ fn check_media_support(spec: &RunSpec, origin: &str) -> Result<()> {
     }
     let references = (0..scenario.frames).any(|f| scenario.reference.wants(f, scenario.frames));
     let volume_path = spec.methods.iter().any(|m| matches!(m.spec, MethodSpec::VolumePath(_)));
-    if let (Some(second), true) = (scenario.media.get(1), references || volume_path) {
+    if let (Some(extra), true) = (scenario.media.get(media::gpu::MAX_MEDIA), references || volume_path) {
         anyhow::bail!(
-            "{origin}: medium '{}': the volumetric path tracer (references, VolumePath) renders one medium; expected a single medium, or more only with VolumeTransmittance methods and no references",
-            second.name
+            "{origin}: medium '{}': the volumetric path tracer (references, VolumePath) renders at most {} media; expected fewer, or more only with VolumeTransmittance methods and no references",
+            extra.name,
+            media::gpu::MAX_MEDIA
         );
     }
     Ok(())
@@ -92,10 +93,10 @@ impl FrameWorld {
         world.insert_resource(RunOutput { folder, records: Vec::new() });
         world.insert_resource(References { cache: ReferenceCache::new(cache_dir), current: None, rendered: 0, cached: 0 });
         world.insert_resource(Progress(progress));
-        // The path tracer renders one medium: the first declared (media/README.md).
-        if let Some(desc) = scenario.media.first() {
+        // The volumetric path tracer renders every declared medium (media/README.md).
+        if !scenario.media.is_empty() {
             let gpu = &world.resource::<GpuDevice>().0;
-            let medium = frame::media::SceneMedium::new(gpu, desc);
+            let medium = frame::media::SceneMedium::new(gpu, &scenario.media);
             world.insert_resource(medium);
         }
         frame::catch_failures(&mut world);

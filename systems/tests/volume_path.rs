@@ -2,8 +2,8 @@
 //! weight with FLIP and relative MSE against the volumetric reference; volume_moving_light.ron's
 //! animated cloud is rebaked per frame (its references change frame to frame, its frames are
 //! measured for flicker); a scenario without media refuses the method by name; a scenario with
-//! media refuses methods that would render it without them, and a second medium where the
-//! volumetric path tracer renders one. Small overrides
+//! media refuses methods that would render it without them, and more media than the
+//! volumetric path tracer binds. Small overrides
 //! (32x18, 2 spp, 16 spp references, 2 frames of the moving light) keep it to seconds on lavapipe.
 
 use std::path::Path;
@@ -47,6 +47,19 @@ fn the_moving_light_scenario_rebakes_its_cloud_and_measures_flicker() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+#[test]
+fn the_mesh_bound_scenario_plays_two_media_and_rebakes_its_turning_torus() {
+    let out = std::env::temp_dir().join(format!("flicker_volume_mesh_{}", std::process::id()));
+    let summary = play("volume_mesh_bound.ron", Some(2), &out);
+    // The torus-bounded cloud turns: each frame has its own reference.
+    assert_eq!(summary.references_rendered, 2, "cached {}", summary.references_cached);
+    assert_eq!(summary.records.len(), 4);
+    for r in &summary.records {
+        assert!(r.flip.is_some_and(|f| f.is_finite() && f > 0.0 && f < 1.0), "{} frame {}: FLIP {:?}", r.method, r.frame, r.flip);
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
 /// The error of running an inline scenario (refused before any frame).
 fn refusal(text: &str, name: &str) -> String {
     let scenario = sim::Scenario::from_ron(text, Path::new("inline.ron")).unwrap();
@@ -66,9 +79,10 @@ fn a_scenario_without_media_refuses_volume_path() {
 #[test]
 fn a_scenario_with_media_refuses_what_would_leave_them_out() {
     let fog = "(name: \"fog\", kind: Homogeneous, box_min: (-1, -1, -1), box_max: (1, 1, 1), sigma_t: 1.0, resolution: (8, 8, 8))";
-    let haze = "(name: \"haze\", kind: Homogeneous, box_min: (-1, -1, -1), box_max: (1, 1, 1), sigma_t: 1.0, resolution: (8, 8, 8))";
     let e = refusal(&format!("Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1,\n methods: [VolumePath(spp: 1), PathTracing(spp: 1)], media: [{fog}])"), "pt");
     assert!(e.contains("inline.ron:2:") && e.contains("does not render participating media") && e.contains("'fog'"), "{e}");
-    let e = refusal(&format!("Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, methods: [VolumePath(spp: 1)], media: [{fog}, {haze}])"), "two");
-    assert!(e.contains("medium 'haze'") && e.contains("renders one medium"), "{e}");
+    // Several media render together, up to media::gpu::MAX_MEDIA.
+    let many: Vec<String> = (0..=media::gpu::MAX_MEDIA).map(|i| format!("(name: \"haze{i}\", kind: Homogeneous, box_min: (-1, -1, -1), box_max: (1, 1, 1), sigma_t: 0.1, resolution: (8, 8, 8))")).collect();
+    let e = refusal(&format!("Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, methods: [VolumePath(spp: 1)], media: [{}])", many.join(", ")), "many");
+    assert!(e.contains(&format!("medium 'haze{}'", media::gpu::MAX_MEDIA)) && e.contains("renders at most 8 media"), "{e}");
 }

@@ -3,22 +3,25 @@
 
 use render::compute::{BufferBinding, binding_layout, buffer_group};
 use render::gpu::Gpu;
+use bytemuck::Zeroable;
 use wgpu::util::DeviceExt;
 
 use crate::medium::{Medium, Segment};
 
 render::gpu_struct! {
-    /// The grid's shape and box.
+    /// One medium's grid shape and box, and where its voxels and super-voxels start in the
+    /// shared buffers (several media bound at once: `MAX_MEDIA` of these in a uniform array).
     pub struct MediumParams {
         pub res: [u32; 3] => "vec3u",
-        pub _pad0: u32 => "u32",
+        pub density_offset: u32 => "u32",
         /// Super-voxels per axis.
         pub dims: [u32; 3] => "vec3u",
-        pub _pad1: u32 => "u32",
+        pub super_voxel_offset: u32 => "u32",
         pub box_min: [f32; 3] => "vec3f",
-        pub _pad2: f32 => "f32",
+        /// Media bound (the same in every element).
+        pub count: u32 => "u32",
         pub box_max: [f32; 3] => "vec3f",
-        pub _pad3: f32 => "f32",
+        pub _pad: f32 => "f32",
     }
 }
 
@@ -39,38 +42,56 @@ impl From<&Segment> for RaySegment {
     }
 }
 
+/// The most media one pass binds (a uniform array; a scenario with more is refused).
+pub const MAX_MEDIA: usize = 8;
+
 pub const BINDINGS: [BufferBinding; 3] = [
-    BufferBinding::uniform("medium", "MediumParams"),
+    BufferBinding::uniform("media", "array<MediumParams, 8>"),
+    // every medium's voxels, one after the other
     BufferBinding::read("density", "array<f32>"),
-    // min, max, mean, RMS of μ − μ_min
+    // min, max, mean, RMS of μ − μ_min, every medium's one after the other
     BufferBinding::read("super_voxels", "array<vec4f>"),
 ];
 
+/// One or several media on the GPU; shaders select one (`select_medium` in media_grid.wgsl,
+/// the first by default).
 pub struct GpuMedium {
     pub layout: wgpu::BindGroupLayout,
     pub group: wgpu::BindGroup,
+    pub count: usize,
 }
 
 impl GpuMedium {
     pub fn new(gpu: &Gpu, medium: &Medium) -> Self {
-        let g = &medium.density;
-        let params = MediumParams {
-            res: g.res.into(),
-            _pad0: 0,
-            dims: medium.super_voxels.dims.into(),
-            _pad1: 0,
-            box_min: g.box_min.into(),
-            _pad2: 0.0,
-            box_max: g.box_max.into(),
-            _pad3: 0.0,
-        };
-        let sv: Vec<[f32; 4]> = medium.super_voxels.cells.iter().map(|c| [c.min, c.max, c.mean, c.rms_excess]).collect();
+        Self::several(gpu, &[medium])
+    }
+
+    /// Up to [`MAX_MEDIA`] media bound together (their buffers concatenated).
+    pub fn several(gpu: &Gpu, media: &[&Medium]) -> Self {
+        assert!((1..=MAX_MEDIA).contains(&media.len()), "{} media; a pass binds 1 to {MAX_MEDIA}", media.len());
+        let mut params = [MediumParams::zeroed(); MAX_MEDIA];
+        let (mut density, mut sv) = (Vec::new(), Vec::new());
+        for (p, medium) in params.iter_mut().zip(media) {
+            let g = &medium.density;
+            *p = MediumParams {
+                res: g.res.into(),
+                density_offset: density.len() as u32,
+                dims: medium.super_voxels.dims.into(),
+                super_voxel_offset: sv.len() as u32,
+                box_min: g.box_min.into(),
+                count: media.len() as u32,
+                box_max: g.box_max.into(),
+                _pad: 0.0,
+            };
+            density.extend_from_slice(&g.data);
+            sv.extend(medium.super_voxels.cells.iter().map(|c| [c.min, c.max, c.mean, c.rms_excess]));
+        }
         let buffer = |label: &str, contents: &[u8], usage| gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
-        let params = buffer("media params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
-        let density = buffer("media density", bytemuck::cast_slice(&g.data), wgpu::BufferUsages::STORAGE);
+        let params = buffer("media params", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
+        let density = buffer("media density", bytemuck::cast_slice(&density), wgpu::BufferUsages::STORAGE);
         let super_voxels = buffer("media super-voxels", bytemuck::cast_slice(&sv), wgpu::BufferUsages::STORAGE);
         let layout = binding_layout(gpu, "media", &BINDINGS);
         let group = buffer_group(gpu, "media", &layout, &[&params, &density, &super_voxels]);
-        Self { layout, group }
+        Self { layout, group, count: media.len() }
     }
 }

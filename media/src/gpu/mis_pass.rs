@@ -2,13 +2,11 @@
 //! per seed, the WGSL weights and Eqs. 9/10 on the same random numbers as the CPU reference. Needs
 //! no medium: its program is the random numbers, the jackknife and the MIS library only.
 
-use render::compute::{BufferBinding, binding_layout, buffer_group, pipelines};
+use render::compute::{BufferBinding, binding_layout, pipelines};
 use render::error::RenderError;
 use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
-use render::readback::read_buffer;
 use render::shader::{Module, Program};
-use wgpu::util::DeviceExt;
 
 use crate::mis_trial::{MisSetup, MisTrial};
 
@@ -56,27 +54,7 @@ impl MisPass {
     pub fn run(&self, gpu: &Gpu, setup: &MisSetup, seeds: &[u32]) -> Result<Vec<MisTrial>, String> {
         let s = setup;
         let params = MisParams { mu: s.mu, majorant: s.majorant, t_max: s.t_max, delta: s.delta, d: s.d, sigma_rel: s.sigma_rel, count: seeds.len() as u32, _pad: 0 };
-        let device = &gpu.device;
-        let init = |label: &str, contents: &[u8], usage| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
-        let params = init("mis params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
-        let seeds_buf = init("mis seeds", bytemuck::cast_slice(seeds), wgpu::BufferUsages::STORAGE);
-        let size = (seeds.len() * 32) as u64;
-        let trials = device.create_buffer(&wgpu::BufferDescriptor { label: Some("mis trials"), size, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
-        let staging = device.create_buffer(&wgpu::BufferDescriptor { label: Some("mis trials staging"), size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
-        let group = buffer_group(gpu, "media mis trials", &self.layout, &[&params, &seeds_buf, &trials]);
-        let mut enc = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &group, &[]);
-            // 2D dispatch: 10^6 trials exceed 65535 workgroups of 64 on one axis.
-            let groups = (seeds.len() as u32).div_ceil(64);
-            let max = gpu.device.limits().max_compute_workgroups_per_dimension;
-            pass.dispatch_workgroups(groups.min(max), groups.div_ceil(max), 1);
-        }
-        enc.copy_buffer_to_buffer(&trials, 0, &staging, 0, size);
-        gpu.queue.submit([enc.finish()]);
-        let raw: Vec<[f32; 8]> = read_buffer(gpu, &staging)?;
+        let raw: Vec<[f32; 8]> = super::trials::run_trials(gpu, "media mis trials", &self.layout, &self.pipeline, bytemuck::bytes_of(&params), seeds)?;
         Ok(raw.into_iter().map(|v| MisTrial { w1: [v[0], v[1], v[2]], eq9: [v[3], v[4], v[5]], eq10: [v[6], v[7]] }).collect())
     }
 }

@@ -2,16 +2,19 @@
 //! (`GpuMedium`) and the pass that runs one estimator on a list of segments with given seeds
 //! (`EstimatorPass`, what the GPU-vs-CPU tests run); the closed-form MIS trials (`MisPass`).
 
+mod closed_form_pass;
 mod estimator_pass;
 mod image_pass;
 mod medium;
 mod mis_pass;
 mod shaders;
+mod trials;
 mod volume_path_pass;
 
+pub use closed_form_pass::{ClosedFormParams, ClosedFormPass};
 pub use estimator_pass::{EstimatorPass, RayResult};
 pub use image_pass::{ImagePass, ImageParams, PASS};
 pub use mis_pass::{MisParams, MisPass};
-pub use medium::{GpuMedium, MediumParams, RaySegment};
+pub use medium::{GpuMedium, MAX_MEDIA, MediumParams, RaySegment};
 pub use shaders::{modules, modules_at, program};
 pub use volume_path_pass::{Combination, MediumOptics, MisWeight, ShadowTransmittance, VolumeImage, VolumePathParams, VolumePathPass, VolumePathSettings, VOLUME_PATH_PASS};

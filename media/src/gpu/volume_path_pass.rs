@@ -1,7 +1,8 @@
 //! Volumetric path tracing on the path tracer's scene (media/shaders/media_path.wgsl): unbiased
-//! references of a scene with one medium. Groups: 0 and 1 the path tracer's scene and geometry,
-//! 2 this pass's parameters and per-sample radiance, 3 the medium (`GpuMedium`). A scene
-//! without media never builds this pass: the path tracer and its shaders are unchanged.
+//! references of a scene with one or several media (their extinctions add). Groups: 0 and 1 the
+//! path tracer's scene and geometry, 2 this pass's parameters, the media's optics and
+//! per-sample radiance, 3 the media (`GpuMedium`). A scene without media never builds this
+//! pass: the path tracer and its shaders are unchanged.
 
 use glam::Vec3;
 use render::compute::{BufferBinding, binding_layout, buffer_group, pipelines};
@@ -82,7 +83,6 @@ impl Default for VolumePathSettings {
 
 render::gpu_struct! {
     pub struct VolumePathParams {
-        pub albedo: [f32; 3] => "vec3f",
         pub mis: u32 => "u32",
         pub eq10: u32 => "u32",
         pub shadow: u32 => "u32",
@@ -91,15 +91,15 @@ render::gpu_struct! {
         pub spp: u32 => "u32",
         pub first_sample: u32 => "u32",
         pub _pad0: u32 => "u32",
-        pub _pad1: u32 => "u32",
-        pub _pad2: u32 => "u32",
-        /// Emitted radiance per unit extinction (zero: none).
-        pub emission: [f32; 3] => "vec3f",
-        pub _pad3: u32 => "u32",
     }
 }
 
-const BINDINGS: [BufferBinding; 2] = [BufferBinding::uniform("vp", "VolumePathParams"), BufferBinding::read_write("samples", "array<vec4f>")];
+const BINDINGS: [BufferBinding; 3] = [
+    BufferBinding::uniform("vp", "VolumePathParams"),
+    // per medium of the GpuMedium: albedo at 2i, emission (radiance per unit extinction) at 2i + 1
+    BufferBinding::uniform("optics", "array<vec4f, 16>"),
+    BufferBinding::read_write("samples", "array<vec4f>"),
+];
 
 /// Paths per dispatch: short invocations (llvmpipe's loop limit, GPU watchdogs) and a bounded
 /// sample buffer.
@@ -152,9 +152,17 @@ impl VolumePathPass {
     }
 
     /// `spp` paths per pixel of the tracer's current scene and camera (seed and frame as the path
-    /// tracer's), in a medium of the given albedo and emission.
+    /// tracer's), in the media of `medium` with the given albedo and emission, one per medium.
     #[allow(clippy::too_many_arguments)]
-    pub fn render(&self, gpu: &Gpu, tracer: &PathTracer, medium: &GpuMedium, optics: MediumOptics, settings: &VolumePathSettings, spp: u32, seed: u64, frame: u32) -> Result<VolumeImage, String> {
+    pub fn render(&self, gpu: &Gpu, tracer: &PathTracer, medium: &GpuMedium, optics: &[MediumOptics], settings: &VolumePathSettings, spp: u32, seed: u64, frame: u32) -> Result<VolumeImage, String> {
+        if optics.len() != medium.count {
+            return Err(format!("{} media bound but {} optics given; expected one albedo and emission per medium", medium.count, optics.len()));
+        }
+        let mut packed = [[0f32; 4]; 2 * super::medium::MAX_MEDIA];
+        for (i, o) in optics.iter().enumerate() {
+            packed[2 * i] = o.albedo.extend(0.0).into();
+            packed[2 * i + 1] = o.emission.extend(0.0).into();
+        }
         let (width, height) = { let s = tracer.settings(); (s.width, s.height) };
         let pixels = width * height;
         let batch = (PATHS_PER_DISPATCH / pixels).clamp(1, spp.max(1));
@@ -169,7 +177,6 @@ impl VolumePathPass {
         while first < spp {
             let n = batch.min(spp - first);
             let params = VolumePathParams {
-                albedo: optics.albedo.into(),
                 mis: settings.mis as u32,
                 eq10: u32::from(settings.combination == Combination::Eq10),
                 shadow: settings.shadow as u32,
@@ -177,14 +184,11 @@ impl VolumePathPass {
                 spp: n,
                 first_sample: first,
                 _pad0: 0,
-                _pad1: 0,
-                _pad2: 0,
-                emission: optics.emission.into(),
-                _pad3: 0,
             };
             let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("volume path params"), contents: bytemuck::bytes_of(&params), usage: wgpu::BufferUsages::UNIFORM });
             tracer.prepare_frame(gpu, spp, 0, seed, frame);
-            let group = buffer_group(gpu, "media volume path", &self.layout, &[&params, &samples]);
+            let optics = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("volume path optics"), contents: bytemuck::cast_slice(&packed), usage: wgpu::BufferUsages::UNIFORM });
+            let group = buffer_group(gpu, "media volume path", &self.layout, &[&params, &optics, &samples]);
             let mut timed = self.timer.begin(gpu, VOLUME_PATH_PASS);
             timed
                 .pass(0, |pass| {

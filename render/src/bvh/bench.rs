@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
+use super::ray_order::sort_for_coherence;
 use super::{BvhError, RayBatch, RayQuery, SceneGeometry, SplitMix64, TraceKind};
 use crate::gpu::Gpu;
 use crate::scene::{Mesh, SceneDesc};
@@ -27,6 +28,10 @@ pub struct TraversalBench {
     pub gpu_rays_per_second: f64,
     /// Closest-hit rays per second of obvhs's traversal on `cpu_threads` threads.
     pub cpu_rays_per_second: f64,
+    /// The same rays in coherence order (`ray_order::sort_for_coherence`, sorted on the CPU and
+    /// not timed): WGSL and obvhs rays per second.
+    pub gpu_sorted_rays_per_second: f64,
+    pub cpu_sorted_rays_per_second: f64,
     pub cpu_threads: usize,
     /// Fraction of rays that hit something.
     pub hit_fraction: f64,
@@ -38,7 +43,7 @@ impl std::fmt::Display for TraversalBench {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} triangles, {} instances, {} rays: GPU {:.3} Mrays/s ({}), CPU {:.3} Mrays/s ({} threads), hits {:.1}%, GPU=CPU {:.2}%, build {:.3} s",
+            "{} triangles, {} instances, {} rays: GPU {:.3} Mrays/s ({}), CPU {:.3} Mrays/s ({} threads), sorted GPU {:.3} CPU {:.3}, hits {:.1}%, GPU=CPU {:.2}%, build {:.3} s",
             self.triangles,
             self.instances,
             self.rays,
@@ -46,6 +51,8 @@ impl std::fmt::Display for TraversalBench {
             self.adapter,
             self.cpu_rays_per_second / 1e6,
             self.cpu_threads,
+            self.gpu_sorted_rays_per_second / 1e6,
+            self.cpu_sorted_rays_per_second / 1e6,
             100.0 * self.hit_fraction,
             100.0 * self.agreement,
             self.build_seconds
@@ -80,6 +87,17 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
     })?;
     let cpu_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
 
+    let sorted = sort_for_coherence(geometry.bounds(), &queries);
+    let sorted_buffers = batch.upload(gpu, &sorted)?;
+    batch.dispatch(gpu, &geometry, &sorted_buffers, TraceKind::Closest)?;
+    let (reps, elapsed) = repeat_until(MIN_TIMED, || batch.dispatch(gpu, &geometry, &sorted_buffers, TraceKind::Closest))?;
+    let gpu_sorted_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
+    let (reps, elapsed) = repeat_until(MIN_TIMED, || {
+        std::hint::black_box(sorted.par_iter().map(|r| cpu.trace_closest(r.origin, r.direction, r.t_max)).collect::<Vec<_>>());
+        Ok(())
+    })?;
+    let cpu_sorted_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
+
     let n = queries.len().max(1) as f64;
     let hit_fraction = cpu_hits.iter().filter(|h| h.is_hit()).count() as f64 / n;
     let agreement =
@@ -92,6 +110,8 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
         build_seconds,
         gpu_rays_per_second,
         cpu_rays_per_second,
+        gpu_sorted_rays_per_second,
+        cpu_sorted_rays_per_second,
         cpu_threads: rayon::current_num_threads(),
         hit_fraction,
         agreement,

@@ -8,12 +8,14 @@
 //! - [`SceneGeometry`]: the same structures in storage buffers (one bind group, `@group(1)`) and
 //!   the WGSL interface `scene_geometry.wgsl` that passes import (`SceneGeometry::modules`).
 //! - [`RayBatch`]: a compute pass tracing a buffer of rays (tests, benchmark).
-//! - [`traversal_benchmark`]: rays/s of the WGSL traversal against obvhs on all CPU cores.
+//! - [`traversal_benchmark`]: rays/s of the WGSL traversal against obvhs on all CPU cores, on
+//!   random rays and on the same rays sorted for coherence ([`ray_order`]).
 
 mod bench;
 mod blas;
 mod cpu_traversal;
 mod ray_batch;
+pub mod ray_order;
 mod scene_geometry;
 mod tlas;
 mod triangle;

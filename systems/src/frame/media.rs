@@ -1,9 +1,9 @@
-//! The scenario's participating medium in the frame (issue 13): the first declared medium,
-//! baked on load and at every frame whose animation state changed (its grid and super-voxel
-//! grid rebuilt, `media::Medium::new`), on the GPU for the volumetric path tracer
-//! (media::gpu::VolumePathPass) that renders the references of a scenario with media and the
-//! `VolumePath` method. A scenario without media has no `SceneMedium`: nothing here runs and the
-//! path tracer renders its references as before.
+//! The scenario's participating media in the frame (issue 13): every declared medium, baked on
+//! load and at every frame whose animation state changed (its grid and super-voxel grid rebuilt,
+//! `media::Medium::new`), on the GPU together for the volumetric path tracer
+//! (media::gpu::VolumePathPass, where their extinctions add) that renders the references of a
+//! scenario with media and the `VolumePath` method. A scenario without media has no
+//! `SceneMedium`: nothing here runs and the path tracer renders its references as before.
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
@@ -25,24 +25,29 @@ pub const REFERENCE_SETTINGS: VolumePathSettings = VolumePathSettings {
 
 #[derive(Resource)]
 pub struct SceneMedium {
-    pub desc: MediumDesc,
-    /// The state the GPU holds.
-    pub state: MediumState,
+    pub descs: Vec<MediumDesc>,
+    /// The states the GPU holds, one per medium.
+    pub states: Vec<MediumState>,
     pub gpu: GpuMedium,
     /// Built on first use (references, the VolumePath method).
     pass: Option<VolumePathPass>,
 }
 
+fn upload(gpu: &render::gpu::Gpu, descs: &[MediumDesc], states: &[MediumState]) -> GpuMedium {
+    let baked: Vec<Medium> = descs.iter().zip(states).map(|(d, s)| Medium::new(DensityGrid::from_state(d, s))).collect();
+    GpuMedium::several(gpu, &baked.iter().collect::<Vec<_>>())
+}
+
 impl SceneMedium {
-    pub fn new(gpu: &render::gpu::Gpu, desc: &MediumDesc) -> Self {
-        let state = desc.at(0.0);
-        let medium = Medium::new(DensityGrid::from_state(desc, &state));
-        Self { desc: desc.clone(), state, gpu: GpuMedium::new(gpu, &medium), pass: None }
+    /// `descs`: 1 to media::gpu::MAX_MEDIA media (playback checks the count first).
+    pub fn new(gpu: &render::gpu::Gpu, descs: &[MediumDesc]) -> Self {
+        let states: Vec<MediumState> = descs.iter().map(|d| d.at(0.0)).collect();
+        Self { gpu: upload(gpu, descs, &states), descs: descs.to_vec(), states, pass: None }
     }
 
-    /// Albedo and emission (none: zero) of the declared medium.
-    pub fn optics(&self) -> MediumOptics {
-        MediumOptics { albedo: self.desc.albedo, emission: self.desc.emission.unwrap_or(Vec3::ZERO) }
+    /// Albedo and emission (none: zero) of each declared medium.
+    pub fn optics(&self) -> Vec<MediumOptics> {
+        self.descs.iter().map(|d| MediumOptics { albedo: d.albedo, emission: d.emission.unwrap_or(Vec3::ZERO) }).collect()
     }
 
     /// The volumetric path tracing pass, compiled on first use.
@@ -53,23 +58,25 @@ impl SceneMedium {
         Ok(self.pass.as_ref().expect("built above"))
     }
 
-    /// What the reference cache keys a frame's medium by: its declaration and current state.
+    /// What the reference cache keys a frame's media by: their declarations and current states.
     pub fn cache_key(&self) -> String {
-        format!("{:?} {:?} {:?}", self.desc, self.state, REFERENCE_SETTINGS)
+        let media: Vec<String> = self.descs.iter().zip(&self.states).map(|(d, s)| format!("{d:?} {s:?}")).collect();
+        format!("{} {:?}", media.join(" "), REFERENCE_SETTINGS)
     }
 }
 
-/// Extract stage: the medium at the simulated time, rebaked and uploaded when it changed.
+/// Extract stage: the media at the simulated time, rebaked and uploaded when one changed.
 pub fn upload_medium(gpu: Res<GpuDevice>, medium: Option<ResMut<SceneMedium>>, clock: Res<sim::resources::Clock>) -> Result {
     let Some(mut medium) = medium else { return Ok(()) };
-    let state = medium.desc.at(clock.time());
-    if state != medium.state {
-        if !(state.box_min.cmplt(state.box_max).all() && state.sigma_t.is_finite()) {
-            return Err(failed(anyhow::anyhow!("medium '{}' at frame {}: degenerate state {state:?}", medium.desc.name, clock.frame)));
+    let states: Vec<MediumState> = medium.descs.iter().map(|d| d.at(clock.time())).collect();
+    if states != medium.states {
+        for (d, state) in medium.descs.iter().zip(&states) {
+            if !(state.box_min.cmplt(state.box_max).all() && state.sigma_t.is_finite()) {
+                return Err(failed(anyhow::anyhow!("medium '{}' at frame {}: degenerate state {state:?}", d.name, clock.frame)));
+            }
         }
-        let baked = Medium::new(DensityGrid::from_state(&medium.desc, &state));
-        medium.gpu = GpuMedium::new(&gpu.0, &baked);
-        medium.state = state;
+        medium.gpu = upload(&gpu.0, &medium.descs, &states);
+        medium.states = states;
     }
     Ok(())
 }
@@ -87,6 +94,6 @@ pub fn render_volume(
     let optics = medium.optics();
     medium.pass(gpu, &tracer.0)?;
     let pass = medium.pass.as_ref().expect("built above");
-    let image = pass.render(gpu, &tracer.0, &medium.gpu, optics, settings, spp, seed, frame).map_err(|e| anyhow::anyhow!(e))?;
+    let image = pass.render(gpu, &tracer.0, &medium.gpu, &optics, settings, spp, seed, frame).map_err(|e| anyhow::anyhow!(e))?;
     Ok((image.mean.iter().map(|c| [c[0], c[1], c[2], 1.0]).collect(), image.timings, image.paths))
 }

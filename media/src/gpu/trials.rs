@@ -1,0 +1,33 @@
+//! What the trial passes share (`MisPass`, `ClosedFormPass`): one invocation per seed of a
+//! pipeline whose @group(0) is (params uniform, seeds, results), a 2D dispatch, the results read
+//! back.
+
+use render::compute::buffer_group;
+use render::gpu::Gpu;
+use render::readback::read_buffer;
+use wgpu::util::DeviceExt;
+
+/// Runs `pipeline` over `seeds`; `T` is one trial's result as the shader writes it.
+pub(super) fn run_trials<T: bytemuck::Pod>(gpu: &Gpu, label: &str, layout: &wgpu::BindGroupLayout, pipeline: &wgpu::ComputePipeline, params: &[u8], seeds: &[u32]) -> Result<Vec<T>, String> {
+    let device = &gpu.device;
+    let init = |contents: &[u8], usage| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
+    let params = init(params, wgpu::BufferUsages::UNIFORM);
+    let seeds_buf = init(bytemuck::cast_slice(seeds), wgpu::BufferUsages::STORAGE);
+    let size = (seeds.len() * std::mem::size_of::<T>()) as u64;
+    let results = device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
+    let staging = device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
+    let group = buffer_group(gpu, label, layout, &[&params, &seeds_buf, &results]);
+    let mut enc = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        // 2D dispatch: 10^6 trials exceed 65535 workgroups of 64 on one axis.
+        let groups = (seeds.len() as u32).div_ceil(64);
+        let max = gpu.device.limits().max_compute_workgroups_per_dimension;
+        pass.dispatch_workgroups(groups.min(max), groups.div_ceil(max), 1);
+    }
+    enc.copy_buffer_to_buffer(&results, 0, &staging, 0, size);
+    gpu.queue.submit([enc.finish()]);
+    read_buffer(gpu, &staging)
+}
