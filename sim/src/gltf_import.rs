@@ -1,6 +1,7 @@
 //! glTF 2.0 import: meshes, node hierarchy, metallic-roughness materials with base-colour
-//! textures, emission (with KHR_materials_emissive_strength), KHR_lights_punctual and
-//! perspective cameras.
+//! textures, emission (with KHR_materials_emissive_strength), KHR_lights_punctual,
+//! perspective cameras, and subsurface parameters from KHR_materials_diffuse_transmission +
+//! KHR_materials_volume ([`subsurface_from_volume`]).
 //!
 //! Light units are taken as they are (lux for directional, candela for point and spot) and
 //! used as the renderer's linear radiometric scale.
@@ -8,7 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec2, Vec3};
-use scene::{Light, Material, Mesh, Texture};
+use scene::{Light, Material, Mesh, Subsurface, Texture};
 
 use crate::components::MeshInstance;
 use crate::template::{NodeTemplate, WorldTemplate};
@@ -111,6 +112,27 @@ fn read_primitive(
     Ok(Mesh { name, positions, normals, uvs, indices })
 }
 
+/// The extension that marks a material as diffusely transmitting (light enters and leaves
+/// through the surface): with KHR_materials_volume it is read as subsurface scattering.
+pub const DIFFUSE_TRANSMISSION: &str = "KHR_materials_diffuse_transmission";
+
+/// Burley's parameters from KHR_materials_volume: light travels `attenuationDistance` before
+/// it is attenuated to `attenuationColor`, so the extinction coefficient per channel is
+/// σ_c = −ln(color_c) / distance, and the diffuse mean free path is taken as 1/σ_c. A
+/// departure: glTF defines no diffusion profile, and Burley's dmfp is the profile's mean free
+/// path on the surface, not the medium's 1/σ_t; the mapping keeps dmfp's ordering over
+/// channels and its scale. Errors: an infinite distance or a channel of colour 1 (no
+/// attenuation, an infinite dmfp), or a colour outside (0, 1].
+pub fn subsurface_from_volume(distance: f32, color: [f32; 3]) -> Result<Subsurface, String> {
+    if !(distance.is_finite() && distance > 0.0) {
+        return Err(format!("KHR_materials_volume attenuationDistance {distance}; expected a finite positive distance for subsurface scattering"));
+    }
+    if let Some(c) = color.iter().find(|c| !(**c > 0.0 && **c < 1.0)) {
+        return Err(format!("KHR_materials_volume attenuationColor {color:?} has {c}; expected each channel in (0, 1) for subsurface scattering"));
+    }
+    Ok(Subsurface { dmfp: Vec3::from(color.map(|c| distance / -c.ln())) })
+}
+
 /// Reads `path` (a .gltf with its buffers and images, or a .glb).
 pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
     let err = |part: &str, message: String| GltfError { file: path.to_path_buf(), part: part.to_string(), message };
@@ -129,12 +151,17 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
         let pbr = m.pbr_metallic_roughness();
         let c = pbr.base_color_factor();
         let strength = m.emissive_strength().unwrap_or(1.0);
+        let subsurface = match (m.extension_value(DIFFUSE_TRANSMISSION), m.volume()) {
+            (Some(_), Some(v)) => Some(subsurface_from_volume(v.attenuation_distance(), v.attenuation_color()).map_err(|e| err(&label("material", m.name(), i), e))?),
+            _ => None,
+        };
         let material = Material {
             base_color: Vec3::new(c[0], c[1], c[2]),
             base_color_texture: pbr.base_color_texture().map(|info| info.texture().source().index() as u32),
             emission: Vec3::from(m.emissive_factor()) * strength,
             roughness: pbr.roughness_factor(),
             metallic: pbr.metallic_factor(),
+            subsurface,
             ..Material::default()
         };
         t.add_material(m.name().unwrap_or(&format!("material{i}")), material);

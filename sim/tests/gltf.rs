@@ -124,3 +124,42 @@ fn unsupported_primitive_mode_names_mesh_and_primitive() {
     let expected = format!("{}: mesh 'Cube' primitive 0: mode Lines is not supported; expected triangles", path.display());
     assert_eq!(e, expected);
 }
+
+/// The test asset with material extensions set: FloorGrey diffusely transmitting with a volume
+/// (subsurface), Checker with a volume only (no subsurface: KHR_materials_volume alone belongs
+/// to refractive transmission).
+fn with_material_extensions(floor: serde_json::Value) -> String {
+    let mut doc: serde_json::Value = serde_json::from_str(&support::test_asset::gltf_text()).unwrap();
+    let materials = doc["materials"].as_array_mut().unwrap();
+    materials[0]["extensions"] = serde_json::json!({"KHR_materials_volume": {"attenuationDistance": 0.5, "attenuationColor": [0.5, 0.5, 0.5]}});
+    materials[1]["extensions"] = floor;
+    doc["extensionsUsed"].as_array_mut().unwrap().extend([serde_json::json!("KHR_materials_volume"), serde_json::json!(sim::gltf_import::DIFFUSE_TRANSMISSION)]);
+    serde_json::to_string_pretty(&doc).unwrap()
+}
+
+#[test]
+fn subsurface_comes_from_diffuse_transmission_and_volume() {
+    let dir = temp_dir("subsurface");
+    let path = dir.join("skin.gltf");
+    let volume = serde_json::json!({"attenuationDistance": 0.2, "attenuationColor": [0.8, 0.5, 0.25]});
+    std::fs::write(&path, with_material_extensions(serde_json::json!({"KHR_materials_diffuse_transmission": {}, "KHR_materials_volume": volume}))).unwrap();
+    let t = import(&path).unwrap_or_else(|e| panic!("{e}"));
+    let material = |name: &str| t.materials.materials[t.materials.index_of(name).unwrap() as usize];
+    let s = material("FloorGrey").subsurface.expect("FloorGrey is subsurface");
+    // dmfp_c = distance / −ln(color_c): 0.2 / 0.2231, 0.2 / 0.6931, 0.2 / 1.3863.
+    for (got, want) in s.dmfp.to_array().iter().zip([0.896_284, 0.288_539, 0.144_270]) {
+        assert!((got - want).abs() < 1e-5, "dmfp {:?}", s.dmfp);
+    }
+    assert_eq!(material("Checker").subsurface, None, "volume without diffuse transmission");
+    assert_eq!(material("Glow").subsurface, None);
+
+    // No attenuation in a channel: infinite dmfp, refused with the file and the material named.
+    let bad = serde_json::json!({"KHR_materials_diffuse_transmission": {}, "KHR_materials_volume": {"attenuationDistance": 0.2, "attenuationColor": [1.0, 0.5, 0.5]}});
+    std::fs::write(&path, with_material_extensions(bad)).unwrap();
+    let e = import(&path).unwrap_err().to_string();
+    assert!(e.starts_with(&format!("{}: material 'FloorGrey': KHR_materials_volume attenuationColor", path.display())) && e.contains("(0, 1)"), "{e}");
+    let bad = serde_json::json!({"KHR_materials_diffuse_transmission": {}, "KHR_materials_volume": {"attenuationColor": [0.5, 0.5, 0.5]}});
+    std::fs::write(&path, with_material_extensions(bad)).unwrap();
+    let e = import(&path).unwrap_err().to_string();
+    assert!(e.contains("material 'FloorGrey'") && e.contains("attenuationDistance inf"), "{e}");
+}

@@ -65,3 +65,57 @@ fn sss_without_a_subsurface_material_is_refused() {
     assert!(e.contains("plain.ron:2:") && e.contains("kappa"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Plays an inline scenario on the skin sphere (constant lamp, no animation) at 32x18.
+fn play_inline(name: &str, seed: u64, frames: u32, methods: &str) -> (Vec<FrameRecord>, PathBuf) {
+    let dir = std::env::temp_dir().join(format!("sss-e2e-{}-{name}-{seed}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join(format!("{name}.ron"));
+    let text = format!(
+        "Scenario(scene: Builtin(\"sss_sphere\"), resolution: (32, 18), frames: {frames}, seed: {seed}, max_depth: 2,\n methods: [{methods}],\n materials: [(material: \"skin\", subsurface: (dmfp: (0.12, 0.05, 0.025)))])"
+    );
+    std::fs::write(&file, text).unwrap();
+    let overrides = Overrides { out: Some(dir.join("run")), ..Default::default() };
+    let spec = RunSpec::load(&file, &overrides).expect("scenario");
+    let opts = RunOptions { scenario: file.clone(), overrides, cache_dir: Some(dir.join("cache")), progress: false };
+    (run_spec(&spec, &opts).expect("run").records, dir)
+}
+
+/// TAA after the pass (render::taa's resolve, Sec. 4.3): the first frame has no history and is
+/// the pass's own image; later frames blend the history, so in a still scene the frame-to-frame
+/// flicker (SMAPE) falls below the pass without TAA: a one-sided 95% Student-t bound over 3
+/// seeds. The separable baseline runs beside them: 2 x 25 fetches per SSS pixel, its two passes
+/// timed.
+#[test]
+fn taa_after_the_pass_lowers_flicker_and_separable_runs() {
+    const FRAMES: u32 = 8;
+    let mut gaps = vec![];
+    for seed in 1..=3u64 {
+        let methods = "Sss(variant: Adaptive, name: \"as\"), Sss(variant: Adaptive, taa: (alpha: 0.1), name: \"as_taa\"), Sss(variant: Separable(taps: 25), name: \"separable\")";
+        let (records, dir) = play_inline("taa", seed, FRAMES, methods);
+        let image = |m: &str, f: u32| systems::output::read_exr(&dir.join(format!("run/frames/{m}/{f:04}.exr"))).unwrap().2;
+        assert_eq!(image("as", 0), image("as_taa", 0), "seed {seed}: frame 0 has no history");
+        assert_ne!(image("as", 3), image("as_taa", 3), "seed {seed}: TAA changed nothing");
+        let mean_smape = |m: &str| {
+            let v: Vec<f64> = records.iter().filter(|r| r.method == m && r.frame > 0).map(|r| r.smape.expect("smape")).collect();
+            v.iter().sum::<f64>() / v.len() as f64
+        };
+        gaps.push(mean_smape("as") - mean_smape("as_taa"));
+        for r in records.iter().filter(|r| r.method == "as_taa") {
+            assert!(r.passes.iter().any(|(p, _)| p == "taa_resolve"), "{:?}", r.passes);
+        }
+        for r in records.iter().filter(|r| r.method == "separable") {
+            assert_eq!(stat(r, "sss_mean_spp"), 50.0);
+            for pass in ["sss_separable_h", "sss_separable_v"] {
+                assert!(r.passes.iter().any(|(p, _)| p == pass), "{:?}", r.passes);
+            }
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+    let n = gaps.len() as f64;
+    let mean = gaps.iter().sum::<f64>() / n;
+    let sd = (gaps.iter().map(|g| (g - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let bound = mean - systems::suite::student_t::quantile(0.95, n - 1.0) * sd / n.sqrt();
+    eprintln!("SMAPE(as) − SMAPE(as_taa) per seed: {gaps:?}, lower 95% bound {bound}");
+    assert!(bound > 0.0, "TAA did not lower flicker: per-seed gaps {gaps:?}, bound {bound}");
+}

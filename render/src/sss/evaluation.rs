@@ -17,31 +17,46 @@ pub struct RunMeasures {
     pub count_image: Vec<f32>,
 }
 
-/// PSNR of the luminance over SSS pixels, peak `peak`.
-pub fn psnr(result: &[PixelResult], reference: &[[f32; 3]], frame: &SssFrame, peak: f64) -> f64 {
+/// PSNR of luminance over the masked pixels, peak `peak`.
+pub fn psnr_luminance(result: &[f32], reference: &[f32], mask: &[bool], peak: f64) -> f64 {
     let (mut se, mut n) = (0.0f64, 0usize);
-    for ((r, f), t) in result.iter().zip(reference).zip(&frame.irradiance) {
-        if t[3] > 0.0 {
-            let e = luminance(r.rgb) as f64 - luminance(*f) as f64;
-            se += e * e;
-            n += 1;
-        }
+    for ((r, f), _) in result.iter().zip(reference).zip(mask).filter(|(_, m)| **m) {
+        let e = *r as f64 - *f as f64;
+        se += e * e;
+        n += 1;
     }
     let mse = se / n.max(1) as f64;
     10.0 * (peak * peak / mse.max(1e-30)).log10()
 }
 
-/// SMAPE = mean over SSS pixels of 2|a − b| / (|a| + |b| + ε) on luminance.
-pub fn smape(a: &[PixelResult], b: &[PixelResult], frame: &SssFrame) -> f64 {
+/// SMAPE = mean over the masked pixels of 2|a − b| / (|a| + |b| + ε) on luminance.
+pub fn smape_luminance(a: &[f32], b: &[f32], mask: &[bool]) -> f64 {
     let (mut s, mut n) = (0.0f64, 0usize);
-    for ((a, b), t) in a.iter().zip(b).zip(&frame.irradiance) {
-        if t[3] > 0.0 {
-            let (x, y) = (luminance(a.rgb) as f64, luminance(b.rgb) as f64);
-            s += 2.0 * (x - y).abs() / (x.abs() + y.abs() + 1e-4);
-            n += 1;
-        }
+    for ((x, y), _) in a.iter().zip(b).zip(mask).filter(|(_, m)| **m) {
+        let (x, y) = (*x as f64, *y as f64);
+        s += 2.0 * (x - y).abs() / (x.abs() + y.abs() + 1e-4);
+        n += 1;
     }
     s / n.max(1) as f64
+}
+
+fn lum(result: &[PixelResult]) -> Vec<f32> {
+    result.iter().map(|r| luminance(r.rgb)).collect()
+}
+
+fn mask(frame: &SssFrame) -> Vec<bool> {
+    frame.irradiance.iter().map(|t| t[3] > 0.0).collect()
+}
+
+/// PSNR of the luminance over SSS pixels, peak `peak`.
+pub fn psnr(result: &[PixelResult], reference: &[[f32; 3]], frame: &SssFrame, peak: f64) -> f64 {
+    let reference: Vec<f32> = reference.iter().map(|c| luminance(*c)).collect();
+    psnr_luminance(&lum(result), &reference, &mask(frame), peak)
+}
+
+/// SMAPE between two frames' results over SSS pixels.
+pub fn smape(a: &[PixelResult], b: &[PixelResult], frame: &SssFrame) -> f64 {
+    smape_luminance(&lum(a), &lum(b), &mask(frame))
 }
 
 /// Accumulates a run frame by frame.

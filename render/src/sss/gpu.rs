@@ -1,8 +1,10 @@
 //! The screen-space SSS pass in WGSL (shaders/sss/sss_pass.wgsl, entry `sss_scatter`): the
 //! same per-pixel step as `screen_pass::pixel_step`, one invocation per pixel, with ping-pong
-//! histories on the GPU. Timed per pass (`sss_scatter`) by `PassTimer`.
+//! histories on the GPU; the separable variant runs shaders/sss/separable.wgsl's two 1-D passes
+//! instead. Timed per pass (`sss_scatter`, `sss_separable_h`, `sss_separable_v`) by `PassTimer`.
 
 use super::control_variates::EmCovariance;
+use super::separable;
 use super::screen_pass::{PixelHistory, PixelResult, SssFrame, SssSettings, SssVariant};
 use super::spvg::SpvgHistory;
 use crate::error::RenderError;
@@ -19,8 +21,8 @@ pub const MAX_COUNT: u32 = 4096;
 
 crate::gpu_struct! {
     /// The pass's uniform: image size, frame and seed, the variant (0 fixed, 1 AS, 2 OCV,
-    /// 3 CCV), SPVG's and the control variates' parameters, d per channel in pixels (w: the
-    /// sampled d).
+    /// 3 CCV, 4 separable), SPVG's and the control variates' parameters, the separable
+    /// kernel's tap count, d per channel in pixels (w: the sampled d).
     pub struct SssParams {
         pub width: u32 => "u32",
         pub height: u32 => "u32",
@@ -37,16 +39,18 @@ crate::gpu_struct! {
         pub a0: f32 => "f32",
         pub a_cv: f32 => "f32",
         pub fast_inverse: u32 => "u32",
-        pub pad: u32 => "u32",
+        pub taps: u32 => "u32",
         pub d_px: [f32; 4] => "vec4f",
     }
 }
 const _: () = assert!(std::mem::size_of::<SssParams>() == 80);
 
-/// The pass's WGSL program.
+/// The pass's WGSL program: the Monte Carlo pass and the separable baseline's two passes.
 pub fn program() -> Program {
     let types = Module::generated("package::sss_types", &[SssParams::WGSL]);
-    Program::new(vec![types, crate::wgsl_file!("pt_sampling.wgsl"), crate::wgsl_file!("sss/sampling.wgsl"), crate::wgsl_file!("sss/spvg.wgsl")]).entry(crate::wgsl_file!("sss/sss_pass.wgsl"))
+    Program::new(vec![types, crate::wgsl_file!("pt_sampling.wgsl"), crate::wgsl_file!("sss/sampling.wgsl"), crate::wgsl_file!("sss/spvg.wgsl")])
+        .entry(crate::wgsl_file!("sss/sss_pass.wgsl"))
+        .entry(crate::wgsl_file!("sss/separable.wgsl"))
 }
 
 /// The pass for one image size, with its buffers and two history sets (read one, write the other).
@@ -54,6 +58,11 @@ pub struct SssPass {
     width: u32,
     height: u32,
     pipeline: wgpu::ComputePipeline,
+    /// The separable baseline's horizontal and vertical passes, and their bind groups.
+    separable: [(wgpu::ComputePipeline, wgpu::BindGroup); 2],
+    kernel: wgpu::Buffer,
+    /// The separable kernel last uploaded: (taps, d_px).
+    kernel_for: Option<(u32, [f32; 3])>,
     params: wgpu::Buffer,
     irradiance: wgpu::Buffer,
     history: [wgpu::Buffer; 2],
@@ -74,7 +83,7 @@ impl SssPass {
         if width == 0 || height == 0 {
             return Err(RenderError::Settings(format!("SSS pass size {width}x{height} must be non-zero")));
         }
-        let [pipeline] = crate::compute::pipelines_auto_layout(gpu, "sss_scatter", &program(), ["sss_scatter"])?;
+        let [pipeline, horizontal, vertical] = crate::compute::pipelines_auto_layout(gpu, "sss_scatter", &program(), ["sss_scatter", "sss_separable_h", "sss_separable_v"])?;
         let size = width as u64 * height as u64 * 16;
         let params = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("sss params"), contents: bytemuck::bytes_of(&<SssParams as bytemuck::Zeroable>::zeroed()), usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST });
         let irradiance = storage(gpu, "sss irradiance", size);
@@ -88,7 +97,18 @@ impl SssPass {
             gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("sss pass"), layout: &layout, entries: &entries })
         };
         let groups = [group(0), group(1)];
-        Ok(Self { width, height, pipeline, params, irradiance, history, cv, scattered, groups, current: 0, timer: PassTimer::new(gpu, &["sss_scatter"]) })
+        let kernel = storage(gpu, "sss separable kernel", separable::MAX_TAPS as u64 * 16);
+        let intermediate = storage(gpu, "sss separable intermediate", size);
+        // Auto layouts hold only what each entry uses: the horizontal pass never sees `scattered`.
+        let separable_group = |pipeline: &wgpu::ComputePipeline, buffers: &[&wgpu::Buffer]| {
+            let entries: Vec<_> = buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("sss separable"), layout: &pipeline.get_bind_group_layout(0), entries: &entries })
+        };
+        let h_group = separable_group(&horizontal, &[&params, &irradiance, &kernel, &intermediate]);
+        let v_group = separable_group(&vertical, &[&params, &irradiance, &kernel, &intermediate, &scattered]);
+        let separable = [(horizontal, h_group), (vertical, v_group)];
+        let timer = PassTimer::new(gpu, &["sss_scatter", "sss_separable_h", "sss_separable_v"]);
+        Ok(Self { width, height, pipeline, separable, kernel, kernel_for: None, params, irradiance, history, cv, scattered, groups, current: 0, timer })
     }
 
     /// Replaces the latest history (empty = cold start everywhere).
@@ -111,10 +131,16 @@ impl SssPass {
             return Err(RenderError::Settings(format!("SSS frame {}x{} ({} texels) does not match the pass's {}x{}", frame.width, frame.height, frame.irradiance.len(), self.width, self.height)));
         }
         settings.spvg.validate().map_err(RenderError::Settings)?;
-        let fixed = match settings.variant {
-            SssVariant::Fixed { count } => count,
-            _ => 0,
+        let (fixed, taps) = match settings.variant {
+            SssVariant::Fixed { count } => (count, 0),
+            SssVariant::Separable { taps } => (0, taps),
+            _ => (0, 0),
         };
+        if taps > 0 && self.kernel_for != Some((taps, frame.d_px)) {
+            let kernel = separable::kernel(taps, frame.d_px).map_err(RenderError::Settings)?;
+            gpu.queue.write_buffer(&self.kernel, 0, bytemuck::cast_slice(&kernel));
+            self.kernel_for = Some((taps, frame.d_px));
+        }
         let most = fixed.max(settings.spvg.n_max);
         if most == 0 || most > MAX_COUNT {
             return Err(RenderError::Settings(format!("SSS sample count {most} must be in [1, {MAX_COUNT}]")));
@@ -137,21 +163,30 @@ impl SssPass {
             a0: settings.a0,
             a_cv: settings.a_cv,
             fast_inverse: settings.fast_inverse as u32,
-            pad: 0,
+            taps,
             d_px: [frame.d_px[0], frame.d_px[1], frame.d_px[2], frame.d_sample()],
         };
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
         gpu.queue.write_buffer(&self.irradiance, 0, bytemuck::cast_slice(&frame.irradiance));
         let mut timed = self.timer.begin(gpu, "sss frame");
-        let (pipeline, group) = (&self.pipeline, &self.groups[self.current]);
         let (gx, gy) = (self.width.div_ceil(8), self.height.div_ceil(8));
-        timed.pass(0, |pass| {
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, group, &[]);
-            pass.dispatch_workgroups(gx, gy, 1);
-        })?;
+        let passes: Vec<(usize, &wgpu::ComputePipeline, &wgpu::BindGroup)> = if taps > 0 {
+            self.separable.iter().enumerate().map(|(k, (p, g))| (1 + k, p, g)).collect()
+        } else {
+            vec![(0, &self.pipeline, &self.groups[self.current])]
+        };
+        for (index, pipeline, group) in passes {
+            timed.pass(index, |pass| {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, group, &[]);
+                pass.dispatch_workgroups(gx, gy, 1);
+            })?;
+        }
         let times = timed.submit()?;
-        self.current = 1 - self.current;
+        // The separable passes keep no history: the Monte Carlo histories stay as they were.
+        if taps == 0 {
+            self.current = 1 - self.current;
+        }
         Ok(times)
     }
 

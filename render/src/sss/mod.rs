@@ -1,7 +1,8 @@
 //! Screen-space subsurface scattering (../shared/seeds/realtime-sss-thesis.txt, Xie 2022):
 //! Burley's profile (`profile`) and its inverse cdfs (`inverse`), the pass's f32 sample math
 //! (`sampling`), single pass variance guiding (`spvg`), control variates in the sample-count
-//! domain (`control_variates`), the pass on the CPU (`screen_pass`) and in WGSL (`gpu`).
+//! domain (`control_variates`), the pass on the CPU (`screen_pass`) and in WGSL (`gpu`), the
+//! separable baseline (`separable`), the random-walk reference (`random_walk`).
 //! README inside.
 
 pub mod control_variates;
@@ -9,8 +10,10 @@ pub mod evaluation;
 pub mod gpu;
 pub mod inverse;
 pub mod profile;
+pub mod random_walk;
 pub mod sampling;
 pub mod screen_pass;
+pub mod separable;
 pub mod spvg;
 pub mod synthetic;
 

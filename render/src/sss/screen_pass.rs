@@ -4,6 +4,7 @@
 //! (eq. 5.2, divided by A: the albedo is applied after the pass), and the histories update.
 
 use super::control_variates::EmCovariance;
+use super::separable;
 use super::sampling::{luminance, pixel_offset, r2_point, radial_pdf, sample_radius};
 use super::spvg::{self, SpvgHistory, SpvgSettings};
 use serde::{Deserialize, Serialize};
@@ -19,6 +20,9 @@ pub enum SssVariant {
     OnlineCv,
     /// AS + CCV: SPVG on f̄ − G(t) (a = 1, Sec. 6.6).
     ConstantCv,
+    /// The separable baseline (Jimenez et al. 2015): two 1-D passes of `taps` taps each with
+    /// Burley's pre-integrated kernel (`separable`); no history.
+    Separable { taps: u32 },
 }
 
 impl SssVariant {
@@ -28,6 +32,7 @@ impl SssVariant {
             SssVariant::Adaptive => 1,
             SssVariant::OnlineCv => 2,
             SssVariant::ConstantCv => 3,
+            SssVariant::Separable { .. } => 4,
         }
     }
 }
@@ -124,8 +129,8 @@ pub fn scatter(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x: u3
     sum.map(|s| s / n as f32)
 }
 
-/// One pixel's step: count, samples, histories.
-pub fn pixel_step(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x: u32, y: u32, prev: &PixelHistory) -> (PixelResult, PixelHistory) {
+/// One pixel's step: count, samples, histories (the Monte Carlo variants).
+fn pixel_step(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x: u32, y: u32, prev: &PixelHistory) -> (PixelResult, PixelHistory) {
     let t = frame.irradiance[(y * frame.width + x) as usize];
     if t[3] <= 0.0 {
         return (PixelResult { rgb: [t[0], t[1], t[2]], count: 0 }, PixelHistory::default());
@@ -133,6 +138,7 @@ pub fn pixel_step(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x:
     let st = spvg::state(&prev.spvg, &settings.spvg);
     let n = match settings.variant {
         SssVariant::Fixed { count } => count,
+        SssVariant::Separable { .. } => unreachable!("the separable variant runs as two 1-D passes in `step`"),
         _ => spvg::sample_count(&st, &settings.spvg),
     };
     let rgb = scatter(frame, settings, frame_index, x, y, n);
@@ -148,9 +154,14 @@ pub fn pixel_step(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x:
     (PixelResult { rgb, count: n }, PixelHistory { spvg: spvg::update(&st, &settings.spvg, monitored, n), cv })
 }
 
-/// The whole image: results and the next frame's histories (`history` empty = cold start).
+/// The whole image: results and the next frame's histories (`history` empty = cold start;
+/// the separable variant keeps none). Errors: a separable kernel that cannot be built.
 pub fn step(frame: &SssFrame, settings: &SssSettings, frame_index: u32, history: &[PixelHistory]) -> (Vec<PixelResult>, Vec<PixelHistory>) {
     let count = (frame.width * frame.height) as usize;
+    if let SssVariant::Separable { taps } = settings.variant {
+        let kernel = separable::kernel(taps, frame.d_px).unwrap_or_else(|e| panic!("{e}"));
+        return (separable::step(frame, &kernel), vec![PixelHistory::default(); count]);
+    }
     let empty = PixelHistory::default();
     let mut results = Vec::with_capacity(count);
     let mut next = Vec::with_capacity(count);

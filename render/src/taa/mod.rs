@@ -381,6 +381,24 @@ impl Taa {
         self.finish(gpu, timings)
     }
 
+    /// Resolves a colour and primary hits held on the CPU (a pass that reads its image back,
+    /// e.g. the SSS method): uploads both and runs [`Self::resolve_external`].
+    pub fn resolve_colour(&mut self, gpu: &Gpu, jitter: [f32; 2], colour: &[[f32; 4]], primary: &[TaaPrimary]) -> Result<TaaOutput, RenderError> {
+        let pixels = (self.width * self.height) as usize;
+        if colour.len() != pixels || primary.len() != pixels {
+            return Err(RenderError::Settings(format!("TAA resolve of {} colours and {} primary hits; expected {pixels} ({}x{})", colour.len(), primary.len(), self.width, self.height)));
+        }
+        let init = |label: &str, contents: &[u8]| {
+            use wgpu::util::DeviceExt;
+            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage: wgpu::BufferUsages::COPY_SRC })
+        };
+        let (c, p) = (init("taa external colour", bytemuck::cast_slice(colour)), init("taa external primary", bytemuck::cast_slice(primary)));
+        self.resolve_external(gpu, jitter, |encoder, colour, primary| {
+            encoder.copy_buffer_to_buffer(&c, 0, colour, 0, c.size());
+            encoder.copy_buffer_to_buffer(&p, 0, primary, 0, p.size());
+        })
+    }
+
     fn write_params(&mut self, gpu: &Gpu, jitter: [f32; 2]) {
         let params = self.settings.params(self.width, self.height, jitter, self.history_valid);
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));

@@ -1,7 +1,9 @@
 //! Screen-space subsurface scattering (render::sss, issue 14, realtime-sss-thesis.txt): the path
 //! tracer's image, demodulated by the G-buffer albedo on the pixels of the scene's subsurface
 //! material, is scattered by the thesis's pass (Burley sampling with SPVG counts and control
-//! variates, or a fixed count) and modulated back. `Sss(variant: OnlineCv)`.
+//! variates, or a fixed count, or the separable baseline) and modulated back; with `taa` set,
+//! render::taa's resolve runs over the result, as the thesis's TAA after the pass.
+//! `Sss(variant: OnlineCv, taa: (alpha: 0.1))`.
 
 use std::time::Instant;
 
@@ -10,6 +12,7 @@ use bevy_ecs::prelude::*;
 use glam::Vec3;
 use render::path_tracer::NO_HIT;
 use render::sss::gpu::SssPass;
+use render::taa::{Taa, TaaPrimary, TaaSettings};
 use render::sss::profile::scaling_from_dmfp;
 use render::sss::{SpvgSettings, SssFrame, SssSettings, SssVariant};
 use serde::{Deserialize, Serialize};
@@ -21,7 +24,8 @@ use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, T
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SssMethodSettings {
-    /// Adaptive (AS), OnlineCv (AS+OCV), ConstantCv (AS+CCV) or Fixed(count: N).
+    /// Adaptive (AS), OnlineCv (AS+OCV), ConstantCv (AS+CCV), Fixed(count: N) or
+    /// Separable(taps: N) (Jimenez et al.'s two 1-D passes, N odd).
     pub variant: SssVariant,
     /// Path-traced samples per pixel of the irradiance the pass scatters.
     pub spp: u32,
@@ -31,23 +35,29 @@ pub struct SssMethodSettings {
     pub eps_a: f32,
     pub a0: f32,
     pub a_cv: f32,
+    /// TAA after the pass (Sec. 4.3/4.5.1: the pass feeds the engine's TAA): render::taa's
+    /// resolve over the modulated image, its history rejected by the G-buffer's instance,
+    /// depth and normal. None: no TAA.
+    pub taa: Option<TaaSettings>,
 }
 
 impl Default for SssMethodSettings {
     fn default() -> Self {
         let s = SssSettings::default();
-        Self { variant: s.variant, spp: 1, fast_inverse: s.fast_inverse, spvg: s.spvg, eps_a: s.eps_a, a0: s.a0, a_cv: s.a_cv }
+        Self { variant: s.variant, spp: 1, fast_inverse: s.fast_inverse, spvg: s.spvg, eps_a: s.eps_a, a0: s.a0, a_cv: s.a_cv, taa: None }
     }
 }
 
 impl SssMethodSettings {
     pub fn label(&self) -> String {
-        match self.variant {
+        let base: String = match self.variant {
             SssVariant::Fixed { count } => format!("sss_fixed{count}"),
             SssVariant::Adaptive => "sss_as".into(),
             SssVariant::OnlineCv => "sss_ocv".into(),
             SssVariant::ConstantCv => "sss_ccv".into(),
-        }
+            SssVariant::Separable { taps } => format!("sss_separable{taps}"),
+        };
+        if self.taa.is_some() { format!("{base}_taa") } else { base }
     }
 
     fn pass_settings(&self, seed: u64) -> SssSettings {
@@ -63,6 +73,7 @@ pub struct SssState {
     d: [f32; 3],
     /// The subsurface material's index in `SceneDesc::materials`.
     material: u32,
+    taa: Option<Taa>,
 }
 
 pub struct Plugin;
@@ -88,6 +99,11 @@ impl MethodPlugin for Plugin {
         {
             bail!("Sss: Fixed count {count}; expected 1 to {}", render::sss::gpu::MAX_COUNT);
         }
+        if let SssVariant::Separable { taps } = s.variant
+            && (taps < 3 || taps % 2 == 0 || taps > render::sss::separable::MAX_TAPS)
+        {
+            bail!("Sss: Separable taps {taps}; expected an odd count in [3, {}]", render::sss::separable::MAX_TAPS);
+        }
         let scene = &world.resource::<sim::ExtractedScene>().scene;
         let subsurface: Vec<(u32, scene::Material)> = scene.materials.iter().enumerate().filter(|(_, m)| m.subsurface.is_some()).map(|(i, m)| (i as u32, *m)).collect();
         let Some(&(material, m)) = subsurface.first() else {
@@ -104,7 +120,8 @@ impl MethodPlugin for Plugin {
             (run.width, run.height)
         };
         let pass = SssPass::new(&world.resource::<GpuDevice>().0, width, height)?;
-        world.entity_mut(entity).insert(SssState { settings: s.clone(), pass, d, material });
+        let taa = s.taa.map(|t| Taa::new(&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0, t)).transpose()?;
+        world.entity_mut(entity).insert(SssState { settings: s.clone(), pass, d, material, taa });
         Ok(())
     }
 }
@@ -152,6 +169,14 @@ pub fn render(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, run: Res<Run>, cl
                 [r.rgb[0] * a[0], r.rgb[1] * a[1], r.rgb[2] * a[2], 1.0]
             })
             .collect();
+        let radiance = match state.taa.as_mut() {
+            Some(taa) => {
+                let resolved = resolve_taa(&gpu.0, taa, &radiance, g).map_err(|e| fail(&e))?;
+                timings.extend(resolved.timings);
+                resolved.radiance
+            }
+            None => radiance,
+        };
         let counts: Vec<[f32; 4]> = results.iter().map(|r| { let v = r.count as f32 / 64.0; [v, v, v, 1.0] }).collect();
         let mean_spp = count_sum as f64 / sss_pixels.max(1) as f64;
         frame.output = Some(MethodOutput {
@@ -162,4 +187,18 @@ pub fn render(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, run: Res<Run>, cl
         frame.add_cpu(start);
     }
     Ok(())
+}
+
+/// render::taa's resolve over the pass's image: the colour and each pixel's primary hit from
+/// the G-buffer (rays through pixel centres: jitter (0.5, 0.5)). The G-buffer has no depth
+/// from the previous camera: `previous_depth` is this frame's depth (exact for the static
+/// camera and sphere of the SSS scenes; the boids' own pixels are not subsurface).
+fn resolve_taa(gpu: &render::gpu::Gpu, taa: &mut Taa, radiance: &[[f32; 4]], g: &render::path_tracer::GBuffer) -> Result<render::taa::TaaOutput, render::error::RenderError> {
+    let primary: Vec<TaaPrimary> = (0..radiance.len())
+        .map(|i| {
+            let depth = if g.depth[i].is_finite() { g.depth[i] } else { 0.0 };
+            TaaPrimary { normal: g.normal[i], depth, motion: g.motion[i], instance: g.instance_id[i], previous_depth: depth }
+        })
+        .collect();
+    taa.resolve_colour(gpu, [0.5, 0.5], radiance, &primary)
 }
