@@ -104,17 +104,6 @@ fn rmse(f: impl Fn(&mut Pcg) -> f32, exact: f64, trials: usize, seed: u32) -> f6
     (se / trials as f64).sqrt()
 }
 
-/// Least-squares slope of log y against log x.
-fn log_slope(x: &[f64], y: &[f64]) -> f64 {
-    let lx: Vec<f64> = x.iter().map(|v| v.ln()).collect();
-    let ly: Vec<f64> = y.iter().map(|v| v.ln()).collect();
-    let n = lx.len() as f64;
-    let (mx, my) = (lx.iter().sum::<f64>() / n, ly.iter().sum::<f64>() / n);
-    let cov: f64 = lx.iter().zip(&ly).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let var: f64 = lx.iter().map(|a| (a - mx).powi(2)).sum();
-    cov / var
-}
-
 #[test]
 fn fig5_stratified_jittered_converges_close_to_one_over_n() {
     // The extinction profile along a ray through the cloud (256 voxels deep).
@@ -131,7 +120,7 @@ fn fig5_stratified_jittered_converges_close_to_one_over_n() {
     let strat: Vec<f64> = ns.iter().map(|&n| rmse(|r| stratified_jittered(mu, t_max, n, r), exact, 10_000, n)).collect();
     let iid: Vec<f64> = ns.iter().map(|&n| rmse(|r| iid_uniform(mu, t_max, n, r), exact, 10_000, 100 + n)).collect();
     let x: Vec<f64> = ns.iter().map(|&n| f64::from(n)).collect();
-    let (s, u) = (log_slope(&x, &strat), log_slope(&x, &iid));
+    let (s, u) = (common::log_slope(&x, &strat), common::log_slope(&x, &iid));
     println!("RMSE slope: stratified jittered {s:.3}, i.i.d. {u:.3}; stratified {strat:?}");
     // The paper: "closer to linear convergence than to the 1/√N of uniform i.i.d. samples".
     assert!(s < -0.75, "stratified jittered slope {s}");
