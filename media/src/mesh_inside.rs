@@ -27,8 +27,9 @@ fn yz(p: Vec3) -> DVec2 {
     DVec2::new(p.y as f64, p.z as f64)
 }
 
-/// The side of `p` relative to the directed edge a → b: +1 left, −1 right, never 0 for a
-/// proper edge (ties broken by the perturbation above), 0 for a degenerate one.
+/// The side of `p` relative to the directed edge a → b: +1 left, −1 right, never 0 (ties broken
+/// by the perturbation above; an edge degenerate in (y, z) gets a sign from `signum(0.0)` = 1,
+/// the same for both of its faces, whose other edges reject the crossing).
 fn side(a: DVec2, b: DVec2, p: DVec2) -> i32 {
     let (s, lo, hi) = if (a.x, a.y) <= (b.x, b.y) { (1, a, b) } else { (-1, b, a) };
     let d = hi - lo;

@@ -79,7 +79,7 @@ fn a_homogeneous_sphere_has_optical_depth_sigma_t_2r_through_its_centre_and_none
                 assert_eq!(e.value, 1.0, "{}: outside the sphere", est.label());
             }
         }
-        // Every voxel farther than a voxel diagonal from the sphere agrees with it.
+        // Every voxel centre farther than the tessellation's sagitta from the sphere agrees with it.
         let g = &medium.density;
         for z in 0..res {
             for y in 0..res {

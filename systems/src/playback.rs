@@ -42,8 +42,8 @@ pub struct FrameWorld {
 }
 
 /// A scenario with media refuses what would silently leave them out: methods that do not
-/// render media, and a second medium where the volumetric path tracer (references, VolumePath)
-/// renders only the first (media/README.md).
+/// render media, and more media than the volumetric path tracer (references, VolumePath) binds
+/// (media/README.md).
 fn check_media_support(spec: &RunSpec, origin: &str) -> Result<()> {
     let scenario = &spec.scenario;
     if scenario.media.is_empty() {
@@ -93,8 +93,10 @@ impl FrameWorld {
         world.insert_resource(RunOutput { folder, records: Vec::new() });
         world.insert_resource(References { cache: ReferenceCache::new(cache_dir), current: None, rendered: 0, cached: 0 });
         world.insert_resource(Progress(progress));
-        // The volumetric path tracer renders every declared medium (media/README.md).
-        if !scenario.media.is_empty() {
+        // The volumetric path tracer renders every declared medium (media/README.md). More than
+        // it binds pass check_media_support only without references and VolumePath, which are
+        // all that use it.
+        if !scenario.media.is_empty() && scenario.media.len() <= media::gpu::MAX_MEDIA {
             let gpu = &world.resource::<GpuDevice>().0;
             let medium = frame::media::SceneMedium::new(gpu, &scenario.media);
             world.insert_resource(medium);

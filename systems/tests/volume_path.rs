@@ -86,3 +86,20 @@ fn a_scenario_with_media_refuses_what_would_leave_them_out() {
     let e = refusal(&format!("Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, methods: [VolumePath(spp: 1)], media: [{}])", many.join(", ")), "many");
     assert!(e.contains(&format!("medium 'haze{}'", media::gpu::MAX_MEDIA)) && e.contains("renders at most 8 media"), "{e}");
 }
+
+/// More media than the volumetric path tracer binds are fine where nothing uses it: a
+/// VolumeTransmittance method draws its one medium and no reference is rendered.
+#[test]
+fn more_media_than_the_path_tracer_binds_play_without_references() {
+    let many: Vec<String> = (0..=media::gpu::MAX_MEDIA).map(|i| format!("(name: \"haze{i}\", kind: Homogeneous, box_min: (-1, -1, -1), box_max: (1, 1, 1), sigma_t: 0.1, resolution: (8, 8, 8))")).collect();
+    let text = format!(
+        "Scenario(scene: Builtin(\"cornell_box\"), resolution: (16, 9), frames: 1, reference: (spp: 0, frames: None), methods: [VolumeTransmittance(estimator: RatioTracking, spp: 1, medium: \"haze3\")], media: [{}])",
+        many.join(", ")
+    );
+    let scenario = sim::Scenario::from_ron(&text, Path::new("inline.ron")).unwrap();
+    let out = std::env::temp_dir().join(format!("flicker_volume_path_many_transmittance_{}", std::process::id()));
+    let spec = RunSpec::from_scenario(scenario, &Overrides { out: Some(out.clone()), ..Default::default() }).unwrap();
+    let summary = run_spec(&spec, &RunOptions { scenario: "inline.ron".into(), overrides: Overrides::default(), cache_dir: Some(out.join("cache")), progress: false });
+    let _ = std::fs::remove_dir_all(&out);
+    summary.unwrap_or_else(|e| panic!("{e:#}"));
+}
