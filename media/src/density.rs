@@ -132,10 +132,20 @@ impl DensityGrid {
 
     /// An animated medium at one of its states (`MediumDesc::at`), clipped to its bound.
     pub fn from_state(desc: &scene::MediumDesc, s: &scene::MediumState) -> Self {
-        let (x, y, z) = desc.resolution;
+        Self::from_state_within(desc, s, Self::bound_of(desc).as_ref())
+    }
+
+    /// The inside test of a medium's mesh bound (None for its box). The mesh lies in the box's
+    /// unit coordinates, so one test serves every state of an animated medium.
+    pub fn bound_of(desc: &scene::MediumDesc) -> Option<MeshInside> {
         // Checked when the scenario loaded (sim::Scenario, errors at the mesh file's line).
         let mesh = desc.bound.mesh(desc.box_min, desc.box_max).unwrap_or_else(|e| panic!("medium '{}': {e}", desc.name));
-        let inside = mesh.as_ref().map(MeshInside::new);
-        Self::bake_bounded(&desc.kind, inside.as_ref(), UVec3::new(x, y, z), s.sigma_t, s.box_min, s.box_max, s.spin)
+        mesh.as_ref().map(MeshInside::new)
+    }
+
+    /// `from_state` with the bound's inside test already built (`bound_of`).
+    pub fn from_state_within(desc: &scene::MediumDesc, s: &scene::MediumState, inside: Option<&MeshInside>) -> Self {
+        let (x, y, z) = desc.resolution;
+        Self::bake_bounded(&desc.kind, inside, UVec3::new(x, y, z), s.sigma_t, s.box_min, s.box_max, s.spin)
     }
 }

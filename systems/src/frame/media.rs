@@ -8,6 +8,7 @@
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use media::gpu::{GpuMedium, MediumOptics, MisWeight, VolumePathPass, VolumePathSettings};
+use media::mesh_inside::MeshInside;
 use media::{DensityGrid, Medium};
 use scene::{MediumDesc, MediumState};
 
@@ -28,21 +29,27 @@ pub struct SceneMedium {
     pub descs: Vec<MediumDesc>,
     /// The states the GPU holds, one per medium.
     pub states: Vec<MediumState>,
+    /// Each medium's mesh-bound inside test, built once (the OBJ is read at load only).
+    bounds: Vec<Option<MeshInside>>,
+    /// Each medium baked at its state; a change rebakes only the media whose state changed.
+    baked: Vec<Medium>,
     pub gpu: GpuMedium,
     /// Built on first use (references, the VolumePath method).
     pass: Option<VolumePathPass>,
 }
 
-fn upload(gpu: &render::gpu::Gpu, descs: &[MediumDesc], states: &[MediumState]) -> GpuMedium {
-    let baked: Vec<Medium> = descs.iter().zip(states).map(|(d, s)| Medium::new(DensityGrid::from_state(d, s))).collect();
-    GpuMedium::several(gpu, &baked.iter().collect::<Vec<_>>())
+fn bake(desc: &MediumDesc, state: &MediumState, bound: Option<&MeshInside>) -> Medium {
+    Medium::new(DensityGrid::from_state_within(desc, state, bound))
 }
 
 impl SceneMedium {
     /// `descs`: 1 to media::gpu::MAX_MEDIA media (playback checks the count first).
     pub fn new(gpu: &render::gpu::Gpu, descs: &[MediumDesc]) -> Self {
         let states: Vec<MediumState> = descs.iter().map(|d| d.at(0.0)).collect();
-        Self { gpu: upload(gpu, descs, &states), descs: descs.to_vec(), states, pass: None }
+        let bounds: Vec<Option<MeshInside>> = descs.iter().map(DensityGrid::bound_of).collect();
+        let baked: Vec<Medium> = descs.iter().zip(&states).zip(&bounds).map(|((d, s), b)| bake(d, s, b.as_ref())).collect();
+        let gpu = GpuMedium::several(gpu, &baked.iter().collect::<Vec<_>>());
+        Self { descs: descs.to_vec(), states, bounds, baked, gpu, pass: None }
     }
 
     /// Albedo and emission (none: zero) of each declared medium.
@@ -75,8 +82,14 @@ pub fn upload_medium(gpu: Res<GpuDevice>, medium: Option<ResMut<SceneMedium>>, c
                 return Err(failed(anyhow::anyhow!("medium '{}' at frame {}: degenerate state {state:?}", d.name, clock.frame)));
             }
         }
-        medium.gpu = upload(&gpu.0, &medium.descs, &states);
-        medium.states = states;
+        let medium = &mut *medium;
+        for (i, state) in states.into_iter().enumerate() {
+            if state != medium.states[i] {
+                medium.baked[i] = bake(&medium.descs[i], &state, medium.bounds[i].as_ref());
+                medium.states[i] = state;
+            }
+        }
+        medium.gpu = GpuMedium::several(&gpu.0, &medium.baked.iter().collect::<Vec<_>>());
     }
     Ok(())
 }
