@@ -45,7 +45,10 @@ impl From<&Segment> for RaySegment {
 /// The most media one pass binds (a uniform array; a scenario with more is refused).
 pub const MAX_MEDIA: usize = 8;
 
+const _: () = assert!(MAX_MEDIA == 8, "update the WGSL array lengths of the media and optics uniforms");
+
 pub const BINDINGS: [BufferBinding; 3] = [
+    // 8 = MAX_MEDIA (a const string cannot be formatted; the assertion above keeps them equal).
     BufferBinding::uniform("media", "array<MediumParams, 8>"),
     // every medium's voxels, one after the other
     BufferBinding::read("density", "array<f32>"),

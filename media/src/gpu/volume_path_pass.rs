@@ -97,6 +97,7 @@ render::gpu_struct! {
 const BINDINGS: [BufferBinding; 3] = [
     BufferBinding::uniform("vp", "VolumePathParams"),
     // per medium of the GpuMedium: albedo at 2i, emission (radiance per unit extinction) at 2i + 1
+    // 2 × MAX_MEDIA (asserted in medium.rs): albedo and emission per medium.
     BufferBinding::uniform("optics", "array<vec4f, 16>"),
     BufferBinding::read_write("samples", "array<vec4f>"),
 ];
