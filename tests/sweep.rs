@@ -242,8 +242,15 @@ fn sweep_runs_locally_and_on_slurm_with_identical_numbers() {
     let sweep = sweep_file();
     let (local, slurm) = (dir.join("local"), dir.join("slurm"));
 
-    // Local executor: plan, 8 jobs two at a time, merge.
-    ok(&flicker(&["sweep", "run", sweep.to_str().unwrap(), "--out", local.to_str().unwrap(), "--jobs", "2"]), "sweep run (local)");
+    // Local executor: plan, 8 jobs two at a time, merge. One CPU thread per job here and the
+    // default elsewhere, so that a metric whose value depends on the thread count (an unordered
+    // parallel sum) shows as a difference below.
+    let o = Command::new(env!("CARGO_BIN_EXE_flicker"))
+        .args(["sweep", "run", sweep.to_str().unwrap(), "--out", local.to_str().unwrap(), "--jobs", "2"])
+        .env("RAYON_NUM_THREADS", "1")
+        .output()
+        .expect("flicker runs");
+    ok(&o, "sweep run (local)");
     let local_numbers = numbers(&local);
     // A failed job is rerun alone: without its record the merge names it, `local` runs only it.
     std::fs::remove_file(local.join("done/job_0003.json")).unwrap();

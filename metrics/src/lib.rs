@@ -12,6 +12,7 @@ pub mod compare;
 pub mod error;
 pub mod flip;
 pub mod image;
+pub mod ordered_sum;
 pub mod region;
 pub mod smape;
 

@@ -55,6 +55,9 @@ pub fn smape(cur: &Image, prev: &Image, eps: f32) -> SmapeResult {
             }
             acc
         })
+        // Partials collected in row order and added sequentially: the same bits on any thread count.
+        .collect::<Vec<f64>>()
+        .iter()
         .sum();
     let n = cur.len().max(1) as f64;
     SmapeResult { mean: sum / n, map, disoccluded_count: 0, disoccluded: Vec::new() }
@@ -91,7 +94,9 @@ pub fn smape_reprojected(cur: &Image, prev: &Image, motion: &[[f32; 2]], eps: f3
             }
             acc
         })
-        .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        .collect::<Vec<(f64, u64)>>()
+        .iter()
+        .fold((0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
     let mean = if valid > 0 { sum / valid as f64 } else { 0.0 };
     SmapeResult { mean, map, disoccluded_count: cur.len() as u64 - valid, disoccluded }
 }
