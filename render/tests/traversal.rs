@@ -1,12 +1,13 @@
 //! The WGSL two-level CWBVH traversal (scene_geometry.wgsl) against obvhs's CPU traversal of the
 //! same BVHs, on seeded random rays over (a) a mesh loaded from a glTF file, (b) a hairball of
 //! thin geometry, (c) several instances with rotations and non-uniform (one mirrored) scales,
-//! before and after they move. The CPU reference itself is checked against brute force.
+//! before and after they move. The CPU reference itself is checked against brute force. The
+//! BVH2 traversal (bvh2_traversal.wgsl) is checked the same way against obvhs's BVH2 traversal.
 
 use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Mat4, Quat, Vec2, Vec3};
-use render::bvh::{Hit, InstanceUpdate, RayBatch, RayQuery, SceneBvh, SceneGeometry, SplitMix64, TraceKind, WatertightRay, intersect_triangle, random_rays};
+use render::bvh::{Bvh2Geometry, Bvh2Traversal, Hit, InstanceTransforms, InstanceUpdate, RayBatch, RayQuery, SceneBvh, SceneBvh2, SceneGeometry, SplitMix64, TraceKind, WatertightRay, intersect_triangle, random_rays};
 use render::gpu::Gpu;
 use render::scene::{Instance, Mesh, SceneDesc};
 
@@ -177,6 +178,37 @@ fn instanced_scene(seed: u64) -> SceneDesc {
 
 // ---------------------------------------------------------------- comparison
 
+/// A CPU traversal the GPU is compared with: obvhs's CWBVH ([`SceneBvh`]) or BVH2 ([`SceneBvh2`]).
+trait Reference {
+    fn closest(&self, ray: &RayQuery) -> Hit;
+    fn any(&self, ray: &RayQuery) -> bool;
+    fn instances(&self) -> &[InstanceTransforms];
+}
+
+impl Reference for SceneBvh {
+    fn closest(&self, r: &RayQuery) -> Hit {
+        self.trace_closest(r.origin, r.direction, r.t_max)
+    }
+    fn any(&self, r: &RayQuery) -> bool {
+        self.trace_any(r.origin, r.direction, r.t_max)
+    }
+    fn instances(&self) -> &[InstanceTransforms] {
+        &self.instances
+    }
+}
+
+impl Reference for SceneBvh2 {
+    fn closest(&self, r: &RayQuery) -> Hit {
+        self.trace_closest(r.origin, r.direction, r.t_max)
+    }
+    fn any(&self, r: &RayQuery) -> bool {
+        self.trace_any(r.origin, r.direction, r.t_max)
+    }
+    fn instances(&self) -> &[InstanceTransforms] {
+        &self.instances
+    }
+}
+
 fn rays_for(scene: &SceneDesc, bvh: &SceneBvh, seed: u64) -> Vec<RayQuery> {
     let bounds = bvh.bounds();
     let mut rays = random_rays(bounds, RAYS, 1e30, seed);
@@ -211,8 +243,8 @@ fn relative_difference(a: f32, b: f32) -> f32 {
 }
 
 /// t of the ray against one triangle of one instance, through the same transform and test.
-fn triangle_t(scene: &SceneDesc, bvh: &SceneBvh, ray: &RayQuery, instance: u32, primitive: u32) -> Option<f32> {
-    let inst = &bvh.instances[instance as usize];
+fn triangle_t(scene: &SceneDesc, bvh: &impl Reference, ray: &RayQuery, instance: u32, primitive: u32) -> Option<f32> {
+    let inst = &bvh.instances()[instance as usize];
     let mesh = &scene.meshes[inst.mesh as usize];
     let o = inst.world_to_object.transform_point3(ray.origin);
     let d = inst.world_to_object.transform_vector3(ray.direction);
@@ -222,8 +254,8 @@ fn triangle_t(scene: &SceneDesc, bvh: &SceneBvh, ray: &RayQuery, instance: u32, 
 
 /// |cos| of the angle between the ray and the triangle's plane normal, in object space (where
 /// the intersection is computed): near 0 the hit distance is ill-conditioned.
-fn grazing_cosine(scene: &SceneDesc, bvh: &SceneBvh, ray: &RayQuery, instance: u32, primitive: u32) -> f32 {
-    let inst = &bvh.instances[instance as usize];
+fn grazing_cosine(scene: &SceneDesc, bvh: &impl Reference, ray: &RayQuery, instance: u32, primitive: u32) -> f32 {
+    let inst = &bvh.instances()[instance as usize];
     let mesh = &scene.meshes[inst.mesh as usize];
     let d = inst.world_to_object.transform_vector3(ray.direction);
     let [a, b, c] = mesh.indices[primitive as usize].map(|i| mesh.positions[i as usize]);
@@ -231,9 +263,9 @@ fn grazing_cosine(scene: &SceneDesc, bvh: &SceneBvh, ray: &RayQuery, instance: u
 }
 
 /// Closest hit by testing every triangle of every instance (no BVH).
-fn brute_force(scene: &SceneDesc, bvh: &SceneBvh, ray: &RayQuery) -> Hit {
+fn brute_force(scene: &SceneDesc, bvh: &impl Reference, ray: &RayQuery) -> Hit {
     let mut best = Hit::miss(ray.t_max);
-    for (i, inst) in bvh.instances.iter().enumerate() {
+    for (i, inst) in bvh.instances().iter().enumerate() {
         let mesh = &scene.meshes[inst.mesh as usize];
         let o = inst.world_to_object.transform_point3(ray.origin);
         let d = inst.world_to_object.transform_vector3(ray.direction);
@@ -262,11 +294,11 @@ struct Agreement {
     failures: Vec<String>,
 }
 
-fn compare(label: &str, scene: &SceneDesc, bvh: &SceneBvh, rays: &[RayQuery], gpu_hits: &[Hit], gpu_any: &[bool]) -> Agreement {
+fn compare(label: &str, scene: &SceneDesc, bvh: &impl Reference, rays: &[RayQuery], gpu_hits: &[Hit], gpu_any: &[bool]) -> Agreement {
     let mut a = Agreement { rays: rays.len(), ..Default::default() };
     for (i, ray) in rays.iter().enumerate() {
-        let cpu = bvh.trace_closest(ray.origin, ray.direction, ray.t_max);
-        let cpu_any = bvh.trace_any(ray.origin, ray.direction, ray.t_max);
+        let cpu = bvh.closest(ray);
+        let cpu_any = bvh.any(ray);
         let gpu = gpu_hits[i];
         a.hits += cpu.is_hit() as usize;
         if cpu_any != cpu.is_hit() {
@@ -329,9 +361,9 @@ fn gpu_matches_cpu(label: &str, gpu: &Gpu, scene: &SceneDesc, geometry: &SceneGe
 }
 
 /// The CPU reference equals brute force on a subset of the rays.
-fn cpu_matches_brute_force(label: &str, scene: &SceneDesc, bvh: &SceneBvh, rays: &[RayQuery]) {
+fn cpu_matches_brute_force(label: &str, scene: &SceneDesc, bvh: &impl Reference, rays: &[RayQuery]) {
     for (i, ray) in rays.iter().enumerate().step_by(10) {
-        let fast = bvh.trace_closest(ray.origin, ray.direction, ray.t_max);
+        let fast = bvh.closest(ray);
         let slow = brute_force(scene, bvh, ray);
         let same = (fast.instance, fast.primitive) == (slow.instance, slow.primitive);
         let tie = fast.is_hit() && slow.is_hit() && relative_difference(fast.t, slow.t) <= 1e-5;
@@ -493,6 +525,35 @@ fn box_room() -> SceneDesc {
         scene.instances.push(Instance { mesh: 1, material: 5, transform: b });
     }
     scene
+}
+
+/// The WGSL BVH2 traversal against obvhs's BVH2 traversal (itself against brute force) on the
+/// traversal tests' scenes and rays (the same seeds): the glTF torus, the hairball, instances
+/// with rotations, mirroring and an empty mesh.
+#[test]
+fn bvh2_gpu_traversal_matches_obvhs_bvh2_and_brute_force() {
+    let gpu = gpu();
+    let dir = std::env::temp_dir().join(format!("flicker-bvh2-traversal-{}", std::process::id()));
+    let path = write_gltf(&dir, &torus(1.0, 0.35, 48, 24), Quat::from_rotation_x(0.7) * Quat::from_rotation_z(0.3), Vec3::new(1.5, 0.6, 1.0), Vec3::new(0.2, -0.1, 0.3));
+    let gltf = load_gltf(&path);
+    std::fs::remove_dir_all(&dir).ok();
+    let hairball = SceneDesc { meshes: vec![hairball(400, 8, 0.006, 2)], instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }], ..Default::default() };
+    let scenes = [
+        ("BVH2 glTF torus", gltf, 1),
+        ("BVH2 hairball", hairball, 2),
+        ("BVH2 instances", instanced_scene(3), 3),
+    ];
+    for (label, scene, seed) in scenes {
+        let geometry = SceneGeometry::new(&gpu, &scene).unwrap();
+        let bvh2 = Bvh2Geometry::new(&gpu, &scene, &geometry).unwrap();
+        let rays = rays_for(&scene, geometry.cpu(), seed);
+        cpu_matches_brute_force(label, &scene, bvh2.cpu(), &rays[..RAYS / 3]);
+        let traversal = Bvh2Traversal { geometry: &geometry, bvh2: &bvh2 };
+        let batch = RayBatch::new_bvh2(&gpu, &traversal);
+        let hits = batch.trace_closest(&gpu, &traversal, &rays).unwrap();
+        let any = batch.trace_any(&gpu, &traversal, &rays).unwrap();
+        check(label, &compare(label, &scene, bvh2.cpu(), &rays, &hits, &any));
+    }
 }
 
 #[test]

@@ -87,6 +87,12 @@ struct TraversalRow {
     cpu_sorted_mrays_per_s: f64,
     /// WGSL on sorted rays over WGSL on the same rays in random order.
     wgsl_sorted_speedup: f64,
+    /// The same random rays through obvhs's binary BVHs (render::bvh::Bvh2Geometry).
+    wgsl_bvh2_mrays_per_s: f64,
+    /// BVH2 over CWBVH, WGSL, same rays.
+    bvh2_vs_cwbvh: f64,
+    /// Fraction of rays whose BVH2 hit is the CPU's (instance and primitive).
+    bvh2_agreement: f64,
 }
 
 /// One path-tracer frame measurement (the JSON's `frames`).
@@ -114,9 +120,9 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
     writeln!(md, "## BVH traversal (closest hit, {} random rays)\n", opts.rays)?;
     writeln!(
         md,
-        "| scene | triangles | instances | WGSL Mrays/s | obvhs CPU Mrays/s | WGSL / CPU | sorted: WGSL Mrays/s | sorted: CPU Mrays/s | sorted / random, WGSL | hits | WGSL = CPU |"
+        "| scene | triangles | instances | WGSL Mrays/s | obvhs CPU Mrays/s | WGSL / CPU | sorted: WGSL Mrays/s | sorted: CPU Mrays/s | sorted / random, WGSL | BVH2: WGSL Mrays/s | BVH2 / CWBVH, WGSL | hits | WGSL = CPU | BVH2 = CPU |"
     )?;
-    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
+    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
     let scenes: Vec<(String, SceneDesc)> = vec![
         ("cornell_box".into(), builtin_scene("cornell_box", (64, 36))?),
         ("hairball".into(), builtin_scene("hairball", (64, 36))?),
@@ -127,7 +133,7 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         let b = traversal_benchmark(&gpu, scene, opts.rays, 1).with_context(|| format!("traversal benchmark on {name}"))?;
         writeln!(
             md,
-            "| {name} | {} | {} | {:.3} | {:.3} | {:.2} | {:.3} | {:.3} | {:.2} | {:.1}% | {:.2}% |",
+            "| {name} | {} | {} | {:.3} | {:.3} | {:.2} | {:.3} | {:.3} | {:.2} | {:.3} | {:.2} | {:.1}% | {:.2}% | {:.2}% |",
             b.triangles,
             b.instances,
             b.gpu_rays_per_second / 1e6,
@@ -136,8 +142,11 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
             b.gpu_sorted_rays_per_second / 1e6,
             b.cpu_sorted_rays_per_second / 1e6,
             b.gpu_sorted_rays_per_second / b.gpu_rays_per_second,
+            b.gpu_bvh2_rays_per_second / 1e6,
+            b.gpu_bvh2_rays_per_second / b.gpu_rays_per_second,
             100.0 * b.hit_fraction,
-            100.0 * b.agreement
+            100.0 * b.agreement,
+            100.0 * b.bvh2_agreement
         )?;
         traversal_rows.push(TraversalRow {
             scene: name.clone(),
@@ -148,6 +157,9 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
             wgsl_sorted_mrays_per_s: b.gpu_sorted_rays_per_second / 1e6,
             cpu_sorted_mrays_per_s: b.cpu_sorted_rays_per_second / 1e6,
             wgsl_sorted_speedup: b.gpu_sorted_rays_per_second / b.gpu_rays_per_second,
+            wgsl_bvh2_mrays_per_s: b.gpu_bvh2_rays_per_second / 1e6,
+            bvh2_vs_cwbvh: b.gpu_bvh2_rays_per_second / b.gpu_rays_per_second,
+            bvh2_agreement: b.bvh2_agreement,
         });
     }
 
@@ -244,6 +256,7 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         "adapter": gpu.summary,
         "cpu_threads": rayon_threads(),
         "traversal_ratio_vs_obvhs": traversal_rows.iter().map(|t| (t.scene.clone(), serde_json::json!(t.traversal_ratio_vs_obvhs))).collect::<serde_json::Map<_, _>>(),
+        "bvh2_vs_cwbvh": traversal_rows.iter().map(|t| (t.scene.clone(), serde_json::json!(t.bvh2_vs_cwbvh))).collect::<serde_json::Map<_, _>>(),
         "traversal": traversal_rows,
         "reference_paths_per_s": reference.paths_per_s,
         "reference_spp": opts.reference_spp,

@@ -1,5 +1,6 @@
 //! Traversal benchmark: rays/s of the WGSL CWBVH traversal against obvhs's CPU traversal on
-//! all cores (rayon), on the same BVHs and the same rays, in one run. Plus the procedural
+//! all cores (rayon), on the same BVHs and the same rays, in one run; and of the WGSL BVH2
+//! traversal of the same triangles on the same rays. Plus the procedural
 //! meshes and rays it (and the tests) use.
 
 use std::time::{Duration, Instant};
@@ -8,7 +9,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::ray_order::sort_for_coherence;
-use super::{BvhError, RayBatch, RayQuery, SceneGeometry, SplitMix64, TraceKind};
+use super::{Bvh2Geometry, Bvh2Traversal, BvhError, RayBatch, RayQuery, SceneGeometry, SplitMix64, TraceKind};
 use crate::gpu::Gpu;
 use crate::scene::{Mesh, SceneDesc};
 
@@ -32,6 +33,13 @@ pub struct TraversalBench {
     /// not timed): WGSL and obvhs rays per second.
     pub gpu_sorted_rays_per_second: f64,
     pub cpu_sorted_rays_per_second: f64,
+    /// The same random rays through obvhs's binary BVHs of the same triangles (`Bvh2Geometry`,
+    /// `bvh2_traversal.wgsl`), timed right after the CWBVH traversal.
+    pub gpu_bvh2_rays_per_second: f64,
+    /// Building the BVH2s on the CPU, plus the upload.
+    pub bvh2_build_seconds: f64,
+    /// Fraction of rays where the BVH2 traversal and the CPU report the same instance and primitive.
+    pub bvh2_agreement: f64,
     pub cpu_threads: usize,
     /// Fraction of rays that hit something.
     pub hit_fraction: f64,
@@ -43,7 +51,7 @@ impl std::fmt::Display for TraversalBench {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} triangles, {} instances, {} rays: GPU {:.3} Mrays/s ({}), CPU {:.3} Mrays/s ({} threads), sorted GPU {:.3} CPU {:.3}, hits {:.1}%, GPU=CPU {:.2}%, build {:.3} s",
+            "{} triangles, {} instances, {} rays: GPU {:.3} Mrays/s ({}), CPU {:.3} Mrays/s ({} threads), sorted GPU {:.3} CPU {:.3}, GPU BVH2 {:.3}, hits {:.1}%, GPU=CPU {:.2}%, BVH2=CPU {:.2}%, build {:.3} s",
             self.triangles,
             self.instances,
             self.rays,
@@ -53,8 +61,10 @@ impl std::fmt::Display for TraversalBench {
             self.cpu_threads,
             self.gpu_sorted_rays_per_second / 1e6,
             self.cpu_sorted_rays_per_second / 1e6,
+            self.gpu_bvh2_rays_per_second / 1e6,
             100.0 * self.hit_fraction,
             100.0 * self.agreement,
+            100.0 * self.bvh2_agreement,
             self.build_seconds
         )
     }
@@ -78,6 +88,19 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
     let gpu_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
     let gpu_hits = batch.read_closest(gpu, &buffers)?;
 
+    let start = Instant::now();
+    let bvh2 = Bvh2Geometry::new(gpu, scene, &geometry)?;
+    gpu.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| BvhError::Readback { what: "BVH2 upload".into(), reason: e.to_string() })?;
+    let bvh2_build_seconds = start.elapsed().as_secs_f64();
+    let traversal = Bvh2Traversal { geometry: &geometry, bvh2: &bvh2 };
+    let bvh2_batch = RayBatch::new_bvh2(gpu, &traversal);
+    bvh2_batch.dispatch(gpu, &traversal, &buffers, TraceKind::Closest)?; // warm-up
+    let (reps, elapsed) = repeat_until(MIN_TIMED, || bvh2_batch.dispatch(gpu, &traversal, &buffers, TraceKind::Closest))?;
+    let gpu_bvh2_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
+    let bvh2_hits = bvh2_batch.read_closest(gpu, &buffers)?;
+
     let cpu = geometry.cpu();
     let trace_all = || queries.par_iter().map(|r| cpu.trace_closest(r.origin, r.direction, r.t_max)).collect::<Vec<_>>();
     let cpu_hits = trace_all(); // warm-up
@@ -100,8 +123,8 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
 
     let n = queries.len().max(1) as f64;
     let hit_fraction = cpu_hits.iter().filter(|h| h.is_hit()).count() as f64 / n;
-    let agreement =
-        gpu_hits.iter().zip(&cpu_hits).filter(|(g, c)| g.instance == c.instance && g.primitive == c.primitive).count() as f64 / n;
+    let agree = |hits: &[super::Hit]| hits.iter().zip(&cpu_hits).filter(|(g, c)| g.instance == c.instance && g.primitive == c.primitive).count() as f64 / n;
+    let (agreement, bvh2_agreement) = (agree(&gpu_hits), agree(&bvh2_hits));
     Ok(TraversalBench {
         adapter: gpu.summary.name.clone(),
         triangles: scene.instances.iter().map(|i| scene.meshes[i.mesh as usize].indices.len() as u64).sum(),
@@ -112,6 +135,9 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
         cpu_rays_per_second,
         gpu_sorted_rays_per_second,
         cpu_sorted_rays_per_second,
+        gpu_bvh2_rays_per_second,
+        bvh2_build_seconds,
+        bvh2_agreement,
         cpu_threads: rayon::current_num_threads(),
         hit_fraction,
         agreement,

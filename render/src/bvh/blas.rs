@@ -23,40 +23,46 @@ impl Blas {
     /// Builds the CWBVH of `mesh` (`index` is only for error messages). A mesh without triangles
     /// gives an empty BLAS that no ray hits.
     pub fn build(index: usize, mesh: &Mesh) -> Result<Self, BvhError> {
-        let err = |reason: String| BvhError::Mesh { index, name: mesh.name.clone(), reason };
-        if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
-            return Err(err(format!("position {i} is not finite: {}", mesh.positions[i])));
-        }
-        let n = mesh.positions.len() as u32;
-        let mut tris = Vec::with_capacity(mesh.indices.len());
-        for (t, idx) in mesh.indices.iter().enumerate() {
-            if let Some(&bad) = idx.iter().find(|&&i| i >= n) {
-                return Err(err(format!("triangle {t} uses vertex {bad}, but the mesh has {n} positions")));
-            }
-            let [a, b, c] = idx.map(|i| Vec3A::from(mesh.positions[i as usize]));
-            tris.push(Triangle { v0: a, v1: b, v2: c });
-        }
-        if !mesh.normals.is_empty() && mesh.normals.len() != mesh.positions.len() {
-            return Err(err(format!("{} normals for {} positions (expected one per position, or none)", mesh.normals.len(), n)));
-        }
-        if !mesh.uvs.is_empty() && mesh.uvs.len() != mesh.positions.len() {
-            return Err(err(format!("{} uvs for {} positions (expected one per position, or none)", mesh.uvs.len(), n)));
-        }
+        let tris = mesh_triangles(index, mesh)?;
         if tris.is_empty() {
             return Ok(Self { bvh: CwBvh::default(), triangles: Vec::new(), bounds: Aabb::empty(), depth: 0 });
         }
         let bvh = build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
-        let triangles = bvh
-            .primitive_indices
-            .iter()
-            .map(|&p| {
-                let t = &tris[p as usize];
-                [t.v0.into(), t.v1.into(), t.v2.into()]
-            })
-            .collect();
+        let triangles = leaf_order(&bvh.primitive_indices, &tris);
         let depth = cwbvh_depth(&bvh);
         Ok(Self { bounds: bvh.total_aabb, bvh, triangles, depth })
     }
+}
+
+/// A mesh's triangles for obvhs, after checking its indices, positions, and per-vertex
+/// attribute counts (`index` only for error messages).
+pub(crate) fn mesh_triangles(index: usize, mesh: &Mesh) -> Result<Vec<Triangle>, BvhError> {
+    let err = |reason: String| BvhError::Mesh { index, name: mesh.name.clone(), reason };
+    if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
+        return Err(err(format!("position {i} is not finite: {}", mesh.positions[i])));
+    }
+    let n = mesh.positions.len() as u32;
+    let mut tris = Vec::with_capacity(mesh.indices.len());
+    for (t, idx) in mesh.indices.iter().enumerate() {
+        if let Some(&bad) = idx.iter().find(|&&i| i >= n) {
+            return Err(err(format!("triangle {t} uses vertex {bad}, but the mesh has {n} positions")));
+        }
+        let [a, b, c] = idx.map(|i| Vec3A::from(mesh.positions[i as usize]));
+        tris.push(Triangle { v0: a, v1: b, v2: c });
+    }
+    if !mesh.normals.is_empty() && mesh.normals.len() != mesh.positions.len() {
+        return Err(err(format!("{} normals for {} positions (expected one per position, or none)", mesh.normals.len(), n)));
+    }
+    if !mesh.uvs.is_empty() && mesh.uvs.len() != mesh.positions.len() {
+        return Err(err(format!("{} uvs for {} positions (expected one per position, or none)", mesh.uvs.len(), n)));
+    }
+    Ok(tris)
+}
+
+/// The triangles' vertices in leaf order (`primitive_indices[i]` is the triangle of slot `i`), so
+/// that traversal reads them without an indirection.
+pub(crate) fn leaf_order(primitive_indices: &[u32], tris: &[Triangle]) -> Vec<[Vec3; 3]> {
+    primitive_indices.iter().map(|&p| [tris[p as usize].v0.into(), tris[p as usize].v1.into(), tris[p as usize].v2.into()]).collect()
 }
 
 /// Node levels of a CWBVH: the bound on traversal stack entries one level of traversal needs.

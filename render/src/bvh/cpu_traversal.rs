@@ -150,12 +150,12 @@ impl SceneBvh {
     }
 }
 
-fn instance_transforms(instances: &[Instance], mesh_count: usize) -> Result<Vec<InstanceTransforms>, BvhError> {
+pub(super) fn instance_transforms(instances: &[Instance], mesh_count: usize) -> Result<Vec<InstanceTransforms>, BvhError> {
     instances.iter().enumerate().map(|(i, inst)| InstanceTransforms::new(i, inst, mesh_count)).collect()
 }
 
 /// obvhs's ray; `+ 0.0` turns a -0.0 direction component into +0.0 so that obvhs's octant (sign
 /// test) and its reciprocal (sign bit) agree, as they do in the WGSL.
-fn obvhs_ray(origin: Vec3, direction: Vec3, t_max: f32) -> Ray {
+pub(super) fn obvhs_ray(origin: Vec3, direction: Vec3, t_max: f32) -> Ray {
     Ray::new(Vec3A::from(origin), Vec3A::from(direction + Vec3::ZERO), 0.0, t_max)
 }

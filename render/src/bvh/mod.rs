@@ -8,11 +8,16 @@
 //! - [`SceneGeometry`]: the same structures in storage buffers (one bind group, `@group(1)`) and
 //!   the WGSL interface `scene_geometry.wgsl` that passes import (`SceneGeometry::modules`).
 //! - [`RayBatch`]: a compute pass tracing a buffer of rays (tests, benchmark).
+//! - [`SceneBvh2`], [`Bvh2Geometry`]: the same two levels as obvhs binary BVHs (BVH2) with
+//!   their CPU reference and WGSL traversal (`bvh2_traversal.wgsl`), measured against the CWBVH
+//!   in the benchmark; the path tracer does not use them.
 //! - [`traversal_benchmark`]: rays/s of the WGSL traversal against obvhs on all CPU cores, on
 //!   random rays and on the same rays sorted for coherence ([`ray_order`]).
 
 mod bench;
 mod blas;
+mod bvh2;
+mod bvh2_geometry;
 mod cpu_traversal;
 mod ray_batch;
 pub mod ray_order;
@@ -22,9 +27,11 @@ mod triangle;
 
 pub use bench::{TraversalBench, displaced_sphere, random_rays, traversal_benchmark};
 pub use blas::Blas;
+pub use bvh2::{BVH2_STACK_SIZE, Bvh2Blas, SceneBvh2};
+pub use bvh2_geometry::{Bvh2Geometry, SgBvh2Node};
 pub use cpu_traversal::{InstanceUpdate, SceneBvh};
 pub use tlas::InstanceTransforms;
-pub use ray_batch::{RayBatch, RayBuffers, RayQuery, SurfaceRecord, TraceKind, struct_layout_mismatches as ray_batch_struct_mismatches};
+pub use ray_batch::{BatchGeometry, Bvh2Traversal, RayBatch, RayBuffers, RayQuery, SurfaceRecord, TraceKind, struct_layout_mismatches as ray_batch_struct_mismatches};
 pub use scene::rng::{SplitMix64, mix64};
 pub use scene_geometry::{SceneGeometry, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTriangle, SgVertex};
 pub use tlas::Tlas;

@@ -3,7 +3,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{BvhError, Hit, SceneGeometry};
+use super::{Bvh2Geometry, BvhError, Hit, SceneGeometry};
 use crate::compute::BufferBinding;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
@@ -100,7 +100,32 @@ pub struct RayBatch {
     layout: wgpu::BindGroupLayout,
     closest: wgpu::ComputePipeline,
     any: wgpu::ComputePipeline,
-    points: wgpu::ComputePipeline,
+    /// Only the CWBVH batch has the surface-point kernel.
+    points: Option<wgpu::ComputePipeline>,
+}
+
+/// The geometry a batch traces through: the bind groups after the batch's own @group(0).
+pub trait BatchGeometry {
+    fn bind_groups(&self) -> Vec<&wgpu::BindGroup>;
+}
+
+impl BatchGeometry for SceneGeometry {
+    fn bind_groups(&self) -> Vec<&wgpu::BindGroup> {
+        vec![self.bind_group()]
+    }
+}
+
+/// The BVH2 traversal's geometry: the scene's (@group(1): instances, ray set-up, triangle test)
+/// and its BVH2s (@group(2)).
+pub struct Bvh2Traversal<'a> {
+    pub geometry: &'a SceneGeometry,
+    pub bvh2: &'a Bvh2Geometry,
+}
+
+impl BatchGeometry for Bvh2Traversal<'_> {
+    fn bind_groups(&self) -> Vec<&wgpu::BindGroup> {
+        vec![self.geometry.bind_group(), self.bvh2.bind_group()]
+    }
 }
 
 /// Rays uploaded once, traced any number of times.
@@ -113,14 +138,31 @@ pub struct RayBuffers {
 }
 
 impl RayBatch {
+    /// The batch of the CWBVH traversal (scene_geometry.wgsl).
     pub fn new(gpu: &Gpu, geometry: &SceneGeometry) -> Self {
+        let (layout, program) = Self::layout_and_program(gpu, SceneGeometry::modules());
+        let program = program.entry(crate::wgsl_file!("bvh_ray_batch.wgsl"));
+        let [closest, any, points] = crate::compute::pipelines(gpu, "bvh_ray_batch.wgsl", &program, &[&layout, geometry.bind_group_layout()], ["trace_closest_rays", "trace_any_rays", "surface_points"])
+            .unwrap_or_else(|e| panic!("the ray batch's WGSL: {e}"));
+        Self { closest, any, points: Some(points), layout }
+    }
+
+    /// The batch of the BVH2 traversal (bvh2_traversal.wgsl): closest and any hits only.
+    pub fn new_bvh2(gpu: &Gpu, traversal: &Bvh2Traversal) -> Self {
+        let (layout, program) = Self::layout_and_program(gpu, [SceneGeometry::modules(), Bvh2Geometry::modules()].concat());
+        let program = program.entry(crate::wgsl_file!("bvh2_ray_batch.wgsl"));
+        let groups = [&layout, traversal.geometry.bind_group_layout(), traversal.bvh2.bind_group_layout()];
+        let [closest, any] = crate::compute::pipelines(gpu, "bvh2_ray_batch.wgsl", &program, &groups, ["trace_closest_rays_bvh2", "trace_any_rays_bvh2"])
+            .unwrap_or_else(|e| panic!("the BVH2 ray batch's WGSL: {e}"));
+        Self { closest, any, points: None, layout }
+    }
+
+    /// The batch's @group(0) layout, and a program of `geometry`'s modules and the batch's.
+    fn layout_and_program(gpu: &Gpu, geometry: Vec<Module>) -> (wgpu::BindGroupLayout, crate::shader::Program) {
         let layout = crate::compute::binding_layout(gpu, "ray batch", &GROUP);
         let types = Module::generated("package::ray_batch_types", &[GpuRay::WGSL, GpuHit::WGSL, GpuPoint::WGSL, BatchParams::WGSL]);
         let bindings = crate::compute::group_module("package::ray_batch_bindings", 0, &GROUP, &[&types]);
-        let program = crate::shader::Program::new(SceneGeometry::modules()).with([types, bindings]).entry(crate::wgsl_file!("bvh_ray_batch.wgsl"));
-        let [closest, any, points] = crate::compute::pipelines(gpu, "bvh_ray_batch.wgsl", &program, &[&layout, geometry.bind_group_layout()], ["trace_closest_rays", "trace_any_rays", "surface_points"])
-            .unwrap_or_else(|e| panic!("the ray batch's WGSL: {e}"));
-        Self { closest, any, points, layout }
+        (layout, crate::shader::Program::new(geometry).with([types, bindings]))
     }
 
     /// Uploads the rays (refuses more than the adapter's buffers hold).
@@ -161,19 +203,22 @@ impl RayBatch {
         Ok(RayBuffers { count, groups, hits, points, bind_group })
     }
 
-    /// Runs one kernel over all rays and waits for the GPU to finish.
-    pub fn dispatch(&self, gpu: &Gpu, geometry: &SceneGeometry, buffers: &RayBuffers, kind: TraceKind) -> Result<(), BvhError> {
+    /// Runs one kernel over all rays and waits for the GPU to finish. Panics on
+    /// `SurfacePoints` with a BVH2 batch (it has no such kernel).
+    pub fn dispatch(&self, gpu: &Gpu, geometry: &impl BatchGeometry, buffers: &RayBuffers, kind: TraceKind) -> Result<(), BvhError> {
         let pipeline = match kind {
             TraceKind::Closest => &self.closest,
             TraceKind::Any => &self.any,
-            TraceKind::SurfacePoints => &self.points,
+            TraceKind::SurfacePoints => self.points.as_ref().expect("surface points need the CWBVH batch (RayBatch::new)"),
         };
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ray batch") });
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("ray batch"), timestamp_writes: None });
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &buffers.bind_group, &[]);
-            pass.set_bind_group(1, geometry.bind_group(), &[]);
+            for (i, group) in geometry.bind_groups().into_iter().enumerate() {
+                pass.set_bind_group(1 + i as u32, group, &[]);
+            }
             pass.dispatch_workgroups(buffers.groups.0, buffers.groups.1, 1);
         }
         let submission = gpu.queue.submit([encoder.finish()]);
@@ -217,14 +262,14 @@ impl RayBatch {
     }
 
     /// Convenience: closest hits of `rays`.
-    pub fn trace_closest(&self, gpu: &Gpu, geometry: &SceneGeometry, rays: &[RayQuery]) -> Result<Vec<Hit>, BvhError> {
+    pub fn trace_closest(&self, gpu: &Gpu, geometry: &impl BatchGeometry, rays: &[RayQuery]) -> Result<Vec<Hit>, BvhError> {
         let buffers = self.upload(gpu, rays)?;
         self.dispatch(gpu, geometry, &buffers, TraceKind::Closest)?;
         self.read_closest(gpu, &buffers)
     }
 
     /// Convenience: any-hit flags of `rays`.
-    pub fn trace_any(&self, gpu: &Gpu, geometry: &SceneGeometry, rays: &[RayQuery]) -> Result<Vec<bool>, BvhError> {
+    pub fn trace_any(&self, gpu: &Gpu, geometry: &impl BatchGeometry, rays: &[RayQuery]) -> Result<Vec<bool>, BvhError> {
         let buffers = self.upload(gpu, rays)?;
         self.dispatch(gpu, geometry, &buffers, TraceKind::Any)?;
         self.read_any(gpu, &buffers)

@@ -142,12 +142,17 @@ impl SceneGeometry {
     /// `trace_any`, `surface_point`, ...); a pass that imports them binds [`Self::bind_group`] at
     /// group 1.
     pub fn modules() -> Vec<Module> {
-        let types = Module::generated(
-            "package::scene_geometry_types",
-            &[SgNode::WGSL, SgTriangle::WGSL, SgMesh::WGSL, SgVertex::WGSL, SgInstance::WGSL, SgInstanceHeader::WGSL, "struct SgInstanceTable { header: SgInstanceHeader, records: array<SgInstance> }\n"],
-        );
+        let types = Self::types();
         let bindings = crate::compute::group_module("package::scene_geometry_bindings", 1, &GROUP, &[&types]);
         vec![types, bindings, crate::wgsl_file!("scene_geometry.wgsl")]
+    }
+
+    /// `package::scene_geometry_types`: the structs of the bind group.
+    pub(crate) fn types() -> Module {
+        Module::generated(
+            "package::scene_geometry_types",
+            &[SgNode::WGSL, SgTriangle::WGSL, SgMesh::WGSL, SgVertex::WGSL, SgInstance::WGSL, SgInstanceHeader::WGSL, "struct SgInstanceTable { header: SgInstanceHeader, records: array<SgInstance> }\n"],
+        )
     }
 
     /// Storage buffers in the bind group: a pass adds its own to check the per-stage limit.
@@ -176,14 +181,7 @@ impl SceneGeometry {
                 n.primitive_base_idx = n.primitive_base_idx.wrapping_add(triangle_offset);
                 n
             }));
-            triangles.extend(blas.triangles.iter().zip(&blas.bvh.primitive_indices).map(|(t, &p)| SgTriangle {
-                v0: t[0].into(),
-                primitive: p,
-                v1: t[1].into(),
-                pad1: 0,
-                v2: t[2].into(),
-                pad2: 0,
-            }));
+            triangles.extend(sg_triangles(&blas.triangles, &blas.bvh.primitive_indices));
             let flags = if mesh.normals.is_empty() { 0 } else { HAS_NORMALS } | if mesh.uvs.is_empty() { 0 } else { HAS_UVS };
             meshes.push(SgMesh {
                 node_offset,
@@ -336,8 +334,13 @@ fn instance_table(bvh: &SceneBvh) -> Vec<u8> {
     bytes
 }
 
+/// Leaf-order triangles as the GPU reads them, each with its mesh triangle index.
+pub(super) fn sg_triangles<'a>(triangles: &'a [[Vec3; 3]], primitive_indices: &'a [u32]) -> impl Iterator<Item = SgTriangle> + 'a {
+    triangles.iter().zip(primitive_indices).map(|(t, &p)| SgTriangle { v0: t[0].into(), primitive: p, v1: t[1].into(), pad1: 0, v2: t[2].into(), pad2: 0 })
+}
+
 /// A read-only storage buffer holding `data`, at least `min_size` bytes (bindings cannot be empty).
-fn storage(gpu: &Gpu, what: &str, data: &[u8], min_size: u64) -> Result<wgpu::Buffer, BvhError> {
+pub(super) fn storage(gpu: &Gpu, what: &str, data: &[u8], min_size: u64) -> Result<wgpu::Buffer, BvhError> {
     storage_with_capacity(gpu, what, data, min_size)
 }
 

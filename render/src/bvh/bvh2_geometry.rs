@@ -1,0 +1,105 @@
+//! The BVH2s of [`SceneBvh2`] on the GPU: every node (all BLAS, then the TLAS) in one storage
+//! buffer of 32-byte nodes with plain f32 boxes, the leaf-order triangles, and the roots, in one
+//! bind group (`@group(2)` of bvh2_traversal.wgsl). The traversal reads the instance table and
+//! uses the ray set-up and triangle test of [`SceneGeometry`] (`@group(1)`), so a pass binds both.
+
+use super::bvh2::SceneBvh2;
+use super::scene_geometry::{sg_triangles, storage};
+use super::{BvhError, NO_HIT, SceneGeometry};
+use crate::compute::BufferBinding;
+use crate::gpu::Gpu;
+use crate::gpu_struct::GpuStruct;
+use crate::scene::SceneDesc;
+use crate::shader::Module;
+
+crate::gpu_struct! {
+    /// obvhs's `Bvh2Node` as the traversal reads it: the box, and `first_index` made absolute.
+    pub struct SgBvh2Node {
+        pub min: [f32; 3] => "vec3f",
+        /// Inner node: its first child (the second follows it). BLAS leaf: its first triangle
+        /// in `bvh2_triangles`. TLAS leaf: its instance.
+        pub first_index: u32 => "u32",
+        pub max: [f32; 3] => "vec3f",
+        /// 0 for an inner node, else the leaf's triangles (1 in a TLAS leaf).
+        pub prim_count: u32 => "u32",
+    }
+}
+
+/// The BVH2 @group(2): nodes, triangles, and roots (`[0]` the TLAS root, `[1 + m]` mesh m's;
+/// `NO_HIT` where empty).
+pub const GROUP: [BufferBinding; 3] = [
+    BufferBinding::read("bvh2_nodes", "array<SgBvh2Node>"),
+    BufferBinding::read("bvh2_triangles", "array<SgTriangle>"),
+    BufferBinding::read("bvh2_roots", "array<u32>"),
+];
+
+pub struct Bvh2Geometry {
+    bvh: SceneBvh2,
+    layout: wgpu::BindGroupLayout,
+    bind_group: wgpu::BindGroup,
+    _buffers: [wgpu::Buffer; 3],
+}
+
+impl Bvh2Geometry {
+    /// The WGSL: the node struct, the @group(2) bindings and `package::bvh2_traversal`
+    /// (`bvh2_trace_closest`, `bvh2_trace_any`), after [`SceneGeometry::modules`].
+    pub fn modules() -> Vec<Module> {
+        let types = Module::generated("package::bvh2_types", &[SgBvh2Node::WGSL]);
+        let bindings = crate::compute::group_module("package::bvh2_bindings", 2, &GROUP, &[&types, &SceneGeometry::types()]);
+        vec![types, bindings, crate::wgsl_file!("bvh2_traversal.wgsl")]
+    }
+
+    /// Builds the BVH2s of `scene` and uploads them. `geometry` must be the scene's
+    /// [`SceneGeometry`] (its instance table is the one traversal reads).
+    pub fn new(gpu: &Gpu, scene: &SceneDesc, geometry: &SceneGeometry) -> Result<Self, BvhError> {
+        let needed = SceneGeometry::STORAGE_BUFFERS + crate::compute::storage_buffers(&GROUP);
+        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
+        if limit < needed {
+            return Err(BvhError::StorageBuffers { needed, limit });
+        }
+        let bvh = SceneBvh2::new(scene)?;
+        assert_eq!(bvh.instances, geometry.instances(), "the BVH2 and the scene geometry must come from the same scene");
+        let node = |n: &obvhs::bvh2::node::Bvh2Node, first_index: u32| SgBvh2Node {
+            min: n.aabb().min.into(),
+            first_index,
+            max: n.aabb().max.into(),
+            prim_count: n.prim_count,
+        };
+        let mut nodes = Vec::new();
+        let mut triangles = Vec::new();
+        let mut roots = vec![NO_HIT];
+        for blas in &bvh.blas {
+            let (node_offset, triangle_offset) = (nodes.len() as u32, triangles.len() as u32);
+            roots.push(if blas.bvh.nodes.is_empty() { NO_HIT } else { node_offset });
+            nodes.extend(blas.bvh.nodes.iter().map(|n| node(n, n.first_index + if n.is_leaf() { triangle_offset } else { node_offset })));
+            triangles.extend(sg_triangles(&blas.triangles, &blas.bvh.primitive_indices));
+        }
+        if !bvh.tlas.nodes.is_empty() {
+            let node_offset = nodes.len() as u32;
+            roots[0] = node_offset;
+            let tlas = &bvh.tlas;
+            nodes.extend(tlas.nodes.iter().map(|n| node(n, if n.is_leaf() { tlas.primitive_indices[n.first_index as usize] } else { n.first_index + node_offset })));
+        }
+        let buffers = [
+            storage(gpu, "BVH2 nodes", bytemuck::cast_slice(&nodes), 32)?,
+            storage(gpu, "BVH2 triangles", bytemuck::cast_slice(&triangles), 48)?,
+            storage(gpu, "BVH2 roots", bytemuck::cast_slice(&roots), 4)?,
+        ];
+        let layout = crate::compute::binding_layout(gpu, "BVH2 geometry", &GROUP);
+        let bind_group = crate::compute::buffer_group(gpu, "BVH2 geometry", &layout, &buffers.iter().collect::<Vec<_>>());
+        Ok(Self { bvh, layout, bind_group, _buffers: buffers })
+    }
+
+    pub fn bind_group_layout(&self) -> &wgpu::BindGroupLayout {
+        &self.layout
+    }
+
+    pub fn bind_group(&self) -> &wgpu::BindGroup {
+        &self.bind_group
+    }
+
+    /// The same BVH2s on the CPU (reference traversal).
+    pub fn cpu(&self) -> &SceneBvh2 {
+        &self.bvh
+    }
+}
