@@ -3,7 +3,8 @@
 // @group(2) (src/bvh/bvh2_geometry.rs); the instance table, the ray set-up and the watertight
 // triangle test are scene_geometry.wgsl's (@group(1)), so both traversals give the same hits.
 // The loop follows obvhs's Bvh2::ray_traverse_dynamic: test both children of an inner node,
-// visit the nearer, push the farther, and intersect BLAS leaves as soon as their box is hit.
+// visit the nearer, push the farther (its child pair), and intersect BLAS leaves as soon as
+// their box is hit.
 
 import package::bvh2_types::SgBvh2Node;
 import package::bvh2_bindings::{bvh2_nodes, bvh2_triangles, bvh2_roots};
@@ -47,9 +48,14 @@ fn bvh2_leaf(ray: SgRay, node: SgBvh2Node, instance: u32, any_hit: bool, hit: pt
     return found;
 }
 
-// One stack for both levels, as sg_traverse: a TLAS leaf is visited like a node; visiting it
-// notes the stack size, moves the ray into the instance's object space (t unchanged) and goes on
-// at the BLAS root. When the stack falls back to that size the world ray is restored.
+// A stack entry or the next step: the index of a pair of sibling nodes (a child pair, whose
+// parent's box the ray hits: obvhs pushes `first_index` too, so a visited node is never loaded
+// twice), or BVH2_ENTER | instance for a TLAS leaf.
+const BVH2_ENTER: u32 = 0x80000000u;
+
+// One stack for both levels, as sg_traverse: entering an instance notes the stack size, moves
+// the ray into the instance's object space (t unchanged) and goes on at the BLAS root. When the
+// stack falls back to that size the world ray is restored.
 fn bvh2_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit: bool) -> Hit {
     var hit = Hit(t_max, NO_HIT, NO_HIT, vec2f(0.0));
     let tlas_root = bvh2_roots[0];
@@ -57,7 +63,8 @@ fn bvh2_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hi
         return hit;
     }
     let world_ray = sg_make_ray(world_origin, world_direction);
-    if bvh2_box(bvh2_nodes[tlas_root], world_ray, t_max) == BVH2_MISS {
+    let root = bvh2_nodes[tlas_root];
+    if bvh2_box(root, world_ray, t_max) == BVH2_MISS {
         return hit;
     }
     var ray = world_ray;
@@ -65,15 +72,29 @@ fn bvh2_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hi
     var stack_size = 0u;
     var tlas_stack_size = NO_HIT; // NO_HIT while traversing the TLAS
     var instance = NO_HIT;
-    var current = tlas_root; // a node whose box the ray hits
+    var step = select(root.first_index, BVH2_ENTER | root.first_index, root.prim_count != 0u);
     loop {
-        let node = bvh2_nodes[current];
-        let in_blas = tlas_stack_size != NO_HIT;
-        if node.prim_count == 0u {
-            var near_index = node.first_index;
-            var far_index = node.first_index + 1u;
-            var near = bvh2_nodes[near_index];
-            var far = bvh2_nodes[far_index];
+        if (step & BVH2_ENTER) != 0u {
+            // A TLAS leaf holds one instance, and only instances with triangles are in the TLAS.
+            instance = step & ~BVH2_ENTER;
+            let w2o = sg_instances.records[instance].world_to_object;
+            ray = sg_make_ray((w2o * vec4f(world_origin, 1.0)).xyz, (w2o * vec4f(world_direction, 0.0)).xyz);
+            tlas_stack_size = stack_size;
+            let blas_root = bvh2_nodes[bvh2_roots[1u + sg_instances.records[instance].mesh]];
+            if bvh2_box(blas_root, ray, hit.t) != BVH2_MISS {
+                if blas_root.prim_count == 0u {
+                    step = blas_root.first_index;
+                    continue;
+                }
+                // A BLAS whose root is a leaf (a mesh of a few triangles).
+                if bvh2_leaf(ray, blas_root, instance, any_hit, &hit) && any_hit {
+                    return hit;
+                }
+            }
+        } else {
+            let in_blas = tlas_stack_size != NO_HIT;
+            var near = bvh2_nodes[step];
+            var far = bvh2_nodes[step + 1u];
             var t_near = bvh2_box(near, ray, hit.t);
             var t_far = bvh2_box(far, ray, hit.t);
             if t_near > t_far {
@@ -83,9 +104,9 @@ fn bvh2_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hi
                 let n = near;
                 near = far;
                 far = n;
-                near_index = far_index;
-                far_index = node.first_index;
             }
+            // BLAS leaves are intersected at once, the nearer first so that its hit shortens
+            // the farther one's test; TLAS leaves are entered as a step.
             var visit_near = t_near != BVH2_MISS;
             if visit_near && in_blas && near.prim_count != 0u {
                 if bvh2_leaf(ray, near, instance, any_hit, &hit) && any_hit {
@@ -93,7 +114,6 @@ fn bvh2_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hi
                 }
                 visit_near = false;
             }
-            // The near leaf may have shortened the ray.
             var visit_far = t_far != BVH2_MISS && t_far < hit.t;
             if visit_far && in_blas && far.prim_count != 0u {
                 if bvh2_leaf(ray, far, instance, any_hit, &hit) && any_hit {
@@ -101,32 +121,20 @@ fn bvh2_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hi
                 }
                 visit_far = false;
             }
+            let near_step = select(near.first_index, BVH2_ENTER | near.first_index, near.prim_count != 0u);
+            let far_step = select(far.first_index, BVH2_ENTER | far.first_index, far.prim_count != 0u);
             if visit_near {
                 if visit_far && stack_size < BVH2_STACK_SIZE {
-                    stack[stack_size] = far_index;
+                    stack[stack_size] = far_step;
                     stack_size += 1u;
                 }
-                current = near_index;
+                step = near_step;
                 continue;
             }
             if visit_far {
-                current = far_index;
+                step = far_step;
                 continue;
             }
-        } else if !in_blas {
-            // A TLAS leaf holds one instance, and only instances with triangles are in the TLAS.
-            instance = node.first_index;
-            let w2o = sg_instances.records[instance].world_to_object;
-            ray = sg_make_ray((w2o * vec4f(world_origin, 1.0)).xyz, (w2o * vec4f(world_direction, 0.0)).xyz);
-            tlas_stack_size = stack_size;
-            let root = bvh2_roots[1u + sg_instances.records[instance].mesh];
-            if bvh2_box(bvh2_nodes[root], ray, hit.t) != BVH2_MISS {
-                current = root;
-                continue;
-            }
-        } else if bvh2_leaf(ray, node, instance, any_hit, &hit) && any_hit {
-            // A BLAS whose root is a leaf (a mesh of a few triangles).
-            return hit;
         }
         if stack_size == tlas_stack_size {
             tlas_stack_size = NO_HIT;
@@ -136,7 +144,7 @@ fn bvh2_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hi
             break;
         }
         stack_size -= 1u;
-        current = stack[stack_size];
+        step = stack[stack_size];
     }
     return hit;
 }

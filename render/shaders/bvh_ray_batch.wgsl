@@ -1,8 +1,11 @@
 // Traces a buffer of rays through the scene geometry (imported from scene_geometry.wgsl):
-// closest hits, any-hit flags and hit attributes, for tests and the traversal benchmark.
+// closest hits, any-hit flags and hit attributes, for tests and the traversal benchmark. The
+// traversal is package::ray_batch::trace, which each batch fills: ray_batch/cwbvh.wgsl or
+// ray_batch/bvh2.wgsl.
 
 import package::ray_batch_bindings::{rays, hits, points, params};
-import package::scene_geometry::{Hit, NO_HIT, previous_world_position, surface_point, trace_any, trace_closest, triangle_world_vertices};
+import package::ray_batch::trace::{batch_any, batch_closest};
+import package::scene_geometry::{Hit, NO_HIT, previous_world_position, surface_point, triangle_world_vertices};
 
 fn ray_index(id: vec3u) -> u32 {
     return id.x + id.y * params.row_pitch;
@@ -15,7 +18,7 @@ fn trace_closest_rays(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     let r = rays[i];
-    let h = trace_closest(r.origin, r.direction, r.t_max);
+    let h = batch_closest(r.origin, r.direction, r.t_max);
     hits[i].t = h.t;
     hits[i].instance = h.instance;
     hits[i].primitive = h.primitive;
@@ -29,7 +32,7 @@ fn trace_any_rays(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     let r = rays[i];
-    hits[i].any_hit = select(0u, 1u, trace_any(r.origin, r.direction, r.t_max));
+    hits[i].any_hit = select(0u, 1u, batch_any(r.origin, r.direction, r.t_max));
 }
 
 // Attributes of the closest hit (after trace_closest_rays).

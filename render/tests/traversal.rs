@@ -185,29 +185,23 @@ trait Reference {
     fn instances(&self) -> &[InstanceTransforms];
 }
 
-impl Reference for SceneBvh {
-    fn closest(&self, r: &RayQuery) -> Hit {
-        self.trace_closest(r.origin, r.direction, r.t_max)
-    }
-    fn any(&self, r: &RayQuery) -> bool {
-        self.trace_any(r.origin, r.direction, r.t_max)
-    }
-    fn instances(&self) -> &[InstanceTransforms] {
-        &self.instances
-    }
+macro_rules! reference {
+    ($bvh:ty) => {
+        impl Reference for $bvh {
+            fn closest(&self, r: &RayQuery) -> Hit {
+                self.trace_closest(r.origin, r.direction, r.t_max)
+            }
+            fn any(&self, r: &RayQuery) -> bool {
+                self.trace_any(r.origin, r.direction, r.t_max)
+            }
+            fn instances(&self) -> &[InstanceTransforms] {
+                &self.instances
+            }
+        }
+    };
 }
-
-impl Reference for SceneBvh2 {
-    fn closest(&self, r: &RayQuery) -> Hit {
-        self.trace_closest(r.origin, r.direction, r.t_max)
-    }
-    fn any(&self, r: &RayQuery) -> bool {
-        self.trace_any(r.origin, r.direction, r.t_max)
-    }
-    fn instances(&self) -> &[InstanceTransforms] {
-        &self.instances
-    }
-}
+reference!(SceneBvh);
+reference!(SceneBvh2);
 
 fn rays_for(scene: &SceneDesc, bvh: &SceneBvh, seed: u64) -> Vec<RayQuery> {
     let bounds = bvh.bounds();

@@ -59,6 +59,8 @@ impl Bvh2Geometry {
         }
         let bvh = SceneBvh2::new(scene)?;
         assert_eq!(bvh.instances, geometry.instances(), "the BVH2 and the scene geometry must come from the same scene");
+        // The traversal marks a TLAS leaf's instance with bit 31 (BVH2_ENTER).
+        assert!(bvh.instances.len() < 1 << 31, "{} instances", bvh.instances.len());
         let node = |n: &obvhs::bvh2::node::Bvh2Node, first_index: u32| SgBvh2Node {
             min: n.aabb().min.into(),
             first_index,

@@ -100,8 +100,7 @@ pub struct RayBatch {
     layout: wgpu::BindGroupLayout,
     closest: wgpu::ComputePipeline,
     any: wgpu::ComputePipeline,
-    /// Only the CWBVH batch has the surface-point kernel.
-    points: Option<wgpu::ComputePipeline>,
+    points: wgpu::ComputePipeline,
 }
 
 /// The geometry a batch traces through: the bind groups after the batch's own @group(0).
@@ -140,29 +139,26 @@ pub struct RayBuffers {
 impl RayBatch {
     /// The batch of the CWBVH traversal (scene_geometry.wgsl).
     pub fn new(gpu: &Gpu, geometry: &SceneGeometry) -> Self {
-        let (layout, program) = Self::layout_and_program(gpu, SceneGeometry::modules());
-        let program = program.entry(crate::wgsl_file!("bvh_ray_batch.wgsl"));
-        let [closest, any, points] = crate::compute::pipelines(gpu, "bvh_ray_batch.wgsl", &program, &[&layout, geometry.bind_group_layout()], ["trace_closest_rays", "trace_any_rays", "surface_points"])
-            .unwrap_or_else(|e| panic!("the ray batch's WGSL: {e}"));
-        Self { closest, any, points: Some(points), layout }
+        Self::with_traversal(gpu, SceneGeometry::modules(), crate::wgsl_file!("ray_batch/cwbvh.wgsl"), &[geometry.bind_group_layout()])
     }
 
-    /// The batch of the BVH2 traversal (bvh2_traversal.wgsl): closest and any hits only.
+    /// The batch of the BVH2 traversal (bvh2_traversal.wgsl).
     pub fn new_bvh2(gpu: &Gpu, traversal: &Bvh2Traversal) -> Self {
-        let (layout, program) = Self::layout_and_program(gpu, [SceneGeometry::modules(), Bvh2Geometry::modules()].concat());
-        let program = program.entry(crate::wgsl_file!("bvh2_ray_batch.wgsl"));
-        let groups = [&layout, traversal.geometry.bind_group_layout(), traversal.bvh2.bind_group_layout()];
-        let [closest, any] = crate::compute::pipelines(gpu, "bvh2_ray_batch.wgsl", &program, &groups, ["trace_closest_rays_bvh2", "trace_any_rays_bvh2"])
-            .unwrap_or_else(|e| panic!("the BVH2 ray batch's WGSL: {e}"));
-        Self { closest, any, points: None, layout }
+        let modules = [SceneGeometry::modules(), Bvh2Geometry::modules()].concat();
+        Self::with_traversal(gpu, modules, crate::wgsl_file!("ray_batch/bvh2.wgsl"), &[traversal.geometry.bind_group_layout(), traversal.bvh2.bind_group_layout()])
     }
 
-    /// The batch's @group(0) layout, and a program of `geometry`'s modules and the batch's.
-    fn layout_and_program(gpu: &Gpu, geometry: Vec<Module>) -> (wgpu::BindGroupLayout, crate::shader::Program) {
+    /// bvh_ray_batch.wgsl's kernels with `trace` as `package::ray_batch::trace`, on the
+    /// geometry's `modules` bound at @group(1), ... (`layouts`).
+    fn with_traversal(gpu: &Gpu, modules: Vec<Module>, trace: Module, layouts: &[&wgpu::BindGroupLayout]) -> Self {
         let layout = crate::compute::binding_layout(gpu, "ray batch", &GROUP);
         let types = Module::generated("package::ray_batch_types", &[GpuRay::WGSL, GpuHit::WGSL, GpuPoint::WGSL, BatchParams::WGSL]);
         let bindings = crate::compute::group_module("package::ray_batch_bindings", 0, &GROUP, &[&types]);
-        (layout, crate::shader::Program::new(geometry).with([types, bindings]))
+        let program = crate::shader::Program::new(modules).with([types, bindings, trace.at("package::ray_batch::trace")]).entry(crate::wgsl_file!("bvh_ray_batch.wgsl"));
+        let groups: Vec<&wgpu::BindGroupLayout> = [&layout].into_iter().chain(layouts.iter().copied()).collect();
+        let [closest, any, points] = crate::compute::pipelines(gpu, "bvh_ray_batch.wgsl", &program, &groups, ["trace_closest_rays", "trace_any_rays", "surface_points"])
+            .unwrap_or_else(|e| panic!("the ray batch's WGSL: {e}"));
+        Self { closest, any, points, layout }
     }
 
     /// Uploads the rays (refuses more than the adapter's buffers hold).
@@ -203,13 +199,12 @@ impl RayBatch {
         Ok(RayBuffers { count, groups, hits, points, bind_group })
     }
 
-    /// Runs one kernel over all rays and waits for the GPU to finish. Panics on
-    /// `SurfacePoints` with a BVH2 batch (it has no such kernel).
+    /// Runs one kernel over all rays and waits for the GPU to finish.
     pub fn dispatch(&self, gpu: &Gpu, geometry: &impl BatchGeometry, buffers: &RayBuffers, kind: TraceKind) -> Result<(), BvhError> {
         let pipeline = match kind {
             TraceKind::Closest => &self.closest,
             TraceKind::Any => &self.any,
-            TraceKind::SurfacePoints => self.points.as_ref().expect("surface points need the CWBVH batch (RayBatch::new)"),
+            TraceKind::SurfacePoints => &self.points,
         };
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ray batch") });
         {
