@@ -91,6 +91,9 @@ struct TraversalRow {
     wgsl_bvh2_mrays_per_s: f64,
     /// BVH2 over CWBVH, WGSL, same rays.
     bvh2_vs_cwbvh: f64,
+    /// obvhs's own CPU traversal of those BVH2s, and its ratio to obvhs's CWBVH traversal.
+    cpu_bvh2_mrays_per_s: f64,
+    cpu_bvh2_vs_cwbvh: f64,
     /// Fraction of rays whose BVH2 hit is the CPU's (instance and primitive).
     bvh2_agreement: f64,
 }
@@ -120,9 +123,9 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
     writeln!(md, "## BVH traversal (closest hit, {} random rays)\n", opts.rays)?;
     writeln!(
         md,
-        "| scene | triangles | instances | WGSL Mrays/s | obvhs CPU Mrays/s | WGSL / CPU | sorted: WGSL Mrays/s | sorted: CPU Mrays/s | sorted / random, WGSL | BVH2: WGSL Mrays/s | BVH2 / CWBVH, WGSL | hits | WGSL = CPU | BVH2 = CPU |"
+        "| scene | triangles | instances | WGSL Mrays/s | obvhs CPU Mrays/s | WGSL / CPU | sorted: WGSL Mrays/s | sorted: CPU Mrays/s | sorted / random, WGSL | BVH2: WGSL Mrays/s | BVH2 / CWBVH, WGSL | BVH2 / CWBVH, obvhs CPU | hits | WGSL = CPU | BVH2 = CPU |"
     )?;
-    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
+    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
     let scenes: Vec<(String, SceneDesc)> = vec![
         ("cornell_box".into(), builtin_scene("cornell_box", (64, 36))?),
         ("hairball".into(), builtin_scene("hairball", (64, 36))?),
@@ -133,7 +136,7 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         let b = traversal_benchmark(&gpu, scene, opts.rays, 1).with_context(|| format!("traversal benchmark on {name}"))?;
         writeln!(
             md,
-            "| {name} | {} | {} | {:.3} | {:.3} | {:.2} | {:.3} | {:.3} | {:.2} | {:.3} | {:.2} | {:.1}% | {:.2}% | {:.2}% |",
+            "| {name} | {} | {} | {:.3} | {:.3} | {:.2} | {:.3} | {:.3} | {:.2} | {:.3} | {:.2} | {:.2} | {:.1}% | {:.2}% | {:.2}% |",
             b.triangles,
             b.instances,
             b.gpu_rays_per_second / 1e6,
@@ -144,6 +147,7 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
             b.gpu_sorted_rays_per_second / b.gpu_rays_per_second,
             b.gpu_bvh2_rays_per_second / 1e6,
             b.gpu_bvh2_rays_per_second / b.gpu_rays_per_second,
+            b.cpu_bvh2_rays_per_second / b.cpu_rays_per_second,
             100.0 * b.hit_fraction,
             100.0 * b.agreement,
             100.0 * b.bvh2_agreement
@@ -159,6 +163,8 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
             wgsl_sorted_speedup: b.gpu_sorted_rays_per_second / b.gpu_rays_per_second,
             wgsl_bvh2_mrays_per_s: b.gpu_bvh2_rays_per_second / 1e6,
             bvh2_vs_cwbvh: b.gpu_bvh2_rays_per_second / b.gpu_rays_per_second,
+            cpu_bvh2_mrays_per_s: b.cpu_bvh2_rays_per_second / 1e6,
+            cpu_bvh2_vs_cwbvh: b.cpu_bvh2_rays_per_second / b.cpu_rays_per_second,
             bvh2_agreement: b.bvh2_agreement,
         });
     }

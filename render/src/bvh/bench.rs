@@ -36,6 +36,8 @@ pub struct TraversalBench {
     /// The same random rays through obvhs's binary BVHs of the same triangles (`Bvh2Geometry`,
     /// `bvh2_traversal.wgsl`), timed right after the CWBVH traversal.
     pub gpu_bvh2_rays_per_second: f64,
+    /// obvhs's own traversal of those BVH2s (`SceneBvh2`) on `cpu_threads` threads.
+    pub cpu_bvh2_rays_per_second: f64,
     /// Building the BVH2s on the CPU, plus the upload.
     pub bvh2_build_seconds: f64,
     /// Fraction of rays where the BVH2 traversal and the CPU report the same instance and primitive.
@@ -100,6 +102,11 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
     let (reps, elapsed) = repeat_until(MIN_TIMED, || bvh2_batch.dispatch(gpu, &traversal, &buffers, TraceKind::Closest))?;
     let gpu_bvh2_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
     let bvh2_hits = bvh2_batch.read_closest(gpu, &buffers)?;
+    let (reps, elapsed) = repeat_until(MIN_TIMED, || {
+        std::hint::black_box(queries.par_iter().map(|r| bvh2.cpu().trace_closest(r.origin, r.direction, r.t_max)).collect::<Vec<_>>());
+        Ok(())
+    })?;
+    let cpu_bvh2_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
 
     let cpu = geometry.cpu();
     let trace_all = || queries.par_iter().map(|r| cpu.trace_closest(r.origin, r.direction, r.t_max)).collect::<Vec<_>>();
@@ -136,6 +143,7 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
         gpu_sorted_rays_per_second,
         cpu_sorted_rays_per_second,
         gpu_bvh2_rays_per_second,
+        cpu_bvh2_rays_per_second,
         bvh2_build_seconds,
         bvh2_agreement,
         cpu_threads: rayon::current_num_threads(),
