@@ -63,6 +63,13 @@ fn sss_without_a_subsurface_material_is_refused() {
     std::fs::write(&file, bad).unwrap();
     let e = RunSpec::load(&file, &Overrides::default()).err().expect("unknown field").to_string();
     assert!(e.contains("plain.ron:2:") && e.contains("kappa"), "{e}");
+    let separable_afis = "Scenario(scene: Builtin(\"sss_sphere\"), resolution: (16, 9), frames: 1,\n methods: [Sss(variant: Separable(taps: 5), prefilter: ())],\n materials: [(material: \"skin\", subsurface: (dmfp: (0.1, 0.05, 0.02)))])";
+    std::fs::write(&file, separable_afis).unwrap();
+    let overrides = Overrides { out: Some(dir.join("run_afis")), ..Default::default() };
+    let spec = RunSpec::load(&file, &overrides).expect("scenario");
+    let opts = RunOptions { scenario: file.clone(), overrides, cache_dir: Some(dir.join("cache")), progress: false };
+    let e = format!("{:#}", run_spec(&spec, &opts).err().expect("separable with prefilter"));
+    assert!(e.contains("prefilter with Separable"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -91,11 +98,16 @@ fn taa_after_the_pass_lowers_flicker_and_separable_runs() {
     const FRAMES: u32 = 8;
     let mut gaps = vec![];
     for seed in 1..=3u64 {
-        let methods = "Sss(variant: Adaptive, name: \"as\"), Sss(variant: Adaptive, taa: (alpha: 0.1), name: \"as_taa\"), Sss(variant: Separable(taps: 25), name: \"separable\")";
+        let methods = "Sss(variant: Adaptive, name: \"as\"), Sss(variant: Adaptive, taa: (alpha: 0.1), name: \"as_taa\"), Sss(variant: Separable(taps: 25), name: \"separable\"), Sss(variant: Adaptive, prefilter: ())";
         let (records, dir) = play_inline("taa", seed, FRAMES, methods);
         let image = |m: &str, f: u32| systems::output::read_exr(&dir.join(format!("run/frames/{m}/{f:04}.exr"))).unwrap().2;
         assert_eq!(image("as", 0), image("as_taa", 0), "seed {seed}: frame 0 has no history");
         assert_ne!(image("as", 3), image("as_taa", 3), "seed {seed}: TAA changed nothing");
+        // AFIS (the default label `sss_as_afis`): its own prefiltering pass, a different image.
+        assert_ne!(image("as", 0), image("sss_as_afis", 0), "seed {seed}: prefiltering changed nothing");
+        for r in records.iter().filter(|r| r.method == "sss_as_afis") {
+            assert!(r.passes.iter().any(|(p, _)| p == "sss_prefilter"), "{:?}", r.passes);
+        }
         let mean_smape = |m: &str| {
             let v: Vec<f64> = records.iter().filter(|r| r.method == m && r.frame > 0).map(|r| r.smape.expect("smape")).collect();
             v.iter().sum::<f64>() / v.len() as f64

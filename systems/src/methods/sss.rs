@@ -14,7 +14,7 @@ use render::path_tracer::NO_HIT;
 use render::sss::gpu::SssPass;
 use render::taa::{Taa, TaaPrimary, TaaSettings};
 use render::sss::profile::scaling_from_dmfp;
-use render::sss::{SpvgSettings, SssFrame, SssSettings, SssVariant};
+use render::sss::{Prefilter, SpvgSettings, SssFrame, SssSettings, SssVariant};
 use serde::{Deserialize, Serialize};
 
 use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
@@ -39,12 +39,16 @@ pub struct SssMethodSettings {
     /// resolve over the modulated image, its history rejected by the G-buffer's instance,
     /// depth and normal. None: no TAA.
     pub taa: Option<TaaSettings>,
+    /// AFIS (Sec. 5.2): samples read a prefiltered MIP chain of the irradiance at eq. 5.12's
+    /// level, `prefilter: (a: 0.0625, levels: 6)` (the thesis's a; `()` takes both defaults).
+    /// None: samples read the irradiance itself. Not with Separable.
+    pub prefilter: Option<Prefilter>,
 }
 
 impl Default for SssMethodSettings {
     fn default() -> Self {
         let s = SssSettings::default();
-        Self { variant: s.variant, spp: 1, fast_inverse: s.fast_inverse, spvg: s.spvg, eps_a: s.eps_a, a0: s.a0, a_cv: s.a_cv, taa: None }
+        Self { variant: s.variant, spp: 1, fast_inverse: s.fast_inverse, spvg: s.spvg, eps_a: s.eps_a, a0: s.a0, a_cv: s.a_cv, taa: None, prefilter: None }
     }
 }
 
@@ -57,11 +61,12 @@ impl SssMethodSettings {
             SssVariant::ConstantCv => "sss_ccv".into(),
             SssVariant::Separable { taps } => format!("sss_separable{taps}"),
         };
+        let base = if self.prefilter.is_some() { format!("{base}_afis") } else { base };
         if self.taa.is_some() { format!("{base}_taa") } else { base }
     }
 
     fn pass_settings(&self, seed: u64) -> SssSettings {
-        SssSettings { variant: self.variant, spvg: self.spvg, fast_inverse: self.fast_inverse, eps_a: self.eps_a, a0: self.a0, a_cv: self.a_cv, seed: seed as u32 }
+        SssSettings { variant: self.variant, spvg: self.spvg, fast_inverse: self.fast_inverse, eps_a: self.eps_a, a0: self.a0, a_cv: self.a_cv, seed: seed as u32, prefilter: self.prefilter }
     }
 }
 
@@ -103,6 +108,12 @@ impl MethodPlugin for Plugin {
             && (taps < 3 || taps % 2 == 0 || taps > render::sss::separable::MAX_TAPS)
         {
             bail!("Sss: Separable taps {taps}; expected an odd count in [3, {}]", render::sss::separable::MAX_TAPS);
+        }
+        if let Some(p) = &s.prefilter {
+            if matches!(s.variant, SssVariant::Separable { .. }) {
+                bail!("Sss: prefilter with Separable; the MIP chain serves the Monte Carlo variants (Adaptive, OnlineCv, ConstantCv, Fixed)");
+            }
+            p.validate().map_err(|e| anyhow::anyhow!("Sss: {e}"))?;
         }
         let scene = &world.resource::<sim::ExtractedScene>().scene;
         let subsurface: Vec<(u32, scene::Material)> = scene.materials.iter().enumerate().filter(|(_, m)| m.subsurface.is_some()).map(|(i, m)| (i as u32, *m)).collect();
