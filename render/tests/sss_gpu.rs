@@ -5,7 +5,8 @@
 use render::gpu::Gpu;
 use render::scene::SplitMix64;
 use render::sss::gpu::SssPass;
-use render::sss::{EmCovariance, PixelHistory, PixelResult, SpvgHistory, SpvgSettings, SssFrame, SssSettings, SssVariant};
+use render::sss::prefilter::MipChain;
+use render::sss::{Prefilter, EmCovariance, PixelHistory, PixelResult, SpvgHistory, SpvgSettings, SssFrame, SssSettings, SssVariant};
 use render::sss::screen_pass::step;
 
 const W: u32 = 20;
@@ -100,6 +101,41 @@ fn gpu_pass_matches_the_cpu_reference() {
             compare(&format!("{what} frame 2"), (&results2, &next2), (&cpu2, &cpu_next2));
         }
     }
+}
+
+/// AFIS: the prefiltering pass's MIP chain against `MipChain::build`, level by level, and the
+/// prefiltered pass against its CPU twin; prefiltering changes the image (the path is taken).
+#[test]
+fn gpu_prefiltered_pass_matches_the_cpu_reference() {
+    let gpu = Gpu::new().expect("a wgpu adapter (lavapipe on CI)");
+    let frame = frame();
+    let mut pass = SssPass::new(&gpu, W, H).unwrap();
+    for (variant, prefilter) in [(SssVariant::Adaptive, Prefilter::default()), (SssVariant::Fixed { count: 24 }, Prefilter { a: 1.0, levels: 3 })] {
+        let plain = SssSettings { variant, seed: 3, ..Default::default() };
+        let settings = SssSettings { prefilter: Some(prefilter), ..plain };
+        let start = histories(&settings.spvg);
+        pass.set_history(&gpu, &start);
+        pass.dispatch(&gpu, &frame, &settings, 5).unwrap();
+        let what = format!("{variant:?} {prefilter:?}");
+        let chain = MipChain::build(W, H, &frame.irradiance, prefilter.levels);
+        let mips = pass.mips(&gpu, prefilter.levels).unwrap();
+        assert_eq!(mips.len(), chain.levels.len());
+        for (k, (g, c)) in mips.iter().zip(&chain.levels).enumerate() {
+            assert_eq!(g.len(), c.len(), "{what} level {k}");
+            for (i, (a, b)) in g.iter().zip(c).enumerate() {
+                assert!((0..4).all(|j| close(a[j], b[j], 1e-6, 1e-7)), "{what} level {k} texel {i}: gpu {a:?} cpu {b:?}");
+            }
+        }
+        let (results, next) = (pass.results(&gpu).unwrap(), pass.history(&gpu).unwrap());
+        let (cpu_results, cpu_next) = step(&frame, &settings, 5, &start);
+        compare(&what, (&results, &next), (&cpu_results, &cpu_next));
+        let (unfiltered, _) = step(&frame, &plain, 5, &start);
+        let changed = results.iter().zip(&unfiltered).filter(|(a, b)| (a.rgb[0] - b.rgb[0]).abs() > 1e-4).count();
+        assert!(changed > 10, "{what}: prefiltering changed {changed} pixels");
+    }
+    // Separable has no samples to prefilter.
+    let bad = SssSettings { variant: SssVariant::Separable { taps: 5 }, prefilter: Some(Prefilter::default()), ..Default::default() };
+    assert!(pass.dispatch(&gpu, &frame, &bad, 0).unwrap_err().to_string().contains("Separable"));
 }
 
 #[test]

@@ -63,16 +63,30 @@ fn sss_without_a_subsurface_material_is_refused() {
     std::fs::write(&file, bad).unwrap();
     let e = RunSpec::load(&file, &Overrides::default()).err().expect("unknown field").to_string();
     assert!(e.contains("plain.ron:2:") && e.contains("kappa"), "{e}");
+    let separable_afis = "Scenario(scene: Builtin(\"sss_sphere\"), resolution: (16, 9), frames: 1,\n methods: [Sss(variant: Separable(taps: 5), prefilter: ())],\n materials: [(material: \"skin\", subsurface: (dmfp: (0.1, 0.05, 0.02)))])";
+    std::fs::write(&file, separable_afis).unwrap();
+    let overrides = Overrides { out: Some(dir.join("run_afis")), ..Default::default() };
+    let spec = RunSpec::load(&file, &overrides).expect("scenario");
+    let opts = RunOptions { scenario: file.clone(), overrides, cache_dir: Some(dir.join("cache")), progress: false };
+    let e = format!("{:#}", run_spec(&spec, &opts).err().expect("separable with prefilter"));
+    assert!(e.contains("prefilter with Separable"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
+const SKIN: &str = "(material: \"skin\", subsurface: (dmfp: (0.12, 0.05, 0.025)))";
+
 /// Plays an inline scenario on the skin sphere (constant lamp, no animation) at 32x18.
 fn play_inline(name: &str, seed: u64, frames: u32, methods: &str) -> (Vec<FrameRecord>, PathBuf) {
+    play_with_materials(name, seed, frames, methods, &[SKIN])
+}
+
+fn play_with_materials(name: &str, seed: u64, frames: u32, methods: &str, materials: &[&str]) -> (Vec<FrameRecord>, PathBuf) {
     let dir = std::env::temp_dir().join(format!("sss-e2e-{}-{name}-{seed}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join(format!("{name}.ron"));
     let text = format!(
-        "Scenario(scene: Builtin(\"sss_sphere\"), resolution: (32, 18), frames: {frames}, seed: {seed}, max_depth: 2,\n methods: [{methods}],\n materials: [(material: \"skin\", subsurface: (dmfp: (0.12, 0.05, 0.025)))])"
+        "Scenario(scene: Builtin(\"sss_sphere\"), resolution: (32, 18), frames: {frames}, seed: {seed}, max_depth: 2,\n methods: [{methods}],\n materials: [{}])",
+        materials.join(", ")
     );
     std::fs::write(&file, text).unwrap();
     let overrides = Overrides { out: Some(dir.join("run")), ..Default::default() };
@@ -91,11 +105,16 @@ fn taa_after_the_pass_lowers_flicker_and_separable_runs() {
     const FRAMES: u32 = 8;
     let mut gaps = vec![];
     for seed in 1..=3u64 {
-        let methods = "Sss(variant: Adaptive, name: \"as\"), Sss(variant: Adaptive, taa: (alpha: 0.1), name: \"as_taa\"), Sss(variant: Separable(taps: 25), name: \"separable\")";
+        let methods = "Sss(variant: Adaptive, name: \"as\"), Sss(variant: Adaptive, taa: (alpha: 0.1), name: \"as_taa\"), Sss(variant: Separable(taps: 25), name: \"separable\"), Sss(variant: Adaptive, prefilter: ())";
         let (records, dir) = play_inline("taa", seed, FRAMES, methods);
         let image = |m: &str, f: u32| systems::output::read_exr(&dir.join(format!("run/frames/{m}/{f:04}.exr"))).unwrap().2;
         assert_eq!(image("as", 0), image("as_taa", 0), "seed {seed}: frame 0 has no history");
         assert_ne!(image("as", 3), image("as_taa", 3), "seed {seed}: TAA changed nothing");
+        // AFIS (the default label `sss_as_afis`): its own prefiltering pass, a different image.
+        assert_ne!(image("as", 0), image("sss_as_afis", 0), "seed {seed}: prefiltering changed nothing");
+        for r in records.iter().filter(|r| r.method == "sss_as_afis") {
+            assert!(r.passes.iter().any(|(p, _)| p == "sss_prefilter"), "{:?}", r.passes);
+        }
         let mean_smape = |m: &str| {
             let v: Vec<f64> = records.iter().filter(|r| r.method == m && r.frame > 0).map(|r| r.smape.expect("smape")).collect();
             v.iter().sum::<f64>() / v.len() as f64
@@ -118,4 +137,36 @@ fn taa_after_the_pass_lowers_flicker_and_separable_runs() {
     let bound = mean - systems::suite::student_t::quantile(0.95, n - 1.0) * sd / n.sqrt();
     eprintln!("SMAPE(as) − SMAPE(as_taa) per seed: {gaps:?}, lower 95% bound {bound}");
     assert!(bound > 0.0, "TAA did not lower flicker: per-seed gaps {gaps:?}, bound {bound}");
+}
+
+/// Two subsurface materials: each is scattered by its own profile and reads only its own
+/// pixels. Making the floor subsurface too leaves every skin pixel bit-identical to the run
+/// where only the skin is, scatters the floor's pixels (they change), and counts both.
+#[test]
+fn two_subsurface_materials_scatter_apart() {
+    let methods = "Sss(variant: Adaptive, name: \"as\")";
+    let floor = "(material: \"floor\", subsurface: (dmfp: (0.3, 0.2, 0.1)))";
+    let (one, dir_one) = play_with_materials("one_material", 4, 3, methods, &[SKIN]);
+    let (two, dir_two) = play_with_materials("two_materials", 4, 3, methods, &[SKIN, floor]);
+    let last = |dir: &Path| systems::output::read_exr(&dir.join("run/frames/as/0002.exr")).unwrap().2;
+    let counts = |dir: &Path| metrics::load_image(&dir.join("run/frames/as/sample_count/0002.png")).unwrap().rgb;
+    let (image_one, image_two) = (last(&dir_one), last(&dir_two));
+    let (counts_one, counts_two) = (counts(&dir_one), counts(&dir_two));
+    let (mut skin, mut floor_changed, mut floor) = (0, 0, 0);
+    for i in 0..image_one.len() {
+        if counts_one[i][0] > 0.0 {
+            skin += 1;
+            assert_eq!(image_one[i], image_two[i], "skin pixel {i} changed when the floor became subsurface");
+        } else if counts_two[i][0] > 0.0 {
+            floor += 1;
+            floor_changed += (image_one[i] != image_two[i]) as usize;
+        }
+    }
+    let pixels = |records: &[FrameRecord]| stat(records.last().unwrap(), "sss_pixels") as usize;
+    assert_eq!(pixels(&one), skin);
+    assert_eq!(pixels(&two), skin + floor);
+    assert!(skin > 20 && floor > 100, "skin {skin}, floor {floor} pixels");
+    assert!(floor_changed > floor / 2, "{floor_changed} of {floor} floor pixels scattered");
+    std::fs::remove_dir_all(&dir_one).ok();
+    std::fs::remove_dir_all(&dir_two).ok();
 }

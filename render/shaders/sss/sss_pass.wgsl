@@ -4,6 +4,7 @@
 
 import package::sss_types::SssParams;
 import package::sss::sampling::{sss_pixel_offset, sss_r2_point, sss_sample_radius, sss_radial_pdf, sss_luminance};
+import package::sss::mip::{sss_level_size, sss_level_offset, sss_mip_level};
 import package::sss::spvg::{SpvgParams, spvg_state, spvg_sample_count, spvg_update, cv_update, cv_coefficient};
 
 @group(0) @binding(0) var<uniform> params: SssParams;
@@ -13,6 +14,7 @@ import package::sss::spvg::{SpvgParams, spvg_state, spvg_sample_count, spvg_upda
 @group(0) @binding(4) var<storage, read_write> scattered: array<vec4f>;
 @group(0) @binding(5) var<storage, read_write> history_out: array<vec4f>;
 @group(0) @binding(6) var<storage, read_write> cv_out: array<vec4f>;
+@group(0) @binding(7) var<storage, read> mips: array<vec4f>;
 
 fn texel(i: i32, j: i32, centre: vec3f) -> vec3f {
     let x = clamp(i, 0, i32(params.width) - 1);
@@ -36,6 +38,44 @@ fn fetch(q: vec2f, centre: vec3f) -> vec3f {
     let cc = texel(i, j + 1, centre);
     let d = texel(i + 1, j + 1, centre);
     return (1.0 - f.y) * ((1.0 - f.x) * a + f.x * b) + f.y * ((1.0 - f.x) * cc + f.x * d);
+}
+
+fn mip_texel(base: u32, size: vec2u, i: i32, j: i32, centre: vec3f) -> vec3f {
+    let x = clamp(i, 0, i32(size.x) - 1);
+    let y = clamp(j, 0, i32(size.y) - 1);
+    let t = mips[base + u32(y) * size.x + u32(x)];
+    if t.w > 0.0 {
+        return t.xyz;
+    }
+    return centre;
+}
+
+// Level k of the MIP chain, bilinear at q (level-0 pixels); texels without SSS read as the centre.
+fn fetch_level(k: u32, q: vec2f, centre: vec3f) -> vec3f {
+    let size = sss_level_size(params.width, params.height, k);
+    let base = sss_level_offset(params.width, params.height, k);
+    let p = q / f32(1u << k) - vec2f(0.5);
+    let p0 = floor(p);
+    let f = p - p0;
+    let c = clamp(p0, vec2f(-2.0), vec2f(f32(size.x) + 1.0, f32(size.y) + 1.0));
+    let i = i32(c.x);
+    let j = i32(c.y);
+    let a = mip_texel(base, size, i, j, centre);
+    let b = mip_texel(base, size, i + 1, j, centre);
+    let cc = mip_texel(base, size, i, j + 1, centre);
+    let d = mip_texel(base, size, i + 1, j + 1, centre);
+    return (1.0 - f.y) * ((1.0 - f.x) * a + f.x * b) + f.y * ((1.0 - f.x) * cc + f.x * d);
+}
+
+// Trilinear between levels floor(l) and floor(l) + 1 (Algorithm 2's tex2Dlod).
+fn fetch_lod(l: f32, q: vec2f, centre: vec3f) -> vec3f {
+    let k0 = u32(floor(l));
+    let f = l - f32(k0);
+    let a = fetch_level(k0, q, centre);
+    if f <= 0.0 {
+        return a;
+    }
+    return a + f * (fetch_level(min(k0 + 1u, params.mip_levels - 1u), q, centre) - a);
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -68,8 +108,14 @@ fn sss_scatter(@builtin(global_invocation_id) id: vec3u) {
         let u = sss_r2_point(offset, j);
         let r = sss_sample_radius(u.x, ds, params.fast_inverse != 0u);
         let phi = 6.2831855 * u.y;
-        let l = fetch(centre_pos + r * vec2f(cos(phi), sin(phi)), t.xyz);
+        let q = centre_pos + r * vec2f(cos(phi), sin(phi));
         let ps = sss_radial_pdf(r, ds);
+        var l: vec3f;
+        if params.mip_levels > 0u {
+            l = fetch_lod(sss_mip_level(r, ps, n, params.mip_a, params.mip_levels), q, t.xyz);
+        } else {
+            l = fetch(q, t.xyz);
+        }
         let w = vec3f(sss_radial_pdf(r, dc.x), sss_radial_pdf(r, dc.y), sss_radial_pdf(r, dc.z)) / ps;
         sum += l * w;
     }

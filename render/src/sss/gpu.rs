@@ -4,6 +4,7 @@
 //! instead. Timed per pass (`sss_scatter`, `sss_separable_h`, `sss_separable_v`) by `PassTimer`.
 
 use super::control_variates::EmCovariance;
+use super::prefilter;
 use super::separable;
 use super::screen_pass::{PixelHistory, PixelResult, SssFrame, SssSettings, SssVariant};
 use super::spvg::SpvgHistory;
@@ -22,7 +23,8 @@ pub const MAX_COUNT: u32 = 4096;
 crate::gpu_struct! {
     /// The pass's uniform: image size, frame and seed, the variant (0 fixed, 1 AS, 2 OCV,
     /// 3 CCV, 4 separable), SPVG's and the control variates' parameters, the separable
-    /// kernel's tap count, d per channel in pixels (w: the sampled d).
+    /// kernel's tap count, AFIS's level count (0: no prefiltering) and eq. 5.12's a, d per
+    /// channel in pixels (w: the sampled d).
     pub struct SssParams {
         pub width: u32 => "u32",
         pub height: u32 => "u32",
@@ -40,17 +42,22 @@ crate::gpu_struct! {
         pub a_cv: f32 => "f32",
         pub fast_inverse: u32 => "u32",
         pub taps: u32 => "u32",
+        pub mip_levels: u32 => "u32",
+        pub mip_a: f32 => "f32",
+        pub pad0: u32 => "u32",
+        pub pad1: u32 => "u32",
         pub d_px: [f32; 4] => "vec4f",
     }
 }
-const _: () = assert!(std::mem::size_of::<SssParams>() == 80);
+const _: () = assert!(std::mem::size_of::<SssParams>() == 96);
 
 /// The pass's WGSL program: the Monte Carlo pass and the separable baseline's two passes.
 pub fn program() -> Program {
     let types = Module::generated("package::sss_types", &[SssParams::WGSL]);
-    Program::new(vec![types, crate::wgsl_file!("pt_sampling.wgsl"), crate::wgsl_file!("sss/sampling.wgsl"), crate::wgsl_file!("sss/spvg.wgsl")])
+    Program::new(vec![types, crate::wgsl_file!("pt_sampling.wgsl"), crate::wgsl_file!("sss/sampling.wgsl"), crate::wgsl_file!("sss/spvg.wgsl"), crate::wgsl_file!("sss/mip.wgsl")])
         .entry(crate::wgsl_file!("sss/sss_pass.wgsl"))
         .entry(crate::wgsl_file!("sss/separable.wgsl"))
+        .entry(crate::wgsl_file!("sss/prefilter.wgsl"))
 }
 
 /// The pass for one image size, with its buffers and two history sets (read one, write the other).
@@ -69,6 +76,10 @@ pub struct SssPass {
     cv: [wgpu::Buffer; 2],
     scattered: wgpu::Buffer,
     groups: [wgpu::BindGroup; 2],
+    /// AFIS's MIP chain (`prefilter::MAX_LEVELS` levels' room) and the prefiltering pass, one
+    /// bind group per level (each with its level's uniform).
+    mips: wgpu::Buffer,
+    prefilter: (wgpu::ComputePipeline, Vec<wgpu::BindGroup>),
     /// Which history set holds the latest history.
     current: usize,
     timer: PassTimer,
@@ -83,16 +94,17 @@ impl SssPass {
         if width == 0 || height == 0 {
             return Err(RenderError::Settings(format!("SSS pass size {width}x{height} must be non-zero")));
         }
-        let [pipeline, horizontal, vertical] = crate::compute::pipelines_auto_layout(gpu, "sss_scatter", &program(), ["sss_scatter", "sss_separable_h", "sss_separable_v"])?;
+        let [pipeline, horizontal, vertical, prefilter_pipeline] = crate::compute::pipelines_auto_layout(gpu, "sss_scatter", &program(), ["sss_scatter", "sss_separable_h", "sss_separable_v", "sss_prefilter"])?;
         let size = width as u64 * height as u64 * 16;
         let params = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("sss params"), contents: bytemuck::bytes_of(&<SssParams as bytemuck::Zeroable>::zeroed()), usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST });
         let irradiance = storage(gpu, "sss irradiance", size);
         let history = [storage(gpu, "sss history 0", size), storage(gpu, "sss history 1", size)];
         let cv = [storage(gpu, "sss cv 0", size), storage(gpu, "sss cv 1", size)];
         let scattered = storage(gpu, "sss scattered", size);
+        let mips = storage(gpu, "sss mips", prefilter::level_offset(width, height, prefilter::MAX_LEVELS) * 16);
         let layout = pipeline.get_bind_group_layout(0);
         let group = |k: usize| {
-            let buffers = [&params, &irradiance, &history[k], &cv[k], &scattered, &history[1 - k], &cv[1 - k]];
+            let buffers = [&params, &irradiance, &history[k], &cv[k], &scattered, &history[1 - k], &cv[1 - k], &mips];
             let entries: Vec<_> = buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
             gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("sss pass"), layout: &layout, entries: &entries })
         };
@@ -107,8 +119,14 @@ impl SssPass {
         let h_group = separable_group(&horizontal, &[&params, &irradiance, &kernel, &intermediate]);
         let v_group = separable_group(&vertical, &[&params, &irradiance, &kernel, &intermediate, &scattered]);
         let separable = [(horizontal, h_group), (vertical, v_group)];
-        let timer = PassTimer::new(gpu, &["sss_scatter", "sss_separable_h", "sss_separable_v"]);
-        Ok(Self { width, height, pipeline, separable, kernel, kernel_for: None, params, irradiance, history, cv, scattered, groups, current: 0, timer })
+        let level_groups = (0..prefilter::MAX_LEVELS)
+            .map(|k| {
+                let level = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("sss mip level"), contents: bytemuck::cast_slice(&[k, 0, 0, 0]), usage: wgpu::BufferUsages::UNIFORM });
+                separable_group(&prefilter_pipeline, &[&params, &irradiance, &mips, &level])
+            })
+            .collect();
+        let timer = PassTimer::new(gpu, &["sss_scatter", "sss_separable_h", "sss_separable_v", "sss_prefilter"]);
+        Ok(Self { width, height, pipeline, separable, kernel, kernel_for: None, params, irradiance, history, cv, scattered, groups, mips, prefilter: (prefilter_pipeline, level_groups), current: 0, timer })
     }
 
     /// Replaces the latest history (empty = cold start everywhere).
@@ -131,6 +149,14 @@ impl SssPass {
             return Err(RenderError::Settings(format!("SSS frame {}x{} ({} texels) does not match the pass's {}x{}", frame.width, frame.height, frame.irradiance.len(), self.width, self.height)));
         }
         settings.spvg.validate().map_err(RenderError::Settings)?;
+        let mip_levels = match (settings.prefilter, settings.variant) {
+            (Some(_), SssVariant::Separable { .. }) => return Err(RenderError::Settings("SSS prefilter applies to the Monte Carlo variants, not Separable".into())),
+            (Some(p), _) => {
+                p.validate().map_err(RenderError::Settings)?;
+                p.levels
+            }
+            (None, _) => 0,
+        };
         let (fixed, taps) = match settings.variant {
             SssVariant::Fixed { count } => (count, 0),
             SssVariant::Separable { taps } => (0, taps),
@@ -164,12 +190,28 @@ impl SssPass {
             a_cv: settings.a_cv,
             fast_inverse: settings.fast_inverse as u32,
             taps,
+            mip_levels,
+            mip_a: settings.prefilter.map_or(0.0, |p| p.a),
+            pad0: 0,
+            pad1: 0,
             d_px: [frame.d_px[0], frame.d_px[1], frame.d_px[2], frame.d_sample()],
         };
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
         gpu.queue.write_buffer(&self.irradiance, 0, bytemuck::cast_slice(&frame.irradiance));
         let mut timed = self.timer.begin(gpu, "sss frame");
         let (gx, gy) = (self.width.div_ceil(8), self.height.div_ceil(8));
+        if mip_levels > 0 {
+            let (pipeline, groups) = &self.prefilter;
+            timed.pass(3, |pass| {
+                pass.set_pipeline(pipeline);
+                // One dispatch per level, each reading the last (wgpu orders them).
+                for (k, group) in groups.iter().enumerate().take(mip_levels as usize) {
+                    let (w, h) = prefilter::level_size(self.width, self.height, k as u32);
+                    pass.set_bind_group(0, group, &[]);
+                    pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+                }
+            })?;
+        }
         let passes: Vec<(usize, &wgpu::ComputePipeline, &wgpu::BindGroup)> = if taps > 0 {
             self.separable.iter().enumerate().map(|(k, (p, g))| (1 + k, p, g)).collect()
         } else {
@@ -191,12 +233,30 @@ impl SssPass {
     }
 
     fn read(&self, gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<[f32; 4]>, RenderError> {
-        let size = self.width as u64 * self.height as u64 * 16;
+        let mut all = self.read_all(gpu, buffer, what)?;
+        all.truncate((self.width * self.height) as usize);
+        Ok(all)
+    }
+
+    fn read_all(&self, gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<[f32; 4]>, RenderError> {
+        let size = buffer.size();
         let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some("sss staging"), size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sss readback") });
         encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
         gpu.queue.submit([encoder.finish()]);
         read_buffer(gpu, &staging).map_err(|reason| RenderError::Readback { what: what.into(), reason })
+    }
+
+    /// The last frame's MIP chain, `levels` levels (rgb, share of SSS texels per texel).
+    pub fn mips(&self, gpu: &Gpu, levels: u32) -> Result<Vec<Vec<[f32; 4]>>, RenderError> {
+        let all = self.read_all(gpu, &self.mips, "sss mips")?;
+        Ok((0..levels.min(prefilter::MAX_LEVELS))
+            .map(|k| {
+                let start = prefilter::level_offset(self.width, self.height, k) as usize;
+                let (w, h) = prefilter::level_size(self.width, self.height, k);
+                all[start..start + (w * h) as usize].to_vec()
+            })
+            .collect())
     }
 
     /// The last frame's results (scattered rgb, count).

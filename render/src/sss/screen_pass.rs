@@ -4,6 +4,7 @@
 //! (eq. 5.2, divided by A: the albedo is applied after the pass), and the histories update.
 
 use super::control_variates::EmCovariance;
+use super::prefilter::{self, MipChain, Prefilter};
 use super::separable;
 use super::sampling::{luminance, pixel_offset, r2_point, radial_pdf, sample_radius};
 use super::spvg::{self, SpvgHistory, SpvgSettings};
@@ -49,11 +50,14 @@ pub struct SssSettings {
     pub a0: f32,
     pub a_cv: f32,
     pub seed: u32,
+    /// AFIS (Sec. 5.2): samples read a prefiltered MIP chain at eq. 5.12's level; None reads
+    /// the irradiance itself (level 0). The Monte Carlo variants only.
+    pub prefilter: Option<Prefilter>,
 }
 
 impl Default for SssSettings {
     fn default() -> Self {
-        Self { variant: SssVariant::Adaptive, spvg: SpvgSettings::default(), fast_inverse: true, eps_a: 1e-6, a0: 1000.0, a_cv: 0.005, seed: 1 }
+        Self { variant: SssVariant::Adaptive, spvg: SpvgSettings::default(), fast_inverse: true, eps_a: 1e-6, a0: 1000.0, a_cv: 0.005, seed: 1, prefilter: None }
     }
 }
 
@@ -92,22 +96,21 @@ pub struct PixelResult {
 /// The irradiance at q (pixel units, texel centres at +0.5), bilinear, clamped to the image;
 /// texels outside the SSS mask read as the centre pixel's (no bleeding across profiles).
 fn fetch(frame: &SssFrame, q: [f32; 2], centre: [f32; 3]) -> [f32; 3] {
-    let (w, h) = (frame.width as i32, frame.height as i32);
-    let (x, y) = (q[0] - 0.5, q[1] - 0.5);
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = (x - x0, y - y0);
-    let texel = |i: i32, j: i32| {
-        let t = frame.irradiance[(j.clamp(0, h - 1) * w + i.clamp(0, w - 1)) as usize];
+    let w = frame.width as i32;
+    prefilter::bilinear(w, frame.height as i32, q, |i, j| {
+        let t = frame.irradiance[(j * w + i) as usize];
         if t[3] > 0.0 { [t[0], t[1], t[2]] } else { centre }
-    };
-    // Clamp before the cast: radii in the far tail are huge.
-    let (xi, yi) = (x0.clamp(-2.0, w as f32 + 1.0) as i32, y0.clamp(-2.0, h as f32 + 1.0) as i32);
-    let (a, b, c, d) = (texel(xi, yi), texel(xi + 1, yi), texel(xi, yi + 1), texel(xi + 1, yi + 1));
-    std::array::from_fn(|k| (1.0 - fy) * ((1.0 - fx) * a[k] + fx * b[k]) + fy * ((1.0 - fx) * c[k] + fx * d[k]))
+    })
 }
 
-/// n Burley samples around pixel (x, y): (1/n) Σ L(q_j) pdf_c(r_j)/pdf_s(r_j) per channel c.
-pub fn scatter(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x: u32, y: u32, n: u32) -> [f32; 3] {
+/// The frame's MIP chain when the settings prefilter.
+pub fn mip_chain(frame: &SssFrame, settings: &SssSettings) -> Option<MipChain> {
+    settings.prefilter.map(|p| MipChain::build(frame.width, frame.height, &frame.irradiance, p.levels))
+}
+
+/// n Burley samples around pixel (x, y): (1/n) Σ L(q_j) pdf_c(r_j)/pdf_s(r_j) per channel c, L
+/// read from `chain` at eq. 5.12's level when given (AFIS, Algorithm 2), else bilinear.
+pub fn scatter(frame: &SssFrame, settings: &SssSettings, chain: Option<&MipChain>, frame_index: u32, x: u32, y: u32, n: u32) -> [f32; 3] {
     let pixel = y * frame.width + x;
     let t = frame.irradiance[pixel as usize];
     let centre = [t[0], t[1], t[2]];
@@ -120,8 +123,11 @@ pub fn scatter(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x: u3
         let r = sample_radius(u[0], ds, settings.fast_inverse);
         let phi = 2.0 * std::f32::consts::PI * u[1];
         let q = [x as f32 + 0.5 + r * phi.cos(), y as f32 + 0.5 + r * phi.sin()];
-        let l = fetch(frame, q, centre);
         let ps = radial_pdf(r, ds);
+        let l = match (chain, settings.prefilter) {
+            (Some(chain), Some(p)) => chain.fetch(prefilter::level(r, ps, n, p.a, p.levels), q, centre),
+            _ => fetch(frame, q, centre),
+        };
         for c in 0..3 {
             sum[c] += l[c] * (radial_pdf(r, d[c]) / ps);
         }
@@ -130,7 +136,7 @@ pub fn scatter(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x: u3
 }
 
 /// One pixel's step: count, samples, histories (the Monte Carlo variants).
-fn pixel_step(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x: u32, y: u32, prev: &PixelHistory) -> (PixelResult, PixelHistory) {
+fn pixel_step(frame: &SssFrame, settings: &SssSettings, chain: Option<&MipChain>, frame_index: u32, x: u32, y: u32, prev: &PixelHistory) -> (PixelResult, PixelHistory) {
     let t = frame.irradiance[(y * frame.width + x) as usize];
     if t[3] <= 0.0 {
         return (PixelResult { rgb: [t[0], t[1], t[2]], count: 0 }, PixelHistory::default());
@@ -141,7 +147,7 @@ fn pixel_step(frame: &SssFrame, settings: &SssSettings, frame_index: u32, x: u32
         SssVariant::Separable { .. } => unreachable!("the separable variant runs as two 1-D passes in `step`"),
         _ => spvg::sample_count(&st, &settings.spvg),
     };
-    let rgb = scatter(frame, settings, frame_index, x, y, n);
+    let rgb = scatter(frame, settings, chain, frame_index, x, y, n);
     let f = luminance(rgb);
     let g = luminance([t[0], t[1], t[2]]);
     let a = match settings.variant {
@@ -162,13 +168,14 @@ pub fn step(frame: &SssFrame, settings: &SssSettings, frame_index: u32, history:
         let kernel = separable::kernel(taps, frame.d_px).unwrap_or_else(|e| panic!("{e}"));
         return (separable::step(frame, &kernel), vec![PixelHistory::default(); count]);
     }
+    let chain = mip_chain(frame, settings);
     let empty = PixelHistory::default();
     let mut results = Vec::with_capacity(count);
     let mut next = Vec::with_capacity(count);
     for y in 0..frame.height {
         for x in 0..frame.width {
             let i = (y * frame.width + x) as usize;
-            let (r, h) = pixel_step(frame, settings, frame_index, x, y, history.get(i).unwrap_or(&empty));
+            let (r, h) = pixel_step(frame, settings, chain.as_ref(), frame_index, x, y, history.get(i).unwrap_or(&empty));
             results.push(r);
             next.push(h);
         }

@@ -1,6 +1,6 @@
 //! Screen-space subsurface scattering (render::sss, issue 14, realtime-sss-thesis.txt): the path
-//! tracer's image, demodulated by the G-buffer albedo on the pixels of the scene's subsurface
-//! material, is scattered by the thesis's pass (Burley sampling with SPVG counts and control
+//! tracer's image, demodulated by the G-buffer albedo on the pixels of each subsurface material
+//! (up to 8, each with its own profile and pass), is scattered by the thesis's pass (Burley sampling with SPVG counts and control
 //! variates, or a fixed count, or the separable baseline) and modulated back; with `taa` set,
 //! render::taa's resolve runs over the result, as the thesis's TAA after the pass.
 //! `Sss(variant: OnlineCv, taa: (alpha: 0.1))`.
@@ -14,7 +14,7 @@ use render::path_tracer::NO_HIT;
 use render::sss::gpu::SssPass;
 use render::taa::{Taa, TaaPrimary, TaaSettings};
 use render::sss::profile::scaling_from_dmfp;
-use render::sss::{SpvgSettings, SssFrame, SssSettings, SssVariant};
+use render::sss::{Prefilter, SpvgSettings, SssFrame, SssSettings, SssVariant};
 use serde::{Deserialize, Serialize};
 
 use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
@@ -39,12 +39,16 @@ pub struct SssMethodSettings {
     /// resolve over the modulated image, its history rejected by the G-buffer's instance,
     /// depth and normal. None: no TAA.
     pub taa: Option<TaaSettings>,
+    /// AFIS (Sec. 5.2): samples read a prefiltered MIP chain of the irradiance at eq. 5.12's
+    /// level, `prefilter: (a: 0.0625, levels: 6)` (the thesis's a; `()` takes both defaults).
+    /// None: samples read the irradiance itself. Not with Separable.
+    pub prefilter: Option<Prefilter>,
 }
 
 impl Default for SssMethodSettings {
     fn default() -> Self {
         let s = SssSettings::default();
-        Self { variant: s.variant, spp: 1, fast_inverse: s.fast_inverse, spvg: s.spvg, eps_a: s.eps_a, a0: s.a0, a_cv: s.a_cv, taa: None }
+        Self { variant: s.variant, spp: 1, fast_inverse: s.fast_inverse, spvg: s.spvg, eps_a: s.eps_a, a0: s.a0, a_cv: s.a_cv, taa: None, prefilter: None }
     }
 }
 
@@ -57,22 +61,33 @@ impl SssMethodSettings {
             SssVariant::ConstantCv => "sss_ccv".into(),
             SssVariant::Separable { taps } => format!("sss_separable{taps}"),
         };
+        let base = if self.prefilter.is_some() { format!("{base}_afis") } else { base };
         if self.taa.is_some() { format!("{base}_taa") } else { base }
     }
 
     fn pass_settings(&self, seed: u64) -> SssSettings {
-        SssSettings { variant: self.variant, spvg: self.spvg, fast_inverse: self.fast_inverse, eps_a: self.eps_a, a0: self.a0, a_cv: self.a_cv, seed: seed as u32 }
+        SssSettings { variant: self.variant, spvg: self.spvg, fast_inverse: self.fast_inverse, eps_a: self.eps_a, a0: self.a0, a_cv: self.a_cv, seed: seed as u32, prefilter: self.prefilter }
     }
+}
+
+/// The most subsurface materials one image scatters (a pass each).
+pub const MAX_SSS_MATERIALS: usize = 8;
+
+/// One subsurface material's profile and its pass. Each material's pixels are scattered by their
+/// own pass, in which the other materials' pixels are off the mask: a profile reads only its own
+/// material's irradiance (no bleeding between materials, as none from other surfaces).
+pub struct SssProfile {
+    /// The material's index in `SceneDesc::materials`.
+    material: u32,
+    /// Burley's d per channel in scene units (Θ3 of eq. 2.44 from dmfp and the base colour).
+    d: [f32; 3],
+    pass: SssPass,
 }
 
 #[derive(Component)]
 pub struct SssState {
     settings: SssMethodSettings,
-    pass: SssPass,
-    /// Burley's d per channel in scene units (Θ3 of eq. 2.44 from dmfp and the base colour).
-    d: [f32; 3],
-    /// The subsurface material's index in `SceneDesc::materials`.
-    material: u32,
+    profiles: Vec<SssProfile>,
     taa: Option<Taa>,
 }
 
@@ -104,24 +119,35 @@ impl MethodPlugin for Plugin {
         {
             bail!("Sss: Separable taps {taps}; expected an odd count in [3, {}]", render::sss::separable::MAX_TAPS);
         }
+        if let Some(p) = &s.prefilter {
+            if matches!(s.variant, SssVariant::Separable { .. }) {
+                bail!("Sss: prefilter with Separable; the MIP chain serves the Monte Carlo variants (Adaptive, OnlineCv, ConstantCv, Fixed)");
+            }
+            p.validate().map_err(|e| anyhow::anyhow!("Sss: {e}"))?;
+        }
         let scene = &world.resource::<sim::ExtractedScene>().scene;
         let subsurface: Vec<(u32, scene::Material)> = scene.materials.iter().enumerate().filter(|(_, m)| m.subsurface.is_some()).map(|(i, m)| (i as u32, *m)).collect();
-        let Some(&(material, m)) = subsurface.first() else {
+        if subsurface.is_empty() {
             bail!("Sss: the scene has no subsurface material; expected a material override in the scenario, e.g. materials: [(material: \"skin\", subsurface: (dmfp: (0.3, 0.12, 0.06)))]");
-        };
-        if subsurface.len() > 1 {
-            bail!("Sss: {} subsurface materials; the pass scatters one profile per image, expected one", subsurface.len());
         }
-        let dmfp = m.subsurface.expect("filtered").dmfp;
-        let albedo = m.base_color;
-        let d = [0, 1, 2].map(|c| (dmfp[c] as f64 / scaling_from_dmfp(albedo[c] as f64)) as f32);
+        if subsurface.len() > MAX_SSS_MATERIALS {
+            bail!("Sss: {} subsurface materials; expected at most {MAX_SSS_MATERIALS} (a pass each)", subsurface.len());
+        }
         let (width, height) = {
             let run = world.resource::<Run>();
             (run.width, run.height)
         };
-        let pass = SssPass::new(&world.resource::<GpuDevice>().0, width, height)?;
-        let taa = s.taa.map(|t| Taa::new(&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0, t)).transpose()?;
-        world.entity_mut(entity).insert(SssState { settings: s.clone(), pass, d, material, taa });
+        let gpu = &world.resource::<GpuDevice>().0;
+        let profiles = subsurface
+            .iter()
+            .map(|&(material, m)| {
+                let dmfp = m.subsurface.expect("filtered").dmfp;
+                let d = [0, 1, 2].map(|c| (dmfp[c] as f64 / scaling_from_dmfp(m.base_color[c] as f64)) as f32);
+                Ok(SssProfile { material, d, pass: SssPass::new(gpu, width, height)? })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let taa = s.taa.map(|t| Taa::new(gpu, &world.resource::<Tracer>().0, t)).transpose()?;
+        world.entity_mut(entity).insert(SssState { settings: s.clone(), profiles, taa });
         Ok(())
     }
 }
@@ -135,40 +161,42 @@ pub fn render(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, run: Res<Run>, cl
         // Pixels per scene unit at distance t: height / (2 t tan(vfov / 2)) (on the axis).
         let focal = out.height as f32 / (2.0 * (0.5 * tracer.0.camera().vfov).tan());
         let g = &out.gbuffer;
-        let material = state.material;
-        let is_sss = |i: usize| {
-            let inst = g.instance_id[i];
-            inst != NO_HIT && scene.scene.instances.get(inst as usize).is_some_and(|x| x.material == material)
-        };
-        let irradiance: Vec<[f32; 4]> = (0..out.radiance.len())
-            .map(|i| {
-                let l = out.radiance[i];
-                if !is_sss(i) {
-                    return [l[0], l[1], l[2], 0.0];
-                }
-                let a = Vec3::from(g.albedo[i]).max(Vec3::splat(1e-4));
-                [l[0] / a.x, l[1] / a.y, l[2] / a.z, focal / g.depth[i].max(1e-6)]
+        // Per pixel: which profile's material it shows (None: not subsurface).
+        let profile_of: Vec<Option<usize>> = g
+            .instance_id
+            .iter()
+            .map(|&inst| {
+                let material = (inst != NO_HIT).then(|| scene.scene.instances.get(inst as usize).map(|x| x.material)).flatten()?;
+                state.profiles.iter().position(|p| p.material == material)
             })
             .collect();
-        let sss_frame = SssFrame { width: out.width, height: out.height, irradiance, d_px: state.d };
         let settings = state.settings.pass_settings(run.scenario.seed);
         let mut timings = out.timings.clone();
-        timings.extend(state.pass.dispatch(&gpu.0, &sss_frame, &settings, clock.global).map_err(|e| fail(&e))?);
-        let results = state.pass.results(&gpu.0).map_err(|e| fail(&e))?;
-        let (mut count_sum, mut sss_pixels) = (0u64, 0u64);
-        let radiance: Vec<[f32; 4]> = results
-            .iter()
-            .enumerate()
-            .map(|(i, r)| {
-                if !is_sss(i) {
-                    return out.radiance[i];
+        let mut radiance = out.radiance.clone();
+        let mut counts = vec![0u32; radiance.len()];
+        for (k, profile) in state.profiles.iter_mut().enumerate() {
+            let irradiance: Vec<[f32; 4]> = (0..out.radiance.len())
+                .map(|i| {
+                    let l = out.radiance[i];
+                    if profile_of[i] != Some(k) {
+                        return [l[0], l[1], l[2], 0.0];
+                    }
+                    let a = Vec3::from(g.albedo[i]).max(Vec3::splat(1e-4));
+                    [l[0] / a.x, l[1] / a.y, l[2] / a.z, focal / g.depth[i].max(1e-6)]
+                })
+                .collect();
+            let sss_frame = SssFrame { width: out.width, height: out.height, irradiance, d_px: profile.d };
+            render::timing::merge(&mut timings, profile.pass.dispatch(&gpu.0, &sss_frame, &settings, clock.global).map_err(|e| fail(&e))?);
+            for (i, r) in profile.pass.results(&gpu.0).map_err(|e| fail(&e))?.iter().enumerate() {
+                if profile_of[i] == Some(k) {
+                    let a = g.albedo[i];
+                    radiance[i] = [r.rgb[0] * a[0], r.rgb[1] * a[1], r.rgb[2] * a[2], 1.0];
+                    counts[i] = r.count;
                 }
-                count_sum += r.count as u64;
-                sss_pixels += 1;
-                let a = g.albedo[i];
-                [r.rgb[0] * a[0], r.rgb[1] * a[1], r.rgb[2] * a[2], 1.0]
-            })
-            .collect();
+            }
+        }
+        let sss_pixels = profile_of.iter().filter(|p| p.is_some()).count() as u64;
+        let count_sum: u64 = counts.iter().map(|&c| c as u64).sum();
         let radiance = match state.taa.as_mut() {
             Some(taa) => {
                 let resolved = resolve_taa(&gpu.0, taa, &radiance, g).map_err(|e| fail(&e))?;
@@ -177,7 +205,7 @@ pub fn render(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, run: Res<Run>, cl
             }
             None => radiance,
         };
-        let counts: Vec<[f32; 4]> = results.iter().map(|r| { let v = r.count as f32 / 64.0; [v, v, v, 1.0] }).collect();
+        let counts: Vec<[f32; 4]> = counts.iter().map(|&c| { let v = c as f32 / 64.0; [v, v, v, 1.0] }).collect();
         let mean_spp = count_sum as f64 / sss_pixels.max(1) as f64;
         frame.output = Some(MethodOutput {
             stats: vec![("sss_mean_spp".into(), mean_spp), ("sss_pixels".into(), sss_pixels as f64)],
