@@ -498,29 +498,6 @@ fn empty_scene_and_bad_input() {
     assert!(SceneGeometry::new(&gpu, &bad).is_err(), "a singular transform is refused");
 }
 
-/// A closed-ish box room with two blocks, like the Cornell box: 5 quads + 2 cubes.
-fn box_room() -> SceneDesc {
-    let mut scene = SceneDesc { meshes: vec![quad(), cube()], ..Default::default() };
-    let walls = [
-        Mat4::IDENTITY,
-        Mat4::from_translation(Vec3::new(0.0, 2.0, 0.0)) * Mat4::from_rotation_x(std::f32::consts::PI),
-        Mat4::from_translation(Vec3::new(0.0, 1.0, -1.0)) * Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2),
-        Mat4::from_translation(Vec3::new(-1.0, 1.0, 0.0)) * Mat4::from_rotation_z(-std::f32::consts::FRAC_PI_2),
-        Mat4::from_translation(Vec3::new(1.0, 1.0, 0.0)) * Mat4::from_rotation_z(std::f32::consts::FRAC_PI_2),
-    ];
-    for (i, w) in walls.into_iter().enumerate() {
-        scene.instances.push(Instance { mesh: 0, material: i as u32, transform: w });
-    }
-    let blocks = [
-        Mat4::from_scale_rotation_translation(Vec3::new(0.6, 1.2, 0.6), Quat::from_rotation_y(0.3), Vec3::new(-0.35, 0.6, -0.3)),
-        Mat4::from_scale_rotation_translation(Vec3::splat(0.6), Quat::from_rotation_y(-0.3), Vec3::new(0.35, 0.3, 0.3)),
-    ];
-    for b in blocks {
-        scene.instances.push(Instance { mesh: 1, material: 5, transform: b });
-    }
-    scene
-}
-
 /// The WGSL BVH2 traversal against obvhs's BVH2 traversal (itself against brute force) on the
 /// traversal tests' scenes and rays (the same seeds): the glTF torus, the hairball, instances
 /// with rotations, mirroring and an empty mesh.
@@ -548,34 +525,4 @@ fn bvh2_gpu_traversal_matches_obvhs_bvh2_and_brute_force() {
         let any = batch.trace_any(&gpu, &traversal, &rays).unwrap();
         check(label, &compare(label, &scene, bvh2.cpu(), &rays, &hits, &any));
     }
-}
-
-#[test]
-#[ignore = "benchmark, run in release: cargo test --release -p render --test traversal -- --ignored --nocapture"]
-fn traversal_benchmark_table() {
-    let gpu = gpu();
-    let one = |mesh: Mesh| SceneDesc { meshes: vec![mesh], instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }], ..Default::default() };
-    let scenes = [
-        ("box room", box_room()),
-        ("hairball", one(hairball(2000, 8, 0.004, 7))),
-        ("100k displaced sphere", one(render::bvh::displaced_sphere(100_000, 7))),
-    ];
-    println!("| scene | triangles | rays | GPU Mrays/s | CPU Mrays/s (threads) | hit % | GPU = CPU | build s |");
-    println!("|---|---|---|---|---|---|---|---|");
-    for (name, scene) in scenes {
-        let b = render::bvh::traversal_benchmark(&gpu, &scene, 100_000, 11).unwrap();
-        println!(
-            "| {name} | {} | {} | {:.3} | {:.3} ({}) | {:.1} | {:.2}% | {:.3} |",
-            b.triangles,
-            b.rays,
-            b.gpu_rays_per_second / 1e6,
-            b.cpu_rays_per_second / 1e6,
-            b.cpu_threads,
-            100.0 * b.hit_fraction,
-            100.0 * b.agreement,
-            b.build_seconds
-        );
-        assert!(b.agreement > 0.99, "{name}: {b}");
-    }
-    println!("adapter: {}", gpu.summary);
 }
