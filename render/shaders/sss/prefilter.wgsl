@@ -3,7 +3,6 @@
 // mask as its share; level k is the 2x2 mean of level k-1 over SSS texels, with their share.
 
 import package::sss_types::SssParams;
-import package::sss::mip::{sss_level_size, sss_level_offset};
 
 struct MipLevel {
     k: u32,
@@ -20,11 +19,11 @@ struct MipLevel {
 @compute @workgroup_size(8, 8, 1)
 fn sss_prefilter(@builtin(global_invocation_id) id: vec3u) {
     let k = mip_level.k;
-    let size = sss_level_size(params.width, params.height, k);
-    if id.x >= size.x || id.y >= size.y {
+    let level = params.mip[k];
+    if id.x >= level.y || id.y >= level.z {
         return;
     }
-    let out = sss_level_offset(params.width, params.height, k) + id.y * size.x + id.x;
+    let out = level.x + id.y * level.y + id.x;
     if k == 0u {
         let t = irradiance[id.y * params.width + id.x];
         if t.w > 0.0 {
@@ -34,8 +33,8 @@ fn sss_prefilter(@builtin(global_invocation_id) id: vec3u) {
         }
         return;
     }
-    let prev = sss_level_size(params.width, params.height, k - 1u);
-    let base = sss_level_offset(params.width, params.height, k - 1u);
+    let prev = params.mip[k - 1u].yz;
+    let base = params.mip[k - 1u].x;
     var sum = vec3f(0.0);
     var share = 0.0;
     for (var c = 0u; c < 4u; c++) {

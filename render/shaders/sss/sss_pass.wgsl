@@ -4,7 +4,7 @@
 
 import package::sss_types::SssParams;
 import package::sss::sampling::{sss_pixel_offset, sss_r2_point, sss_sample_radius, sss_radial_pdf, sss_luminance};
-import package::sss::mip::{sss_level_size, sss_level_offset, sss_mip_level};
+import package::sss::mip::sss_mip_level;
 import package::sss::spvg::{SpvgParams, spvg_state, spvg_sample_count, spvg_update, cv_update, cv_coefficient};
 
 @group(0) @binding(0) var<uniform> params: SssParams;
@@ -16,55 +16,49 @@ import package::sss::spvg::{SpvgParams, spvg_state, spvg_sample_count, spvg_upda
 @group(0) @binding(6) var<storage, read_write> cv_out: array<vec4f>;
 @group(0) @binding(7) var<storage, read> mips: array<vec4f>;
 
-fn texel(i: i32, j: i32, centre: vec3f) -> vec3f {
-    let x = clamp(i, 0, i32(params.width) - 1);
-    let y = clamp(j, 0, i32(params.height) - 1);
-    let t = irradiance[u32(y) * params.width + u32(x)];
-    if t.w > 0.0 {
-        return t.xyz;
-    }
-    return centre;
-}
-
-fn fetch(q: vec2f, centre: vec3f) -> vec3f {
-    let p = q - vec2f(0.5);
-    let p0 = floor(p);
-    let f = p - p0;
-    let c = clamp(p0, vec2f(-2.0), vec2f(f32(params.width) + 1.0, f32(params.height) + 1.0));
-    let i = i32(c.x);
-    let j = i32(c.y);
-    let a = texel(i, j, centre);
-    let b = texel(i + 1, j, centre);
-    let cc = texel(i, j + 1, centre);
-    let d = texel(i + 1, j + 1, centre);
-    return (1.0 - f.y) * ((1.0 - f.x) * a + f.x * b) + f.y * ((1.0 - f.x) * cc + f.x * d);
-}
-
-fn mip_texel(base: u32, size: vec2u, i: i32, j: i32, centre: vec3f) -> vec3f {
+// A texel of the irradiance (from_mips false) or of the MIP chain at `base` (a level of `size`
+// texels), clamped to the image; texels without SSS read as the centre.
+fn texel(from_mips: bool, base: u32, size: vec2u, i: i32, j: i32, centre: vec3f) -> vec3f {
     let x = clamp(i, 0, i32(size.x) - 1);
     let y = clamp(j, 0, i32(size.y) - 1);
-    let t = mips[base + u32(y) * size.x + u32(x)];
+    let index = base + u32(y) * size.x + u32(x);
+    var t: vec4f;
+    if from_mips {
+        t = mips[index];
+    } else {
+        t = irradiance[index];
+    }
     if t.w > 0.0 {
         return t.xyz;
     }
     return centre;
 }
 
-// Level k of the MIP chain, bilinear at q (level-0 pixels); texels without SSS read as the centre.
-fn fetch_level(k: u32, q: vec2f, centre: vec3f) -> vec3f {
-    let size = sss_level_size(params.width, params.height, k);
-    let base = sss_level_offset(params.width, params.height, k);
-    let p = q / f32(1u << k) - vec2f(0.5);
-    let p0 = floor(p);
-    let f = p - p0;
-    let c = clamp(p0, vec2f(-2.0), vec2f(f32(size.x) + 1.0, f32(size.y) + 1.0));
+// Bilinear at p (texel units of that image, texel centres at +0.5).
+fn bilinear(from_mips: bool, base: u32, size: vec2u, p: vec2f, centre: vec3f) -> vec3f {
+    let s = p - vec2f(0.5);
+    let s0 = floor(s);
+    let f = s - s0;
+    // Clamp before the cast: radii in the far tail are huge.
+    let c = clamp(s0, vec2f(-2.0), vec2f(f32(size.x) + 1.0, f32(size.y) + 1.0));
     let i = i32(c.x);
     let j = i32(c.y);
-    let a = mip_texel(base, size, i, j, centre);
-    let b = mip_texel(base, size, i + 1, j, centre);
-    let cc = mip_texel(base, size, i, j + 1, centre);
-    let d = mip_texel(base, size, i + 1, j + 1, centre);
+    let a = texel(from_mips, base, size, i, j, centre);
+    let b = texel(from_mips, base, size, i + 1, j, centre);
+    let cc = texel(from_mips, base, size, i, j + 1, centre);
+    let d = texel(from_mips, base, size, i + 1, j + 1, centre);
     return (1.0 - f.y) * ((1.0 - f.x) * a + f.x * b) + f.y * ((1.0 - f.x) * cc + f.x * d);
+}
+
+// The irradiance at q (pixels), bilinear.
+fn fetch(q: vec2f, centre: vec3f) -> vec3f {
+    return bilinear(false, 0u, vec2u(params.width, params.height), q, centre);
+}
+
+// Level k of the MIP chain, bilinear at q (level-0 pixels).
+fn fetch_level(k: u32, q: vec2f, centre: vec3f) -> vec3f {
+    let level = params.mip[k];
+    return bilinear(true, level.x, level.yz, q / f32(1u << k), centre);
 }
 
 // Trilinear between levels floor(l) and floor(l) + 1 (Algorithm 2's tex2Dlod).

@@ -24,7 +24,8 @@ crate::gpu_struct! {
     /// The pass's uniform: image size, frame and seed, the variant (0 fixed, 1 AS, 2 OCV,
     /// 3 CCV, 4 separable), SPVG's and the control variates' parameters, the separable
     /// kernel's tap count, AFIS's level count (0: no prefiltering) and eq. 5.12's a, d per
-    /// channel in pixels (w: the sampled d).
+    /// channel in pixels (w: the sampled d), and per MIP level (offset in the chain's buffer,
+    /// width, height, 0), computed once here rather than per fetch in the shader.
     pub struct SssParams {
         pub width: u32 => "u32",
         pub height: u32 => "u32",
@@ -47,9 +48,12 @@ crate::gpu_struct! {
         pub pad0: u32 => "u32",
         pub pad1: u32 => "u32",
         pub d_px: [f32; 4] => "vec4f",
+        pub mip: [[u32; 4]; 8] => "array<vec4u, 8>",
     }
 }
-const _: () = assert!(std::mem::size_of::<SssParams>() == 96);
+const _: () = assert!(std::mem::size_of::<SssParams>() == 224);
+// The WGSL array length above is the chain's level bound.
+const _: () = assert!(prefilter::MAX_LEVELS == 8);
 
 /// The pass's WGSL program: the Monte Carlo pass and the separable baseline's two passes.
 pub fn program() -> Program {
@@ -149,14 +153,7 @@ impl SssPass {
             return Err(RenderError::Settings(format!("SSS frame {}x{} ({} texels) does not match the pass's {}x{}", frame.width, frame.height, frame.irradiance.len(), self.width, self.height)));
         }
         settings.spvg.validate().map_err(RenderError::Settings)?;
-        let mip_levels = match (settings.prefilter, settings.variant) {
-            (Some(_), SssVariant::Separable { .. }) => return Err(RenderError::Settings("SSS prefilter applies to the Monte Carlo variants, not Separable".into())),
-            (Some(p), _) => {
-                p.validate().map_err(RenderError::Settings)?;
-                p.levels
-            }
-            (None, _) => 0,
-        };
+        let mip_levels = settings.mip_levels().map_err(|e| RenderError::Settings(format!("SSS {e}")))?;
         let (fixed, taps) = match settings.variant {
             SssVariant::Fixed { count } => (count, 0),
             SssVariant::Separable { taps } => (0, taps),
@@ -195,6 +192,10 @@ impl SssPass {
             pad0: 0,
             pad1: 0,
             d_px: [frame.d_px[0], frame.d_px[1], frame.d_px[2], frame.d_sample()],
+            mip: std::array::from_fn(|k| {
+                let (w, h) = prefilter::level_size(self.width, self.height, k as u32);
+                [prefilter::level_offset(self.width, self.height, k as u32) as u32, w, h, 0]
+            }),
         };
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
         gpu.queue.write_buffer(&self.irradiance, 0, bytemuck::cast_slice(&frame.irradiance));

@@ -55,6 +55,18 @@ pub struct SssSettings {
     pub prefilter: Option<Prefilter>,
 }
 
+impl SssSettings {
+    /// The MIP levels the pass reads (0: no prefiltering); errors for a bad prefilter or one
+    /// with the separable variant, which takes no samples to prefilter.
+    pub fn mip_levels(&self) -> Result<u32, String> {
+        match (self.prefilter, self.variant) {
+            (None, _) => Ok(0),
+            (Some(_), SssVariant::Separable { .. }) => Err("prefilter with Separable; the MIP chain serves the Monte Carlo variants (Adaptive, OnlineCv, ConstantCv, Fixed)".into()),
+            (Some(p), _) => p.validate().map(|()| p.levels),
+        }
+    }
+}
+
 impl Default for SssSettings {
     fn default() -> Self {
         Self { variant: SssVariant::Adaptive, spvg: SpvgSettings::default(), fast_inverse: true, eps_a: 1e-6, a0: 1000.0, a_cv: 0.005, seed: 1, prefilter: None }

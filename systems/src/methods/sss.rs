@@ -119,12 +119,7 @@ impl MethodPlugin for Plugin {
         {
             bail!("Sss: Separable taps {taps}; expected an odd count in [3, {}]", render::sss::separable::MAX_TAPS);
         }
-        if let Some(p) = &s.prefilter {
-            if matches!(s.variant, SssVariant::Separable { .. }) {
-                bail!("Sss: prefilter with Separable; the MIP chain serves the Monte Carlo variants (Adaptive, OnlineCv, ConstantCv, Fixed)");
-            }
-            p.validate().map_err(|e| anyhow::anyhow!("Sss: {e}"))?;
-        }
+        s.pass_settings(0).mip_levels().map_err(|e| anyhow::anyhow!("Sss: {e}"))?;
         let scene = &world.resource::<sim::ExtractedScene>().scene;
         let subsurface: Vec<(u32, scene::Material)> = scene.materials.iter().enumerate().filter(|(_, m)| m.subsurface.is_some()).map(|(i, m)| (i as u32, *m)).collect();
         if subsurface.is_empty() {
