@@ -11,7 +11,11 @@ use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 fn flicker(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_flicker")).args(args).output().expect("flicker runs")
+    flicker_with_env(args, &[])
+}
+
+fn flicker_with_env(args: &[&str], env: &[(&str, &str)]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_flicker")).args(args).envs(env.iter().copied()).output().expect("flicker runs")
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -245,12 +249,8 @@ fn sweep_runs_locally_and_on_slurm_with_identical_numbers() {
     // Local executor: plan, 8 jobs two at a time, merge. One CPU thread per job here and the
     // default elsewhere, so that a metric whose value depends on the thread count (an unordered
     // parallel sum) shows as a difference below.
-    let o = Command::new(env!("CARGO_BIN_EXE_flicker"))
-        .args(["sweep", "run", sweep.to_str().unwrap(), "--out", local.to_str().unwrap(), "--jobs", "2"])
-        .env("RAYON_NUM_THREADS", "1")
-        .output()
-        .expect("flicker runs");
-    ok(&o, "sweep run (local)");
+    let run = ["sweep", "run", sweep.to_str().unwrap(), "--out", local.to_str().unwrap(), "--jobs", "2"];
+    ok(&flicker_with_env(&run, &[("RAYON_NUM_THREADS", "1")]), "sweep run (local)");
     let local_numbers = numbers(&local);
     // A failed job is rerun alone: without its record the merge names it, `local` runs only it.
     std::fs::remove_file(local.join("done/job_0003.json")).unwrap();
