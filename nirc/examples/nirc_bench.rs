@@ -1,4 +1,4 @@
-//! Throughput of the GPU cache at width 64 on this adapter, both MLP forms:
+//! Throughput of the GPU cache at width 64 on this adapter, every MLP form:
 //! `cargo run --release -p nirc --example nirc_bench [batch] [queries] [reps]`
 //! (`flicker bench --nirc` runs the default form and writes JSON).
 
@@ -12,7 +12,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let reps = args.get(2).copied().unwrap_or(3);
     let gpu = render::gpu::Gpu::new()?;
     let config = NircConfig::default();
-    for placement in [WeightPlacement::Tiled, WeightPlacement::Storage] {
+    for placement in [WeightPlacement::Registers, WeightPlacement::Tiled, WeightPlacement::Storage] {
         let r = nirc::bench::run(&gpu, &config, Some(placement), batch, queries, reps)?;
         println!("{}", serde_json::to_string_pretty(&r)?);
     }

@@ -32,3 +32,26 @@ fn write_answer(qi: u32, pos: vec3<f32>, mode: u32, f_ema: vec3<f32>, f_cur: vec
     }
     answers[qi] = vec4<f32>(max((1.0 - sigma) * f_ema + sigma * f_cur, vec3<f32>(0.0)), sigma);
 }
+
+// Which predictors a network mode (not 4) evaluates: EMA (net 1) unless High-LR only, High-LR
+// (net 0) unless EMA only. The tiled and register-form passes run `first_net` first and, with
+// `both`, High-LR second.
+struct Predictors {
+    need_ema: bool,
+    need_cur: bool,
+    both: bool,
+    first_net: u32,
+}
+
+fn predictors(mode: u32) -> Predictors {
+    let need_ema = mode != 1u;
+    let need_cur = mode != 0u;
+    return Predictors(need_ema, need_cur, need_ema && need_cur, select(0u, 1u, need_ema));
+}
+
+// write_answer from the first predictor's output f1 and, with `both`, the second's f2.
+fn write_predictions(qi: u32, pos: vec3<f32>, mode: u32, pr: Predictors, f1: vec3<f32>, f2: vec3<f32>) {
+    let f_ema = select(vec3<f32>(0.0), f1, pr.need_ema);
+    let f_cur = select(f1, f2, pr.both);
+    write_answer(qi, pos, mode, f_ema, select(vec3<f32>(0.0), f_cur, pr.need_cur));
+}

@@ -14,7 +14,12 @@ struct Corners {
 // The 8 vertices of the cell around the normalised position p on one level: the parameter
 // index of each vertex's first feature and its trilinear weight.
 fn level_corners(level: u32, p: vec3<f32>) -> Corners {
-    let res = level_resolution[level];
+    return corners_at(p, level_resolution[level], level_dense[level] == 1u, level_table_size[level], level_offset[level]);
+}
+
+// level_corners with the level's resolution, density, table size and offset given (the
+// generated register-form inference passes them as constants, so nothing is looked up).
+fn corners_at(p: vec3<f32>, res: u32, dense: bool, table_size: u32, offset: u32) -> Corners {
     var cell = vec3<u32>(0u);
     var frac = vec3<f32>(0.0);
     for (var a = 0u; a < 3u; a++) {
@@ -28,14 +33,14 @@ fn level_corners(level: u32, p: vec3<f32>) -> Corners {
         let d = vec3<u32>(c & 1u, (c >> 1u) & 1u, c >> 2u);
         let v = cell + d;
         var entry: u32;
-        if level_dense[level] == 1u {
+        if dense {
             let side = res + 1u;
             entry = v.x + v.y * side + v.z * side * side;
         } else {
-            entry = spatial_hash(v) & (level_table_size[level] - 1u);
+            entry = spatial_hash(v) & (table_size - 1u);
         }
         let w = select(vec3<f32>(1.0) - frac, frac, d == vec3<u32>(1u));
-        out.index[c] = level_offset[level] + entry * FEATURES;
+        out.index[c] = offset + entry * FEATURES;
         out.weight[c] = w.x * w.y * w.z;
     }
     return out;

@@ -7,7 +7,7 @@ import package::nirc::bindings::{call, hyper, queries};
 import package::nirc::tile::{RQ, STASH_VEC4, TILE, tile_a};
 import package::nirc::bindings_common::{normalize_to_bounds};
 import package::nirc::encoding::{corner_sum, direction_feature, level_corners};
-import package::nirc::answer::{write_answer};
+import package::nirc::answer::{predictors, write_answer, write_predictions};
 import package::nirc::mlp_tile::{mlp_forward_tile};
 
 var<workgroup> stash: array<vec4<f32>, STASH_VEC4>;
@@ -31,10 +31,9 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
         }
         return;
     }
-    let need_ema = mode != 1u;
-    let need_cur = mode != 0u;
-    let both = need_ema && need_cur;
-    let first_net = select(0u, 1u, need_ema);
+    let pr = predictors(mode);
+    let both = pr.both;
+    let first_net = pr.first_net;
 
     // Encoding: invocation lid takes query lid % TILE and one half of the levels.
     let t = lid % TILE;
@@ -80,9 +79,7 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
             if qi < call.n {
                 let f1 = vec3<f32>(f_first[0][c], f_first[1][c], f_first[2][c]);
                 let f2 = vec3<f32>(f_second[0][c], f_second[1][c], f_second[2][c]);
-                let f_ema = select(vec3<f32>(0.0), f1, need_ema);
-                let f_cur = select(f1, f2, both);
-                write_answer(qi, queries[qi].position.xyz, mode, f_ema, select(vec3<f32>(0.0), f_cur, need_cur));
+                write_predictions(qi, queries[qi].position.xyz, mode, pr, f1, f2);
             }
         }
     }

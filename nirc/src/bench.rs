@@ -11,6 +11,7 @@ use crate::state::CacheState;
 use crate::bounds::SceneBounds;
 use render::gpu::Gpu;
 use std::time::Instant;
+use wgpu::util::DeviceExt;
 
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct BenchReport {
@@ -190,4 +191,53 @@ pub fn probes(gpu: &Gpu, reps: u32) -> Result<Probes, NircError> {
         layer_4x16_gflops: layer(&block4x16)?,
         layer_16x16_gflops: layer(&block16x16)?,
     })
+}
+
+/// One 64x64 layer with one record per invocation, its 64 inputs in named registers, the weights
+/// read from `kind` memory ("uniform", "storage", "workgroup"); with `unroll_q` every offset is
+/// a constant, else the 16 output quads are a loop (the register form's shape, src/gpu/lane.rs).
+/// GFLOP/s, and the seconds of pipeline creation plus the first dispatch (lavapipe compiles then).
+pub fn register_layer_probe(gpu: &Gpu, reps: u32, kind: &str, unroll_q: bool) -> Result<(f64, f64), NircError> {
+    let mut s = String::from("@group(0) @binding(0) var<storage, read> input: array<vec4<f32>>;\n@group(0) @binding(2) var<storage, read_write> out: array<vec4<f32>>;\n");
+    match kind {
+        "uniform" => s.push_str("@group(0) @binding(1) var<uniform> w: array<vec4<f32>, 1024>;\n"),
+        "storage" => s.push_str("@group(0) @binding(1) var<storage, read> w: array<vec4<f32>, 1024>;\n"),
+        _ => s.push_str("@group(0) @binding(1) var<storage, read> wsrc: array<vec4<f32>, 1024>;\nvar<workgroup> w: array<vec4<f32>, 1024>;\n"),
+    }
+    s.push_str("@compute @workgroup_size(64)\nfn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {\n    let r = gid.x;\n");
+    if kind == "workgroup" {
+        s.push_str("    for (var e = lid; e < 1024u; e += 64u) { w[e] = wsrc[e]; }\n    workgroupBarrier();\n");
+    }
+    for q in 0..16 {
+        s.push_str(&format!("    let v{q} = input[r * 16u + {q}u];\n"));
+    }
+    let comp = ["x", "y", "z", "w"];
+    s.push_str("    var total = vec4<f32>(0.0);\n");
+    if unroll_q {
+        for q in 0..16 {
+            s.push_str("    {\n        var acc = vec4<f32>(0.0);\n");
+            for k in 0..64 {
+                s.push_str(&format!("        acc += v{}.{} * w[{}u];\n", k / 4, comp[k % 4], k * 16 + q));
+            }
+            s.push_str("        total += max(acc, vec4<f32>(0.0));\n    }\n");
+        }
+    } else {
+        s.push_str("    for (var q = 0u; q < 16u; q++) {\n        var acc = vec4<f32>(0.0);\n");
+        for k in 0..64 {
+            s.push_str(&format!("        acc += v{}.{} * w[{}u + q];\n", k / 4, comp[k % 4], k * 16));
+        }
+        s.push_str("        total += max(acc, vec4<f32>(0.0));\n    }\n");
+    }
+    s.push_str("    out[r] = total;\n}\n");
+    let t0 = Instant::now();
+    let [p] = render::compute::pipelines_auto_layout(gpu, "register layer", &render::shader::Program::single("package::nirc::register_layer", &s), ["main"])?;
+    let records = 64 * 256u32;
+    let input = upload(gpu, "probe input", &vec![0.01f32; records as usize * 64]);
+    let usage = if kind == "uniform" { wgpu::BufferUsages::UNIFORM } else { wgpu::BufferUsages::STORAGE };
+    let weights = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("probe w"), contents: bytemuck::cast_slice(&vec![0.02f32; 4096]), usage });
+    let out = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some("probe out"), size: records as u64 * 16, usage: wgpu::BufferUsages::STORAGE, mapped_at_creation: false });
+    let secs = dispatch_timed(gpu, reps, &p, &[(0, &input), (1, &weights), (2, &out)], records / 64)?;
+    // dispatch_timed ran one warm-up dispatch before the timed ones.
+    let compile_s = t0.elapsed().as_secs_f64() - reps as f64 * secs;
+    Ok((records as f64 * 2.0 * 4096.0 / secs / 1e9, compile_s))
 }

@@ -127,6 +127,15 @@ impl Gpu {
         Ok(())
     }
 
+    /// Refuses a uniform binding larger than the adapter binds.
+    pub fn check_uniform_size(&self, what: &str, bytes: u64) -> Result<(), GpuError> {
+        let limit = self.limits.max_uniform_buffer_binding_size as u64;
+        if bytes > limit {
+            return Err(self.over(&format!("{what} size in bytes"), bytes, limit));
+        }
+        Ok(())
+    }
+
     /// Refuses a compute pass whose workgroup memory exceeds the budget.
     pub fn check_workgroup_memory(&self, pass: &str, bytes: u32) -> Result<(), GpuError> {
         let limit = self.workgroup_memory_budget();

@@ -16,6 +16,7 @@
 
 pub mod readback;
 pub mod shaders;
+pub mod lane;
 
 use crate::bounds::SceneBounds;
 use crate::config::{NircConfig, PredictorMode};
@@ -98,6 +99,8 @@ struct Pipelines {
     reliability_walk: wgpu::ComputePipeline,
     finish_step: wgpu::ComputePipeline,
     infer: wgpu::ComputePipeline,
+    /// The register form's staging of both predictors' MLP weights (lane_stage.wgsl).
+    lane_stage: Option<wgpu::ComputePipeline>,
 }
 
 struct Buffers {
@@ -116,6 +119,9 @@ struct Buffers {
     reliability_accum: wgpu::Buffer,
     moments: wgpu::Buffer,
     counters: wgpu::Buffer,
+    /// Both predictors' MLP weights as the register form reads them (storage for
+    /// lane_stage.wgsl, uniform for infer_lane.wgsl).
+    lane_staged: wgpu::Buffer,
 }
 
 /// The bind groups of one training step ([`NeuralCache::prepare_step`]).
@@ -139,6 +145,7 @@ type Stage<'a> = (&'static str, &'a wgpu::ComputePipeline, &'a wgpu::BindGroup, 
 /// Bind groups that depend on neither the caller's buffers nor the call's uniforms.
 struct FixedBindGroups {
     reliability_update: wgpu::BindGroup,
+    lane_stage: Option<wgpu::BindGroup>,
 }
 
 /// The neural incident radiance cache on the GPU.
@@ -224,12 +231,24 @@ impl NeuralCache {
             }
             Ok(gpu.check_workgroup_memory("nirc tiled MLP (tiles in workgroup memory)", wg_bytes)?)
         };
+        let registers = || -> Result<(), NircError> {
+            if let Some(why) = lane::unsupported(&layout) {
+                return Err(NircError::Config(format!("the register-form inference cannot run this network: {why}")));
+            }
+            Ok(gpu.check_uniform_size("nirc register-form inference (both predictors' MLP weights in one uniform binding)", lane::uniform_bytes(&layout) as u64)?)
+        };
         let placement = match placement {
             Some(WeightPlacement::Tiled) => {
                 tiled()?;
                 WeightPlacement::Tiled
             }
+            Some(WeightPlacement::Registers) => {
+                tiled()?;
+                registers()?;
+                WeightPlacement::Registers
+            }
             Some(WeightPlacement::Storage) => WeightPlacement::Storage,
+            None if tiled().is_ok() && registers().is_ok() && gpu.summary.device_type == "Cpu" => WeightPlacement::Registers,
             None if tiled().is_ok() => WeightPlacement::Tiled,
             None => WeightPlacement::Storage,
         };
@@ -266,7 +285,7 @@ impl NeuralCache {
         let one = |pass: &str| -> Result<wgpu::ComputePipeline, NircError> { Ok(build(pass, &["main"])?.remove(0)) };
         let [weight_partial, weight_reduce] = <[wgpu::ComputePipeline; 2]>::try_from(build("weight_gradient", &["partial_sums", "reduce"])?).expect("two pipelines");
         let [adam_check, adam_apply, ema_update] = <[wgpu::ComputePipeline; 3]>::try_from(build("adam_ema", &["check", "apply", "ema_update"])?).expect("three pipelines");
-        let tiled = placement == WeightPlacement::Tiled;
+        let tiled = placement.tiled_training();
         Ok(Pipelines {
             train: one(if tiled { "train_tile" } else { "train_forward_backward" })?,
             weight_partial: (!tiled).then_some(weight_partial),
@@ -278,7 +297,12 @@ impl NeuralCache {
             reliability_update: one("reliability_update")?,
             reliability_walk: one("reliability_walk")?,
             finish_step: one("finish_step")?,
-            infer: one(if tiled { "infer_tile" } else { "infer" })?,
+            infer: one(match placement {
+                WeightPlacement::Tiled => "infer_tile",
+                WeightPlacement::Registers => "infer_lane",
+                WeightPlacement::Storage => "infer",
+            })?,
+            lane_stage: (placement == WeightPlacement::Registers).then(|| one("lane_stage")).transpose()?,
         })
     }
 
@@ -346,12 +370,19 @@ impl NeuralCache {
             reliability_accum: storage(gpu, "nirc reliability sums", cell_count(&config.reliability) as u64 * ACCUM_PER_CELL * 4)?,
             moments: storage_init(gpu, "nirc reliability moments", bytemuck::cast_slice(&state.reliability))?,
             counters: storage_init(gpu, "nirc counters", bytemuck::bytes_of(&counters))?,
+            lane_staged: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("nirc staged MLP weights"),
+                size: (lane::uniform_bytes(layout) as u64).max(16),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::UNIFORM,
+                mapped_at_creation: false,
+            }),
         })
     }
 
     fn fixed_groups(gpu: &Gpu, p: &Pipelines, b: &Buffers) -> FixedBindGroups {
         FixedBindGroups {
             reliability_update: bind(gpu, "nirc reliability update", &p.reliability_update, &[(1, &b.hyper), (2, &b.reliability_accum), (3, &b.moments), (4, &b.counters)]),
+            lane_stage: p.lane_stage.as_ref().map(|stage| bind(gpu, "nirc lane stage", stage, &[(3, &b.params), (4, &b.ema), (9, &b.lane_staged)])),
         }
     }
 
@@ -410,7 +441,7 @@ impl NeuralCache {
         let call = Self::call_buffer(gpu, Call::new(n, 0, num_chunks));
         let mut fb_entries: Vec<(u32, &wgpu::Buffer)> =
             vec![(0, &call), (1, &b.hyper), (2, records), (3, &b.params), (4, &b.ema), (5, &b.scratch), (6, &b.grid_accum), (7, &b.samples), (8, &b.losses), (9, &b.counters)];
-        if self.placement == WeightPlacement::Tiled {
+        if self.placement.tiled_training() {
             fb_entries.push((10, &b.partials));
         }
         let fb = bind(gpu, "nirc train", &p.train, &fb_entries);
@@ -611,6 +642,10 @@ impl NeuralCache {
     fn encode_infer_code(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: (u32, f32)) -> Result<(), NircError> {
         let Some(group) = self.infer_group(gpu, queries, n, out, mode)? else { return Ok(()) };
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc infer"), timestamp_writes: None });
+        if let (Some(stage), Some(stage_group)) = (&self.pipelines.lane_stage, &self.groups.lane_stage) {
+            // The weights as this inference sees them (the last committed step's).
+            dispatch(&mut pass, stage, stage_group, (lane::uniform_bytes(&self.layout) / 16).div_ceil(WORKGROUP_SIZE));
+        }
         dispatch(&mut pass, &self.pipelines.infer, &group, self.infer_groups(n));
         Ok(())
     }
@@ -619,7 +654,7 @@ impl NeuralCache {
     fn infer_groups(&self, n: u32) -> u32 {
         match self.placement {
             WeightPlacement::Tiled => n.div_ceil(shaders::INFER_TILE_QUERIES),
-            WeightPlacement::Storage => n.div_ceil(WORKGROUP_SIZE),
+            WeightPlacement::Storage | WeightPlacement::Registers => n.div_ceil(WORKGROUP_SIZE),
         }
     }
 
@@ -636,12 +671,11 @@ impl NeuralCache {
         }
         let b = &self.buffers;
         let call = Self::call_buffer(gpu, Call { fixed_sigma: mode.1, ..Call::new(n, mode.0, 0) });
-        Ok(Some(bind(
-            gpu,
-            "nirc infer",
-            &self.pipelines.infer,
-            &[(0, &call), (1, &b.hyper), (2, queries), (3, &b.params), (4, &b.ema), (5, &b.moments), (6, &b.counters), (7, out)],
-        )))
+        let mut entries = vec![(0, &call), (1, &b.hyper), (2, queries), (3, &b.params), (4, &b.ema), (5, &b.moments), (6, &b.counters), (7, out)];
+        if self.placement == WeightPlacement::Registers {
+            entries.push((8, &b.lane_staged));
+        }
+        Ok(Some(bind(gpu, "nirc infer", &self.pipelines.infer, &entries)))
     }
 
     pub fn counters(&self, gpu: &Gpu) -> Result<Counters, NircError> {

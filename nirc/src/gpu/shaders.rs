@@ -26,6 +26,17 @@ pub enum WeightPlacement {
     Tiled,
     /// One invocation per record, weights read from the storage buffer (any network).
     Storage,
+    /// Training as `Tiled`; inference with one query per invocation, its activations in
+    /// registers and each layer's weights in workgroup memory (src/gpu/lane.rs,
+    /// infer_lane.wgsl). The default on CPU adapters, where it is the faster form.
+    Registers,
+}
+
+impl WeightPlacement {
+    /// Whether training runs the tiled pass.
+    pub fn tiled_training(self) -> bool {
+        self != WeightPlacement::Storage
+    }
 }
 
 /// Invocation (rq, oq) of a tile computes 4 records x OPT outputs: RQ = tile / 4 record quads,
@@ -173,6 +184,9 @@ pub fn program(config: &NircConfig, layout: &ParameterLayout, pass: &str) -> Pro
     if let Some((records, training)) = tile {
         modules.push(Module::generated("package::nirc::tile", &[&tile_constants(layout, &tile_shape(layout, records), training)]));
     }
+    if pass == "infer_lane" || pass == "lane_stage" {
+        modules.push(Module::generated("package::nirc::lane", &[&super::lane::module(layout)]));
+    }
     let (own, entry) = pass_files(pass);
     modules.extend(own);
     modules.extend(shared_files());
@@ -180,7 +194,7 @@ pub fn program(config: &NircConfig, layout: &ParameterLayout, pass: &str) -> Pro
 }
 
 /// The passes, by name.
-const PASSES: [&str; 10] = ["train_tile", "infer_tile", "train_forward_backward", "infer", "reliability_accumulate", "reliability_update", "reliability_walk", "weight_gradient", "adam_ema", "finish_step"];
+const PASSES: [&str; 12] = ["train_tile", "infer_tile", "infer_lane", "lane_stage", "train_forward_backward", "infer", "reliability_accumulate", "reliability_update", "reliability_walk", "weight_gradient", "adam_ema", "finish_step"];
 
 /// A pass's own files: its bindings (`package::nirc::bindings`), the tiled passes' activation hook
 /// (`package::nirc::keep`), and its entry-point file.
@@ -190,6 +204,8 @@ fn pass_files(pass: &str) -> (Vec<Module>, Module) {
     match pass {
         "train_tile" => (vec![bindings(nirc_file!("train_bindings.wgsl")), keep(nirc_file!("train_keep.wgsl"))], nirc_file!("train_tile.wgsl")),
         "infer_tile" => (vec![bindings(nirc_file!("infer_bindings.wgsl")), keep(nirc_file!("keep_none.wgsl"))], nirc_file!("infer_tile.wgsl")),
+        "infer_lane" => (vec![bindings(nirc_file!("infer_bindings.wgsl"))], nirc_file!("infer_lane.wgsl")),
+        "lane_stage" => (vec![bindings(nirc_file!("infer_bindings.wgsl"))], nirc_file!("lane_stage.wgsl")),
         "train_forward_backward" => (vec![bindings(nirc_file!("train_bindings.wgsl"))], nirc_file!("train_forward_backward.wgsl")),
         "infer" => (vec![bindings(nirc_file!("infer_bindings.wgsl"))], nirc_file!("infer.wgsl")),
         "reliability_accumulate" => (vec![bindings(nirc_file!("reliability_accumulate_bindings.wgsl"))], nirc_file!("reliability_accumulate.wgsl")),

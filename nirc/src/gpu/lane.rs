@@ -1,0 +1,116 @@
+//! The register form of inference (`WeightPlacement::Registers`): one query per invocation, its
+//! inputs and activations in named registers, both predictors' MLP weights in one uniform buffer
+//! (`lane_stage.wgsl` copies them there, transposed, before each inference; `infer_lane.wgsl`).
+//! Why this shape, from `nirc::bench::register_layer_probe` on lavapipe (Mesa 22.3): a storage or
+//! workgroup load whose address is not a constant becomes a loop over the SIMD lanes, a private
+//! array indexed at run time a scatter/gather, while a uniform-buffer load at a dynamically
+//! uniform address is one scalar load; and a workgroup barrier is compiled as a coroutine
+//! suspension, which made LLVM's coroutine splitting run for many minutes on a fully unrolled
+//! network, so this form has no barrier. Each layer loops over its output quads with the inputs
+//! unrolled; every sum runs over the inputs in order, as on the CPU. On a GPU every invocation
+//! reads the same weight at once, which uniform memory serves as a broadcast.
+
+use crate::layout::ParameterLayout;
+
+const XYZW: [&str; 4] = ["x", "y", "z", "w"];
+
+/// Where each matrix starts in one predictor's staged weights (vec4s), and the vec4s of one
+/// predictor: matrix m as W^T by output quads, lane_w[base_m + k * quads + q] = outputs
+/// 4q..4q+3 of input k. Predictor `net` starts at net * the total.
+pub fn lane_w_layout(layout: &ParameterLayout) -> (Vec<u32>, u32) {
+    let mut bases = Vec::new();
+    let mut total = 0;
+    for m in &layout.matrices {
+        bases.push(total);
+        total += m.rows.div_ceil(4) * m.cols;
+    }
+    (bases, total)
+}
+
+/// Bytes of the uniform buffer holding both predictors' staged weights.
+pub fn uniform_bytes(layout: &ParameterLayout) -> u32 {
+    2 * lane_w_layout(layout).1 * 16
+}
+
+/// Why the register form cannot run this network, if it cannot: the unrolled code grows with
+/// inputs x width, so it takes what the tiled form takes.
+pub fn unsupported(layout: &ParameterLayout) -> Option<String> {
+    super::shaders::tiled_unsupported(layout)
+}
+
+/// The generated module `package::nirc::lane`: the staged weights' binding and bases, the input
+/// vector, `lane_inputs` (the encoding of one query, level by level with its constants) and
+/// `lane_net` (the forward pass of the predictor whose weights start at `net_base`).
+pub fn module(layout: &ParameterLayout) -> String {
+    let in_vec4 = layout.input_dims.div_ceil(4);
+    let (bases, total) = lane_w_layout(layout);
+    let mut s = String::from("import package::nirc::encoding::{corners_at, corner_sum, direction_feature};\n\n");
+    let bases_text: Vec<String> = bases.iter().map(|b| format!("{b}u")).collect();
+    s.push_str(&format!(
+        "const LANE_W_VEC4: u32 = {total}u;\nconst LANE_MATRICES: u32 = {}u;\nconst LANE_BASE = array<u32, {}>({});\n@group(0) @binding(8) var<uniform> lane_w: array<vec4<f32>, {}>;\nstruct LaneIn {{ {} }}\nstruct LanePair {{ a: LaneIn, b: LaneIn }}\n\n",
+        bases.len(),
+        bases.len(),
+        bases_text.join(", "),
+        2 * total,
+        (0..in_vec4).map(|i| format!("v{i}: vec4<f32>")).collect::<Vec<_>>().join(", ")
+    ));
+    s.push_str("fn lane_relu(v: vec4<f32>) -> vec4<f32> {\n    return select(vec4<f32>(0.0), v, v > vec4<f32>(0.0));\n}\n\n");
+    s.push_str(&inputs(layout));
+    s.push_str(&net(layout, &bases));
+    s
+}
+
+/// `lane_inputs(p, dir, first_net, both)`: the network input of predictor `first_net` in `.a`
+/// and, with `both`, of predictor 0 in `.b`, from one set of corners per level.
+fn inputs(layout: &ParameterLayout) -> String {
+    let f = layout.features_per_level;
+    let slot = |i: u32| format!("v{}.{}", i / 4, XYZW[(i % 4) as usize]);
+    let mut s = String::from("fn lane_inputs(p: vec3<f32>, dir: vec3<f32>, first_net: u32, both: bool) -> LanePair {\n    var x: LanePair;\n");
+    for (l, level) in layout.levels.iter().enumerate() {
+        s.push_str(&format!("    {{\n        let c = corners_at(p, {}u, {}, {}u, {}u);\n", level.resolution, level.dense, level.table_size, level.offset));
+        for k in 0..f {
+            let i = l as u32 * f + k;
+            s.push_str(&format!("        x.a.{} = corner_sum(first_net, c, {k}u);\n        if both {{\n            x.b.{} = corner_sum(0u, c, {k}u);\n        }}\n", slot(i), slot(i)));
+        }
+        s.push_str("    }\n");
+    }
+    let base = layout.levels.len() as u32 * f;
+    for i in 0..layout.direction_dims {
+        s.push_str(&format!("    x.a.{} = direction_feature(dir, {i}u);\n    x.b.{} = x.a.{};\n", slot(base + i), slot(base + i), slot(base + i)));
+    }
+    s.push_str("    return x;\n}\n\n");
+    s
+}
+
+/// `lane_net(net_base, x) -> vec4`: every layer, looping over its output quads with the sum over
+/// the layer's inputs unrolled (inputs in order); each quad lands in its named register through a
+/// switch on the (uniform) quad index. ReLU on hidden layers; the outputs in .xyz.
+fn net(layout: &ParameterLayout, bases: &[u32]) -> String {
+    let mut s = String::from("fn lane_net(net_base: u32, x: LaneIn) -> vec4<f32> {\n");
+    let last = layout.matrices.len() - 1;
+    for (m, (matrix, base)) in layout.matrices.iter().zip(bases).enumerate() {
+        let quads = matrix.rows.div_ceil(4);
+        let input = |k: u32| if m == 0 { format!("x.v{}", k / 4) } else { format!("h{}_{}", m - 1, k / 4) };
+        if m < last {
+            for q in 0..quads {
+                s.push_str(&format!("    var h{m}_{q} = vec4<f32>(0.0);\n"));
+            }
+        }
+        s.push_str(&format!("    for (var q = 0u; q < {quads}u; q++) {{\n        let row = net_base + {base}u + q;\n        var acc = vec4<f32>(0.0);\n"));
+        for k in 0..matrix.cols {
+            s.push_str(&format!("        acc += {}.{} * lane_w[row + {}u];\n", input(k), XYZW[(k % 4) as usize], k * quads));
+        }
+        if m < last {
+            s.push_str("        switch q {\n");
+            for q in 0..quads {
+                s.push_str(&format!("            case {q}u: {{ h{m}_{q} = lane_relu(acc); }}\n"));
+            }
+            s.push_str("            default: {}\n        }\n    }\n");
+        } else {
+            // The output layer has one quad.
+            s.push_str("        return acc;\n    }\n    return vec4<f32>(0.0);\n");
+        }
+    }
+    s.push_str("}\n");
+    s
+}
