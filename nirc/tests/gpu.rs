@@ -59,16 +59,23 @@ fn forward_matches_cpu_in_every_weight_placement() {
 
 /// The register form (one query per invocation, weights in a uniform buffer) sums every layer
 /// in the tiled form's order, so its answers match the tiled form's far closer than the CPU
-/// tolerance; with the default network (width 64, the paper's) as well as the small one.
+/// tolerance (on lavapipe they are bit-identical); with the default network (width 64, the
+/// paper's) as well as the small one. Both ways of recording an inference are checked, each
+/// after a training step changed the weights: the register form stages them per inference.
 #[test]
 fn register_form_matches_the_tiled_form() {
     for config in [small_config(), nirc::NircConfig { max_batch: 256, ..Default::default() }] {
         let state = randomized_state(&config, 31);
+        let batch = records(&mut Rng(6), 128);
         let queries: Vec<_> = records(&mut Rng(5), 150).iter().map(|r| r.query()).collect();
         let tiled = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Tiled)).unwrap();
         let lane = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Registers)).unwrap();
         for mode in [PredictorMode::EmaOnly, PredictorMode::Blend] {
-            let (a, b) = (tiled.infer_queries(gpu(), &queries, mode).unwrap(), lane.infer_queries(gpu(), &queries, mode).unwrap());
+            lane.infer_queries(gpu(), &queries, mode).unwrap();
+            tiled.train_records(gpu(), &batch).unwrap();
+            lane.train_records(gpu(), &batch).unwrap();
+            let a = tiled.infer_queries(gpu(), &queries, mode).unwrap();
+            let b = if mode == PredictorMode::Blend { infer_timed(&lane, &queries, mode) } else { lane.infer_queries(gpu(), &queries, mode).unwrap() };
             for (t, l) in a.iter().zip(&b) {
                 assert_eq!(t.sigma, l.sigma, "width {} {mode:?}", config.network.width);
                 for c in 0..3 {
@@ -77,6 +84,18 @@ fn register_form_matches_the_tiled_form() {
             }
         }
     }
+}
+
+/// `infer_timed`, the way a scenario's frame records an inference.
+fn infer_timed(cache: &NeuralCache, queries: &[nirc::records::CacheQuery], mode: PredictorMode) -> Vec<nirc::records::CacheAnswer> {
+    let qbuf = nirc::gpu::upload(gpu(), "queries", queries);
+    let out = nirc::gpu::answer_buffer(gpu(), queries.len() as u32);
+    let timer = render::timing::PassTimer::wall(&["infer"]);
+    let mut frame = timer.begin(gpu(), "infer");
+    cache.infer_timed(gpu(), &mut frame, 0, &qbuf, queries.len() as u32, &out, mode).unwrap();
+    frame.submit().unwrap();
+    let bytes = nirc::gpu::readback::read_bytes(gpu(), &out, "answers").unwrap();
+    bytemuck::cast_slice::<u8, nirc::records::CacheAnswer>(&bytes[..queries.len() * std::mem::size_of::<nirc::records::CacheAnswer>()]).to_vec()
 }
 
 #[test]

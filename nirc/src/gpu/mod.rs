@@ -623,7 +623,7 @@ impl NeuralCache {
     /// [`Self::encode_infer`] as pass `index` of a timed frame.
     pub fn infer_timed(&self, gpu: &Gpu, timed: &mut TimedFrame, index: usize, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: PredictorMode) -> Result<(), NircError> {
         let Some(group) = self.infer_group(gpu, queries, n, out, (mode.code(), mode.fixed_sigma()))? else { return Ok(()) };
-        timed.pass(index, |pass| dispatch(pass, &self.pipelines.infer, &group, self.infer_groups(n)))?;
+        timed.pass(index, |pass| self.dispatch_infer(pass, &group, n))?;
         Ok(())
     }
 
@@ -642,12 +642,17 @@ impl NeuralCache {
     fn encode_infer_code(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: (u32, f32)) -> Result<(), NircError> {
         let Some(group) = self.infer_group(gpu, queries, n, out, mode)? else { return Ok(()) };
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc infer"), timestamp_writes: None });
-        if let (Some(stage), Some(stage_group)) = (&self.pipelines.lane_stage, &self.groups.lane_stage) {
-            // The weights as this inference sees them (the last committed step's).
-            dispatch(&mut pass, stage, stage_group, (lane::uniform_bytes(&self.layout) / 16).div_ceil(WORKGROUP_SIZE));
-        }
-        dispatch(&mut pass, &self.pipelines.infer, &group, self.infer_groups(n));
+        self.dispatch_infer(&mut pass, &group, n);
         Ok(())
+    }
+
+    /// Every inference goes through here: the register form first stages the weights as this
+    /// inference must see them (the last committed step's), then the inference pass.
+    fn dispatch_infer(&self, pass: &mut wgpu::ComputePass, group: &wgpu::BindGroup, n: u32) {
+        if let (Some(stage), Some(stage_group)) = (&self.pipelines.lane_stage, &self.groups.lane_stage) {
+            dispatch(pass, stage, stage_group, (lane::uniform_bytes(&self.layout) / 16).div_ceil(WORKGROUP_SIZE));
+        }
+        dispatch(pass, &self.pipelines.infer, group, self.infer_groups(n));
     }
 
     /// Workgroups of an inference of `n` queries.
