@@ -451,7 +451,9 @@ impl NeuralCache {
         let adam_entries: &[(u32, &wgpu::Buffer)] =
             &[(0, &call), (1, &b.hyper), (2, &b.params), (3, &b.ema), (4, &b.adam_m), (5, &b.adam_v), (6, &b.grad), (7, &b.grid_accum), (8, &b.counters)];
         let check = bind(gpu, "nirc adam check", &p.adam_check, adam_entries);
-        let apply = bind(gpu, "nirc adam apply", &p.adam_apply, adam_entries);
+        // `apply` does not read the EMA (adam_ema.wgsl), so its layout has no binding 3.
+        let apply_entries: Vec<(u32, &wgpu::Buffer)> = adam_entries.iter().copied().filter(|&(binding, _)| binding != 3).collect();
+        let apply = bind(gpu, "nirc adam apply", &p.adam_apply, &apply_entries);
         let ema = bind(gpu, "nirc ema update", &p.ema_update, &[(1, &b.hyper), (2, &b.params), (3, &b.ema), (8, &b.counters)]);
         let finish = bind(gpu, "nirc finish", &p.finish_step, &[(0, &call), (1, &b.hyper), (2, &b.counters)]);
         Ok(Some(TrainStep { n, num_chunks, fb, accumulate, walk, partial, reduce, check, apply, ema, finish }))
