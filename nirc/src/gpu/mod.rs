@@ -218,8 +218,9 @@ impl NeuralCache {
         Self::from_state(gpu, &CacheState::initial(config, scene_bounds)?, None)
     }
 
-    /// Uploads a whole state. `placement` None chooses the tiled MLP where the network and the
-    /// adapter's workgroup memory allow it, else the per-record passes.
+    /// Uploads a whole state. `placement` None takes `FLICKER_NIRC_MLP` if set, else chooses the
+    /// register-form inference on a CPU adapter and the tiled MLP on others where the network
+    /// and the adapter allow them, else the per-record passes.
     pub fn from_state(gpu: &Gpu, state: &CacheState, placement: Option<WeightPlacement>) -> Result<Self, NircError> {
         let config = state.config.clone();
         config.validate()?;
@@ -237,7 +238,7 @@ impl NeuralCache {
             }
             Ok(gpu.check_uniform_size("nirc register-form inference (both predictors' MLP weights in one uniform binding)", lane::uniform_bytes(&layout) as u64)?)
         };
-        let placement = match placement {
+        let placement = match placement.or(WeightPlacement::from_env()?) {
             Some(WeightPlacement::Tiled) => {
                 tiled()?;
                 WeightPlacement::Tiled

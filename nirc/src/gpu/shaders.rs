@@ -33,6 +33,18 @@ pub enum WeightPlacement {
 }
 
 impl WeightPlacement {
+    /// The form `FLICKER_NIRC_MLP` asks for (`tiled`, `registers` or `storage`), to compare forms
+    /// in whole scenarios; unset or empty: the adapter's default.
+    pub fn from_env() -> Result<Option<Self>, crate::NircError> {
+        match std::env::var("FLICKER_NIRC_MLP").unwrap_or_default().as_str() {
+            "" => Ok(None),
+            "tiled" => Ok(Some(Self::Tiled)),
+            "registers" => Ok(Some(Self::Registers)),
+            "storage" => Ok(Some(Self::Storage)),
+            other => Err(crate::NircError::Config(format!("FLICKER_NIRC_MLP is '{other}'; expected tiled, registers or storage"))),
+        }
+    }
+
     /// Whether training runs the tiled pass.
     pub fn tiled_training(self) -> bool {
         self != WeightPlacement::Storage
