@@ -12,10 +12,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if what != "forms" {
         let p = nirc::bench::probes(&gpu, 3)?;
         println!("FMA ceiling {:.1} GFLOP/s; tiled 4x16 {:.2}, 16x16 {:.2}", p.fma_gflops, p.layer_4x16_gflops, p.layer_16x16_gflops);
-        for kind in ["uniform", "storage", "workgroup"] {
+        for kind in ["uniform", "uniform2", "storage", "workgroup"] {
             for unroll in [true, false] {
+                if kind == "uniform2" && unroll {
+                    continue; // two records per invocation exist in the loop shape only
+                }
                 let (gflops, compile_s) = nirc::bench::register_layer_probe(&gpu, 3, kind, unroll)?;
-                println!("weights in {kind}, output quads {}: {gflops:.2} GFLOP/s (pipeline and first dispatch {compile_s:.1} s)", if unroll { "unrolled" } else { "in a loop" });
+                let memory = if kind == "uniform2" { "uniform, two records per invocation" } else { kind };
+                println!("weights in {memory}, output quads {}: {gflops:.2} GFLOP/s (pipeline and first dispatch {compile_s:.1} s)", if unroll { "unrolled" } else { "in a loop" });
             }
         }
     }

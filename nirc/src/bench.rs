@@ -196,11 +196,12 @@ pub fn probes(gpu: &Gpu, reps: u32) -> Result<Probes, NircError> {
 /// One 64x64 layer with one record per invocation, its 64 inputs in named registers, the weights
 /// read from `kind` memory ("uniform", "storage", "workgroup"); with `unroll_q` every offset is
 /// a constant, else the 16 output quads are a loop (the register form's shape, src/gpu/lane.rs).
+/// Kind "uniform2": "uniform" with two records per invocation, each weight load feeding both.
 /// GFLOP/s, and the seconds of pipeline creation plus the first dispatch (lavapipe compiles then).
 pub fn register_layer_probe(gpu: &Gpu, reps: u32, kind: &str, unroll_q: bool) -> Result<(f64, f64), NircError> {
     let mut s = String::from("@group(0) @binding(0) var<storage, read> input: array<vec4<f32>>;\n@group(0) @binding(2) var<storage, read_write> out: array<vec4<f32>>;\n");
     match kind {
-        "uniform" => s.push_str("@group(0) @binding(1) var<uniform> w: array<vec4<f32>, 1024>;\n"),
+        "uniform" | "uniform2" => s.push_str("@group(0) @binding(1) var<uniform> w: array<vec4<f32>, 1024>;\n"),
         "storage" => s.push_str("@group(0) @binding(1) var<storage, read> w: array<vec4<f32>, 1024>;\n"),
         _ => s.push_str("@group(0) @binding(1) var<storage, read> wsrc: array<vec4<f32>, 1024>;\nvar<workgroup> w: array<vec4<f32>, 1024>;\n"),
     }
@@ -208,12 +209,23 @@ pub fn register_layer_probe(gpu: &Gpu, reps: u32, kind: &str, unroll_q: bool) ->
     if kind == "workgroup" {
         s.push_str("    for (var e = lid; e < 1024u; e += 64u) { w[e] = wsrc[e]; }\n    workgroupBarrier();\n");
     }
+    let pair = kind == "uniform2";
+    let per = if pair { 2 } else { 1 };
     for q in 0..16 {
-        s.push_str(&format!("    let v{q} = input[r * 16u + {q}u];\n"));
+        s.push_str(&format!("    let v{q} = input[r * {} + {q}u];\n", 16 * per));
+        if pair {
+            s.push_str(&format!("    let u{q} = input[r * 32u + 16u + {q}u];\n"));
+        }
     }
     let comp = ["x", "y", "z", "w"];
     s.push_str("    var total = vec4<f32>(0.0);\n");
-    if unroll_q {
+    if pair {
+        s.push_str("    var total2 = vec4<f32>(0.0);\n    for (var q = 0u; q < 16u; q++) {\n        var acc = vec4<f32>(0.0);\n        var acc2 = vec4<f32>(0.0);\n");
+        for k in 0..64 {
+            s.push_str(&format!("        let w{k} = w[{}u + q];\n        acc += v{}.{} * w{k};\n        acc2 += u{}.{} * w{k};\n", k * 16, k / 4, comp[k % 4], k / 4, comp[k % 4]));
+        }
+        s.push_str("        total += max(acc, vec4<f32>(0.0));\n        total2 += max(acc2, vec4<f32>(0.0));\n    }\n    out[2u * r + 1u] = total2;\n    out[2u * r] = total;\n}\n");
+    } else if unroll_q {
         for q in 0..16 {
             s.push_str("    {\n        var acc = vec4<f32>(0.0);\n");
             for k in 0..64 {
@@ -228,15 +240,17 @@ pub fn register_layer_probe(gpu: &Gpu, reps: u32, kind: &str, unroll_q: bool) ->
         }
         s.push_str("        total += max(acc, vec4<f32>(0.0));\n    }\n");
     }
-    s.push_str("    out[r] = total;\n}\n");
+    if !pair {
+        s.push_str("    out[r] = total;\n}\n");
+    }
     let t0 = Instant::now();
     let [p] = render::compute::pipelines_auto_layout(gpu, "register layer", &render::shader::Program::single("package::nirc::register_layer", &s), ["main"])?;
     let records = 64 * 256u32;
     let input = upload(gpu, "probe input", &vec![0.01f32; records as usize * 64]);
-    let usage = if kind == "uniform" { wgpu::BufferUsages::UNIFORM } else { wgpu::BufferUsages::STORAGE };
+    let usage = if kind.starts_with("uniform") { wgpu::BufferUsages::UNIFORM } else { wgpu::BufferUsages::STORAGE };
     let weights = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("probe w"), contents: bytemuck::cast_slice(&vec![0.02f32; 4096]), usage });
     let out = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some("probe out"), size: records as u64 * 16, usage: wgpu::BufferUsages::STORAGE, mapped_at_creation: false });
-    let secs = dispatch_timed(gpu, reps, &p, &[(0, &input), (1, &weights), (2, &out)], records / 64)?;
+    let secs = dispatch_timed(gpu, reps, &p, &[(0, &input), (1, &weights), (2, &out)], records / 64 / per)?;
     // dispatch_timed ran one warm-up dispatch before the timed ones.
     let compile_s = t0.elapsed().as_secs_f64() - reps as f64 * secs;
     Ok((records as f64 * 2.0 * 4096.0 / secs / 1e9, compile_s))
