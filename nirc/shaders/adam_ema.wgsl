@@ -51,12 +51,10 @@ fn update(i: u32, pw: Powers) -> Update {
         let b = 3u * (i - MLP_PARAMS);
         g = fixed_to_f32(grid_accum[b], grid_accum[b + 1u], grid_accum[b + 2u]) * call.inv_n;
     }
-    let b1t = pw.b1t;
-    let b2t = pw.b2t;
     let m1 = hyper.beta1 * adam_m[i] + (1.0 - hyper.beta1) * g;
     let v1 = hyper.beta2 * adam_v[i] + (1.0 - hyper.beta2) * (g * g);
-    let m_hat = m1 / (1.0 - b1t);
-    let v_hat = v1 / (1.0 - b2t);
+    let m_hat = m1 / (1.0 - pw.b1t);
+    let v_hat = v1 / (1.0 - pw.b2t);
     let w1 = params[i] - hyper.learning_rate * m_hat / (sqrt(v_hat) + hyper.adam_epsilon);
     return Update(w1, m1, v1, g);
 }

@@ -32,12 +32,6 @@ pub fn uniform_bytes(layout: &ParameterLayout) -> u32 {
     2 * lane_w_layout(layout).1 * 16
 }
 
-/// Why the register form cannot run this network, if it cannot: the unrolled code grows with
-/// inputs x width, so it takes what the tiled form takes.
-pub fn unsupported(layout: &ParameterLayout) -> Option<String> {
-    super::shaders::tiled_unsupported(layout)
-}
-
 /// The generated module `package::nirc::lane`: the staged weights' binding and bases, the input
 /// vector, `lane_inputs` (the encoding of one query, level by level with its constants) and
 /// `lane_net` (the forward pass of the predictor whose weights start at `net_base`).
@@ -47,8 +41,7 @@ pub fn module(layout: &ParameterLayout) -> String {
     let mut s = String::from("import package::nirc::encoding::{corners_at, corner_sum, direction_feature};\n\n");
     let bases_text: Vec<String> = bases.iter().map(|b| format!("{b}u")).collect();
     s.push_str(&format!(
-        "const LANE_W_VEC4: u32 = {total}u;\nconst LANE_MATRICES: u32 = {}u;\nconst LANE_BASE = array<u32, {}>({});\n@group(0) @binding(8) var<uniform> lane_w: array<vec4<f32>, {}>;\nstruct LaneIn {{ {} }}\nstruct LanePair {{ a: LaneIn, b: LaneIn }}\n\n",
-        bases.len(),
+        "const LANE_W_VEC4: u32 = {total}u;\nconst LANE_BASE = array<u32, {}>({});\n@group(0) @binding(8) var<uniform> lane_w: array<vec4<f32>, {}>;\nstruct LaneIn {{ {} }}\nstruct LanePair {{ a: LaneIn, b: LaneIn }}\n\n",
         bases.len(),
         bases_text.join(", "),
         2 * total,

@@ -120,8 +120,8 @@ struct Buffers {
     moments: wgpu::Buffer,
     counters: wgpu::Buffer,
     /// Both predictors' MLP weights as the register form reads them (storage for
-    /// lane_stage.wgsl, uniform for infer_lane.wgsl).
-    lane_staged: wgpu::Buffer,
+    /// lane_stage.wgsl, uniform for infer_lane.wgsl); only in that form.
+    lane_staged: Option<wgpu::Buffer>,
 }
 
 /// The bind groups of one training step ([`NeuralCache::prepare_step`]).
@@ -203,6 +203,12 @@ pub fn upload<T: Pod>(gpu: &Gpu, label: &str, items: &[T]) -> wgpu::Buffer {
 }
 
 /// An output buffer for `n` answers.
+/// The first `n` answers of an answer buffer, read back.
+pub fn read_answers(gpu: &Gpu, answers: &wgpu::Buffer, n: u32) -> Result<Vec<CacheAnswer>, NircError> {
+    let bytes = readback::read_bytes(gpu, answers, "nirc answers")?;
+    Ok(bytemuck::cast_slice::<u8, CacheAnswer>(&bytes[..n as usize * std::mem::size_of::<CacheAnswer>()]).to_vec())
+}
+
 pub fn answer_buffer(gpu: &Gpu, n: u32) -> wgpu::Buffer {
     gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("nirc answers"),
@@ -232,10 +238,9 @@ impl NeuralCache {
             }
             Ok(gpu.check_workgroup_memory("nirc tiled MLP (tiles in workgroup memory)", wg_bytes)?)
         };
+        // The register form trains with the tiled pass, so it also needs `tiled`.
         let registers = || -> Result<(), NircError> {
-            if let Some(why) = lane::unsupported(&layout) {
-                return Err(NircError::Config(format!("the register-form inference cannot run this network: {why}")));
-            }
+            tiled()?;
             Ok(gpu.check_uniform_size("nirc register-form inference (both predictors' MLP weights in one uniform binding)", lane::uniform_bytes(&layout) as u64)?)
         };
         let placement = match placement.or(WeightPlacement::from_env()?) {
@@ -244,12 +249,11 @@ impl NeuralCache {
                 WeightPlacement::Tiled
             }
             Some(WeightPlacement::Registers) => {
-                tiled()?;
                 registers()?;
                 WeightPlacement::Registers
             }
             Some(WeightPlacement::Storage) => WeightPlacement::Storage,
-            None if tiled().is_ok() && registers().is_ok() && gpu.summary.device_type == "Cpu" => WeightPlacement::Registers,
+            None if gpu.summary.device_type == "Cpu" && registers().is_ok() => WeightPlacement::Registers,
             None if tiled().is_ok() => WeightPlacement::Tiled,
             None => WeightPlacement::Storage,
         };
@@ -265,7 +269,7 @@ impl NeuralCache {
             return Err(NircError::Config(format!("max_batch {} needs more workgroups than this adapter dispatches", config.max_batch)));
         }
         let pipelines = Self::pipelines(gpu, &config, &layout, placement)?;
-        let buffers = Self::buffers(gpu, &config, &layout, state)?;
+        let buffers = Self::buffers(gpu, &config, &layout, state, placement)?;
         let groups = Self::fixed_groups(gpu, &pipelines, &buffers);
         Ok(Self { bounds: state.bounds, config, layout, placement, pipelines, buffers, groups })
     }
@@ -331,7 +335,7 @@ impl NeuralCache {
         }
     }
 
-    fn buffers(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, state: &CacheState) -> Result<Buffers, NircError> {
+    fn buffers(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, state: &CacheState, placement: WeightPlacement) -> Result<Buffers, NircError> {
         let n = layout.total_params as usize;
         for (name, len, expected) in [
             ("params", state.params.len(), n),
@@ -371,11 +375,13 @@ impl NeuralCache {
             reliability_accum: storage(gpu, "nirc reliability sums", cell_count(&config.reliability) as u64 * ACCUM_PER_CELL * 4)?,
             moments: storage_init(gpu, "nirc reliability moments", bytemuck::cast_slice(&state.reliability))?,
             counters: storage_init(gpu, "nirc counters", bytemuck::bytes_of(&counters))?,
-            lane_staged: gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("nirc staged MLP weights"),
-                size: (lane::uniform_bytes(layout) as u64).max(16),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::UNIFORM,
-                mapped_at_creation: false,
+            lane_staged: (placement == WeightPlacement::Registers).then(|| {
+                gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("nirc staged MLP weights"),
+                    size: lane::uniform_bytes(layout) as u64,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::UNIFORM,
+                    mapped_at_creation: false,
+                })
             }),
         })
     }
@@ -383,7 +389,7 @@ impl NeuralCache {
     fn fixed_groups(gpu: &Gpu, p: &Pipelines, b: &Buffers) -> FixedBindGroups {
         FixedBindGroups {
             reliability_update: bind(gpu, "nirc reliability update", &p.reliability_update, &[(1, &b.hyper), (2, &b.reliability_accum), (3, &b.moments), (4, &b.counters)]),
-            lane_stage: p.lane_stage.as_ref().map(|stage| bind(gpu, "nirc lane stage", stage, &[(3, &b.params), (4, &b.ema), (9, &b.lane_staged)])),
+            lane_stage: p.lane_stage.as_ref().zip(b.lane_staged.as_ref()).map(|(stage, staged)| bind(gpu, "nirc lane stage", stage, &[(3, &b.params), (4, &b.ema), (9, staged)])),
         }
     }
 
@@ -680,8 +686,8 @@ impl NeuralCache {
         let b = &self.buffers;
         let call = Self::call_buffer(gpu, Call { fixed_sigma: mode.1, ..Call::new(n, mode.0, 0) });
         let mut entries = vec![(0, &call), (1, &b.hyper), (2, queries), (3, &b.params), (4, &b.ema), (5, &b.moments), (6, &b.counters), (7, out)];
-        if self.placement == WeightPlacement::Registers {
-            entries.push((8, &b.lane_staged));
+        if let Some(staged) = &b.lane_staged {
+            entries.push((8, staged));
         }
         Ok(Some(bind(gpu, "nirc infer", &self.pipelines.infer, &entries)))
     }
@@ -734,7 +740,6 @@ impl NeuralCache {
         let n = queries.len() as u32;
         let out = answer_buffer(gpu, n);
         self.infer(gpu, &upload(gpu, "nirc queries", queries), n, &out, mode)?;
-        let bytes = readback::read_bytes(gpu, &out, "nirc answers")?;
-        Ok(bytemuck::cast_slice::<u8, CacheAnswer>(&bytes[..queries.len() * std::mem::size_of::<CacheAnswer>()]).to_vec())
+        read_answers(gpu, &out, n)
     }
 }

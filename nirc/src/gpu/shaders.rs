@@ -26,9 +26,10 @@ pub enum WeightPlacement {
     Tiled,
     /// One invocation per record, weights read from the storage buffer (any network).
     Storage,
-    /// Training as `Tiled`; inference with one query per invocation, its activations in
-    /// registers and each layer's weights in workgroup memory (src/gpu/lane.rs,
-    /// infer_lane.wgsl). The default on CPU adapters, where it is the faster form.
+    /// Training as `Tiled` (so it takes the networks `Tiled` takes); inference with one query
+    /// per invocation, its activations in registers and both predictors' weights in a uniform
+    /// buffer (src/gpu/lane.rs, infer_lane.wgsl). The default on CPU adapters, where it is the
+    /// faster form.
     Registers,
 }
 
