@@ -18,7 +18,8 @@
 // estimate of ∫ T σ_t ε dt.
 
 import package::scene_types::{GpuMaterial};
-import package::scene_bindings::{frame, lights, materials};
+import package::scene_bindings::{frame};
+import package::scene_tables::{material, light};
 import package::scene_geometry::{NO_HIT, surface_point, trace_any, trace_closest};
 import package::pt_sampling::{max_component, power_heuristic, rng_next, rng_next2, sample_uniform_sphere};
 import package::pt_bsdf::{Bsdf, bsdf_eval, bsdf_pdf, bsdf_sample, make_bsdf};
@@ -177,7 +178,7 @@ fn equiangular_lights(ray: MediaRay, span: vec2f, rng: ptr<function, u32>) -> ve
     let dir = ray.dir;
     var sum = vec3f(0.0);
     for (var i = 0u; i < frame.analytic_lights; i++) {
-        let l = lights[i];
+        let l = light(i);
         if l.kind == LIGHT_DIRECTIONAL {
             continue;
         }
@@ -215,7 +216,7 @@ fn equiangular_lights(ray: MediaRay, span: vec2f, rng: ptr<function, u32>) -> ve
 fn next_event(v: Vertex, ray: MediaRay, span: vec2f, t: f32, rng: ptr<function, u32>) -> vec3f {
     var radiance = vec3f(0.0);
     for (var i = 0u; i < frame.analytic_lights; i++) {
-        let l = lights[i];
+        let l = light(i);
         let ls = sample_analytic_light(l, v.p, rng_next2(rng));
         if !faces(v, ls.wi) || max_component(ls.weight) <= 0.0 {
             continue;
@@ -317,7 +318,7 @@ fn volume_path_radiance(origin_in: vec3f, dir_in: vec3f, rng: ptr<function, u32>
                 break;
             }
             let sp = surface_point(hit, origin, dir);
-            let m = materials[sp.material];
+            let m = material(sp.material);
             v.wo = -dir;
             v.sh = orient(sp, v.wo);
             v.in_medium = false;

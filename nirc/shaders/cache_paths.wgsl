@@ -25,7 +25,8 @@
 // frame's max depth. Replacing the cache by cache_target (the oracle) gives an estimator with
 // the same mean as the path tracer's (test: tests/integrator.rs).
 
-import package::scene_bindings::{frame, materials};
+import package::scene_bindings::{frame};
+import package::scene_tables::{material};
 import package::scene_geometry::{NO_HIT, sg_rays_traced, surface_point, trace_closest};
 import package::pt_sampling::{max_component, rng_next, rng_next2, rng_seed};
 import package::pt_bsdf::{bsdf_sample, make_bsdf};
@@ -53,7 +54,7 @@ fn cache_target(origin: vec3f, dir: vec3f, depth: u32, rng: ptr<function, u32>) 
         return frame.environment;
     }
     let sp = surface_point(hit, origin, dir);
-    let m = materials[sp.material];
+    let m = material(sp.material);
     let wo = -dir;
     let sh = orient(sp, wo);
     // The hit's own emission is direct light: NEE's at x_k, not the cache's.

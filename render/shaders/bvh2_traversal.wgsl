@@ -7,14 +7,29 @@
 // their box is hit.
 
 import package::bvh2_types::SgBvh2Node;
-import package::bvh2_bindings::{bvh2_nodes, bvh2_triangles, bvh2_roots};
-import package::scene_geometry::{Hit, NO_HIT, SgRay, sg_make_ray, sg_intersect_triangle};
-import package::scene_geometry_bindings::sg_instances;
+import package::bvh2_bindings::{bvh2_node_table, bvh2_triangle_table, bvh2_roots};
+import package::scene_geometry::{Hit, NO_HIT, SgRay, sg_instance, sg_make_ray, sg_intersect_triangle};
+import package::scene_geometry_types::SgTriangle;
+import package::texel_table::texel_fetch;
 
 // Node indices on the stack (BVH2_STACK_SIZE on the Rust side): at most one per level, and the
 // scene is refused on the CPU if TLAS depth + BLAS depth could exceed it; were it ever exceeded,
 // the push is dropped (possible missed hits, no hang).
 const BVH2_STACK_SIZE: u32 = 64u;
+// Nodes and triangles are texel tables (src/texel_table.rs), as the CWBVH's.
+fn bvh2_node(index: u32) -> SgBvh2Node {
+    let a = texel_fetch(bvh2_node_table, index, 2u, 0u);
+    let b = texel_fetch(bvh2_node_table, index, 2u, 1u);
+    return SgBvh2Node(bitcast<vec3f>(a.xyz), a.w, bitcast<vec3f>(b.xyz), b.w);
+}
+
+fn bvh2_triangle(index: u32) -> SgTriangle {
+    let a = texel_fetch(bvh2_triangle_table, index, 3u, 0u);
+    let b = texel_fetch(bvh2_triangle_table, index, 3u, 1u);
+    let c = texel_fetch(bvh2_triangle_table, index, 3u, 2u);
+    return SgTriangle(bitcast<vec3f>(a.xyz), a.w, bitcast<vec3f>(b.xyz), b.w, bitcast<vec3f>(c.xyz), c.w);
+}
+
 // What bvh2_box returns for a missed box (no hit distance reaches it).
 const BVH2_MISS: f32 = 3.4028235e38;
 
@@ -35,7 +50,7 @@ fn bvh2_box(node: SgBvh2Node, ray: SgRay, t_max: f32) -> f32 {
 fn bvh2_leaf(ray: SgRay, node: SgBvh2Node, instance: u32, any_hit: bool, hit: ptr<function, Hit>) -> bool {
     var found = false;
     for (var i = 0u; i < node.prim_count; i++) {
-        let tri = bvh2_triangles[node.first_index + i];
+        let tri = bvh2_triangle(node.first_index + i);
         let r = sg_intersect_triangle(ray, tri.v0, tri.v1, tri.v2, (*hit).t);
         if r.w > 0.0 {
             *hit = Hit(r.x, instance, tri.primitive, r.yz);
@@ -63,7 +78,7 @@ fn bvh2_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hi
         return hit;
     }
     let world_ray = sg_make_ray(world_origin, world_direction);
-    let root = bvh2_nodes[tlas_root];
+    let root = bvh2_node(tlas_root);
     if bvh2_box(root, world_ray, t_max) == BVH2_MISS {
         return hit;
     }
@@ -77,10 +92,11 @@ fn bvh2_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hi
         if (step & BVH2_ENTER) != 0u {
             // A TLAS leaf holds one instance, and only instances with triangles are in the TLAS.
             instance = step & ~BVH2_ENTER;
-            let w2o = sg_instances.records[instance].world_to_object;
+            let record = sg_instance(instance);
+            let w2o = record.world_to_object;
             ray = sg_make_ray((w2o * vec4f(world_origin, 1.0)).xyz, (w2o * vec4f(world_direction, 0.0)).xyz);
             tlas_stack_size = stack_size;
-            let blas_root = bvh2_nodes[bvh2_roots[1u + sg_instances.records[instance].mesh]];
+            let blas_root = bvh2_node(bvh2_roots[1u + record.mesh]);
             if bvh2_box(blas_root, ray, hit.t) != BVH2_MISS {
                 if blas_root.prim_count == 0u {
                     step = blas_root.first_index;
@@ -93,8 +109,8 @@ fn bvh2_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hi
             }
         } else {
             let in_blas = tlas_stack_size != NO_HIT;
-            var near = bvh2_nodes[step];
-            var far = bvh2_nodes[step + 1u];
+            var near = bvh2_node(step);
+            var far = bvh2_node(step + 1u);
             var t_near = bvh2_box(near, ray, hit.t);
             var t_far = bvh2_box(far, ray, hit.t);
             if t_near > t_far {

@@ -1,23 +1,29 @@
 // Megakernel path tracer: one thread per pixel, `spp` paths per dispatch, and a separate G-buffer
 // entry point that traces the un-jittered pixel-centre ray.
 
-import package::scene_bindings::{frame, materials};
+import package::scene_bindings::{frame};
+import package::scene_tables::{material};
 import package::scene_geometry::{NO_HIT, sg_rays_traced, surface_point, trace_closest};
 import package::pt_sampling::{rng_next2, rng_seed};
 import package::pt_lights::{FAR};
 import package::pt_scene::{base_color_at, camera_ray_direction, orient, primary_motion};
-import package::pt_integrator::{path_radiance};
+import package::pt_integrator::{NO_STOP, PathPrefix, PathState, path_start, path_vertex};
 import package::path_tracer_types::{GBufferTexel, SAMPLES_PER_THREAD};
 import package::path_tracer_bindings::{gbuffer, pt_counters, radiance_sum, sample_partials};
 
-fn trace_path(pixel: vec2u, sample_index: u32) -> vec3f {
-    var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, pixel.y * frame.width + pixel.x, sample_index);
-    let jitter = rng_next2(&rng);
+// Sample `sample_index` of `pixel`: its camera path, and its random-number stream in `rng`.
+fn camera_path(pixel: vec2u, sample_index: u32, rng: ptr<function, u32>) -> PathState {
+    *rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, pixel.y * frame.width + pixel.x, sample_index);
+    let jitter = rng_next2(rng);
     let dir = camera_ray_direction(frame.camera, vec2f(pixel) + jitter);
-    return path_radiance(frame.camera.position, dir, 0.0, 0u, &rng);
+    return path_start(frame.camera.position, dir, 0.0, 0u);
 }
 
 // One thread per pixel and chunk of at most SAMPLES_PER_THREAD samples (global id z = chunk).
+// The thread advances its path one vertex per loop trip and starts its next sample as soon as a
+// path ends (path regeneration), so the lanes that run together (8 per AVX2 instruction on
+// lavapipe, a warp on a GPU) do not wait for the longest path among them. A sample's path and
+// random numbers do not depend on this order, and the chunk's sum adds the samples in order.
 // Few samples per thread keep every invocation short: llvmpipe (Mesa 22) silently ends a shader's
 // loops after 65535 iterations in total per invocation, and real GPUs reset a device whose
 // dispatch runs too long; spreading samples over z also keeps small images parallel.
@@ -28,9 +34,22 @@ fn trace_main(@builtin(global_invocation_id) id: vec3u) {
     }
     let first = id.z * SAMPLES_PER_THREAD;
     var sum = vec3f(0.0);
-    for (var s = 0u; s < SAMPLES_PER_THREAD; s++) {
-        if first + s < frame.spp {
-            sum += trace_path(id.xy, frame.first_sample + first + s);
+    if first < frame.spp {
+        let count = min(SAMPLES_PER_THREAD, frame.spp - first);
+        var rng: u32;
+        var path = camera_path(id.xy, frame.first_sample + first, &rng);
+        var unused: PathPrefix;
+        var s = 0u;
+        loop {
+            path_vertex(&path, NO_STOP, &rng, &unused);
+            if path.done {
+                sum += path.radiance;
+                s += 1u;
+                if s >= count {
+                    break;
+                }
+                path = camera_path(id.xy, frame.first_sample + first + s, &rng);
+            }
         }
     }
     let pixels = frame.width * frame.height;
@@ -82,7 +101,7 @@ fn gbuffer_main(@builtin(global_invocation_id) id: vec3u) {
         let sh = orient(sp, -dir);
         g.depth = length(sp.position - origin);
         g.normal = sh.ns;
-        g.albedo = base_color_at(materials[sp.material], sp.uv);
+        g.albedo = base_color_at(material(sp.material), sp.uv);
         g.motion = primary_motion(hit, origin, dir, sp.position);
     }
     gbuffer[id.y * frame.width + id.x] = g;

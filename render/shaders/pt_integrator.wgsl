@@ -2,7 +2,8 @@
 // and the path loop.
 
 import package::scene_types::{GpuMaterial};
-import package::scene_bindings::{frame, lights, materials};
+import package::scene_bindings::{frame};
+import package::scene_tables::{material, light};
 import package::scene_geometry::{NO_HIT, SurfacePoint, surface_point, trace_any, trace_closest};
 import package::pt_sampling::{luminance, max_component, power_heuristic, rng_next, rng_next2, sample_uniform_sphere};
 import package::pt_bsdf::{Bsdf, bsdf_eval, bsdf_pdf, bsdf_sample, make_bsdf};
@@ -23,7 +24,7 @@ fn next_event(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u
 fn next_event_analytic(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>, mis: bool) -> vec3f {
     var radiance = vec3f(0.0);
     for (var i = 0u; i < frame.analytic_lights; i++) {
-        let ls = sample_analytic_light(lights[i], p, rng_next2(rng));
+        let ls = sample_analytic_light(light(i), p, rng_next2(rng));
         if dot(ls.wi, sh.ng) <= 0.0 || max_component(ls.weight) <= 0.0 {
             continue;
         }
@@ -130,64 +131,96 @@ fn path_radiance(origin: vec3f, dir: vec3f, prev_bsdf_pdf: f32, depth: u32, rng:
     return trace_path_prefix(origin, dir, prev_bsdf_pdf, depth, NO_STOP, rng).radiance;
 }
 
+// The state a path carries from one vertex to the next, so that a kernel can advance paths one
+// vertex at a time and start a new path in a lane whose path has ended while the other lanes go
+// on (path regeneration, Novák, Havran & Dachsbacher 2010); trace_path_prefix runs one path.
+struct PathState {
+    origin: vec3f,
+    dir: vec3f,
+    throughput: vec3f,
+    radiance: vec3f,
+    prev_bsdf_pdf: f32,
+    depth: u32,
+    done: bool,
+}
+
+// A path starting with the ray (origin, dir) at vertex `depth`, as path_radiance's arguments.
+fn path_start(origin: vec3f, dir: vec3f, prev_bsdf_pdf: f32, depth: u32) -> PathState {
+    return PathState(origin, dir, vec3f(1.0), vec3f(0.0), prev_bsdf_pdf, depth, depth > frame.max_depth);
+}
+
+// One vertex of the path loop: the ray's hit, its emission, NEE and the next direction, with
+// Russian roulette from frame.rr_start_depth on. Sets `done` when the path ends; at the surface
+// vertex `stop_depth` (below the max depth) it ends before NEE and fills `stop`.
+fn path_vertex(s: ptr<function, PathState>, stop_depth: u32, rng: ptr<function, u32>, stop: ptr<function, PathPrefix>) {
+    let depth = (*s).depth;
+    let dir = (*s).dir;
+    let prev_bsdf_pdf = (*s).prev_bsdf_pdf;
+    var throughput = (*s).throughput;
+    var radiance = (*s).radiance;
+    let max_depth = frame.max_depth;
+    // Every return below but the last ends the path.
+    (*s).done = true;
+    let hit = trace_closest((*s).origin, dir, FAR);
+    if hit.instance == NO_HIT {
+        (*s).radiance = radiance + throughput * escaped_radiance(dir, prev_bsdf_pdf);
+        return;
+    }
+    let sp = surface_point(hit, (*s).origin, dir);
+    let m = material(sp.material);
+    let wo = -dir;
+    let sh = orient(sp, wo);
+    radiance += throughput * emitted_radiance(sp, m, dir, hit.t, prev_bsdf_pdf);
+    (*s).radiance = radiance;
+    if depth == max_depth {
+        return;
+    }
+    let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);
+    let p = sp.position;
+    if depth == stop_depth {
+        (*stop).stopped = true;
+        (*stop).p = p;
+        (*stop).sh = sh;
+        (*stop).bsdf = bsdf;
+        (*stop).wo = wo;
+        (*stop).depth = depth;
+        return;
+    }
+    (*s).radiance = radiance + throughput * next_event(p, sh, bsdf, wo, rng);
+
+    // Continue the path by sampling the BSDF.
+    let u_lobe = rng_next(rng);
+    let bs = bsdf_sample(bsdf, sh.ns, wo, u_lobe, rng_next2(rng));
+    if !bs.valid || dot(bs.wi, sh.ng) <= 0.0 {
+        return;
+    }
+    throughput *= bs.f * (dot(sh.ns, bs.wi) / bs.pdf);
+    (*s).throughput = throughput;
+    (*s).prev_bsdf_pdf = bs.pdf;
+    if depth + 1u >= frame.rr_start_depth {
+        let survive = min(max_component(throughput), 0.95);
+        if rng_next(rng) >= survive {
+            return;
+        }
+        (*s).throughput = throughput / survive;
+    }
+    (*s).origin = offset_origin(p, sh.ng, bs.wi);
+    (*s).dir = bs.wi;
+    (*s).depth = depth + 1u;
+    (*s).done = depth + 1u > max_depth;
+}
+
 // The path loop of `path_radiance`, stopping at the surface vertex `stop_depth` (if the path
 // gets there below the max depth) before its NEE: the caller continues from there with the
 // same random-number stream.
 fn trace_path_prefix(origin_in: vec3f, dir_in: vec3f, prev_bsdf_pdf_in: f32, depth_in: u32, stop_depth: u32, rng: ptr<function, u32>) -> PathPrefix {
     var out: PathPrefix;
     out.stopped = false;
-    var origin = origin_in;
-    var dir = dir_in;
-    var throughput = vec3f(1.0);
-    var radiance = vec3f(0.0);
-    var prev_bsdf_pdf = prev_bsdf_pdf_in;
-    let max_depth = frame.max_depth;
-    for (var depth = depth_in; depth <= max_depth; depth++) {
-        let hit = trace_closest(origin, dir, FAR);
-        if hit.instance == NO_HIT {
-            radiance += throughput * escaped_radiance(dir, prev_bsdf_pdf);
-            break;
-        }
-        let sp = surface_point(hit, origin, dir);
-        let m = materials[sp.material];
-        let wo = -dir;
-        let sh = orient(sp, wo);
-        radiance += throughput * emitted_radiance(sp, m, dir, hit.t, prev_bsdf_pdf);
-        if depth == max_depth {
-            break;
-        }
-        let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);
-        let p = sp.position;
-        if depth == stop_depth {
-            out.stopped = true;
-            out.p = p;
-            out.sh = sh;
-            out.bsdf = bsdf;
-            out.wo = wo;
-            out.depth = depth;
-            break;
-        }
-        radiance += throughput * next_event(p, sh, bsdf, wo, rng);
-
-        // Continue the path by sampling the BSDF.
-        let u_lobe = rng_next(rng);
-        let bs = bsdf_sample(bsdf, sh.ns, wo, u_lobe, rng_next2(rng));
-        if !bs.valid || dot(bs.wi, sh.ng) <= 0.0 {
-            break;
-        }
-        throughput *= bs.f * (dot(sh.ns, bs.wi) / bs.pdf);
-        prev_bsdf_pdf = bs.pdf;
-        if depth + 1u >= frame.rr_start_depth {
-            let survive = min(max_component(throughput), 0.95);
-            if rng_next(rng) >= survive {
-                break;
-            }
-            throughput /= survive;
-        }
-        origin = offset_origin(p, sh.ng, bs.wi);
-        dir = bs.wi;
+    var s = path_start(origin_in, dir_in, prev_bsdf_pdf_in, depth_in);
+    while !s.done {
+        path_vertex(&s, stop_depth, rng, &out);
     }
-    out.radiance = radiance;
-    out.throughput = throughput;
+    out.radiance = s.radiance;
+    out.throughput = s.throughput;
     return out;
 }

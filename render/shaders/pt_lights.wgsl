@@ -5,7 +5,7 @@
 // area lights do by default.
 
 import package::scene_types::{GpuLight};
-import package::scene_bindings::{lights};
+import package::scene_tables::{light, light_cdf};
 import package::pt_sampling::{TWO_PI, sample_triangle, sample_uniform_cone, to_world};
 
 const LIGHT_DIRECTIONAL: u32 = 0u;
@@ -76,7 +76,7 @@ fn find_emitter(first: u32, count: u32, u: f32) -> u32 {
     var hi = first + count - 1u;
     while lo < hi {
         let mid = (lo + hi) / 2u;
-        if lights[mid].cdf > u {
+        if light_cdf(mid) > u {
             hi = mid;
         } else {
             lo = mid + 1u;
@@ -90,10 +90,10 @@ fn sample_emitter(first: u32, count: u32, p: vec3f, u_select: f32, u: vec2f) -> 
     s.pdf = 0.0;
     s.weight = vec3f(0.0);
     let i = find_emitter(first, count, u_select);
-    let l = lights[i];
+    let l = light(i);
     var cdf_before = 0.0;
     if i > first {
-        cdf_before = lights[i - 1u].cdf;
+        cdf_before = light_cdf(i - 1u);
     }
     let p_select = l.cdf - cdf_before;
     let b = sample_triangle(u);

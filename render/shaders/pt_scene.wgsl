@@ -5,7 +5,8 @@
 // materials.rs: gpu_struct!) as package::scene_types (PassLibrary::modules).
 
 import package::scene_types::{CameraFrame, GpuMaterial};
-import package::scene_bindings::{frame, lights, texels};
+import package::scene_bindings::{frame, texels};
+import package::scene_tables::{light};
 import package::scene_geometry::{Hit, NO_HIT, SurfacePoint, previous_world_position};
 import package::pt_sampling::{PI, max_component, power_heuristic};
 import package::pt_bsdf::{bsdf_pdf};
@@ -91,7 +92,7 @@ fn escaped_radiance(dir: vec3f, bsdf_pdf: f32) -> vec3f {
         l *= power_heuristic(bsdf_pdf, environment_pdf());
     }
     for (var i = 0u; i < frame.analytic_lights; i++) {
-        let light = lights[i];
+        let light = light(i);
         if light.kind == LIGHT_DIRECTIONAL && light.a > 0.0 && 1.0 - dot(dir, -normalize(light.p1)) <= light.a {
             var w = 1.0;
             if bsdf_pdf > 0.0 {

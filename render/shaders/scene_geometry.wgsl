@@ -3,8 +3,9 @@
 // A pass imports it (SceneGeometry::modules) and binds the geometry at @group(1); internal names
 // start with `sg_`.
 
-import package::scene_geometry_types::{SgNode, SgTriangle, SgMesh, SgVertex, SgInstance};
-import package::scene_geometry_bindings::{sg_blas_nodes, sg_blas_triangles, sg_meshes, sg_vertices, sg_indices, sg_tlas_nodes, sg_tlas_instances, sg_instances};
+import package::scene_geometry_types::{SgNode, SgTriangle, SgTlasLeaf, SgMesh, SgVertex, SgInstance};
+import package::scene_geometry_bindings::{sg_instance_header, sg_nodes, sg_triangles, sg_tlas_leaves, sg_instances, sg_meshes, sg_vertices, sg_indices};
+import package::texel_table::texel_fetch;
 
 const NO_HIT: u32 = 0xffffffffu;
 
@@ -21,6 +22,64 @@ struct SurfacePoint {
 
 // The node, triangle, mesh, vertex and instance structs and the @group(1) bindings are declared
 // once with their Rust twins (src/bvh/scene_geometry.rs).
+
+// Every table but the instance header is a texel table (src/texel_table.rs): texel_fetch(table,
+// record, texels per record, j) reads texel j of a record.
+
+// A BLAS node (records from 0) or a TLAS node (records from header.tlas_root).
+fn sg_node(index: u32) -> SgNode {
+    let a = texel_fetch(sg_nodes, index, 5u, 0u);
+    let b = texel_fetch(sg_nodes, index, 5u, 1u);
+    return SgNode(bitcast<vec3f>(a.xyz), a.w, b.x, b.y, b.zw, texel_fetch(sg_nodes, index, 5u, 2u), texel_fetch(sg_nodes, index, 5u, 3u), texel_fetch(sg_nodes, index, 5u, 4u));
+}
+
+fn sg_triangle(slot: u32) -> SgTriangle {
+    let a = texel_fetch(sg_triangles, slot, 3u, 0u);
+    let b = texel_fetch(sg_triangles, slot, 3u, 1u);
+    let c = texel_fetch(sg_triangles, slot, 3u, 2u);
+    return SgTriangle(bitcast<vec3f>(a.xyz), a.w, bitcast<vec3f>(b.xyz), b.w, bitcast<vec3f>(c.xyz), c.w);
+}
+
+fn sg_tlas_leaf(slot: u32) -> SgTlasLeaf {
+    let m = mat4x4f(
+        bitcast<vec4f>(texel_fetch(sg_tlas_leaves, slot, 5u, 0u)),
+        bitcast<vec4f>(texel_fetch(sg_tlas_leaves, slot, 5u, 1u)),
+        bitcast<vec4f>(texel_fetch(sg_tlas_leaves, slot, 5u, 2u)),
+        bitcast<vec4f>(texel_fetch(sg_tlas_leaves, slot, 5u, 3u)),
+    );
+    let e = texel_fetch(sg_tlas_leaves, slot, 5u, 4u);
+    return SgTlasLeaf(m, e.x, e.y, e.z, e.w);
+}
+
+fn sg_texel_f(table: texture_2d<u32>, record: u32, texels: u32, j: u32) -> vec4f {
+    return bitcast<vec4f>(texel_fetch(table, record, texels, j));
+}
+
+fn sg_instance(index: u32) -> SgInstance {
+    let t = texel_fetch(sg_instances, index, 13u, 12u);
+    return SgInstance(
+        mat4x4f(sg_texel_f(sg_instances, index, 13u, 0u), sg_texel_f(sg_instances, index, 13u, 1u), sg_texel_f(sg_instances, index, 13u, 2u), sg_texel_f(sg_instances, index, 13u, 3u)),
+        mat4x4f(sg_texel_f(sg_instances, index, 13u, 4u), sg_texel_f(sg_instances, index, 13u, 5u), sg_texel_f(sg_instances, index, 13u, 6u), sg_texel_f(sg_instances, index, 13u, 7u)),
+        mat4x4f(sg_texel_f(sg_instances, index, 13u, 8u), sg_texel_f(sg_instances, index, 13u, 9u), sg_texel_f(sg_instances, index, 13u, 10u), sg_texel_f(sg_instances, index, 13u, 11u)),
+        t.x, t.y, t.zw,
+    );
+}
+
+fn sg_mesh(index: u32) -> SgMesh {
+    let a = texel_fetch(sg_meshes, index, 2u, 0u);
+    let b = texel_fetch(sg_meshes, index, 2u, 1u);
+    return SgMesh(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w);
+}
+
+fn sg_vertex(index: u32) -> SgVertex {
+    let a = sg_texel_f(sg_vertices, index, 2u, 0u);
+    let b = sg_texel_f(sg_vertices, index, 2u, 1u);
+    return SgVertex(a.xyz, a.w, b.xyz, b.w);
+}
+
+fn sg_vertex_position(index: u32) -> vec3f {
+    return sg_texel_f(sg_vertices, index, 2u, 0u).xyz;
+}
 
 // Node groups on the traversal stack (TRAVERSAL_STACK_SIZE on the Rust side). The scene is
 // refused on the CPU if TLAS depth + BLAS depth + 1 could exceed it; were it ever exceeded, the
@@ -159,7 +218,7 @@ fn sg_intersect_node(node: SgNode, ray: SgRay, t_max: f32) -> u32 {
 // falls back to that size the BLAS is done and the world ray is restored.
 fn sg_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit: bool) -> Hit {
     var hit = Hit(t_max, NO_HIT, NO_HIT, vec2f(0.0));
-    if sg_instances.header.tlas_node_count == 0u || !(t_max > 0.0) {
+    if sg_instance_header.tlas_node_count == 0u || !(t_max > 0.0) {
         return hit;
     }
     let world_ray = sg_make_ray(world_origin, world_direction);
@@ -169,7 +228,7 @@ fn sg_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit:
     var tlas_stack_size = NO_HIT; // NO_HIT while traversing the TLAS
     var instance = NO_HIT;
     // A group: x = base index, y = hit bits (24-31 inner children, 0-23 primitives) | imask (0-7).
-    var node_group = vec2u(0u, 0x80000000u);
+    var node_group = vec2u(sg_instance_header.tlas_root, 0x80000000u);
     loop {
         var primitive_group = vec2u(0u);
         if (node_group.y & 0xff000000u) != 0u {
@@ -182,12 +241,7 @@ fn sg_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit:
             }
             let slot = (child_bit - 24u) ^ (ray.octant_inv4 & 0xffu);
             let node_index = node_group.x + countOneBits(hits_imask & ~(0xffffffffu << slot));
-            var node: SgNode;
-            if tlas_stack_size == NO_HIT {
-                node = sg_tlas_nodes[node_index];
-            } else {
-                node = sg_blas_nodes[node_index];
-            }
+            let node = sg_node(node_index);
             let hitmask = sg_intersect_node(node, ray, hit.t);
             node_group = vec2u(node.child_base, (hitmask & 0xff000000u) | (node.exponents_imask >> 24u));
             primitive_group = vec2u(node.primitive_base, hitmask & 0x00ffffffu);
@@ -210,14 +264,13 @@ fn sg_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit:
                     stack_size += 1u;
                 }
                 tlas_stack_size = stack_size;
-                instance = sg_tlas_instances[slot];
-                let world_to_object = sg_instances.records[instance].world_to_object;
-                let mesh = sg_meshes[sg_instances.records[instance].mesh];
-                ray = sg_make_ray((world_to_object * vec4f(world_origin, 1.0)).xyz, (world_to_object * vec4f(world_direction, 0.0)).xyz);
-                node_group = vec2u(mesh.node_offset, select(0u, 0x80000000u, mesh.node_count != 0u));
+                let leaf = sg_tlas_leaf(slot);
+                instance = leaf.instance;
+                ray = sg_make_ray((leaf.world_to_object * vec4f(world_origin, 1.0)).xyz, (leaf.world_to_object * vec4f(world_direction, 0.0)).xyz);
+                node_group = vec2u(leaf.blas_root, select(0u, 0x80000000u, leaf.blas_nodes != 0u));
                 break;
             }
-            let tri = sg_blas_triangles[slot];
+            let tri = sg_triangle(slot);
             let r = sg_intersect_triangle(ray, tri.v0, tri.v1, tri.v2, hit.t);
             if r.w > 0.0 {
                 hit = Hit(r.x, instance, tri.primitive, r.yz);
@@ -259,13 +312,12 @@ fn trace_any(origin: vec3f, direction: vec3f, t_max: f32) -> bool {
 }
 
 fn instance_count() -> u32 {
-    return sg_instances.header.count;
+    return sg_instance_header.count;
 }
 
-// Vertex indices (into sg_vertices) of a mesh triangle.
+// Vertex indices (into the vertex table) of a mesh triangle.
 fn sg_triangle_vertex_indices(mesh: SgMesh, primitive: u32) -> vec3u {
-    let base = 3u * (mesh.index_offset + primitive);
-    return vec3u(sg_indices[base], sg_indices[base + 1u], sg_indices[base + 2u]) + vec3u(mesh.vertex_offset);
+    return texel_fetch(sg_indices, mesh.index_offset + primitive, 1u, 0u).xyz + vec3u(mesh.vertex_offset);
 }
 
 fn sg_normalize_or(v: vec3f, fallback: vec3f) -> vec3f {
@@ -277,10 +329,10 @@ fn sg_normalize_or(v: vec3f, fallback: vec3f) -> vec3f {
 }
 
 fn sg_object_point(hit: Hit) -> vec3f {
-    let mesh = sg_meshes[sg_instances.records[hit.instance].mesh];
+    let mesh = sg_mesh(sg_instance(hit.instance).mesh);
     let idx = sg_triangle_vertex_indices(mesh, hit.primitive);
     let b = hit.barycentrics;
-    return (1.0 - b.x - b.y) * sg_vertices[idx.x].position + b.x * sg_vertices[idx.y].position + b.y * sg_vertices[idx.z].position;
+    return (1.0 - b.x - b.y) * sg_vertex_position(idx.x) + b.x * sg_vertex_position(idx.y) + b.y * sg_vertex_position(idx.z);
 }
 
 // World-space attributes of a hit. The position is the barycentric point on the triangle (not
@@ -288,12 +340,12 @@ fn sg_object_point(hit: Hit) -> vec3f {
 // winding (cross(v1 - v0, v2 - v0)) and is NOT flipped towards the ray; both normals go through
 // the inverse transpose of object_to_world, so they stay on the same side under mirroring.
 fn surface_point(hit: Hit, origin: vec3f, direction: vec3f) -> SurfacePoint {
-    let record = sg_instances.records[hit.instance];
-    let mesh = sg_meshes[record.mesh];
+    let record = sg_instance(hit.instance);
+    let mesh = sg_mesh(record.mesh);
     let idx = sg_triangle_vertex_indices(mesh, hit.primitive);
-    let v0 = sg_vertices[idx.x];
-    let v1 = sg_vertices[idx.y];
-    let v2 = sg_vertices[idx.z];
+    let v0 = sg_vertex(idx.x);
+    let v1 = sg_vertex(idx.y);
+    let v2 = sg_vertex(idx.z);
     let b = vec3f(1.0 - hit.barycentrics.x - hit.barycentrics.y, hit.barycentrics.x, hit.barycentrics.y);
     let object_position = b.x * v0.position + b.y * v1.position + b.z * v2.position;
     let w2o = record.world_to_object;
@@ -317,17 +369,17 @@ fn surface_point(hit: Hit, origin: vec3f, direction: vec3f) -> SurfacePoint {
 
 // The hit's object-space point through last frame's transform (motion vectors).
 fn previous_world_position(hit: Hit) -> vec3f {
-    return (sg_instances.records[hit.instance].previous_object_to_world * vec4f(sg_object_point(hit), 1.0)).xyz;
+    return (sg_instance(hit.instance).previous_object_to_world * vec4f(sg_object_point(hit), 1.0)).xyz;
 }
 
 // World-space vertices of a triangle of an instance (area-light sampling).
 fn triangle_world_vertices(instance: u32, primitive: u32) -> array<vec3f, 3> {
-    let record = sg_instances.records[instance];
-    let idx = sg_triangle_vertex_indices(sg_meshes[record.mesh], primitive);
+    let record = sg_instance(instance);
+    let idx = sg_triangle_vertex_indices(sg_mesh(record.mesh), primitive);
     let m = record.object_to_world;
     return array<vec3f, 3>(
-        (m * vec4f(sg_vertices[idx.x].position, 1.0)).xyz,
-        (m * vec4f(sg_vertices[idx.y].position, 1.0)).xyz,
-        (m * vec4f(sg_vertices[idx.z].position, 1.0)).xyz,
+        (m * vec4f(sg_vertex_position(idx.x), 1.0)).xyz,
+        (m * vec4f(sg_vertex_position(idx.y), 1.0)).xyz,
+        (m * vec4f(sg_vertex_position(idx.z), 1.0)).xyz,
     );
 }

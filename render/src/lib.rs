@@ -19,5 +19,6 @@ pub mod shader;
 pub mod scene_bindings;
 pub mod sss;
 pub mod taa;
+pub mod texel_table;
 pub mod termination;
 pub mod timing;

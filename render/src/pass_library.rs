@@ -36,10 +36,12 @@ impl PassLibrary {
         static MODULES: std::sync::OnceLock<Vec<Module>> = std::sync::OnceLock::new();
         MODULES.get_or_init(|| {
             let types = Module::generated("package::scene_types", &[CameraFrame::WGSL, Frame::WGSL, GpuMaterial::WGSL, GpuLight::WGSL]);
-            let bindings = compute::group_module("package::scene_bindings", 0, &crate::scene_bindings::GROUP, &[&types]);
+            let mut bindings = compute::group_module("package::scene_bindings", 0, &crate::scene_bindings::GROUP, &[&types]);
+            bindings.source = format!("{}{}", bindings.source, crate::texel_table::declare(0, crate::scene_bindings::GROUP.len() as u32, &crate::scene_bindings::TABLES)).into();
             let mut modules = vec![types, bindings];
             modules.extend(SceneGeometry::modules());
             modules.extend([
+                crate::wgsl_file!("scene_tables.wgsl"),
                 crate::wgsl_file!("pt_sampling.wgsl"),
                 crate::wgsl_file!("pt_bsdf.wgsl"),
                 crate::wgsl_file!("pt_lights.wgsl"),

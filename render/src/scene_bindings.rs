@@ -1,7 +1,8 @@
 //! The scene as every pass built on the shading library binds it: @group(0) holds the `Frame`
-//! uniform (camera, previous camera, lights, seed, spp, depth), materials, the texture atlas and
-//! the light table, all read only; @group(1) is the geometry (BLAS, TLAS, instances). One per
-//! run, updated once per frame; methods read it and never write it.
+//! uniform (camera, previous camera, lights, seed, spp, depth), the texture atlas, and the
+//! materials and the light table as texel tables (read per hit at per-ray addresses:
+//! `crate::texel_table` says why), all read only; @group(1) is the geometry (BLAS, TLAS,
+//! instances). One per run, updated once per frame; methods read it and never write it.
 
 use crate::bvh::SceneGeometry;
 use crate::compute::{self, BufferBinding};
@@ -10,18 +11,21 @@ use crate::frame::{CameraBasis, Frame, FrameParams};
 use crate::gpu::Gpu;
 use crate::lights::{LightTable, build_light_table};
 use crate::materials::pack_materials;
+use crate::texel_table::TexelTable;
 use crate::scene::{Camera, SceneChanges, SceneDesc};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 
-/// @group(0): frame uniform, materials, texels, lights (declared into the library's WGSL).
-pub const GROUP: [BufferBinding; 4] = [
-    BufferBinding::uniform("frame", "Frame"),
-    BufferBinding::read("materials", "array<GpuMaterial>"),
-    BufferBinding::read("texels", "array<u32>"),
-    BufferBinding::read("lights", "array<GpuLight>"),
-];
+/// @group(0)'s buffers: frame uniform, texels (declared into the library's WGSL).
+pub const GROUP: [BufferBinding; 2] = [BufferBinding::uniform("frame", "Frame"), BufferBinding::read("texels", "array<u32>")];
+/// Its texel tables after the buffers: `GpuMaterial`s (3 texels) and `GpuLight`s (4 texels),
+/// read through scene_tables.wgsl.
+pub const TABLES: [&str; 2] = ["material_table", "light_table"];
+const MATERIAL_TEXELS: u32 = 3;
+const LIGHT_TEXELS: u32 = 4;
+const _: () = assert!(size_of::<crate::materials::GpuMaterial>() == 16 * MATERIAL_TEXELS as usize);
+const _: () = assert!(size_of::<crate::lights::GpuLight>() == 16 * LIGHT_TEXELS as usize);
 
 /// Storage buffers of @group(0).
 pub const STORAGE_BUFFERS: u32 = compute::storage_buffers(&GROUP);
@@ -44,9 +48,9 @@ pub struct SceneBindings {
     layout: wgpu::BindGroupLayout,
     bind_group: wgpu::BindGroup,
     frame_buffer: wgpu::Buffer,
-    materials: wgpu::Buffer,
     texels: wgpu::Buffer,
-    lights: wgpu::Buffer,
+    materials: TexelTable,
+    lights: TexelTable,
     light_table: LightTable,
     camera: Camera,
     /// Camera before the last `update` (motion vectors), like the instances' previous
@@ -69,17 +73,17 @@ impl SceneBindings {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             }))
         };
-        let materials = storage("materials", bytemuck::cast_slice(&materials))?;
+        let materials = TexelTable::new(gpu, "materials", MATERIAL_TEXELS, bytemuck::cast_slice(&materials), 0)?;
         let texels = storage("base-colour texels", bytemuck::cast_slice(&texels))?;
-        let lights = storage("lights", bytemuck::cast_slice(&light_table.lights))?;
+        let lights = TexelTable::new(gpu, "lights", LIGHT_TEXELS, bytemuck::cast_slice(&light_table.lights), 0)?;
         let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame uniform"),
             size: size_of::<Frame>() as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let layout = compute::binding_layout(gpu, "scene", &GROUP);
-        let bind_group = compute::buffer_group(gpu, "scene", &layout, &[&frame_buffer, &materials, &texels, &lights]);
+        let layout = crate::texel_table::group_layout(gpu, "scene", &GROUP, TABLES.len());
+        let bind_group = bind_group(gpu, &layout, &frame_buffer, &texels, &materials, &lights);
         Ok(Self {
             settings,
             geometry,
@@ -107,11 +111,11 @@ impl SceneBindings {
         let mut rebind = false;
         let mut uploads: Vec<(&mut wgpu::Buffer, &str, &[u8])> = Vec::new();
         if let Some((materials, texels)) = &materials {
-            uploads.push((&mut self.materials, "materials", bytemuck::cast_slice::<_, u8>(materials)));
+            rebind |= self.materials.replace(gpu, bytemuck::cast_slice(materials))?;
             uploads.push((&mut self.texels, "base-colour texels", bytemuck::cast_slice(texels)));
         }
         if let Some(table) = &light_table {
-            uploads.push((&mut self.lights, "lights", bytemuck::cast_slice(&table.lights)));
+            rebind |= self.lights.replace(gpu, bytemuck::cast_slice(&table.lights))?;
         }
         for (buffer, label, bytes) in uploads {
             if buffer.size() == bytes.len() as u64 {
@@ -127,7 +131,7 @@ impl SceneBindings {
             }
         }
         if rebind {
-            self.bind_group = compute::buffer_group(gpu, "scene", &self.layout, &[&self.frame_buffer, &self.materials, &self.texels, &self.lights]);
+            self.bind_group = bind_group(gpu, &self.layout, &self.frame_buffer, &self.texels, &self.materials, &self.lights);
         }
         if let Some(table) = light_table {
             self.light_table = table;
@@ -190,4 +194,14 @@ impl SceneBindings {
     pub fn settings(&self) -> PathTracerSettings {
         self.settings
     }
+}
+
+fn bind_group(gpu: &Gpu, layout: &wgpu::BindGroupLayout, frame: &wgpu::Buffer, texels: &wgpu::Buffer, materials: &TexelTable, lights: &TexelTable) -> wgpu::BindGroup {
+    let entries = [
+        wgpu::BindGroupEntry { binding: 0, resource: frame.as_entire_binding() },
+        wgpu::BindGroupEntry { binding: 1, resource: texels.as_entire_binding() },
+        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(materials.view()) },
+        wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(lights.view()) },
+    ];
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("scene"), layout, entries: &entries })
 }

@@ -15,7 +15,8 @@
 // WGSL has no 64-bit atomics: the checksum alone is claimed by compare-exchange, last access is
 // a separate word every accessor stores the same value into.
 
-import package::scene_bindings::{frame, materials};
+import package::scene_bindings::{frame};
+import package::scene_tables::{material};
 import package::scene_geometry::{Hit, NO_HIT, sg_rays_traced, surface_point, trace_closest};
 import package::pt_sampling::{hash_mix, rng_next, rng_next2, rng_seed};
 import package::pt_bsdf::{bsdf_sample, make_bsdf};
@@ -114,7 +115,7 @@ fn hc_trace(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     let sp = surface_point(hit, origin, dir);
-    let m = materials[sp.material];
+    let m = material(sp.material);
     let sh = orient(sp, -dir);
     r.direct = emitted_radiance(sp, m, dir, hit.t, 0.0);
     if hc.lookup == 0u {
@@ -144,7 +145,7 @@ fn hc_trace(@builtin(global_invocation_id) id: vec3u) {
             return;
         }
         let sp2 = surface_point(hit2, o2, bs.wi);
-        r.direct += throughput * emitted_radiance(sp2, materials[sp2.material], bs.wi, hit2.t, bs.pdf);
+        r.direct += throughput * emitted_radiance(sp2, material(sp2.material), bs.wi, hit2.t, bs.pdf);
         r.key_hit = hc_pack_hit(hit2);
         r.key_point = sp2.position;
         r.key_normal = orient(sp2, -bs.wi).ns;
@@ -189,7 +190,7 @@ fn hc_unpack_hit(h: vec4u) -> Hit {
 fn hc_sample(r: HcRecord) -> vec3f {
     var rng = r.rng;
     let sp = surface_point(hc_unpack_hit(r.key_hit), r.ray_origin, r.ray_dir);
-    let m = materials[sp.material];
+    let m = material(sp.material);
     let wo = -r.ray_dir;
     let sh = orient(sp, wo);
     let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);

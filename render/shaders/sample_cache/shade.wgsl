@@ -4,7 +4,8 @@
 // factor α_min once c_s >= 1/α_min - 1 (α_min = `alpha`, or App. C's roughness-dependent one;
 // α = 0 keeps the mean).
 
-import package::scene_bindings::{frame, materials};
+import package::scene_bindings::{frame};
+import package::scene_tables::{material};
 import package::scene_geometry::{sg_rays_traced};
 import package::pt_sampling::{max_component, rng_next, rng_next2, rng_seed};
 import package::pt_bsdf::{bsdf_sample, make_bsdf};
@@ -24,7 +25,7 @@ fn ssc_shade(hit: vec4u, rng: ptr<function, u32>) -> vec3f {
     let dir = d / dist;
     let wo = -dir;
     let sh = orient(sp, wo);
-    let m = materials[sp.material];
+    let m = material(sp.material);
     var radiance = emitted_radiance(sp, m, dir, dist, 0.0);
     let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);
     radiance += next_event(sp.position, sh, bsdf, wo, rng);
@@ -50,7 +51,7 @@ fn ssc_alpha_min(hit: vec4u) -> f32 {
     if ssc.roughness_alpha == 0u || ssc_is_background(hit) {
         return ssc.alpha;
     }
-    let m = materials[ssc_surface(hit).material];
+    let m = material(ssc_surface(hit).material);
     let a_ggx = make_bsdf(vec3f(0.0), m.metallic, m.roughness, m.specular).alpha;
     return mix(0.5, 0.1, a_ggx);
 }

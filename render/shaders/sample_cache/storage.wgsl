@@ -6,7 +6,7 @@
 // plus the shading cache (accumulated radiance, sample count c_s) in a vec4f.
 // Hit packing (fixes listing 1, which ORs 8-bit material fields over 32-bit barycentrics): plain
 // vec4u = (instance, primitive, bits(b1), bits(b2)) with full f32 barycentrics; the material is
-// the instance's (sg_instances.records[i].material), so no material bits are stored at all.
+// the instance's (sg_instance(i).material), so no material bits are stored at all.
 // A background sample (its primary ray left the scene) is (NO_HIT, bits(dir.x, dir.y, dir.z)).
 // Mask: one u32 per pixel, occupancy o_s in bits 0..N-1 and visibility v_s in bits N..2N-1
 // (N <= 16), bits 2N..31 always zero.

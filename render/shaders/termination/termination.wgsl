@@ -17,7 +17,8 @@
 // this frame; `vertices` the stored vertices, then the candidates (pixels, then propagation).
 // Records are never evicted (static scenes, the cache in equilibrium as in the paper's §6).
 
-import package::scene_bindings::{frame, materials};
+import package::scene_bindings::{frame};
+import package::scene_tables::{material};
 import package::scene_geometry::{NO_HIT, sg_rays_traced, surface_point, trace_closest};
 import package::pt_sampling::{luminance, rng_next, rng_next2, rng_seed};
 import package::pt_bsdf::{bsdf_sample, make_bsdf};
@@ -134,7 +135,7 @@ fn tc_propagate(@builtin(global_invocation_id) id: vec3u) {
     }
     var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, id.x, 0x70726f70u);
     let sp = surface_point(hit, v.origin, v.dir);
-    let m = materials[sp.material];
+    let m = material(sp.material);
     let wo = -v.dir;
     let sh = orient(sp, wo);
     let bsdf = make_bsdf(base_color_at(m, sp.uv), m.metallic, m.roughness, m.specular);
@@ -157,7 +158,7 @@ fn tc_propagate(@builtin(global_invocation_id) id: vec3u) {
             } else {
                 let sp2 = surface_point(hit2, o2, bs.wi);
                 let sh2 = orient(sp2, -bs.wi);
-                y += w * emitted_radiance(sp2, materials[sp2.material], bs.wi, hit2.t, bs.pdf);
+                y += w * emitted_radiance(sp2, material(sp2.material), bs.wi, hit2.t, bs.pdf);
                 let key2 = tc_key(sp2.position, sh2.ns, rng_next2(&rng));
                 var s2 = tc_find(key2);
                 if s2 != HC_NONE && records[s2].vertices > 0.0 {
@@ -247,7 +248,7 @@ fn tc_trace(@builtin(global_invocation_id) id: vec3u) {
             break;
         }
         let sp = surface_point(hit, origin, dir);
-        let m = materials[sp.material];
+        let m = material(sp.material);
         let wo = -dir;
         let sh = orient(sp, wo);
         path_vertices += blend_alpha;

@@ -1,6 +1,7 @@
-//! The BVH2s of [`SceneBvh2`] on the GPU: every node (all BLAS, then the TLAS) in one storage
-//! buffer of 32-byte nodes with plain f32 boxes, the leaf-order triangles, and the roots, in one
-//! bind group (`@group(2)` of bvh2_traversal.wgsl). The traversal reads the instance table and
+//! The BVH2s of [`SceneBvh2`] on the GPU: every node (all BLAS, then the TLAS) in one texel
+//! table of 32-byte nodes with plain f32 boxes, the leaf-order triangles in another (texel
+//! tables as the CWBVH's, so that the two traversals are compared on the same kind of loads),
+//! and the roots, in one bind group (`@group(2)` of bvh2_traversal.wgsl). The traversal reads the instance table and
 //! uses the ray set-up and triangle test of [`SceneGeometry`] (`@group(1)`), so a pass binds both.
 
 use super::bvh2::SceneBvh2;
@@ -11,13 +12,14 @@ use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
 use crate::scene::SceneDesc;
 use crate::shader::Module;
+use crate::texel_table::TexelTable;
 
 crate::gpu_struct! {
     /// obvhs's `Bvh2Node` as the traversal reads it: the box, and `first_index` made absolute.
     pub struct SgBvh2Node {
         pub min: [f32; 3] => "vec3f",
         /// Inner node: its first child (the second follows it). BLAS leaf: its first triangle
-        /// in `bvh2_triangles`. TLAS leaf: its instance.
+        /// in the triangle table. TLAS leaf: its instance.
         pub first_index: u32 => "u32",
         pub max: [f32; 3] => "vec3f",
         /// 0 for an inner node, else the leaf's triangles (1 in a TLAS leaf).
@@ -25,19 +27,19 @@ crate::gpu_struct! {
     }
 }
 
-/// The BVH2 @group(2): nodes, triangles, and roots (`[0]` the TLAS root, `[1 + m]` mesh m's;
-/// `NO_HIT` where empty).
-pub const GROUP: [BufferBinding; 3] = [
-    BufferBinding::read("bvh2_nodes", "array<SgBvh2Node>"),
-    BufferBinding::read("bvh2_triangles", "array<SgTriangle>"),
-    BufferBinding::read("bvh2_roots", "array<u32>"),
-];
+/// The BVH2 @group(2): the roots (`[0]` the TLAS root, `[1 + m]` mesh m's; `NO_HIT` where
+/// empty), then the texel tables [`TABLES`].
+pub const GROUP: [BufferBinding; 1] = [BufferBinding::read("bvh2_roots", "array<u32>")];
+/// Nodes (an `SgBvh2Node`, 2 texels) and triangles (an `SgTriangle`, 3 texels).
+const TABLES: [&str; 2] = ["bvh2_node_table", "bvh2_triangle_table"];
+const _: () = assert!(size_of::<SgBvh2Node>() == 32);
 
 pub struct Bvh2Geometry {
     bvh: SceneBvh2,
     layout: wgpu::BindGroupLayout,
     bind_group: wgpu::BindGroup,
-    _buffers: [wgpu::Buffer; 3],
+    _roots: wgpu::Buffer,
+    _tables: [TexelTable; 2],
 }
 
 impl Bvh2Geometry {
@@ -45,7 +47,8 @@ impl Bvh2Geometry {
     /// (`bvh2_trace_closest`, `bvh2_trace_any`), after [`SceneGeometry::modules`].
     pub fn modules() -> Vec<Module> {
         let types = Module::generated("package::bvh2_types", &[SgBvh2Node::WGSL]);
-        let bindings = crate::compute::group_module("package::bvh2_bindings", 2, &GROUP, &[&types, &SceneGeometry::types()]);
+        let mut bindings = crate::compute::group_module("package::bvh2_bindings", 2, &GROUP, &[&types, &SceneGeometry::types()]);
+        bindings.source = format!("{}{}", bindings.source, crate::texel_table::declare(2, GROUP.len() as u32, &TABLES)).into();
         vec![types, bindings, crate::wgsl_file!("bvh2_traversal.wgsl")]
     }
 
@@ -82,14 +85,22 @@ impl Bvh2Geometry {
             let tlas = &bvh.tlas;
             nodes.extend(tlas.nodes.iter().map(|n| node(n, if n.is_leaf() { tlas.primitive_indices[n.first_index as usize] } else { n.first_index + node_offset })));
         }
-        let buffers = [
-            storage(gpu, "BVH2 nodes", bytemuck::cast_slice(&nodes), 32)?,
-            storage(gpu, "BVH2 triangles", bytemuck::cast_slice(&triangles), 48)?,
-            storage(gpu, "BVH2 roots", bytemuck::cast_slice(&roots), 4)?,
+        let roots = storage(gpu, "BVH2 roots", bytemuck::cast_slice(&roots), 4)?;
+        let tables = [
+            TexelTable::new(gpu, "BVH2 nodes", 2, bytemuck::cast_slice(&nodes), 0)?,
+            TexelTable::new(gpu, "BVH2 triangles", 3, bytemuck::cast_slice(&triangles), 0)?,
         ];
-        let layout = crate::compute::binding_layout(gpu, "BVH2 geometry", &GROUP);
-        let bind_group = crate::compute::buffer_group(gpu, "BVH2 geometry", &layout, &buffers.iter().collect::<Vec<_>>());
-        Ok(Self { bvh, layout, bind_group, _buffers: buffers })
+        let layout = crate::texel_table::group_layout(gpu, "BVH2 geometry", &GROUP, TABLES.len());
+        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("BVH2 geometry"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: roots.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(tables[0].view()) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(tables[1].view()) },
+            ],
+        });
+        Ok(Self { bvh, layout, bind_group, _roots: roots, _tables: tables })
     }
 
     pub fn bind_group_layout(&self) -> &wgpu::BindGroupLayout {

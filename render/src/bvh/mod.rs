@@ -33,7 +33,7 @@ pub use cpu_traversal::{InstanceUpdate, SceneBvh};
 pub use tlas::InstanceTransforms;
 pub use ray_batch::{BatchGeometry, Bvh2Traversal, RayBatch, RayBuffers, RayQuery, SurfaceRecord, TraceKind, struct_layout_mismatches as ray_batch_struct_mismatches};
 pub use scene::rng::{SplitMix64, mix64};
-pub use scene_geometry::{SceneGeometry, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTriangle, SgVertex};
+pub use scene_geometry::{SceneGeometry, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTlasLeaf, SgTriangle, SgVertex};
 pub use tlas::Tlas;
 pub use triangle::{WatertightRay, intersect_triangle};
 

@@ -1,9 +1,14 @@
-//! The scene's geometry on the GPU: both BVH levels, triangles and instances in storage buffers
-//! of one bind group (`@group(1)` of scene_geometry.wgsl).
+//! The scene's geometry on the GPU: both BVH levels, triangles, meshes and instances in one bind
+//! group (`@group(1)` of scene_geometry.wgsl). Every table that traversal and hit shading read
+//! at a per-ray address is a texel table ([`TexelTable`]: texture fetches, which lavapipe
+//! gathers, where it loops over the SIMD lanes for a storage load); only the instance table's
+//! header, read at one address by every invocation, is a storage buffer.
 
 use glam::{Mat4, Vec3};
+use obvhs::cwbvh::node::CwBvhNode;
 
 use super::cpu_traversal::InstanceUpdate;
+use crate::texel_table::{TexelTable, whole_rows};
 use super::tlas::InstanceTransforms;
 use super::{BvhError, SceneBvh};
 use crate::compute::BufferBinding;
@@ -13,7 +18,7 @@ use crate::shader::Module;
 use crate::scene::{Instance, SceneDesc};
 
 /// Storage buffers the bind group holds (a pass adds its own to the per-stage count).
-pub const STORAGE_BUFFERS: u32 = 8;
+pub const STORAGE_BUFFERS: u32 = 1;
 
 crate::gpu_struct! {
     /// obvhs's `CwBvhNode` as the traversal reads it: the same 80 bytes (uploaded by a cast), its
@@ -105,35 +110,71 @@ crate::gpu_struct! {
     pub struct SgInstanceHeader {
         pub count: u32 => "u32",
         pub tlas_node_count: u32 => "u32",
-        pub pad: [u32; 2] => "vec2u",
+        /// The TLAS root's record in the node table (the TLAS follows the BLASes there).
+        pub tlas_root: u32 => "u32",
+        pub pad: u32 => "u32",
     }
 }
 
-/// The geometry's @group(1), declared once (its WGSL and its layout).
-pub const GROUP: [BufferBinding; 8] = [
-    BufferBinding::read("sg_blas_nodes", "array<SgNode>"),
-    BufferBinding::read("sg_blas_triangles", "array<SgTriangle>"),
-    BufferBinding::read("sg_meshes", "array<SgMesh>"),
-    BufferBinding::read("sg_vertices", "array<SgVertex>"),
-    BufferBinding::read("sg_indices", "array<u32>"),
-    BufferBinding::read("sg_tlas_nodes", "array<SgNode>"),
-    BufferBinding::read("sg_tlas_instances", "array<u32>"),
-    BufferBinding::read("sg_instances", "SgInstanceTable"),
-];
+crate::gpu_struct! {
+    /// What traversal needs on entering a TLAS leaf, in TLAS leaf order (so no indirection).
+    pub struct SgTlasLeaf {
+        pub world_to_object: [f32; 16] => "mat4x4f",
+        /// Index into the instance table.
+        pub instance: u32 => "u32",
+        /// The instance's BLAS root in the node table.
+        pub blas_root: u32 => "u32",
+        /// The BLAS's node count (0: a mesh without triangles).
+        pub blas_nodes: u32 => "u32",
+        pub pad: u32 => "u32",
+    }
+}
+
+/// The geometry's storage buffer, @group(1) binding 0, declared once (WGSL and layout).
+pub const GROUP: [BufferBinding; 1] = [BufferBinding::read("sg_instance_header", "SgInstanceHeader")];
 const _: () = assert!(crate::compute::storage_buffers(&GROUP) == STORAGE_BUFFERS);
+
+/// The texel tables after the buffer, each record a struct of whole 16-byte texels: (WGSL
+/// name, record struct, texels per record).
+const TABLES: [(&str, &str, u32); 7] = [
+    ("sg_nodes", "SgNode", 5),
+    ("sg_triangles", "SgTriangle", 3),
+    ("sg_tlas_leaves", "SgTlasLeaf", 5),
+    ("sg_instances", "SgInstance", 13),
+    ("sg_meshes", "SgMesh", 2),
+    ("sg_vertices", "SgVertex", 2),
+    ("sg_indices", "vec4u", 1),
+];
+const NODES: usize = 0;
+const TRIANGLES: usize = 1;
+const TLAS_LEAVES: usize = 2;
+const INSTANCES: usize = 3;
+const MESHES: usize = 4;
+const VERTICES: usize = 5;
+const INDICES: usize = 6;
+const fn record_bytes(table: usize) -> usize {
+    16 * TABLES[table].2 as usize
+}
+const _: () = {
+    let t = record_bytes;
+    assert!(size_of::<SgNode>() == t(NODES) && size_of::<SgTriangle>() == t(TRIANGLES) && size_of::<SgTlasLeaf>() == t(TLAS_LEAVES));
+    assert!(size_of::<SgInstance>() == t(INSTANCES) && size_of::<SgMesh>() == t(MESHES) && size_of::<SgVertex>() == t(VERTICES) && t(INDICES) == 16);
+};
+
+const fn texels(table: usize) -> u32 {
+    TABLES[table].2
+}
 
 pub struct SceneGeometry {
     bvh: SceneBvh,
     layout: wgpu::BindGroupLayout,
     bind_group: wgpu::BindGroup,
-    blas_nodes: wgpu::Buffer,
-    blas_triangles: wgpu::Buffer,
-    meshes: wgpu::Buffer,
-    vertices: wgpu::Buffer,
-    indices: wgpu::Buffer,
-    tlas_nodes: wgpu::Buffer,
-    tlas_instances: wgpu::Buffer,
-    instances: wgpu::Buffer,
+    /// The TLAS root's record in the node table (the BLAS nodes come first).
+    tlas_root: u32,
+    header: wgpu::Buffer,
+    /// In [`TABLES`]' order. The node table holds the BLAS nodes from record 0, then the TLAS
+    /// from `tlas_root` (a row boundary) with room to grow, as do the TLAS leaves and instances.
+    tables: [TexelTable; 7],
 }
 
 impl SceneGeometry {
@@ -143,15 +184,17 @@ impl SceneGeometry {
     /// group 1.
     pub fn modules() -> Vec<Module> {
         let types = Self::types();
-        let bindings = crate::compute::group_module("package::scene_geometry_bindings", 1, &GROUP, &[&types]);
-        vec![types, bindings, crate::wgsl_file!("scene_geometry.wgsl")]
+        let mut bindings = crate::compute::group_module("package::scene_geometry_bindings", 1, &GROUP, &[&types]);
+        let names: Vec<&str> = TABLES.iter().map(|t| t.0).collect();
+        bindings.source = format!("{}{}", bindings.source, crate::texel_table::declare(1, GROUP.len() as u32, &names)).into();
+        vec![crate::texel_table::module(), types, bindings, crate::wgsl_file!("scene_geometry.wgsl")]
     }
 
     /// `package::scene_geometry_types`: the structs of the bind group.
     pub(crate) fn types() -> Module {
         Module::generated(
             "package::scene_geometry_types",
-            &[SgNode::WGSL, SgTriangle::WGSL, SgMesh::WGSL, SgVertex::WGSL, SgInstance::WGSL, SgInstanceHeader::WGSL, "struct SgInstanceTable { header: SgInstanceHeader, records: array<SgInstance> }\n"],
+            &[SgNode::WGSL, SgTriangle::WGSL, SgTlasLeaf::WGSL, SgMesh::WGSL, SgVertex::WGSL, SgInstance::WGSL, SgInstanceHeader::WGSL],
         )
     }
 
@@ -166,21 +209,14 @@ impl SceneGeometry {
         }
         let bvh = SceneBvh::new(scene)?;
 
-        let mut nodes = Vec::new();
+        let nodes = blas_nodes(&bvh);
         let mut triangles = Vec::new();
         let mut meshes = Vec::new();
         let mut vertices = Vec::new();
         let mut indices = Vec::new();
+        let mut node_offset = 0;
         for (mesh, blas) in scene.meshes.iter().zip(&bvh.blas) {
-            let node_offset = nodes.len() as u32;
             let triangle_offset = triangles.len() as u32;
-            // Child and primitive indices become absolute in the concatenated buffers.
-            nodes.extend(blas.bvh.nodes.iter().map(|n| {
-                let mut n = *n;
-                n.child_base_idx = n.child_base_idx.wrapping_add(node_offset);
-                n.primitive_base_idx = n.primitive_base_idx.wrapping_add(triangle_offset);
-                n
-            }));
             triangles.extend(sg_triangles(&blas.triangles, &blas.bvh.primitive_indices));
             let flags = if mesh.normals.is_empty() { 0 } else { HAS_NORMALS } | if mesh.uvs.is_empty() { 0 } else { HAS_UVS };
             meshes.push(SgMesh {
@@ -189,36 +225,37 @@ impl SceneGeometry {
                 triangle_offset,
                 triangle_count: blas.triangles.len() as u32,
                 vertex_offset: vertices.len() as u32,
-                index_offset: (indices.len() / 3) as u32,
+                index_offset: indices.len() as u32,
                 flags,
                 pad: 0,
             });
+            node_offset += blas.bvh.nodes.len() as u32;
             vertices.extend(mesh.positions.iter().enumerate().map(|(i, p)| {
                 let n = mesh.normals.get(i).copied().unwrap_or(Vec3::ZERO);
                 let uv = mesh.uvs.get(i).copied().unwrap_or_default();
                 SgVertex { position: (*p).into(), u: uv.x, normal: n.into(), v: uv.y }
             }));
-            indices.extend(mesh.indices.iter().flatten().copied());
+            indices.extend(mesh.indices.iter().map(|t| [t[0], t[1], t[2], 0]));
         }
 
-        let blas_nodes = storage(gpu, "BLAS nodes", bytemuck::cast_slice(&nodes), 80)?;
-        let blas_triangles = storage(gpu, "BLAS triangles", bytemuck::cast_slice(&triangles), 48)?;
-        let meshes = storage(gpu, "mesh table", bytemuck::cast_slice(&meshes), 32)?;
-        let vertices = storage(gpu, "vertices", bytemuck::cast_slice(&vertices), 32)?;
-        let indices = storage(gpu, "triangle indices", bytemuck::cast_slice(&indices), 4)?;
-        let (tlas_nodes, tlas_instances, instances) = Self::instance_buffers(gpu, &bvh)?;
-
-        let layout = crate::compute::binding_layout(gpu, "scene geometry", &GROUP);
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scene geometry"),
-            layout: &layout,
-            entries: &[&blas_nodes, &blas_triangles, &meshes, &vertices, &indices, &tlas_nodes, &tlas_instances, &instances]
-                .iter()
-                .enumerate()
-                .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
-                .collect::<Vec<_>>(),
+        let triangles = TexelTable::new(gpu, "BLAS triangles", texels(TRIANGLES), bytemuck::cast_slice(&triangles), 0)?;
+        let meshes = TexelTable::new(gpu, "mesh table", texels(MESHES), bytemuck::cast_slice(&meshes), 0)?;
+        let vertices = TexelTable::new(gpu, "vertices", texels(VERTICES), bytemuck::cast_slice(&vertices), 0)?;
+        let indices = TexelTable::new(gpu, "triangle indices", texels(INDICES), bytemuck::cast_slice(&indices), 0)?;
+        let tlas_root = whole_rows(nodes.len() as u32);
+        let [node_table, tlas_leaves, instances] = Self::instance_tables(gpu, &bvh, &nodes, tlas_root)?;
+        let header = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("instance table header"),
+            size: size_of::<SgInstanceHeader>() as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
         });
-        Ok(Self { bvh, layout, bind_group, blas_nodes, blas_triangles, meshes, vertices, indices, tlas_nodes, tlas_instances, instances })
+        gpu.queue.write_buffer(&header, 0, &instance_header(&bvh, tlas_root));
+
+        let layout = crate::texel_table::group_layout(gpu, "scene geometry", &GROUP, TABLES.len());
+        let tables = [node_table, triangles, tlas_leaves, instances, meshes, vertices, indices];
+        let bind_group = bind_group(gpu, &layout, &header, &tables);
+        Ok(Self { bvh, layout, bind_group, tlas_root, header, tables })
     }
 
     /// Next frame's instances: the current transforms become the previous ones (motion
@@ -236,56 +273,44 @@ impl SceneGeometry {
         match update {
             InstanceUpdate::Unchanged => {}
             InstanceUpdate::TableOnly => {
-                gpu.queue.write_buffer(&self.instances, 0, &instance_table(&self.bvh));
+                self.tables[INSTANCES].write(gpu, 0, &instance_records(&self.bvh));
+                self.tables[TLAS_LEAVES].write(gpu, 0, &tlas_leaves(&self.bvh));
             }
             InstanceUpdate::Rebuilt => {
-                let tlas = tlas_nodes(&self.bvh);
-                let table = instance_table(&self.bvh);
-                let fits = tlas.len() as u64 <= self.tlas_nodes.size()
-                    && self.bvh.tlas.bvh.primitive_indices.len() as u64 * 4 <= self.tlas_instances.size()
-                    && table.len() as u64 <= self.instances.size();
+                let instances = self.bvh.instances.len() as u32;
+                let fits = self.tlas_root + self.bvh.tlas.bvh.nodes.len() as u32 <= self.tables[NODES].capacity()
+                    && self.bvh.tlas.bvh.primitive_indices.len() as u32 <= self.tables[TLAS_LEAVES].capacity()
+                    && instances <= self.tables[INSTANCES].capacity();
                 if fits {
-                    gpu.queue.write_buffer(&self.tlas_nodes, 0, &tlas);
-                    gpu.queue.write_buffer(&self.tlas_instances, 0, bytemuck::cast_slice(&self.bvh.tlas.bvh.primitive_indices));
-                    gpu.queue.write_buffer(&self.instances, 0, &table);
+                    self.tables[NODES].write(gpu, self.tlas_root, &tlas_nodes(&self.bvh, self.tlas_root));
+                    self.tables[TLAS_LEAVES].write(gpu, 0, &tlas_leaves(&self.bvh));
+                    self.tables[INSTANCES].write(gpu, 0, &instance_records(&self.bvh));
                 } else {
-                    // More instances than the buffers hold: new buffers, so a new bind group
+                    // More instances than the tables hold: new ones, so a new bind group
                     // (passes must fetch `bind_group()` each frame).
-                    let (t, ti, i) = Self::instance_buffers(gpu, &self.bvh)?;
-                    (self.tlas_nodes, self.tlas_instances, self.instances) = (t, ti, i);
-                    self.bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("scene geometry"),
-                        layout: &self.layout,
-                        entries: &[
-                            &self.blas_nodes,
-                            &self.blas_triangles,
-                            &self.meshes,
-                            &self.vertices,
-                            &self.indices,
-                            &self.tlas_nodes,
-                            &self.tlas_instances,
-                            &self.instances,
-                        ]
-                        .iter()
-                        .enumerate()
-                        .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
-                        .collect::<Vec<_>>(),
-                    });
+                    let [n, l, i] = Self::instance_tables(gpu, &self.bvh, &blas_nodes(&self.bvh), self.tlas_root)?;
+                    (self.tables[NODES], self.tables[TLAS_LEAVES], self.tables[INSTANCES]) = (n, l, i);
+                    self.bind_group = bind_group(gpu, &self.layout, &self.header, &self.tables);
                 }
+                gpu.queue.write_buffer(&self.header, 0, &instance_header(&self.bvh, self.tlas_root));
             }
         }
         Ok(update)
     }
 
-    /// TLAS nodes, TLAS leaf -> instance, and the instance table, with room for twice the
-    /// current instances so that a growing scene does not reallocate every frame.
-    fn instance_buffers(gpu: &Gpu, bvh: &SceneBvh) -> Result<(wgpu::Buffer, wgpu::Buffer, wgpu::Buffer), BvhError> {
+    /// The node table (the BLAS nodes, then the TLAS from `tlas_root`), the TLAS leaves and the
+    /// instance records, with room for twice the current instances so that a growing scene does
+    /// not reallocate every frame.
+    fn instance_tables(gpu: &Gpu, bvh: &SceneBvh, blas: &[CwBvhNode], tlas_root: u32) -> Result<[TexelTable; 3], BvhError> {
         let room = 2 * bvh.instances.len().max(1) as u64;
         // A CWBVH over n boxes has at most n nodes (every inner node has two or more children).
-        let tlas = storage_with_capacity(gpu, "TLAS nodes", &tlas_nodes(&bvh), room * 80)?;
-        let leaves = storage_with_capacity(gpu, "TLAS instance indices", bytemuck::cast_slice(&bvh.tlas.bvh.primitive_indices), room * 4)?;
-        let table = storage_with_capacity(gpu, "instance table", &instance_table(bvh), 16 + room * 208)?;
-        Ok((tlas, leaves, table))
+        let mut nodes = bytemuck::cast_slice(blas).to_vec();
+        nodes.resize(tlas_root as usize * size_of::<SgNode>(), 0);
+        nodes.extend(tlas_nodes(bvh, tlas_root));
+        let nodes = TexelTable::new(gpu, "BVH nodes", texels(NODES), &nodes, tlas_root + room as u32)?;
+        let leaves = TexelTable::new(gpu, "TLAS leaves", texels(TLAS_LEAVES), &tlas_leaves(bvh), room as u32)?;
+        let instances = TexelTable::new(gpu, "instance table", texels(INSTANCES), &instance_records(bvh), room as u32)?;
+        Ok([nodes, leaves, instances])
     }
 
     pub fn bind_group_layout(&self) -> &wgpu::BindGroupLayout {
@@ -312,13 +337,85 @@ impl SceneGeometry {
     }
 }
 
-fn tlas_nodes(bvh: &SceneBvh) -> Vec<u8> {
-    bytemuck::cast_slice(&bvh.tlas.bvh.nodes).to_vec()
+/// Every BLAS's nodes, concatenated, with child and primitive indices made absolute (into the
+/// node table and the triangle table).
+fn blas_nodes(bvh: &SceneBvh) -> Vec<CwBvhNode> {
+    let mut nodes = Vec::new();
+    let mut triangle_offset = 0u32;
+    for blas in &bvh.blas {
+        let node_offset = nodes.len() as u32;
+        nodes.extend(blas.bvh.nodes.iter().map(|n| {
+            let mut n = *n;
+            n.child_base_idx = n.child_base_idx.wrapping_add(node_offset);
+            n.primitive_base_idx = n.primitive_base_idx.wrapping_add(triangle_offset);
+            n
+        }));
+        triangle_offset += blas.triangles.len() as u32;
+    }
+    nodes
 }
 
-fn instance_table(bvh: &SceneBvh) -> Vec<u8> {
-    let header = SgInstanceHeader { count: bvh.instances.len() as u32, tlas_node_count: bvh.tlas.bvh.nodes.len() as u32, pad: [0; 2] };
-    let mut bytes = bytemuck::bytes_of(&header).to_vec();
+/// The TLAS nodes as they sit in the node table from record `tlas_root` (child indices made
+/// absolute there; primitive indices stay TLAS leaf slots).
+fn tlas_nodes(bvh: &SceneBvh, tlas_root: u32) -> Vec<u8> {
+    let nodes: Vec<CwBvhNode> = bvh
+        .tlas
+        .bvh
+        .nodes
+        .iter()
+        .map(|n| {
+            let mut n = *n;
+            n.child_base_idx = n.child_base_idx.wrapping_add(tlas_root);
+            n
+        })
+        .collect();
+    bytemuck::cast_slice(&nodes).to_vec()
+}
+
+/// The bind group: the header, then the texel tables in [`TABLES`]' order.
+fn bind_group(gpu: &Gpu, layout: &wgpu::BindGroupLayout, header: &wgpu::Buffer, tables: &[TexelTable; 7]) -> wgpu::BindGroup {
+    let mut entries = vec![wgpu::BindGroupEntry { binding: 0, resource: header.as_entire_binding() }];
+    for (i, table) in tables.iter().enumerate() {
+        entries.push(wgpu::BindGroupEntry { binding: (GROUP.len() + i) as u32, resource: wgpu::BindingResource::TextureView(table.view()) });
+    }
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("scene geometry"), layout, entries: &entries })
+}
+
+/// The TLAS leaves in leaf order: each slot's instance, its world-to-object transform and its
+/// BLAS root.
+fn tlas_leaves(bvh: &SceneBvh) -> Vec<u8> {
+    let mut blas_roots = Vec::with_capacity(bvh.blas.len());
+    let mut offset = 0u32;
+    for blas in &bvh.blas {
+        blas_roots.push(offset);
+        offset += blas.bvh.nodes.len() as u32;
+    }
+    let leaves: Vec<SgTlasLeaf> = bvh
+        .tlas
+        .bvh
+        .primitive_indices
+        .iter()
+        .map(|&instance| {
+            let i = &bvh.instances[instance as usize];
+            SgTlasLeaf {
+                world_to_object: i.world_to_object.to_cols_array(),
+                instance,
+                blas_root: blas_roots[i.mesh as usize],
+                blas_nodes: bvh.blas[i.mesh as usize].bvh.nodes.len() as u32,
+                pad: 0,
+            }
+        })
+        .collect();
+    bytemuck::cast_slice(&leaves).to_vec()
+}
+
+fn instance_header(bvh: &SceneBvh, tlas_root: u32) -> Vec<u8> {
+    let header = SgInstanceHeader { count: bvh.instances.len() as u32, tlas_node_count: bvh.tlas.bvh.nodes.len() as u32, tlas_root, pad: 0 };
+    bytemuck::bytes_of(&header).to_vec()
+}
+
+fn instance_records(bvh: &SceneBvh) -> Vec<u8> {
+    let mut bytes = Vec::new();
     let m = |m: &Mat4| m.to_cols_array();
     for i in &bvh.instances {
         let record = SgInstance {
