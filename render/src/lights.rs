@@ -13,8 +13,8 @@ const SPOT: u32 = 2;
 const TRIANGLE: u32 = 3;
 
 crate::gpu_struct! {
-    /// One entry of the light table (`lights`, @group(0) binding 3); the meaning of p0, p1, p2,
-    /// a and b depends on `kind` (see pt_lights.wgsl).
+    /// One entry of the light table (texel table `light_table`, @group(0) binding 3, read with
+    /// `light(i)`); the meaning of p0, p1, p2, a and b depends on `kind` (see pt_lights.wgsl).
     pub struct GpuLight {
         pub p0: [f32; 3] => "vec3f",
         pub kind: u32 => "u32",

@@ -8,7 +8,8 @@ use bytemuck::Zeroable;
 pub(crate) const NO_TEXTURE: u32 = u32::MAX;
 
 crate::gpu_struct! {
-    /// One scene material as the shaders read it (`materials`, @group(0) binding 1).
+    /// One scene material as the shaders read it (texel table `material_table`, @group(0)
+    /// binding 2, read with `material(i)`).
     pub struct GpuMaterial {
         pub base_color: [f32; 3] => "vec3f",
         /// First texel in `texels`, NO_TEXTURE if none.

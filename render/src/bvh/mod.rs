@@ -5,7 +5,7 @@
 //! - [`Tlas`]: one CWBVH over the world-space boxes of the instances, rebuilt when one moves.
 //! - [`SceneBvh`]: both levels on the CPU, with a reference traversal through obvhs's own
 //!   CWBVH traversal (the ground truth the WGSL traversal is tested against).
-//! - [`SceneGeometry`]: the same structures in storage buffers (one bind group, `@group(1)`) and
+//! - [`SceneGeometry`]: the same structures in texel tables (one bind group, `@group(1)`) and
 //!   the WGSL interface `scene_geometry.wgsl` that passes import (`SceneGeometry::modules`).
 //! - [`RayBatch`]: a compute pass tracing a buffer of rays (tests, benchmark).
 //! - [`SceneBvh2`], [`Bvh2Geometry`]: the same two levels as obvhs binary BVHs (BVH2) with
