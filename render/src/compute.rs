@@ -117,7 +117,12 @@ pub fn binding_layout(gpu: &Gpu, label: &str, bindings: &[BufferBinding]) -> wgp
 
 /// A bind group layout whose binding i is a buffer of kind `kinds[i]`, visible to compute.
 pub fn buffer_layout(gpu: &Gpu, label: &str, kinds: &[wgpu::BufferBindingType]) -> wgpu::BindGroupLayout {
-    let entries: Vec<_> = kinds
+    gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &buffer_entries(kinds) })
+}
+
+/// Layout entries whose binding i is a buffer of kind `kinds[i]`, visible to compute.
+pub fn buffer_entries(kinds: &[wgpu::BufferBindingType]) -> Vec<wgpu::BindGroupLayoutEntry> {
+    kinds
         .iter()
         .enumerate()
         .map(|(i, &ty)| wgpu::BindGroupLayoutEntry {
@@ -126,8 +131,7 @@ pub fn buffer_layout(gpu: &Gpu, label: &str, kinds: &[wgpu::BufferBindingType]) 
             ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
             count: None,
         })
-        .collect();
-    gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
+        .collect()
 }
 
 /// A bind group binding `buffers[i]` whole at binding i.

@@ -36,8 +36,7 @@ impl PassLibrary {
         static MODULES: std::sync::OnceLock<Vec<Module>> = std::sync::OnceLock::new();
         MODULES.get_or_init(|| {
             let types = Module::generated("package::scene_types", &[CameraFrame::WGSL, Frame::WGSL, GpuMaterial::WGSL, GpuLight::WGSL]);
-            let mut bindings = compute::group_module("package::scene_bindings", 0, &crate::scene_bindings::GROUP, &[&types]);
-            bindings.source = format!("{}{}", bindings.source, crate::texel_table::declare(0, crate::scene_bindings::GROUP.len() as u32, &crate::scene_bindings::TABLES)).into();
+            let bindings = crate::texel_table::group_module("package::scene_bindings", 0, &crate::scene_bindings::GROUP, &crate::scene_bindings::TABLES, &[&types]);
             let mut modules = vec![types, bindings];
             modules.extend(SceneGeometry::modules());
             modules.extend([

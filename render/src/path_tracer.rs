@@ -28,8 +28,8 @@ pub const PATHS_PER_DISPATCH: u64 = 1 << 20;
 /// Samples one invocation of the trace pass traces; a dispatch spreads its samples over
 /// workgroup z (see trace_main in path_tracer.wgsl for why invocations must stay short). An
 /// invocation starts its next sample's path as soon as one ends (path regeneration), so more
-/// samples per invocation keep its lanes busier: 8 against 2 made the bench's reference 1.2-1.3x
-/// faster on lavapipe (render/README.md), while an invocation stays far below llvmpipe's loop cap.
+/// samples per invocation keep its lanes busier (2 before regeneration; render/README.md), while
+/// an invocation stays far below llvmpipe's loop cap.
 pub const SAMPLES_PER_THREAD: u32 = 8;
 
 /// Upper bound on sample chunks (workgroups along z) per dispatch.

@@ -196,12 +196,7 @@ impl SceneBindings {
     }
 }
 
+/// @group(0): [`GROUP`]'s buffers, then [`TABLES`].
 fn bind_group(gpu: &Gpu, layout: &wgpu::BindGroupLayout, frame: &wgpu::Buffer, texels: &wgpu::Buffer, materials: &TexelTable, lights: &TexelTable) -> wgpu::BindGroup {
-    let entries = [
-        wgpu::BindGroupEntry { binding: 0, resource: frame.as_entire_binding() },
-        wgpu::BindGroupEntry { binding: 1, resource: texels.as_entire_binding() },
-        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(materials.view()) },
-        wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(lights.view()) },
-    ];
-    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("scene"), layout, entries: &entries })
+    crate::texel_table::group(gpu, "scene", layout, &[frame, texels], &[materials, lights])
 }

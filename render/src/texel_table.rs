@@ -11,6 +11,7 @@
 //! Layout: record `i` is texels `(TEXELS * (i % RECORDS_PER_ROW) + j, i / RECORDS_PER_ROW)`,
 //! `j < TEXELS`, so a record never spans two rows and a row-aligned range can be rewritten alone.
 
+use crate::compute::BufferBinding;
 use crate::gpu::{Gpu, GpuError};
 use crate::shader::Module;
 
@@ -138,24 +139,29 @@ pub fn module() -> Module {
     )
 }
 
-/// A bind group layout of `buffers` at bindings 0.., then `tables` texel tables after them,
-/// visible to compute.
-pub fn group_layout(gpu: &Gpu, label: &str, buffers: &[crate::compute::BufferBinding], tables: usize) -> wgpu::BindGroupLayout {
-    let mut entries: Vec<_> = buffers
-        .iter()
-        .enumerate()
-        .map(|(i, b)| wgpu::BindGroupLayoutEntry {
-            binding: i as u32,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer { ty: b.kind(), has_dynamic_offset: false, min_binding_size: None },
-            count: None,
-        })
-        .collect();
+// A group of buffers and texel tables: the buffers at bindings 0.., the tables after them. The
+// three functions below are its WGSL, its layout and its bind group.
+
+/// [`crate::compute::group_module`] of `buffers`, with the texel tables `tables` declared after them.
+pub fn group_module(path: &str, group: u32, buffers: &[BufferBinding], tables: &[&str], types: &[&Module]) -> Module {
+    let mut module = crate::compute::group_module(path, group, buffers, types);
+    let declarations: String = tables.iter().enumerate().map(|(i, name)| format!("@group({group}) @binding({}) var {name}: texture_2d<u32>;\n", buffers.len() + i)).collect();
+    module.source = format!("{}{declarations}", module.source).into();
+    module
+}
+
+/// The layout of `buffers`, then `tables` texel tables, visible to compute.
+pub fn group_layout(gpu: &Gpu, label: &str, buffers: &[BufferBinding], tables: usize) -> wgpu::BindGroupLayout {
+    let mut entries = crate::compute::buffer_entries(&buffers.iter().map(BufferBinding::kind).collect::<Vec<_>>());
     entries.extend((0..tables).map(|i| TexelTable::layout_entry((buffers.len() + i) as u32)));
     gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
 }
 
-/// WGSL declarations of texel tables `names` at @group(`group`), bindings from `first_binding`.
-pub fn declare(group: u32, first_binding: u32, names: &[&str]) -> String {
-    names.iter().enumerate().map(|(i, name)| format!("@group({group}) @binding({}) var {name}: texture_2d<u32>;\n", first_binding + i as u32)).collect()
+/// The bind group of such a layout: `buffers` whole, then `tables`.
+pub fn group(gpu: &Gpu, label: &str, layout: &wgpu::BindGroupLayout, buffers: &[&wgpu::Buffer], tables: &[&TexelTable]) -> wgpu::BindGroup {
+    let mut entries: Vec<_> = buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
+    for (i, table) in tables.iter().enumerate() {
+        entries.push(wgpu::BindGroupEntry { binding: (buffers.len() + i) as u32, resource: wgpu::BindingResource::TextureView(table.view()) });
+    }
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
 }

@@ -202,13 +202,13 @@ pub fn upload<T: Pod>(gpu: &Gpu, label: &str, items: &[T]) -> wgpu::Buffer {
     })
 }
 
-/// An output buffer for `n` answers.
 /// The first `n` answers of an answer buffer, read back.
 pub fn read_answers(gpu: &Gpu, answers: &wgpu::Buffer, n: u32) -> Result<Vec<CacheAnswer>, NircError> {
     let bytes = readback::read_bytes(gpu, answers, "nirc answers")?;
     Ok(bytemuck::cast_slice::<u8, CacheAnswer>(&bytes[..n as usize * std::mem::size_of::<CacheAnswer>()]).to_vec())
 }
 
+/// An output buffer for `n` answers.
 pub fn answer_buffer(gpu: &Gpu, n: u32) -> wgpu::Buffer {
     gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("nirc answers"),

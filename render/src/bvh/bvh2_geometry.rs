@@ -1,8 +1,8 @@
 //! The BVH2s of [`SceneBvh2`] on the GPU: every node (all BLAS, then the TLAS) in one texel
 //! table of 32-byte nodes with plain f32 boxes, the leaf-order triangles in another (texel
 //! tables as the CWBVH's, so that the two traversals are compared on the same kind of loads),
-//! and the roots, in one bind group (`@group(2)` of bvh2_traversal.wgsl). The traversal reads the instance table and
-//! uses the ray set-up and triangle test of [`SceneGeometry`] (`@group(1)`), so a pass binds both.
+//! and the roots, in one bind group (`@group(2)` of bvh2_traversal.wgsl). The traversal reads
+//! the instance table and uses the ray set-up and triangle test of [`SceneGeometry`] (`@group(1)`), so a pass binds both.
 
 use super::bvh2::SceneBvh2;
 use super::scene_geometry::{sg_triangles, storage};
@@ -47,8 +47,7 @@ impl Bvh2Geometry {
     /// (`bvh2_trace_closest`, `bvh2_trace_any`), after [`SceneGeometry::modules`].
     pub fn modules() -> Vec<Module> {
         let types = Module::generated("package::bvh2_types", &[SgBvh2Node::WGSL]);
-        let mut bindings = crate::compute::group_module("package::bvh2_bindings", 2, &GROUP, &[&types, &SceneGeometry::types()]);
-        bindings.source = format!("{}{}", bindings.source, crate::texel_table::declare(2, GROUP.len() as u32, &TABLES)).into();
+        let bindings = crate::texel_table::group_module("package::bvh2_bindings", 2, &GROUP, &TABLES, &[&types, &SceneGeometry::types()]);
         vec![types, bindings, crate::wgsl_file!("bvh2_traversal.wgsl")]
     }
 
@@ -91,15 +90,7 @@ impl Bvh2Geometry {
             TexelTable::new(gpu, "BVH2 triangles", 3, bytemuck::cast_slice(&triangles), 0)?,
         ];
         let layout = crate::texel_table::group_layout(gpu, "BVH2 geometry", &GROUP, TABLES.len());
-        let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("BVH2 geometry"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: roots.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(tables[0].view()) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(tables[1].view()) },
-            ],
-        });
+        let bind_group = crate::texel_table::group(gpu, "BVH2 geometry", &layout, &[&roots], &tables.each_ref());
         Ok(Self { bvh, layout, bind_group, _roots: roots, _tables: tables })
     }
 

@@ -184,9 +184,8 @@ impl SceneGeometry {
     /// group 1.
     pub fn modules() -> Vec<Module> {
         let types = Self::types();
-        let mut bindings = crate::compute::group_module("package::scene_geometry_bindings", 1, &GROUP, &[&types]);
         let names: Vec<&str> = TABLES.iter().map(|t| t.0).collect();
-        bindings.source = format!("{}{}", bindings.source, crate::texel_table::declare(1, GROUP.len() as u32, &names)).into();
+        let bindings = crate::texel_table::group_module("package::scene_geometry_bindings", 1, &GROUP, &names, &[&types]);
         vec![crate::texel_table::module(), types, bindings, crate::wgsl_file!("scene_geometry.wgsl")]
     }
 
@@ -210,12 +209,12 @@ impl SceneGeometry {
         let bvh = SceneBvh::new(scene)?;
 
         let nodes = blas_nodes(&bvh);
+        let blas_roots = blas_roots(&bvh);
         let mut triangles = Vec::new();
         let mut meshes = Vec::new();
         let mut vertices = Vec::new();
         let mut indices = Vec::new();
-        let mut node_offset = 0;
-        for (mesh, blas) in scene.meshes.iter().zip(&bvh.blas) {
+        for ((mesh, blas), &node_offset) in scene.meshes.iter().zip(&bvh.blas).zip(&blas_roots) {
             let triangle_offset = triangles.len() as u32;
             triangles.extend(sg_triangles(&blas.triangles, &blas.bvh.primitive_indices));
             let flags = if mesh.normals.is_empty() { 0 } else { HAS_NORMALS } | if mesh.uvs.is_empty() { 0 } else { HAS_UVS };
@@ -229,7 +228,6 @@ impl SceneGeometry {
                 flags,
                 pad: 0,
             });
-            node_offset += blas.bvh.nodes.len() as u32;
             vertices.extend(mesh.positions.iter().enumerate().map(|(i, p)| {
                 let n = mesh.normals.get(i).copied().unwrap_or(Vec3::ZERO);
                 let uv = mesh.uvs.get(i).copied().unwrap_or_default();
@@ -244,13 +242,7 @@ impl SceneGeometry {
         let indices = TexelTable::new(gpu, "triangle indices", texels(INDICES), bytemuck::cast_slice(&indices), 0)?;
         let tlas_root = whole_rows(nodes.len() as u32);
         let [node_table, tlas_leaves, instances] = Self::instance_tables(gpu, &bvh, &nodes, tlas_root)?;
-        let header = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("instance table header"),
-            size: size_of::<SgInstanceHeader>() as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        gpu.queue.write_buffer(&header, 0, &instance_header(&bvh, tlas_root));
+        let header = storage(gpu, "instance table header", &instance_header(&bvh, tlas_root), 0)?;
 
         let layout = crate::texel_table::group_layout(gpu, "scene geometry", &GROUP, TABLES.len());
         let tables = [node_table, triangles, tlas_leaves, instances, meshes, vertices, indices];
@@ -337,13 +329,24 @@ impl SceneGeometry {
     }
 }
 
+/// Each BLAS's root in the node table (the BLASes' nodes one after another from record 0).
+fn blas_roots(bvh: &SceneBvh) -> Vec<u32> {
+    bvh.blas
+        .iter()
+        .scan(0u32, |next, blas| {
+            let root = *next;
+            *next += blas.bvh.nodes.len() as u32;
+            Some(root)
+        })
+        .collect()
+}
+
 /// Every BLAS's nodes, concatenated, with child and primitive indices made absolute (into the
 /// node table and the triangle table).
 fn blas_nodes(bvh: &SceneBvh) -> Vec<CwBvhNode> {
     let mut nodes = Vec::new();
     let mut triangle_offset = 0u32;
-    for blas in &bvh.blas {
-        let node_offset = nodes.len() as u32;
+    for (blas, node_offset) in bvh.blas.iter().zip(blas_roots(bvh)) {
         nodes.extend(blas.bvh.nodes.iter().map(|n| {
             let mut n = *n;
             n.child_base_idx = n.child_base_idx.wrapping_add(node_offset);
@@ -374,22 +377,13 @@ fn tlas_nodes(bvh: &SceneBvh, tlas_root: u32) -> Vec<u8> {
 
 /// The bind group: the header, then the texel tables in [`TABLES`]' order.
 fn bind_group(gpu: &Gpu, layout: &wgpu::BindGroupLayout, header: &wgpu::Buffer, tables: &[TexelTable; 7]) -> wgpu::BindGroup {
-    let mut entries = vec![wgpu::BindGroupEntry { binding: 0, resource: header.as_entire_binding() }];
-    for (i, table) in tables.iter().enumerate() {
-        entries.push(wgpu::BindGroupEntry { binding: (GROUP.len() + i) as u32, resource: wgpu::BindingResource::TextureView(table.view()) });
-    }
-    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("scene geometry"), layout, entries: &entries })
+    crate::texel_table::group(gpu, "scene geometry", layout, &[header], &tables.each_ref())
 }
 
 /// The TLAS leaves in leaf order: each slot's instance, its world-to-object transform and its
 /// BLAS root.
 fn tlas_leaves(bvh: &SceneBvh) -> Vec<u8> {
-    let mut blas_roots = Vec::with_capacity(bvh.blas.len());
-    let mut offset = 0u32;
-    for blas in &bvh.blas {
-        blas_roots.push(offset);
-        offset += blas.bvh.nodes.len() as u32;
-    }
+    let blas_roots = blas_roots(bvh);
     let leaves: Vec<SgTlasLeaf> = bvh
         .tlas
         .bvh
@@ -438,11 +432,7 @@ pub(super) fn sg_triangles<'a>(triangles: &'a [[Vec3; 3]], primitive_indices: &'
 
 /// A read-only storage buffer holding `data`, at least `min_size` bytes (bindings cannot be empty).
 pub(super) fn storage(gpu: &Gpu, what: &str, data: &[u8], min_size: u64) -> Result<wgpu::Buffer, BvhError> {
-    storage_with_capacity(gpu, what, data, min_size)
-}
-
-fn storage_with_capacity(gpu: &Gpu, what: &str, data: &[u8], capacity: u64) -> Result<wgpu::Buffer, BvhError> {
-    let size = (data.len() as u64).max(capacity).next_multiple_of(16);
+    let size = (data.len() as u64).max(min_size).next_multiple_of(16);
     gpu.check_buffer_size(what, size)?;
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(what),
