@@ -13,7 +13,7 @@ use crate::records::{CacheAnswer, CacheQuery, TrainingRecord};
 use render::gpu_struct::GpuStruct;
 use render::compute::BufferBinding;
 use render::gpu::Gpu;
-use render::pass_library::PassLibrary;
+use render::pass_library::{LibraryPipeline, PassLibrary};
 use render::path_tracer::PathTracer;
 use render::shader::{Module, Program};
 use render::timing::TimedFrame;
@@ -93,11 +93,11 @@ pub struct CachePaths {
     height: u32,
     spp: u32,
     layout: wgpu::BindGroupLayout,
-    queries_pipeline: wgpu::ComputePipeline,
-    targets_pipeline: wgpu::ComputePipeline,
-    compact_pipeline: wgpu::ComputePipeline,
-    oracle_pipeline: wgpu::ComputePipeline,
-    resolve_pipeline: wgpu::ComputePipeline,
+    queries_pipeline: LibraryPipeline,
+    targets_pipeline: LibraryPipeline,
+    compact_pipeline: LibraryPipeline,
+    oracle_pipeline: LibraryPipeline,
+    resolve_pipeline: LibraryPipeline,
     params: wgpu::Buffer,
     queries: wgpu::Buffer,
     meta: wgpu::Buffer,
@@ -243,13 +243,13 @@ impl CachePaths {
         render::compute::buffer_group(gpu, "nirc cache paths", &self.layout, &buffers)
     }
 
-    fn pass(&self, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer, group: &wgpu::BindGroup, pipeline: &wgpu::ComputePipeline, label: &str, workgroups: (u32, u32)) {
+    fn pass(&self, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer, group: &wgpu::BindGroup, pipeline: &LibraryPipeline, label: &str, workgroups: (u32, u32)) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
         record(&mut pass, tracer, group, &[(pipeline, workgroups)]);
     }
 
     /// One timed pass (pass `index` of `timed`) of `pipelines`, in order, each over its workgroups.
-    fn timed_pass(&self, timed: &mut TimedFrame, index: usize, tracer: &PathTracer, group: &wgpu::BindGroup, pipelines: &[(&wgpu::ComputePipeline, (u32, u32))]) -> Result<(), NircError> {
+    fn timed_pass(&self, timed: &mut TimedFrame, index: usize, tracer: &PathTracer, group: &wgpu::BindGroup, pipelines: &[(&LibraryPipeline, (u32, u32))]) -> Result<(), NircError> {
         timed.pass(index, |pass| record(pass, tracer, group, pipelines))?;
         Ok(())
     }
@@ -352,12 +352,12 @@ impl CachePaths {
 
 /// Binds the scene (@group(0)), the geometry (@group(1)) and `group` (@group(2)), then dispatches
 /// each of `pipelines` over its workgroups.
-fn record(pass: &mut wgpu::ComputePass, tracer: &PathTracer, group: &wgpu::BindGroup, pipelines: &[(&wgpu::ComputePipeline, (u32, u32))]) {
+fn record(pass: &mut wgpu::ComputePass, tracer: &PathTracer, group: &wgpu::BindGroup, pipelines: &[(&LibraryPipeline, (u32, u32))]) {
     pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
     pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
     pass.set_bind_group(2, group, &[]);
     for (pipeline, groups) in pipelines {
-        pass.set_pipeline(pipeline);
+        pass.set_pipeline(&pipeline.get());
         pass.dispatch_workgroups(groups.0, groups.1, 1);
     }
 }

@@ -2,6 +2,7 @@
 // and the path loop.
 
 import package::scene_types::{GpuMaterial};
+import package::scene_features::{HAS_ANALYTIC_LIGHTS, HAS_EMITTERS, HAS_ENVIRONMENT};
 import package::scene_bindings::{frame};
 import package::scene_tables::{material, light};
 import package::scene_geometry::{NO_HIT, SurfacePoint, surface_point, trace_any, trace_closest};
@@ -14,7 +15,8 @@ import package::pt_scene::{Shading, base_color_at, environment_pdf, escaped_radi
 // environment, each MIS-weighted (power heuristic) against the BSDF's pdf. The three parts are
 // separate functions because a cache-terminated path (nirc) needs some of them without MIS;
 // `mis` = false gives the plain light-sampling estimate. The random numbers drawn do not
-// depend on `mis`.
+// depend on `mis`. A kind of light the scene lacks is compiled out (scene_features.rs says why);
+// its estimator draws no random numbers either way.
 fn next_event(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>) -> vec3f {
     return next_event_analytic(p, sh, bsdf, wo, rng, true)
         + next_event_emitter(p, sh, bsdf, wo, rng, true)
@@ -23,6 +25,9 @@ fn next_event(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u
 
 fn next_event_analytic(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>, mis: bool) -> vec3f {
     var radiance = vec3f(0.0);
+    if !HAS_ANALYTIC_LIGHTS {
+        return radiance;
+    }
     for (var i = 0u; i < frame.analytic_lights; i++) {
         let ls = sample_analytic_light(light(i), p, rng_next2(rng));
         if dot(ls.wi, sh.ng) <= 0.0 || max_component(ls.weight) <= 0.0 {
@@ -48,7 +53,7 @@ fn next_event_analytic(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<fu
 // One emissive triangle, chosen by power.
 fn next_event_emitter(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>, mis: bool) -> vec3f {
     let emitter_count = frame.emitters;
-    if emitter_count == 0u {
+    if !HAS_EMITTERS || emitter_count == 0u {
         return vec3f(0.0);
     }
     let u_select = rng_next(rng);
@@ -74,7 +79,7 @@ fn next_event_emitter(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<fun
 // The constant environment, sampled uniformly over the sphere, always MIS-weighted.
 fn next_event_environment(p: vec3f, sh: Shading, bsdf: Bsdf, wo: vec3f, rng: ptr<function, u32>) -> vec3f {
     let env_pdf = environment_pdf();
-    if env_pdf <= 0.0 {
+    if !HAS_ENVIRONMENT || env_pdf <= 0.0 {
         return vec3f(0.0);
     }
     let wi = sample_uniform_sphere(rng_next2(rng));

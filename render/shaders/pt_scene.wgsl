@@ -6,6 +6,7 @@
 
 import package::scene_types::{CameraFrame, GpuMaterial};
 import package::scene_bindings::{frame, texels};
+import package::scene_features::{HAS_ANALYTIC_LIGHTS, HAS_TEXTURES};
 import package::scene_tables::{light};
 import package::scene_geometry::{Hit, NO_HIT, SurfacePoint, previous_world_position};
 import package::pt_sampling::{PI, max_component, power_heuristic};
@@ -29,9 +30,10 @@ fn texel(m: GpuMaterial, x: i32, y: i32) -> vec3f {
     return srgb_to_linear(unpack4x8unorm(packed).rgb);
 }
 
-// Bilinear, repeat wrap, filtered in linear space (sRGB decoded per texel).
+// Bilinear, repeat wrap, filtered in linear space (sRGB decoded per texel). Compiled out of a
+// scene without textures (scene_features.rs).
 fn base_color_at(m: GpuMaterial, uv: vec2f) -> vec3f {
-    if m.texture_offset == NO_TEXTURE || m.texture_width == 0u || m.texture_height == 0u {
+    if !HAS_TEXTURES || m.texture_offset == NO_TEXTURE || m.texture_width == 0u || m.texture_height == 0u {
         return m.base_color;
     }
     let st = uv * vec2f(f32(m.texture_width), f32(m.texture_height)) - 0.5;
@@ -90,6 +92,9 @@ fn escaped_radiance(dir: vec3f, bsdf_pdf: f32) -> vec3f {
     var l = frame.environment;
     if bsdf_pdf > 0.0 {
         l *= power_heuristic(bsdf_pdf, environment_pdf());
+    }
+    if !HAS_ANALYTIC_LIGHTS {
+        return l;
     }
     for (var i = 0u; i < frame.analytic_lights; i++) {
         let light = light(i);

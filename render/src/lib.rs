@@ -17,6 +17,7 @@ pub mod readback;
 pub mod sample_cache;
 pub mod shader;
 pub mod scene_bindings;
+pub mod scene_features;
 pub mod sss;
 pub mod taa;
 pub mod texel_table;

@@ -1,9 +1,10 @@
 //! The shading library every method's passes are built on: its WGSL modules (scene geometry,
 //! sampling, BSDFs, lights, the scene's @group(0) and the path integrator, without entry points) and the
-//! run's cache of compiled passes, so that methods with equal passes share their pipelines.
+//! run's cache of compiled passes, so that methods with equal passes share their pipelines,
+//! each compiled for the features the scene has ([`SceneFeatures`]: kinds of light, textures).
 
 use std::collections::HashMap;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 use crate::bvh::SceneGeometry;
 use crate::compute::{self, BufferBinding};
@@ -13,6 +14,7 @@ use crate::lights::GpuLight;
 use crate::materials::GpuMaterial;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
+use crate::scene_features::SceneFeatures;
 use crate::scene_bindings::SceneBindings;
 use crate::shader::{Module, Program};
 
@@ -20,24 +22,89 @@ use crate::shader::{Module, Program};
 /// @group(1) (geometry). Add the pass's own to check the adapter limit.
 pub const LIBRARY_STORAGE_BUFFERS: u32 = crate::scene_bindings::STORAGE_BUFFERS + SceneGeometry::STORAGE_BUFFERS;
 
-type Compiled = (wgpu::BindGroupLayout, Vec<wgpu::ComputePipeline>);
+/// A pipeline of the library, compiled for the features the scene has now. Fetch it with
+/// [`Self::get`] each time a pass is recorded: [`PassLibrary::specialise`] replaces it when the
+/// scene gains or loses a feature.
+#[derive(Clone, Debug)]
+pub struct LibraryPipeline(Arc<Mutex<wgpu::ComputePipeline>>);
 
-#[derive(Default)]
-pub struct PassLibrary {
+impl LibraryPipeline {
+    pub fn get(&self) -> wgpu::ComputePipeline {
+        self.0.lock().unwrap_or_else(|e| e.into_inner()).clone()
+    }
+}
+
+/// The same pass (shared by the methods that built it), not merely equal code.
+impl PartialEq for LibraryPipeline {
+    fn eq(&self, other: &Self) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+type Compile = Box<dyn Fn(&Gpu, &SceneBindings, SceneFeatures) -> Result<Vec<wgpu::ComputePipeline>, RenderError> + Send>;
+
+/// One pass built on the library: its own group's layout, its pipelines as the methods hold
+/// them, and how to compile them for other features.
+struct Pass {
+    layout: wgpu::BindGroupLayout,
+    pipelines: Vec<LibraryPipeline>,
+    compile: Compile,
+    /// Pipelines compiled so far, by features: a scene whose light comes back reuses them.
+    variants: HashMap<SceneFeatures, Vec<wgpu::ComputePipeline>>,
+}
+
+struct State {
+    features: SceneFeatures,
     /// Passes built so far, by (pass, source, own group, entry points).
-    compiled: Mutex<HashMap<u64, Compiled>>,
+    passes: HashMap<u64, Pass>,
+}
+
+pub struct PassLibrary {
+    state: Mutex<State>,
 }
 
 impl PassLibrary {
+    /// A library whose passes are compiled for `features`, the scene's.
+    pub fn new(features: SceneFeatures) -> Self {
+        Self { state: Mutex::new(State { features, passes: HashMap::new() }) }
+    }
+
+    /// The features the passes are compiled for.
+    pub fn features(&self) -> SceneFeatures {
+        self.state.lock().unwrap_or_else(|e| e.into_inner()).features
+    }
+
+    /// Compiles every pass built so far for `features` (or takes an earlier compilation) and
+    /// swaps the pipelines the methods hold; later passes are built for `features`. Call when
+    /// the scene's features change; a no-op otherwise.
+    pub fn specialise(&self, gpu: &Gpu, scene: &SceneBindings, features: SceneFeatures) -> Result<(), RenderError> {
+        let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        if state.features == features {
+            return Ok(());
+        }
+        for pass in state.passes.values_mut() {
+            if !pass.variants.contains_key(&features) {
+                let compiled = (pass.compile)(gpu, scene, features)?;
+                pass.variants.insert(features, compiled);
+            }
+            for (held, new) in pass.pipelines.iter().zip(&pass.variants[&features]) {
+                *held.0.lock().unwrap_or_else(|e| e.into_inner()) = new.clone();
+            }
+        }
+        state.features = features;
+        Ok(())
+    }
+
     /// The library's modules, each after those it imports: the scene's structs and its
-    /// @group(0) (generated), the geometry's @group(1) and traversal, sampling, BSDFs, lights,
+    /// @group(0) (generated), the scene's features (all of them; [`Self::pass`] compiles for
+    /// the scene's own), the geometry's @group(1) and traversal, sampling, BSDFs, lights,
     /// the scene's shading helpers and the path integrator. A pass's program starts with them.
     pub fn modules() -> &'static [Module] {
         static MODULES: std::sync::OnceLock<Vec<Module>> = std::sync::OnceLock::new();
         MODULES.get_or_init(|| {
             let types = Module::generated("package::scene_types", &[CameraFrame::WGSL, Frame::WGSL, GpuMaterial::WGSL, GpuLight::WGSL]);
             let bindings = crate::texel_table::group_module("package::scene_bindings", 0, &crate::scene_bindings::GROUP, &crate::scene_bindings::TABLES, &[&types]);
-            let mut modules = vec![types, bindings];
+            let mut modules = vec![types, bindings, SceneFeatures::ALL.module()];
             modules.extend(SceneGeometry::modules());
             modules.extend([
                 crate::wgsl_file!("scene_tables.wgsl"),
@@ -61,8 +128,8 @@ impl PassLibrary {
 
     /// The layout of a pass's own @group(2) and the pipelines of `entries` in `program` (a
     /// [`Self::program`] whose own modules include `compute::group_module(.., 2, own, ..)`, so a
-    /// pass states its buffers once). Refuses a pass with more storage buffers than the adapter
-    /// binds. Equal passes are compiled once per run.
+    /// pass states its buffers once), compiled for the library's scene features. Refuses a pass
+    /// with more storage buffers than the adapter binds. Equal passes are compiled once per run.
     pub fn pass<const N: usize>(
         &self,
         gpu: &Gpu,
@@ -71,7 +138,7 @@ impl PassLibrary {
         program: &Program,
         own: &[BufferBinding],
         entries: [&str; N],
-    ) -> Result<(wgpu::BindGroupLayout, [wgpu::ComputePipeline; N]), RenderError> {
+    ) -> Result<(wgpu::BindGroupLayout, [LibraryPipeline; N]), RenderError> {
         let needed = LIBRARY_STORAGE_BUFFERS + compute::storage_buffers(own);
         let limit = gpu.limits.max_storage_buffers_per_shader_stage;
         if needed > limit {
@@ -86,15 +153,26 @@ impl PassLibrary {
             (pass, program, format!("{own:?}"), entries.as_slice()).hash(&mut h);
             h.finish()
         };
-        let mut compiled = self.compiled.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((layout, pipelines)) = compiled.get(&key)
-            && let Ok(pipelines) = <[wgpu::ComputePipeline; N]>::try_from(pipelines.clone())
+        let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(built) = state.passes.get(&key)
+            && let Ok(pipelines) = <[LibraryPipeline; N]>::try_from(built.pipelines.clone())
         {
-            return Ok((layout.clone(), pipelines));
+            return Ok((built.layout.clone(), pipelines));
         }
         let layout = compute::binding_layout(gpu, pass, own);
-        let pipelines = compute::pipelines(gpu, pass, program, &[scene.layout(), scene.geometry().bind_group_layout(), &layout], entries)?;
-        compiled.insert(key, (layout.clone(), pipelines.to_vec()));
-        Ok((layout, pipelines))
+        let compile: Compile = {
+            let (name, program, layout, entries) = (pass.to_string(), program.clone(), layout.clone(), entries.map(String::from));
+            Box::new(move |gpu: &Gpu, scene: &SceneBindings, features: SceneFeatures| {
+                let specialised = program.replacing(&features.module());
+                let groups = [scene.layout(), scene.geometry().bind_group_layout(), &layout];
+                Ok(compute::pipelines(gpu, &name, &specialised, &groups, entries.each_ref().map(String::as_str))?.to_vec())
+            })
+        };
+        let features = state.features;
+        let compiled = compile(gpu, scene, features)?;
+        let pipelines: Vec<LibraryPipeline> = compiled.iter().map(|p| LibraryPipeline(Arc::new(Mutex::new(p.clone())))).collect();
+        let held = <[LibraryPipeline; N]>::try_from(pipelines.clone()).unwrap_or_else(|_| unreachable!("one pipeline per entry point"));
+        state.passes.insert(key, Pass { layout: layout.clone(), pipelines, compile, variants: HashMap::from([(features, compiled)]) });
+        Ok((layout, held))
     }
 }

@@ -11,7 +11,7 @@ use crate::compute::{self, BufferBinding};
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
-use crate::pass_library::PassLibrary;
+use crate::pass_library::{LibraryPipeline, PassLibrary};
 use crate::readback::read_buffer;
 use crate::scene::{Camera, SceneChanges, SceneDesc};
 use crate::scene_bindings::SceneBindings;
@@ -107,13 +107,13 @@ pub struct PathTracer {
     /// The path tracer's own @group(2) and its buffers.
     layout: wgpu::BindGroupLayout,
     bind_group: wgpu::BindGroup,
-    trace_pipeline: wgpu::ComputePipeline,
-    gbuffer_pipeline: wgpu::ComputePipeline,
+    trace_pipeline: LibraryPipeline,
+    gbuffer_pipeline: LibraryPipeline,
     radiance_sum: wgpu::Buffer,
     gbuffer: wgpu::Buffer,
     /// Per-(chunk, pixel) sums of one dispatch, summed by `accumulate_main`.
     sample_partials: wgpu::Buffer,
-    accumulate_pipeline: wgpu::ComputePipeline,
+    accumulate_pipeline: LibraryPipeline,
     max_chunks: u32,
     radiance_readback: wgpu::Buffer,
     gbuffer_readback: wgpu::Buffer,
@@ -163,19 +163,14 @@ impl PathTracer {
         let counters = per_pixel("path tracer ray counter", COUNTER_WORDS * 4, rw | wgpu::BufferUsages::COPY_DST);
         let counters_readback = per_pixel("path tracer ray counter readback", COUNTER_WORDS * 4, readback);
 
-        let layout = compute::binding_layout(gpu, "path tracer", &OWN_GROUP);
-        let [trace_pipeline, gbuffer_pipeline, accumulate_pipeline] = compute::pipelines(
-            gpu,
-            "path_tracer.wgsl",
-            Self::program(),
-            &[scene.layout(), scene.geometry().bind_group_layout(), &layout],
-            ["trace_main", "gbuffer_main", "accumulate_main"],
-        )?;
+        let library = PassLibrary::new(scene.features());
+        let (layout, [trace_pipeline, gbuffer_pipeline, accumulate_pipeline]) =
+            library.pass(gpu, &scene, "path_tracer.wgsl", Self::program(), &OWN_GROUP, ["trace_main", "gbuffer_main", "accumulate_main"])?;
         let bind_group = compute::buffer_group(gpu, "path tracer", &layout, &[&radiance_sum, &gbuffer, &sample_partials, &counters]);
         Ok(Self {
             settings,
             scene,
-            library: PassLibrary::default(),
+            library,
             layout,
             bind_group,
             trace_pipeline,
@@ -233,7 +228,7 @@ impl PathTracer {
         program: &Program,
         own: &[BufferBinding],
         entries: [&str; N],
-    ) -> Result<(wgpu::BindGroupLayout, [wgpu::ComputePipeline; N]), RenderError> {
+    ) -> Result<(wgpu::BindGroupLayout, [LibraryPipeline; N]), RenderError> {
         self.library.pass(gpu, &self.scene, pass, program, own, entries)
     }
 
@@ -277,12 +272,15 @@ impl PathTracer {
 
     /// [`Self::update`] that reports an inconsistent scene instead of panicking.
     pub fn try_update(&mut self, gpu: &Gpu, scene: &SceneDesc) -> Result<(), RenderError> {
-        self.scene.update_changed(gpu, scene, SceneChanges::ALL)
+        self.update_changed(gpu, scene, SceneChanges::ALL)
     }
 
     /// [`Self::try_update`] uploading only what `changes` names ([`SceneBindings::update_changed`]).
+    /// When the scene gains or loses a feature (a kind of light, textures), every pass of the
+    /// library is compiled again for its features ([`PassLibrary::specialise`]).
     pub fn update_changed(&mut self, gpu: &Gpu, scene: &SceneDesc, changes: SceneChanges) -> Result<(), RenderError> {
-        self.scene.update_changed(gpu, scene, changes)
+        self.scene.update_changed(gpu, scene, changes)?;
+        self.library.specialise(gpu, &self.scene, self.scene.features())
     }
 
     /// One frame: G-buffer of the pixel-centre rays, then `spp` jittered paths per pixel.
@@ -295,7 +293,7 @@ impl PathTracer {
         let mut timed = self.timer.begin(gpu, "gbuffer");
         timed.encoder().clear_buffer(&self.counters, 0, None);
         timed.pass(0, |pass| {
-            pass.set_pipeline(&self.gbuffer_pipeline);
+            pass.set_pipeline(&self.gbuffer_pipeline.get());
             pass.set_bind_group(0, self.scene.bind_group(), &[]);
             pass.set_bind_group(1, self.scene.geometry().bind_group(), &[]);
             pass.set_bind_group(2, &self.bind_group, &[]);
@@ -374,9 +372,9 @@ impl PathTracer {
                 pass.set_bind_group(0, self.scene.bind_group(), &[]);
                 pass.set_bind_group(1, self.scene.geometry().bind_group(), &[]);
                 pass.set_bind_group(2, &self.bind_group, &[]);
-                pass.set_pipeline(&self.trace_pipeline);
+                pass.set_pipeline(&self.trace_pipeline.get());
                 pass.dispatch_workgroups(x, y, batch.div_ceil(SAMPLES_PER_THREAD));
-                pass.set_pipeline(&self.accumulate_pipeline);
+                pass.set_pipeline(&self.accumulate_pipeline.get());
                 pass.dispatch_workgroups(x, y, 1);
             })?;
             merge(&mut timings, timed.submit()?);

@@ -9,8 +9,9 @@ use crate::compute::{self, BufferBinding};
 use crate::error::RenderError;
 use crate::frame::{CameraBasis, Frame, FrameParams};
 use crate::gpu::Gpu;
+use crate::scene_features::SceneFeatures;
 use crate::lights::{LightTable, build_light_table};
-use crate::materials::pack_materials;
+use crate::materials::{GpuMaterial, NO_TEXTURE, pack_materials};
 use crate::texel_table::TexelTable;
 use crate::scene::{Camera, SceneChanges, SceneDesc};
 use glam::Vec3;
@@ -57,12 +58,14 @@ pub struct SceneBindings {
     /// transforms; the current camera before the first update.
     previous_camera: Camera,
     environment: Vec3,
+    /// Some material has a base-colour texture.
+    textured: bool,
 }
 
 impl SceneBindings {
     pub fn new(gpu: &Gpu, scene: &SceneDesc, settings: PathTracerSettings) -> Result<Self, RenderError> {
         let geometry = SceneGeometry::new(gpu, scene)?;
-        let (materials, texels) = pack_materials(scene)?;
+        let (materials_cpu, texels) = pack_materials(scene)?;
         let light_table = build_light_table(scene)?;
         let device = &gpu.device;
         let storage = |label: &str, contents: &[u8]| -> Result<wgpu::Buffer, RenderError> {
@@ -73,7 +76,7 @@ impl SceneBindings {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             }))
         };
-        let materials = TexelTable::new(gpu, "materials", MATERIAL_TEXELS, bytemuck::cast_slice(&materials), 0)?;
+        let materials = TexelTable::new(gpu, "materials", MATERIAL_TEXELS, bytemuck::cast_slice(&materials_cpu), 0)?;
         let texels = storage("base-colour texels", bytemuck::cast_slice(&texels))?;
         let lights = TexelTable::new(gpu, "lights", LIGHT_TEXELS, bytemuck::cast_slice(&light_table.lights), 0)?;
         let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
@@ -97,6 +100,7 @@ impl SceneBindings {
             camera: scene.camera,
             previous_camera: scene.camera,
             environment: scene.environment,
+            textured: textured(&materials_cpu),
         })
     }
 
@@ -113,6 +117,7 @@ impl SceneBindings {
         if let Some((materials, texels)) = &materials {
             rebind |= self.materials.replace(gpu, bytemuck::cast_slice(materials))?;
             uploads.push((&mut self.texels, "base-colour texels", bytemuck::cast_slice(texels)));
+            self.textured = textured(materials);
         }
         if let Some(table) = &light_table {
             rebind |= self.lights.replace(gpu, bytemuck::cast_slice(&table.lights))?;
@@ -172,6 +177,17 @@ impl SceneBindings {
         gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&params.gpu()));
     }
 
+    /// The scene's features as last uploaded: what the library's passes are compiled for
+    /// ([`crate::pass_library::PassLibrary::specialise`]).
+    pub fn features(&self) -> SceneFeatures {
+        SceneFeatures {
+            analytic_lights: self.light_table.analytic > 0,
+            emitters: self.light_table.emitters > 0,
+            environment: self.environment.max_element() > 0.0,
+            textures: self.textured,
+        }
+    }
+
     /// @group(0). It changes when an update had to grow a buffer: fetch it every frame.
     pub fn bind_group(&self) -> &wgpu::BindGroup {
         &self.bind_group
@@ -194,6 +210,11 @@ impl SceneBindings {
     pub fn settings(&self) -> PathTracerSettings {
         self.settings
     }
+}
+
+/// Whether a material's base colour is read from a texture (base_color_at in pt_scene.wgsl).
+fn textured(materials: &[GpuMaterial]) -> bool {
+    materials.iter().any(|m| m.texture_offset != NO_TEXTURE && m.texture_width > 0 && m.texture_height > 0)
 }
 
 /// @group(0): [`GROUP`]'s buffers, then [`TABLES`].

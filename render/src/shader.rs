@@ -86,6 +86,16 @@ impl Program {
         self
     }
 
+    /// This program with `module` in place of its module of the same path; unchanged when it has
+    /// none (a program that does not import it).
+    pub fn replacing(&self, module: &Module) -> Self {
+        let mut program = self.clone();
+        for m in program.modules.iter_mut().filter(|m| m.path == module.path) {
+            *m = module.clone();
+        }
+        program
+    }
+
     /// This program with `file` as an entry-point file.
     pub fn entry(mut self, file: Module) -> Self {
         self.entry_files.push(file);

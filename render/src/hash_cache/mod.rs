@@ -261,7 +261,7 @@ pub struct HashCache {
     primary: wgpu::Buffer,
     colour: wgpu::Buffer,
     group: wgpu::BindGroup,
-    pipelines: [wgpu::ComputePipeline; 4],
+    pipelines: [crate::pass_library::LibraryPipeline; 4],
     timer: PassTimer,
     /// Frames rendered so far; the stamp of the next one is `frames + 1`.
     frames: u32,
@@ -352,7 +352,7 @@ impl HashCache {
         let mut timed = self.timer.begin(gpu, "hash cache");
         for (i, pipeline) in self.pipelines.iter().enumerate() {
             timed.pass(i, |pass| {
-                pass.set_pipeline(pipeline);
+                pass.set_pipeline(&pipeline.get());
                 pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
                 pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
                 pass.set_bind_group(2, &self.group, &[]);

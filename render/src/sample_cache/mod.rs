@@ -32,6 +32,7 @@ pub use settings::{Retrace, SampleCacheSettings, ShadingMode};
 pub use storage::{GpuSlot, SscSlot};
 
 
+use crate::pass_library::LibraryPipeline;
 use crate::compute::BufferBinding;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
@@ -266,18 +267,18 @@ pub struct SampleCache {
 }
 
 struct Pipelines {
-    begin: wgpu::ComputePipeline,
-    reserve: wgpu::ComputePipeline,
-    retrace: wgpu::ComputePipeline,
-    retrace_args: wgpu::ComputePipeline,
-    retrace_list: wgpu::ComputePipeline,
-    finish: wgpu::ComputePipeline,
-    rates: wgpu::ComputePipeline,
-    select: wgpu::ComputePipeline,
-    shade_args: wgpu::ComputePipeline,
-    shade: wgpu::ComputePipeline,
-    reconstruct: wgpu::ComputePipeline,
-    audit: wgpu::ComputePipeline,
+    begin: LibraryPipeline,
+    reserve: LibraryPipeline,
+    retrace: LibraryPipeline,
+    retrace_args: LibraryPipeline,
+    retrace_list: LibraryPipeline,
+    finish: LibraryPipeline,
+    rates: LibraryPipeline,
+    select: LibraryPipeline,
+    shade_args: LibraryPipeline,
+    shade: LibraryPipeline,
+    reconstruct: LibraryPipeline,
+    audit: LibraryPipeline,
 }
 
 impl SampleCache {
@@ -455,7 +456,7 @@ impl SampleCache {
         let list = |l: u64| Some((12 * l, [RETRACE_ARGS_WORD, SHADE_ARGS_WORD][l as usize]));
         let whole_list = list_dispatch(s.slots * w * h);
         // In the order of DISPATCHES: pipeline, direct workgroups, list.
-        let dispatches: [(&wgpu::ComputePipeline, [u32; 3], Option<(u64, u64)>); 11] = [
+        let dispatches: [(&LibraryPipeline, [u32; 3], Option<(u64, u64)>); 11] = [
             (&p.begin, [1, 1, 1], None),
             (&p.reserve, [gx, gy, s.slots], None),
             (&p.retrace, [gx, gy, 1], None),
@@ -478,7 +479,7 @@ impl SampleCache {
                 pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
                 pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
                 pass.set_bind_group(2, bind_group, &[]);
-                pass.set_pipeline(pipeline);
+                pass.set_pipeline(&pipeline.get());
                 match indirect {
                     Some((offset, _)) => pass.dispatch_workgroups_indirect(&self.list_args, offset),
                     None => pass.dispatch_workgroups(x, y, z),
@@ -577,7 +578,7 @@ impl SampleCache {
             pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
             // The bind group whose destination is the cache the last frame wrote.
             pass.set_bind_group(2, &self.bind_groups[1 - self.current], &[]);
-            pass.set_pipeline(&self.pipelines.audit);
+            pass.set_pipeline(&self.pipelines.audit.get());
             pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), self.settings.slots);
         }
         encoder.copy_buffer_to_buffer(&self.work, 0, &self.header_readback, 0, HEADER_WORDS * 4);

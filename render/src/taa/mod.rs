@@ -232,7 +232,7 @@ pub struct Taa {
     primary: [wgpu::Buffer; 2],
     history: [wgpu::Buffer; 2],
     trace_layout: wgpu::BindGroupLayout,
-    trace_pipeline: wgpu::ComputePipeline,
+    trace_pipeline: crate::pass_library::LibraryPipeline,
     resolve_groups: [wgpu::BindGroup; 2],
     resolve_pipeline: wgpu::ComputePipeline,
     /// [0]: rays traced by the trace pass this frame.
@@ -335,7 +335,7 @@ impl Taa {
         let mut timed = self.timer.begin(gpu, "taa trace");
         timed.encoder().clear_buffer(&self.counters, 0, None);
         timed.pass(0, |pass| {
-            pass.set_pipeline(&self.trace_pipeline);
+            pass.set_pipeline(&self.trace_pipeline.get());
             pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
             pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
             pass.set_bind_group(2, &group, &[]);

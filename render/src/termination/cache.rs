@@ -181,7 +181,7 @@ pub struct TerminationCache {
     colour: wgpu::Buffer,
     path_length: wgpu::Buffer,
     group: wgpu::BindGroup,
-    pipelines: [wgpu::ComputePipeline; 4],
+    pipelines: [crate::pass_library::LibraryPipeline; 4],
     timer: PassTimer,
     /// Frames (warm-up included) run so far.
     frames: u32,
@@ -325,7 +325,7 @@ impl TerminationCache {
                 _ => 0,
             };
             timed.pass(i, |pass| {
-                pass.set_pipeline(pipeline);
+                pass.set_pipeline(&pipeline.get());
                 pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
                 pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
                 pass.set_bind_group(2, &self.group, &[]);

@@ -1,0 +1,45 @@
+//! What kinds of light and surface a scene has (analytic lights, emissive triangles, a constant
+//! environment, textured materials), as the WGSL constants the library's passes are compiled
+//! with.
+//!
+//! Why: lavapipe runs a branch that no invocation takes under an empty mask instead of jumping
+//! over it, so next-event estimation towards a kind of light the scene lacks costs a light sample
+//! and a shadow ray's traversal per vertex all the same, and an untextured scene pays for four
+//! texel loads per hit (render/README.md). A pass compiled with the feature's constant `false`
+//! has no such code. A GPU skips such branches anyway. No result changes: a light kind's
+//! estimator draws no random numbers when the scene has none of it.
+
+use crate::shader::Module;
+
+/// Module path of the constants: `import package::scene_features::{HAS_EMITTERS, ...}`.
+pub const MODULE: &str = "package::scene_features";
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct SceneFeatures {
+    /// Point, spot or directional lights (`frame.analytic_lights` > 0).
+    pub analytic_lights: bool,
+    /// Emissive triangles (`frame.emitters` > 0).
+    pub emitters: bool,
+    /// A non-black constant environment (`environment_pdf()` > 0).
+    pub environment: bool,
+    /// A material with a base-colour texture.
+    pub textures: bool,
+}
+
+impl SceneFeatures {
+    /// Every feature: right for any scene. Programs are written with it; the pass library
+    /// compiles its passes for the scene's own features.
+    pub const ALL: Self = Self { analytic_lights: true, emitters: true, environment: true, textures: true };
+
+    /// The constants as a module at [`MODULE`].
+    pub fn module(self) -> Module {
+        let constants = [
+            ("HAS_ANALYTIC_LIGHTS", self.analytic_lights),
+            ("HAS_EMITTERS", self.emitters),
+            ("HAS_ENVIRONMENT", self.environment),
+            ("HAS_TEXTURES", self.textures),
+        ]
+        .map(|(name, value)| format!("const {name}: bool = {value};"));
+        Module::generated(MODULE, &[&constants.join("\n")])
+    }
+}
