@@ -250,27 +250,31 @@ fn sg_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit:
             primitive_group = node_group;
             node_group = vec2u(0u);
         }
+        // A TLAS leaf is an instance: enter it, saving the rest of the group and the node group.
+        // Outside the triangle loop, so that this code runs once per trip: lavapipe executes a
+        // branch no invocation takes all the same (render/README.md).
+        if tlas_stack_size == NO_HIT && primitive_group.y != 0u {
+            let local = firstLeadingBit(primitive_group.y);
+            primitive_group.y &= ~(1u << local);
+            if primitive_group.y != 0u && stack_size < SG_STACK_SIZE {
+                stack[stack_size] = primitive_group;
+                stack_size += 1u;
+            }
+            if (node_group.y & 0xff000000u) != 0u && stack_size < SG_STACK_SIZE {
+                stack[stack_size] = node_group;
+                stack_size += 1u;
+            }
+            tlas_stack_size = stack_size;
+            let leaf = sg_tlas_leaf(primitive_group.x + local);
+            instance = leaf.instance;
+            ray = sg_make_ray((leaf.world_to_object * vec4f(world_origin, 1.0)).xyz, (leaf.world_to_object * vec4f(world_direction, 0.0)).xyz);
+            node_group = vec2u(leaf.blas_root, select(0u, 0x80000000u, leaf.blas_nodes != 0u));
+            primitive_group.y = 0u;
+        }
         while primitive_group.y != 0u {
             let local = firstLeadingBit(primitive_group.y);
             primitive_group.y &= ~(1u << local);
-            let slot = primitive_group.x + local;
-            if tlas_stack_size == NO_HIT {
-                if primitive_group.y != 0u && stack_size < SG_STACK_SIZE {
-                    stack[stack_size] = primitive_group;
-                    stack_size += 1u;
-                }
-                if (node_group.y & 0xff000000u) != 0u && stack_size < SG_STACK_SIZE {
-                    stack[stack_size] = node_group;
-                    stack_size += 1u;
-                }
-                tlas_stack_size = stack_size;
-                let leaf = sg_tlas_leaf(slot);
-                instance = leaf.instance;
-                ray = sg_make_ray((leaf.world_to_object * vec4f(world_origin, 1.0)).xyz, (leaf.world_to_object * vec4f(world_direction, 0.0)).xyz);
-                node_group = vec2u(leaf.blas_root, select(0u, 0x80000000u, leaf.blas_nodes != 0u));
-                break;
-            }
-            let tri = sg_triangle(slot);
+            let tri = sg_triangle(primitive_group.x + local);
             let r = sg_intersect_triangle(ray, tri.v0, tri.v1, tri.v2, hit.t);
             if r.w > 0.0 {
                 hit = Hit(r.x, instance, tri.primitive, r.yz);
