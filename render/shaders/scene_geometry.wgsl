@@ -6,6 +6,7 @@
 import package::scene_geometry_types::{SgNode, SgTriangle, SgTlasLeaf, SgMesh, SgVertex, SgInstance};
 import package::scene_geometry_bindings::{sg_instance_header, sg_nodes, sg_triangles, sg_tlas_leaves, sg_instances, sg_meshes, sg_vertices, sg_indices};
 import package::texel_table::texel_fetch;
+import package::scene_features::TRAVERSAL_STACK_ENTRIES;
 
 const NO_HIT: u32 = 0xffffffffu;
 
@@ -81,10 +82,11 @@ fn sg_vertex_position(index: u32) -> vec3f {
     return sg_texel_f(sg_vertices, index, 2u, 0u).xyz;
 }
 
-// Node groups on the traversal stack (TRAVERSAL_STACK_SIZE on the Rust side). The scene is
-// refused on the CPU if TLAS depth + BLAS depth + 1 could exceed it; were it ever exceeded, the
-// push is dropped: the siblings in that group are skipped (possible missed hits, no hang).
-const SG_STACK_SIZE: u32 = 32u;
+// Node groups on the traversal stack: TRAVERSAL_STACK_ENTRIES (scene_features.rs), what the
+// scene's BVH can need (TLAS depth + BLAS depth + 1, refused on the CPU above
+// TRAVERSAL_STACK_SIZE). Were it ever exceeded, the push is dropped: the siblings in that group
+// are skipped (possible missed hits, no hang).
+const SG_STACK_SIZE: u32 = TRAVERSAL_STACK_ENTRIES;
 const SG_FLT_EPSILON: f32 = 1.1920929e-7;
 
 struct SgRay {
@@ -212,6 +214,24 @@ fn sg_intersect_node(node: SgNode, ray: SgRay, t_max: f32) -> u32 {
     return hits;
 }
 
+// The stack is read and written at constant indices only, one select per entry, so that it stays
+// in registers: an array indexed at run time goes to per-invocation scratch memory on lavapipe,
+// accessed one lane at a time (render/README.md). The cost grows with the stack's size, hence a
+// stack sized for the scene.
+fn sg_push(stack: ptr<function, array<vec2u, SG_STACK_SIZE>>, size: u32, group: vec2u) {
+    for (var i = 0u; i < SG_STACK_SIZE; i++) {
+        (*stack)[i] = select((*stack)[i], group, i == size);
+    }
+}
+
+fn sg_top(stack: ptr<function, array<vec2u, SG_STACK_SIZE>>, size: u32) -> vec2u {
+    var group = vec2u(0u);
+    for (var i = 0u; i < SG_STACK_SIZE; i++) {
+        group = select(group, (*stack)[i], i + 1u == size);
+    }
+    return group;
+}
+
 // Two-level traversal with one stack: TLAS leaves are instances; entering one saves the rest of
 // the TLAS level on the stack, notes the stack size, and continues at the BLAS root with the ray
 // in object space (t is unchanged: the direction is transformed, not normalised). When the stack
@@ -236,7 +256,7 @@ fn sg_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit:
             let child_bit = firstLeadingBit(hits_imask);
             node_group.y &= ~(1u << child_bit);
             if (node_group.y & 0xff000000u) != 0u && stack_size < SG_STACK_SIZE {
-                stack[stack_size] = node_group;
+                sg_push(&stack, stack_size, node_group);
                 stack_size += 1u;
             }
             let slot = (child_bit - 24u) ^ (ray.octant_inv4 & 0xffu);
@@ -257,11 +277,11 @@ fn sg_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit:
             let local = firstLeadingBit(primitive_group.y);
             primitive_group.y &= ~(1u << local);
             if primitive_group.y != 0u && stack_size < SG_STACK_SIZE {
-                stack[stack_size] = primitive_group;
+                sg_push(&stack, stack_size, primitive_group);
                 stack_size += 1u;
             }
             if (node_group.y & 0xff000000u) != 0u && stack_size < SG_STACK_SIZE {
-                stack[stack_size] = node_group;
+                sg_push(&stack, stack_size, node_group);
                 stack_size += 1u;
             }
             tlas_stack_size = stack_size;
@@ -291,8 +311,8 @@ fn sg_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit:
                 tlas_stack_size = NO_HIT;
                 ray = world_ray;
             }
+            node_group = sg_top(&stack, stack_size);
             stack_size -= 1u;
-            node_group = stack[stack_size];
         }
     }
     return hit;

@@ -96,15 +96,15 @@ impl PassLibrary {
     }
 
     /// The library's modules, each after those it imports: the scene's structs and its
-    /// @group(0) (generated), the scene's features (all of them; [`Self::pass`] compiles for
-    /// the scene's own), the geometry's @group(1) and traversal, sampling, BSDFs, lights,
+    /// @group(0) (generated), the geometry's modules (first the scene's features, all of them:
+    /// [`Self::pass`] compiles for the scene's own), its @group(1) and traversal, sampling, BSDFs, lights,
     /// the scene's shading helpers and the path integrator. A pass's program starts with them.
     pub fn modules() -> &'static [Module] {
         static MODULES: std::sync::OnceLock<Vec<Module>> = std::sync::OnceLock::new();
         MODULES.get_or_init(|| {
             let types = Module::generated("package::scene_types", &[CameraFrame::WGSL, Frame::WGSL, GpuMaterial::WGSL, GpuLight::WGSL]);
             let bindings = crate::texel_table::group_module("package::scene_bindings", 0, &crate::scene_bindings::GROUP, &crate::scene_bindings::TABLES, &[&types]);
-            let mut modules = vec![types, bindings, SceneFeatures::ALL.module()];
+            let mut modules = vec![types, bindings];
             modules.extend(SceneGeometry::modules());
             modules.extend([
                 crate::wgsl_file!("scene_tables.wgsl"),

@@ -185,6 +185,7 @@ impl SceneBindings {
             emitters: self.light_table.emitters > 0,
             environment: self.environment.max_element() > 0.0,
             textures: self.textured,
+            traversal_stack: SceneFeatures::stack_for(self.geometry.stack_entries()),
         }
     }
 

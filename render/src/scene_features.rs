@@ -1,6 +1,6 @@
 //! What kinds of light and surface a scene has (analytic lights, emissive triangles, a constant
-//! environment, textured materials), as the WGSL constants the library's passes are compiled
-//! with.
+//! environment, textured materials) and how deep its BVH is, as the WGSL constants the library's
+//! passes are compiled with.
 //!
 //! Why: lavapipe runs a branch that no invocation takes under an empty mask instead of jumping
 //! over it, so next-event estimation towards a kind of light the scene lacks costs a light sample
@@ -8,7 +8,13 @@
 //! texel loads per hit (render/README.md). A pass compiled with the feature's constant `false`
 //! has no such code. A GPU skips such branches anyway. No result changes: a light kind's
 //! estimator draws no random numbers when the scene has none of it.
+//!
+//! The traversal stack is sized for the scene's BVH because lavapipe keeps an array indexed at
+//! run time in per-invocation scratch memory, read and written one lane at a time. The stack is
+//! instead indexed with selects over every entry (scene_geometry.wgsl), which keeps it in
+//! registers and costs in proportion to its size.
 
+use crate::bvh::TRAVERSAL_STACK_SIZE;
 use crate::shader::Module;
 
 /// Module path of the constants: `import package::scene_features::{HAS_EMITTERS, ...}`.
@@ -24,12 +30,21 @@ pub struct SceneFeatures {
     pub environment: bool,
     /// A material with a base-colour texture.
     pub textures: bool,
+    /// Entries of the traversal stack: what the scene's BVH can need ([`Self::stack_for`]).
+    pub traversal_stack: u32,
 }
 
 impl SceneFeatures {
     /// Every feature: right for any scene. Programs are written with it; the pass library
     /// compiles its passes for the scene's own features.
-    pub const ALL: Self = Self { analytic_lights: true, emitters: true, environment: true, textures: true };
+    pub const ALL: Self = Self { analytic_lights: true, emitters: true, environment: true, textures: true, traversal_stack: TRAVERSAL_STACK_SIZE };
+
+    /// The stack for a BVH that can need `entries`: rounded up to a multiple of 4, so that a TLAS
+    /// rebuilt one level deeper or shallower seldom asks for new pipelines; at most
+    /// [`TRAVERSAL_STACK_SIZE`] (deeper scenes are refused when their BVH is built).
+    pub fn stack_for(entries: u32) -> u32 {
+        entries.next_multiple_of(4).clamp(4, TRAVERSAL_STACK_SIZE)
+    }
 
     /// The constants as a module at [`MODULE`].
     pub fn module(self) -> Module {
@@ -40,6 +55,7 @@ impl SceneFeatures {
             ("HAS_TEXTURES", self.textures),
         ]
         .map(|(name, value)| format!("const {name}: bool = {value};"));
-        Module::generated(MODULE, &[&constants.join("\n")])
+        let stack = format!("const TRAVERSAL_STACK_ENTRIES: u32 = {}u;", self.traversal_stack);
+        Module::generated(MODULE, &[&constants.join("\n"), &stack])
     }
 }

@@ -1,5 +1,6 @@
 //! Passes compiled for the features a scene has (render/src/scene_features.rs): the same images
-//! as passes compiled for every feature, and compiled again when the scene gains one.
+//! as passes compiled for every feature and the largest traversal stack, and compiled again when
+//! the scene gains a feature.
 
 mod common;
 
@@ -36,13 +37,16 @@ fn lit_open_scene() -> SceneDesc {
 #[test]
 fn passes_for_the_scene_s_lights_render_what_passes_for_every_light_do() {
     let mut tracer = PathTracer::new(gpu(), &room_scene(), settings()).expect("tracer");
-    assert_eq!(tracer.library().features(), SceneFeatures { analytic_lights: false, emitters: true, environment: false, textures: false }, "the room has only its emissive panel, and no textures");
+    let stack = SceneFeatures::stack_for(tracer.geometry().stack_entries());
+    assert!(stack < SceneFeatures::ALL.traversal_stack, "the room's BVH is shallow: {stack} entries");
+    let room = SceneFeatures { analytic_lights: false, emitters: true, environment: false, textures: false, traversal_stack: stack };
+    assert_eq!(tracer.library().features(), room, "the room has only its emissive panel, and no textures");
     let own = tracer.render(gpu(), 4, 7, 0).expect("frame");
     tracer.library().specialise(gpu(), tracer.scene(), SceneFeatures::ALL).expect("compile for every feature");
     assert_eq!(tracer.library().features(), SceneFeatures::ALL);
     let every = tracer.render(gpu(), 4, 7, 0).expect("frame");
     assert!(own.radiance.iter().any(|p| p[0] > 0.0), "the room is lit");
-    assert_eq!(own.radiance, every.radiance, "the estimators of absent lights draw no random numbers and add nothing");
+    assert_eq!(own.radiance, every.radiance, "the estimators of absent lights draw no random numbers and add nothing, and the stack holds what the BVH needs");
 }
 
 #[test]
@@ -60,7 +64,8 @@ fn a_scene_that_gains_features_gets_passes_compiled_for_them() {
     let dark = tracer.render(gpu(), 4, 7, 0).expect("frame");
 
     tracer.try_update(gpu(), &lit_open_scene()).expect("update");
-    assert_eq!(tracer.library().features(), SceneFeatures::ALL);
+    let stack = SceneFeatures::stack_for(tracer.geometry().stack_entries());
+    assert_eq!(tracer.library().features(), SceneFeatures { traversal_stack: stack, ..SceneFeatures::ALL });
     assert!(before.get() != held, "the held pipeline was swapped for one compiled with the new features");
     let updated = tracer.render(gpu(), 4, 7, 0).expect("frame");
     // A tracer built on the lit scene from the start: its passes were compiled for its features.

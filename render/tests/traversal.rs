@@ -486,6 +486,13 @@ fn empty_scene_and_bad_input() {
     let batch = RayBatch::new(&gpu, &geometry);
     assert!(!batch.trace_closest(&gpu, &geometry, &rays).unwrap()[0].is_hit());
     assert_eq!(geometry.bounds(), (Vec3::ZERO, Vec3::ZERO));
+    // The batch's stack was sized for the empty scene: it refuses a deeper BVH.
+    let deep = SceneDesc { meshes: vec![render::bvh::displaced_sphere(20_000, 1)], instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }], ..Default::default() };
+    let deep = SceneGeometry::new(&gpu, &deep).unwrap();
+    assert!(deep.stack_entries() > render::scene_features::SceneFeatures::stack_for(geometry.stack_entries()), "{} entries", deep.stack_entries());
+    let err = batch.trace_closest(&gpu, &deep, &rays).err().expect("a deeper BVH than the stack holds is refused").to_string();
+    assert!(err.contains("build a new batch"), "{err}");
+    assert!(RayBatch::new(&gpu, &deep).trace_closest(&gpu, &deep, &rays).is_ok());
 
     let mut bad = SceneDesc { meshes: vec![cube()], ..Default::default() };
     bad.meshes[0].indices.push([0, 1, 99]);

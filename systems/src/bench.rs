@@ -123,9 +123,9 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
     writeln!(md, "## BVH traversal (closest hit, {} random rays)\n", opts.rays)?;
     writeln!(
         md,
-        "| scene | triangles | instances | WGSL Mrays/s | obvhs CPU Mrays/s | WGSL / CPU | sorted: WGSL Mrays/s | sorted: CPU Mrays/s | sorted / random, WGSL | BVH2: WGSL Mrays/s | BVH2 / CWBVH, WGSL | BVH2 / CWBVH, obvhs CPU | hits | WGSL = CPU | BVH2 = CPU |"
+        "| scene | triangles | instances | stack entries | WGSL Mrays/s | obvhs CPU Mrays/s | WGSL / CPU | sorted: WGSL Mrays/s | sorted: CPU Mrays/s | sorted / random, WGSL | BVH2: WGSL Mrays/s | BVH2 / CWBVH, WGSL | BVH2 / CWBVH, obvhs CPU | hits | WGSL = CPU | BVH2 = CPU |"
     )?;
-    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
+    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
     let scenes: Vec<(String, SceneDesc)> = vec![
         ("cornell_box".into(), builtin_scene("cornell_box", (64, 36))?),
         ("hairball".into(), builtin_scene("hairball", (64, 36))?),
@@ -136,9 +136,10 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         let b = traversal_benchmark(&gpu, scene, opts.rays, 1).with_context(|| format!("traversal benchmark on {name}"))?;
         writeln!(
             md,
-            "| {name} | {} | {} | {:.3} | {:.3} | {:.2} | {:.3} | {:.3} | {:.2} | {:.3} | {:.2} | {:.2} | {:.1}% | {:.2}% | {:.2}% |",
+            "| {name} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.3} | {:.3} | {:.2} | {:.3} | {:.2} | {:.2} | {:.1}% | {:.2}% | {:.2}% |",
             b.triangles,
             b.instances,
+            b.stack_entries,
             b.gpu_rays_per_second / 1e6,
             b.cpu_rays_per_second / 1e6,
             b.gpu_rays_per_second / b.cpu_rays_per_second,

@@ -62,9 +62,14 @@ impl SceneBvh {
         }
     }
 
+    /// Entries the two-level traversal's stack can need: TLAS depth + deepest BLAS depth + 1.
+    pub fn stack_entries(&self) -> u32 {
+        self.tlas.depth + self.blas.iter().map(|b| b.depth).max().unwrap_or(0) + 1
+    }
+
     fn check_stack_depth(&self) -> Result<(), BvhError> {
         let (deepest, depth) = self.blas.iter().enumerate().map(|(i, b)| (i, b.depth)).max_by_key(|&(_, d)| d).unwrap_or((0, 0));
-        if self.tlas.depth + depth + 1 > TRAVERSAL_STACK_SIZE {
+        if self.stack_entries() > TRAVERSAL_STACK_SIZE {
             return Err(BvhError::TooDeep {
                 tlas: self.tlas.depth,
                 blas: depth,

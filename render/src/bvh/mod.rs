@@ -86,6 +86,8 @@ pub enum BvhError {
         TRAVERSAL_STACK_SIZE
     )]
     TooDeep { tlas: u32, blas: u32, mesh: String },
+    #[error("this ray batch's traversal stack holds {compiled} entries, and the geometry's BVH can need {needed} (it grew deeper): build a new batch on it")]
+    StackTooSmall { compiled: u32, needed: u32 },
     #[error("the adapter allows {limit} storage buffers per shader stage; the scene geometry alone needs {needed}")]
     StorageBuffers { needed: u32, limit: u32 },
     #[error("reading back '{what}' from the GPU failed: {reason}")]

@@ -7,6 +7,7 @@ use super::{Bvh2Geometry, BvhError, Hit, SceneGeometry};
 use crate::compute::BufferBinding;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
+use crate::scene_features::SceneFeatures;
 use crate::shader::Module;
 
 const WORKGROUP_SIZE: u32 = 64;
@@ -101,16 +102,24 @@ pub struct RayBatch {
     closest: wgpu::ComputePipeline,
     any: wgpu::ComputePipeline,
     points: wgpu::ComputePipeline,
+    /// Entries of the compiled traversal stack.
+    stack: u32,
 }
 
 /// The geometry a batch traces through: the bind groups after the batch's own @group(0).
 pub trait BatchGeometry {
     fn bind_groups(&self) -> Vec<&wgpu::BindGroup>;
+    /// Entries the CWBVH traversal stack can need ([`SceneGeometry::stack_entries`]).
+    fn stack_entries(&self) -> u32;
 }
 
 impl BatchGeometry for SceneGeometry {
     fn bind_groups(&self) -> Vec<&wgpu::BindGroup> {
         vec![self.bind_group()]
+    }
+
+    fn stack_entries(&self) -> u32 {
+        SceneGeometry::stack_entries(self)
     }
 }
 
@@ -125,6 +134,10 @@ impl BatchGeometry for Bvh2Traversal<'_> {
     fn bind_groups(&self) -> Vec<&wgpu::BindGroup> {
         vec![self.geometry.bind_group(), self.bvh2.bind_group()]
     }
+
+    fn stack_entries(&self) -> u32 {
+        self.geometry.stack_entries()
+    }
 }
 
 /// Rays uploaded once, traced any number of times.
@@ -137,28 +150,36 @@ pub struct RayBuffers {
 }
 
 impl RayBatch {
-    /// The batch of the CWBVH traversal (scene_geometry.wgsl).
+    /// The batch of the CWBVH traversal (scene_geometry.wgsl), its stack sized for `geometry`:
+    /// it traces geometry whose BVH needs no more ([`Self::dispatch`] checks).
     pub fn new(gpu: &Gpu, geometry: &SceneGeometry) -> Self {
-        Self::with_traversal(gpu, SceneGeometry::modules(), crate::wgsl_file!("ray_batch/cwbvh.wgsl"), &[geometry.bind_group_layout()])
+        Self::with_traversal(gpu, SceneGeometry::modules(), crate::wgsl_file!("ray_batch/cwbvh.wgsl"), &[geometry.bind_group_layout()], geometry.stack_entries())
     }
 
     /// The batch of the BVH2 traversal (bvh2_traversal.wgsl).
     pub fn new_bvh2(gpu: &Gpu, traversal: &Bvh2Traversal) -> Self {
         let modules = [SceneGeometry::modules(), Bvh2Geometry::modules()].concat();
-        Self::with_traversal(gpu, modules, crate::wgsl_file!("ray_batch/bvh2.wgsl"), &[traversal.geometry.bind_group_layout(), traversal.bvh2.bind_group_layout()])
+        let layouts = [traversal.geometry.bind_group_layout(), traversal.bvh2.bind_group_layout()];
+        Self::with_traversal(gpu, modules, crate::wgsl_file!("ray_batch/bvh2.wgsl"), &layouts, traversal.geometry.stack_entries())
     }
 
     /// bvh_ray_batch.wgsl's kernels with `trace` as `package::ray_batch::trace`, on the
-    /// geometry's `modules` bound at @group(1), ... (`layouts`).
-    fn with_traversal(gpu: &Gpu, modules: Vec<Module>, trace: Module, layouts: &[&wgpu::BindGroupLayout]) -> Self {
+    /// geometry's `modules` bound at @group(1), ... (`layouts`), with a CWBVH stack for
+    /// `stack_entries`. Only the stack is specialised: the kernels do not shade.
+    fn with_traversal(gpu: &Gpu, modules: Vec<Module>, trace: Module, layouts: &[&wgpu::BindGroupLayout], stack_entries: u32) -> Self {
+        let stack = SceneFeatures::stack_for(stack_entries);
+        let features = SceneFeatures { traversal_stack: stack, ..SceneFeatures::ALL };
         let layout = crate::compute::binding_layout(gpu, "ray batch", &GROUP);
         let types = Module::generated("package::ray_batch_types", &[GpuRay::WGSL, GpuHit::WGSL, GpuPoint::WGSL, BatchParams::WGSL]);
         let bindings = crate::compute::group_module("package::ray_batch_bindings", 0, &GROUP, &[&types]);
-        let program = crate::shader::Program::new(modules).with([types, bindings, trace.at("package::ray_batch::trace")]).entry(crate::wgsl_file!("bvh_ray_batch.wgsl"));
+        let program = crate::shader::Program::new(modules)
+            .with([types, bindings, trace.at("package::ray_batch::trace")])
+            .entry(crate::wgsl_file!("bvh_ray_batch.wgsl"))
+            .replacing(&features.module());
         let groups: Vec<&wgpu::BindGroupLayout> = [&layout].into_iter().chain(layouts.iter().copied()).collect();
         let [closest, any, points] = crate::compute::pipelines(gpu, "bvh_ray_batch.wgsl", &program, &groups, ["trace_closest_rays", "trace_any_rays", "surface_points"])
             .unwrap_or_else(|e| panic!("the ray batch's WGSL: {e}"));
-        Self { closest, any, points, layout }
+        Self { closest, any, points, layout, stack }
     }
 
     /// Uploads the rays (refuses more than the adapter's buffers hold).
@@ -201,6 +222,9 @@ impl RayBatch {
 
     /// Runs one kernel over all rays and waits for the GPU to finish.
     pub fn dispatch(&self, gpu: &Gpu, geometry: &impl BatchGeometry, buffers: &RayBuffers, kind: TraceKind) -> Result<(), BvhError> {
+        if geometry.stack_entries() > self.stack {
+            return Err(BvhError::StackTooSmall { compiled: self.stack, needed: geometry.stack_entries() });
+        }
         let pipeline = match kind {
             TraceKind::Closest => &self.closest,
             TraceKind::Any => &self.any,

@@ -14,6 +14,7 @@ use super::{BvhError, SceneBvh};
 use crate::compute::BufferBinding;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
+use crate::scene_features::SceneFeatures;
 use crate::shader::Module;
 use crate::scene::{Instance, SceneDesc};
 
@@ -181,12 +182,13 @@ impl SceneGeometry {
     /// The WGSL interface: its structs (`package::scene_geometry_types`), its @group(1)
     /// (`package::scene_geometry_bindings`) and `package::scene_geometry` (`trace_closest`,
     /// `trace_any`, `surface_point`, ...); a pass that imports them binds [`Self::bind_group`] at
-    /// group 1.
+    /// group 1. They start with [`SceneFeatures::ALL`]'s module, which sizes the traversal stack
+    /// for any scene; a pass replaces it with its scene's (`Program::replacing`).
     pub fn modules() -> Vec<Module> {
         let types = Self::types();
         let names: Vec<&str> = TABLES.iter().map(|t| t.0).collect();
         let bindings = crate::texel_table::group_module("package::scene_geometry_bindings", 1, &GROUP, &names, &[&types]);
-        vec![crate::texel_table::module(), types, bindings, crate::wgsl_file!("scene_geometry.wgsl")]
+        vec![SceneFeatures::ALL.module(), crate::texel_table::module(), types, bindings, crate::wgsl_file!("scene_geometry.wgsl")]
     }
 
     /// `package::scene_geometry_types`: the structs of the bind group.
@@ -195,6 +197,12 @@ impl SceneGeometry {
             "package::scene_geometry_types",
             &[SgNode::WGSL, SgTriangle::WGSL, SgTlasLeaf::WGSL, SgMesh::WGSL, SgVertex::WGSL, SgInstance::WGSL, SgInstanceHeader::WGSL],
         )
+    }
+
+    /// Entries the traversal stack can need in this scene ([`SceneBvh::stack_entries`]); a pass
+    /// compiles its stack for it ([`SceneFeatures::traversal_stack`]).
+    pub fn stack_entries(&self) -> u32 {
+        self.bvh.stack_entries()
     }
 
     /// Storage buffers in the bind group: a pass adds its own to check the per-stage limit.
