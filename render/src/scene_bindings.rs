@@ -60,6 +60,10 @@ pub struct SceneBindings {
     environment: Vec3,
     /// Some material has a base-colour texture.
     textured: bool,
+    /// The most traversal-stack entries the scene's BVH has needed so far: the stack never
+    /// shrinks within a run, so that a TLAS whose depth moves up and down under animation costs
+    /// a compilation only when it grows past its deepest.
+    traversal_stack: u32,
 }
 
 impl SceneBindings {
@@ -87,6 +91,7 @@ impl SceneBindings {
         });
         let layout = crate::texel_table::group_layout(gpu, "scene", &GROUP, TABLES.len());
         let bind_group = bind_group(gpu, &layout, &frame_buffer, &texels, &materials, &lights);
+        let geometry_stack = geometry.stack_entries();
         Ok(Self {
             settings,
             geometry,
@@ -101,6 +106,7 @@ impl SceneBindings {
             previous_camera: scene.camera,
             environment: scene.environment,
             textured: textured(&materials_cpu),
+            traversal_stack: geometry_stack,
         })
     }
 
@@ -112,6 +118,7 @@ impl SceneBindings {
         let materials = (changes.materials || changes.geometry).then(|| pack_materials(scene)).transpose()?;
         let light_table = (changes.lights || changes.instances || changes.materials || changes.geometry).then(|| build_light_table(scene)).transpose()?;
         self.geometry.try_update_instances(gpu, &scene.instances)?;
+        self.traversal_stack = self.traversal_stack.max(self.geometry.stack_entries());
         let mut rebind = false;
         let mut uploads: Vec<(&mut wgpu::Buffer, &str, &[u8])> = Vec::new();
         if let Some((materials, texels)) = &materials {
@@ -185,7 +192,7 @@ impl SceneBindings {
             emitters: self.light_table.emitters > 0,
             environment: self.environment.max_element() > 0.0,
             textures: self.textured,
-            traversal_stack: SceneFeatures::stack_for(self.geometry.stack_entries()),
+            traversal_stack: SceneFeatures::stack_for(self.traversal_stack),
         }
     }
 

@@ -39,11 +39,11 @@ impl SceneFeatures {
     /// compiles its passes for the scene's own features.
     pub const ALL: Self = Self { analytic_lights: true, emitters: true, environment: true, textures: true, traversal_stack: TRAVERSAL_STACK_SIZE };
 
-    /// The stack for a BVH that can need `entries`: rounded up to a multiple of 4, so that a TLAS
-    /// rebuilt one level deeper or shallower seldom asks for new pipelines; at most
-    /// [`TRAVERSAL_STACK_SIZE`] (deeper scenes are refused when their BVH is built).
+    /// The stack for a BVH that can need `entries`: exactly that (each entry costs a select per
+    /// push and per pop), at most [`TRAVERSAL_STACK_SIZE`] (deeper scenes are refused when their
+    /// BVH is built).
     pub fn stack_for(entries: u32) -> u32 {
-        entries.next_multiple_of(4).clamp(4, TRAVERSAL_STACK_SIZE)
+        entries.clamp(1, TRAVERSAL_STACK_SIZE)
     }
 
     /// The constants as a module at [`MODULE`].

@@ -5,11 +5,11 @@
 mod common;
 
 use common::{H, W, gpu, room_scene};
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use render::compute::BufferBinding;
 use render::scene_features::SceneFeatures;
 use render::path_tracer::{PathTracer, PathTracerSettings};
-use render::scene::{Light, SceneDesc, Texture};
+use render::scene::{Instance, Light, SceneDesc, Texture};
 use render::taa::Taa;
 
 fn settings() -> PathTracerSettings {
@@ -72,4 +72,19 @@ fn a_scene_that_gains_features_gets_passes_compiled_for_them() {
     let fresh = PathTracer::new(gpu(), &lit_open_scene(), settings()).expect("tracer").render(gpu(), 4, 7, 0).expect("frame");
     assert_eq!(updated.radiance, fresh.radiance, "after the update the passes sample the environment and the point light, and read the texture");
     assert!(updated.radiance != dark.radiance);
+}
+
+#[test]
+fn the_traversal_stack_never_shrinks_within_a_run() {
+    // 64 boxes in a row: a TLAS some levels deep; then the room's three instances.
+    let mut crowd = room_scene();
+    crowd.instances = (0..64).map(|i| Instance { mesh: 1, material: 1, transform: Mat4::from_translation(Vec3::new(i as f32 * 3.0, 0.0, -4.0)) }).collect();
+    let mut tracer = PathTracer::new(gpu(), &crowd, settings()).expect("tracer");
+    let deep = tracer.geometry().stack_entries();
+    assert_eq!(tracer.library().features().traversal_stack, SceneFeatures::stack_for(deep));
+    tracer.try_update(gpu(), &room_scene()).expect("update");
+    assert!(tracer.geometry().stack_entries() < deep, "fewer instances, a shallower TLAS: {} against {deep}", tracer.geometry().stack_entries());
+    assert_eq!(tracer.library().features().traversal_stack, SceneFeatures::stack_for(deep), "kept: a TLAS that deepens again needs no new pipelines");
+    let frame = tracer.render(gpu(), 1, 7, 0).expect("frame");
+    assert!(frame.radiance.iter().any(|p| p[0] > 0.0));
 }
