@@ -1,7 +1,8 @@
 //! The shading library every method's passes are built on: its WGSL modules (scene geometry,
 //! sampling, BSDFs, lights, the scene's @group(0) and the path integrator, without entry points) and the
 //! run's cache of compiled passes, so that methods with equal passes share their pipelines,
-//! each compiled for the features the scene has ([`SceneFeatures`]: kinds of light, textures).
+//! each compiled for the features the scene has ([`SceneFeatures`]: kinds of light, textures,
+//! the traversal stack its BVH needs).
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
@@ -76,7 +77,8 @@ impl PassLibrary {
 
     /// Compiles every pass built so far for `features` (or takes an earlier compilation) and
     /// swaps the pipelines the methods hold; later passes are built for `features`. Call when
-    /// the scene's features change; a no-op otherwise.
+    /// the scene's features change; a no-op otherwise. Every pass is compiled before any is
+    /// swapped, so a failed compilation leaves all of them as they were.
     pub fn specialise(&self, gpu: &Gpu, scene: &SceneBindings, features: SceneFeatures) -> Result<(), RenderError> {
         let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
         if state.features == features {
@@ -87,6 +89,8 @@ impl PassLibrary {
                 let compiled = (pass.compile)(gpu, scene, features)?;
                 pass.variants.insert(features, compiled);
             }
+        }
+        for pass in state.passes.values() {
             for (held, new) in pass.pipelines.iter().zip(&pass.variants[&features]) {
                 *held.0.lock().unwrap_or_else(|e| e.into_inner()) = new.clone();
             }
@@ -126,6 +130,17 @@ impl PassLibrary {
         program
     }
 
+    /// Refuses a pass whose own group `own`, with the library's groups, binds more storage
+    /// buffers than the adapter allows per stage.
+    pub fn check_storage_buffers(gpu: &Gpu, pass: &str, own: &[BufferBinding]) -> Result<(), RenderError> {
+        let needed = LIBRARY_STORAGE_BUFFERS + compute::storage_buffers(own);
+        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
+        if needed > limit {
+            return Err(crate::gpu::GpuError::OverLimit { what: format!("storage buffers of pass '{pass}'"), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
+        }
+        Ok(())
+    }
+
     /// The layout of a pass's own @group(2) and the pipelines of `entries` in `program` (a
     /// [`Self::program`] whose own modules include `compute::group_module(.., 2, own, ..)`, so a
     /// pass states its buffers once), compiled for the library's scene features. Refuses a pass
@@ -139,11 +154,7 @@ impl PassLibrary {
         own: &[BufferBinding],
         entries: [&str; N],
     ) -> Result<(wgpu::BindGroupLayout, [LibraryPipeline; N]), RenderError> {
-        let needed = LIBRARY_STORAGE_BUFFERS + compute::storage_buffers(own);
-        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
-        if needed > limit {
-            return Err(crate::gpu::GpuError::OverLimit { what: format!("storage buffers of pass '{pass}'"), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
-        }
+        Self::check_storage_buffers(gpu, pass, own)?;
         // Methods of one run share the pipelines of equal passes (three sample caches, two hash
         // caches): fewer compiled shaders, and on llvmpipe a working set that stays inside its
         // shader-variant cache, whose evictions cost seconds of recompilation per frame.

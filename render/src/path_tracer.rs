@@ -130,17 +130,8 @@ impl PathTracer {
             return Err(RenderError::Settings("max_depth must be at least 1 (1 = direct lighting)".into()));
         }
         gpu.check_resolution(settings.width, settings.height, BYTES_PER_PIXEL)?;
-        let needed = LIBRARY_STORAGE_BUFFERS + compute::storage_buffers(&OWN_GROUP);
-        let limit = gpu.limits.max_storage_buffers_per_shader_stage;
-        if needed > limit {
-            return Err(crate::gpu::GpuError::OverLimit {
-                what: "storage buffers of the path tracer pass".into(),
-                requested: needed as u64,
-                limit: limit as u64,
-                adapter: gpu.summary.name.clone(),
-            }
-            .into());
-        }
+        // Before the scene is uploaded; `PassLibrary::pass` checks again when it builds the pass.
+        PassLibrary::check_storage_buffers(gpu, "path_tracer.wgsl", &OWN_GROUP)?;
         // No workgroup memory is declared (var<workgroup>): nothing to check against the budget.
         gpu.check_workgroup_memory("path_trace", 0)?;
 

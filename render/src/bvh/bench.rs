@@ -22,7 +22,7 @@ pub struct TraversalBench {
     pub triangles: u64,
     pub instances: u32,
     /// Entries of the WGSL traversal's stack, sized for the scene's BVH
-    /// ([`crate::scene_features::SceneFeatures::stack_for`]).
+    /// ([`RayBatch::stack_entries`]).
     pub stack_entries: u32,
     pub rays: u32,
     /// Building every BLAS and the TLAS on the CPU, plus the upload.
@@ -139,7 +139,7 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
         adapter: gpu.summary.name.clone(),
         triangles: scene.instances.iter().map(|i| scene.meshes[i.mesh as usize].indices.len() as u64).sum(),
         instances: scene.instances.len() as u32,
-        stack_entries: crate::scene_features::SceneFeatures::stack_for(geometry.stack_entries()),
+        stack_entries: batch.stack_entries(),
         rays,
         build_seconds,
         gpu_rays_per_second,

@@ -182,6 +182,11 @@ impl RayBatch {
         Self { closest, any, points, layout, stack }
     }
 
+    /// Entries of the traversal stack the batch was compiled with.
+    pub fn stack_entries(&self) -> u32 {
+        self.stack
+    }
+
     /// Uploads the rays (refuses more than the adapter's buffers hold).
     pub fn upload(&self, gpu: &Gpu, rays: &[RayQuery]) -> Result<RayBuffers, BvhError> {
         let count = rays.len() as u32;
