@@ -232,84 +232,100 @@ fn sg_top(stack: ptr<function, array<vec2u, SG_STACK_SIZE>>, size: u32) -> vec2u
     return group;
 }
 
-// Two-level traversal with one stack: TLAS leaves are instances; entering one saves the rest of
-// the TLAS level on the stack, notes the stack size, and continues at the BLAS root with the ray
-// in object space (t is unchanged: the direction is transformed, not normalised). When the stack
-// falls back to that size the BLAS is done and the world ray is restored.
+// The next node group and primitive group of a trip (Ylitie et al., Algorithm 1): the nearest
+// inner child of `node_group` is intersected and the rest of the group pushed; a group without
+// inner children is a primitive group.
+struct SgTrip { node_group: vec2u, primitive_group: vec2u }
+
+fn sg_trip(
+    stack: ptr<function, array<vec2u, SG_STACK_SIZE>>,
+    stack_size: ptr<function, u32>,
+    group: vec2u,
+    ray: SgRay,
+    t_max: f32,
+) -> SgTrip {
+    var node_group = group;
+    if (node_group.y & 0xff000000u) != 0u {
+        let hits_imask = node_group.y;
+        let child_bit = firstLeadingBit(hits_imask);
+        node_group.y &= ~(1u << child_bit);
+        if (node_group.y & 0xff000000u) != 0u && *stack_size < SG_STACK_SIZE {
+            sg_push(stack, *stack_size, node_group);
+            *stack_size += 1u;
+        }
+        let slot = (child_bit - 24u) ^ (ray.octant_inv4 & 0xffu);
+        let node_index = node_group.x + countOneBits(hits_imask & ~(0xffffffffu << slot));
+        let node = sg_node(node_index);
+        let hitmask = sg_intersect_node(node, ray, t_max);
+        return SgTrip(vec2u(node.child_base, (hitmask & 0xff000000u) | (node.exponents_imask >> 24u)), vec2u(node.primitive_base, hitmask & 0x00ffffffu));
+    }
+    // Only primitive groups are pushed without inner-child bits.
+    return SgTrip(vec2u(0u), node_group);
+}
+
+// Two-level traversal, one loop per level: TLAS leaves are instances, and entering one runs the
+// BLAS loop to its end (the ray in object space; t is unchanged: the direction is transformed,
+// not normalised) before the TLAS loop's next trip. lavapipe runs every statement of a loop's
+// body on every trip, under a mask when no invocation needs it (render/README.md), so the
+// instance entry lives in the TLAS loop, which few trips reach, and not in the BLAS loop, where
+// it would cost every node visit. Both loops share one stack: the BLAS pushes above the TLAS's
+// entries and stops when it falls back to them. The visiting order is that of a single loop:
+// the leaf group's other instances are pushed before entering one, and the TLAS's node group is
+// taken up after the BLAS.
 fn sg_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit: bool) -> Hit {
     var hit = Hit(t_max, NO_HIT, NO_HIT, vec2f(0.0));
     if sg_instance_header.tlas_node_count == 0u || !(t_max > 0.0) {
         return hit;
     }
     let world_ray = sg_make_ray(world_origin, world_direction);
-    var ray = world_ray;
     var stack: array<vec2u, SG_STACK_SIZE>;
     var stack_size = 0u;
-    var tlas_stack_size = NO_HIT; // NO_HIT while traversing the TLAS
-    var instance = NO_HIT;
     // A group: x = base index, y = hit bits (24-31 inner children, 0-23 primitives) | imask (0-7).
     var node_group = vec2u(sg_instance_header.tlas_root, 0x80000000u);
     loop {
-        var primitive_group = vec2u(0u);
-        if (node_group.y & 0xff000000u) != 0u {
-            let hits_imask = node_group.y;
-            let child_bit = firstLeadingBit(hits_imask);
-            node_group.y &= ~(1u << child_bit);
-            if (node_group.y & 0xff000000u) != 0u && stack_size < SG_STACK_SIZE {
-                sg_push(&stack, stack_size, node_group);
+        let trip = sg_trip(&stack, &stack_size, node_group, world_ray, hit.t);
+        node_group = trip.node_group;
+        var instances = trip.primitive_group;
+        var blas_group = vec2u(0u);
+        var ray = world_ray;
+        var instance = NO_HIT;
+        if instances.y != 0u {
+            let local = firstLeadingBit(instances.y);
+            instances.y &= ~(1u << local);
+            if instances.y != 0u && stack_size < SG_STACK_SIZE {
+                sg_push(&stack, stack_size, instances);
                 stack_size += 1u;
             }
-            let slot = (child_bit - 24u) ^ (ray.octant_inv4 & 0xffu);
-            let node_index = node_group.x + countOneBits(hits_imask & ~(0xffffffffu << slot));
-            let node = sg_node(node_index);
-            let hitmask = sg_intersect_node(node, ray, hit.t);
-            node_group = vec2u(node.child_base, (hitmask & 0xff000000u) | (node.exponents_imask >> 24u));
-            primitive_group = vec2u(node.primitive_base, hitmask & 0x00ffffffu);
-        } else {
-            // Only primitive groups are pushed without inner-child bits.
-            primitive_group = node_group;
-            node_group = vec2u(0u);
-        }
-        // A TLAS leaf is an instance: enter it, saving the rest of the group and the node group.
-        // Outside the triangle loop, so that this code runs once per trip: lavapipe executes a
-        // branch no invocation takes all the same (render/README.md).
-        if tlas_stack_size == NO_HIT && primitive_group.y != 0u {
-            let local = firstLeadingBit(primitive_group.y);
-            primitive_group.y &= ~(1u << local);
-            if primitive_group.y != 0u && stack_size < SG_STACK_SIZE {
-                sg_push(&stack, stack_size, primitive_group);
-                stack_size += 1u;
-            }
-            if (node_group.y & 0xff000000u) != 0u && stack_size < SG_STACK_SIZE {
-                sg_push(&stack, stack_size, node_group);
-                stack_size += 1u;
-            }
-            tlas_stack_size = stack_size;
-            let leaf = sg_tlas_leaf(primitive_group.x + local);
+            let leaf = sg_tlas_leaf(instances.x + local);
             instance = leaf.instance;
             ray = sg_make_ray((leaf.world_to_object * vec4f(world_origin, 1.0)).xyz, (leaf.world_to_object * vec4f(world_direction, 0.0)).xyz);
-            node_group = vec2u(leaf.blas_root, select(0u, 0x80000000u, leaf.blas_nodes != 0u));
-            primitive_group.y = 0u;
+            blas_group = vec2u(leaf.blas_root, select(0u, 0x80000000u, leaf.blas_nodes != 0u));
         }
-        while primitive_group.y != 0u {
-            let local = firstLeadingBit(primitive_group.y);
-            primitive_group.y &= ~(1u << local);
-            let tri = sg_triangle(primitive_group.x + local);
-            let r = sg_intersect_triangle(ray, tri.v0, tri.v1, tri.v2, hit.t);
-            if r.w > 0.0 {
-                hit = Hit(r.x, instance, tri.primitive, r.yz);
-                if any_hit {
-                    return hit;
+        let tlas_stack_size = stack_size;
+        while (blas_group.y & 0xff000000u) != 0u {
+            let blas_trip = sg_trip(&stack, &stack_size, blas_group, ray, hit.t);
+            blas_group = blas_trip.node_group;
+            var triangles = blas_trip.primitive_group;
+            while triangles.y != 0u {
+                let local = firstLeadingBit(triangles.y);
+                triangles.y &= ~(1u << local);
+                let tri = sg_triangle(triangles.x + local);
+                let r = sg_intersect_triangle(ray, tri.v0, tri.v1, tri.v2, hit.t);
+                if r.w > 0.0 {
+                    hit = Hit(r.x, instance, tri.primitive, r.yz);
+                    if any_hit {
+                        return hit;
+                    }
                 }
+            }
+            if (blas_group.y & 0xff000000u) == 0u && stack_size > tlas_stack_size {
+                blas_group = sg_top(&stack, stack_size);
+                stack_size -= 1u;
             }
         }
         if (node_group.y & 0xff000000u) == 0u {
             if stack_size == 0u {
                 break;
-            }
-            if stack_size == tlas_stack_size {
-                tlas_stack_size = NO_HIT;
-                ray = world_ray;
             }
             node_group = sg_top(&stack, stack_size);
             stack_size -= 1u;
