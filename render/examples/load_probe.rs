@@ -1,6 +1,7 @@
-//! How fast one invocation's data-dependent 16-byte load is, from a storage buffer and from an
-//! `rgba32uint` texture (textureLoad), on the adapter at hand. Each invocation chases a chain of
-//! loads whose next address depends on the last value, as BVH traversal does. A third variant
+//! How fast one invocation's data-dependent 16-byte load is, from a storage buffer, from a sampled
+//! `rgba32uint` texture and from the same texture bound as a read-only storage texture (both read
+//! with textureLoad; texel tables are the latter), on the adapter at hand. Each invocation chases
+//! a chain of loads whose next address depends on the last value, as BVH traversal does. A fourth variant
 //! adds a branch that almost no invocation takes: on lavapipe its body still costs (a divergent
 //! branch is run under a mask, not jumped over), which is why work for a few lanes is not free.
 //! `cargo run -p render --example load_probe`
@@ -15,6 +16,9 @@ const SHADER: &str = r#"
 @group(0) @binding(0) var<storage, read> buf: array<vec4u>;
 @group(0) @binding(1) var tex: texture_2d<u32>;
 @group(0) @binding(2) var<storage, read_write> out: array<u32>;
+#ifdef STORAGE_TEXTURE
+@group(0) @binding(3) var stex: texture_storage_2d<rgba32uint, read>;
+#endif
 
 fn hash(x: u32) -> u32 {
     var h = x * 0x9e3779b1u;
@@ -23,9 +27,13 @@ fn hash(x: u32) -> u32 {
 }
 
 fn fetch(i: u32) -> vec4u {
+#ifdef STORAGE_TEXTURE
+    return textureLoad(stex, vec2u(i & WMASK, i >> WLOG2));
+#endif
 #ifdef TEXTURE
     return textureLoad(tex, vec2u(i & WMASK, i >> WLOG2), 0);
-#else
+#endif
+#ifdef BUFFER
     return buf[i];
 #endif
 }
@@ -50,7 +58,7 @@ fn main(@builtin(global_invocation_id) id: vec3u) {
 }
 "#;
 
-fn source(texture: bool, rare: bool) -> String {
+fn source(kind: Kind, rare: bool) -> String {
     let body = SHADER
         .replace("WMASK", &format!("{}u", (1u32 << WIDTH_LOG2) - 1))
         .replace("MASK", &format!("{}u", (1u32 << TEXELS_LOG2) - 1))
@@ -62,7 +70,15 @@ fn source(texture: bool, rare: bool) -> String {
     for line in body.lines() {
         let t = line.trim();
         if t == "#ifdef TEXTURE" {
-            state = if texture { 1 } else { 2 };
+            state = if kind == Kind::Texture { 1 } else { 2 };
+            continue;
+        }
+        if t == "#ifdef STORAGE_TEXTURE" {
+            state = if kind == Kind::StorageTexture { 1 } else { 2 };
+            continue;
+        }
+        if t == "#ifdef BUFFER" {
+            state = if kind == Kind::Buffer { 1 } else { 2 };
             continue;
         }
         if t == "#ifdef RARE" {
@@ -85,6 +101,13 @@ fn source(texture: bool, rare: bool) -> String {
     out
 }
 
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Buffer,
+    Texture,
+    StorageTexture,
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let gpu = render::gpu::Gpu::new()?;
     println!("adapter: {}", gpu.summary);
@@ -105,8 +128,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = device.create_buffer(&wgpu::BufferDescriptor { label: Some("probe out"), size: 4 * INVOCATIONS as u64, usage: wgpu::BufferUsages::STORAGE, mapped_at_creation: false });
     let table = render::texel_table::TexelTable::new(&gpu, "probe texture", 1, bytes, 0)?;
     let view = table.view();
-    for (texture, rare) in [(false, false), (true, false), (true, true), (false, false), (true, false), (true, true)] {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("probe"), source: wgpu::ShaderSource::Wgsl(source(texture, rare).into()) });
+    // The same texels in a texture that is read as a read-only storage texture.
+    let storage_texture = device.create_texture_with_data(
+        &gpu.queue,
+        &wgpu::TextureDescriptor {
+            label: Some("probe storage texture"),
+            size: wgpu::Extent3d { width: 1 << WIDTH_LOG2, height: 1 << (TEXELS_LOG2 - WIDTH_LOG2), depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Uint,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytes,
+    );
+    let storage_view = storage_texture.create_view(&Default::default());
+    use Kind::*;
+    for (kind, rare) in [(Buffer, false), (Texture, false), (StorageTexture, false), (Texture, true), (Buffer, false), (Texture, false), (StorageTexture, false), (Texture, true)] {
+        let texture = kind == Texture;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("probe"), source: wgpu::ShaderSource::Wgsl(source(kind, rare).into()) });
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("probe"),
             layout: None,
@@ -122,6 +164,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         if texture {
             entries.push(wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(view) });
+        } else if kind == StorageTexture {
+            entries.push(wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&storage_view) });
         } else {
             entries.push(wgpu::BindGroupEntry { binding: 0, resource: buf.as_entire_binding() });
         }
@@ -141,10 +185,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             best = best.min(start.elapsed().as_secs_f64());
         }
         let loads = (INVOCATIONS * CHAIN) as f64;
-        let what = match (texture, rare) {
-            (false, _) => "storage vec4u",
-            (true, false) => "texture rgba32uint",
-            (true, true) => "texture rgba32uint, and a branch taken by 1 in 1024 invocations that loads 16 words from storage",
+        let what = match (kind, rare) {
+            (Buffer, _) => "storage vec4u",
+            (StorageTexture, _) => "read-only storage texture rgba32uint",
+            (Texture, false) => "texture rgba32uint",
+            (Texture, true) => "texture rgba32uint, and a branch taken by 1 in 1024 invocations that loads 16 words from storage",
         };
         println!("{what}: {:.1} M loads/s of 16 bytes (best of 4)", loads / best / 1e6);
     }

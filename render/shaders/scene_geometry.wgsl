@@ -52,7 +52,7 @@ fn sg_tlas_leaf(slot: u32) -> SgTlasLeaf {
     return SgTlasLeaf(m, e.x, e.y, e.z, e.w);
 }
 
-fn sg_texel_f(table: texture_2d<u32>, record: u32, texels: u32, j: u32) -> vec4f {
+fn sg_texel_f(table: texture_storage_2d<rgba32uint, read>, record: u32, texels: u32, j: u32) -> vec4f {
     return bitcast<vec4f>(texel_fetch(table, record, texels, j));
 }
 

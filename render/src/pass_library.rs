@@ -23,6 +23,9 @@ use crate::shader::{Module, Program};
 /// @group(1) (geometry). Add the pass's own to check the adapter limit.
 pub const LIBRARY_STORAGE_BUFFERS: u32 = crate::scene_bindings::STORAGE_BUFFERS + SceneGeometry::STORAGE_BUFFERS;
 
+/// Texel tables (read-only storage textures) of the same two groups.
+pub const LIBRARY_TEXEL_TABLES: u32 = crate::scene_bindings::TABLES.len() as u32 + SceneGeometry::TEXEL_TABLES;
+
 /// A pipeline of the library, compiled for the features the scene has now. Fetch it with
 /// [`Self::get`] each time a pass is recorded: [`PassLibrary::specialise`] replaces it when the
 /// scene gains or loses a feature.
@@ -131,12 +134,16 @@ impl PassLibrary {
     }
 
     /// Refuses a pass whose own group `own`, with the library's groups, binds more storage
-    /// buffers than the adapter allows per stage.
-    pub fn check_storage_buffers(gpu: &Gpu, pass: &str, own: &[BufferBinding]) -> Result<(), RenderError> {
+    /// buffers, or the library more storage textures, than the adapter allows per stage.
+    pub fn check_storage_bindings(gpu: &Gpu, pass: &str, own: &[BufferBinding]) -> Result<(), RenderError> {
         let needed = LIBRARY_STORAGE_BUFFERS + compute::storage_buffers(own);
         let limit = gpu.limits.max_storage_buffers_per_shader_stage;
         if needed > limit {
             return Err(crate::gpu::GpuError::OverLimit { what: format!("storage buffers of pass '{pass}'"), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
+        }
+        let limit = gpu.limits.max_storage_textures_per_shader_stage;
+        if LIBRARY_TEXEL_TABLES > limit {
+            return Err(crate::gpu::GpuError::OverLimit { what: format!("storage textures (texel tables) of pass '{pass}'"), requested: LIBRARY_TEXEL_TABLES as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
         }
         Ok(())
     }
@@ -144,7 +151,7 @@ impl PassLibrary {
     /// The layout of a pass's own @group(2) and the pipelines of `entries` in `program` (a
     /// [`Self::program`] whose own modules include `compute::group_module(.., 2, own, ..)`, so a
     /// pass states its buffers once), compiled for the library's scene features. Refuses a pass
-    /// with more storage buffers than the adapter binds. Equal passes are compiled once per run.
+    /// with more storage buffers or textures than the adapter binds. Equal passes are compiled once per run.
     pub fn pass<const N: usize>(
         &self,
         gpu: &Gpu,
@@ -154,7 +161,7 @@ impl PassLibrary {
         own: &[BufferBinding],
         entries: [&str; N],
     ) -> Result<(wgpu::BindGroupLayout, [LibraryPipeline; N]), RenderError> {
-        Self::check_storage_buffers(gpu, pass, own)?;
+        Self::check_storage_bindings(gpu, pass, own)?;
         // Methods of one run share the pipelines of equal passes (three sample caches, two hash
         // caches): fewer compiled shaders, and on llvmpipe a working set that stays inside its
         // shader-variant cache, whose evictions cost seconds of recompilation per frame.

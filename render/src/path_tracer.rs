@@ -131,7 +131,7 @@ impl PathTracer {
         }
         gpu.check_resolution(settings.width, settings.height, BYTES_PER_PIXEL)?;
         // Before the scene is uploaded; `PassLibrary::pass` checks again when it builds the pass.
-        PassLibrary::check_storage_buffers(gpu, "path_tracer.wgsl", &OWN_GROUP)?;
+        PassLibrary::check_storage_bindings(gpu, "path_tracer.wgsl", &OWN_GROUP)?;
         // No workgroup memory is declared (var<workgroup>): nothing to check against the budget.
         gpu.check_workgroup_memory("path_trace", 0)?;
 

@@ -1,12 +1,15 @@
-//! Fixed-size records in an `rgba32uint` texture, read in WGSL with `textureLoad`.
+//! Fixed-size records in an `rgba32uint` texture, bound as a read-only storage texture and read
+//! in WGSL with `textureLoad`.
 //!
 //! Why a texture and not a storage buffer: on Mesa 22.3's lavapipe (what CI runs) a storage load
 //! at a per-invocation address is a loop over the 8 SIMD lanes for every 32-bit word, while a
-//! texel fetch is gathered. `cargo run -p render --example load_probe` measures a chain of
-//! dependent 16-byte loads at 4-5x the storage rate through a texture (render/README.md). BVH
-//! nodes and triangles are read-only during a frame and fetched at data-dependent addresses on
-//! every traversal step, which is the case this helps; on GPUs a texel fetch is as fast as a
-//! buffer load (texture-bound BVHs are the classic layout, Aila & Laine 2009).
+//! texel load is gathered. Why a read-only storage texture and not a sampled one: lavapipe
+//! fetches a sampled texel through an out-of-line function that looks up every lane's mip level,
+//! and reads a storage texel inline. `cargo run -p render --example load_probe` measures chains of
+//! dependent 16-byte loads all three ways (render/README.md). BVH nodes and triangles are
+//! read-only during a frame and fetched at data-dependent addresses on every traversal step,
+//! which is the case this helps; on GPUs a texel load is as fast as a buffer load
+//! (texture-bound BVHs are the classic layout, Aila & Laine 2009).
 //!
 //! Layout: record `i` is texels `(TEXELS * (i % RECORDS_PER_ROW) + j, i / RECORDS_PER_ROW)`,
 //! `j < TEXELS`, so a record never spans two rows and a row-aligned range can be rewritten alone.
@@ -58,7 +61,7 @@ impl TexelTable {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format: wgpu::TextureFormat::Rgba32Uint,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
@@ -113,7 +116,7 @@ impl TexelTable {
         wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Uint, view_dimension: wgpu::TextureViewDimension::D2, multisampled: false },
+            ty: wgpu::BindingType::StorageTexture { access: wgpu::StorageTextureAccess::ReadOnly, format: wgpu::TextureFormat::Rgba32Uint, view_dimension: wgpu::TextureViewDimension::D2 },
             count: None,
         }
     }
@@ -131,9 +134,9 @@ pub fn module() -> Module {
         "package::texel_table",
         &[&format!(
             "const RECORDS_PER_ROW_LOG2: u32 = {RECORDS_PER_ROW_LOG2}u;\n\
-             fn texel_fetch(table: texture_2d<u32>, record: u32, texels: u32, j: u32) -> vec4u {{\n\
+             fn texel_fetch(table: texture_storage_2d<rgba32uint, read>, record: u32, texels: u32, j: u32) -> vec4u {{\n\
              \x20   let row_mask = (1u << RECORDS_PER_ROW_LOG2) - 1u;\n\
-             \x20   return textureLoad(table, vec2u(texels * (record & row_mask) + j, record >> RECORDS_PER_ROW_LOG2), 0);\n\
+             \x20   return textureLoad(table, vec2u(texels * (record & row_mask) + j, record >> RECORDS_PER_ROW_LOG2));\n\
              }}\n"
         )],
     )
@@ -145,7 +148,7 @@ pub fn module() -> Module {
 /// [`crate::compute::group_module`] of `buffers`, with the texel tables `tables` declared after them.
 pub fn group_module(path: &str, group: u32, buffers: &[BufferBinding], tables: &[&str], types: &[&Module]) -> Module {
     let mut module = crate::compute::group_module(path, group, buffers, types);
-    let declarations: String = tables.iter().enumerate().map(|(i, name)| format!("@group({group}) @binding({}) var {name}: texture_2d<u32>;\n", buffers.len() + i)).collect();
+    let declarations: String = tables.iter().enumerate().map(|(i, name)| format!("@group({group}) @binding({}) var {name}: texture_storage_2d<rgba32uint, read>;\n", buffers.len() + i)).collect();
     module.source = format!("{}{declarations}", module.source).into();
     module
 }

@@ -208,6 +208,9 @@ impl SceneGeometry {
     /// Storage buffers in the bind group: a pass adds its own to check the per-stage limit.
     pub const STORAGE_BUFFERS: u32 = STORAGE_BUFFERS;
 
+    /// Texel tables (read-only storage textures) in the bind group.
+    pub const TEXEL_TABLES: u32 = TABLES.len() as u32;
+
     /// Builds every BLAS and the TLAS and uploads them.
     pub fn new(gpu: &Gpu, scene: &SceneDesc) -> Result<Self, BvhError> {
         let limit = gpu.limits.max_storage_buffers_per_shader_stage;
