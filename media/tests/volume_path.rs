@@ -30,7 +30,7 @@ use media::{DensityGrid, DensityKind, Medium};
 use render::frame::CameraBasis;
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
-use render::scene::{Camera, Instance, Light, Material, Mesh, SceneDesc};
+use render::scene::{Camera, Instance, Light, Material, Mesh, SceneDesc, Texture};
 
 const W: u32 = 32;
 const H: u32 = 18;
@@ -397,4 +397,31 @@ fn two_media_in_one_box_render_as_the_medium_of_their_summed_extinction() {
             assert!(z.abs() <= 4.5, "{what}, {mis:?}: z over three seeds {z}");
         }
     }
+}
+
+/// The pass is compiled for the scene's features (render/src/scene_features.rs), so when the
+/// tracer's scene gains one (here a texture on the ground, which a pass compiled without
+/// textures would not read) the pass must be compiled again: after the update it renders what a
+/// pass built on the updated scene renders.
+#[test]
+fn the_pass_follows_the_scene_s_features() {
+    let (scene, cloud) = cloud_scene();
+    let settings = PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 2 };
+    let mut tracer = PathTracer::new(gpu(), &scene, settings).expect("path tracer");
+    let pass = VolumePathPass::new(gpu(), &tracer, &cloud).expect("volume path pass compiles");
+    assert!(!pass.features().textures, "the cloud scene has no textures");
+    let before = render_spp(&tracer, &pass, &cloud, VolumePathSettings::default(), 4, 3);
+
+    let mut lit = scene.clone();
+    lit.textures.push(Texture { name: "dark".into(), width: 1, height: 1, rgba8: vec![40, 40, 40, 255] });
+    lit.materials[0].base_color_texture = Some(0);
+    tracer.try_update(gpu(), &lit).expect("update");
+    let after = render_spp(&tracer, &pass, &cloud, VolumePathSettings::default(), 4, 3);
+    assert!(pass.features().textures, "compiled again for the texture");
+
+    let fresh_tracer = PathTracer::new(gpu(), &lit, settings).expect("path tracer");
+    let fresh = VolumePathPass::new(gpu(), &fresh_tracer, &cloud).expect("volume path pass compiles");
+    let expected = render_spp(&fresh_tracer, &fresh, &cloud, VolumePathSettings::default(), 4, 3);
+    assert_eq!(after.mean, expected.mean);
+    assert!(after.mean != before.mean, "the texture darkens the ground");
 }

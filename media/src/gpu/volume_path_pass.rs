@@ -4,6 +4,8 @@
 //! per-sample radiance, 3 the media (`GpuMedium`). A scene without media never builds this
 //! pass: the path tracer and its shaders are unchanged.
 
+use std::sync::Mutex;
+
 use glam::Vec3;
 use render::compute::{BufferBinding, binding_layout, buffer_group, pipelines};
 use render::error::RenderError;
@@ -11,6 +13,7 @@ use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::pass_library::PassLibrary;
 use render::path_tracer::PathTracer;
+use render::scene_features::SceneFeatures;
 use render::readback::read_buffer;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming, merge};
@@ -123,7 +126,11 @@ pub const VOLUME_PATH_PASS: &str = "volume_path";
 
 pub struct VolumePathPass {
     layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::ComputePipeline,
+    /// The pipeline and the scene features it was compiled for: compiled again when the tracer's
+    /// scene has others (a light kind gained or lost, a deeper BVH), as the library's passes are
+    /// (`PassLibrary::specialise`; this pass binds a fourth group, which the library's passes do
+    /// not, so it holds its own).
+    pipeline: Mutex<(SceneFeatures, wgpu::ComputePipeline)>,
     timer: PassTimer,
 }
 
@@ -146,10 +153,31 @@ impl VolumePathPass {
 
     pub fn new(gpu: &Gpu, tracer: &PathTracer, medium: &GpuMedium) -> Result<Self, RenderError> {
         let layout = binding_layout(gpu, "media volume path", &BINDINGS);
-        let program = Self::program();
+        let features = tracer.scene().features();
+        let pipeline = Self::compile(gpu, tracer, &layout, medium, features)?;
+        Ok(Self { layout, pipeline: Mutex::new((features, pipeline)), timer: PassTimer::new(gpu, &[VOLUME_PATH_PASS]) })
+    }
+
+    fn compile(gpu: &Gpu, tracer: &PathTracer, layout: &wgpu::BindGroupLayout, medium: &GpuMedium, features: SceneFeatures) -> Result<wgpu::ComputePipeline, RenderError> {
+        let program = Self::program().replacing(&features.module());
         let scene = tracer.scene();
-        let [pipeline] = pipelines(gpu, "media volume path", &program, &[scene.layout(), scene.geometry().bind_group_layout(), &layout, &medium.layout], ["volume_path"])?;
-        Ok(Self { layout, pipeline, timer: PassTimer::new(gpu, &[VOLUME_PATH_PASS]) })
+        let [pipeline] = pipelines(gpu, "media volume path", &program, &[scene.layout(), scene.geometry().bind_group_layout(), layout, &medium.layout], ["volume_path"])?;
+        Ok(pipeline)
+    }
+
+    /// The pipeline for the tracer's scene as it is now.
+    fn pipeline(&self, gpu: &Gpu, tracer: &PathTracer, medium: &GpuMedium) -> Result<wgpu::ComputePipeline, RenderError> {
+        let features = tracer.scene().features();
+        let mut held = self.pipeline.lock().unwrap_or_else(|e| e.into_inner());
+        if held.0 != features {
+            *held = (features, Self::compile(gpu, tracer, &self.layout, medium, features)?);
+        }
+        Ok(held.1.clone())
+    }
+
+    /// The scene features the pipeline was last compiled for.
+    pub fn features(&self) -> SceneFeatures {
+        self.pipeline.lock().unwrap_or_else(|e| e.into_inner()).0
     }
 
     /// `spp` paths per pixel of the tracer's current scene and camera (seed and frame as the path
@@ -175,6 +203,7 @@ impl VolumePathPass {
         let mut lum = vec![(0f64, 0f64); pixels as usize];
         let mut first = 0;
         let mut timings = Vec::new();
+        let pipeline = self.pipeline(gpu, tracer, medium).map_err(|e| e.to_string())?;
         while first < spp {
             let n = batch.min(spp - first);
             let params = VolumePathParams {
@@ -193,7 +222,7 @@ impl VolumePathPass {
             let mut timed = self.timer.begin(gpu, VOLUME_PATH_PASS);
             timed
                 .pass(0, |pass| {
-                    pass.set_pipeline(&self.pipeline);
+                    pass.set_pipeline(&pipeline);
                     pass.set_bind_group(0, tracer.scene().bind_group(), &[]);
                     pass.set_bind_group(1, tracer.scene().geometry().bind_group(), &[]);
                     pass.set_bind_group(2, &group, &[]);
