@@ -83,8 +83,7 @@ fn sg_vertex_position(index: u32) -> vec3f {
 }
 
 // Node groups on the traversal stack: TRAVERSAL_STACK_ENTRIES (scene_features.rs), what the
-// scene's BVH can need (TLAS depth + BLAS depth + 1, refused on the CPU above
-// TRAVERSAL_STACK_SIZE). Were it ever exceeded, the push is dropped: the siblings in that group
+// scene's BVH can need (src/bvh/stack_need.rs; refused on the CPU above TRAVERSAL_STACK_SIZE). Were it ever exceeded, the push is dropped: the siblings in that group
 // are skipped (possible missed hits, no hang).
 const SG_STACK_SIZE: u32 = TRAVERSAL_STACK_ENTRIES;
 const SG_FLT_EPSILON: f32 = 1.1920929e-7;

@@ -17,6 +17,8 @@ pub struct Blas {
     pub bounds: Aabb,
     /// Node levels from the root to the deepest node (0 without triangles).
     pub depth: u32,
+    /// Traversal stack entries its traversal can hold (`stack_need.rs`).
+    pub stack_need: u32,
 }
 
 impl Blas {
@@ -25,12 +27,13 @@ impl Blas {
     pub fn build(index: usize, mesh: &Mesh) -> Result<Self, BvhError> {
         let tris = mesh_triangles(index, mesh)?;
         if tris.is_empty() {
-            return Ok(Self { bvh: CwBvh::default(), triangles: Vec::new(), bounds: Aabb::empty(), depth: 0 });
+            return Ok(Self { bvh: CwBvh::default(), triangles: Vec::new(), bounds: Aabb::empty(), depth: 0, stack_need: 0 });
         }
         let bvh = build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
         let triangles = leaf_order(&bvh.primitive_indices, &tris);
         let depth = cwbvh_depth(&bvh);
-        Ok(Self { bounds: bvh.total_aabb, bvh, triangles, depth })
+        let stack_need = super::stack_need::blas_stack_need(&bvh);
+        Ok(Self { bounds: bvh.total_aabb, bvh, triangles, depth, stack_need })
     }
 }
 

@@ -85,7 +85,7 @@ impl SceneBvh2 {
         if let Some((i, b)) = deepest
             && tlas_depth + b.depth > BVH2_STACK_SIZE
         {
-            return Err(BvhError::TooDeep { tlas: tlas_depth, blas: b.depth, mesh: scene.meshes[i].name.clone() });
+            return Err(BvhError::TooDeep { needed: tlas_depth + b.depth, limit: BVH2_STACK_SIZE, tlas: tlas_depth, blas: b.depth, mesh: scene.meshes[i].name.clone() });
         }
         // The GPU layout stores a TLAS leaf's instance in place of its first primitive slot.
         assert!(tlas.nodes.iter().all(|n| !n.is_leaf() || n.prim_count == 1), "a BVH2 TLAS leaf with more than one instance");

@@ -62,15 +62,19 @@ impl SceneBvh {
         }
     }
 
-    /// Entries the two-level traversal's stack can need: TLAS depth + deepest BLAS depth + 1.
+    /// Entries the two-level traversal's stack can hold (`stack_need.rs`): the TLAS's, with the
+    /// neediest BLAS's on top wherever an instance is entered.
     pub fn stack_entries(&self) -> u32 {
-        self.tlas.depth + self.blas.iter().map(|b| b.depth).max().unwrap_or(0) + 1
+        super::stack_need::tlas_stack_need(&self.tlas.bvh, self.blas.iter().map(|b| b.stack_need).max().unwrap_or(0))
     }
 
     fn check_stack_depth(&self) -> Result<(), BvhError> {
         let (deepest, depth) = self.blas.iter().enumerate().map(|(i, b)| (i, b.depth)).max_by_key(|&(_, d)| d).unwrap_or((0, 0));
-        if self.stack_entries() > TRAVERSAL_STACK_SIZE {
+        let needed = self.stack_entries();
+        if needed > TRAVERSAL_STACK_SIZE {
             return Err(BvhError::TooDeep {
+                needed,
+                limit: TRAVERSAL_STACK_SIZE,
                 tlas: self.tlas.depth,
                 blas: depth,
                 mesh: self.mesh_names.get(deepest).cloned().unwrap_or_default(),
@@ -163,4 +167,116 @@ pub(super) fn instance_transforms(instances: &[Instance], mesh_count: usize) -> 
 /// test) and its reciprocal (sign bit) agree, as they do in the WGSL.
 pub(super) fn obvhs_ray(origin: Vec3, direction: Vec3, t_max: f32) -> Ray {
     Ray::new(Vec3A::from(origin), Vec3A::from(direction + Vec3::ZERO), 0.0, t_max)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Mat4, Quat};
+    use obvhs::cwbvh::CwBvh;
+
+    use super::*;
+    use crate::bvh::{SplitMix64, displaced_sphere, random_rays};
+    use crate::scene::{Material, Mesh};
+
+    /// The WGSL's (7 - octant) in every byte.
+    fn octant_inv4(d: Vec3) -> u32 {
+        (if d.x < 0.0 { 0 } else { 0x0404_0404 }) | (if d.y < 0.0 { 0 } else { 0x0202_0202 }) | (if d.z < 0.0 { 0 } else { 0x0101_0101 })
+    }
+
+    /// One trip of `sg_trip`: the nearest inner child of `group` is intersected (the rest of the
+    /// group pushed), or a group without inner children is returned as the primitive group.
+    fn trip(bvh: &CwBvh, stack: &mut Vec<(u32, u32)>, deepest: &mut usize, group: (u32, u32), ray: &Ray, oct: u32) -> ((u32, u32), (u32, u32)) {
+        let (base, mut bits) = group;
+        if bits & 0xff00_0000 == 0 {
+            return ((0, 0), group);
+        }
+        let hits_imask = bits;
+        let child_bit = 31 - bits.leading_zeros();
+        bits &= !(1 << child_bit);
+        if bits & 0xff00_0000 != 0 {
+            stack.push((base, bits));
+            *deepest = (*deepest).max(stack.len());
+        }
+        let slot = (child_bit - 24) ^ (oct & 0xff);
+        let node = &bvh.nodes[(base + (hits_imask & !(u32::MAX << slot)).count_ones()) as usize];
+        let hitmask = node.intersect_ray(ray, oct);
+        ((node.child_base_idx, (hitmask & 0xff00_0000) | u32::from(node.imask)), (node.primitive_base_idx, hitmask & 0x00ff_ffff))
+    }
+
+    /// The most entries `sg_traverse`'s stack holds for this ray, replayed on the CPU without
+    /// shortening the ray at hits (which only prunes).
+    fn deepest_stack(bvh: &SceneBvh, origin: Vec3, direction: Vec3) -> usize {
+        let (mut stack, mut deepest) = (Vec::new(), 0);
+        let (world, oct) = (obvhs_ray(origin, direction, 1e30), octant_inv4(direction));
+        let mut node_group = (0u32, 0x8000_0000u32);
+        if bvh.tlas.bvh.nodes.is_empty() {
+            return 0;
+        }
+        loop {
+            let (next, mut instances) = trip(&bvh.tlas.bvh, &mut stack, &mut deepest, node_group, &world, oct);
+            node_group = next;
+            if instances.1 != 0 {
+                let local = 31 - instances.1.leading_zeros();
+                instances.1 &= !(1 << local);
+                if instances.1 != 0 {
+                    stack.push(instances);
+                    deepest = deepest.max(stack.len());
+                }
+                let instance = bvh.tlas.bvh.primitive_indices[(instances.0 + local) as usize];
+                let (blas, o, d) = bvh.object_ray(instance, origin, direction);
+                let (ray, blas_oct) = (obvhs_ray(o, d, 1e30), octant_inv4(d));
+                let tlas_entries = stack.len();
+                let mut group = (0u32, if blas.bvh.nodes.is_empty() { 0 } else { 0x8000_0000u32 });
+                while group.1 & 0xff00_0000 != 0 {
+                    group = trip(&blas.bvh, &mut stack, &mut deepest, group, &ray, blas_oct).0;
+                    if group.1 & 0xff00_0000 == 0 && stack.len() > tlas_entries {
+                        group = stack.pop().unwrap_or_default();
+                    }
+                }
+            }
+            if node_group.1 & 0xff00_0000 == 0 {
+                match stack.pop() {
+                    Some(group) => node_group = group,
+                    None => return deepest,
+                }
+            }
+        }
+    }
+
+    fn scene(meshes: Vec<Mesh>, instances: Vec<Instance>) -> SceneDesc {
+        SceneDesc { meshes, materials: vec![Material::default()], instances, ..Default::default() }
+    }
+
+    #[test]
+    fn the_stack_bound_holds_what_the_traversal_pushes() {
+        let mut rng = SplitMix64::new(9);
+        // A deep BLAS over a floor; then hundreds of small instances, so that the TLAS is a few
+        // levels deep and its leaf groups hold several instances each.
+        let sphere = scene(vec![displaced_sphere(20_000, 1), Mesh::plane(4.0)], vec![
+            Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY },
+            Instance { mesh: 1, material: 0, transform: Mat4::from_translation(Vec3::new(0.0, -1.2, 0.0)) },
+        ]);
+        let crowd = scene(
+            vec![displaced_sphere(300, 2), Mesh::plane(0.5)],
+            (0..600)
+                .map(|i| Instance {
+                    mesh: i % 2,
+                    material: 0,
+                    transform: Mat4::from_scale_rotation_translation(
+                        Vec3::splat(rng.range(0.05, 0.4)),
+                        Quat::from_axis_angle(rng.unit_vector(), rng.range(0.0, 6.0)),
+                        Vec3::new(rng.range(-5.0, 5.0), rng.range(-5.0, 5.0), rng.range(-5.0, 5.0)),
+                    ),
+                })
+                .collect(),
+        );
+        for (name, desc) in [("sphere and floor", sphere), ("600 instances", crowd)] {
+            let bvh = SceneBvh::new(&desc).expect("bvh");
+            let bound = bvh.stack_entries() as usize;
+            let deepest = random_rays(bvh.bounds(), 20_000, 1e30, 3).iter().map(|r| deepest_stack(&bvh, r.origin, r.direction)).max().unwrap_or(0);
+            eprintln!("{name}: TLAS depth {}, bound {bound}, deepest replayed stack {deepest}", bvh.tlas.depth);
+            assert!(deepest <= bound, "{name}: a ray's traversal held {deepest} entries, the bound is {bound}");
+            assert!(deepest > 0, "{name}: the rays push groups");
+        }
+    }
 }

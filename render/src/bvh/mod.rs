@@ -22,6 +22,7 @@ mod cpu_traversal;
 mod ray_batch;
 pub mod ray_order;
 mod scene_geometry;
+mod stack_need;
 mod tlas;
 mod triangle;
 
@@ -40,9 +41,9 @@ pub use triangle::{WatertightRay, intersect_triangle};
 use crate::gpu::GpuError;
 use glam::Vec2;
 
-/// Entries of the WGSL traversal stack (`SG_STACK_SIZE` in scene_geometry.wgsl). A two-level
-/// traversal needs at most `tlas depth + blas depth + 1` entries; [`SceneBvh`] refuses scenes
-/// that could need more, so the shader's overflow guard never drops a node group.
+/// Entries of the WGSL traversal stack at most (`SG_STACK_SIZE` in scene_geometry.wgsl). A scene
+/// needs [`SceneBvh::stack_entries`] (stack_need.rs); [`SceneBvh`] refuses scenes that could need
+/// more, so the shader's overflow guard never drops a node group.
 pub const TRAVERSAL_STACK_SIZE: u32 = 32;
 
 /// Marks "no instance" / "no primitive" in a [`Hit`], as `NO_HIT` does in WGSL.
@@ -81,11 +82,8 @@ pub enum BvhError {
     InstanceMesh { instance: usize, mesh: u32, meshes: usize },
     #[error("instance {instance} has a non-invertible or non-finite transform {transform}")]
     InstanceTransform { instance: usize, transform: String },
-    #[error(
-        "BVH too deep for the GPU traversal stack: TLAS depth {tlas} + deepest BLAS depth {blas} (mesh '{mesh}') + 1 > {} entries",
-        TRAVERSAL_STACK_SIZE
-    )]
-    TooDeep { tlas: u32, blas: u32, mesh: String },
+    #[error("BVH too deep for the GPU traversal stack: it can need {needed} entries (TLAS depth {tlas}, deepest BLAS depth {blas} in mesh '{mesh}'), more than the {limit} the stack holds")]
+    TooDeep { needed: u32, limit: u32, tlas: u32, blas: u32, mesh: String },
     #[error("this ray batch's traversal stack holds {compiled} entries, and the geometry's BVH can need {needed} (it grew deeper): build a new batch on it")]
     StackTooSmall { compiled: u32, needed: u32 },
     #[error("the adapter allows {limit} storage buffers per shader stage; the scene geometry alone needs {needed}")]
