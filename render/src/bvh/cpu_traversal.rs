@@ -62,10 +62,10 @@ impl SceneBvh {
         }
     }
 
-    /// Entries the two-level traversal's stack can hold (`stack_need.rs`): the TLAS's, with the
-    /// neediest BLAS's on top wherever an instance is entered.
+    /// Entries the two-level traversal's stack can hold ([`Tlas::stack_need`], computed when the
+    /// TLAS is built).
     pub fn stack_entries(&self) -> u32 {
-        super::stack_need::tlas_stack_need(&self.tlas.bvh, self.blas.iter().map(|b| b.stack_need).max().unwrap_or(0))
+        self.tlas.stack_need
     }
 
     fn check_stack_depth(&self) -> Result<(), BvhError> {

@@ -47,6 +47,9 @@ pub struct Tlas {
     /// World bounds of all instances with geometry (empty when there are none).
     pub bounds: Aabb,
     pub depth: u32,
+    /// Traversal stack entries the two-level traversal can hold (`stack_need.rs`): the TLAS's,
+    /// with the neediest BLAS's on top wherever an instance is entered.
+    pub stack_need: u32,
 }
 
 impl Tlas {
@@ -63,7 +66,7 @@ impl Tlas {
             boxes.push(world_bounds(&inst.object_to_world, &b.bounds));
         }
         if boxes.is_empty() {
-            return Self { bvh: CwBvh::default(), bounds: Aabb::empty(), depth: 0 };
+            return Self { bvh: CwBvh::default(), bounds: Aabb::empty(), depth: 0, stack_need: 0 };
         }
         let mut bvh = build_cwbvh(&boxes, BvhBuildParams::fast_build(), &mut Duration::default());
         for p in &mut bvh.primitive_indices {
@@ -71,7 +74,8 @@ impl Tlas {
         }
         let bounds = boxes.iter().fold(Aabb::empty(), |acc, b| acc.union(b));
         let depth = cwbvh_depth(&bvh);
-        Self { bvh, bounds, depth }
+        let stack_need = super::stack_need::tlas_stack_need(&bvh, blas.iter().map(|b| b.stack_need).max().unwrap_or(0));
+        Self { bvh, bounds, depth, stack_need }
     }
 }
 
