@@ -1,6 +1,7 @@
 //! Throughput of the GPU cache at width 64 on this adapter, every MLP form:
 //! `cargo run --release -p nirc --example nirc_bench [batch] [queries] [reps]`
-//! (`flicker bench --nirc` runs the default form and writes JSON).
+//! (`flicker bench --nirc` runs the default form and writes JSON). With `FLICKER_NIRC_MLP` set,
+//! only that form runs.
 
 use nirc::NircConfig;
 use nirc::gpu::shaders::WeightPlacement;
@@ -12,7 +13,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let reps = args.get(2).copied().unwrap_or(3);
     let gpu = render::gpu::Gpu::new()?;
     let config = NircConfig::default();
-    for placement in [WeightPlacement::Registers, WeightPlacement::Tiled, WeightPlacement::Storage] {
+    let forms = match WeightPlacement::from_env()? {
+        Some(one) => vec![one],
+        None => vec![WeightPlacement::Registers, WeightPlacement::Tiled, WeightPlacement::Storage],
+    };
+    for placement in forms {
         let r = nirc::bench::run(&gpu, &config, Some(placement), batch, queries, reps)?;
         println!("{}", serde_json::to_string_pretty(&r)?);
     }

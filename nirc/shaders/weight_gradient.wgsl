@@ -4,7 +4,7 @@
 // Deterministic, and the CPU reference sums in the same order.
 
 import package::nirc::types::{Call};
-import package::nirc::config::{ACT_FLOATS, CHUNK, HIDDEN, MLP_PARAMS, SCRATCH_STRIDE};
+import package::nirc::config::{ACT_FLOATS, CHUNK, HIDDEN, MLP_PARAMS, MLP_WEIGHTS, SCRATCH_STRIDE};
 import package::nirc::mlp_layout::{act_base, delta_base, mat_cols, mat_offset};
 
 @group(0) @binding(0) var<uniform> call: Call;
@@ -36,7 +36,9 @@ fn partial_sums(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
         let d = ACT_FLOATS + delta_base(k) + i;
         let a = act_base(k) + j;
         var s = 0.0;
-        for (var r = r0; r < r1; r++) {
+        // The quad padding after the last matrix (layout.rs) has no gradient.
+        let r_end = select(r0, r1, w < MLP_WEIGHTS);
+        for (var r = r0; r < r_end; r++) {
             let b = r * SCRATCH_STRIDE;
             s += scratch[b + d] * scratch[b + a];
         }

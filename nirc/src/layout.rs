@@ -1,6 +1,7 @@
 //! Where every parameter lives in the one flat parameter vector shared by the CPU reference and
 //! the GPU: MLP matrices first (row-major [out][in], layer by layer), then the hash-grid tables
-//! level by level (entry-major, F features per entry).
+//! level by level (entry-major, F features per entry). Both regions end on a multiple of 4
+//! parameters (zero padding), so that no quad of parameters straddles them.
 
 use crate::config::NircConfig;
 
@@ -34,7 +35,9 @@ pub struct ParameterLayout {
     pub hidden_layers: u32,
     /// hidden_layers + 1 matrices: input->width, (width->width)*, width->3.
     pub matrices: Vec<Matrix>,
+    /// The MLP matrices' parameters, rounded up to a multiple of 4 (where the grid starts).
     pub mlp_params: u32,
+    /// Every parameter, rounded up to a multiple of 4.
     pub total_params: u32,
 }
 
@@ -55,6 +58,10 @@ impl ParameterLayout {
             matrices.push(Matrix { rows, cols, offset });
             offset += rows * cols;
         }
+        // The MLP region and the whole vector are rounded up to whole quads (unused, zero
+        // parameters): the Adam and EMA passes read four parameters per load, and a quad must
+        // not straddle the MLP and the grid, whose gradients live in different buffers.
+        offset = offset.next_multiple_of(4);
         let mlp_params = offset;
         let max_table = 1u64 << e.log2_table_size;
         let mut levels = Vec::new();
@@ -76,10 +83,21 @@ impl ParameterLayout {
             hidden_layers: hidden,
             matrices,
             mlp_params,
-            total_params: offset,
+            total_params: offset.next_multiple_of(4),
         }
     }
 
+    /// The MLP matrices' weights, without the quad padding after them.
+    pub fn mlp_weights(&self) -> u32 {
+        self.matrices.iter().map(|m| m.rows * m.cols).sum()
+    }
+
+    /// Parameters of the hash-grid tables, without the quad padding at the end.
+    pub fn grid_table_params(&self) -> u32 {
+        self.levels.iter().map(|l| l.table_size * self.features_per_level).sum()
+    }
+
+    /// Parameters after the MLP region: the grid tables and the quad padding.
     pub fn grid_params(&self) -> u32 {
         self.total_params - self.mlp_params
     }

@@ -66,7 +66,9 @@ impl CacheState {
             let scale = (6.0 / (m.rows + m.cols) as f32).sqrt();
             params.extend((0..m.rows * m.cols).map(|_| rng.symmetric(scale)));
         }
-        params.extend((0..layout.grid_params()).map(|_| rng.symmetric(config.encoding.init_scale)));
+        params.resize(layout.mlp_params as usize, 0.0);
+        params.extend((0..layout.grid_table_params()).map(|_| rng.symmetric(config.encoding.init_scale)));
+        params.resize(layout.total_params as usize, 0.0);
         let n = params.len();
         Ok(Self {
             config: config.clone(),

@@ -283,6 +283,8 @@ fn other_encodings_widths_and_loss_normalisation_match_cpu() {
     let variants = [
         (DirectionEncoding::Identity, LossNormalization::Luminance, NetworkConfig { width: 32, hidden_layers: 1 }),
         (DirectionEncoding::None, LossNormalization::PerChannel, NetworkConfig { width: 16, hidden_layers: 3 }),
+        // An odd width: the MLP's weights end inside a quad, so the layout pads before the grid.
+        (DirectionEncoding::Identity, LossNormalization::PerChannel, NetworkConfig { width: 5, hidden_layers: 1 }),
     ];
     for (direction, normalization, network) in variants {
         let mut config = small_config();
@@ -298,6 +300,16 @@ fn other_encodings_widths_and_loss_normalisation_match_cpu() {
         cache.train_records(gpu(), &batch).unwrap();
         let got = cache.download_state(gpu()).unwrap();
         let what = format!("{direction:?} {normalization:?} {network:?}");
+        let layout = state.layout();
+        if network.width == 5 {
+            assert_ne!(layout.mlp_weights() % 4, 0, "{what}: the case must leave a gap before the grid");
+        }
+        // The quad padding (after the matrices, after the grid tables) stays zero.
+        let grid_end = (layout.mlp_params + layout.grid_table_params()) as usize;
+        let padding = (layout.mlp_weights() as usize..layout.mlp_params as usize).chain(grid_end..layout.total_params as usize);
+        for i in padding {
+            assert_eq!((got.params[i], got.ema[i], got.adam_m[i]), (0.0, 0.0, 0.0), "{what}: padding parameter {i}");
+        }
         let lr = config.optimizer.learning_rate;
         assert_vec_close(&format!("{what} params"), &got.params, &cpu.state.params, 1e-5, 1e-3 * lr);
         assert_vec_close(&format!("{what} adam m"), &got.adam_m, &cpu.state.adam_m, 1e-3, 1e-9);

@@ -231,12 +231,12 @@ impl NeuralCache {
         let config = state.config.clone();
         config.validate()?;
         let layout = ParameterLayout::new(&config);
-        let wg_bytes = shaders::workgroup_bytes(&layout);
         let tiled = || -> Result<(), NircError> {
             if let Some(why) = shaders::tiled_unsupported(&layout) {
                 return Err(NircError::Config(format!("the tiled MLP cannot run this network: {why}")));
             }
-            Ok(gpu.check_workgroup_memory("nirc tiled MLP (tiles in workgroup memory)", wg_bytes)?)
+            // Only a network the tiles take has a tile shape (a width of 5 has none).
+            Ok(gpu.check_workgroup_memory("nirc tiled MLP (tiles in workgroup memory)", shaders::workgroup_bytes(&layout))?)
         };
         // The register form trains with the tiled pass, so it also needs `tiled`.
         let registers = || -> Result<(), NircError> {
@@ -496,7 +496,7 @@ impl NeuralCache {
     /// gradients, the Adam step (name, pipeline, bind group, workgroups).
     fn adam_stages<'a>(&'a self, s: &'a TrainStep) -> Vec<Stage<'a>> {
         let p = &self.pipelines;
-        let all = groups_for(self.layout.total_params as u64);
+        let all = groups_for(self.layout.total_params as u64 / 4);
         let mut stages: Vec<Stage> = vec![
             ("train (forward, backward)", &p.train, &s.fb, s.n.div_ceil(WORKGROUP_SIZE)),
             ("reliability accumulate", &p.reliability_accumulate, &s.accumulate, groups_for(s.n as u64)),
@@ -512,7 +512,7 @@ impl NeuralCache {
 
     /// The `nirc::ema` part: the debiased EMA of every parameter.
     fn ema_stages<'a>(&'a self, s: &'a TrainStep) -> Vec<Stage<'a>> {
-        vec![("ema update (every parameter)", &self.pipelines.ema_update, &s.ema, groups_for(self.layout.total_params as u64))]
+        vec![("ema update (every parameter)", &self.pipelines.ema_update, &s.ema, groups_for(self.layout.total_params as u64 / 4))]
     }
 
     /// The `nirc::reliability_update` part: the per-sample moment walk (not for the batch-mean

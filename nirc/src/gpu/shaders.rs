@@ -111,6 +111,7 @@ fn config_constants(config: &NircConfig, layout: &ParameterLayout) -> String {
     c("DIR_KIND", dir_kind);
     c("DIR_BANDS", dir_bands);
     c("MLP_PARAMS", layout.mlp_params);
+    c("MLP_WEIGHTS", layout.mlp_weights());
     c("TOTAL_PARAMS", layout.total_params);
     c("ACT_FLOATS", layout.activation_floats());
     c("DELTA_FLOATS", layout.delta_floats());
