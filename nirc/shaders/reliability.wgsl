@@ -8,7 +8,8 @@ import package::nirc::bindings_common::{normalize_to_bounds, spatial_hash};
 // Per cell: [M^y, Q^y, M^f_cur, Q^f_cur, C_cur, M^f_ema, Q^f_ema, C_ema] x RGB.
 const MOMENTS_PER_CELL: u32 = 24u;
 // Per cell accumulator: 24 fixed-point sums of 3 words (per batch) or 24 staged moments (per
-// sample), the owner (~ its first sample's index, per sample), then the sample count.
+// sample), the head of the cell's list of samples (index + 1, per sample), then the sample
+// count.
 const ACCUM_PER_CELL: u32 = 73u;
 const ACCUM_OWNER: u32 = 71u;
 const ACCUM_COUNT: u32 = 72u;

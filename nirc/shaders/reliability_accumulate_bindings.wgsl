@@ -8,4 +8,5 @@ import package::nirc::types::{Call, CountersAtomic, Hyper, ReliabilitySample};
 @group(0) @binding(2) var<storage, read> samples: array<ReliabilitySample>;
 @group(0) @binding(3) var<storage, read_write> accum: array<atomic<u32>>;
 @group(0) @binding(4) var<storage, read_write> counters: CountersAtomic;
-@group(0) @binding(5) var<storage, read_write> sample_cells: array<u32>;
+// Per sample: its cell, and the next link of the cell's list (reliability_walk.wgsl).
+@group(0) @binding(5) var<storage, read_write> sample_cells: array<vec2<u32>>;

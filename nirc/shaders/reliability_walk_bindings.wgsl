@@ -8,4 +8,4 @@ import package::nirc::types::{Call, Hyper, ReliabilitySample};
 @group(0) @binding(2) var<storage, read> samples: array<ReliabilitySample>;
 @group(0) @binding(3) var<storage, read_write> accum: array<u32>;
 @group(0) @binding(4) var<storage, read> moments: array<f32>;
-@group(0) @binding(5) var<storage, read> sample_cells: array<u32>;
+@group(0) @binding(5) var<storage, read> sample_cells: array<vec2<u32>>;

@@ -370,7 +370,7 @@ impl NeuralCache {
             scratch: storage(gpu, "nirc training scratch", max_batch * (layout.activation_floats() + layout.delta_floats()) as u64 * 4)?,
             grid_accum: storage(gpu, "nirc hash-grid gradient sums", layout.grid_params() as u64 * 12)?,
             samples: storage(gpu, "nirc reliability samples", max_batch * std::mem::size_of::<ReliabilitySample>() as u64)?,
-            sample_cells: storage(gpu, "nirc reliability sample cells", max_batch * 4)?,
+            sample_cells: storage(gpu, "nirc reliability sample cells and links", max_batch * 8)?,
             losses: storage(gpu, "nirc losses", max_batch * 4)?,
             reliability_accum: storage(gpu, "nirc reliability sums", cell_count(&config.reliability) as u64 * ACCUM_PER_CELL * 4)?,
             moments: storage_init(gpu, "nirc reliability moments", bytemuck::cast_slice(&state.reliability))?,
