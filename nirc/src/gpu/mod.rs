@@ -4,12 +4,13 @@
 //! A training step is one submission of these passes (nirc/shaders/):
 //! 1. train_forward_backward  per record: both forwards, loss, backward; hash-grid gradients as
 //!                            exact fixed-point sums; reliability samples (y, f_cur, f_ema)
-//! 2. reliability_accumulate  per sample: its reliability cell, the cell's count and owner (per
-//!                            sample) or fixed-point sums (per batch)
+//! 2. reliability_accumulate  per sample: its reliability cell, the cell's count and list of
+//!                            samples (per sample) or fixed-point sums (per batch)
 //! 3. weight_gradient         per weight and chunk of records, then over chunks (no atomics)
 //! 4. adam_ema check, apply   Adam; any non-finite value raises a flag and nothing is written
 //!    adam_ema ema_update     debiased EMA of the new weights (skipped on a flagged step)
-//! 5. reliability_walk        per cell (its owner): the per-sample EMAs of the moments in order
+//! 5. reliability_walk        per cell (its list's head): the per-sample EMAs of the moments in
+//!                            record order
 //!    reliability_update      per cell: keep the new moments (or the batch-mean step)
 //! 6. finish_step             commit the counters, or count the rolled-back step
 //! Every sum has a fixed order or is exact, so a step is deterministic.
