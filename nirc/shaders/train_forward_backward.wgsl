@@ -5,7 +5,7 @@
 
 import package::nirc::types::{ReliabilitySample};
 import package::nirc::config::{ACT_FLOATS, DELTA_FLOATS, FEATURES, LEVELS, MLP_PARAMS, SCRATCH_STRIDE};
-import package::nirc::bindings::{call, counters, hyper, losses, records, samples, scratch};
+import package::nirc::bindings::{call, counters, hyper, losses, records, samples, scratch_set};
 import package::nirc::bindings_common::{is_finite, normalize_to_bounds};
 import package::nirc::fixed_sum::{fixed_add};
 import package::nirc::loss::{relative_l2};
@@ -41,10 +41,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
     mlp_backward(d_out);
     let base = r * SCRATCH_STRIDE;
     for (var i = 0u; i < ACT_FLOATS; i++) {
-        scratch[base + i] = acts[i];
+        scratch_set(base + i, acts[i]);
     }
     for (var i = 0u; i < DELTA_FLOATS; i++) {
-        scratch[base + ACT_FLOATS + i] = deltas[i];
+        scratch_set(base + ACT_FLOATS + i, deltas[i]);
     }
 
     let p = normalize_to_bounds(hyper, pos);

@@ -1,6 +1,7 @@
 // What the tiled training keeps for the backward pass (mlp_tile.wgsl's `keep_activation` hook):
 // the High-LR predictor's activations and pre-activation gradients in each record's `scratch`
-// slot. `tile_first` is the tile's first record (set by train_tile.wgsl).
+// slot, a quad at a time (the offsets, o0 and the counts kept are multiples of 4 in the networks
+// the tiles take). `tile_first` is the tile's first record (set by train_tile.wgsl).
 
 import package::nirc::config::{SCRATCH_STRIDE, WIDTH};
 import package::nirc::bindings::{call, scratch};
@@ -22,10 +23,10 @@ fn record_valid(rq: u32, c: u32) -> bool {
 fn keep_block(offset: u32, rq: u32, o0: u32, block: Block, count: u32) {
     for (var c = 0u; c < 4u; c++) {
         if record_valid(rq, c) {
-            let b = record_slot(rq, c) + offset + o0;
-            for (var j = 0u; j < OPT; j++) {
+            let b = (record_slot(rq, c) + offset + o0) / 4u;
+            for (var j = 0u; j < OPT; j += 4u) {
                 if o0 + j < count {
-                    scratch[b + j] = block[j][c];
+                    scratch[b + j / 4u] = vec4<f32>(block[j][c], block[j + 1u][c], block[j + 2u][c], block[j + 3u][c]);
                 }
             }
         }

@@ -7,8 +7,8 @@
 // pre-activation gradients go through `scratch` (record-major, as the per-record pass).
 
 import package::nirc::types::{ReliabilitySample};
-import package::nirc::config::{ACT_FLOATS, DIR_DIMS, FEATURES, HIDDEN, IN_DIMS, LEVELS, MLP_PARAMS, SCRATCH_STRIDE, WG_SIZE, WIDTH};
-import package::nirc::bindings::{call, counters, hyper, losses, records, samples, scratch};
+import package::nirc::config::{ACT_FLOATS, DIR_DIMS, FEATURES, HIDDEN, IN_DIMS, IN_STRIDE, LEVELS, MLP_PARAMS, SCRATCH_STRIDE, WG_SIZE, WIDTH};
+import package::nirc::bindings::{call, counters, hyper, losses, records, samples, scratch, scratch_set};
 import package::nirc::tile::{Block, OPT, RQ, TILE, tile_a, tile_matmul, tile_w};
 import package::nirc::bindings_common::{is_finite, normalize_to_bounds};
 import package::nirc::mlp_layout::{act_base, delta_base, mat_cols, mat_offset, mat_rows};
@@ -21,18 +21,22 @@ import package::nirc::mlp_tile::{block_stride, load_matrix, mlp_forward_tile, st
 @group(0) @binding(10) var<storage, read_write> partials: array<f32>;
 
 // Gradient of the pre-activation of matrix m - 1 from that of matrix m's input: ReLU passes it
-// where the activation (saved by this invocation in the forward pass) was positive.
+// where the activation (saved by this invocation in the forward pass) was positive. The
+// activations are read a quad at a time (WIDTH and o0 are multiples of 4).
 fn relu_backward(g: Block, m: u32, rq: u32, o0: u32) -> Block {
     var out = g;
     for (var c = 0u; c < 4u; c++) {
         let valid = record_valid(rq, c);
-        let b = select(0u, record_slot(rq, c) + act_base(m) + o0, valid);
-        for (var j = 0u; j < OPT; j++) {
-            var keep = false;
+        let b = select(0u, record_slot(rq, c) + act_base(m) + o0, valid) / 4u;
+        for (var j = 0u; j < OPT; j += 4u) {
+            var keep = vec4<bool>(false);
             if valid && o0 + j < WIDTH {
-                keep = scratch[b + j] > 0.0;
+                keep = scratch[b + j / 4u] > vec4<f32>(0.0);
             }
-            out[j][c] = select(0.0, g[j][c], keep);
+            out[j][c] = select(0.0, g[j][c], keep.x);
+            out[j + 1u][c] = select(0.0, g[j + 1u][c], keep.y);
+            out[j + 2u][c] = select(0.0, g[j + 2u][c], keep.z);
+            out[j + 3u][c] = select(0.0, g[j + 3u][c], keep.w);
         }
     }
     return out;
@@ -54,7 +58,7 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
         for (var k = 0u; k < FEATURES; k++) {
             tile_a[(l * FEATURES + k) * RQ + lid / 4u][lid % 4u] = corner_sum(1u, corners, k);
             if in_range {
-                scratch[r * SCRATCH_STRIDE + l * FEATURES + k] = corner_sum(0u, corners, k);
+                scratch_set(r * SCRATCH_STRIDE + l * FEATURES + k, corner_sum(0u, corners, k));
             }
         }
     }
@@ -62,7 +66,7 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
         let d = direction_feature(rec.direction.xyz, i);
         tile_a[(LEVELS * FEATURES + i) * RQ + lid / 4u][lid % 4u] = d;
         if in_range {
-            scratch[r * SCRATCH_STRIDE + LEVELS * FEATURES + i] = d;
+            scratch_set(r * SCRATCH_STRIDE + LEVELS * FEATURES + i, d);
         }
     }
 
@@ -70,12 +74,16 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
     let fe = mlp_forward_tile(1u, lid, false);
     let f_ema = array<vec4<f32>, 3>(fe[0], fe[1], fe[2]);
     workgroupBarrier();
-    for (var i = 0u; i < IN_DIMS; i++) {
-        var v = 0.0;
+    // A quad at a time; the rows from IN_DIMS to IN_STRIDE are padding the matrices do not read.
+    for (var i = 0u; i < IN_STRIDE; i += 4u) {
+        var v = vec4<f32>(0.0);
         if in_range {
-            v = scratch[r * SCRATCH_STRIDE + i];
+            v = scratch[(r * SCRATCH_STRIDE + i) / 4u];
         }
-        tile_a[i * RQ + lid / 4u][lid % 4u] = v;
+        tile_a[i * RQ + lid / 4u][lid % 4u] = v.x;
+        tile_a[(i + 1u) * RQ + lid / 4u][lid % 4u] = v.y;
+        tile_a[(i + 2u) * RQ + lid / 4u][lid % 4u] = v.z;
+        tile_a[(i + 3u) * RQ + lid / 4u][lid % 4u] = v.w;
     }
     let fc = mlp_forward_tile(0u, lid, true);
 
@@ -93,7 +101,7 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
                 let loss = l2.w;
                 for (var ch = 0u; ch < 3u; ch++) {
                     d_out[ch][c] = l2[ch];
-                    scratch[rr * SCRATCH_STRIDE + ACT_FLOATS + delta_base(HIDDEN) + ch] = l2[ch];
+                    scratch_set(rr * SCRATCH_STRIDE + ACT_FLOATS + delta_base(HIDDEN) + ch, l2[ch]);
                 }
                 losses[rr] = loss;
                 ok = is_finite(loss) && ok;
@@ -155,23 +163,24 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
         let cols = mat_cols(m);
         let s = block_stride(cols);
         workgroupBarrier();
-        for (var e = lid; e < TILE * RQ * 4u; e += WG_SIZE) {
-            let rl = e / (RQ * 4u);
-            let i = e % (RQ * 4u);
-            var v = 0.0;
+        // A quad of values per load; the parts of a quad past `rows` or `cols` are zeroed.
+        for (var e = lid; e < TILE * RQ; e += WG_SIZE) {
+            let rl = e / RQ;
+            let i = 4u * (e % RQ);
+            var v = vec4<f32>(0.0);
             if i < rows && tile_first + rl < call.n {
-                v = scratch[(tile_first + rl) * SCRATCH_STRIDE + ACT_FLOATS + delta_base(m) + i];
+                v = scratch[((tile_first + rl) * SCRATCH_STRIDE + ACT_FLOATS + delta_base(m) + i) / 4u];
             }
-            tile_a[e / 4u][e % 4u] = v;
+            tile_a[e] = select(vec4<f32>(0.0), v, vec4<u32>(i) + vec4<u32>(0u, 1u, 2u, 3u) < vec4<u32>(rows));
         }
-        for (var e = lid; e < TILE * s * 4u; e += WG_SIZE) {
-            let rl = e / (s * 4u);
-            let j = e % (s * 4u);
-            var v = 0.0;
+        for (var e = lid; e < TILE * s; e += WG_SIZE) {
+            let rl = e / s;
+            let j = 4u * (e % s);
+            var v = vec4<f32>(0.0);
             if j < cols && tile_first + rl < call.n {
-                v = scratch[(tile_first + rl) * SCRATCH_STRIDE + act_base(m) + j];
+                v = scratch[((tile_first + rl) * SCRATCH_STRIDE + act_base(m) + j) / 4u];
             }
-            tile_w[e / 4u][e % 4u] = v;
+            tile_w[e] = select(vec4<f32>(0.0), v, vec4<u32>(j) + vec4<u32>(0u, 1u, 2u, 3u) < vec4<u32>(cols));
         }
         workgroupBarrier();
         if 4u * rq < rows && o0 < cols {

@@ -102,13 +102,22 @@ impl ParameterLayout {
         self.total_params - self.mlp_params
     }
 
-    /// Per-record floats of the training scratch: inputs + hidden activations, then the
-    /// pre-activation gradients of every hidden layer and of the output.
+    /// Per-record floats of the training scratch: inputs (padded to a quad) + hidden
+    /// activations, then the pre-activation gradients of every hidden layer and of the output.
+    /// The padding lets the tiled pass move whole quads (vec4) where the width is a multiple of 4.
     pub fn activation_floats(&self) -> u32 {
-        self.input_dims + self.hidden_layers * self.width
+        self.input_stride() + self.hidden_layers * self.width
     }
     pub fn delta_floats(&self) -> u32 {
         self.hidden_layers * self.width + OUTPUT_DIMS
+    }
+    /// Where the first hidden activation starts in a record's scratch slot.
+    pub fn input_stride(&self) -> u32 {
+        self.input_dims.next_multiple_of(4)
+    }
+    /// Floats of one record's scratch slot, a whole number of quads.
+    pub fn scratch_stride(&self) -> u32 {
+        (self.activation_floats() + self.delta_floats()).next_multiple_of(4)
     }
 
     /// Multiply-adds of one forward pass of the MLP (the FLOP count is twice this).

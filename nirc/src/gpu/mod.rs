@@ -368,7 +368,7 @@ impl NeuralCache {
             adam_v: storage_init(gpu, "nirc adam v", bytemuck::cast_slice(&state.adam_v))?,
             grad: storage(gpu, "nirc mlp gradient", layout.mlp_params as u64 * 4)?,
             partials: storage(gpu, "nirc gradient partial sums", chunks * layout.mlp_params as u64 * 4)?,
-            scratch: storage(gpu, "nirc training scratch", max_batch * (layout.activation_floats() + layout.delta_floats()) as u64 * 4)?,
+            scratch: storage(gpu, "nirc training scratch", max_batch * layout.scratch_stride() as u64 * 4)?,
             grid_accum: storage(gpu, "nirc hash-grid gradient sums", layout.grid_params() as u64 * 12)?,
             samples: storage(gpu, "nirc reliability samples", max_batch * std::mem::size_of::<ReliabilitySample>() as u64)?,
             sample_cells: storage(gpu, "nirc reliability sample cells and links", max_batch * 8)?,

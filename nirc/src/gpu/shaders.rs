@@ -115,7 +115,8 @@ fn config_constants(config: &NircConfig, layout: &ParameterLayout) -> String {
     c("TOTAL_PARAMS", layout.total_params);
     c("ACT_FLOATS", layout.activation_floats());
     c("DELTA_FLOATS", layout.delta_floats());
-    c("SCRATCH_STRIDE", layout.activation_floats() + layout.delta_floats());
+    c("IN_STRIDE", layout.input_stride());
+    c("SCRATCH_STRIDE", layout.scratch_stride());
     c("CELL_COUNT", cell_count(&config.reliability));
     c("CHUNK", CHUNK);
     c("WG_SIZE", WORKGROUP_SIZE);
