@@ -14,6 +14,7 @@
 import package::nirc::types::{Call, CountersAtomic, Hyper};
 import package::nirc::config::{MLP_PARAMS, TOTAL_PARAMS};
 import package::nirc::fixed_sum_read::{fixed_to_f32};
+import package::nirc::grid_write::{mirror_ema, mirror_params};
 
 @group(0) @binding(0) var<uniform> call: Call;
 @group(0) @binding(1) var<uniform> hyper: Hyper;
@@ -93,11 +94,13 @@ fn finite_update(q: u32, g: vec4<f32>, pw: Powers) -> bool {
     return is_finite4(u.g) && is_finite4(u.w) && is_finite4(u.m) && is_finite4(u.v) && is_finite4(ema_of(q, u.w, pw));
 }
 
-fn write_update(q: u32, g: vec4<f32>, pw: Powers) {
+// Writes quad q's step and returns its new weights.
+fn write_update(q: u32, g: vec4<f32>, pw: Powers) -> vec4<f32> {
     let u = update(q, g, pw);
     params[q] = u.w;
     adam_m[q] = u.m;
     adam_v[q] = u.v;
+    return u.w;
 }
 
 // Two loops, the MLP's quads and then the grid's, so that no quad loads both gradients.
@@ -125,10 +128,11 @@ fn apply(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups)
     let pw = powers();
     let stride = groups.x * 64u;
     for (var q = gid.x; q < MLP_QUADS; q += stride) {
-        write_update(q, grad[q], pw);
+        _ = write_update(q, grad[q], pw);
     }
+    // Grid quads also go to the register form's texture mirror (src/gpu/grid_textures.rs).
     for (var q = MLP_QUADS + gid.x; q < QUADS; q += stride) {
-        write_update(q, grid_gradient(q), pw);
+        mirror_params(q, write_update(q, grid_gradient(q), pw));
     }
 }
 
@@ -138,7 +142,13 @@ fn ema_update(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         return;
     }
     let pw = powers();
-    for (var q = gid.x; q < QUADS; q += groups.x * 64u) {
+    let stride = groups.x * 64u;
+    for (var q = gid.x; q < MLP_QUADS; q += stride) {
         ema[q] = ema_of(q, params[q], pw);
+    }
+    for (var q = MLP_QUADS + gid.x; q < QUADS; q += stride) {
+        let e = ema_of(q, params[q], pw);
+        ema[q] = e;
+        mirror_ema(q, e);
     }
 }

@@ -15,6 +15,7 @@ import package::nirc::mlp_layout::{act_base, delta_base, mat_cols, mat_offset, m
 import package::nirc::fixed_sum::{fixed_add};
 import package::nirc::loss::{relative_l2};
 import package::nirc::encoding::{corner_sum, direction_feature, level_corners};
+import package::nirc::grid::{GRID_PAIRS, corner_pair};
 import package::nirc::keep::{keep_block, record_slot, record_valid, tile_first};
 import package::nirc::mlp_tile::{block_stride, load_matrix, mlp_forward_tile, store_block};
 
@@ -55,10 +56,22 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
     // 1. Inputs: the EMA predictor's into tile_a, the High-LR predictor's into the scratch.
     for (var l = 0u; l < LEVELS; l++) {
         let corners = level_corners(l, p);
-        for (var k = 0u; k < FEATURES; k++) {
-            tile_a[(l * FEATURES + k) * RQ + lid / 4u][lid % 4u] = corner_sum(1u, corners, k);
+        if GRID_PAIRS {
+            // Both features of a corner in one texel of the grid mirror (src/gpu/grid_textures.rs).
+            let e = corner_pair(1u, corners);
+            let h = corner_pair(0u, corners);
+            tile_a[(l * FEATURES) * RQ + lid / 4u][lid % 4u] = e.x;
+            tile_a[(l * FEATURES + 1u) * RQ + lid / 4u][lid % 4u] = e.y;
             if in_range {
-                scratch_set(r * SCRATCH_STRIDE + l * FEATURES + k, corner_sum(0u, corners, k));
+                scratch_set(r * SCRATCH_STRIDE + l * FEATURES, h.x);
+                scratch_set(r * SCRATCH_STRIDE + l * FEATURES + 1u, h.y);
+            }
+        } else {
+            for (var k = 0u; k < FEATURES; k++) {
+                tile_a[(l * FEATURES + k) * RQ + lid / 4u][lid % 4u] = corner_sum(1u, corners, k);
+                if in_range {
+                    scratch_set(r * SCRATCH_STRIDE + l * FEATURES + k, corner_sum(0u, corners, k));
+                }
             }
         }
     }

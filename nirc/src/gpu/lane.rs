@@ -35,10 +35,10 @@ pub fn uniform_bytes(layout: &ParameterLayout) -> u32 {
 /// The generated module `package::nirc::lane`: the staged weights' binding and bases, the input
 /// vector, `lane_inputs` (the encoding of one query, level by level with its constants) and
 /// `lane_net` (the forward pass of the predictor whose weights start at `net_base`).
-pub fn module(layout: &ParameterLayout) -> String {
+pub fn module(layout: &ParameterLayout, grid_textures: bool) -> String {
     let in_vec4 = layout.input_dims.div_ceil(4);
     let (bases, total) = lane_w_layout(layout);
-    let mut s = String::from("import package::nirc::encoding::{corners_at, corner_sum, direction_feature};\n\n");
+    let mut s = String::from("import package::nirc::encoding::{corners_at, corner_sum, direction_feature};\nimport package::nirc::grid::{corner_pair};\n\n");
     let bases_text: Vec<String> = bases.iter().map(|b| format!("{b}u")).collect();
     s.push_str(&format!(
         "const LANE_W_VEC4: u32 = {total}u;\nconst LANE_BASE = array<u32, {}>({});\n@group(0) @binding(8) var<uniform> lane_w: array<vec4<f32>, {}>;\nstruct LaneIn {{ {} }}\nstruct LanePair {{ a: LaneIn, b: LaneIn }}\n\n",
@@ -48,20 +48,25 @@ pub fn module(layout: &ParameterLayout) -> String {
         (0..in_vec4).map(|i| format!("v{i}: vec4<f32>")).collect::<Vec<_>>().join(", ")
     ));
     s.push_str("fn lane_relu(v: vec4<f32>) -> vec4<f32> {\n    return select(vec4<f32>(0.0), v, v > vec4<f32>(0.0));\n}\n\n");
-    s.push_str(&inputs(layout));
+    s.push_str(&inputs(layout, grid_textures));
     s.push_str(&net(layout, &bases));
     s
 }
 
 /// `lane_inputs(p, dir, first_net, both)`: the network input of predictor `first_net` in `.a`
-/// and, with `both`, of predictor 0 in `.b`, from one set of corners per level.
-fn inputs(layout: &ParameterLayout) -> String {
+/// and, with `both`, of predictor 0 in `.b`, from one set of corners per level. With the grid
+/// mirror (`grid_textures`, two features per level) each corner's two features are one texel.
+fn inputs(layout: &ParameterLayout, grid_textures: bool) -> String {
     let f = layout.features_per_level;
     let slot = |i: u32| format!("v{}.{}", i / 4, XYZW[(i % 4) as usize]);
     let mut s = String::from("fn lane_inputs(p: vec3<f32>, dir: vec3<f32>, first_net: u32, both: bool) -> LanePair {\n    var x: LanePair;\n");
     for (l, level) in layout.levels.iter().enumerate() {
         s.push_str(&format!("    {{\n        let c = corners_at(p, {}u, {}, {}u, {}u);\n", level.resolution, level.dense, level.table_size, level.offset));
-        for k in 0..f {
+        if grid_textures {
+            let (i, j) = (slot(l as u32 * f), slot(l as u32 * f + 1));
+            s.push_str(&format!("        let a = corner_pair(first_net, c);\n        x.a.{i} = a.x;\n        x.a.{j} = a.y;\n        if both {{\n            let b = corner_pair(0u, c);\n            x.b.{i} = b.x;\n            x.b.{j} = b.y;\n        }}\n"));
+        }
+        for k in (0..f).filter(|_| !grid_textures) {
             let i = l as u32 * f + k;
             s.push_str(&format!("        x.a.{} = corner_sum(first_net, c, {k}u);\n        if both {{\n            x.b.{} = corner_sum(0u, c, {k}u);\n        }}\n", slot(i), slot(i)));
         }

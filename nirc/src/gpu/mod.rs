@@ -18,6 +18,7 @@
 pub mod readback;
 pub mod shaders;
 pub mod lane;
+pub mod grid_textures;
 
 use crate::bounds::SceneBounds;
 use crate::config::{NircConfig, PredictorMode};
@@ -123,6 +124,8 @@ struct Buffers {
     /// Both predictors' MLP weights as the register form reads them (storage for
     /// lane_stage.wgsl, uniform for infer_lane.wgsl); only in that form.
     lane_staged: Option<wgpu::Buffer>,
+    /// The grid mirror the register form reads (grid_textures.rs).
+    grid: Option<grid_textures::GridTextures>,
 }
 
 /// The bind groups of one training step ([`NeuralCache::prepare_step`]).
@@ -184,7 +187,16 @@ fn storage_init(gpu: &Gpu, label: &str, data: &[u8]) -> Result<wgpu::Buffer, Nir
 }
 
 fn bind(gpu: &Gpu, label: &str, pipeline: &wgpu::ComputePipeline, entries: &[(u32, &wgpu::Buffer)]) -> wgpu::BindGroup {
-    let entries: Vec<wgpu::BindGroupEntry> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
+    bind_with_views(gpu, label, pipeline, entries, &[])
+}
+
+/// `bind` with storage-texture views as well (the grid mirror, grid_textures.rs).
+fn bind_with_views(gpu: &Gpu, label: &str, pipeline: &wgpu::ComputePipeline, entries: &[(u32, &wgpu::Buffer)], views: &[(u32, &wgpu::TextureView)]) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = entries
+        .iter()
+        .map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() })
+        .chain(views.iter().map(|&(binding, v)| wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) }))
+        .collect();
     gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout: &pipeline.get_bind_group_layout(0), entries: &entries })
 }
 
@@ -269,17 +281,18 @@ impl NeuralCache {
         if config.max_batch.div_ceil(WORKGROUP_SIZE) > gpu.limits.max_compute_workgroups_per_dimension {
             return Err(NircError::Config(format!("max_batch {} needs more workgroups than this adapter dispatches", config.max_batch)));
         }
-        let pipelines = Self::pipelines(gpu, &config, &layout, placement)?;
-        let buffers = Self::buffers(gpu, &config, &layout, state, placement)?;
+        let grid_width = grid_textures::width_for(gpu, &layout, placement);
+        let pipelines = Self::pipelines(gpu, &config, &layout, placement, grid_width)?;
+        let buffers = Self::buffers(gpu, &config, &layout, state, placement, grid_width)?;
         let groups = Self::fixed_groups(gpu, &pipelines, &buffers);
         Ok(Self { bounds: state.bounds, config, layout, placement, pipelines, buffers, groups })
     }
 
     /// Every pass's pipelines, validated (render::compute): a shader the driver refuses is an
     /// error naming the pass.
-    fn pipelines(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, placement: WeightPlacement) -> Result<Pipelines, NircError> {
+    fn pipelines(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, placement: WeightPlacement, grid_width: Option<u32>) -> Result<Pipelines, NircError> {
         let build = |pass: &str, entries: &[&str]| -> Result<Vec<wgpu::ComputePipeline>, NircError> {
-            let source = shaders::program(config, layout, pass);
+            let source = shaders::program(config, layout, pass, grid_width);
             let label = format!("nirc {pass}");
             Ok(match entries {
                 [a] => render::compute::pipelines_auto_layout(gpu, &label, &source, [*a])?.to_vec(),
@@ -336,7 +349,7 @@ impl NeuralCache {
         }
     }
 
-    fn buffers(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, state: &CacheState, placement: WeightPlacement) -> Result<Buffers, NircError> {
+    fn buffers(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, state: &CacheState, placement: WeightPlacement, grid_width: Option<u32>) -> Result<Buffers, NircError> {
         let n = layout.total_params as usize;
         for (name, len, expected) in [
             ("params", state.params.len(), n),
@@ -384,6 +397,7 @@ impl NeuralCache {
                     mapped_at_creation: false,
                 })
             }),
+            grid: grid_width.map(|w| grid_textures::GridTextures::new(gpu, layout, state, w)),
         })
     }
 
@@ -452,7 +466,7 @@ impl NeuralCache {
         if self.placement.tiled_training() {
             fb_entries.push((10, &b.partials));
         }
-        let fb = bind(gpu, "nirc train", &p.train, &fb_entries);
+        let fb = bind_with_views(gpu, "nirc train", &p.train, &fb_entries, &self.grid_views(grid_textures::READ_BINDINGS));
         let (accumulate, walk) = self.reliability_groups(gpu, &call, &b.samples);
         let partial = p.weight_partial.as_ref().map(|wp| bind(gpu, "nirc weight partial", wp, &[(0, &call), (1, &b.scratch), (2, &b.partials)]));
         let reduce = bind(gpu, "nirc weight reduce", &p.weight_reduce, &[(0, &call), (2, &b.partials), (3, &b.grad)]);
@@ -461,8 +475,9 @@ impl NeuralCache {
         let check = bind(gpu, "nirc adam check", &p.adam_check, adam_entries);
         // `apply` does not read the EMA (adam_ema.wgsl), so its layout has no binding 3.
         let apply_entries: Vec<(u32, &wgpu::Buffer)> = adam_entries.iter().copied().filter(|&(binding, _)| binding != 3).collect();
-        let apply = bind(gpu, "nirc adam apply", &p.adam_apply, &apply_entries);
-        let ema = bind(gpu, "nirc ema update", &p.ema_update, &[(1, &b.hyper), (2, &b.params), (3, &b.ema), (8, &b.counters)]);
+        let mirror = self.grid_views(grid_textures::WRITE_BINDINGS);
+        let apply = bind_with_views(gpu, "nirc adam apply", &p.adam_apply, &apply_entries, &mirror[..mirror.len().min(1)]);
+        let ema = bind_with_views(gpu, "nirc ema update", &p.ema_update, &[(1, &b.hyper), (2, &b.params), (3, &b.ema), (8, &b.counters)], &mirror[mirror.len().min(1)..]);
         let finish = bind(gpu, "nirc finish", &p.finish_step, &[(0, &call), (1, &b.hyper), (2, &b.counters)]);
         Ok(Some(TrainStep { n, num_chunks, fb, accumulate, walk, partial, reduce, check, apply, ema, finish }))
     }
@@ -690,7 +705,22 @@ impl NeuralCache {
         if let Some(staged) = &b.lane_staged {
             entries.push((8, staged));
         }
-        Ok(Some(bind(gpu, "nirc infer", &self.pipelines.infer, &entries)))
+        if b.grid.is_some() {
+            // The register form then reads the grid from the mirror and its weights from the
+            // staged uniform: the parameter buffers are not in its layout.
+            entries.retain(|&(binding, _)| binding != 3 && binding != 4);
+        }
+        Ok(Some(bind_with_views(gpu, "nirc infer", &self.pipelines.infer, &entries, &self.grid_views(grid_textures::READ_BINDINGS))))
+    }
+
+    /// Whether the passes read the hash grid from its texture mirror (grid_textures.rs).
+    pub fn reads_grid_mirror(&self) -> bool {
+        self.buffers.grid.is_some()
+    }
+
+    /// The grid mirror's two views at `bindings` ([High-LR, EMA]); none without the mirror.
+    fn grid_views(&self, bindings: [u32; 2]) -> Vec<(u32, &wgpu::TextureView)> {
+        self.buffers.grid.iter().flat_map(|g| [(bindings[0], &g.views[0]), (bindings[1], &g.views[1])]).collect()
     }
 
     pub fn counters(&self, gpu: &Gpu) -> Result<Counters, NircError> {

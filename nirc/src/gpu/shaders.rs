@@ -188,9 +188,15 @@ macro_rules! nirc_file {
 /// (`package::nirc::config`, and `package::nirc::tile` for the tiled passes), the pass's bindings
 /// as `package::nirc::bindings` and, for the tiled passes, its activation hook as
 /// `package::nirc::keep` (the shared files import both by those names), the shared files, and
-/// the pass's entry-point file.
-pub fn program(config: &NircConfig, layout: &ParameterLayout, pass: &str) -> Program {
-    let mut modules = vec![Module::generated("package::nirc::types", &[&structs()]), Module::generated("package::nirc::config", &[&config_constants(config, layout)])];
+/// the pass's entry-point file. `grid_width`: the grid mirror's texture width where the
+/// passes read and write it (grid_textures.rs).
+pub fn program(config: &NircConfig, layout: &ParameterLayout, pass: &str, grid_width: Option<u32>) -> Program {
+    let mut modules = vec![
+        Module::generated("package::nirc::types", &[&structs()]),
+        Module::generated("package::nirc::config", &[&config_constants(config, layout)]),
+        Module::generated("package::nirc::grid", &[&super::grid_textures::read_module(grid_width)]),
+        Module::generated("package::nirc::grid_write", &[&super::grid_textures::write_module(grid_width)]),
+    ];
     let tile = match pass {
         "train_tile" => Some((TRAIN_TILE_RECORDS, true)),
         "infer_tile" => Some((INFER_TILE_QUERIES, false)),
@@ -200,7 +206,7 @@ pub fn program(config: &NircConfig, layout: &ParameterLayout, pass: &str) -> Pro
         modules.push(Module::generated("package::nirc::tile", &[&tile_constants(layout, &tile_shape(layout, records), training)]));
     }
     if pass == "infer_lane" || pass == "lane_stage" {
-        modules.push(Module::generated("package::nirc::lane", &[&super::lane::module(layout)]));
+        modules.push(Module::generated("package::nirc::lane", &[&super::lane::module(layout, grid_width.is_some())]));
     }
     let (own, entry) = pass_files(pass);
     modules.extend(own);
