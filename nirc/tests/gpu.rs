@@ -42,7 +42,7 @@ fn forward_matches_cpu_in_every_weight_placement() {
         let cache = NeuralCache::from_state(gpu(), &state, Some(placement)).unwrap();
         assert_eq!(cache.placement, placement);
         // Two features per level: the register form reads the grid from its texture mirror
-        // (lavapipe and the GPUs the lab runs on have rg32float storage textures).
+        // (lavapipe and the GPUs the lab runs on have rgba32float storage textures).
         assert_eq!(cache.reads_grid_mirror(), placement == WeightPlacement::Registers, "{placement:?}");
         for mode in [PredictorMode::HighLrOnly, PredictorMode::EmaOnly, PredictorMode::Blend, PredictorMode::Switch, PredictorMode::Fixed(0.3)] {
             let got = cache.infer_queries(gpu(), &queries, mode).unwrap();

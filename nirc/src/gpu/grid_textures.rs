@@ -1,5 +1,5 @@
-//! The hash-grid tables of both predictors mirrored in `rg32float` storage textures, one texel
-//! per entry (its two features), for the register form on CPU adapters.
+//! The hash-grid tables of both predictors mirrored in `rgba32float` storage textures, one texel
+//! per quad of parameters (two entries of two features), for the register form on CPU adapters.
 //!
 //! Why: lavapipe reads a storage texel inline, in a gathered load, where a storage-buffer load at
 //! a per-invocation address is a loop over the SIMD lanes (render/src/texel_table.rs,
@@ -9,7 +9,8 @@
 //! `apply` and `ema_update` for every grid quad), and only the encodings of the tiled training
 //! pass and of the register-form inference read them.
 //!
-//! Texel t holds parameters MLP_PARAMS + 2t and + 2t + 1, at (t % width, t / width).
+//! Texel t holds parameters MLP_PARAMS + 4t .. + 4t + 3, at (t % width, t / width): a grid quad
+//! is one store, and an entry's two features are one half of a fetched texel.
 
 use crate::gpu::shaders::WeightPlacement;
 use crate::layout::ParameterLayout;
@@ -30,19 +31,19 @@ pub struct GridTextures {
     pub views: [wgpu::TextureView; 2],
 }
 
-/// Texels of the mirror: every grid quad's two entries (the layout pads the grid to quads).
+/// Texels of the mirror: one per grid quad (the layout pads the grid to quads).
 fn texels(layout: &ParameterLayout) -> u32 {
-    layout.grid_params() / 2
+    layout.grid_params() / 4
 }
 
 /// The texture width if the register form would use the mirror on this adapter: two features
-/// per level, `rg32float` storage textures, and a texture within the adapter's size limit.
+/// per level, `rgba32float` storage textures, and a texture within the adapter's size limit.
 /// Otherwise the passes read the grid from the parameter buffers.
 pub fn width_for(gpu: &Gpu, layout: &ParameterLayout, placement: WeightPlacement) -> Option<u32> {
     let max = gpu.limits.max_texture_dimension_2d;
     let width = MAX_WIDTH.min(max);
     let fits = texels(layout).div_ceil(width) <= max;
-    let storage = gpu.adapter.get_texture_format_features(wgpu::TextureFormat::Rg32Float).allowed_usages.contains(wgpu::TextureUsages::STORAGE_BINDING);
+    let storage = gpu.adapter.get_texture_format_features(wgpu::TextureFormat::Rgba32Float).allowed_usages.contains(wgpu::TextureUsages::STORAGE_BINDING);
     (placement == WeightPlacement::Registers && layout.features_per_level == 2 && fits && storage).then_some(width)
 }
 
@@ -59,19 +60,19 @@ impl GridTextures {
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rg32Float,
+                format: wgpu::TextureFormat::Rgba32Float,
                 usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_DST,
                 view_formats: &[],
             });
             // Whole rows, then the last row's remaining texels.
             let bytes: &[u8] = bytemuck::cast_slice(values);
-            let row_bytes = width as usize * 8;
+            let row_bytes = width as usize * 16;
             let full = n / width;
             let write = |y: u32, texels: u32, data: &[u8]| {
                 gpu.queue.write_texture(
                     wgpu::TexelCopyTextureInfo { texture: &texture, mip_level: 0, origin: wgpu::Origin3d { x: 0, y, z: 0 }, aspect: wgpu::TextureAspect::All },
                     data,
-                    wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(texels * 8), rows_per_image: None },
+                    wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(texels * 16), rows_per_image: None },
                     wgpu::Extent3d { width: texels, height: if y < full { full } else { 1 }, depth_or_array_layers: 1 },
                 );
             };
@@ -97,9 +98,9 @@ pub fn read_module(width: Option<u32>) -> String {
         Some(w) => format!(
             "{common}import package::nirc::config::{{MLP_PARAMS}};\n\
              const GRID_PAIRS: bool = true;\n\
-             @group(0) @binding({}) var grid_params: texture_storage_2d<rg32float, read>;\n\
-             @group(0) @binding({}) var grid_ema: texture_storage_2d<rg32float, read>;\n\
-             fn grid_texel(net: u32, i: u32) -> vec2<f32> {{\n    let t = (i - MLP_PARAMS) / 2u;\n    let at = vec2<u32>(t % {w}u, t / {w}u);\n    if net == 0u {{\n        return textureLoad(grid_params, at).xy;\n    }}\n    return textureLoad(grid_ema, at).xy;\n}}\n\
+             @group(0) @binding({}) var grid_params: texture_storage_2d<rgba32float, read>;\n\
+             @group(0) @binding({}) var grid_ema: texture_storage_2d<rgba32float, read>;\n\
+             fn grid_texel(net: u32, i: u32) -> vec2<f32> {{\n    let t = (i - MLP_PARAMS) / 4u;\n    let at = vec2<u32>(t % {w}u, t / {w}u);\n    var q: vec4<f32>;\n    if net == 0u {{\n        q = textureLoad(grid_params, at);\n    }} else {{\n        q = textureLoad(grid_ema, at);\n    }}\n    return select(q.xy, q.zw, (i & 2u) != 0u);\n}}\n\
              // Features 0 and 1 of one level: corner_sum of each, the same sums in the same order.\n\
              fn corner_pair(net: u32, corners: Corners) -> vec2<f32> {{\n    var acc = vec2<f32>(0.0);\n    for (var c = 0u; c < 8u; c++) {{\n        acc += corners.weight[c] * grid_texel(net, corners.index[c]);\n    }}\n    return acc;\n}}\n",
             READ_BINDINGS[0], READ_BINDINGS[1]
@@ -111,16 +112,16 @@ pub fn read_module(width: Option<u32>) -> String {
     }
 }
 
-/// `package::nirc::grid_write`: `mirror(net, q, v)` stores grid quad q (q >= MLP_PARAMS / 4) of
-/// predictor `net` in its texture (two texels); without the textures it does nothing.
+/// `package::nirc::grid_write`: `mirror_params(q, v)` and `mirror_ema(q, v)` store grid quad q
+/// (q >= MLP_PARAMS / 4) of that predictor in its texel; without the textures they do nothing.
 pub fn write_module(width: Option<u32>) -> String {
     match width {
         Some(w) => format!(
             "import package::nirc::config::{{MLP_PARAMS}};\n\
-             @group(0) @binding({}) var grid_params_out: texture_storage_2d<rg32float, write>;\n\
-             @group(0) @binding({}) var grid_ema_out: texture_storage_2d<rg32float, write>;\n\
-             fn mirror_params(q: u32, v: vec4<f32>) {{\n    let t = 2u * q - MLP_PARAMS / 2u;\n    textureStore(grid_params_out, vec2<u32>(t % {w}u, t / {w}u), vec4<f32>(v.xy, 0.0, 0.0));\n    textureStore(grid_params_out, vec2<u32>((t + 1u) % {w}u, (t + 1u) / {w}u), vec4<f32>(v.zw, 0.0, 0.0));\n}}\n\
-             fn mirror_ema(q: u32, v: vec4<f32>) {{\n    let t = 2u * q - MLP_PARAMS / 2u;\n    textureStore(grid_ema_out, vec2<u32>(t % {w}u, t / {w}u), vec4<f32>(v.xy, 0.0, 0.0));\n    textureStore(grid_ema_out, vec2<u32>((t + 1u) % {w}u, (t + 1u) / {w}u), vec4<f32>(v.zw, 0.0, 0.0));\n}}\n",
+             @group(0) @binding({}) var grid_params_out: texture_storage_2d<rgba32float, write>;\n\
+             @group(0) @binding({}) var grid_ema_out: texture_storage_2d<rgba32float, write>;\n\
+             fn mirror_params(q: u32, v: vec4<f32>) {{\n    let t = q - MLP_PARAMS / 4u;\n    textureStore(grid_params_out, vec2<u32>(t % {w}u, t / {w}u), v);\n}}\n\
+             fn mirror_ema(q: u32, v: vec4<f32>) {{\n    let t = q - MLP_PARAMS / 4u;\n    textureStore(grid_ema_out, vec2<u32>(t % {w}u, t / {w}u), v);\n}}\n",
             WRITE_BINDINGS[0], WRITE_BINDINGS[1]
         ),
         None => "fn mirror_params(q: u32, v: vec4<f32>) {}\nfn mirror_ema(q: u32, v: vec4<f32>) {}\n".to_string(),
