@@ -475,9 +475,11 @@ impl NeuralCache {
         let check = bind(gpu, "nirc adam check", &p.adam_check, adam_entries);
         // `apply` does not read the EMA (adam_ema.wgsl), so its layout has no binding 3.
         let apply_entries: Vec<(u32, &wgpu::Buffer)> = adam_entries.iter().copied().filter(|&(binding, _)| binding != 3).collect();
+        // The grid mirror's write views, if any: apply writes the High-LR one, the EMA pass the other.
         let mirror = self.grid_views(grid_textures::WRITE_BINDINGS);
-        let apply = bind_with_views(gpu, "nirc adam apply", &p.adam_apply, &apply_entries, &mirror[..mirror.len().min(1)]);
-        let ema = bind_with_views(gpu, "nirc ema update", &p.ema_update, &[(1, &b.hyper), (2, &b.params), (3, &b.ema), (8, &b.counters)], &mirror[mirror.len().min(1)..]);
+        let (params_out, ema_out) = mirror.split_at(mirror.len() / 2);
+        let apply = bind_with_views(gpu, "nirc adam apply", &p.adam_apply, &apply_entries, params_out);
+        let ema = bind_with_views(gpu, "nirc ema update", &p.ema_update, &[(1, &b.hyper), (2, &b.params), (3, &b.ema), (8, &b.counters)], ema_out);
         let finish = bind(gpu, "nirc finish", &p.finish_step, &[(0, &call), (1, &b.hyper), (2, &b.counters)]);
         Ok(Some(TrainStep { n, num_chunks, fb, accumulate, walk, partial, reduce, check, apply, ema, finish }))
     }
