@@ -60,6 +60,37 @@ fn forward_matches_cpu_in_every_weight_placement() {
     }
 }
 
+/// With other than two features per level the register form reads the grid from the parameter
+/// buffers (no texture mirror), and still trains and infers as the CPU does.
+#[test]
+fn register_form_without_the_grid_mirror_matches_cpu() {
+    let mut config = small_config();
+    config.encoding.features_per_level = 1;
+    let state = randomized_state(&config, 31);
+    let mut cpu = CpuCache::new(state.clone());
+    let cache = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Registers)).unwrap();
+    assert!(!cache.reads_grid_mirror());
+    let mut rng = Rng(32);
+    let queries: Vec<_> = records(&mut rng, 200).iter().map(|r| r.query()).collect();
+    let batch = records(&mut rng, 100);
+    // Before the step the two predictors differ (after the first step the debiased EMA equals
+    // the weights), and after it the step's writes must be read.
+    for trained in [false, true] {
+        if trained {
+            assert!(cpu.train_step(&batch).committed);
+            cache.train_records(gpu(), &batch).unwrap();
+        }
+        for mode in [PredictorMode::EmaOnly, PredictorMode::HighLrOnly, PredictorMode::Blend] {
+            let (got, want) = (cache.infer_queries(gpu(), &queries, mode).unwrap(), cpu.infer(&queries, mode));
+            for (g, w) in got.iter().zip(&want) {
+                for c in 0..3 {
+                    assert!(close(g.radiance[c], w.radiance[c], 1e-4, 1e-6), "trained {trained}, {mode:?}: {:?} vs {:?}", g.radiance, w.radiance);
+                }
+            }
+        }
+    }
+}
+
 /// The register form (one query per invocation, weights in a uniform buffer) sums every layer
 /// in the tiled form's order, so its answers match the tiled form's far closer than the CPU
 /// tolerance (on lavapipe they are bit-identical); with the default network (width 64, the
