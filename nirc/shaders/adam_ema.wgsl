@@ -13,6 +13,7 @@
 
 import package::nirc::types::{Call, CountersAtomic, Hyper};
 import package::nirc::config::{MLP_PARAMS, TOTAL_PARAMS};
+import package::nirc::bindings_common::{is_finite4};
 import package::nirc::fixed_sum_read::{fixed_to_f32};
 import package::nirc::grid_write::{mirror_ema, mirror_params};
 
@@ -51,10 +52,6 @@ struct Powers {
 fn powers() -> Powers {
     let at = counters.alpha_pow * hyper.alpha;
     return Powers(counters.beta1_pow * hyper.beta1, counters.beta2_pow * hyper.beta2, (1.0 - hyper.alpha) / (1.0 - at), counters.alpha_pow == 1.0);
-}
-
-fn is_finite4(x: vec4<f32>) -> bool {
-    return all((bitcast<vec4<u32>>(x) & vec4<u32>(0x7f800000u)) != vec4<u32>(0x7f800000u));
 }
 
 // The mean gradient of grid quad q (q >= MLP_QUADS): its exact fixed-point sums as f32.

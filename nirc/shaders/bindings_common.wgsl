@@ -12,6 +12,11 @@ fn is_finite(x: f32) -> bool {
     return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
 }
 
+// is_finite of every component.
+fn is_finite4(x: vec4<f32>) -> bool {
+    return all((bitcast<vec4<u32>>(x) & vec4<u32>(0x7f800000u)) != vec4<u32>(0x7f800000u));
+}
+
 fn normalize_to_bounds(hyper: Hyper, p: vec3<f32>) -> vec3<f32> {
     return clamp((p - hyper.bounds_min.xyz) * hyper.inv_extent.xyz, vec3<f32>(0.0), vec3<f32>(1.0));
 }

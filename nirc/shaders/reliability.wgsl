@@ -11,7 +11,7 @@ const MOMENTS_PER_CELL: u32 = 24u;
 // sample), the head of the cell's list of samples (index + 1, per sample), then the sample
 // count.
 const ACCUM_PER_CELL: u32 = 73u;
-const ACCUM_OWNER: u32 = 71u;
+const ACCUM_HEAD: u32 = 71u;
 const ACCUM_COUNT: u32 = 72u;
 const MOMENTS_CUR: u32 = 6u;
 const MOMENTS_EMA: u32 = 15u;

@@ -1,6 +1,6 @@
 // Reliability grid, step 1 of an update (one invocation per sample): finds the sample's cell
 // and counts it. Per sample (the paper's rule) the sample is pushed onto its cell's list (the
-// head, index + 1, in the owner word; 0 ends a list); the list's order depends on the threads'
+// head, index + 1, in the ACCUM_HEAD word; 0 ends a list); the list's order depends on the threads'
 // order, and the list's final head replays the cell's samples in record order
 // (reliability_walk.wgsl). Per batch, the sample's 24 quantities (y, y^2, f, f^2, y f per
 // predictor, per channel) are added to the cell's exact fixed-point sums. Deterministic.
@@ -8,7 +8,7 @@
 import package::nirc::bindings::{accum, call, counters, hyper, sample_cells, samples};
 import package::nirc::bindings_common::{is_finite};
 import package::nirc::fixed_sum::{fixed_add_clamped};
-import package::nirc::reliability::{ACCUM_COUNT, ACCUM_OWNER, ACCUM_PER_CELL, MOMENTS_CUR, MOMENTS_EMA, cell_index};
+import package::nirc::reliability::{ACCUM_COUNT, ACCUM_HEAD, ACCUM_PER_CELL, MOMENTS_CUR, MOMENTS_EMA, cell_index};
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
@@ -19,7 +19,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         let base = cell * ACCUM_PER_CELL;
         atomicAdd(&accum[base + ACCUM_COUNT], 1u);
         if hyper.moments_per_sample == 1u {
-            sample_cells[s] = vec2<u32>(cell, atomicExchange(&accum[base + ACCUM_OWNER], s + 1u));
+            sample_cells[s] = vec2<u32>(cell, atomicExchange(&accum[base + ACCUM_HEAD], s + 1u));
             for (var c = 0u; c < 3u; c++) {
                 ok = ok && is_finite(sample.target_rgb[c]) && is_finite(sample.f_cur[c]) && is_finite(sample.f_ema[c]);
             }

@@ -12,7 +12,7 @@
 // as a loop over its lanes.
 
 import package::nirc::bindings::{accum, call, hyper, moments, sample_cells, samples};
-import package::nirc::reliability::{ACCUM_COUNT, ACCUM_OWNER, ACCUM_PER_CELL, MOMENTS_CUR, MOMENTS_EMA, MOMENTS_PER_CELL};
+import package::nirc::reliability::{ACCUM_COUNT, ACCUM_HEAD, ACCUM_PER_CELL, MOMENTS_CUR, MOMENTS_EMA, MOMENTS_PER_CELL};
 import package::nirc::types::{ReliabilitySample};
 
 // [M^y, Q^y, M^f_cur, Q^f_cur, C_cur, M^f_ema, Q^f_ema, C_ema], each RGB.
@@ -60,7 +60,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     for (var s = gid.x; s < call.n; s += groups.x * 64u) {
         let cell = sample_cells[s].x;
         let base = cell * ACCUM_PER_CELL;
-        if accum[base + ACCUM_OWNER] != s + 1u {
+        if accum[base + ACCUM_HEAD] != s + 1u {
             continue;
         }
         let count = accum[base + ACCUM_COUNT];
