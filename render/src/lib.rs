@@ -23,3 +23,4 @@ pub mod taa;
 pub mod texel_table;
 pub mod termination;
 pub mod timing;
+pub mod wavefront;

@@ -384,6 +384,21 @@ impl PathTracer {
         Ok(words[0] as u64)
     }
 
+    /// The radiance sum (w: samples) that [`crate::wavefront::Wavefront`] also accumulates into.
+    pub(crate) fn radiance_sum_buffer(&self) -> &wgpu::Buffer {
+        &self.radiance_sum
+    }
+
+    /// The ray counter ([0]: rays traced since the last clear).
+    pub(crate) fn counters_buffer(&self) -> &wgpu::Buffer {
+        &self.counters
+    }
+
+    /// The radiance sum as per-pixel means.
+    pub(crate) fn read_radiance_mean(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, RenderError> {
+        self.read_radiance(gpu)
+    }
+
     fn read_radiance(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, RenderError> {
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("radiance readback") });
         encoder.copy_buffer_to_buffer(&self.radiance_sum, 0, &self.radiance_readback, 0, self.radiance_sum.size());

@@ -196,6 +196,11 @@ impl SceneBindings {
         }
     }
 
+    /// Point, spot and directional lights as last uploaded (`frame.analytic_lights`).
+    pub fn analytic_lights(&self) -> u32 {
+        self.light_table.analytic
+    }
+
     /// @group(0). It changes when an update had to grow a buffer: fetch it every frame.
     pub fn bind_group(&self) -> &wgpu::BindGroup {
         &self.bind_group

@@ -188,6 +188,13 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         mean(reference.mean_rgb),
         mitsuba_ratio.map_or("n/a".into(), |r| format!("{r:.2}"))
     )?;
+    writeln!(
+        md,
+        "| flicker WGSL, wavefront (extend, shade, shadow kernels) | {:.3} | largest pixel difference from the megakernel: {:.3e} | {} |",
+        reference.wavefront_paths_per_s / 1e6,
+        reference.wavefront_max_difference,
+        reference.mitsuba.as_ref().map_or("n/a".into(), |m| format!("{:.2}", reference.wavefront_paths_per_s / m.paths_per_second()))
+    )?;
     match &reference.mitsuba {
         Some(m) => writeln!(md, "| Mitsuba {} scalar_rgb ({} threads) | {:.3} | {} | 1.00 |", m.version, m.threads, m.paths_per_second() / 1e6, mean(m.mean_rgb))?,
         None => writeln!(md, "\nMitsuba 3 not measured: {}", reference.mitsuba_missing.as_deref().unwrap_or("?"))?,
@@ -267,6 +274,8 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         "traversal": traversal_rows,
         "reference_paths_per_s": reference.paths_per_s,
         "reference_spp": opts.reference_spp,
+        "reference_wavefront_paths_per_s": reference.wavefront_paths_per_s,
+        "reference_wavefront_max_difference": reference.wavefront_max_difference,
         "reference_mean_rgb": reference.mean_rgb,
         "mitsuba_paths_per_s": reference.mitsuba.as_ref().map(|m| m.paths_per_second()),
         "mitsuba_threads": reference.mitsuba.as_ref().map(|m| m.threads),
@@ -285,6 +294,10 @@ const REFERENCE_MAX_DEPTH: u32 = 1000;
 
 struct ReferenceBench {
     paths_per_s: f64,
+    /// The same reference traced as a wavefront (render::wavefront), and the largest difference
+    /// of any pixel's channel from the megakernel's image.
+    wavefront_paths_per_s: f64,
+    wavefront_max_difference: f32,
     mean_rgb: [f64; 3],
     mitsuba: Option<crate::mitsuba::MitsubaRun>,
     mitsuba_missing: Option<String>,
@@ -304,6 +317,12 @@ fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
     let image = tracer.render_reference(gpu, spp, 1, 0, &mut |_, _| {})?;
     let seconds = start.elapsed().as_secs_f64();
     let paths_per_s = (size * size) as f64 * spp as f64 / seconds;
+    let wavefront = render::wavefront::Wavefront::new(gpu, &tracer)?;
+    wavefront.render_reference(gpu, &tracer, 1, 1, 0)?;
+    let start = Instant::now();
+    let wf_image = wavefront.render_reference(gpu, &tracer, spp, 1, 0)?;
+    let wavefront_paths_per_s = (size * size) as f64 * spp as f64 / start.elapsed().as_secs_f64();
+    let wavefront_max_difference = image.iter().zip(&wf_image).flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs())).fold(0.0f32, f32::max);
     let n = image.len() as f64;
     let mean_rgb = [0, 1, 2].map(|c| image.iter().map(|p| p[c] as f64).sum::<f64>() / n);
     let (mitsuba, mitsuba_missing) = match crate::mitsuba::python() {
@@ -316,7 +335,7 @@ fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
             (Some(run), None)
         }
     };
-    Ok(ReferenceBench { paths_per_s, mean_rgb, mitsuba, mitsuba_missing })
+    Ok(ReferenceBench { paths_per_s, wavefront_paths_per_s, wavefront_max_difference, mean_rgb, mitsuba, mitsuba_missing })
 }
 
 /// A GPU fresh from idle runs at a fraction of its clock for a while (an H200 started at 345 of
