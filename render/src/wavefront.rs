@@ -135,6 +135,16 @@ impl Wavefront {
     /// [`PathTracer::render_reference`] as a wavefront: `spp` samples per pixel in waves of
     /// [`Self::samples_per_wave`].
     pub fn render_reference(&self, gpu: &Gpu, tracer: &PathTracer, spp: u32, seed: u64, frame: u32) -> Result<Vec<[f32; 4]>, RenderError> {
+        self.trace(gpu, tracer, spp, seed, frame, None)
+    }
+
+    /// [`Self::render_reference`] with each kernel submitted alone and waited for, its wall time
+    /// added to `times`: slower, for seeing where a wavefront's time goes.
+    pub fn render_reference_per_kernel(&self, gpu: &Gpu, tracer: &PathTracer, spp: u32, seed: u64, frame: u32, times: &mut KernelTimes) -> Result<Vec<[f32; 4]>, RenderError> {
+        self.trace(gpu, tracer, spp, seed, frame, Some(times))
+    }
+
+    fn trace(&self, gpu: &Gpu, tracer: &PathTracer, spp: u32, seed: u64, frame: u32, mut times: Option<&mut KernelTimes>) -> Result<Vec<[f32; 4]>, RenderError> {
         if spp == 0 {
             return Err(RenderError::Settings("reference spp must be at least 1".into()));
         }
@@ -149,6 +159,27 @@ impl Wavefront {
         let pixels = settings.width as u64 * settings.height as u64;
         let bind_group = compute::buffer_group(gpu, "wavefront", &self.layout, &[tracer.radiance_sum_buffer(), tracer.counters_buffer(), &self.state, &self.control]);
         let per_wave = self.samples_per_wave(tracer);
+        let new_encoder = || gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("wavefront") });
+        // One kernel in its own compute pass; with `times`, submitted and waited for alone.
+        let run = |encoder: &mut wgpu::CommandEncoder, kernel: Kernel, dispatch: Dispatch, times: &mut Option<&mut KernelTimes>| {
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(kernel.name()), timestamp_writes: None });
+                pass.set_bind_group(0, tracer.scene().bind_group(), &[]);
+                pass.set_bind_group(1, tracer.scene().geometry().bind_group(), &[]);
+                pass.set_bind_group(2, &bind_group, &[]);
+                pass.set_pipeline(&self.pipeline(kernel).get());
+                match dispatch {
+                    Dispatch::Direct(x, y) => pass.dispatch_workgroups(x, y, 1),
+                    Dispatch::Indirect => pass.dispatch_workgroups_indirect(&self.args, 0),
+                }
+            }
+            if let Some(times) = times {
+                let start = std::time::Instant::now();
+                gpu.queue.submit([std::mem::replace(encoder, new_encoder()).finish()]);
+                let _ = gpu.device.poll(wgpu::PollType::wait_indefinitely());
+                times.seconds[kernel as usize] += start.elapsed().as_secs_f64();
+            }
+        };
         let mut done = 0;
         while done < spp {
             let batch = per_wave.min(spp - done);
@@ -157,50 +188,79 @@ impl Wavefront {
             let groups = paths.div_ceil(WF_GROUP);
             let control: [u32; CONTROL_WORDS as usize] = [paths, 0, 0, self.capacity as u32, groups, 1, 1, 0];
             gpu.queue.write_buffer(&self.control, 0, bytemuck::cast_slice(&control));
+            let mut encoder = new_encoder();
+            run(&mut encoder, Kernel::Generate, Dispatch::Direct(groups, 1), &mut times);
             let mut bounces = 0u32;
-            let mut first = true;
             loop {
-                let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("wavefront") });
                 for _ in 0..BOUNCES_PER_SUBMISSION {
                     // The indirect arguments are copied out of wf_control: a buffer bound for
                     // storage cannot also be a dispatch's indirect buffer.
                     encoder.copy_buffer_to_buffer(&self.control, CTRL_ARGS * 4, &self.args, 0, 12);
-                    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("wavefront bounce"), timestamp_writes: None });
-                    pass.set_bind_group(0, tracer.scene().bind_group(), &[]);
-                    pass.set_bind_group(1, tracer.scene().geometry().bind_group(), &[]);
-                    pass.set_bind_group(2, &bind_group, &[]);
-                    if first {
-                        pass.set_pipeline(&self.generate.get());
-                        pass.dispatch_workgroups(groups, 1, 1);
-                        first = false;
+                    for kernel in [Kernel::Extend, Kernel::Shade, Kernel::Shadow] {
+                        run(&mut encoder, kernel, Dispatch::Indirect, &mut times);
                     }
-                    for kernel in [&self.extend, &self.shade, &self.shadow] {
-                        pass.set_pipeline(&kernel.get());
-                        pass.dispatch_workgroups_indirect(&self.args, 0);
-                    }
-                    pass.set_pipeline(&self.advance.get());
-                    pass.dispatch_workgroups(1, 1, 1);
+                    run(&mut encoder, Kernel::Advance, Dispatch::Direct(1, 1), &mut times);
                 }
                 encoder.copy_buffer_to_buffer(&self.control, 0, &self.control_readback, 0, CONTROL_WORDS * 4);
-                gpu.queue.submit([encoder.finish()]);
+                gpu.queue.submit([std::mem::replace(&mut encoder, new_encoder()).finish()]);
                 let words: Vec<u32> = read_buffer(gpu, &self.control_readback).map_err(|reason| RenderError::Readback { what: "wavefront control".into(), reason })?;
                 bounces += BOUNCES_PER_SUBMISSION;
                 if words[0] == 0 || bounces > settings.max_depth + 1 {
                     break;
                 }
             }
-            let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("wavefront reduce") });
-            {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("wavefront reduce"), timestamp_writes: None });
-                pass.set_bind_group(0, tracer.scene().bind_group(), &[]);
-                pass.set_bind_group(1, tracer.scene().geometry().bind_group(), &[]);
-                pass.set_bind_group(2, &bind_group, &[]);
-                pass.set_pipeline(&self.reduce.get());
-                pass.dispatch_workgroups(settings.width.div_ceil(8), settings.height.div_ceil(8), 1);
-            }
+            run(&mut encoder, Kernel::Reduce, Dispatch::Direct(settings.width.div_ceil(8), settings.height.div_ceil(8)), &mut times);
             gpu.queue.submit([encoder.finish()]);
             done += batch;
         }
         tracer.read_radiance_mean(gpu)
     }
+
+    fn pipeline(&self, kernel: Kernel) -> &LibraryPipeline {
+        match kernel {
+            Kernel::Generate => &self.generate,
+            Kernel::Extend => &self.extend,
+            Kernel::Shade => &self.shade,
+            Kernel::Shadow => &self.shadow,
+            Kernel::Advance => &self.advance,
+            Kernel::Reduce => &self.reduce,
+        }
+    }
+}
+
+/// The wavefront's kernels, in the order of [`KernelTimes::seconds`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kernel {
+    Generate,
+    Extend,
+    Shade,
+    Shadow,
+    Advance,
+    Reduce,
+}
+
+impl Kernel {
+    pub const ALL: [Kernel; 6] = [Kernel::Generate, Kernel::Extend, Kernel::Shade, Kernel::Shadow, Kernel::Advance, Kernel::Reduce];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Kernel::Generate => "generate",
+            Kernel::Extend => "extend",
+            Kernel::Shade => "shade",
+            Kernel::Shadow => "shadow",
+            Kernel::Advance => "advance",
+            Kernel::Reduce => "reduce",
+        }
+    }
+}
+
+enum Dispatch {
+    Direct(u32, u32),
+    Indirect,
+}
+
+/// Wall seconds per kernel, indexed by [`Kernel`].
+#[derive(Clone, Debug, Default)]
+pub struct KernelTimes {
+    pub seconds: [f64; 6],
 }

@@ -195,6 +195,12 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         reference.wavefront_max_difference,
         reference.mitsuba.as_ref().map_or("n/a".into(), |m| format!("{:.2}", reference.wavefront_paths_per_s / m.paths_per_second()))
     )?;
+    writeln!(
+        md,
+        "\nThe wavefront's kernels, each submitted and waited for alone, against the megakernel's {:.3} s for the whole reference: {}\n",
+        reference.seconds,
+        reference.wavefront_kernel_seconds.iter().map(|(k, s)| format!("{k} {s:.3} s")).collect::<Vec<_>>().join(", ")
+    )?;
     match &reference.mitsuba {
         Some(m) => writeln!(md, "| Mitsuba {} scalar_rgb ({} threads) | {:.3} | {} | 1.00 |", m.version, m.threads, m.paths_per_second() / 1e6, mean(m.mean_rgb))?,
         None => writeln!(md, "\nMitsuba 3 not measured: {}", reference.mitsuba_missing.as_deref().unwrap_or("?"))?,
@@ -276,6 +282,8 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         "reference_spp": opts.reference_spp,
         "reference_wavefront_paths_per_s": reference.wavefront_paths_per_s,
         "reference_wavefront_max_difference": reference.wavefront_max_difference,
+        "reference_seconds": reference.seconds,
+        "reference_wavefront_kernel_seconds": reference.wavefront_kernel_seconds.iter().map(|(k, s)| (k.clone(), serde_json::json!(s))).collect::<serde_json::Map<_, _>>(),
         "reference_mean_rgb": reference.mean_rgb,
         "mitsuba_paths_per_s": reference.mitsuba.as_ref().map(|m| m.paths_per_second()),
         "mitsuba_threads": reference.mitsuba.as_ref().map(|m| m.threads),
@@ -294,6 +302,10 @@ const REFERENCE_MAX_DEPTH: u32 = 1000;
 
 struct ReferenceBench {
     paths_per_s: f64,
+    /// The megakernel's time for the whole reference.
+    seconds: f64,
+    /// Each wavefront kernel's wall time when submitted alone, in render::wavefront::Kernel order.
+    wavefront_kernel_seconds: Vec<(String, f64)>,
     /// The same reference traced as a wavefront (render::wavefront), and the largest difference
     /// of any pixel's channel from the megakernel's image.
     wavefront_paths_per_s: f64,
@@ -322,6 +334,11 @@ fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
     let start = Instant::now();
     let wf_image = wavefront.render_reference(gpu, &tracer, spp, 1, 0)?;
     let wavefront_paths_per_s = (size * size) as f64 * spp as f64 / start.elapsed().as_secs_f64();
+    // Where its time goes: each kernel waited for alone (slower than the timed run above).
+    let mut kernel_times = render::wavefront::KernelTimes::default();
+    wavefront.render_reference_per_kernel(gpu, &tracer, spp, 1, 0, &mut kernel_times)?;
+    let wavefront_kernel_seconds: Vec<(String, f64)> =
+        render::wavefront::Kernel::ALL.iter().map(|k| (k.name().to_string(), kernel_times.seconds[*k as usize])).collect();
     let wavefront_max_difference = image.iter().zip(&wf_image).flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs())).fold(0.0f32, f32::max);
     let n = image.len() as f64;
     let mean_rgb = [0, 1, 2].map(|c| image.iter().map(|p| p[c] as f64).sum::<f64>() / n);
@@ -335,7 +352,7 @@ fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
             (Some(run), None)
         }
     };
-    Ok(ReferenceBench { paths_per_s, wavefront_paths_per_s, wavefront_max_difference, mean_rgb, mitsuba, mitsuba_missing })
+    Ok(ReferenceBench { paths_per_s, seconds, wavefront_kernel_seconds, wavefront_paths_per_s, wavefront_max_difference, mean_rgb, mitsuba, mitsuba_missing })
 }
 
 /// A GPU fresh from idle runs at a fraction of its clock for a while (an H200 started at 345 of
