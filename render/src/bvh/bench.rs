@@ -16,6 +16,10 @@ use crate::scene::{Mesh, SceneDesc};
 /// Minimum wall time of each timed side; repetitions are added until it is reached.
 const MIN_TIMED: Duration = Duration::from_millis(500);
 
+/// Rounds of the WGSL-against-obvhs measurement: each times the WGSL traversal and then obvhs on
+/// the same rays, so that each round's ratio compares two timings taken under the same load.
+pub const PAIRED_ROUNDS: usize = 5;
+
 #[derive(Clone, Debug)]
 pub struct TraversalBench {
     pub adapter: String,
@@ -28,10 +32,14 @@ pub struct TraversalBench {
     /// Building every BLAS and the TLAS on the CPU, plus the upload.
     pub build_seconds: f64,
     /// Closest-hit rays per second of the WGSL traversal, dispatch to completion (the rays are
-    /// already on the GPU; no readback in the timing).
+    /// already on the GPU; no readback in the timing): the median of [`PAIRED_ROUNDS`] rounds.
     pub gpu_rays_per_second: f64,
-    /// Closest-hit rays per second of obvhs's traversal on `cpu_threads` threads.
+    /// Closest-hit rays per second of obvhs's traversal on `cpu_threads` threads: the median of
+    /// the same rounds, each timed right after the round's WGSL timing.
     pub cpu_rays_per_second: f64,
+    /// WGSL over obvhs in each round, in round order (the machine's speed drifts between rounds;
+    /// within one it barely does).
+    pub paired_ratios: Vec<f64>,
     /// The same rays in coherence order (`ray_order::sort_for_coherence`, sorted on the CPU and
     /// not timed): WGSL and obvhs rays per second.
     pub gpu_sorted_rays_per_second: f64,
@@ -89,8 +97,6 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
     let batch = RayBatch::new(gpu, &geometry);
     let buffers = batch.upload(gpu, &queries)?;
     batch.dispatch(gpu, &geometry, &buffers, TraceKind::Closest)?; // warm-up (pipeline compile, caches)
-    let (reps, elapsed) = repeat_until(MIN_TIMED, || batch.dispatch(gpu, &geometry, &buffers, TraceKind::Closest))?;
-    let gpu_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
     let gpu_hits = batch.read_closest(gpu, &buffers)?;
 
     let start = Instant::now();
@@ -114,11 +120,20 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
     let cpu = geometry.cpu();
     let trace_all = || queries.par_iter().map(|r| cpu.trace_closest(r.origin, r.direction, r.t_max)).collect::<Vec<_>>();
     let cpu_hits = trace_all(); // warm-up
-    let (reps, elapsed) = repeat_until(MIN_TIMED, || {
-        std::hint::black_box(trace_all());
-        Ok(())
-    })?;
-    let cpu_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
+    let (mut gpu_rates, mut cpu_rates, mut paired_ratios) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..PAIRED_ROUNDS {
+        let (reps, elapsed) = repeat_until(MIN_TIMED, || batch.dispatch(gpu, &geometry, &buffers, TraceKind::Closest))?;
+        let gpu_rate = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
+        let (reps, elapsed) = repeat_until(MIN_TIMED, || {
+            std::hint::black_box(trace_all());
+            Ok(())
+        })?;
+        let cpu_rate = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
+        gpu_rates.push(gpu_rate);
+        cpu_rates.push(cpu_rate);
+        paired_ratios.push(gpu_rate / cpu_rate);
+    }
+    let (gpu_rays_per_second, cpu_rays_per_second) = (median(&gpu_rates), median(&cpu_rates));
 
     let sorted = sort_for_coherence(geometry.bounds(), &queries);
     let sorted_buffers = batch.upload(gpu, &sorted)?;
@@ -144,6 +159,7 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
         build_seconds,
         gpu_rays_per_second,
         cpu_rays_per_second,
+        paired_ratios,
         gpu_sorted_rays_per_second,
         cpu_sorted_rays_per_second,
         gpu_bvh2_rays_per_second,
@@ -154,6 +170,17 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
         hit_fraction,
         agreement,
     })
+}
+
+/// The median (the mean of the middle two for an even count).
+pub fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
 }
 
 fn repeat_until(min: Duration, mut f: impl FnMut() -> Result<(), BvhError>) -> Result<(u32, Duration), BvhError> {
@@ -251,5 +278,12 @@ mod tests {
         }
         assert!(outward as f64 > 0.999 * m.indices.len() as f64, "{outward} of {}", m.indices.len());
         assert_eq!(m.positions, displaced_sphere(100_000, 3).positions, "deterministic");
+    }
+
+    #[test]
+    fn median_of_odd_and_even_counts() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert!(median(&[]).is_nan());
     }
 }

@@ -26,7 +26,7 @@ mod stack_need;
 mod tlas;
 mod triangle;
 
-pub use bench::{TraversalBench, displaced_sphere, random_rays, traversal_benchmark};
+pub use bench::{PAIRED_ROUNDS, TraversalBench, displaced_sphere, median, random_rays, traversal_benchmark};
 pub use blas::Blas;
 pub use bvh2::{BVH2_STACK_SIZE, Bvh2Blas, SceneBvh2};
 pub use bvh2_geometry::{Bvh2Geometry, SgBvh2Node};
