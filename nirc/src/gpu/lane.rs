@@ -1,5 +1,6 @@
-//! The register form of inference (`WeightPlacement::Registers`): one query per invocation, its
-//! inputs and activations in named registers, both predictors' MLP weights in one uniform buffer
+//! The register form of inference (`WeightPlacement::Registers`): two queries per invocation
+//! (each staged weight loaded once for both: 1.6-1.8x the queries/s of one per invocation on a
+//! newer lavapipe machine, nirc/README.md), their inputs and activations in named registers, both predictors' MLP weights in one uniform buffer
 //! (`lane_stage.wgsl` copies them there, transposed, before each inference; `infer_lane.wgsl`).
 //! Why this shape, from `nirc::bench::register_layer_probe` on lavapipe (Mesa 22.3): a storage or
 //! workgroup load whose address is not a constant becomes a loop over the SIMD lanes, a private
@@ -80,33 +81,35 @@ fn inputs(layout: &ParameterLayout, grid_textures: bool) -> String {
     s
 }
 
-/// `lane_net(net_base, x) -> vec4`: every layer, looping over its output quads with the sum over
-/// the layer's inputs unrolled (inputs in order); each quad lands in its named register through a
-/// switch on the (uniform) quad index. ReLU on hidden layers; the outputs in .xyz.
+/// `lane_net(net_base, x, y) -> LaneOut`: the forward pass of two queries at once, each weight
+/// loaded once for both. Every layer loops over its output quads with the sum over the layer's
+/// inputs unrolled (inputs in order); each quad lands in its named register through a switch on
+/// the (uniform) quad index. ReLU on hidden layers; the outputs in .xyz.
 fn net(layout: &ParameterLayout, bases: &[u32]) -> String {
-    let mut s = String::from("fn lane_net(net_base: u32, x: LaneIn) -> vec4<f32> {\n");
+    let mut s = String::from("struct LaneOut { a: vec4<f32>, b: vec4<f32> }\n\nfn lane_net(net_base: u32, x: LaneIn, y: LaneIn) -> LaneOut {\n");
     let last = layout.matrices.len() - 1;
     for (m, (matrix, base)) in layout.matrices.iter().zip(bases).enumerate() {
         let quads = matrix.rows.div_ceil(4);
-        let input = |k: u32| if m == 0 { format!("x.v{}", k / 4) } else { format!("h{}_{}", m - 1, k / 4) };
+        let input = |k: u32, who: &str| if m == 0 { format!("{who}.v{}", k / 4) } else { format!("{who}{}_{}", m - 1, k / 4) };
         if m < last {
             for q in 0..quads {
-                s.push_str(&format!("    var h{m}_{q} = vec4<f32>(0.0);\n"));
+                s.push_str(&format!("    var ha{m}_{q} = vec4<f32>(0.0);\n    var hb{m}_{q} = vec4<f32>(0.0);\n"));
             }
         }
-        s.push_str(&format!("    for (var q = 0u; q < {quads}u; q++) {{\n        let row = net_base + {base}u + q;\n        var acc = vec4<f32>(0.0);\n"));
+        s.push_str(&format!("    for (var q = 0u; q < {quads}u; q++) {{\n        let row = net_base + {base}u + q;\n        var acc = vec4<f32>(0.0);\n        var acc2 = vec4<f32>(0.0);\n"));
+        let (xa, xb) = if m == 0 { ("x", "y") } else { ("ha", "hb") };
         for k in 0..matrix.cols {
-            s.push_str(&format!("        acc += {}.{} * lane_w[row + {}u];\n", input(k), XYZW[(k % 4) as usize], k * quads));
+            s.push_str(&format!("        let w{k} = lane_w[row + {}u];\n        acc += {}.{c} * w{k};\n        acc2 += {}.{c} * w{k};\n", k * quads, input(k, xa), input(k, xb), c = XYZW[(k % 4) as usize]));
         }
         if m < last {
             s.push_str("        switch q {\n");
             for q in 0..quads {
-                s.push_str(&format!("            case {q}u: {{ h{m}_{q} = lane_relu(acc); }}\n"));
+                s.push_str(&format!("            case {q}u: {{ ha{m}_{q} = lane_relu(acc); hb{m}_{q} = lane_relu(acc2); }}\n"));
             }
             s.push_str("            default: {}\n        }\n    }\n");
         } else {
             // The output layer has one quad.
-            s.push_str("        return acc;\n    }\n    return vec4<f32>(0.0);\n");
+            s.push_str("        return LaneOut(acc, acc2);\n    }\n    return LaneOut(vec4<f32>(0.0), vec4<f32>(0.0));\n");
         }
     }
     s.push_str("}\n");

@@ -686,7 +686,9 @@ impl NeuralCache {
     fn infer_groups(&self, n: u32) -> u32 {
         match self.placement {
             WeightPlacement::Tiled => n.div_ceil(shaders::INFER_TILE_QUERIES),
-            WeightPlacement::Storage | WeightPlacement::Registers => n.div_ceil(WORKGROUP_SIZE),
+            WeightPlacement::Storage => n.div_ceil(WORKGROUP_SIZE),
+            // Two queries per invocation (infer_lane.wgsl).
+            WeightPlacement::Registers => n.div_ceil(2 * WORKGROUP_SIZE),
         }
     }
 
