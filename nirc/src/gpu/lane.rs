@@ -15,6 +15,10 @@ use crate::layout::ParameterLayout;
 
 const XYZW: [&str; 4] = ["x", "y", "z", "w"];
 
+/// Queries per invocation of the register-form inference: each staged weight is loaded once for
+/// all of them (nirc/README.md, "Several queries per invocation").
+pub const LANE_QUERIES: u32 = 4;
+
 /// Where each matrix starts in one predictor's staged weights (vec4s), and the vec4s of one
 /// predictor: matrix m as W^T by output quads, lane_w[base_m + k * quads + q] = outputs
 /// 4q..4q+3 of input k. Predictor `net` starts at net * the total.
@@ -81,36 +85,75 @@ fn inputs(layout: &ParameterLayout, grid_textures: bool) -> String {
     s
 }
 
-/// `lane_net(net_base, x, y) -> LaneOut`: the forward pass of two queries at once, each weight
-/// loaded once for both. Every layer loops over its output quads with the sum over the layer's
-/// inputs unrolled (inputs in order); each quad lands in its named register through a switch on
-/// the (uniform) quad index. ReLU on hidden layers; the outputs in .xyz.
+/// `lane_net(net_base, x0, .., x{K-1}) -> LaneOut`: the forward pass of `LANE_QUERIES` queries at
+/// once, each weight loaded once for all. Every layer loops over its output quads with the sum
+/// over the layer's inputs unrolled (inputs in order); each quad lands in its named register
+/// through a switch on the (uniform) quad index. ReLU on hidden layers; the outputs in .xyz.
 fn net(layout: &ParameterLayout, bases: &[u32]) -> String {
-    let mut s = String::from("struct LaneOut { a: vec4<f32>, b: vec4<f32> }\n\nfn lane_net(net_base: u32, x: LaneIn, y: LaneIn) -> LaneOut {\n");
+    let kq = LANE_QUERIES;
+    let fields: Vec<String> = (0..kq).map(|j| format!("o{j}: vec4<f32>")).collect();
+    let params: Vec<String> = (0..kq).map(|j| format!("x{j}: LaneIn")).collect();
+    let mut s = format!("struct LaneOut {{ {} }}\n\nfn lane_net(net_base: u32, {}) -> LaneOut {{\n", fields.join(", "), params.join(", "));
     let last = layout.matrices.len() - 1;
     for (m, (matrix, base)) in layout.matrices.iter().zip(bases).enumerate() {
         let quads = matrix.rows.div_ceil(4);
-        let input = |k: u32, who: &str| if m == 0 { format!("{who}.v{}", k / 4) } else { format!("{who}{}_{}", m - 1, k / 4) };
+        let input = |k: u32, j: u32| if m == 0 { format!("x{j}.v{}", k / 4) } else { format!("h{j}_{}_{}", m - 1, k / 4) };
         if m < last {
             for q in 0..quads {
-                s.push_str(&format!("    var ha{m}_{q} = vec4<f32>(0.0);\n    var hb{m}_{q} = vec4<f32>(0.0);\n"));
+                for j in 0..kq {
+                    s.push_str(&format!("    var h{j}_{m}_{q} = vec4<f32>(0.0);\n"));
+                }
             }
         }
-        s.push_str(&format!("    for (var q = 0u; q < {quads}u; q++) {{\n        let row = net_base + {base}u + q;\n        var acc = vec4<f32>(0.0);\n        var acc2 = vec4<f32>(0.0);\n"));
-        let (xa, xb) = if m == 0 { ("x", "y") } else { ("ha", "hb") };
+        s.push_str(&format!("    for (var q = 0u; q < {quads}u; q++) {{\n        let row = net_base + {base}u + q;\n"));
+        for j in 0..kq {
+            s.push_str(&format!("        var acc{j} = vec4<f32>(0.0);\n"));
+        }
         for k in 0..matrix.cols {
-            s.push_str(&format!("        let w{k} = lane_w[row + {}u];\n        acc += {}.{c} * w{k};\n        acc2 += {}.{c} * w{k};\n", k * quads, input(k, xa), input(k, xb), c = XYZW[(k % 4) as usize]));
+            s.push_str(&format!("        let w{k} = lane_w[row + {}u];\n", k * quads));
+            for j in 0..kq {
+                s.push_str(&format!("        acc{j} += {}.{} * w{k};\n", input(k, j), XYZW[(k % 4) as usize]));
+            }
         }
         if m < last {
             s.push_str("        switch q {\n");
             for q in 0..quads {
-                s.push_str(&format!("            case {q}u: {{ ha{m}_{q} = lane_relu(acc); hb{m}_{q} = lane_relu(acc2); }}\n"));
+                let sets: String = (0..kq).map(|j| format!(" h{j}_{m}_{q} = lane_relu(acc{j});")).collect();
+                s.push_str(&format!("            case {q}u: {{{sets} }}\n"));
             }
             s.push_str("            default: {}\n        }\n    }\n");
         } else {
             // The output layer has one quad.
-            s.push_str("        return LaneOut(acc, acc2);\n    }\n    return LaneOut(vec4<f32>(0.0), vec4<f32>(0.0));\n");
+            let accs: Vec<String> = (0..kq).map(|j| format!("acc{j}")).collect();
+            let zeros: Vec<String> = (0..kq).map(|_| "vec4<f32>(0.0)".to_string()).collect();
+            s.push_str(&format!("        return LaneOut({});\n    }}\n    return LaneOut({});\n", accs.join(", "), zeros.join(", ")));
         }
+    }
+    s.push_str("}\n");
+    s
+}
+
+/// The generated module `package::nirc::lane_queries` of `infer_lane.wgsl`: `lane_infer(first, pr,
+/// mode)` answers queries first, first + 64, .. (`LANE_QUERIES` of them) with one pass of each
+/// predictor's layers; those past the end compute the last query again and write nothing.
+pub fn queries_module() -> String {
+    let kq = LANE_QUERIES;
+    let wg = crate::gpu::shaders::WORKGROUP_SIZE;
+    let list = |f: &dyn Fn(u32) -> String| (0..kq).map(f).collect::<Vec<_>>().join(", ");
+    let mut s = String::from(
+        "import package::nirc::bindings::{call, hyper, queries};\nimport package::nirc::bindings_common::{normalize_to_bounds};\nimport package::nirc::lane::{LANE_W_VEC4, LaneOut, lane_inputs, lane_net};\nimport package::nirc::answer::{Predictors, write_predictions};\n\n",
+    );
+    s.push_str(&format!("const LANE_QUERIES: u32 = {kq}u;\n\nfn lane_infer(first: u32, pr: Predictors, mode: u32) {{\n    let last = call.n - 1u;\n"));
+    for j in 0..kq {
+        s.push_str(&format!(
+            "    let i{j} = min(first + {}u, last);\n    let r{j} = queries[i{j}];\n    let x{j} = lane_inputs(normalize_to_bounds(hyper, r{j}.position.xyz), r{j}.direction.xyz, pr.first_net, pr.both);\n",
+            j * wg
+        ));
+    }
+    s.push_str(&format!("    let f = lane_net(pr.first_net * LANE_W_VEC4, {});\n", list(&|j| format!("x{j}.a"))));
+    s.push_str(&format!("    var g = LaneOut({});\n    if pr.both {{\n        g = lane_net(0u, {});\n    }}\n", list(&|_| "vec4<f32>(0.0)".into()), list(&|j| format!("x{j}.b"))));
+    for j in 0..kq {
+        s.push_str(&format!("    if first + {}u <= last {{\n        write_predictions(i{j}, r{j}.position.xyz, mode, pr, f.o{j}.xyz, g.o{j}.xyz);\n    }}\n", j * wg));
     }
     s.push_str("}\n");
     s

@@ -688,7 +688,7 @@ impl NeuralCache {
             WeightPlacement::Tiled => n.div_ceil(shaders::INFER_TILE_QUERIES),
             WeightPlacement::Storage => n.div_ceil(WORKGROUP_SIZE),
             // Two queries per invocation (infer_lane.wgsl).
-            WeightPlacement::Registers => n.div_ceil(2 * WORKGROUP_SIZE),
+            WeightPlacement::Registers => n.div_ceil(lane::LANE_QUERIES * WORKGROUP_SIZE),
         }
     }
 

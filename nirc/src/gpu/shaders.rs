@@ -208,6 +208,9 @@ pub fn program(config: &NircConfig, layout: &ParameterLayout, pass: &str, grid_w
     if pass == "infer_lane" || pass == "lane_stage" {
         modules.push(Module::generated("package::nirc::lane", &[&super::lane::module(layout, grid_width.is_some())]));
     }
+    if pass == "infer_lane" {
+        modules.push(Module::generated("package::nirc::lane_queries", &[&super::lane::queries_module()]));
+    }
     let (own, entry) = pass_files(pass);
     modules.extend(own);
     modules.extend(shared_files());
