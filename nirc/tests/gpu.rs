@@ -104,7 +104,7 @@ fn register_form_matches_the_tiled_form() {
         let queries: Vec<_> = records(&mut Rng(5), 150).iter().map(|r| r.query()).collect();
         let tiled = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Tiled)).unwrap();
         let lane = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Registers)).unwrap();
-        // Every mode: those with both predictors run the register form's High-LR pass first.
+        // Every mode: one predictor, both blended (three ways), or both switched.
         for mode in [PredictorMode::EmaOnly, PredictorMode::Blend, PredictorMode::HighLrOnly, PredictorMode::Switch, PredictorMode::Fixed(0.3)] {
             lane.infer_queries(gpu(), &queries, mode).unwrap();
             tiled.train_records(gpu(), &batch).unwrap();

@@ -1,7 +1,8 @@
 //! The register form of inference (`WeightPlacement::Registers`): `LANE_QUERIES` (4) queries per
 //! invocation, each staged weight loaded once for all of them (2x the queries/s of one per
 //! invocation on a newer lavapipe machine; nirc/README.md), their inputs and activations in named
-//! registers, both predictors' MLP weights in one uniform buffer (`lane_stage.wgsl` copies them there, transposed, before each inference; `infer_lane.wgsl`).
+//! registers, both predictors' MLP weights in one uniform buffer (`lane_stage.wgsl` copies them
+//! there, transposed, before each inference; `infer_lane.wgsl`).
 //! Why this shape, from `nirc::bench::register_layer_probe` on lavapipe (Mesa 22.3): a storage or
 //! workgroup load whose address is not a constant becomes a loop over the SIMD lanes, a private
 //! array indexed at run time a scatter/gather, while a uniform-buffer load at a dynamically

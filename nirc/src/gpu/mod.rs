@@ -687,7 +687,7 @@ impl NeuralCache {
         match self.placement {
             WeightPlacement::Tiled => n.div_ceil(shaders::INFER_TILE_QUERIES),
             WeightPlacement::Storage => n.div_ceil(WORKGROUP_SIZE),
-            // Two queries per invocation (infer_lane.wgsl).
+            // LANE_QUERIES queries per invocation (infer_lane.wgsl).
             WeightPlacement::Registers => n.div_ceil(lane::LANE_QUERIES * WORKGROUP_SIZE),
         }
     }
