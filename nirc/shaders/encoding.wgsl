@@ -17,31 +17,59 @@ fn level_corners(level: u32, p: vec3<f32>) -> Corners {
     return corners_at(p, level_resolution[level], level_dense[level] == 1u, level_table_size[level], level_offset[level]);
 }
 
-// level_corners with the level's resolution, density, table size and offset given (the
-// generated register-form inference passes them as constants, so nothing is looked up).
-fn corners_at(p: vec3<f32>, res: u32, dense: bool, table_size: u32, offset: u32) -> Corners {
-    var cell = vec3<u32>(0u);
-    var frac = vec3<f32>(0.0);
+// The cell of a level that holds p, and p's fractions inside it.
+struct Cell {
+    cell: vec3<u32>,
+    frac: vec3<f32>,
+}
+
+struct Corner {
+    index: u32,
+    weight: f32,
+}
+
+fn cell_at(p: vec3<f32>, res: u32) -> Cell {
+    var out: Cell;
     for (var a = 0u; a < 3u; a++) {
         let x = p[a] * f32(res);
         // The upper face (p = 1) belongs to the last cell, with fraction 1.
-        cell[a] = min(u32(floor(x)), res - 1u);
-        frac[a] = x - f32(cell[a]);
+        out.cell[a] = min(u32(floor(x)), res - 1u);
+        out.frac[a] = x - f32(out.cell[a]);
     }
+    return out;
+}
+
+// Vertex c (bits x, y, z) of a cell: the parameter index of its first feature and its
+// trilinear weight.
+fn cell_corner(cell: Cell, c: u32, res: u32, dense: bool, table_size: u32, offset: u32) -> Corner {
+    let d = vec3<u32>(c & 1u, (c >> 1u) & 1u, c >> 2u);
+    let v = cell.cell + d;
+    var entry: u32;
+    if dense {
+        let side = res + 1u;
+        entry = v.x + v.y * side + v.z * side * side;
+    } else {
+        entry = spatial_hash(v) & (table_size - 1u);
+    }
+    let w = select(vec3<f32>(1.0) - cell.frac, cell.frac, d == vec3<u32>(1u));
+    return Corner(offset + entry * FEATURES, w.x * w.y * w.z);
+}
+
+// Vertex c of the cell around p on one level (a loop over c then keeps no array of corners:
+// lavapipe puts a dynamically indexed private array in memory).
+fn level_corner(level: u32, cell: Cell, c: u32) -> Corner {
+    return cell_corner(cell, c, level_resolution[level], level_dense[level] == 1u, level_table_size[level], level_offset[level]);
+}
+
+// level_corners with the level's resolution, density, table size and offset given (the
+// generated register-form inference passes them as constants, so nothing is looked up).
+fn corners_at(p: vec3<f32>, res: u32, dense: bool, table_size: u32, offset: u32) -> Corners {
+    let cell = cell_at(p, res);
     var out: Corners;
     for (var c = 0u; c < 8u; c++) {
-        let d = vec3<u32>(c & 1u, (c >> 1u) & 1u, c >> 2u);
-        let v = cell + d;
-        var entry: u32;
-        if dense {
-            let side = res + 1u;
-            entry = v.x + v.y * side + v.z * side * side;
-        } else {
-            entry = spatial_hash(v) & (table_size - 1u);
-        }
-        let w = select(vec3<f32>(1.0) - frac, frac, d == vec3<u32>(1u));
-        out.index[c] = offset + entry * FEATURES;
-        out.weight[c] = w.x * w.y * w.z;
+        let corner = cell_corner(cell, c, res, dense, table_size, offset);
+        out.index[c] = corner.index;
+        out.weight[c] = corner.weight;
     }
     return out;
 }

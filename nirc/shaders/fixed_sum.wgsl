@@ -34,37 +34,39 @@ fn fixed_add(base: u32, x: f32) -> bool {
     let r = u32(shift) % 32u;
     let low = m << r;
     let high = select(m >> (32u - r), 0u, r == 0u);
-    var w = array<u32, 3>(0u, 0u, 0u);
-    w[q] = low;
-    if q < 2u {
-        w[q + 1u] = high;
-    }
+    // Word q gets low, word q + 1 high; selects rather than an indexed array (lavapipe keeps a
+    // dynamically indexed private array in memory).
+    var w0 = select(0u, low, q == 0u);
+    var w1 = select(select(0u, high, q == 0u), low, q == 1u);
+    var w2 = select(select(0u, high, q == 1u), low, q == 2u);
     if (bits >> 31u) == 1u {
         // Two's complement negation of the 96 bits.
-        w[0] = ~w[0];
-        w[1] = ~w[1];
-        w[2] = ~w[2];
-        w[0] = w[0] + 1u;
-        if w[0] == 0u {
-            w[1] = w[1] + 1u;
-            if w[1] == 0u {
-                w[2] = w[2] + 1u;
-            }
-        }
+        w0 = ~w0 + 1u;
+        w1 = ~w1 + select(0u, 1u, w0 == 0u);
+        w2 = ~w2 + select(0u, 1u, w0 == 0u && w1 == 0u);
     }
-    fixed_add_words(base, w[0], w[1], w[2]);
+    fixed_add_words(base, w0, w1, w2);
     return true;
 }
 
 fn fixed_add_words(base: u32, w0: u32, w1: u32, w2: u32) {
+    // Adding zero to a word is skipped (on lavapipe each atomic is a loop over the active
+    // lanes). Most addends of the upper words are zero: a small value has no middle or high
+    // bits, and a small negative one's all-ones upper words plus the carry wrap to zero.
     let old0 = atomicAdd(&accum[base], w0);
     let carry0 = select(0u, 1u, old0 + w0 < old0);
     let w1c = w1 + carry0;
     // w1 = 0xffffffff plus a carry wraps to 0: the carry moves on to the top word.
     let carry_through = select(0u, 1u, w1c < w1);
-    let old1 = atomicAdd(&accum[base + 1u], w1c);
-    let carry1 = select(0u, 1u, old1 + w1c < old1);
-    atomicAdd(&accum[base + 2u], w2 + carry1 + carry_through);
+    var carry1 = 0u;
+    if w1c != 0u {
+        let old1 = atomicAdd(&accum[base + 1u], w1c);
+        carry1 = select(0u, 1u, old1 + w1c < old1);
+    }
+    let w2c = w2 + carry1 + carry_through;
+    if w2c != 0u {
+        atomicAdd(&accum[base + 2u], w2c);
+    }
 }
 
 // Adds x clamped to ±(2^32 - 2^8) (statistics: a firefly must not void a step).

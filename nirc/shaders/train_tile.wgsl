@@ -7,14 +7,14 @@
 // pre-activation gradients go through `scratch` (record-major, as the per-record pass).
 
 import package::nirc::types::{ReliabilitySample};
-import package::nirc::config::{ACT_FLOATS, DIR_DIMS, FEATURES, HIDDEN, IN_DIMS, IN_STRIDE, LEVELS, MLP_PARAMS, SCRATCH_STRIDE, WG_SIZE, WIDTH};
+import package::nirc::config::{level_resolution, ACT_FLOATS, DIR_DIMS, FEATURES, HIDDEN, IN_DIMS, IN_STRIDE, LEVELS, MLP_PARAMS, SCRATCH_STRIDE, WG_SIZE, WIDTH};
 import package::nirc::bindings::{call, counters, hyper, losses, records, samples, scratch, scratch_set};
 import package::nirc::tile::{Block, OPT, RQ, TILE, tile_a, tile_matmul, tile_w};
 import package::nirc::bindings_common::{is_finite, normalize_to_bounds};
 import package::nirc::mlp_layout::{act_base, delta_base, mat_cols, mat_offset, mat_rows};
 import package::nirc::fixed_sum::{fixed_add};
 import package::nirc::loss::{relative_l2};
-import package::nirc::encoding::{corner_sum, direction_feature, level_corners};
+import package::nirc::encoding::{cell_at, corner_sum, direction_feature, level_corner, level_corners};
 import package::nirc::grid::{GRID_PAIRS, corner_pair};
 import package::nirc::keep::{keep_block, record_slot, record_valid, tile_first};
 import package::nirc::mlp_tile::{block_stride, load_matrix, mlp_forward_tile, store_block};
@@ -151,14 +151,18 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
     }
     workgroupBarrier();
 
-    // 5. Hash-grid gradients, per record.
+    // 5. Hash-grid gradients, per record, corner by corner.
     if in_range {
         for (var l = 0u; l < LEVELS; l++) {
-            let corners = level_corners(l, p);
+            let cell = cell_at(p, level_resolution[l]);
+            var d = array<f32, FEATURES>();
             for (var k = 0u; k < FEATURES; k++) {
-                let d = tile_a[(l * FEATURES + k) * RQ + lid / 4u][lid % 4u];
-                for (var c = 0u; c < 8u; c++) {
-                    ok = fixed_add(3u * (corners.index[c] + k - MLP_PARAMS), corners.weight[c] * d) && ok;
+                d[k] = tile_a[(l * FEATURES + k) * RQ + lid / 4u][lid % 4u];
+            }
+            for (var c = 0u; c < 8u; c++) {
+                let corner = level_corner(l, cell, c);
+                for (var k = 0u; k < FEATURES; k++) {
+                    ok = fixed_add(3u * (corner.index + k - MLP_PARAMS), corner.weight * d[k]) && ok;
                 }
             }
         }
