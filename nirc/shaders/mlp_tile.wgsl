@@ -29,16 +29,21 @@ fn load_matrix(net: u32, m: u32, lid: u32, transposed: bool) {
     let cols = mat_cols(m);
     let outputs = select(cols, rows, transposed);
     let row = block_stride(outputs) * 4u;
-    for (var e = lid; e < row * select(rows, cols, transposed); e += WG_SIZE) {
-        let k = e / row;
-        let o = e % row;
-        var v = 0.0;
-        if o < outputs {
-            let i = select(k, o, transposed);
-            let j = select(o, k, transposed);
-            v = weight(net, mat_offset(m) + i * cols + j);
+    // A quad of tile_w per step, stored whole (one workgroup store where four would each be a
+    // loop over the SIMD lanes on lavapipe); row is a multiple of 4, so a quad never spans rows.
+    for (var e4 = lid; e4 < row / 4u * select(rows, cols, transposed); e4 += WG_SIZE) {
+        let k = (4u * e4) / row;
+        let o0 = (4u * e4) % row;
+        var v = vec4<f32>(0.0);
+        for (var c = 0u; c < 4u; c++) {
+            let o = o0 + c;
+            if o < outputs {
+                let i = select(k, o, transposed);
+                let j = select(o, k, transposed);
+                v[c] = weight(net, mat_offset(m) + i * cols + j);
+            }
         }
-        tile_w[e / 4u][e % 4u] = v;
+        tile_w[e4] = v;
     }
 }
 
