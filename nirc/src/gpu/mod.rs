@@ -163,6 +163,12 @@ pub struct NeuralCache {
     groups: FixedBindGroups,
 }
 
+/// Parameter quads each invocation of Adam's and the EMA's passes updates (their loops stride
+/// over the whole vector): the per-invocation work (the step's bias corrections and the flag,
+/// read from `counters`) is then paid once per 4 quads. On lavapipe one quad per invocation
+/// made these passes 1.3-1.6x slower (nirc/README.md); 16 was slower again.
+const PARAM_QUADS_PER_INVOCATION: u64 = 4;
+
 fn groups_for(threads: u64) -> u32 {
     threads.div_ceil(WORKGROUP_SIZE as u64).clamp(1, 65535) as u32
 }
@@ -514,7 +520,7 @@ impl NeuralCache {
     /// gradients, the Adam step (name, pipeline, bind group, workgroups).
     fn adam_stages<'a>(&'a self, s: &'a TrainStep) -> Vec<Stage<'a>> {
         let p = &self.pipelines;
-        let all = groups_for(self.layout.total_params as u64 / 4);
+        let all = groups_for((self.layout.total_params as u64 / 4).div_ceil(PARAM_QUADS_PER_INVOCATION));
         let mut stages: Vec<Stage> = vec![
             ("train (forward, backward)", &p.train, &s.fb, s.n.div_ceil(WORKGROUP_SIZE)),
             ("reliability accumulate", &p.reliability_accumulate, &s.accumulate, groups_for(s.n as u64)),
@@ -530,7 +536,7 @@ impl NeuralCache {
 
     /// The `nirc::ema` part: the debiased EMA of every parameter.
     fn ema_stages<'a>(&'a self, s: &'a TrainStep) -> Vec<Stage<'a>> {
-        vec![("ema update (every parameter)", &self.pipelines.ema_update, &s.ema, groups_for(self.layout.total_params as u64 / 4))]
+        vec![("ema update (every parameter)", &self.pipelines.ema_update, &s.ema, groups_for((self.layout.total_params as u64 / 4).div_ceil(PARAM_QUADS_PER_INVOCATION)))]
     }
 
     /// The `nirc::reliability_update` part: the per-sample moment walk (not for the batch-mean
