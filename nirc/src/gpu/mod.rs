@@ -520,7 +520,7 @@ impl NeuralCache {
     /// gradients, the Adam step (name, pipeline, bind group, workgroups).
     fn adam_stages<'a>(&'a self, s: &'a TrainStep) -> Vec<Stage<'a>> {
         let p = &self.pipelines;
-        let all = groups_for((self.layout.total_params as u64 / 4).div_ceil(PARAM_QUADS_PER_INVOCATION));
+        let all = self.param_groups();
         let mut stages: Vec<Stage> = vec![
             ("train (forward, backward)", &p.train, &s.fb, s.n.div_ceil(WORKGROUP_SIZE)),
             ("reliability accumulate", &p.reliability_accumulate, &s.accumulate, groups_for(s.n as u64)),
@@ -534,9 +534,14 @@ impl NeuralCache {
         stages
     }
 
+    /// Workgroups of the passes over every parameter quad (Adam's check and apply, the EMA).
+    fn param_groups(&self) -> u32 {
+        groups_for((self.layout.total_params as u64 / 4).div_ceil(PARAM_QUADS_PER_INVOCATION))
+    }
+
     /// The `nirc::ema` part: the debiased EMA of every parameter.
     fn ema_stages<'a>(&'a self, s: &'a TrainStep) -> Vec<Stage<'a>> {
-        vec![("ema update (every parameter)", &self.pipelines.ema_update, &s.ema, groups_for((self.layout.total_params as u64 / 4).div_ceil(PARAM_QUADS_PER_INVOCATION)))]
+        vec![("ema update (every parameter)", &self.pipelines.ema_update, &s.ema, self.param_groups())]
     }
 
     /// The `nirc::reliability_update` part: the per-sample moment walk (not for the batch-mean
