@@ -309,8 +309,7 @@ impl CachePaths {
 
     /// Reads `out.image` back: the radiance (alpha 1) and per pixel (mean σ, answered samples).
     pub fn read_image(&self, gpu: &Gpu, out: &CacheOutput) -> Result<(Vec<[f32; 4]>, Vec<[f32; 4]>), NircError> {
-        let bytes = crate::gpu::readback::read_bytes(gpu, &out.image, "nirc image")?;
-        let texels: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        let texels: Vec<[f32; 4]> = crate::gpu::readback::read_pod(gpu, &out.image, "nirc image")?;
         let n = self.pixels() as usize;
         Ok((texels[..n].to_vec(), texels[n..2 * n].to_vec()))
     }
@@ -318,35 +317,36 @@ impl CachePaths {
     /// Per pixel motion (previous image position - current, pixels) of the last
     /// `encode_queries`, from the pixel-centre primary hit as the path tracer's G-buffer.
     pub fn read_motion(&self, gpu: &Gpu) -> Result<Vec<[f32; 2]>, NircError> {
-        let bytes = crate::gpu::readback::read_bytes(gpu, &self.motion, "nirc motion")?;
-        Ok(bytemuck::cast_slice::<u8, [f32; 2]>(&bytes)[..self.pixels() as usize].to_vec())
+        let mut motion: Vec<[f32; 2]> = crate::gpu::readback::read_pod(gpu, &self.motion, "nirc motion")?;
+        motion.truncate(self.pixels() as usize);
+        Ok(motion)
     }
 
     /// Rays traced since the last `encode_queries` (camera paths, training targets), counted on
     /// the GPU as every other method's.
     pub fn read_rays(&self, gpu: &Gpu) -> Result<[u64; 2], NircError> {
-        let bytes = crate::gpu::readback::read_bytes(gpu, &self.ray_counters, "nirc ray counters")?;
-        let c: &[u32] = bytemuck::cast_slice(&bytes);
+        let c: Vec<u32> = crate::gpu::readback::read_pod(gpu, &self.ray_counters, "nirc ray counters")?;
         Ok([c[0] as u64, c[1] as u64])
     }
 
     /// Reads `out.answers` back (e.g. after `NeuralCache::encode_reliability`).
     pub fn read_answers(&self, gpu: &Gpu, out: &CacheOutput) -> Result<Vec<[f32; 4]>, NircError> {
-        let bytes = crate::gpu::readback::read_bytes(gpu, &out.answers, "nirc answers")?;
-        Ok(bytemuck::cast_slice::<u8, [f32; 4]>(&bytes)[..self.query_count() as usize].to_vec())
+        let mut answers: Vec<[f32; 4]> = crate::gpu::readback::read_pod(gpu, &out.answers, "nirc answers")?;
+        answers.truncate(self.query_count() as usize);
+        Ok(answers)
     }
 
     /// Per query of the last `encode_queries`: whether the path reached its termination vertex.
     pub fn read_query_valid(&self, gpu: &Gpu) -> Result<Vec<bool>, NircError> {
-        let bytes = crate::gpu::readback::read_bytes(gpu, &self.meta, "nirc query weights")?;
-        let floats: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        let floats: Vec<[f32; 4]> = crate::gpu::readback::read_pod(gpu, &self.meta, "nirc query weights")?;
         Ok(floats.chunks_exact(3).take(self.query_count() as usize).map(|m| m[0][3] > 0.0).collect())
     }
 
     /// The training records of the last frame (tests, diagnostics).
     pub fn read_records(&self, gpu: &Gpu) -> Result<Vec<TrainingRecord>, NircError> {
-        let bytes = crate::gpu::readback::read_bytes(gpu, &self.records, "nirc training records")?;
-        Ok(bytemuck::cast_slice::<u8, TrainingRecord>(&bytes)[..self.record_count() as usize].to_vec())
+        let mut records: Vec<TrainingRecord> = crate::gpu::readback::read_pod(gpu, &self.records, "nirc training records")?;
+        records.truncate(self.record_count() as usize);
+        Ok(records)
     }
 }
 

@@ -51,8 +51,8 @@ fn gpu_sums(gpu: &Gpu, values: &[f32]) -> (Vec<[u32; 3]>, Vec<bool>) {
         pass.dispatch_workgroups((values.len() as u32).div_ceil(64), 1, 1);
     }
     gpu.queue.submit([encoder.finish()]);
-    let words: Vec<u32> = bytemuck::cast_slice(&nirc::gpu::readback::read_bytes(gpu, &accum, "accum").unwrap()).to_vec();
-    let flags: Vec<u32> = bytemuck::cast_slice(&nirc::gpu::readback::read_bytes(gpu, &accepted, "accepted").unwrap()).to_vec();
+    let words: Vec<u32> = nirc::gpu::readback::read_pod(gpu, &accum, "accum").unwrap();
+    let flags: Vec<u32> = nirc::gpu::readback::read_pod(gpu, &accepted, "accepted").unwrap();
     (words.chunks(3).map(|w| [w[0], w[1], w[2]]).collect(), flags.iter().map(|&f| f == 1).collect())
 }
 
@@ -68,8 +68,8 @@ fn gpu_fixed_sums_equal_the_cpu_word_for_word() {
         f32::powi(2.0, -49),
         1.0,
         -1.0,
-        f32::powi(2.0, 7),   // lowest bit lands exactly on the middle word
-        -f32::powi(2.0, 8),  // and exactly on the top word
+        f32::powi(2.0, 7),   // its mantissa starts exactly at the middle word's bit 0 (shift 32)
+        -f32::powi(2.0, 8),  // one bit further (shift 33), negated; no value reaches the top word at bit 0
         f32::powi(2.0, 31),
         -4_294_967_040.0, // largest accepted magnitude
         4_294_967_296.0,  // 2^32: refused

@@ -223,8 +223,9 @@ pub fn upload<T: Pod>(gpu: &Gpu, label: &str, items: &[T]) -> wgpu::Buffer {
 
 /// The first `n` answers of an answer buffer, read back.
 pub fn read_answers(gpu: &Gpu, answers: &wgpu::Buffer, n: u32) -> Result<Vec<CacheAnswer>, NircError> {
-    let bytes = readback::read_bytes(gpu, answers, "nirc answers")?;
-    Ok(bytemuck::cast_slice::<u8, CacheAnswer>(&bytes[..n as usize * std::mem::size_of::<CacheAnswer>()]).to_vec())
+    let mut all: Vec<CacheAnswer> = readback::read_pod(gpu, answers, "nirc answers")?;
+    all.truncate(n as usize);
+    Ok(all)
 }
 
 /// An output buffer for `n` answers.
@@ -739,7 +740,8 @@ impl NeuralCache {
     }
 
     pub fn counters(&self, gpu: &Gpu) -> Result<Counters, NircError> {
-        Ok(*bytemuck::from_bytes(&readback::read_bytes(gpu, &self.buffers.counters, "nirc counters")?[..std::mem::size_of::<Counters>()]))
+        let counters: Vec<Counters> = readback::read_pod(gpu, &self.buffers.counters, "nirc counters")?;
+        counters.first().copied().ok_or_else(|| NircError::Readback { what: "nirc counters".into(), reason: "the buffer is smaller than Counters".into() })
     }
 
     /// Mean loss of the last training step's first `n` records (before that step's update).

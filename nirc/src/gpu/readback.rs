@@ -26,9 +26,20 @@ pub fn read_bytes(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<u8
     Ok(data)
 }
 
-pub fn read_f32(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<f32>, NircError> {
+/// The buffer as whole values of `T` (trailing bytes that make no whole value are dropped). A
+/// `Vec<u8>` carries no alignment guarantee for `T`, so the bytes are copied into a `Vec<T>`
+/// rather than cast in place.
+pub fn read_pod<T: bytemuck::Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<T>, NircError> {
     let bytes = read_bytes(gpu, buffer, what)?;
-    Ok(bytes.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect())
+    let size = std::mem::size_of::<T>();
+    let n = bytes.len() / size;
+    let mut values = vec![T::zeroed(); n];
+    bytemuck::cast_slice_mut::<T, u8>(&mut values).copy_from_slice(&bytes[..n * size]);
+    Ok(values)
+}
+
+pub fn read_f32(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<f32>, NircError> {
+    read_pod(gpu, buffer, what)
 }
 
 /// Blocks until the GPU has finished everything submitted (for timing).
