@@ -92,6 +92,13 @@ enum Command {
         /// With --nirc: queries per inference.
         #[arg(long, default_value_t = 16384)]
         nirc_queries: u32,
+        /// With --nirc: timed whole frames per predictor (High-LR, EMA-only, blend) in the
+        /// Cornell box, the paper's Table 1; 0 skips them.
+        #[arg(long, default_value_t = 16)]
+        nirc_frames: u32,
+        /// With --nirc: the resolution of those frames.
+        #[arg(long, default_value = "160x90", value_parser = parse_resolution)]
+        nirc_resolution: (u32, u32),
         /// Also write the numbers as JSON to this file (with --nirc: the neural cache's).
         #[arg(long)]
         json: Option<PathBuf>,
@@ -272,7 +279,7 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 }
 
 /// `flicker bench --nirc`: the cache's throughput (nirc::bench) as a table, and as JSON.
-fn bench_nirc(out: Option<PathBuf>, json: Option<PathBuf>, batch: u32, queries: u32, repeats: u32) -> anyhow::Result<()> {
+fn bench_nirc(out: Option<PathBuf>, json: Option<PathBuf>, batch: u32, queries: u32, repeats: u32, frames: u32, resolution: (u32, u32)) -> anyhow::Result<()> {
     let gpu = render::gpu::Gpu::new()?;
     eprintln!("bench: NIRC at width 64, {batch} training records, {queries} queries, {repeats} repetitions");
     let r = nirc::bench::run(&gpu, &nirc::NircConfig::default(), None, batch, queries, repeats)?;
@@ -280,10 +287,10 @@ fn bench_nirc(out: Option<PathBuf>, json: Option<PathBuf>, batch: u32, queries: 
         "Adapter: {}; MLP form: {:?} (width {}, {} hidden layers)\n\n| measure | value |\n|---|---:|\n\
          | FMA ceiling (GFLOP/s) | {:.1} |\n| training (records/s) | {:.0} |\n| training (GFLOP/s, % of ceiling) | {:.2} ({:.1}%) |\n\
          | EMA-only inference (queries/s) | {:.0} |\n| inference (GFLOP/s, % of ceiling) | {:.2} ({:.1}%) |\n| blend (queries/s) | {:.0} |\n\
-         | blend overhead (% of a NIRC frame) | {:.1} |\n| blend overhead (% of EMA-only inference) | {:.1} |\n\
+         | blend overhead (% of a training step + EMA-only inference) | {:.1} |\n| blend overhead (% of EMA-only inference) | {:.1} |\n\
          | one 64x64 layer, 4x16 blocks (GFLOP/s) | {:.2} |\n| one 64x64 layer, 16x16 blocks (GFLOP/s) | {:.2} |\n",
         r.adapter, r.placement, r.width, r.hidden_layers, r.peak_gflops, r.train_records_per_s, r.train_gflops, r.train_percent_of_peak,
-        r.ema_only_queries_per_s, r.infer_gflops, r.infer_percent_of_peak, r.blend_queries_per_s, r.blend_overhead_frame_percent,
+        r.ema_only_queries_per_s, r.infer_gflops, r.infer_percent_of_peak, r.blend_queries_per_s, r.blend_overhead_step_percent,
         r.blend_overhead_infer_percent, r.layer_probe_4x16_gflops, r.layer_probe_16x16_gflops
     );
     let mut md = md;
@@ -291,12 +298,23 @@ fn bench_nirc(out: Option<PathBuf>, json: Option<PathBuf>, batch: u32, queries: 
     for (name, ms) in &r.train_stages_ms {
         md.push_str(&format!("| {name} | {ms:.2} |\n"));
     }
+    drop(gpu);
+    let table = if frames > 0 {
+        let scratch = std::env::temp_dir().join(format!("flicker-bench-nirc-frames-{}", std::process::id()));
+        let t = systems::bench_nirc_frames::run(resolution, 2, frames, &scratch)?;
+        md.push('\n');
+        md.push_str(&systems::bench_nirc_frames::markdown(&t));
+        Some(t)
+    } else {
+        None
+    };
     print!("{md}");
     if let Some(path) = out {
         systems::output::write_text(&path, &md)?;
     }
     if let Some(path) = json {
-        systems::output::write_text(&path, &serde_json::to_string_pretty(&r)?)?;
+        let j = systems::bench_nirc_frames::BenchJson { throughput: r, blend_overhead_frame_percent: table.as_ref().map(|t| t.blend_overhead_frame_percent), frames: table };
+        systems::output::write_text(&path, &serde_json::to_string_pretty(&j)?)?;
     }
     Ok(())
 }
@@ -362,7 +380,9 @@ fn main() -> ExitCode {
         }
         Command::Compare(args) => metrics::compare(&args),
         Command::Report(args) => report::report(&args).map(|path| println!("wrote {}", path.display())),
-        Command::Bench { out, repeats, nirc: true, nirc_batch, nirc_queries, json, .. } => bench_nirc(out, json, nirc_batch, nirc_queries, repeats),
+        Command::Bench { out, repeats, nirc: true, nirc_batch, nirc_queries, nirc_frames, nirc_resolution, json, .. } => {
+            bench_nirc(out, json, nirc_batch, nirc_queries, repeats, nirc_frames, nirc_resolution)
+        }
         Command::Bench { out, rays, frames, no_metrics, repeats, json, .. } => bench(out, json, rays, frames, no_metrics, repeats),
     };
     match result {

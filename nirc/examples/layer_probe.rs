@@ -28,8 +28,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for placement in [WeightPlacement::Tiled, WeightPlacement::Registers] {
             let r = nirc::bench::run(&gpu, &config, Some(placement), 4096, 16384, 3)?;
             println!(
-                "{placement:?}: EMA-only {:.0} queries/s ({:.2} GFLOP/s), blend {:.0} queries/s, blend overhead {:.1}% of the bench's frame, {:.1}% of EMA-only inference",
-                r.ema_only_queries_per_s, r.infer_gflops, r.blend_queries_per_s, r.blend_overhead_frame_percent, r.blend_overhead_infer_percent
+                "{placement:?}: EMA-only {:.0} queries/s ({:.2} GFLOP/s), blend {:.0} queries/s, blend overhead {:.1}% of the bench's step + inference, {:.1}% of EMA-only inference",
+                r.ema_only_queries_per_s, r.infer_gflops, r.blend_queries_per_s, r.blend_overhead_step_percent, r.blend_overhead_infer_percent
             );
         }
     }

@@ -34,9 +34,10 @@ pub struct BenchReport {
     /// EMA-only inference: 2 x the forward's multiply-adds per query.
     pub infer_gflops: f64,
     pub infer_percent_of_peak: f64,
-    /// Extra time of the blend over EMA-only inference, in percent of a NIRC frame of this
-    /// bench: one training step of `batch` records plus EMA-only inference of `queries`.
-    pub blend_overhead_frame_percent: f64,
+    /// Extra time of the blend over EMA-only inference, in percent of one training step of
+    /// `batch` records plus EMA-only inference of `queries` (no camera paths; `flicker bench
+    /// --nirc` measures whole frames as well, systems::bench_nirc_frames).
+    pub blend_overhead_step_percent: f64,
     /// Extra time of the blend over EMA-only inference, in percent of EMA-only inference.
     pub blend_overhead_infer_percent: f64,
     /// One 64x64 layer as a tiled product, 4 records x 16 outputs per invocation (the
@@ -111,7 +112,7 @@ pub fn run(gpu: &Gpu, config: &NircConfig, placement: Option<WeightPlacement>, b
         blend_queries_per_s: queries as f64 / blend_s,
         infer_gflops,
         infer_percent_of_peak: 100.0 * infer_gflops / probes.fma_gflops,
-        blend_overhead_frame_percent: 100.0 * (blend_s - ema_s) / (train_s + ema_s),
+        blend_overhead_step_percent: 100.0 * (blend_s - ema_s) / (train_s + ema_s),
         blend_overhead_infer_percent: 100.0 * (blend_s - ema_s) / ema_s,
         layer_probe_4x16_gflops: probes.layer_4x16_gflops,
         layer_probe_16x16_gflops: probes.layer_16x16_gflops,

@@ -2,6 +2,7 @@
 //! measurement, recording, and scenario playback.
 
 pub mod bench;
+pub mod bench_nirc_frames;
 pub mod frame;
 pub mod frame_record;
 pub mod manifest;

@@ -1,0 +1,193 @@
+//! The analogue of Table 1 of reliability-weighted-nirc.txt on this adapter: milliseconds per
+//! whole NIRC frame (camera paths, inference, resolve, training records, the training step,
+//! the EMA and the reliability grid) for High-LR only, EMA-only and the blend, and the blend's
+//! cost over EMA-only as a share of EMA-only's frame (the paper: 15.37 -> 15.83 ms, +3%).
+//!
+//! Each predictor plays the built-in Cornell box in a world of its own, so each pays the
+//! training step alone, as in the paper, where the scenario's methods share one. The worlds'
+//! frames are interleaved, in an order rotated every frame, so that drift in the machine's
+//! speed and the first-inference-after-training cost (nirc/README.md) fall on all three alike.
+//! A frame's time is the sum of its passes' times (`FrameRecord::passes`: GPU timestamps, or
+//! each pass submitted alone where the adapter has none). The cache starts untrained
+//! (`pretrain_frames: 0`): a frame does the same work whatever the weights.
+
+use anyhow::{Context, Result};
+use indicatif::ProgressBar;
+use render::gpu::Gpu;
+use sim::Scenario;
+
+use crate::frame::RunOutput;
+use crate::playback::{FrameWorld, Overrides, RunSpec};
+use crate::run_folder::RunFolder;
+
+/// The predictors of Table 1, in its column order.
+pub const PREDICTORS: [&str; 3] = ["HighLrOnly", "EmaOnly", "Blend"];
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct FrameTimes {
+    pub predictor: String,
+    /// Mean over the timed frames of the sum of the frame's pass times.
+    pub ms_per_frame: f64,
+    /// Mean of the method's own inference pass (`nirc_infer`).
+    pub infer_ms: f64,
+    /// Mean of every pass, in the frame's order.
+    pub pass_ms: Vec<(String, f64)>,
+    /// The frames' totals, in frame order.
+    pub frame_ms: Vec<f64>,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Table1 {
+    pub scene: String,
+    pub resolution: (u32, u32),
+    pub warmup_frames: u32,
+    pub timed_frames: u32,
+    /// High-LR only, EMA-only, blend.
+    pub rows: Vec<FrameTimes>,
+    /// 100 x (blend - EMA-only) / EMA-only, per whole frame: the mean of the paired frames'
+    /// differences over EMA-only's mean frame.
+    pub blend_overhead_frame_percent: f64,
+    /// The 95% interval of that mean (Student's t over the paired differences; needs 2 frames).
+    pub blend_overhead_frame_percent_ci95: (f64, f64),
+    /// The blend's extra inference time alone (`nirc_infer`, blend - EMA-only) over EMA-only's
+    /// mean frame: the other passes do the same work for every predictor, so this share has
+    /// less of the machine's noise.
+    pub blend_infer_extra_frame_percent: f64,
+}
+
+/// The JSON of `flicker bench --nirc`: the throughput report and, unless skipped, whole frames.
+#[derive(serde::Serialize)]
+pub struct BenchJson {
+    #[serde(flatten)]
+    pub throughput: nirc::bench::BenchReport,
+    /// The blend's cost over EMA-only in whole frames (`frames`), as the paper's Table 1.
+    pub blend_overhead_frame_percent: Option<f64>,
+    pub frames: Option<Table1>,
+}
+
+fn scenario_text(resolution: (u32, u32), warmup: u32, frames: u32, predictor: &str) -> String {
+    format!(
+        "Scenario(\n    scene: Builtin(\"cornell_box\"),\n    resolution: ({}, {}),\n    frames: {frames},\n    warmup_frames: {warmup},\n    seed: 21,\n    max_depth: 6,\n    methods: [Nirc(spp: 1, predictor: {predictor}, pretrain_frames: 0)],\n    reference: (spp: 1, frames: None),\n)\n",
+        resolution.0, resolution.1
+    )
+}
+
+/// Plays `warmup` untimed and then `frames` timed frames per predictor at `resolution`; the run
+/// folders go under `scratch`, which is removed afterwards.
+pub fn run(resolution: (u32, u32), warmup: u32, frames: u32, scratch: &std::path::Path) -> Result<Table1> {
+    anyhow::ensure!(frames > 0, "the NIRC frame bench needs at least 1 timed frame");
+    let mut worlds = Vec::new();
+    for predictor in PREDICTORS {
+        eprintln!("bench: NIRC frames, building the {predictor} world ({}x{})", resolution.0, resolution.1);
+        let origin = scratch.join(format!("{predictor}.ron"));
+        let scenario = Scenario::from_ron(&scenario_text(resolution, warmup, frames, predictor), &origin)?;
+        let folder = RunFolder::new(scratch.join(predictor));
+        let spec = RunSpec::from_scenario(scenario, &Overrides { out: Some(folder.root.clone()), ..Default::default() })?;
+        let gpu = Gpu::new()?;
+        let world = FrameWorld::build(&spec, gpu, scratch.join("references"), folder.clone(), ProgressBar::hidden())?;
+        folder.prepare()?;
+        worlds.push(world);
+    }
+    for step in 0..warmup + frames {
+        for k in 0..worlds.len() {
+            let i = (step as usize + k) % worlds.len();
+            worlds[i].run_frame(step, warmup).with_context(|| format!("NIRC frame bench, {} world, frame {step}", PREDICTORS[i]))?;
+        }
+    }
+    let mut rows = Vec::new();
+    for (predictor, world) in PREDICTORS.iter().zip(&mut worlds) {
+        let records = std::mem::take(&mut world.world.resource_mut::<RunOutput>().records);
+        let total = |r: &crate::frame_record::FrameRecord| r.passes.iter().filter_map(|(_, t)| *t).sum::<f64>();
+        let frame_ms: Vec<f64> = records.iter().map(total).collect();
+        anyhow::ensure!(frame_ms.len() == frames as usize, "the {predictor} world recorded {} frames, expected {frames}", frame_ms.len());
+        let pass_mean = |name: &str| mean(&records.iter().filter_map(|r| r.passes.iter().find(|(p, _)| p == name).and_then(|(_, t)| *t)).collect::<Vec<f64>>());
+        let pass_ms: Vec<(String, f64)> = records[0].passes.iter().map(|(p, _)| (p.clone(), pass_mean(p))).collect();
+        rows.push(FrameTimes { predictor: predictor.to_string(), ms_per_frame: mean(&frame_ms), infer_ms: pass_mean("nirc_infer"), pass_ms, frame_ms });
+    }
+    drop(worlds);
+    std::fs::remove_dir_all(scratch).with_context(|| format!("removing the NIRC frame bench's scratch folder {}", scratch.display()))?;
+    Ok(table(resolution, warmup, frames, rows))
+}
+
+/// Table 1 from its rows (High-LR only, EMA-only, blend). Frame k of each world ran in the same
+/// round, so the blend's and EMA-only's frames are paired.
+fn table(resolution: (u32, u32), warmup: u32, frames: u32, rows: Vec<FrameTimes>) -> Table1 {
+    let (ema, blend) = (&rows[1], &rows[2]);
+    let percent = |ms: f64| 100.0 * ms / ema.ms_per_frame;
+    let diffs: Vec<f64> = blend.frame_ms.iter().zip(&ema.frame_ms).map(|(b, e)| b - e).collect();
+    let d = mean(&diffs);
+    let half = if diffs.len() > 1 {
+        let n = diffs.len() as f64;
+        let sd = (diffs.iter().map(|x| (x - d).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        crate::suite::student_t::quantile(0.975, n - 1.0) * sd / n.sqrt()
+    } else {
+        f64::NAN
+    };
+    Table1 {
+        scene: "cornell_box".into(),
+        resolution,
+        warmup_frames: warmup,
+        timed_frames: frames,
+        blend_overhead_frame_percent: percent(d),
+        blend_overhead_frame_percent_ci95: (percent(d - half), percent(d + half)),
+        blend_infer_extra_frame_percent: percent(blend.infer_ms - ema.infer_ms),
+        rows,
+    }
+}
+
+fn mean(v: &[f64]) -> f64 {
+    if v.is_empty() { f64::NAN } else { v.iter().sum::<f64>() / v.len() as f64 }
+}
+
+/// The table as Markdown: ms and FPS per predictor, as the paper prints them.
+pub fn markdown(t: &Table1) -> String {
+    let mut s = format!(
+        "Whole NIRC frames, {} at {}x{}, {} timed frames after {} untimed (Table 1 of the paper)\n\n| predictor | ms / frame | FPS | its inference (ms) |\n|---|---:|---:|---:|\n",
+        t.scene, t.resolution.0, t.resolution.1, t.timed_frames, t.warmup_frames
+    );
+    for r in &t.rows {
+        s.push_str(&format!("| {} | {:.2} | {:.2} | {:.2} |\n", r.predictor, r.ms_per_frame, 1e3 / r.ms_per_frame, r.infer_ms));
+    }
+    let (lo, hi) = t.blend_overhead_frame_percent_ci95;
+    s.push_str(&format!(
+        "\nblend overhead, % of EMA-only's whole frame: {:.1} (95% interval {lo:.1} to {hi:.1}); its inference pass alone: {:.1}\n\n| pass (ms) |",
+        t.blend_overhead_frame_percent, t.blend_infer_extra_frame_percent
+    ));
+    for r in &t.rows {
+        s.push_str(&format!(" {} |", r.predictor));
+    }
+    s.push_str(&format!("\n|---|{}\n", "---:|".repeat(t.rows.len())));
+    for (i, (pass, _)) in t.rows[0].pass_ms.iter().enumerate() {
+        s.push_str(&format!("| {pass} |"));
+        for r in &t.rows {
+            let ms = r.pass_ms.get(i).filter(|(p, _)| p == pass).map_or(f64::NAN, |(_, ms)| *ms);
+            s.push_str(&format!(" {ms:.2} |"));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(predictor: &str, frame_ms: &[f64], infer_ms: f64) -> FrameTimes {
+        FrameTimes { predictor: predictor.into(), ms_per_frame: mean(frame_ms), infer_ms, pass_ms: vec![("nirc_infer".into(), infer_ms)], frame_ms: frame_ms.to_vec() }
+    }
+
+    #[test]
+    fn overhead_is_the_mean_paired_difference_with_its_t_interval() {
+        // Differences 4, 6, 5 ms over EMA-only's mean frame of 100 ms: mean 5%, sd 1 ms,
+        // half-width t(0.975, 2) / sqrt(3) = 4.3027 / 1.7321 = 2.4841 ms.
+        let rows = vec![row("HighLrOnly", &[90.0, 90.0, 90.0], 10.0), row("EmaOnly", &[98.0, 102.0, 100.0], 10.0), row("Blend", &[102.0, 108.0, 105.0], 13.0)];
+        let t = table((8, 8), 1, 3, rows);
+        assert!((t.blend_overhead_frame_percent - 5.0).abs() < 1e-12);
+        let (lo, hi) = t.blend_overhead_frame_percent_ci95;
+        assert!((lo - (5.0 - 2.4841)).abs() < 1e-3 && (hi - (5.0 + 2.4841)).abs() < 1e-3, "{lo} {hi}");
+        assert!((t.blend_infer_extra_frame_percent - 3.0).abs() < 1e-12);
+        // One frame: no interval.
+        let t = table((8, 8), 1, 1, vec![row("HighLrOnly", &[90.0], 1.0), row("EmaOnly", &[100.0], 1.0), row("Blend", &[104.0], 2.0)]);
+        assert!((t.blend_overhead_frame_percent - 4.0).abs() < 1e-12 && t.blend_overhead_frame_percent_ci95.0.is_nan());
+    }
+}
