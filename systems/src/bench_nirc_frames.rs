@@ -5,9 +5,9 @@
 //!
 //! Each predictor plays the built-in Cornell box in a world of its own, so each pays the
 //! training step alone, as in the paper, where the scenario's methods share one. The worlds'
-//! frames are interleaved, in an order rotated every frame, so that drift in the machine's
-//! speed and the first-inference-after-training cost (nirc/README.md) fall on all three alike.
-//! A frame's time is the sum of its passes' times (`FrameRecord::passes`: GPU timestamps, or
+//! frames are interleaved, in an order that changes every frame (`ORDERS`), so that drift in
+//! the machine's speed, the first-inference-after-training cost (nirc/README.md) and whatever a
+//! frame leaves behind for the next fall on all three alike. A frame's time is the sum of its passes' times (`FrameRecord::passes`: GPU timestamps, or
 //! each pass submitted alone where the adapter has none). The cache starts untrained
 //! (`pretrain_frames: 0`): a frame does the same work whatever the weights.
 
@@ -22,6 +22,10 @@ use crate::run_folder::RunFolder;
 
 /// The predictors of Table 1, in its column order.
 pub const PREDICTORS: [&str; 3] = ["HighLrOnly", "EmaOnly", "Blend"];
+
+/// The worlds' order in successive frames: all six permutations, so that over six frames each
+/// world runs first, second and third twice and after each other world equally often.
+const ORDERS: [[usize; 3]; 6] = [[0, 1, 2], [1, 2, 0], [2, 0, 1], [0, 2, 1], [2, 1, 0], [1, 0, 2]];
 
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct FrameTimes {
@@ -89,8 +93,7 @@ pub fn run(resolution: (u32, u32), warmup: u32, frames: u32, scratch: &std::path
         worlds.push(world);
     }
     for step in 0..warmup + frames {
-        for k in 0..worlds.len() {
-            let i = (step as usize + k) % worlds.len();
+        for &i in &ORDERS[step as usize % ORDERS.len()] {
             worlds[i].run_frame(step, warmup).with_context(|| format!("NIRC frame bench, {} world, frame {step}", PREDICTORS[i]))?;
         }
     }
