@@ -160,8 +160,7 @@ fn training_records_are_queries_with_finite_targets() {
     // Camera rays, motion rays and NEE shadow rays; every training record traces at least one.
     let [camera, training] = paths.read_rays(g).unwrap();
     assert!(camera > 2 * (W * H) as u64 && training >= 256, "rays: camera {camera}, training {training}");
-    let bytes = nirc::gpu::readback::read_bytes(g, paths.queries(), "queries").unwrap();
-    let queries: &[nirc::CacheQuery] = bytemuck::cast_slice(&bytes);
+    let queries: Vec<nirc::CacheQuery> = nirc::gpu::readback::read_pod(g, paths.queries(), "queries").unwrap();
     let mut distinct = std::collections::HashSet::new();
     for r in &records {
         assert_eq!(r.position[3], 1.0, "every slot holds a valid record: {r:?}");

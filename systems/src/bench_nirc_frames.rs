@@ -1,6 +1,7 @@
 //! The analogue of Table 1 of reliability-weighted-nirc.txt on this adapter: milliseconds per
 //! whole NIRC frame (camera paths, inference, resolve, training records, the training step,
-//! the EMA and the reliability grid) for High-LR only, EMA-only and the blend, and the blend's
+//! the EMA and the reliability grid's update; the diagnostic reliability look-up before
+//! training is not timed, in any world) for High-LR only, EMA-only and the blend, and the blend's
 //! cost over EMA-only as a share of EMA-only's frame (the paper: 15.37 -> 15.83 ms, +3%).
 //!
 //! Each predictor plays the built-in Cornell box in a world of its own, so each pays the
@@ -51,7 +52,9 @@ pub struct Table1 {
     /// 100 x (blend - EMA-only) / EMA-only, per whole frame: the mean of the paired frames'
     /// differences over EMA-only's mean frame.
     pub blend_overhead_frame_percent: f64,
-    /// The 95% interval of that mean (Student's t over the paired differences; needs 2 frames).
+    /// The 95% interval of that mean (Student's t over the paired differences; NaN with fewer
+    /// than 2 frames). Approximate as a percentage: it divides by EMA-only's mean frame as if
+    /// that had no error of its own.
     pub blend_overhead_frame_percent_ci95: (f64, f64),
     /// The blend's extra inference time alone (`nirc_infer`, blend - EMA-only) over EMA-only's
     /// mean frame: the other passes do the same work for every predictor, so this share has
@@ -76,10 +79,31 @@ fn scenario_text(resolution: (u32, u32), warmup: u32, frames: u32, predictor: &s
     )
 }
 
+/// The scratch folder of the worlds' run folders: created new (an existing folder is refused, so
+/// nothing of anyone's is removed) and removed when dropped, whether the bench finished or not.
+struct Scratch(std::path::PathBuf);
+
+impl Scratch {
+    fn create(path: &std::path::Path) -> Result<Scratch> {
+        std::fs::create_dir(path).with_context(|| format!("creating the NIRC frame bench's scratch folder {} (it must not exist)", path.display()))?;
+        Ok(Scratch(path.to_path_buf()))
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if let Err(e) = std::fs::remove_dir_all(&self.0) {
+            eprintln!("warning: could not remove the NIRC frame bench's scratch folder {}: {e}", self.0.display());
+        }
+    }
+}
+
 /// Plays `warmup` untimed and then `frames` timed frames per predictor at `resolution`; the run
-/// folders go under `scratch`, which is removed afterwards.
+/// folders go under `scratch`, a folder this creates (it must not exist) and removes afterwards,
+/// also on an error.
 pub fn run(resolution: (u32, u32), warmup: u32, frames: u32, scratch: &std::path::Path) -> Result<Table1> {
     anyhow::ensure!(frames > 0, "the NIRC frame bench needs at least 1 timed frame");
+    let guard = Scratch::create(scratch)?;
     let mut worlds = Vec::new();
     for predictor in PREDICTORS {
         eprintln!("bench: NIRC frames, building the {predictor} world ({}x{})", resolution.0, resolution.1);
@@ -108,7 +132,7 @@ pub fn run(resolution: (u32, u32), warmup: u32, frames: u32, scratch: &std::path
         rows.push(FrameTimes { predictor: predictor.to_string(), ms_per_frame: mean(&frame_ms), infer_ms: pass_mean("nirc_infer"), pass_ms, frame_ms });
     }
     drop(worlds);
-    std::fs::remove_dir_all(scratch).with_context(|| format!("removing the NIRC frame bench's scratch folder {}", scratch.display()))?;
+    drop(guard);
     Ok(table(resolution, warmup, frames, rows))
 }
 
