@@ -8,8 +8,9 @@
 //! training step alone, as in the paper, where the scenario's methods share one. The worlds'
 //! frames are interleaved, in an order that changes every frame (`ORDERS`), so that drift in
 //! the machine's speed, the first-inference-after-training cost (nirc/README.md) and whatever a
-//! frame leaves behind for the next fall on all three alike. A frame's time is the sum of its passes' times (`FrameRecord::passes`: GPU timestamps, or
-//! each pass submitted alone where the adapter has none). The cache starts untrained
+//! frame leaves behind for the next fall on all three alike. A frame's time is the sum of its
+//! passes' times (`FrameRecord::passes_total_ms`: GPU timestamps, or each pass submitted alone
+//! where the adapter has none). The cache starts untrained
 //! (`pretrain_frames: 0`): a frame does the same work whatever the weights.
 
 use anyhow::{Context, Result};
@@ -20,6 +21,7 @@ use sim::Scenario;
 use crate::frame::RunOutput;
 use crate::playback::{FrameWorld, Overrides, RunSpec};
 use crate::run_folder::RunFolder;
+use crate::suite::welch::Sample;
 
 /// The predictors of Table 1, in its column order.
 pub const PREDICTORS: [&str; 3] = ["HighLrOnly", "EmaOnly", "Blend"];
@@ -124,9 +126,11 @@ pub fn run(resolution: (u32, u32), warmup: u32, frames: u32, scratch: &std::path
     let mut rows = Vec::new();
     for (predictor, world) in PREDICTORS.iter().zip(&mut worlds) {
         let records = std::mem::take(&mut world.world.resource_mut::<RunOutput>().records);
-        let total = |r: &crate::frame_record::FrameRecord| r.passes.iter().filter_map(|(_, t)| *t).sum::<f64>();
-        let frame_ms: Vec<f64> = records.iter().map(total).collect();
-        anyhow::ensure!(frame_ms.len() == frames as usize, "the {predictor} world recorded {} frames, expected {frames}", frame_ms.len());
+        anyhow::ensure!(records.len() == frames as usize, "the {predictor} world recorded {} frames, expected {frames}", records.len());
+        let frame_ms = records
+            .iter()
+            .map(|r| r.passes_total_ms().with_context(|| format!("the {predictor} world's frame {} has an untimed pass", r.frame)))
+            .collect::<Result<Vec<f64>>>()?;
         let pass_mean = |name: &str| mean(&records.iter().filter_map(|r| r.passes.iter().find(|(p, _)| p == name).and_then(|(_, t)| *t)).collect::<Vec<f64>>());
         let pass_ms: Vec<(String, f64)> = records[0].passes.iter().map(|(p, _)| (p.clone(), pass_mean(p))).collect();
         rows.push(FrameTimes { predictor: predictor.to_string(), ms_per_frame: mean(&frame_ms), infer_ms: pass_mean("nirc_infer"), pass_ms, frame_ms });
@@ -142,14 +146,9 @@ fn table(resolution: (u32, u32), warmup: u32, frames: u32, rows: Vec<FrameTimes>
     let (ema, blend) = (&rows[1], &rows[2]);
     let percent = |ms: f64| 100.0 * ms / ema.ms_per_frame;
     let diffs: Vec<f64> = blend.frame_ms.iter().zip(&ema.frame_ms).map(|(b, e)| b - e).collect();
-    let d = mean(&diffs);
-    let half = if diffs.len() > 1 {
-        let n = diffs.len() as f64;
-        let sd = (diffs.iter().map(|x| (x - d).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
-        crate::suite::student_t::quantile(0.975, n - 1.0) * sd / n.sqrt()
-    } else {
-        f64::NAN
-    };
+    let s = Sample::of(&diffs);
+    let d = s.mean;
+    let half = if s.n > 1 { crate::suite::student_t::quantile(0.975, (s.n - 1) as f64) * s.standard_error() } else { f64::NAN };
     Table1 {
         scene: "cornell_box".into(),
         resolution,
@@ -162,8 +161,9 @@ fn table(resolution: (u32, u32), warmup: u32, frames: u32, rows: Vec<FrameTimes>
     }
 }
 
+/// The mean (NaN for no values).
 fn mean(v: &[f64]) -> f64 {
-    if v.is_empty() { f64::NAN } else { v.iter().sum::<f64>() / v.len() as f64 }
+    Sample::of(v).mean
 }
 
 /// The table as Markdown: ms and FPS per predictor, as the paper prints them.

@@ -28,6 +28,15 @@ pub struct FrameRecord {
     pub stats: Vec<(String, f64)>,
 }
 
+impl FrameRecord {
+    /// The frame's time: the sum of its passes' times, when it has passes and every one was
+    /// timed (frames.csv's total column, a sweep job's frame time, the NIRC frame bench).
+    pub fn passes_total_ms(&self) -> Option<f64> {
+        let total: Option<f64> = self.passes.iter().map(|(_, t)| *t).sum();
+        total.filter(|_| !self.passes.is_empty())
+    }
+}
+
 fn clock_prefix(row: &FrameRecord) -> &'static str {
     row.clock.unwrap_or(render::timing::Clock::Gpu).name()
 }
@@ -77,11 +86,7 @@ pub fn to_csv(rows: &[FrameRecord]) -> String {
             .iter()
             .map(|p| row.passes.iter().find(|(q, _)| format!("{}_ms_{q}", clock_prefix(row)) == *p).and_then(|(_, t)| *t))
             .collect();
-        let total = if row.passes.iter().all(|(_, t)| t.is_some()) && !row.passes.is_empty() {
-            Some(row.passes.iter().filter_map(|(_, t)| *t).sum())
-        } else {
-            None
-        };
+        let total = row.passes_total_ms();
         let wall = clock_prefix(row) == "wall";
         write!(out, "{},{},{:.4},{}", row.method, row.frame, row.cpu_ms, cell(if wall { None } else { total })).unwrap();
         if wall_total {

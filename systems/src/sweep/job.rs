@@ -45,8 +45,7 @@ fn mean(values: impl Iterator<Item = Option<f64>>) -> Option<f64> {
 
 /// A frame's time: its passes' sum when every pass was timed, else the CPU time.
 fn frame_ms(r: &FrameRecord) -> f64 {
-    let passes: Option<f64> = r.passes.iter().map(|p| p.1).sum();
-    passes.filter(|_| !r.passes.is_empty()).unwrap_or(r.cpu_ms)
+    r.passes_total_ms().unwrap_or(r.cpu_ms)
 }
 
 pub fn numbers(records: &[FrameRecord]) -> BTreeMap<String, MethodNumbers> {
