@@ -9,7 +9,11 @@ use clap::{Parser, Subcommand};
 use systems::playback::{self, Overrides, RunOptions};
 
 #[derive(Parser)]
-#[command(name = "flicker", version, about = "A lab for the temporal stability of real-time light transport")]
+#[command(
+    name = "flicker",
+    version,
+    about = "A lab for the temporal stability of real-time light transport"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -135,7 +139,13 @@ struct SuiteArgs {
 
 impl SuiteArgs {
     fn options(self) -> systems::suite::SuiteOptions {
-        systems::suite::SuiteOptions { suite: self.suite, out: self.out, cache_dir: self.cache_dir, baselines: self.baselines, progress: !self.quiet }
+        systems::suite::SuiteOptions {
+            suite: self.suite,
+            out: self.out,
+            cache_dir: self.cache_dir,
+            baselines: self.baselines,
+            progress: !self.quiet,
+        }
     }
 }
 
@@ -218,17 +228,30 @@ fn sweep(action: SweepAction) -> ExitCode {
     let cores = || std::thread::available_parallelism().map_or(1, |n| n.get());
     let result = (|| -> anyhow::Result<bool> {
         let exe = std::env::current_exe()?;
-        let local = |dir: &std::path::Path, jobs: Option<usize>, again: bool| -> anyhow::Result<bool> {
+        let local = |dir: &std::path::Path,
+                     jobs: Option<usize>,
+                     again: bool|
+         -> anyhow::Result<bool> {
             let outcome = sweep::run_local(dir, &exe, jobs.unwrap_or_else(cores), again)?;
             if !outcome.failed.is_empty() {
-                let list = outcome.failed.iter().map(usize::to_string).collect::<Vec<_>>().join(", ");
-                eprintln!("error: jobs {list} failed (logs in {}/logs/); rerun them with `flicker sweep local {}`", dir.display(), dir.display());
+                let list =
+                    outcome.failed.iter().map(usize::to_string).collect::<Vec<_>>().join(", ");
+                eprintln!(
+                    "error: jobs {list} failed (logs in {}/logs/); rerun them with `flicker sweep local {}`",
+                    dir.display(),
+                    dir.display()
+                );
             }
             Ok(outcome.failed.is_empty())
         };
         let merged = |dir: &std::path::Path| -> anyhow::Result<()> {
             let m = sweep::merge(dir)?;
-            println!("wrote {}, {} and {}", m.summary_file.display(), m.chart.display(), m.report.display());
+            println!(
+                "wrote {}, {} and {}",
+                m.summary_file.display(),
+                m.chart.display(),
+                m.report.display()
+            );
             Ok(())
         };
         match action {
@@ -270,8 +293,14 @@ fn exit_code(result: anyhow::Result<bool>) -> ExitCode {
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WIDTHxHEIGHT such as 160x90, got '{s}'"))?;
-    let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("expected WIDTHxHEIGHT such as 160x90, got '{s}'"));
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT such as 160x90, got '{s}'"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("expected WIDTHxHEIGHT such as 160x90, got '{s}'"))
+    };
     let (w, h) = (parse(w)?, parse(h)?);
     if w == 0 || h == 0 {
         return Err(format!("width and height must be at least 1, got '{s}'"));
@@ -280,9 +309,19 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 }
 
 /// `flicker bench --nirc`: the cache's throughput (nirc::bench) as a table, and as JSON.
-fn bench_nirc(out: Option<PathBuf>, json: Option<PathBuf>, batch: u32, queries: u32, repeats: u32, frames: u32, resolution: (u32, u32)) -> anyhow::Result<()> {
+fn bench_nirc(
+    out: Option<PathBuf>,
+    json: Option<PathBuf>,
+    batch: u32,
+    queries: u32,
+    repeats: u32,
+    frames: u32,
+    resolution: (u32, u32),
+) -> anyhow::Result<()> {
     let gpu = render::gpu::Gpu::new()?;
-    eprintln!("bench: NIRC at width 64, {batch} training records, {queries} queries, {repeats} repetitions");
+    eprintln!(
+        "bench: NIRC at width 64, {batch} training records, {queries} queries, {repeats} repetitions"
+    );
     let r = nirc::bench::run(&gpu, &nirc::NircConfig::default(), None, batch, queries, repeats)?;
     let md = format!(
         "Adapter: {}; MLP form: {:?} (width {}, {} hidden layers)\n\n| measure | value |\n|---|---:|\n\
@@ -290,9 +329,22 @@ fn bench_nirc(out: Option<PathBuf>, json: Option<PathBuf>, batch: u32, queries: 
          | EMA-only inference (queries/s) | {:.0} |\n| inference (GFLOP/s, % of ceiling) | {:.2} ({:.1}%) |\n| blend (queries/s) | {:.0} |\n\
          | blend overhead (% of a training step + EMA-only inference) | {:.1} |\n| blend overhead (% of EMA-only inference) | {:.1} |\n\
          | one 64x64 layer, 4x16 blocks (GFLOP/s) | {:.2} |\n| one 64x64 layer, 16x16 blocks (GFLOP/s) | {:.2} |\n",
-        r.adapter, r.placement, r.width, r.hidden_layers, r.peak_gflops, r.train_records_per_s, r.train_gflops, r.train_percent_of_peak,
-        r.ema_only_queries_per_s, r.infer_gflops, r.infer_percent_of_peak, r.blend_queries_per_s, r.blend_overhead_step_percent,
-        r.blend_overhead_infer_percent, r.layer_probe_4x16_gflops, r.layer_probe_16x16_gflops
+        r.adapter,
+        r.placement,
+        r.width,
+        r.hidden_layers,
+        r.peak_gflops,
+        r.train_records_per_s,
+        r.train_gflops,
+        r.train_percent_of_peak,
+        r.ema_only_queries_per_s,
+        r.infer_gflops,
+        r.infer_percent_of_peak,
+        r.blend_queries_per_s,
+        r.blend_overhead_step_percent,
+        r.blend_overhead_infer_percent,
+        r.layer_probe_4x16_gflops,
+        r.layer_probe_16x16_gflops
     );
     let mut md = md;
     md.push_str("\n| training step, stage by stage (each submitted alone) | ms |\n|---|---:|\n");
@@ -304,7 +356,8 @@ fn bench_nirc(out: Option<PathBuf>, json: Option<PathBuf>, batch: u32, queries: 
     // The throughput is printed first, and written even if the frames fail.
     print!("{md}");
     let frames = if frames > 0 {
-        let scratch = std::env::temp_dir().join(format!("flicker-bench-nirc-frames-{}", std::process::id()));
+        let scratch =
+            std::env::temp_dir().join(format!("flicker-bench-nirc-frames-{}", std::process::id()));
         systems::bench_nirc_frames::run(resolution, 2, frames, &scratch).map(Some)
     } else {
         Ok(None)
@@ -319,19 +372,38 @@ fn bench_nirc(out: Option<PathBuf>, json: Option<PathBuf>, batch: u32, queries: 
         systems::output::write_text(&path, &md)?;
     }
     if let Some(path) = json {
-        let j = systems::bench_nirc_frames::BenchJson { throughput: r, blend_overhead_frame_percent: table.as_ref().map(|t| t.blend_overhead_frame_percent), frames: table };
+        let j = systems::bench_nirc_frames::BenchJson {
+            throughput: r,
+            blend_overhead_frame_percent: table.as_ref().map(|t| t.blend_overhead_frame_percent),
+            frames: table,
+        };
         systems::output::write_text(&path, &serde_json::to_string_pretty(&j)?)?;
     }
-    frames.map(|_| ()).context("the whole-frame part of the NIRC bench (the throughput above was kept)")
+    frames
+        .map(|_| ())
+        .context("the whole-frame part of the NIRC bench (the throughput above was kept)")
 }
 
-fn bench(out: Option<PathBuf>, json: Option<PathBuf>, rays: u32, frames: u32, no_metrics: bool, repeats: u32) -> anyhow::Result<()> {
+fn bench(
+    out: Option<PathBuf>,
+    json: Option<PathBuf>,
+    rays: u32,
+    frames: u32,
+    no_metrics: bool,
+    repeats: u32,
+) -> anyhow::Result<()> {
     let opts = systems::bench::BenchOptions { rays, frames, ..Default::default() };
     let report = systems::bench::run(&opts, |step| eprintln!("bench: {step}"))?;
     let mut md = report.markdown;
     if !no_metrics {
         eprintln!("bench: image metrics at 1280x720");
-        let args = metrics::bench::BenchArgs { width: 1280, height: 720, repeats, no_reference: false, smape_only: false };
+        let args = metrics::bench::BenchArgs {
+            width: 1280,
+            height: 720,
+            repeats,
+            no_reference: false,
+            smape_only: false,
+        };
         let r = metrics::bench::bench(&args)?;
         md.push_str(&format!(
             "\n## Image metrics, {}x{} HDR pair ({} threads)\n\n| metric | ms |\n|---|---:|\n| SMAPE | {:.2} |\n| HDR-FLIP (flicker) | {:.1} |\n",
@@ -374,9 +446,11 @@ fn main() -> ExitCode {
                 );
             })
         }
-        Command::Schedule { scenario } => systems::scenario::RunSpec::load(&scenario, &Overrides::default())
-            .and_then(|spec| systems::methods::describe_schedule(&spec.methods))
-            .map(|text| print!("{text}")),
+        Command::Schedule { scenario } => {
+            systems::scenario::RunSpec::load(&scenario, &Overrides::default())
+                .and_then(|spec| systems::methods::describe_schedule(&spec.methods))
+                .map(|text| print!("{text}"))
+        }
         Command::Scenes => {
             for name in sim::scenes::names() {
                 let description = sim::scenes::describe(name).unwrap_or_default();
@@ -385,11 +459,23 @@ fn main() -> ExitCode {
             Ok(())
         }
         Command::Compare(args) => metrics::compare(&args),
-        Command::Report(args) => report::report(&args).map(|path| println!("wrote {}", path.display())),
-        Command::Bench { out, repeats, nirc: true, nirc_batch, nirc_queries, nirc_frames, nirc_resolution, json, .. } => {
-            bench_nirc(out, json, nirc_batch, nirc_queries, repeats, nirc_frames, nirc_resolution)
+        Command::Report(args) => {
+            report::report(&args).map(|path| println!("wrote {}", path.display()))
         }
-        Command::Bench { out, rays, frames, no_metrics, repeats, json, .. } => bench(out, json, rays, frames, no_metrics, repeats),
+        Command::Bench {
+            out,
+            repeats,
+            nirc: true,
+            nirc_batch,
+            nirc_queries,
+            nirc_frames,
+            nirc_resolution,
+            json,
+            ..
+        } => bench_nirc(out, json, nirc_batch, nirc_queries, repeats, nirc_frames, nirc_resolution),
+        Command::Bench { out, rays, frames, no_metrics, repeats, json, .. } => {
+            bench(out, json, rays, frames, no_metrics, repeats)
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -34,7 +34,9 @@ pub fn ensure() {
     match private_dir() {
         // SAFETY: called at the start of main, while the program has a single thread.
         Ok(dir) => unsafe { std::env::set_var("XDG_RUNTIME_DIR", dir) },
-        Err(e) => eprintln!("note: XDG_RUNTIME_DIR is unset and no private folder could be made ({e}); a message about it from the graphics drivers is harmless"),
+        Err(e) => eprintln!(
+            "note: XDG_RUNTIME_DIR is unset and no private folder could be made ({e}); a message about it from the graphics drivers is harmless"
+        ),
     }
 }
 

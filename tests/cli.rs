@@ -20,7 +20,8 @@ fn text(bytes: &[u8]) -> String {
 
 /// Runs `flicker run` expecting failure; returns stderr and checks nothing was written.
 fn run_fails(scenario: &Path, extra: &[&str], out: &Path) -> String {
-    let mut args = vec!["run", scenario.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap()];
+    let mut args =
+        vec!["run", scenario.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap()];
     args.extend_from_slice(extra);
     let o = flicker(&args);
     let stderr = text(&o.stderr);
@@ -38,7 +39,10 @@ fn tiny_scenario(dir: &Path, body: &str) -> PathBuf {
 #[test]
 fn malformed_ron_names_file_line_and_column() {
     let dir = scratch("malformed");
-    let path = tiny_scenario(&dir, "Scenario(\n    scene: Builtin(\"cornell_box\"),\n    resolution: (16, 9)\n    frames: 2,\n)\n");
+    let path = tiny_scenario(
+        &dir,
+        "Scenario(\n    scene: Builtin(\"cornell_box\"),\n    resolution: (16, 9)\n    frames: 2,\n)\n",
+    );
     let err = run_fails(&path, &[], &dir.join("out"));
     assert!(err.contains("scenario.ron:4:"), "error should point at line 4: {err}");
 }
@@ -59,11 +63,20 @@ fn unknown_entity_is_an_error_before_frame_zero() {
 #[test]
 fn unknown_scene_and_missing_gltf_are_errors() {
     let dir = scratch("scene");
-    let path = tiny_scenario(&dir, r#"Scenario(scene: Builtin("cornel_box"), resolution: (16, 9), frames: 2, methods: [PathTracing(spp: 1)])"#);
+    let path = tiny_scenario(
+        &dir,
+        r#"Scenario(scene: Builtin("cornel_box"), resolution: (16, 9), frames: 2, methods: [PathTracing(spp: 1)])"#,
+    );
     let err = run_fails(&path, &[], &dir.join("out"));
-    assert!(err.contains("cornel_box") && err.contains("cornell_box"), "should list the known scenes: {err}");
+    assert!(
+        err.contains("cornel_box") && err.contains("cornell_box"),
+        "should list the known scenes: {err}"
+    );
 
-    let path = tiny_scenario(&dir, r#"Scenario(scene: Gltf("assets/missing.gltf"), resolution: (16, 9), frames: 2, methods: [PathTracing(spp: 1)])"#);
+    let path = tiny_scenario(
+        &dir,
+        r#"Scenario(scene: Gltf("assets/missing.gltf"), resolution: (16, 9), frames: 2, methods: [PathTracing(spp: 1)])"#,
+    );
     let err = run_fails(&path, &[], &dir.join("out"));
     assert!(err.contains("missing.gltf"), "{err}");
 }
@@ -71,9 +84,17 @@ fn unknown_scene_and_missing_gltf_are_errors() {
 #[test]
 fn oversize_resolution_is_refused_with_the_limit() {
     let dir = scratch("oversize");
-    let err = run_fails(Path::new("scenarios/cornell_box.ron"), &["--resolution", "100000x8"], &dir.join("out"));
+    let err = run_fails(
+        Path::new("scenarios/cornell_box.ron"),
+        &["--resolution", "100000x8"],
+        &dir.join("out"),
+    );
     assert!(err.contains("100000") && err.contains("limit"), "{err}");
-    let err = run_fails(Path::new("scenarios/cornell_box.ron"), &["--resolution", "160by90"], &dir.join("out"));
+    let err = run_fails(
+        Path::new("scenarios/cornell_box.ron"),
+        &["--resolution", "160by90"],
+        &dir.join("out"),
+    );
     assert!(err.contains("WIDTHxHEIGHT"), "{err}");
 }
 
@@ -115,14 +136,20 @@ fn two_runs_give_byte_identical_frames_and_a_complete_run_folder() {
             assert!(a == b, "{name} differs between two runs of the same scenario");
             assert!(outs[0].join(format!("frames/{method}/{frame:04}.png")).exists());
             // A still camera: its motion vectors, recorded for the report's viewer, are zero.
-            let motion = metrics::load_image(outs[0].join(format!("frames/{method}/motion/{frame:04}.exr"))).unwrap();
-            assert!(motion.rgb.iter().all(|p| p[0] == 0.0 && p[1] == 0.0), "{method} frame {frame}: non-zero motion");
+            let motion =
+                metrics::load_image(outs[0].join(format!("frames/{method}/motion/{frame:04}.exr")))
+                    .unwrap();
+            assert!(
+                motion.rgb.iter().all(|p| p[0] == 0.0 && p[1] == 0.0),
+                "{method} frame {frame}: non-zero motion"
+            );
         }
     }
     let run = &outs[0];
     assert!(run.join("reference/0001.exr").exists() && run.join("reference/0001.png").exists());
     assert!(!run.join("reference/0000.exr").exists());
-    let manifest: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run.join("manifest.json")).unwrap()).unwrap();
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("manifest.json")).unwrap()).unwrap();
     assert_eq!(manifest["seed"], 7);
     assert_eq!(manifest["resolution"], serde_json::json!([32, 18]));
     assert!(manifest["adapter"]["name"].as_str().is_some_and(|n| !n.is_empty()));
@@ -130,12 +157,21 @@ fn two_runs_give_byte_identical_frames_and_a_complete_run_folder() {
     let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
     let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 6, "one row per (method, frame)");
-    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no column {name} in {header:?}"));
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+    };
     for row in &rows {
         let frame: u32 = row[col("frame")].parse().unwrap();
         let flip = row[col("flip")];
         assert_eq!(flip.is_empty(), frame != 1, "FLIP exactly on the reference frame: {row:?}");
-        assert_eq!(row[col("smape")].is_empty(), frame == 0, "SMAPE from the second frame on: {row:?}");
+        assert_eq!(
+            row[col("smape")].is_empty(),
+            frame == 0,
+            "SMAPE from the second frame on: {row:?}"
+        );
         if frame == 1 {
             let f: f64 = flip.parse().unwrap();
             assert!(f > 0.0 && f < 1.0, "{f}");
@@ -143,7 +179,8 @@ fn two_runs_give_byte_identical_frames_and_a_complete_run_folder() {
         }
     }
     assert!(run.join("summary.json").exists() && run.join("report.html").exists());
-    let leftovers: Vec<_> = walk(run).into_iter().filter(|p| p.extension().is_some_and(|e| e == "tmp")).collect();
+    let leftovers: Vec<_> =
+        walk(run).into_iter().filter(|p| p.extension().is_some_and(|e| e == "tmp")).collect();
     assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
 }
 
@@ -152,7 +189,15 @@ fn scenes_lists_every_builtin() {
     let o = flicker(&["scenes"]);
     assert!(o.status.success());
     let out = text(&o.stdout);
-    for name in ["cornell_box", "corridor", "door_gap", "courtyard", "hairball", "rotating_cone", "sss_sphere"] {
+    for name in [
+        "cornell_box",
+        "corridor",
+        "door_gap",
+        "courtyard",
+        "hairball",
+        "rotating_cone",
+        "sss_sphere",
+    ] {
         assert!(out.contains(name), "{out}");
     }
 }
@@ -176,7 +221,11 @@ fn schedule_lists_each_stage_and_the_methods_systems() {
     let out = text(&o.stdout);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let at = |s: &str| out.find(s).unwrap_or_else(|| panic!("'{s}' missing from:\n{out}"));
-    let stages: Vec<usize> = ["\nSimulate\n", "\nExtract\n", "\nRender\n", "\nLearn\n", "\nMeasure\n", "\nRecord\n"].iter().map(|s| at(s)).collect();
+    let stages: Vec<usize> =
+        ["\nSimulate\n", "\nExtract\n", "\nRender\n", "\nLearn\n", "\nMeasure\n", "\nRecord\n"]
+            .iter()
+            .map(|s| at(s))
+            .collect();
     assert!(stages.windows(2).all(|w| w[0] < w[1]), "stages out of order:\n{out}");
     assert!(at("nirc_blend_1spp (Nirc)") < stages[0]);
     assert!((stages[2]..stages[3]).contains(&at("nirc::infer")), "{out}");
@@ -193,7 +242,12 @@ fn duplicate_method_labels_are_refused_before_anything_is_written() {
         "Scenario(scene: Builtin(\"cornell_box\"), resolution: (16, 9), frames: 2,\n  methods: [PathTracing(spp: 1),\n    PathTracing(spp: 1)])",
     );
     let err = run_fails(&path, &[], &dir.join("out"));
-    assert!(err.contains("scenario.ron:3:5") && err.contains("scenario.ron:2:13") && err.contains("pt_1spp"), "{err}");
+    assert!(
+        err.contains("scenario.ron:3:5")
+            && err.contains("scenario.ron:2:13")
+            && err.contains("pt_1spp"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -207,7 +261,15 @@ fn no_xdg_runtime_dir_message_when_it_is_unset_or_invalid() {
     let run = |value: Option<&str>, name: &str| {
         let mut cmd = Command::new(env!("CARGO_BIN_EXE_flicker"));
         let out = dir.join(name);
-        cmd.args(["run", scenario.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap(), "--cache-dir", dir.join("cache").to_str().unwrap()]);
+        cmd.args([
+            "run",
+            scenario.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+            "--cache-dir",
+            dir.join("cache").to_str().unwrap(),
+        ]);
         match value {
             Some(v) => cmd.env("XDG_RUNTIME_DIR", v),
             None => cmd.env_remove("XDG_RUNTIME_DIR"),
@@ -216,7 +278,8 @@ fn no_xdg_runtime_dir_message_when_it_is_unset_or_invalid() {
         assert!(o.status.success(), "run failed: {}", text(&o.stderr));
         text(&o.stderr)
     };
-    for (value, name) in [(None, "unset"), (Some("relative/dir"), "relative"), (Some(""), "empty")] {
+    for (value, name) in [(None, "unset"), (Some("relative/dir"), "relative"), (Some(""), "empty")]
+    {
         let stderr = run(value, name);
         assert!(!stderr.contains("XDG_RUNTIME_DIR"), "XDG_RUNTIME_DIR {value:?}: {stderr}");
     }
@@ -238,13 +301,34 @@ fn suite_exit_codes_summary_and_junit() {
     )
     .unwrap();
     let out = dir.join("out");
-    let o = flicker(&["suite", "run", suite.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap(), "--cache-dir", dir.join("cache").to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(1), "stdout: {}\nstderr: {}", text(&o.stdout), text(&o.stderr));
+    let o = flicker(&[
+        "suite",
+        "run",
+        suite.to_str().unwrap(),
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        "--cache-dir",
+        dir.join("cache").to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "stdout: {}\nstderr: {}",
+        text(&o.stdout),
+        text(&o.stderr)
+    );
     let summary = std::fs::read_to_string(out.join("summary.md")).unwrap();
-    assert!(summary.contains("1 of 2 checks failed") && summary.contains("**FAIL** | box | pt_1spp | flip overall <= -0.1"), "{summary}");
+    assert!(
+        summary.contains("1 of 2 checks failed")
+            && summary.contains("**FAIL** | box | pt_1spp | flip overall <= -0.1"),
+        "{summary}"
+    );
     let junit = std::fs::read_to_string(out.join("junit.xml")).unwrap();
     assert!(junit.contains("tests=\"2\" failures=\"1\" errors=\"0\""), "{junit}");
-    assert!(out.join("box/seed_1/frames.csv").exists() && out.join("box/seed_2/report.html").exists());
+    assert!(
+        out.join("box/seed_1/frames.csv").exists() && out.join("box/seed_2/report.html").exists()
+    );
     // A bad suite file: exit code 2, the error at file:line.
     std::fs::write(&suite, "Suite(\n  cases: [],\n  gates: [(metric: Flip, window: Overall, bound: Absolute(limit: 1.0))],\n  extra: 1,\n)\n").unwrap();
     let o = flicker(&["suite", "run", suite.to_str().unwrap(), "--quiet"]);

@@ -18,7 +18,11 @@ fn cornell_box_reference_is_stable_under_seed_change() {
     let b = tracer.render_reference(&gpu, spp, 2, 0, &mut |_, _| {}).unwrap();
     // Relative L1 difference of the two images: the mean over pixels of |a - b|, relative to
     // the mean radiance (per-pixel ratios would be dominated by the darkest corners).
-    let diff: f64 = a.iter().zip(&b).map(|(x, y)| (0..3).map(|c| (x[c] - y[c]).abs() as f64).sum::<f64>()).sum();
+    let diff: f64 = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (0..3).map(|c| (x[c] - y[c]).abs() as f64).sum::<f64>())
+        .sum();
     let total: f64 = b.iter().map(|y| (0..3).map(|c| y[c] as f64).sum::<f64>()).sum();
     let rel = diff / total;
     eprintln!("cornell box, {spp} spp, seeds 1 and 2: mean relative difference {rel:.5}");

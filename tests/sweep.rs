@@ -15,7 +15,11 @@ fn flicker(args: &[&str]) -> Output {
 }
 
 fn flicker_with_env(args: &[&str], env: &[(&str, &str)]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_flicker")).args(args).envs(env.iter().copied()).output().expect("flicker runs")
+    Command::new(env!("CARGO_BIN_EXE_flicker"))
+        .args(args)
+        .envs(env.iter().copied())
+        .output()
+        .expect("flicker runs")
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -30,7 +34,13 @@ fn text(bytes: &[u8]) -> String {
 }
 
 fn ok(o: &Output, what: &str) {
-    assert!(o.status.success(), "{what} failed ({}):\nstdout: {}\nstderr: {}", o.status, text(&o.stdout), text(&o.stderr));
+    assert!(
+        o.status.success(),
+        "{what} failed ({}):\nstdout: {}\nstderr: {}",
+        o.status,
+        text(&o.stdout),
+        text(&o.stderr)
+    );
 }
 
 fn sweep_file() -> PathBuf {
@@ -39,7 +49,8 @@ fn sweep_file() -> PathBuf {
 
 /// summary.json without its `timing` entries (wall-clock times differ between any two runs).
 fn numbers(dir: &Path) -> serde_json::Value {
-    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
     for c in v["configurations"].as_array_mut().unwrap() {
         c.as_object_mut().unwrap().remove("timing");
     }
@@ -51,25 +62,60 @@ fn plan_is_deterministic() {
     let dir = scratch("plan");
     let (a, b) = (dir.join("a"), dir.join("nested/b"));
     for out in [&a, &b] {
-        ok(&flicker(&["sweep", "plan", sweep_file().to_str().unwrap(), "--out", out.to_str().unwrap()]), "sweep plan");
+        ok(
+            &flicker(&[
+                "sweep",
+                "plan",
+                sweep_file().to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ]),
+            "sweep plan",
+        );
     }
     let plan_a = std::fs::read(a.join("plan.json")).unwrap();
-    assert_eq!(plan_a, std::fs::read(b.join("plan.json")).unwrap(), "two plans of one sweep file differ");
+    assert_eq!(
+        plan_a,
+        std::fs::read(b.join("plan.json")).unwrap(),
+        "two plans of one sweep file differ"
+    );
     let plan: serde_json::Value = serde_json::from_slice(&plan_a).unwrap();
-    let jobs: Vec<(String, u64)> = plan["jobs"].as_array().unwrap().iter().map(|j| (j["point"].as_str().unwrap().to_string(), j["seed"].as_u64().unwrap())).collect();
+    let jobs: Vec<(String, u64)> = plan["jobs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|j| (j["point"].as_str().unwrap().to_string(), j["seed"].as_u64().unwrap()))
+        .collect();
     // Points in file order, seeds fastest.
-    let expected: Vec<(String, u64)> = ["0.05", "0.1", "0.3", "1.0"].iter().flat_map(|a| [1, 2].map(|s| (format!("taa.alpha={a}"), s))).collect();
+    let expected: Vec<(String, u64)> = ["0.05", "0.1", "0.3", "1.0"]
+        .iter()
+        .flat_map(|a| [1, 2].map(|s| (format!("taa.alpha={a}"), s)))
+        .collect();
     assert_eq!(jobs, expected);
     // The executors' files name every job once.
     let lines = std::fs::read_to_string(a.join("jobs.txt")).unwrap();
     assert_eq!(lines.lines().count(), 8);
-    assert!(lines.lines().enumerate().all(|(i, l)| l.contains(&format!("sweep job '{}' --index {i} ", a.display()))), "{lines}");
-    assert!(std::fs::read_to_string(a.join("sweep.sbatch")).unwrap().contains("#SBATCH --array=0-7\n"));
+    assert!(
+        lines
+            .lines()
+            .enumerate()
+            .all(|(i, l)| l.contains(&format!("sweep job '{}' --index {i} ", a.display()))),
+        "{lines}"
+    );
+    assert!(
+        std::fs::read_to_string(a.join("sweep.sbatch")).unwrap().contains("#SBATCH --array=0-7\n")
+    );
     // Planning again into the same folder is allowed; another sweep's plan there is not.
-    ok(&flicker(&["sweep", "plan", sweep_file().to_str().unwrap(), "--out", a.to_str().unwrap()]), "sweep plan again");
+    ok(
+        &flicker(&["sweep", "plan", sweep_file().to_str().unwrap(), "--out", a.to_str().unwrap()]),
+        "sweep plan again",
+    );
     let other = dir.join("other.ron");
     let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("suites/scenarios/smoke_cornell.ron");
-    let body = std::fs::read_to_string(sweep_file()).unwrap().replace("[1, 2]", "[1, 3]").replace("../suites/scenarios/smoke_cornell.ron", scenario.to_str().unwrap());
+    let body = std::fs::read_to_string(sweep_file())
+        .unwrap()
+        .replace("[1, 2]", "[1, 3]")
+        .replace("../suites/scenarios/smoke_cornell.ron", scenario.to_str().unwrap());
     std::fs::write(&other, body).unwrap();
     let o = flicker(&["sweep", "plan", other.to_str().unwrap(), "--out", a.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
@@ -81,12 +127,19 @@ fn plan_is_deterministic() {
 fn shipped_sweeps_plan() {
     let dir = scratch("shipped");
     let sweeps = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&sweeps).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "ron")).collect();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&sweeps)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
     files.sort();
     assert!(files.len() >= 2, "{files:?}");
     for f in files {
         let out = dir.join(f.file_stem().unwrap());
-        ok(&flicker(&["sweep", "plan", f.to_str().unwrap(), "--out", out.to_str().unwrap()]), &format!("sweep plan {}", f.display()));
+        ok(
+            &flicker(&["sweep", "plan", f.to_str().unwrap(), "--out", out.to_str().unwrap()]),
+            &format!("sweep plan {}", f.display()),
+        );
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -95,16 +148,37 @@ fn shipped_sweeps_plan() {
 fn bad_sweep_files_name_file_and_line() {
     let dir = scratch("bad");
     let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("suites/scenarios/smoke_cornell.ron");
-    let head = format!("Sweep(\n    cases: [(name: \"c\", scenario: \"{}\", seeds: [1], methods: [\"taa\"])],\n", scenario.display());
+    let head = format!(
+        "Sweep(\n    cases: [(name: \"c\", scenario: \"{}\", seeds: [1], methods: [\"taa\"])],\n",
+        scenario.display()
+    );
     let cases = [
         // A field TAA does not have: found when the plan builds the jobs, reported at the axis.
-        (format!("{head}    grid: [\n        (\"taa.alpah\", [0.1]),\n    ],\n)"), 4, "no field 'alpah'"),
+        (
+            format!("{head}    grid: [\n        (\"taa.alpah\", [0.1]),\n    ],\n)"),
+            4,
+            "no field 'alpah'",
+        ),
         // A method the case does not run.
-        (format!("{head}    grid: [\n        (\"pt_1spp.spp\", [2]),\n    ],\n)"), 4, "no method labelled 'pt_1spp'"),
+        (
+            format!("{head}    grid: [\n        (\"pt_1spp.spp\", [2]),\n    ],\n)"),
+            4,
+            "no method labelled 'pt_1spp'",
+        ),
         // A value of the wrong type.
-        (format!("{head}    list: [\n        [(\"taa.alpha\", 0.1)],\n        [(\"taa.jitter_length\", \"many\")],\n    ],\n)"), 5, "jitter_length"),
+        (
+            format!(
+                "{head}    list: [\n        [(\"taa.alpha\", 0.1)],\n        [(\"taa.jitter_length\", \"many\")],\n    ],\n)"
+            ),
+            5,
+            "jitter_length",
+        ),
         // RON syntax.
-        (format!("{head}    grid: [\n        (\"taa.alpha\" [0.1]),\n    ],\n)"), 4, "Expected comma"),
+        (
+            format!("{head}    grid: [\n        (\"taa.alpha\" [0.1]),\n    ],\n)"),
+            4,
+            "Expected comma",
+        ),
     ];
     for (i, (body, line, what)) in cases.iter().enumerate() {
         let file = dir.join(format!("bad{i}.ron"));
@@ -113,7 +187,11 @@ fn bad_sweep_files_name_file_and_line() {
         let o = flicker(&["sweep", "plan", file.to_str().unwrap(), "--out", out.to_str().unwrap()]);
         let err = text(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{err}");
-        assert!(err.contains(&format!("{}:{line}:", file.display())), "expected {}:{line}: in: {err}", file.display());
+        assert!(
+            err.contains(&format!("{}:{line}:", file.display())),
+            "expected {}:{line}: in: {err}",
+            file.display()
+        );
         assert!(err.contains(what), "expected '{what}' in: {err}");
         assert!(!out.join("plan.json").exists(), "a bad sweep file must not leave a plan");
     }
@@ -143,8 +221,16 @@ impl Cluster {
     /// Every log the daemons wrote, for a failure message.
     fn logs(&self) -> String {
         let mut out = String::new();
-        for name in ["munged.log", "munged.stderr", "slurmctld.log", "slurmctld.stderr", "slurmd.log", "slurmd.stderr"] {
-            let body = std::fs::read_to_string(self.dir.join(name)).unwrap_or_else(|e| format!("(unreadable: {e})"));
+        for name in [
+            "munged.log",
+            "munged.stderr",
+            "slurmctld.log",
+            "slurmctld.stderr",
+            "slurmd.log",
+            "slurmd.stderr",
+        ] {
+            let body = std::fs::read_to_string(self.dir.join(name))
+                .unwrap_or_else(|e| format!("(unreadable: {e})"));
             out.push_str(&format!("\n--- {name} ---\n{body}"));
         }
         out
@@ -153,13 +239,20 @@ impl Cluster {
     fn spawn(&mut self, name: &'static str, program: &str, args: &[&str]) {
         let stderr = std::fs::File::create(self.dir.join(format!("{name}.stderr"))).unwrap();
         // The daemons live in /usr/sbin, which a non-login PATH may lack.
-        let program = ["/usr/sbin", "/sbin"].iter().map(|d| Path::new(d).join(program)).find(|p| p.exists()).unwrap_or_else(|| PathBuf::from(program));
+        let program = ["/usr/sbin", "/sbin"]
+            .iter()
+            .map(|d| Path::new(d).join(program))
+            .find(|p| p.exists())
+            .unwrap_or_else(|| PathBuf::from(program));
         let program = program.to_str().unwrap();
         let mut c = self.slurm(program);
         c.args(args).stdin(Stdio::null()).stdout(stderr.try_clone().unwrap()).stderr(stderr);
         match c.spawn() {
             Ok(child) => self.daemons.push((name, child)),
-            Err(e) => panic!("cannot start {program} ({e}); install Debian's slurm-wlm and munge (scripts/setup.sh){}", self.logs()),
+            Err(e) => panic!(
+                "cannot start {program} ({e}); install Debian's slurm-wlm and munge (scripts/setup.sh){}",
+                self.logs()
+            ),
         }
     }
 
@@ -170,14 +263,18 @@ impl Cluster {
         // munged refuses a key others can read and a socket folder others can write.
         std::fs::set_permissions(&munge, std::fs::Permissions::from_mode(0o711)).unwrap();
         let mut key = vec![0u8; 1024];
-        std::io::Read::read_exact(&mut std::fs::File::open("/dev/urandom").unwrap(), &mut key).unwrap();
+        std::io::Read::read_exact(&mut std::fs::File::open("/dev/urandom").unwrap(), &mut key)
+            .unwrap();
         let key_file = munge.join("munge.key");
         std::fs::write(&key_file, &key).unwrap();
         std::fs::set_permissions(&key_file, std::fs::Permissions::from_mode(0o600)).unwrap();
         for sub in ["state", "spool"] {
             std::fs::create_dir_all(dir.join(sub)).unwrap();
         }
-        let host = text(&Command::new("hostname").arg("-s").output().expect("hostname runs").stdout).trim().to_string();
+        let host =
+            text(&Command::new("hostname").arg("-s").output().expect("hostname runs").stdout)
+                .trim()
+                .to_string();
         let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
         let d = dir.display();
         let conf = dir.join("slurm.conf");
@@ -202,7 +299,15 @@ impl Cluster {
         cluster.spawn(
             "munged",
             "munged",
-            &["--foreground", "--force", &format!("--key-file={}", m("munge.key")), &format!("--socket={}", m("munge.sock")), &format!("--pid-file={}", m("munged.pid")), &format!("--seed-file={}", m("munged.seed")), &format!("--log-file={d}/munged.log")],
+            &[
+                "--foreground",
+                "--force",
+                &format!("--key-file={}", m("munge.key")),
+                &format!("--socket={}", m("munge.sock")),
+                &format!("--pid-file={}", m("munged.pid")),
+                &format!("--seed-file={}", m("munged.seed")),
+                &format!("--log-file={d}/munged.log"),
+            ],
         );
         cluster.wait_for("munged's socket", || dir.join("munge/munge.sock").exists());
         cluster.spawn("slurmctld", "slurmctld", &["-D", "-i"]);
@@ -210,7 +315,11 @@ impl Cluster {
         cluster.spawn("slurmd", "slurmd", &["-D", "-N", &host]);
         let conf = cluster.conf.clone();
         cluster.wait_for("the node to be idle", || {
-            Command::new("sinfo").env("SLURM_CONF", &conf).args(["-h", "-o", "%T"]).output().is_ok_and(|o| text(&o.stdout).trim() == "idle")
+            Command::new("sinfo")
+                .env("SLURM_CONF", &conf)
+                .args(["-h", "-o", "%T"])
+                .output()
+                .is_ok_and(|o| text(&o.stdout).trim() == "idle")
         });
         cluster
     }
@@ -218,7 +327,10 @@ impl Cluster {
     fn wait_for(&mut self, what: &str, ready: impl Fn() -> bool) {
         let start = Instant::now();
         while !ready() {
-            let exited = self.daemons.iter_mut().find_map(|(name, child)| child.try_wait().ok().flatten().map(|s| (*name, s)));
+            let exited = self
+                .daemons
+                .iter_mut()
+                .find_map(|(name, child)| child.try_wait().ok().flatten().map(|s| (*name, s)));
             if let Some((name, status)) = exited {
                 panic!("{name} exited ({status}) while waiting for {what}{}", self.logs());
             }
@@ -249,7 +361,8 @@ fn sweep_runs_locally_and_on_slurm_with_identical_numbers() {
     // Local executor: plan, 8 jobs two at a time, merge. One CPU thread per job here and the
     // default elsewhere, so that a metric whose value depends on the thread count (an unordered
     // parallel sum) shows as a difference below.
-    let run = ["sweep", "run", sweep.to_str().unwrap(), "--out", local.to_str().unwrap(), "--jobs", "2"];
+    let run =
+        ["sweep", "run", sweep.to_str().unwrap(), "--out", local.to_str().unwrap(), "--jobs", "2"];
     ok(&flicker_with_env(&run, &[("RAYON_NUM_THREADS", "1")]), "sweep run (local)");
     let local_numbers = numbers(&local);
     // A failed job is rerun alone: without its record the merge names it, `local` runs only it.
@@ -259,36 +372,81 @@ fn sweep_runs_locally_and_on_slurm_with_identical_numbers() {
     assert!(text(&o.stderr).contains("1 of 8 jobs have not finished (3)"), "{}", text(&o.stderr));
     let o = flicker(&["sweep", "local", local.to_str().unwrap()]);
     ok(&o, "sweep local (rerun)");
-    assert_eq!(text(&o.stderr).matches(" done").count(), 1, "only job 3 reruns: {}", text(&o.stderr));
+    assert_eq!(
+        text(&o.stderr).matches(" done").count(),
+        1,
+        "only job 3 reruns: {}",
+        text(&o.stderr)
+    );
     ok(&flicker(&["sweep", "merge", local.to_str().unwrap()]), "sweep merge (local, after rerun)");
     assert_eq!(numbers(&local), local_numbers, "a rerun job changed the merged numbers");
 
     // Slurm: the same plan as an 8-task array on a one-node cluster.
-    ok(&flicker(&["sweep", "plan", sweep.to_str().unwrap(), "--out", slurm.to_str().unwrap()]), "sweep plan (slurm)");
+    ok(
+        &flicker(&["sweep", "plan", sweep.to_str().unwrap(), "--out", slurm.to_str().unwrap()]),
+        "sweep plan (slurm)",
+    );
     let cluster = Cluster::start(dir.join("cluster"));
-    let o = cluster.slurm("sbatch").args(["--wait", "--parsable"]).arg(slurm.join("sweep.sbatch")).output().expect("sbatch runs");
-    let task_logs: Vec<PathBuf> = std::fs::read_dir(slurm.join("logs")).unwrap().map(|e| e.unwrap().path()).filter(|p| p.file_name().unwrap().to_string_lossy().starts_with("slurm_")).collect();
-    let outputs: String = task_logs.iter().map(|p| format!("\n--- {} ---\n{}", p.display(), std::fs::read_to_string(p).unwrap_or_default())).collect();
-    assert!(o.status.success(), "sbatch --wait failed ({}): {}{outputs}{}", o.status, text(&o.stderr), cluster.logs());
+    let o = cluster
+        .slurm("sbatch")
+        .args(["--wait", "--parsable"])
+        .arg(slurm.join("sweep.sbatch"))
+        .output()
+        .expect("sbatch runs");
+    let task_logs: Vec<PathBuf> = std::fs::read_dir(slurm.join("logs"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.file_name().unwrap().to_string_lossy().starts_with("slurm_"))
+        .collect();
+    let outputs: String = task_logs
+        .iter()
+        .map(|p| {
+            format!("\n--- {} ---\n{}", p.display(), std::fs::read_to_string(p).unwrap_or_default())
+        })
+        .collect();
+    assert!(
+        o.status.success(),
+        "sbatch --wait failed ({}): {}{outputs}{}",
+        o.status,
+        text(&o.stderr),
+        cluster.logs()
+    );
     let job_id = text(&o.stdout).trim().to_string();
     drop(cluster);
     // Every array task left its Slurm output file, so Slurm (not this test) ran the jobs.
     for i in 0..8 {
-        assert!(slurm.join(format!("logs/slurm_{job_id}_{i}.out")).exists(), "no output of array task {i}{outputs}");
+        assert!(
+            slurm.join(format!("logs/slurm_{job_id}_{i}.out")).exists(),
+            "no output of array task {i}{outputs}"
+        );
     }
     ok(&flicker(&["sweep", "merge", slurm.to_str().unwrap()]), "sweep merge (slurm)");
 
     let slurm_numbers = numbers(&slurm);
-    assert_eq!(slurm_numbers, local_numbers, "local and Slurm runs of one sweep merged to different numbers");
+    assert_eq!(
+        slurm_numbers, local_numbers,
+        "local and Slurm runs of one sweep merged to different numbers"
+    );
 
     // GNU parallel: the plan's job file, one shell command per line, two at a time.
     let par = dir.join("parallel");
-    ok(&flicker(&["sweep", "plan", sweep.to_str().unwrap(), "--out", par.to_str().unwrap()]), "sweep plan (parallel)");
+    ok(
+        &flicker(&["sweep", "plan", sweep.to_str().unwrap(), "--out", par.to_str().unwrap()]),
+        "sweep plan (parallel)",
+    );
     let jobs = std::fs::File::open(par.join("jobs.txt")).unwrap();
-    let o = Command::new("parallel").args(["--jobs", "2", "--halt", "now,fail=1"]).stdin(jobs).output().expect("GNU parallel runs (scripts/setup.sh installs it)");
+    let o = Command::new("parallel")
+        .args(["--jobs", "2", "--halt", "now,fail=1"])
+        .stdin(jobs)
+        .output()
+        .expect("GNU parallel runs (scripts/setup.sh installs it)");
     ok(&o, "parallel < jobs.txt");
     ok(&flicker(&["sweep", "merge", par.to_str().unwrap()]), "sweep merge (parallel)");
-    assert_eq!(numbers(&par), local_numbers, "local and GNU parallel runs of one sweep merged to different numbers");
+    assert_eq!(
+        numbers(&par),
+        local_numbers,
+        "local and GNU parallel runs of one sweep merged to different numbers"
+    );
     // The summary holds what the sweep asked for: 4 configurations of 2 seeds, FLIP in (0, 1).
     let configs = slurm_numbers["configurations"].as_array().unwrap();
     assert_eq!(configs.len(), 4);

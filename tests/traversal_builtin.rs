@@ -40,7 +40,12 @@ fn assert_same_hits(label: &str, scene: &SceneDesc) {
             assert!(tie, "{label} ray {i}: GPU {g:?}, CPU {c:?}");
             ties += 1;
         }
-        assert!((g.t - c.t).abs() <= 1e-4 * c.t.abs().max(1e-3), "{label} ray {i}: t {} vs {}", g.t, c.t);
+        assert!(
+            (g.t - c.t).abs() <= 1e-4 * c.t.abs().max(1e-3),
+            "{label} ray {i}: t {} vs {}",
+            g.t,
+            c.t
+        );
     }
     eprintln!("{label}: {hits} of {} rays hit, {ties} ties", rays.len());
     assert!(hits > rays.len() / 20, "{label}: too few hits ({hits}) for a meaningful comparison");

@@ -32,7 +32,11 @@ impl ErrorDistribution {
             ErrorDistribution::Laplace => {
                 // u = v + 2^−25 − 0.5 on the open interval; 1 − 2|u| exactly, never 0.
                 let v = rng.next_f32();
-                let (sign, w) = if v >= 0.5 { (1.0, 2.0 * (1.0 - v) - 2f32.powi(-24)) } else { (-1.0, 2.0 * v + 2f32.powi(-24)) };
+                let (sign, w) = if v >= 0.5 {
+                    (1.0, 2.0 * (1.0 - v) - 2f32.powi(-24))
+                } else {
+                    (-1.0, 2.0 * v + 2f32.powi(-24))
+                };
                 -std::f32::consts::FRAC_1_SQRT_2 * sign * w.ln()
             }
             ErrorDistribution::Exponential => -(1.0 - rng.next_f32()).ln() - 1.0,

@@ -54,7 +54,13 @@ impl Dda {
             return false;
         }
         // One axis per step (ties broken x, y, z): the same order as the WGSL twin.
-        let axis = if self.t_next.x == t { 0 } else if self.t_next.y == t { 1 } else { 2 };
+        let axis = if self.t_next.x == t {
+            0
+        } else if self.t_next.y == t {
+            1
+        } else {
+            2
+        };
         self.cell[axis] += self.step[axis];
         self.t_next[axis] += self.t_delta[axis];
         self.cell[axis] >= 0 && self.cell[axis] < self.dims[axis]
@@ -62,7 +68,13 @@ impl Dda {
 }
 
 fn sign(x: f32) -> i32 {
-    if x > 0.0 { 1 } else if x < 0.0 { -1 } else { 0 }
+    if x > 0.0 {
+        1
+    } else if x < 0.0 {
+        -1
+    } else {
+        0
+    }
 }
 
 fn cross_at(boundary: f32, o: f32, d: f32, t0: f32) -> f32 {

@@ -24,20 +24,41 @@ pub struct DensityGrid {
 impl DensityGrid {
     /// Bakes `kind` at the voxel centres of a `res` grid filling [box_min, box_max], peak
     /// extinction `sigma_t`.
-    pub fn bake(kind: &DensityKind, res: UVec3, sigma_t: f32, box_min: Vec3, box_max: Vec3) -> Self {
+    pub fn bake(
+        kind: &DensityKind,
+        res: UVec3,
+        sigma_t: f32,
+        box_min: Vec3,
+        box_max: Vec3,
+    ) -> Self {
         Self::bake_spun(kind, res, sigma_t, box_min, box_max, 0.0)
     }
 
     /// [`Self::bake`] with the field turned by `spin` radians about the box's vertical axis
     /// (an animated medium; the field is looked up at the voxel centre turned back).
-    pub fn bake_spun(kind: &DensityKind, res: UVec3, sigma_t: f32, box_min: Vec3, box_max: Vec3, spin: f32) -> Self {
+    pub fn bake_spun(
+        kind: &DensityKind,
+        res: UVec3,
+        sigma_t: f32,
+        box_min: Vec3,
+        box_max: Vec3,
+        spin: f32,
+    ) -> Self {
         Self::bake_bounded(kind, None, res, sigma_t, box_min, box_max, spin)
     }
 
     /// [`Self::bake_spun`] clipped to a closed mesh in the box's unit coordinates: a voxel whose
     /// centre lies outside it is empty (so the boundary is resolved to a voxel; the super-voxel
     /// grid then skips what lies outside). The mesh turns with the field.
-    pub fn bake_bounded(kind: &DensityKind, bound: Option<&MeshInside>, res: UVec3, sigma_t: f32, box_min: Vec3, box_max: Vec3, spin: f32) -> Self {
+    pub fn bake_bounded(
+        kind: &DensityKind,
+        bound: Option<&MeshInside>,
+        res: UVec3,
+        sigma_t: f32,
+        box_min: Vec3,
+        box_max: Vec3,
+        spin: f32,
+    ) -> Self {
         let mut data = Vec::with_capacity((res.x * res.y * res.z) as usize);
         let field = Field::new(kind);
         let turn = glam::Quat::from_rotation_y(-spin);
@@ -93,10 +114,16 @@ impl Field {
     fn new(kind: &DensityKind) -> Self {
         match *kind {
             DensityKind::Homogeneous => Field::Constant,
-            DensityKind::Cloud { octaves, frequency, seed } => Field::Cloud(Fbm::<Perlin>::new(seed).set_octaves(octaves).set_frequency(frequency)),
-            DensityKind::Explosion { frequency, seed } => Field::Explosion(Perlin::new(seed), frequency),
+            DensityKind::Cloud { octaves, frequency, seed } => {
+                Field::Cloud(Fbm::<Perlin>::new(seed).set_octaves(octaves).set_frequency(frequency))
+            }
+            DensityKind::Explosion { frequency, seed } => {
+                Field::Explosion(Perlin::new(seed), frequency)
+            }
             // Checked when the scenario loaded (sim::Scenario, errors at the grid file's line).
-            DensityKind::Grid { ref file } => Field::Grid(scene::RawGrid::load(file).unwrap_or_else(|e| panic!("{e}"))),
+            DensityKind::Grid { ref file } => {
+                Field::Grid(scene::RawGrid::load(file).unwrap_or_else(|e| panic!("{e}")))
+            }
         }
     }
 
@@ -127,7 +154,15 @@ impl Field {
 impl DensityGrid {
     /// A scenario's medium, baked.
     pub fn from_desc(desc: &scene::MediumDesc) -> Self {
-        Self::from_state(desc, &scene::MediumState { box_min: desc.box_min, box_max: desc.box_max, sigma_t: desc.sigma_t, spin: 0.0 })
+        Self::from_state(
+            desc,
+            &scene::MediumState {
+                box_min: desc.box_min,
+                box_max: desc.box_max,
+                sigma_t: desc.sigma_t,
+                spin: 0.0,
+            },
+        )
     }
 
     /// An animated medium at one of its states (`MediumDesc::at`), clipped to its bound.
@@ -139,13 +174,28 @@ impl DensityGrid {
     /// unit coordinates, so one test serves every state of an animated medium.
     pub fn bound_of(desc: &scene::MediumDesc) -> Option<MeshInside> {
         // Checked when the scenario loaded (sim::Scenario, errors at the mesh file's line).
-        let mesh = desc.bound.mesh(desc.box_min, desc.box_max).unwrap_or_else(|e| panic!("medium '{}': {e}", desc.name));
+        let mesh = desc
+            .bound
+            .mesh(desc.box_min, desc.box_max)
+            .unwrap_or_else(|e| panic!("medium '{}': {e}", desc.name));
         mesh.as_ref().map(MeshInside::new)
     }
 
     /// `from_state` with the bound's inside test already built (`bound_of`).
-    pub fn from_state_within(desc: &scene::MediumDesc, s: &scene::MediumState, inside: Option<&MeshInside>) -> Self {
+    pub fn from_state_within(
+        desc: &scene::MediumDesc,
+        s: &scene::MediumState,
+        inside: Option<&MeshInside>,
+    ) -> Self {
         let (x, y, z) = desc.resolution;
-        Self::bake_bounded(&desc.kind, inside, UVec3::new(x, y, z), s.sigma_t, s.box_min, s.box_max, s.spin)
+        Self::bake_bounded(
+            &desc.kind,
+            inside,
+            UVec3::new(x, y, z),
+            s.sigma_t,
+            s.box_min,
+            s.box_max,
+            s.spin,
+        )
     }
 }

@@ -17,7 +17,13 @@ pub const T_MAX: f32 = 1.0e4;
 
 /// Unit ray directions through the pixel centres, row-major.
 pub fn directions(camera: &CameraBasis, width: u32, height: u32) -> Vec<Vec3> {
-    (0..height).flat_map(|y| (0..width).map(move |x| camera.ray_direction(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), width, height))).collect()
+    (0..height)
+        .flat_map(|y| {
+            (0..width).map(move |x| {
+                camera.ray_direction(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), width, height)
+            })
+        })
+        .collect()
 }
 
 /// Which image of a run: its seed and frame.
@@ -29,7 +35,13 @@ pub struct ImageKey {
 }
 
 /// All estimates, pixel-major (`spp` per pixel), as the GPU pass writes them.
-pub fn estimates(medium: &Medium, origin: Vec3, dirs: &[Vec3], estimator: Estimator, key: ImageKey) -> Vec<Estimate> {
+pub fn estimates(
+    medium: &Medium,
+    origin: Vec3,
+    dirs: &[Vec3],
+    estimator: Estimator,
+    key: ImageKey,
+) -> Vec<Estimate> {
     let mut out = Vec::with_capacity(dirs.len() * key.spp as usize);
     for (pixel, &d) in dirs.iter().enumerate() {
         for sample in 0..key.spp {
@@ -56,7 +68,8 @@ pub fn reduce(estimates: &[Estimate], spp: u32) -> PixelStats {
     for px in estimates.chunks(spp as usize) {
         let n = px.len() as f64;
         let mean = px.iter().map(|e| f64::from(e.value)).sum::<f64>() / n;
-        let var = px.iter().map(|e| (f64::from(e.value) - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        let var = px.iter().map(|e| (f64::from(e.value) - mean).powi(2)).sum::<f64>()
+            / (n - 1.0).max(1.0);
         s.mean.push(mean as f32);
         s.std.push(var.sqrt() as f32);
         s.lookups.push((px.iter().map(|e| f64::from(e.lookups)).sum::<f64>() / n) as f32);
@@ -66,5 +79,11 @@ pub fn reduce(estimates: &[Estimate], spp: u32) -> PixelStats {
 
 /// exp(−τ) per pixel by regular tracking.
 pub fn exact(medium: &Medium, origin: Vec3, dirs: &[Vec3]) -> Vec<f32> {
-    dirs.iter().map(|&d| medium.segment(origin, d, T_MAX).map_or(1.0, |seg| (-optical_depth(medium, &seg)).exp() as f32)).collect()
+    dirs.iter()
+        .map(|&d| {
+            medium
+                .segment(origin, d, T_MAX)
+                .map_or(1.0, |seg| (-optical_depth(medium, &seg)).exp() as f32)
+        })
+        .collect()
 }

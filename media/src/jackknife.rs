@@ -11,9 +11,24 @@ pub fn jackknife(x0: f32, x1: f32) -> f32 {
 }
 
 /// Two estimates of N = `samples` samples each, variance-aware importance, stratified jitter.
-pub fn jackknife_transmittance(medium: &Medium, seg: &Segment, samples: u32, rng: &mut Pcg) -> Estimate {
+pub fn jackknife_transmittance(
+    medium: &Medium,
+    seg: &Segment,
+    samples: u32,
+    rng: &mut Pcg,
+) -> Estimate {
     let prep = prepare(medium, seg, Importance::VarianceAware);
     let mut x = [0.0; MAX_ESTIMATES];
-    let lookups = estimate(medium, seg, &prep, 2, samples, Importance::VarianceAware, Jitter::Stratified, rng, &mut x);
+    let lookups = estimate(
+        medium,
+        seg,
+        &prep,
+        2,
+        samples,
+        Importance::VarianceAware,
+        Jitter::Stratified,
+        rng,
+        &mut x,
+    );
     Estimate { value: jackknife(x[0], x[1]), lookups }
 }

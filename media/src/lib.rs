@@ -11,10 +11,10 @@
 
 pub mod closed_form;
 pub mod dda;
-pub mod gpu;
-pub mod image;
 pub mod density;
 pub mod equiangular;
+pub mod gpu;
+pub mod image;
 pub mod jackknife;
 pub mod majorant_tracking;
 pub mod medium;

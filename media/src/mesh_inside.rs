@@ -52,10 +52,18 @@ impl MeshInside {
             hi = hi.max(yz(p));
         }
         let bins = ((mesh.triangles.len() as f64).sqrt().ceil() as usize).clamp(1, 64);
-        let mut inside = MeshInside { positions: mesh.positions.clone(), triangles: mesh.triangles.clone(), lo, hi, bins, cells: vec![Vec::new(); bins * bins] };
+        let mut inside = MeshInside {
+            positions: mesh.positions.clone(),
+            triangles: mesh.triangles.clone(),
+            lo,
+            hi,
+            bins,
+            cells: vec![Vec::new(); bins * bins],
+        };
         for (t, tri) in mesh.triangles.iter().enumerate() {
             let ps = tri.map(|i| yz(mesh.positions[i as usize]));
-            let (a, b) = (inside.bin(ps[0].min(ps[1]).min(ps[2])), inside.bin(ps[0].max(ps[1]).max(ps[2])));
+            let (a, b) =
+                (inside.bin(ps[0].min(ps[1]).min(ps[2])), inside.bin(ps[0].max(ps[1]).max(ps[2])));
             for y in a.0..=b.0 {
                 for z in a.1..=b.1 {
                     inside.cells[y + bins * z].push(t as u32);
@@ -66,7 +74,8 @@ impl MeshInside {
     }
 
     fn bin(&self, p: DVec2) -> (usize, usize) {
-        let u = ((p - self.lo) / (self.hi - self.lo).max(DVec2::splat(1e-30)) * self.bins as f64).floor();
+        let u = ((p - self.lo) / (self.hi - self.lo).max(DVec2::splat(1e-30)) * self.bins as f64)
+            .floor();
         let c = |v: f64| (v.max(0.0) as usize).min(self.bins - 1);
         (c(u.x), c(u.y))
     }

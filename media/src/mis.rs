@@ -51,7 +51,15 @@ pub fn miller_weight(mu: f32, p0: f32, t_ratio_tracking: f32) -> f32 {
 /// Eq. 9 (unbiased for any weight estimates whose expectations sum to 1): the sample t0 of the
 /// other strategy weighted by w̃0 with an independent unbiased transmittance estimate T̃(t0),
 /// the free-flight sample t1 by w̃1 (its T μ / p1 cancelled).
-pub fn eq9(w0: f32, transmittance_t0: f32, mu_t0: f32, p0_t0: f32, ls0: f32, w1: f32, ls1: f32) -> f32 {
+pub fn eq9(
+    w0: f32,
+    transmittance_t0: f32,
+    mu_t0: f32,
+    p0_t0: f32,
+    ls0: f32,
+    w1: f32,
+    ls1: f32,
+) -> f32 {
     w0 * transmittance_t0 * mu_t0 * ls0 / p0_t0 + w1 * ls1
 }
 

@@ -25,5 +25,7 @@ impl Pcg {
 /// The stream of one estimate of an image: (seed, frame, pixel, sample) spread by odd
 /// multipliers (golden ratio and MurmurHash3's constants); the first PCG step mixes them.
 pub fn image_seed(seed: u32, frame: u32, pixel: u32, sample: u32) -> u32 {
-    (seed ^ frame.wrapping_mul(0x9e37_79b9)).wrapping_add(pixel.wrapping_mul(0x85eb_ca6b)).wrapping_add(sample.wrapping_mul(0xc2b2_ae35))
+    (seed ^ frame.wrapping_mul(0x9e37_79b9))
+        .wrapping_add(pixel.wrapping_mul(0x85eb_ca6b))
+        .wrapping_add(sample.wrapping_mul(0xc2b2_ae35))
 }

@@ -65,7 +65,12 @@ pub fn voxel_range(res: UVec3, c: UVec3) -> (UVec3, UVec3) {
 }
 
 fn summarise(grid: &DensityGrid, lo: UVec3, hi: UVec3) -> SuperVoxel {
-    let voxels = || (lo.z..=hi.z).flat_map(move |z| (lo.y..=hi.y).flat_map(move |y| (lo.x..=hi.x).map(move |x| grid.at(UVec3::new(x, y, z)))));
+    let voxels = || {
+        (lo.z..=hi.z).flat_map(move |z| {
+            (lo.y..=hi.y)
+                .flat_map(move |y| (lo.x..=hi.x).map(move |x| grid.at(UVec3::new(x, y, z))))
+        })
+    };
     let count = voxels().count() as f64;
     let min = voxels().fold(f32::INFINITY, f32::min);
     let max = voxels().fold(0.0, f32::max);

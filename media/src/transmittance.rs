@@ -15,13 +15,21 @@ pub enum Estimator {
     TrackLength,
     RatioTracking,
     /// Kettunen et al.'s exp(−X), their sample count times `multiplier`.
-    BiasedRayMarching { multiplier: f32 },
+    BiasedRayMarching {
+        multiplier: f32,
+    },
     /// Kettunen et al.'s power series (degree ≤ 8), their sample count times `multiplier`.
-    UnbiasedRayMarching { multiplier: f32 },
+    UnbiasedRayMarching {
+        multiplier: f32,
+    },
     /// exp(−X) of one estimate with `samples` = mN samples (paper's optical-depth estimator).
-    Naive { samples: u32 },
+    Naive {
+        samples: u32,
+    },
     /// Eq. 4 from m = 2 estimates of `samples` = N samples each.
-    Jackknife { samples: u32 },
+    Jackknife {
+        samples: u32,
+    },
 }
 
 impl Estimator {
@@ -40,8 +48,12 @@ impl Estimator {
         match *self {
             Estimator::TrackLength => track_length(medium, seg, rng),
             Estimator::RatioTracking => ratio_tracking(medium, seg, rng),
-            Estimator::BiasedRayMarching { multiplier } => biased_ray_marching(medium, seg, multiplier, rng),
-            Estimator::UnbiasedRayMarching { multiplier } => unbiased_ray_marching(medium, seg, multiplier, rng),
+            Estimator::BiasedRayMarching { multiplier } => {
+                biased_ray_marching(medium, seg, multiplier, rng)
+            }
+            Estimator::UnbiasedRayMarching { multiplier } => {
+                unbiased_ray_marching(medium, seg, multiplier, rng)
+            }
             Estimator::Naive { samples } => naive(medium, seg, samples, rng),
             Estimator::Jackknife { samples } => jackknife_transmittance(medium, seg, samples, rng),
         }

@@ -8,7 +8,9 @@
 //! endpoint matching (as in the paper).
 
 use crate::medium::{Estimate, Medium, Segment};
-use crate::optical_depth::{Importance, Jitter, MAX_ESTIMATES, estimate, kettunen_sample_count, prepare};
+use crate::optical_depth::{
+    Importance, Jitter, MAX_ESTIMATES, estimate, kettunen_sample_count, prepare,
+};
 use crate::rng::Pcg;
 
 pub const MAX_DEGREE: usize = MAX_ESTIMATES - 1;
@@ -72,11 +74,26 @@ pub fn power_series(x: &[f32; MAX_ESTIMATES], degree: usize, prob: &[f32; MAX_DE
     total / (degree + 1) as f32
 }
 
-pub fn unbiased_ray_marching(medium: &Medium, seg: &Segment, multiplier: f32, rng: &mut Pcg) -> Estimate {
+pub fn unbiased_ray_marching(
+    medium: &Medium,
+    seg: &Segment,
+    multiplier: f32,
+    rng: &mut Pcg,
+) -> Estimate {
     let (degree, prob) = power_series_degree(rng);
     let prep = prepare(medium, seg, Importance::Mean);
     let samples = kettunen_sample_count(prep.total, multiplier);
     let mut x = [0.0; MAX_ESTIMATES];
-    let lookups = estimate(medium, seg, &prep, degree + 1, samples, Importance::Mean, Jitter::Uniform, rng, &mut x);
+    let lookups = estimate(
+        medium,
+        seg,
+        &prep,
+        degree + 1,
+        samples,
+        Importance::Mean,
+        Jitter::Uniform,
+        rng,
+        &mut x,
+    );
     Estimate { value: power_series(&x, degree, &prob), lookups }
 }

@@ -21,7 +21,12 @@ const TRIALS: usize = 1_000_000;
 const Z: f64 = 4.5;
 
 fn assert_close(what: &str, got: f64, want: f64, se: f64) {
-    assert!((got - want).abs() <= Z * se, "{what}: {got} vs {want} (|diff| {} > {Z} SE = {})", (got - want).abs(), Z * se);
+    assert!(
+        (got - want).abs() <= Z * se,
+        "{what}: {got} vs {want} (|diff| {} > {Z} SE = {})",
+        (got - want).abs(),
+        Z * se
+    );
 }
 
 #[test]
@@ -84,7 +89,9 @@ fn distributions() -> [Dist; 3] {
                 let u = f64::from(r.next_f32()) + 0.5f64.powi(25) - 0.5; // open interval: no infinite tail
                 -B_LAPLACE * u.signum() * (1.0 - 2.0 * u.abs()).ln()
             },
-            mgf: |s| C::new(1.0, 0.0).div(C::new(1.0, 0.0).add(s.mul(s).scale(-B_LAPLACE * B_LAPLACE))),
+            mgf: |s| {
+                C::new(1.0, 0.0).div(C::new(1.0, 0.0).add(s.mul(s).scale(-B_LAPLACE * B_LAPLACE)))
+            },
         },
         Dist {
             // single-sided: θ(E − 1), E ~ Exp(1), θ = 1
@@ -113,7 +120,11 @@ fn fig2_jackknife_has_less_bias_than_naive_and_underestimates_on_laplace() {
         }
         assert_close(&format!("{} jackknife bias", d.name), jack.mean() - t, jack_exact, jack.se());
         assert_close(&format!("{} naive bias", d.name), naive.mean() - t, naive_exact, naive.se());
-        assert!(jack_exact.abs() < naive_exact.abs(), "{}: exact |bias| jackknife {jack_exact} vs naive {naive_exact}", d.name);
+        assert!(
+            jack_exact.abs() < naive_exact.abs(),
+            "{}: exact |bias| jackknife {jack_exact} vs naive {naive_exact}",
+            d.name
+        );
         assert!(
             (jack.mean() - t).abs() + Z * jack.se() < (naive.mean() - t).abs(),
             "{}: measured |bias| jackknife {} vs naive {}",
@@ -122,7 +133,11 @@ fn fig2_jackknife_has_less_bias_than_naive_and_underestimates_on_laplace() {
             naive.mean() - t
         );
         if d.name == "laplace" {
-            assert!(jack_exact < 0.0 && jack.mean() - t < -Z * jack.se(), "the jackknife underestimates on Laplace: {}", jack.mean() - t);
+            assert!(
+                jack_exact < 0.0 && jack.mean() - t < -Z * jack.se(),
+                "the jackknife underestimates on Laplace: {}",
+                jack.mean() - t
+            );
         }
     }
 }
@@ -135,8 +150,15 @@ fn gpu() -> &'static Gpu {
 /// 10^6 GPU trials: their moments (K, exp(−X̄)), after checking them against the CPU twin on the
 /// same seeds (log and cos may round differently on the GPU: a relative 1e-4 allowance, and at
 /// most 1 in 10^4 trials beyond it).
-fn gpu_trials(pass: &ClosedFormPass, dist: ErrorDistribution, tau: f64, sigma: f64, base: u32) -> (Moments, Moments) {
-    let seeds: Vec<u32> = (0..TRIALS as u32).map(|i| i.wrapping_mul(2654435761).wrapping_add(base)).collect();
+fn gpu_trials(
+    pass: &ClosedFormPass,
+    dist: ErrorDistribution,
+    tau: f64,
+    sigma: f64,
+    base: u32,
+) -> (Moments, Moments) {
+    let seeds: Vec<u32> =
+        (0..TRIALS as u32).map(|i| i.wrapping_mul(2654435761).wrapping_add(base)).collect();
     let got = pass.run(gpu(), dist, tau as f32, sigma as f32, &seeds).expect("closed-form trials");
     let (mut k, mut naive, mut differ) = (Moments::default(), Moments::default(), 0);
     for (&(gk, gn), &seed) in got.iter().zip(&seeds) {
@@ -147,8 +169,19 @@ fn gpu_trials(pass: &ClosedFormPass, dist: ErrorDistribution, tau: f64, sigma: f
         naive.add(f64::from(gn));
     }
     let t = (-tau).exp();
-    println!("GPU {dist:?} τ={tau} σ={sigma}: {differ} of {TRIALS} trials differ from the CPU twin; E[K] − T = {:.3e} ± {:.1e}, V(K) = {:.4e} ± {:.1e}, E[exp(−X̄)] − T = {:.3e} ± {:.1e}", k.mean() - t, k.se(), k.var(), k.var_se(), naive.mean() - t, naive.se());
-    assert!(differ * 10_000 <= TRIALS, "{dist:?} τ={tau} σ={sigma}: {differ} of {TRIALS} GPU trials differ from the CPU twin");
+    println!(
+        "GPU {dist:?} τ={tau} σ={sigma}: {differ} of {TRIALS} trials differ from the CPU twin; E[K] − T = {:.3e} ± {:.1e}, V(K) = {:.4e} ± {:.1e}, E[exp(−X̄)] − T = {:.3e} ± {:.1e}",
+        k.mean() - t,
+        k.se(),
+        k.var(),
+        k.var_se(),
+        naive.mean() - t,
+        naive.se()
+    );
+    assert!(
+        differ * 10_000 <= TRIALS,
+        "{dist:?} τ={tau} σ={sigma}: {differ} of {TRIALS} GPU trials differ from the CPU twin"
+    );
     (k, naive)
 }
 
@@ -160,22 +193,53 @@ fn the_gpu_holds_the_closed_forms_on_the_cpu_twins_random_numbers() {
         let (k, naive) = gpu_trials(&pass, ErrorDistribution::Normal, tau, sigma, base);
         let t = (-tau).exp();
         assert_close(&format!("GPU E[K] at τ={tau} σ={sigma}"), k.mean(), t, k.se());
-        assert_close(&format!("GPU V(K) at τ={tau} σ={sigma}"), k.var(), ((sigma * sigma).exp() - 1.0) / 2.0 * (-2.0 * tau).exp(), k.var_se());
+        assert_close(
+            &format!("GPU V(K) at τ={tau} σ={sigma}"),
+            k.var(),
+            ((sigma * sigma).exp() - 1.0) / 2.0 * (-2.0 * tau).exp(),
+            k.var_se(),
+        );
         // The naive estimate's input is X̄ of the two, of variance σ²/2: bias (exp(σ²/4) − 1)·T.
-        assert_close(&format!("GPU naive bias at τ={tau} σ={sigma}"), naive.mean() - t, ((sigma * sigma / 4.0).exp() - 1.0) * t, naive.se());
+        assert_close(
+            &format!("GPU naive bias at τ={tau} σ={sigma}"),
+            naive.mean() - t,
+            ((sigma * sigma / 4.0).exp() - 1.0) * t,
+            naive.se(),
+        );
     }
     let tau = 3.0f64;
     let t = (-tau).exp();
-    let kinds = [ErrorDistribution::Uniform, ErrorDistribution::Laplace, ErrorDistribution::Exponential];
+    let kinds =
+        [ErrorDistribution::Uniform, ErrorDistribution::Laplace, ErrorDistribution::Exponential];
     for (i, (dist, d)) in kinds.into_iter().zip(distributions()).enumerate() {
         let (jack, naive) = gpu_trials(&pass, dist, tau, 1.0, 20 + i as u32);
         let jack_exact = t * (d.mgf)(C::new(-0.5, 0.5)).mul((d.mgf)(C::new(-0.5, -0.5))).re - t;
         let naive_exact = t * (d.mgf)(C::new(-0.5, 0.0)).re.powi(2) - t;
-        assert_close(&format!("GPU {} jackknife bias", d.name), jack.mean() - t, jack_exact, jack.se());
-        assert_close(&format!("GPU {} naive bias", d.name), naive.mean() - t, naive_exact, naive.se());
-        assert!((jack.mean() - t).abs() + Z * jack.se() < (naive.mean() - t).abs(), "GPU {}: |bias| jackknife {} vs naive {}", d.name, jack.mean() - t, naive.mean() - t);
+        assert_close(
+            &format!("GPU {} jackknife bias", d.name),
+            jack.mean() - t,
+            jack_exact,
+            jack.se(),
+        );
+        assert_close(
+            &format!("GPU {} naive bias", d.name),
+            naive.mean() - t,
+            naive_exact,
+            naive.se(),
+        );
+        assert!(
+            (jack.mean() - t).abs() + Z * jack.se() < (naive.mean() - t).abs(),
+            "GPU {}: |bias| jackknife {} vs naive {}",
+            d.name,
+            jack.mean() - t,
+            naive.mean() - t
+        );
         if dist == ErrorDistribution::Laplace {
-            assert!(jack.mean() - t < -Z * jack.se(), "GPU: the jackknife underestimates on Laplace: {}", jack.mean() - t);
+            assert!(
+                jack.mean() - t < -Z * jack.se(),
+                "GPU: the jackknife underestimates on Laplace: {}",
+                jack.mean() - t
+            );
         }
     }
 }

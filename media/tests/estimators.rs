@@ -16,7 +16,13 @@ const Z: f64 = 4.5;
 
 fn cloud(res: u32) -> Medium {
     let kind = DensityKind::Cloud { octaves: 4, frequency: 3.0, seed: 7 };
-    Medium::new(DensityGrid::bake(&kind, UVec3::splat(res), 8.0, Vec3::splat(-1.0), Vec3::splat(1.0)))
+    Medium::new(DensityGrid::bake(
+        &kind,
+        UVec3::splat(res),
+        8.0,
+        Vec3::splat(-1.0),
+        Vec3::splat(1.0),
+    ))
 }
 
 /// Rays through the cloud, from a camera in front of it, spread over its face.
@@ -25,7 +31,11 @@ fn cloud_rays(medium: &Medium, n: usize) -> Vec<Segment> {
     (0..n)
         .filter_map(|i| {
             let a = i as f32 / n as f32;
-            let target = Vec3::new(1.2 * (a * std::f32::consts::TAU * 3.0).cos() * a, 1.2 * (a * std::f32::consts::TAU * 3.0).sin() * a, 0.0);
+            let target = Vec3::new(
+                1.2 * (a * std::f32::consts::TAU * 3.0).cos() * a,
+                1.2 * (a * std::f32::consts::TAU * 3.0).sin() * a,
+                0.0,
+            );
             medium.segment(eye, (target - eye).normalize(), 100.0)
         })
         .collect()
@@ -43,7 +53,13 @@ fn mean_of(est: Estimator, medium: &Medium, seg: &Segment, trials: usize, seed: 
 #[test]
 fn homogeneous_slab_matches_exp_minus_sigma_t_d() {
     let sigma_t = 1.5;
-    let medium = Medium::new(DensityGrid::bake(&DensityKind::Homogeneous, UVec3::new(40, 40, 20), sigma_t, Vec3::new(-2.0, -2.0, 0.0), Vec3::new(2.0, 2.0, 1.0)));
+    let medium = Medium::new(DensityGrid::bake(
+        &DensityKind::Homogeneous,
+        UVec3::new(40, 40, 20),
+        sigma_t,
+        Vec3::new(-2.0, -2.0, 0.0),
+        Vec3::new(2.0, 2.0, 1.0),
+    ));
     // A slanted ray: d = 1 / cos θ through the slab of depth 1.
     let dir = Vec3::new(0.3, 0.2, 1.0).normalize();
     let seg = medium.segment(Vec3::new(0.0, 0.0, -1.0), dir, 10.0).unwrap();
@@ -54,7 +70,13 @@ fn homogeneous_slab_matches_exp_minus_sigma_t_d() {
     for (i, est) in all_estimators().into_iter().enumerate() {
         let m = mean_of(est, &medium, &seg, 200_000, 10 + i as u32);
         // The ray-marching estimators are exact here (μ − μ_min = 0): SE is 0, allow rounding.
-        assert!((m.mean() - exact).abs() <= Z * m.se() + 1e-5, "{}: {} vs exp(-σ_t d) = {exact} (SE {})", est.label(), m.mean(), m.se());
+        assert!(
+            (m.mean() - exact).abs() <= Z * m.se() + 1e-5,
+            "{}: {} vs exp(-σ_t d) = {exact} (SE {})",
+            est.label(),
+            m.mean(),
+            m.se()
+        );
     }
 }
 
@@ -65,14 +87,28 @@ fn unbiased_estimators_are_unbiased_on_the_cloud() {
     assert!(rays.len() >= 5);
     for (r, seg) in rays.iter().enumerate() {
         let exact = (-optical_depth(&medium, seg)).exp();
-        for est in [Estimator::TrackLength, Estimator::RatioTracking, Estimator::UnbiasedRayMarching { multiplier: 1.0 }] {
+        for est in [
+            Estimator::TrackLength,
+            Estimator::RatioTracking,
+            Estimator::UnbiasedRayMarching { multiplier: 1.0 },
+        ] {
             let m = mean_of(est, &medium, seg, 100_000, 1000 + r as u32);
-            assert!((m.mean() - exact).abs() <= Z * m.se(), "ray {r} {}: {} vs exact {exact} (SE {})", est.label(), m.mean(), m.se());
+            assert!(
+                (m.mean() - exact).abs() <= Z * m.se(),
+                "ray {r} {}: {} vs exact {exact} (SE {})",
+                est.label(),
+                m.mean(),
+                m.se()
+            );
             if est == Estimator::TrackLength {
                 // Bernoulli: std sqrt((1 − T)T); the std's SE is var_se / (2 std).
                 let want = ((1.0 - exact) * exact).sqrt();
                 let se = m.var_se() / (2.0 * want.max(1e-3));
-                assert!((m.std() - want).abs() <= Z * se + 1e-3, "ray {r} track-length std {} vs {want}", m.std());
+                assert!(
+                    (m.std() - want).abs() <= Z * se + 1e-3,
+                    "ray {r} track-length std {} vs {want}",
+                    m.std()
+                );
             }
         }
     }
@@ -85,16 +121,27 @@ fn jackknife_has_at_most_half_the_naive_bias_at_equal_mn() {
     let (mut jack_bias, mut naive_bias, mut var) = (0.0, 0.0, 0.0);
     for (r, seg) in rays.iter().enumerate() {
         let exact = (-optical_depth(&medium, seg)).exp();
-        let j = mean_of(Estimator::Jackknife { samples: 8 }, &medium, seg, 400_000, 2000 + r as u32);
+        let j =
+            mean_of(Estimator::Jackknife { samples: 8 }, &medium, seg, 400_000, 2000 + r as u32);
         let n = mean_of(Estimator::Naive { samples: 16 }, &medium, seg, 400_000, 3000 + r as u32);
-        println!("ray {r}: T {exact:.4} jackknife {:.5} ± {:.5} naive {:.5} ± {:.5}", j.mean() - exact, j.se(), n.mean() - exact, n.se());
+        println!(
+            "ray {r}: T {exact:.4} jackknife {:.5} ± {:.5} naive {:.5} ± {:.5}",
+            j.mean() - exact,
+            j.se(),
+            n.mean() - exact,
+            n.se()
+        );
         jack_bias += (j.mean() - exact).abs();
         naive_bias += (n.mean() - exact).abs();
         var += j.se().powi(2) + 0.25 * n.se().powi(2);
     }
     // One-sided: half the naive sum minus the jackknife sum, above Z of its standard error.
     let margin = 0.5 * naive_bias - jack_bias;
-    assert!(margin > Z * var.sqrt(), "Σ|bias| jackknife {jack_bias} vs naive {naive_bias}: margin {margin} ≤ {Z} × SE {}", var.sqrt());
+    assert!(
+        margin > Z * var.sqrt(),
+        "Σ|bias| jackknife {jack_bias} vs naive {naive_bias}: margin {margin} ≤ {Z} × SE {}",
+        var.sqrt()
+    );
 }
 
 /// RMSE of `f` over `trials` runs against the exact integral.
@@ -117,8 +164,14 @@ fn fig5_stratified_jittered_converges_close_to_one_over_n() {
     let exact = optical_depth(&medium, &seg);
     assert!(exact > 1.0, "the ray must cross the cloud: τ = {exact}");
     let ns = [2u32, 4, 8, 16, 32, 64];
-    let strat: Vec<f64> = ns.iter().map(|&n| rmse(|r| stratified_jittered(mu, t_max, n, r), exact, 10_000, n)).collect();
-    let iid: Vec<f64> = ns.iter().map(|&n| rmse(|r| iid_uniform(mu, t_max, n, r), exact, 10_000, 100 + n)).collect();
+    let strat: Vec<f64> = ns
+        .iter()
+        .map(|&n| rmse(|r| stratified_jittered(mu, t_max, n, r), exact, 10_000, n))
+        .collect();
+    let iid: Vec<f64> = ns
+        .iter()
+        .map(|&n| rmse(|r| iid_uniform(mu, t_max, n, r), exact, 10_000, 100 + n))
+        .collect();
     let x: Vec<f64> = ns.iter().map(|&n| f64::from(n)).collect();
     let (s, u) = (common::log_slope(&x, &strat), common::log_slope(&x, &iid));
     println!("RMSE slope: stratified jittered {s:.3}, i.i.d. {u:.3}; stratified {strat:?}");

@@ -25,14 +25,24 @@ const W: u32 = 32;
 const H: u32 = 18;
 
 fn camera(position: Vec3) -> CameraBasis {
-    CameraBasis::new(&Camera { position, target: Vec3::ZERO, up: Vec3::Y, vfov: 40f32.to_radians() }, W, H)
+    CameraBasis::new(
+        &Camera { position, target: Vec3::ZERO, up: Vec3::Y, vfov: 40f32.to_radians() },
+        W,
+        H,
+    )
 }
 
 #[test]
 fn homogeneous_slab_image_is_exp_minus_sigma_t_d() {
     let sigma_t = 0.8;
     // A slab 1 deep in z, wide enough that every camera ray crosses its whole depth.
-    let medium = Medium::new(DensityGrid::bake(&DensityKind::Homogeneous, UVec3::new(32, 32, 8), sigma_t, Vec3::new(-20.0, -20.0, -0.5), Vec3::new(20.0, 20.0, 0.5)));
+    let medium = Medium::new(DensityGrid::bake(
+        &DensityKind::Homogeneous,
+        UVec3::new(32, 32, 8),
+        sigma_t,
+        Vec3::new(-20.0, -20.0, -0.5),
+        Vec3::new(20.0, 20.0, 0.5),
+    ));
     let cam = camera(Vec3::new(0.0, 0.0, -3.0));
     let dirs = directions(&cam, W, H);
     let gm = GpuMedium::new(gpu(), &medium);
@@ -56,18 +66,42 @@ fn homogeneous_slab_image_is_exp_minus_sigma_t_d() {
 
 #[test]
 fn cloud_image_matches_the_cpu_reference_estimate_for_estimate() {
-    let medium = Medium::new(DensityGrid::bake(&DensityKind::Cloud { octaves: 4, frequency: 3.0, seed: 7 }, UVec3::splat(48), 6.0, Vec3::splat(-1.0), Vec3::splat(1.0)));
+    let medium = Medium::new(DensityGrid::bake(
+        &DensityKind::Cloud { octaves: 4, frequency: 3.0, seed: 7 },
+        UVec3::splat(48),
+        6.0,
+        Vec3::splat(-1.0),
+        Vec3::splat(1.0),
+    ));
     let cam = camera(Vec3::new(0.3, 0.4, -3.0));
     let dirs = directions(&cam, W, H);
     let gm = GpuMedium::new(gpu(), &medium);
     let pass = ImagePass::new(gpu(), &gm).expect("media image pass compiles");
     let key = ImageKey { seed: 9, frame: 3, spp: 4 };
     let reference = exact(&medium, cam.position, &dirs);
-    assert!(reference.iter().any(|&t| t < 0.5) && reference.iter().any(|&t| t == 1.0), "the image must show the cloud and empty space");
-    for est in [Estimator::Jackknife { samples: 8 }, Estimator::UnbiasedRayMarching { multiplier: 1.0 }, Estimator::TrackLength] {
+    assert!(
+        reference.iter().any(|&t| t < 0.5) && reference.iter().any(|&t| t == 1.0),
+        "the image must show the cloud and empty space"
+    );
+    for est in [
+        Estimator::Jackknife { samples: 8 },
+        Estimator::UnbiasedRayMarching { multiplier: 1.0 },
+        Estimator::TrackLength,
+    ] {
         let (got, _) = pass.run(gpu(), &gm, cam.position, &dirs, W, est, key).expect("image");
         let want = estimates(&medium, cam.position, &dirs, est, key);
-        let differ = got.iter().zip(&want).filter(|(g, w)| (g.value - w.value).abs() > 1e-4 + 1e-3 * w.value.abs() || g.lookups != w.lookups).count();
-        assert!(differ * 100 <= got.len(), "{}: {differ} of {} estimates differ", est.label(), got.len());
+        let differ = got
+            .iter()
+            .zip(&want)
+            .filter(|(g, w)| {
+                (g.value - w.value).abs() > 1e-4 + 1e-3 * w.value.abs() || g.lookups != w.lookups
+            })
+            .count();
+        assert!(
+            differ * 100 <= got.len(),
+            "{}: {differ} of {} estimates differ",
+            est.label(),
+            got.len()
+        );
     }
 }

@@ -19,7 +19,13 @@ fn gpu() -> &'static Gpu {
 }
 
 fn medium(kind: DensityKind) -> Medium {
-    Medium::new(DensityGrid::bake(&kind, UVec3::splat(48), 6.0, Vec3::splat(-1.0), Vec3::splat(1.0)))
+    Medium::new(DensityGrid::bake(
+        &kind,
+        UVec3::splat(48),
+        6.0,
+        Vec3::splat(-1.0),
+        Vec3::splat(1.0),
+    ))
 }
 
 /// Segments from random points on a sphere around the medium towards random points inside.
@@ -47,13 +53,18 @@ fn struct_layouts_match() {
 fn every_estimator_matches_the_cpu_reference_on_the_same_random_numbers() {
     let estimators = common::all_estimators();
     let gpu = gpu();
-    for kind in [DensityKind::Cloud { octaves: 4, frequency: 3.0, seed: 7 }, DensityKind::Explosion { frequency: 12.0, seed: 3 }] {
+    for kind in [
+        DensityKind::Cloud { octaves: 4, frequency: 3.0, seed: 7 },
+        DensityKind::Explosion { frequency: 12.0, seed: 3 },
+    ] {
         let m = medium(kind.clone());
         let gm = GpuMedium::new(gpu, &m);
         let pass = EstimatorPass::new(gpu, &gm).expect("media pass compiles");
         let segs = segments(&m, 2000);
         let rays: Vec<RaySegment> = segs.iter().map(RaySegment::from).collect();
-        let seeds: Vec<u32> = (0..segs.len() as u32).map(|i| i.wrapping_mul(2654435761).wrapping_add(12345)).collect();
+        let seeds: Vec<u32> = (0..segs.len() as u32)
+            .map(|i| i.wrapping_mul(2654435761).wrapping_add(12345))
+            .collect();
         for est in estimators {
             let got = pass.run(gpu, &gm, est, &rays, &seeds).expect("readback");
             let mut differ = 0;
@@ -68,8 +79,19 @@ fn every_estimator_matches_the_cpu_reference_on_the_same_random_numbers() {
                 lookups.0 += u64::from(g.lookups);
                 lookups.1 += u64::from(want.lookups);
             }
-            println!("{kind:?} {}: {differ} of {} differ; lookups GPU {} CPU {}", est.label(), segs.len(), lookups.0, lookups.1);
-            assert!(differ * 100 <= segs.len(), "{kind:?} {}: {differ} of {} estimates differ", est.label(), segs.len());
+            println!(
+                "{kind:?} {}: {differ} of {} differ; lookups GPU {} CPU {}",
+                est.label(),
+                segs.len(),
+                lookups.0,
+                lookups.1
+            );
+            assert!(
+                differ * 100 <= segs.len(),
+                "{kind:?} {}: {differ} of {} estimates differ",
+                est.label(),
+                segs.len()
+            );
             assert!(lookups.0 > 0);
         }
     }
@@ -85,7 +107,8 @@ fn fig5_the_gpu_optical_depth_converges_close_to_one_over_n() {
     let m = medium(DensityKind::Cloud { octaves: 4, frequency: 3.0, seed: 7 });
     let gm = GpuMedium::new(gpu, &m);
     let pass = EstimatorPass::new(gpu, &gm).expect("media pass compiles");
-    let seg = m.segment(Vec3::new(0.05, 0.1, -4.0), Vec3::Z, 100.0).expect("the ray crosses the cloud");
+    let seg =
+        m.segment(Vec3::new(0.05, 0.1, -4.0), Vec3::Z, 100.0).expect("the ray crosses the cloud");
     let exact = media::regular_tracking::optical_depth(&m, &seg);
     assert!(exact > 1.0, "the ray must cross the cloud: τ = {exact}");
     const TRIALS: u32 = 170_000;
@@ -93,8 +116,12 @@ fn fig5_the_gpu_optical_depth_converges_close_to_one_over_n() {
     let ns = [2u32, 4, 8, 16, 32, 64];
     let mut rmse = Vec::new();
     for &n in &ns {
-        let seeds: Vec<u32> = (0..TRIALS).map(|i| (i + n * TRIALS).wrapping_mul(2654435761).wrapping_add(99)).collect();
-        let got = pass.run(gpu, &gm, media::Estimator::Naive { samples: n }, &rays, &seeds).expect("readback");
+        let seeds: Vec<u32> = (0..TRIALS)
+            .map(|i| (i + n * TRIALS).wrapping_mul(2654435761).wrapping_add(99))
+            .collect();
+        let got = pass
+            .run(gpu, &gm, media::Estimator::Naive { samples: n }, &rays, &seeds)
+            .expect("readback");
         let se: f64 = got.iter().map(|r| (-f64::from(r.value).ln() - exact).powi(2)).sum();
         rmse.push((se / f64::from(TRIALS)).sqrt());
     }

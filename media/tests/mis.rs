@@ -13,14 +13,22 @@ use media::mis::{Ratio, miller_weight};
 fn real_form_equals_complex_arithmetic() {
     let mut rng = Pcg::new(9);
     for _ in 0..10_000 {
-        let r = Ratio { u0: rng.next_f32(), u1: rng.next_f32(), v0: rng.next_f32() + 0.01, v1: rng.next_f32() + 0.01 };
+        let r = Ratio {
+            u0: rng.next_f32(),
+            u1: rng.next_f32(),
+            v0: rng.next_f32() + 0.01,
+            v1: rng.next_f32() + 0.01,
+        };
         let (x0, x1) = (4.0 * rng.next_f32(), 4.0 * rng.next_f32());
         let z = C::new(-0.5 * f64::from(x0 + x1), -0.5 * f64::from((x0 - x1).abs())).exp(); // exp(−(X̄ + iS))
         let u = z.scale(f64::from(r.u0)).add(C::new(f64::from(r.u1), 0.0));
         let v = z.scale(f64::from(r.v0)).add(C::new(f64::from(r.v1), 0.0));
         let want = u.div(v).re;
         let got = f64::from(r.jackknife(x0, x1));
-        assert!((got - want).abs() <= 1e-5 * want.abs().max(1.0), "{r:?} X=({x0},{x1}): {got} vs {want}");
+        assert!(
+            (got - want).abs() <= 1e-5 * want.abs().max(1.0),
+            "{r:?} X=({x0},{x1}): {got} vs {want}"
+        );
     }
 }
 
@@ -30,7 +38,8 @@ fn weights_of_both_strategies_sum_to_one() {
     for _ in 0..10_000 {
         let (mu, p0) = (5.0 * rng.next_f32() + 1e-3, 5.0 * rng.next_f32() + 1e-3);
         let (x0, x1) = (3.0 * rng.next_f32(), 3.0 * rng.next_f32());
-        let jack = Ratio::free_flight(mu, p0).jackknife(x0, x1) + Ratio::other(mu, p0).jackknife(x0, x1);
+        let jack =
+            Ratio::free_flight(mu, p0).jackknife(x0, x1) + Ratio::other(mu, p0).jackknife(x0, x1);
         let naive = Ratio::free_flight(mu, p0).naive(x0) + Ratio::other(mu, p0).naive(x0);
         assert!((jack - 1.0).abs() < 1e-5 && (naive - 1.0).abs() < 1e-5, "sums {jack} {naive}");
         let m = miller_weight(mu, p0, rng.next_f32());
@@ -53,7 +62,14 @@ fn fig7_jackknife_weight_has_less_bias_than_naive() {
             naive.add(f64::from(r.naive(0.5 * (x0 + x1))));
         }
         let (bj, bn) = (jack.mean() - exact, naive.mean() - exact);
-        println!("τ={tau} σ={sigma}: bias jackknife {bj:.5} ± {:.5}, naive {bn:.5} ± {:.5}", jack.se(), naive.se());
-        assert!(bj.abs() + 4.5 * jack.se() < bn.abs() - 4.5 * naive.se(), "τ={tau} σ={sigma}: jackknife {bj} naive {bn}");
+        println!(
+            "τ={tau} σ={sigma}: bias jackknife {bj:.5} ± {:.5}, naive {bn:.5} ± {:.5}",
+            jack.se(),
+            naive.se()
+        );
+        assert!(
+            bj.abs() + 4.5 * jack.se() < bn.abs() - 4.5 * naive.se(),
+            "τ={tau} σ={sigma}: jackknife {bj} naive {bn}"
+        );
     }
 }

@@ -21,7 +21,16 @@ const SETUPS: [MisSetup; 2] = [
     MisSetup { mu: 1.0, majorant: 2.0, t_max: 4.0, delta: 1.5, d: 0.3, sigma_rel: 1.0 },
 ];
 const TRIALS: u32 = 1_000_000;
-const LABELS: [&str; 8] = ["w1 naive", "w1 jackknife", "w1 Miller", "Eq.9 naive", "Eq.9 jackknife", "Eq.9 Miller", "Eq.10 naive", "Eq.10 jackknife"];
+const LABELS: [&str; 8] = [
+    "w1 naive",
+    "w1 jackknife",
+    "w1 Miller",
+    "Eq.9 naive",
+    "Eq.9 jackknife",
+    "Eq.9 Miller",
+    "Eq.10 naive",
+    "Eq.10 jackknife",
+];
 
 fn seed(i: u32) -> u32 {
     i.wrapping_mul(2654435761).wrapping_add(0x5eed)
@@ -31,7 +40,10 @@ fn seed(i: u32) -> u32 {
 /// analytic integrands here).
 fn normal_nodes() -> Vec<(f64, f64)> {
     let h = 0.25;
-    (-32..=32).map(|k| f64::from(k) * h).map(|z| (z, h * (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt())).collect()
+    (-32..=32)
+        .map(|k| f64::from(k) * h)
+        .map(|z| (z, h * (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt()))
+        .collect()
 }
 
 /// (exact L_i, predicted bias of Eq. 10 naive, of Eq. 10 jackknife), integrated over the
@@ -83,25 +95,44 @@ fn check_closed_forms(who: &str, setup: &MisSetup, trials: &[MisTrial]) {
         }
     }
     for (k, label) in LABELS.iter().enumerate().skip(3) {
-        println!("{who} {label}: mean {:.5} ± {:.5} (exact {exact:.5}, bias {:+.5})", m[k].mean(), m[k].se(), m[k].mean() - exact);
+        println!(
+            "{who} {label}: mean {:.5} ± {:.5} (exact {exact:.5}, bias {:+.5})",
+            m[k].mean(),
+            m[k].se(),
+            m[k].mean() - exact
+        );
     }
     println!("{who} predicted Eq.10 bias: naive {b_naive:+.5}, jackknife {b_jack:+.5}");
     for k in 3..6 {
-        assert!((m[k].mean() - exact).abs() < 4.5 * m[k].se(), "{who} {}: {} vs exact {exact}", LABELS[k], m[k].mean());
+        assert!(
+            (m[k].mean() - exact).abs() < 4.5 * m[k].se(),
+            "{who} {}: {} vs exact {exact}",
+            LABELS[k],
+            m[k].mean()
+        );
     }
     for (k, predicted) in [(6, b_naive), (7, b_jack)] {
-        assert!((m[k].mean() - exact - predicted).abs() < 4.5 * m[k].se(), "{who} {}: bias {} vs predicted {predicted}", LABELS[k], m[k].mean() - exact);
+        assert!(
+            (m[k].mean() - exact - predicted).abs() < 4.5 * m[k].se(),
+            "{who} {}: bias {} vs predicted {predicted}",
+            LABELS[k],
+            m[k].mean() - exact
+        );
     }
     // The naive Eq. 10 is visibly biased (the test can fail); the jackknife's predicted bias is far
     // smaller (where it is resolved, the match above checks its sign and size).
-    assert!((m[6].mean() - exact).abs() > 4.5 * m[6].se(), "{who}: the naive Eq. 10's bias is not resolved");
+    assert!(
+        (m[6].mean() - exact).abs() > 4.5 * m[6].se(),
+        "{who}: the naive Eq. 10's bias is not resolved"
+    );
     assert!(b_jack.abs() < 0.2 * b_naive.abs(), "{who}: predicted {b_jack} vs {b_naive}");
 }
 
 #[test]
 fn eq9_unbiased_and_eq10_bias_as_predicted_on_the_cpu() {
     for setup in &SETUPS {
-        let trials: Vec<MisTrial> = (0..TRIALS).map(|i| trial(setup, &mut Pcg::new(seed(i)))).collect();
+        let trials: Vec<MisTrial> =
+            (0..TRIALS).map(|i| trial(setup, &mut Pcg::new(seed(i)))).collect();
         check_closed_forms("CPU", setup, &trials);
     }
 }

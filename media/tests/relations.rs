@@ -45,8 +45,23 @@ struct Setup {
 fn setup() -> &'static Setup {
     static SETUP: OnceLock<Setup> = OnceLock::new();
     SETUP.get_or_init(|| {
-        let medium = Medium::new(DensityGrid::bake(&DensityKind::Cloud { octaves: 5, frequency: 3.0, seed: 7 }, UVec3::splat(96), 6.0, Vec3::splat(-1.0), Vec3::splat(1.0)));
-        let camera = CameraBasis::new(&Camera { position: Vec3::new(0.0, 0.3, -3.5), target: Vec3::ZERO, up: Vec3::Y, vfov: 40f32.to_radians() }, W, H);
+        let medium = Medium::new(DensityGrid::bake(
+            &DensityKind::Cloud { octaves: 5, frequency: 3.0, seed: 7 },
+            UVec3::splat(96),
+            6.0,
+            Vec3::splat(-1.0),
+            Vec3::splat(1.0),
+        ));
+        let camera = CameraBasis::new(
+            &Camera {
+                position: Vec3::new(0.0, 0.3, -3.5),
+                target: Vec3::ZERO,
+                up: Vec3::Y,
+                vfov: 40f32.to_radians(),
+            },
+            W,
+            H,
+        );
         let dirs = directions(&camera, W, H);
         let exact = exact(&medium, camera.position, &dirs);
         let gpu_medium = GpuMedium::new(gpu(), &medium);
@@ -60,13 +75,31 @@ fn image(est: Estimator, seed: u32, spp: u32) -> PixelStats {
     static LOCK: std::sync::Mutex<()> = std::sync::Mutex::new(());
     let _one = LOCK.lock().unwrap_or_else(|e| e.into_inner());
     let s = setup();
-    let (e, _) = s.pass.run(gpu(), &s.gpu_medium, s.camera.position, &s.dirs, W, est, ImageKey { seed, frame: 0, spp }).expect("image");
+    let (e, _) = s
+        .pass
+        .run(
+            gpu(),
+            &s.gpu_medium,
+            s.camera.position,
+            &s.dirs,
+            W,
+            est,
+            ImageKey { seed, frame: 0, spp },
+        )
+        .expect("image");
     reduce(&e, spp)
 }
 
 /// RMS over pixels of the noise-corrected bias (see the file's comment).
 fn rms_bias(stats: &PixelStats, exact: &[f32], spp: u32) -> f64 {
-    let b2: f64 = stats.mean.iter().zip(&stats.std).zip(exact).map(|((m, s), t)| f64::from(m - t).powi(2) - f64::from(*s).powi(2) / f64::from(spp)).sum::<f64>() / exact.len() as f64;
+    let b2: f64 = stats
+        .mean
+        .iter()
+        .zip(&stats.std)
+        .zip(exact)
+        .map(|((m, s), t)| f64::from(m - t).powi(2) - f64::from(*s).powi(2) / f64::from(spp))
+        .sum::<f64>()
+        / exact.len() as f64;
     b2.max(0.0).sqrt()
 }
 
@@ -85,14 +118,18 @@ fn jackknife_bias_is_at_most_half_the_naive_bias_at_equal_mn() {
     let margins: Vec<f64> = SEEDS
         .iter()
         .map(|&seed| {
-            let jack = rms_bias(&image(Estimator::Jackknife { samples: 4 }, seed, spp), &s.exact, spp);
+            let jack =
+                rms_bias(&image(Estimator::Jackknife { samples: 4 }, seed, spp), &s.exact, spp);
             let naive = rms_bias(&image(Estimator::Naive { samples: 8 }, seed, spp), &s.exact, spp);
             println!("seed {seed}: RMS bias jackknife {jack:.5}, naive {naive:.5}");
             0.5 * naive - jack
         })
         .collect();
     let (m, se) = mean_se(&margins);
-    assert!(m > T_ONE_SIDED_95 * se, "half the naive bias minus the jackknife's: {m} ± {se} over seeds {margins:?}");
+    assert!(
+        m > T_ONE_SIDED_95 * se,
+        "half the naive bias minus the jackknife's: {m} ± {se} over seeds {margins:?}"
+    );
 }
 
 #[test]
@@ -103,15 +140,24 @@ fn track_length_variance_is_one_minus_t_times_t() {
         .iter()
         .map(|&seed| {
             let img = image(Estimator::TrackLength, seed, spp);
-            img.std.iter().zip(&s.exact).map(|(sd, &t)| f64::from(*sd).powi(2) - f64::from((1.0 - t) * t)).sum::<f64>() / s.exact.len() as f64
+            img.std
+                .iter()
+                .zip(&s.exact)
+                .map(|(sd, &t)| f64::from(*sd).powi(2) - f64::from((1.0 - t) * t))
+                .sum::<f64>()
+                / s.exact.len() as f64
         })
         .collect();
-    let mean_var = s.exact.iter().map(|&t| f64::from((1.0 - t) * t)).sum::<f64>() / s.exact.len() as f64;
+    let mean_var =
+        s.exact.iter().map(|&t| f64::from((1.0 - t) * t)).sum::<f64>() / s.exact.len() as f64;
     let (m, se) = mean_se(&diffs);
     println!("mean (s² − (1−T)T) {m:.6} ± {se:.6}; mean (1−T)T {mean_var:.4}");
     let partial = s.exact.iter().filter(|&&t| (0.1..0.9).contains(&t)).count();
     assert!(partial >= 20, "the cloud must have pixels of intermediate transmittance: {partial}");
-    assert!(m.abs() <= T_TWO_SIDED_99 * se, "track-length variance differs from (1−T)T by {m} ± {se} over seeds {diffs:?}");
+    assert!(
+        m.abs() <= T_TWO_SIDED_99 * se,
+        "track-length variance differs from (1−T)T by {m} ± {se} over seeds {diffs:?}"
+    );
 }
 
 #[test]
@@ -123,22 +169,31 @@ fn ratio_tracking_and_unbiased_ray_marching_are_unbiased() {
             .iter()
             .map(|&seed| {
                 let img = image(est, seed, spp);
-                img.mean.iter().zip(&s.exact).map(|(m, t)| f64::from(m - t)).sum::<f64>() / s.exact.len() as f64
+                img.mean.iter().zip(&s.exact).map(|(m, t)| f64::from(m - t)).sum::<f64>()
+                    / s.exact.len() as f64
             })
             .collect();
         let (m, se) = mean_se(&bias);
         println!("{}: mean bias {m:.6} ± {se:.6}", est.label());
-        assert!(m.abs() <= T_TWO_SIDED_99 * se, "{}: mean bias {m} ± {se} over seeds {bias:?}", est.label());
+        assert!(
+            m.abs() <= T_TWO_SIDED_99 * se,
+            "{}: mean bias {m} ± {se} over seeds {bias:?}",
+            est.label()
+        );
     }
     // The test can tell: the naive estimate's bias at few samples is outside the same bound.
     let bias: Vec<f64> = SEEDS
         .iter()
         .map(|&seed| {
             let img = image(Estimator::Naive { samples: 2 }, seed, spp);
-            img.mean.iter().zip(&s.exact).map(|(m, t)| f64::from(m - t)).sum::<f64>() / s.exact.len() as f64
+            img.mean.iter().zip(&s.exact).map(|(m, t)| f64::from(m - t)).sum::<f64>()
+                / s.exact.len() as f64
         })
         .collect();
     let (m, se) = mean_se(&bias);
-    assert!(m.abs() > T_TWO_SIDED_99 * se, "naive with 2 samples should be visibly biased: {m} ± {se}");
+    assert!(
+        m.abs() > T_TWO_SIDED_99 * se,
+        "naive with 2 samples should be visibly biased: {m} ± {se}"
+    );
     let _ = &s.medium;
 }

@@ -25,7 +25,10 @@
 use std::sync::OnceLock;
 
 use glam::{Mat4, UVec3, Vec2, Vec3};
-use media::gpu::{Combination, GpuMedium, MediumOptics, MisWeight, ShadowTransmittance, VolumeImage, VolumePathPass, VolumePathSettings};
+use media::gpu::{
+    Combination, GpuMedium, MediumOptics, MisWeight, ShadowTransmittance, VolumeImage,
+    VolumePathPass, VolumePathSettings,
+};
 use media::{DensityGrid, DensityKind, Medium};
 use render::frame::CameraBasis;
 use render::gpu::Gpu;
@@ -43,7 +46,11 @@ fn gpu() -> &'static Gpu {
 fn ground(camera: Camera, lights: Vec<Light>) -> SceneDesc {
     SceneDesc {
         meshes: vec![Mesh::plane(50.0)],
-        materials: vec![Material { base_color: Vec3::splat(0.5), specular: 0.0, ..Default::default() }],
+        materials: vec![Material {
+            base_color: Vec3::splat(0.5),
+            specular: 0.0,
+            ..Default::default()
+        }],
         instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }],
         lights,
         camera,
@@ -52,7 +59,10 @@ fn ground(camera: Camera, lights: Vec<Light>) -> SceneDesc {
 }
 
 fn medium(kind: DensityKind, res: u32, sigma_t: f32, lo: Vec3, hi: Vec3) -> GpuMedium {
-    GpuMedium::new(gpu(), &Medium::new(DensityGrid::bake(&kind, UVec3::splat(res), sigma_t, lo, hi)))
+    GpuMedium::new(
+        gpu(),
+        &Medium::new(DensityGrid::bake(&kind, UVec3::splat(res), sigma_t, lo, hi)),
+    )
 }
 
 /// ε (1 − exp(−σ ℓ)) over each pixel's footprint (16 x 16 points), ℓ = `chord` / |d.y|.
@@ -65,7 +75,10 @@ fn slab_image(camera: &Camera, sigma: f64, chord: f64, scale: f64) -> Vec<f64> {
             let mut sum = 0.0;
             for j in 0..k {
                 for s in 0..k {
-                    let p = Vec2::new(x as f32 + (s as f32 + 0.5) / k as f32, y as f32 + (j as f32 + 0.5) / k as f32);
+                    let p = Vec2::new(
+                        x as f32 + (s as f32 + 0.5) / k as f32,
+                        y as f32 + (j as f32 + 0.5) / k as f32,
+                    );
                     sum += (-sigma * chord / f64::from(basis.ray_direction(p, W, H).y.abs())).exp();
                 }
             }
@@ -94,16 +107,43 @@ fn compare(a: &VolumeImage, b: &[f64], var_b: &[f64]) -> (f64, f64) {
 #[test]
 fn absorbing_slab_attenuates_the_path_tracer_image_by_its_closed_form() {
     let sigma = 0.6;
-    let camera = Camera { position: Vec3::new(0.0, 4.0, 0.0), target: Vec3::ZERO, up: Vec3::NEG_Z, vfov: 50f32.to_radians() };
+    let camera = Camera {
+        position: Vec3::new(0.0, 4.0, 0.0),
+        target: Vec3::ZERO,
+        up: Vec3::NEG_Z,
+        vfov: 50f32.to_radians(),
+    };
     // Straight down: the shadow ray's chord through the slab y in [1, 2] is 1.
-    let sun = Light::Directional { direction: Vec3::NEG_Y, irradiance: Vec3::splat(2.0), angular_radius: 0.0 };
+    let sun = Light::Directional {
+        direction: Vec3::NEG_Y,
+        irradiance: Vec3::splat(2.0),
+        angular_radius: 0.0,
+    };
     let scene = ground(camera, vec![sun]);
     let settings = PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 8 };
     let mut tracer = PathTracer::new(gpu(), &scene, settings).expect("path tracer");
     let plain = tracer.render(gpu(), 4, 3, 0).expect("render").radiance;
-    let slab = medium(DensityKind::Homogeneous, 8, sigma, Vec3::new(-60.0, 1.0, -60.0), Vec3::new(60.0, 2.0, 60.0));
+    let slab = medium(
+        DensityKind::Homogeneous,
+        8,
+        sigma,
+        Vec3::new(-60.0, 1.0, -60.0),
+        Vec3::new(60.0, 2.0, 60.0),
+    );
     let setup = cloud_setup();
-    let image = setup.pass.render(gpu(), &tracer, &slab, &[MediumOptics::scattering(Vec3::ZERO)], &VolumePathSettings::default(), 128, 5, 0).expect("render");
+    let image = setup
+        .pass
+        .render(
+            gpu(),
+            &tracer,
+            &slab,
+            &[MediumOptics::scattering(Vec3::ZERO)],
+            &VolumePathSettings::default(),
+            128,
+            5,
+            0,
+        )
+        .expect("render");
     // exp(−σ ℓ) over each pixel's footprint, ℓ = 1 / |d.y| through the slab; the sun's chord is 1.
     let expected: Vec<f64> = slab_image(&camera, f64::from(sigma), 1.0, (-f64::from(sigma)).exp())
         .iter()
@@ -113,52 +153,107 @@ fn absorbing_slab_attenuates_the_path_tracer_image_by_its_closed_form() {
     let (z, worst) = compare(&image, &expected, &vec![0.0; expected.len()]);
     let mean = image.mean.iter().map(lum).sum::<f64>() / expected.len() as f64;
     let want = expected.iter().sum::<f64>() / expected.len() as f64;
-    println!("absorbing slab: mean {mean:.5} expected {want:.5}, z = {z:.2}, worst pixel {worst:.2} SE");
+    println!(
+        "absorbing slab: mean {mean:.5} expected {want:.5}, z = {z:.2}, worst pixel {worst:.2} SE"
+    );
     assert!(z.abs() <= 4.5 && worst <= 6.0, "absorbing slab: z = {z}, worst pixel {worst} SE");
 }
 
 #[test]
 fn medium_emission_matches_its_closed_forms() {
-    let camera = Camera { position: Vec3::new(0.0, 4.0, 0.0), target: Vec3::ZERO, up: Vec3::NEG_Z, vfov: 50f32.to_radians() };
+    let camera = Camera {
+        position: Vec3::new(0.0, 4.0, 0.0),
+        target: Vec3::ZERO,
+        up: Vec3::NEG_Z,
+        vfov: 50f32.to_radians(),
+    };
     // No lights, no environment, a black ground: all light is the medium's emission.
     let mut scene = ground(camera, vec![]);
     scene.materials[0].base_color = Vec3::ZERO;
     let depth = 3;
-    let tracer = PathTracer::new(gpu(), &scene, PathTracerSettings { width: W, height: H, max_depth: depth, rr_start_depth: 8 }).expect("path tracer");
+    let tracer = PathTracer::new(
+        gpu(),
+        &scene,
+        PathTracerSettings { width: W, height: H, max_depth: depth, rr_start_depth: 8 },
+    )
+    .expect("path tracer");
     let emission = Vec3::new(1.5, 1.0, 0.5);
 
     let sigma = 0.8;
-    let slab = medium(DensityKind::Homogeneous, 8, sigma, Vec3::new(-60.0, 1.0, -60.0), Vec3::new(60.0, 2.0, 60.0));
+    let slab = medium(
+        DensityKind::Homogeneous,
+        8,
+        sigma,
+        Vec3::new(-60.0, 1.0, -60.0),
+        Vec3::new(60.0, 2.0, 60.0),
+    );
     let setup = cloud_setup();
     let pass = &setup.pass;
     let optics = MediumOptics { albedo: Vec3::ZERO, emission };
-    let image = pass.render(gpu(), &tracer, &slab, &[optics], &VolumePathSettings::default(), 128, 7, 0).expect("render");
+    let image = pass
+        .render(gpu(), &tracer, &slab, &[optics], &VolumePathSettings::default(), 128, 7, 0)
+        .expect("render");
     let transmitted = slab_image(&camera, f64::from(sigma), 1.0, 1.0);
-    let expected: Vec<f64> = transmitted.iter().map(|t| lum(&emission.to_array()) * (1.0 - t)).collect();
+    let expected: Vec<f64> =
+        transmitted.iter().map(|t| lum(&emission.to_array()) * (1.0 - t)).collect();
     let (z, worst) = compare(&image, &expected, &vec![0.0; expected.len()]);
     let mean = image.mean.iter().map(lum).sum::<f64>() / expected.len() as f64;
     let want = expected.iter().sum::<f64>() / expected.len() as f64;
-    println!("emissive absorbing slab: mean {mean:.5} expected {want:.5}, z = {z:.2}, worst pixel {worst:.2} SE");
+    println!(
+        "emissive absorbing slab: mean {mean:.5} expected {want:.5}, z = {z:.2}, worst pixel {worst:.2} SE"
+    );
     assert!(z.abs() <= 4.5 && worst <= 6.0, "emissive slab: z = {z}, worst pixel {worst} SE");
 
     // σ_t = 20 in a box around everything: the ground, 4 units away, is reached with e^{−80}.
     let fog = medium(DensityKind::Homogeneous, 8, 20.0, Vec3::splat(-1000.0), Vec3::splat(1000.0));
     let albedo = Vec3::new(0.5, 0.25, 0.8);
-    let image = pass.render(gpu(), &tracer, &fog, &[MediumOptics { albedo, emission }], &VolumePathSettings::default(), 4, 7, 0).expect("render");
+    let image = pass
+        .render(
+            gpu(),
+            &tracer,
+            &fog,
+            &[MediumOptics { albedo, emission }],
+            &VolumePathSettings::default(),
+            4,
+            7,
+            0,
+        )
+        .expect("render");
     let want = emission * (0..=depth).map(|k| albedo.powf(k as f32)).fold(Vec3::ZERO, |a, b| a + b);
-    let got = image.mean.iter().fold(Vec3::ZERO, |a, m| a + Vec3::from_array(*m)) / image.mean.len() as f32;
-    let worst = image.mean.iter().map(|m| (Vec3::from_array(*m) - want).abs().max_element()).fold(0f32, f32::max);
-    println!("emissive scattering fog, depth {depth}: mean {got} expected {want}, worst pixel off by {worst:.2e}");
-    assert!(worst <= 1e-4 * want.max_element(), "emissive fog: mean {got}, expected {want}, worst pixel off by {worst}");
+    let got = image.mean.iter().fold(Vec3::ZERO, |a, m| a + Vec3::from_array(*m))
+        / image.mean.len() as f32;
+    let worst = image
+        .mean
+        .iter()
+        .map(|m| (Vec3::from_array(*m) - want).abs().max_element())
+        .fold(0f32, f32::max);
+    println!(
+        "emissive scattering fog, depth {depth}: mean {got} expected {want}, worst pixel off by {worst:.2e}"
+    );
+    assert!(
+        worst <= 1e-4 * want.max_element(),
+        "emissive fog: mean {got}, expected {want}, worst pixel off by {worst}"
+    );
 }
 
 /// A point light inside a cloud over the ground, just above the view (no camera ray passes
 /// through it: a pixel whose rays pass arbitrarily close has a heavy-tailed estimate, and the
 /// per-pixel variances the comparisons use would not be reliable there).
 fn cloud_scene() -> (SceneDesc, GpuMedium) {
-    let camera = Camera { position: Vec3::new(0.0, 1.0, 3.5), target: Vec3::new(0.0, 0.8, 0.0), up: Vec3::Y, vfov: 40f32.to_radians() };
+    let camera = Camera {
+        position: Vec3::new(0.0, 1.0, 3.5),
+        target: Vec3::new(0.0, 0.8, 0.0),
+        up: Vec3::Y,
+        vfov: 40f32.to_radians(),
+    };
     let light = Light::Point { position: Vec3::new(0.0, 2.3, 0.0), intensity: Vec3::splat(3.0) };
-    let cloud = medium(DensityKind::Cloud { octaves: 3, frequency: 2.0, seed: 5 }, 32, 3.0, Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 3.0, 1.0));
+    let cloud = medium(
+        DensityKind::Cloud { octaves: 3, frequency: 2.0, seed: 5 },
+        32,
+        3.0,
+        Vec3::new(-1.0, 0.0, -1.0),
+        Vec3::new(1.0, 3.0, 1.0),
+    );
     (ground(camera, vec![light]), cloud)
 }
 
@@ -180,27 +275,66 @@ fn cloud_setup() -> std::sync::MutexGuard<'static, CloudSetup> {
     SETUP
         .get_or_init(|| {
             let (scene, cloud) = cloud_scene();
-            let tracer = PathTracer::new(gpu(), &scene, PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 2 }).expect("path tracer");
-            let pass = VolumePathPass::new(gpu(), &tracer, &cloud).expect("volume path pass compiles");
-            let explosion = medium(DensityKind::Explosion { frequency: 8.0, seed: 3 }, 48, 8.0, Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 3.0, 1.0));
+            let tracer = PathTracer::new(
+                gpu(),
+                &scene,
+                PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 2 },
+            )
+            .expect("path tracer");
+            let pass =
+                VolumePathPass::new(gpu(), &tracer, &cloud).expect("volume path pass compiles");
+            let explosion = medium(
+                DensityKind::Explosion { frequency: 8.0, seed: 3 },
+                48,
+                8.0,
+                Vec3::new(-1.0, 0.0, -1.0),
+                Vec3::new(1.0, 3.0, 1.0),
+            );
             std::sync::Mutex::new(CloudSetup { tracer, pass, cloud, explosion })
         })
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
-fn render_cloud(tracer: &PathTracer, pass: &VolumePathPass, cloud: &GpuMedium, s: VolumePathSettings, seed: u64) -> VolumeImage {
+fn render_cloud(
+    tracer: &PathTracer,
+    pass: &VolumePathPass,
+    cloud: &GpuMedium,
+    s: VolumePathSettings,
+    seed: u64,
+) -> VolumeImage {
     render_spp(tracer, pass, cloud, s, 256, seed)
 }
 
-fn render_spp(tracer: &PathTracer, pass: &VolumePathPass, medium: &GpuMedium, s: VolumePathSettings, spp: u32, seed: u64) -> VolumeImage {
-    pass.render(gpu(), tracer, medium, &[MediumOptics::scattering(Vec3::splat(0.8))], &s, spp, seed, 0).expect("render")
+fn render_spp(
+    tracer: &PathTracer,
+    pass: &VolumePathPass,
+    medium: &GpuMedium,
+    s: VolumePathSettings,
+    spp: u32,
+    seed: u64,
+) -> VolumeImage {
+    pass.render(
+        gpu(),
+        tracer,
+        medium,
+        &[MediumOptics::scattering(Vec3::splat(0.8))],
+        &s,
+        spp,
+        seed,
+        0,
+    )
+    .expect("render")
 }
 
 fn agree(what: &str, a: &VolumeImage, b: &VolumeImage) {
     let (z, worst) = compare(a, &b.mean.iter().map(lum).collect::<Vec<_>>(), &b.var_of_mean);
     let (ma, mb) = (a.mean.iter().map(lum).sum::<f64>(), b.mean.iter().map(lum).sum::<f64>());
-    println!("{what}: mean {:.5} vs {:.5}, z = {z:.2}, worst pixel {worst:.2} SE", ma / a.mean.len() as f64, mb / b.mean.len() as f64);
+    println!(
+        "{what}: mean {:.5} vs {:.5}, z = {z:.2}, worst pixel {worst:.2} SE",
+        ma / a.mean.len() as f64,
+        mb / b.mean.len() as f64
+    );
     assert!(z.abs() <= 4.5 && worst <= 6.0, "{what}: z = {z}, worst pixel {worst} SE");
 }
 
@@ -210,12 +344,25 @@ fn shadow_ratio_tracking_equals_delta_tracking_and_mis_is_unbiased_in_a_cloud() 
     let (tracer, pass, cloud) = (&setup.tracer, &setup.pass, &setup.cloud);
     let base = VolumePathSettings::default();
     let ratio = render_cloud(tracer, pass, cloud, base, 11);
-    let track = render_cloud(tracer, pass, cloud, VolumePathSettings { shadow: ShadowTransmittance::TrackLength, ..base }, 12);
+    let track = render_cloud(
+        tracer,
+        pass,
+        cloud,
+        VolumePathSettings { shadow: ShadowTransmittance::TrackLength, ..base },
+        12,
+    );
     agree("shadow rays: ratio tracking vs track-length", &ratio, &track);
-    let mean_var = |im: &VolumeImage| im.var_of_mean.iter().sum::<f64>() / im.var_of_mean.len() as f64;
+    let mean_var =
+        |im: &VolumeImage| im.var_of_mean.iter().sum::<f64>() / im.var_of_mean.len() as f64;
     println!("mean variance of a pixel's mean: free-flight only {:.3e}", mean_var(&ratio));
     for mis in [MisWeight::Naive, MisWeight::Jackknife, MisWeight::Miller] {
-        let im = render_cloud(tracer, pass, cloud, VolumePathSettings { mis, combination: Combination::Eq9, ..base }, 13);
+        let im = render_cloud(
+            tracer,
+            pass,
+            cloud,
+            VolumePathSettings { mis, combination: Combination::Eq9, ..base },
+            13,
+        );
         println!("{mis:?} Eq. 9: mean variance {:.3e}", mean_var(&im));
         agree(&format!("{mis:?} Eq. 9 vs free-flight only"), &im, &ratio);
     }
@@ -238,10 +385,22 @@ const T_TWO_SIDED_95: f64 = 4.303;
 /// Per variant and seed: the MSE of the image's luminance against a 1024-spp reference (Eq. 9,
 /// jackknife weights: unbiased), less the reference's own mean variance (so an unbiased
 /// estimate of the MSE against the truth); and the relative bias of the image's mean.
-fn mis_errors(setup: &CloudSetup, medium: &GpuMedium, samples: u32, spp: u32) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+fn mis_errors(
+    setup: &CloudSetup,
+    medium: &GpuMedium,
+    samples: u32,
+    spp: u32,
+) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
     let (tracer, pass) = (&setup.tracer, &setup.pass);
     let base = VolumePathSettings { samples, ..VolumePathSettings::default() };
-    let reference = render_spp(tracer, pass, medium, VolumePathSettings { mis: MisWeight::Jackknife, ..base }, 1024, 1000);
+    let reference = render_spp(
+        tracer,
+        pass,
+        medium,
+        VolumePathSettings { mis: MisWeight::Jackknife, ..base },
+        1024,
+        1000,
+    );
     let truth: Vec<f64> = reference.mean.iter().map(lum).collect();
     let n = truth.len() as f64;
     let ref_var = reference.var_of_mean.iter().sum::<f64>() / n;
@@ -250,8 +409,18 @@ fn mis_errors(setup: &CloudSetup, medium: &GpuMedium, samples: u32, spp: u32) ->
     for &(_, mis, combination) in &VARIANTS {
         let (mut m, mut b) = (Vec::new(), Vec::new());
         for &seed in &SEEDS {
-            let im = render_spp(tracer, pass, medium, VolumePathSettings { mis, combination, ..base }, spp, seed);
-            m.push(im.mean.iter().zip(&truth).map(|(x, t)| (lum(x) - t).powi(2)).sum::<f64>() / n - ref_var);
+            let im = render_spp(
+                tracer,
+                pass,
+                medium,
+                VolumePathSettings { mis, combination, ..base },
+                spp,
+                seed,
+            );
+            m.push(
+                im.mean.iter().zip(&truth).map(|(x, t)| (lum(x) - t).powi(2)).sum::<f64>() / n
+                    - ref_var,
+            );
             b.push(im.mean.iter().map(lum).sum::<f64>() / n / ref_mean - 1.0);
         }
         mse.push(m);
@@ -294,12 +463,26 @@ fn mis_variants_keep_their_measured_order_over_seeds() {
     let setup = cloud_setup();
     let mut failures: Vec<String> = Vec::new();
     let settings: [(&str, &GpuMedium, u32, &[(usize, usize)], &[(usize, usize)]); 2] = [
-        ("cloud, N = 4", &setup.cloud, 4, &[(NAIVE_10, NAIVE_9), (JACKKNIFE_10, JACKKNIFE_9), (JACKKNIFE_10, MILLER_9)], &[(NAIVE_9, JACKKNIFE_9), (NAIVE_10, JACKKNIFE_10)]),
+        (
+            "cloud, N = 4",
+            &setup.cloud,
+            4,
+            &[(NAIVE_10, NAIVE_9), (JACKKNIFE_10, JACKKNIFE_9), (JACKKNIFE_10, MILLER_9)],
+            &[(NAIVE_9, JACKKNIFE_9), (NAIVE_10, JACKKNIFE_10)],
+        ),
         (
             "explosion, N = 1",
             &setup.explosion,
             1,
-            &[(NAIVE_10, NAIVE_9), (JACKKNIFE_10, JACKKNIFE_9), (NAIVE_9, MILLER_9), (JACKKNIFE_9, MILLER_9), (FREE, JACKKNIFE_9), (NAIVE_9, JACKKNIFE_9), (NAIVE_10, JACKKNIFE_10)],
+            &[
+                (NAIVE_10, NAIVE_9),
+                (JACKKNIFE_10, JACKKNIFE_9),
+                (NAIVE_9, MILLER_9),
+                (JACKKNIFE_9, MILLER_9),
+                (FREE, JACKKNIFE_9),
+                (NAIVE_9, JACKKNIFE_9),
+                (NAIVE_10, JACKKNIFE_10),
+            ],
             &[],
         ),
     ];
@@ -313,17 +496,29 @@ fn mis_variants_keep_their_measured_order_over_seeds() {
         for &(a, b) in below {
             let (mean, sd) = mean_sd(&relative(&mse, a, b));
             let bound = mean + T_ONE_SIDED_95 * sd / (SEEDS.len() as f64).sqrt();
-            println!("  {} below {}: relative difference {mean:+.3}, upper bound {bound:+.3}", VARIANTS[a].0, VARIANTS[b].0);
+            println!(
+                "  {} below {}: relative difference {mean:+.3}, upper bound {bound:+.3}",
+                VARIANTS[a].0, VARIANTS[b].0
+            );
             if bound >= 0.0 {
-                failures.push(format!("{name}: {} not below {} (relative difference {mean:+.3}, bound {bound:+.3})", VARIANTS[a].0, VARIANTS[b].0));
+                failures.push(format!(
+                    "{name}: {} not below {} (relative difference {mean:+.3}, bound {bound:+.3})",
+                    VARIANTS[a].0, VARIANTS[b].0
+                ));
             }
         }
         for &(a, b) in alike {
             let (mean, sd) = mean_sd(&relative(&mse, a, b));
             let half = T_TWO_SIDED_95 * sd / (SEEDS.len() as f64).sqrt();
-            println!("  {} alike {}: relative difference {mean:+.4} ± {half:.4}", VARIANTS[a].0, VARIANTS[b].0);
+            println!(
+                "  {} alike {}: relative difference {mean:+.4} ± {half:.4}",
+                VARIANTS[a].0, VARIANTS[b].0
+            );
             if mean.abs() + half >= 0.05 {
-                failures.push(format!("{name}: {} and {} differ (relative difference {mean:+.4} ± {half:.4})", VARIANTS[a].0, VARIANTS[b].0));
+                failures.push(format!(
+                    "{name}: {} and {} differ (relative difference {mean:+.4} ± {half:.4})",
+                    VARIANTS[a].0, VARIANTS[b].0
+                ));
             }
         }
     }
@@ -332,26 +527,72 @@ fn mis_variants_keep_their_measured_order_over_seeds() {
 
 #[test]
 fn two_disjoint_absorbing_slabs_multiply_their_transmittances() {
-    let camera = Camera { position: Vec3::new(0.0, 4.0, 0.0), target: Vec3::ZERO, up: Vec3::NEG_Z, vfov: 50f32.to_radians() };
-    let sun = Light::Directional { direction: Vec3::NEG_Y, irradiance: Vec3::splat(2.0), angular_radius: 0.0 };
+    let camera = Camera {
+        position: Vec3::new(0.0, 4.0, 0.0),
+        target: Vec3::ZERO,
+        up: Vec3::NEG_Z,
+        vfov: 50f32.to_radians(),
+    };
+    let sun = Light::Directional {
+        direction: Vec3::NEG_Y,
+        irradiance: Vec3::splat(2.0),
+        angular_radius: 0.0,
+    };
     let scene = ground(camera, vec![sun]);
-    let mut tracer = PathTracer::new(gpu(), &scene, PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 8 }).expect("path tracer");
+    let mut tracer = PathTracer::new(
+        gpu(),
+        &scene,
+        PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 8 },
+    )
+    .expect("path tracer");
     let plain = tracer.render(gpu(), 4, 3, 0).expect("render").radiance;
     // σ 0.5 in y ∈ [1, 1.4] and σ 1.0 in y ∈ [1.6, 2]: optical depth (0.2 + 0.4) / |d.y| along a
     // camera ray, 0.6 along the sun's.
-    let bake = |sigma: f32, y0: f32, y1: f32| Medium::new(DensityGrid::bake(&DensityKind::Homogeneous, UVec3::splat(8), sigma, Vec3::new(-60.0, y0, -60.0), Vec3::new(60.0, y1, 60.0)));
+    let bake = |sigma: f32, y0: f32, y1: f32| {
+        Medium::new(DensityGrid::bake(
+            &DensityKind::Homogeneous,
+            UVec3::splat(8),
+            sigma,
+            Vec3::new(-60.0, y0, -60.0),
+            Vec3::new(60.0, y1, 60.0),
+        ))
+    };
     let (low, high) = (bake(0.5, 1.0, 1.4), bake(1.0, 1.6, 2.0));
     let both = GpuMedium::several(gpu(), &[&low, &high]);
     let setup = cloud_setup();
     let absorbing = MediumOptics::scattering(Vec3::ZERO);
-    let image = setup.pass.render(gpu(), &tracer, &both, &[absorbing, absorbing], &VolumePathSettings::default(), 128, 5, 0).expect("render");
-    let expected: Vec<f64> = slab_image(&camera, 1.0, 0.6, (-0.6f64).exp()).iter().zip(&plain).map(|(t, p)| t * lum(&[p[0], p[1], p[2]])).collect();
+    let image = setup
+        .pass
+        .render(
+            gpu(),
+            &tracer,
+            &both,
+            &[absorbing, absorbing],
+            &VolumePathSettings::default(),
+            128,
+            5,
+            0,
+        )
+        .expect("render");
+    let expected: Vec<f64> = slab_image(&camera, 1.0, 0.6, (-0.6f64).exp())
+        .iter()
+        .zip(&plain)
+        .map(|(t, p)| t * lum(&[p[0], p[1], p[2]]))
+        .collect();
     let (z, worst) = compare(&image, &expected, &vec![0.0; expected.len()]);
     let mean = image.mean.iter().map(lum).sum::<f64>() / expected.len() as f64;
     let want = expected.iter().sum::<f64>() / expected.len() as f64;
-    println!("two absorbing slabs: mean {mean:.5} expected {want:.5}, z = {z:.2}, worst pixel {worst:.2} SE");
+    println!(
+        "two absorbing slabs: mean {mean:.5} expected {want:.5}, z = {z:.2}, worst pixel {worst:.2} SE"
+    );
     assert!(z.abs() <= 4.5 && worst <= 6.0, "two slabs: z = {z}, worst pixel {worst} SE");
-    assert!(setup.pass.render(gpu(), &tracer, &both, &[absorbing], &VolumePathSettings::default(), 1, 5, 0).is_err(), "one optics for two media is refused");
+    assert!(
+        setup
+            .pass
+            .render(gpu(), &tracer, &both, &[absorbing], &VolumePathSettings::default(), 1, 5, 0)
+            .is_err(),
+        "one optics for two media is refused"
+    );
 }
 
 #[test]
@@ -359,8 +600,12 @@ fn two_media_in_one_box_render_as_the_medium_of_their_summed_extinction() {
     let setup = cloud_setup();
     let (tracer, pass) = (&setup.tracer, &setup.pass);
     let (lo, hi) = (Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 3.0, 1.0));
-    let bake = |kind: &DensityKind, sigma: f32| DensityGrid::bake(kind, UVec3::splat(32), sigma, lo, hi);
-    let sum = |a: &DensityGrid, b: &DensityGrid| DensityGrid { data: a.data.iter().zip(&b.data).map(|(x, y)| x + y).collect(), ..a.clone() };
+    let bake =
+        |kind: &DensityKind, sigma: f32| DensityGrid::bake(kind, UVec3::splat(32), sigma, lo, hi);
+    let sum = |a: &DensityGrid, b: &DensityGrid| DensityGrid {
+        data: a.data.iter().zip(&b.data).map(|(x, y)| x + y).collect(),
+        ..a.clone()
+    };
     let cases = {
         // Two homogeneous media of different albedo and emission: the one medium has σ 1 + 2,
         // albedo (0.9 · 1 + 0.3 · 2) / 3 and emission (1 ε1 + 2 ε2) / 3 (source terms σ ε add).
@@ -368,13 +613,26 @@ fn two_media_in_one_box_render_as_the_medium_of_their_summed_extinction() {
         let (e1, e2) = (Vec3::new(0.3, 0.0, 0.0), Vec3::new(0.0, 0.0, 0.6));
         let homogeneous = (
             "homogeneous σ 1 + 2",
-            vec![(a.clone(), MediumOptics { albedo: Vec3::splat(0.9), emission: e1 }), (b.clone(), MediumOptics { albedo: Vec3::splat(0.3), emission: e2 })],
-            (sum(&a, &b), MediumOptics { albedo: Vec3::splat(0.5), emission: (e1 + 2.0 * e2) / 3.0 }),
+            vec![
+                (a.clone(), MediumOptics { albedo: Vec3::splat(0.9), emission: e1 }),
+                (b.clone(), MediumOptics { albedo: Vec3::splat(0.3), emission: e2 }),
+            ],
+            (
+                sum(&a, &b),
+                MediumOptics { albedo: Vec3::splat(0.5), emission: (e1 + 2.0 * e2) / 3.0 },
+            ),
         );
         // A cloud and a thin homogeneous haze: the one medium is their voxel sum.
-        let (c, h) = (bake(&DensityKind::Cloud { octaves: 3, frequency: 2.0, seed: 5 }, 3.0), bake(&DensityKind::Homogeneous, 0.5));
+        let (c, h) = (
+            bake(&DensityKind::Cloud { octaves: 3, frequency: 2.0, seed: 5 }, 3.0),
+            bake(&DensityKind::Homogeneous, 0.5),
+        );
         let grey = MediumOptics::scattering(Vec3::splat(0.8));
-        let cloud = ("cloud σ 3 + haze σ 0.5", vec![(c.clone(), grey), (h.clone(), grey)], (sum(&c, &h), grey));
+        let cloud = (
+            "cloud σ 3 + haze σ 0.5",
+            vec![(c.clone(), grey), (h.clone(), grey)],
+            (sum(&c, &h), grey),
+        );
         [homogeneous, cloud]
     };
     for (what, parts, (one, one_optics)) in cases {
@@ -386,8 +644,12 @@ fn two_media_in_one_box_render_as_the_medium_of_their_summed_extinction() {
             let s = VolumePathSettings { mis, ..VolumePathSettings::default() };
             let mut zs = Vec::new();
             for seed in [1u64, 2, 3] {
-                let a = pass.render(gpu(), tracer, &several, &optics, &s, 64, 100 + seed, 0).expect("render");
-                let b = pass.render(gpu(), tracer, &single, &[one_optics], &s, 64, 200 + seed, 0).expect("render");
+                let a = pass
+                    .render(gpu(), tracer, &several, &optics, &s, 64, 100 + seed, 0)
+                    .expect("render");
+                let b = pass
+                    .render(gpu(), tracer, &single, &[one_optics], &s, 64, 200 + seed, 0)
+                    .expect("render");
                 agree(&format!("{what}, {mis:?}, seed {seed}: two media vs one"), &a, &b);
                 zs.push(compare(&a, &b.mean.iter().map(lum).collect::<Vec<_>>(), &b.var_of_mean).0);
             }
@@ -413,14 +675,20 @@ fn the_pass_follows_the_scene_s_features() {
     let before = render_spp(&tracer, &pass, &cloud, VolumePathSettings::default(), 4, 3);
 
     let mut lit = scene.clone();
-    lit.textures.push(Texture { name: "dark".into(), width: 1, height: 1, rgba8: vec![40, 40, 40, 255] });
+    lit.textures.push(Texture {
+        name: "dark".into(),
+        width: 1,
+        height: 1,
+        rgba8: vec![40, 40, 40, 255],
+    });
     lit.materials[0].base_color_texture = Some(0);
     tracer.try_update(gpu(), &lit).expect("update");
     let after = render_spp(&tracer, &pass, &cloud, VolumePathSettings::default(), 4, 3);
     assert!(pass.features().textures, "compiled again for the texture");
 
     let fresh_tracer = PathTracer::new(gpu(), &lit, settings).expect("path tracer");
-    let fresh = VolumePathPass::new(gpu(), &fresh_tracer, &cloud).expect("volume path pass compiles");
+    let fresh =
+        VolumePathPass::new(gpu(), &fresh_tracer, &cloud).expect("volume path pass compiles");
     let expected = render_spp(&fresh_tracer, &fresh, &cloud, VolumePathSettings::default(), 4, 3);
     assert_eq!(after.mean, expected.mean);
     assert!(after.mean != before.mean, "the texture darkens the ground");

@@ -47,7 +47,8 @@ pub struct BenchReport {
 
 /// Deterministic integer hash to [0, 1).
 pub fn hash01(x: u32, y: u32, seed: u32) -> f32 {
-    let mut h = x.wrapping_mul(0x8da6_b343) ^ y.wrapping_mul(0xd816_3841) ^ seed.wrapping_mul(0xcb1a_b31f);
+    let mut h =
+        x.wrapping_mul(0x8da6_b343) ^ y.wrapping_mul(0xd816_3841) ^ seed.wrapping_mul(0xcb1a_b31f);
     h ^= h >> 16;
     h = h.wrapping_mul(0x7feb_352d);
     h ^= h >> 15;
@@ -104,20 +105,34 @@ pub fn reference_flip_available() -> bool {
 }
 
 /// Runs NVIDIA's `flip` tool on two EXR files; returns (its evaluation time in ms, mean FLIP).
-pub fn run_reference_flip(reference: &std::path::Path, test: &std::path::Path, ppd: f32) -> anyhow::Result<(f64, f64)> {
+pub fn run_reference_flip(
+    reference: &std::path::Path,
+    test: &std::path::Path,
+    ppd: f32,
+) -> anyhow::Result<(f64, f64)> {
     let out = reference_flip_command()
         .args(["-r".as_ref(), reference.as_os_str(), "-t".as_ref(), test.as_os_str()])
         .args(["-ppd", &ppd.to_string(), "-nerm", "-nexm", "-v", "2"])
         .output()
-        .context("cannot run python3 -m flip_evaluator.flip_python_api (pip install flip-evaluator)")?;
+        .context(
+            "cannot run python3 -m flip_evaluator.flip_python_api (pip install flip-evaluator)",
+        )?;
     let text = String::from_utf8_lossy(&out.stdout);
-    anyhow::ensure!(out.status.success(), "`flip` failed: {}{}", text, String::from_utf8_lossy(&out.stderr));
+    anyhow::ensure!(
+        out.status.success(),
+        "`flip` failed: {}{}",
+        text,
+        String::from_utf8_lossy(&out.stderr)
+    );
     let number_after = |key: &str| -> Option<f64> {
         let line = text.lines().find(|l| l.contains(key))?;
-        line.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == 'e')).filter_map(|s| s.parse().ok()).next_back()
+        line.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == 'e'))
+            .filter_map(|s| s.parse().ok())
+            .next_back()
     };
     let mean = number_after("Mean:").context(format!("no 'Mean:' in flip's output:\n{text}"))?;
-    let seconds = number_after("Evaluation time:").context(format!("no 'Evaluation time:' in flip's output:\n{text}"))?;
+    let seconds = number_after("Evaluation time:")
+        .context(format!("no 'Evaluation time:' in flip's output:\n{text}"))?;
     Ok((seconds * 1e3, mean))
 }
 
@@ -128,17 +143,21 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<BenchReport> {
     });
     let (mut flip_hdr_ms, mut flip_hdr_mean) = (None, None);
     if !args.smape_only {
-        flip_hdr_ms = Some(best_ms(args.repeats, || flip_hdr_mean = Some(flip_hdr(&reference, &test, DEFAULT_PPD).mean)));
+        flip_hdr_ms = Some(best_ms(args.repeats, || {
+            flip_hdr_mean = Some(flip_hdr(&reference, &test, DEFAULT_PPD).mean)
+        }));
     }
     let (mut reference_flip_ms, mut reference_flip_mean) = (None, None);
     if !args.no_reference && !args.smape_only {
-        let dir: PathBuf = std::env::temp_dir().join(format!("flicker-bench-{}", std::process::id()));
+        let dir: PathBuf =
+            std::env::temp_dir().join(format!("flicker-bench-{}", std::process::id()));
         std::fs::create_dir_all(&dir)?;
         write_exr(&reference, dir.join("reference.exr"))?;
         write_exr(&test, dir.join("test.exr"))?;
         let mut best = f64::INFINITY;
         for _ in 0..args.repeats.max(1) {
-            let (ms, mean) = run_reference_flip(&dir.join("reference.exr"), &dir.join("test.exr"), DEFAULT_PPD)?;
+            let (ms, mean) =
+                run_reference_flip(&dir.join("reference.exr"), &dir.join("test.exr"), DEFAULT_PPD)?;
             best = best.min(ms);
             reference_flip_mean = Some(mean);
         }

@@ -41,10 +41,16 @@ pub fn magma_bytes(map: &[f32], scale: f32) -> Vec<u8> {
 }
 
 /// Writes a per-pixel map in [0, 1] as a magma PNG.
-pub fn write_map_png(map: &[f32], width: u32, height: u32, path: impl AsRef<Path>) -> anyhow::Result<()> {
+pub fn write_map_png(
+    map: &[f32],
+    width: u32,
+    height: u32,
+    path: impl AsRef<Path>,
+) -> anyhow::Result<()> {
     let path = path.as_ref();
     assert_eq!(map.len(), width as usize * height as usize, "map size must be width * height");
-    let buf = ::image::RgbImage::from_raw(width, height, magma_bytes(map, 1.0)).expect("buffer size matches");
+    let buf = ::image::RgbImage::from_raw(width, height, magma_bytes(map, 1.0))
+        .expect("buffer size matches");
     buf.save(path).with_context(|| format!("cannot write error map {}", path.display()))
 }
 

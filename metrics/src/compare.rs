@@ -61,12 +61,21 @@ pub struct Comparison {
 }
 
 fn default_mode(reference: &Path) -> FlipMode {
-    let exr = reference.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    let exr = reference
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
     if exr { FlipMode::Hdr } else { FlipMode::Ldr }
 }
 
 /// Loads both images and measures them.
-pub fn compare_files(reference: &Path, test: &Path, mode: Option<FlipMode>, ppd: f32, eps: f32) -> anyhow::Result<Comparison> {
+pub fn compare_files(
+    reference: &Path,
+    test: &Path,
+    mode: Option<FlipMode>,
+    ppd: f32,
+    eps: f32,
+) -> anyhow::Result<Comparison> {
     if ppd.is_nan() || ppd <= 0.0 {
         bail!("--ppd must be positive, got {ppd}");
     }
@@ -138,6 +147,9 @@ pub fn text_report(c: &Comparison) -> String {
     if let Some(e) = c.exposures {
         s += &format!("      exposures {:.4} to {:.4} stops, {} steps\n", e.start, e.stop, e.count);
     }
-    s += &format!("SMAPE {:.6}\nPSNR  {:.3} dB (MSE {:.6e}, relative MSE {:.6e})", c.smape, c.psnr, c.mse, c.relative_mse);
+    s += &format!(
+        "SMAPE {:.6}\nPSNR  {:.3} dB (MSE {:.6e}, relative MSE {:.6e})",
+        c.smape, c.psnr, c.mse, c.relative_mse
+    );
     s
 }

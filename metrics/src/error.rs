@@ -8,9 +8,16 @@ use crate::image::Image;
 /// ε of relative MSE's denominator, keeping black reference pixels finite.
 pub const REL_MSE_EPS: f32 = 0.01;
 
-fn mean_over_channels(reference: &Image, test: &Image, what: &str, f: impl Fn(f32, f32) -> f64 + Sync) -> f64 {
+fn mean_over_channels(
+    reference: &Image,
+    test: &Image,
+    what: &str,
+    f: impl Fn(f32, f32) -> f64 + Sync,
+) -> f64 {
     reference.assert_same_size(test, what);
-    let sum = ordered_sum(reference.len(), |i| (0..3).map(|c| f(reference.rgb[i][c], test.rgb[i][c])).sum::<f64>());
+    let sum = ordered_sum(reference.len(), |i| {
+        (0..3).map(|c| f(reference.rgb[i][c], test.rgb[i][c])).sum::<f64>()
+    });
     sum / (3 * reference.len().max(1)) as f64
 }
 

@@ -17,7 +17,11 @@ pub struct Image {
 
 impl Image {
     pub fn new(width: u32, height: u32, rgb: Vec<[f32; 3]>) -> Self {
-        assert_eq!(rgb.len(), width as usize * height as usize, "pixel count must be width * height");
+        assert_eq!(
+            rgb.len(),
+            width as usize * height as usize,
+            "pixel count must be width * height"
+        );
         Self { width, height, rgb }
     }
 
@@ -26,7 +30,10 @@ impl Image {
     }
 
     pub fn from_fn(width: u32, height: u32, f: impl Fn(u32, u32) -> [f32; 3]) -> Self {
-        let rgb = (0..height).flat_map(|y| (0..width).map(move |x| (x, y))).map(|(x, y)| f(x, y)).collect();
+        let rgb = (0..height)
+            .flat_map(|y| (0..width).map(move |x| (x, y)))
+            .map(|(x, y)| f(x, y))
+            .collect();
         Self::new(width, height, rgb)
     }
 
@@ -76,12 +83,15 @@ pub fn load_image(path: impl AsRef<Path>) -> anyhow::Result<Image> {
     if ext != "png" && ext != "exr" {
         bail!("{}: expected a .png or .exr image", path.display());
     }
-    let decoded = ::image::open(path).with_context(|| format!("cannot read image {}", path.display()))?;
+    let decoded =
+        ::image::open(path).with_context(|| format!("cannot read image {}", path.display()))?;
     let (width, height) = (decoded.width(), decoded.height());
     let rgb = if ext == "png" {
         // 8-bit sRGB like the FLIP reference tool reads it; 16-bit keeps its precision.
         let px = decoded.to_rgb32f();
-        px.pixels().map(|p| [srgb_to_linear(p[0]), srgb_to_linear(p[1]), srgb_to_linear(p[2])]).collect()
+        px.pixels()
+            .map(|p| [srgb_to_linear(p[0]), srgb_to_linear(p[1]), srgb_to_linear(p[2])])
+            .collect()
     } else {
         let px = decoded.to_rgb32f();
         px.pixels().map(|p| [p[0], p[1], p[2]]).collect()
@@ -97,7 +107,8 @@ pub fn write_png_srgb(image: &Image, path: impl AsRef<Path>) -> anyhow::Result<(
         .iter()
         .flat_map(|p| p.map(|c| (linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8))
         .collect();
-    let buf = ::image::RgbImage::from_raw(image.width, image.height, bytes).expect("buffer size matches");
+    let buf =
+        ::image::RgbImage::from_raw(image.width, image.height, bytes).expect("buffer size matches");
     buf.save(path).with_context(|| format!("cannot write PNG {}", path.display()))
 }
 
@@ -111,7 +122,11 @@ pub fn write_exr(image: &Image, path: impl AsRef<Path>) -> anyhow::Result<()> {
         let p = image.rgb[y * w + x];
         (p[0], p[1], p[2])
     });
-    let encoding = Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
+    let encoding = Encoding {
+        compression: Compression::ZIP16,
+        blocks: Blocks::ScanLines,
+        line_order: LineOrder::Increasing,
+    };
     exr::image::Image::from_encoded_channels((w, image.height as usize), encoding, channels)
         .write()
         .to_file(path)

@@ -41,7 +41,12 @@ impl Region {
     }
 
     /// Mean over the region of a map where some pixels were not measured (`valid[i] == false`).
-    pub fn mean_of_valid(&self, map: &[f32], valid: impl Fn(usize) -> bool, width: u32) -> Option<f64> {
+    pub fn mean_of_valid(
+        &self,
+        map: &[f32],
+        valid: impl Fn(usize) -> bool,
+        width: u32,
+    ) -> Option<f64> {
         let height = map.len() as u32 / width.max(1);
         let (x0, y0, x1, y1) = self.clip(width, height);
         let (mut sum, mut n) = (0.0f64, 0usize);
@@ -84,8 +89,11 @@ mod tests {
     #[test]
     fn steady_and_changing_crops_of_real_metrics() {
         // The right half changes between frames, the left half does not.
-        let prev = Image::from_fn(48, 24, |x, y| [0.3 + 0.01 * (x % 5) as f32, 0.2, 0.1 + 0.01 * y as f32]);
-        let cur = Image::from_fn(48, 24, |x, y| if x >= 24 { [0.9, 0.1, 0.5] } else { prev.get(x, y) });
+        let prev = Image::from_fn(48, 24, |x, y| {
+            [0.3 + 0.01 * (x % 5) as f32, 0.2, 0.1 + 0.01 * y as f32]
+        });
+        let cur =
+            Image::from_fn(48, 24, |x, y| if x >= 24 { [0.9, 0.1, 0.5] } else { prev.get(x, y) });
         let steady = Region { name: "steady".into(), x: 0, y: 0, width: 12, height: 24 };
         let changing = Region { name: "changing".into(), x: 30, y: 0, width: 18, height: 24 };
         let s = smape(&cur, &prev, 0.01);

@@ -45,9 +45,14 @@ pub fn smape(cur: &Image, prev: &Image, eps: f32) -> SmapeResult {
         .enumerate()
         .map(|(chunk, out)| {
             let start = 3 * chunk * w * ROWS_PER_TASK;
-            let (a, b) = (&cur_flat[start..start + 3 * out.len()], &prev_flat[start..start + 3 * out.len()]);
+            let (a, b) =
+                (&cur_flat[start..start + 3 * out.len()], &prev_flat[start..start + 3 * out.len()]);
             // Per channel over a flat slice first (vectorises), then the channel average.
-            let terms: Vec<f32> = a.iter().zip(b).map(|(&a, &b)| 2.0 * (a - b).abs() / (a.abs() + b.abs() + eps)).collect();
+            let terms: Vec<f32> = a
+                .iter()
+                .zip(b)
+                .map(|(&a, &b)| 2.0 * (a - b).abs() / (a.abs() + b.abs() + eps))
+                .collect();
             let mut acc = 0.0f64;
             for (o, t) in out.iter_mut().zip(terms.chunks_exact(3)) {
                 *o = (t[0] + t[1] + t[2]) * (1.0 / 3.0);
@@ -103,7 +108,13 @@ pub fn smape_reprojected(cur: &Image, prev: &Image, motion: &[[f32; 2]], eps: f3
 
 /// Bilinear sample at pixel coordinates (pixel centres at integers); `None` outside the image.
 fn sample_bilinear(img: &Image, w: usize, h: usize, x: f32, y: f32) -> Option<[f32; 3]> {
-    if !x.is_finite() || !y.is_finite() || x < -0.5 || y < -0.5 || x > w as f32 - 0.5 || y > h as f32 - 0.5 {
+    if !x.is_finite()
+        || !y.is_finite()
+        || x < -0.5
+        || y < -0.5
+        || x > w as f32 - 0.5
+        || y > h as f32 - 0.5
+    {
         return None;
     }
     let (x, y) = (x.clamp(0.0, (w - 1) as f32), y.clamp(0.0, (h - 1) as f32));
@@ -148,7 +159,9 @@ mod tests {
 
     #[test]
     fn mean_is_mean_of_map() {
-        let cur = Image::from_fn(50, 31, |x, y| [((x * 7 + y) % 5) as f32, (x % 3) as f32, 0.1 * y as f32]);
+        let cur = Image::from_fn(50, 31, |x, y| {
+            [((x * 7 + y) % 5) as f32, (x % 3) as f32, 0.1 * y as f32]
+        });
         let prev = Image::from_fn(50, 31, |x, y| [((x + y * 3) % 4) as f32, (y % 2) as f32, 0.2]);
         let r = smape(&cur, &prev, 0.01);
         let m: f64 = r.map.iter().map(|&v| v as f64).sum::<f64>() / r.map.len() as f64;
@@ -159,7 +172,8 @@ mod tests {
     #[test]
     fn reprojection_undoes_a_camera_pan_and_counts_disocclusions() {
         // The scene moves 3 pixels to the right: the current pixel x saw what was at x - 3.
-        let pattern = |x: i32, y: i32| [((x * 13 + y * 7) % 11) as f32 + 0.5, (x % 4) as f32, (y % 3) as f32];
+        let pattern =
+            |x: i32, y: i32| [((x * 13 + y * 7) % 11) as f32 + 0.5, (x % 4) as f32, (y % 3) as f32];
         let prev = Image::from_fn(24, 10, |x, y| pattern(x as i32, y as i32));
         let cur = Image::from_fn(24, 10, |x, y| pattern(x as i32 - 3, y as i32));
         let motion = vec![[-3.0, 0.0]; cur.len()];

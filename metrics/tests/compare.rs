@@ -2,7 +2,9 @@
 //! bad input is reported with the file name.
 
 use metrics::compare::{CompareArgs, FlipMode, compare, compare_files};
-use metrics::{DEFAULT_PPD, Image, flip_hdr, flip_ldr, load_image, psnr, smape, write_exr, write_png_srgb};
+use metrics::{
+    DEFAULT_PPD, Image, flip_hdr, flip_ldr, load_image, psnr, smape, write_exr, write_png_srgb,
+};
 
 fn dir(name: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("metrics-compare-{name}-{}", std::process::id()));
@@ -14,7 +16,8 @@ fn dir(name: &str) -> std::path::PathBuf {
 fn compare_matches_library_and_writes_map() {
     let d = dir("ok");
     let r = Image::from_fn(40, 30, |x, y| [x as f32 / 40.0 * 3.0, y as f32 / 30.0, 0.5]);
-    let t = Image::from_fn(40, 30, |x, y| if (x + y) % 7 == 0 { [2.0, 0.1, 0.1] } else { r.get(x, y) });
+    let t =
+        Image::from_fn(40, 30, |x, y| if (x + y) % 7 == 0 { [2.0, 0.1, 0.1] } else { r.get(x, y) });
     write_exr(&r, d.join("r.exr")).unwrap();
     write_exr(&t, d.join("t.exr")).unwrap();
     let c = compare_files(&d.join("r.exr"), &d.join("t.exr"), None, DEFAULT_PPD, 0.01).unwrap();
@@ -23,10 +26,19 @@ fn compare_matches_library_and_writes_map() {
     assert_eq!(c.smape, smape(&t, &r, 0.01).mean);
     assert_eq!(c.psnr, psnr(&r, &t));
     assert!(c.flip_mean > 0.01 && c.exposures.is_some());
-    let ldr = compare_files(&d.join("r.exr"), &d.join("t.exr"), Some(FlipMode::Ldr), 40.0, 0.01).unwrap();
+    let ldr =
+        compare_files(&d.join("r.exr"), &d.join("t.exr"), Some(FlipMode::Ldr), 40.0, 0.01).unwrap();
     assert_eq!(ldr.flip_mean, flip_ldr(&r, &t, 40.0).mean);
 
-    let args = CompareArgs { reference: d.join("r.exr"), test: d.join("t.exr"), mode: None, ppd: DEFAULT_PPD, map: Some(d.join("map.png")), json: true, eps: 0.01 };
+    let args = CompareArgs {
+        reference: d.join("r.exr"),
+        test: d.join("t.exr"),
+        mode: None,
+        ppd: DEFAULT_PPD,
+        map: Some(d.join("map.png")),
+        json: true,
+        eps: 0.01,
+    };
     compare(&args).unwrap();
     let map = ::image::open(d.join("map.png")).unwrap().to_rgb8();
     assert_eq!(map.dimensions(), (40, 30));
@@ -39,11 +51,19 @@ fn compare_reports_bad_inputs_by_name() {
     let d = dir("bad");
     write_png_srgb(&Image::filled(8, 8, [0.5; 3]), d.join("a.png")).unwrap();
     write_png_srgb(&Image::filled(9, 8, [0.5; 3]), d.join("b.png")).unwrap();
-    let err = compare_files(&d.join("a.png"), &d.join("b.png"), None, DEFAULT_PPD, 0.01).unwrap_err().to_string();
+    let err = compare_files(&d.join("a.png"), &d.join("b.png"), None, DEFAULT_PPD, 0.01)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("a.png") && err.contains("b.png") && err.contains("same size"), "{err}");
-    let err = format!("{:#}", compare_files(&d.join("a.png"), &d.join("missing.png"), None, DEFAULT_PPD, 0.01).unwrap_err());
+    let err = format!(
+        "{:#}",
+        compare_files(&d.join("a.png"), &d.join("missing.png"), None, DEFAULT_PPD, 0.01)
+            .unwrap_err()
+    );
     assert!(err.contains("missing.png"), "{err}");
-    let err = compare_files(&d.join("a.png"), &d.join("a.png"), None, -1.0, 0.01).unwrap_err().to_string();
+    let err = compare_files(&d.join("a.png"), &d.join("a.png"), None, -1.0, 0.01)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("ppd"), "{err}");
     // PNG holds sRGB: linear 0.5 is stored as byte 188 and read back as linear again.
     assert_eq!(::image::open(d.join("a.png")).unwrap().to_rgb8().get_pixel(0, 0).0, [188; 3]);

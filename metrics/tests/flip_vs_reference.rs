@@ -5,7 +5,9 @@
 
 use std::path::{Path, PathBuf};
 
-use metrics::bench::{hash01, reference_flip_available, reference_flip_command, synthetic_hdr_pair};
+use metrics::bench::{
+    hash01, reference_flip_available, reference_flip_command, synthetic_hdr_pair,
+};
 use metrics::{DEFAULT_PPD, Image, flip_hdr, flip_ldr, load_image, write_exr, write_png_srgb};
 
 const W: u32 = 80;
@@ -56,15 +58,30 @@ fn box_blur(img: &Image) -> Image {
 /// Runs the reference tool; returns (mean, map).
 fn reference(dir: &Path, name: &str, r: &Path, t: &Path, ppd: f32) -> (f64, Vec<f32>) {
     let out = reference_flip_command()
-        .args(["-r".as_ref(), r.as_os_str(), "-t".as_ref(), t.as_os_str(), "-d".as_ref(), dir.as_os_str()])
+        .args([
+            "-r".as_ref(),
+            r.as_os_str(),
+            "-t".as_ref(),
+            t.as_os_str(),
+            "-d".as_ref(),
+            dir.as_os_str(),
+        ])
         .args(["-b", name, "-ppd", &ppd.to_string(), "-nm", "-nexm", "-v", "2"])
         .output()
         .expect("run python3 -m flip_evaluator.flip_python_api");
     let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    assert!(out.status.success(), "reference FLIP failed on {name}: {stdout}{}", String::from_utf8_lossy(&out.stderr));
-    let mean_line = stdout.lines().find(|l| l.contains("Mean:")).unwrap_or_else(|| panic!("no mean in:\n{stdout}"));
+    assert!(
+        out.status.success(),
+        "reference FLIP failed on {name}: {stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mean_line = stdout
+        .lines()
+        .find(|l| l.contains("Mean:"))
+        .unwrap_or_else(|| panic!("no mean in:\n{stdout}"));
     let mean: f64 = mean_line.split(':').nth(1).unwrap().trim().parse().unwrap();
-    let png = ::image::open(dir.join(format!("{name}.png"))).expect("reference error map").to_rgb8();
+    let png =
+        ::image::open(dir.join(format!("{name}.png"))).expect("reference error map").to_rgb8();
     let map = png.pixels().map(|p| p[0] as f32 / 255.0).collect();
     (mean, map)
 }
@@ -74,9 +91,18 @@ fn check(name: &str, ours_mean: f64, ours_map: &[f32], reference: (f64, Vec<f32>
     assert_eq!(ours_map.len(), ref_map.len());
     let bad = ours_map.iter().zip(&ref_map).filter(|(a, b)| (**a - **b).abs() > 0.01).count();
     let worst = ours_map.iter().zip(&ref_map).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
-    eprintln!("{name}: mean ours {ours_mean:.6} reference {ref_mean:.6}; pixels off by > 0.01: {bad}; worst {worst:.4}");
-    assert!((ours_mean - ref_mean).abs() < 0.001, "{name}: mean FLIP {ours_mean} vs reference {ref_mean}");
-    assert!(bad as f64 <= 0.01 * ref_map.len() as f64, "{name}: {bad} of {} pixels differ by more than 0.01", ref_map.len());
+    eprintln!(
+        "{name}: mean ours {ours_mean:.6} reference {ref_mean:.6}; pixels off by > 0.01: {bad}; worst {worst:.4}"
+    );
+    assert!(
+        (ours_mean - ref_mean).abs() < 0.001,
+        "{name}: mean FLIP {ours_mean} vs reference {ref_mean}"
+    );
+    assert!(
+        bad as f64 <= 0.01 * ref_map.len() as f64,
+        "{name}: {bad} of {} pixels differ by more than 0.01",
+        ref_map.len()
+    );
     assert!(ref_mean > 0.005, "{name}: the pair must actually differ (reference mean {ref_mean})");
 }
 
@@ -92,12 +118,18 @@ fn flip_matches_nvidia_reference() {
     let ldr_pairs: Vec<(&str, Image, f32)> = vec![
         (
             "ldr_noise",
-            map_image(&base, |x, y, p| p.map(|c| (c + 0.3 * (hash01(x, y, 3) - 0.5)).clamp(0.0, 1.0))),
+            map_image(&base, |x, y, p| {
+                p.map(|c| (c + 0.3 * (hash01(x, y, 3) - 0.5)).clamp(0.0, 1.0))
+            }),
             DEFAULT_PPD,
         ),
         ("ldr_blur", box_blur(&box_blur(&base)), DEFAULT_PPD),
         ("ldr_shift", map_image(&base, |x, y, _| base.get(x.saturating_sub(2), y)), DEFAULT_PPD),
-        ("ldr_colour_shift", map_image(&base, |_, _, p| [p[0], (p[1] * 0.8).min(1.0), (p[2] * 1.3 + 0.05).min(1.0)]), 30.0),
+        (
+            "ldr_colour_shift",
+            map_image(&base, |_, _, p| [p[0], (p[1] * 0.8).min(1.0), (p[2] * 1.3 + 0.05).min(1.0)]),
+            30.0,
+        ),
     ];
     let ref_png = dir.join("ldr_reference.png");
     write_png_srgb(&base, &ref_png).unwrap();
@@ -113,7 +145,11 @@ fn flip_matches_nvidia_reference() {
     let (hdr_ref, hdr_noisy) = synthetic_hdr_pair(96, 64, 11);
     let hdr_pairs: Vec<(&str, Image, Image)> = vec![
         ("hdr_wide_range_noise", hdr_ref.clone(), hdr_noisy),
-        ("hdr_shift_and_exposure", hdr_ref.clone(), map_image(&hdr_ref, |x, y, _| hdr_ref.get(x.saturating_sub(1), y).map(|c| c * 1.5))),
+        (
+            "hdr_shift_and_exposure",
+            hdr_ref.clone(),
+            map_image(&hdr_ref, |x, y, _| hdr_ref.get(x.saturating_sub(1), y).map(|c| c * 1.5)),
+        ),
         (
             "hdr_colour_shift_dark",
             map_image(&hdr_ref, |_, _, p| p.map(|c| c * 0.01)),

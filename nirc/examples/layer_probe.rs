@@ -11,15 +11,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let gpu = render::gpu::Gpu::new()?;
     if what != "forms" {
         let p = nirc::bench::probes(&gpu, 3)?;
-        println!("FMA ceiling {:.1} GFLOP/s; tiled 4x16 {:.2}, 16x16 {:.2}", p.fma_gflops, p.layer_4x16_gflops, p.layer_16x16_gflops);
+        println!(
+            "FMA ceiling {:.1} GFLOP/s; tiled 4x16 {:.2}, 16x16 {:.2}",
+            p.fma_gflops, p.layer_4x16_gflops, p.layer_16x16_gflops
+        );
         for kind in ["uniform", "uniform2", "storage", "workgroup"] {
             for unroll in [true, false] {
                 if kind == "uniform2" && unroll {
                     continue; // two records per invocation exist in the loop shape only
                 }
                 let (gflops, compile_s) = nirc::bench::register_layer_probe(&gpu, 3, kind, unroll)?;
-                let memory = if kind == "uniform2" { "uniform, two records per invocation" } else { kind };
-                println!("weights in {memory}, output quads {}: {gflops:.2} GFLOP/s (pipeline and first dispatch {compile_s:.1} s)", if unroll { "unrolled" } else { "in a loop" });
+                let memory =
+                    if kind == "uniform2" { "uniform, two records per invocation" } else { kind };
+                println!(
+                    "weights in {memory}, output quads {}: {gflops:.2} GFLOP/s (pipeline and first dispatch {compile_s:.1} s)",
+                    if unroll { "unrolled" } else { "in a loop" }
+                );
             }
         }
     }
@@ -29,7 +36,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let r = nirc::bench::run(&gpu, &config, Some(placement), 4096, 16384, 3)?;
             println!(
                 "{placement:?}: EMA-only {:.0} queries/s ({:.2} GFLOP/s), blend {:.0} queries/s, blend overhead {:.1}% of the bench's step + inference, {:.1}% of EMA-only inference",
-                r.ema_only_queries_per_s, r.infer_gflops, r.blend_queries_per_s, r.blend_overhead_step_percent, r.blend_overhead_infer_percent
+                r.ema_only_queries_per_s,
+                r.infer_gflops,
+                r.blend_queries_per_s,
+                r.blend_overhead_step_percent,
+                r.blend_overhead_infer_percent
             );
         }
     }

@@ -7,7 +7,8 @@ use nirc::NircConfig;
 use nirc::gpu::shaders::WeightPlacement;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<u32> = std::env::args().skip(1).map(|a| a.parse().expect("numbers: batch queries reps")).collect();
+    let args: Vec<u32> =
+        std::env::args().skip(1).map(|a| a.parse().expect("numbers: batch queries reps")).collect();
     let batch = args.first().copied().unwrap_or(4096);
     let queries = args.get(1).copied().unwrap_or(16384);
     let reps = args.get(2).copied().unwrap_or(3);

@@ -2,13 +2,13 @@
 //! GFLOP/s against the adapter's FMA ceiling measured in the same run, and the cost of
 //! evaluating both predictors + blend over EMA-only.
 
+use crate::bounds::SceneBounds;
 use crate::config::{NircConfig, PredictorMode};
 use crate::error::NircError;
 use crate::gpu::shaders::WeightPlacement;
 use crate::gpu::{NeuralCache, answer_buffer, readback, upload};
 use crate::records::{CacheQuery, TrainingRecord};
 use crate::state::CacheState;
-use crate::bounds::SceneBounds;
 use render::gpu::Gpu;
 use std::time::Instant;
 use wgpu::util::DeviceExt;
@@ -59,13 +59,18 @@ fn records(n: u32) -> Vec<TrainingRecord> {
     (0..n)
         .map(|_| {
             let p = [rnd(), rnd(), rnd()];
-            let d = glam::Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or(glam::Vec3::Z);
+            let d =
+                glam::Vec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5).normalize_or(glam::Vec3::Z);
             TrainingRecord::new(p, d.into(), [p[0], p[1] * p[2], 0.5])
         })
         .collect()
 }
 
-fn time<F: FnMut() -> Result<(), NircError>>(gpu: &Gpu, reps: u32, mut f: F) -> Result<f64, NircError> {
+fn time<F: FnMut() -> Result<(), NircError>>(
+    gpu: &Gpu,
+    reps: u32,
+    mut f: F,
+) -> Result<f64, NircError> {
     f()?; // warm-up (pipeline compilation, first touch)
     readback::wait_idle(gpu)?;
     let t = Instant::now();
@@ -78,7 +83,14 @@ fn time<F: FnMut() -> Result<(), NircError>>(gpu: &Gpu, reps: u32, mut f: F) -> 
 
 /// Runs the benchmark with `config` (e.g. width 64) on `batch` training records and `queries`
 /// queries, `reps` repetitions each.
-pub fn run(gpu: &Gpu, config: &NircConfig, placement: Option<WeightPlacement>, batch: u32, queries: u32, reps: u32) -> Result<BenchReport, NircError> {
+pub fn run(
+    gpu: &Gpu,
+    config: &NircConfig,
+    placement: Option<WeightPlacement>,
+    batch: u32,
+    queries: u32,
+    reps: u32,
+) -> Result<BenchReport, NircError> {
     let mut config = config.clone();
     config.max_batch = config.max_batch.max(batch);
     // Warm-up 0 so that the blend really reads the reliability grid.
@@ -87,7 +99,11 @@ pub fn run(gpu: &Gpu, config: &NircConfig, placement: Option<WeightPlacement>, b
     let cache = NeuralCache::from_state(gpu, &state, placement)?;
     let recs = upload(gpu, "bench records", &records(batch));
     let train_s = time(gpu, reps, || cache.train(gpu, &recs, batch))?;
-    let train_stages_ms = cache.train_stage_seconds(gpu, &recs, batch, reps)?.into_iter().map(|(n, s)| (n.to_string(), 1e3 * s)).collect();
+    let train_stages_ms = cache
+        .train_stage_seconds(gpu, &recs, batch, reps)?
+        .into_iter()
+        .map(|(n, s)| (n.to_string(), 1e3 * s))
+        .collect();
     let q: Vec<CacheQuery> = records(queries).iter().map(|r| r.query()).collect();
     let qbuf = upload(gpu, "bench queries", &q);
     let out = answer_buffer(gpu, queries);
@@ -127,13 +143,31 @@ pub struct Probes {
     pub layer_16x16_gflops: f64,
 }
 
-fn dispatch_timed(gpu: &Gpu, reps: u32, pipeline: &wgpu::ComputePipeline, entries: &[(u32, &wgpu::Buffer)], groups: u32) -> Result<f64, NircError> {
-    let entries: Vec<wgpu::BindGroupEntry> = entries.iter().map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }).collect();
-    let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("nirc probe"), layout: &pipeline.get_bind_group_layout(0), entries: &entries });
+fn dispatch_timed(
+    gpu: &Gpu,
+    reps: u32,
+    pipeline: &wgpu::ComputePipeline,
+    entries: &[(u32, &wgpu::Buffer)],
+    groups: u32,
+) -> Result<f64, NircError> {
+    let entries: Vec<wgpu::BindGroupEntry> = entries
+        .iter()
+        .map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() })
+        .collect();
+    let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("nirc probe"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    });
     time(gpu, reps, || {
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc probe") });
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc probe") });
         {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc probe"), timestamp_writes: None });
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("nirc probe"),
+                timestamp_writes: None,
+            });
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &group, &[]);
             pass.dispatch_workgroups(groups, 1, 1);
@@ -151,7 +185,8 @@ fn tile_layer_probe(r: u32, o: u32) -> String {
         inv = (64 / r) * (64 / o),
         per = 64 / r
     );
-    let accs: Vec<String> = (0..rq).flat_map(|a| (0..o).map(move |j| format!("c{a}_{j}"))).collect();
+    let accs: Vec<String> =
+        (0..rq).flat_map(|a| (0..o).map(move |j| format!("c{a}_{j}"))).collect();
     for acc in &accs {
         s.push_str(&format!("    var {acc} = vec4<f32>(0.0);\n"));
     }
@@ -164,7 +199,11 @@ fn tile_layer_probe(r: u32, o: u32) -> String {
     }
     for a in 0..rq {
         for j in 0..o {
-            s.push_str(&format!("        c{a}_{j} += a{a} * w{}.{};\n", j / 4, ["x", "y", "z", "w"][j as usize % 4]));
+            s.push_str(&format!(
+                "        c{a}_{j} += a{a} * w{}.{};\n",
+                j / 4,
+                ["x", "y", "z", "w"][j as usize % 4]
+            ));
         }
     }
     s.push_str(&format!("    }}\n    out[wid.x * 64u + lid] = {};\n}}\n", accs.join(" + ")));
@@ -176,17 +215,43 @@ fn tile_layer_probe(r: u32, o: u32) -> String {
 pub fn probes(gpu: &Gpu, reps: u32) -> Result<Probes, NircError> {
     const ITERATIONS: u32 = 4096;
     let invocations = 64 * 256u32;
-    let out = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some("nirc probe out"), size: invocations as u64 * 16, usage: wgpu::BufferUsages::STORAGE, mapped_at_creation: false });
-    let fma_src = format!("const ITERATIONS: u32 = {ITERATIONS}u;\n{}", include_str!("../shaders/bench/fma_peak.wgsl"));
-    let [fma] = render::compute::pipelines_auto_layout(gpu, "fma peak", &render::shader::Program::single("package::nirc::fma_peak", &fma_src), ["main"])?;
+    let out = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("nirc probe out"),
+        size: invocations as u64 * 16,
+        usage: wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    });
+    let fma_src = format!(
+        "const ITERATIONS: u32 = {ITERATIONS}u;\n{}",
+        include_str!("../shaders/bench/fma_peak.wgsl")
+    );
+    let [fma] = render::compute::pipelines_auto_layout(
+        gpu,
+        "fma peak",
+        &render::shader::Program::single("package::nirc::fma_peak", &fma_src),
+        ["main"],
+    )?;
     let fma_s = dispatch_timed(gpu, reps, &fma, &[(0, &out)], invocations / 64)?;
-    let layer_src = format!("{}\n{}\n{}", include_str!("../shaders/bench/tile_layer.wgsl"), tile_layer_probe(4, 16), tile_layer_probe(16, 16));
-    let [block4x16, block16x16] = render::compute::pipelines_auto_layout(gpu, "tile layer", &render::shader::Program::single("package::nirc::tile_layer", &layer_src), ["block4x16", "block16x16"])?;
+    let layer_src = format!(
+        "{}\n{}\n{}",
+        include_str!("../shaders/bench/tile_layer.wgsl"),
+        tile_layer_probe(4, 16),
+        tile_layer_probe(16, 16)
+    );
+    let [block4x16, block16x16] = render::compute::pipelines_auto_layout(
+        gpu,
+        "tile layer",
+        &render::shader::Program::single("package::nirc::tile_layer", &layer_src),
+        ["block4x16", "block16x16"],
+    )?;
     let tiles = 256u32;
     let input = upload(gpu, "probe input", &vec![0.01f32; tiles as usize * 4096]);
     let weights = upload(gpu, "probe weights", &vec![0.02f32; 4096]);
     let layer_flops = tiles as f64 * 2.0 * 64f64.powi(3);
-    let layer = |p: &wgpu::ComputePipeline| dispatch_timed(gpu, reps, p, &[(0, &input), (1, &weights), (2, &out)], tiles).map(|s| layer_flops / s / 1e9);
+    let layer = |p: &wgpu::ComputePipeline| {
+        dispatch_timed(gpu, reps, p, &[(0, &input), (1, &weights), (2, &out)], tiles)
+            .map(|s| layer_flops / s / 1e9)
+    };
     Ok(Probes {
         fma_gflops: invocations as f64 * ITERATIONS as f64 * 8.0 * 4.0 * 2.0 / fma_s / 1e9,
         layer_4x16_gflops: layer(&block4x16)?,
@@ -199,8 +264,15 @@ pub fn probes(gpu: &Gpu, reps: u32) -> Result<Probes, NircError> {
 /// a constant, else the 16 output quads are a loop (the register form's shape, src/gpu/lane.rs).
 /// Kind "uniform2": "uniform" with two records per invocation, each weight load feeding both.
 /// GFLOP/s, and the seconds of pipeline creation plus the first dispatch (lavapipe compiles then).
-pub fn register_layer_probe(gpu: &Gpu, reps: u32, kind: &str, unroll_q: bool) -> Result<(f64, f64), NircError> {
-    let mut s = String::from("@group(0) @binding(0) var<storage, read> input: array<vec4<f32>>;\n@group(0) @binding(2) var<storage, read_write> out: array<vec4<f32>>;\n");
+pub fn register_layer_probe(
+    gpu: &Gpu,
+    reps: u32,
+    kind: &str,
+    unroll_q: bool,
+) -> Result<(f64, f64), NircError> {
+    let mut s = String::from(
+        "@group(0) @binding(0) var<storage, read> input: array<vec4<f32>>;\n@group(0) @binding(2) var<storage, read_write> out: array<vec4<f32>>;\n",
+    );
     match kind {
         "uniform" | "uniform2" => s.push_str("@group(0) @binding(1) var<uniform> w: array<vec4<f32>, 1024>;\n"),
         "storage" => s.push_str("@group(0) @binding(1) var<storage, read> w: array<vec4<f32>, 1024>;\n"),
@@ -230,14 +302,24 @@ pub fn register_layer_probe(gpu: &Gpu, reps: u32, kind: &str, unroll_q: bool) ->
         for q in 0..16 {
             s.push_str("    {\n        var acc = vec4<f32>(0.0);\n");
             for k in 0..64 {
-                s.push_str(&format!("        acc += v{}.{} * w[{}u];\n", k / 4, comp[k % 4], k * 16 + q));
+                s.push_str(&format!(
+                    "        acc += v{}.{} * w[{}u];\n",
+                    k / 4,
+                    comp[k % 4],
+                    k * 16 + q
+                ));
             }
             s.push_str("        total += max(acc, vec4<f32>(0.0));\n    }\n");
         }
     } else {
         s.push_str("    for (var q = 0u; q < 16u; q++) {\n        var acc = vec4<f32>(0.0);\n");
         for k in 0..64 {
-            s.push_str(&format!("        acc += v{}.{} * w[{}u + q];\n", k / 4, comp[k % 4], k * 16));
+            s.push_str(&format!(
+                "        acc += v{}.{} * w[{}u + q];\n",
+                k / 4,
+                comp[k % 4],
+                k * 16
+            ));
         }
         s.push_str("        total += max(acc, vec4<f32>(0.0));\n    }\n");
     }
@@ -245,13 +327,37 @@ pub fn register_layer_probe(gpu: &Gpu, reps: u32, kind: &str, unroll_q: bool) ->
         s.push_str("    out[r] = total;\n}\n");
     }
     let t0 = Instant::now();
-    let [p] = render::compute::pipelines_auto_layout(gpu, "register layer", &render::shader::Program::single("package::nirc::register_layer", &s), ["main"])?;
+    let [p] = render::compute::pipelines_auto_layout(
+        gpu,
+        "register layer",
+        &render::shader::Program::single("package::nirc::register_layer", &s),
+        ["main"],
+    )?;
     let records = 64 * 256u32;
     let input = upload(gpu, "probe input", &vec![0.01f32; records as usize * 64]);
-    let usage = if kind.starts_with("uniform") { wgpu::BufferUsages::UNIFORM } else { wgpu::BufferUsages::STORAGE };
-    let weights = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("probe w"), contents: bytemuck::cast_slice(&vec![0.02f32; 4096]), usage });
-    let out = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some("probe out"), size: records as u64 * 16, usage: wgpu::BufferUsages::STORAGE, mapped_at_creation: false });
-    let secs = dispatch_timed(gpu, reps, &p, &[(0, &input), (1, &weights), (2, &out)], records / 64 / per)?;
+    let usage = if kind.starts_with("uniform") {
+        wgpu::BufferUsages::UNIFORM
+    } else {
+        wgpu::BufferUsages::STORAGE
+    };
+    let weights = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("probe w"),
+        contents: bytemuck::cast_slice(&vec![0.02f32; 4096]),
+        usage,
+    });
+    let out = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("probe out"),
+        size: records as u64 * 16,
+        usage: wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    });
+    let secs = dispatch_timed(
+        gpu,
+        reps,
+        &p,
+        &[(0, &input), (1, &weights), (2, &out)],
+        records / 64 / per,
+    )?;
     // dispatch_timed ran one warm-up dispatch before the timed ones.
     let compile_s = t0.elapsed().as_secs_f64() - reps as f64 * secs;
     Ok((records as f64 * 2.0 * 4096.0 / secs / 1e9, compile_s))

@@ -61,7 +61,14 @@ pub struct HashGridConfig {
 impl Default for HashGridConfig {
     fn default() -> Self {
         // NRC/NIRC public settings: L = 16, F = 2, T in 2^15..2^19, b in 1.5..2.0.
-        Self { levels: 16, features_per_level: 2, log2_table_size: 16, base_resolution: 16, growth_factor: 1.5, init_scale: 1e-4 }
+        Self {
+            levels: 16,
+            features_per_level: 2,
+            log2_table_size: 16,
+            base_resolution: 16,
+            growth_factor: 1.5,
+            init_scale: 1e-4,
+        }
     }
 }
 
@@ -214,7 +221,15 @@ pub enum MomentUpdate {
 impl Default for ReliabilityConfig {
     fn default() -> Self {
         // λ ≈ 0.9, K = 128, κ = 4 from the paper; resolution, table size and ε are ours.
-        Self { resolution: 32, log2_cells: 16, lambda: 0.9, warmup: 128, kappa: 4.0, epsilon: 1e-4, update: MomentUpdate::PerSample }
+        Self {
+            resolution: 32,
+            log2_cells: 16,
+            lambda: 0.9,
+            warmup: 128,
+            kappa: 4.0,
+            epsilon: 1e-4,
+            update: MomentUpdate::PerSample,
+        }
     }
 }
 
@@ -276,13 +291,22 @@ impl NircConfig {
             return bad("encoding.levels", format!("{} not in 1..=32", e.levels));
         }
         if e.features_per_level == 0 || e.features_per_level > 8 {
-            return bad("encoding.features_per_level", format!("{} not in 1..=8", e.features_per_level));
+            return bad(
+                "encoding.features_per_level",
+                format!("{} not in 1..=8", e.features_per_level),
+            );
         }
         if !(4..=24).contains(&e.log2_table_size) {
             return bad("encoding.log2_table_size", format!("{} not in 4..=24", e.log2_table_size));
         }
         if e.base_resolution == 0 || !(e.growth_factor >= 1.0) {
-            return bad("encoding", format!("base_resolution {} must be >= 1 and growth_factor {} >= 1", e.base_resolution, e.growth_factor));
+            return bad(
+                "encoding",
+                format!(
+                    "base_resolution {} must be >= 1 and growth_factor {} >= 1",
+                    e.base_resolution, e.growth_factor
+                ),
+            );
         }
         if let DirectionEncoding::SphericalHarmonics { bands } = self.direction
             && !(1..=3).contains(&bands)
@@ -291,13 +315,20 @@ impl NircConfig {
         }
         let n = &self.network;
         if !(1..=128).contains(&n.width) {
-            return bad("network.width", format!("{} not in 1..=128 (16, 32 or 64 expected)", n.width));
+            return bad(
+                "network.width",
+                format!("{} not in 1..=128 (16, 32 or 64 expected)", n.width),
+            );
         }
         if !(1..=5).contains(&n.hidden_layers) {
             return bad("network.hidden_layers", format!("{} not in 1..=5", n.hidden_layers));
         }
         let o = &self.optimizer;
-        if !(o.learning_rate > 0.0) || !(0.0..1.0).contains(&o.beta1) || !(0.0..1.0).contains(&o.beta2) || !(o.epsilon >= 0.0) {
+        if !(o.learning_rate > 0.0)
+            || !(0.0..1.0).contains(&o.beta1)
+            || !(0.0..1.0).contains(&o.beta2)
+            || !(o.epsilon >= 0.0)
+        {
             return bad("optimizer", format!("{o:?}: need lr > 0, 0 <= β < 1, ε >= 0"));
         }
         if !(self.loss.epsilon > 0.0) {
@@ -308,7 +339,13 @@ impl NircConfig {
         }
         let r = &self.reliability;
         if r.resolution == 0 || !(1..=24).contains(&r.log2_cells) {
-            return bad("reliability", format!("resolution {} must be >= 1 and log2_cells {} in 1..=24", r.resolution, r.log2_cells));
+            return bad(
+                "reliability",
+                format!(
+                    "resolution {} must be >= 1 and log2_cells {} in 1..=24",
+                    r.resolution, r.log2_cells
+                ),
+            );
         }
         if !(0.0..1.0).contains(&r.lambda) || !(r.kappa > 0.0) || !(r.epsilon >= 0.0) {
             return bad("reliability", format!("{r:?}: need 0 <= λ < 1, κ > 0, ε >= 0"));
@@ -330,21 +367,32 @@ mod tests {
         c.validate().unwrap();
         assert_eq!((c.encoding.levels, c.encoding.features_per_level), (16, 2));
         assert_eq!((c.optimizer.beta2, c.optimizer.epsilon, c.ema.alpha), (0.99, 1e-15, 0.99));
-        assert_eq!((c.reliability.lambda, c.reliability.warmup, c.reliability.kappa), (0.9, 128, 4.0));
+        assert_eq!(
+            (c.reliability.lambda, c.reliability.warmup, c.reliability.kappa),
+            (0.9, 128, 4.0)
+        );
         assert_eq!(c.loss.epsilon, 0.01);
     }
 
     #[test]
     fn partial_settings_fill_in_defaults_and_unknown_fields_are_refused() {
-        let c: NircConfig = serde_json::from_str(r#"{"network": {"width": 32}, "direction": {"SphericalHarmonics": {"bands": 2}}}"#).unwrap();
+        let c: NircConfig = serde_json::from_str(
+            r#"{"network": {"width": 32}, "direction": {"SphericalHarmonics": {"bands": 2}}}"#,
+        )
+        .unwrap();
         assert_eq!(c.network, NetworkConfig { width: 32, hidden_layers: 2 });
         assert_eq!(c.direction.dims(), 4);
         assert_eq!(c.encoding, HashGridConfig::default());
         let back: NircConfig = serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
         assert_eq!(back, c);
-        let err = serde_json::from_str::<NircConfig>(r#"{"network": {"widht": 32}}"#).unwrap_err().to_string();
+        let err = serde_json::from_str::<NircConfig>(r#"{"network": {"widht": 32}}"#)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("widht"), "{err}");
-        let bad = NircConfig { network: NetworkConfig { width: 64, hidden_layers: 7 }, ..Default::default() };
+        let bad = NircConfig {
+            network: NetworkConfig { width: 64, hidden_layers: 7 },
+            ..Default::default()
+        };
         let err = bad.validate().unwrap_err().to_string();
         assert!(err.contains("network.hidden_layers") && err.contains('7'), "{err}");
     }

@@ -50,7 +50,9 @@ impl FixedSum {
         let negative = self.0 < 0;
         let magnitude = FixedSum(wrap96(self.0.wrapping_neg()));
         let w = if negative { magnitude.words() } else { self.words() };
-        let value = (w[2] as f32) * 65536.0 + (w[1] as f32) * (1.0 / 65536.0) + (w[0] as f32) * f32::powi(2.0, -48);
+        let value = (w[2] as f32) * 65536.0
+            + (w[1] as f32) * (1.0 / 65536.0)
+            + (w[0] as f32) * f32::powi(2.0, -48);
         if negative { -value } else { value }
     }
 }
@@ -69,7 +71,8 @@ mod tests {
 
     #[test]
     fn sums_are_exact_and_order_independent() {
-        let values: Vec<f32> = (0..1000).map(|i| (i as f32 * 0.7319).sin() * 10f32.powi(i % 9 - 4)).collect();
+        let values: Vec<f32> =
+            (0..1000).map(|i| (i as f32 * 0.7319).sin() * 10f32.powi(i % 9 - 4)).collect();
         let mut forward = FixedSum::default();
         let mut backward = FixedSum::default();
         for &v in &values {
@@ -80,7 +83,11 @@ mod tests {
         }
         assert_eq!(forward, backward);
         let exact: f64 = values.iter().map(|&v| v as f64).sum();
-        assert!((forward.to_f32() as f64 - exact).abs() <= 1e-6 * exact.abs().max(1.0), "{} vs {exact}", forward.to_f32());
+        assert!(
+            (forward.to_f32() as f64 - exact).abs() <= 1e-6 * exact.abs().max(1.0),
+            "{} vs {exact}",
+            forward.to_f32()
+        );
     }
 
     #[test]
@@ -91,7 +98,11 @@ mod tests {
             let back = FixedSum::from_words(s.words());
             assert_eq!(back, s);
             let rel = ((back.to_f32() - x) / x).abs();
-            assert!(rel < 1e-6 || (x.abs() < 1e-13 && (back.to_f32() - x).abs() < 4e-15), "{x} -> {}", back.to_f32());
+            assert!(
+                rel < 1e-6 || (x.abs() < 1e-13 && (back.to_f32() - x).abs() < 4e-15),
+                "{x} -> {}",
+                back.to_f32()
+            );
         }
         let mut s = FixedSum::default();
         assert!(!s.add(f32::NAN));

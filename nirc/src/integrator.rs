@@ -10,9 +10,9 @@
 
 use crate::error::NircError;
 use crate::records::{CacheAnswer, CacheQuery, TrainingRecord};
-use render::gpu_struct::GpuStruct;
 use render::compute::BufferBinding;
 use render::gpu::Gpu;
+use render::gpu_struct::GpuStruct;
 use render::pass_library::{LibraryPipeline, PassLibrary};
 use render::path_tracer::PathTracer;
 use render::shader::{Module, Program};
@@ -115,9 +115,17 @@ impl CachePaths {
     pub fn program() -> &'static Program {
         static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
         PROGRAM.get_or_init(|| {
-            let types = Module::generated("package::nirc::cache_path_types", &[CacheParams::WGSL, &crate::records::wgsl()]);
+            let types = Module::generated(
+                "package::nirc::cache_path_types",
+                &[CacheParams::WGSL, &crate::records::wgsl()],
+            );
             let meta = render::wgsl_file!("query_meta.wgsl");
-            let bindings = render::compute::group_module("package::nirc::cache_path_bindings", 2, &OWN_GROUP, &[&types, &meta]);
+            let bindings = render::compute::group_module(
+                "package::nirc::cache_path_bindings",
+                2,
+                &OWN_GROUP,
+                &[&types, &meta],
+            );
             PassLibrary::program([types, meta, bindings], [render::wgsl_file!("cache_paths.wgsl")])
         })
     }
@@ -129,46 +137,91 @@ impl CachePaths {
     }
 
     /// Passes for `tracer`'s resolution at `spp` paths per pixel.
-    pub fn new(gpu: &Gpu, tracer: &PathTracer, spp: u32, settings: CachePathSettings) -> Result<Self, NircError> {
+    pub fn new(
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        spp: u32,
+        settings: CachePathSettings,
+    ) -> Result<Self, NircError> {
         if spp == 0 {
             return Err(NircError::Config("spp must be at least 1".into()));
         }
         if settings.termination_vertex == 0 {
-            return Err(NircError::Config("termination_vertex must be at least 1 (1 = the primary hit)".into()));
+            return Err(NircError::Config(
+                "termination_vertex must be at least 1 (1 = the primary hit)".into(),
+            ));
         }
         if settings.train_records == 0 || settings.train_steps == 0 {
-            return Err(NircError::Config(format!("train_records ({}) and train_steps ({}) must be at least 1", settings.train_records, settings.train_steps)));
+            return Err(NircError::Config(format!(
+                "train_records ({}) and train_steps ({}) must be at least 1",
+                settings.train_records, settings.train_steps
+            )));
         }
         let s = tracer.settings();
         let (width, height) = (s.width, s.height);
         let query_count = width as u64 * height as u64 * spp as u64;
         if query_count > u32::MAX as u64 / 2 {
-            return Err(NircError::Config(format!("{width}x{height} at {spp} spp is {query_count} queries, too many")));
+            return Err(NircError::Config(format!(
+                "{width}x{height} at {spp} spp is {query_count} queries, too many"
+            )));
         }
-        let groups = settings.train_records.div_ceil(WORKGROUP_1D).max(query_count.div_ceil(WORKGROUP_1D as u64) as u32);
+        let groups = settings
+            .train_records
+            .div_ceil(WORKGROUP_1D)
+            .max(query_count.div_ceil(WORKGROUP_1D as u64) as u32);
         if groups > gpu.limits.max_compute_workgroups_per_dimension {
-            return Err(NircError::Config(format!("{groups} workgroups in one dispatch, over this adapter's limit")));
+            return Err(NircError::Config(format!(
+                "{groups} workgroups in one dispatch, over this adapter's limit"
+            )));
         }
         // No var<workgroup> in cache_paths.wgsl.
         gpu.check_workgroup_memory("nirc cache_paths", 0)?;
 
         let device = &gpu.device;
-        let (layout, [queries_pipeline, targets_pipeline, compact_pipeline, oracle_pipeline, resolve_pipeline]) = tracer
-            .library_pass(gpu, "cache_paths.wgsl", Self::program(), &OWN_GROUP, ["queries_main", "targets_main", "compact_main", "oracle_main", "resolve_main"])?;
+        let (
+            layout,
+            [
+                queries_pipeline,
+                targets_pipeline,
+                compact_pipeline,
+                oracle_pipeline,
+                resolve_pipeline,
+            ],
+        ) = tracer.library_pass(
+            gpu,
+            "cache_paths.wgsl",
+            Self::program(),
+            &OWN_GROUP,
+            ["queries_main", "targets_main", "compact_main", "oracle_main", "resolve_main"],
+        )?;
         let buffer = |label: &str, bytes: u64| -> Result<wgpu::Buffer, NircError> {
             gpu.check_buffer_size(label, bytes)?;
             Ok(device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
                 size: bytes.max(16),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             }))
         };
-        let params = CacheParams { query_count: query_count as u32, record_count: settings.train_records, termination_vertex: settings.termination_vertex, spp };
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("nirc cache params"), contents: bytemuck::bytes_of(&params), usage: wgpu::BufferUsages::UNIFORM });
+        let params = CacheParams {
+            query_count: query_count as u32,
+            record_count: settings.train_records,
+            termination_vertex: settings.termination_vertex,
+            spp,
+        };
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("nirc cache params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
         let queries = buffer("nirc cache queries", query_count * size_of::<CacheQuery>() as u64)?;
         let meta = buffer("nirc query weights", query_count * META_BYTES)?;
-        let records = buffer("nirc training records", 2 * settings.train_records as u64 * size_of::<TrainingRecord>() as u64)?;
+        let records = buffer(
+            "nirc training records",
+            2 * settings.train_records as u64 * size_of::<TrainingRecord>() as u64,
+        )?;
         let motion = buffer("nirc motion", width as u64 * height as u64 * 8)?;
         let ray_counters = buffer("nirc ray counters", 8)?;
         let mut me = Self {
@@ -188,7 +241,10 @@ impl CachePaths {
             records,
             motion,
             ray_counters,
-            scratch: CacheOutput { answers: buffer("nirc scratch", 16)?, image: buffer("nirc scratch", 16)? },
+            scratch: CacheOutput {
+                answers: buffer("nirc scratch", 16)?,
+                image: buffer("nirc scratch", 16)?,
+            },
         };
         me.scratch = me.output(gpu)?;
         Ok(me)
@@ -204,7 +260,9 @@ impl CachePaths {
             gpu.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
                 size,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             })
         };
@@ -239,40 +297,106 @@ impl CachePaths {
     }
 
     fn bind_group(&self, gpu: &Gpu, out: &CacheOutput) -> wgpu::BindGroup {
-        let buffers = [&self.params, &self.queries, &self.meta, &self.records, &out.answers, &out.image, &self.motion, &self.ray_counters];
+        let buffers = [
+            &self.params,
+            &self.queries,
+            &self.meta,
+            &self.records,
+            &out.answers,
+            &out.image,
+            &self.motion,
+            &self.ray_counters,
+        ];
         render::compute::buffer_group(gpu, "nirc cache paths", &self.layout, &buffers)
     }
 
-    fn pass(&self, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer, group: &wgpu::BindGroup, pipeline: &LibraryPipeline, label: &str, workgroups: (u32, u32)) {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(label), timestamp_writes: None });
+    fn pass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        tracer: &PathTracer,
+        group: &wgpu::BindGroup,
+        pipeline: &LibraryPipeline,
+        label: &str,
+        workgroups: (u32, u32),
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(label),
+            timestamp_writes: None,
+        });
         record(&mut pass, tracer, group, &[(pipeline, workgroups)]);
     }
 
     /// One timed pass (pass `index` of `timed`) of `pipelines`, in order, each over its workgroups.
-    fn timed_pass(&self, timed: &mut TimedFrame, index: usize, tracer: &PathTracer, group: &wgpu::BindGroup, pipelines: &[(&LibraryPipeline, (u32, u32))]) -> Result<(), NircError> {
+    fn timed_pass(
+        &self,
+        timed: &mut TimedFrame,
+        index: usize,
+        tracer: &PathTracer,
+        group: &wgpu::BindGroup,
+        pipelines: &[(&LibraryPipeline, (u32, u32))],
+    ) -> Result<(), NircError> {
         timed.pass(index, |pass| record(pass, tracer, group, pipelines))?;
         Ok(())
     }
 
     /// [`Self::encode_queries`] as pass `index` of a timed frame.
-    pub fn queries_timed(&self, gpu: &Gpu, timed: &mut TimedFrame, index: usize, tracer: &PathTracer, seed: u64, frame: u32) -> Result<(), NircError> {
+    pub fn queries_timed(
+        &self,
+        gpu: &Gpu,
+        timed: &mut TimedFrame,
+        index: usize,
+        tracer: &PathTracer,
+        seed: u64,
+        frame: u32,
+    ) -> Result<(), NircError> {
         tracer.prepare_frame(gpu, self.spp, 0, seed, frame);
         timed.encoder().clear_buffer(&self.ray_counters, 0, None);
         let group = self.bind_group(gpu, &self.scratch);
-        self.timed_pass(timed, index, tracer, &group, &[(&self.queries_pipeline, self.image_groups())])
+        self.timed_pass(
+            timed,
+            index,
+            tracer,
+            &group,
+            &[(&self.queries_pipeline, self.image_groups())],
+        )
     }
 
     /// [`Self::encode_records`] (targets, then compaction) as pass `index` of a timed frame.
-    pub fn records_timed(&self, gpu: &Gpu, timed: &mut TimedFrame, index: usize, tracer: &PathTracer) -> Result<(), NircError> {
+    pub fn records_timed(
+        &self,
+        gpu: &Gpu,
+        timed: &mut TimedFrame,
+        index: usize,
+        tracer: &PathTracer,
+    ) -> Result<(), NircError> {
         let group = self.bind_group(gpu, &self.scratch);
         let targets = (self.settings.train_records.div_ceil(WORKGROUP_1D), 1);
-        self.timed_pass(timed, index, tracer, &group, &[(&self.targets_pipeline, targets), (&self.compact_pipeline, (1, 1))])
+        self.timed_pass(
+            timed,
+            index,
+            tracer,
+            &group,
+            &[(&self.targets_pipeline, targets), (&self.compact_pipeline, (1, 1))],
+        )
     }
 
     /// [`Self::encode_resolve`] as pass `index` of a timed frame.
-    pub fn resolve_timed(&self, gpu: &Gpu, timed: &mut TimedFrame, index: usize, tracer: &PathTracer, out: &CacheOutput) -> Result<(), NircError> {
+    pub fn resolve_timed(
+        &self,
+        gpu: &Gpu,
+        timed: &mut TimedFrame,
+        index: usize,
+        tracer: &PathTracer,
+        out: &CacheOutput,
+    ) -> Result<(), NircError> {
         let group = self.bind_group(gpu, out);
-        self.timed_pass(timed, index, tracer, &group, &[(&self.resolve_pipeline, self.image_groups())])
+        self.timed_pass(
+            timed,
+            index,
+            tracer,
+            &group,
+            &[(&self.resolve_pipeline, self.image_groups())],
+        )
     }
 
     fn image_groups(&self) -> (u32, u32) {
@@ -281,34 +405,97 @@ impl CachePaths {
 
     /// Writes the frame uniform (seed, frame) and records the camera paths into `encoder`.
     /// The uniform is written at the next submission: submit before preparing another frame.
-    pub fn encode_queries(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer, seed: u64, frame: u32) {
+    pub fn encode_queries(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        tracer: &PathTracer,
+        seed: u64,
+        frame: u32,
+    ) {
         tracer.prepare_frame(gpu, self.spp, 0, seed, frame);
         encoder.clear_buffer(&self.ray_counters, 0, None);
         let group = self.bind_group(gpu, &self.scratch);
-        self.pass(encoder, tracer, &group, &self.queries_pipeline, "nirc queries", self.image_groups());
+        self.pass(
+            encoder,
+            tracer,
+            &group,
+            &self.queries_pipeline,
+            "nirc queries",
+            self.image_groups(),
+        );
     }
 
     /// Records the training targets of the queries of `encode_queries` (same frame uniform).
-    pub fn encode_records(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer) {
+    pub fn encode_records(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        tracer: &PathTracer,
+    ) {
         let group = self.bind_group(gpu, &self.scratch);
-        self.pass(encoder, tracer, &group, &self.targets_pipeline, "nirc training targets", (self.settings.train_records.div_ceil(WORKGROUP_1D), 1));
-        self.pass(encoder, tracer, &group, &self.compact_pipeline, "nirc record compaction", (1, 1));
+        self.pass(
+            encoder,
+            tracer,
+            &group,
+            &self.targets_pipeline,
+            "nirc training targets",
+            (self.settings.train_records.div_ceil(WORKGROUP_1D), 1),
+        );
+        self.pass(
+            encoder,
+            tracer,
+            &group,
+            &self.compact_pipeline,
+            "nirc record compaction",
+            (1, 1),
+        );
     }
 
     /// Test oracle: answers every query with its own Monte Carlo target of Lc.
-    pub fn encode_oracle(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer, out: &CacheOutput) {
+    pub fn encode_oracle(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        tracer: &PathTracer,
+        out: &CacheOutput,
+    ) {
         let group = self.bind_group(gpu, out);
-        self.pass(encoder, tracer, &group, &self.oracle_pipeline, "nirc oracle", (self.query_count().div_ceil(WORKGROUP_1D), 1));
+        self.pass(
+            encoder,
+            tracer,
+            &group,
+            &self.oracle_pipeline,
+            "nirc oracle",
+            (self.query_count().div_ceil(WORKGROUP_1D), 1),
+        );
     }
 
     /// Records the image from `out.answers` into `out.image`.
-    pub fn encode_resolve(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, tracer: &PathTracer, out: &CacheOutput) {
+    pub fn encode_resolve(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        tracer: &PathTracer,
+        out: &CacheOutput,
+    ) {
         let group = self.bind_group(gpu, out);
-        self.pass(encoder, tracer, &group, &self.resolve_pipeline, "nirc resolve", self.image_groups());
+        self.pass(
+            encoder,
+            tracer,
+            &group,
+            &self.resolve_pipeline,
+            "nirc resolve",
+            self.image_groups(),
+        );
     }
 
     /// Reads `out.image` back: the radiance (alpha 1) and per pixel (mean σ, answered samples).
-    pub fn read_image(&self, gpu: &Gpu, out: &CacheOutput) -> Result<(Vec<[f32; 4]>, Vec<[f32; 4]>), NircError> {
+    pub fn read_image(
+        &self,
+        gpu: &Gpu,
+        out: &CacheOutput,
+    ) -> Result<(Vec<[f32; 4]>, Vec<[f32; 4]>), NircError> {
         let texels: Vec<[f32; 4]> = crate::gpu::readback::read_pod(gpu, &out.image, "nirc image")?;
         let n = self.pixels() as usize;
         Ok((texels[..n].to_vec(), texels[n..2 * n].to_vec()))
@@ -317,7 +504,8 @@ impl CachePaths {
     /// Per pixel motion (previous image position - current, pixels) of the last
     /// `encode_queries`, from the pixel-centre primary hit as the path tracer's G-buffer.
     pub fn read_motion(&self, gpu: &Gpu) -> Result<Vec<[f32; 2]>, NircError> {
-        let mut motion: Vec<[f32; 2]> = crate::gpu::readback::read_pod(gpu, &self.motion, "nirc motion")?;
+        let mut motion: Vec<[f32; 2]> =
+            crate::gpu::readback::read_pod(gpu, &self.motion, "nirc motion")?;
         motion.truncate(self.pixels() as usize);
         Ok(motion)
     }
@@ -325,26 +513,34 @@ impl CachePaths {
     /// Rays traced since the last `encode_queries` (camera paths, training targets), counted on
     /// the GPU as every other method's.
     pub fn read_rays(&self, gpu: &Gpu) -> Result<[u64; 2], NircError> {
-        let c: Vec<u32> = crate::gpu::readback::read_pod(gpu, &self.ray_counters, "nirc ray counters")?;
+        let c: Vec<u32> =
+            crate::gpu::readback::read_pod(gpu, &self.ray_counters, "nirc ray counters")?;
         Ok([c[0] as u64, c[1] as u64])
     }
 
     /// Reads `out.answers` back (e.g. after `NeuralCache::encode_reliability`).
     pub fn read_answers(&self, gpu: &Gpu, out: &CacheOutput) -> Result<Vec<[f32; 4]>, NircError> {
-        let mut answers: Vec<[f32; 4]> = crate::gpu::readback::read_pod(gpu, &out.answers, "nirc answers")?;
+        let mut answers: Vec<[f32; 4]> =
+            crate::gpu::readback::read_pod(gpu, &out.answers, "nirc answers")?;
         answers.truncate(self.query_count() as usize);
         Ok(answers)
     }
 
     /// Per query of the last `encode_queries`: whether the path reached its termination vertex.
     pub fn read_query_valid(&self, gpu: &Gpu) -> Result<Vec<bool>, NircError> {
-        let floats: Vec<[f32; 4]> = crate::gpu::readback::read_pod(gpu, &self.meta, "nirc query weights")?;
-        Ok(floats.chunks_exact(3).take(self.query_count() as usize).map(|m| m[0][3] > 0.0).collect())
+        let floats: Vec<[f32; 4]> =
+            crate::gpu::readback::read_pod(gpu, &self.meta, "nirc query weights")?;
+        Ok(floats
+            .chunks_exact(3)
+            .take(self.query_count() as usize)
+            .map(|m| m[0][3] > 0.0)
+            .collect())
     }
 
     /// The training records of the last frame (tests, diagnostics).
     pub fn read_records(&self, gpu: &Gpu) -> Result<Vec<TrainingRecord>, NircError> {
-        let mut records: Vec<TrainingRecord> = crate::gpu::readback::read_pod(gpu, &self.records, "nirc training records")?;
+        let mut records: Vec<TrainingRecord> =
+            crate::gpu::readback::read_pod(gpu, &self.records, "nirc training records")?;
         records.truncate(self.record_count() as usize);
         Ok(records)
     }
@@ -352,7 +548,12 @@ impl CachePaths {
 
 /// Binds the scene (@group(0)), the geometry (@group(1)) and `group` (@group(2)), then dispatches
 /// each of `pipelines` over its workgroups.
-fn record(pass: &mut wgpu::ComputePass, tracer: &PathTracer, group: &wgpu::BindGroup, pipelines: &[(&LibraryPipeline, (u32, u32))]) {
+fn record(
+    pass: &mut wgpu::ComputePass,
+    tracer: &PathTracer,
+    group: &wgpu::BindGroup,
+    pipelines: &[(&LibraryPipeline, (u32, u32))],
+) {
     pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
     pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
     pass.set_bind_group(2, group, &[]);

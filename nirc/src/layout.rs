@@ -67,11 +67,18 @@ impl ParameterLayout {
         let mut levels = Vec::new();
         for l in 0..e.levels {
             // f64 so that every platform gets the same integer resolutions.
-            let resolution = ((e.base_resolution as f64) * (e.growth_factor as f64).powi(l as i32)).floor().max(1.0) as u64;
+            let resolution = ((e.base_resolution as f64) * (e.growth_factor as f64).powi(l as i32))
+                .floor()
+                .max(1.0) as u64;
             let dense_size = (resolution + 1).pow(3);
             let dense = dense_size <= max_table;
             let table_size = if dense { dense_size } else { max_table } as u32;
-            levels.push(GridLevel { resolution: resolution.min(u32::MAX as u64 / 2) as u32, table_size, offset, dense });
+            levels.push(GridLevel {
+                resolution: resolution.min(u32::MAX as u64 / 2) as u32,
+                table_size,
+                offset,
+                dense,
+            });
             offset += table_size * e.features_per_level;
         }
         Self {
@@ -130,11 +137,15 @@ impl ParameterLayout {
     /// clearing) or a blending inference thread (encode, two forwards), plus its share of the
     /// workgroup weight copy. Drivers that cap it (llvmpipe) are checked against this.
     pub fn loop_iterations_per_invocation(&self, workgroup_size: u32) -> u64 {
-        let matrix_loops = |m: &Matrix| m.rows as u64 * m.cols as u64 + m.rows.max(m.cols) as u64 + 1;
+        let matrix_loops =
+            |m: &Matrix| m.rows as u64 * m.cols as u64 + m.rows.max(m.cols) as u64 + 1;
         let forward: u64 = self.matrices.iter().map(matrix_loops).sum::<u64>() + 1;
         let encoding = self.levels.len() as u64 * (8 * self.features_per_level as u64 + 8 + 3);
         let copy = (2 * self.mlp_params as u64).div_ceil(workgroup_size.max(1) as u64);
-        let train = encoding * 2 + forward * 2 + (self.activation_floats() + self.delta_floats()) as u64 + 3;
+        let train = encoding * 2
+            + forward * 2
+            + (self.activation_floats() + self.delta_floats()) as u64
+            + 3;
         let infer = encoding + forward * 2;
         train.max(infer) + copy
     }

@@ -50,7 +50,6 @@ pub struct CacheAnswer {
     pub sigma: f32,
 }
 
-
 impl TrainingRecord {
     pub fn new(position: [f32; 3], direction: [f32; 3], target: [f32; 3]) -> Self {
         Self {
@@ -66,6 +65,9 @@ impl TrainingRecord {
 
 impl CacheQuery {
     pub fn new(position: [f32; 3], direction: [f32; 3]) -> Self {
-        Self { position: [position[0], position[1], position[2], 0.0], direction: [direction[0], direction[1], direction[2], 0.0] }
+        Self {
+            position: [position[0], position[1], position[2], 0.0],
+            direction: [direction[0], direction[1], direction[2], 0.0],
+        }
     }
 }

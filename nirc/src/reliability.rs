@@ -55,14 +55,28 @@ pub fn sample_quantities(s: &ReliabilitySample) -> [f32; MOMENTS_PER_CELL] {
 
 /// One grid update from a batch of samples, as the GPU computes it (see the module docs).
 /// Returns false (and changes nothing) if a sample is not finite.
-pub fn update(config: &ReliabilityConfig, bounds: &SceneBounds, moments: &mut [f32], samples: &[ReliabilitySample]) -> bool {
+pub fn update(
+    config: &ReliabilityConfig,
+    bounds: &SceneBounds,
+    moments: &mut [f32],
+    samples: &[ReliabilitySample],
+) -> bool {
     let cells = cell_count(config) as usize;
-    assert_eq!(moments.len(), cells * MOMENTS_PER_CELL, "reliability moments sized for another grid");
+    assert_eq!(
+        moments.len(),
+        cells * MOMENTS_PER_CELL,
+        "reliability moments sized for another grid"
+    );
     if config.update == MomentUpdate::PerSample {
-        let finite = samples.iter().all(|s| (0..3).all(|c| s.target_rgb[c].is_finite() && s.f_cur[c].is_finite() && s.f_ema[c].is_finite()));
+        let finite = samples.iter().all(|s| {
+            (0..3).all(|c| {
+                s.target_rgb[c].is_finite() && s.f_cur[c].is_finite() && s.f_ema[c].is_finite()
+            })
+        });
         if finite {
             for s in samples {
-                let cell = cell_index(config, bounds, [s.position[0], s.position[1], s.position[2]]) as usize;
+                let cell = cell_index(config, bounds, [s.position[0], s.position[1], s.position[2]])
+                    as usize;
                 for (k, q) in sample_quantities(s).into_iter().enumerate() {
                     let i = cell * MOMENTS_PER_CELL + k;
                     moments[i] = ema_step(config.lambda, moments[i], q);
@@ -74,7 +88,8 @@ pub fn update(config: &ReliabilityConfig, bounds: &SceneBounds, moments: &mut [f
     let mut sums = vec![FixedSum::default(); cells * MOMENTS_PER_CELL];
     let mut counts = vec![0u32; cells];
     for s in samples {
-        let cell = cell_index(config, bounds, [s.position[0], s.position[1], s.position[2]]) as usize;
+        let cell =
+            cell_index(config, bounds, [s.position[0], s.position[1], s.position[2]]) as usize;
         counts[cell] += 1;
         for (k, q) in sample_quantities(s).into_iter().enumerate() {
             if !sums[cell * MOMENTS_PER_CELL + k].add_clamped(q) {
@@ -88,7 +103,8 @@ pub fn update(config: &ReliabilityConfig, bounds: &SceneBounds, moments: &mut [f
         }
         for k in 0..MOMENTS_PER_CELL {
             let i = cell * MOMENTS_PER_CELL + k;
-            moments[i] = ema_step(config.lambda, moments[i], sums[i].to_f32() / counts[cell] as f32);
+            moments[i] =
+                ema_step(config.lambda, moments[i], sums[i].to_f32() / counts[cell] as f32);
         }
     }
     true
@@ -118,7 +134,12 @@ pub fn reliabilities(config: &ReliabilityConfig, cell_moments: &[f32]) -> (f32, 
 }
 
 /// Weight of the High-LR predictor for a query in a cell with these moments.
-pub fn high_lr_weight(config: &ReliabilityConfig, mode: PredictorMode, grid_updates: u32, cell_moments: &[f32]) -> f32 {
+pub fn high_lr_weight(
+    config: &ReliabilityConfig,
+    mode: PredictorMode,
+    grid_updates: u32,
+    cell_moments: &[f32],
+) -> f32 {
     match mode {
         PredictorMode::EmaOnly => 0.0,
         PredictorMode::HighLrOnly => 1.0,
@@ -155,7 +176,10 @@ mod tests {
     }
 
     /// Feeds `frames` updates of one sample each into the cell at the origin.
-    fn run(frames: usize, mut sample: impl FnMut(usize) -> ([f32; 3], [f32; 3], [f32; 3])) -> Vec<f32> {
+    fn run(
+        frames: usize,
+        mut sample: impl FnMut(usize) -> ([f32; 3], [f32; 3], [f32; 3]),
+    ) -> Vec<f32> {
         let cfg = config();
         let bounds = SceneBounds::new([0.0; 3], [1.0; 3]);
         let mut moments = vec![0.0; cell_count(&cfg) as usize * MOMENTS_PER_CELL];
@@ -199,7 +223,8 @@ mod tests {
                 let f = [lcg(&mut rng), lcg(&mut rng), lcg(&mut rng)];
                 (y, f, y.map(|v| 1.0 - v))
             });
-            let (r_cur, r_ema) = reliabilities(&ReliabilityConfig { epsilon: 1e-7, ..config() }, &m);
+            let (r_cur, r_ema) =
+                reliabilities(&ReliabilityConfig { epsilon: 1e-7, ..config() }, &m);
             assert!((r_ema + 1.0).abs() < 1e-3, "anti-correlated: {r_ema}");
             r_sum += r_cur;
             windows += 1;
@@ -237,7 +262,10 @@ mod tests {
         let (rc, re) = reliabilities(&cfg, &m);
         let mut same = m.clone();
         same.copy_within(CUR..CUR + 9, EMA);
-        assert!((high_lr_weight(&cfg, PredictorMode::Blend, 1000, &same) - 0.5).abs() < 1e-6, "{rc} {re}");
+        assert!(
+            (high_lr_weight(&cfg, PredictorMode::Blend, 1000, &same) - 0.5).abs() < 1e-6,
+            "{rc} {re}"
+        );
         assert_eq!(combine(0.25, [4.0, 0.0, -8.0], [0.0, 4.0, -8.0]), [1.0, 3.0, 0.0]);
     }
 
@@ -248,11 +276,21 @@ mod tests {
         let bounds = SceneBounds::new([0.0; 3], [1.0; 3]);
         let cells = cell_count(&cfg) as usize * MOMENTS_PER_CELL;
         let batch: Vec<ReliabilitySample> = (0..50)
-            .map(|i| ReliabilitySample { position: [0.1, 0.1, 0.1, 0.0], target_rgb: [i as f32, 0.0, 0.0, 0.0], f_cur: [0.0; 4], f_ema: [0.0; 4] })
+            .map(|i| ReliabilitySample {
+                position: [0.1, 0.1, 0.1, 0.0],
+                target_rgb: [i as f32, 0.0, 0.0, 0.0],
+                f_cur: [0.0; 4],
+                f_ema: [0.0; 4],
+            })
             .collect();
         let (mut per_sample, mut batch_mean) = (vec![0.0f32; cells], vec![0.0f32; cells]);
         assert!(update(&cfg, &bounds, &mut per_sample, &batch));
-        assert!(update(&ReliabilityConfig { update: MomentUpdate::BatchMean, ..cfg.clone() }, &bounds, &mut batch_mean, &batch));
+        assert!(update(
+            &ReliabilityConfig { update: MomentUpdate::BatchMean, ..cfg.clone() },
+            &bounds,
+            &mut batch_mean,
+            &batch
+        ));
         let cell = cell_index(&cfg, &bounds, [0.1, 0.1, 0.1]) as usize * MOMENTS_PER_CELL;
         // Per sample, the last ~10 samples dominate: 49 - λ/(1 - λ) (1 - λ^49) = 40.05.
         let expected = 49.0 - 0.9 / 0.1 * (1.0 - 0.9f32.powi(49));
@@ -272,7 +310,10 @@ mod tests {
         let cfg = config();
         let b = SceneBounds::new([-2.0; 3], [2.0; 3]);
         // Same voxel -> same cell; positions are clamped to the box.
-        assert_eq!(cell_index(&cfg, &b, [-1.9, -1.9, -1.9]), cell_index(&cfg, &b, [-1.1, -1.5, -1.01]));
+        assert_eq!(
+            cell_index(&cfg, &b, [-1.9, -1.9, -1.9]),
+            cell_index(&cfg, &b, [-1.1, -1.5, -1.01])
+        );
         assert_eq!(cell_index(&cfg, &b, [5.0, 5.0, 5.0]), cell_index(&cfg, &b, [1.9, 1.9, 1.9]));
         assert_eq!(cell_index(&cfg, &b, [0.5, 0.5, 0.5]), spatial_hash(2, 2, 2) & 63);
     }

@@ -67,7 +67,9 @@ impl CacheState {
             params.extend((0..m.rows * m.cols).map(|_| rng.symmetric(scale)));
         }
         params.resize(layout.mlp_params as usize, 0.0);
-        params.extend((0..layout.grid_table_params()).map(|_| rng.symmetric(config.encoding.init_scale)));
+        params.extend(
+            (0..layout.grid_table_params()).map(|_| rng.symmetric(config.encoding.init_scale)),
+        );
         params.resize(layout.total_params as usize, 0.0);
         let n = params.len();
         Ok(Self {
@@ -88,8 +90,12 @@ impl CacheState {
 
     pub fn save(&self, path: &Path) -> Result<(), NircError> {
         let io = |source| NircError::Io { path: path.to_path_buf(), source };
-        let header = serde_json::to_vec(&Header { config: self.config.clone(), bounds: self.bounds, counters: self.counters })
-            .map_err(|e| NircError::Format { path: path.to_path_buf(), what: e.to_string() })?;
+        let header = serde_json::to_vec(&Header {
+            config: self.config.clone(),
+            bounds: self.bounds,
+            counters: self.counters,
+        })
+        .map_err(|e| NircError::Format { path: path.to_path_buf(), what: e.to_string() })?;
         let mut bytes = Vec::new();
         bytes.extend_from_slice(MAGIC);
         bytes.extend_from_slice(&(header.len() as u64).to_le_bytes());
@@ -116,7 +122,9 @@ impl CacheState {
             .map_err(|source| NircError::Io { path: path.to_path_buf(), source })?;
         let mut at = 0usize;
         let mut take = |n: usize, what: &str| -> Result<&[u8], NircError> {
-            let s = bytes.get(at..at + n).ok_or_else(|| bad(format!("truncated while reading {what} at byte {at}")))?;
+            let s = bytes
+                .get(at..at + n)
+                .ok_or_else(|| bad(format!("truncated while reading {what} at byte {at}")))?;
             at += n;
             Ok(s)
         };
@@ -124,18 +132,29 @@ impl CacheState {
             return Err(bad("does not start with FLKNIRC1 (not a flicker NIRC state)".into()));
         }
         let header_len = u64::from_le_bytes(take(8, "header length")?.try_into().unwrap()) as usize;
-        let header: Header = serde_json::from_slice(take(header_len, "JSON header")?).map_err(|e| bad(format!("JSON header: {e}")))?;
+        let header: Header = serde_json::from_slice(take(header_len, "JSON header")?)
+            .map_err(|e| bad(format!("JSON header: {e}")))?;
         header.config.validate().map_err(|e| bad(e.to_string()))?;
         let layout = ParameterLayout::new(&header.config);
         let cells = cell_count(&header.config.reliability) as usize * MOMENTS_PER_CELL;
         let mut arrays = Vec::new();
-        for (name, expected) in [("params", layout.total_params as usize), ("ema", layout.total_params as usize), ("adam_m", layout.total_params as usize), ("adam_v", layout.total_params as usize), ("reliability", cells)] {
+        for (name, expected) in [
+            ("params", layout.total_params as usize),
+            ("ema", layout.total_params as usize),
+            ("adam_m", layout.total_params as usize),
+            ("adam_v", layout.total_params as usize),
+            ("reliability", cells),
+        ] {
             let n = u64::from_le_bytes(take(8, name)?.try_into().unwrap()) as usize;
             if n != expected {
                 return Err(bad(format!("{name} has {n} values, the config needs {expected}")));
             }
             let raw = take(n * 4, name)?;
-            arrays.push(raw.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect::<Vec<f32>>());
+            arrays.push(
+                raw.chunks_exact(4)
+                    .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+                    .collect::<Vec<f32>>(),
+            );
         }
         if at != bytes.len() {
             return Err(bad(format!("{} trailing bytes", bytes.len() - at)));
@@ -145,6 +164,15 @@ impl CacheState {
         let adam_m = arrays.pop().unwrap();
         let ema = arrays.pop().unwrap();
         let params = arrays.pop().unwrap();
-        Ok(Self { config: header.config, bounds: header.bounds, params, ema, adam_m, adam_v, counters: header.counters, reliability })
+        Ok(Self {
+            config: header.config,
+            bounds: header.bounds,
+            params,
+            ema,
+            adam_m,
+            adam_v,
+            counters: header.counters,
+            reliability,
+        })
     }
 }

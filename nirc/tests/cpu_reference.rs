@@ -15,7 +15,10 @@ fn gradients_match_central_finite_differences() {
     let recs = records(&mut rng, 6);
     let params: Vec<f64> = cache.state.params.iter().map(|&w| w as f64).collect();
     // Stop-gradient: the denominators are constants of the loss, frozen at the current point.
-    let frozen: Vec<[f64; 3]> = recs.iter().map(|r| denominators(&config.loss, cache.predict(&r.query(), false).map(|v| v as f64))).collect();
+    let frozen: Vec<[f64; 3]> = recs
+        .iter()
+        .map(|r| denominators(&config.loss, cache.predict(&r.query(), false).map(|v| v as f64)))
+        .collect();
     let (_, grad) = cache.loss_and_gradient(&params, &recs, Some(&frozen));
     let mlp = cache.layout.mlp_params as usize;
     // Every MLP weight, and every grid entry some record touches.
@@ -31,10 +34,17 @@ fn gradients_match_central_finite_differences() {
         plus[i] += h;
         let mut minus = params.clone();
         minus[i] -= h;
-        let fd = (cache.loss_and_gradient(&plus, &recs, Some(&frozen)).0 - cache.loss_and_gradient(&minus, &recs, Some(&frozen)).0) / (2.0 * h);
+        let fd = (cache.loss_and_gradient(&plus, &recs, Some(&frozen)).0
+            - cache.loss_and_gradient(&minus, &recs, Some(&frozen)).0)
+            / (2.0 * h);
         let err = (fd - grad[i]).abs() / (grad[i].abs() + 1e-7);
         worst = worst.max(err);
-        assert!(err < 1e-4, "parameter {i} ({}): analytic {} vs finite difference {fd}", if i < mlp { "MLP" } else { "grid" }, grad[i]);
+        assert!(
+            err < 1e-4,
+            "parameter {i} ({}): analytic {} vs finite difference {fd}",
+            if i < mlp { "MLP" } else { "grid" },
+            grad[i]
+        );
         checked_grid += (i >= mlp) as usize;
     }
     assert!(checked_grid > 50);

@@ -31,18 +31,41 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 fn gpu_sums(gpu: &Gpu, values: &[f32]) -> (Vec<[u32; 3]>, Vec<bool>) {
     let program = Program::new(vec![
         Module::generated("package::nirc::types", &[&nirc::gpu::shaders::structs()]),
-        Module::generated("package::nirc::bindings", &["@group(0) @binding(1) var<storage, read_write> accum: array<atomic<u32>>;"]),
+        Module::generated(
+            "package::nirc::bindings",
+            &["@group(0) @binding(1) var<storage, read_write> accum: array<atomic<u32>>;"],
+        ),
         render::wgsl_file!("bindings_common.wgsl"),
         render::wgsl_file!("fixed_sum.wgsl"),
     ])
-    .entry(Module::generated("package::fixed_sum_probe", &[ENTRY, &format!("const ACCUMULATORS: u32 = {ACCUMULATORS}u;")]));
+    .entry(Module::generated(
+        "package::fixed_sum_probe",
+        &[ENTRY, &format!("const ACCUMULATORS: u32 = {ACCUMULATORS}u;")],
+    ));
     let [pipeline] = pipelines_auto_layout(gpu, "fixed_sum_probe", &program, ["main"]).unwrap();
     let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
     let device = &gpu.device;
-    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("values"), contents: bytemuck::cast_slice(values), usage });
-    let accum = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("accum"), contents: &vec![0u8; ACCUMULATORS * 12], usage });
-    let accepted = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("accepted"), contents: &vec![0u8; values.len() * 4], usage });
-    let group = buffer_group(gpu, "fixed_sum_probe", &pipeline.get_bind_group_layout(0), &[&input, &accum, &accepted]);
+    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("values"),
+        contents: bytemuck::cast_slice(values),
+        usage,
+    });
+    let accum = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("accum"),
+        contents: &vec![0u8; ACCUMULATORS * 12],
+        usage,
+    });
+    let accepted = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("accepted"),
+        contents: &vec![0u8; values.len() * 4],
+        usage,
+    });
+    let group = buffer_group(
+        gpu,
+        "fixed_sum_probe",
+        &pipeline.get_bind_group_layout(0),
+        &[&input, &accum, &accepted],
+    );
     let mut encoder = device.create_command_encoder(&Default::default());
     {
         let mut pass = encoder.begin_compute_pass(&Default::default());
@@ -68,8 +91,8 @@ fn gpu_fixed_sums_equal_the_cpu_word_for_word() {
         f32::powi(2.0, -49),
         1.0,
         -1.0,
-        f32::powi(2.0, 7),   // its mantissa starts exactly at the middle word's bit 0 (shift 32)
-        -f32::powi(2.0, 8),  // one bit further (shift 33), negated; no value reaches the top word at bit 0
+        f32::powi(2.0, 7), // its mantissa starts exactly at the middle word's bit 0 (shift 32)
+        -f32::powi(2.0, 8), // one bit further (shift 33), negated; no value reaches the top word at bit 0
         f32::powi(2.0, 31),
         -4_294_967_040.0, // largest accepted magnitude
         4_294_967_296.0,  // 2^32: refused
@@ -92,11 +115,20 @@ fn gpu_fixed_sums_equal_the_cpu_word_for_word() {
     let (words, accepted) = gpu_sums(&gpu, &values);
     let mut cpu = vec![FixedSum::default(); ACCUMULATORS];
     for (i, &x) in values.iter().enumerate() {
-        assert_eq!(cpu[i % ACCUMULATORS].add(x), accepted[i], "value {i} ({x:e}): accepted on the CPU and the GPU alike");
+        assert_eq!(
+            cpu[i % ACCUMULATORS].add(x),
+            accepted[i],
+            "value {i} ({x:e}): accepted on the CPU and the GPU alike"
+        );
     }
     assert!(accepted.iter().filter(|a| !**a).count() >= 4, "the refused values are refused");
     for (a, (g, c)) in words.iter().zip(&cpu).enumerate() {
-        assert_eq!(*g, c.words(), "accumulator {a}: GPU {g:08x?} against the CPU's {:08x?}", c.words());
+        assert_eq!(
+            *g,
+            c.words(),
+            "accumulator {a}: GPU {g:08x?} against the CPU's {:08x?}",
+            c.words()
+        );
     }
     // The sums are not trivially zero: the test would pass on a shader that adds nothing.
     assert!(cpu.iter().all(|c| *c != FixedSum::default()));

@@ -28,7 +28,13 @@ fn assert_vec_close(what: &str, gpu: &[f32], cpu: &[f32], rel: f32, abs: f32) {
             bad.push((i, *g, *c));
         }
     }
-    assert!(bad.is_empty(), "{what}: {} of {} values differ, first: {:?}", bad.len(), gpu.len(), &bad[..bad.len().min(8)]);
+    assert!(
+        bad.is_empty(),
+        "{what}: {} of {} values differ, first: {:?}",
+        bad.len(),
+        gpu.len(),
+        &bad[..bad.len().min(8)]
+    );
 }
 
 #[test]
@@ -38,20 +44,41 @@ fn forward_matches_cpu_in_every_weight_placement() {
     let cpu = CpuCache::new(state.clone());
     let mut rng = Rng(4);
     let queries: Vec<_> = records(&mut rng, 200).iter().map(|r| r.query()).collect();
-    for placement in [WeightPlacement::Tiled, WeightPlacement::Storage, WeightPlacement::Registers] {
+    for placement in [WeightPlacement::Tiled, WeightPlacement::Storage, WeightPlacement::Registers]
+    {
         let cache = NeuralCache::from_state(gpu(), &state, Some(placement)).unwrap();
         assert_eq!(cache.placement, placement);
         // Two features per level: the register form reads the grid from its texture mirror
         // (lavapipe and the GPUs the lab runs on have rgba32float storage textures).
-        assert_eq!(cache.reads_grid_mirror(), placement == WeightPlacement::Registers, "{placement:?}");
-        for mode in [PredictorMode::HighLrOnly, PredictorMode::EmaOnly, PredictorMode::Blend, PredictorMode::Switch, PredictorMode::Fixed(0.3)] {
+        assert_eq!(
+            cache.reads_grid_mirror(),
+            placement == WeightPlacement::Registers,
+            "{placement:?}"
+        );
+        for mode in [
+            PredictorMode::HighLrOnly,
+            PredictorMode::EmaOnly,
+            PredictorMode::Blend,
+            PredictorMode::Switch,
+            PredictorMode::Fixed(0.3),
+        ] {
             let got = cache.infer_queries(gpu(), &queries, mode).unwrap();
             let want = cpu.infer(&queries, mode);
             let mut nonzero = 0;
             for (g, w) in got.iter().zip(&want) {
-                assert!(close(g.sigma, w.sigma, 1e-5, 1e-6), "{placement:?} {mode:?}: sigma {} vs {}", g.sigma, w.sigma);
+                assert!(
+                    close(g.sigma, w.sigma, 1e-5, 1e-6),
+                    "{placement:?} {mode:?}: sigma {} vs {}",
+                    g.sigma,
+                    w.sigma
+                );
                 for c in 0..3 {
-                    assert!(close(g.radiance[c], w.radiance[c], 1e-4, 1e-6), "{placement:?} {mode:?}: {:?} vs {:?}", g.radiance, w.radiance);
+                    assert!(
+                        close(g.radiance[c], w.radiance[c], 1e-4, 1e-6),
+                        "{placement:?} {mode:?}: {:?} vs {:?}",
+                        g.radiance,
+                        w.radiance
+                    );
                     nonzero += (w.radiance[c] > 1e-3) as usize;
                 }
             }
@@ -81,10 +108,16 @@ fn register_form_without_the_grid_mirror_matches_cpu() {
             cache.train_records(gpu(), &batch).unwrap();
         }
         for mode in [PredictorMode::EmaOnly, PredictorMode::HighLrOnly, PredictorMode::Blend] {
-            let (got, want) = (cache.infer_queries(gpu(), &queries, mode).unwrap(), cpu.infer(&queries, mode));
+            let (got, want) =
+                (cache.infer_queries(gpu(), &queries, mode).unwrap(), cpu.infer(&queries, mode));
             for (g, w) in got.iter().zip(&want) {
                 for c in 0..3 {
-                    assert!(close(g.radiance[c], w.radiance[c], 1e-4, 1e-6), "trained {trained}, {mode:?}: {:?} vs {:?}", g.radiance, w.radiance);
+                    assert!(
+                        close(g.radiance[c], w.radiance[c], 1e-4, 1e-6),
+                        "trained {trained}, {mode:?}: {:?} vs {:?}",
+                        g.radiance,
+                        w.radiance
+                    );
                 }
             }
         }
@@ -103,18 +136,35 @@ fn register_form_matches_the_tiled_form() {
         let batch = records(&mut Rng(6), 128);
         let queries: Vec<_> = records(&mut Rng(5), 150).iter().map(|r| r.query()).collect();
         let tiled = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Tiled)).unwrap();
-        let lane = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Registers)).unwrap();
+        let lane =
+            NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Registers)).unwrap();
         // Every mode: one predictor, both blended (three ways), or both switched.
-        for mode in [PredictorMode::EmaOnly, PredictorMode::Blend, PredictorMode::HighLrOnly, PredictorMode::Switch, PredictorMode::Fixed(0.3)] {
+        for mode in [
+            PredictorMode::EmaOnly,
+            PredictorMode::Blend,
+            PredictorMode::HighLrOnly,
+            PredictorMode::Switch,
+            PredictorMode::Fixed(0.3),
+        ] {
             lane.infer_queries(gpu(), &queries, mode).unwrap();
             tiled.train_records(gpu(), &batch).unwrap();
             lane.train_records(gpu(), &batch).unwrap();
             let a = tiled.infer_queries(gpu(), &queries, mode).unwrap();
-            let b = if mode == PredictorMode::Blend { infer_timed(&lane, &queries, mode) } else { lane.infer_queries(gpu(), &queries, mode).unwrap() };
+            let b = if mode == PredictorMode::Blend {
+                infer_timed(&lane, &queries, mode)
+            } else {
+                lane.infer_queries(gpu(), &queries, mode).unwrap()
+            };
             for (t, l) in a.iter().zip(&b) {
                 assert_eq!(t.sigma, l.sigma, "width {} {mode:?}", config.network.width);
                 for c in 0..3 {
-                    assert!(close(l.radiance[c], t.radiance[c], 1e-6, 1e-7), "width {} {mode:?}: {:?} vs {:?}", config.network.width, l.radiance, t.radiance);
+                    assert!(
+                        close(l.radiance[c], t.radiance[c], 1e-6, 1e-7),
+                        "width {} {mode:?}: {:?} vs {:?}",
+                        config.network.width,
+                        l.radiance,
+                        t.radiance
+                    );
                 }
             }
         }
@@ -122,7 +172,11 @@ fn register_form_matches_the_tiled_form() {
 }
 
 /// `infer_timed`, the way a scenario's frame records an inference.
-fn infer_timed(cache: &NeuralCache, queries: &[nirc::records::CacheQuery], mode: PredictorMode) -> Vec<nirc::records::CacheAnswer> {
+fn infer_timed(
+    cache: &NeuralCache,
+    queries: &[nirc::records::CacheQuery],
+    mode: PredictorMode,
+) -> Vec<nirc::records::CacheAnswer> {
     let qbuf = nirc::gpu::upload(gpu(), "queries", queries);
     let out = nirc::gpu::answer_buffer(gpu(), queries.len() as u32);
     let timer = render::timing::PassTimer::wall(&["infer"]);
@@ -157,7 +211,12 @@ fn one_training_step_matches_cpu() {
         assert_vec_close("adam v", &got.adam_v, &cpu.state.adam_v, 2e-3, 1e-12);
         assert_vec_close("reliability", &got.reliability, &cpu.state.reliability, 1e-4, 1e-6);
         // The step really moved the weights.
-        let moved = got.params.iter().zip(&state.params).filter(|(a, b)| (*a - *b).abs() > 0.5 * lr).count();
+        let moved = got
+            .params
+            .iter()
+            .zip(&state.params)
+            .filter(|(a, b)| (*a - *b).abs() > 0.5 * lr)
+            .count();
         assert!(moved > got.params.len() / 10, "only {moved} parameters moved");
     }
 }
@@ -182,13 +241,22 @@ fn twelve_steps_keep_weights_ema_and_blend_on_the_cpu_reference() {
     assert_vec_close("params", &got.params, &cpu.state.params, 1e-4, 2e-2 * lr);
     assert_vec_close("ema", &got.ema, &cpu.state.ema, 1e-4, 2e-2 * lr);
     let apart = got.ema.iter().zip(&got.params).filter(|(e, p)| (*e - *p).abs() > lr).count();
-    assert!(apart > got.ema.len() / 10, "after 12 steps the EMA must lag the weights ({apart} apart)");
+    assert!(
+        apart > got.ema.len() / 10,
+        "after 12 steps the EMA must lag the weights ({apart} apart)"
+    );
     let q: Vec<_> = records(&mut rng, 100).iter().map(|r| r.query()).collect();
     for mode in [PredictorMode::EmaOnly, PredictorMode::Blend] {
-        for (g, w) in cache.infer_queries(gpu(), &q, mode).unwrap().iter().zip(cpu.infer(&q, mode)) {
+        for (g, w) in cache.infer_queries(gpu(), &q, mode).unwrap().iter().zip(cpu.infer(&q, mode))
+        {
             assert!(close(g.sigma, w.sigma, 1e-3, 1e-4), "{mode:?}: σ {} vs {}", g.sigma, w.sigma);
             for c in 0..3 {
-                assert!(close(g.radiance[c], w.radiance[c], 1e-3, 1e-4), "{mode:?}: {:?} vs {:?}", g.radiance, w.radiance);
+                assert!(
+                    close(g.radiance[c], w.radiance[c], 1e-3, 1e-4),
+                    "{mode:?}: {:?} vs {:?}",
+                    g.radiance,
+                    w.radiance
+                );
             }
         }
     }
@@ -222,25 +290,46 @@ fn reliability_stream(rule: nirc::config::MomentUpdate, resolution: u32, log2_ce
     for update in 0..6 {
         let samples: Vec<ReliabilitySample> = (0..400)
             .map(|_| {
-                let p = [rng.range(b.min[0], b.max[0]), rng.range(b.min[1], b.max[1]), rng.range(b.min[2], b.max[2])];
+                let p = [
+                    rng.range(b.min[0], b.max[0]),
+                    rng.range(b.min[1], b.max[1]),
+                    rng.range(b.min[2], b.max[2]),
+                ];
                 let y = [rng.range(0.0, 3.0), rng.range(0.0, 1.0), rng.range(0.0, 0.1)];
                 // cur tracks y, ema lags with noise: distinct correlations per cell.
                 let fc = y.map(|v| 0.9 * v + 0.1);
                 let fe = [rng.range(0.0, 3.0), y[1] * 0.5, rng.range(0.0, 0.1)];
-                ReliabilitySample { position: [p[0], p[1], p[2], 0.0], target_rgb: [y[0], y[1], y[2], 0.0], f_cur: [fc[0], fc[1], fc[2], 0.0], f_ema: [fe[0], fe[1], fe[2], 0.0] }
+                ReliabilitySample {
+                    position: [p[0], p[1], p[2], 0.0],
+                    target_rgb: [y[0], y[1], y[2], 0.0],
+                    f_cur: [fc[0], fc[1], fc[2], 0.0],
+                    f_ema: [fe[0], fe[1], fe[2], 0.0],
+                }
             })
             .collect();
         assert!(nirc::reliability::update(&config.reliability, &b, &mut moments, &samples));
-        cache.update_reliability(gpu(), &upload(gpu(), "samples", &samples), samples.len() as u32).unwrap();
+        cache
+            .update_reliability(gpu(), &upload(gpu(), "samples", &samples), samples.len() as u32)
+            .unwrap();
         let got = cache.download_state(gpu()).unwrap();
-        assert_vec_close(&format!("{rule:?} moments after update {update}"), &got.reliability, &moments, 1e-5, 1e-7);
+        assert_vec_close(
+            &format!("{rule:?} moments after update {update}"),
+            &got.reliability,
+            &moments,
+            1e-5,
+            1e-7,
+        );
         assert_eq!(got.counters.grid_updates, update + 1);
     }
     if log2_cells < 6 {
         return; // too few cells for the answers below to differ between cells
     }
     // Blend and switch answers follow the CPU reliabilities (warm-up over).
-    let cpu = CpuCache::new(CacheState { reliability: moments, counters: cache.counters(gpu()).unwrap(), ..state });
+    let cpu = CpuCache::new(CacheState {
+        reliability: moments,
+        counters: cache.counters(gpu()).unwrap(),
+        ..state
+    });
     let queries: Vec<_> = records(&mut rng, 300).iter().map(|r| r.query()).collect();
     for mode in [PredictorMode::Blend, PredictorMode::Switch] {
         let got = cache.infer_queries(gpu(), &queries, mode).unwrap();
@@ -254,10 +343,17 @@ fn reliability_stream(rule: nirc::config::MomentUpdate, resolution: u32, log2_ce
     }
     // The fixed blend ignores the grid: σ is the setting, the radiance the blend of both.
     let fixed = PredictorMode::Fixed(0.3);
-    for (g, w) in cache.infer_queries(gpu(), &queries, fixed).unwrap().iter().zip(cpu.infer(&queries, fixed)) {
+    for (g, w) in
+        cache.infer_queries(gpu(), &queries, fixed).unwrap().iter().zip(cpu.infer(&queries, fixed))
+    {
         assert_eq!((g.sigma, w.sigma), (0.3, 0.3));
         for c in 0..3 {
-            assert!(close(g.radiance[c], w.radiance[c], 1e-4, 1e-6), "{:?} vs {:?}", g.radiance, w.radiance);
+            assert!(
+                close(g.radiance[c], w.radiance[c], 1e-4, 1e-6),
+                "{:?} vs {:?}",
+                g.radiance,
+                w.radiance
+            );
         }
     }
 }
@@ -289,8 +385,17 @@ fn save_load_reproduces_the_next_step_and_inference_exactly() {
     assert_eq!(a.reliability, b.reliability);
     assert_eq!(a.counters, b.counters);
     let q: Vec<_> = next.iter().map(|r| r.query()).collect();
-    for mode in [PredictorMode::EmaOnly, PredictorMode::HighLrOnly, PredictorMode::Blend, PredictorMode::Switch] {
-        assert_eq!(cache.infer_queries(gpu(), &q, mode).unwrap(), loaded.infer_queries(gpu(), &q, mode).unwrap(), "{mode:?}");
+    for mode in [
+        PredictorMode::EmaOnly,
+        PredictorMode::HighLrOnly,
+        PredictorMode::Blend,
+        PredictorMode::Switch,
+    ] {
+        assert_eq!(
+            cache.infer_queries(gpu(), &q, mode).unwrap(),
+            loaded.infer_queries(gpu(), &q, mode).unwrap(),
+            "{mode:?}"
+        );
     }
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -326,10 +431,22 @@ fn nan_target_rolls_the_step_back_and_is_counted() {
 fn other_encodings_widths_and_loss_normalisation_match_cpu() {
     use nirc::config::{DirectionEncoding, LossNormalization, NetworkConfig};
     let variants = [
-        (DirectionEncoding::Identity, LossNormalization::Luminance, NetworkConfig { width: 32, hidden_layers: 1 }),
-        (DirectionEncoding::None, LossNormalization::PerChannel, NetworkConfig { width: 16, hidden_layers: 3 }),
+        (
+            DirectionEncoding::Identity,
+            LossNormalization::Luminance,
+            NetworkConfig { width: 32, hidden_layers: 1 },
+        ),
+        (
+            DirectionEncoding::None,
+            LossNormalization::PerChannel,
+            NetworkConfig { width: 16, hidden_layers: 3 },
+        ),
         // An odd width: the MLP's weights end inside a quad, so the layout pads before the grid.
-        (DirectionEncoding::Identity, LossNormalization::PerChannel, NetworkConfig { width: 5, hidden_layers: 1 }),
+        (
+            DirectionEncoding::Identity,
+            LossNormalization::PerChannel,
+            NetworkConfig { width: 5, hidden_layers: 1 },
+        ),
     ];
     for (direction, normalization, network) in variants {
         let mut config = small_config();
@@ -347,22 +464,45 @@ fn other_encodings_widths_and_loss_normalisation_match_cpu() {
         let what = format!("{direction:?} {normalization:?} {network:?}");
         let layout = state.layout();
         if network.width == 5 {
-            assert_ne!(layout.mlp_weights() % 4, 0, "{what}: the case must leave a gap before the grid");
+            assert_ne!(
+                layout.mlp_weights() % 4,
+                0,
+                "{what}: the case must leave a gap before the grid"
+            );
         }
         // The quad padding (after the matrices, after the grid tables) stays zero.
         let grid_end = (layout.mlp_params + layout.grid_table_params()) as usize;
-        let padding = (layout.mlp_weights() as usize..layout.mlp_params as usize).chain(grid_end..layout.total_params as usize);
+        let padding = (layout.mlp_weights() as usize..layout.mlp_params as usize)
+            .chain(grid_end..layout.total_params as usize);
         for i in padding {
-            assert_eq!((got.params[i], got.ema[i], got.adam_m[i]), (0.0, 0.0, 0.0), "{what}: padding parameter {i}");
+            assert_eq!(
+                (got.params[i], got.ema[i], got.adam_m[i]),
+                (0.0, 0.0, 0.0),
+                "{what}: padding parameter {i}"
+            );
         }
         let lr = config.optimizer.learning_rate;
-        assert_vec_close(&format!("{what} params"), &got.params, &cpu.state.params, 1e-5, 1e-3 * lr);
+        assert_vec_close(
+            &format!("{what} params"),
+            &got.params,
+            &cpu.state.params,
+            1e-5,
+            1e-3 * lr,
+        );
         assert_vec_close(&format!("{what} adam m"), &got.adam_m, &cpu.state.adam_m, 1e-3, 1e-9);
         let q: Vec<_> = batch.iter().map(|r| r.query()).collect();
-        let (g, w) = (cache.infer_queries(gpu(), &q, PredictorMode::HighLrOnly).unwrap(), cpu.infer(&q, PredictorMode::HighLrOnly));
+        let (g, w) = (
+            cache.infer_queries(gpu(), &q, PredictorMode::HighLrOnly).unwrap(),
+            cpu.infer(&q, PredictorMode::HighLrOnly),
+        );
         for (a, b) in g.iter().zip(&w) {
             for c in 0..3 {
-                assert!(close(a.radiance[c], b.radiance[c], 1e-4, 1e-6), "{what}: {:?} vs {:?}", a.radiance, b.radiance);
+                assert!(
+                    close(a.radiance[c], b.radiance[c], 1e-4, 1e-6),
+                    "{what}: {:?} vs {:?}",
+                    a.radiance,
+                    b.radiance
+                );
             }
         }
     }
@@ -398,9 +538,12 @@ fn steps_recorded_in_one_encoder_equal_separate_submissions() {
     let mut encoder = gpu().device.create_command_encoder(&Default::default());
     together.encode_train(gpu(), &mut encoder, &r1, b1.len() as u32).unwrap();
     together.encode_train(gpu(), &mut encoder, &r2, b2.len() as u32).unwrap();
-    together.encode_infer(gpu(), &mut encoder, &qb, q.len() as u32, &out, PredictorMode::Blend).unwrap();
+    together
+        .encode_infer(gpu(), &mut encoder, &qb, q.len() as u32, &out, PredictorMode::Blend)
+        .unwrap();
     gpu().queue.submit([encoder.finish()]);
-    let got: Vec<nirc::CacheAnswer> = nirc::gpu::readback::read_pod(gpu(), &out, "answers").unwrap();
+    let got: Vec<nirc::CacheAnswer> =
+        nirc::gpu::readback::read_pod(gpu(), &out, "answers").unwrap();
     assert_eq!(&got[..q.len()], &want[..]);
     assert_eq!(together.download_state(gpu()).unwrap(), separate.download_state(gpu()).unwrap());
 }
@@ -432,7 +575,11 @@ fn gpu_training_converges_like_the_cpu_reference() {
 fn networks_the_tiled_mlp_does_not_take_fall_back_to_storage_or_are_refused() {
     let small = NeuralCache::new(gpu(), &small_config(), bounds()).unwrap();
     // On a CPU adapter (lavapipe) the default is the register-form inference, else the tiled.
-    let expected = if gpu().summary.device_type == "Cpu" { WeightPlacement::Registers } else { WeightPlacement::Tiled };
+    let expected = if gpu().summary.device_type == "Cpu" {
+        WeightPlacement::Registers
+    } else {
+        WeightPlacement::Tiled
+    };
     assert_eq!(small.placement, expected);
     assert!(nirc::gpu::shaders::workgroup_bytes(&small.layout) <= 32768);
     let default = nirc::layout::ParameterLayout::new(&nirc::NircConfig::default());
@@ -442,9 +589,15 @@ fn networks_the_tiled_mlp_does_not_take_fall_back_to_storage_or_are_refused() {
     let big = NeuralCache::new(gpu(), &config, bounds()).unwrap();
     assert_eq!(big.placement, WeightPlacement::Storage);
     let state = CacheState::initial(&config, bounds()).unwrap();
-    let err = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Tiled)).err().expect("refused").to_string();
+    let err = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Tiled))
+        .err()
+        .expect("refused")
+        .to_string();
     assert!(err.contains("tiled MLP") && err.contains("width 128"), "{err}");
-    let err = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Registers)).err().expect("refused").to_string();
+    let err = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Registers))
+        .err()
+        .expect("refused")
+        .to_string();
     assert!(err.contains("width 128"), "{err}");
     // The fallback computes the same thing.
     let cpu = CpuCache::new(state);
@@ -466,7 +619,12 @@ fn networks_over_the_drivers_loop_cap_are_refused() {
     match gpu().loop_iteration_limit() {
         Some(limit) => {
             let err = result.err().expect("refused on a driver with a loop cap").to_string();
-            assert!(err.contains("loop iterations") && err.contains(&limit.to_string()) && err.contains("width 128"), "{err}");
+            assert!(
+                err.contains("loop iterations")
+                    && err.contains(&limit.to_string())
+                    && err.contains("width 128"),
+                "{err}"
+            );
         }
         None => assert!(result.is_ok(), "no loop cap on this adapter, yet refused"),
     }
@@ -492,8 +650,18 @@ fn training_profile_names_every_stage_of_a_step_once() {
         if placement == WeightPlacement::Storage {
             expected.push("weight gradient partials");
         }
-        expected.extend(["weight gradient reduce", "adam check (every parameter)", "adam apply (every parameter)", "ema update (every parameter)"]);
-        expected.extend(["reliability walk", "reliability update", "finish step", "clear the step's accumulators"]);
+        expected.extend([
+            "weight gradient reduce",
+            "adam check (every parameter)",
+            "adam apply (every parameter)",
+            "ema update (every parameter)",
+        ]);
+        expected.extend([
+            "reliability walk",
+            "reliability update",
+            "finish step",
+            "clear the step's accumulators",
+        ]);
         assert_eq!(names, expected, "{placement:?}");
         assert!(stages.iter().all(|s| s.1.is_finite() && s.1 >= 0.0), "{stages:?}");
     }

@@ -22,6 +22,9 @@ fn nirc_structs_have_one_layout() {
     }
     // The atomic view differs only in its name and the flag's type (same size and alignment).
     let atomic = counters_atomic_wgsl();
-    assert_eq!(atomic.replace("CountersAtomic", "Counters").replace("atomic<u32>", "u32"), Counters::WGSL);
+    assert_eq!(
+        atomic.replace("CountersAtomic", "Counters").replace("atomic<u32>", "u32"),
+        Counters::WGSL
+    );
     assert!(atomic.contains("flag: atomic<u32>"), "{atomic}");
 }

@@ -124,8 +124,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .collect();
     let bytes: &[u8] = bytemuck::cast_slice(&data);
     use wgpu::util::DeviceExt;
-    let buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("probe data"), contents: bytes, usage: wgpu::BufferUsages::STORAGE });
-    let out = device.create_buffer(&wgpu::BufferDescriptor { label: Some("probe out"), size: 4 * INVOCATIONS as u64, usage: wgpu::BufferUsages::STORAGE, mapped_at_creation: false });
+    let buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("probe data"),
+        contents: bytes,
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let out = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("probe out"),
+        size: 4 * INVOCATIONS as u64,
+        usage: wgpu::BufferUsages::STORAGE,
+        mapped_at_creation: false,
+    });
     let table = render::texel_table::TexelTable::new(&gpu, "probe texture", 1, bytes, 0)?;
     let view = table.view();
     // The same texels in a texture that is read as a read-only storage texture.
@@ -133,7 +142,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &gpu.queue,
         &wgpu::TextureDescriptor {
             label: Some("probe storage texture"),
-            size: wgpu::Extent3d { width: 1 << WIDTH_LOG2, height: 1 << (TEXELS_LOG2 - WIDTH_LOG2), depth_or_array_layers: 1 },
+            size: wgpu::Extent3d {
+                width: 1 << WIDTH_LOG2,
+                height: 1 << (TEXELS_LOG2 - WIDTH_LOG2),
+                depth_or_array_layers: 1,
+            },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -146,9 +159,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let storage_view = storage_texture.create_view(&Default::default());
     use Kind::*;
-    for (kind, rare) in [(Buffer, false), (Texture, false), (StorageTexture, false), (Texture, true), (Buffer, false), (Texture, false), (StorageTexture, false), (Texture, true)] {
+    for (kind, rare) in [
+        (Buffer, false),
+        (Texture, false),
+        (StorageTexture, false),
+        (Texture, true),
+        (Buffer, false),
+        (Texture, false),
+        (StorageTexture, false),
+        (Texture, true),
+    ] {
         let texture = kind == Texture;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some("probe"), source: wgpu::ShaderSource::Wgsl(source(kind, rare).into()) });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("probe"),
+            source: wgpu::ShaderSource::Wgsl(source(kind, rare).into()),
+        });
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("probe"),
             layout: None,
@@ -158,18 +183,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             cache: None,
         });
         let layout = pipeline.get_bind_group_layout(0);
-        let mut entries = vec![wgpu::BindGroupEntry { binding: 2, resource: out.as_entire_binding() }];
+        let mut entries =
+            vec![wgpu::BindGroupEntry { binding: 2, resource: out.as_entire_binding() }];
         if rare {
             entries.push(wgpu::BindGroupEntry { binding: 0, resource: buf.as_entire_binding() });
         }
         if texture {
-            entries.push(wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(view) });
+            entries.push(wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(view),
+            });
         } else if kind == StorageTexture {
-            entries.push(wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&storage_view) });
+            entries.push(wgpu::BindGroupEntry {
+                binding: 3,
+                resource: wgpu::BindingResource::TextureView(&storage_view),
+            });
         } else {
             entries.push(wgpu::BindGroupEntry { binding: 0, resource: buf.as_entire_binding() });
         }
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("probe"), layout: &layout, entries: &entries });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("probe"),
+            layout: &layout,
+            entries: &entries,
+        });
         let mut best = f64::INFINITY;
         for _ in 0..4 {
             let mut encoder = device.create_command_encoder(&Default::default());
@@ -189,7 +225,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             (Buffer, _) => "storage vec4u",
             (StorageTexture, _) => "read-only storage texture rgba32uint",
             (Texture, false) => "texture rgba32uint",
-            (Texture, true) => "texture rgba32uint, and a branch taken by 1 in 1024 invocations that loads 16 words from storage",
+            (Texture, true) => {
+                "texture rgba32uint, and a branch taken by 1 in 1024 invocations that loads 16 words from storage"
+            }
         };
         println!("{what}: {:.1} M loads/s of 16 bytes (best of 4)", loads / best / 1e6);
     }

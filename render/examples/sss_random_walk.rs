@@ -10,12 +10,19 @@
 
 use render::sss::inverse::numeric_inverse;
 use render::sss::profile::{cdf, scaling_from_dmfp};
-use render::sss::random_walk::{Medium, plane_albedo, point_light, point_light_burley, searchlight};
+use render::sss::random_walk::{
+    Medium, plane_albedo, point_light, point_light_burley, searchlight,
+};
 
 fn main() {
-    let paths: u64 = std::env::args().nth(1).map(|a| a.parse().expect("PATHS: a whole number")).unwrap_or(400_000);
+    let paths: u64 = std::env::args()
+        .nth(1)
+        .map(|a| a.parse().expect("PATHS: a whole number"))
+        .unwrap_or(400_000);
     println!("{paths} walks per row, seed 1 (model tally: seed 2)\n");
-    println!("| α | A walk | A = 1 − H(1)√(1−α) | ℓ_d | d | r50 walk / Burley | r90 walk / Burley | max cdf gap | point light: R walk / model | exitance L1 gap |");
+    println!(
+        "| α | A walk | A = 1 − H(1)√(1−α) | ℓ_d | d | r50 walk / Burley | r90 walk / Burley | max cdf gap | point light: R walk / model | exitance L1 gap |"
+    );
     println!("|---|---|---|---|---|---|---|---|---|---|");
     for alpha in [0.9, 0.99, 0.999] {
         let medium = Medium::unit(alpha);
@@ -33,11 +40,14 @@ fn main() {
             lo
         };
         let walk_cdf = |r: f64| walk.cdf(r);
-        let gap = (1..2000).map(|k| (walk.cdf(k as f64 * width) - cdf(k as f64 * width, d)).abs()).fold(0.0, f64::max);
+        let gap = (1..2000)
+            .map(|k| (walk.cdf(k as f64 * width) - cdf(k as f64 * width, d)).abs())
+            .fold(0.0, f64::max);
         let h = ld;
         let lit = point_light(&medium, h, paths, 1, width * 4.0, 500);
         let model = point_light_burley(a, d, h, paths, 2, width * 4.0, 500);
-        let l1: f64 = lit.bins.iter().zip(&model.bins).map(|(x, y)| (x - y).abs()).sum::<f64>() / lit.bins.iter().sum::<f64>();
+        let l1: f64 = lit.bins.iter().zip(&model.bins).map(|(x, y)| (x - y).abs()).sum::<f64>()
+            / lit.bins.iter().sum::<f64>();
         println!(
             "| {alpha} | {a:.4} ± {se:.4} | {:.4} | {ld:.3} | {d:.4} | {:.3} / {:.3} | {:.3} / {:.3} | {gap:.3} | {:.4} / {:.4} | {l1:.3} |",
             plane_albedo(alpha, 1.0),

@@ -22,18 +22,28 @@ const D_REL: [f32; 3] = [0.15, 0.08, 0.04];
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let arg = |i: usize, default: &str| args.get(i).cloned().unwrap_or_else(|| default.to_string());
-    let (width, height, frames): (u32, u32, u32) = (arg(0, "320").parse()?, arg(1, "180").parse()?, arg(2, "60").parse()?);
+    let (width, height, frames): (u32, u32, u32) =
+        (arg(0, "320").parse()?, arg(1, "180").parse()?, arg(2, "60").parse()?);
     let out = std::path::PathBuf::from(arg(3, "sss_table"));
-    let afis_a: Vec<f32> = arg(4, "0.0625").split(',').map(|a| a.parse()).collect::<Result<_, _>>()?;
+    let afis_a: Vec<f32> =
+        arg(4, "0.0625").split(',').map(|a| a.parse()).collect::<Result<_, _>>()?;
     std::fs::create_dir_all(&out)?;
     let gpu = Gpu::new()?;
     let measured = |t: u32| t >= 10 && t % 6 == 4;
-    let mut table = format!("{width}x{height}, {frames} frames, adapter {}\n\n| test | variant | mean spp | ms/frame | PSNR dB | SMAPE | reference SMAPE |\n|---|---|---|---|---|---|---|\n", gpu.adapter.get_info().name);
+    let mut table = format!(
+        "{width}x{height}, {frames} frames, adapter {}\n\n| test | variant | mean spp | ms/frame | PSNR dB | SMAPE | reference SMAPE |\n|---|---|---|---|---|---|---|\n",
+        gpu.adapter.get_info().name
+    );
     for test in [DynamicTest::Flash, DynamicTest::Toggle, DynamicTest::Boids] {
         // References, and the reference's own SMAPE between consecutive frames (the flicker the
         // lighting itself has).
         let mut reference_pass = SssPass::new(&gpu, width, height)?;
-        let reference_settings = SssSettings { variant: SssVariant::Fixed { count: 2048 }, fast_inverse: false, seed: 1000, ..Default::default() };
+        let reference_settings = SssSettings {
+            variant: SssVariant::Fixed { count: 2048 },
+            fast_inverse: false,
+            seed: 1000,
+            ..Default::default()
+        };
         let mut references = vec![None; frames as usize];
         let mut peak = 0.0f64;
         for t in (0..frames).filter(|&t| measured(t)) {
@@ -46,7 +56,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut ref_smape = Accumulator::default();
         for t in 0..frames {
             let f = frame(test, width, height, t, D_REL);
-            reference_pass.dispatch(&gpu, &f, &SssSettings { variant: SssVariant::Fixed { count: 128 }, ..reference_settings }, t)?;
+            reference_pass.dispatch(
+                &gpu,
+                &f,
+                &SssSettings { variant: SssVariant::Fixed { count: 128 }, ..reference_settings },
+                t,
+            )?;
             ref_smape.add(&f, reference_pass.results(&gpu)?, None);
         }
         let ref_smape = ref_smape.finish().smape;
@@ -57,7 +72,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ("fixed 64".into(), SssVariant::Fixed { count: 64 }, None),
         ];
         for &a in &afis_a {
-            variants.push((format!("AFIS a={a}"), SssVariant::Adaptive, Some(Prefilter { a, ..Default::default() })));
+            variants.push((
+                format!("AFIS a={a}"),
+                SssVariant::Adaptive,
+                Some(Prefilter { a, ..Default::default() }),
+            ));
         }
         variants.push(("separable".into(), SssVariant::Separable { taps: 25 }, None));
         for (name, variant, prefilter) in variants {
@@ -68,14 +87,36 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             for t in 0..frames {
                 let f = frame(test, width, height, t, D_REL);
                 ms += pass.dispatch(&gpu, &f, &settings, t)?.iter().map(|p| p.ms).sum::<f64>();
-                acc.add(&f, pass.results(&gpu)?, references[t as usize].as_deref().map(|r| (r, peak)));
+                acc.add(
+                    &f,
+                    pass.results(&gpu)?,
+                    references[t as usize].as_deref().map(|r| (r, peak)),
+                );
             }
             let m = acc.finish();
-            writeln!(table, "| {test:?} | {name} | {:.2} | {:.2} | {:.2} | {:.4} | {ref_smape:.4} |", m.mean_spp, ms / frames as f64, m.psnr_db, m.smape)?;
-            eprintln!("{test:?} {name}: {:.2} spp, {:.2} ms, {:.2} dB, SMAPE {:.4}", m.mean_spp, ms / frames as f64, m.psnr_db, m.smape);
+            writeln!(
+                table,
+                "| {test:?} | {name} | {:.2} | {:.2} | {:.2} | {:.4} | {ref_smape:.4} |",
+                m.mean_spp,
+                ms / frames as f64,
+                m.psnr_db,
+                m.smape
+            )?;
+            eprintln!(
+                "{test:?} {name}: {:.2} spp, {:.2} ms, {:.2} dB, SMAPE {:.4}",
+                m.mean_spp,
+                ms / frames as f64,
+                m.psnr_db,
+                m.smape
+            );
             let mut pgm = format!("P5\n{width} {height}\n255\n").into_bytes();
-            pgm.extend(m.count_image.iter().map(|c| (c / 64.0 * 255.0).round().clamp(0.0, 255.0) as u8));
-            std::fs::write(out.join(format!("counts_{test:?}_{}.pgm", name.replace([' ', '+', '='], "_"))), pgm)?;
+            pgm.extend(
+                m.count_image.iter().map(|c| (c / 64.0 * 255.0).round().clamp(0.0, 255.0) as u8),
+            );
+            std::fs::write(
+                out.join(format!("counts_{test:?}_{}.pgm", name.replace([' ', '+', '='], "_"))),
+                pgm,
+            )?;
         }
     }
     std::fs::write(out.join("table.md"), &table)?;

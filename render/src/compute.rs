@@ -65,7 +65,11 @@ pub fn declare(group: u32, bindings: &[BufferBinding]) -> String {
 }
 
 /// [`declare`] of `bindings[range]` only, each at its index in `bindings`.
-pub fn declare_range(group: u32, bindings: &[BufferBinding], range: std::ops::Range<usize>) -> String {
+pub fn declare_range(
+    group: u32,
+    bindings: &[BufferBinding],
+    range: std::ops::Range<usize>,
+) -> String {
     bindings
         .iter()
         .enumerate()
@@ -83,21 +87,38 @@ pub fn declare_range(group: u32, bindings: &[BufferBinding], range: std::ops::Ra
 
 /// A module importable as `path` that declares `bindings` as @group(`group`) ([`declare`]),
 /// importing each struct type they name from the module of `types` that declares it.
-pub fn group_module(path: &str, group: u32, bindings: &[BufferBinding], types: &[&Module]) -> Module {
+pub fn group_module(
+    path: &str,
+    group: u32,
+    bindings: &[BufferBinding],
+    types: &[&Module],
+) -> Module {
     group_module_range(path, group, bindings, 0..bindings.len(), types)
 }
 
 /// [`group_module`] of `bindings[range]` only, each at its index in `bindings`: a group split
 /// over two modules (a pass that shares another pass's uniform and the functions importing it).
-pub fn group_module_range(path: &str, group: u32, bindings: &[BufferBinding], range: std::ops::Range<usize>, types: &[&Module]) -> Module {
+pub fn group_module_range(
+    path: &str,
+    group: u32,
+    bindings: &[BufferBinding],
+    range: std::ops::Range<usize>,
+    types: &[&Module],
+) -> Module {
     let mut imports: Vec<(String, Vec<String>)> = Vec::new();
     for b in &bindings[range.clone()] {
         // `array<atomic<u32>>`, `array<SscSlot>`, `SscParams`: the struct names start upper case.
-        for name in b.wgsl_type.split(|c: char| !c.is_alphanumeric() && c != '_').filter(|w| w.starts_with(|c: char| c.is_ascii_uppercase())) {
-            let module = types
-                .iter()
-                .find(|m| m.declares_struct(name))
-                .unwrap_or_else(|| panic!("binding {} of {path}: no module among its types declares struct {name}", b.name));
+        for name in b
+            .wgsl_type
+            .split(|c: char| !c.is_alphanumeric() && c != '_')
+            .filter(|w| w.starts_with(|c: char| c.is_ascii_uppercase()))
+        {
+            let module = types.iter().find(|m| m.declares_struct(name)).unwrap_or_else(|| {
+                panic!(
+                    "binding {} of {path}: no module among its types declares struct {name}",
+                    b.name
+                )
+            });
             let from = &*module.path;
             match imports.iter_mut().find(|(p, _)| p == from) {
                 Some((_, names)) if names.iter().any(|n| n == name) => {}
@@ -106,7 +127,10 @@ pub fn group_module_range(path: &str, group: u32, bindings: &[BufferBinding], ra
             }
         }
     }
-    let imports: String = imports.iter().map(|(p, names)| format!("import {p}::{{{}}};\n", names.join(", "))).collect();
+    let imports: String = imports
+        .iter()
+        .map(|(p, names)| format!("import {p}::{{{}}};\n", names.join(", ")))
+        .collect();
     Module::generated(path, &[&imports, &declare_range(group, bindings, range)])
 }
 
@@ -116,8 +140,15 @@ pub fn binding_layout(gpu: &Gpu, label: &str, bindings: &[BufferBinding]) -> wgp
 }
 
 /// A bind group layout whose binding i is a buffer of kind `kinds[i]`, visible to compute.
-pub fn buffer_layout(gpu: &Gpu, label: &str, kinds: &[wgpu::BufferBindingType]) -> wgpu::BindGroupLayout {
-    gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &buffer_entries(kinds) })
+pub fn buffer_layout(
+    gpu: &Gpu,
+    label: &str,
+    kinds: &[wgpu::BufferBindingType],
+) -> wgpu::BindGroupLayout {
+    gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &buffer_entries(kinds),
+    })
 }
 
 /// Layout entries whose binding i is a buffer of kind `kinds[i]`, visible to compute.
@@ -135,9 +166,22 @@ pub fn buffer_entries(kinds: &[wgpu::BufferBindingType]) -> Vec<wgpu::BindGroupL
 }
 
 /// A bind group binding `buffers[i]` whole at binding i.
-pub fn buffer_group(gpu: &Gpu, label: &str, layout: &wgpu::BindGroupLayout, buffers: &[&wgpu::Buffer]) -> wgpu::BindGroup {
-    let entries: Vec<_> = buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
-    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+pub fn buffer_group(
+    gpu: &Gpu,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    let entries: Vec<_> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+        .collect();
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
 }
 
 /// The pipelines of `entries` in `program`'s entry-point files (named `pass` in errors), bound
@@ -151,33 +195,58 @@ pub fn pipelines<const N: usize>(
 ) -> Result<[wgpu::ComputePipeline; N], RenderError> {
     let device = &gpu.device;
     let layouts: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|&g| Some(g)).collect();
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(pass), bind_group_layouts: &layouts, immediate_size: 0 });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(pass),
+        bind_group_layouts: &layouts,
+        immediate_size: 0,
+    });
     validated(gpu, pass, program, Some(&layout), entries)
 }
 
 /// [`pipelines`] whose bind group layouts are derived from the shader (each entry point's own
 /// @group(0), fetched with `get_bind_group_layout`): for passes whose entry points bind
 /// different subsets of one module's buffers.
-pub fn pipelines_auto_layout<const N: usize>(gpu: &Gpu, pass: &str, program: &Program, entries: [&str; N]) -> Result<[wgpu::ComputePipeline; N], RenderError> {
+pub fn pipelines_auto_layout<const N: usize>(
+    gpu: &Gpu,
+    pass: &str,
+    program: &Program,
+    entries: [&str; N],
+) -> Result<[wgpu::ComputePipeline; N], RenderError> {
     validated(gpu, pass, program, None, entries)
 }
 
-fn validated<const N: usize>(gpu: &Gpu, pass: &str, program: &Program, layout: Option<&wgpu::PipelineLayout>, entries: [&str; N]) -> Result<[wgpu::ComputePipeline; N], RenderError> {
+fn validated<const N: usize>(
+    gpu: &Gpu,
+    pass: &str,
+    program: &Program,
+    layout: Option<&wgpu::PipelineLayout>,
+    entries: [&str; N],
+) -> Result<[wgpu::ComputePipeline; N], RenderError> {
     let linked = program.compose()?;
     // The file of each entry point.
     let mut file_of = [0usize; N];
     for (slot, entry) in file_of.iter_mut().zip(entries) {
-        *slot = linked
-            .iter()
-            .position(|wgsl| wgsl.contains(&format!("fn {entry}(")))
-            .ok_or_else(|| RenderError::Shader { pass: pass.into(), message: format!("no entry point '{entry}' in {:?}", program.entry_files.iter().map(|m| &m.file).collect::<Vec<_>>()) })?;
+        *slot = linked.iter().position(|wgsl| wgsl.contains(&format!("fn {entry}("))).ok_or_else(
+            || RenderError::Shader {
+                pass: pass.into(),
+                message: format!(
+                    "no entry point '{entry}' in {:?}",
+                    program.entry_files.iter().map(|m| &m.file).collect::<Vec<_>>()
+                ),
+            },
+        )?;
     }
     let device = &gpu.device;
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let modules: Vec<wgpu::ShaderModule> = linked
         .into_iter()
         .zip(&program.entry_files)
-        .map(|(wgsl, file)| device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(&file.file), source: wgpu::ShaderSource::Wgsl(wgsl.into()) }))
+        .map(|(wgsl, file)| {
+            device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(&file.file),
+                source: wgpu::ShaderSource::Wgsl(wgsl.into()),
+            })
+        })
         .collect();
     let mut i = 0;
     let made = entries.map(|entry| {

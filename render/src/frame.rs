@@ -20,13 +20,24 @@ impl CameraBasis {
         let forward = (camera.target - camera.position).normalize_or(Vec3::NEG_Z);
         let right = forward.cross(camera.up).normalize_or(Vec3::X);
         let up = right.cross(forward);
-        Self { position: camera.position, forward, right, up, tan_half_fov: (0.5 * camera.vfov).tan(), aspect: width as f32 / height as f32 }
+        Self {
+            position: camera.position,
+            forward,
+            right,
+            up,
+            tan_half_fov: (0.5 * camera.vfov).tan(),
+            aspect: width as f32 / height as f32,
+        }
     }
 
     /// Direction of the ray through image point `pixel` (x right, y down, pixel centres at +0.5).
     pub fn ray_direction(&self, pixel: Vec2, width: u32, height: u32) -> Vec3 {
-        let ndc = Vec2::new(2.0 * pixel.x / width as f32 - 1.0, 1.0 - 2.0 * pixel.y / height as f32);
-        (self.forward + ndc.x * self.tan_half_fov * self.aspect * self.right + ndc.y * self.tan_half_fov * self.up).normalize()
+        let ndc =
+            Vec2::new(2.0 * pixel.x / width as f32 - 1.0, 1.0 - 2.0 * pixel.y / height as f32);
+        (self.forward
+            + ndc.x * self.tan_half_fov * self.aspect * self.right
+            + ndc.y * self.tan_half_fov * self.up)
+            .normalize()
     }
 
     /// Image point of a world position, `None` behind the camera.
@@ -36,7 +47,10 @@ impl CameraBasis {
         if z <= 0.0 {
             return None;
         }
-        let ndc = Vec2::new(d.dot(self.right) / (z * self.tan_half_fov * self.aspect), d.dot(self.up) / (z * self.tan_half_fov));
+        let ndc = Vec2::new(
+            d.dot(self.right) / (z * self.tan_half_fov * self.aspect),
+            d.dot(self.up) / (z * self.tan_half_fov),
+        );
         Some(Vec2::new((0.5 * ndc.x + 0.5) * width as f32, (0.5 - 0.5 * ndc.y) * height as f32))
     }
 
@@ -148,7 +162,12 @@ mod tests {
 
     #[test]
     fn projection_inverts_ray_generation_and_matches_view_projection() {
-        let camera = Camera { position: Vec3::new(1.0, 2.0, 3.0), target: Vec3::new(-0.5, 0.3, 0.0), up: Vec3::Y, vfov: 0.9 };
+        let camera = Camera {
+            position: Vec3::new(1.0, 2.0, 3.0),
+            target: Vec3::new(-0.5, 0.3, 0.0),
+            up: Vec3::Y,
+            vfov: 0.9,
+        };
         let (w, h) = (64, 36);
         let b = CameraBasis::new(&camera, w, h);
         let clip = camera.projection(w as f32 / h as f32) * camera.view();
@@ -157,7 +176,8 @@ mod tests {
             assert!(b.project(p, w, h).unwrap().abs_diff_eq(pixel, 1e-3));
             // The same pixel through Camera::view/projection (NDC y up, image y down).
             let ndc = clip.project_point3(p);
-            let from_matrices = Vec2::new((ndc.x + 1.0) * 0.5 * w as f32, (1.0 - ndc.y) * 0.5 * h as f32);
+            let from_matrices =
+                Vec2::new((ndc.x + 1.0) * 0.5 * w as f32, (1.0 - ndc.y) * 0.5 * h as f32);
             assert!(from_matrices.abs_diff_eq(pixel, 1e-3), "{from_matrices} vs {pixel}");
         }
         assert!(b.project(camera.position - b.forward, w, h).is_none());

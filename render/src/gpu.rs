@@ -9,7 +9,9 @@ pub const WORKGROUP_MEMORY_BUDGET: u32 = 32 * 1024;
 
 #[derive(Debug, thiserror::Error)]
 pub enum GpuError {
-    #[error("no GPU adapter found (on a machine without a GPU install Mesa's lavapipe: `apt-get install mesa-vulkan-drivers libvulkan1`): {0}")]
+    #[error(
+        "no GPU adapter found (on a machine without a GPU install Mesa's lavapipe: `apt-get install mesa-vulkan-drivers libvulkan1`): {0}"
+    )]
     NoAdapter(String),
     #[error("the adapter '{adapter}' refused the device: {reason}")]
     Device { adapter: String, reason: String },
@@ -55,7 +57,8 @@ impl Gpu {
     }
 
     async fn new_async() -> Result<Self, GpuError> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = match wgpu::util::initialize_adapter_from_env(&instance, None).await {
             Ok(adapter) => adapter,
             Err(_) => instance
@@ -77,7 +80,8 @@ impl Gpu {
             device_type: format!("{:?}", info.device_type),
         };
         // Timestamps are optional: passes report no GPU time where the adapter has none.
-        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let wanted =
+            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let features = adapter.features() & wanted;
         let limits = adapter.limits();
         let (device, queue) = adapter
@@ -90,7 +94,10 @@ impl Gpu {
                 trace: wgpu::Trace::Off,
             })
             .await
-            .map_err(|e| GpuError::Device { adapter: summary.name.clone(), reason: e.to_string() })?;
+            .map_err(|e| GpuError::Device {
+                adapter: summary.name.clone(),
+                reason: e.to_string(),
+            })?;
         Ok(Self { device, queue, adapter, summary, limits, features })
     }
 
@@ -105,14 +112,24 @@ impl Gpu {
 
     /// Refuses an image size the adapter cannot hold as a 2D texture or as a storage buffer of
     /// `bytes_per_pixel` per pixel.
-    pub fn check_resolution(&self, width: u32, height: u32, bytes_per_pixel: u64) -> Result<(), GpuError> {
+    pub fn check_resolution(
+        &self,
+        width: u32,
+        height: u32,
+        bytes_per_pixel: u64,
+    ) -> Result<(), GpuError> {
         let max_dim = self.limits.max_texture_dimension_2d;
         for (what, v) in [("image width", width), ("image height", height)] {
             if v > max_dim {
                 return Err(self.over(what, v as u64, max_dim as u64));
             }
             if v == 0 {
-                return Err(GpuError::OverLimit { what: what.into(), requested: 0, limit: max_dim as u64, adapter: format!("{} must be at least 1", what) });
+                return Err(GpuError::OverLimit {
+                    what: what.into(),
+                    requested: 0,
+                    limit: max_dim as u64,
+                    adapter: format!("{} must be at least 1", what),
+                });
             }
         }
         self.check_buffer_size("per-pixel buffer", width as u64 * height as u64 * bytes_per_pixel)
@@ -120,7 +137,8 @@ impl Gpu {
 
     /// Refuses a storage buffer larger than the adapter binds.
     pub fn check_buffer_size(&self, what: &str, bytes: u64) -> Result<(), GpuError> {
-        let limit = (self.limits.max_storage_buffer_binding_size as u64).min(self.limits.max_buffer_size);
+        let limit =
+            (self.limits.max_storage_buffer_binding_size as u64).min(self.limits.max_buffer_size);
         if bytes > limit {
             return Err(self.over(&format!("{what} size in bytes"), bytes, limit));
         }
@@ -140,7 +158,11 @@ impl Gpu {
     pub fn check_workgroup_memory(&self, pass: &str, bytes: u32) -> Result<(), GpuError> {
         let limit = self.workgroup_memory_budget();
         if bytes > limit {
-            return Err(self.over(&format!("workgroup memory of pass '{pass}'"), bytes as u64, limit as u64));
+            return Err(self.over(
+                &format!("workgroup memory of pass '{pass}'"),
+                bytes as u64,
+                limit as u64,
+            ));
         }
         Ok(())
     }
@@ -149,19 +171,29 @@ impl Gpu {
     /// known (llvmpipe); `None` on drivers without such a cap.
     pub fn loop_iteration_limit(&self) -> Option<u64> {
         let is_llvmpipe = |s: &str| s.to_ascii_lowercase().contains("llvmpipe");
-        (is_llvmpipe(&self.summary.name) || is_llvmpipe(&self.summary.driver)).then_some(LLVMPIPE_LOOP_ITERATIONS)
+        (is_llvmpipe(&self.summary.name) || is_llvmpipe(&self.summary.driver))
+            .then_some(LLVMPIPE_LOOP_ITERATIONS)
     }
 
     /// Refuses a pass whose invocations would run more loop iterations than the driver allows.
     pub fn check_loop_iterations(&self, pass: &str, iterations: u64) -> Result<(), GpuError> {
         match self.loop_iteration_limit() {
-            Some(limit) if iterations > limit => Err(self.over(&format!("loop iterations per invocation of pass '{pass}'"), iterations, limit)),
+            Some(limit) if iterations > limit => Err(self.over(
+                &format!("loop iterations per invocation of pass '{pass}'"),
+                iterations,
+                limit,
+            )),
             _ => Ok(()),
         }
     }
 
     fn over(&self, what: &str, requested: u64, limit: u64) -> GpuError {
-        GpuError::OverLimit { what: what.into(), requested, limit, adapter: self.summary.name.clone() }
+        GpuError::OverLimit {
+            what: what.into(),
+            requested,
+            limit,
+            adapter: self.summary.name.clone(),
+        }
     }
 }
 

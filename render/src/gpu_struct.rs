@@ -27,8 +27,12 @@ pub fn layout_mismatches<T: GpuStruct>(deps: &str) -> Vec<String> {
         return vec![format!("layout: {e}")];
     }
     let name = T::WGSL.split_whitespace().nth(1).unwrap_or("?");
-    let Some((_, ty)) = module.types.iter().find(|(_, t)| t.name.as_deref() == Some(name)) else { return vec![format!("{name} not declared")] };
-    let naga::TypeInner::Struct { members, span } = &ty.inner else { return vec![format!("{name} is not a struct")] };
+    let Some((_, ty)) = module.types.iter().find(|(_, t)| t.name.as_deref() == Some(name)) else {
+        return vec![format!("{name} not declared")];
+    };
+    let naga::TypeInner::Struct { members, span } = &ty.inner else {
+        return vec![format!("{name} is not a struct")];
+    };
     let rust = T::offsets();
     let mut out = Vec::new();
     if members.len() != rust.len() {
@@ -36,7 +40,10 @@ pub fn layout_mismatches<T: GpuStruct>(deps: &str) -> Vec<String> {
     }
     for (m, (field, offset)) in members.iter().zip(&rust) {
         if m.name.as_deref() != Some(*field) || m.offset as usize != *offset {
-            out.push(format!("{name}.{field}: Rust offset {offset}, WGSL {:?} at {}", m.name, m.offset));
+            out.push(format!(
+                "{name}.{field}: Rust offset {offset}, WGSL {:?} at {}",
+                m.name, m.offset
+            ));
         }
     }
     if *span as usize != size_of::<T>() {

@@ -2,25 +2,25 @@
 
 /// The plain-data scene (its own crate, shared with `sim`).
 pub use ::scene;
-pub mod gpu;
-pub mod gpu_struct;
-pub mod hash_cache;
 pub mod bvh;
 pub mod compute;
 pub mod error;
 pub mod frame;
+pub mod gpu;
+pub mod gpu_struct;
+pub mod hash_cache;
 pub mod lights;
 pub mod materials;
 pub mod pass_library;
 pub mod path_tracer;
 pub mod readback;
 pub mod sample_cache;
-pub mod shader;
 pub mod scene_bindings;
 pub mod scene_features;
+pub mod shader;
 pub mod sss;
 pub mod taa;
-pub mod texel_table;
 pub mod termination;
+pub mod texel_table;
 pub mod timing;
 pub mod wavefront;

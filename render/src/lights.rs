@@ -51,7 +51,8 @@ pub(crate) fn build_light_table(scene: &SceneDesc) -> Result<LightTable, RenderE
                 let r = angular_radius.clamp(0.0, std::f32::consts::FRAC_PI_2) as f64;
                 // 1 - cos r in a form that keeps precision for the sun's ~0.005 rad.
                 let one_minus_cos = 2.0 * (0.5 * r).sin().powi(2);
-                let disk = if r > 0.0 { 1.0 / (std::f64::consts::PI * r.sin().powi(2)) } else { 0.0 };
+                let disk =
+                    if r > 0.0 { 1.0 / (std::f64::consts::PI * r.sin().powi(2)) } else { 0.0 };
                 GpuLight {
                     kind: DIRECTIONAL,
                     p1: direction.normalize_or(Vec3::NEG_Y).to_array(),
@@ -61,9 +62,12 @@ pub(crate) fn build_light_table(scene: &SceneDesc) -> Result<LightTable, RenderE
                     ..Zeroable::zeroed()
                 }
             }
-            Light::Point { position, intensity } => {
-                GpuLight { kind: POINT, p0: position.to_array(), radiance: intensity.to_array(), ..Zeroable::zeroed() }
-            }
+            Light::Point { position, intensity } => GpuLight {
+                kind: POINT,
+                p0: position.to_array(),
+                radiance: intensity.to_array(),
+                ..Zeroable::zeroed()
+            },
             Light::Spot { position, direction, intensity, inner_angle, outer_angle } => GpuLight {
                 kind: SPOT,
                 p0: position.to_array(),
@@ -80,20 +84,33 @@ pub(crate) fn build_light_table(scene: &SceneDesc) -> Result<LightTable, RenderE
     let mut weights = Vec::new();
     for (i, inst) in scene.instances.iter().enumerate() {
         let Some(material) = scene.materials.get(inst.material as usize) else {
-            return Err(RenderError::Scene(format!("instance {i} uses material {}, but the scene has {} materials", inst.material, scene.materials.len())));
+            return Err(RenderError::Scene(format!(
+                "instance {i} uses material {}, but the scene has {} materials",
+                inst.material,
+                scene.materials.len()
+            )));
         };
         let le = material.emission;
         if !(luminance(le) > 0.0) {
             continue;
         }
         let Some(mesh) = scene.meshes.get(inst.mesh as usize) else {
-            return Err(RenderError::Scene(format!("instance {i} uses mesh {}, but the scene has {} meshes", inst.mesh, scene.meshes.len())));
+            return Err(RenderError::Scene(format!(
+                "instance {i} uses mesh {}, but the scene has {} meshes",
+                inst.mesh,
+                scene.meshes.len()
+            )));
         };
         for (t, tri) in mesh.indices.iter().enumerate() {
             let mut v = [Vec3::ZERO; 3];
             for k in 0..3 {
                 let p = mesh.positions.get(tri[k] as usize).ok_or_else(|| {
-                    RenderError::Scene(format!("mesh '{}' triangle {t} uses vertex {}, but it has {} positions", mesh.name, tri[k], mesh.positions.len()))
+                    RenderError::Scene(format!(
+                        "mesh '{}' triangle {t} uses vertex {}, but it has {} positions",
+                        mesh.name,
+                        tri[k],
+                        mesh.positions.len()
+                    ))
                 })?;
                 v[k] = inst.transform.transform_point3(*p);
             }
@@ -102,7 +119,14 @@ pub(crate) fn build_light_table(scene: &SceneDesc) -> Result<LightTable, RenderE
                 continue; // degenerate: never hit, never sampled
             }
             weights.push(luminance(le) as f64 * area as f64);
-            lights.push(GpuLight { kind: TRIANGLE, p0: v[0].to_array(), p1: v[1].to_array(), p2: v[2].to_array(), radiance: le.to_array(), ..Zeroable::zeroed() });
+            lights.push(GpuLight {
+                kind: TRIANGLE,
+                p0: v[0].to_array(),
+                p1: v[1].to_array(),
+                p2: v[2].to_array(),
+                radiance: le.to_array(),
+                ..Zeroable::zeroed()
+            });
         }
     }
     let total: f64 = weights.iter().sum();
@@ -110,7 +134,8 @@ pub(crate) fn build_light_table(scene: &SceneDesc) -> Result<LightTable, RenderE
     let emitters = weights.len();
     for (k, w) in weights.iter().enumerate() {
         running += w;
-        lights[analytic as usize + k].cdf = if k + 1 == emitters { 1.0 } else { (running / total) as f32 };
+        lights[analytic as usize + k].cdf =
+            if k + 1 == emitters { 1.0 } else { (running / total) as f32 };
     }
     if lights.is_empty() {
         lights.push(GpuLight::zeroed()); // storage buffers may not be empty
@@ -125,7 +150,12 @@ mod tests {
     use glam::Mat4;
 
     fn triangle_mesh() -> Mesh {
-        Mesh { name: "tri".into(), positions: vec![Vec3::ZERO, Vec3::X, Vec3::Z], indices: vec![[0, 1, 2]], ..Default::default() }
+        Mesh {
+            name: "tri".into(),
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Z],
+            indices: vec![[0, 1, 2]],
+            ..Default::default()
+        }
     }
 
     #[test]
@@ -140,7 +170,11 @@ mod tests {
             ],
             instances: vec![
                 Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY },
-                Instance { mesh: 0, material: 1, transform: Mat4::from_scale(Vec3::new(3.0, 1.0, 1.0)) },
+                Instance {
+                    mesh: 0,
+                    material: 1,
+                    transform: Mat4::from_scale(Vec3::new(3.0, 1.0, 1.0)),
+                },
                 Instance { mesh: 0, material: 2, transform: Mat4::IDENTITY },
             ],
             lights: vec![Light::Point { position: Vec3::Y, intensity: Vec3::ONE }],
@@ -159,7 +193,14 @@ mod tests {
     #[test]
     fn sun_cone_constants_keep_precision() {
         let r = 0.00465f32;
-        let scene = SceneDesc { lights: vec![Light::Directional { direction: Vec3::NEG_Y, irradiance: Vec3::ONE, angular_radius: r }], ..Default::default() };
+        let scene = SceneDesc {
+            lights: vec![Light::Directional {
+                direction: Vec3::NEG_Y,
+                irradiance: Vec3::ONE,
+                angular_radius: r,
+            }],
+            ..Default::default()
+        };
         let l = build_light_table(&scene).unwrap().lights[0];
         let one_minus_cos = 1.0 - (r as f64).cos();
         assert!((l.a as f64 / one_minus_cos - 1.0).abs() < 1e-5);

@@ -27,7 +27,9 @@ const _: () = assert!(size_of::<GpuMaterial>() == 48);
 
 /// Packs the materials and the texture atlas; refuses dangling texture indices and texel
 /// arrays that do not match their size.
-pub(crate) fn pack_materials(scene: &SceneDesc) -> Result<(Vec<GpuMaterial>, Vec<u32>), RenderError> {
+pub(crate) fn pack_materials(
+    scene: &SceneDesc,
+) -> Result<(Vec<GpuMaterial>, Vec<u32>), RenderError> {
     let mut offsets = Vec::with_capacity(scene.textures.len());
     let mut texels: Vec<u32> = Vec::new();
     for (i, t) in scene.textures.iter().enumerate() {
@@ -42,7 +44,8 @@ pub(crate) fn pack_materials(scene: &SceneDesc) -> Result<(Vec<GpuMaterial>, Vec
             )));
         }
         offsets.push(texels.len() as u32);
-        texels.extend(t.rgba8.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])));
+        texels
+            .extend(t.rgba8.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])));
     }
     if texels.is_empty() {
         texels.push(0); // storage buffers may not be empty
@@ -53,7 +56,10 @@ pub(crate) fn pack_materials(scene: &SceneDesc) -> Result<(Vec<GpuMaterial>, Vec
             None => (NO_TEXTURE, 0, 0),
             Some(t) => {
                 let tex = scene.textures.get(t as usize).ok_or_else(|| {
-                    RenderError::Scene(format!("material {i} uses base-colour texture {t}, but the scene has {} textures", scene.textures.len()))
+                    RenderError::Scene(format!(
+                        "material {i} uses base-colour texture {t}, but the scene has {} textures",
+                        scene.textures.len()
+                    ))
                 })?;
                 (offsets[t as usize], tex.width, tex.height)
             }

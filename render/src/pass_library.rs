@@ -9,22 +9,24 @@ use std::sync::{Arc, Mutex};
 
 use crate::bvh::SceneGeometry;
 use crate::compute::{self, BufferBinding};
+use crate::error::RenderError;
 use crate::frame::{CameraFrame, Frame};
+use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
 use crate::lights::GpuLight;
 use crate::materials::GpuMaterial;
-use crate::error::RenderError;
-use crate::gpu::Gpu;
-use crate::scene_features::SceneFeatures;
 use crate::scene_bindings::SceneBindings;
+use crate::scene_features::SceneFeatures;
 use crate::shader::{Module, Program};
 
 /// Storage buffers a pass built on the library binds before its own: @group(0) (scene) and
 /// @group(1) (geometry). Add the pass's own to check the adapter limit.
-pub const LIBRARY_STORAGE_BUFFERS: u32 = crate::scene_bindings::STORAGE_BUFFERS + SceneGeometry::STORAGE_BUFFERS;
+pub const LIBRARY_STORAGE_BUFFERS: u32 =
+    crate::scene_bindings::STORAGE_BUFFERS + SceneGeometry::STORAGE_BUFFERS;
 
 /// Texel tables (read-only storage textures) of the same two groups.
-pub const LIBRARY_TEXEL_TABLES: u32 = crate::scene_bindings::TABLES.len() as u32 + SceneGeometry::TEXEL_TABLES;
+pub const LIBRARY_TEXEL_TABLES: u32 =
+    crate::scene_bindings::TABLES.len() as u32 + SceneGeometry::TEXEL_TABLES;
 
 /// A pipeline of the library, compiled for the features the scene has now. Fetch it with
 /// [`Self::get`] each time a pass is recorded: [`PassLibrary::specialise`] replaces it when the
@@ -45,7 +47,10 @@ impl PartialEq for LibraryPipeline {
     }
 }
 
-type Compile = Box<dyn Fn(&Gpu, &SceneBindings, SceneFeatures) -> Result<Vec<wgpu::ComputePipeline>, RenderError> + Send>;
+type Compile = Box<
+    dyn Fn(&Gpu, &SceneBindings, SceneFeatures) -> Result<Vec<wgpu::ComputePipeline>, RenderError>
+        + Send,
+>;
 
 /// One pass built on the library: its own group's layout, its pipelines as the methods hold
 /// them, and how to compile them for other features.
@@ -82,7 +87,12 @@ impl PassLibrary {
     /// swaps the pipelines the methods hold; later passes are built for `features`. Call when
     /// the scene's features change; a no-op otherwise. Every pass is compiled before any is
     /// swapped, so a failed compilation leaves all of them as they were.
-    pub fn specialise(&self, gpu: &Gpu, scene: &SceneBindings, features: SceneFeatures) -> Result<(), RenderError> {
+    pub fn specialise(
+        &self,
+        gpu: &Gpu,
+        scene: &SceneBindings,
+        features: SceneFeatures,
+    ) -> Result<(), RenderError> {
         let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
         if state.features == features {
             return Ok(());
@@ -109,8 +119,17 @@ impl PassLibrary {
     pub fn modules() -> &'static [Module] {
         static MODULES: std::sync::OnceLock<Vec<Module>> = std::sync::OnceLock::new();
         MODULES.get_or_init(|| {
-            let types = Module::generated("package::scene_types", &[CameraFrame::WGSL, Frame::WGSL, GpuMaterial::WGSL, GpuLight::WGSL]);
-            let bindings = crate::texel_table::group_module("package::scene_bindings", 0, &crate::scene_bindings::GROUP, &crate::scene_bindings::TABLES, &[&types]);
+            let types = Module::generated(
+                "package::scene_types",
+                &[CameraFrame::WGSL, Frame::WGSL, GpuMaterial::WGSL, GpuLight::WGSL],
+            );
+            let bindings = crate::texel_table::group_module(
+                "package::scene_bindings",
+                0,
+                &crate::scene_bindings::GROUP,
+                &crate::scene_bindings::TABLES,
+                &[&types],
+            );
             let mut modules = vec![types, bindings];
             modules.extend(SceneGeometry::modules());
             modules.extend([
@@ -127,7 +146,10 @@ impl PassLibrary {
 
     /// A program on the library: its modules, then `own` (the pass's structs, bindings and
     /// files it imports), with the pass's entry-point files.
-    pub fn program(own: impl IntoIterator<Item = Module>, entry_files: impl IntoIterator<Item = Module>) -> Program {
+    pub fn program(
+        own: impl IntoIterator<Item = Module>,
+        entry_files: impl IntoIterator<Item = Module>,
+    ) -> Program {
         let mut program = Program::new(Self::modules().to_vec()).with(own);
         program.entry_files.extend(entry_files);
         program
@@ -135,15 +157,31 @@ impl PassLibrary {
 
     /// Refuses a pass whose own group `own`, with the library's groups, binds more storage
     /// buffers, or the library more storage textures, than the adapter allows per stage.
-    pub fn check_storage_bindings(gpu: &Gpu, pass: &str, own: &[BufferBinding]) -> Result<(), RenderError> {
+    pub fn check_storage_bindings(
+        gpu: &Gpu,
+        pass: &str,
+        own: &[BufferBinding],
+    ) -> Result<(), RenderError> {
         let needed = LIBRARY_STORAGE_BUFFERS + compute::storage_buffers(own);
         let limit = gpu.limits.max_storage_buffers_per_shader_stage;
         if needed > limit {
-            return Err(crate::gpu::GpuError::OverLimit { what: format!("storage buffers of pass '{pass}'"), requested: needed as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
+            return Err(crate::gpu::GpuError::OverLimit {
+                what: format!("storage buffers of pass '{pass}'"),
+                requested: needed as u64,
+                limit: limit as u64,
+                adapter: gpu.summary.name.clone(),
+            }
+            .into());
         }
         let limit = gpu.limits.max_storage_textures_per_shader_stage;
         if LIBRARY_TEXEL_TABLES > limit {
-            return Err(crate::gpu::GpuError::OverLimit { what: format!("storage textures (texel tables) of pass '{pass}'"), requested: LIBRARY_TEXEL_TABLES as u64, limit: limit as u64, adapter: gpu.summary.name.clone() }.into());
+            return Err(crate::gpu::GpuError::OverLimit {
+                what: format!("storage textures (texel tables) of pass '{pass}'"),
+                requested: LIBRARY_TEXEL_TABLES as u64,
+                limit: limit as u64,
+                adapter: gpu.summary.name.clone(),
+            }
+            .into());
         }
         Ok(())
     }
@@ -179,18 +217,36 @@ impl PassLibrary {
         }
         let layout = compute::binding_layout(gpu, pass, own);
         let compile: Compile = {
-            let (name, program, layout, entries) = (pass.to_string(), program.clone(), layout.clone(), entries.map(String::from));
+            let (name, program, layout, entries) =
+                (pass.to_string(), program.clone(), layout.clone(), entries.map(String::from));
             Box::new(move |gpu: &Gpu, scene: &SceneBindings, features: SceneFeatures| {
                 let specialised = program.replacing(&features.module());
                 let groups = [scene.layout(), scene.geometry().bind_group_layout(), &layout];
-                Ok(compute::pipelines(gpu, &name, &specialised, &groups, entries.each_ref().map(String::as_str))?.to_vec())
+                Ok(compute::pipelines(
+                    gpu,
+                    &name,
+                    &specialised,
+                    &groups,
+                    entries.each_ref().map(String::as_str),
+                )?
+                .to_vec())
             })
         };
         let features = state.features;
         let compiled = compile(gpu, scene, features)?;
-        let pipelines: Vec<LibraryPipeline> = compiled.iter().map(|p| LibraryPipeline(Arc::new(Mutex::new(p.clone())))).collect();
-        let held = <[LibraryPipeline; N]>::try_from(pipelines.clone()).unwrap_or_else(|_| unreachable!("one pipeline per entry point"));
-        state.passes.insert(key, Pass { layout: layout.clone(), pipelines, compile, variants: HashMap::from([(features, compiled)]) });
+        let pipelines: Vec<LibraryPipeline> =
+            compiled.iter().map(|p| LibraryPipeline(Arc::new(Mutex::new(p.clone())))).collect();
+        let held = <[LibraryPipeline; N]>::try_from(pipelines.clone())
+            .unwrap_or_else(|_| unreachable!("one pipeline per entry point"));
+        state.passes.insert(
+            key,
+            Pass {
+                layout: layout.clone(),
+                pipelines,
+                compile,
+                variants: HashMap::from([(features, compiled)]),
+            },
+        );
         Ok((layout, held))
     }
 }

@@ -125,9 +125,15 @@ pub struct PathTracer {
 }
 
 impl PathTracer {
-    pub fn new(gpu: &Gpu, scene: &SceneDesc, settings: PathTracerSettings) -> Result<Self, RenderError> {
+    pub fn new(
+        gpu: &Gpu,
+        scene: &SceneDesc,
+        settings: PathTracerSettings,
+    ) -> Result<Self, RenderError> {
         if settings.max_depth == 0 {
-            return Err(RenderError::Settings("max_depth must be at least 1 (1 = direct lighting)".into()));
+            return Err(RenderError::Settings(
+                "max_depth must be at least 1 (1 = direct lighting)".into(),
+            ));
         }
         gpu.check_resolution(settings.width, settings.height, BYTES_PER_PIXEL)?;
         // Before the scene is uploaded; `PassLibrary::pass` checks again when it builds the pass.
@@ -139,7 +145,12 @@ impl PathTracer {
         let device = &gpu.device;
         let pixels = settings.width as u64 * settings.height as u64;
         let per_pixel = |label: &str, size: u64, usage: wgpu::BufferUsages| {
-            device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
         };
         let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
         let readback = wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST;
@@ -150,14 +161,34 @@ impl PathTracer {
         let radiance_readback = per_pixel("radiance readback", radiance_size, readback);
         let gbuffer_readback = per_pixel("gbuffer readback", gbuffer_size, readback);
         let max_chunks = MAX_CHUNKS.min(gpu.limits.max_compute_workgroups_per_dimension);
-        let sample_partials = Self::partials_buffer(gpu, pixels, Self::chunks_for(PATHS_PER_DISPATCH, pixels, max_chunks))?;
-        let counters = per_pixel("path tracer ray counter", COUNTER_WORDS * 4, rw | wgpu::BufferUsages::COPY_DST);
-        let counters_readback = per_pixel("path tracer ray counter readback", COUNTER_WORDS * 4, readback);
+        let sample_partials = Self::partials_buffer(
+            gpu,
+            pixels,
+            Self::chunks_for(PATHS_PER_DISPATCH, pixels, max_chunks),
+        )?;
+        let counters = per_pixel(
+            "path tracer ray counter",
+            COUNTER_WORDS * 4,
+            rw | wgpu::BufferUsages::COPY_DST,
+        );
+        let counters_readback =
+            per_pixel("path tracer ray counter readback", COUNTER_WORDS * 4, readback);
 
         let library = PassLibrary::new(scene.features());
-        let (layout, [trace_pipeline, gbuffer_pipeline, accumulate_pipeline]) =
-            library.pass(gpu, &scene, "path_tracer.wgsl", Self::program(), &OWN_GROUP, ["trace_main", "gbuffer_main", "accumulate_main"])?;
-        let bind_group = compute::buffer_group(gpu, "path tracer", &layout, &[&radiance_sum, &gbuffer, &sample_partials, &counters]);
+        let (layout, [trace_pipeline, gbuffer_pipeline, accumulate_pipeline]) = library.pass(
+            gpu,
+            &scene,
+            "path_tracer.wgsl",
+            Self::program(),
+            &OWN_GROUP,
+            ["trace_main", "gbuffer_main", "accumulate_main"],
+        )?;
+        let bind_group = compute::buffer_group(
+            gpu,
+            "path tracer",
+            &layout,
+            &[&radiance_sum, &gbuffer, &sample_partials, &counters],
+        );
         Ok(Self {
             settings,
             scene,
@@ -194,8 +225,15 @@ impl PathTracer {
     pub fn program() -> &'static Program {
         static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
         PROGRAM.get_or_init(|| {
-            let types = Module::generated("package::path_tracer_types", &[GBufferTexel::WGSL, &format!("const SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;")]);
-            let bindings = compute::group_module("package::path_tracer_bindings", 2, &OWN_GROUP, &[&types]);
+            let types = Module::generated(
+                "package::path_tracer_types",
+                &[
+                    GBufferTexel::WGSL,
+                    &format!("const SAMPLES_PER_THREAD: u32 = {SAMPLES_PER_THREAD}u;"),
+                ],
+            );
+            let bindings =
+                compute::group_module("package::path_tracer_bindings", 2, &OWN_GROUP, &[&types]);
             PassLibrary::program([types, bindings], [crate::wgsl_file!("path_tracer.wgsl")])
         })
     }
@@ -208,7 +246,12 @@ impl PathTracer {
 
     /// Group 2 over the current buffers, after one of them was replaced.
     fn rebind(&mut self, gpu: &Gpu) {
-        self.bind_group = compute::buffer_group(gpu, "path tracer", &self.layout, &[&self.radiance_sum, &self.gbuffer, &self.sample_partials, &self.counters]);
+        self.bind_group = compute::buffer_group(
+            gpu,
+            "path tracer",
+            &self.layout,
+            &[&self.radiance_sum, &self.gbuffer, &self.sample_partials, &self.counters],
+        );
     }
 
     /// [`PassLibrary::pass`] on this run's scene bindings.
@@ -269,13 +312,24 @@ impl PathTracer {
     /// [`Self::try_update`] uploading only what `changes` names ([`SceneBindings::update_changed`]).
     /// When the scene gains or loses a feature (a kind of light, textures), every pass of the
     /// library is compiled again for its features ([`PassLibrary::specialise`]).
-    pub fn update_changed(&mut self, gpu: &Gpu, scene: &SceneDesc, changes: SceneChanges) -> Result<(), RenderError> {
+    pub fn update_changed(
+        &mut self,
+        gpu: &Gpu,
+        scene: &SceneDesc,
+        changes: SceneChanges,
+    ) -> Result<(), RenderError> {
         self.scene.update_changed(gpu, scene, changes)?;
         self.library.specialise(gpu, &self.scene, self.scene.features())
     }
 
     /// One frame: G-buffer of the pixel-centre rays, then `spp` jittered paths per pixel.
-    pub fn render(&mut self, gpu: &Gpu, spp: u32, seed: u64, frame: u32) -> Result<FrameOutput, RenderError> {
+    pub fn render(
+        &mut self,
+        gpu: &Gpu,
+        spp: u32,
+        seed: u64,
+        frame: u32,
+    ) -> Result<FrameOutput, RenderError> {
         if spp == 0 {
             return Err(RenderError::Settings("spp must be at least 1".into()));
         }
@@ -288,7 +342,11 @@ impl PathTracer {
             pass.set_bind_group(0, self.scene.bind_group(), &[]);
             pass.set_bind_group(1, self.scene.geometry().bind_group(), &[]);
             pass.set_bind_group(2, &self.bind_group, &[]);
-            pass.dispatch_workgroups(self.settings.width.div_ceil(WORKGROUP), self.settings.height.div_ceil(WORKGROUP), 1);
+            pass.dispatch_workgroups(
+                self.settings.width.div_ceil(WORKGROUP),
+                self.settings.height.div_ceil(WORKGROUP),
+                1,
+            );
         })?;
         let mut timings = timed.submit()?;
 
@@ -299,13 +357,28 @@ impl PathTracer {
         let gbuffer = self.read_gbuffer(gpu)?;
         let rays = self.read_rays(gpu)?;
         let shaded = self.settings.width as u64 * self.settings.height as u64 * spp as u64;
-        Ok(FrameOutput { width: self.settings.width, height: self.settings.height, radiance, gbuffer, timings, rays, shaded })
+        Ok(FrameOutput {
+            width: self.settings.width,
+            height: self.settings.height,
+            radiance,
+            gbuffer,
+            timings,
+            rays,
+            shaded,
+        })
     }
 
     /// The current scene accumulated to `spp` samples per pixel in batches of at most
     /// [`PATHS_PER_DISPATCH`] paths, one submission each; `progress(done_spp, total_spp)` after
     /// every batch. Radiance only (no G-buffer).
-    pub fn render_reference(&mut self, gpu: &Gpu, spp: u32, seed: u64, frame: u32, progress: &mut dyn FnMut(u32, u32)) -> Result<Vec<[f32; 4]>, RenderError> {
+    pub fn render_reference(
+        &mut self,
+        gpu: &Gpu,
+        spp: u32,
+        seed: u64,
+        frame: u32,
+        progress: &mut dyn FnMut(u32, u32),
+    ) -> Result<Vec<[f32; 4]>, RenderError> {
         if spp == 0 {
             return Err(RenderError::Settings("reference spp must be at least 1".into()));
         }
@@ -350,7 +423,14 @@ impl PathTracer {
     }
 
     /// Traces `spp` samples into the radiance sum; returns the summed time of the batches.
-    fn trace_batches(&self, gpu: &Gpu, spp: u32, seed: u64, frame: u32, progress: &mut dyn FnMut(u32, u32)) -> Result<Vec<PassTiming>, RenderError> {
+    fn trace_batches(
+        &self,
+        gpu: &Gpu,
+        spp: u32,
+        seed: u64,
+        frame: u32,
+        progress: &mut dyn FnMut(u32, u32),
+    ) -> Result<Vec<PassTiming>, RenderError> {
         let per_dispatch = self.samples_per_dispatch();
         let mut done = 0;
         let mut timings = Vec::new();
@@ -359,7 +439,10 @@ impl PathTracer {
             self.scene.write_frame(gpu, batch, done, seed, frame, done > 0);
             let mut timed = self.timer.begin(gpu, "path trace");
             timed.pass(1, |pass| {
-                let (x, y) = (self.settings.width.div_ceil(WORKGROUP), self.settings.height.div_ceil(WORKGROUP));
+                let (x, y) = (
+                    self.settings.width.div_ceil(WORKGROUP),
+                    self.settings.height.div_ceil(WORKGROUP),
+                );
                 pass.set_bind_group(0, self.scene.bind_group(), &[]);
                 pass.set_bind_group(1, self.scene.geometry().bind_group(), &[]);
                 pass.set_bind_group(2, &self.bind_group, &[]);
@@ -377,10 +460,19 @@ impl PathTracer {
 
     /// Rays the passes since the last clear traced (the frame's G-buffer and paths).
     fn read_rays(&self, gpu: &Gpu) -> Result<u64, RenderError> {
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ray counter readback") });
-        encoder.copy_buffer_to_buffer(&self.counters, 0, &self.counters_readback, 0, COUNTER_WORDS * 4);
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("ray counter readback"),
+        });
+        encoder.copy_buffer_to_buffer(
+            &self.counters,
+            0,
+            &self.counters_readback,
+            0,
+            COUNTER_WORDS * 4,
+        );
         gpu.queue.submit([encoder.finish()]);
-        let words: Vec<u32> = read_buffer(gpu, &self.counters_readback).map_err(|reason| RenderError::Readback { what: "ray counter".into(), reason })?;
+        let words: Vec<u32> = read_buffer(gpu, &self.counters_readback)
+            .map_err(|reason| RenderError::Readback { what: "ray counter".into(), reason })?;
         Ok(words[0] as u64)
     }
 
@@ -400,19 +492,46 @@ impl PathTracer {
     }
 
     fn read_radiance(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, RenderError> {
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("radiance readback") });
-        encoder.copy_buffer_to_buffer(&self.radiance_sum, 0, &self.radiance_readback, 0, self.radiance_sum.size());
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("radiance readback"),
+        });
+        encoder.copy_buffer_to_buffer(
+            &self.radiance_sum,
+            0,
+            &self.radiance_readback,
+            0,
+            self.radiance_sum.size(),
+        );
         gpu.queue.submit([encoder.finish()]);
-        let sums: Vec<[f32; 4]> = read_buffer(gpu, &self.radiance_readback).map_err(|reason| RenderError::Readback { what: "radiance".into(), reason })?;
+        let sums: Vec<[f32; 4]> = read_buffer(gpu, &self.radiance_readback)
+            .map_err(|reason| RenderError::Readback { what: "radiance".into(), reason })?;
         // w holds the sample count: the mean is sum / count.
-        Ok(sums.into_iter().map(|s| if s[3] > 0.0 { [s[0] / s[3], s[1] / s[3], s[2] / s[3], 1.0] } else { [0.0, 0.0, 0.0, 1.0] }).collect())
+        Ok(sums
+            .into_iter()
+            .map(|s| {
+                if s[3] > 0.0 {
+                    [s[0] / s[3], s[1] / s[3], s[2] / s[3], 1.0]
+                } else {
+                    [0.0, 0.0, 0.0, 1.0]
+                }
+            })
+            .collect())
     }
 
     fn read_gbuffer(&self, gpu: &Gpu) -> Result<GBuffer, RenderError> {
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("gbuffer readback") });
-        encoder.copy_buffer_to_buffer(&self.gbuffer, 0, &self.gbuffer_readback, 0, self.gbuffer.size());
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("gbuffer readback"),
+        });
+        encoder.copy_buffer_to_buffer(
+            &self.gbuffer,
+            0,
+            &self.gbuffer_readback,
+            0,
+            self.gbuffer.size(),
+        );
         gpu.queue.submit([encoder.finish()]);
-        let texels: Vec<GBufferTexel> = read_buffer(gpu, &self.gbuffer_readback).map_err(|reason| RenderError::Readback { what: "gbuffer".into(), reason })?;
+        let texels: Vec<GBufferTexel> = read_buffer(gpu, &self.gbuffer_readback)
+            .map_err(|reason| RenderError::Readback { what: "gbuffer".into(), reason })?;
         let mut g = GBuffer::default();
         for t in texels {
             g.depth.push(if t.instance == NO_HIT { f32::INFINITY } else { t.depth });

@@ -9,17 +9,17 @@ use crate::compute::{self, BufferBinding};
 use crate::error::RenderError;
 use crate::frame::{CameraBasis, Frame, FrameParams};
 use crate::gpu::Gpu;
-use crate::scene_features::SceneFeatures;
 use crate::lights::{LightTable, build_light_table};
 use crate::materials::{GpuMaterial, NO_TEXTURE, pack_materials};
-use crate::texel_table::TexelTable;
 use crate::scene::{Camera, SceneChanges, SceneDesc};
+use crate::scene_features::SceneFeatures;
+use crate::texel_table::TexelTable;
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-
 /// @group(0)'s buffers: frame uniform, texels (declared into the library's WGSL).
-pub const GROUP: [BufferBinding; 2] = [BufferBinding::uniform("frame", "Frame"), BufferBinding::read("texels", "array<u32>")];
+pub const GROUP: [BufferBinding; 2] =
+    [BufferBinding::uniform("frame", "Frame"), BufferBinding::read("texels", "array<u32>")];
 /// Its texel tables after the buffers: `GpuMaterial`s (3 texels) and `GpuLight`s (4 texels),
 /// read through scene_tables.wgsl.
 pub const TABLES: [&str; 2] = ["material_table", "light_table"];
@@ -67,7 +67,11 @@ pub struct SceneBindings {
 }
 
 impl SceneBindings {
-    pub fn new(gpu: &Gpu, scene: &SceneDesc, settings: PathTracerSettings) -> Result<Self, RenderError> {
+    pub fn new(
+        gpu: &Gpu,
+        scene: &SceneDesc,
+        settings: PathTracerSettings,
+    ) -> Result<Self, RenderError> {
         let geometry = SceneGeometry::new(gpu, scene)?;
         let (materials_cpu, texels) = pack_materials(scene)?;
         let light_table = build_light_table(scene)?;
@@ -80,9 +84,21 @@ impl SceneBindings {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             }))
         };
-        let materials = TexelTable::new(gpu, "materials", MATERIAL_TEXELS, bytemuck::cast_slice(&materials_cpu), 0)?;
+        let materials = TexelTable::new(
+            gpu,
+            "materials",
+            MATERIAL_TEXELS,
+            bytemuck::cast_slice(&materials_cpu),
+            0,
+        )?;
         let texels = storage("base-colour texels", bytemuck::cast_slice(&texels))?;
-        let lights = TexelTable::new(gpu, "lights", LIGHT_TEXELS, bytemuck::cast_slice(&light_table.lights), 0)?;
+        let lights = TexelTable::new(
+            gpu,
+            "lights",
+            LIGHT_TEXELS,
+            bytemuck::cast_slice(&light_table.lights),
+            0,
+        )?;
         let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame uniform"),
             size: size_of::<Frame>() as u64,
@@ -114,9 +130,18 @@ impl SceneBindings {
     /// table when lights, instances (emissive triangles follow them) or materials changed.
     /// Instance transforms and the camera are taken every frame: they become the previous ones
     /// of motion vectors.
-    pub fn update_changed(&mut self, gpu: &Gpu, scene: &SceneDesc, changes: SceneChanges) -> Result<(), RenderError> {
-        let materials = (changes.materials || changes.geometry).then(|| pack_materials(scene)).transpose()?;
-        let light_table = (changes.lights || changes.instances || changes.materials || changes.geometry).then(|| build_light_table(scene)).transpose()?;
+    pub fn update_changed(
+        &mut self,
+        gpu: &Gpu,
+        scene: &SceneDesc,
+        changes: SceneChanges,
+    ) -> Result<(), RenderError> {
+        let materials =
+            (changes.materials || changes.geometry).then(|| pack_materials(scene)).transpose()?;
+        let light_table =
+            (changes.lights || changes.instances || changes.materials || changes.geometry)
+                .then(|| build_light_table(scene))
+                .transpose()?;
         self.geometry.try_update_instances(gpu, &scene.instances)?;
         self.traversal_stack = self.traversal_stack.max(self.geometry.stack_entries());
         let mut rebind = false;
@@ -143,7 +168,14 @@ impl SceneBindings {
             }
         }
         if rebind {
-            self.bind_group = bind_group(gpu, &self.layout, &self.frame_buffer, &self.texels, &self.materials, &self.lights);
+            self.bind_group = bind_group(
+                gpu,
+                &self.layout,
+                &self.frame_buffer,
+                &self.texels,
+                &self.materials,
+                &self.lights,
+            );
         }
         if let Some(table) = light_table {
             self.light_table = table;
@@ -162,7 +194,15 @@ impl SceneBindings {
 
     /// [`Self::prepare_frame`] with `accumulate`: the path tracer's later batches add to the
     /// radiance sum instead of replacing it.
-    pub(crate) fn write_frame(&self, gpu: &Gpu, spp: u32, first_sample: u32, seed: u64, frame: u32, accumulate: bool) {
+    pub(crate) fn write_frame(
+        &self,
+        gpu: &Gpu,
+        spp: u32,
+        first_sample: u32,
+        seed: u64,
+        frame: u32,
+        accumulate: bool,
+    ) {
         let (w, h) = (self.settings.width, self.settings.height);
         let params = FrameParams {
             camera: CameraBasis::new(&self.camera, w, h),
@@ -227,10 +267,19 @@ impl SceneBindings {
 
 /// Whether a material's base colour is read from a texture (base_color_at in pt_scene.wgsl).
 fn textured(materials: &[GpuMaterial]) -> bool {
-    materials.iter().any(|m| m.texture_offset != NO_TEXTURE && m.texture_width > 0 && m.texture_height > 0)
+    materials
+        .iter()
+        .any(|m| m.texture_offset != NO_TEXTURE && m.texture_width > 0 && m.texture_height > 0)
 }
 
 /// @group(0): [`GROUP`]'s buffers, then [`TABLES`].
-fn bind_group(gpu: &Gpu, layout: &wgpu::BindGroupLayout, frame: &wgpu::Buffer, texels: &wgpu::Buffer, materials: &TexelTable, lights: &TexelTable) -> wgpu::BindGroup {
+fn bind_group(
+    gpu: &Gpu,
+    layout: &wgpu::BindGroupLayout,
+    frame: &wgpu::Buffer,
+    texels: &wgpu::Buffer,
+    materials: &TexelTable,
+    lights: &TexelTable,
+) -> wgpu::BindGroup {
     crate::texel_table::group(gpu, "scene", layout, &[frame, texels], &[materials, lights])
 }

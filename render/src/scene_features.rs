@@ -37,7 +37,13 @@ pub struct SceneFeatures {
 impl SceneFeatures {
     /// Every feature: right for any scene. Programs are written with it; the pass library
     /// compiles its passes for the scene's own features.
-    pub const ALL: Self = Self { analytic_lights: true, emitters: true, environment: true, textures: true, traversal_stack: TRAVERSAL_STACK_SIZE };
+    pub const ALL: Self = Self {
+        analytic_lights: true,
+        emitters: true,
+        environment: true,
+        textures: true,
+        traversal_stack: TRAVERSAL_STACK_SIZE,
+    };
 
     /// The stack for a BVH that can need `entries`: exactly that (each entry costs a select per
     /// push and per pop), at most [`TRAVERSAL_STACK_SIZE`] (deeper scenes are refused when their

@@ -31,13 +31,25 @@ impl Module {
     /// `package::STEM` for the render crate, `package::CRATE::STEM` for others.
     pub fn file(krate: &str, relative: &str, source: &'static str) -> Self {
         let stem = relative.trim_end_matches(".wgsl").replace('/', "::");
-        let path = if krate == "render" { format!("package::{stem}") } else { format!("package::{krate}::{stem}") };
-        Self { path: Cow::Owned(path), file: Cow::Owned(format!("{krate}/shaders/{relative}")), source: Cow::Borrowed(source) }
+        let path = if krate == "render" {
+            format!("package::{stem}")
+        } else {
+            format!("package::{krate}::{stem}")
+        };
+        Self {
+            path: Cow::Owned(path),
+            file: Cow::Owned(format!("{krate}/shaders/{relative}")),
+            source: Cow::Borrowed(source),
+        }
     }
 
     /// Generated declarations importable as `path` (e.g. `package::scene_bindings`).
     pub fn generated(path: &str, parts: &[&str]) -> Self {
-        Self { path: Cow::Owned(path.to_string()), file: Cow::Borrowed("generated"), source: Cow::Owned(parts.join("\n")) }
+        Self {
+            path: Cow::Owned(path.to_string()),
+            file: Cow::Borrowed("generated"),
+            source: Cow::Owned(parts.join("\n")),
+        }
     }
 
     /// This module under another path: a file that plays a role each program fills with its own
@@ -49,7 +61,12 @@ impl Module {
 
     /// Whether it declares `struct NAME`.
     pub fn declares_struct(&self, name: &str) -> bool {
-        self.source.lines().any(|l| l.trim_start().strip_prefix("struct ").and_then(|r| r.strip_prefix(name)).is_some_and(|r| r.starts_with([' ', '{'])))
+        self.source.lines().any(|l| {
+            l.trim_start()
+                .strip_prefix("struct ")
+                .and_then(|r| r.strip_prefix(name))
+                .is_some_and(|r| r.starts_with([' ', '{']))
+        })
     }
 }
 
@@ -57,7 +74,11 @@ impl Module {
 #[macro_export]
 macro_rules! wgsl_file {
     ($path:literal) => {
-        $crate::shader::Module::file(env!("CARGO_PKG_NAME"), $path, include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders/", $path)))
+        $crate::shader::Module::file(
+            env!("CARGO_PKG_NAME"),
+            $path,
+            include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders/", $path)),
+        )
     };
 }
 
@@ -104,7 +125,11 @@ impl Program {
 
     /// Every source, in order: what a cache of this program's results is keyed by.
     pub fn fingerprint(&self) -> String {
-        self.modules.iter().chain(&self.entry_files).map(|m| format!("// {} ({})\n{}\n", m.path, m.file, m.source)).collect()
+        self.modules
+            .iter()
+            .chain(&self.entry_files)
+            .map(|m| format!("// {} ({})\n{}\n", m.path, m.file, m.source))
+            .collect()
     }
 
     /// Each entry-point file linked with the modules it imports: one WGSL source per file.
@@ -116,20 +141,37 @@ impl Program {
         let mut compiler = Wesl::new_barebones().set_custom_resolver(resolver);
         // Imports only: no dead-code stripping or lowering, so the linked WGSL is the files'
         // own declarations, renamed.
-        compiler.set_options(CompileOptions { imports: true, condcomp: false, generics: false, strip: false, lower: false, validate: false, lazy: false, mangle_root: false, keep: None, keep_root: false, features: Default::default() });
+        compiler.set_options(CompileOptions {
+            imports: true,
+            condcomp: false,
+            generics: false,
+            strip: false,
+            lower: false,
+            validate: false,
+            lazy: false,
+            mangle_root: false,
+            keep: None,
+            keep_root: false,
+            features: Default::default(),
+        });
         compiler.set_mangler(ManglerKind::Escape);
         self.entry_files
             .iter()
             .map(|m| {
-                compiler
-                    .compile(&parse_path(&m.path)?)
-                    .map(|linked| linked.to_string())
-                    .map_err(|e| RenderError::Shader { pass: m.file.to_string(), message: format!("linking {}: {e}", m.path) })
+                compiler.compile(&parse_path(&m.path)?).map(|linked| linked.to_string()).map_err(
+                    |e| RenderError::Shader {
+                        pass: m.file.to_string(),
+                        message: format!("linking {}: {e}", m.path),
+                    },
+                )
             })
             .collect()
     }
 }
 
 fn parse_path(path: &str) -> Result<wesl::ModulePath, RenderError> {
-    path.parse().map_err(|e| RenderError::Shader { pass: path.to_string(), message: format!("not a module path: {e:?}") })
+    path.parse().map_err(|e| RenderError::Shader {
+        pass: path.to_string(),
+        message: format!("not a module path: {e:?}"),
+    })
 }

@@ -36,15 +36,30 @@ pub struct TexelTable {
 impl TexelTable {
     /// A table of `texels` texels per record, holding at least `capacity` records (at least one
     /// row: bindings cannot be empty), filled with `records` from record 0.
-    pub fn new(gpu: &Gpu, what: &str, texels: u32, records: &[u8], capacity: u32) -> Result<Self, GpuError> {
+    pub fn new(
+        gpu: &Gpu,
+        what: &str,
+        texels: u32,
+        records: &[u8],
+        capacity: u32,
+    ) -> Result<Self, GpuError> {
         let record_bytes = texels as usize * TEXEL_BYTES;
-        assert!(records.len() % record_bytes == 0, "{what}: {} bytes is not a whole number of {record_bytes}-byte records", records.len());
+        assert!(
+            records.len() % record_bytes == 0,
+            "{what}: {} bytes is not a whole number of {record_bytes}-byte records",
+            records.len()
+        );
         let count = (records.len() / record_bytes) as u32;
         let rows = count.max(capacity).max(1).div_ceil(RECORDS_PER_ROW);
         let width = texels * RECORDS_PER_ROW;
         let max = gpu.limits.max_texture_dimension_2d;
         if width > max {
-            return Err(GpuError::OverLimit { what: format!("{what} texture width"), requested: width as u64, limit: max as u64, adapter: gpu.summary.to_string() });
+            return Err(GpuError::OverLimit {
+                what: format!("{what} texture width"),
+                requested: width as u64,
+                limit: max as u64,
+                adapter: gpu.summary.to_string(),
+            });
         }
         if rows > max {
             return Err(GpuError::OverLimit {
@@ -65,7 +80,13 @@ impl TexelTable {
             view_formats: &[],
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-        let table = Self { what: what.to_string(), texture, view, texels, capacity: rows * RECORDS_PER_ROW };
+        let table = Self {
+            what: what.to_string(),
+            texture,
+            view,
+            texels,
+            capacity: rows * RECORDS_PER_ROW,
+        };
         table.write(gpu, 0, records);
         Ok(table)
     }
@@ -79,14 +100,30 @@ impl TexelTable {
         if rows == 0 {
             return;
         }
-        assert!(first + rows * RECORDS_PER_ROW <= self.capacity, "texel table write past its capacity");
+        assert!(
+            first + rows * RECORDS_PER_ROW <= self.capacity,
+            "texel table write past its capacity"
+        );
         let mut padded = records.to_vec();
         padded.resize(rows as usize * row_bytes, 0);
         gpu.queue.write_texture(
-            wgpu::TexelCopyTextureInfo { texture: &self.texture, mip_level: 0, origin: wgpu::Origin3d { x: 0, y: first / RECORDS_PER_ROW, z: 0 }, aspect: wgpu::TextureAspect::All },
+            wgpu::TexelCopyTextureInfo {
+                texture: &self.texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: 0, y: first / RECORDS_PER_ROW, z: 0 },
+                aspect: wgpu::TextureAspect::All,
+            },
             &padded,
-            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row_bytes as u32), rows_per_image: Some(rows) },
-            wgpu::Extent3d { width: self.texels * RECORDS_PER_ROW, height: rows, depth_or_array_layers: 1 },
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row_bytes as u32),
+                rows_per_image: Some(rows),
+            },
+            wgpu::Extent3d {
+                width: self.texels * RECORDS_PER_ROW,
+                height: rows,
+                depth_or_array_layers: 1,
+            },
         );
     }
 
@@ -116,7 +153,11 @@ impl TexelTable {
         wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::StorageTexture { access: wgpu::StorageTextureAccess::ReadOnly, format: wgpu::TextureFormat::Rgba32Uint, view_dimension: wgpu::TextureViewDimension::D2 },
+            ty: wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::ReadOnly,
+                format: wgpu::TextureFormat::Rgba32Uint,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
             count: None,
         }
     }
@@ -146,25 +187,67 @@ pub fn module() -> Module {
 // three functions below are its WGSL, its layout and its bind group.
 
 /// [`crate::compute::group_module`] of `buffers`, with the texel tables `tables` declared after them.
-pub fn group_module(path: &str, group: u32, buffers: &[BufferBinding], tables: &[&str], types: &[&Module]) -> Module {
+pub fn group_module(
+    path: &str,
+    group: u32,
+    buffers: &[BufferBinding],
+    tables: &[&str],
+    types: &[&Module],
+) -> Module {
     let mut module = crate::compute::group_module(path, group, buffers, types);
-    let declarations: String = tables.iter().enumerate().map(|(i, name)| format!("@group({group}) @binding({}) var {name}: texture_storage_2d<rgba32uint, read>;\n", buffers.len() + i)).collect();
+    let declarations: String = tables
+        .iter()
+        .enumerate()
+        .map(|(i, name)| {
+            format!(
+                "@group({group}) @binding({}) var {name}: texture_storage_2d<rgba32uint, read>;\n",
+                buffers.len() + i
+            )
+        })
+        .collect();
     module.source = format!("{}{declarations}", module.source).into();
     module
 }
 
 /// The layout of `buffers`, then `tables` texel tables, visible to compute.
-pub fn group_layout(gpu: &Gpu, label: &str, buffers: &[BufferBinding], tables: usize) -> wgpu::BindGroupLayout {
-    let mut entries = crate::compute::buffer_entries(&buffers.iter().map(BufferBinding::kind).collect::<Vec<_>>());
+pub fn group_layout(
+    gpu: &Gpu,
+    label: &str,
+    buffers: &[BufferBinding],
+    tables: usize,
+) -> wgpu::BindGroupLayout {
+    let mut entries = crate::compute::buffer_entries(
+        &buffers.iter().map(BufferBinding::kind).collect::<Vec<_>>(),
+    );
     entries.extend((0..tables).map(|i| TexelTable::layout_entry((buffers.len() + i) as u32)));
-    gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
+    gpu.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &entries,
+    })
 }
 
 /// The bind group of such a layout: `buffers` whole, then `tables`.
-pub fn group(gpu: &Gpu, label: &str, layout: &wgpu::BindGroupLayout, buffers: &[&wgpu::Buffer], tables: &[&TexelTable]) -> wgpu::BindGroup {
-    let mut entries: Vec<_> = buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
+pub fn group(
+    gpu: &Gpu,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+    tables: &[&TexelTable],
+) -> wgpu::BindGroup {
+    let mut entries: Vec<_> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+        .collect();
     for (i, table) in tables.iter().enumerate() {
-        entries.push(wgpu::BindGroupEntry { binding: (buffers.len() + i) as u32, resource: wgpu::BindingResource::TextureView(table.view()) });
+        entries.push(wgpu::BindGroupEntry {
+            binding: (buffers.len() + i) as u32,
+            resource: wgpu::BindingResource::TextureView(table.view()),
+        });
     }
-    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
 }

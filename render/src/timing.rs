@@ -50,7 +50,11 @@ impl PassTimestamps {
             return None;
         }
         let count = 2 * passes;
-        let query_set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor { label: Some("pass timestamps"), ty: wgpu::QueryType::Timestamp, count });
+        let query_set = gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("pass timestamps"),
+            ty: wgpu::QueryType::Timestamp,
+            count,
+        });
         let size = count as u64 * 8;
         let resolve = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("timestamp resolve"),
@@ -64,13 +68,23 @@ impl PassTimestamps {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Some(Self { query_set, resolve, readback, passes, period_ns: gpu.queue.get_timestamp_period() as f64 })
+        Some(Self {
+            query_set,
+            resolve,
+            readback,
+            passes,
+            period_ns: gpu.queue.get_timestamp_period() as f64,
+        })
     }
 
     /// Timestamp writes bracketing pass number `pass`.
     pub fn writes(&self, pass: u32) -> wgpu::ComputePassTimestampWrites<'_> {
         assert!(pass < self.passes, "pass {pass} of {}", self.passes);
-        wgpu::ComputePassTimestampWrites { query_set: &self.query_set, beginning_of_pass_write_index: Some(2 * pass), end_of_pass_write_index: Some(2 * pass + 1) }
+        wgpu::ComputePassTimestampWrites {
+            query_set: &self.query_set,
+            beginning_of_pass_write_index: Some(2 * pass),
+            end_of_pass_write_index: Some(2 * pass + 1),
+        }
     }
 
     /// Records the resolve and the copy to the readback buffer; call after the last pass.
@@ -82,7 +96,10 @@ impl PassTimestamps {
     /// Milliseconds of each pass; call after the submission holding `resolve` has completed.
     pub fn read(&self, gpu: &Gpu) -> Result<Vec<f64>, String> {
         let ticks: Vec<u64> = crate::readback::read_buffer(gpu, &self.readback)?;
-        Ok(ticks.chunks_exact(2).map(|p| p[1].saturating_sub(p[0]) as f64 * self.period_ns * 1e-6).collect())
+        Ok(ticks
+            .chunks_exact(2)
+            .map(|p| p[1].saturating_sub(p[0]) as f64 * self.period_ns * 1e-6)
+            .collect())
     }
 }
 
@@ -95,7 +112,10 @@ pub struct PassTimer {
 impl PassTimer {
     /// Timestamp queries where the adapter has them, else wall time per pass.
     pub fn new(gpu: &Gpu, names: &[&str]) -> Self {
-        Self { names: names.iter().map(|n| n.to_string()).collect(), timestamps: PassTimestamps::new(gpu, names.len() as u32) }
+        Self {
+            names: names.iter().map(|n| n.to_string()).collect(),
+            timestamps: PassTimestamps::new(gpu, names.len() as u32),
+        }
     }
 
     /// Wall time per pass even where timestamps exist (tests of the fallback; comparing clocks).
@@ -113,7 +133,13 @@ impl PassTimer {
 
     /// Starts a frame's command recording.
     pub fn begin<'a>(&'a self, gpu: &'a Gpu, label: &str) -> TimedFrame<'a> {
-        TimedFrame { timer: self, gpu, encoder: new_encoder(gpu, label), wall: vec![None; self.names.len()], used: vec![false; self.names.len()] }
+        TimedFrame {
+            timer: self,
+            gpu,
+            encoder: new_encoder(gpu, label),
+            wall: vec![None; self.names.len()],
+            used: vec![false; self.names.len()],
+        }
     }
 }
 
@@ -122,7 +148,10 @@ fn new_encoder(gpu: &Gpu, label: &str) -> wgpu::CommandEncoder {
 }
 
 fn wait(gpu: &Gpu) -> Result<(), RenderError> {
-    gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| RenderError::Readback { what: "pass submission".into(), reason: e.to_string() })?;
+    gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| RenderError::Readback {
+        what: "pass submission".into(),
+        reason: e.to_string(),
+    })?;
     Ok(())
 }
 
@@ -144,13 +173,20 @@ impl TimedFrame<'_> {
 
     /// Records pass `index` (of the timer's names) as one compute pass. With the wall clock the
     /// commands recorded so far are submitted and waited for first, then the pass alone.
-    pub fn pass(&mut self, index: usize, record: impl FnOnce(&mut wgpu::ComputePass<'_>)) -> Result<(), RenderError> {
+    pub fn pass(
+        &mut self,
+        index: usize,
+        record: impl FnOnce(&mut wgpu::ComputePass<'_>),
+    ) -> Result<(), RenderError> {
         let name = &self.timer.names[index];
         assert!(!self.used[index], "pass {name} recorded twice in one frame");
         self.used[index] = true;
         match &self.timer.timestamps {
             Some(t) => {
-                let mut pass = self.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(name), timestamp_writes: Some(t.writes(index as u32)) });
+                let mut pass = self.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(name),
+                    timestamp_writes: Some(t.writes(index as u32)),
+                });
                 record(&mut pass);
             }
             None => {
@@ -159,7 +195,10 @@ impl TimedFrame<'_> {
                 wait(self.gpu)?;
                 let start = Instant::now();
                 {
-                    let mut pass = self.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(name), timestamp_writes: None });
+                    let mut pass = self.encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some(name),
+                        timestamp_writes: None,
+                    });
                     record(&mut pass);
                 }
                 let this = std::mem::replace(&mut self.encoder, new_encoder(self.gpu, name));
@@ -179,14 +218,22 @@ impl TimedFrame<'_> {
         }
         self.gpu.queue.submit([self.encoder.finish()]);
         wait(self.gpu)?;
-        let gpu_ms = match &self.timer.timestamps {
-            Some(t) => Some(t.read(self.gpu).map_err(|reason| RenderError::Readback { what: "timestamps".into(), reason })?),
-            None => None,
-        };
+        let gpu_ms =
+            match &self.timer.timestamps {
+                Some(t) => Some(t.read(self.gpu).map_err(|reason| RenderError::Readback {
+                    what: "timestamps".into(),
+                    reason,
+                })?),
+                None => None,
+            };
         let clock = self.timer.clock();
         Ok((0..self.timer.names.len())
             .filter(|&i| self.used[i])
-            .map(|i| PassTiming { pass: self.timer.names[i].clone(), ms: gpu_ms.as_ref().map_or_else(|| self.wall[i].unwrap_or(0.0), |g| g[i]), clock })
+            .map(|i| PassTiming {
+                pass: self.timer.names[i].clone(),
+                ms: gpu_ms.as_ref().map_or_else(|| self.wall[i].unwrap_or(0.0), |g| g[i]),
+                clock,
+            })
             .collect())
     }
 }

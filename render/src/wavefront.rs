@@ -65,7 +65,11 @@ impl Wavefront {
 
     /// Waves of whole chunks of [`SAMPLES_PER_THREAD`] samples per pixel, as many as fit in
     /// `wave_paths` paths (at least one chunk) and in the adapter's largest storage binding.
-    pub fn with_wave_paths(gpu: &Gpu, tracer: &PathTracer, wave_paths: u64) -> Result<Self, RenderError> {
+    pub fn with_wave_paths(
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        wave_paths: u64,
+    ) -> Result<Self, RenderError> {
         let (layout, [generate, extend, shade, shadow, advance, reduce]) = tracer.library_pass(
             gpu,
             "wavefront.wgsl",
@@ -77,20 +81,34 @@ impl Wavefront {
         let pixels = settings.width as u64 * settings.height as u64;
         let light_samples = Self::light_samples(tracer);
         let per_path = 16 * (VEC4S_PER_PATH + VEC4S_PER_LIGHT_SAMPLE * light_samples);
-        let max_paths = (gpu.limits.max_storage_buffer_binding_size as u64).min(gpu.limits.max_buffer_size) / per_path;
+        let max_paths = (gpu.limits.max_storage_buffer_binding_size as u64)
+            .min(gpu.limits.max_buffer_size)
+            / per_path;
         let chunk_paths = pixels * SAMPLES_PER_THREAD as u64;
         let chunks = (wave_paths.min(max_paths) / chunk_paths).max(1);
         let capacity = chunks * chunk_paths;
-        if capacity > max_paths || capacity.div_ceil(WF_GROUP as u64) > gpu.limits.max_compute_workgroups_per_dimension as u64 {
-            return Err(RenderError::Settings(format!("a wavefront of {pixels} pixels x {SAMPLES_PER_THREAD} samples does not fit this adapter")));
+        if capacity > max_paths
+            || capacity.div_ceil(WF_GROUP as u64)
+                > gpu.limits.max_compute_workgroups_per_dimension as u64
+        {
+            return Err(RenderError::Settings(format!(
+                "a wavefront of {pixels} pixels x {SAMPLES_PER_THREAD} samples does not fit this adapter"
+            )));
         }
         let size = capacity * per_path;
         gpu.check_buffer_size("wavefront state", size)?;
-        let state = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some("wavefront state"), size, usage: wgpu::BufferUsages::STORAGE, mapped_at_creation: false });
+        let state = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("wavefront state"),
+            size,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
         let control = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("wavefront control"),
             size: CONTROL_WORDS * 4,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
         let control_readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -105,13 +123,29 @@ impl Wavefront {
             usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Ok(Self { layout, generate, extend, shade, shadow, advance, reduce, state, control, args, control_readback, capacity, light_samples })
+        Ok(Self {
+            layout,
+            generate,
+            extend,
+            shade,
+            shadow,
+            advance,
+            reduce,
+            state,
+            control,
+            args,
+            control_readback,
+            capacity,
+            light_samples,
+        })
     }
 
     /// Light samples per shading point, as wavefront.wgsl's `light_samples` counts them.
     fn light_samples(tracer: &PathTracer) -> u64 {
         let features = tracer.library().features();
-        tracer.scene().analytic_lights() as u64 * features.analytic_lights as u64 + features.emitters as u64 + features.environment as u64
+        tracer.scene().analytic_lights() as u64 * features.analytic_lights as u64
+            + features.emitters as u64
+            + features.environment as u64
     }
 
     fn program() -> &'static Program {
@@ -134,17 +168,40 @@ impl Wavefront {
 
     /// [`PathTracer::render_reference`] as a wavefront: `spp` samples per pixel in waves of
     /// [`Self::samples_per_wave`].
-    pub fn render_reference(&self, gpu: &Gpu, tracer: &PathTracer, spp: u32, seed: u64, frame: u32) -> Result<Vec<[f32; 4]>, RenderError> {
+    pub fn render_reference(
+        &self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        spp: u32,
+        seed: u64,
+        frame: u32,
+    ) -> Result<Vec<[f32; 4]>, RenderError> {
         self.trace(gpu, tracer, spp, seed, frame, None)
     }
 
     /// [`Self::render_reference`] with each kernel submitted alone and waited for, its wall time
     /// added to `times`: slower, for seeing where a wavefront's time goes.
-    pub fn render_reference_per_kernel(&self, gpu: &Gpu, tracer: &PathTracer, spp: u32, seed: u64, frame: u32, times: &mut KernelTimes) -> Result<Vec<[f32; 4]>, RenderError> {
+    pub fn render_reference_per_kernel(
+        &self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        spp: u32,
+        seed: u64,
+        frame: u32,
+        times: &mut KernelTimes,
+    ) -> Result<Vec<[f32; 4]>, RenderError> {
         self.trace(gpu, tracer, spp, seed, frame, Some(times))
     }
 
-    fn trace(&self, gpu: &Gpu, tracer: &PathTracer, spp: u32, seed: u64, frame: u32, mut times: Option<&mut KernelTimes>) -> Result<Vec<[f32; 4]>, RenderError> {
+    fn trace(
+        &self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        spp: u32,
+        seed: u64,
+        frame: u32,
+        mut times: Option<&mut KernelTimes>,
+    ) -> Result<Vec<[f32; 4]>, RenderError> {
         if spp == 0 {
             return Err(RenderError::Settings("reference spp must be at least 1".into()));
         }
@@ -157,13 +214,28 @@ impl Wavefront {
         }
         let settings = tracer.settings();
         let pixels = settings.width as u64 * settings.height as u64;
-        let bind_group = compute::buffer_group(gpu, "wavefront", &self.layout, &[tracer.radiance_sum_buffer(), tracer.counters_buffer(), &self.state, &self.control]);
+        let bind_group = compute::buffer_group(
+            gpu,
+            "wavefront",
+            &self.layout,
+            &[tracer.radiance_sum_buffer(), tracer.counters_buffer(), &self.state, &self.control],
+        );
         let per_wave = self.samples_per_wave(tracer);
-        let new_encoder = || gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("wavefront") });
+        let new_encoder = || {
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("wavefront"),
+            })
+        };
         // One kernel in its own compute pass; with `times`, submitted and waited for alone.
-        let run = |encoder: &mut wgpu::CommandEncoder, kernel: Kernel, dispatch: Dispatch, times: &mut Option<&mut KernelTimes>| {
+        let run = |encoder: &mut wgpu::CommandEncoder,
+                   kernel: Kernel,
+                   dispatch: Dispatch,
+                   times: &mut Option<&mut KernelTimes>| {
             {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(kernel.name()), timestamp_writes: None });
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(kernel.name()),
+                    timestamp_writes: None,
+                });
                 pass.set_bind_group(0, tracer.scene().bind_group(), &[]);
                 pass.set_bind_group(1, tracer.scene().geometry().bind_group(), &[]);
                 pass.set_bind_group(2, &bind_group, &[]);
@@ -186,7 +258,8 @@ impl Wavefront {
             tracer.scene().write_frame(gpu, batch, done, seed, frame, done > 0);
             let paths = pixels as u32 * batch;
             let groups = paths.div_ceil(WF_GROUP);
-            let control: [u32; CONTROL_WORDS as usize] = [paths, 0, 0, self.capacity as u32, groups, 1, 1, 0];
+            let control: [u32; CONTROL_WORDS as usize] =
+                [paths, 0, 0, self.capacity as u32, groups, 1, 1, 0];
             gpu.queue.write_buffer(&self.control, 0, bytemuck::cast_slice(&control));
             let mut encoder = new_encoder();
             run(&mut encoder, Kernel::Generate, Dispatch::Direct(groups, 1), &mut times);
@@ -201,15 +274,29 @@ impl Wavefront {
                     }
                     run(&mut encoder, Kernel::Advance, Dispatch::Direct(1, 1), &mut times);
                 }
-                encoder.copy_buffer_to_buffer(&self.control, 0, &self.control_readback, 0, CONTROL_WORDS * 4);
+                encoder.copy_buffer_to_buffer(
+                    &self.control,
+                    0,
+                    &self.control_readback,
+                    0,
+                    CONTROL_WORDS * 4,
+                );
                 gpu.queue.submit([std::mem::replace(&mut encoder, new_encoder()).finish()]);
-                let words: Vec<u32> = read_buffer(gpu, &self.control_readback).map_err(|reason| RenderError::Readback { what: "wavefront control".into(), reason })?;
+                let words: Vec<u32> =
+                    read_buffer(gpu, &self.control_readback).map_err(|reason| {
+                        RenderError::Readback { what: "wavefront control".into(), reason }
+                    })?;
                 bounces += BOUNCES_PER_SUBMISSION;
                 if words[0] == 0 || bounces > settings.max_depth + 1 {
                     break;
                 }
             }
-            run(&mut encoder, Kernel::Reduce, Dispatch::Direct(settings.width.div_ceil(8), settings.height.div_ceil(8)), &mut times);
+            run(
+                &mut encoder,
+                Kernel::Reduce,
+                Dispatch::Direct(settings.width.div_ceil(8), settings.height.div_ceil(8)),
+                &mut times,
+            );
             gpu.queue.submit([encoder.finish()]);
             done += batch;
         }
@@ -240,7 +327,14 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 6] = [Kernel::Generate, Kernel::Extend, Kernel::Shade, Kernel::Shadow, Kernel::Advance, Kernel::Reduce];
+    pub const ALL: [Kernel; 6] = [
+        Kernel::Generate,
+        Kernel::Extend,
+        Kernel::Shade,
+        Kernel::Shadow,
+        Kernel::Advance,
+        Kernel::Reduce,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {

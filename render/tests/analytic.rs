@@ -30,7 +30,11 @@ fn sphere(segments: u32, rings: u32) -> Mesh {
         let theta = PI as f32 * r as f32 / rings as f32;
         for s in 0..segments {
             let phi = 2.0 * PI as f32 * s as f32 / segments as f32;
-            positions.push(Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()));
+            positions.push(Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            ));
         }
     }
     let mut indices = vec![];
@@ -56,7 +60,12 @@ fn lambert(albedo: f32) -> Material {
 }
 
 fn top_down_camera(height: f32) -> Camera {
-    Camera { position: Vec3::new(0.0, height, 0.0), target: Vec3::ZERO, up: Vec3::NEG_Z, vfov: 50f32.to_radians() }
+    Camera {
+        position: Vec3::new(0.0, height, 0.0),
+        target: Vec3::ZERO,
+        up: Vec3::NEG_Z,
+        vfov: 50f32.to_radians(),
+    }
 }
 
 fn settings(max_depth: u32) -> PathTracerSettings {
@@ -86,7 +95,11 @@ const RENDERS: u64 = 8;
 
 fn renders(scene: &SceneDesc, s: PathTracerSettings, spp: u32, seed: u64) -> Vec<Vec<f64>> {
     let mut pt = PathTracer::new(gpu(), scene, s).expect("path tracer");
-    (seed..seed + RENDERS).map(|k| pt.render(gpu(), spp, k, 0).expect("render").radiance.iter().map(mean_rgb).collect()).collect()
+    (seed..seed + RENDERS)
+        .map(|k| {
+            pt.render(gpu(), spp, k, 0).expect("render").radiance.iter().map(mean_rgb).collect()
+        })
+        .collect()
 }
 
 /// Compares the mean of independent renders with `expected` per pixel. Each pixel's standard
@@ -114,7 +127,8 @@ fn assert_matches(what: &str, renders: &[Vec<f64>], expected: &[f64], slack: f64
         );
     }
     assert!(
-        sum_err.abs() <= 5.0 * sum_var.sqrt() + slack * expected.iter().map(|e| e.abs()).sum::<f64>(),
+        sum_err.abs()
+            <= 5.0 * sum_var.sqrt() + slack * expected.iter().map(|e| e.abs()).sum::<f64>(),
         "{what}: summed error {sum_err:.4e} over {n} pixels, standard error {:.4e}",
         sum_var.sqrt()
     );
@@ -136,7 +150,10 @@ fn footprint_average(camera: &Camera, f: impl Fn(Vec3, Vec3) -> f64) -> Vec<f64>
             let mut sum = 0.0;
             for j in 0..k {
                 for i in 0..k {
-                    let p = Vec2::new(x as f32 + (i as f32 + 0.5) / k as f32, y as f32 + (j as f32 + 0.5) / k as f32);
+                    let p = Vec2::new(
+                        x as f32 + (i as f32 + 0.5) / k as f32,
+                        y as f32 + (j as f32 + 0.5) / k as f32,
+                    );
                     sum += f(camera.position, basis.ray_direction(p, W, H));
                 }
             }
@@ -164,13 +181,22 @@ fn ground_scene(albedo: f32, camera: Camera) -> SceneDesc {
 
 /// A white Lambertian sphere resting on a white plane in a constant environment L = 1.
 fn white_furnace() -> SceneDesc {
-    let camera = Camera { position: Vec3::new(0.0, 1.5, 4.0), target: Vec3::new(0.0, 0.7, 0.0), up: Vec3::Y, vfov: 60f32.to_radians() };
+    let camera = Camera {
+        position: Vec3::new(0.0, 1.5, 4.0),
+        target: Vec3::new(0.0, 0.7, 0.0),
+        up: Vec3::Y,
+        vfov: 60f32.to_radians(),
+    };
     SceneDesc {
         meshes: vec![Mesh::plane(3.0), sphere(24, 12)],
         materials: vec![lambert(1.0)],
         instances: vec![
             Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY },
-            Instance { mesh: 1, material: 0, transform: Mat4::from_translation(Vec3::new(0.0, 1.0, 0.0)) },
+            Instance {
+                mesh: 1,
+                material: 0,
+                transform: Mat4::from_translation(Vec3::new(0.0, 1.0, 0.0)),
+            },
         ],
         environment: Vec3::ONE,
         camera,
@@ -209,14 +235,22 @@ fn long_dispatch_keeps_every_sample() {
     assert_eq!(dispatches, 1);
     let mean = image.iter().map(mean_rgb).sum::<f64>() / image.len() as f64;
     let worst = image.iter().map(|p| (mean_rgb(p) - 1.0).abs()).fold(0.0, f64::max);
-    assert!((mean - 1.0).abs() < 0.01 && worst < 0.05, "furnace at {spp} spp in one dispatch: mean {mean}, worst pixel off by {worst}");
+    assert!(
+        (mean - 1.0).abs() < 0.01 && worst < 0.05,
+        "furnace at {spp} spp in one dispatch: mean {mean}, worst pixel off by {worst}"
+    );
 }
 
 #[test]
 fn furnace_convex_object_reflects_its_albedo() {
     // A convex Lambertian object of albedo a in a constant environment L: every point sees only
     // the environment over its hemisphere, so the reflected radiance is exactly a L.
-    let camera = Camera { position: Vec3::new(0.0, 0.0, 1.6), target: Vec3::ZERO, up: Vec3::Y, vfov: 30f32.to_radians() };
+    let camera = Camera {
+        position: Vec3::new(0.0, 0.0, 1.6),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        vfov: 30f32.to_radians(),
+    };
     let scene = SceneDesc {
         meshes: vec![sphere(32, 16)],
         materials: vec![lambert(0.5)],
@@ -226,7 +260,10 @@ fn furnace_convex_object_reflects_its_albedo() {
         ..Default::default()
     };
     let s = settings(8);
-    assert!(render(&scene, s, 1, 0).gbuffer.instance_id.iter().all(|&i| i == 0), "the sphere must fill the image");
+    assert!(
+        render(&scene, s, 1, 0).gbuffer.instance_id.iter().all(|&i| i == 0),
+        "the sphere must fill the image"
+    );
     assert_matches("convex furnace", &renders(&scene, s, 4, 3), &vec![1.0; (W * H) as usize], 1e-4);
 }
 
@@ -261,10 +298,16 @@ fn directional_lights_give_e_cos_theta() {
     let expected = albedo as f64 / PI * e as f64 * theta.cos() as f64;
     for angular_radius in [0.0, 0.1] {
         let mut scene = ground_scene(albedo, top_down_camera(2.0));
-        scene.lights = vec![Light::Directional { direction, irradiance: Vec3::splat(e), angular_radius }];
+        scene.lights =
+            vec![Light::Directional { direction, irradiance: Vec3::splat(e), angular_radius }];
         let s = settings(1);
         let images = renders(&scene, s, 4, 7);
-        assert_matches(&format!("directional light, radius {angular_radius}"), &images, &vec![expected; (W * H) as usize], 2e-4);
+        assert_matches(
+            &format!("directional light, radius {angular_radius}"),
+            &images,
+            &vec![expected; (W * H) as usize],
+            2e-4,
+        );
     }
 }
 
@@ -282,7 +325,13 @@ fn spot_light_over_diffuse_plane() {
     let intensity = 4.0;
     let camera = top_down_camera(2.0);
     let mut scene = ground_scene(albedo, camera);
-    scene.lights = vec![Light::Spot { position, direction: axis, intensity: Vec3::splat(intensity), inner_angle: inner, outer_angle: outer }];
+    scene.lights = vec![Light::Spot {
+        position,
+        direction: axis,
+        intensity: Vec3::splat(intensity),
+        inner_angle: inner,
+        outer_angle: outer,
+    }];
     let s = settings(1);
     let images = renders(&scene, s, 4, 9);
     let expected_full = footprint_average(&camera, |o, d| {
@@ -290,7 +339,11 @@ fn spot_light_over_diffuse_plane() {
         let to_light = position - p;
         let r = to_light.length() as f64;
         let cos_axis = (-to_light).normalize().dot(axis) as f64;
-        albedo as f64 / PI * intensity as f64 * spot_falloff(cos_axis, outer.cos() as f64, inner.cos() as f64) * (to_light.y as f64 / r) / (r * r)
+        albedo as f64 / PI
+            * intensity as f64
+            * spot_falloff(cos_axis, outer.cos() as f64, inner.cos() as f64)
+            * (to_light.y as f64 / r)
+            / (r * r)
     });
     // Compare where the spot lights the plane (the closed form is 0 outside the cone).
     let lit: Vec<usize> = (0..expected_full.len()).filter(|&i| expected_full[i] > 1e-3).collect();
@@ -334,11 +387,22 @@ fn emissive_rectangle_over_diffuse_plane() {
         * Mat4::from_scale(Vec3::new((x1 - x0) / 2.0, 1.0, (z1 - z0) / 2.0))
         * Mat4::from_rotation_x(std::f32::consts::PI);
     // Camera beside the light, looking down at the plane under it.
-    let camera = Camera { position: Vec3::new(0.0, 1.4, 1.6), target: Vec3::new(-0.1, 0.0, 0.0), up: Vec3::Y, vfov: 50f32.to_radians() };
+    let camera = Camera {
+        position: Vec3::new(0.0, 1.4, 1.6),
+        target: Vec3::new(-0.1, 0.0, 0.0),
+        up: Vec3::Y,
+        vfov: 50f32.to_radians(),
+    };
     let scene = SceneDesc {
         meshes: vec![Mesh::plane(50.0), Mesh::plane(1.0)],
-        materials: vec![lambert(albedo), Material { base_color: Vec3::ZERO, emission: Vec3::splat(le), ..lambert(0.0) }],
-        instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }, Instance { mesh: 1, material: 1, transform: light_transform }],
+        materials: vec![
+            lambert(albedo),
+            Material { base_color: Vec3::ZERO, emission: Vec3::splat(le), ..lambert(0.0) },
+        ],
+        instances: vec![
+            Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY },
+            Instance { mesh: 1, material: 1, transform: light_transform },
+        ],
         camera,
         ..Default::default()
     };
@@ -364,12 +428,20 @@ fn emissive_rectangle_over_diffuse_plane() {
     let emitter: Vec<usize> = (0..coverage.len()).filter(|&i| coverage[i] == 1.0).collect();
     assert!(emitter.len() > 20, "{} pixels see the emitter", emitter.len());
     for &i in &emitter {
-        assert!(images.iter().all(|img| img[i].abs() < 1e-5), "pixel {i} sees the emitter's back face: {}", images[0][i]);
+        assert!(
+            images.iter().all(|img| img[i].abs() < 1e-5),
+            "pixel {i} sees the emitter's back face: {}",
+            images[0][i]
+        );
     }
     // Far from the rectangle the form factor is tiny and the relative noise huge: compare where
     // the plane receives at least 1% of the peak.
-    let peak = (0..expected.len()).filter(|&i| coverage[i] == 0.0).map(|i| expected[i]).fold(0.0, f64::max);
-    let near: Vec<usize> = (0..expected.len()).filter(|&i| coverage[i] == 0.0 && expected[i] > 0.01 * peak).collect();
+    let peak = (0..expected.len())
+        .filter(|&i| coverage[i] == 0.0)
+        .map(|i| expected[i])
+        .fold(0.0, f64::max);
+    let near: Vec<usize> =
+        (0..expected.len()).filter(|&i| coverage[i] == 0.0 && expected[i] > 0.01 * peak).collect();
     assert!(near.len() > 300, "{} pixels", near.len());
     let e: Vec<f64> = near.iter().map(|&i| expected[i]).collect();
     let relative_error = assert_matches("emissive rectangle", &pick(&images, &near), &e, 5e-4);
@@ -394,7 +466,8 @@ fn gltf_brdf(m: &Material, n: glam::DVec3, wo: glam::DVec3, wi: glam::DVec3) -> 
     let f = f0 + (DVec3::splat(f90) - f0) * (1.0 - wo.dot(h)).clamp(0.0, 1.0).powi(5);
     let nh = n.dot(h);
     let d = a2 / (PI * (nh * nh * (a2 - 1.0) + 1.0).powi(2));
-    let v = 0.5 / (nl * (nv * nv * (1.0 - a2) + a2).sqrt() + nv * (nl * nl * (1.0 - a2) + a2).sqrt());
+    let v =
+        0.5 / (nl * (nv * nv * (1.0 - a2) + a2).sqrt() + nv * (nl * nl * (1.0 - a2) + a2).sqrt());
     (DVec3::ONE - f) * base * (1.0 - metallic) / PI + f * d * v
 }
 
@@ -423,11 +496,26 @@ fn ggx_plane_under_constant_environment_matches_cpu_integral() {
     // sampling (GGX half vectors / cosine) are combined by MIS, so a wrong pdf or a sampling
     // routine that disagrees with its pdf shows up as bias. A distant camera with a narrow field
     // of view looks at the plane at about 60 degrees from the normal (Fresnel and masking matter).
-    let camera = Camera { position: Vec3::new(60f32.to_radians().sin(), 60f32.to_radians().cos(), 0.0) * 40.0, target: Vec3::ZERO, up: Vec3::Y, vfov: 2f32.to_radians() };
+    let camera = Camera {
+        position: Vec3::new(60f32.to_radians().sin(), 60f32.to_radians().cos(), 0.0) * 40.0,
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        vfov: 2f32.to_radians(),
+    };
     let basis = CameraBasis::new(&camera, W, H);
     let materials = [
-        Material { base_color: Vec3::new(0.9, 0.6, 0.3), metallic: 1.0, roughness: 0.5, ..Default::default() },
-        Material { base_color: Vec3::new(0.2, 0.5, 0.8), metallic: 0.0, roughness: 0.3, ..Default::default() },
+        Material {
+            base_color: Vec3::new(0.9, 0.6, 0.3),
+            metallic: 1.0,
+            roughness: 0.5,
+            ..Default::default()
+        },
+        Material {
+            base_color: Vec3::new(0.2, 0.5, 0.8),
+            metallic: 0.0,
+            roughness: 0.3,
+            ..Default::default()
+        },
     ];
     for material in materials {
         let scene = SceneDesc {
@@ -441,12 +529,20 @@ fn ggx_plane_under_constant_environment_matches_cpu_integral() {
         let images = renders(&scene, settings(1), 16, 21);
         // The BRDF is isotropic, so the albedo depends only on the view angle; it is smooth, so
         // a table over the image's range of angles, linearly interpolated, stands for the pixels.
-        let cos_view: Vec<f64> = (0..W * H).map(|i| -basis.ray_direction(Vec2::new((i % W) as f32 + 0.5, (i / W) as f32 + 0.5), W, H).y as f64).collect();
-        let (lo, hi) = cos_view.iter().fold((f64::MAX, f64::MIN), |(a, b), &c| (a.min(c), b.max(c)));
+        let cos_view: Vec<f64> = (0..W * H)
+            .map(|i| {
+                -basis.ray_direction(Vec2::new((i % W) as f32 + 0.5, (i / W) as f32 + 0.5), W, H).y
+                    as f64
+            })
+            .collect();
+        let (lo, hi) =
+            cos_view.iter().fold((f64::MAX, f64::MIN), |(a, b), &c| (a.min(c), b.max(c)));
         let table: Vec<f64> = (0..=16)
             .map(|k| {
                 let c = lo + (hi - lo) * k as f64 / 16.0;
-                directional_albedo(&material, glam::DVec3::new((1.0 - c * c).sqrt(), c, 0.0)).element_sum() / 3.0
+                directional_albedo(&material, glam::DVec3::new((1.0 - c * c).sqrt(), c, 0.0))
+                    .element_sum()
+                    / 3.0
             })
             .collect();
         let expected: Vec<f64> = cos_view
@@ -462,22 +558,55 @@ fn ggx_plane_under_constant_environment_matches_cpu_integral() {
 }
 
 fn small_scene() -> SceneDesc {
-    let camera = Camera { position: Vec3::new(0.0, 1.2, 3.0), target: Vec3::new(0.0, 0.6, 0.0), up: Vec3::Y, vfov: 55f32.to_radians() };
+    let camera = Camera {
+        position: Vec3::new(0.0, 1.2, 3.0),
+        target: Vec3::new(0.0, 0.6, 0.0),
+        up: Vec3::Y,
+        vfov: 55f32.to_radians(),
+    };
     SceneDesc {
         meshes: vec![Mesh::plane(2.0), sphere(16, 8), Mesh::plane(0.5)],
         materials: vec![
             Material { base_color: Vec3::new(0.7, 0.6, 0.5), roughness: 0.8, ..Default::default() },
-            Material { base_color: Vec3::new(0.9, 0.5, 0.2), roughness: 0.5, metallic: 1.0, ..Default::default() },
-            Material { base_color: Vec3::ZERO, emission: Vec3::new(3.0, 2.6, 2.2), ..Default::default() },
+            Material {
+                base_color: Vec3::new(0.9, 0.5, 0.2),
+                roughness: 0.5,
+                metallic: 1.0,
+                ..Default::default()
+            },
+            Material {
+                base_color: Vec3::ZERO,
+                emission: Vec3::new(3.0, 2.6, 2.2),
+                ..Default::default()
+            },
         ],
         instances: vec![
             Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY },
-            Instance { mesh: 1, material: 1, transform: Mat4::from_scale_rotation_translation(Vec3::splat(0.5), glam::Quat::IDENTITY, Vec3::new(0.0, 0.5, 0.0)) },
-            Instance { mesh: 2, material: 2, transform: Mat4::from_rotation_translation(glam::Quat::from_rotation_x(PI as f32), Vec3::new(0.5, 1.5, 0.3)) },
+            Instance {
+                mesh: 1,
+                material: 1,
+                transform: Mat4::from_scale_rotation_translation(
+                    Vec3::splat(0.5),
+                    glam::Quat::IDENTITY,
+                    Vec3::new(0.0, 0.5, 0.0),
+                ),
+            },
+            Instance {
+                mesh: 2,
+                material: 2,
+                transform: Mat4::from_rotation_translation(
+                    glam::Quat::from_rotation_x(PI as f32),
+                    Vec3::new(0.5, 1.5, 0.3),
+                ),
+            },
         ],
         lights: vec![
             Light::Point { position: Vec3::new(-1.0, 1.5, 1.0), intensity: Vec3::splat(2.0) },
-            Light::Directional { direction: Vec3::new(-0.3, -1.0, -0.4), irradiance: Vec3::splat(1.0), angular_radius: 0.05 },
+            Light::Directional {
+                direction: Vec3::new(-0.3, -1.0, -0.4),
+                irradiance: Vec3::splat(1.0),
+                angular_radius: 0.05,
+            },
         ],
         environment: Vec3::new(0.1, 0.15, 0.2),
         camera,
@@ -497,14 +626,26 @@ fn same_seed_same_bytes_other_seed_other_bytes() {
     assert_ne!(bytes(&a), bytes(&c), "another seed must give another image");
     assert_eq!(a.gbuffer, b.gbuffer);
     assert!(a.radiance.iter().all(|p| p.iter().all(|v| v.is_finite())), "radiance must be finite");
-    assert_eq!(a.timings.iter().map(|t| t.pass.as_str()).collect::<Vec<_>>(), ["gbuffer", "path_trace"]);
+    assert_eq!(
+        a.timings.iter().map(|t| t.pass.as_str()).collect::<Vec<_>>(),
+        ["gbuffer", "path_trace"]
+    );
     for t in &a.timings {
         assert!(t.ms > 0.0, "{t:?}");
-        let clock = if gpu().has_timestamps() { render::timing::Clock::Gpu } else { render::timing::Clock::Wall };
+        let clock = if gpu().has_timestamps() {
+            render::timing::Clock::Gpu
+        } else {
+            render::timing::Clock::Wall
+        };
         assert_eq!(t.clock, clock, "{t:?}");
     }
     // Every ray is counted: at least the G-buffer's and the camera rays of the 2 spp paths.
-    assert!(a.rays >= 3 * a.radiance.len() as u64, "{} rays for {} pixels", a.rays, a.radiance.len());
+    assert!(
+        a.rays >= 3 * a.radiance.len() as u64,
+        "{} rays for {} pixels",
+        a.rays,
+        a.radiance.len()
+    );
     assert_eq!(a.rays, b.rays, "the ray count is deterministic");
     assert_eq!(a.shaded, 2 * a.radiance.len() as u64);
 }
@@ -516,11 +657,17 @@ fn reference_is_stable_under_seed_change() {
     let mut pt = PathTracer::new(gpu(), &scene, s).unwrap();
     let spp = 16384;
     let mut calls = vec![];
-    let a = pt.render_reference(gpu(), spp, 1, 0, &mut |done, total| calls.push((done, total))).unwrap();
+    let a = pt
+        .render_reference(gpu(), spp, 1, 0, &mut |done, total| calls.push((done, total)))
+        .unwrap();
     assert_eq!(calls.last(), Some(&(spp, spp)));
     assert!(calls.windows(2).all(|w| w[0].0 < w[1].0), "progress must grow: {calls:?}");
     let b = pt.render_reference(gpu(), spp, 2, 0, &mut |_, _| {}).unwrap();
-    let diff: f64 = a.iter().zip(&b).map(|(x, y)| (0..3).map(|c| (x[c] - y[c]).abs() as f64).sum::<f64>()).sum();
+    let diff: f64 = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (0..3).map(|c| (x[c] - y[c]).abs() as f64).sum::<f64>())
+        .sum();
     let total: f64 = b.iter().map(|y| (0..3).map(|c| y[c] as f64).sum::<f64>()).sum();
     let rel = diff / total;
     assert!(rel < 0.01, "mean relative difference between two converged references: {rel:.4}");
@@ -550,7 +697,12 @@ fn reference_batches_sum_the_same_samples() {
 #[test]
 fn gbuffer_of_a_known_plane_and_motion_of_a_moved_instance() {
     let camera = top_down_camera(2.0);
-    let texture = Texture { name: "grey".into(), width: 2, height: 2, rgba8: [188u8, 188, 188, 255].repeat(4) };
+    let texture = Texture {
+        name: "grey".into(),
+        width: 2,
+        height: 2,
+        rgba8: [188u8, 188, 188, 255].repeat(4),
+    };
     let mut scene = SceneDesc {
         meshes: vec![Mesh::plane(1.0), Mesh::plane(0.25)],
         textures: vec![texture],
@@ -560,7 +712,11 @@ fn gbuffer_of_a_known_plane_and_motion_of_a_moved_instance() {
         ],
         instances: vec![
             Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY },
-            Instance { mesh: 1, material: 1, transform: Mat4::from_translation(Vec3::new(0.3, 0.5, 0.0)) },
+            Instance {
+                mesh: 1,
+                material: 1,
+                transform: Mat4::from_translation(Vec3::new(0.3, 0.5, 0.0)),
+            },
         ],
         lights: vec![Light::Point { position: Vec3::new(0.0, 1.0, 0.0), intensity: Vec3::ONE }],
         camera,
@@ -582,8 +738,16 @@ fn gbuffer_of_a_known_plane_and_motion_of_a_moved_instance() {
                 0 => {
                     counts[0] += 1;
                     let depth = (ground - camera.position).length();
-                    assert!((g.depth[i] - depth).abs() < 1e-4 * depth, "depth at ({x},{y}): {} vs {depth}", g.depth[i]);
-                    assert!(Vec3::from(g.normal[i]).abs_diff_eq(Vec3::Y, 1e-5), "normal {:?}", g.normal[i]);
+                    assert!(
+                        (g.depth[i] - depth).abs() < 1e-4 * depth,
+                        "depth at ({x},{y}): {} vs {depth}",
+                        g.depth[i]
+                    );
+                    assert!(
+                        Vec3::from(g.normal[i]).abs_diff_eq(Vec3::Y, 1e-5),
+                        "normal {:?}",
+                        g.normal[i]
+                    );
                     assert!(Vec3::from(g.albedo[i]).abs_diff_eq(Vec3::new(0.2, 0.4, 0.6), 1e-6));
                     assert!(g.primitive_id[i] < 2);
                     assert!(ground.x.abs() <= 1.0 + 1e-3 && ground.z.abs() <= 1.0 + 1e-3);
@@ -593,14 +757,21 @@ fn gbuffer_of_a_known_plane_and_motion_of_a_moved_instance() {
                     let depth = (2.0 - 0.5) / d.dot(Vec3::NEG_Y);
                     assert!((g.depth[i] - depth).abs() < 1e-4 * depth);
                     for c in 0..3 {
-                        assert!((g.albedo[i][c] as f64 - srgb_188).abs() < 2e-3, "texture albedo {:?} vs {srgb_188}", g.albedo[i]);
+                        assert!(
+                            (g.albedo[i][c] as f64 - srgb_188).abs() < 2e-3,
+                            "texture albedo {:?} vs {srgb_188}",
+                            g.albedo[i]
+                        );
                     }
                 }
                 NO_HIT => {
                     counts[2] += 1;
                     assert_eq!(g.depth[i], f32::INFINITY);
                     assert_eq!(g.primitive_id[i], NO_HIT);
-                    assert!(ground.x.abs() >= 1.0 - 1e-3 || ground.z.abs() >= 1.0 - 1e-3, "pixel ({x},{y}) should see the plane");
+                    assert!(
+                        ground.x.abs() >= 1.0 - 1e-3 || ground.z.abs() >= 1.0 - 1e-3,
+                        "pixel ({x},{y}) should see the plane"
+                    );
                 }
                 other => panic!("instance id {other}"),
             }
@@ -628,7 +799,11 @@ fn gbuffer_of_a_known_plane_and_motion_of_a_moved_instance() {
             }
             _ => Vec2::ZERO,
         };
-        assert!(Vec2::from(g.motion[i]).abs_diff_eq(expected, 2e-3), "motion at ({x},{y}): {:?} vs {expected}", g.motion[i]);
+        assert!(
+            Vec2::from(g.motion[i]).abs_diff_eq(expected, 2e-3),
+            "motion at ({x},{y}): {:?} vs {expected}",
+            g.motion[i]
+        );
     }
     assert!(moved > 20);
 
@@ -650,7 +825,11 @@ fn gbuffer_of_a_known_plane_and_motion_of_a_moved_instance() {
         let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
         let p = moved_camera.position + now.ray_direction(centre, W, H) * g.depth[i];
         let expected = basis.project(p, W, H).unwrap() - centre;
-        assert!(Vec2::from(g.motion[i]).abs_diff_eq(expected, 5e-3), "camera motion at ({x},{y}): {:?} vs {expected}", g.motion[i]);
+        assert!(
+            Vec2::from(g.motion[i]).abs_diff_eq(expected, 5e-3),
+            "camera motion at ({x},{y}): {:?} vs {expected}",
+            g.motion[i]
+        );
         checked += 1;
     }
     assert!(checked > 100);
@@ -660,12 +839,25 @@ fn gbuffer_of_a_known_plane_and_motion_of_a_moved_instance() {
 fn bad_settings_and_scenes_are_refused() {
     let scene = ground_scene(0.5, top_down_camera(2.0));
     let huge = gpu().limits.max_texture_dimension_2d + 1;
-    let err = PathTracer::new(gpu(), &scene, PathTracerSettings { width: huge, height: 4, max_depth: 1, rr_start_depth: 1 }).err().expect("oversize refused").to_string();
+    let err = PathTracer::new(
+        gpu(),
+        &scene,
+        PathTracerSettings { width: huge, height: 4, max_depth: 1, rr_start_depth: 1 },
+    )
+    .err()
+    .expect("oversize refused")
+    .to_string();
     assert!(err.contains("image width"), "{err}");
-    let err = PathTracer::new(gpu(), &scene, PathTracerSettings { max_depth: 0, ..settings(1) }).err().expect("depth 0 refused").to_string();
+    let err = PathTracer::new(gpu(), &scene, PathTracerSettings { max_depth: 0, ..settings(1) })
+        .err()
+        .expect("depth 0 refused")
+        .to_string();
     assert!(err.contains("max_depth"), "{err}");
     let mut bad = scene.clone();
     bad.materials[0].base_color_texture = Some(3);
-    let err = PathTracer::new(gpu(), &bad, settings(1)).err().expect("dangling texture refused").to_string();
+    let err = PathTracer::new(gpu(), &bad, settings(1))
+        .err()
+        .expect("dangling texture refused")
+        .to_string();
     assert!(err.contains("texture 3"), "{err}");
 }

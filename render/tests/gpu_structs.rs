@@ -1,13 +1,15 @@
 //! Every struct shared by Rust and WGSL (gpu_struct!) has each field at the same byte offset and
 //! the same size on both sides, as naga lays the WGSL declaration out.
 
-use render::bvh::{SgBvh2Node, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTlasLeaf, SgTriangle, SgVertex};
+use render::bvh::{
+    SgBvh2Node, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTlasLeaf, SgTriangle, SgVertex,
+};
 use render::frame::{CameraFrame, Frame};
-use render::hash_cache::{HashCacheParams, HcRecord};
-use render::path_tracer::GBufferTexel;
 use render::gpu_struct::GpuStruct;
-use render::materials::GpuMaterial;
+use render::hash_cache::{HashCacheParams, HcRecord};
 use render::lights::GpuLight;
+use render::materials::GpuMaterial;
+use render::path_tracer::GBufferTexel;
 use render::sample_cache::{SscParams, SscPixel, SscSlot};
 use render::taa::{TaaParams, TaaPrimary};
 use render::termination::cache::{TcParams, TcRecord, TcVertex};
@@ -62,7 +64,10 @@ render::gpu_struct! {
 #[test]
 fn a_layout_mismatch_is_found() {
     let found = mismatches::<Misaligned>("");
-    assert!(found.iter().any(|m| m.contains("Misaligned.b") && m.contains("offset 12")), "{found:?}");
+    assert!(
+        found.iter().any(|m| m.contains("Misaligned.b") && m.contains("offset 12")),
+        "{found:?}"
+    );
     let _ = Misaligned { a: [0.0; 3], b: [0.0; 3] };
 }
 
@@ -74,5 +79,8 @@ fn declarations_name_every_field() {
         "{}",
         Frame::WGSL
     );
-    assert!(Frame::WGSL.contains("    max_depth: u32,") && Frame::WGSL.contains("    rr_start_depth: u32,"));
+    assert!(
+        Frame::WGSL.contains("    max_depth: u32,")
+            && Frame::WGSL.contains("    rr_start_depth: u32,")
+    );
 }

@@ -7,9 +7,9 @@ mod common;
 use common::{H, W, gpu, room_scene};
 use glam::{Mat4, Vec3};
 use render::compute::BufferBinding;
-use render::scene_features::SceneFeatures;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::{Instance, Light, SceneDesc, Texture};
+use render::scene_features::SceneFeatures;
 use render::taa::Taa;
 
 fn settings() -> PathTracerSettings {
@@ -27,9 +27,16 @@ fn open_scene() -> SceneDesc {
 fn lit_open_scene() -> SceneDesc {
     let mut scene = open_scene();
     scene.environment = Vec3::splat(0.3);
-    scene.lights.push(Light::Point { position: Vec3::new(1.0, 1.0, 1.0), intensity: Vec3::splat(2.0) });
+    scene
+        .lights
+        .push(Light::Point { position: Vec3::new(1.0, 1.0, 1.0), intensity: Vec3::splat(2.0) });
     let (dark, light) = ([40u8, 40, 40, 255], [220u8, 220, 220, 255]);
-    scene.textures.push(Texture { name: "checker".into(), width: 2, height: 2, rgba8: [dark, light, light, dark].concat() });
+    scene.textures.push(Texture {
+        name: "checker".into(),
+        width: 2,
+        height: 2,
+        rgba8: [dark, light, light, dark].concat(),
+    });
     scene.materials[1].base_color_texture = Some(0);
     scene
 }
@@ -38,15 +45,34 @@ fn lit_open_scene() -> SceneDesc {
 fn passes_for_the_scene_s_lights_render_what_passes_for_every_light_do() {
     let mut tracer = PathTracer::new(gpu(), &room_scene(), settings()).expect("tracer");
     let stack = SceneFeatures::stack_for(tracer.geometry().stack_entries());
-    assert!(stack < SceneFeatures::ALL.traversal_stack, "the room's BVH is shallow: {stack} entries");
-    let room = SceneFeatures { analytic_lights: false, emitters: true, environment: false, textures: false, traversal_stack: stack };
-    assert_eq!(tracer.library().features(), room, "the room has only its emissive panel, and no textures");
+    assert!(
+        stack < SceneFeatures::ALL.traversal_stack,
+        "the room's BVH is shallow: {stack} entries"
+    );
+    let room = SceneFeatures {
+        analytic_lights: false,
+        emitters: true,
+        environment: false,
+        textures: false,
+        traversal_stack: stack,
+    };
+    assert_eq!(
+        tracer.library().features(),
+        room,
+        "the room has only its emissive panel, and no textures"
+    );
     let own = tracer.render(gpu(), 4, 7, 0).expect("frame");
-    tracer.library().specialise(gpu(), tracer.scene(), SceneFeatures::ALL).expect("compile for every feature");
+    tracer
+        .library()
+        .specialise(gpu(), tracer.scene(), SceneFeatures::ALL)
+        .expect("compile for every feature");
     assert_eq!(tracer.library().features(), SceneFeatures::ALL);
     let every = tracer.render(gpu(), 4, 7, 0).expect("frame");
     assert!(own.radiance.iter().any(|p| p[0] > 0.0), "the room is lit");
-    assert_eq!(own.radiance, every.radiance, "the estimators of absent lights draw no random numbers and add nothing, and the stack holds what the BVH needs");
+    assert_eq!(
+        own.radiance, every.radiance,
+        "the estimators of absent lights draw no random numbers and add nothing, and the stack holds what the BVH needs"
+    );
 }
 
 #[test]
@@ -59,18 +85,32 @@ fn a_scene_that_gains_features_gets_passes_compiled_for_them() {
         BufferBinding::read_write("taa_primary", "array<TaaPrimary>"),
         BufferBinding::read_write("taa_counters", "array<atomic<u32>>"),
     ];
-    let (_, [before]) = tracer.library_pass(gpu(), "taa_trace.wgsl", Taa::trace_program(), &own, ["taa_trace"]).expect("pass");
+    let (_, [before]) = tracer
+        .library_pass(gpu(), "taa_trace.wgsl", Taa::trace_program(), &own, ["taa_trace"])
+        .expect("pass");
     let held = before.get();
     let dark = tracer.render(gpu(), 4, 7, 0).expect("frame");
 
     tracer.try_update(gpu(), &lit_open_scene()).expect("update");
     let stack = SceneFeatures::stack_for(tracer.geometry().stack_entries());
-    assert_eq!(tracer.library().features(), SceneFeatures { traversal_stack: stack, ..SceneFeatures::ALL });
-    assert!(before.get() != held, "the held pipeline was swapped for one compiled with the new features");
+    assert_eq!(
+        tracer.library().features(),
+        SceneFeatures { traversal_stack: stack, ..SceneFeatures::ALL }
+    );
+    assert!(
+        before.get() != held,
+        "the held pipeline was swapped for one compiled with the new features"
+    );
     let updated = tracer.render(gpu(), 4, 7, 0).expect("frame");
     // A tracer built on the lit scene from the start: its passes were compiled for its features.
-    let fresh = PathTracer::new(gpu(), &lit_open_scene(), settings()).expect("tracer").render(gpu(), 4, 7, 0).expect("frame");
-    assert_eq!(updated.radiance, fresh.radiance, "after the update the passes sample the environment and the point light, and read the texture");
+    let fresh = PathTracer::new(gpu(), &lit_open_scene(), settings())
+        .expect("tracer")
+        .render(gpu(), 4, 7, 0)
+        .expect("frame");
+    assert_eq!(
+        updated.radiance, fresh.radiance,
+        "after the update the passes sample the environment and the point light, and read the texture"
+    );
     assert!(updated.radiance != dark.radiance);
 }
 
@@ -78,13 +118,27 @@ fn a_scene_that_gains_features_gets_passes_compiled_for_them() {
 fn the_traversal_stack_never_shrinks_within_a_run() {
     // 64 boxes in a row: a TLAS some levels deep; then the room's three instances.
     let mut crowd = room_scene();
-    crowd.instances = (0..64).map(|i| Instance { mesh: 1, material: 1, transform: Mat4::from_translation(Vec3::new(i as f32 * 3.0, 0.0, -4.0)) }).collect();
+    crowd.instances = (0..64)
+        .map(|i| Instance {
+            mesh: 1,
+            material: 1,
+            transform: Mat4::from_translation(Vec3::new(i as f32 * 3.0, 0.0, -4.0)),
+        })
+        .collect();
     let mut tracer = PathTracer::new(gpu(), &crowd, settings()).expect("tracer");
     let deep = tracer.geometry().stack_entries();
     assert_eq!(tracer.library().features().traversal_stack, SceneFeatures::stack_for(deep));
     tracer.try_update(gpu(), &room_scene()).expect("update");
-    assert!(tracer.geometry().stack_entries() < deep, "fewer instances, a shallower TLAS: {} against {deep}", tracer.geometry().stack_entries());
-    assert_eq!(tracer.library().features().traversal_stack, SceneFeatures::stack_for(deep), "kept: a TLAS that deepens again needs no new pipelines");
+    assert!(
+        tracer.geometry().stack_entries() < deep,
+        "fewer instances, a shallower TLAS: {} against {deep}",
+        tracer.geometry().stack_entries()
+    );
+    assert_eq!(
+        tracer.library().features().traversal_stack,
+        SceneFeatures::stack_for(deep),
+        "kept: a TLAS that deepens again needs no new pipelines"
+    );
     let frame = tracer.render(gpu(), 1, 7, 0).expect("frame");
     assert!(frame.radiance.iter().any(|p| p[0] > 0.0));
 }

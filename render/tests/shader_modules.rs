@@ -25,21 +25,42 @@ fn imports_resolve_and_entry_points_keep_their_names() {
 
 #[test]
 fn a_missing_import_names_the_module() {
-    let program = Program::new(vec![module("package::a", "fn f() {}\n")]).entry(module("package::main", "import package::a::{g};\n@compute @workgroup_size(1) fn main() { g(); }\n"));
+    let program = Program::new(vec![module("package::a", "fn f() {}\n")]).entry(module(
+        "package::main",
+        "import package::a::{g};\n@compute @workgroup_size(1) fn main() { g(); }\n",
+    ));
     let err = program.compose().expect_err("g is not in package::a").to_string();
     assert!(err.contains("package::main") && err.contains('g'), "{err}");
-    let program = Program::new(vec![]).entry(module("package::main", "import package::nowhere::{g};\n@compute @workgroup_size(1) fn main() { g(); }\n"));
+    let program = Program::new(vec![]).entry(module(
+        "package::main",
+        "import package::nowhere::{g};\n@compute @workgroup_size(1) fn main() { g(); }\n",
+    ));
     let err = program.compose().expect_err("no such module").to_string();
     assert!(err.contains("nowhere"), "{err}");
 }
 
 #[test]
 fn a_group_module_imports_the_structs_its_bindings_name() {
-    let types = module("package::types", "struct Params { n: u32, p0: f32 }\nstruct Slot { v: vec4f }\n");
-    let group = [BufferBinding::uniform("params", "Params"), BufferBinding::read_write("slots", "array<Slot>"), BufferBinding::read_write("counts", "array<atomic<u32>>")];
+    let types =
+        module("package::types", "struct Params { n: u32, p0: f32 }\nstruct Slot { v: vec4f }\n");
+    let group = [
+        BufferBinding::uniform("params", "Params"),
+        BufferBinding::read_write("slots", "array<Slot>"),
+        BufferBinding::read_write("counts", "array<atomic<u32>>"),
+    ];
     let bindings = compute::group_module("package::bindings", 2, &group, &[&types]);
-    assert!(bindings.source.contains("import package::types::{Params, Slot};"), "{}", bindings.source);
-    assert!(bindings.source.contains("@group(2) @binding(1) var<storage, read_write> slots: array<Slot>;"), "{}", bindings.source);
+    assert!(
+        bindings.source.contains("import package::types::{Params, Slot};"),
+        "{}",
+        bindings.source
+    );
+    assert!(
+        bindings
+            .source
+            .contains("@group(2) @binding(1) var<storage, read_write> slots: array<Slot>;"),
+        "{}",
+        bindings.source
+    );
     // A struct member ending in a digit (naga_oil could not import it) survives the link.
     let program = Program::new(vec![types, bindings]).entry(module(
         "package::main",
@@ -52,7 +73,12 @@ fn a_group_module_imports_the_structs_its_bindings_name() {
 
 #[test]
 fn the_shipped_programs_link_to_valid_wgsl() {
-    for program in [render::path_tracer::PathTracer::program(), render::taa::Taa::trace_program(), render::hash_cache::HashCache::program(), render::sample_cache::program()] {
+    for program in [
+        render::path_tracer::PathTracer::program(),
+        render::taa::Taa::trace_program(),
+        render::hash_cache::HashCache::program(),
+        render::sample_cache::program(),
+    ] {
         for (wgsl, file) in program.compose().expect("links").iter().zip(&program.entry_files) {
             if let Err(e) = naga::front::wgsl::parse_str(wgsl) {
                 panic!("{}: {}", file.file, e.emit_to_string(wgsl));

@@ -45,28 +45,51 @@ fn lower_bound(v: &[f64]) -> f64 {
 fn flash_relations_of_table_7_3() {
     let base = frame(DynamicTest::Flash, W, H, 0, D_REL);
     assert_eq!(flash_intensity(0), 1.0);
-    let reference_settings = SssSettings { variant: SssVariant::Fixed { count: 2048 }, fast_inverse: false, seed: 1000, ..Default::default() };
-    let reference: Vec<[f32; 3]> = step(&base, &reference_settings, 0, &[]).0.iter().map(|r| r.rgb).collect();
+    let reference_settings = SssSettings {
+        variant: SssVariant::Fixed { count: 2048 },
+        fast_inverse: false,
+        seed: 1000,
+        ..Default::default()
+    };
+    let reference: Vec<[f32; 3]> =
+        step(&base, &reference_settings, 0, &[]).0.iter().map(|r| r.rgb).collect();
     let peak = 2.0 * reference.iter().map(|r| luminance(*r) as f64).fold(0.0, f64::max);
-    let variants = [SssVariant::Fixed { count: 64 }, SssVariant::Adaptive, SssVariant::OnlineCv, SssVariant::ConstantCv];
+    let variants = [
+        SssVariant::Fixed { count: 64 },
+        SssVariant::Adaptive,
+        SssVariant::OnlineCv,
+        SssVariant::ConstantCv,
+    ];
     let mut measured = vec![vec![]; variants.len()];
     for seed in 1..=3 {
         for (k, v) in variants.iter().enumerate() {
             let m = run(*v, seed, &reference, peak);
-            eprintln!("seed {seed} {v:?}: mean spp {:.2}, PSNR {:.2} dB, SMAPE {:.4}", m.mean_spp, m.psnr_db, m.smape);
+            eprintln!(
+                "seed {seed} {v:?}: mean spp {:.2}, PSNR {:.2} dB, SMAPE {:.4}",
+                m.mean_spp, m.psnr_db, m.smape
+            );
             assert!(m.count_image.iter().all(|&c| c == 0.0 || (8.0..=64.0).contains(&c)));
             measured[k].push(m);
         }
     }
-    let per_seed = |k: usize, f: &dyn Fn(&RunMeasures) -> f64| measured[k].iter().map(f).collect::<Vec<_>>();
+    let per_seed =
+        |k: usize, f: &dyn Fn(&RunMeasures) -> f64| measured[k].iter().map(f).collect::<Vec<_>>();
     let (fixed, adaptive, ocv) = (0, 1, 2);
     // AS reaches the fixed-64 PSNR within 1 dB ...
-    let psnr_gap: Vec<f64> = per_seed(adaptive, &|m| m.psnr_db).iter().zip(per_seed(fixed, &|m| m.psnr_db)).map(|(a, f)| a - f + 1.0).collect();
+    let psnr_gap: Vec<f64> = per_seed(adaptive, &|m| m.psnr_db)
+        .iter()
+        .zip(per_seed(fixed, &|m| m.psnr_db))
+        .map(|(a, f)| a - f + 1.0)
+        .collect();
     assert!(lower_bound(&psnr_gap) > 0.0, "AS PSNR + 1 dB − fixed-64 PSNR per seed: {psnr_gap:?}");
     // ... with fewer mean samples.
     let saved: Vec<f64> = per_seed(adaptive, &|m| 64.0 - m.mean_spp);
     assert!(lower_bound(&saved) > 0.0, "64 − AS mean spp per seed: {saved:?}");
     // OCV needs no more mean samples than AS at equal target.
-    let ocv_saved: Vec<f64> = per_seed(adaptive, &|m| m.mean_spp).iter().zip(per_seed(ocv, &|m| m.mean_spp)).map(|(a, o)| a - o).collect();
+    let ocv_saved: Vec<f64> = per_seed(adaptive, &|m| m.mean_spp)
+        .iter()
+        .zip(per_seed(ocv, &|m| m.mean_spp))
+        .map(|(a, o)| a - o)
+        .collect();
     assert!(lower_bound(&ocv_saved) >= 0.0, "AS − OCV mean spp per seed: {ocv_saved:?}");
 }

@@ -24,7 +24,8 @@ fn frame(f: impl Fn(f32, f32) -> f32) -> SssFrame {
 #[test]
 fn prefiltering_is_exact_on_a_linear_irradiance() {
     let ramp = frame(|x, y| 0.2 + 0.01 * x + 0.004 * y);
-    let plain = SssSettings { variant: SssVariant::Fixed { count: 32 }, seed: 5, ..Default::default() };
+    let plain =
+        SssSettings { variant: SssVariant::Fixed { count: 32 }, seed: 5, ..Default::default() };
     let afis = SssSettings { prefilter: Some(Prefilter { a: 1.0 / 16.0, levels: 5 }), ..plain };
     let chain = mip_chain(&ramp, &afis).expect("a chain");
     assert_eq!(chain.levels.len(), 5);
@@ -37,13 +38,22 @@ fn prefiltering_is_exact_on_a_linear_irradiance() {
         let a = scatter(&ramp, &plain, None, 3, x, y, 32);
         let b = scatter(&ramp, &afis, Some(&chain), 3, x, y, 32);
         for c in 0..3 {
-            assert!((a[c] - b[c]).abs() <= 2e-5 * a[c].abs(), "pixel ({x}, {y}) channel {c}: plain {a:?} afis {b:?}");
+            assert!(
+                (a[c] - b[c]).abs() <= 2e-5 * a[c].abs(),
+                "pixel ({x}, {y}) channel {c}: plain {a:?} afis {b:?}"
+            );
         }
         largest_level_gap = largest_level_gap.max((a[0] - b[0]).abs());
     }
     // The samples did read levels above 0 (else the comparison proves nothing): at n = 32 and
     // d = 0.6 px a tail sample stands for far more than a/4 texels.
-    let tail = render::sss::prefilter::level(8.0, render::sss::sampling::radial_pdf(8.0, 0.6), 32, 1.0 / 16.0, 5);
+    let tail = render::sss::prefilter::level(
+        8.0,
+        render::sss::sampling::radial_pdf(8.0, 0.6),
+        32,
+        1.0 / 16.0,
+        5,
+    );
     assert!(tail > 2.0, "tail level {tail}");
     eprintln!("largest plain/afis gap on the ramp: {largest_level_gap}");
 }
@@ -51,7 +61,8 @@ fn prefiltering_is_exact_on_a_linear_irradiance() {
 #[test]
 fn prefiltering_blurs_an_edge() {
     let edge = frame(|x, _| if x < 48.0 { 1.0 } else { 0.1 });
-    let plain = SssSettings { variant: SssVariant::Fixed { count: 32 }, seed: 5, ..Default::default() };
+    let plain =
+        SssSettings { variant: SssVariant::Fixed { count: 32 }, seed: 5, ..Default::default() };
     let afis = SssSettings { prefilter: Some(Prefilter::default()), ..plain };
     let chain = mip_chain(&edge, &afis).expect("a chain");
     let a = scatter(&edge, &plain, None, 3, 46, 40, 32);

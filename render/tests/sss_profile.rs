@@ -24,8 +24,23 @@ fn cdf_matches_numeric_integration_of_the_profile() {
         let p = BurleyProfile { albedo: 0.8, d };
         for r0 in [0.01 * d, 0.3 * d, d, 4.0 * d, 20.0 * d] {
             // ∫_0^{r0} 2πr R(r) dr / A; R's 1/r cancels against 2πr, no singularity.
-            let integral = simpson(|r| if r == 0.0 { 2.0 * PI * p.albedo * 2.0 / (8.0 * PI * d) } else { 2.0 * PI * r * p.reflectance(r) }, 0.0, r0, 2000) / p.albedo;
-            assert!((integral - cdf(r0, d)).abs() < 1e-10, "d {d} r0 {r0}: integral {integral} vs cdf {}", cdf(r0, d));
+            let integral = simpson(
+                |r| {
+                    if r == 0.0 {
+                        2.0 * PI * p.albedo * 2.0 / (8.0 * PI * d)
+                    } else {
+                        2.0 * PI * r * p.reflectance(r)
+                    }
+                },
+                0.0,
+                r0,
+                2000,
+            ) / p.albedo;
+            assert!(
+                (integral - cdf(r0, d)).abs() < 1e-10,
+                "d {d} r0 {r0}: integral {integral} vs cdf {}",
+                cdf(r0, d)
+            );
         }
         assert_eq!(cdf(0.0, d), 0.0);
     }
@@ -36,11 +51,15 @@ fn profile_integrates_to_the_albedo() {
     for (albedo, d) in [(0.2, 0.05), (0.8, 1.0), (0.99, 7.5)] {
         let p = BurleyProfile { albedo, d };
         // Split at 5d to resolve the fast exponential; the tail past 120d is e^-40.
-        let f = |r: f64| if r == 0.0 { albedo / (2.0 * d) } else { 2.0 * PI * r * p.reflectance(r) };
+        let f =
+            |r: f64| if r == 0.0 { albedo / (2.0 * d) } else { 2.0 * PI * r * p.reflectance(r) };
         let total = simpson(f, 0.0, 5.0 * d, 2000) + simpson(f, 5.0 * d, 120.0 * d, 4000);
         assert!((total - albedo).abs() < 1e-9 * albedo.max(1.0), "A {albedo} d {d}: {total}");
         // The radial density is the normalised profile.
-        assert!((p.radial_pdf(0.7 * d) * albedo - 2.0 * PI * 0.7 * d * p.reflectance(0.7 * d)).abs() < 1e-12 / d);
+        assert!(
+            (p.radial_pdf(0.7 * d) * albedo - 2.0 * PI * 0.7 * d * p.reflectance(0.7 * d)).abs()
+                < 1e-12 / d
+        );
     }
 }
 
@@ -84,7 +103,9 @@ fn fast_inverse_error_stays_under_the_stated_bound() {
                 worst_r = worst_r.max((g - exact).abs() / exact);
             }
         }
-        eprintln!("d {d}: max |cdf(g) - u| {worst_cdf:.5}, max relative radius error (u <= 0.99) {worst_r:.5}");
+        eprintln!(
+            "d {d}: max |cdf(g) - u| {worst_cdf:.5}, max relative radius error (u <= 0.99) {worst_r:.5}"
+        );
         assert!(worst_cdf <= FAST_CDF_ERROR, "d {d}: {worst_cdf}");
         assert!(worst_r <= FAST_RADIUS_ERROR, "d {d}: {worst_r}");
         // It is an approximation, not the inverse: the error is not negligible either.
@@ -99,9 +120,19 @@ fn f32_sampler_matches_the_f64_inverses() {
             let u = i as f32 / 100.0;
             let exact = analytic_inverse(u as f64, d as f64);
             let fast = fast_inverse(u as f64, d as f64);
-            assert!(((sample_radius(u, d, false) as f64) - exact).abs() < 2e-5 * exact.max(d as f64), "u {u}");
-            assert!(((sample_radius(u, d, true) as f64) - fast).abs() < 2e-6 * fast.max(d as f64), "u {u}");
-            assert!((render::sss::sampling::radial_pdf(u, d) as f64 - radial_pdf(u as f64, d as f64)).abs() < 1e-6);
+            assert!(
+                ((sample_radius(u, d, false) as f64) - exact).abs() < 2e-5 * exact.max(d as f64),
+                "u {u}"
+            );
+            assert!(
+                ((sample_radius(u, d, true) as f64) - fast).abs() < 2e-6 * fast.max(d as f64),
+                "u {u}"
+            );
+            assert!(
+                (render::sss::sampling::radial_pdf(u, d) as f64 - radial_pdf(u as f64, d as f64))
+                    .abs()
+                    < 1e-6
+            );
         }
     }
 }

@@ -3,7 +3,10 @@
 //! reflectance 1 − H(1)√(1 − α) of the half-space, and its mean over the cosines of a point
 //! light, over 3 seeds each.
 
-use render::sss::random_walk::{Medium, gauss_legendre_unit, h_function, plane_albedo, point_light, point_light_burley, searchlight};
+use render::sss::random_walk::{
+    Medium, gauss_legendre_unit, h_function, plane_albedo, point_light, point_light_burley,
+    searchlight,
+};
 
 #[test]
 fn quadrature_and_h_function() {
@@ -31,8 +34,16 @@ fn walk_meets_the_single_scattering_and_plane_albedo_limits() {
     for seed in 1..=3 {
         for alpha in [0.3, 0.9, 0.99] {
             let t = searchlight(&Medium::unit(alpha), 40_000, seed, 0.1, 10);
-            within(&format!("α {alpha} seed {seed}: single scattering"), t.single_scattering(), alpha * (1.0 - 2f64.ln()) / 2.0);
-            within(&format!("α {alpha} seed {seed}: plane albedo"), t.reflectance(), plane_albedo(alpha, 1.0));
+            within(
+                &format!("α {alpha} seed {seed}: single scattering"),
+                t.single_scattering(),
+                alpha * (1.0 - 2f64.ln()) / 2.0,
+            );
+            within(
+                &format!("α {alpha} seed {seed}: plane albedo"),
+                t.reflectance(),
+                plane_albedo(alpha, 1.0),
+            );
         }
     }
 }
@@ -45,7 +56,11 @@ fn point_light_walk_meets_the_spherical_albedo() {
         for alpha in [0.5, 0.95] {
             let t = point_light(&Medium::unit(alpha), 2.0, 40_000, seed, 0.5, 20);
             let s = (1.0f64 - alpha).sqrt();
-            within(&format!("α {alpha} seed {seed}: point light"), t.reflectance(), 1.0 - 2.0 * s * (1.0 - s) / alpha);
+            within(
+                &format!("α {alpha} seed {seed}: point light"),
+                t.reflectance(),
+                1.0 - 2.0 * s * (1.0 - s) / alpha,
+            );
         }
     }
     // The model's tally: weight A per photon, so its reflectance is A exactly.

@@ -18,7 +18,8 @@ fn projected_tail(a: f64, d: f64) -> f64 {
     let h = s_max / n as f64;
     let f = |s: f64| {
         let r = a + s * s;
-        let angular = if r <= 0.0 { 0.0 } else { 1.0 - 2.0 / std::f64::consts::PI * (a / r).min(1.0).asin() };
+        let angular =
+            if r <= 0.0 { 0.0 } else { 1.0 - 2.0 / std::f64::consts::PI * (a / r).min(1.0).asin() };
         radial_pdf(r, d) * angular * 2.0 * s
     };
     let mut sum = f(0.0) + f(s_max);
@@ -108,7 +109,10 @@ impl Exact {
         let (n, t_max) = (4000, 40.0 * d);
         let h = 2.0 * t_max / n as f64;
         let cdf: Vec<f64> = (0..=n).map(|j| kernel_cdf(-t_max + j as f64 * h, d)).collect();
-        Self { cells: (0..n).map(|j| (-t_max + (j as f64 + 0.5) * h, cdf[j + 1] - cdf[j])).collect(), tail: cdf[0] }
+        Self {
+            cells: (0..n).map(|j| (-t_max + (j as f64 + 0.5) * h, cdf[j + 1] - cdf[j])).collect(),
+            tail: cdf[0],
+        }
     }
 
     fn at(&self, s: f64) -> f64 {
@@ -127,7 +131,12 @@ fn rank_one_kernel_is_exact_for_a_vertical_edge_not_a_diagonal_one() {
     let margin = 8 * 3 + 1;
     let run = |n: [f64; 2], c: f64| -> (Vec<f64>, Vec<f64>) {
         let frame = edge_frame(size, size, n, c, d_px);
-        let (results, _) = step(&frame, &SssSettings { variant: SssVariant::Separable { taps }, ..Default::default() }, 0, &[]);
+        let (results, _) = step(
+            &frame,
+            &SssSettings { variant: SssVariant::Separable { taps }, ..Default::default() },
+            0,
+            &[],
+        );
         let (mut errors, mut bounds) = (vec![], vec![]);
         for y in margin..size - margin {
             for x in margin..size - margin {
@@ -139,8 +148,18 @@ fn rank_one_kernel_is_exact_for_a_vertical_edge_not_a_diagonal_one() {
                     // For an edge along y the pass is one 1-D sum: it differs from the integral
                     // by at most Σ_i w_i × b's oscillation over tap i's cell, plus the linear
                     // fetch's error |b''|/8 and the f32 arithmetic.
-                    let edge = |i: usize| if i == 0 { f64::NEG_INFINITY } else if i == offsets.len() { f64::INFINITY } else { 0.5 * (offsets[i - 1] + offsets[i]) };
-                    let cells: f64 = (0..offsets.len()).map(|i| k[i][ch + 1] as f64 * (b(s - edge(i)) - b(s - edge(i + 1))).abs()).sum();
+                    let edge = |i: usize| {
+                        if i == 0 {
+                            f64::NEG_INFINITY
+                        } else if i == offsets.len() {
+                            f64::INFINITY
+                        } else {
+                            0.5 * (offsets[i - 1] + offsets[i])
+                        }
+                    };
+                    let cells: f64 = (0..offsets.len())
+                        .map(|i| k[i][ch + 1] as f64 * (b(s - edge(i)) - b(s - edge(i + 1))).abs())
+                        .sum();
                     bounds.push(cells + b_curvature() / 8.0 + 1e-5);
                 }
             }
@@ -152,12 +171,23 @@ fn rank_one_kernel_is_exact_for_a_vertical_edge_not_a_diagonal_one() {
     for (e, b) in e_vertical.iter().zip(&bound) {
         assert!(e <= b, "vertical edge: error {e} over the discretisation bound {b}");
     }
-    let (e_diagonal, _) = run([std::f64::consts::FRAC_1_SQRT_2; 2], half * std::f64::consts::SQRT_2);
+    let (e_diagonal, _) =
+        run([std::f64::consts::FRAC_1_SQRT_2; 2], half * std::f64::consts::SQRT_2);
     let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
-    eprintln!("separable vs exact: vertical edge max {:.5} (bound max {:.5}), diagonal edge max {:.5}", max(&e_vertical), max(&bound), max(&e_diagonal));
+    eprintln!(
+        "separable vs exact: vertical edge max {:.5} (bound max {:.5}), diagonal edge max {:.5}",
+        max(&e_vertical),
+        max(&bound),
+        max(&e_diagonal)
+    );
     // k(x)k(y) is not radially symmetric: along the diagonal it scatters differently (the
     // separable filter's anisotropy).
-    assert!(max(&e_diagonal) > 2.0 * max(&e_vertical), "diagonal {} vertical {}", max(&e_diagonal), max(&e_vertical));
+    assert!(
+        max(&e_diagonal) > 2.0 * max(&e_vertical),
+        "diagonal {} vertical {}",
+        max(&e_diagonal),
+        max(&e_vertical)
+    );
 }
 
 #[test]
@@ -177,7 +207,8 @@ fn gpu_separable_matches_the_cpu_twin() {
     let frame = SssFrame { width: w, height: h, irradiance, d_px: [1.5, 0.8, 0.4] };
     let mut pass = SssPass::new(&gpu, w, h).unwrap();
     for taps in [5, 25] {
-        let settings = SssSettings { variant: SssVariant::Separable { taps }, ..Default::default() };
+        let settings =
+            SssSettings { variant: SssVariant::Separable { taps }, ..Default::default() };
         pass.dispatch(&gpu, &frame, &settings, 0).unwrap();
         let gpu_results = pass.results(&gpu).unwrap();
         let (cpu_results, _) = step(&frame, &settings, 0, &[]);
@@ -185,13 +216,32 @@ fn gpu_separable_matches_the_cpu_twin() {
         for (i, (g, c)) in gpu_results.iter().zip(&cpu_results).enumerate() {
             assert_eq!(g.count, c.count, "taps {taps} pixel {i}");
             for ch in 0..3 {
-                assert!((g.rgb[ch] - c.rgb[ch]).abs() <= 1e-4 * g.rgb[ch].abs().max(c.rgb[ch].abs()) + 1e-6, "taps {taps} pixel {i}: gpu {:?} cpu {:?}", g.rgb, c.rgb);
+                assert!(
+                    (g.rgb[ch] - c.rgb[ch]).abs()
+                        <= 1e-4 * g.rgb[ch].abs().max(c.rgb[ch].abs()) + 1e-6,
+                    "taps {taps} pixel {i}: gpu {:?} cpu {:?}",
+                    g.rgb,
+                    c.rgb
+                );
             }
             if (c.rgb[0] - frame.irradiance[i][0]).abs() > 1e-3 {
                 differs_from_input += 1;
             }
         }
-        assert!(differs_from_input > 20, "taps {taps}: the pass changed only {differs_from_input} pixels");
+        assert!(
+            differs_from_input > 20,
+            "taps {taps}: the pass changed only {differs_from_input} pixels"
+        );
     }
-    assert!(pass.dispatch(&gpu, &frame, &SssSettings { variant: SssVariant::Separable { taps: 4 }, ..Default::default() }, 0).unwrap_err().to_string().contains("odd"));
+    assert!(
+        pass.dispatch(
+            &gpu,
+            &frame,
+            &SssSettings { variant: SssVariant::Separable { taps: 4 }, ..Default::default() },
+            0
+        )
+        .unwrap_err()
+        .to_string()
+        .contains("odd")
+    );
 }

@@ -39,14 +39,18 @@ fn mean(v: &[u32]) -> f64 {
 fn counts_stay_clamped_rise_after_a_variance_step_and_fall_back() {
     let s = SpvgSettings::default();
     // Per-sample variance 4e-4 needs 4 samples for σ0² = 1e-4 (clamped to 8); 4e-3 needs 40.
-    let schedule: Vec<f64> = (0..300).map(|t| if (100..200).contains(&t) { 4e-3 } else { 4e-4 }).collect();
+    let schedule: Vec<f64> =
+        (0..300).map(|t| if (100..200).contains(&t) { 4e-3 } else { 4e-4 }).collect();
     for seed in 1..=3 {
         let counts = run_pixel(&schedule, &s, seed);
         assert!(counts.iter().all(|&n| (8..=64).contains(&n)), "seed {seed}: {counts:?}");
         // The first frame is a cold start: no history, n_min (Fig. 4.3, no initial overshoot).
         assert_eq!(counts[0], 8);
-        let (before, during, after) = (mean(&counts[70..100]), mean(&counts[150..200]), mean(&counts[270..300]));
-        eprintln!("seed {seed}: mean count before {before:.1}, during {during:.1}, after {after:.1}");
+        let (before, during, after) =
+            (mean(&counts[70..100]), mean(&counts[150..200]), mean(&counts[270..300]));
+        eprintln!(
+            "seed {seed}: mean count before {before:.1}, during {during:.1}, after {after:.1}"
+        );
         assert!(before < 10.0, "seed {seed}: {before}");
         // n ≈ v/σ0² = 40 at equilibrium: well above the floor.
         assert!(during > 25.0 && during > 2.5 * before, "seed {seed}: {during} vs {before}");
@@ -72,7 +76,8 @@ fn disocclusion_resets_the_history() {
     assert_eq!(spvg::sample_count(&spvg::state(&after, &s), &s), 8);
 
     // Through the pass: a pixel that leaves the SSS mask for a frame comes back at n_min.
-    let mut frame = SssFrame { width: 4, height: 1, irradiance: vec![[1.0, 1.0, 1.0, 1.0]; 4], d_px: [0.5; 3] };
+    let mut frame =
+        SssFrame { width: 4, height: 1, irradiance: vec![[1.0, 1.0, 1.0, 1.0]; 4], d_px: [0.5; 3] };
     let settings = SssSettings::default();
     let hot = PixelHistory { spvg: busy, ..Default::default() };
     let (r, h) = step(&frame, &settings, 0, &[hot; 4]);
@@ -110,7 +115,15 @@ fn emc_is_the_exponentially_weighted_covariance() {
     let mut emc = EmCovariance::start(xs[0] as f32, ys[0] as f32);
     for t in 1..xs.len() {
         emc = emc.update(alpha as f32, xs[t] as f32, ys[t] as f32);
-        let w: Vec<f64> = (0..=t).map(|i| if i == 0 { (1.0 - alpha).powi(t as i32) } else { alpha * (1.0 - alpha).powi((t - i) as i32) }).collect();
+        let w: Vec<f64> = (0..=t)
+            .map(|i| {
+                if i == 0 {
+                    (1.0 - alpha).powi(t as i32)
+                } else {
+                    alpha * (1.0 - alpha).powi((t - i) as i32)
+                }
+            })
+            .collect();
         let mx: f64 = (0..=t).map(|i| w[i] * xs[i]).sum();
         let my: f64 = (0..=t).map(|i| w[i] * ys[i]).sum();
         let cov: f64 = (0..=t).map(|i| w[i] * (xs[i] - mx) * (ys[i] - my)).sum();
@@ -181,7 +194,12 @@ fn eq_2_18_optimum_has_var_g_in_the_denominator() {
         assert!(residual(right) < residual(right + step), "a {right} vs {}", right + step);
     }
     assert!((right - 2.0).abs() < 0.02, "{right}");
-    assert!(residual(printed) > 10.0 * residual(right), "printed a {printed}: {} vs {}", residual(printed), residual(right));
+    assert!(
+        residual(printed) > 10.0 * residual(right),
+        "printed a {printed}: {} vs {}",
+        residual(printed),
+        residual(right)
+    );
     // Eq. 2.19 holds at the right optimum: Var = (1 − Corr²) Var(F).
     let corr2 = cov * cov / (var_f * var_g);
     assert!((residual(right) - (1.0 - corr2) * var_f).abs() < 1e-9);

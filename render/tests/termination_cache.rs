@@ -4,13 +4,20 @@
 
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::SceneDesc;
-use render::termination::{TerminationCache, TerminationOutput, TerminationRule, TerminationSettings};
+use render::termination::{
+    TerminationCache, TerminationOutput, TerminationRule, TerminationSettings,
+};
 
 mod common;
 use common::{H, W, furnace, gpu, room_scene};
 
 fn tracer(scene: &SceneDesc, max_depth: u32) -> PathTracer {
-    PathTracer::new(gpu(), scene, PathTracerSettings { width: W, height: H, max_depth, rr_start_depth: max_depth + 1 }).expect("path tracer")
+    PathTracer::new(
+        gpu(),
+        scene,
+        PathTracerSettings { width: W, height: H, max_depth, rr_start_depth: max_depth + 1 },
+    )
+    .expect("path tracer")
 }
 
 fn settings(rule: TerminationRule) -> TerminationSettings {
@@ -18,7 +25,12 @@ fn settings(rule: TerminationRule) -> TerminationSettings {
 }
 
 /// `frames` frames of one rule (the first after the warm-up).
-fn run(pt: &PathTracer, scene: &SceneDesc, rule: TerminationRule, frames: u32) -> Vec<TerminationOutput> {
+fn run(
+    pt: &PathTracer,
+    scene: &SceneDesc,
+    rule: TerminationRule,
+    frames: u32,
+) -> Vec<TerminationOutput> {
     let mut cache = TerminationCache::new(gpu(), pt, settings(rule)).expect("termination cache");
     (0..frames).map(|f| cache.render(gpu(), pt, &scene.camera, 5, f).expect("render")).collect()
 }
@@ -35,22 +47,36 @@ fn furnace_radiance_through_the_cache_for_every_rule() {
     // Walls of albedo 0.5 emitting 0.5: L = 1 everywhere; the cache holds 0.5 (emission apart).
     let (scene, expected) = furnace();
     let pt = tracer(&scene, 12);
-    let rules = [TerminationRule::FirstVertex, TerminationRule::VarianceBounding { t: 0.01, relative: false }, TerminationRule::MseMinimisation { s: 100.0, margin: 1.1, bias_clamp: 0.1 }, TerminationRule::AreaSpread { c: 0.01 }];
+    let rules = [
+        TerminationRule::FirstVertex,
+        TerminationRule::VarianceBounding { t: 0.01, relative: false },
+        TerminationRule::MseMinimisation { s: 100.0, margin: 1.1, bias_clamp: 0.1 },
+        TerminationRule::AreaSpread { c: 0.01 },
+    ];
     for rule in rules {
         let out = run(&pt, &scene, rule, 2);
         let mean = image_mean(&out[1].radiance);
         eprintln!("{rule:?}: furnace image mean {mean}");
         // 12 bounces of path tracing lose 0.5^12 of L; the cache converges to the same within
         // its 32 warm-up propagations. 3 % covers 1 spp noise over 576 pixels.
-        assert!((mean - expected as f64).abs() < 0.03, "{rule:?}: image mean {mean}, expected {expected}");
+        assert!(
+            (mean - expected as f64).abs() < 0.03,
+            "{rule:?}: image mean {mean}, expected {expected}"
+        );
         // After the warm-up nearly every vertex finds a filled record (the others path trace).
         eprintln!("{rule:?}: {:?}", out[1].stats);
-        assert!(out[1].stats.unknown * 20 <= W * H, "{rule:?}: {} vertices without a filled record", out[1].stats.unknown);
+        assert!(
+            out[1].stats.unknown * 20 <= W * H,
+            "{rule:?}: {} vertices without a filled record",
+            out[1].stats.unknown
+        );
     }
     // Uniform lighting: the record's squared bias is noise around zero, small next to E[Y]².
-    let mut cache = TerminationCache::new(gpu(), &pt, settings(TerminationRule::FirstVertex)).unwrap();
+    let mut cache =
+        TerminationCache::new(gpu(), &pt, settings(TerminationRule::FirstVertex)).unwrap();
     cache.render(gpu(), &pt, &scene.camera, 5, 0).unwrap();
-    let records: Vec<_> = cache.read_records(gpu()).unwrap().into_iter().filter(|r| r.vertices > 0.0).collect();
+    let records: Vec<_> =
+        cache.read_records(gpu()).unwrap().into_iter().filter(|r| r.vertices > 0.0).collect();
     assert!(records.len() > 20, "only {} filled records", records.len());
     let (mut bias, mut mean2) = (0.0, 0.0);
     for r in &records {
@@ -78,7 +104,8 @@ fn the_ends_path_tracing_and_first_vertex() {
     // frames against 8 spp of PathTracer, within 4 standard errors of the difference.
     let mut ours = vec![0.0f64; (W * H) as usize];
     let theirs = pt_mean_image(&pt, 8);
-    let mut cache = TerminationCache::new(gpu(), &pt, settings(TerminationRule::PathTracing)).unwrap();
+    let mut cache =
+        TerminationCache::new(gpu(), &pt, settings(TerminationRule::PathTracing)).unwrap();
     let mut per_frame = Vec::new();
     for f in 0..8 {
         let out = cache.render(gpu(), &pt, &scene.camera, 5, 100 + f).unwrap();
@@ -87,24 +114,44 @@ fn the_ends_path_tracing_and_first_vertex() {
             *o += (c[0] + c[1] + c[2]) as f64 / 3.0 / 8.0;
         }
     }
-    let (m_ours, m_theirs) = (ours.iter().sum::<f64>() / ours.len() as f64, theirs.iter().sum::<f64>() / theirs.len() as f64);
+    let (m_ours, m_theirs) = (
+        ours.iter().sum::<f64>() / ours.len() as f64,
+        theirs.iter().sum::<f64>() / theirs.len() as f64,
+    );
     let mean_pf = per_frame.iter().sum::<f64>() / 8.0;
-    let se = (per_frame.iter().map(|v| (v - mean_pf) * (v - mean_pf)).sum::<f64>() / 7.0 / 8.0).sqrt();
-    assert!((m_ours - m_theirs).abs() < 4.0 * se * 2f64.sqrt() + 1e-6, "path tracing rule {m_ours} vs PathTracer {m_theirs} (se {se})");
+    let se =
+        (per_frame.iter().map(|v| (v - mean_pf) * (v - mean_pf)).sum::<f64>() / 7.0 / 8.0).sqrt();
+    assert!(
+        (m_ours - m_theirs).abs() < 4.0 * se * 2f64.sqrt() + 1e-6,
+        "path tracing rule {m_ours} vs PathTracer {m_theirs} (se {se})"
+    );
     // t = 0 terminates at the first vertex: the first-vertex image, path length 1 where a
     // record exists.
     let first = run(&pt, &scene, TerminationRule::FirstVertex, 2);
     let zero = run(&pt, &scene, VB_ZERO, 2);
     let same = first[1].radiance.iter().zip(&zero[1].radiance).filter(|(x, y)| x == y).count();
-    assert!(same as f64 >= 0.99 * (W * H) as f64, "t = 0 equals first vertex at {same} of {} pixels", W * H);
-    assert!(first[1].mean_path_length <= 1.0 + first[1].stats.unknown as f64 / (W * H) as f64 * 6.0, "first vertex path length {}", first[1].mean_path_length);
+    assert!(
+        same as f64 >= 0.99 * (W * H) as f64,
+        "t = 0 equals first vertex at {same} of {} pixels",
+        W * H
+    );
+    assert!(
+        first[1].mean_path_length <= 1.0 + first[1].stats.unknown as f64 / (W * H) as f64 * 6.0,
+        "first vertex path length {}",
+        first[1].mean_path_length
+    );
     assert!(a[1].mean_path_length > 2.0, "path tracing path length {}", a[1].mean_path_length);
 }
 
 fn pt_mean_image(pt: &PathTracer, spp: u32) -> Vec<f64> {
     let mut pt2 = tracer(&room_scene(), 6);
     let _ = pt;
-    pt2.render(gpu(), spp, 77, 0).unwrap().radiance.iter().map(|c| (c[0] + c[1] + c[2]) as f64 / 3.0).collect()
+    pt2.render(gpu(), spp, 77, 0)
+        .unwrap()
+        .radiance
+        .iter()
+        .map(|c| (c[0] + c[1] + c[2]) as f64 / 3.0)
+        .collect()
 }
 
 #[test]
@@ -125,7 +172,6 @@ fn path_length_grows_with_the_variance_threshold() {
     }
     assert!(lengths[4] > lengths[0] + 1.0, "path length by t: {lengths:?}");
 }
-
 
 #[test]
 fn two_runs_give_the_same_images() {

@@ -1,6 +1,8 @@
 //! The termination decision at one vertex (render::termination::decide) on hand-computed cases.
 
-use render::termination::{Decision, LocalStats, PathState, TerminationRule, arrive_area_spread, decide, path_threshold};
+use render::termination::{
+    Decision, LocalStats, PathState, TerminationRule, arrive_area_spread, decide, path_threshold,
+};
 
 fn stats(variance: f64, bias2: f64, deferred_bias2: f64) -> LocalStats {
     LocalStats { radiance: 2.0, variance, marginal: 1.0, bias2, deferred_bias2 }
@@ -9,7 +11,13 @@ fn stats(variance: f64, bias2: f64, deferred_bias2: f64) -> LocalStats {
 #[test]
 fn variance_bounding_blends_the_overshooting_vertex_with_eq5_alpha() {
     let rule = TerminationRule::VarianceBounding { t: 1.0, relative: false };
-    let mut s = PathState { throughput2: 4.0, path_variance: 0.5, threshold: 1.0, vertex: 2, ..Default::default() };
+    let mut s = PathState {
+        throughput2: 4.0,
+        path_variance: 0.5,
+        threshold: 1.0,
+        vertex: 2,
+        ..Default::default()
+    };
     // P = 4 · 0.1 = 0.4: 0.9 <= 1, continue.
     assert_eq!(decide(&rule, 1.0, &mut s, &stats(0.1, 0.0, 0.0)), Decision::Continue);
     assert!((s.path_variance - 0.9).abs() < 1e-12);
@@ -22,8 +30,14 @@ fn variance_bounding_blends_the_overshooting_vertex_with_eq5_alpha() {
 
 #[test]
 fn relative_threshold_scales_with_the_first_cache_value() {
-    assert_eq!(path_threshold(&TerminationRule::VarianceBounding { t: 0.5, relative: true }, 3.0), 4.5);
-    assert_eq!(path_threshold(&TerminationRule::VarianceBounding { t: 0.5, relative: false }, 3.0), 0.5);
+    assert_eq!(
+        path_threshold(&TerminationRule::VarianceBounding { t: 0.5, relative: true }, 3.0),
+        4.5
+    );
+    assert_eq!(
+        path_threshold(&TerminationRule::VarianceBounding { t: 0.5, relative: false }, 3.0),
+        0.5
+    );
 }
 
 #[test]
@@ -63,17 +77,33 @@ fn area_spread_never_ends_at_the_primary_vertex_and_ends_past_c() {
 #[test]
 fn the_two_ends() {
     let mut s = PathState { throughput2: 1.0, vertex: 1, ..Default::default() };
-    assert_eq!(decide(&TerminationRule::FirstVertex, 1.0, &mut s, &stats(1e9, 1e9, 0.0)), Decision::Terminate);
-    assert_eq!(decide(&TerminationRule::PathTracing, 1.0, &mut s, &stats(1e9, 1e9, 0.0)), Decision::Continue);
+    assert_eq!(
+        decide(&TerminationRule::FirstVertex, 1.0, &mut s, &stats(1e9, 1e9, 0.0)),
+        Decision::Terminate
+    );
+    assert_eq!(
+        decide(&TerminationRule::PathTracing, 1.0, &mut s, &stats(1e9, 1e9, 0.0)),
+        Decision::Continue
+    );
     // t = 0: the first vertex already overshoots, α = 0: terminate.
     let mut s = PathState { throughput2: 1.0, vertex: 1, ..Default::default() };
-    assert_eq!(decide(&TerminationRule::VarianceBounding { t: 0.0, relative: false }, 1.0, &mut s, &stats(0.5, 0.0, 0.0)), Decision::Terminate);
+    assert_eq!(
+        decide(
+            &TerminationRule::VarianceBounding { t: 0.0, relative: false },
+            1.0,
+            &mut s,
+            &stats(0.5, 0.0, 0.0)
+        ),
+        Decision::Terminate
+    );
 }
 
 #[test]
 fn bad_rules_are_refused_with_their_parameter() {
     let e = TerminationRule::VarianceBounding { t: -1.0, relative: false }.validate().unwrap_err();
     assert!(e.contains("VarianceBounding t"), "{e}");
-    let e = TerminationRule::MseMinimisation { s: 0.5, margin: 1.1, bias_clamp: 0.1 }.validate().unwrap_err();
+    let e = TerminationRule::MseMinimisation { s: 0.5, margin: 1.1, bias_clamp: 0.1 }
+        .validate()
+        .unwrap_err();
     assert!(e.contains("sample target"), "{e}");
 }

@@ -20,22 +20,44 @@ fn fig4_variance_bound_is_followed_until_it_detaches() {
     let truth = tree.value(0);
     let detach = tree.detach_threshold();
     let full = tree.path_tracing();
-    assert!(detach > 1e-3 && detach < full.variance(), "detach {detach} should lie inside the range of thresholds");
+    assert!(
+        detach > 1e-3 && detach < full.variance(),
+        "detach {detach} should lie inside the range of thresholds"
+    );
     for q in [1.0, 0.6, 0.2] {
         for t in thresholds() {
             let m = tree.estimator(&vb(t), q);
             // Exact caches: unbiased at every threshold.
-            assert!((m.mean - truth).abs() < 1e-12 * truth.max(1.0), "q {q} t {t}: mean {} != {truth}", m.mean);
+            assert!(
+                (m.mean - truth).abs() < 1e-12 * truth.max(1.0),
+                "q {q} t {t}: mean {} != {truth}",
+                m.mean
+            );
             // The estimator's variance is the closed form Σ p · min(S, t)...
             let closed = tree.bounded_variance(t, q);
-            assert!((m.variance() - closed).abs() <= 1e-9 * closed.max(1e-12), "q {q} t {t}: variance {} != closed form {closed}", m.variance());
+            assert!(
+                (m.variance() - closed).abs() <= 1e-9 * closed.max(1e-12),
+                "q {q} t {t}: variance {} != closed form {closed}",
+                m.variance()
+            );
             // ... never above the bound, and equal to it until the first subtree is expanded.
-            assert!(m.variance() <= t * (1.0 + 1e-9), "q {q} t {t}: variance {} above the bound", m.variance());
+            assert!(
+                m.variance() <= t * (1.0 + 1e-9),
+                "q {q} t {t}: variance {} above the bound",
+                m.variance()
+            );
             if q == 1.0 && t <= detach {
-                assert!((m.variance() - t).abs() <= 1e-9 * t, "t {t} <= detach {detach}: variance {} should equal t", m.variance());
+                assert!(
+                    (m.variance() - t).abs() <= 1e-9 * t,
+                    "t {t} <= detach {detach}: variance {} should equal t",
+                    m.variance()
+                );
             }
             if q == 1.0 && t > detach * 1.01 {
-                assert!(m.variance() < t * (1.0 - 1e-6), "t {t} > detach {detach}: the bound should have detached");
+                assert!(
+                    m.variance() < t * (1.0 - 1e-6),
+                    "t {t} > detach {detach}: the bound should have detached"
+                );
             }
         }
     }
@@ -55,7 +77,13 @@ fn fig4_roulette_raises_the_estimator_variance() {
     // spends its budget t earlier (§6, Fig. 7): path tracing's variance grows as q falls.
     let tree = SamplingTree::exact(DEPTH, ALBEDO);
     let v = |q: f64| tree.bounded_variance(1e12, q);
-    assert!(v(0.2) > v(0.6) && v(0.6) > v(1.0), "roulette should raise path tracing's variance: {} {} {}", v(1.0), v(0.6), v(0.2));
+    assert!(
+        v(0.2) > v(0.6) && v(0.6) > v(1.0),
+        "roulette should raise path tracing's variance: {} {} {}",
+        v(1.0),
+        v(0.6),
+        v(0.2)
+    );
 }
 
 /// Fig. 5's tree: inner nodes at depth d hold their value times 1 + 0.5 · 0.3^d.
@@ -64,7 +92,11 @@ fn fig5_tree() -> SamplingTree {
 }
 
 fn mse_rule(s: f64) -> TerminationRule {
-    TerminationRule::MseMinimisation { s, margin: render::termination::rule::default_margin(), bias_clamp: render::termination::rule::default_bias_clamp() }
+    TerminationRule::MseMinimisation {
+        s,
+        margin: render::termination::rule::default_margin(),
+        bias_clamp: render::termination::rule::default_bias_clamp(),
+    }
 }
 
 #[test]
@@ -82,9 +114,20 @@ fn fig5_mse_minimisation_lands_at_its_target() {
     for (k, &n) in targets.iter().enumerate() {
         let own = tree.mse(moments[k], n);
         for (j, m) in moments.iter().enumerate() {
-            assert!(own <= tree.mse(*m, n) * (1.0 + 1e-12), "at N = {n}: target {} has MSE {own}, target {} has {}", targets[k], targets[j], tree.mse(*m, n));
+            assert!(
+                own <= tree.mse(*m, n) * (1.0 + 1e-12),
+                "at N = {n}: target {} has MSE {own}, target {} has {}",
+                targets[k],
+                targets[j],
+                tree.mse(*m, n)
+            );
         }
-        assert!(own <= tree.mse(first, n) && own <= tree.mse(full, n), "at N = {n}: MSE {own} vs first vertex {} and path tracing {}", tree.mse(first, n), tree.mse(full, n));
+        assert!(
+            own <= tree.mse(first, n) && own <= tree.mse(full, n),
+            "at N = {n}: MSE {own} vs first vertex {} and path tracing {}",
+            tree.mse(first, n),
+            tree.mse(full, n)
+        );
     }
     // More samples to accumulate: less bias accepted, so more variance (longer paths).
     for k in 1..targets.len() {
@@ -101,7 +144,10 @@ fn mse_minimisation_always_defers_at_large_sample_counts() {
     let tree = fig5_tree();
     let m = tree.estimator(&mse_rule(1e15), 1.0);
     let full = tree.estimator(&TerminationRule::PathTracing, 1.0);
-    assert!((m.mean - full.mean).abs() < 1e-9 && (m.variance() - full.variance()).abs() < 1e-6 * full.variance());
+    assert!(
+        (m.mean - full.mean).abs() < 1e-9
+            && (m.variance() - full.variance()).abs() < 1e-6 * full.variance()
+    );
 }
 
 #[test]
@@ -140,18 +186,36 @@ fn record_moments_separate_variance_from_bias() {
     }
     let se = |x: &Vec<f64>| {
         let m = x.iter().sum::<f64>() / x.len() as f64;
-        (x.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (x.len() as f64 - 1.0) / x.len() as f64).sqrt()
+        (x.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (x.len() as f64 - 1.0) / x.len() as f64)
+            .sqrt()
     };
     let (se_var, se_marg) = (se(&per_vertex[0]), se(&per_vertex[1]));
-    assert!((rec.average_variance() - 1.0 / 3.0).abs() < 5.0 * se_var, "average variance {} (se {se_var})", rec.average_variance());
+    assert!(
+        (rec.average_variance() - 1.0 / 3.0).abs() < 5.0 * se_var,
+        "average variance {} (se {se_var})",
+        rec.average_variance()
+    );
     // E[Y]² has its own error (about 2 E[Y] se(mean)), well below that of the marginal moment.
-    assert!((rec.squared_bias() - 1.0).abs() < 5.0 * se_marg + 0.02, "squared bias {} (se {se_marg})", rec.squared_bias());
-    assert!((rec.total_variance() - 4.0 / 3.0).abs() < 0.02, "plain variance {}", rec.total_variance());
+    assert!(
+        (rec.squared_bias() - 1.0).abs() < 5.0 * se_marg + 0.02,
+        "squared bias {} (se {se_marg})",
+        rec.squared_bias()
+    );
+    assert!(
+        (rec.total_variance() - 4.0 / 3.0).abs() < 0.02,
+        "plain variance {}",
+        rec.total_variance()
+    );
     // A uniformly lit record (one kind of vertex): no bias.
     let mut flat = RecordMoments::default();
     for _ in 0..100_000 {
         let samples: Vec<f64> = (0..4).map(|_| 2.0 * rng.next_f32() as f64).collect();
         flat.add_vertex(&samples, f64::INFINITY);
     }
-    assert!(flat.squared_bias() < 0.01 && (flat.average_variance() - 1.0 / 3.0).abs() < 0.01, "flat: bias² {} variance {}", flat.squared_bias(), flat.average_variance());
+    assert!(
+        flat.squared_bias() < 0.01 && (flat.average_variance() - 1.0 / 3.0).abs() < 0.01,
+        "flat: bias² {} variance {}",
+        flat.squared_bias(),
+        flat.average_variance()
+    );
 }

@@ -7,7 +7,11 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Mat4, Quat, Vec2, Vec3};
-use render::bvh::{Bvh2Geometry, Bvh2Traversal, Hit, InstanceTransforms, InstanceUpdate, RayBatch, RayQuery, SceneBvh, SceneBvh2, SceneGeometry, SplitMix64, TraceKind, WatertightRay, intersect_triangle, random_rays};
+use render::bvh::{
+    Bvh2Geometry, Bvh2Traversal, Hit, InstanceTransforms, InstanceUpdate, RayBatch, RayQuery,
+    SceneBvh, SceneBvh2, SceneGeometry, SplitMix64, TraceKind, WatertightRay, intersect_triangle,
+    random_rays,
+};
 use render::gpu::Gpu;
 use render::scene::{Instance, Mesh, SceneDesc};
 
@@ -52,7 +56,8 @@ fn write_gltf(dir: &Path, mesh: &Mesh, rotation: Quat, scale: Vec3, translation:
     let indices_offset = bin.len();
     bin.extend(mesh.indices.iter().flatten().flat_map(|i| i.to_le_bytes()));
     std::fs::write(dir.join("torus.bin"), &bin).unwrap();
-    let (lo, hi) = mesh.positions.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let (lo, hi) =
+        mesh.positions.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
     let n = mesh.positions.len();
     let json = format!(
         r#"{{
@@ -73,14 +78,28 @@ fn write_gltf(dir: &Path, mesh: &Mesh, rotation: Quat, scale: Vec3, translation:
     {{ "bufferView": 2, "componentType": 5125, "count": {}, "type": "SCALAR" }}
   ]
 }}"#,
-        rotation.x, rotation.y, rotation.z, rotation.w, scale.x, scale.y, scale.z, translation.x, translation.y, translation.z,
+        rotation.x,
+        rotation.y,
+        rotation.z,
+        rotation.w,
+        scale.x,
+        scale.y,
+        scale.z,
+        translation.x,
+        translation.y,
+        translation.z,
         bin.len(),
         normals_offset,
         normals_offset,
         indices_offset - normals_offset,
         indices_offset,
         bin.len() - indices_offset,
-        lo.x, lo.y, lo.z, hi.x, hi.y, hi.z,
+        lo.x,
+        lo.y,
+        lo.z,
+        hi.x,
+        hi.y,
+        hi.z,
         mesh.indices.len() * 3,
     );
     let path = dir.join("torus.gltf");
@@ -90,19 +109,32 @@ fn write_gltf(dir: &Path, mesh: &Mesh, rotation: Quat, scale: Vec3, translation:
 
 /// Loads every mesh primitive of every node of a glTF file as (mesh, instance).
 fn load_gltf(path: &Path) -> SceneDesc {
-    let (doc, buffers, _) = gltf::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let (doc, buffers, _) =
+        gltf::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut scene = SceneDesc::default();
     for node in doc.nodes() {
         let Some(mesh) = node.mesh() else { continue };
         let transform = Mat4::from_cols_array_2d(&node.transform().matrix());
         for primitive in mesh.primitives() {
             let reader = primitive.reader(|b| Some(&buffers[b.index()]));
-            let positions: Vec<Vec3> = reader.read_positions().expect("POSITION").map(Vec3::from).collect();
-            let normals: Vec<Vec3> = reader.read_normals().map(|n| n.map(Vec3::from).collect()).unwrap_or_default();
+            let positions: Vec<Vec3> =
+                reader.read_positions().expect("POSITION").map(Vec3::from).collect();
+            let normals: Vec<Vec3> =
+                reader.read_normals().map(|n| n.map(Vec3::from).collect()).unwrap_or_default();
             let flat: Vec<u32> = reader.read_indices().expect("indices").into_u32().collect();
             let indices = flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-            scene.instances.push(Instance { mesh: scene.meshes.len() as u32, material: 0, transform });
-            scene.meshes.push(Mesh { name: mesh.name().unwrap_or("gltf").into(), positions, normals, uvs: Vec::new(), indices });
+            scene.instances.push(Instance {
+                mesh: scene.meshes.len() as u32,
+                material: 0,
+                transform,
+            });
+            scene.meshes.push(Mesh {
+                name: mesh.name().unwrap_or("gltf").into(),
+                positions,
+                normals,
+                uvs: Vec::new(),
+                indices,
+            });
         }
     }
     scene
@@ -141,8 +173,11 @@ fn hairball(strands: u32, segments: u32, radius: f32, seed: u64) -> Mesh {
 }
 
 fn cube() -> Mesh {
-    let p: Vec<Vec3> = (0..8).map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32) - 0.5).collect();
-    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let p: Vec<Vec3> = (0..8)
+        .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32) - 0.5)
+        .collect();
+    let quads =
+        [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     let indices = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
     Mesh { name: "cube".into(), positions: p, normals: Vec::new(), uvs: Vec::new(), indices }
 }
@@ -150,9 +185,19 @@ fn cube() -> Mesh {
 fn quad() -> Mesh {
     Mesh {
         name: "quad".into(),
-        positions: vec![Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, -1.0), Vec3::new(1.0, 0.0, 1.0), Vec3::new(-1.0, 0.0, 1.0)],
+        positions: vec![
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, 1.0),
+            Vec3::new(-1.0, 0.0, 1.0),
+        ],
         normals: vec![Vec3::Y; 4],
-        uvs: vec![Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)],
+        uvs: vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(0.0, 1.0),
+        ],
         indices: vec![[0, 2, 1], [0, 3, 2]],
     }
 }
@@ -169,9 +214,21 @@ fn random_transform(rng: &mut SplitMix64, mirrored: bool) -> Mat4 {
 
 fn instanced_scene(seed: u64) -> SceneDesc {
     let mut rng = SplitMix64::new(seed);
-    let mut scene = SceneDesc { meshes: vec![torus(1.0, 0.3, 32, 16), cube(), quad(), Mesh { name: "empty".into(), ..Default::default() }], ..Default::default() };
+    let mut scene = SceneDesc {
+        meshes: vec![
+            torus(1.0, 0.3, 32, 16),
+            cube(),
+            quad(),
+            Mesh { name: "empty".into(), ..Default::default() },
+        ],
+        ..Default::default()
+    };
     for i in 0..9u32 {
-        scene.instances.push(Instance { mesh: i % 4, material: 10 + i, transform: random_transform(&mut rng, i == 4) });
+        scene.instances.push(Instance {
+            mesh: i % 4,
+            material: 10 + i,
+            transform: random_transform(&mut rng, i == 4),
+        });
     }
     scene
 }
@@ -215,12 +272,15 @@ fn rays_for(scene: &SceneDesc, bvh: &SceneBvh, seed: u64) -> Vec<RayQuery> {
             let instance = &bvh.instances[(rng.next_u64() % bvh.instances.len() as u64) as usize];
             let mesh = &scene.meshes[instance.mesh as usize];
             if !mesh.indices.is_empty() {
-                let tri = mesh.indices[(rng.next_u64() % mesh.indices.len() as u64) as usize].map(|k| mesh.positions[k as usize]);
+                let tri = mesh.indices[(rng.next_u64() % mesh.indices.len() as u64) as usize]
+                    .map(|k| mesh.positions[k as usize]);
                 let (mut u, mut v) = (rng.next_f32(), rng.next_f32());
                 if u + v > 1.0 {
                     (u, v) = (1.0 - u, 1.0 - v);
                 }
-                let target = instance.object_to_world.transform_point3(tri[0] + u * (tri[1] - tri[0]) + v * (tri[2] - tri[0]));
+                let target = instance
+                    .object_to_world
+                    .transform_point3(tri[0] + u * (tri[1] - tri[0]) + v * (tri[2] - tri[0]));
                 r.direction = (target - r.origin) * rng.range(0.2, 3.0);
             }
         }
@@ -237,7 +297,13 @@ fn relative_difference(a: f32, b: f32) -> f32 {
 }
 
 /// t of the ray against one triangle of one instance, through the same transform and test.
-fn triangle_t(scene: &SceneDesc, bvh: &impl Reference, ray: &RayQuery, instance: u32, primitive: u32) -> Option<f32> {
+fn triangle_t(
+    scene: &SceneDesc,
+    bvh: &impl Reference,
+    ray: &RayQuery,
+    instance: u32,
+    primitive: u32,
+) -> Option<f32> {
     let inst = &bvh.instances()[instance as usize];
     let mesh = &scene.meshes[inst.mesh as usize];
     let o = inst.world_to_object.transform_point3(ray.origin);
@@ -248,7 +314,13 @@ fn triangle_t(scene: &SceneDesc, bvh: &impl Reference, ray: &RayQuery, instance:
 
 /// |cos| of the angle between the ray and the triangle's plane normal, in object space (where
 /// the intersection is computed): near 0 the hit distance is ill-conditioned.
-fn grazing_cosine(scene: &SceneDesc, bvh: &impl Reference, ray: &RayQuery, instance: u32, primitive: u32) -> f32 {
+fn grazing_cosine(
+    scene: &SceneDesc,
+    bvh: &impl Reference,
+    ray: &RayQuery,
+    instance: u32,
+    primitive: u32,
+) -> f32 {
     let inst = &bvh.instances()[instance as usize];
     let mesh = &scene.meshes[inst.mesh as usize];
     let d = inst.world_to_object.transform_vector3(ray.direction);
@@ -288,7 +360,14 @@ struct Agreement {
     failures: Vec<String>,
 }
 
-fn compare(label: &str, scene: &SceneDesc, bvh: &impl Reference, rays: &[RayQuery], gpu_hits: &[Hit], gpu_any: &[bool]) -> Agreement {
+fn compare(
+    label: &str,
+    scene: &SceneDesc,
+    bvh: &impl Reference,
+    rays: &[RayQuery],
+    gpu_hits: &[Hit],
+    gpu_any: &[bool],
+) -> Agreement {
     let mut a = Agreement { rays: rays.len(), ..Default::default() };
     for (i, ray) in rays.iter().enumerate() {
         let cpu = bvh.closest(ray);
@@ -296,14 +375,22 @@ fn compare(label: &str, scene: &SceneDesc, bvh: &impl Reference, rays: &[RayQuer
         let gpu = gpu_hits[i];
         a.hits += cpu.is_hit() as usize;
         if cpu_any != cpu.is_hit() {
-            a.failures.push(format!("{label} ray {i}: CPU trace_any {cpu_any} but trace_closest {cpu:?}"));
+            a.failures.push(format!(
+                "{label} ray {i}: CPU trace_any {cpu_any} but trace_closest {cpu:?}"
+            ));
         }
         let near = gpu.t.min(cpu.t) < 1e-4;
         if gpu_any[i] != cpu_any && !near {
-            a.failures.push(format!("{label} ray {i} {ray:?}: GPU trace_any {} vs CPU {cpu_any}", gpu_any[i]));
+            a.failures.push(format!(
+                "{label} ray {i} {ray:?}: GPU trace_any {} vs CPU {cpu_any}",
+                gpu_any[i]
+            ));
         }
         if gpu_any[i] != gpu.is_hit() {
-            a.failures.push(format!("{label} ray {i}: GPU trace_any {} but trace_closest {gpu:?}", gpu_any[i]));
+            a.failures.push(format!(
+                "{label} ray {i}: GPU trace_any {} but trace_closest {gpu:?}",
+                gpu_any[i]
+            ));
         }
         if gpu.instance == cpu.instance && gpu.primitive == cpu.primitive {
             if cpu.is_hit() {
@@ -311,7 +398,8 @@ fn compare(label: &str, scene: &SceneDesc, bvh: &impl Reference, rays: &[RayQuer
                 // amplified by 1/|cos| in t and in the barycentrics.
                 let cos = grazing_cosine(scene, bvh, ray, cpu.instance, cpu.primitive);
                 let t_ok = relative_difference(gpu.t, cpu.t) <= 1e-4;
-                let uv_ok = (gpu.barycentrics - cpu.barycentrics).abs().max_element() <= (1e-5 / cos).max(1e-3);
+                let uv_ok = (gpu.barycentrics - cpu.barycentrics).abs().max_element()
+                    <= (1e-5 / cos).max(1e-3);
                 if cos < 1e-3 && !(t_ok && uv_ok) {
                     a.grazing += 1;
                     continue;
@@ -327,7 +415,8 @@ fn compare(label: &str, scene: &SceneDesc, bvh: &impl Reference, rays: &[RayQuer
         } else if gpu.is_hit()
             && cpu.is_hit()
             && relative_difference(gpu.t, cpu.t) <= 1e-4
-            && triangle_t(scene, bvh, ray, gpu.instance, gpu.primitive).is_some_and(|t| relative_difference(t, cpu.t) <= 1e-4)
+            && triangle_t(scene, bvh, ray, gpu.instance, gpu.primitive)
+                .is_some_and(|t| relative_difference(t, cpu.t) <= 1e-4)
         {
             a.ties += 1;
         } else {
@@ -339,14 +428,34 @@ fn compare(label: &str, scene: &SceneDesc, bvh: &impl Reference, rays: &[RayQuer
 
 fn check(label: &str, a: &Agreement) {
     println!("{label}: {a:?}");
-    assert!(a.failures.is_empty(), "{label}: {} of {} rays disagree:\n{}", a.failures.len(), a.rays, a.failures.iter().take(10).cloned().collect::<Vec<_>>().join("\n"));
-    assert!(a.ties + a.near_origin + a.grazing <= a.rays / 100, "{label}: too many ties/near-origin/grazing hits: {a:?}");
+    assert!(
+        a.failures.is_empty(),
+        "{label}: {} of {} rays disagree:\n{}",
+        a.failures.len(),
+        a.rays,
+        a.failures.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
+    );
+    assert!(
+        a.ties + a.near_origin + a.grazing <= a.rays / 100,
+        "{label}: too many ties/near-origin/grazing hits: {a:?}"
+    );
     // The rays must exercise both outcomes for the comparison to mean anything.
-    assert!(a.hits > a.rays / 5 && a.hits < a.rays * 19 / 20, "{label}: {} hits of {} rays", a.hits, a.rays);
+    assert!(
+        a.hits > a.rays / 5 && a.hits < a.rays * 19 / 20,
+        "{label}: {} hits of {} rays",
+        a.hits,
+        a.rays
+    );
 }
 
 /// Traces `rays` on the GPU (closest + any) and checks them against the CPU; returns the GPU hits.
-fn gpu_matches_cpu(label: &str, gpu: &Gpu, scene: &SceneDesc, geometry: &SceneGeometry, rays: &[RayQuery]) -> Vec<Hit> {
+fn gpu_matches_cpu(
+    label: &str,
+    gpu: &Gpu,
+    scene: &SceneDesc,
+    geometry: &SceneGeometry,
+    rays: &[RayQuery],
+) -> Vec<Hit> {
     let batch = RayBatch::new(gpu, geometry);
     let hits = batch.trace_closest(gpu, geometry, rays).unwrap();
     let any = batch.trace_any(gpu, geometry, rays).unwrap();
@@ -355,7 +464,12 @@ fn gpu_matches_cpu(label: &str, gpu: &Gpu, scene: &SceneDesc, geometry: &SceneGe
 }
 
 /// The CPU reference equals brute force on a subset of the rays.
-fn cpu_matches_brute_force(label: &str, scene: &SceneDesc, bvh: &impl Reference, rays: &[RayQuery]) {
+fn cpu_matches_brute_force(
+    label: &str,
+    scene: &SceneDesc,
+    bvh: &impl Reference,
+    rays: &[RayQuery],
+) {
     for (i, ray) in rays.iter().enumerate().step_by(10) {
         let fast = bvh.closest(ray);
         let slow = brute_force(scene, bvh, ray);
@@ -371,7 +485,13 @@ fn cpu_matches_brute_force(label: &str, scene: &SceneDesc, bvh: &impl Reference,
 #[test]
 fn gltf_mesh_gpu_traversal_matches_obvhs() {
     let dir = std::env::temp_dir().join(format!("flicker-traversal-{}", std::process::id()));
-    let path = write_gltf(&dir, &torus(1.0, 0.35, 48, 24), Quat::from_rotation_x(0.7) * Quat::from_rotation_z(0.3), Vec3::new(1.5, 0.6, 1.0), Vec3::new(0.2, -0.1, 0.3));
+    let path = write_gltf(
+        &dir,
+        &torus(1.0, 0.35, 48, 24),
+        Quat::from_rotation_x(0.7) * Quat::from_rotation_z(0.3),
+        Vec3::new(1.5, 0.6, 1.0),
+        Vec3::new(0.2, -0.1, 0.3),
+    );
     let scene = load_gltf(&path);
     std::fs::remove_dir_all(&dir).ok();
     assert_eq!(scene.meshes.len(), 1);
@@ -386,7 +506,11 @@ fn gltf_mesh_gpu_traversal_matches_obvhs() {
 #[test]
 fn hairball_gpu_traversal_matches_obvhs() {
     let mesh = hairball(400, 8, 0.006, 2);
-    let scene = SceneDesc { meshes: vec![mesh], instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }], ..Default::default() };
+    let scene = SceneDesc {
+        meshes: vec![mesh],
+        instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }],
+        ..Default::default()
+    };
     let gpu = gpu();
     let geometry = SceneGeometry::new(&gpu, &scene).unwrap();
     let rays = rays_for(&scene, geometry.cpu(), 2);
@@ -410,30 +534,53 @@ fn transformed_instances_gpu_traversal_and_surface_points_match_cpu() {
     for (i, inst) in moved.instances.iter_mut().enumerate() {
         inst.transform = random_transform(&mut rng, i == 4);
     }
-    assert_eq!(geometry.try_update_instances(&gpu, &moved.instances).unwrap(), InstanceUpdate::Rebuilt);
+    assert_eq!(
+        geometry.try_update_instances(&gpu, &moved.instances).unwrap(),
+        InstanceUpdate::Rebuilt
+    );
     let rays = rays_for(&moved, geometry.cpu(), 4);
     let hits = gpu_matches_cpu("moved instances", &gpu, &moved, &geometry, &rays);
     check_surface_points(&gpu, &geometry, &moved, &old, &rays, &hits);
 
     // Nothing moves: first the previous transforms catch up, then there is nothing to do.
-    assert_eq!(geometry.try_update_instances(&gpu, &moved.instances).unwrap(), InstanceUpdate::TableOnly);
-    assert_eq!(geometry.try_update_instances(&gpu, &moved.instances).unwrap(), InstanceUpdate::Unchanged);
+    assert_eq!(
+        geometry.try_update_instances(&gpu, &moved.instances).unwrap(),
+        InstanceUpdate::TableOnly
+    );
+    assert_eq!(
+        geometry.try_update_instances(&gpu, &moved.instances).unwrap(),
+        InstanceUpdate::Unchanged
+    );
     let (lo, hi) = geometry.bounds();
     assert!(lo.cmplt(hi).all(), "bounds {lo} {hi}");
 
     // More instances than the buffers were made for: they grow and traversal still agrees.
     let mut more = moved.clone();
     for i in 0..40u32 {
-        more.instances.push(Instance { mesh: i % 3, material: i, transform: random_transform(&mut rng, i % 5 == 0) });
+        more.instances.push(Instance {
+            mesh: i % 3,
+            material: i,
+            transform: random_transform(&mut rng, i % 5 == 0),
+        });
     }
-    assert_eq!(geometry.try_update_instances(&gpu, &more.instances).unwrap(), InstanceUpdate::Rebuilt);
+    assert_eq!(
+        geometry.try_update_instances(&gpu, &more.instances).unwrap(),
+        InstanceUpdate::Rebuilt
+    );
     let rays = rays_for(&more, geometry.cpu(), 5);
     gpu_matches_cpu("grown instances", &gpu, &more, &geometry, &rays);
 }
 
 /// surface_point, previous_world_position and triangle_world_vertices against the same
 /// quantities computed here from the scene description.
-fn check_surface_points(gpu: &Gpu, geometry: &SceneGeometry, scene: &SceneDesc, previous: &SceneDesc, rays: &[RayQuery], hits: &[Hit]) {
+fn check_surface_points(
+    gpu: &Gpu,
+    geometry: &SceneGeometry,
+    scene: &SceneDesc,
+    previous: &SceneDesc,
+    rays: &[RayQuery],
+    hits: &[Hit],
+) {
     let batch = RayBatch::new(gpu, geometry);
     let buffers = batch.upload(gpu, rays).unwrap();
     batch.dispatch(gpu, geometry, &buffers, TraceKind::Closest).unwrap();
@@ -450,28 +597,56 @@ fn check_surface_points(gpu: &Gpu, geometry: &SceneGeometry, scene: &SceneDesc, 
         let mesh = &scene.meshes[inst.mesh as usize];
         let idx = mesh.indices[hit.primitive as usize];
         let [v0, v1, v2] = idx.map(|i| mesh.positions[i as usize]);
-        let w = Vec3::new(1.0 - hit.barycentrics.x - hit.barycentrics.y, hit.barycentrics.x, hit.barycentrics.y);
+        let w = Vec3::new(
+            1.0 - hit.barycentrics.x - hit.barycentrics.y,
+            hit.barycentrics.x,
+            hit.barycentrics.y,
+        );
         let object = w.x * v0 + w.y * v1 + w.z * v2;
         let world = inst.transform.transform_point3(object);
         assert!(close(p.position, world, 1e-4), "position {} vs {world}", p.position);
-        assert!(close(p.position, ray.origin + hit.t * ray.direction, 1e-3), "position {} vs ray at t {}", p.position, hit.t);
+        assert!(
+            close(p.position, ray.origin + hit.t * ray.direction, 1e-3),
+            "position {} vs ray at t {}",
+            p.position,
+            hit.t
+        );
         let normal_matrix = Mat3::from_mat4(inst.transform).inverse().transpose();
         let geometric = (normal_matrix * (v1 - v0).cross(v2 - v0)).normalize();
-        assert!(close(p.geometric_normal, geometric, 1e-4), "geometric normal {} vs {geometric}", p.geometric_normal);
+        assert!(
+            close(p.geometric_normal, geometric, 1e-4),
+            "geometric normal {} vs {geometric}",
+            p.geometric_normal
+        );
         let shading = if mesh.normals.is_empty() {
             geometric
         } else {
             let [n0, n1, n2] = idx.map(|i| mesh.normals[i as usize]);
             (normal_matrix * (w.x * n0 + w.y * n1 + w.z * n2)).normalize()
         };
-        assert!(close(p.shading_normal, shading, 1e-4), "shading normal {} vs {shading}", p.shading_normal);
-        let uv = if mesh.uvs.is_empty() { Vec2::ZERO } else { idx.iter().zip(w.to_array()).map(|(&i, wk)| wk * mesh.uvs[i as usize]).sum() };
+        assert!(
+            close(p.shading_normal, shading, 1e-4),
+            "shading normal {} vs {shading}",
+            p.shading_normal
+        );
+        let uv = if mesh.uvs.is_empty() {
+            Vec2::ZERO
+        } else {
+            idx.iter().zip(w.to_array()).map(|(&i, wk)| wk * mesh.uvs[i as usize]).sum()
+        };
         assert!((p.uv - uv).abs().max_element() < 1e-4, "uv {} vs {uv}", p.uv);
         assert_eq!(p.material, inst.material);
         let before = previous.instances[hit.instance as usize].transform.transform_point3(object);
-        assert!(close(p.previous_position, before, 1e-4), "previous position {} vs {before}", p.previous_position);
+        assert!(
+            close(p.previous_position, before, 1e-4),
+            "previous position {} vs {before}",
+            p.previous_position
+        );
         for (k, v) in [v0, v1, v2].into_iter().enumerate() {
-            assert!(close(p.triangle[k], inst.transform.transform_point3(v), 1e-4), "triangle vertex {k}");
+            assert!(
+                close(p.triangle[k], inst.transform.transform_point3(v), 1e-4),
+                "triangle vertex {k}"
+            );
         }
     }
     assert!(checked > 100, "only {checked} hits to check");
@@ -487,21 +662,43 @@ fn empty_scene_and_bad_input() {
     assert!(!batch.trace_closest(&gpu, &geometry, &rays).unwrap()[0].is_hit());
     assert_eq!(geometry.bounds(), (Vec3::ZERO, Vec3::ZERO));
     // The batch's stack was sized for the empty scene: it refuses a deeper BVH.
-    let deep = SceneDesc { meshes: vec![render::bvh::displaced_sphere(20_000, 1)], instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }], ..Default::default() };
+    let deep = SceneDesc {
+        meshes: vec![render::bvh::displaced_sphere(20_000, 1)],
+        instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }],
+        ..Default::default()
+    };
     let deep = SceneGeometry::new(&gpu, &deep).unwrap();
-    assert!(deep.stack_entries() > render::scene_features::SceneFeatures::stack_for(geometry.stack_entries()), "{} entries", deep.stack_entries());
-    let err = batch.trace_closest(&gpu, &deep, &rays).err().expect("a deeper BVH than the stack holds is refused").to_string();
+    assert!(
+        deep.stack_entries()
+            > render::scene_features::SceneFeatures::stack_for(geometry.stack_entries()),
+        "{} entries",
+        deep.stack_entries()
+    );
+    let err = batch
+        .trace_closest(&gpu, &deep, &rays)
+        .err()
+        .expect("a deeper BVH than the stack holds is refused")
+        .to_string();
     assert!(err.contains("build a new batch"), "{err}");
     assert!(RayBatch::new(&gpu, &deep).trace_closest(&gpu, &deep, &rays).is_ok());
 
     let mut bad = SceneDesc { meshes: vec![cube()], ..Default::default() };
     bad.meshes[0].indices.push([0, 1, 99]);
-    let err = SceneGeometry::new(&gpu, &bad).err().expect("an index out of range is refused").to_string();
+    let err =
+        SceneGeometry::new(&gpu, &bad).err().expect("an index out of range is refused").to_string();
     assert!(err.contains("cube") && err.contains("99"), "{err}");
-    let bad = SceneDesc { meshes: vec![cube()], instances: vec![Instance { mesh: 3, material: 0, transform: Mat4::IDENTITY }], ..Default::default() };
+    let bad = SceneDesc {
+        meshes: vec![cube()],
+        instances: vec![Instance { mesh: 3, material: 0, transform: Mat4::IDENTITY }],
+        ..Default::default()
+    };
     let err = SceneGeometry::new(&gpu, &bad).err().expect("a missing mesh is refused").to_string();
     assert!(err.contains("mesh 3"), "{err}");
-    let bad = SceneDesc { meshes: vec![cube()], instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::ZERO }], ..Default::default() };
+    let bad = SceneDesc {
+        meshes: vec![cube()],
+        instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::ZERO }],
+        ..Default::default()
+    };
     assert!(SceneGeometry::new(&gpu, &bad).is_err(), "a singular transform is refused");
 }
 
@@ -512,10 +709,20 @@ fn empty_scene_and_bad_input() {
 fn bvh2_gpu_traversal_matches_obvhs_bvh2_and_brute_force() {
     let gpu = gpu();
     let dir = std::env::temp_dir().join(format!("flicker-bvh2-traversal-{}", std::process::id()));
-    let path = write_gltf(&dir, &torus(1.0, 0.35, 48, 24), Quat::from_rotation_x(0.7) * Quat::from_rotation_z(0.3), Vec3::new(1.5, 0.6, 1.0), Vec3::new(0.2, -0.1, 0.3));
+    let path = write_gltf(
+        &dir,
+        &torus(1.0, 0.35, 48, 24),
+        Quat::from_rotation_x(0.7) * Quat::from_rotation_z(0.3),
+        Vec3::new(1.5, 0.6, 1.0),
+        Vec3::new(0.2, -0.1, 0.3),
+    );
     let gltf = load_gltf(&path);
     std::fs::remove_dir_all(&dir).ok();
-    let hairball = SceneDesc { meshes: vec![hairball(400, 8, 0.006, 2)], instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }], ..Default::default() };
+    let hairball = SceneDesc {
+        meshes: vec![hairball(400, 8, 0.006, 2)],
+        instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }],
+        ..Default::default()
+    };
     let scenes = [
         ("BVH2 glTF torus", gltf, 1),
         ("BVH2 hairball", hairball, 2),

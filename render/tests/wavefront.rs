@@ -21,10 +21,20 @@ fn lit_room() -> SceneDesc {
     let mut scene = room_scene();
     scene.instances.remove(0);
     scene.environment = Vec3::splat(0.3);
-    scene.lights.push(Light::Point { position: Vec3::new(0.3, 0.8, 0.2), intensity: Vec3::splat(2.0) });
-    scene.lights.push(Light::Point { position: Vec3::new(-0.4, 0.5, 0.6), intensity: Vec3::new(1.0, 0.5, 0.2) });
+    scene
+        .lights
+        .push(Light::Point { position: Vec3::new(0.3, 0.8, 0.2), intensity: Vec3::splat(2.0) });
+    scene.lights.push(Light::Point {
+        position: Vec3::new(-0.4, 0.5, 0.6),
+        intensity: Vec3::new(1.0, 0.5, 0.2),
+    });
     let (dark, light) = ([40u8, 40, 40, 255], [220u8, 220, 220, 255]);
-    scene.textures.push(Texture { name: "checker".into(), width: 2, height: 2, rgba8: [dark, light, light, dark].concat() });
+    scene.textures.push(Texture {
+        name: "checker".into(),
+        width: 2,
+        height: 2,
+        rgba8: [dark, light, light, dark].concat(),
+    });
     scene.materials[1].base_color_texture = Some(0);
     scene
 }
@@ -50,7 +60,12 @@ fn assert_same(mega: &[[f32; 4]], wave: &[[f32; 4]]) {
     for (i, (a, b)) in mega.iter().zip(wave).enumerate() {
         for c in 0..3 {
             let tolerance = 1e-5 * a[c].abs().max(1e-3);
-            assert!((a[c] - b[c]).abs() <= tolerance, "pixel {i} channel {c}: megakernel {} wavefront {}", a[c], b[c]);
+            assert!(
+                (a[c] - b[c]).abs() <= tolerance,
+                "pixel {i} channel {c}: megakernel {} wavefront {}",
+                a[c],
+                b[c]
+            );
         }
     }
 }
@@ -75,7 +90,10 @@ fn the_wavefront_follows_passes_compiled_for_every_feature() {
     let scene = room_scene();
     let mut tracer = PathTracer::new(gpu(), &scene, settings()).expect("tracer");
     tracer.update(gpu(), &scene);
-    tracer.library().specialise(gpu(), tracer.scene(), SceneFeatures::ALL).expect("compile for every feature");
+    tracer
+        .library()
+        .specialise(gpu(), tracer.scene(), SceneFeatures::ALL)
+        .expect("compile for every feature");
     let pixels = (W * H) as u64;
     let wavefront = Wavefront::with_wave_paths(gpu(), &tracer, pixels * 8).expect("wavefront");
     tracer.set_paths_per_dispatch(gpu(), pixels * 8).expect("dispatch size");

@@ -28,9 +28,15 @@ pub fn data_uri(mime: &str, bytes: &[u8]) -> String {
 mod tests {
     #[test]
     fn rfc4648_vectors() {
-        for (plain, coded) in
-            [("", ""), ("f", "Zg=="), ("fo", "Zm8="), ("foo", "Zm9v"), ("foob", "Zm9vYg=="), ("fooba", "Zm9vYmE="), ("foobar", "Zm9vYmFy")]
-        {
+        for (plain, coded) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foob", "Zm9vYg=="),
+            ("fooba", "Zm9vYmE="),
+            ("foobar", "Zm9vYmFy"),
+        ] {
             assert_eq!(super::encode(plain.as_bytes()), coded);
         }
         assert_eq!(super::encode(&[0xff, 0xfe]), "//4=");

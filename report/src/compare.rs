@@ -26,38 +26,65 @@ pub fn write_comparison(run_a: &Path, run_b: &Path, out: &Path) -> anyhow::Resul
     if let (Some(ra), Some(rb)) = (ma.resolution, mb.resolution)
         && ra != rb
     {
-        bail!("{} is {}x{} and {} is {}x{}: the viewer compares runs of one resolution", run_a.display(), ra[0], ra[1], run_b.display(), rb[0], rb[1]);
+        bail!(
+            "{} is {}x{} and {} is {}x{}: the viewer compares runs of one resolution",
+            run_a.display(),
+            ra[0],
+            ra[1],
+            run_b.display(),
+            rb[0],
+            rb[1]
+        );
     }
     let (methods_a, methods_b) = (methods(&ma, &fa), methods(&mb, &fb));
     // A's reference, then each method of A beside the same method of B; methods only in one run last.
-    let mut panels = vec![Panel { label: "reference".into(), run_dir: run_a.to_path_buf(), method: None }];
+    let mut panels =
+        vec![Panel { label: "reference".into(), run_dir: run_a.to_path_buf(), method: None }];
     let mut flip_maps = HashMap::new();
-    for (tag, dir, manifest, list) in [("A", run_a, &ma, &methods_a), ("B", run_b, &mb, &methods_b)] {
+    for (tag, dir, manifest, list) in [("A", run_a, &ma, &methods_a), ("B", run_b, &mb, &methods_b)]
+    {
         for fi in write_frame_images(dir, manifest, list)? {
             for m in fi.methods {
                 flip_maps.insert((fi.frame, format!("{tag}: {}", m.method)), m.flip);
             }
         }
     }
-    let panel = |tag: &str, dir: &Path, m: &str| Panel { label: format!("{tag}: {m}"), run_dir: dir.to_path_buf(), method: Some(m.to_string()) };
+    let panel = |tag: &str, dir: &Path, m: &str| Panel {
+        label: format!("{tag}: {m}"),
+        run_dir: dir.to_path_buf(),
+        method: Some(m.to_string()),
+    };
     for m in &methods_a {
         panels.push(panel("A", run_a, m));
         if methods_b.contains(m) {
             panels.push(panel("B", run_b, m));
         }
     }
-    panels.extend(methods_b.iter().filter(|m| !methods_a.contains(m)).map(|m| panel("B", run_b, m)));
+    panels
+        .extend(methods_b.iter().filter(|m| !methods_a.contains(m)).map(|m| panel("B", run_b, m)));
 
     let out_dir = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    std::fs::create_dir_all(out_dir).with_context(|| format!("cannot create {}", out_dir.display()))?;
+    std::fs::create_dir_all(out_dir)
+        .with_context(|| format!("cannot create {}", out_dir.display()))?;
     let stem = out.file_stem().and_then(|s| s.to_str()).unwrap_or("compare");
     let linked_dir = format!("{stem}_viewer");
     let frame_count = fa.frame_count(&ma).max(fb.frame_count(&mb));
-    let viewer = viewer::build(&viewer::Output { dir: out_dir, linked_dir: &linked_dir }, &panels, frame_count, &ma, &flip_maps)?;
+    let viewer = viewer::build(
+        &viewer::Output { dir: out_dir, linked_dir: &linked_dir },
+        &panels,
+        frame_count,
+        &ma,
+        &flip_maps,
+    )?;
 
     let mut h = String::new();
     let title = format!("flicker: {} vs {}", run_a.display(), run_b.display());
-    let _ = write!(h, "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}{}</style></head><body>\n", esc(&title), viewer::STYLE);
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}{}</style></head><body>\n",
+        esc(&title),
+        viewer::STYLE
+    );
     let _ = writeln!(h, "<h1>{}</h1>", esc(&title));
     h.push_str("<table id=\"runs\"><tr><th>run</th><th>folder</th><th>scenario</th><th>commit</th><th>frames</th><th>methods</th></tr>\n");
     for (tag, dir, m, list) in [("A", run_a, &ma, &methods_a), ("B", run_b, &mb, &methods_b)] {

@@ -36,7 +36,11 @@ img.px{image-rendering:pixelated}pre{background:#f7f7f7;padding:10px;overflow:au
 
 /// A chart as an image; charts against frame carry where frames lie (for the cursor).
 fn chart_html(c: &WrittenChart) -> String {
-    let img = format!("<img class=\"chart-img\" src=\"{}\" alt=\"{}\">", data_uri("image/svg+xml", c.svg.as_bytes()), esc(&c.title));
+    let img = format!(
+        "<img class=\"chart-img\" src=\"{}\" alt=\"{}\">",
+        data_uri("image/svg+xml", c.svg.as_bytes()),
+        esc(&c.title)
+    );
     match c.frame_axis {
         Some(m) => format!(
             "<figure class=\"chart\" data-f0=\"{}\" data-f1=\"{}\" data-x0=\"{}\" data-x1=\"{}\" data-w=\"{}\">{img}<div class=\"cursor\"></div></figure>\n",
@@ -56,13 +60,24 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
     let frames = Frames::load(run_dir)?;
     let summary = summarize(&manifest, &frames, DEFAULT_WINDOW);
     let charts = write_charts(run_dir, &manifest, &frames)?;
-    let methods = if manifest.methods.is_empty() { frames.methods() } else { manifest.methods.clone() };
+    let methods =
+        if manifest.methods.is_empty() { frames.methods() } else { manifest.methods.clone() };
     let frame_images = write_frame_images(run_dir, &manifest, &methods)?;
-    let flip_maps: HashMap<(u32, String), Vec<f32>> =
-        frame_images.iter().flat_map(|fi| fi.methods.iter().map(move |m| ((fi.frame, m.method.clone()), m.flip.clone()))).collect();
+    let flip_maps: HashMap<(u32, String), Vec<f32>> = frame_images
+        .iter()
+        .flat_map(|fi| {
+            fi.methods.iter().map(move |m| ((fi.frame, m.method.clone()), m.flip.clone()))
+        })
+        .collect();
     let frame_count = frames.frame_count(&manifest);
     let out = viewer::Output { dir: run_dir, linked_dir: viewer::LINKED_DIR };
-    let viewer = viewer::build(&out, &viewer::Panel::of_run(run_dir, &methods), frame_count, &manifest, &flip_maps)?;
+    let viewer = viewer::build(
+        &out,
+        &viewer::Panel::of_run(run_dir, &methods),
+        frame_count,
+        &manifest,
+        &flip_maps,
+    )?;
 
     let mut h = String::new();
     let title = format!("flicker run: {}", manifest.scenario);
@@ -74,7 +89,9 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
     );
     let _ = writeln!(h, "<h1>{}</h1>", esc(&title));
     let raw = &manifest.raw;
-    let field = |k: &str| raw.get(k).map(|v| v.to_string().trim_matches('"').to_string()).unwrap_or_default();
+    let field = |k: &str| {
+        raw.get(k).map(|v| v.to_string().trim_matches('"').to_string()).unwrap_or_default()
+    };
     let _ = writeln!(
         h,
         "<p>commit <code>{}</code> · seed {} · resolution {} · {} frames · methods: {}</p>",
@@ -85,7 +102,11 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
         esc(&methods.join(", "))
     );
     if !manifest.events.is_empty() {
-        let ev: Vec<String> = manifest.events.iter().map(|e| format!("frame {}: {}", e.frame, esc(&e.label))).collect();
+        let ev: Vec<String> = manifest
+            .events
+            .iter()
+            .map(|e| format!("frame {}: {}", e.frame, esc(&e.label)))
+            .collect();
         let _ = writeln!(h, "<p>Events: {}</p>", ev.join(" · "));
     }
     match &viewer {
@@ -93,7 +114,8 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
         None => h.push_str("<p>No frames of this run are on disk: nothing to view.</p>\n"),
     }
 
-    let (speed, per_frame): (Vec<&WrittenChart>, Vec<&WrittenChart>) = charts.iter().partition(|c| c.stem.starts_with("speed_vs_"));
+    let (speed, per_frame): (Vec<&WrittenChart>, Vec<&WrittenChart>) =
+        charts.iter().partition(|c| c.stem.starts_with("speed_vs_"));
     if !speed.is_empty() {
         h.push_str("<h2>Speed vs accuracy</h2><div class=\"charts\">\n");
         speed.iter().for_each(|c| h.push_str(&chart_html(c)));
@@ -111,7 +133,8 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
         h.push_str("</div>\n");
     }
 
-    let crops: Vec<_> = frame_images.iter().flat_map(|fi| fi.crops.iter().map(move |c| (fi, c))).collect();
+    let crops: Vec<_> =
+        frame_images.iter().flat_map(|fi| fi.crops.iter().map(move |c| (fi, c))).collect();
     let any_crops = !crops.is_empty();
     if any_crops {
         h.push_str("<h2>Regions at reference frames</h2><div>\n");
@@ -123,7 +146,8 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
             uri = png_uri(path)?,
             name = esc(region),
             frame = fi.frame,
-            list = esc(&fi.methods.iter().map(|m| m.method.as_str()).collect::<Vec<_>>().join(", "))
+            list =
+                esc(&fi.methods.iter().map(|m| m.method.as_str()).collect::<Vec<_>>().join(", "))
         );
     }
     if any_crops {

@@ -29,7 +29,12 @@ pub struct FrameImages {
 }
 
 /// The image of a frame: EXR when present (HDR-FLIP), else PNG (LDR-FLIP); plus a PNG to show.
-fn load_frame(run_dir: &Path, method: Option<&str>, frame: u32, charts: &Path) -> anyhow::Result<Option<(Image, bool, PathBuf)>> {
+fn load_frame(
+    run_dir: &Path,
+    method: Option<&str>,
+    frame: u32,
+    charts: &Path,
+) -> anyhow::Result<Option<(Image, bool, PathBuf)>> {
     let exr = frame_file(run_dir, method, frame, "exr");
     let png = frame_file(run_dir, method, frame, "png");
     let (img, hdr) = if exr.exists() {
@@ -51,12 +56,16 @@ fn load_frame(run_dir: &Path, method: Option<&str>, frame: u32, charts: &Path) -
 
 /// Scales an RGB image up by an integer factor (nearest neighbour keeps pixels crisp).
 fn upscale(img: &RgbImage, factor: u32) -> RgbImage {
-    RgbImage::from_fn(img.width() * factor, img.height() * factor, |x, y| *img.get_pixel(x / factor, y / factor))
+    RgbImage::from_fn(img.width() * factor, img.height() * factor, |x, y| {
+        *img.get_pixel(x / factor, y / factor)
+    })
 }
 
 fn to_rgb8(img: &Image) -> RgbImage {
     RgbImage::from_fn(img.width, img.height, |x, y| {
-        Rgb(img.get(x, y).map(|c| (metrics::image::linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8))
+        Rgb(img
+            .get(x, y)
+            .map(|c| (metrics::image::linear_to_srgb(c.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8))
     })
 }
 
@@ -82,27 +91,61 @@ fn tile(rows: &[Vec<RgbImage>]) -> RgbImage {
     out
 }
 
-pub fn write_frame_images(run_dir: &Path, manifest: &Manifest, methods: &[String]) -> anyhow::Result<Vec<FrameImages>> {
+pub fn write_frame_images(
+    run_dir: &Path,
+    manifest: &Manifest,
+    methods: &[String],
+) -> anyhow::Result<Vec<FrameImages>> {
     let charts = run_dir.join("charts");
-    std::fs::create_dir_all(&charts).with_context(|| format!("cannot create {}", charts.display()))?;
+    std::fs::create_dir_all(&charts)
+        .with_context(|| format!("cannot create {}", charts.display()))?;
     let mut out = Vec::new();
     for &frame in &manifest.reference.frames {
-        let Some((reference, ref_hdr, ref_shown)) = load_frame(run_dir, None, frame, &charts)? else { continue };
+        let Some((reference, ref_hdr, ref_shown)) = load_frame(run_dir, None, frame, &charts)?
+        else {
+            continue;
+        };
         let mut entries = Vec::new();
         let mut loaded = Vec::new();
         for method in methods {
-            let Some((img, hdr, shown)) = load_frame(run_dir, Some(method), frame, &charts)? else { continue };
+            let Some((img, hdr, shown)) = load_frame(run_dir, Some(method), frame, &charts)? else {
+                continue;
+            };
             if (img.width, img.height) != (reference.width, reference.height) {
-                anyhow::bail!("{}: frame {frame} of {method} is {}x{}, the reference is {}x{}", run_dir.display(), img.width, img.height, reference.width, reference.height);
+                anyhow::bail!(
+                    "{}: frame {frame} of {method} is {}x{}, the reference is {}x{}",
+                    run_dir.display(),
+                    img.width,
+                    img.height,
+                    reference.width,
+                    reference.height
+                );
             }
-            let flip = if hdr && ref_hdr { flip_hdr(&reference, &img, DEFAULT_PPD) } else { flip_ldr(&reference, &img, DEFAULT_PPD) };
+            let flip = if hdr && ref_hdr {
+                flip_hdr(&reference, &img, DEFAULT_PPD)
+            } else {
+                flip_ldr(&reference, &img, DEFAULT_PPD)
+            };
             let map_path = charts.join(format!("flip_{method}_{frame:04}.png"));
             metrics::write_map_png(&flip.map, img.width, img.height, &map_path)?;
-            entries.push(MethodImage { method: method.clone(), image: shown, flip_map: map_path, flip: flip.map.clone(), flip_mean: flip.mean });
+            entries.push(MethodImage {
+                method: method.clone(),
+                image: shown,
+                flip_map: map_path,
+                flip: flip.map.clone(),
+                flip_mean: flip.mean,
+            });
             loaded.push((img, flip.map));
         }
-        let full = Region { name: "full".into(), x: 0, y: 0, width: reference.width, height: reference.height };
-        let regions: Vec<Region> = if manifest.regions.is_empty() { vec![full] } else { manifest.regions.clone() };
+        let full = Region {
+            name: "full".into(),
+            x: 0,
+            y: 0,
+            width: reference.width,
+            height: reference.height,
+        };
+        let regions: Vec<Region> =
+            if manifest.regions.is_empty() { vec![full] } else { manifest.regions.clone() };
         let mut crops = Vec::new();
         for region in &regions {
             let r = region.crop(&reference);
@@ -111,16 +154,23 @@ pub fn write_frame_images(run_dir: &Path, manifest: &Manifest, methods: &[String
             }
             let factor = (160 / r.height.max(1)).clamp(1, 8);
             let mut top = vec![upscale(&to_rgb8(&r), factor)];
-            let mut bottom = vec![RgbImage::from_pixel(r.width * factor, r.height * factor, Rgb([255, 255, 255]))];
+            let mut bottom = vec![RgbImage::from_pixel(
+                r.width * factor,
+                r.height * factor,
+                Rgb([255, 255, 255]),
+            )];
             for (img, map) in &loaded {
                 top.push(upscale(&to_rgb8(&region.crop(img)), factor));
-                let map_img = Image::new(img.width, img.height, map.iter().map(|&v| [v, v, v]).collect());
+                let map_img =
+                    Image::new(img.width, img.height, map.iter().map(|&v| [v, v, v]).collect());
                 let m = region.crop(&map_img);
                 let values: Vec<f32> = m.rgb.iter().map(|p| p[0]).collect();
                 bottom.push(upscale(&map_to_rgb8(&values, m.width, m.height), factor));
             }
             let path = charts.join(format!("crops_{}_{frame:04}.png", region.name));
-            tile(&[top, bottom]).save(&path).with_context(|| format!("cannot write {}", path.display()))?;
+            tile(&[top, bottom])
+                .save(&path)
+                .with_context(|| format!("cannot write {}", path.display()))?;
             crops.push((region.name.clone(), path));
         }
         out.push(FrameImages { frame, reference: ref_shown, methods: entries, crops });

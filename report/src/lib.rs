@@ -40,7 +40,9 @@ pub fn report(args: &ReportArgs) -> anyhow::Result<PathBuf> {
             let out = args.out.clone().unwrap_or_else(|| runs[1].join("compare.html"));
             compare::write_comparison(&runs[0], &runs[1], &out)
         }
-        (None, Some(_)) if args.out.is_some() => anyhow::bail!("--out names the page of --compare; a run's report is RUN_DIR/report.html"),
+        (None, Some(_)) if args.out.is_some() => anyhow::bail!(
+            "--out names the page of --compare; a run's report is RUN_DIR/report.html"
+        ),
         (None, Some(run_dir)) => rebuild(run_dir),
         (None, None) => anyhow::bail!("give a run folder, or --compare RUN_A RUN_B"),
     }
@@ -66,11 +68,17 @@ mod tests {
     fn report_takes_a_run_or_two_runs_to_compare() {
         let one = Cli::try_parse_from(["report", "runs/a"]).unwrap().args;
         assert_eq!(one.run_dir.unwrap().to_str(), Some("runs/a"));
-        let two = Cli::try_parse_from(["report", "--compare", "runs/a", "runs/b", "--out", "c.html"]).unwrap().args;
+        let two =
+            Cli::try_parse_from(["report", "--compare", "runs/a", "runs/b", "--out", "c.html"])
+                .unwrap()
+                .args;
         assert_eq!(two.compare.unwrap().len(), 2);
         assert!(two.run_dir.is_none() && two.out.is_some());
         assert!(Cli::try_parse_from(["report"]).is_err(), "a run is required");
-        assert!(Cli::try_parse_from(["report", "--compare", "runs/a"]).is_err(), "--compare takes two runs");
+        assert!(
+            Cli::try_parse_from(["report", "--compare", "runs/a"]).is_err(),
+            "--compare takes two runs"
+        );
         let stray_out = Cli::try_parse_from(["report", "runs/a", "--out", "c.html"]).unwrap().args;
         assert!(format!("{:#}", super::report(&stray_out).unwrap_err()).contains("--out"));
     }

@@ -64,11 +64,16 @@ pub struct Manifest {
 impl Manifest {
     pub fn load(run_dir: &Path) -> anyhow::Result<Self> {
         let path = run_dir.join("manifest.json");
-        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
-        let raw: serde_json::Value =
-            serde_json::from_str(&text).with_context(|| format!("{}: not valid JSON", path.display()))?;
-        let mut m: Manifest = serde_json::from_value(raw.clone())
-            .with_context(|| format!("{}: expected the run manifest (scenario, methods, events, regions, ...)", path.display()))?;
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let raw: serde_json::Value = serde_json::from_str(&text)
+            .with_context(|| format!("{}: not valid JSON", path.display()))?;
+        let mut m: Manifest = serde_json::from_value(raw.clone()).with_context(|| {
+            format!(
+                "{}: expected the run manifest (scenario, methods, events, regions, ...)",
+                path.display()
+            )
+        })?;
         m.raw = raw;
         m.events = merge_events(m.events);
         Ok(m)
@@ -82,7 +87,9 @@ pub fn merge_events(mut events: Vec<Event>) -> Vec<Event> {
     let mut out: Vec<Event> = Vec::new();
     for e in events {
         match out.last_mut() {
-            Some(last) if last.frame == e.frame => last.label = format!("{} + {}", last.label, e.label),
+            Some(last) if last.frame == e.frame => {
+                last.label = format!("{} + {}", last.label, e.label)
+            }
             _ => out.push(e),
         }
     }
@@ -108,24 +115,46 @@ pub struct Frames {
 impl Frames {
     pub fn load(run_dir: &Path) -> anyhow::Result<Self> {
         let path = run_dir.join("frames.csv");
-        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
         Self::parse(&text, &path)
     }
 
     pub fn parse(text: &str, path: &Path) -> anyhow::Result<Self> {
         let mut lines = text.lines().filter(|l| !l.trim().is_empty());
-        let header: Vec<&str> = lines.next().with_context(|| format!("{}: empty file", path.display()))?.split(',').collect();
+        let header: Vec<&str> = lines
+            .next()
+            .with_context(|| format!("{}: empty file", path.display()))?
+            .split(',')
+            .collect();
         if header.len() < 2 || header[0] != "method" || header[1] != "frame" {
-            bail!("{}: header must start with `method,frame`, found `{}`", path.display(), header.join(","));
+            bail!(
+                "{}: header must start with `method,frame`, found `{}`",
+                path.display(),
+                header.join(",")
+            );
         }
         let columns: Vec<String> = header[2..].iter().map(|s| s.trim().to_string()).collect();
         let mut rows = Vec::new();
         for (i, line) in lines.enumerate() {
             let cells: Vec<&str> = line.split(',').collect();
             if cells.len() != header.len() {
-                bail!("{}: line {} has {} cells, the header has {}", path.display(), i + 2, cells.len(), header.len());
+                bail!(
+                    "{}: line {} has {} cells, the header has {}",
+                    path.display(),
+                    i + 2,
+                    cells.len(),
+                    header.len()
+                );
             }
-            let frame = cells[1].trim().parse().with_context(|| format!("{}: line {}: frame `{}` is not an integer", path.display(), i + 2, cells[1]))?;
+            let frame = cells[1].trim().parse().with_context(|| {
+                format!(
+                    "{}: line {}: frame `{}` is not an integer",
+                    path.display(),
+                    i + 2,
+                    cells[1]
+                )
+            })?;
             let values = cells[2..]
                 .iter()
                 .map(|c| {
@@ -133,7 +162,9 @@ impl Frames {
                     if c.is_empty() {
                         Ok(None)
                     } else {
-                        c.parse::<f64>().map(Some).with_context(|| format!("{}: line {}: `{c}` is not a number", path.display(), i + 2))
+                        c.parse::<f64>().map(Some).with_context(|| {
+                            format!("{}: line {}: `{c}` is not a number", path.display(), i + 2)
+                        })
                     }
                 })
                 .collect::<anyhow::Result<_>>()?;
@@ -159,8 +190,12 @@ impl Frames {
 
     /// (frame, value) of a column for one method, skipping empty cells, sorted by frame.
     pub fn series(&self, method: &str, column: usize) -> Vec<(f64, f64)> {
-        let mut s: Vec<(f64, f64)> =
-            self.rows.iter().filter(|r| r.method == method).filter_map(|r| r.values[column].map(|v| (r.frame as f64, v))).collect();
+        let mut s: Vec<(f64, f64)> = self
+            .rows
+            .iter()
+            .filter(|r| r.method == method)
+            .filter_map(|r| r.values[column].map(|v| (r.frame as f64, v)))
+            .collect();
         s.sort_by(|a, b| a.0.total_cmp(&b.0));
         s
     }

@@ -49,15 +49,30 @@ pub fn windows(manifest: &Manifest, frame_count: u32, n: u32) -> Vec<Window> {
     if let Some(first) = events.first()
         && first.frame > 0
     {
-        out.push(Window { name: "before_first_event".into(), first: 0, last: first.frame - 1, event: None });
+        out.push(Window {
+            name: "before_first_event".into(),
+            first: 0,
+            last: first.frame - 1,
+            event: None,
+        });
     }
     for (i, e) in events.iter().enumerate() {
         let end = events.get(i + 1).map(|next| next.frame.saturating_sub(1)).unwrap_or(last);
         let transient_end = (e.frame + n.max(1) - 1).min(end);
         let label = Some(format!("frame {}: {}", e.frame, e.label));
-        out.push(Window { name: format!("after_event_{i}"), first: e.frame, last: transient_end, event: label.clone() });
+        out.push(Window {
+            name: format!("after_event_{i}"),
+            first: e.frame,
+            last: transient_end,
+            event: label.clone(),
+        });
         if transient_end < end {
-            out.push(Window { name: format!("steady_after_event_{i}"), first: transient_end + 1, last: end, event: label });
+            out.push(Window {
+                name: format!("steady_after_event_{i}"),
+                first: transient_end + 1,
+                last: end,
+                event: label,
+            });
         }
     }
     out.push(Window { name: "overall".into(), first: 0, last, event: None });
@@ -75,20 +90,32 @@ pub fn summarize(manifest: &Manifest, frames: &Frames, n: u32) -> Summary {
             let means = windows
                 .iter()
                 .map(|w| {
-                    let in_window: Vec<_> = rows.iter().filter(|r| r.frame >= w.first && r.frame <= w.last).collect();
+                    let in_window: Vec<_> =
+                        rows.iter().filter(|r| r.frame >= w.first && r.frame <= w.last).collect();
                     let cols = frames
                         .columns
                         .iter()
                         .enumerate()
                         .filter_map(|(c, name)| {
-                            let vals: Vec<f64> = in_window.iter().filter_map(|r| r.values[c]).filter(|v| v.is_finite()).collect();
-                            (!vals.is_empty()).then(|| (name.clone(), vals.iter().sum::<f64>() / vals.len() as f64))
+                            let vals: Vec<f64> = in_window
+                                .iter()
+                                .filter_map(|r| r.values[c])
+                                .filter(|v| v.is_finite())
+                                .collect();
+                            (!vals.is_empty()).then(|| {
+                                (name.clone(), vals.iter().sum::<f64>() / vals.len() as f64)
+                            })
                         })
                         .collect();
                     (w.name.clone(), cols)
                 })
                 .collect();
-            let temporal_window = manifest.settings.methods.iter().find(|m| m.label == method).and_then(|m| m.temporal_window);
+            let temporal_window = manifest
+                .settings
+                .methods
+                .iter()
+                .find(|m| m.label == method)
+                .and_then(|m| m.temporal_window);
             MethodSummary { method, means, temporal_window }
         })
         .collect();
@@ -105,7 +132,8 @@ pub fn write_summary_with_window(run_dir: &Path, n: u32) -> anyhow::Result<()> {
     let frames = Frames::load(run_dir)?;
     let summary = summarize(&manifest, &frames, n);
     let path = run_dir.join("summary.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&summary)?).with_context(|| format!("cannot write {}", path.display()))
+    std::fs::write(&path, serde_json::to_string_pretty(&summary)?)
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 #[cfg(test)]
@@ -116,23 +144,32 @@ mod temporal_window_tests {
     /// summary and the summary table; runs that state none show no column.
     #[test]
     fn the_manifest_temporal_windows_reach_the_summary_table() {
-        let frames = Frames::parse("method,frame,flip\ntaa,0,0.2\nssc,0,0.1\npt,0,0.3\n", Path::new("frames.csv")).unwrap();
+        let frames = Frames::parse(
+            "method,frame,flip\ntaa,0,0.2\nssc,0,0.1\npt,0,0.3\n",
+            Path::new("frames.csv"),
+        )
+        .unwrap();
         let manifest: Manifest = serde_json::from_str(
             r#"{"scenario": "s", "methods": ["taa", "ssc", "pt"], "settings": {"methods": [
                 {"label": "taa", "temporal_window": 19.0}, {"label": "ssc", "temporal_window": 76.0}, {"label": "pt"}]}}"#,
         )
         .unwrap();
         let summary = summarize(&manifest, &frames, DEFAULT_WINDOW);
-        let windows: Vec<_> = summary.methods.iter().map(|m| (m.method.as_str(), m.temporal_window)).collect();
+        let windows: Vec<_> =
+            summary.methods.iter().map(|m| (m.method.as_str(), m.temporal_window)).collect();
         assert_eq!(windows, [("taa", Some(19.0)), ("ssc", Some(76.0)), ("pt", None)]);
         let html = crate::table::html(&summary, &frames);
         assert!(html.contains("temporal window (frames)</th>"), "{html}");
-        assert!(html.contains(">ssc</td><td>76.0</td>") && html.contains(">pt</td><td></td>"), "{html}");
+        assert!(
+            html.contains(">ssc</td><td>76.0</td>") && html.contains(">pt</td><td></td>"),
+            "{html}"
+        );
         let json = serde_json::to_value(&summary).unwrap();
         assert_eq!(json["methods"][1]["temporal_window"], 76.0);
         assert!(json["methods"][2].get("temporal_window").is_none());
 
-        let old: Manifest = serde_json::from_str(r#"{"scenario": "s", "methods": ["taa", "ssc", "pt"]}"#).unwrap();
+        let old: Manifest =
+            serde_json::from_str(r#"{"scenario": "s", "methods": ["taa", "ssc", "pt"]}"#).unwrap();
         let html = crate::table::html(&summarize(&old, &frames, DEFAULT_WINDOW), &frames);
         assert!(!html.contains("temporal window"), "{html}");
     }

@@ -30,19 +30,30 @@ pub enum Better {
 
 /// Index of the best value, when at least two methods have one and one of them is best.
 pub fn best(values: &[Option<f64>], better: Better) -> Option<usize> {
-    let finite: Vec<(usize, f64)> = values.iter().enumerate().filter_map(|(i, v)| v.filter(|v| v.is_finite()).map(|v| (i, v))).collect();
+    let finite: Vec<(usize, f64)> = values
+        .iter()
+        .enumerate()
+        .filter_map(|(i, v)| v.filter(|v| v.is_finite()).map(|v| (i, v)))
+        .collect();
     if finite.len() < 2 || better == Better::Neither {
         return None;
     }
-    let pick = |a: &(usize, f64), b: &(usize, f64)| if better == Better::Lower { a.1.total_cmp(&b.1) } else { b.1.total_cmp(&a.1) };
+    let pick = |a: &(usize, f64), b: &(usize, f64)| {
+        if better == Better::Lower { a.1.total_cmp(&b.1) } else { b.1.total_cmp(&a.1) }
+    };
     let best = finite.iter().min_by(|a, b| pick(a, b))?;
     // A tie marks nobody: "best" must mean something.
     (finite.iter().filter(|v| v.1 == best.1).count() == 1).then_some(best.0)
 }
 
 pub fn html(summary: &Summary, frames: &Frames) -> String {
-    let cols: Vec<_> = COLUMNS.iter().copied().filter(|(c, ..)| frames.column(c).is_some_and(|i| frames.has_data(i))).collect();
-    let mut h = String::from("<table id=\"summary\"><tr><th>window</th><th>frames</th><th>method</th>");
+    let cols: Vec<_> = COLUMNS
+        .iter()
+        .copied()
+        .filter(|(c, ..)| frames.column(c).is_some_and(|i| frames.has_data(i)))
+        .collect();
+    let mut h =
+        String::from("<table id=\"summary\"><tr><th>window</th><th>frames</th><th>method</th>");
     // Each method's effective temporal window (issue 15): compare flicker at equal windows.
     let temporal = summary.methods.iter().any(|m| m.temporal_window.is_some());
     if temporal {
@@ -58,18 +69,36 @@ pub fn html(summary: &Summary, frames: &Frames) -> String {
     }
     h.push_str("</tr>\n");
     for w in &summary.windows {
-        let value = |m: usize, c: &str| summary.methods[m].means.get(&w.name).and_then(|means| means.get(c)).copied();
-        let bests: Vec<Option<usize>> =
-            cols.iter().map(|(c, _, better)| best(&(0..summary.methods.len()).map(|m| value(m, c)).collect::<Vec<_>>(), *better)).collect();
+        let value = |m: usize, c: &str| {
+            summary.methods[m].means.get(&w.name).and_then(|means| means.get(c)).copied()
+        };
+        let bests: Vec<Option<usize>> = cols
+            .iter()
+            .map(|(c, _, better)| {
+                best(&(0..summary.methods.len()).map(|m| value(m, c)).collect::<Vec<_>>(), *better)
+            })
+            .collect();
         for (mi, m) in summary.methods.iter().enumerate() {
-            let _ = write!(h, "<tr><td class=\"m\">{}</td><td>{}–{}</td><td class=\"m\">{}</td>", esc(&w.name), w.first, w.last, esc(&m.method));
+            let _ = write!(
+                h,
+                "<tr><td class=\"m\">{}</td><td>{}–{}</td><td class=\"m\">{}</td>",
+                esc(&w.name),
+                w.first,
+                w.last,
+                esc(&m.method)
+            );
             if temporal {
-                let _ = write!(h, "<td>{}</td>", m.temporal_window.map(|v| format!("{v:.1}")).unwrap_or_default());
+                let _ = write!(
+                    h,
+                    "<td>{}</td>",
+                    m.temporal_window.map(|v| format!("{v:.1}")).unwrap_or_default()
+                );
             }
             for (ci, (c, ..)) in cols.iter().enumerate() {
                 let text = value(mi, c).map(|v| format!("{v:.4}")).unwrap_or_default();
                 if bests[ci] == Some(mi) {
-                    let _ = write!(h, "<td class=\"best\" title=\"best in this window\">{text}</td>");
+                    let _ =
+                        write!(h, "<td class=\"best\" title=\"best in this window\">{text}</td>");
                 } else {
                     let _ = write!(h, "<td>{text}</td>");
                 }
@@ -85,20 +114,37 @@ pub fn html(summary: &Summary, frames: &Frames) -> String {
 /// in B, and B − A (relative, in %), coloured by whether B is better.
 pub fn differences_html(a: &Summary, b: &Summary, frames_a: &Frames, frames_b: &Frames) -> String {
     let has = |f: &Frames, c: &str| f.column(c).is_some_and(|i| f.has_data(i));
-    let cols: Vec<_> = COLUMNS.iter().copied().filter(|(c, ..)| has(frames_a, c) && has(frames_b, c)).collect();
-    let overall = |s: &Summary, method: &str, c: &str| s.methods.iter().find(|m| m.method == method).and_then(|m| m.means.get("overall")?.get(c).copied());
-    let mut h = String::from("<table id=\"differences\"><tr><th>method</th><th>column</th><th>A</th><th>B</th><th>B − A</th><th>change</th></tr>\n");
+    let cols: Vec<_> =
+        COLUMNS.iter().copied().filter(|(c, ..)| has(frames_a, c) && has(frames_b, c)).collect();
+    let overall = |s: &Summary, method: &str, c: &str| {
+        s.methods
+            .iter()
+            .find(|m| m.method == method)
+            .and_then(|m| m.means.get("overall")?.get(c).copied())
+    };
+    let mut h = String::from(
+        "<table id=\"differences\"><tr><th>method</th><th>column</th><th>A</th><th>B</th><th>B − A</th><th>change</th></tr>\n",
+    );
     for m in a.methods.iter().filter(|m| b.methods.iter().any(|n| n.method == m.method)) {
         for (c, name, better) in &cols {
-            let (Some(va), Some(vb)) = (overall(a, &m.method, c), overall(b, &m.method, c)) else { continue };
+            let (Some(va), Some(vb)) = (overall(a, &m.method, c), overall(b, &m.method, c)) else {
+                continue;
+            };
             let d = vb - va;
             let class = match (better, d.partial_cmp(&0.0)) {
-                (Better::Lower, Some(std::cmp::Ordering::Less)) | (Better::Higher, Some(std::cmp::Ordering::Greater)) => " class=\"better\"",
-                (Better::Lower, Some(std::cmp::Ordering::Greater)) | (Better::Higher, Some(std::cmp::Ordering::Less)) => " class=\"worse\"",
+                (Better::Lower, Some(std::cmp::Ordering::Less))
+                | (Better::Higher, Some(std::cmp::Ordering::Greater)) => " class=\"better\"",
+                (Better::Lower, Some(std::cmp::Ordering::Greater))
+                | (Better::Higher, Some(std::cmp::Ordering::Less)) => " class=\"worse\"",
                 _ => "",
             };
-            let rel = if va != 0.0 { format!("{:+.1} %", 100.0 * d / va.abs()) } else { String::new() };
-            let _ = writeln!(h, "<tr><td class=\"m\">{}</td><td class=\"m\">{name}</td><td>{va:.4}</td><td>{vb:.4}</td><td{class}>{d:+.4}</td><td{class}>{rel}</td></tr>", esc(&m.method));
+            let rel =
+                if va != 0.0 { format!("{:+.1} %", 100.0 * d / va.abs()) } else { String::new() };
+            let _ = writeln!(
+                h,
+                "<tr><td class=\"m\">{}</td><td class=\"m\">{name}</td><td>{va:.4}</td><td>{vb:.4}</td><td{class}>{d:+.4}</td><td{class}>{rel}</td></tr>",
+                esc(&m.method)
+            );
         }
     }
     h.push_str("</table>\n");

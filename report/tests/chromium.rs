@@ -32,16 +32,28 @@ struct Outcome {
 
 fn check_page(bin: &Path, work: &Path, html: &str, name: &str) -> Outcome {
     let page = work.join(name);
-    let with_check = html.replacen("<head>", &format!("<head>{ERROR_HOOK}"), 1).replacen("</body>", &format!("{CHECK_SCRIPT}</body>"), 1);
+    let with_check = html.replacen("<head>", &format!("<head>{ERROR_HOOK}"), 1).replacen(
+        "</body>",
+        &format!("{CHECK_SCRIPT}</body>"),
+        1,
+    );
     std::fs::write(&page, with_check).unwrap();
     let out = browser(bin, work, &["--dump-dom".into()], &file_url(&page));
     let dom = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    let line = element_text(&dom, "flicker-check")
-        .unwrap_or_else(|| panic!("{name}: the check did not run; chromium stdout tail:\n{}\nstderr:\n{stderr}", &dom[dom.len().saturating_sub(500)..]));
+    let line = element_text(&dom, "flicker-check").unwrap_or_else(|| {
+        panic!(
+            "{name}: the check did not run; chromium stdout tail:\n{}\nstderr:\n{stderr}",
+            &dom[dom.len().saturating_sub(500)..]
+        )
+    });
     let words: Vec<&str> = line.split_whitespace().collect();
     let hooked: usize = words[5].parse().unwrap();
-    let mut console_errors: Vec<String> = stderr.lines().filter(|l| l.contains("CONSOLE") && l.contains("Uncaught")).map(str::to_string).collect();
+    let mut console_errors: Vec<String> = stderr
+        .lines()
+        .filter(|l| l.contains("CONSOLE") && l.contains("Uncaught"))
+        .map(str::to_string)
+        .collect();
     if hooked > 0 {
         console_errors.push(line.clone());
     }
@@ -58,25 +70,40 @@ fn report_displays_every_image_without_console_errors() {
     std::fs::create_dir_all(&work).unwrap();
 
     let ok = check_page(&bin, &work, &html, "report.html");
-    assert_eq!(ok.images, html.matches("<img ").count(), "every <img> of the report is seen by the browser");
+    assert_eq!(
+        ok.images,
+        html.matches("<img ").count(),
+        "every <img> of the report is seen by the browser"
+    );
     assert!(ok.images >= 16, "12 charts and 4 region crops");
     assert_eq!(ok.bad, 0, "images not displayed");
     assert!(ok.console_errors.is_empty(), "console errors: {:?}", ok.console_errors);
 
     // Controls: a broken image and a console error must be caught.
-    let broken = html.replacen("<img ", "<img alt=\"broken\" src=\"data:image/png;base64,AAAA\" data-x=", 1);
+    let broken =
+        html.replacen("<img ", "<img alt=\"broken\" src=\"data:image/png;base64,AAAA\" data-x=", 1);
     assert_eq!(check_page(&bin, &work, &broken, "broken.html").bad, 1);
     let noisy = html.replacen("</body>", "<script>console.error('boom')</script></body>", 1);
     let thrown = html.replacen("</body>", "<script>undefined_function()</script></body>", 1);
-    assert!(!check_page(&bin, &work, &thrown, "thrown.html").console_errors.is_empty(), "exceptions must be detected");
-    assert!(!check_page(&bin, &work, &noisy, "noisy.html").console_errors.is_empty(), "console.error must be detected");
+    assert!(
+        !check_page(&bin, &work, &thrown, "thrown.html").console_errors.is_empty(),
+        "exceptions must be detected"
+    );
+    assert!(
+        !check_page(&bin, &work, &noisy, "noisy.html").console_errors.is_empty(),
+        "console.error must be detected"
+    );
 
     // The rendered page is not blank: its screenshot has plenty of non-white pixels.
     let shot = work.join("shot.png");
-    let out = browser(&bin, &work, &[format!("--screenshot={}", shot.display())], &file_url(&report));
+    let out =
+        browser(&bin, &work, &[format!("--screenshot={}", shot.display())], &file_url(&report));
     assert!(shot.exists(), "no screenshot: {}", String::from_utf8_lossy(&out.stderr));
     let img = image::open(&shot).unwrap().to_rgb8();
     let inked = img.pixels().filter(|p| p.0.iter().any(|&c| c < 200)).count();
-    assert!(inked as f64 > 0.01 * (img.width() * img.height()) as f64, "screenshot mostly blank ({inked} inked pixels)");
+    assert!(
+        inked as f64 > 0.01 * (img.width() * img.height()) as f64,
+        "screenshot mostly blank ({inked} inked pixels)"
+    );
     std::fs::remove_dir_all(&run).ok();
 }

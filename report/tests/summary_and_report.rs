@@ -10,7 +10,8 @@ fn summary_windows_and_means() {
     let run = fake_run("summary");
     report::write_summary_with_window(&run, 5).unwrap();
     let s = read_json(&run.join("summary.json"));
-    let names: Vec<&str> = s["windows"].as_array().unwrap().iter().map(|w| w["name"].as_str().unwrap()).collect();
+    let names: Vec<&str> =
+        s["windows"].as_array().unwrap().iter().map(|w| w["name"].as_str().unwrap()).collect();
     assert_eq!(names, ["before_first_event", "after_event_0", "steady_after_event_0", "overall"]);
     let w = &s["windows"][1];
     assert_eq!((w["first"].as_u64(), w["last"].as_u64()), (Some(20), Some(24)));
@@ -21,7 +22,12 @@ fn summary_windows_and_means() {
     let c = frames.column("smape").unwrap();
     for method in METHODS {
         let manual = |lo: u32, hi: u32| {
-            let v: Vec<f64> = frames.rows.iter().filter(|r| r.method == method && r.frame >= lo && r.frame <= hi).filter_map(|r| r.values[c]).collect();
+            let v: Vec<f64> = frames
+                .rows
+                .iter()
+                .filter(|r| r.method == method && r.frame >= lo && r.frame <= hi)
+                .filter_map(|r| r.values[c])
+                .collect();
             v.iter().sum::<f64>() / v.len() as f64
         };
         let m = s["methods"].as_array().unwrap().iter().find(|m| m["method"] == method).unwrap();
@@ -32,12 +38,17 @@ fn summary_windows_and_means() {
         assert!((after - manual(20, 24)).abs() < 1e-9);
         assert!((steady - manual(25, 29)).abs() < 1e-9);
         // FLIP only on reference frames: before-window mean is frame 0's value.
-        let f0 = frames.rows.iter().find(|r| r.method == method && r.frame == 0).unwrap().values[frames.column("flip").unwrap()].unwrap();
+        let f0 = frames.rows.iter().find(|r| r.method == method && r.frame == 0).unwrap().values
+            [frames.column("flip").unwrap()]
+        .unwrap();
         assert!((m["means"]["before_first_event"]["flip"].as_f64().unwrap() - f0).abs() < 1e-9);
     }
     // The slowly adapting method flickers more right after the event than before it.
     let ema = s["methods"].as_array().unwrap().iter().find(|m| m["method"] == "cache_ema").unwrap();
-    assert!(ema["means"]["after_event_0"]["smape"].as_f64().unwrap() > ema["means"]["before_first_event"]["smape"].as_f64().unwrap());
+    assert!(
+        ema["means"]["after_event_0"]["smape"].as_f64().unwrap()
+            > ema["means"]["before_first_event"]["smape"].as_f64().unwrap()
+    );
     std::fs::remove_dir_all(&run).ok();
 }
 
@@ -47,33 +58,59 @@ fn report_is_self_contained_with_charts_maps_and_crops() {
     let path = report::rebuild(&run).unwrap();
     assert_eq!(path, run.join("report.html"));
     let html = std::fs::read_to_string(&path).unwrap();
-    for stem in ["frames_flip", "frames_smape", "frames_psnr", "frames_gpu_ms_total", "frames_steady_flip", "frames_changing_smape", "speed_vs_flip", "speed_vs_smape"] {
+    for stem in [
+        "frames_flip",
+        "frames_smape",
+        "frames_psnr",
+        "frames_gpu_ms_total",
+        "frames_steady_flip",
+        "frames_changing_smape",
+        "speed_vs_flip",
+        "speed_vs_smape",
+    ] {
         for ext in ["svg", "png"] {
             let f = run.join("charts").join(format!("{stem}.{ext}"));
-            assert!(f.exists() && std::fs::metadata(&f).unwrap().len() > 500, "{} missing or empty", f.display());
+            assert!(
+                f.exists() && std::fs::metadata(&f).unwrap().len() > 500,
+                "{} missing or empty",
+                f.display()
+            );
         }
     }
     // smape_reprojected has no data in this run: no chart for it.
     assert!(!run.join("charts/frames_smape_reprojected.svg").exists());
-    for f in ["flip_pt_1spp_0020.png", "flip_cache_ema_0000.png", "crops_steady_0020.png", "crops_changing_0000.png"] {
+    for f in [
+        "flip_pt_1spp_0020.png",
+        "flip_cache_ema_0000.png",
+        "crops_steady_0020.png",
+        "crops_changing_0000.png",
+    ] {
         assert!(run.join("charts").join(f).exists(), "{f}");
     }
     // Every image is inlined.
     let imgs = html.matches("<img ").count();
     assert_eq!(imgs, html.matches("src=\"data:image/").count());
-    assert_eq!(imgs, 12 + 2 * 2, "12 charts (7 metrics, 2 regions x 2, 2 speed); 2 region crops per reference frame");
+    assert_eq!(
+        imgs,
+        12 + 2 * 2,
+        "12 charts (7 metrics, 2 regions x 2, 2 speed); 2 region crops per reference frame"
+    );
     // The viewer carries every frame once, FLIP maps where a reference exists.
     assert_eq!(html.matches("<script>flickerFrame(").count(), FRAMES as usize);
     assert_eq!(html.matches("\"flip:pt_1spp\"").count(), 2);
     assert_eq!(html.matches("class=\"event-mark\"").count(), 1);
     assert!(!run.join("viewer").exists(), "a small run's frames are embedded, not linked");
-    assert!(!html.contains("data-mode=\"motion\"") && html.contains("records no motion vectors"), "no motion toggle without motion vectors");
+    assert!(
+        !html.contains("data-mode=\"motion\"") && html.contains("records no motion vectors"),
+        "no motion toggle without motion vectors"
+    );
     // The best method of each column is marked, once per column and window with data.
     // 3 windows (before, after the event, overall) x 6 columns with data (FLIP, SMAPE, PSNR,
     // rel. MSE, GPU ms, CPU ms): no ties in this run.
     assert_eq!(html.matches("class=\"best\"").count(), 3 * 6);
     // The cheaper method (1 ms against 2.5 ms) is marked in the GPU column of every window.
-    let rows: Vec<&str> = html.split("<tr>").filter(|r| r.contains("<td class=\"m\">pt_1spp</td>")).collect();
+    let rows: Vec<&str> =
+        html.split("<tr>").filter(|r| r.contains("<td class=\"m\">pt_1spp</td>")).collect();
     assert_eq!(rows.len(), 3);
     for r in rows {
         let cells: Vec<&str> = r.split("<td").collect();
@@ -82,7 +119,11 @@ fn report_is_self_contained_with_charts_maps_and_crops() {
     }
     // The Pareto chart comes before the summary table, the table before the frame charts.
     let at = |s: &str| html.find(s).unwrap_or_else(|| panic!("{s} missing"));
-    assert!(at("id=\"viewer\"") < at("Speed vs accuracy") && at("Speed vs accuracy") < at("id=\"summary\"") && at("id=\"summary\"") < at("<h2>Charts"));
+    assert!(
+        at("id=\"viewer\"") < at("Speed vs accuracy")
+            && at("Speed vs accuracy") < at("id=\"summary\"")
+            && at("id=\"summary\"") < at("<h2>Charts")
+    );
     assert!(html.contains("id=\"summary\"") && html.contains("rotate light"));
     // The event is drawn on the frame charts.
     let svg = std::fs::read_to_string(run.join("charts/frames_flip.svg")).unwrap();
@@ -99,13 +140,21 @@ fn minimal_run_without_reference_events_or_regions() {
     let run = std::env::temp_dir().join(format!("report-minimal-{}", std::process::id()));
     std::fs::create_dir_all(&run).unwrap();
     std::fs::write(run.join("manifest.json"), r#"{"scenario": "tiny", "methods": ["a"]}"#).unwrap();
-    std::fs::write(run.join("frames.csv"), "method,frame,cpu_ms,smape\na,0,1.0,\na,1,1.2,0.5\na,2,1.1,0.25\n").unwrap();
+    std::fs::write(
+        run.join("frames.csv"),
+        "method,frame,cpu_ms,smape\na,0,1.0,\na,1,1.2,0.5\na,2,1.1,0.25\n",
+    )
+    .unwrap();
     let html = std::fs::read_to_string(report::rebuild(&run).unwrap()).unwrap();
     let s = read_json(&run.join("summary.json"));
-    let names: Vec<&str> = s["windows"].as_array().unwrap().iter().map(|w| w["name"].as_str().unwrap()).collect();
+    let names: Vec<&str> =
+        s["windows"].as_array().unwrap().iter().map(|w| w["name"].as_str().unwrap()).collect();
     assert_eq!(names, ["overall"]);
     assert_eq!(s["methods"][0]["means"]["overall"]["smape"].as_f64(), Some(0.375));
-    assert!(run.join("charts/frames_smape.svg").exists() && run.join("charts/speed_vs_smape.png").exists());
+    assert!(
+        run.join("charts/frames_smape.svg").exists()
+            && run.join("charts/speed_vs_smape.png").exists()
+    );
     assert_eq!(html.matches("<img ").count(), 3, "smape, cpu_ms, speed vs smape");
     // A malformed manifest is reported with its path.
     std::fs::write(run.join("manifest.json"), "{").unwrap();

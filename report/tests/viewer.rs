@@ -15,7 +15,12 @@ use serde_json::Value;
 const FPS: f64 = 20.0;
 
 fn viewer_run(name: &str) -> (FakeRun, std::path::PathBuf) {
-    let spec = FakeRun { static_noise: true, time_step: Some(1.0 / FPS), motion: true, ..FakeRun::default() };
+    let spec = FakeRun {
+        static_noise: true,
+        time_step: Some(1.0 / FPS),
+        motion: true,
+        ..FakeRun::default()
+    };
     let dir = fake_run_with(name, &spec);
     report::rebuild(&dir).unwrap();
     (spec, dir)
@@ -112,11 +117,23 @@ window.addEventListener('load', async () => {
 fn interact(bin: &Path, run: &Path) -> Value {
     let html = std::fs::read_to_string(run.join("report.html")).unwrap();
     let page = run.join("interact.html");
-    std::fs::write(&page, html.replacen("<head>", &format!("<head>{ERROR_HOOK}"), 1).replacen("</body>", &format!("{INTERACT}</body>"), 1)).unwrap();
+    std::fs::write(
+        &page,
+        html.replacen("<head>", &format!("<head>{ERROR_HOOK}"), 1).replacen(
+            "</body>",
+            &format!("{INTERACT}</body>"),
+            1,
+        ),
+    )
+    .unwrap();
     let out = browser(bin, run, &["--dump-dom".into()], &file_url(&page));
     let dom = String::from_utf8_lossy(&out.stdout);
-    let text = element_text(&dom, "viewer-test")
-        .unwrap_or_else(|| panic!("the interaction script did not finish; stderr:\n{}", String::from_utf8_lossy(&out.stderr)));
+    let text = element_text(&dom, "viewer-test").unwrap_or_else(|| {
+        panic!(
+            "the interaction script did not finish; stderr:\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        )
+    });
     serde_json::from_str(&text).unwrap()
 }
 
@@ -137,7 +154,10 @@ fn slider_play_exposure_zoom_maps_and_pixel_values() {
     // The slider changes the frame shown.
     assert_eq!(out["slider"]["shown"], 25);
     assert_eq!(out["slider"]["label"], "frame 25 / 29");
-    assert_eq!(out["slider"]["changed"], true, "frame 25 looks like frame 10, though the light changed at 20");
+    assert_eq!(
+        out["slider"]["changed"], true,
+        "frame 25 looks like frame 10, though the light changed at 20"
+    );
 
     // Play advances frames, no faster than the scenario's rate (500 ms at 20 frames/s = 10).
     assert_eq!(out["playingText"], "pause");
@@ -150,7 +170,10 @@ fn slider_play_exposure_zoom_maps_and_pixel_values() {
     // Exposure +2 EV: displayed bytes brighten, radiance under them is unchanged.
     let (before, after) = (&out["exposure"]["before"], &out["exposure"]["after"]);
     for c in 0..3 {
-        assert!(f(&after[c]) > f(&before[c]) + 20.0, "exposure did not brighten: {before} -> {after}");
+        assert!(
+            f(&after[c]) > f(&before[c]) + 20.0,
+            "exposure did not brighten: {before} -> {after}"
+        );
     }
     assert_eq!(out["exposure"]["valueBefore"], out["exposure"]["valueAfter"]);
     assert_eq!(out["exposure"]["label"], "+2 EV");
@@ -160,22 +183,37 @@ fn slider_play_exposure_zoom_maps_and_pixel_values() {
     assert_eq!(z["before"], z["after"], "the pixel under the cursor moved while zooming");
     assert!(f(&z["zoomAfter"]) > 1.5 * f(&z["zoomBefore"]));
     let t = z["transforms"].as_array().unwrap();
-    assert!(t.iter().all(|x| x == &t[0]) && t[0].as_str().unwrap().contains("scale"), "panels not synchronised: {t:?}");
+    assert!(
+        t.iter().all(|x| x == &t[0]) && t[0].as_str().unwrap().contains("scale"),
+        "panels not synchronised: {t:?}"
+    );
     assert_eq!(z["rendering"], "pixelated");
 
     // The values under the pointer are each method's radiance at that pixel (RGBE: ~1%).
-    let (x, y) = (out["readout"]["pixel"][0].as_u64().unwrap() as u32, out["readout"]["pixel"][1].as_u64().unwrap() as u32);
+    let (x, y) = (
+        out["readout"]["pixel"][0].as_u64().unwrap() as u32,
+        out["readout"]["pixel"][1].as_u64().unwrap() as u32,
+    );
     assert_eq!(out["readout"]["text"], format!("pixel ({x}, {y})"));
     let frame = out["readout"]["frame"].as_u64().unwrap() as u32;
     let values = out["readout"]["values"].as_array().unwrap();
     assert_eq!(values[0], "", "no reference at frame {frame}");
     for (m, method) in spec.methods.iter().enumerate() {
-        let exr = load_image(run.join(format!("frames/{method}/{frame:04}.exr"))).unwrap().get(x, y);
-        let shown: Vec<f32> = values[m + 1].as_str().unwrap().split_whitespace().map(|v| v.parse().unwrap()).collect();
+        let exr =
+            load_image(run.join(format!("frames/{method}/{frame:04}.exr"))).unwrap().get(x, y);
+        let shown: Vec<f32> = values[m + 1]
+            .as_str()
+            .unwrap()
+            .split_whitespace()
+            .map(|v| v.parse().unwrap())
+            .collect();
         assert_eq!(shown.len(), 3, "{method}: {shown:?}");
         let max = exr.iter().cloned().fold(0.0, f32::max);
         for c in 0..3 {
-            assert!((shown[c] - exr[c]).abs() <= max / 100.0, "{method} at ({x}, {y}): page {shown:?}, EXR {exr:?}");
+            assert!(
+                (shown[c] - exr[c]).abs() <= max / 100.0,
+                "{method} at ({x}, {y}): page {shown:?}, EXR {exr:?}"
+            );
         }
     }
 
@@ -184,20 +222,37 @@ fn slider_play_exposure_zoom_maps_and_pixel_values() {
     let img20 = load_image(run.join("frames/pt_1spp/0020.exr")).unwrap();
     let flip = flip_hdr(&reference, &img20, DEFAULT_PPD).map[(12 * spec.width + 6) as usize];
     assert_eq!(out["flip20"]["empty"], false);
-    assert!((f(&out["flip20"]["value"][0]) - flip as f64).abs() <= 1.0 / 255.0 + 1e-6, "FLIP {} vs {flip}", out["flip20"]["value"]);
+    assert!(
+        (f(&out["flip20"]["value"][0]) - flip as f64).abs() <= 1.0 / 255.0 + 1e-6,
+        "FLIP {} vs {flip}",
+        out["flip20"]["value"]
+    );
     assert_eq!(out["flip21"]["empty"], true);
     assert!(out["flip21"]["value"].is_null());
     // SMAPE at frame 21 against frame 20 (the right half changes while cache_ema adapts).
     let img21 = load_image(run.join("frames/pt_1spp/0021.exr")).unwrap();
     let s = smape(&img21, &img20, 0.01).map[(12 * spec.width + 40) as usize] as f64;
     assert_eq!(out["smape21"]["empty"], false);
-    assert!((f(&out["smape21"]["value"][0]) - s).abs() < 0.02, "SMAPE {} vs {s}", out["smape21"]["value"]);
+    assert!(
+        (f(&out["smape21"]["value"][0]) - s).abs() < 0.02,
+        "SMAPE {} vs {s}",
+        out["smape21"]["value"]
+    );
 
     // Motion vectors of the method that records them, as written (1/8 pixel steps), coloured.
     let [dx, dy] = motion(6, 12, 21);
     assert_eq!(out["motion21"]["empty"], false);
-    assert!((f(&out["motion21"]["value"][0]) - dx as f64).abs() <= 1.0 / 16.0 && (f(&out["motion21"]["value"][1]) - dy as f64).abs() <= 1.0 / 16.0, "{}", out["motion21"]);
-    assert!(out["motion21"]["pixel"].as_array().unwrap().iter().any(|c| f(c) > 20.0), "motion drawn black: {}", out["motion21"]);
+    assert!(
+        (f(&out["motion21"]["value"][0]) - dx as f64).abs() <= 1.0 / 16.0
+            && (f(&out["motion21"]["value"][1]) - dy as f64).abs() <= 1.0 / 16.0,
+        "{}",
+        out["motion21"]
+    );
+    assert!(
+        out["motion21"]["pixel"].as_array().unwrap().iter().any(|c| f(c) > 20.0),
+        "motion drawn black: {}",
+        out["motion21"]
+    );
     assert_eq!(out["motion21"]["otherEmpty"], true, "cache_ema records no motion");
 
     // The event is marked on the slider at its frame.
@@ -210,8 +265,18 @@ fn slider_play_exposure_zoom_maps_and_pixel_values() {
     // Chart cursors sit at the frame, along the chart's own frame axis.
     let (c0, c15) = (&out["cursor0"], &out["cursor15"]);
     let num = |c: &Value, k: &str| c[k].as_str().unwrap().parse::<f64>().unwrap();
-    let at = |c: &Value, frame: f64| 100.0 * (num(c, "x0") + (frame - num(c, "f0")) / (num(c, "f1") - num(c, "f0")) * (num(c, "x1") - num(c, "x0"))) / num(c, "w");
-    assert!((f(&c0["left"]) - at(c0, 0.0)).abs() < 0.01 && (f(&c15["left"]) - at(c15, 15.0)).abs() < 0.01, "{c0} {c15}");
+    let at = |c: &Value, frame: f64| {
+        100.0
+            * (num(c, "x0")
+                + (frame - num(c, "f0")) / (num(c, "f1") - num(c, "f0"))
+                    * (num(c, "x1") - num(c, "x0")))
+            / num(c, "w")
+    };
+    assert!(
+        (f(&c0["left"]) - at(c0, 0.0)).abs() < 0.01
+            && (f(&c15["left"]) - at(c15, 15.0)).abs() < 0.01,
+        "{c0} {c15}"
+    );
     assert!(f(&c15["left"]) > f(&c0["left"]) + 10.0);
     std::fs::remove_dir_all(&run).ok();
 }
@@ -223,7 +288,13 @@ fn diff(a: &image::RgbImage, b: &image::RgbImage, r: [f64; 4]) -> f64 {
     let mut sum = 0u64;
     for y in y0..y1 {
         for x in x0..x1 {
-            sum += a.get_pixel(x, y).0.iter().zip(b.get_pixel(x, y).0).map(|(p, q)| p.abs_diff(q) as u64).sum::<u64>();
+            sum += a
+                .get_pixel(x, y)
+                .0
+                .iter()
+                .zip(b.get_pixel(x, y).0)
+                .map(|(p, q)| p.abs_diff(q) as u64)
+                .sum::<u64>();
         }
     }
     sum as f64 / ((x1 - x0) * (y1 - y0)) as f64
@@ -237,7 +308,12 @@ fn screenshots_differ_where_the_scene_changes_and_only_there() {
     let views = interact(&bin, &run)["views"].clone();
     let shot = |frame: u32| {
         let path = run.join(format!("shot_{frame}.png"));
-        let out = browser(&bin, &run, &[format!("--screenshot={}", path.display())], &format!("{}#frame={frame}", file_url(&run.join("report.html"))));
+        let out = browser(
+            &bin,
+            &run,
+            &[format!("--screenshot={}", path.display())],
+            &format!("{}#frame={frame}", file_url(&run.join("report.html"))),
+        );
         assert!(path.exists(), "no screenshot: {}", String::from_utf8_lossy(&out.stderr));
         let img = image::open(&path).unwrap().to_rgb8();
         assert_eq!((img.width(), img.height()), WINDOW);
@@ -249,10 +325,18 @@ fn screenshots_differ_where_the_scene_changes_and_only_there() {
         let left = [r[0], r[1], r[2] / 2.0 - 2.0, r[3]];
         let right = [r[0] + r[2] / 2.0 + 2.0, r[1], r[2] / 2.0 - 2.0, r[3]];
         // Before the event nothing moves: frames 5 and 10 look the same.
-        assert_eq!(diff(&a, &b, [r[0], r[1], r[2], r[3]]), 0.0, "panel {i}: frames 5 and 10 differ");
+        assert_eq!(
+            diff(&a, &b, [r[0], r[1], r[2], r[3]]),
+            0.0,
+            "panel {i}: frames 5 and 10 differ"
+        );
         // After it, the lit right half changes and the left half does not.
         assert_eq!(diff(&b, &c, left), 0.0, "panel {i}: the unlit half changed");
-        assert!(diff(&b, &c, right) > 10.0, "panel {i}: the lit half did not change ({})", diff(&b, &c, right));
+        assert!(
+            diff(&b, &c, right) > 10.0,
+            "panel {i}: the lit half did not change ({})",
+            diff(&b, &c, right)
+        );
     }
     std::fs::remove_dir_all(&run).ok();
 }
@@ -299,17 +383,35 @@ fn a_320x180_60_frame_6_method_report_opens_in_under_3_s() {
     let build_s = t.elapsed().as_secs_f64();
     let html = std::fs::read_to_string(run.join("report.html")).unwrap();
     let page = run.join("timed.html");
-    std::fs::write(&page, html.replacen("<head>", &format!("<head>{ERROR_HOOK}"), 1).replacen("</body>", &format!("{FIRST_FRAME}</body>"), 1)).unwrap();
+    std::fs::write(
+        &page,
+        html.replacen("<head>", &format!("<head>{ERROR_HOOK}"), 1).replacen(
+            "</body>",
+            &format!("{FIRST_FRAME}</body>"),
+            1,
+        ),
+    )
+    .unwrap();
     let blank = run.join("blank.html");
-    std::fs::write(&blank, "<!DOCTYPE html><html><body><pre id=\"first-frame\">blank</pre></body></html>").unwrap();
+    std::fs::write(
+        &blank,
+        "<!DOCTYPE html><html><body><pre id=\"first-frame\">blank</pre></body></html>",
+    )
+    .unwrap();
     let size = |p: &Path| std::fs::metadata(p).map(|m| m.len()).unwrap_or(0);
-    let linked: u64 = std::fs::read_dir(run.join("viewer")).map(|d| d.map(|e| size(&e.unwrap().path())).sum()).unwrap_or(0);
+    let linked: u64 = std::fs::read_dir(run.join("viewer"))
+        .map(|d| d.map(|e| size(&e.unwrap().path())).sum())
+        .unwrap_or(0);
     // Best of three of each: the machine may be busy with other work.
     let mut times = Vec::new();
     for _ in 0..3 {
         let (blank_s, _) = open_seconds(&bin, &run, &blank);
         let (page_s, dom) = open_seconds(&bin, &run, &page);
-        assert_eq!(element_text(&dom, "first-frame").as_deref(), Some("shown 0 empty 0 errors 0"), "the first frame was not shown in every panel");
+        assert_eq!(
+            element_text(&dom, "first-frame").as_deref(),
+            Some("shown 0 empty 0 errors 0"),
+            "the first frame was not shown in every panel"
+        );
         times.push((page_s - blank_s, page_s, blank_s));
     }
     let (open, page_s, blank_s) = times.into_iter().min_by(|a, b| a.0.total_cmp(&b.0)).unwrap();
@@ -323,7 +425,10 @@ fn a_320x180_60_frame_6_method_report_opens_in_under_3_s() {
     );
     assert!(open < 3.0, "opening took {open:.2} s");
     // This run is past the embedding threshold: its frames came from RUN/viewer/.
-    assert!(linked > report::viewer::EMBED_LIMIT_BYTES as u64 && size(&run.join("report.html")) < 2 << 20);
+    assert!(
+        linked > report::viewer::EMBED_LIMIT_BYTES as u64
+            && size(&run.join("report.html")) < 2 << 20
+    );
     std::fs::remove_dir_all(&run).ok();
 }
 
@@ -333,32 +438,50 @@ fn compare_puts_two_runs_in_one_viewer_with_a_table_of_differences() {
     let a = fake_run_with("compare-a", &FakeRun::default());
     // B: the same scene with noise that holds still from frame to frame (less flicker).
     let b = fake_run_with("compare-b", &FakeRun { static_noise: true, ..FakeRun::default() });
-    let args = report::ReportArgs { run_dir: None, compare: Some(vec![a.clone(), b.clone()]), out: None };
+    let args =
+        report::ReportArgs { run_dir: None, compare: Some(vec![a.clone(), b.clone()]), out: None };
     let page = report::report(&args).unwrap();
     assert_eq!(page, b.join("compare.html"));
     let html = std::fs::read_to_string(&page).unwrap();
-    let labels: Vec<&str> = html.split("data-label=\"").skip(1).map(|s| s.split('"').next().unwrap()).collect();
+    let labels: Vec<&str> =
+        html.split("data-label=\"").skip(1).map(|s| s.split('"').next().unwrap()).collect();
     assert_eq!(labels, ["reference", "A: pt_1spp", "B: pt_1spp", "A: cache_ema", "B: cache_ema"]);
     assert_eq!(html.matches("<script>flickerFrame(").count(), FRAMES as usize);
-    assert_eq!(html.matches("\"flip:B: cache_ema\"").count(), 2, "FLIP maps of B at both reference frames");
+    assert_eq!(
+        html.matches("\"flip:B: cache_ema\"").count(),
+        2,
+        "FLIP maps of B at both reference frames"
+    );
 
     // Differences: the overall SMAPE of each run, from its frames.csv; B flickers less.
     let frames = |dir: &Path| report::run::Frames::load(dir).unwrap();
     let mean_smape = |dir: &Path, method: &str| {
         let f = frames(dir);
-        let v: Vec<f64> = f.series(method, f.column("smape").unwrap()).into_iter().map(|p| p.1).collect();
+        let v: Vec<f64> =
+            f.series(method, f.column("smape").unwrap()).into_iter().map(|p| p.1).collect();
         v.iter().sum::<f64>() / v.len() as f64
     };
     let row = |method: &str, column: &str| -> Vec<String> {
         let start = format!("<tr><td class=\"m\">{method}</td><td class=\"m\">{column}</td>");
-        let r = html.split(&start).nth(1).unwrap_or_else(|| panic!("no row {method} {column}")).split("</tr>").next().unwrap();
+        let r = html
+            .split(&start)
+            .nth(1)
+            .unwrap_or_else(|| panic!("no row {method} {column}"))
+            .split("</tr>")
+            .next()
+            .unwrap();
         r.split("<td").skip(1).map(|c| c.to_string()).collect()
     };
     for method in METHODS {
         let (sa, sb) = (mean_smape(&a, method), mean_smape(&b, method));
         let cells = row(method, "SMAPE");
-        let num = |c: &str| c.split('>').nth(1).unwrap().split('<').next().unwrap().parse::<f64>().unwrap();
-        assert!((num(&cells[0]) - sa).abs() < 1e-4 && (num(&cells[1]) - sb).abs() < 1e-4, "{method}: {cells:?} vs {sa} {sb}");
+        let num = |c: &str| {
+            c.split('>').nth(1).unwrap().split('<').next().unwrap().parse::<f64>().unwrap()
+        };
+        assert!(
+            (num(&cells[0]) - sa).abs() < 1e-4 && (num(&cells[1]) - sb).abs() < 1e-4,
+            "{method}: {cells:?} vs {sa} {sb}"
+        );
         assert!(sb < sa && cells[2].starts_with(" class=\"better\""), "{method}: {cells:?}");
         // GPU time is the same in both runs: no colour.
         assert!(row(method, "GPU ms")[2].starts_with(">+0.0000"));
@@ -366,7 +489,15 @@ fn compare_puts_two_runs_in_one_viewer_with_a_table_of_differences() {
 
     // In the browser: every panel shows frame 0.
     let timed = b.join("compare-check.html");
-    std::fs::write(&timed, html.replacen("<head>", &format!("<head>{ERROR_HOOK}"), 1).replacen("</body>", &format!("{FIRST_FRAME}</body>"), 1)).unwrap();
+    std::fs::write(
+        &timed,
+        html.replacen("<head>", &format!("<head>{ERROR_HOOK}"), 1).replacen(
+            "</body>",
+            &format!("{FIRST_FRAME}</body>"),
+            1,
+        ),
+    )
+    .unwrap();
     let (_, dom) = open_seconds(&bin, &b, &timed);
     assert_eq!(element_text(&dom, "first-frame").as_deref(), Some("shown 0 empty 0 errors 0"));
     std::fs::remove_dir_all(&a).ok();

@@ -35,9 +35,19 @@ impl Mesh {
     pub fn plane(half: f32) -> Mesh {
         Mesh {
             name: "plane".into(),
-            positions: vec![Vec3::new(-half, 0.0, -half), Vec3::new(-half, 0.0, half), Vec3::new(half, 0.0, half), Vec3::new(half, 0.0, -half)],
+            positions: vec![
+                Vec3::new(-half, 0.0, -half),
+                Vec3::new(-half, 0.0, half),
+                Vec3::new(half, 0.0, half),
+                Vec3::new(half, 0.0, -half),
+            ],
             normals: vec![],
-            uvs: vec![Vec2::new(0.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0)],
+            uvs: vec![
+                Vec2::new(0.0, 0.0),
+                Vec2::new(0.0, 1.0),
+                Vec2::new(1.0, 1.0),
+                Vec2::new(1.0, 0.0),
+            ],
             indices: vec![[0, 1, 2], [0, 2, 3]],
         }
     }
@@ -154,7 +164,12 @@ pub struct Camera {
 
 impl Default for Camera {
     fn default() -> Self {
-        Self { position: Vec3::new(0.0, 1.0, 3.0), target: Vec3::new(0.0, 1.0, 0.0), up: Vec3::Y, vfov: 45f32.to_radians() }
+        Self {
+            position: Vec3::new(0.0, 1.0, 3.0),
+            target: Vec3::new(0.0, 1.0, 0.0),
+            up: Vec3::Y,
+            vfov: 45f32.to_radians(),
+        }
     }
 }
 
@@ -198,13 +213,20 @@ pub struct SceneChanges {
 
 impl SceneChanges {
     /// Everything changed (a first frame).
-    pub const ALL: SceneChanges =
-        SceneChanges { geometry: true, instances: true, materials: true, lights: true, camera: true, environment: true };
+    pub const ALL: SceneChanges = SceneChanges {
+        geometry: true,
+        instances: true,
+        materials: true,
+        lights: true,
+        camera: true,
+        environment: true,
+    };
 
     /// Compares the dynamic parts; geometry is compared by counts only (it is static).
     pub fn between(previous: &SceneDesc, next: &SceneDesc) -> SceneChanges {
         SceneChanges {
-            geometry: previous.meshes.len() != next.meshes.len() || previous.textures.len() != next.textures.len(),
+            geometry: previous.meshes.len() != next.meshes.len()
+                || previous.textures.len() != next.textures.len(),
             instances: previous.instances != next.instances,
             materials: previous.materials != next.materials,
             lights: previous.lights != next.lights,
@@ -232,7 +254,10 @@ mod material_debug_tests {
     #[test]
     fn debug_form_without_subsurface_is_unchanged() {
         let m = Material::default();
-        assert_eq!(format!("{m:?}"), "Material { base_color: Vec3(0.8, 0.8, 0.8), base_color_texture: None, emission: Vec3(0.0, 0.0, 0.0), roughness: 1.0, metallic: 0.0, specular: 1.0 }");
+        assert_eq!(
+            format!("{m:?}"),
+            "Material { base_color: Vec3(0.8, 0.8, 0.8), base_color_texture: None, emission: Vec3(0.0, 0.0, 0.0), roughness: 1.0, metallic: 0.0, specular: 1.0 }"
+        );
         let s = Material { subsurface: Some(Subsurface { dmfp: Vec3::ONE }), ..m };
         assert!(format!("{s:?}").contains("subsurface: Subsurface { dmfp: Vec3(1.0, 1.0, 1.0) }"));
     }

@@ -39,7 +39,8 @@ impl RawGrid {
     pub const MAX_RES: u32 = 256;
 
     pub fn load(path: &std::path::Path) -> Result<RawGrid, String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: cannot read the density grid: {e}", path.display()))?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| format!("{}: cannot read the density grid: {e}", path.display()))?;
         Self::parse(&text, &path.display().to_string())
     }
 
@@ -59,24 +60,49 @@ impl RawGrid {
                 let words: Vec<&str> = line.split_whitespace().collect();
                 let dims: Vec<Option<u32>> = words.iter().skip(1).map(|w| w.parse().ok()).collect();
                 match (words.first(), dims.as_slice()) {
-                    (Some(&"density_grid"), [Some(x), Some(y), Some(z)]) if [*x, *y, *z].iter().all(|&r| (1..=Self::MAX_RES).contains(&r)) => res = Some((*x, *y, *z)),
-                    _ => return Err(format!("{file}:{n}: found '{line}'; expected the header 'density_grid NX NY NZ' with each size 1 to {}", Self::MAX_RES)),
+                    (Some(&"density_grid"), [Some(x), Some(y), Some(z)])
+                        if [*x, *y, *z].iter().all(|&r| (1..=Self::MAX_RES).contains(&r)) =>
+                    {
+                        res = Some((*x, *y, *z))
+                    }
+                    _ => {
+                        return Err(format!(
+                            "{file}:{n}: found '{line}'; expected the header 'density_grid NX NY NZ' with each size 1 to {}",
+                            Self::MAX_RES
+                        ));
+                    }
                 }
                 continue;
             };
             for word in line.split_whitespace() {
                 match word.parse::<f32>() {
                     Ok(v) if v.is_finite() && (0.0..=1.0).contains(&v) => data.push(v),
-                    _ => return Err(format!("{file}:{n}: found '{word}'; expected a density in [0, 1]")),
+                    _ => {
+                        return Err(format!(
+                            "{file}:{n}: found '{word}'; expected a density in [0, 1]"
+                        ));
+                    }
                 }
                 if data.len() as u64 > u64::from(x) * u64::from(y) * u64::from(z) {
-                    return Err(format!("{file}:{n}: more than the {x}x{y}x{z} = {} values of the header", x * y * z));
+                    return Err(format!(
+                        "{file}:{n}: more than the {x}x{y}x{z} = {} values of the header",
+                        x * y * z
+                    ));
                 }
             }
         }
-        let Some((x, y, z)) = res else { return Err(format!("{file}:{}: no header; expected 'density_grid NX NY NZ'", last_line.max(1))) };
+        let Some((x, y, z)) = res else {
+            return Err(format!(
+                "{file}:{}: no header; expected 'density_grid NX NY NZ'",
+                last_line.max(1)
+            ));
+        };
         if data.len() as u64 != u64::from(x) * u64::from(y) * u64::from(z) {
-            return Err(format!("{file}:{last_line}: {} values; expected {x}x{y}x{z} = {}", data.len(), x * y * z));
+            return Err(format!(
+                "{file}:{last_line}: {} values; expected {x}x{y}x{z} = {}",
+                data.len(),
+                x * y * z
+            ));
         }
         Ok(RawGrid { res: (x, y, z), data })
     }
@@ -157,7 +183,10 @@ fn is_box(b: &crate::MediumBound) -> bool {
 impl std::fmt::Debug for MediumDesc {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let mut d = f.debug_struct("MediumDesc");
-        d.field("name", &self.name).field("kind", &self.kind).field("box_min", &self.box_min).field("box_max", &self.box_max);
+        d.field("name", &self.name)
+            .field("kind", &self.kind)
+            .field("box_min", &self.box_min)
+            .field("box_max", &self.box_max);
         if !is_box(&self.bound) {
             d.field("bound", &self.bound);
         }
@@ -186,22 +215,42 @@ impl MediumDesc {
     pub fn problem(&self) -> Option<String> {
         let (x, y, z) = self.resolution;
         if !(self.box_min.cmplt(self.box_max).all()) {
-            return Some(format!("medium '{}': box_min {} must be below box_max {} on every axis", self.name, self.box_min, self.box_max));
+            return Some(format!(
+                "medium '{}': box_min {} must be below box_max {} on every axis",
+                self.name, self.box_min, self.box_max
+            ));
         }
         if !(self.sigma_t.is_finite() && self.sigma_t >= 0.0) {
-            return Some(format!("medium '{}': sigma_t {} must be a finite extinction >= 0", self.name, self.sigma_t));
+            return Some(format!(
+                "medium '{}': sigma_t {} must be a finite extinction >= 0",
+                self.name, self.sigma_t
+            ));
         }
         if [x, y, z].iter().any(|&r| r == 0 || r > MAX_MEDIUM_RESOLUTION) {
-            return Some(format!("medium '{}': resolution ({x}, {y}, {z}) must be 1 to {MAX_MEDIUM_RESOLUTION} voxels per axis", self.name));
+            return Some(format!(
+                "medium '{}': resolution ({x}, {y}, {z}) must be 1 to {MAX_MEDIUM_RESOLUTION} voxels per axis",
+                self.name
+            ));
         }
         if !(self.albedo.cmpge(Vec3::ZERO).all() && self.albedo.cmple(Vec3::ONE).all()) {
-            return Some(format!("medium '{}': albedo {} must lie in [0, 1]", self.name, self.albedo));
+            return Some(format!(
+                "medium '{}': albedo {} must lie in [0, 1]",
+                self.name, self.albedo
+            ));
         }
         let m = &self.motion;
-        if !(m.velocity.is_finite() && m.scale_per_second.is_finite() && m.spin_degrees_per_second.is_finite()) {
-            return Some(format!("medium '{}': motion velocity, scale_per_second and spin_degrees_per_second must be finite", self.name));
+        if !(m.velocity.is_finite()
+            && m.scale_per_second.is_finite()
+            && m.spin_degrees_per_second.is_finite())
+        {
+            return Some(format!(
+                "medium '{}': motion velocity, scale_per_second and spin_degrees_per_second must be finite",
+                self.name
+            ));
         }
-        if !(0.0..1.0).contains(&m.pulse_amplitude) || (m.pulse_amplitude > 0.0 && !(m.pulse_period.is_finite() && m.pulse_period > 0.0)) {
+        if !(0.0..1.0).contains(&m.pulse_amplitude)
+            || (m.pulse_amplitude > 0.0 && !(m.pulse_period.is_finite() && m.pulse_period > 0.0))
+        {
             return Some(format!(
                 "medium '{}': motion pulse_amplitude {} must lie in [0, 1) and pulse_period {} must be > 0 where it pulses",
                 self.name, m.pulse_amplitude, m.pulse_period
@@ -209,7 +258,10 @@ impl MediumDesc {
         }
         if let Some(e) = self.emission {
             if !(e.is_finite() && e.cmpge(Vec3::ZERO).all()) {
-                return Some(format!("medium '{}': emission {e} must be finite and >= 0", self.name));
+                return Some(format!(
+                    "medium '{}': emission {e} must be finite and >= 0",
+                    self.name
+                ));
             }
         }
         None
@@ -221,10 +273,24 @@ impl MediumDesc {
         let centre = 0.5 * (self.box_min + self.box_max) + m.velocity * t;
         // Never inverted or collapsed: a shrinking box stops at 1% of its size.
         let half = 0.5 * (self.box_max - self.box_min) * (1.0 + m.scale_per_second * t).max(0.01);
-        let pulse = if m.pulse_amplitude > 0.0 { 1.0 + m.pulse_amplitude * (std::f32::consts::TAU * t / m.pulse_period).sin() } else { 1.0 };
+        let pulse = if m.pulse_amplitude > 0.0 {
+            1.0 + m.pulse_amplitude * (std::f32::consts::TAU * t / m.pulse_period).sin()
+        } else {
+            1.0
+        };
         if m.is_still() {
-            return MediumState { box_min: self.box_min, box_max: self.box_max, sigma_t: self.sigma_t, spin: 0.0 };
+            return MediumState {
+                box_min: self.box_min,
+                box_max: self.box_max,
+                sigma_t: self.sigma_t,
+                spin: 0.0,
+            };
         }
-        MediumState { box_min: centre - half, box_max: centre + half, sigma_t: self.sigma_t * pulse, spin: m.spin_degrees_per_second.to_radians() * t }
+        MediumState {
+            box_min: centre - half,
+            box_max: centre + half,
+            sigma_t: self.sigma_t * pulse,
+            spin: m.spin_degrees_per_second.to_radians() * t,
+        }
     }
 }

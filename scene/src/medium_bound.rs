@@ -64,7 +64,9 @@ impl ClosedMesh {
     /// The UV sphere of [`MediumBound::Sphere`] in [0, 1]³ (centre 0.5, radius 0.5).
     pub fn sphere(segments: u32) -> Result<ClosedMesh, String> {
         if !(4..=256).contains(&segments) || segments % 2 != 0 {
-            return Err(format!("sphere segments {segments}; expected an even number from 4 to 256"));
+            return Err(format!(
+                "sphere segments {segments}; expected an even number from 4 to 256"
+            ));
         }
         let (around, rings) = (segments, segments / 2);
         // Vertex 0 is the south pole, 1 the north pole, then rings 1..rings-1 of `around` each.
@@ -73,7 +75,15 @@ impl ClosedMesh {
             let theta = std::f32::consts::PI * r as f32 / rings as f32;
             for a in 0..around {
                 let phi = std::f32::consts::TAU * a as f32 / around as f32;
-                positions.push(Vec3::splat(0.5) + 0.5 * Vec3::new(theta.sin() * phi.cos(), -theta.cos(), theta.sin() * phi.sin()));
+                positions.push(
+                    Vec3::splat(0.5)
+                        + 0.5
+                            * Vec3::new(
+                                theta.sin() * phi.cos(),
+                                -theta.cos(),
+                                theta.sin() * phi.sin(),
+                            ),
+                );
             }
         }
         let ring = |r: u32, a: u32| 2 + (r - 1) * around + a % around;
@@ -94,7 +104,8 @@ impl ClosedMesh {
     }
 
     pub fn load_obj(path: &Path) -> Result<ClosedMesh, String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: cannot read the OBJ mesh: {e}", path.display()))?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| format!("{}: cannot read the OBJ mesh: {e}", path.display()))?;
         Self::parse_obj(&text, &path.display().to_string())
     }
 
@@ -110,10 +121,17 @@ impl ClosedMesh {
             let mut words = line.split_whitespace();
             match words.next() {
                 Some("v") => {
-                    let c: Vec<Option<f32>> = words.map(|w| w.parse().ok().filter(|v: &f32| v.is_finite())).collect();
+                    let c: Vec<Option<f32>> =
+                        words.map(|w| w.parse().ok().filter(|v: &f32| v.is_finite())).collect();
                     match c.as_slice() {
-                        [Some(x), Some(y), Some(z)] | [Some(x), Some(y), Some(z), Some(_)] => positions.push(Vec3::new(*x, *y, *z)),
-                        _ => return Err(format!("{file}:{n}: found '{line}'; expected a vertex 'v X Y Z' with finite coordinates")),
+                        [Some(x), Some(y), Some(z)] | [Some(x), Some(y), Some(z), Some(_)] => {
+                            positions.push(Vec3::new(*x, *y, *z))
+                        }
+                        _ => {
+                            return Err(format!(
+                                "{file}:{n}: found '{line}'; expected a vertex 'v X Y Z' with finite coordinates"
+                            ));
+                        }
                     }
                 }
                 Some("f") => {
@@ -125,12 +143,18 @@ impl ClosedMesh {
                         let resolved = match index {
                             Some(k) if k >= 1 && k <= count => k - 1,
                             Some(k) if k < 0 && -k <= count => count + k,
-                            _ => return Err(format!("{file}:{n}: found '{w}'; expected a vertex index 1 to {count} (or -1 to -{count}) of the vertices above")),
+                            _ => {
+                                return Err(format!(
+                                    "{file}:{n}: found '{w}'; expected a vertex index 1 to {count} (or -1 to -{count}) of the vertices above"
+                                ));
+                            }
                         };
                         face.push(resolved as u32);
                     }
                     if face.len() < 3 {
-                        return Err(format!("{file}:{n}: found '{line}'; expected a face of at least 3 vertices"));
+                        return Err(format!(
+                            "{file}:{n}: found '{line}'; expected a face of at least 3 vertices"
+                        ));
                     }
                     for k in 1..face.len() - 1 {
                         triangles.push([face[0], face[k], face[k + 1]]);
@@ -141,7 +165,10 @@ impl ClosedMesh {
             }
         }
         if triangles.is_empty() {
-            return Err(format!("{file}:{}: no faces; expected a closed mesh of 'v' and 'f' lines", text.lines().count().max(1)));
+            return Err(format!(
+                "{file}:{}: no faces; expected a closed mesh of 'v' and 'f' lines",
+                text.lines().count().max(1)
+            ));
         }
         let mesh = ClosedMesh { positions, triangles };
         mesh.check_closed(&lines, file)?;
@@ -154,7 +181,10 @@ impl ClosedMesh {
         let mut edges: HashMap<(u32, u32), usize> = HashMap::new();
         for (t, tri) in self.triangles.iter().enumerate() {
             if tri[0] == tri[1] || tri[1] == tri[2] || tri[2] == tri[0] {
-                return Err(format!("{file}:{}: a face repeats a vertex; expected distinct vertices", lines[t]));
+                return Err(format!(
+                    "{file}:{}: a face repeats a vertex; expected distinct vertices",
+                    lines[t]
+                ));
             }
             for k in 0..3 {
                 let e = (tri[k], tri[(k + 1) % 3]);
@@ -172,7 +202,9 @@ impl ClosedMesh {
         }
         // In face order, so that the error names the same edge every run.
         for (t, tri) in self.triangles.iter().enumerate() {
-            let open = (0..3).map(|k| (tri[k], tri[(k + 1) % 3])).find(|&(a, b)| !edges.contains_key(&(b, a)));
+            let open = (0..3)
+                .map(|k| (tri[k], tri[(k + 1) % 3]))
+                .find(|&(a, b)| !edges.contains_key(&(b, a)));
             if let Some((a, b)) = open {
                 return Err(format!(
                     "{file}:{}: the edge from vertex {} to {} has no face on its other side; expected a closed mesh (every edge shared by two faces)",

@@ -17,9 +17,11 @@ pub fn world_light(light: &Light, global: &GlobalTransform, factor: f32) -> Ligh
     let m = global.0;
     let dir = |d: Vec3| m.transform_vector3(d).normalize_or(d);
     match *light {
-        Light::Directional { direction, irradiance, angular_radius } => {
-            Light::Directional { direction: dir(direction), irradiance: irradiance * factor, angular_radius }
-        }
+        Light::Directional { direction, irradiance, angular_radius } => Light::Directional {
+            direction: dir(direction),
+            irradiance: irradiance * factor,
+            angular_radius,
+        },
         Light::Point { position, intensity } => {
             Light::Point { position: m.transform_point3(position), intensity: intensity * factor }
         }
@@ -54,9 +56,18 @@ pub fn extract_dynamic(world: &mut World, out: &mut SceneDesc) {
 
     type Key = (Option<SpawnOrder>, Entity);
     let mut instances: Vec<(Key, Instance)> = Vec::new();
-    let mut query = world.query_filtered::<(Entity, Option<&SpawnOrder>, &MeshInstance, &GlobalTransform, Option<&Intensity>), Without<Hidden>>();
+    let mut query = world.query_filtered::<(
+        Entity,
+        Option<&SpawnOrder>,
+        &MeshInstance,
+        &GlobalTransform,
+        Option<&Intensity>,
+    ), Without<Hidden>>();
     for (entity, order, mesh, global, intensity) in query.iter(world) {
-        instances.push(((order.copied(), entity), Instance { mesh: mesh.mesh, material: mesh.material, transform: global.0 }));
+        instances.push((
+            (order.copied(), entity),
+            Instance { mesh: mesh.mesh, material: mesh.material, transform: global.0 },
+        ));
         if let Some(intensity) = intensity {
             let mut own = table[mesh.material as usize];
             own.emission *= intensity.factor();
@@ -79,9 +90,12 @@ pub fn extract_dynamic(world: &mut World, out: &mut SceneDesc) {
     out.instances.extend(instances.into_iter().map(|(_, i)| i));
 
     let mut lights: Vec<(Key, Light)> = world
-        .query::<(Entity, Option<&SpawnOrder>, &LightSource, &GlobalTransform, Option<&Intensity>)>()
+        .query::<(Entity, Option<&SpawnOrder>, &LightSource, &GlobalTransform, Option<&Intensity>)>(
+        )
         .iter(world)
-        .map(|(e, o, l, g, i)| ((o.copied(), e), world_light(&l.0, g, i.map_or(1.0, Intensity::factor))))
+        .map(|(e, o, l, g, i)| {
+            ((o.copied(), e), world_light(&l.0, g, i.map_or(1.0, Intensity::factor)))
+        })
         .collect();
     lights.sort_by_key(|(k, _)| *k);
     out.lights.clear();
@@ -89,7 +103,9 @@ pub fn extract_dynamic(world: &mut World, out: &mut SceneDesc) {
 
     out.environment = world.resource::<Environment>().0;
     let active = world.resource::<ActiveCamera>().0;
-    if let (Some(camera), Some(global)) = (world.get::<Camera>(active), world.get::<GlobalTransform>(active)) {
+    if let (Some(camera), Some(global)) =
+        (world.get::<Camera>(active), world.get::<GlobalTransform>(active))
+    {
         out.camera = world_camera(camera, global);
     }
 }
@@ -105,7 +121,10 @@ mod tests {
             Vec3::new(1.0, 2.0, 3.0),
         ));
         let p = world_light(&Light::Point { position: Vec3::ZERO, intensity: Vec3::ONE }, &g, 2.0);
-        assert_eq!(p, Light::Point { position: Vec3::new(1.0, 2.0, 3.0), intensity: Vec3::splat(2.0) });
+        assert_eq!(
+            p,
+            Light::Point { position: Vec3::new(1.0, 2.0, 3.0), intensity: Vec3::splat(2.0) }
+        );
         let d = world_light(
             &Light::Directional { direction: Vec3::X, irradiance: Vec3::ONE, angular_radius: 0.01 },
             &g,

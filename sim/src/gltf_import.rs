@@ -44,11 +44,20 @@ fn to_rgba8(data: &gltf::image::Data) -> Result<Vec<u8>, String> {
         Format::R16G16 => (2, 2),
         Format::R16G16B16 => (3, 2),
         Format::R16G16B16A16 => (4, 2),
-        other => return Err(format!("pixel format {other:?} is not supported; expected 8 or 16 bits per channel")),
+        other => {
+            return Err(format!(
+                "pixel format {other:?} is not supported; expected 8 or 16 bits per channel"
+            ));
+        }
     };
     let texels = (data.width * data.height) as usize;
     if data.pixels.len() != texels * channels * bytes_per {
-        return Err(format!("{} bytes of pixels for {}x{}", data.pixels.len(), data.width, data.height));
+        return Err(format!(
+            "{} bytes of pixels for {}x{}",
+            data.pixels.len(),
+            data.width,
+            data.height
+        ));
     }
     let mut out = Vec::with_capacity(texels * 4);
     for t in 0..texels {
@@ -67,7 +76,9 @@ fn to_rgba8(data: &gltf::image::Data) -> Result<Vec<u8>, String> {
 
 fn node_transform(t: gltf::scene::Transform) -> Transform {
     match t {
-        gltf::scene::Transform::Matrix { matrix } => Transform::from_matrix(Mat4::from_cols_array_2d(&matrix)),
+        gltf::scene::Transform::Matrix { matrix } => {
+            Transform::from_matrix(Mat4::from_cols_array_2d(&matrix))
+        }
         gltf::scene::Transform::Decomposed { translation, rotation, scale } => Transform::from_trs(
             Vec3::from(translation),
             Quat::from_array(rotation).normalize(),
@@ -90,11 +101,15 @@ fn read_primitive(
         .ok_or("no POSITION attribute; expected vertex positions")?
         .map(Vec3::from)
         .collect();
-    let normals: Vec<Vec3> = reader.read_normals().map(|n| n.map(Vec3::from).collect()).unwrap_or_default();
+    let normals: Vec<Vec3> =
+        reader.read_normals().map(|n| n.map(Vec3::from).collect()).unwrap_or_default();
     if !normals.is_empty() && normals.len() != positions.len() {
         return Err(format!("{} normals for {} positions", normals.len(), positions.len()));
     }
-    let uvs: Vec<Vec2> = reader.read_tex_coords(0).map(|t| t.into_f32().map(Vec2::from).collect()).unwrap_or_default();
+    let uvs: Vec<Vec2> = reader
+        .read_tex_coords(0)
+        .map(|t| t.into_f32().map(Vec2::from).collect())
+        .unwrap_or_default();
     if !uvs.is_empty() && uvs.len() != positions.len() {
         return Err(format!("{} TEXCOORD_0 for {} positions", uvs.len(), positions.len()));
     }
@@ -125,39 +140,58 @@ pub const DIFFUSE_TRANSMISSION: &str = "KHR_materials_diffuse_transmission";
 /// attenuation, an infinite dmfp), or a colour outside (0, 1].
 pub fn subsurface_from_volume(distance: f32, color: [f32; 3]) -> Result<Subsurface, String> {
     if !(distance.is_finite() && distance > 0.0) {
-        return Err(format!("KHR_materials_volume attenuationDistance {distance}; expected a finite positive distance for subsurface scattering"));
+        return Err(format!(
+            "KHR_materials_volume attenuationDistance {distance}; expected a finite positive distance for subsurface scattering"
+        ));
     }
     if let Some(c) = color.iter().find(|c| !(**c > 0.0 && **c < 1.0)) {
-        return Err(format!("KHR_materials_volume attenuationColor {color:?} has {c}; expected each channel in (0, 1) for subsurface scattering"));
+        return Err(format!(
+            "KHR_materials_volume attenuationColor {color:?} has {c}; expected each channel in (0, 1) for subsurface scattering"
+        ));
     }
     Ok(Subsurface { dmfp: Vec3::from(color.map(|c| distance / -c.ln())) })
 }
 
 /// Reads `path` (a .gltf with its buffers and images, or a .glb).
 pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
-    let err = |part: &str, message: String| GltfError { file: path.to_path_buf(), part: part.to_string(), message };
+    let err = |part: &str, message: String| GltfError {
+        file: path.to_path_buf(),
+        part: part.to_string(),
+        message,
+    };
     if !path.is_file() {
         return Err(err("file", "not found; expected a .gltf or .glb file".into()));
     }
-    let (doc, buffers, images) = gltf::import(path).map_err(|e| err("file", format!("cannot import: {e}")))?;
+    let (doc, buffers, images) =
+        gltf::import(path).map_err(|e| err("file", format!("cannot import: {e}")))?;
 
     let mut t = WorldTemplate::default();
     for (i, image) in images.iter().enumerate() {
         let name = label("image", doc.images().nth(i).and_then(|im| im.name()), i);
         let rgba8 = to_rgba8(image).map_err(|m| err(&name, m))?;
-        t.textures.push(Texture { name: name.clone(), width: image.width, height: image.height, rgba8 });
+        t.textures.push(Texture {
+            name: name.clone(),
+            width: image.width,
+            height: image.height,
+            rgba8,
+        });
     }
     for (i, m) in doc.materials().enumerate() {
         let pbr = m.pbr_metallic_roughness();
         let c = pbr.base_color_factor();
         let strength = m.emissive_strength().unwrap_or(1.0);
         let subsurface = match (m.extension_value(DIFFUSE_TRANSMISSION), m.volume()) {
-            (Some(_), Some(v)) => Some(subsurface_from_volume(v.attenuation_distance(), v.attenuation_color()).map_err(|e| err(&label("material", m.name(), i), e))?),
+            (Some(_), Some(v)) => Some(
+                subsurface_from_volume(v.attenuation_distance(), v.attenuation_color())
+                    .map_err(|e| err(&label("material", m.name(), i), e))?,
+            ),
             _ => None,
         };
         let material = Material {
             base_color: Vec3::new(c[0], c[1], c[2]),
-            base_color_texture: pbr.base_color_texture().map(|info| info.texture().source().index() as u32),
+            base_color_texture: pbr
+                .base_color_texture()
+                .map(|info| info.texture().source().index() as u32),
             emission: Vec3::from(m.emissive_factor()) * strength,
             roughness: pbr.roughness_factor(),
             metallic: pbr.metallic_factor(),
@@ -179,7 +213,8 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
             let geometry = read_primitive(&p, &buffers, name).map_err(|m| err(&part, m))?;
             let material = match p.material().index() {
                 Some(i) => i as u32,
-                None => *default_material.get_or_insert_with(|| t.add_material("default", Material::default())),
+                None => *default_material
+                    .get_or_insert_with(|| t.add_material("default", Material::default())),
             };
             list.push(MeshInstance { mesh: t.add_mesh(geometry), material });
         }
@@ -189,11 +224,15 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
     let scene = doc.default_scene().or_else(|| doc.scenes().next());
     let roots: Vec<gltf::Node> = match &scene {
         Some(s) => s.nodes().collect(),
-        None => return Err(err("scenes", "no scene; expected at least one scene with nodes".into())),
+        None => {
+            return Err(err("scenes", "no scene; expected at least one scene with nodes".into()));
+        }
     };
-    let mut stack: Vec<(gltf::Node, Option<usize>)> = roots.into_iter().rev().map(|n| (n, None)).collect();
+    let mut stack: Vec<(gltf::Node, Option<usize>)> =
+        roots.into_iter().rev().map(|n| (n, None)).collect();
     while let Some((node, parent)) = stack.pop() {
-        let name = node.name().map(str::to_string).unwrap_or_else(|| format!("node{}", node.index()));
+        let name =
+            node.name().map(str::to_string).unwrap_or_else(|| format!("node{}", node.index()));
         let part = label("node", node.name(), node.index());
         let mut tn = NodeTemplate::new(name.clone(), node_transform(node.transform()));
         tn.parent = parent;
@@ -206,17 +245,23 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
         if let Some(light) = node.light() {
             let color = Vec3::from(light.color()) * light.intensity();
             tn.light = Some(match light.kind() {
-                gltf::khr_lights_punctual::Kind::Directional => {
-                    Light::Directional { direction: Vec3::NEG_Z, irradiance: color, angular_radius: 0.0 }
-                }
-                gltf::khr_lights_punctual::Kind::Point => Light::Point { position: Vec3::ZERO, intensity: color },
-                gltf::khr_lights_punctual::Kind::Spot { inner_cone_angle, outer_cone_angle } => Light::Spot {
-                    position: Vec3::ZERO,
+                gltf::khr_lights_punctual::Kind::Directional => Light::Directional {
                     direction: Vec3::NEG_Z,
-                    intensity: color,
-                    inner_angle: inner_cone_angle,
-                    outer_angle: outer_cone_angle,
+                    irradiance: color,
+                    angular_radius: 0.0,
                 },
+                gltf::khr_lights_punctual::Kind::Point => {
+                    Light::Point { position: Vec3::ZERO, intensity: color }
+                }
+                gltf::khr_lights_punctual::Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+                    Light::Spot {
+                        position: Vec3::ZERO,
+                        direction: Vec3::NEG_Z,
+                        intensity: color,
+                        inner_angle: inner_cone_angle,
+                        outer_angle: outer_cone_angle,
+                    }
+                }
             });
         }
         if let Some(camera) = node.camera() {

@@ -16,5 +16,9 @@ pub mod simulation;
 pub mod template;
 pub mod transform;
 
-pub use scenario::{MethodEntry, ReferenceFrames, ReferenceSpec, Region, Scenario, ScenarioError, SceneSource};
-pub use simulation::{ExtractedScene, SimError, Simulation, advance_clock, animation_systems, extract_scene};
+pub use scenario::{
+    MethodEntry, ReferenceFrames, ReferenceSpec, Region, Scenario, ScenarioError, SceneSource,
+};
+pub use simulation::{
+    ExtractedScene, SimError, Simulation, advance_clock, animation_systems, extract_scene,
+};

@@ -3,8 +3,8 @@
 //! Optional fields may be written bare (`camera: (position: ..)`): the `implicit_some`
 //! extension is on. Errors carry the file, line and column and say what was expected.
 
-use std::fmt;
 use scene::DensityKind;
+use std::fmt;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
@@ -51,7 +51,11 @@ impl MethodEntry {
 
     /// The file position of a (1-based) line and column inside the entry's text.
     pub fn position_in_file(&self, line: usize, column: usize) -> (usize, usize) {
-        if line <= 1 { (self.line, self.column + column.saturating_sub(1)) } else { (self.line + line - 1, column) }
+        if line <= 1 {
+            (self.line, self.column + column.saturating_sub(1))
+        } else {
+            (self.line + line - 1, column)
+        }
     }
 }
 
@@ -207,12 +211,28 @@ pub enum AnimationSpec {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum ActionSpec {
-    RotateLight { light: String, axis: Vec3, degrees: f32 },
-    Rotate { entity: String, axis: Vec3, degrees: f32 },
+    RotateLight {
+        light: String,
+        axis: Vec3,
+        degrees: f32,
+    },
+    Rotate {
+        entity: String,
+        axis: Vec3,
+        degrees: f32,
+    },
     /// Switch a light or an emissive mesh off (or back on).
-    Toggle { entity: String },
-    MoveTo { entity: String, translation: Vec3 },
-    MoveBy { entity: String, offset: Vec3 },
+    Toggle {
+        entity: String,
+    },
+    MoveTo {
+        entity: String,
+        translation: Vec3,
+    },
+    MoveBy {
+        entity: String,
+        offset: Vec3,
+    },
     SetMaterial {
         material: String,
         #[serde(default)]
@@ -348,7 +368,9 @@ pub struct ScenarioError {
 impl fmt::Display for ScenarioError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.position {
-            Some((line, col)) => write!(f, "{}:{line}:{col}: {}", self.file.display(), self.message),
+            Some((line, col)) => {
+                write!(f, "{}:{line}:{col}: {}", self.file.display(), self.message)
+            }
             None => write!(f, "{}: {}", self.file.display(), self.message),
         }
     }
@@ -403,7 +425,8 @@ impl Scenario {
     /// Parses scenario text; `origin` is the file it came from (names it in errors and
     /// anchors relative glTF paths).
     pub fn from_ron(text: &str, origin: &Path) -> Result<Scenario, ScenarioError> {
-        let options = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+        let options = ron::Options::default()
+            .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
         let mut file: ScenarioFile = options.from_str(text).map_err(|e| ScenarioError {
             file: origin.to_path_buf(),
             position: Some((e.span.start.line, e.span.start.col)),
@@ -413,22 +436,34 @@ impl Scenario {
             file: origin.to_path_buf(),
             position: text.find(&format!("{what}:")).map(|at| {
                 let before = &text[..at];
-                (before.matches('\n').count() + 1, before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1)
+                (
+                    before.matches('\n').count() + 1,
+                    before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1,
+                )
             }),
             message,
         };
         let (w, h) = file.resolution;
         if w == 0 || h == 0 {
-            return Err(invalid("resolution", format!("resolution {w}x{h}; expected both sides > 0")));
+            return Err(invalid(
+                "resolution",
+                format!("resolution {w}x{h}; expected both sides > 0"),
+            ));
         }
         if file.frames == 0 {
             return Err(invalid("frames", "frames: 0; expected at least 1 frame".into()));
         }
         if !(file.time_step > 0.0 && file.time_step.is_finite()) {
-            return Err(invalid("time_step", format!("time_step {}; expected a positive number of seconds", file.time_step)));
+            return Err(invalid(
+                "time_step",
+                format!("time_step {}; expected a positive number of seconds", file.time_step),
+            ));
         }
         if file.methods.is_empty() {
-            return Err(invalid("methods", "no methods; expected e.g. [PathTracing(spp: 4)]".into()));
+            return Err(invalid(
+                "methods",
+                "no methods; expected e.g. [PathTracing(spp: 4)]".into(),
+            ));
         }
         for r in &file.regions {
             if r.width == 0 || r.height == 0 || r.x + r.width > w || r.y + r.height > h {
@@ -448,22 +483,39 @@ impl Scenario {
                     *grid = origin.parent().unwrap_or(Path::new("")).join(&*grid);
                 }
                 if let Err(e) = scene::RawGrid::load(grid) {
-                    return Err(ScenarioError { file: origin.to_path_buf(), position: find_quoted(text, &m.name), message: format!("medium '{}': {e}", m.name) });
+                    return Err(ScenarioError {
+                        file: origin.to_path_buf(),
+                        position: find_quoted(text, &m.name),
+                        message: format!("medium '{}': {e}", m.name),
+                    });
                 }
             }
         }
         for m in &mut file.media {
             m.bound.resolve(origin.parent().unwrap_or(Path::new("")));
             if let Err(e) = m.bound.mesh(m.box_min, m.box_max) {
-                return Err(ScenarioError { file: origin.to_path_buf(), position: find_quoted(text, &m.name), message: format!("medium '{}': bound: {e}", m.name) });
+                return Err(ScenarioError {
+                    file: origin.to_path_buf(),
+                    position: find_quoted(text, &m.name),
+                    message: format!("medium '{}': bound: {e}", m.name),
+                });
             }
         }
         for m in &file.media {
             if let Some(message) = m.problem() {
-                return Err(ScenarioError { file: origin.to_path_buf(), position: find_quoted(text, &m.name).or_else(|| invalid("media", String::new()).position), message });
+                return Err(ScenarioError {
+                    file: origin.to_path_buf(),
+                    position: find_quoted(text, &m.name)
+                        .or_else(|| invalid("media", String::new()).position),
+                    message,
+                });
             }
             if file.media.iter().filter(|o| o.name == m.name).count() > 1 {
-                return Err(ScenarioError { file: origin.to_path_buf(), position: find_quoted(text, &m.name), message: format!("two media named '{}'; expected unique names", m.name) });
+                return Err(ScenarioError {
+                    file: origin.to_path_buf(),
+                    position: find_quoted(text, &m.name),
+                    message: format!("two media named '{}'; expected unique names", m.name),
+                });
             }
         }
         for m in &file.materials {
@@ -472,14 +524,21 @@ impl Scenario {
                 if !(d.min_element() > 0.0 && d.is_finite()) {
                     return Err(ScenarioError {
                         file: origin.to_path_buf(),
-                        position: find_quoted(text, &m.material).or_else(|| invalid("materials", String::new()).position),
-                        message: format!("material '{}': subsurface dmfp ({}, {}, {}); expected three positive diffuse mean free paths in scene units", m.material, d.x, d.y, d.z),
+                        position: find_quoted(text, &m.material)
+                            .or_else(|| invalid("materials", String::new()).position),
+                        message: format!(
+                            "material '{}': subsurface dmfp ({}, {}, {}); expected three positive diffuse mean free paths in scene units",
+                            m.material, d.x, d.y, d.z
+                        ),
                     });
                 }
             }
         }
         let name = file.name.unwrap_or_else(|| {
-            origin.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scenario".into())
+            origin
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "scenario".into())
         });
         let scene = match file.scene {
             SceneSource::Gltf(p) if p.is_relative() => {
@@ -524,11 +583,19 @@ impl Scenario {
         }
         for e in &self.events {
             let text = match &e.action {
-                ActionSpec::RotateLight { light, degrees, .. } => format!("rotate light '{light}' by {degrees}°"),
-                ActionSpec::Rotate { entity, degrees, .. } => format!("rotate '{entity}' by {degrees}°"),
+                ActionSpec::RotateLight { light, degrees, .. } => {
+                    format!("rotate light '{light}' by {degrees}°")
+                }
+                ActionSpec::Rotate { entity, degrees, .. } => {
+                    format!("rotate '{entity}' by {degrees}°")
+                }
                 ActionSpec::Toggle { entity } => format!("toggle '{entity}'"),
-                ActionSpec::MoveTo { entity, translation } => format!("move '{entity}' to {}", axis_label(*translation)),
-                ActionSpec::MoveBy { entity, offset } => format!("move '{entity}' by {}", axis_label(*offset)),
+                ActionSpec::MoveTo { entity, translation } => {
+                    format!("move '{entity}' to {}", axis_label(*translation))
+                }
+                ActionSpec::MoveBy { entity, offset } => {
+                    format!("move '{entity}' by {}", axis_label(*offset))
+                }
                 ActionSpec::SetMaterial { material, .. } => format!("change material '{material}'"),
             };
             out.push((e.frame, text));

@@ -13,7 +13,9 @@ use crate::components::{Camera, Hidden, Intensity, LightSource, MeshInstance, Na
 use crate::extract::extract_dynamic;
 use crate::gltf_import::{self, GltfError};
 use crate::resources::{ActiveCamera, Clock, Environment, MaterialTable, SimRng};
-use crate::scenario::{ActionSpec, AnimationSpec, Scenario, SceneSource, WaveformSpec, find_quoted};
+use crate::scenario::{
+    ActionSpec, AnimationSpec, Scenario, SceneSource, WaveformSpec, find_quoted,
+};
 use crate::template::WorldTemplate;
 use crate::transform::{GlobalTransform, Transform, propagate_transforms};
 
@@ -23,7 +25,13 @@ pub enum SimError {
     #[error("{0}")]
     Gltf(#[from] GltfError),
     #[error("{}: unknown {kind} '{name}'; expected one of: {}", place(file, *position), list(known))]
-    UnknownName { file: PathBuf, position: Option<(usize, usize)>, kind: &'static str, name: String, known: Vec<String> },
+    UnknownName {
+        file: PathBuf,
+        position: Option<(usize, usize)>,
+        kind: &'static str,
+        name: String,
+        known: Vec<String>,
+    },
     #[error("{}: {message}", place(file, *position))]
     Invalid { file: PathBuf, position: Option<(usize, usize)>, message: String },
 }
@@ -63,11 +71,18 @@ impl Names<'_> {
     }
 
     fn invalid(&self, name: &str, message: String) -> SimError {
-        SimError::Invalid { file: self.scenario.origin.clone(), position: find_quoted(&self.scenario.source, name), message }
+        SimError::Invalid {
+            file: self.scenario.origin.clone(),
+            position: find_quoted(&self.scenario.source, name),
+            message,
+        }
     }
 
     fn entity(&self, name: &str) -> Result<Entity, SimError> {
-        self.entities.get(name).copied().ok_or_else(|| self.unknown("entity", name, self.ordered.clone()))
+        self.entities
+            .get(name)
+            .copied()
+            .ok_or_else(|| self.unknown("entity", name, self.ordered.clone()))
     }
 
     fn material(&self, world: &World, name: &str) -> Result<u32, SimError> {
@@ -91,7 +106,8 @@ pub fn advance_clock(mut clock: ResMut<Clock>) {
 }
 
 /// Simulate stage, in order: animations, this frame's events, transform propagation.
-pub fn animation_systems() -> bevy_ecs::schedule::ScheduleConfigs<bevy_ecs::system::ScheduleSystem> {
+pub fn animation_systems() -> bevy_ecs::schedule::ScheduleConfigs<bevy_ecs::system::ScheduleSystem>
+{
     (
         animation::rotate,
         animation::rotate_once,
@@ -139,11 +155,16 @@ impl Simulation {
     /// checked now, before frame 0) and sets up frame 0.
     pub fn new(scenario: &Scenario) -> Result<Simulation, SimError> {
         let template: WorldTemplate = match &scenario.scene {
-            SceneSource::Builtin(name) => crate::scenes::build(name).ok_or_else(|| SimError::Invalid {
-                file: scenario.origin.clone(),
-                position: find_quoted(&scenario.source, name),
-                message: format!("unknown scene '{name}'; expected one of: {}", crate::scenes::names().join(", ")),
-            })?,
+            SceneSource::Builtin(name) => {
+                crate::scenes::build(name).ok_or_else(|| SimError::Invalid {
+                    file: scenario.origin.clone(),
+                    position: find_quoted(&scenario.source, name),
+                    message: format!(
+                        "unknown scene '{name}'; expected one of: {}",
+                        crate::scenes::names().join(", ")
+                    ),
+                })?
+            }
             SceneSource::Gltf(path) => gltf_import::import(path)?,
         };
         let mut world = World::new();
@@ -173,7 +194,8 @@ impl Simulation {
         world.run_system_cached(propagate_transforms).expect("transform propagation runs");
         if let Some(c) = &scenario.camera {
             let camera = detach_active_camera(&mut world);
-            *world.get_mut::<Transform>(camera).unwrap() = Transform::looking_at(c.position, c.target, c.up);
+            *world.get_mut::<Transform>(camera).unwrap() =
+                Transform::looking_at(c.position, c.target, c.up);
             world.get_mut::<Camera>(camera).unwrap().vfov = c.vfov_degrees.to_radians();
         }
 
@@ -192,9 +214,16 @@ impl Simulation {
                 ActionSpec::RotateLight { light, axis, degrees } => {
                     let entity = names.entity(light)?;
                     if world.get::<LightSource>(entity).is_none() {
-                        return Err(names.invalid(light, format!("'{light}' is not a light; expected an entity with a light")));
+                        return Err(names.invalid(
+                            light,
+                            format!("'{light}' is not a light; expected an entity with a light"),
+                        ));
                     }
-                    EventAction::Rotate { entity, axis: checked_axis(&names, light, *axis)?, angle: degrees.to_radians() }
+                    EventAction::Rotate {
+                        entity,
+                        axis: checked_axis(&names, light, *axis)?,
+                        angle: degrees.to_radians(),
+                    }
                 }
                 ActionSpec::Rotate { entity, axis, degrees } => EventAction::Rotate {
                     entity: names.entity(entity)?,
@@ -209,14 +238,18 @@ impl Simulation {
                 ActionSpec::MoveTo { entity, translation } => {
                     EventAction::MoveTo { entity: names.entity(entity)?, translation: *translation }
                 }
-                ActionSpec::MoveBy { entity, offset } => EventAction::MoveBy { entity: names.entity(entity)?, offset: *offset },
-                ActionSpec::SetMaterial { material, base_color, emission, roughness, metallic } => EventAction::SetMaterial {
-                    material: names.material(&world, material)?,
-                    base_color: *base_color,
-                    emission: *emission,
-                    roughness: *roughness,
-                    metallic: *metallic,
-                },
+                ActionSpec::MoveBy { entity, offset } => {
+                    EventAction::MoveBy { entity: names.entity(entity)?, offset: *offset }
+                }
+                ActionSpec::SetMaterial { material, base_color, emission, roughness, metallic } => {
+                    EventAction::SetMaterial {
+                        material: names.material(&world, material)?,
+                        base_color: *base_color,
+                        emission: *emission,
+                        roughness: *roughness,
+                        metallic: *metallic,
+                    }
+                }
             };
             events.push(ScheduledEvent { frame: e.frame, action });
         }
@@ -227,7 +260,11 @@ impl Simulation {
         first.set_executor(SingleThreadedExecutor::default());
         first.add_systems(animation_systems());
         first.run(&mut world);
-        let mut scene = SceneDesc { meshes: template.meshes, textures: template.textures, ..Default::default() };
+        let mut scene = SceneDesc {
+            meshes: template.meshes,
+            textures: template.textures,
+            ..Default::default()
+        };
         extract_dynamic(&mut world, &mut scene);
         world.insert_resource(ExtractedScene { scene, changes: SceneChanges::ALL });
 
@@ -313,26 +350,44 @@ fn checked_axis(names: &Names, who: &str, axis: Vec3) -> Result<Vec3, SimError> 
     if axis.length_squared() > 1e-12 && axis.is_finite() {
         Ok(axis.normalize())
     } else {
-        Err(names.invalid(who, format!("rotation axis of '{who}' is zero; expected a non-zero vector")))
+        Err(names
+            .invalid(who, format!("rotation axis of '{who}' is zero; expected a non-zero vector")))
     }
 }
 
 /// Lights already carry an [`Intensity`]; an emissive mesh gets one here.
-fn ensure_emitter(world: &mut World, names: &Names, name: &str, entity: Entity) -> Result<(), SimError> {
+fn ensure_emitter(
+    world: &mut World,
+    names: &Names,
+    name: &str,
+    entity: Entity,
+) -> Result<(), SimError> {
     if world.get::<Intensity>(entity).is_some() {
         return Ok(());
     }
     let emissive = world.get::<MeshInstance>(entity).is_some_and(|m| {
-        world.resource::<MaterialTable>().materials[m.material as usize].emission.max_element() > 0.0
+        world.resource::<MaterialTable>().materials[m.material as usize].emission.max_element()
+            > 0.0
     });
     if !emissive {
-        return Err(names.invalid(name, format!("'{name}' is neither a light nor an emissive mesh; expected something that emits")));
+        return Err(names.invalid(
+            name,
+            format!(
+                "'{name}' is neither a light nor an emissive mesh; expected something that emits"
+            ),
+        ));
     }
     world.entity_mut(entity).insert(Intensity::default());
     Ok(())
 }
 
-fn attach_animation(world: &mut World, names: &Names, spec: &AnimationSpec, index: u64, seed: u64) -> Result<(), SimError> {
+fn attach_animation(
+    world: &mut World,
+    names: &Names,
+    spec: &AnimationSpec,
+    index: u64,
+    seed: u64,
+) -> Result<(), SimError> {
     match spec {
         AnimationSpec::Rotate { entity, axis, degrees_per_second } => {
             let e = names.entity(entity)?;
@@ -342,7 +397,11 @@ fn attach_animation(world: &mut World, names: &Names, spec: &AnimationSpec, inde
         AnimationSpec::RotateOnce { entity, axis, degrees, frame } => {
             let e = names.entity(entity)?;
             let axis = checked_axis(names, entity, *axis)?;
-            world.entity_mut(e).insert(RotateOnce { axis, angle: degrees.to_radians(), frame: *frame });
+            world.entity_mut(e).insert(RotateOnce {
+                axis,
+                angle: degrees.to_radians(),
+                frame: *frame,
+            });
         }
         AnimationSpec::Flash { entity, waveform } => {
             let e = names.entity(entity)?;
@@ -351,16 +410,29 @@ fn attach_animation(world: &mut World, names: &Names, spec: &AnimationSpec, inde
                 WaveformSpec::Sine { frequency } => Waveform::Sine { frequency },
                 WaveformSpec::Square { period } if period > 0.0 => Waveform::Square { period },
                 WaveformSpec::Square { period } => {
-                    return Err(names.invalid(entity, format!("square period {period}; expected > 0 seconds")));
+                    return Err(names
+                        .invalid(entity, format!("square period {period}; expected > 0 seconds")));
                 }
                 WaveformSpec::Strobe { probability } => Waveform::Strobe { probability },
             };
             world.entity_mut(e).insert(Flash { waveform, stream: index });
         }
-        AnimationSpec::Boids { prototype, count, bounds_min, bounds_max, separation, view_radius, max_speed, min_speed } => {
+        AnimationSpec::Boids {
+            prototype,
+            count,
+            bounds_min,
+            bounds_max,
+            separation,
+            view_radius,
+            max_speed,
+            min_speed,
+        } => {
             let proto = names.entity(prototype)?;
             let Some(mesh) = world.get::<MeshInstance>(proto).copied() else {
-                return Err(names.invalid(prototype, format!("'{prototype}' has no mesh; expected an entity with a mesh to copy")));
+                return Err(names.invalid(
+                    prototype,
+                    format!("'{prototype}' has no mesh; expected an entity with a mesh to copy"),
+                ));
             };
             let d = FlockParams::default();
             let params = FlockParams {
@@ -373,12 +445,16 @@ fn attach_animation(world: &mut World, names: &Names, spec: &AnimationSpec, inde
                 ..d
             };
             if !params.bounds_min.cmplt(params.bounds_max).all() {
-                return Err(names.invalid(prototype, "boids bounds_min must be below bounds_max on every axis".into()));
+                return Err(names.invalid(
+                    prototype,
+                    "boids bounds_min must be below bounds_max on every axis".into(),
+                ));
             }
             let scale = world.get::<Transform>(proto).map_or(Vec3::ONE, |t| t.scale);
             world.entity_mut(proto).insert((Flock { params }, Hidden));
             let mut rng = crate::rng::stream(seed, index);
-            let first = world.query::<&SpawnOrder>().iter(world).map(|o| o.0 + 1).max().unwrap_or(0);
+            let first =
+                world.query::<&SpawnOrder>().iter(world).map(|o| o.0 + 1).max().unwrap_or(0);
             for (i, (p, v)) in initial_boids(&params, *count, &mut rng).into_iter().enumerate() {
                 world.spawn((
                     Name::new(format!("{prototype}_{i}")),
@@ -393,7 +469,10 @@ fn attach_animation(world: &mut World, names: &Names, spec: &AnimationSpec, inde
         AnimationSpec::Keyframes { entity, keys, repeat } => {
             let e = names.entity(entity)?;
             if keys.is_empty() {
-                return Err(names.invalid(entity, format!("keyframes of '{entity}' are empty; expected at least one key")));
+                return Err(names.invalid(
+                    entity,
+                    format!("keyframes of '{entity}' are empty; expected at least one key"),
+                ));
             }
             let rest = *world.get::<Transform>(e).unwrap();
             let mut keys: Vec<Keyframe> = keys
@@ -402,10 +481,9 @@ fn attach_animation(world: &mut World, names: &Names, spec: &AnimationSpec, inde
                     frame: k.frame,
                     transform: Transform {
                         translation: k.translation.unwrap_or(rest.translation),
-                        rotation: k
-                            .rotation
-                            .as_ref()
-                            .map_or(rest.rotation, |r| Quat::from_axis_angle(r.axis.normalize(), r.degrees.to_radians())),
+                        rotation: k.rotation.as_ref().map_or(rest.rotation, |r| {
+                            Quat::from_axis_angle(r.axis.normalize(), r.degrees.to_radians())
+                        }),
                         scale: k.scale.unwrap_or(rest.scale),
                     },
                 })

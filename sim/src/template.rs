@@ -57,7 +57,13 @@ impl WorldTemplate {
     }
 
     /// A node showing `mesh` with `material`.
-    pub fn add_object(&mut self, name: &str, mesh: u32, material: u32, transform: Transform) -> usize {
+    pub fn add_object(
+        &mut self,
+        name: &str,
+        mesh: u32,
+        material: u32,
+        transform: Transform,
+    ) -> usize {
         let mut node = NodeTemplate::new(name, transform);
         node.mesh = Some(MeshInstance { mesh, material });
         self.add_node(node)
@@ -67,12 +73,19 @@ impl WorldTemplate {
     /// rotating the node turns the light in place.
     pub fn add_light(&mut self, name: &str, light: Light) -> usize {
         let (transform, light) = match light {
-            Light::Point { position, intensity } => {
-                (Transform::from_translation(position), Light::Point { position: Vec3::ZERO, intensity })
-            }
+            Light::Point { position, intensity } => (
+                Transform::from_translation(position),
+                Light::Point { position: Vec3::ZERO, intensity },
+            ),
             Light::Spot { position, direction, intensity, inner_angle, outer_angle } => (
                 Transform::from_translation(position),
-                Light::Spot { position: Vec3::ZERO, direction, intensity, inner_angle, outer_angle },
+                Light::Spot {
+                    position: Vec3::ZERO,
+                    direction,
+                    intensity,
+                    inner_angle,
+                    outer_angle,
+                },
             ),
             directional => (Transform::IDENTITY, directional),
         };

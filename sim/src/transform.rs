@@ -20,7 +20,8 @@ impl Default for Transform {
 }
 
 impl Transform {
-    pub const IDENTITY: Self = Self { translation: Vec3::ZERO, rotation: Quat::IDENTITY, scale: Vec3::ONE };
+    pub const IDENTITY: Self =
+        Self { translation: Vec3::ZERO, rotation: Quat::IDENTITY, scale: Vec3::ONE };
 
     pub fn from_translation(translation: Vec3) -> Self {
         Self { translation, ..Self::IDENTITY }
@@ -111,7 +112,10 @@ mod tests {
     fn children_follow_parents() {
         let mut world = World::new();
         let parent = world
-            .spawn((Transform::from_translation(Vec3::new(1.0, 0.0, 0.0)), GlobalTransform::default()))
+            .spawn((
+                Transform::from_translation(Vec3::new(1.0, 0.0, 0.0)),
+                GlobalTransform::default(),
+            ))
             .id();
         let child = world
             .spawn((

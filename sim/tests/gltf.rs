@@ -25,7 +25,8 @@ fn test_asset_is_generated_by_the_support_code() {
     if std::env::var_os("FLICKER_REGENERATE").is_some() {
         std::fs::write(asset_path(), &text).unwrap();
     }
-    let committed = std::fs::read_to_string(asset_path()).expect("scenarios/assets/test_scene.gltf exists");
+    let committed =
+        std::fs::read_to_string(asset_path()).expect("scenarios/assets/test_scene.gltf exists");
     assert!(committed == text, "test_scene.gltf is stale; run with FLICKER_REGENERATE=1");
 }
 
@@ -49,12 +50,20 @@ fn test_asset_imports_with_expected_counts() {
     assert_eq!(t.materials.materials[checker].base_color_texture, Some(0));
     assert!((t.materials.materials[checker].roughness - 0.7).abs() < 1e-6);
     let glow = &t.materials.materials[t.materials.index_of("Glow").unwrap() as usize];
-    assert!((glow.emission - Vec3::new(5.0, 4.0, 3.0)).length() < 1e-5, "emissive x strength: {}", glow.emission);
+    assert!(
+        (glow.emission - Vec3::new(5.0, 4.0, 3.0)).length() < 1e-5,
+        "emissive x strength: {}",
+        glow.emission
+    );
 
     // Hierarchy: Cube and Floor are children of Root.
     let root = t.nodes.iter().position(|n| n.name == "Root").unwrap();
     for child in ["Cube", "Floor"] {
-        assert_eq!(t.nodes.iter().find(|n| n.name == child).unwrap().parent, Some(root), "{child}'s parent");
+        assert_eq!(
+            t.nodes.iter().find(|n| n.name == child).unwrap().parent,
+            Some(root),
+            "{child}'s parent"
+        );
     }
     // The matrix node decomposes to scale 4 x 1 x 4 and y = -0.5.
     let floor = t.nodes.iter().find(|n| n.name == "Floor").unwrap();
@@ -94,7 +103,12 @@ fn imported_lights_point_along_their_node() {
     assert!((scene.camera.vfov - 0.8).abs() < 1e-6);
     // Cube sits under Root (y = 0.5).
     assert_eq!(scene.instances.len(), 3);
-    assert!(scene.instances.iter().any(|i| (i.transform.w_axis.truncate() - Vec3::new(0.0, 0.5, 0.0)).length() < 1e-6));
+    assert!(
+        scene
+            .instances
+            .iter()
+            .any(|i| (i.transform.w_axis.truncate() - Vec3::new(0.0, 0.5, 0.0)).length() < 1e-6)
+    );
 }
 
 #[test]
@@ -121,7 +135,10 @@ fn unsupported_primitive_mode_names_mesh_and_primitive() {
     let text = support::test_asset::gltf_text().replacen("\"mode\": 4", "\"mode\": 1", 1);
     std::fs::write(&path, text).unwrap();
     let e = import(&path).unwrap_err().to_string();
-    let expected = format!("{}: mesh 'Cube' primitive 0: mode Lines is not supported; expected triangles", path.display());
+    let expected = format!(
+        "{}: mesh 'Cube' primitive 0: mode Lines is not supported; expected triangles",
+        path.display()
+    );
     assert_eq!(e, expected);
 }
 
@@ -129,11 +146,15 @@ fn unsupported_primitive_mode_names_mesh_and_primitive() {
 /// (subsurface), Checker with a volume only (no subsurface: KHR_materials_volume alone belongs
 /// to refractive transmission).
 fn with_material_extensions(floor: serde_json::Value) -> String {
-    let mut doc: serde_json::Value = serde_json::from_str(&support::test_asset::gltf_text()).unwrap();
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&support::test_asset::gltf_text()).unwrap();
     let materials = doc["materials"].as_array_mut().unwrap();
     materials[0]["extensions"] = serde_json::json!({"KHR_materials_volume": {"attenuationDistance": 0.5, "attenuationColor": [0.5, 0.5, 0.5]}});
     materials[1]["extensions"] = floor;
-    doc["extensionsUsed"].as_array_mut().unwrap().extend([serde_json::json!("KHR_materials_volume"), serde_json::json!(sim::gltf_import::DIFFUSE_TRANSMISSION)]);
+    doc["extensionsUsed"].as_array_mut().unwrap().extend([
+        serde_json::json!("KHR_materials_volume"),
+        serde_json::json!(sim::gltf_import::DIFFUSE_TRANSMISSION),
+    ]);
     serde_json::to_string_pretty(&doc).unwrap()
 }
 
@@ -141,7 +162,8 @@ fn with_material_extensions(floor: serde_json::Value) -> String {
 fn subsurface_comes_from_diffuse_transmission_and_volume() {
     let dir = temp_dir("subsurface");
     let path = dir.join("skin.gltf");
-    let volume = serde_json::json!({"attenuationDistance": 0.2, "attenuationColor": [0.8, 0.5, 0.25]});
+    let volume =
+        serde_json::json!({"attenuationDistance": 0.2, "attenuationColor": [0.8, 0.5, 0.25]});
     std::fs::write(&path, with_material_extensions(serde_json::json!({"KHR_materials_diffuse_transmission": {}, "KHR_materials_volume": volume}))).unwrap();
     let t = import(&path).unwrap_or_else(|e| panic!("{e}"));
     let material = |name: &str| t.materials.materials[t.materials.index_of(name).unwrap() as usize];
@@ -157,7 +179,13 @@ fn subsurface_comes_from_diffuse_transmission_and_volume() {
     let bad = serde_json::json!({"KHR_materials_diffuse_transmission": {}, "KHR_materials_volume": {"attenuationDistance": 0.2, "attenuationColor": [1.0, 0.5, 0.5]}});
     std::fs::write(&path, with_material_extensions(bad)).unwrap();
     let e = import(&path).unwrap_err().to_string();
-    assert!(e.starts_with(&format!("{}: material 'FloorGrey': KHR_materials_volume attenuationColor", path.display())) && e.contains("(0, 1)"), "{e}");
+    assert!(
+        e.starts_with(&format!(
+            "{}: material 'FloorGrey': KHR_materials_volume attenuationColor",
+            path.display()
+        )) && e.contains("(0, 1)"),
+        "{e}"
+    );
     let bad = serde_json::json!({"KHR_materials_diffuse_transmission": {}, "KHR_materials_volume": {"attenuationColor": [0.5, 0.5, 0.5]}});
     std::fs::write(&path, with_material_extensions(bad)).unwrap();
     let e = import(&path).unwrap_err().to_string();

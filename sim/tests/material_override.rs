@@ -7,7 +7,9 @@ use glam::Vec3;
 use sim::{Scenario, Simulation};
 
 fn text(materials: &str) -> String {
-    format!("Scenario(\n scene: Builtin(\"sss_sphere\"),\n resolution: (32, 18),\n frames: 2,\n methods: [PathTracing(spp: 1)],\n materials: [{materials}],\n)")
+    format!(
+        "Scenario(\n scene: Builtin(\"sss_sphere\"),\n resolution: (32, 18),\n frames: 2,\n methods: [PathTracing(spp: 1)],\n materials: [{materials}],\n)"
+    )
 }
 
 fn load(materials: &str) -> Result<Scenario, String> {

@@ -51,20 +51,48 @@ fn every_shipped_scenario_loads_and_plays() {
         .filter(|p| p.extension().is_some_and(|x| x == "ron"))
         .collect();
     files.sort();
-    let required = ["cornell_box", "corridor", "door_gap", "courtyard", "hairball", "rotating_cone", "flash_sine",
-        "flash_square", "strobe", "boids", "keyframes", "camera_path", "events", "sss_flash", "sss_toggle", "sss_boids"];
+    let required = [
+        "cornell_box",
+        "corridor",
+        "door_gap",
+        "courtyard",
+        "hairball",
+        "rotating_cone",
+        "flash_sine",
+        "flash_square",
+        "strobe",
+        "boids",
+        "keyframes",
+        "camera_path",
+        "events",
+        "sss_flash",
+        "sss_toggle",
+        "sss_boids",
+    ];
     for r in required {
         assert!(files.iter().any(|f| f.file_stem().unwrap() == r), "scenarios/{r}.ron is missing");
     }
     for f in &files {
         let scenario = Scenario::load(f).unwrap_or_else(|e| panic!("{e}"));
-        assert!(scenario.resolution.0 * scenario.resolution.1 <= 160 * 90, "{}: too big for CI", f.display());
+        assert!(
+            scenario.resolution.0 * scenario.resolution.1 <= 160 * 90,
+            "{}: too big for CI",
+            f.display()
+        );
         // References are cached by scene content, so a still scene renders only a few: 1024 spp
         // at 64x36 (a dark corridor needs it) takes minutes on lavapipe.
-        assert!(scenario.frames <= 60 && scenario.reference.spp <= 1024, "{}: too long for CI", f.display());
+        assert!(
+            scenario.frames <= 60 && scenario.reference.spp <= 1024,
+            "{}: too long for CI",
+            f.display()
+        );
         assert_eq!(scenario.output, Path::new("runs").join(&scenario.name));
         let mut s = Simulation::new(&scenario).unwrap_or_else(|e| panic!("{e}"));
-        assert!(!s.scene().meshes.is_empty() && !s.scene().instances.is_empty(), "{}: empty scene", f.display());
+        assert!(
+            !s.scene().meshes.is_empty() && !s.scene().instances.is_empty(),
+            "{}: empty scene",
+            f.display()
+        );
         for _ in 0..3 {
             s.step();
         }
@@ -84,10 +112,14 @@ fn ron_syntax_error_reports_line_column_and_expectation() {
 
 #[test]
 fn unknown_field_is_reported_with_the_expected_ones() {
-    let text = "Scenario(\n  scene: Builtin(\"cornell_box\"),\n  resolution: (32, 18),\n  frame: 3,\n)";
+    let text =
+        "Scenario(\n  scene: Builtin(\"cornell_box\"),\n  resolution: (32, 18),\n  frame: 3,\n)";
     let e = Scenario::from_ron(text, Path::new("x.ron")).unwrap_err().to_string();
     assert!(e.starts_with("x.ron:4:"), "{e}");
-    assert!(e.contains("frame") && e.contains("frames"), "should name the field and the expected ones: {e}");
+    assert!(
+        e.contains("frame") && e.contains("frames"),
+        "should name the field and the expected ones: {e}"
+    );
 }
 
 #[test]
@@ -100,18 +132,39 @@ fn unknown_scene_name_lists_the_builtins() {
 
 #[test]
 fn unknown_entity_fails_before_frame_zero_naming_file_and_known_names() {
-    let s = with("cornell_box", "events: [\n (frame: 5, action: Toggle(entity: \"celing_light\")),\n]");
+    let s =
+        with("cornell_box", "events: [\n (frame: 5, action: Toggle(entity: \"celing_light\")),\n]");
     let e = Simulation::new(&s).err().expect("unknown entity must fail");
     assert!(matches!(&e, SimError::UnknownName { name, .. } if name == "celing_light"));
     let msg = e.to_string();
     assert!(msg.contains("inline.ron:4:"), "{msg}");
-    assert!(msg.contains("unknown entity 'celing_light'") && msg.contains("ceiling_light") && msg.contains("tall_box"), "{msg}");
+    assert!(
+        msg.contains("unknown entity 'celing_light'")
+            && msg.contains("ceiling_light")
+            && msg.contains("tall_box"),
+        "{msg}"
+    );
 
-    let s = with("courtyard", "animations: [Rotate(entity: \"moon\", axis: (0, 1, 0), degrees_per_second: 1)]");
+    let s = with(
+        "courtyard",
+        "animations: [Rotate(entity: \"moon\", axis: (0, 1, 0), degrees_per_second: 1)]",
+    );
     assert!(Simulation::new(&s).err().unwrap().to_string().contains("unknown entity 'moon'"));
-    let s = with("courtyard", "events: [(frame: 1, action: SetMaterial(material: \"gold\", metallic: 1.0))]");
-    assert!(Simulation::new(&s).err().unwrap().to_string().contains("unknown material 'gold'; expected one of: paving, walls"));
-    let s = with("courtyard", "events: [(frame: 1, action: RotateLight(light: \"ground\", axis: (0, 1, 0), degrees: 3))]");
+    let s = with(
+        "courtyard",
+        "events: [(frame: 1, action: SetMaterial(material: \"gold\", metallic: 1.0))]",
+    );
+    assert!(
+        Simulation::new(&s)
+            .err()
+            .unwrap()
+            .to_string()
+            .contains("unknown material 'gold'; expected one of: paving, walls")
+    );
+    let s = with(
+        "courtyard",
+        "events: [(frame: 1, action: RotateLight(light: \"ground\", axis: (0, 1, 0), degrees: 3))]",
+    );
     assert!(Simulation::new(&s).err().unwrap().to_string().contains("'ground' is not a light"));
 }
 
@@ -147,7 +200,10 @@ fn method_labels_reference_frames_and_summary() {
 
 #[test]
 fn light_rotation_event_turns_the_sun_by_its_angle_at_its_frame() {
-    let s = with("courtyard", "events: [(frame: 4, action: RotateLight(light: \"sun\", axis: (0, 1, 0), degrees: 30))]");
+    let s = with(
+        "courtyard",
+        "events: [(frame: 4, action: RotateLight(light: \"sun\", axis: (0, 1, 0), degrees: 30))]",
+    );
     let mut sim = Simulation::new(&s).unwrap();
     let before = sun_direction(sim.scene());
     for _ in 0..3 {
@@ -187,7 +243,10 @@ fn one_shot_rotation_applies_once_and_continuous_rotation_accumulates() {
     assert!(body(&mut sim).abs_diff_eq(expected, 1e-5), "rotated once only");
 
     // 45°/s at 0.1 s per frame: 36° after 8 frames.
-    let s = with("rotating_cone", "animations: [Rotate(entity: \"cone\", axis: (0, 1, 0), degrees_per_second: 45)]");
+    let s = with(
+        "rotating_cone",
+        "animations: [Rotate(entity: \"cone\", axis: (0, 1, 0), degrees_per_second: 45)]",
+    );
     let mut sim = Simulation::new(&s).unwrap();
     let rest = body(&mut sim);
     for _ in 0..8 {
@@ -200,7 +259,10 @@ fn one_shot_rotation_applies_once_and_continuous_rotation_accumulates() {
 #[test]
 fn flash_waveforms_drive_light_intensity_at_given_frames() {
     // Sine at 1.25 Hz with 0.1 s frames: frame 2 is t = 0.2 s -> sin(π/2) + 1 = 2.
-    let s = with("rotating_cone", "animations: [Flash(entity: \"lamp\", waveform: Sine(frequency: 1.25))]");
+    let s = with(
+        "rotating_cone",
+        "animations: [Flash(entity: \"lamp\", waveform: Sine(frequency: 1.25))]",
+    );
     let mut sim = Simulation::new(&s).unwrap();
     let i0 = Vec3::splat(8.0);
     assert!((point_intensity(sim.scene()) - i0).length() < 1e-4, "frame 0: sin 0 + 1 = 1");
@@ -214,7 +276,10 @@ fn flash_waveforms_drive_light_intensity_at_given_frames() {
     assert!(point_intensity(sim.scene()).length() < 1e-4);
 
     // Square, period 0.4 s = 4 frames: on, on, off, off, on ...
-    let s = with("rotating_cone", "animations: [Flash(entity: \"lamp\", waveform: Square(period: 0.4))]");
+    let s = with(
+        "rotating_cone",
+        "animations: [Flash(entity: \"lamp\", waveform: Square(period: 0.4))]",
+    );
     let mut sim = Simulation::new(&s).unwrap();
     let mut on = vec![point_intensity(sim.scene()).x > 0.0];
     for _ in 0..7 {
@@ -224,19 +289,31 @@ fn flash_waveforms_drive_light_intensity_at_given_frames() {
     assert_eq!(on, [true, true, false, false, true, true, false, false]);
 
     // An emissive mesh flashes through its own copy of its material.
-    let s = with("cornell_box", "animations: [Flash(entity: \"ceiling_light\", waveform: Sine(frequency: 1.25))]");
+    let s = with(
+        "cornell_box",
+        "animations: [Flash(entity: \"ceiling_light\", waveform: Sine(frequency: 1.25))]",
+    );
     let mut sim = Simulation::new(&s).unwrap();
     sim.step();
     sim.step();
     let scene = sim.scene();
     let light = scene.instances[5];
-    assert!((scene.materials[light.material as usize].emission - 2.0 * Vec3::new(17.0, 12.0, 4.0)).length() < 1e-3);
-    assert_eq!(scene.materials[3].emission, Vec3::new(17.0, 12.0, 4.0), "the table entry is untouched");
+    assert!(
+        (scene.materials[light.material as usize].emission - 2.0 * Vec3::new(17.0, 12.0, 4.0))
+            .length()
+            < 1e-3
+    );
+    assert_eq!(
+        scene.materials[3].emission,
+        Vec3::new(17.0, 12.0, 4.0),
+        "the table entry is untouched"
+    );
 }
 
 #[test]
 fn events_toggle_move_and_repaint() {
-    let mut sim = Simulation::new(&Scenario::load(&scenarios_dir().join("events.ron")).unwrap()).unwrap();
+    let mut sim =
+        Simulation::new(&Scenario::load(&scenarios_dir().join("events.ron")).unwrap()).unwrap();
     let lamp_on = |s: &SceneDesc| point_intensity(s).length() > 0.0;
     let walls_before = sim.scene().materials[1];
     while sim.frame() < 19 {
@@ -245,7 +322,9 @@ fn events_toggle_move_and_repaint() {
     assert!(lamp_on(sim.scene()));
     sim.step();
     assert!(!lamp_on(sim.scene()), "lamp off at frame 20");
-    let pillar = |s: &SceneDesc| s.instances.iter().filter(|i| i.mesh == 1).map(|i| i.transform.w_axis.z).sum::<f32>();
+    let pillar = |s: &SceneDesc| {
+        s.instances.iter().filter(|i| i.mesh == 1).map(|i| i.transform.w_axis.z).sum::<f32>()
+    };
     let before = pillar(sim.scene());
     while sim.frame() < 30 {
         sim.step();
@@ -260,7 +339,8 @@ fn events_toggle_move_and_repaint() {
 
 #[test]
 fn keyframes_and_camera_path_follow_their_keys() {
-    let mut sim = Simulation::new(&Scenario::load(&scenarios_dir().join("keyframes.ron")).unwrap()).unwrap();
+    let mut sim =
+        Simulation::new(&Scenario::load(&scenarios_dir().join("keyframes.ron")).unwrap()).unwrap();
     for _ in 0..10 {
         sim.step();
     }
@@ -268,7 +348,9 @@ fn keyframes_and_camera_path_follow_their_keys() {
     let t = sim.scene().instances[7].transform.w_axis.truncate();
     assert!((t - Vec3::new(0.225, 0.3, 0.4)).length() < 1e-5, "{t}");
 
-    let mut sim = Simulation::new(&Scenario::load(&scenarios_dir().join("camera_path.ron")).unwrap()).unwrap();
+    let mut sim =
+        Simulation::new(&Scenario::load(&scenarios_dir().join("camera_path.ron")).unwrap())
+            .unwrap();
     assert!((sim.scene().camera.position - Vec3::new(0.0, 1.5, 0.6)).length() < 1e-5);
     for _ in 0..25 {
         sim.step();
@@ -282,16 +364,26 @@ fn keyframes_and_camera_path_follow_their_keys() {
 
 #[test]
 fn boids_scenario_keeps_the_flock_in_its_box() {
-    let mut sim = Simulation::new(&Scenario::load(&scenarios_dir().join("boids.ron")).unwrap()).unwrap();
+    let mut sim =
+        Simulation::new(&Scenario::load(&scenarios_dir().join("boids.ron")).unwrap()).unwrap();
     let bird_mesh = 2;
     for _ in 0..60 {
         sim.step();
         assert!(sim.changed());
-        let birds: Vec<Vec3> =
-            sim.scene().instances.iter().filter(|i| i.mesh == bird_mesh).map(|i| i.transform.w_axis.truncate()).collect();
+        let birds: Vec<Vec3> = sim
+            .scene()
+            .instances
+            .iter()
+            .filter(|i| i.mesh == bird_mesh)
+            .map(|i| i.transform.w_axis.truncate())
+            .collect();
         assert_eq!(birds.len(), 24, "the prototype is hidden, 24 boids fly");
         for (i, a) in birds.iter().enumerate() {
-            assert!(a.cmpge(Vec3::new(-4.0, 1.5, -4.0) - 1e-4).all() && a.cmple(Vec3::new(4.0, 4.0, 3.0) + 1e-4).all(), "{a}");
+            assert!(
+                a.cmpge(Vec3::new(-4.0, 1.5, -4.0) - 1e-4).all()
+                    && a.cmple(Vec3::new(4.0, 4.0, 3.0) + 1e-4).all(),
+                "{a}"
+            );
             for b in &birds[i + 1..] {
                 assert!(a.distance(*b) >= 0.5 * 0.999, "{} apart", a.distance(*b));
             }
@@ -328,8 +420,16 @@ fn method_entries_keep_their_text_and_place() {
     let s = parse(
         "Scenario(scene: Builtin(\"courtyard\"), resolution: (32, 18), frames: 1,\n methods: [\n  Taa(),\n    HashCache(lookup: FirstHit,\n  taa: true), Taa(alpha: 0.2)])",
     );
-    let entries: Vec<(&str, usize, usize)> = s.methods.iter().map(|m| (m.text.as_str(), m.line, m.column)).collect();
-    assert_eq!(entries, [("Taa()", 3, 3), ("HashCache(lookup: FirstHit,\n  taa: true)", 4, 5), ("Taa(alpha: 0.2)", 5, 15)]);
+    let entries: Vec<(&str, usize, usize)> =
+        s.methods.iter().map(|m| (m.text.as_str(), m.line, m.column)).collect();
+    assert_eq!(
+        entries,
+        [
+            ("Taa()", 3, 3),
+            ("HashCache(lookup: FirstHit,\n  taa: true)", 4, 5),
+            ("Taa(alpha: 0.2)", 5, 15)
+        ]
+    );
     // A place inside the second entry, as a parser of that text reports it.
     assert_eq!(s.methods[1].position_in_file(1, 11), (4, 15));
     assert_eq!(s.methods[1].position_in_file(2, 3), (5, 3));

@@ -64,15 +64,35 @@ fn main() -> anyhow::Result<()> {
     scenario.resolution = (w, h);
     let gpu = Gpu::new()?;
     let mut sim = Simulation::new(&scenario)?;
-    let settings = PathTracerSettings { width: w, height: h, max_depth: scenario.max_depth, rr_start_depth: 3 };
+    let settings = PathTracerSettings {
+        width: w,
+        height: h,
+        max_depth: scenario.max_depth,
+        rr_start_depth: 3,
+    };
     let mut tracer = PathTracer::new(&gpu, sim.scene(), settings)?;
     let mut taa = Taa::new(&gpu, &tracer, TaaSettings::default())?;
     let mut hc = HashCache::new(&gpu, &tracer, HashCacheSettings::default())?;
-    let mut hc_taa = (HashCache::new(&gpu, &tracer, HashCacheSettings::default())?, Taa::new(&gpu, &tracer, TaaSettings::default())?);
+    let mut hc_taa = (
+        HashCache::new(&gpu, &tracer, HashCacheSettings::default())?,
+        Taa::new(&gpu, &tracer, TaaSettings::default())?,
+    );
     let strategies = [Retrace::Single, Retrace::Multi, Retrace::Adaptive];
-    let mut caches: Vec<SampleCache> =
-        strategies.iter().map(|&retrace| SampleCache::new(&gpu, &tracer, SampleCacheSettings { retrace, ..Default::default() })).collect::<Result<_, _>>()?;
-    let labels = ["pt_1spp", "taa", "hash_cache", "hash_cache_taa", "ssc_single", "ssc_multi", "ssc_adaptive"];
+    let mut caches: Vec<SampleCache> = strategies
+        .iter()
+        .map(|&retrace| {
+            SampleCache::new(&gpu, &tracer, SampleCacheSettings { retrace, ..Default::default() })
+        })
+        .collect::<Result<_, _>>()?;
+    let labels = [
+        "pt_1spp",
+        "taa",
+        "hash_cache",
+        "hash_cache_taa",
+        "ssc_single",
+        "ssc_multi",
+        "ssc_adaptive",
+    ];
     let mut sums: BTreeMap<&str, Sums> = BTreeMap::new();
     let mut dispatch: Vec<Vec<f64>> = vec![vec![0.0; DISPATCHES.len()]; strategies.len()];
     let mut primary_rays = [0u64; 3];
@@ -93,7 +113,14 @@ fn main() -> anyhow::Result<()> {
         record("taa", &t.timings, t.rays, t.shaded);
         let o = hc.render(&gpu, &tracer, &sim.scene().camera, scenario.seed, frame, None)?;
         record("hash_cache", &o.timings, o.rays, o.shaded);
-        let o = hc_taa.0.render(&gpu, &tracer, &sim.scene().camera, scenario.seed, frame, Some(&mut hc_taa.1))?;
+        let o = hc_taa.0.render(
+            &gpu,
+            &tracer,
+            &sim.scene().camera,
+            scenario.seed,
+            frame,
+            Some(&mut hc_taa.1),
+        )?;
         record("hash_cache_taa", &o.timings, o.rays, o.shaded);
         for (i, cache) in caches.iter_mut().enumerate() {
             let o = cache.render(&gpu, &tracer, scenario.seed, frame)?;
@@ -107,29 +134,60 @@ fn main() -> anyhow::Result<()> {
         }
         sim.step();
         // Per frame, to tell a steady cost from outliers in the means.
-        let ms = |timings: &[PassTiming], pass: &str| timings.iter().find(|t| t.pass == pass).map_or(0.0, |t| t.ms);
-        eprintln!("frame {f}: pt path_trace {:.0} ms, taa_trace {:.0} ms", ms(&pt.timings, "path_trace"), ms(&t.timings, "taa_trace"));
+        let ms = |timings: &[PassTiming], pass: &str| {
+            timings.iter().find(|t| t.pass == pass).map_or(0.0, |t| t.ms)
+        };
+        eprintln!(
+            "frame {f}: pt path_trace {:.0} ms, taa_trace {:.0} ms",
+            ms(&pt.timings, "path_trace"),
+            ms(&t.timings, "taa_trace")
+        );
     }
     let n = (frames - WARM_UP) as f64;
     let clock = clock.map_or("?", |c| c.name());
-    println!("adapter: {}; hairball_camera.ron at {w}x{h}, max depth {}, mean of frames {WARM_UP}..{frames}; clock: {clock}\n", gpu.summary, scenario.max_depth);
-    println!("| method | pass ms ({clock}) | total ms | rays / frame | shaded paths / frame |\n|---|---|---:|---:|---:|");
+    println!(
+        "adapter: {}; hairball_camera.ron at {w}x{h}, max depth {}, mean of frames {WARM_UP}..{frames}; clock: {clock}\n",
+        gpu.summary, scenario.max_depth
+    );
+    println!(
+        "| method | pass ms ({clock}) | total ms | rays / frame | shaded paths / frame |\n|---|---|---:|---:|---:|"
+    );
     for label in labels {
         let s = &sums[label];
-        let passes: Vec<String> = s.passes.iter().map(|(p, ms)| format!("{p} {:.1}", ms / n)).collect();
-        println!("| {label} | {} | {:.1} | {} | {} |", passes.join(", "), s.total(), s.rays / s.frames as u64, s.shaded / s.frames as u64);
+        let passes: Vec<String> =
+            s.passes.iter().map(|(p, ms)| format!("{p} {:.1}", ms / n)).collect();
+        println!(
+            "| {label} | {} | {:.1} | {} | {} |",
+            passes.join(", "),
+            s.total(),
+            s.rays / s.frames as u64,
+            s.shaded / s.frames as u64
+        );
     }
-    println!("\nsample cache per dispatch (ms, {clock}):\n\n| dispatch | single | multi | adaptive |\n|---|---:|---:|---:|");
+    println!(
+        "\nsample cache per dispatch (ms, {clock}):\n\n| dispatch | single | multi | adaptive |\n|---|---:|---:|---:|"
+    );
     for (d, name) in DISPATCHES.iter().enumerate() {
-        println!("| {name} | {:.1} | {:.1} | {:.1} |", dispatch[0][d] / n, dispatch[1][d] / n, dispatch[2][d] / n);
+        println!(
+            "| {name} | {:.1} | {:.1} | {:.1} |",
+            dispatch[0][d] / n,
+            dispatch[1][d] / n,
+            dispatch[2][d] / n
+        );
     }
-    println!("| primary rays / frame | {} | {} | {} |", primary_rays[0] / n as u64, primary_rays[1] / n as u64, primary_rays[2] / n as u64);
+    println!(
+        "| primary rays / frame | {} | {} | {} |",
+        primary_rays[0] / n as u64,
+        primary_rays[1] / n as u64,
+        primary_rays[2] / n as u64
+    );
     // The paper's figure 7 times reprojection and retracing without shading.
     let no_shade = |label: &str| {
         let s = &sums[label];
         s.mean("reserve") + s.mean("trace") + s.mean("reconstruct")
     };
-    let (single, multi, adaptive) = (no_shade("ssc_single"), no_shade("ssc_multi"), no_shade("ssc_adaptive"));
+    let (single, multi, adaptive) =
+        (no_shade("ssc_single"), no_shade("ssc_multi"), no_shade("ssc_adaptive"));
     println!(
         "\nreprojection (1-pass, `reserve`): {:.1} ms; without shading: single {single:.1}, multi {multi:.1}, adaptive {adaptive:.1} ms; \
          adaptive / multi = {:.2}, single / multi = {:.2} (paper, RTX 3060 1080p: 5.79 / 10.37 = 0.56, 5.06 / 10.37 = 0.49)",

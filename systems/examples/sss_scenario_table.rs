@@ -20,13 +20,26 @@ const REFERENCE: &str = "pass_2048";
 
 /// frames.csv as (header, rows).
 fn read_csv(path: &Path) -> Result<(Vec<String>, Vec<Vec<String>>)> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let mut lines = text.lines();
-    let header: Vec<String> = lines.next().with_context(|| format!("{}: empty", path.display()))?.split(',').map(str::to_string).collect();
-    let rows: Vec<Vec<String>> = lines.map(|l| l.split(',').map(str::to_string).collect()).collect();
+    let header: Vec<String> = lines
+        .next()
+        .with_context(|| format!("{}: empty", path.display()))?
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let rows: Vec<Vec<String>> =
+        lines.map(|l| l.split(',').map(str::to_string).collect()).collect();
     for (i, r) in rows.iter().enumerate() {
         if r.len() != header.len() {
-            bail!("{}:{}: {} fields; expected {} as in the header", path.display(), i + 2, r.len(), header.len());
+            bail!(
+                "{}:{}: {} fields; expected {} as in the header",
+                path.display(),
+                i + 2,
+                r.len(),
+                header.len()
+            );
         }
     }
     Ok((header, rows))
@@ -37,7 +50,8 @@ fn luminance_image(path: &Path) -> Result<Vec<f32>> {
 }
 
 fn mask(path: &Path) -> Result<Vec<bool>> {
-    let img = image::open(path).with_context(|| format!("reading {}", path.display()))?.into_luma8();
+    let img =
+        image::open(path).with_context(|| format!("reading {}", path.display()))?.into_luma8();
     Ok(img.pixels().map(|p| p.0[0] > 0).collect())
 }
 
@@ -52,9 +66,16 @@ struct Row {
 fn table(run: &Path) -> Result<(Vec<Row>, String)> {
     let folder = RunFolder::new(run);
     let (header, rows) = read_csv(&folder.frames_csv())?;
-    let column = |name: &str| header.iter().position(|h| h == name).with_context(|| format!("{}: no column {name}", folder.frames_csv().display()));
-    let (method_col, frame_col, spp_col) = (column("method")?, column("frame")?, column("sss_mean_spp")?);
-    let pass_cols: Vec<usize> = header.iter().enumerate().filter(|(_, h)| h.contains("_ms_sss_")).map(|(i, _)| i).collect();
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .with_context(|| format!("{}: no column {name}", folder.frames_csv().display()))
+    };
+    let (method_col, frame_col, spp_col) =
+        (column("method")?, column("frame")?, column("sss_mean_spp")?);
+    let pass_cols: Vec<usize> =
+        header.iter().enumerate().filter(|(_, h)| h.contains("_ms_sss_")).map(|(i, _)| i).collect();
     let mut methods: Vec<String> = vec![];
     for r in &rows {
         if !methods.contains(&r[method_col]) {
@@ -62,24 +83,66 @@ fn table(run: &Path) -> Result<(Vec<Row>, String)> {
         }
     }
     if !methods.iter().any(|m| m == REFERENCE) {
-        bail!("{}: no method {REFERENCE}; expected the SSS scenarios' reference pass", run.display());
+        bail!(
+            "{}: no method {REFERENCE}; expected the SSS scenarios' reference pass",
+            run.display()
+        );
     }
-    let frames: u32 = rows.iter().map(|r| r[frame_col].parse::<u32>().map(|f| f + 1)).collect::<Result<Vec<_>, _>>()?.into_iter().max().unwrap_or(0);
-    let masks: Vec<Vec<bool>> = (0..frames).map(|f| mask(&folder.method_image(REFERENCE, "sample_count", f, "png"))).collect::<Result<_>>()?;
-    let references: Vec<Vec<f32>> = (0..frames).map(|f| luminance_image(&folder.frame(REFERENCE, f, "exr"))).collect::<Result<_>>()?;
-    let peak = references.iter().zip(&masks).flat_map(|(r, m)| r.iter().zip(m).filter(|(_, m)| **m).map(|(l, _)| *l as f64)).fold(0.0, f64::max);
+    let frames: u32 = rows
+        .iter()
+        .map(|r| r[frame_col].parse::<u32>().map(|f| f + 1))
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .max()
+        .unwrap_or(0);
+    let masks: Vec<Vec<bool>> = (0..frames)
+        .map(|f| mask(&folder.method_image(REFERENCE, "sample_count", f, "png")))
+        .collect::<Result<_>>()?;
+    let references: Vec<Vec<f32>> = (0..frames)
+        .map(|f| luminance_image(&folder.frame(REFERENCE, f, "exr")))
+        .collect::<Result<_>>()?;
+    let peak = references
+        .iter()
+        .zip(&masks)
+        .flat_map(|(r, m)| r.iter().zip(m).filter(|(_, m)| **m).map(|(l, _)| *l as f64))
+        .fold(0.0, f64::max);
     let mut out = vec![];
     let mut per_frame: Vec<Vec<f64>> = vec![];
     for m in &methods {
         let mine: Vec<&Vec<String>> = rows.iter().filter(|r| &r[method_col] == m).collect();
-        let number = |s: &str| if s.is_empty() { Ok(0.0) } else { s.parse::<f64>().with_context(|| format!("{}: '{s}' is not a number", folder.frames_csv().display())) };
-        let spp = mine.iter().map(|r| number(&r[spp_col])).sum::<Result<f64>>()? / mine.len() as f64;
-        let ms = mine.iter().map(|r| pass_cols.iter().map(|&c| number(&r[c])).sum::<Result<f64>>()).sum::<Result<f64>>()? / mine.len() as f64;
-        let images: Vec<Vec<f32>> = (0..frames).map(|f| luminance_image(&folder.frame(m, f, "exr"))).collect::<Result<_>>()?;
-        let psnr: Vec<f64> = (0..frames as usize).map(|f| psnr_luminance(&images[f], &references[f], &masks[f], peak)).collect();
-        let smape: Vec<f64> = (1..frames as usize).map(|f| smape_luminance(&images[f], &images[f - 1], &masks[f])).collect();
+        let number = |s: &str| {
+            if s.is_empty() {
+                Ok(0.0)
+            } else {
+                s.parse::<f64>().with_context(|| {
+                    format!("{}: '{s}' is not a number", folder.frames_csv().display())
+                })
+            }
+        };
+        let spp =
+            mine.iter().map(|r| number(&r[spp_col])).sum::<Result<f64>>()? / mine.len() as f64;
+        let ms = mine
+            .iter()
+            .map(|r| pass_cols.iter().map(|&c| number(&r[c])).sum::<Result<f64>>())
+            .sum::<Result<f64>>()?
+            / mine.len() as f64;
+        let images: Vec<Vec<f32>> = (0..frames)
+            .map(|f| luminance_image(&folder.frame(m, f, "exr")))
+            .collect::<Result<_>>()?;
+        let psnr: Vec<f64> = (0..frames as usize)
+            .map(|f| psnr_luminance(&images[f], &references[f], &masks[f], peak))
+            .collect();
+        let smape: Vec<f64> = (1..frames as usize)
+            .map(|f| smape_luminance(&images[f], &images[f - 1], &masks[f]))
+            .collect();
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-        out.push(Row { method: m.clone(), spp, ms, psnr: if m == REFERENCE { f64::INFINITY } else { mean(&psnr) }, smape: mean(&smape) });
+        out.push(Row {
+            method: m.clone(),
+            spp,
+            ms,
+            psnr: if m == REFERENCE { f64::INFINITY } else { mean(&psnr) },
+            smape: mean(&smape),
+        });
         per_frame.push(smape);
     }
     let mut csv = format!("frame,{}\n", methods.join(","));
@@ -95,12 +158,17 @@ fn main() -> Result<()> {
     if runs.is_empty() {
         bail!("usage: sss_scenario_table RUN...; expected run folders of the SSS scenarios");
     }
-    println!("| scenario | method | mean spp | SSS ms/frame | PSNR dB vs {REFERENCE} | SMAPE |\n|---|---|---|---|---|---|");
+    println!(
+        "| scenario | method | mean spp | SSS ms/frame | PSNR dB vs {REFERENCE} | SMAPE |\n|---|---|---|---|---|---|"
+    );
     for run in &runs {
         let (rows, csv) = table(run)?;
         let name = run.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         for r in rows {
-            println!("| {name} | {} | {:.2} | {:.2} | {:.2} | {:.4} |", r.method, r.spp, r.ms, r.psnr, r.smape);
+            println!(
+                "| {name} | {} | {:.2} | {:.2} | {:.2} | {:.4} |",
+                r.method, r.spp, r.ms, r.psnr, r.smape
+            );
         }
         systems::output::write_text(&run.join("sss_smape.csv"), &csv)?;
     }

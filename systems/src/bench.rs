@@ -129,7 +129,10 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         "| scene | triangles | instances | stack entries | WGSL Mrays/s | obvhs CPU Mrays/s | WGSL / CPU (median of {} paired rounds) | rounds: lowest, highest | sorted: WGSL Mrays/s | sorted: CPU Mrays/s | sorted / random, WGSL | BVH2: WGSL Mrays/s | BVH2 / CWBVH, WGSL | BVH2 / CWBVH, obvhs CPU | hits | WGSL = CPU | BVH2 = CPU |",
         render::bvh::PAIRED_ROUNDS
     )?;
-    writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")?;
+    writeln!(
+        md,
+        "|---|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    )?;
     let scenes: Vec<(String, SceneDesc)> = vec![
         ("cornell_box".into(), builtin_scene("cornell_box", (64, 36))?),
         ("hairball".into(), builtin_scene("hairball", (64, 36))?),
@@ -137,7 +140,8 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
     ];
     for (name, scene) in &scenes {
         log(&format!("traversal: {name}"));
-        let b = traversal_benchmark(&gpu, scene, opts.rays, 1).with_context(|| format!("traversal benchmark on {name}"))?;
+        let b = traversal_benchmark(&gpu, scene, opts.rays, 1)
+            .with_context(|| format!("traversal benchmark on {name}"))?;
         let ratio = render::bvh::median(&b.paired_ratios);
         writeln!(
             md,
@@ -185,9 +189,13 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         "\n## Reference path tracing (Lambertian Cornell box {0}x{0}, {1} spp, unlimited depth, Russian roulette from depth {2})\n",
         REFERENCE_SIZE, opts.reference_spp, REFERENCE_INTEGRATOR.rr_depth
     )?;
-    writeln!(md, "| renderer | M paths/s | mean radiance (RGB) | ratio to Mitsuba |\n|---|---:|---|---:|")?;
+    writeln!(
+        md,
+        "| renderer | M paths/s | mean radiance (RGB) | ratio to Mitsuba |\n|---|---:|---|---:|"
+    )?;
     let mean = |m: [f64; 3]| format!("{:.4} {:.4} {:.4}", m[0], m[1], m[2]);
-    let mitsuba_ratio = reference.mitsuba.as_ref().map(|m| reference.paths_per_s / m.paths_per_second());
+    let mitsuba_ratio =
+        reference.mitsuba.as_ref().map(|m| reference.paths_per_s / m.paths_per_second());
     writeln!(
         md,
         "| flicker WGSL ({}) | {:.3} | {} | {} |",
@@ -201,28 +209,55 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         "| flicker WGSL, wavefront (extend, shade, shadow kernels) | {:.3} | largest pixel difference from the megakernel: {:.3e} | {} |",
         reference.wavefront_paths_per_s / 1e6,
         reference.wavefront_max_difference,
-        reference.mitsuba.as_ref().map_or("n/a".into(), |m| format!("{:.2}", reference.wavefront_paths_per_s / m.paths_per_second()))
+        reference.mitsuba.as_ref().map_or("n/a".into(), |m| format!(
+            "{:.2}",
+            reference.wavefront_paths_per_s / m.paths_per_second()
+        ))
     )?;
     // The Mitsuba row belongs to the table above, so the kernel times follow it.
     match &reference.mitsuba {
-        Some(m) => writeln!(md, "| Mitsuba {} scalar_rgb ({} threads) | {:.3} | {} | 1.00 |", m.version, m.threads, m.paths_per_second() / 1e6, mean(m.mean_rgb))?,
-        None => writeln!(md, "\nMitsuba 3 not measured: {}", reference.mitsuba_missing.as_deref().unwrap_or("?"))?,
+        Some(m) => writeln!(
+            md,
+            "| Mitsuba {} scalar_rgb ({} threads) | {:.3} | {} | 1.00 |",
+            m.version,
+            m.threads,
+            m.paths_per_second() / 1e6,
+            mean(m.mean_rgb)
+        )?,
+        None => writeln!(
+            md,
+            "\nMitsuba 3 not measured: {}",
+            reference.mitsuba_missing.as_deref().unwrap_or("?")
+        )?,
     }
     writeln!(
         md,
         "\nThe wavefront's kernels, each submitted and waited for alone, against the megakernel's {:.3} s for the whole reference: {}\n",
         reference.seconds,
-        reference.wavefront_kernel_seconds.iter().map(|(k, s)| format!("{k} {s:.3} s")).collect::<Vec<_>>().join(", ")
+        reference
+            .wavefront_kernel_seconds
+            .iter()
+            .map(|(k, s)| format!("{k} {s:.3} s"))
+            .collect::<Vec<_>>()
+            .join(", ")
     )?;
 
-    writeln!(md, "\n## Path tracer frame time ({} frames after one warm-up, 1 spp, max depth 8)\n", opts.frames)?;
-    writeln!(md, "| scene | resolution | pass | GPU ms (mean) | CPU ms per frame incl. readback (mean) |")?;
+    writeln!(
+        md,
+        "\n## Path tracer frame time ({} frames after one warm-up, 1 spp, max depth 8)\n",
+        opts.frames
+    )?;
+    writeln!(
+        md,
+        "| scene | resolution | pass | GPU ms (mean) | CPU ms per frame incl. readback (mean) |"
+    )?;
     writeln!(md, "|---|---|---|---:|---:|")?;
     for name in &opts.frame_scenes {
         for &(w, h) in &opts.resolutions {
             log(&format!("frame time: {name} {w}x{h}"));
             let scene = builtin_scene(name, (w, h))?;
-            let settings = PathTracerSettings { width: w, height: h, max_depth: 8, rr_start_depth: 3 };
+            let settings =
+                PathTracerSettings { width: w, height: h, max_depth: 8, rr_start_depth: 3 };
             let mut tracer = PathTracer::new(&gpu, &scene, settings)?;
             tracer.update(&gpu, &scene);
             tracer.render(&gpu, 1, 1, 0)?;
@@ -247,10 +282,19 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
             }
             let cpu_ms = start.elapsed().as_secs_f64() * 1e3 / opts.frames as f64;
             for (pass, sum, n) in &gpu_ms {
-                let g = if *n > 0 { format!("{:.2}{}", sum / *n as f64, if gpu.has_timestamps() { "" } else { " (wall)" }) } else { "n/a".into() };
+                let g = if *n > 0 {
+                    format!(
+                        "{:.2}{}",
+                        sum / *n as f64,
+                        if gpu.has_timestamps() { "" } else { " (wall)" }
+                    )
+                } else {
+                    "n/a".into()
+                };
                 writeln!(md, "| {name} | {w}x{h} | {pass} | {g} | {cpu_ms:.2} |")?;
             }
-            let mean_ms: std::collections::BTreeMap<String, f64> = gpu_ms.iter().map(|(p, sum, n)| (p.clone(), sum / (*n).max(1) as f64)).collect();
+            let mean_ms: std::collections::BTreeMap<String, f64> =
+                gpu_ms.iter().map(|(p, sum, n)| (p.clone(), sum / (*n).max(1) as f64)).collect();
             let frame_ms: f64 = mean_ms.values().sum();
             let rays_per_frame = rays as f64 / opts.frames as f64;
             frame_rows.push(FrameRow {
@@ -265,7 +309,10 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
     }
     // Traversal's share of a frame, to first order: the frame's rays at the traversal-only rate
     // of the same scene (random rays, like the bounces' rays) against the frame's time.
-    writeln!(md, "\n| scene | resolution | rays per frame | Mrays/s within the frame | traversal-only Mrays/s | frame rate / traversal-only rate |")?;
+    writeln!(
+        md,
+        "\n| scene | resolution | rays per frame | Mrays/s within the frame | traversal-only Mrays/s | frame rate / traversal-only rate |"
+    )?;
     writeln!(md, "|---|---|---:|---:|---:|---:|")?;
     for f in &frame_rows {
         let alone = traversal_rows.iter().find(|t| t.scene == f.scene).map(|t| t.wgsl_mrays_per_s);
@@ -306,7 +353,8 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
 const REFERENCE_SIZE: u32 = 64;
 /// "Unlimited" depth on our side is a bound no Cornell-box path reaches under roulette (a path
 /// survives 1000 white bounces with probability below 0.73^997).
-const REFERENCE_INTEGRATOR: crate::mitsuba::Integrator = crate::mitsuba::Integrator { max_depth: None, rr_depth: 3 };
+const REFERENCE_INTEGRATOR: crate::mitsuba::Integrator =
+    crate::mitsuba::Integrator { max_depth: None, rr_depth: 3 };
 const REFERENCE_MAX_DEPTH: u32 = 1000;
 
 struct ReferenceBench {
@@ -330,7 +378,12 @@ struct ReferenceBench {
 fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
     let size = REFERENCE_SIZE;
     let scene = lambertian_cornell_box((size, size))?;
-    let settings = PathTracerSettings { width: size, height: size, max_depth: REFERENCE_MAX_DEPTH, rr_start_depth: REFERENCE_INTEGRATOR.rr_depth };
+    let settings = PathTracerSettings {
+        width: size,
+        height: size,
+        max_depth: REFERENCE_MAX_DEPTH,
+        rr_start_depth: REFERENCE_INTEGRATOR.rr_depth,
+    };
     let mut tracer = PathTracer::new(gpu, &scene, settings)?;
     tracer.update(gpu, &scene);
     tracer.render_reference(gpu, 1, 1, 0, &mut |_, _| {})?;
@@ -346,9 +399,15 @@ fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
     // Where its time goes: each kernel waited for alone (slower than the timed run above).
     let mut kernel_times = render::wavefront::KernelTimes::default();
     wavefront.render_reference_per_kernel(gpu, &tracer, spp, 1, 0, &mut kernel_times)?;
-    let wavefront_kernel_seconds: Vec<(String, f64)> =
-        render::wavefront::Kernel::ALL.iter().map(|k| (k.name().to_string(), kernel_times.seconds[*k as usize])).collect();
-    let wavefront_max_difference = image.iter().zip(&wf_image).flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs())).fold(0.0f32, f32::max);
+    let wavefront_kernel_seconds: Vec<(String, f64)> = render::wavefront::Kernel::ALL
+        .iter()
+        .map(|k| (k.name().to_string(), kernel_times.seconds[*k as usize]))
+        .collect();
+    let wavefront_max_difference = image
+        .iter()
+        .zip(&wf_image)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
+        .fold(0.0f32, f32::max);
     let n = image.len() as f64;
     let mean_rgb = [0, 1, 2].map(|c| image.iter().map(|p| p[c] as f64).sum::<f64>() / n);
     let (mitsuba, mitsuba_missing) = match crate::mitsuba::python() {
@@ -361,7 +420,16 @@ fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
             (Some(run), None)
         }
     };
-    Ok(ReferenceBench { paths_per_s, seconds, wavefront_kernel_seconds, wavefront_paths_per_s, wavefront_max_difference, mean_rgb, mitsuba, mitsuba_missing })
+    Ok(ReferenceBench {
+        paths_per_s,
+        seconds,
+        wavefront_kernel_seconds,
+        wavefront_paths_per_s,
+        wavefront_max_difference,
+        mean_rgb,
+        mitsuba,
+        mitsuba_missing,
+    })
 }
 
 /// A GPU fresh from idle runs at a fraction of its clock for a while (an H200 started at 345 of
@@ -369,7 +437,11 @@ fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
 /// so that every timed section starts at working clocks.
 fn warm_up(gpu: &Gpu) -> Result<()> {
     let scene = builtin_scene("cornell_box", (320, 180))?;
-    let mut tracer = PathTracer::new(gpu, &scene, PathTracerSettings { width: 320, height: 180, max_depth: 8, rr_start_depth: 3 })?;
+    let mut tracer = PathTracer::new(
+        gpu,
+        &scene,
+        PathTracerSettings { width: 320, height: 180, max_depth: 8, rr_start_depth: 3 },
+    )?;
     tracer.update(gpu, &scene);
     let start = Instant::now();
     let mut frame = 0;

@@ -87,7 +87,12 @@ struct Scratch(std::path::PathBuf);
 
 impl Scratch {
     fn create(path: &std::path::Path) -> Result<Scratch> {
-        std::fs::create_dir(path).with_context(|| format!("creating the NIRC frame bench's scratch folder {} (it must not exist)", path.display()))?;
+        std::fs::create_dir(path).with_context(|| {
+            format!(
+                "creating the NIRC frame bench's scratch folder {} (it must not exist)",
+                path.display()
+            )
+        })?;
         Ok(Scratch(path.to_path_buf()))
     }
 }
@@ -95,7 +100,10 @@ impl Scratch {
 impl Drop for Scratch {
     fn drop(&mut self) {
         if let Err(e) = std::fs::remove_dir_all(&self.0) {
-            eprintln!("warning: could not remove the NIRC frame bench's scratch folder {}: {e}", self.0.display());
+            eprintln!(
+                "warning: could not remove the NIRC frame bench's scratch folder {}: {e}",
+                self.0.display()
+            );
         }
     }
 }
@@ -103,37 +111,79 @@ impl Drop for Scratch {
 /// Plays `warmup` untimed and then `frames` timed frames per predictor at `resolution`; the run
 /// folders go under `scratch`, a folder this creates (it must not exist) and removes afterwards,
 /// also on an error.
-pub fn run(resolution: (u32, u32), warmup: u32, frames: u32, scratch: &std::path::Path) -> Result<Table1> {
+pub fn run(
+    resolution: (u32, u32),
+    warmup: u32,
+    frames: u32,
+    scratch: &std::path::Path,
+) -> Result<Table1> {
     anyhow::ensure!(frames > 0, "the NIRC frame bench needs at least 1 timed frame");
     let guard = Scratch::create(scratch)?;
     let mut worlds = Vec::new();
     for predictor in PREDICTORS {
-        eprintln!("bench: NIRC frames, building the {predictor} world ({}x{})", resolution.0, resolution.1);
+        eprintln!(
+            "bench: NIRC frames, building the {predictor} world ({}x{})",
+            resolution.0, resolution.1
+        );
         let origin = scratch.join(format!("{predictor}.ron"));
-        let scenario = Scenario::from_ron(&scenario_text(resolution, warmup, frames, predictor), &origin)?;
+        let scenario =
+            Scenario::from_ron(&scenario_text(resolution, warmup, frames, predictor), &origin)?;
         let folder = RunFolder::new(scratch.join(predictor));
-        let spec = RunSpec::from_scenario(scenario, &Overrides { out: Some(folder.root.clone()), ..Default::default() })?;
+        let spec = RunSpec::from_scenario(
+            scenario,
+            &Overrides { out: Some(folder.root.clone()), ..Default::default() },
+        )?;
         let gpu = Gpu::new()?;
-        let world = FrameWorld::build(&spec, gpu, scratch.join("references"), folder.clone(), ProgressBar::hidden())?;
+        let world = FrameWorld::build(
+            &spec,
+            gpu,
+            scratch.join("references"),
+            folder.clone(),
+            ProgressBar::hidden(),
+        )?;
         folder.prepare()?;
         worlds.push(world);
     }
     for step in 0..warmup + frames {
         for &i in &ORDERS[step as usize % ORDERS.len()] {
-            worlds[i].run_frame(step, warmup).with_context(|| format!("NIRC frame bench, {} world, frame {step}", PREDICTORS[i]))?;
+            worlds[i].run_frame(step, warmup).with_context(|| {
+                format!("NIRC frame bench, {} world, frame {step}", PREDICTORS[i])
+            })?;
         }
     }
     let mut rows = Vec::new();
     for (predictor, world) in PREDICTORS.iter().zip(&mut worlds) {
         let records = std::mem::take(&mut world.world.resource_mut::<RunOutput>().records);
-        anyhow::ensure!(records.len() == frames as usize, "the {predictor} world recorded {} frames, expected {frames}", records.len());
+        anyhow::ensure!(
+            records.len() == frames as usize,
+            "the {predictor} world recorded {} frames, expected {frames}",
+            records.len()
+        );
         let frame_ms = records
             .iter()
-            .map(|r| r.passes_total_ms().with_context(|| format!("the {predictor} world's frame {} has an untimed pass", r.frame)))
+            .map(|r| {
+                r.passes_total_ms().with_context(|| {
+                    format!("the {predictor} world's frame {} has an untimed pass", r.frame)
+                })
+            })
             .collect::<Result<Vec<f64>>>()?;
-        let pass_mean = |name: &str| mean(&records.iter().filter_map(|r| r.passes.iter().find(|(p, _)| p == name).and_then(|(_, t)| *t)).collect::<Vec<f64>>());
-        let pass_ms: Vec<(String, f64)> = records[0].passes.iter().map(|(p, _)| (p.clone(), pass_mean(p))).collect();
-        rows.push(FrameTimes { predictor: predictor.to_string(), ms_per_frame: mean(&frame_ms), infer_ms: pass_mean("nirc_infer"), pass_ms, frame_ms });
+        let pass_mean = |name: &str| {
+            mean(
+                &records
+                    .iter()
+                    .filter_map(|r| r.passes.iter().find(|(p, _)| p == name).and_then(|(_, t)| *t))
+                    .collect::<Vec<f64>>(),
+            )
+        };
+        let pass_ms: Vec<(String, f64)> =
+            records[0].passes.iter().map(|(p, _)| (p.clone(), pass_mean(p))).collect();
+        rows.push(FrameTimes {
+            predictor: predictor.to_string(),
+            ms_per_frame: mean(&frame_ms),
+            infer_ms: pass_mean("nirc_infer"),
+            pass_ms,
+            frame_ms,
+        });
     }
     drop(worlds);
     drop(guard);
@@ -148,7 +198,11 @@ fn table(resolution: (u32, u32), warmup: u32, frames: u32, rows: Vec<FrameTimes>
     let diffs: Vec<f64> = blend.frame_ms.iter().zip(&ema.frame_ms).map(|(b, e)| b - e).collect();
     let s = Sample::of(&diffs);
     let d = s.mean;
-    let half = if s.n > 1 { crate::suite::student_t::quantile(0.975, (s.n - 1) as f64) * s.standard_error() } else { f64::NAN };
+    let half = if s.n > 1 {
+        crate::suite::student_t::quantile(0.975, (s.n - 1) as f64) * s.standard_error()
+    } else {
+        f64::NAN
+    };
     Table1 {
         scene: "cornell_box".into(),
         resolution,
@@ -173,7 +227,13 @@ pub fn markdown(t: &Table1) -> String {
         t.scene, t.resolution.0, t.resolution.1, t.timed_frames, t.warmup_frames
     );
     for r in &t.rows {
-        s.push_str(&format!("| {} | {:.2} | {:.2} | {:.2} |\n", r.predictor, r.ms_per_frame, 1e3 / r.ms_per_frame, r.infer_ms));
+        s.push_str(&format!(
+            "| {} | {:.2} | {:.2} | {:.2} |\n",
+            r.predictor,
+            r.ms_per_frame,
+            1e3 / r.ms_per_frame,
+            r.infer_ms
+        ));
     }
     let (lo, hi) = t.blend_overhead_frame_percent_ci95;
     s.push_str(&format!(
@@ -200,21 +260,46 @@ mod tests {
     use super::*;
 
     fn row(predictor: &str, frame_ms: &[f64], infer_ms: f64) -> FrameTimes {
-        FrameTimes { predictor: predictor.into(), ms_per_frame: mean(frame_ms), infer_ms, pass_ms: vec![("nirc_infer".into(), infer_ms)], frame_ms: frame_ms.to_vec() }
+        FrameTimes {
+            predictor: predictor.into(),
+            ms_per_frame: mean(frame_ms),
+            infer_ms,
+            pass_ms: vec![("nirc_infer".into(), infer_ms)],
+            frame_ms: frame_ms.to_vec(),
+        }
     }
 
     #[test]
     fn overhead_is_the_mean_paired_difference_with_its_t_interval() {
         // Differences 4, 6, 5 ms over EMA-only's mean frame of 100 ms: mean 5%, sd 1 ms,
         // half-width t(0.975, 2) / sqrt(3) = 4.3027 / 1.7321 = 2.4841 ms.
-        let rows = vec![row("HighLrOnly", &[90.0, 90.0, 90.0], 10.0), row("EmaOnly", &[98.0, 102.0, 100.0], 10.0), row("Blend", &[102.0, 108.0, 105.0], 13.0)];
+        let rows = vec![
+            row("HighLrOnly", &[90.0, 90.0, 90.0], 10.0),
+            row("EmaOnly", &[98.0, 102.0, 100.0], 10.0),
+            row("Blend", &[102.0, 108.0, 105.0], 13.0),
+        ];
         let t = table((8, 8), 1, 3, rows);
         assert!((t.blend_overhead_frame_percent - 5.0).abs() < 1e-12);
         let (lo, hi) = t.blend_overhead_frame_percent_ci95;
-        assert!((lo - (5.0 - 2.4841)).abs() < 1e-3 && (hi - (5.0 + 2.4841)).abs() < 1e-3, "{lo} {hi}");
+        assert!(
+            (lo - (5.0 - 2.4841)).abs() < 1e-3 && (hi - (5.0 + 2.4841)).abs() < 1e-3,
+            "{lo} {hi}"
+        );
         assert!((t.blend_infer_extra_frame_percent - 3.0).abs() < 1e-12);
         // One frame: no interval.
-        let t = table((8, 8), 1, 1, vec![row("HighLrOnly", &[90.0], 1.0), row("EmaOnly", &[100.0], 1.0), row("Blend", &[104.0], 2.0)]);
-        assert!((t.blend_overhead_frame_percent - 4.0).abs() < 1e-12 && t.blend_overhead_frame_percent_ci95.0.is_nan());
+        let t = table(
+            (8, 8),
+            1,
+            1,
+            vec![
+                row("HighLrOnly", &[90.0], 1.0),
+                row("EmaOnly", &[100.0], 1.0),
+                row("Blend", &[104.0], 2.0),
+            ],
+        );
+        assert!(
+            (t.blend_overhead_frame_percent - 4.0).abs() < 1e-12
+                && t.blend_overhead_frame_percent_ci95.0.is_nan()
+        );
     }
 }

@@ -84,11 +84,24 @@ pub fn to_csv(rows: &[FrameRecord]) -> String {
     for row in rows {
         let times: Vec<Option<f64>> = passes
             .iter()
-            .map(|p| row.passes.iter().find(|(q, _)| format!("{}_ms_{q}", clock_prefix(row)) == *p).and_then(|(_, t)| *t))
+            .map(|p| {
+                row.passes
+                    .iter()
+                    .find(|(q, _)| format!("{}_ms_{q}", clock_prefix(row)) == *p)
+                    .and_then(|(_, t)| *t)
+            })
             .collect();
         let total = row.passes_total_ms();
         let wall = clock_prefix(row) == "wall";
-        write!(out, "{},{},{:.4},{}", row.method, row.frame, row.cpu_ms, cell(if wall { None } else { total })).unwrap();
+        write!(
+            out,
+            "{},{},{:.4},{}",
+            row.method,
+            row.frame,
+            row.cpu_ms,
+            cell(if wall { None } else { total })
+        )
+        .unwrap();
         if wall_total {
             write!(out, ",{}", cell(if wall { total } else { None })).unwrap();
         }
@@ -111,7 +124,8 @@ pub fn to_csv(rows: &[FrameRecord]) -> String {
         .unwrap();
         for r in &regions {
             let found = row.regions.iter().find(|(q, _, _)| q == r);
-            write!(out, ",{},{}", cell(found.and_then(|f| f.1)), cell(found.and_then(|f| f.2))).unwrap();
+            write!(out, ",{},{}", cell(found.and_then(|f| f.1)), cell(found.and_then(|f| f.2)))
+                .unwrap();
         }
         for k in &stats {
             write!(out, ",{}", cell(row.stats.iter().find(|(q, _)| q == k).map(|s| s.1))).unwrap();
@@ -142,10 +156,18 @@ mod tests {
             stats: vec![("occupancy".into(), 0.5)],
             ..Default::default()
         };
-        let b = FrameRecord { method: "pt_4spp".into(), frame: 0, passes: vec![("shade".into(), None)], ..Default::default() };
+        let b = FrameRecord {
+            method: "pt_4spp".into(),
+            frame: 0,
+            passes: vec![("shade".into(), None)],
+            ..Default::default()
+        };
         let csv = to_csv(&[a, b]);
         let lines: Vec<&str> = csv.lines().collect();
-        assert_eq!(lines[0], "method,frame,cpu_ms,gpu_ms_total,gpu_ms_trace,gpu_ms_shade,smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr,rays,shaded,occupancy");
+        assert_eq!(
+            lines[0],
+            "method,frame,cpu_ms,gpu_ms_total,gpu_ms_trace,gpu_ms_shade,smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr,rays,shaded,occupancy"
+        );
         assert_eq!(lines[1], "pt_1spp,0,2.0000,1.500000,1.500000,,0.250000,,,,,,,120,40,0.500000");
         assert_eq!(lines[2], "pt_4spp,0,0.0000,,,,,,,,,,,,,");
     }
@@ -158,7 +180,12 @@ mod tests {
             clock: Some(render::timing::Clock::Wall),
             ..Default::default()
         };
-        let b = FrameRecord { method: "pt_1spp".into(), passes: vec![("path_trace".into(), Some(2.0))], clock: Some(render::timing::Clock::Gpu), ..Default::default() };
+        let b = FrameRecord {
+            method: "pt_1spp".into(),
+            passes: vec![("path_trace".into(), Some(2.0))],
+            clock: Some(render::timing::Clock::Gpu),
+            ..Default::default()
+        };
         let csv = to_csv(&[a, b]);
         let lines: Vec<&str> = csv.lines().collect();
         assert!(lines[0].starts_with("method,frame,cpu_ms,gpu_ms_total,wall_ms_total,wall_ms_taa_trace,wall_ms_taa_resolve,gpu_ms_path_trace,smape"), "{}", lines[0]);

@@ -2,10 +2,10 @@
 
 use std::path::Path;
 
+use crate::scenario::{Overrides, RunSpec};
 use anyhow::Result;
 use render::gpu::Gpu;
 use serde_json::{Value, json};
-use crate::scenario::{Overrides, RunSpec};
 
 /// The scenario's events in recorded frames (frames.csv's `frame`): simulation frame minus the
 /// warm-up frames; events during the warm-up or after the last recorded frame are left out.
@@ -13,14 +13,25 @@ pub fn recorded_events(scenario: &sim::Scenario) -> Vec<(u32, String)> {
     scenario
         .events_summary()
         .into_iter()
-        .filter_map(|(frame, label)| frame.checked_sub(scenario.warmup_frames).filter(|f| *f < scenario.frames).map(|f| (f, label)))
+        .filter_map(|(frame, label)| {
+            frame
+                .checked_sub(scenario.warmup_frames)
+                .filter(|f| *f < scenario.frames)
+                .map(|f| (f, label))
+        })
         .collect()
 }
 
-pub fn build(spec: &RunSpec, scenario_file: &Path, gpu: &Gpu, overrides: &Overrides) -> Result<Value> {
+pub fn build(
+    spec: &RunSpec,
+    scenario_file: &Path,
+    gpu: &Gpu,
+    overrides: &Overrides,
+) -> Result<Value> {
     let scenario = &spec.scenario;
     let frames = scenario.frames;
-    let reference_frames: Vec<u32> = (0..frames).filter(|&f| scenario.reference.wants(f, frames)).collect();
+    let reference_frames: Vec<u32> =
+        (0..frames).filter(|&f| scenario.reference.wants(f, frames)).collect();
     Ok(json!({
         "scenario": scenario.name,
         "scenario_file": scenario_file.display().to_string(),
@@ -56,7 +67,8 @@ pub fn build(spec: &RunSpec, scenario_file: &Path, gpu: &Gpu, overrides: &Overri
 /// The commit of the checkout the tool runs from, with `-dirty` when it has local changes;
 /// "unknown" outside a git checkout.
 pub fn commit(scenario_file: &Path) -> String {
-    let dir = scenario_file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir =
+        scenario_file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let git = |args: &[&str]| {
         std::process::Command::new("git")
             .args(args)
@@ -68,7 +80,8 @@ pub fn commit(scenario_file: &Path) -> String {
     };
     match git(&["rev-parse", "HEAD"]) {
         Some(hash) => {
-            let dirty = git(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
+            let dirty = git(&["status", "--porcelain", "--untracked-files=no"])
+                .is_some_and(|s| !s.is_empty());
             if dirty { format!("{hash}-dirty") } else { hash }
         }
         None => "unknown".into(),

@@ -16,7 +16,12 @@ pub struct Frame {
 }
 
 impl Frame {
-    pub fn from_radiance(width: u32, height: u32, rgba: &[[f32; 4]], motion: Option<&[[f32; 2]]>) -> Self {
+    pub fn from_radiance(
+        width: u32,
+        height: u32,
+        rgba: &[[f32; 4]],
+        motion: Option<&[[f32; 2]]>,
+    ) -> Self {
         let rgb = rgba.iter().map(|p| [p[0], p[1], p[2]]).collect();
         Self { image: Image::new(width, height, rgb), motion: motion.map(|m| m.to_vec()) }
     }
@@ -24,7 +29,12 @@ impl Frame {
 
 /// Flicker: SMAPE of `current` against the method's `previous` frame, plain and reprojected
 /// along `current`'s motion. Returns the per-pixel map (for regions).
-pub fn smape_vs_previous(rec: &mut FrameRecord, current: &Frame, previous: Option<&Frame>, eps: f32) -> Option<Vec<f32>> {
+pub fn smape_vs_previous(
+    rec: &mut FrameRecord,
+    current: &Frame,
+    previous: Option<&Frame>,
+    eps: f32,
+) -> Option<Vec<f32>> {
     let prev = previous?;
     let smape = metrics::smape(&current.image, &prev.image, eps);
     rec.smape = Some(smape.mean);
@@ -37,7 +47,11 @@ pub fn smape_vs_previous(rec: &mut FrameRecord, current: &Frame, previous: Optio
 }
 
 /// Error against the reference: HDR-FLIP, MSE, relative MSE, PSNR. Returns the FLIP map.
-pub fn error_vs_reference(rec: &mut FrameRecord, current: &Frame, reference: Option<&Frame>) -> Option<Vec<f32>> {
+pub fn error_vs_reference(
+    rec: &mut FrameRecord,
+    current: &Frame,
+    reference: Option<&Frame>,
+) -> Option<Vec<f32>> {
     let r = reference?;
     rec.mse = Some(metrics::mse(&r.image, &current.image));
     rec.rel_mse = Some(metrics::relative_mse(&r.image, &current.image));
@@ -48,12 +62,19 @@ pub fn error_vs_reference(rec: &mut FrameRecord, current: &Frame, reference: Opt
 }
 
 /// Per region of interest: the means of the FLIP and SMAPE maps inside it.
-pub fn regions(rec: &mut FrameRecord, scenario: &Scenario, width: u32, flip: Option<&[f32]>, smape: Option<&[f32]>) {
+pub fn regions(
+    rec: &mut FrameRecord,
+    scenario: &Scenario,
+    width: u32,
+    flip: Option<&[f32]>,
+    smape: Option<&[f32]>,
+) {
     rec.regions = scenario
         .regions
         .iter()
         .map(|r| {
-            let r = Region { name: r.name.clone(), x: r.x, y: r.y, width: r.width, height: r.height };
+            let r =
+                Region { name: r.name.clone(), x: r.x, y: r.y, width: r.width, height: r.height };
             let f = flip.and_then(|f| r.mean_of(f, width));
             let s = smape.and_then(|s| r.mean_of(s, width));
             (r.name.clone(), f, s)
@@ -63,7 +84,12 @@ pub fn regions(rec: &mut FrameRecord, scenario: &Scenario, width: u32, flip: Opt
 
 /// Every measurement of `current` at once: [`smape_vs_previous`], [`error_vs_reference`],
 /// [`regions`] (the frame's Measure stage runs them as separate systems).
-pub fn record(current: &Frame, previous: Option<&Frame>, reference: Option<&Frame>, scenario: &Scenario) -> FrameRecord {
+pub fn record(
+    current: &Frame,
+    previous: Option<&Frame>,
+    reference: Option<&Frame>,
+    scenario: &Scenario,
+) -> FrameRecord {
     let mut rec = FrameRecord::default();
     let smape = smape_vs_previous(&mut rec, current, previous, scenario.smape_epsilon);
     let flip = error_vs_reference(&mut rec, current, reference);

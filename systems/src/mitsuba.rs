@@ -23,12 +23,21 @@ pub struct Integrator {
 }
 
 /// Writes `dir/scene.xml` and one OBJ per instance (world space); returns the XML's path.
-pub fn write_scene(scene: &SceneDesc, (width, height): (u32, u32), integrator: &Integrator, dir: &Path) -> Result<PathBuf> {
+pub fn write_scene(
+    scene: &SceneDesc,
+    (width, height): (u32, u32),
+    integrator: &Integrator,
+    dir: &Path,
+) -> Result<PathBuf> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let rgb = |v: Vec3| format!("{} {} {}", v.x, v.y, v.z);
     let mut xml = String::from("<scene version=\"3.0.0\">\n");
     let depth = integrator.max_depth.map_or(-1, |d| d as i64);
-    writeln!(xml, "  <integrator type=\"path\"><integer name=\"max_depth\" value=\"{depth}\"/><integer name=\"rr_depth\" value=\"{}\"/></integrator>", integrator.rr_depth)?;
+    writeln!(
+        xml,
+        "  <integrator type=\"path\"><integer name=\"max_depth\" value=\"{depth}\"/><integer name=\"rr_depth\" value=\"{}\"/></integrator>",
+        integrator.rr_depth
+    )?;
     let c = &scene.camera;
     writeln!(
         xml,
@@ -42,13 +51,20 @@ pub fn write_scene(scene: &SceneDesc, (width, height): (u32, u32), integrator: &
         rgb(c.up)
     )?;
     if scene.environment != Vec3::ZERO {
-        writeln!(xml, "  <emitter type=\"constant\"><rgb name=\"radiance\" value=\"{}\"/></emitter>", rgb(scene.environment))?;
+        writeln!(
+            xml,
+            "  <emitter type=\"constant\"><rgb name=\"radiance\" value=\"{}\"/></emitter>",
+            rgb(scene.environment)
+        )?;
     }
     for light in &scene.lights {
         match light {
-            Light::Point { position, intensity } => {
-                writeln!(xml, "  <emitter type=\"point\"><point name=\"position\" value=\"{}\"/><rgb name=\"intensity\" value=\"{}\"/></emitter>", rgb(*position), rgb(*intensity))?
-            }
+            Light::Point { position, intensity } => writeln!(
+                xml,
+                "  <emitter type=\"point\"><point name=\"position\" value=\"{}\"/><rgb name=\"intensity\" value=\"{}\"/></emitter>",
+                rgb(*position),
+                rgb(*intensity)
+            )?,
             other => bail!("the Mitsuba export covers point lights only, not {other:?}"),
         }
     }
@@ -56,7 +72,10 @@ pub fn write_scene(scene: &SceneDesc, (width, height): (u32, u32), integrator: &
         let mesh = &scene.meshes[instance.mesh as usize];
         let material = &scene.materials[instance.material as usize];
         if material.base_color_texture.is_some() {
-            bail!("the Mitsuba export has no textures (material of instance {i}, mesh {:?})", mesh.name);
+            bail!(
+                "the Mitsuba export has no textures (material of instance {i}, mesh {:?})",
+                mesh.name
+            );
         }
         let file = format!("instance_{i}.obj");
         let normal_matrix = Mat3::from_mat4(instance.transform).inverse().transpose();
@@ -77,11 +96,15 @@ pub fn write_scene(scene: &SceneDesc, (width, height): (u32, u32), integrator: &
                 writeln!(obj, "f {a}//{a} {b}//{b} {c}//{c}")?;
             }
         }
-        std::fs::write(dir.join(&file), obj).with_context(|| format!("writing {}", dir.join(&file).display()))?;
+        std::fs::write(dir.join(&file), obj)
+            .with_context(|| format!("writing {}", dir.join(&file).display()))?;
         // Without specular and metal our BSDF is Lambertian, as Mitsuba's `diffuse`. Otherwise
         // `principled`: our specular factor scales F0 = 0.04, Mitsuba's `specular` gives F0 = 0.08 s.
         let bsdf = if material.specular == 0.0 && material.metallic == 0.0 {
-            format!("<bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"{}\"/></bsdf>", rgb(material.base_color))
+            format!(
+                "<bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"{}\"/></bsdf>",
+                rgb(material.base_color)
+            )
         } else {
             format!(
                 "<bsdf type=\"principled\"><rgb name=\"base_color\" value=\"{}\"/><float name=\"roughness\" value=\"{}\"/>\
@@ -98,7 +121,11 @@ pub fn write_scene(scene: &SceneDesc, (width, height): (u32, u32), integrator: &
             mesh.normals.is_empty(),
         )?;
         if material.emission != Vec3::ZERO {
-            writeln!(xml, "    <emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>", rgb(material.emission))?;
+            writeln!(
+                xml,
+                "    <emitter type=\"area\"><rgb name=\"radiance\" value=\"{}\"/></emitter>",
+                rgb(material.emission)
+            )?;
         }
         xml.push_str("  </shape>\n");
     }
@@ -127,7 +154,11 @@ impl MitsubaRun {
 /// The Python that has Mitsuba 3, if any: `$FLICKER_PYTHON` or `python3`.
 pub fn python() -> Option<String> {
     let python = std::env::var("FLICKER_PYTHON").unwrap_or_else(|_| "python3".into());
-    let ok = Command::new(&python).args(["-c", "import mitsuba"]).output().map(|o| o.status.success()).unwrap_or(false);
+    let ok = Command::new(&python)
+        .args(["-c", "import mitsuba"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false);
     ok.then_some(python)
 }
 

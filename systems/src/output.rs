@@ -24,7 +24,8 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()
         write(&mut out)?;
         out.flush()?;
         out.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        fs::rename(&tmp, path).with_context(|| format!("renaming {} to {}", tmp.display(), path.display()))
+        fs::rename(&tmp, path)
+            .with_context(|| format!("renaming {} to {}", tmp.display(), path.display()))
     })();
     if result.is_err() {
         let _ = fs::remove_file(&tmp);
@@ -50,11 +51,20 @@ pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
 
 /// Linear HDR radiance as a 32-bit float RGBA OpenEXR file.
 pub fn write_exr(path: &Path, width: u32, height: u32, rgba: &[[f32; 4]]) -> Result<()> {
-    anyhow::ensure!(rgba.len() == (width * height) as usize, "image of {width}x{height} has {} pixels", rgba.len());
+    anyhow::ensure!(
+        rgba.len() == (width * height) as usize,
+        "image of {width}x{height} has {} pixels",
+        rgba.len()
+    );
     write_atomic(path, |w| {
         let mut cursor = std::io::Cursor::new(Vec::new());
         image::codecs::openexr::OpenExrEncoder::new(&mut cursor)
-            .write_image(bytemuck::cast_slice(rgba), width, height, image::ExtendedColorType::Rgba32F)
+            .write_image(
+                bytemuck::cast_slice(rgba),
+                width,
+                height,
+                image::ExtendedColorType::Rgba32F,
+            )
             .with_context(|| format!("encoding {}", path.display()))?;
         w.write_all(cursor.get_ref())?;
         Ok(())
@@ -62,7 +72,13 @@ pub fn write_exr(path: &Path, width: u32, height: u32, rgba: &[[f32; 4]]) -> Res
 }
 
 /// Tone-mapped 8-bit sRGB PNG of linear radiance.
-pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[[f32; 4]], exposure: f32) -> Result<()> {
+pub fn write_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgba: &[[f32; 4]],
+    exposure: f32,
+) -> Result<()> {
     let ldr = tonemap::to_srgb8(rgba, exposure);
     write_atomic(path, |w| {
         image::codecs::png::PngEncoder::new(w)
@@ -88,7 +104,8 @@ pub fn write_png_linear(path: &Path, width: u32, height: u32, rgba: &[[f32; 4]])
 
 /// Reads an RGBA32F EXR written by [`write_exr`].
 pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
-    let img = image::open(path).with_context(|| format!("reading {}", path.display()))?.into_rgba32f();
+    let img =
+        image::open(path).with_context(|| format!("reading {}", path.display()))?.into_rgba32f();
     let (w, h) = img.dimensions();
     let pixels = img.pixels().map(|p| p.0).collect();
     Ok((w, h, pixels))

@@ -10,7 +10,10 @@ use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use sim::Simulation;
 
-use crate::frame::{self, FrameClock, GpuDevice, MethodFrame, MethodInfo, Progress, References, Run, RunOutput, Tracer};
+use crate::frame::{
+    self, FrameClock, GpuDevice, MethodFrame, MethodInfo, Progress, References, Run, RunOutput,
+    Tracer,
+};
 use crate::frame_record::FrameRecord;
 use crate::methods::MethodSpec;
 use crate::output;
@@ -63,7 +66,9 @@ fn check_media_support(spec: &RunSpec, origin: &str) -> Result<()> {
     }
     let references = (0..scenario.frames).any(|f| scenario.reference.wants(f, scenario.frames));
     let volume_path = spec.methods.iter().any(|m| matches!(m.spec, MethodSpec::VolumePath(_)));
-    if let (Some(extra), true) = (scenario.media.get(media::gpu::MAX_MEDIA), references || volume_path) {
+    if let (Some(extra), true) =
+        (scenario.media.get(media::gpu::MAX_MEDIA), references || volume_path)
+    {
         anyhow::bail!(
             "{origin}: medium '{}': the volumetric path tracer (references, VolumePath) renders at most {} media; expected fewer, or more only with VolumeTransmittance methods and no references",
             extra.name,
@@ -76,22 +81,40 @@ fn check_media_support(spec: &RunSpec, origin: &str) -> Result<()> {
 impl FrameWorld {
     /// Everything a run needs before its first frame; input errors (names, sizes over the
     /// adapter's limits) surface here, before anything is written.
-    pub fn build(spec: &RunSpec, gpu: Gpu, cache_dir: PathBuf, folder: RunFolder, progress: ProgressBar) -> Result<FrameWorld> {
+    pub fn build(
+        spec: &RunSpec,
+        gpu: Gpu,
+        cache_dir: PathBuf,
+        folder: RunFolder,
+        progress: ProgressBar,
+    ) -> Result<FrameWorld> {
         let scenario = &spec.scenario;
         let origin = scenario.origin.display().to_string();
         check_media_support(spec, &origin)?;
         let sim = Simulation::new(scenario)?;
         let (width, height) = scenario.resolution;
-        let settings = PathTracerSettings { width, height, max_depth: scenario.max_depth, rr_start_depth: 3 };
-        let tracer = PathTracer::new(&gpu, sim.scene(), settings).with_context(|| format!("{origin}: preparing the path tracer"))?;
+        let settings =
+            PathTracerSettings { width, height, max_depth: scenario.max_depth, rr_start_depth: 3 };
+        let tracer = PathTracer::new(&gpu, sim.scene(), settings)
+            .with_context(|| format!("{origin}: preparing the path tracer"))?;
 
         let mut world = sim.into_world();
         world.insert_resource(GpuDevice(gpu));
         world.insert_resource(Tracer(tracer));
-        world.insert_resource(Run { scenario: scenario.clone(), width, height, cache_dir: cache_dir.clone() });
+        world.insert_resource(Run {
+            scenario: scenario.clone(),
+            width,
+            height,
+            cache_dir: cache_dir.clone(),
+        });
         world.insert_resource(FrameClock::default());
         world.insert_resource(RunOutput { folder, records: Vec::new() });
-        world.insert_resource(References { cache: ReferenceCache::new(cache_dir), current: None, rendered: 0, cached: 0 });
+        world.insert_resource(References {
+            cache: ReferenceCache::new(cache_dir),
+            current: None,
+            rendered: 0,
+            cached: 0,
+        });
         world.insert_resource(Progress(progress));
         // The volumetric path tracer renders every declared medium (media/README.md). More than
         // it binds pass check_media_support only without references and VolumePath, which are
@@ -105,12 +128,15 @@ impl FrameWorld {
 
         for (index, method) in spec.methods.iter().enumerate() {
             let label = method.label();
-            let entity = world.spawn((MethodInfo { index, label: label.clone() }, MethodFrame::default())).id();
-            method
-                .spec
-                .plugin()
-                .spawn(&mut world, entity, method)
-                .with_context(|| format!("{origin}:{}:{}: preparing method {label}", method.entry.line, method.entry.column))?;
+            let entity = world
+                .spawn((MethodInfo { index, label: label.clone() }, MethodFrame::default()))
+                .id();
+            method.spec.plugin().spawn(&mut world, entity, method).with_context(|| {
+                format!(
+                    "{origin}:{}:{}: preparing method {label}",
+                    method.entry.line, method.entry.column
+                )
+            })?;
         }
         let schedule = crate::methods::schedule_for(&spec.methods);
         Ok(FrameWorld { world, schedule })
@@ -125,7 +151,11 @@ impl FrameWorld {
             clock.recorded = recorded;
             clock.frame = step.saturating_sub(warmup);
         }
-        self.world.resource::<Progress>().0.set_message(if recorded { format!("frame {:04}", step - warmup) } else { "warm-up".into() });
+        self.world.resource::<Progress>().0.set_message(if recorded {
+            format!("frame {:04}", step - warmup)
+        } else {
+            "warm-up".into()
+        });
         self.schedule.run(&mut self.world);
         match frame::take_failure() {
             Some(e) => Err(anyhow!("{e}")),
@@ -162,8 +192,14 @@ pub fn run_spec(spec: &RunSpec, opts: &RunOptions) -> Result<RunSummary> {
     let records = std::mem::take(&mut world.resource_mut::<RunOutput>().records);
     let references = world.resource::<References>();
     let (rendered, cached) = (references.rendered, references.cached);
-    report::rebuild(&folder.root).with_context(|| format!("writing the report of {}", folder.root.display()))?;
-    Ok(RunSummary { folder: folder.root, records, references_rendered: rendered, references_cached: cached })
+    report::rebuild(&folder.root)
+        .with_context(|| format!("writing the report of {}", folder.root.display()))?;
+    Ok(RunSummary {
+        folder: folder.root,
+        records,
+        references_rendered: rendered,
+        references_cached: cached,
+    })
 }
 
 fn progress_bar(enabled: bool, len: u64) -> ProgressBar {
@@ -172,8 +208,10 @@ fn progress_bar(enabled: bool, len: u64) -> ProgressBar {
     }
     let bar = ProgressBar::new(len);
     bar.set_style(
-        ProgressStyle::with_template("{bar:30} {pos}/{len} frames  {elapsed_precise} elapsed, ETA {eta_precise}  {msg}")
-            .expect("valid progress template"),
+        ProgressStyle::with_template(
+            "{bar:30} {pos}/{len} frames  {elapsed_precise} elapsed, ETA {eta_precise}  {msg}",
+        )
+        .expect("valid progress template"),
     );
     bar
 }

@@ -51,7 +51,10 @@ impl ReferenceCache {
     pub fn key(scene: &SceneDesc, key: &ReferenceKey) -> String {
         let mut h = Sha256::new();
         h.update(b"flicker-reference-v1");
-        h.update(format!("{}x{} spp{} seed{} depth{} rr{}", key.width, key.height, key.spp, key.seed, key.max_depth, key.rr_start_depth));
+        h.update(format!(
+            "{}x{} spp{} seed{} depth{} rr{}",
+            key.width, key.height, key.spp, key.seed, key.max_depth, key.rr_start_depth
+        ));
         h.update(key.adapter.as_bytes());
         h.update(key.shader_source.as_bytes());
         hash_scene(&mut h, scene);
@@ -90,7 +93,10 @@ fn hash_scene(h: &mut Sha256, scene: &SceneDesc) {
         h.update(format!("{} {}", inst.mesh, inst.material));
         h.update(bytemuck::cast_slice::<_, u8>(&inst.transform.to_cols_array()));
     }
-    h.update(format!("{:?}|{:?}|{:?}|{:?}", scene.materials, scene.lights, scene.environment, scene.camera));
+    h.update(format!(
+        "{:?}|{:?}|{:?}|{:?}",
+        scene.materials, scene.lights, scene.environment, scene.camera
+    ));
 }
 
 #[cfg(test)]
@@ -99,13 +105,29 @@ mod tests {
     use render::scene::{Instance, Mesh};
 
     fn key(scene: &SceneDesc, spp: u32) -> String {
-        ReferenceCache::key(scene, &ReferenceKey { width: 8, height: 4, spp, seed: 1, max_depth: 4, rr_start_depth: 3, adapter: "a", shader_source: "s" })
+        ReferenceCache::key(
+            scene,
+            &ReferenceKey {
+                width: 8,
+                height: 4,
+                spp,
+                seed: 1,
+                max_depth: 4,
+                rr_start_depth: 3,
+                adapter: "a",
+                shader_source: "s",
+            },
+        )
     }
 
     #[test]
     fn key_changes_with_what_affects_the_image() {
         let mut scene = SceneDesc::default();
-        scene.meshes.push(Mesh { positions: vec![glam::Vec3::ZERO; 3], indices: vec![[0, 1, 2]], ..Default::default() });
+        scene.meshes.push(Mesh {
+            positions: vec![glam::Vec3::ZERO; 3],
+            indices: vec![[0, 1, 2]],
+            ..Default::default()
+        });
         scene.instances.push(Instance { mesh: 0, material: 0, transform: glam::Mat4::IDENTITY });
         let base = key(&scene, 16);
         assert_eq!(base, key(&scene.clone(), 16));

@@ -47,7 +47,8 @@ impl RunSpec {
             for m in &mut methods {
                 m.spec.set_spp(spp);
             }
-            check_labels(&scenario, &methods).map_err(|e| anyhow::anyhow!("{e} (after --spp {spp})"))?;
+            check_labels(&scenario, &methods)
+                .map_err(|e| anyhow::anyhow!("{e} (after --spp {spp})"))?;
         }
         if let Some(s) = o.seed {
             scenario.seed = s;
@@ -59,10 +60,17 @@ impl RunSpec {
             bail!("{}: frames must be at least 1", path.display());
         }
         if !(scenario.smape_epsilon.is_finite() && scenario.smape_epsilon >= 0.0) {
-            bail!("{}: smape_epsilon must be a finite number >= 0, got {}", path.display(), scenario.smape_epsilon);
+            bail!(
+                "{}: smape_epsilon must be a finite number >= 0, got {}",
+                path.display(),
+                scenario.smape_epsilon
+            );
         }
         if methods.is_empty() {
-            bail!("{}: no methods to run; add e.g. `methods: [PathTracing(spp: 1)]`", path.display());
+            bail!(
+                "{}: no methods to run; add e.g. `methods: [PathTracing(spp: 1)]`",
+                path.display()
+            );
         }
         Ok(RunSpec { scenario, methods })
     }

@@ -9,8 +9,11 @@ use systems::methods::{Method, MethodSpec};
 use systems::scenario::{Overrides, RunSpec};
 
 fn spec(methods: &str) -> RunSpec {
-    let text = format!("Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 2,\n  methods: [{methods}])");
-    let scenario = sim::Scenario::from_ron(&text, Path::new("inline.ron")).unwrap_or_else(|e| panic!("{e}"));
+    let text = format!(
+        "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 2,\n  methods: [{methods}])"
+    );
+    let scenario =
+        sim::Scenario::from_ron(&text, Path::new("inline.ron")).unwrap_or_else(|e| panic!("{e}"));
     RunSpec::from_scenario(scenario, &Overrides::default()).unwrap_or_else(|e| panic!("{e:#}"))
 }
 
@@ -25,12 +28,17 @@ fn in_stage(listing: &[(Stage, String)], stage: Stage) -> Vec<String> {
 }
 
 fn position(listing: &[(Stage, String)], name: &str) -> usize {
-    listing.iter().position(|(_, n)| n == name).unwrap_or_else(|| panic!("{name} is not in the frame: {listing:?}"))
+    listing
+        .iter()
+        .position(|(_, n)| n == name)
+        .unwrap_or_else(|| panic!("{name} is not in the frame: {listing:?}"))
 }
 
 #[test]
 fn every_method_system_runs_in_its_stage_in_order() {
-    let s = spec("PathTracing(spp: 1), Nirc(spp: 1, predictor: Blend), SampleCache(), Taa(), HashCache(taa: true)");
+    let s = spec(
+        "PathTracing(spp: 1), Nirc(spp: 1, predictor: Blend), SampleCache(), Taa(), HashCache(taa: true)",
+    );
     let l = listing(&s.methods);
     // Stages never interleave: listing() refuses an out-of-order system, so this is the order.
     let stages: Vec<Stage> = l.iter().map(|(s, _)| *s).collect();
@@ -41,10 +49,24 @@ fn every_method_system_runs_in_its_stage_in_order() {
 
     let simulate = in_stage(&l, Stage::Simulate);
     assert_eq!(simulate.first().map(String::as_str), Some("simulation::advance_clock"));
-    for name in ["rotate::rotate", "flash::flash", "boids::flock", "events::apply_events", "transform::propagate_transforms"] {
+    for name in [
+        "rotate::rotate",
+        "flash::flash",
+        "boids::flock",
+        "events::apply_events",
+        "transform::propagate_transforms",
+    ] {
         assert!(simulate.contains(&name.to_string()), "{name} not in Simulate: {simulate:?}");
     }
-    assert_eq!(in_stage(&l, Stage::Extract), ["simulation::extract_scene", "extract::frame_number", "extract::upload_scene", "media::upload_medium"]);
+    assert_eq!(
+        in_stage(&l, Stage::Extract),
+        [
+            "simulation::extract_scene",
+            "extract::frame_number",
+            "extract::upload_scene",
+            "media::upload_medium"
+        ]
+    );
 
     let render = in_stage(&l, Stage::Render);
     for name in [
@@ -63,9 +85,34 @@ fn every_method_system_runs_in_its_stage_in_order() {
     ] {
         assert!(render.contains(&name.to_string()), "{name} not in Render: {render:?}");
     }
-    assert_eq!(in_stage(&l, Stage::Learn), ["nirc::reliability", "nirc::train", "nirc::ema", "nirc::reliability_update", "nirc::frame_output"]);
-    assert_eq!(in_stage(&l, Stage::Measure), ["measure::prepare", "measure::smape_vs_previous", "measure::flip_vs_reference", "measure::regions"]);
-    assert_eq!(in_stage(&l, Stage::Record), ["record::write_reference", "record::write_method_images", "record::write_frames_csv", "record::end_frame"]);
+    assert_eq!(
+        in_stage(&l, Stage::Learn),
+        [
+            "nirc::reliability",
+            "nirc::train",
+            "nirc::ema",
+            "nirc::reliability_update",
+            "nirc::frame_output"
+        ]
+    );
+    assert_eq!(
+        in_stage(&l, Stage::Measure),
+        [
+            "measure::prepare",
+            "measure::smape_vs_previous",
+            "measure::flip_vs_reference",
+            "measure::regions"
+        ]
+    );
+    assert_eq!(
+        in_stage(&l, Stage::Record),
+        [
+            "record::write_reference",
+            "record::write_method_images",
+            "record::write_frames_csv",
+            "record::end_frame"
+        ]
+    );
 
     // Within a method, its passes run in the paper's order.
     for pair in [
@@ -79,14 +126,24 @@ fn every_method_system_runs_in_its_stage_in_order() {
         ("nirc::train", "nirc::ema"),
         ("nirc::ema", "nirc::reliability_update"),
     ] {
-        assert!(position(&l, pair.0) < position(&l, pair.1), "{} should run before {}", pair.0, pair.1);
+        assert!(
+            position(&l, pair.0) < position(&l, pair.1),
+            "{} should run before {}",
+            pair.0,
+            pair.1
+        );
     }
 }
 
 #[test]
 fn a_scene_pays_only_for_its_methods() {
     let l = listing(&spec("PathTracing(spp: 1)").methods);
-    assert!(l.iter().all(|(_, n)| !n.starts_with("nirc::") && !n.starts_with("taa::") && !n.starts_with("sample_cache::")), "{l:?}");
+    assert!(
+        l.iter().all(|(_, n)| !n.starts_with("nirc::")
+            && !n.starts_with("taa::")
+            && !n.starts_with("sample_cache::")),
+        "{l:?}"
+    );
     assert_eq!(in_stage(&l, Stage::Learn), Vec::<String>::new());
     assert!(l.iter().any(|(_, n)| n == "path_tracing::render"));
 }
@@ -112,7 +169,8 @@ fn misplaced_systems_are_detected() {
 
 #[test]
 fn describe_groups_systems_by_stage() {
-    let text = systems::methods::describe_schedule(&spec("Taa(), PathTracing(spp: 2)").methods).unwrap();
+    let text =
+        systems::methods::describe_schedule(&spec("Taa(), PathTracing(spp: 2)").methods).unwrap();
     let at = |s: &str| text.find(s).unwrap_or_else(|| panic!("{s} missing from:\n{text}"));
     assert!(at("  taa (Taa)") < at("  pt_2spp (PathTracing)"));
     let stages: Vec<usize> = Stage::ALL.iter().map(|s| at(&format!("\n{}\n", s.name()))).collect();
@@ -122,13 +180,21 @@ fn describe_groups_systems_by_stage() {
 
 #[test]
 fn methods_take_their_settings_defaults_and_names() {
-    let s = spec("Taa(), Taa(name: \"taa_fast\", alpha: 0.2, clamp: MinMax), HashCache(), HashCache(lookup: SecondaryHit, taa: true, capacity: 1024), SampleCache(retrace: Multi)");
+    let s = spec(
+        "Taa(), Taa(name: \"taa_fast\", alpha: 0.2, clamp: MinMax), HashCache(), HashCache(lookup: SecondaryHit, taa: true, capacity: 1024), SampleCache(retrace: Multi)",
+    );
     let d = render::taa::TaaSettings::default();
     assert_eq!(s.methods[0].spec, MethodSpec::Taa(d));
     let MethodSpec::Taa(t) = &s.methods[1].spec else { panic!("{:?}", s.methods[1]) };
-    assert_eq!((t.alpha, t.clamp, t.jitter_length), (0.2, render::taa::TaaClamp::MinMax, d.jitter_length));
+    assert_eq!(
+        (t.alpha, t.clamp, t.jitter_length),
+        (0.2, render::taa::TaaClamp::MinMax, d.jitter_length)
+    );
     let labels: Vec<String> = s.methods.iter().map(|m| m.label()).collect();
-    assert_eq!(labels, ["taa", "taa_fast", "hash_cache", "hash_cache_secondary_hit_taa", "ssc_multi"]);
+    assert_eq!(
+        labels,
+        ["taa", "taa_fast", "hash_cache", "hash_cache_secondary_hit_taa", "ssc_multi"]
+    );
     assert!(s.methods[..4].iter().all(|m| m.spec.spp() == 1.0));
     let MethodSpec::HashCache(h) = &s.methods[3].spec else { panic!() };
     assert_eq!((h.capacity, h.probe_limit, h.taa), (1024, 8, true));
@@ -143,10 +209,15 @@ fn duplicate_labels_are_refused_naming_both_entries() {
     assert!(e.contains("'nirc_blend_1spp'") && e.contains("dup.ron:3:5"), "{e}");
 
     // Named apart, they run side by side.
-    let named = text.replace("predictor: Blend, cache", "name: \"blend_fast\", predictor: Blend, cache");
+    let named =
+        text.replace("predictor: Blend, cache", "name: \"blend_fast\", predictor: Blend, cache");
     let scenario = sim::Scenario::from_ron(&named, Path::new("dup.ron")).unwrap();
-    let s = RunSpec::from_scenario(scenario, &Overrides::default()).unwrap_or_else(|e| panic!("{e:#}"));
-    assert_eq!(s.methods.iter().map(|m| m.label()).collect::<Vec<_>>(), ["nirc_blend_1spp", "blend_fast"]);
+    let s =
+        RunSpec::from_scenario(scenario, &Overrides::default()).unwrap_or_else(|e| panic!("{e:#}"));
+    assert_eq!(
+        s.methods.iter().map(|m| m.label()).collect::<Vec<_>>(),
+        ["nirc_blend_1spp", "blend_fast"]
+    );
 
     // --spp can make two labels equal too.
     let scenario = sim::Scenario::from_ron(
@@ -154,7 +225,9 @@ fn duplicate_labels_are_refused_naming_both_entries() {
         Path::new("spp.ron"),
     )
     .unwrap();
-    let e = RunSpec::from_scenario(scenario, &Overrides { spp: Some(2), ..Default::default() }).unwrap_err().to_string();
+    let e = RunSpec::from_scenario(scenario, &Overrides { spp: Some(2), ..Default::default() })
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("'pt_2spp'") && e.contains("--spp 2"), "{e}");
 }
 
@@ -179,12 +252,30 @@ fn paper_scale_scenarios_parse_with_the_controls_and_the_nrc_batch() {
     let mut count = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
-        let spec = RunSpec::load(&path, &Default::default()).unwrap_or_else(|e| panic!("{}: {e:#}", path.display()));
+        let spec = RunSpec::load(&path, &Default::default())
+            .unwrap_or_else(|e| panic!("{}: {e:#}", path.display()));
         let labels: Vec<String> = spec.methods.iter().map(|m| m.label()).collect();
-        assert_eq!(labels, ["nirc_ema_1spp", "nirc_highlr_1spp", "nirc_blend_1spp", "nirc_switch_1spp", "nirc_fixed50_1spp", "pt_1spp"], "{}", path.display());
+        assert_eq!(
+            labels,
+            [
+                "nirc_ema_1spp",
+                "nirc_highlr_1spp",
+                "nirc_blend_1spp",
+                "nirc_switch_1spp",
+                "nirc_fixed50_1spp",
+                "pt_1spp"
+            ],
+            "{}",
+            path.display()
+        );
         for m in &spec.methods {
             if let MethodSpec::Nirc(n) = &m.spec {
-                assert_eq!((n.pretrain_frames, n.paths.train_records), (5000, 16384), "{}", path.display());
+                assert_eq!(
+                    (n.pretrain_frames, n.paths.train_records),
+                    (5000, 16384),
+                    "{}",
+                    path.display()
+                );
             }
         }
         count += 1;

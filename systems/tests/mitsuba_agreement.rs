@@ -12,13 +12,19 @@ fn lambertian_cornell_box_matches_mitsuba() {
     let (size, spp) = (16u32, 2048u32);
     let scene = systems::bench::lambertian_cornell_box((size, size)).unwrap();
     let gpu = Gpu::new().expect("a wgpu adapter (lavapipe on CI)");
-    let mut tracer = PathTracer::new(&gpu, &scene, PathTracerSettings { width: size, height: size, max_depth: 1000, rr_start_depth: 3 }).unwrap();
+    let mut tracer = PathTracer::new(
+        &gpu,
+        &scene,
+        PathTracerSettings { width: size, height: size, max_depth: 1000, rr_start_depth: 3 },
+    )
+    .unwrap();
     tracer.update(&gpu, &scene);
     let ours = tracer.render_reference(&gpu, spp, 7, 0, &mut |_, _| {}).unwrap();
 
     let python = python().expect("python3 with the mitsuba package (scripts/setup.sh installs it)");
     let dir = std::env::temp_dir().join(format!("flicker-mitsuba-{}", std::process::id()));
-    let xml = write_scene(&scene, (size, size), &Integrator { max_depth: None, rr_depth: 3 }, &dir).unwrap();
+    let xml = write_scene(&scene, (size, size), &Integrator { max_depth: None, rr_depth: 3 }, &dir)
+        .unwrap();
     let exr = dir.join("mitsuba.exr");
     let run = render(&python, &xml, spp, &exr).unwrap();
     let (w, h, theirs) = systems::output::read_exr(&exr).unwrap();
@@ -26,10 +32,16 @@ fn lambertian_cornell_box_matches_mitsuba() {
     std::fs::remove_dir_all(&dir).unwrap();
 
     let lum = |p: &[f32; 4]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
-    let mean = |img: &[[f32; 4]], c: usize| img.iter().map(|p| p[c] as f64).sum::<f64>() / img.len() as f64;
+    let mean = |img: &[[f32; 4]], c: usize| {
+        img.iter().map(|p| p[c] as f64).sum::<f64>() / img.len() as f64
+    };
     for c in 0..3 {
         let (a, b) = (mean(&ours, c), mean(&theirs, c));
-        eprintln!("channel {c}: ours {a:.5}, Mitsuba {b:.5} (Mitsuba's own mean {:.5}), ratio {:.4}", run.mean_rgb[c], a / b);
+        eprintln!(
+            "channel {c}: ours {a:.5}, Mitsuba {b:.5} (Mitsuba's own mean {:.5}), ratio {:.4}",
+            run.mean_rgb[c],
+            a / b
+        );
         assert!(b > 0.01, "Mitsuba's image is black in channel {c}: the export lost the light");
         // 524k paths each: the means' noise is a few tenths of a percent.
         assert!((a / b - 1.0).abs() < 0.015, "channel {c}: mean {a} against Mitsuba's {b}");

@@ -29,7 +29,16 @@ const CACHE: &str = "cache: (
 
 const SEEDS: [u64; 3] = [3, 4, 5];
 
-fn scenario(dir: &Path, name: &str, seed: u64, frames: u32, warmup: u32, pretrain: u32, events: &str, reference: bool) -> PathBuf {
+fn scenario(
+    dir: &Path,
+    name: &str,
+    seed: u64,
+    frames: u32,
+    warmup: u32,
+    pretrain: u32,
+    events: &str,
+    reference: bool,
+) -> PathBuf {
     // The Cornell box: its only light is an emissive quad. Its direct light is NEE's at the
     // termination vertex; the cache holds the indirect light (colour bleeding), which a light
     // change reaches through the targets (see cache_paths.wgsl).
@@ -37,7 +46,8 @@ fn scenario(dir: &Path, name: &str, seed: u64, frames: u32, warmup: u32, pretrai
         .iter()
         .map(|p| format!("Nirc(spp: 1, predictor: {p}, pretrain_frames: {pretrain}, {CACHE})"))
         .collect();
-    let reference = if reference { "(spp: 64, frames: Every(1))" } else { "(spp: 64, frames: None)" };
+    let reference =
+        if reference { "(spp: 64, frames: Every(1))" } else { "(spp: 64, frames: None)" };
     let text = format!(
         "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: {frames}, warmup_frames: {warmup}, seed: {seed}, max_depth: 3,
     methods: [{}], reference: {reference}, events: [{events}])",
@@ -48,8 +58,17 @@ fn scenario(dir: &Path, name: &str, seed: u64, frames: u32, warmup: u32, pretrai
     path
 }
 
-fn play(name: &str, seed: u64, frames: u32, warmup: u32, pretrain: u32, events: &str, reference: bool) -> Vec<FrameRecord> {
-    let dir = std::env::temp_dir().join(format!("nirc-relations-{}-{name}-{seed}", std::process::id()));
+fn play(
+    name: &str,
+    seed: u64,
+    frames: u32,
+    warmup: u32,
+    pretrain: u32,
+    events: &str,
+    reference: bool,
+) -> Vec<FrameRecord> {
+    let dir =
+        std::env::temp_dir().join(format!("nirc-relations-{}-{name}-{seed}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = scenario(&dir, name, seed, frames, warmup, pretrain, events, reference);
     let opts = RunOptions {
@@ -63,7 +82,11 @@ fn play(name: &str, seed: u64, frames: u32, warmup: u32, pretrain: u32, events: 
     summary.records
 }
 
-fn series(records: &[FrameRecord], method: &str, f: impl Fn(&FrameRecord) -> Option<f64>) -> Vec<f64> {
+fn series(
+    records: &[FrameRecord],
+    method: &str,
+    f: impl Fn(&FrameRecord) -> Option<f64>,
+) -> Vec<f64> {
     let mut rows: Vec<&FrameRecord> = records.iter().filter(|r| r.method == method).collect();
     rows.sort_by_key(|r| r.frame);
     // NaN where a frame has no value (SMAPE of the first frame).

@@ -27,12 +27,20 @@ fn sample_cache_on_a_moving_hairball_camera() {
     scenario.resolution = (w, h);
     let gpu = Gpu::new().expect("a wgpu adapter");
     let mut sim = Simulation::new(&scenario).expect("simulation");
-    let settings = PathTracerSettings { width: w, height: h, max_depth: scenario.max_depth, rr_start_depth: 3 };
+    let settings = PathTracerSettings {
+        width: w,
+        height: h,
+        max_depth: scenario.max_depth,
+        rr_start_depth: 3,
+    };
     let mut tracer = PathTracer::new(&gpu, sim.scene(), settings).expect("path tracer");
     let variants = [Retrace::Single, Retrace::Multi, Retrace::Adaptive];
     let mut caches: Vec<SampleCache> = variants
         .iter()
-        .map(|&retrace| SampleCache::new(&gpu, &tracer, SampleCacheSettings { retrace, ..Default::default() }).expect("sample cache"))
+        .map(|&retrace| {
+            SampleCache::new(&gpu, &tracer, SampleCacheSettings { retrace, ..Default::default() })
+                .expect("sample cache")
+        })
         .collect();
     let mut taa = Taa::new(&gpu, &tracer, TaaSettings::default()).expect("taa");
     // Per method (pt_1spp, single, multi, adaptive, taa): previous frame and SMAPE sum; per cache
@@ -85,10 +93,24 @@ fn sample_cache_on_a_moving_hairball_camera() {
     for (i, name) in ["single", "multi", "adaptive"].iter().enumerate() {
         assert!(smape[i + 1] < smape[4], "{name} cache flickers more than 1 spp + TAA: {smape:?}");
     }
-    assert!(rays[2] as f64 <= 0.6 * rays[1] as f64, "adaptive traces {} rays vs multi {}", rays[2], rays[1]);
-    assert!(stale[2] < stale[0], "adaptive leaves {} stale visible samples vs single {}", stale[2], stale[0]);
+    assert!(
+        rays[2] as f64 <= 0.6 * rays[1] as f64,
+        "adaptive traces {} rays vs multi {}",
+        rays[2],
+        rays[1]
+    );
+    assert!(
+        stale[2] < stale[0],
+        "adaptive leaves {} stale visible samples vs single {}",
+        stale[2],
+        stale[0]
+    );
     // Multi retraces every sample every frame, so none can be stale after its trace pass.
-    assert_eq!(stale[1], 0, "multi retraces everything, yet leaves {} stale visible samples", stale[1]);
+    assert_eq!(
+        stale[1], 0,
+        "multi retraces everything, yet leaves {} stale visible samples",
+        stale[1]
+    );
 }
 
 #[test]
@@ -98,31 +120,64 @@ fn hairball_camera_scenario_plays_end_to_end() {
     let out = std::env::temp_dir().join(format!("flicker-ssc-{}", std::process::id()));
     let summary = run(&RunOptions {
         scenario,
-        overrides: Overrides { frames: Some(3), resolution: Some((32, 18)), out: Some(out.clone()), ..Default::default() },
+        overrides: Overrides {
+            frames: Some(3),
+            resolution: Some((32, 18)),
+            out: Some(out.clone()),
+            ..Default::default()
+        },
         cache_dir: Some(out.join("cache")),
         progress: false,
     })
     .expect("run");
-    let labels: std::collections::BTreeSet<String> = summary.records.iter().map(|r| r.method.clone()).collect();
-    for label in ["pt_1spp", "pt_4spp", "ssc_single", "ssc_multi", "ssc_adaptive", "ssc_adaptive_taa", "hash_cache_taa"] {
+    let labels: std::collections::BTreeSet<String> =
+        summary.records.iter().map(|r| r.method.clone()).collect();
+    for label in [
+        "pt_1spp",
+        "pt_4spp",
+        "ssc_single",
+        "ssc_multi",
+        "ssc_adaptive",
+        "ssc_adaptive_taa",
+        "hash_cache_taa",
+    ] {
         assert!(labels.contains(label), "{label} missing from {labels:?}");
     }
     // Each method's effective temporal window is in the manifest (issue 15): TAA's exponential
     // blend (α 0.1: 19 frames), the cache's n_target · 19 shades at one per pixel and frame, and
     // TAA over the cache longer than either.
-    let manifest: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).expect("manifest.json")).expect("manifest JSON");
+    let manifest: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(out.join("manifest.json")).expect("manifest.json"),
+    )
+    .expect("manifest JSON");
     let window = |label: &str| {
         let methods = manifest["settings"]["methods"].as_array().expect("settings.methods");
-        methods.iter().find(|m| m["label"] == label).and_then(|m| m["temporal_window"].as_f64()).unwrap_or_else(|| panic!("{label}: no temporal window"))
+        methods
+            .iter()
+            .find(|m| m["label"] == label)
+            .and_then(|m| m["temporal_window"].as_f64())
+            .unwrap_or_else(|| panic!("{label}: no temporal window"))
     };
     // (α is an f32: 19 up to its rounding.)
     for (label, expected) in [("pt_1spp", 1.0), ("taa", 19.0), ("ssc_adaptive", 76.0)] {
-        assert!((window(label) - expected).abs() < 1e-5 * expected, "{label}: {} frames, expected {expected}", window(label));
+        assert!(
+            (window(label) - expected).abs() < 1e-5 * expected,
+            "{label}: {} frames, expected {expected}",
+            window(label)
+        );
     }
-    assert!(window("ssc_adaptive_taa") > 76.0 && window("hash_cache_taa") > window("hash_cache_secondary_hit"));
+    assert!(
+        window("ssc_adaptive_taa") > 76.0
+            && window("hash_cache_taa") > window("hash_cache_secondary_hit")
+    );
     // TAA over the cache: the resolve's pass follows the cache's four.
-    let taa_rows: Vec<_> = summary.records.iter().filter(|r| r.method == "ssc_adaptive_taa").collect();
-    assert!(taa_rows.iter().all(|r| r.passes.iter().any(|(p, _)| p == "taa_resolve")), "{:?}", taa_rows.first().map(|r| &r.passes));
+    let taa_rows: Vec<_> =
+        summary.records.iter().filter(|r| r.method == "ssc_adaptive_taa").collect();
+    assert!(
+        taa_rows.iter().all(|r| r.passes.iter().any(|(p, _)| p == "taa_resolve")),
+        "{:?}",
+        taa_rows.first().map(|r| &r.passes)
+    );
     let csv = std::fs::read_to_string(out.join("frames.csv")).expect("frames.csv");
     for column in ["shaded", "rays", "primary_rays", "occupancy", "gpu_ms_reserve"] {
         assert!(csv.lines().next().unwrap().contains(column), "{column} not in frames.csv");
@@ -138,7 +193,13 @@ fn hairball_camera_scenario_plays_end_to_end() {
     // Every method reports its rays and shaded paths, and no pass carries a whole frame: the
     // path tracer books two passes, the caches four (reserve = reprojection only).
     for r in &summary.records {
-        assert!(r.rays.is_some_and(|n| n > 0) && r.shaded.is_some(), "{}: rays {:?}, shaded {:?}", r.method, r.rays, r.shaded);
+        assert!(
+            r.rays.is_some_and(|n| n > 0) && r.shaded.is_some(),
+            "{}: rays {:?}, shaded {:?}",
+            r.method,
+            r.rays,
+            r.shaded
+        );
         assert!(r.passes.iter().all(|(_, ms)| ms.is_some()), "{}: {:?}", r.method, r.passes);
     }
     let _ = std::fs::remove_dir_all(&out);

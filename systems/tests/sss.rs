@@ -11,11 +11,21 @@ use systems::scenario::{Overrides, RunSpec};
 fn play(scenario: &str, frames: u32, keep: &[&str]) -> (Vec<FrameRecord>, PathBuf) {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("scenarios").join(scenario);
     let dir = std::env::temp_dir().join(format!("sss-e2e-{}-{scenario}", std::process::id()));
-    let overrides = Overrides { frames: Some(frames), resolution: Some((32, 18)), out: Some(dir.join("run")), ..Default::default() };
+    let overrides = Overrides {
+        frames: Some(frames),
+        resolution: Some((32, 18)),
+        out: Some(dir.join("run")),
+        ..Default::default()
+    };
     let mut spec = RunSpec::load(&file, &overrides).expect("scenario");
     spec.methods.retain(|m| keep.contains(&m.label().as_str()));
     assert_eq!(spec.methods.len(), keep.len(), "{scenario}: methods {keep:?}");
-    let opts = RunOptions { scenario: file.clone(), overrides, cache_dir: Some(dir.join("cache")), progress: false };
+    let opts = RunOptions {
+        scenario: file.clone(),
+        overrides,
+        cache_dir: Some(dir.join("cache")),
+        progress: false,
+    };
     let summary = run_spec(&spec, &opts).expect("run");
     (summary.records, dir)
 }
@@ -31,11 +41,21 @@ fn sss_scenarios_play_with_clamped_counts() {
         assert_eq!(records.len(), 15, "{scenario}");
         for r in &records {
             let (spp, pixels) = (stat(r, "sss_mean_spp"), stat(r, "sss_pixels"));
-            assert!(pixels > 20.0, "{scenario} {} frame {}: {pixels} SSS pixels", r.method, r.frame);
+            assert!(
+                pixels > 20.0,
+                "{scenario} {} frame {}: {pixels} SSS pixels",
+                r.method,
+                r.frame
+            );
             if r.method == "fixed64" {
                 assert_eq!(spp, 64.0);
             } else {
-                assert!((8.0..=64.0).contains(&spp), "{scenario} {} frame {}: {spp}", r.method, r.frame);
+                assert!(
+                    (8.0..=64.0).contains(&spp),
+                    "{scenario} {} frame {}: {spp}",
+                    r.method,
+                    r.frame
+                );
                 // No history on the first frame: every SSS pixel at n_min (eq. 4.11/4.12).
                 if r.frame == 0 {
                     assert_eq!(spp, 8.0, "{scenario} {}", r.method);
@@ -56,7 +76,12 @@ fn sss_without_a_subsurface_material_is_refused() {
     std::fs::write(&file, "Scenario(scene: Builtin(\"sss_sphere\"), resolution: (16, 9), frames: 1, methods: [Sss(variant: Adaptive)])").unwrap();
     let overrides = Overrides { out: Some(dir.join("run")), ..Default::default() };
     let spec = RunSpec::load(&file, &overrides).expect("scenario");
-    let opts = RunOptions { scenario: file.clone(), overrides, cache_dir: Some(dir.join("cache")), progress: false };
+    let opts = RunOptions {
+        scenario: file.clone(),
+        overrides,
+        cache_dir: Some(dir.join("cache")),
+        progress: false,
+    };
     let e = format!("{:#}", run_spec(&spec, &opts).err().expect("no subsurface material"));
     assert!(e.contains("no subsurface material") && e.contains("materials:"), "{e}");
     let bad = "Scenario(scene: Builtin(\"sss_sphere\"), resolution: (16, 9), frames: 1,\n methods: [Sss(variant: Adaptive, kappa: 0.2)])";
@@ -67,7 +92,12 @@ fn sss_without_a_subsurface_material_is_refused() {
     std::fs::write(&file, separable_afis).unwrap();
     let overrides = Overrides { out: Some(dir.join("run_afis")), ..Default::default() };
     let spec = RunSpec::load(&file, &overrides).expect("scenario");
-    let opts = RunOptions { scenario: file.clone(), overrides, cache_dir: Some(dir.join("cache")), progress: false };
+    let opts = RunOptions {
+        scenario: file.clone(),
+        overrides,
+        cache_dir: Some(dir.join("cache")),
+        progress: false,
+    };
     let e = format!("{:#}", run_spec(&spec, &opts).err().expect("separable with prefilter"));
     assert!(e.contains("prefilter with Separable"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
@@ -80,7 +110,13 @@ fn play_inline(name: &str, seed: u64, frames: u32, methods: &str) -> (Vec<FrameR
     play_with_materials(name, seed, frames, methods, &[SKIN])
 }
 
-fn play_with_materials(name: &str, seed: u64, frames: u32, methods: &str, materials: &[&str]) -> (Vec<FrameRecord>, PathBuf) {
+fn play_with_materials(
+    name: &str,
+    seed: u64,
+    frames: u32,
+    methods: &str,
+    materials: &[&str],
+) -> (Vec<FrameRecord>, PathBuf) {
     let dir = std::env::temp_dir().join(format!("sss-e2e-{}-{name}-{seed}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join(format!("{name}.ron"));
@@ -91,7 +127,12 @@ fn play_with_materials(name: &str, seed: u64, frames: u32, methods: &str, materi
     std::fs::write(&file, text).unwrap();
     let overrides = Overrides { out: Some(dir.join("run")), ..Default::default() };
     let spec = RunSpec::load(&file, &overrides).expect("scenario");
-    let opts = RunOptions { scenario: file.clone(), overrides, cache_dir: Some(dir.join("cache")), progress: false };
+    let opts = RunOptions {
+        scenario: file.clone(),
+        overrides,
+        cache_dir: Some(dir.join("cache")),
+        progress: false,
+    };
     (run_spec(&spec, &opts).expect("run").records, dir)
 }
 
@@ -107,16 +148,26 @@ fn taa_after_the_pass_lowers_flicker_and_separable_runs() {
     for seed in 1..=3u64 {
         let methods = "Sss(variant: Adaptive, name: \"as\"), Sss(variant: Adaptive, taa: (alpha: 0.1), name: \"as_taa\"), Sss(variant: Separable(taps: 25), name: \"separable\"), Sss(variant: Adaptive, prefilter: ())";
         let (records, dir) = play_inline("taa", seed, FRAMES, methods);
-        let image = |m: &str, f: u32| systems::output::read_exr(&dir.join(format!("run/frames/{m}/{f:04}.exr"))).unwrap().2;
+        let image = |m: &str, f: u32| {
+            systems::output::read_exr(&dir.join(format!("run/frames/{m}/{f:04}.exr"))).unwrap().2
+        };
         assert_eq!(image("as", 0), image("as_taa", 0), "seed {seed}: frame 0 has no history");
         assert_ne!(image("as", 3), image("as_taa", 3), "seed {seed}: TAA changed nothing");
         // AFIS (the default label `sss_as_afis`): its own prefiltering pass, a different image.
-        assert_ne!(image("as", 0), image("sss_as_afis", 0), "seed {seed}: prefiltering changed nothing");
+        assert_ne!(
+            image("as", 0),
+            image("sss_as_afis", 0),
+            "seed {seed}: prefiltering changed nothing"
+        );
         for r in records.iter().filter(|r| r.method == "sss_as_afis") {
             assert!(r.passes.iter().any(|(p, _)| p == "sss_prefilter"), "{:?}", r.passes);
         }
         let mean_smape = |m: &str| {
-            let v: Vec<f64> = records.iter().filter(|r| r.method == m && r.frame > 0).map(|r| r.smape.expect("smape")).collect();
+            let v: Vec<f64> = records
+                .iter()
+                .filter(|r| r.method == m && r.frame > 0)
+                .map(|r| r.smape.expect("smape"))
+                .collect();
             v.iter().sum::<f64>() / v.len() as f64
         };
         gaps.push(mean_smape("as") - mean_smape("as_taa"));
@@ -148,15 +199,21 @@ fn two_subsurface_materials_scatter_apart() {
     let floor = "(material: \"floor\", subsurface: (dmfp: (0.3, 0.2, 0.1)))";
     let (one, dir_one) = play_with_materials("one_material", 4, 3, methods, &[SKIN]);
     let (two, dir_two) = play_with_materials("two_materials", 4, 3, methods, &[SKIN, floor]);
-    let last = |dir: &Path| systems::output::read_exr(&dir.join("run/frames/as/0002.exr")).unwrap().2;
-    let counts = |dir: &Path| metrics::load_image(&dir.join("run/frames/as/sample_count/0002.png")).unwrap().rgb;
+    let last =
+        |dir: &Path| systems::output::read_exr(&dir.join("run/frames/as/0002.exr")).unwrap().2;
+    let counts = |dir: &Path| {
+        metrics::load_image(&dir.join("run/frames/as/sample_count/0002.png")).unwrap().rgb
+    };
     let (image_one, image_two) = (last(&dir_one), last(&dir_two));
     let (counts_one, counts_two) = (counts(&dir_one), counts(&dir_two));
     let (mut skin, mut floor_changed, mut floor) = (0, 0, 0);
     for i in 0..image_one.len() {
         if counts_one[i][0] > 0.0 {
             skin += 1;
-            assert_eq!(image_one[i], image_two[i], "skin pixel {i} changed when the floor became subsurface");
+            assert_eq!(
+                image_one[i], image_two[i],
+                "skin pixel {i} changed when the floor became subsurface"
+            );
         } else if counts_two[i][0] > 0.0 {
             floor += 1;
             floor_changed += (image_one[i] != image_two[i]) as usize;

@@ -44,7 +44,15 @@ fn runs(values: &[f64]) -> CaseRuns {
 }
 
 fn gate(confidence: f64) -> Gate {
-    Gate { metric: Metric::Flip, window: Window::Overall, bound: Bound::Relative { tolerance: 0.0 }, confidence, cases: None, methods: None, entry: None }
+    Gate {
+        metric: Metric::Flip,
+        window: Window::Overall,
+        bound: Bound::Relative { tolerance: 0.0 },
+        confidence,
+        cases: None,
+        methods: None,
+        entry: None,
+    }
 }
 
 /// Share of `RUNS` synthetic runs the gate fails, the new mean `shift` above the baseline's.
@@ -53,7 +61,8 @@ fn fail_rate(rng: &mut Normal, gate: &Gate, seeds: usize, shift: f64) -> f64 {
     let failed = (0..RUNS)
         .filter(|_| {
             let base: Vec<f64> = (0..seeds).map(|_| rng.sample(mean, sigma)).collect();
-            let new: Vec<f64> = (0..seeds).map(|_| rng.sample(mean + shift * sigma, sigma)).collect();
+            let new: Vec<f64> =
+                (0..seeds).map(|_| rng.sample(mean + shift * sigma, sigma)).collect();
             !judge(gate, "case", "m", &runs(&new), Some(&runs(&base))).passed()
         })
         .count();
@@ -68,8 +77,16 @@ fn three_standard_errors_are_caught_and_no_difference_passes() {
     let caught = fail_rate(&mut rng, &g, 6, 3.0);
     let false_failures = fail_rate(&mut rng, &g, 6, 0.0);
     eprintln!("6 seeds, 99%: caught {caught:.3}, no difference failed {false_failures:.3}");
-    assert!(caught >= 0.95, "a true difference of 3 σ was caught in {:.1}% of {RUNS} runs", caught * 100.0);
-    assert!(false_failures <= 0.05, "with no difference {:.1}% of {RUNS} runs failed", false_failures * 100.0);
+    assert!(
+        caught >= 0.95,
+        "a true difference of 3 σ was caught in {:.1}% of {RUNS} runs",
+        caught * 100.0
+    );
+    assert!(
+        false_failures <= 0.05,
+        "with no difference {:.1}% of {RUNS} runs failed",
+        false_failures * 100.0
+    );
     // Improvements never fail a one-sided gate.
     assert_eq!(fail_rate(&mut rng, &g, 6, -3.0), 0.0);
 }
@@ -81,7 +98,9 @@ fn false_failures_match_the_stated_confidence() {
     // Welch's df (estimated from two 3-value variances) makes the test conservative: fewer fail.
     let mut rng = Normal(SplitMix64::new(12));
     let g = gate(0.95);
-    let rate = |rng: &mut Normal, seeds| (0..10).map(|_| fail_rate(rng, &g, seeds, 0.0)).sum::<f64>() / 10.0;
+    let rate = |rng: &mut Normal, seeds| {
+        (0..10).map(|_| fail_rate(rng, &g, seeds, 0.0)).sum::<f64>() / 10.0
+    };
     let (ten, three) = (rate(&mut rng, 10), rate(&mut rng, 3));
     eprintln!("95%: no difference failed {ten:.4} with 10 seeds, {three:.4} with 3");
     assert!((0.035..=0.065).contains(&ten), "false-failure rate {ten} at 95% confidence, 10 seeds");
@@ -96,7 +115,10 @@ fn two_methods(a: &[f64], b: &[f64]) -> CaseRuns {
         .enumerate()
         .map(|(i, (&x, &y))| {
             let one = |v: f64| BTreeMap::from([(Metric::Flip.name().to_string(), vec![Some(v)])]);
-            SeedRun { seed: i as u64, methods: BTreeMap::from([("a".to_string(), one(x)), ("b".to_string(), one(y))]) }
+            SeedRun {
+                seed: i as u64,
+                methods: BTreeMap::from([("a".to_string(), one(x)), ("b".to_string(), one(y))]),
+            }
         })
         .collect();
     CaseRuns { frames: 1, events: Vec::new(), seeds }
@@ -119,14 +141,17 @@ fn relation_gates_pass_only_when_the_method_is_better_with_confidence() {
         let passed = (0..RUNS)
             .filter(|_| {
                 let b: Vec<f64> = (0..6).map(|_| rng.sample(0.3, 0.02)).collect();
-                let a: Vec<f64> = b.iter().map(|v| v - shift * 0.02 + rng.sample(0.0, 0.02)).collect();
+                let a: Vec<f64> =
+                    b.iter().map(|v| v - shift * 0.02 + rng.sample(0.0, 0.02)).collect();
                 judge(&gate, "case", "a", &two_methods(&a, &b), None).passed()
             })
             .count();
         passed as f64 / RUNS as f64
     };
     let (caught, false_pass) = (rate(3.0), rate(0.0));
-    eprintln!("relation gate: a true 3σ advantage shown in {caught:.3} of runs, no advantage passes in {false_pass:.3}");
+    eprintln!(
+        "relation gate: a true 3σ advantage shown in {caught:.3} of runs, no advantage passes in {false_pass:.3}"
+    );
     assert!(caught >= 0.95, "{caught}");
     assert!(false_pass <= 0.08, "{false_pass}");
 }

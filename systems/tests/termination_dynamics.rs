@@ -30,10 +30,24 @@ const SEEDS: [u64; 3] = [3, 4, 5];
 
 /// The scenario's methods named in `keep` at 32x18 for `frames` frames; `edit` changes the spec
 /// (references, events).
-fn play(scenario: &str, keep: &[&str], seed: u64, frames: u32, tag: &str, edit: impl Fn(&mut RunSpec)) -> Vec<FrameRecord> {
+fn play(
+    scenario: &str,
+    keep: &[&str],
+    seed: u64,
+    frames: u32,
+    tag: &str,
+    edit: impl Fn(&mut RunSpec),
+) -> Vec<FrameRecord> {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("scenarios").join(scenario);
-    let dir = std::env::temp_dir().join(format!("termination-dynamics-{}-{scenario}-{tag}-{seed}", std::process::id()));
-    let overrides = Overrides { frames: Some(frames), resolution: Some((32, 18)), seed: Some(seed), out: Some(dir.join("run")), ..Default::default() };
+    let dir = std::env::temp_dir()
+        .join(format!("termination-dynamics-{}-{scenario}-{tag}-{seed}", std::process::id()));
+    let overrides = Overrides {
+        frames: Some(frames),
+        resolution: Some((32, 18)),
+        seed: Some(seed),
+        out: Some(dir.join("run")),
+        ..Default::default()
+    };
     let mut spec = RunSpec::load(&file, &overrides).expect("scenario");
     spec.methods.retain(|m| keep.contains(&m.label().as_str()));
     assert_eq!(spec.methods.len(), keep.len(), "{scenario}: methods {keep:?}");
@@ -44,7 +58,12 @@ fn play(scenario: &str, keep: &[&str], seed: u64, frames: u32, tag: &str, edit: 
         }
     }
     edit(&mut spec);
-    let opts = RunOptions { scenario: PathBuf::from(&file), overrides, cache_dir: Some(std::env::temp_dir().join("termination-dynamics-references")), progress: false };
+    let opts = RunOptions {
+        scenario: PathBuf::from(&file),
+        overrides,
+        cache_dir: Some(std::env::temp_dir().join("termination-dynamics-references")),
+        progress: false,
+    };
     let summary = run_spec(&spec, &opts).expect("run");
     std::fs::remove_dir_all(&dir).ok();
     summary.records
@@ -54,7 +73,15 @@ fn play(scenario: &str, keep: &[&str], seed: u64, frames: u32, tag: &str, edit: 
 fn series(records: &[FrameRecord], method: &str, stat: &str) -> Vec<f64> {
     let mut rows: Vec<&FrameRecord> = records.iter().filter(|r| r.method == method).collect();
     rows.sort_by_key(|r| r.frame);
-    rows.iter().map(|r| r.stats.iter().find(|(k, _)| k == stat).unwrap_or_else(|| panic!("{method}: no {stat}")).1).collect()
+    rows.iter()
+        .map(|r| {
+            r.stats
+                .iter()
+                .find(|(k, _)| k == stat)
+                .unwrap_or_else(|| panic!("{method}: no {stat}"))
+                .1
+        })
+        .collect()
 }
 
 fn mean(v: &[f64]) -> f64 {
@@ -89,7 +116,10 @@ fn cache_follows_a_flash_and_forgets_it_slower_than_its_memory() {
         }
     };
     let frames = LAST as u32 + 1;
-    let flashed: Vec<_> = SEEDS.iter().map(|&s| play("termination_flash_corridor.ron", &keep, s, frames, "flash", setup)).collect();
+    let flashed: Vec<_> = SEEDS
+        .iter()
+        .map(|&s| play("termination_flash_corridor.ron", &keep, s, frames, "flash", setup))
+        .collect();
     let control: Vec<_> = SEEDS
         .iter()
         .map(|&s| {
@@ -108,32 +138,56 @@ fn cache_follows_a_flash_and_forgets_it_slower_than_its_memory() {
     let mut mse_length_change = vec![];
     for ((seed, f), c) in SEEDS.iter().zip(&flashed).zip(&control) {
         for (i, m) in keep.iter().enumerate() {
-            let (value, var, len) = (series(f, m, "cache_mean"), series(f, m, "cache_variance"), series(f, m, "path_length"));
-            let (value_c, var_c, len_c) = (series(c, m, "cache_mean"), series(c, m, "cache_variance"), series(c, m, "path_length"));
-            eprintln!("seed {seed} {m}, flash: cache mean {value:.3?}\n  variance {var:.3?}\n  path length {len:.3?}");
-            eprintln!("seed {seed} {m}, control: cache mean {value_c:.3?}\n  variance {var_c:.3?}\n  path length {len_c:.3?}");
+            let (value, var, len) = (
+                series(f, m, "cache_mean"),
+                series(f, m, "cache_variance"),
+                series(f, m, "path_length"),
+            );
+            let (value_c, var_c, len_c) = (
+                series(c, m, "cache_mean"),
+                series(c, m, "cache_variance"),
+                series(c, m, "path_length"),
+            );
+            eprintln!(
+                "seed {seed} {m}, flash: cache mean {value:.3?}\n  variance {var:.3?}\n  path length {len:.3?}"
+            );
+            eprintln!(
+                "seed {seed} {m}, control: cache mean {value_c:.3?}\n  variance {var_c:.3?}\n  path length {len_c:.3?}"
+            );
             let excess = |a: &[f64], b: &[f64], f: usize| a[f] - b[f];
             let last = FLASH.1 - 1;
             rise[i].push((value[last] / value_c[last]).ln());
             variance_rise[i].push((var[last] / var_c[last]).ln());
-            let per_frame = |a: &[f64], b: &[f64]| (excess(a, b, LAST) / excess(a, b, FLASH.1)).powf(1.0 / DECAY_FRAMES as f64);
+            let per_frame = |a: &[f64], b: &[f64]| {
+                (excess(a, b, LAST) / excess(a, b, FLASH.1)).powf(1.0 / DECAY_FRAMES as f64)
+            };
             factor[i].push(per_frame(&value, &value_c));
             variance_factor[i].push(per_frame(&var, &var_c));
             if i == 0 {
-                mse_length_change.push(mean(&len[FLASH.1..FLASH.1 + 4]) - mean(&len_c[FLASH.1..FLASH.1 + 4]));
+                mse_length_change
+                    .push(mean(&len[FLASH.1..FLASH.1 + 4]) - mean(&len_c[FLASH.1..FLASH.1 + 4]));
             }
         }
     }
-    eprintln!("rise {rise:.3?}\nvariance rise {variance_rise:.3?}\nfactor {factor:.3?}\nvariance factor {variance_factor:.3?}\nMSE path length change {mse_length_change:.3?}");
+    eprintln!(
+        "rise {rise:.3?}\nvariance rise {variance_rise:.3?}\nfactor {factor:.3?}\nvariance factor {variance_factor:.3?}\nMSE path length change {mse_length_change:.3?}"
+    );
     for (i, m) in keep.iter().enumerate() {
-        assert_positive(&format!("{m}: ln(cache value at the flash's last frame / control)"), &rise[i]);
-        assert_positive(&format!("{m}: ln(cache variance at the flash's last frame / control)"), &variance_rise[i]);
+        assert_positive(
+            &format!("{m}: ln(cache value at the flash's last frame / control)"),
+            &rise[i],
+        );
+        assert_positive(
+            &format!("{m}: ln(cache variance at the flash's last frame / control)"),
+            &variance_rise[i],
+        );
     }
     // The shorter memory takes up more of the flash in its 4 frames ...
     let d: Vec<f64> = rise[1].iter().zip(&rise[0]).map(|(a, b)| a - b).collect();
     assert_positive("rise of the cache value, 16 minus 64 estimates", &d);
     // ... and forgets the flash's variance faster.
-    let d: Vec<f64> = variance_factor[0].iter().zip(&variance_factor[1]).map(|(a, b)| a - b).collect();
+    let d: Vec<f64> =
+        variance_factor[0].iter().zip(&variance_factor[1]).map(|(a, b)| a - b).collect();
     assert_positive("per-frame forgetting factor of the cache variance, 64 minus 16 estimates", &d);
     // The cache keeps more of the flash than its memory alone would ((1 - 1/n)^4 a frame, the
     // bound above): a record's new estimates read neighbouring records that still hold the
@@ -142,17 +196,30 @@ fn cache_follows_a_flash_and_forgets_it_slower_than_its_memory() {
     for (i, n) in [64.0f64, 16.0].into_iter().enumerate() {
         let bound = (1.0 - 1.0 / n).powi(4);
         let d: Vec<f64> = factor[i].iter().map(|f| f - bound).collect();
-        assert_positive(&format!("{}: per-frame forgetting factor of the cache value minus (1 - 1/{n})^4", keep[i]), &d);
+        assert_positive(
+            &format!(
+                "{}: per-frame forgetting factor of the cache value minus (1 - 1/{n})^4",
+                keep[i]
+            ),
+            &d,
+        );
     }
     // Termination moves: the flash raised the records' squared-bias estimate (E[E[Y|y]²]
     // remembers the flash's 25-fold squares longer than E[Y]² does), and MSE minimisation defers
     // termination where the local bias is large: its paths over the 4 frames after the flash
     // are longer than the control's.
-    assert_positive("MSE minimisation: path length after the flash minus the control's", &mse_length_change);
+    assert_positive(
+        "MSE minimisation: path length after the flash minus the control's",
+        &mse_length_change,
+    );
 }
 
 fn flip(records: &[FrameRecord], method: &str) -> f64 {
-    records.iter().find(|r| r.method == method).and_then(|r| r.flip).unwrap_or_else(|| panic!("{method}: no FLIP"))
+    records
+        .iter()
+        .find(|r| r.method == method)
+        .and_then(|r| r.flip)
+        .unwrap_or_else(|| panic!("{method}: no FLIP"))
 }
 
 #[test]
@@ -167,9 +234,16 @@ fn glossy_surfaces_bias_termination_into_direction_independent_records() {
     let mut excess = vec![];
     for &seed in &SEEDS {
         let glossy = play("termination_failure_glossy.ron", &keep, seed, 1, "glossy", |_| {});
-        let diffuse = play("termination_failure_glossy.ron", &keep, seed, 1, "diffuse", |s| s.scenario.events.clear());
-        let (g, d) = (flip(&glossy, "first_vertex") - flip(&glossy, "pt"), flip(&diffuse, "first_vertex") - flip(&diffuse, "pt"));
-        eprintln!("seed {seed}: first-vertex FLIP minus path tracing's: glossy {g:.4}, diffuse {d:.4}");
+        let diffuse = play("termination_failure_glossy.ron", &keep, seed, 1, "diffuse", |s| {
+            s.scenario.events.clear()
+        });
+        let (g, d) = (
+            flip(&glossy, "first_vertex") - flip(&glossy, "pt"),
+            flip(&diffuse, "first_vertex") - flip(&diffuse, "pt"),
+        );
+        eprintln!(
+            "seed {seed}: first-vertex FLIP minus path tracing's: glossy {g:.4}, diffuse {d:.4}"
+        );
         excess.push(g - d);
     }
     assert_positive("first vertex: (FLIP - path tracing's FLIP), glossy minus diffuse", &excess);

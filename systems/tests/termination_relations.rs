@@ -37,8 +37,15 @@ const T975_DF2: f64 = 4.303;
 /// FLIP) per seed.
 fn play(scenario: &str, keep: &[&str], seed: u64) -> Vec<FrameRecord> {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("scenarios").join(scenario);
-    let dir = std::env::temp_dir().join(format!("termination-relations-{}-{scenario}-{seed}", std::process::id()));
-    let overrides = Overrides { frames: Some(1), resolution: Some((32, 18)), seed: Some(seed), out: Some(dir.join("run")), ..Default::default() };
+    let dir = std::env::temp_dir()
+        .join(format!("termination-relations-{}-{scenario}-{seed}", std::process::id()));
+    let overrides = Overrides {
+        frames: Some(1),
+        resolution: Some((32, 18)),
+        seed: Some(seed),
+        out: Some(dir.join("run")),
+        ..Default::default()
+    };
     let mut spec = RunSpec::load(&file, &overrides).expect("scenario");
     spec.methods.retain(|m| keep.contains(&m.label().as_str()));
     for m in &mut spec.methods {
@@ -48,14 +55,20 @@ fn play(scenario: &str, keep: &[&str], seed: u64) -> Vec<FrameRecord> {
         }
     }
     assert_eq!(spec.methods.len(), keep.len(), "{scenario}: methods {keep:?}");
-    let opts = RunOptions { scenario: PathBuf::from(&file), overrides, cache_dir: Some(std::env::temp_dir().join("termination-relations-references")), progress: false };
+    let opts = RunOptions {
+        scenario: PathBuf::from(&file),
+        overrides,
+        cache_dir: Some(std::env::temp_dir().join("termination-relations-references")),
+        progress: false,
+    };
     let summary = run_spec(&spec, &opts).expect("run");
     std::fs::remove_dir_all(&dir).ok();
     summary.records
 }
 
 fn value(records: &[FrameRecord], method: &str, f: impl Fn(&FrameRecord) -> Option<f64>) -> f64 {
-    let row = records.iter().find(|r| r.method == method).unwrap_or_else(|| panic!("no row of {method}"));
+    let row =
+        records.iter().find(|r| r.method == method).unwrap_or_else(|| panic!("no row of {method}"));
     f(row).unwrap_or_else(|| panic!("{method}: value missing"))
 }
 
@@ -69,7 +82,14 @@ fn path_length_relations(scenario: &str, runs: &[Vec<FrameRecord>]) {
     // Grows with t in every seed: 6 of 6 paired comparisons (probability 1/64 if the order
     // were a coin toss).
     for s in 0..runs.len() {
-        assert!(r001[s] < r01[s] && r01[s] < r1[s], "{scenario} seed {}: path length by relative t 0.01, 0.1, 1: {} {} {}", SEEDS[s], r001[s], r01[s], r1[s]);
+        assert!(
+            r001[s] < r01[s] && r01[s] < r1[s],
+            "{scenario} seed {}: path length by relative t 0.01, 0.1, 1: {} {} {}",
+            SEEDS[s],
+            r001[s],
+            r01[s],
+            r1[s]
+        );
     }
     // Across the decade range, by a margin from the spread over seeds: the path length grows
     // multiplicatively, and the seeds' caches differ in scale, so the log ratio.
@@ -87,7 +107,11 @@ fn door_relations() {
     let runs: Vec<_> = SEEDS.iter().map(|&s| play("termination_door_gap.ron", &keep, s)).collect();
     for (seed, r) in SEEDS.iter().zip(&runs) {
         for m in keep {
-            eprintln!("door seed {seed} {m}: path length {:.3} FLIP {:.4}", value(r, m, path_length), value(r, m, |r| r.flip));
+            eprintln!(
+                "door seed {seed} {m}: path length {:.3} FLIP {:.4}",
+                value(r, m, path_length),
+                value(r, m, |r| r.flip)
+            );
         }
     }
     path_length_relations("door", &runs);
@@ -96,13 +120,23 @@ fn door_relations() {
     // (README "Termination relations"). What is measured, and asserted: the two are not
     // distinguishable, the two-sided 95% interval of the mean difference contains zero.
     let flip = |m: &str| runs.iter().map(|r| value(r, m, |r| r.flip)).collect::<Vec<f64>>();
-    let d: Vec<f64> = flip("spread_0.01").iter().zip(flip("vb_rel_1")).map(|(a, b)| a - b).collect();
+    let d: Vec<f64> =
+        flip("spread_0.01").iter().zip(flip("vb_rel_1")).map(|(a, b)| a - b).collect();
     let n = d.len() as f64;
     let m = d.iter().sum::<f64>() / n;
     let sd = (d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)).sqrt();
     let half = T975_DF2 * sd / n.sqrt();
-    eprintln!("door: FLIP area spread c 0.01 - variance bounding relative t 1: per seed {d:.4?}, 95% interval [{:.4}, {:.4}]", m - half, m + half);
-    assert!(m - half < 0.0 && m + half > 0.0, "door: FLIP difference {d:.4?}: interval [{:.4}, {:.4}] no longer contains 0; update the README and this test", m - half, m + half);
+    eprintln!(
+        "door: FLIP area spread c 0.01 - variance bounding relative t 1: per seed {d:.4?}, 95% interval [{:.4}, {:.4}]",
+        m - half,
+        m + half
+    );
+    assert!(
+        m - half < 0.0 && m + half > 0.0,
+        "door: FLIP difference {d:.4?}: interval [{:.4}, {:.4}] no longer contains 0; update the README and this test",
+        m - half,
+        m + half
+    );
 }
 
 #[test]

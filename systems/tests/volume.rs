@@ -9,34 +9,74 @@ use systems::scenario::{Overrides, RunSpec};
 
 fn play(scenario: &str, out: &Path) -> systems::playback::RunSummary {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios").join(scenario);
-    let overrides = Overrides { resolution: Some((32, 18)), spp: Some(8), out: Some(out.to_path_buf()), ..Default::default() };
+    let overrides = Overrides {
+        resolution: Some((32, 18)),
+        spp: Some(8),
+        out: Some(out.to_path_buf()),
+        ..Default::default()
+    };
     let spec = RunSpec::load(&path, &overrides).unwrap_or_else(|e| panic!("{e:#}"));
-    run_spec(&spec, &RunOptions { scenario: path, overrides, cache_dir: Some(out.join("cache")), progress: false }).unwrap_or_else(|e| panic!("{e:#}"))
+    run_spec(
+        &spec,
+        &RunOptions {
+            scenario: path,
+            overrides,
+            cache_dir: Some(out.join("cache")),
+            progress: false,
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e:#}"))
 }
 
 fn stat(r: &systems::frame_record::FrameRecord, name: &str) -> f64 {
-    r.stats.iter().find(|(n, _)| n == name).unwrap_or_else(|| panic!("{} has no {name}: {:?}", r.method, r.stats)).1
+    r.stats
+        .iter()
+        .find(|(n, _)| n == name)
+        .unwrap_or_else(|| panic!("{} has no {name}: {:?}", r.method, r.stats))
+        .1
 }
 
 #[test]
 fn volume_scenarios_play_every_estimator() {
     for scenario in ["volume_cloud.ron", "volume_explosion.ron"] {
-        let out = std::env::temp_dir().join(format!("flicker_volume_{}_{}", std::process::id(), scenario));
+        let out = std::env::temp_dir().join(format!(
+            "flicker_volume_{}_{}",
+            std::process::id(),
+            scenario
+        ));
         let summary = play(scenario, &out);
         assert_eq!(summary.records.len(), 6, "{scenario}: one row per estimator");
         for r in &summary.records {
-            assert!(r.passes.iter().any(|(p, ms)| p == media::gpu::PASS && ms.is_some()), "{}: no media pass time", r.method);
+            assert!(
+                r.passes.iter().any(|(p, ms)| p == media::gpu::PASS && ms.is_some()),
+                "{}: no media pass time",
+                r.method
+            );
             let lookups = stat(r, "lookups_per_estimate");
             assert!(lookups > 0.0, "{}: no density lookups counted", r.method);
             assert!(stat(r, "mean_std").is_finite() && stat(r, "mean_abs_bias").is_finite());
             for map in ["bias", "std", "exact"] {
                 let dir = summary.folder.join("frames").join(&r.method).join(map);
-                assert!(dir.read_dir().is_ok_and(|mut d| d.next().is_some()), "{}: no {map} map in {}", r.method, dir.display());
+                assert!(
+                    dir.read_dir().is_ok_and(|mut d| d.next().is_some()),
+                    "{}: no {map} map in {}",
+                    r.method,
+                    dir.display()
+                );
             }
         }
         // Equal mN: naive (16) and jackknife (2 × 8) take the same number of lookups.
-        let by = |label: &str| summary.records.iter().find(|r| r.method.contains(label)).unwrap_or_else(|| panic!("no {label} row"));
-        assert_eq!(stat(by("naive"), "lookups_per_estimate"), stat(by("jackknife"), "lookups_per_estimate"));
+        let by = |label: &str| {
+            summary
+                .records
+                .iter()
+                .find(|r| r.method.contains(label))
+                .unwrap_or_else(|| panic!("no {label} row"))
+        };
+        assert_eq!(
+            stat(by("naive"), "lookups_per_estimate"),
+            stat(by("jackknife"), "lookups_per_estimate")
+        );
         let _ = std::fs::remove_dir_all(&out);
     }
 }
@@ -46,7 +86,21 @@ fn a_scenario_without_media_refuses_the_method() {
     let text = "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, methods: [VolumeTransmittance(spp: 1)])";
     let scenario = sim::Scenario::from_ron(text, Path::new("inline.ron")).unwrap();
     let out = std::env::temp_dir().join(format!("flicker_volume_none_{}", std::process::id()));
-    let spec = RunSpec::from_scenario(scenario, &Overrides { out: Some(out.clone()), ..Default::default() }).unwrap();
-    let e = run_spec(&spec, &RunOptions { scenario: "inline.ron".into(), overrides: Overrides::default(), cache_dir: Some(out.join("cache")), progress: false }).err().expect("refused");
+    let spec = RunSpec::from_scenario(
+        scenario,
+        &Overrides { out: Some(out.clone()), ..Default::default() },
+    )
+    .unwrap();
+    let e = run_spec(
+        &spec,
+        &RunOptions {
+            scenario: "inline.ron".into(),
+            overrides: Overrides::default(),
+            cache_dir: Some(out.join("cache")),
+            progress: false,
+        },
+    )
+    .err()
+    .expect("refused");
     assert!(format!("{e:#}").contains("declares no media"), "{e:#}");
 }

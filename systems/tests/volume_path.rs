@@ -13,10 +13,25 @@ use systems::scenario::{Overrides, RunSpec};
 
 fn play(scenario: &str, frames: Option<u32>, out: &Path) -> RunSummary {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios").join(scenario);
-    let overrides = Overrides { resolution: Some((32, 18)), spp: Some(2), frames, out: Some(out.to_path_buf()), ..Default::default() };
+    let overrides = Overrides {
+        resolution: Some((32, 18)),
+        spp: Some(2),
+        frames,
+        out: Some(out.to_path_buf()),
+        ..Default::default()
+    };
     let mut spec = RunSpec::load(&path, &overrides).unwrap_or_else(|e| panic!("{e:#}"));
     spec.scenario.reference.spp = 16;
-    run_spec(&spec, &RunOptions { scenario: path, overrides, cache_dir: Some(out.join("cache")), progress: false }).unwrap_or_else(|e| panic!("{e:#}"))
+    run_spec(
+        &spec,
+        &RunOptions {
+            scenario: path,
+            overrides,
+            cache_dir: Some(out.join("cache")),
+            progress: false,
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e:#}"))
 }
 
 #[test]
@@ -28,7 +43,11 @@ fn volume_mis_plays_every_weight_against_the_volumetric_reference() {
     for r in &summary.records {
         let flip = r.flip.unwrap_or_else(|| panic!("{}: no FLIP against the reference", r.method));
         assert!(flip.is_finite() && flip > 0.0 && flip < 1.0, "{}: FLIP {flip}", r.method);
-        assert!(r.passes.iter().any(|(p, ms)| p == media::gpu::VOLUME_PATH_PASS && ms.is_some()), "{}: no pass time", r.method);
+        assert!(
+            r.passes.iter().any(|(p, ms)| p == media::gpu::VOLUME_PATH_PASS && ms.is_some()),
+            "{}: no pass time",
+            r.method
+        );
         println!("{}: FLIP {flip:.4}, rel MSE {:?}", r.method, r.rel_mse);
     }
     let _ = std::fs::remove_dir_all(&out);
@@ -42,7 +61,14 @@ fn the_moving_light_scenario_rebakes_its_cloud_and_measures_flicker() {
     assert_eq!(summary.references_rendered, 2, "cached {}", summary.references_cached);
     assert_eq!(summary.records.len(), 6);
     for r in summary.records.iter().filter(|r| r.frame > 0) {
-        assert!(r.smape.is_some_and(|s| s.is_finite()) && r.flip.is_some_and(|f| f.is_finite()), "{} frame {}: {:?} {:?}", r.method, r.frame, r.smape, r.flip);
+        assert!(
+            r.smape.is_some_and(|s| s.is_finite()) && r.flip.is_some_and(|f| f.is_finite()),
+            "{} frame {}: {:?} {:?}",
+            r.method,
+            r.frame,
+            r.smape,
+            r.flip
+        );
     }
     let _ = std::fs::remove_dir_all(&out);
 }
@@ -55,7 +81,13 @@ fn the_mesh_bound_scenario_plays_two_media_and_rebakes_its_turning_torus() {
     assert_eq!(summary.references_rendered, 2, "cached {}", summary.references_cached);
     assert_eq!(summary.records.len(), 4);
     for r in &summary.records {
-        assert!(r.flip.is_some_and(|f| f.is_finite() && f > 0.0 && f < 1.0), "{} frame {}: FLIP {:?}", r.method, r.frame, r.flip);
+        assert!(
+            r.flip.is_some_and(|f| f.is_finite() && f > 0.0 && f < 1.0),
+            "{} frame {}: FLIP {:?}",
+            r.method,
+            r.frame,
+            r.flip
+        );
     }
     let _ = std::fs::remove_dir_all(&out);
 }
@@ -63,28 +95,66 @@ fn the_mesh_bound_scenario_plays_two_media_and_rebakes_its_turning_torus() {
 /// The error of running an inline scenario (refused before any frame).
 fn refusal(text: &str, name: &str) -> String {
     let scenario = sim::Scenario::from_ron(text, Path::new("inline.ron")).unwrap();
-    let out = std::env::temp_dir().join(format!("flicker_volume_path_{name}_{}", std::process::id()));
-    let spec = RunSpec::from_scenario(scenario, &Overrides { out: Some(out.clone()), ..Default::default() }).unwrap();
-    let e = run_spec(&spec, &RunOptions { scenario: "inline.ron".into(), overrides: Overrides::default(), cache_dir: Some(out.join("cache")), progress: false }).err().expect("refused");
+    let out =
+        std::env::temp_dir().join(format!("flicker_volume_path_{name}_{}", std::process::id()));
+    let spec = RunSpec::from_scenario(
+        scenario,
+        &Overrides { out: Some(out.clone()), ..Default::default() },
+    )
+    .unwrap();
+    let e = run_spec(
+        &spec,
+        &RunOptions {
+            scenario: "inline.ron".into(),
+            overrides: Overrides::default(),
+            cache_dir: Some(out.join("cache")),
+            progress: false,
+        },
+    )
+    .err()
+    .expect("refused");
     let _ = std::fs::remove_dir_all(&out);
     format!("{e:#}")
 }
 
 #[test]
 fn a_scenario_without_media_refuses_volume_path() {
-    let e = refusal("Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, methods: [VolumePath(spp: 1)])", "none");
+    let e = refusal(
+        "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, methods: [VolumePath(spp: 1)])",
+        "none",
+    );
     assert!(e.contains("declares no media"), "{e}");
 }
 
 #[test]
 fn a_scenario_with_media_refuses_what_would_leave_them_out() {
     let fog = "(name: \"fog\", kind: Homogeneous, box_min: (-1, -1, -1), box_max: (1, 1, 1), sigma_t: 1.0, resolution: (8, 8, 8))";
-    let e = refusal(&format!("Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1,\n methods: [VolumePath(spp: 1), PathTracing(spp: 1)], media: [{fog}])"), "pt");
-    assert!(e.contains("inline.ron:2:") && e.contains("does not render participating media") && e.contains("'fog'"), "{e}");
+    let e = refusal(
+        &format!(
+            "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1,\n methods: [VolumePath(spp: 1), PathTracing(spp: 1)], media: [{fog}])"
+        ),
+        "pt",
+    );
+    assert!(
+        e.contains("inline.ron:2:")
+            && e.contains("does not render participating media")
+            && e.contains("'fog'"),
+        "{e}"
+    );
     // Several media render together, up to media::gpu::MAX_MEDIA.
     let many: Vec<String> = (0..=media::gpu::MAX_MEDIA).map(|i| format!("(name: \"haze{i}\", kind: Homogeneous, box_min: (-1, -1, -1), box_max: (1, 1, 1), sigma_t: 0.1, resolution: (8, 8, 8))")).collect();
-    let e = refusal(&format!("Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, methods: [VolumePath(spp: 1)], media: [{}])", many.join(", ")), "many");
-    assert!(e.contains(&format!("medium 'haze{}'", media::gpu::MAX_MEDIA)) && e.contains("renders at most 8 media"), "{e}");
+    let e = refusal(
+        &format!(
+            "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, methods: [VolumePath(spp: 1)], media: [{}])",
+            many.join(", ")
+        ),
+        "many",
+    );
+    assert!(
+        e.contains(&format!("medium 'haze{}'", media::gpu::MAX_MEDIA))
+            && e.contains("renders at most 8 media"),
+        "{e}"
+    );
 }
 
 /// More media than the volumetric path tracer binds are fine where nothing uses it: a
@@ -97,9 +167,22 @@ fn more_media_than_the_path_tracer_binds_play_without_references() {
         many.join(", ")
     );
     let scenario = sim::Scenario::from_ron(&text, Path::new("inline.ron")).unwrap();
-    let out = std::env::temp_dir().join(format!("flicker_volume_path_many_transmittance_{}", std::process::id()));
-    let spec = RunSpec::from_scenario(scenario, &Overrides { out: Some(out.clone()), ..Default::default() }).unwrap();
-    let summary = run_spec(&spec, &RunOptions { scenario: "inline.ron".into(), overrides: Overrides::default(), cache_dir: Some(out.join("cache")), progress: false });
+    let out = std::env::temp_dir()
+        .join(format!("flicker_volume_path_many_transmittance_{}", std::process::id()));
+    let spec = RunSpec::from_scenario(
+        scenario,
+        &Overrides { out: Some(out.clone()), ..Default::default() },
+    )
+    .unwrap();
+    let summary = run_spec(
+        &spec,
+        &RunOptions {
+            scenario: "inline.ron".into(),
+            overrides: Overrides::default(),
+            cache_dir: Some(out.join("cache")),
+            progress: false,
+        },
+    );
     let _ = std::fs::remove_dir_all(&out);
     summary.unwrap_or_else(|e| panic!("{e:#}"));
 }

@@ -33,18 +33,49 @@ pub struct ClosedFormPass {
 impl ClosedFormPass {
     pub fn new(gpu: &Gpu) -> Result<Self, RenderError> {
         let layout = binding_layout(gpu, "media closed-form trials", &BINDINGS);
-        let types = Module::generated("package::media::closed_form_types", &[ClosedFormParams::WGSL]);
-        let bindings = render::compute::group_module("package::media::closed_form_bindings", 0, &BINDINGS, &[&types]);
-        let program = Program::new(vec![render::wgsl_file!("media_rng.wgsl"), render::wgsl_file!("media_jackknife.wgsl"), types, bindings])
-            .entry(render::wgsl_file!("media_closed_form_trials.wgsl"));
-        let [pipeline] = pipelines(gpu, "media closed-form trials", &program, &[&layout], ["closed_form_trials"])?;
+        let types =
+            Module::generated("package::media::closed_form_types", &[ClosedFormParams::WGSL]);
+        let bindings = render::compute::group_module(
+            "package::media::closed_form_bindings",
+            0,
+            &BINDINGS,
+            &[&types],
+        );
+        let program = Program::new(vec![
+            render::wgsl_file!("media_rng.wgsl"),
+            render::wgsl_file!("media_jackknife.wgsl"),
+            types,
+            bindings,
+        ])
+        .entry(render::wgsl_file!("media_closed_form_trials.wgsl"));
+        let [pipeline] = pipelines(
+            gpu,
+            "media closed-form trials",
+            &program,
+            &[&layout],
+            ["closed_form_trials"],
+        )?;
         Ok(Self { layout, pipeline })
     }
 
     /// (K, exp(−X̄)) per seed.
-    pub fn run(&self, gpu: &Gpu, dist: ErrorDistribution, tau: f32, sigma: f32, seeds: &[u32]) -> Result<Vec<(f32, f32)>, String> {
+    pub fn run(
+        &self,
+        gpu: &Gpu,
+        dist: ErrorDistribution,
+        tau: f32,
+        sigma: f32,
+        seeds: &[u32],
+    ) -> Result<Vec<(f32, f32)>, String> {
         let params = ClosedFormParams { tau, sigma, kind: dist as u32, count: seeds.len() as u32 };
-        let raw: Vec<[f32; 2]> = super::trials::run_trials(gpu, "media closed-form trials", &self.layout, &self.pipeline, bytemuck::bytes_of(&params), seeds)?;
+        let raw: Vec<[f32; 2]> = super::trials::run_trials(
+            gpu,
+            "media closed-form trials",
+            &self.layout,
+            &self.pipeline,
+            bytemuck::bytes_of(&params),
+            seeds,
+        )?;
         Ok(raw.into_iter().map(|v| (v[0], v[1])).collect())
     }
 }

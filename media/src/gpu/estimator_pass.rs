@@ -42,24 +42,58 @@ impl EstimatorPass {
     pub fn new(gpu: &Gpu, medium: &GpuMedium) -> Result<Self, RenderError> {
         use render::gpu_struct::GpuStruct;
         let layout = binding_layout(gpu, "media rays", &BINDINGS);
-        let program = super::shaders::program("rays", RayParams::WGSL, &BINDINGS, render::wgsl_file!("media_rays.wgsl"));
-        let [pipeline] = pipelines(gpu, "media rays", &program, &[&medium.layout, &layout], ["estimate_rays"])?;
+        let program = super::shaders::program(
+            "rays",
+            RayParams::WGSL,
+            &BINDINGS,
+            render::wgsl_file!("media_rays.wgsl"),
+        );
+        let [pipeline] =
+            pipelines(gpu, "media rays", &program, &[&medium.layout, &layout], ["estimate_rays"])?;
         Ok(Self { layout, pipeline })
     }
 
-    pub fn run(&self, gpu: &Gpu, medium: &GpuMedium, estimator: Estimator, rays: &[RaySegment], seeds: &[u32]) -> Result<Vec<RayResult>, String> {
+    pub fn run(
+        &self,
+        gpu: &Gpu,
+        medium: &GpuMedium,
+        estimator: Estimator,
+        rays: &[RaySegment],
+        seeds: &[u32],
+    ) -> Result<Vec<RayResult>, String> {
         assert_eq!(rays.len(), seeds.len());
         let (kind, samples, multiplier) = estimator.gpu_settings();
         let params = RayParams { count: rays.len() as u32, kind, samples, multiplier };
         let device = &gpu.device;
-        let init = |label: &str, contents: &[u8], usage| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
+        let init = |label: &str, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
         let params = init("ray params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
         let rays_buf = init("rays", bytemuck::cast_slice(rays), wgpu::BufferUsages::STORAGE);
         let seeds_buf = init("seeds", bytemuck::cast_slice(seeds), wgpu::BufferUsages::STORAGE);
         let size = (rays.len() * 8) as u64;
-        let results = device.create_buffer(&wgpu::BufferDescriptor { label: Some("results"), size, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
-        let staging = device.create_buffer(&wgpu::BufferDescriptor { label: Some("results staging"), size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
-        let group = buffer_group(gpu, "media rays", &self.layout, &[&params, &rays_buf, &seeds_buf, &results]);
+        let results = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("results"),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("results staging"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let group = buffer_group(
+            gpu,
+            "media rays",
+            &self.layout,
+            &[&params, &rays_buf, &seeds_buf, &results],
+        );
         let mut enc = device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
@@ -71,6 +105,9 @@ impl EstimatorPass {
         enc.copy_buffer_to_buffer(&results, 0, &staging, 0, size);
         gpu.queue.submit([enc.finish()]);
         let raw: Vec<[u32; 2]> = read_buffer(gpu, &staging)?;
-        Ok(raw.into_iter().map(|[v, l]| RayResult { value: f32::from_bits(v), lookups: l }).collect())
+        Ok(raw
+            .into_iter()
+            .map(|[v, l]| RayResult { value: f32::from_bits(v), lookups: l })
+            .collect())
     }
 }

@@ -49,27 +49,76 @@ pub struct ImagePass {
 impl ImagePass {
     pub fn new(gpu: &Gpu, medium: &GpuMedium) -> Result<Self, RenderError> {
         let layout = binding_layout(gpu, "media image", &BINDINGS);
-        let program = super::shaders::program("image", ImageParams::WGSL, &BINDINGS, render::wgsl_file!("media_image.wgsl"));
-        let [pipeline] = pipelines(gpu, "media image", &program, &[&medium.layout, &layout], ["transmittance_image"])?;
+        let program = super::shaders::program(
+            "image",
+            ImageParams::WGSL,
+            &BINDINGS,
+            render::wgsl_file!("media_image.wgsl"),
+        );
+        let [pipeline] = pipelines(
+            gpu,
+            "media image",
+            &program,
+            &[&medium.layout, &layout],
+            ["transmittance_image"],
+        )?;
         Ok(Self { timer: PassTimer::new(gpu, &[PASS]), layout, pipeline })
     }
 
     /// The estimates of every (pixel, sample), pixel-major, and the pass's time.
     #[allow(clippy::too_many_arguments)]
-    pub fn run(&self, gpu: &Gpu, medium: &GpuMedium, origin: Vec3, dirs: &[Vec3], width: u32, estimator: Estimator, key: ImageKey) -> Result<(Vec<Estimate>, Vec<PassTiming>), String> {
+    pub fn run(
+        &self,
+        gpu: &Gpu,
+        medium: &GpuMedium,
+        origin: Vec3,
+        dirs: &[Vec3],
+        width: u32,
+        estimator: Estimator,
+        key: ImageKey,
+    ) -> Result<(Vec<Estimate>, Vec<PassTiming>), String> {
         let height = dirs.len() as u32 / width;
         let (kind, samples, multiplier) = estimator.gpu_settings();
-        let params = ImageParams { origin: origin.into(), t_max: T_MAX, width, height, spp: key.spp, seed: key.seed, frame: key.frame, kind, samples, multiplier };
+        let params = ImageParams {
+            origin: origin.into(),
+            t_max: T_MAX,
+            width,
+            height,
+            spp: key.spp,
+            seed: key.seed,
+            frame: key.frame,
+            kind,
+            samples,
+            multiplier,
+        };
         let device = &gpu.device;
-        let init = |label: &str, contents: &[u8], usage| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
-        let params = init("media image params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
+        let init = |label: &str, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let params =
+            init("media image params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
         let d4: Vec<[f32; 4]> = dirs.iter().map(|d| [d.x, d.y, d.z, 0.0]).collect();
-        let dirs_buf = init("media image directions", bytemuck::cast_slice(&d4), wgpu::BufferUsages::STORAGE);
+        let dirs_buf =
+            init("media image directions", bytemuck::cast_slice(&d4), wgpu::BufferUsages::STORAGE);
         let count = dirs.len() as u64 * u64::from(key.spp);
         gpu.check_buffer_size("media image results", count * 8).map_err(|e| e.to_string())?;
         let size = count * 8;
-        let results = device.create_buffer(&wgpu::BufferDescriptor { label: Some("media image results"), size, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
-        let staging = device.create_buffer(&wgpu::BufferDescriptor { label: Some("media image staging"), size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
+        let results = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("media image results"),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("media image staging"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         let group = buffer_group(gpu, "media image", &self.layout, &[&params, &dirs_buf, &results]);
         let groups = (count as u32).div_ceil(64);
         let mut timed = self.timer.begin(gpu, "media image");
@@ -84,6 +133,11 @@ impl ImagePass {
         timed.encoder().copy_buffer_to_buffer(&results, 0, &staging, 0, size);
         let timings = timed.submit().map_err(|e| e.to_string())?;
         let raw: Vec<[u32; 2]> = read_buffer(gpu, &staging)?;
-        Ok((raw.into_iter().map(|[v, l]| Estimate { value: f32::from_bits(v), lookups: l }).collect(), timings))
+        Ok((
+            raw.into_iter()
+                .map(|[v, l]| Estimate { value: f32::from_bits(v), lookups: l })
+                .collect(),
+            timings,
+        ))
     }
 }

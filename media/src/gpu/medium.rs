@@ -1,9 +1,9 @@
 //! A medium on the GPU: its parameters (uniform), voxel densities and super-voxels (storage),
 //! bound as @group(0) of every media pass.
 
+use bytemuck::Zeroable;
 use render::compute::{BufferBinding, binding_layout, buffer_group};
 use render::gpu::Gpu;
-use bytemuck::Zeroable;
 use wgpu::util::DeviceExt;
 
 use crate::medium::{Medium, Segment};
@@ -45,7 +45,8 @@ impl From<&Segment> for RaySegment {
 /// The most media one pass binds (a uniform array; a scenario with more is refused).
 pub const MAX_MEDIA: usize = 8;
 
-const _: () = assert!(MAX_MEDIA == 8, "update the WGSL array lengths of the media and optics uniforms");
+const _: () =
+    assert!(MAX_MEDIA == 8, "update the WGSL array lengths of the media and optics uniforms");
 
 pub const BINDINGS: [BufferBinding; 3] = [
     // 8 = MAX_MEDIA (a const string cannot be formatted; the assertion above keeps them equal).
@@ -71,7 +72,11 @@ impl GpuMedium {
 
     /// Up to [`MAX_MEDIA`] media bound together (their buffers concatenated).
     pub fn several(gpu: &Gpu, media: &[&Medium]) -> Self {
-        assert!((1..=MAX_MEDIA).contains(&media.len()), "{} media; a pass binds 1 to {MAX_MEDIA}", media.len());
+        assert!(
+            (1..=MAX_MEDIA).contains(&media.len()),
+            "{} media; a pass binds 1 to {MAX_MEDIA}",
+            media.len()
+        );
         let mut params = [MediumParams::zeroed(); MAX_MEDIA];
         let (mut density, mut sv) = (Vec::new(), Vec::new());
         for (p, medium) in params.iter_mut().zip(media) {
@@ -87,12 +92,23 @@ impl GpuMedium {
                 _pad: 0.0,
             };
             density.extend_from_slice(&g.data);
-            sv.extend(medium.super_voxels.cells.iter().map(|c| [c.min, c.max, c.mean, c.rms_excess]));
+            sv.extend(
+                medium.super_voxels.cells.iter().map(|c| [c.min, c.max, c.mean, c.rms_excess]),
+            );
         }
-        let buffer = |label: &str, contents: &[u8], usage| gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
-        let params = buffer("media params", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
-        let density = buffer("media density", bytemuck::cast_slice(&density), wgpu::BufferUsages::STORAGE);
-        let super_voxels = buffer("media super-voxels", bytemuck::cast_slice(&sv), wgpu::BufferUsages::STORAGE);
+        let buffer = |label: &str, contents: &[u8], usage| {
+            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let params =
+            buffer("media params", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
+        let density =
+            buffer("media density", bytemuck::cast_slice(&density), wgpu::BufferUsages::STORAGE);
+        let super_voxels =
+            buffer("media super-voxels", bytemuck::cast_slice(&sv), wgpu::BufferUsages::STORAGE);
         let layout = binding_layout(gpu, "media", &BINDINGS);
         let group = buffer_group(gpu, "media", &layout, &[&params, &density, &super_voxels]);
         Self { layout, group, count: media.len() }

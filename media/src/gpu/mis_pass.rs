@@ -38,7 +38,12 @@ impl MisPass {
     pub fn new(gpu: &Gpu) -> Result<Self, RenderError> {
         let layout = binding_layout(gpu, "media mis trials", &BINDINGS);
         let types = Module::generated("package::media::mis_trials_types", &[MisParams::WGSL]);
-        let bindings = render::compute::group_module("package::media::mis_trials_bindings", 0, &BINDINGS, &[&types]);
+        let bindings = render::compute::group_module(
+            "package::media::mis_trials_bindings",
+            0,
+            &BINDINGS,
+            &[&types],
+        );
         let program = Program::new(vec![
             render::wgsl_file!("media_rng.wgsl"),
             render::wgsl_file!("media_jackknife.wgsl"),
@@ -53,8 +58,31 @@ impl MisPass {
 
     pub fn run(&self, gpu: &Gpu, setup: &MisSetup, seeds: &[u32]) -> Result<Vec<MisTrial>, String> {
         let s = setup;
-        let params = MisParams { mu: s.mu, majorant: s.majorant, t_max: s.t_max, delta: s.delta, d: s.d, sigma_rel: s.sigma_rel, count: seeds.len() as u32, _pad: 0 };
-        let raw: Vec<[f32; 8]> = super::trials::run_trials(gpu, "media mis trials", &self.layout, &self.pipeline, bytemuck::bytes_of(&params), seeds)?;
-        Ok(raw.into_iter().map(|v| MisTrial { w1: [v[0], v[1], v[2]], eq9: [v[3], v[4], v[5]], eq10: [v[6], v[7]] }).collect())
+        let params = MisParams {
+            mu: s.mu,
+            majorant: s.majorant,
+            t_max: s.t_max,
+            delta: s.delta,
+            d: s.d,
+            sigma_rel: s.sigma_rel,
+            count: seeds.len() as u32,
+            _pad: 0,
+        };
+        let raw: Vec<[f32; 8]> = super::trials::run_trials(
+            gpu,
+            "media mis trials",
+            &self.layout,
+            &self.pipeline,
+            bytemuck::bytes_of(&params),
+            seeds,
+        )?;
+        Ok(raw
+            .into_iter()
+            .map(|v| MisTrial {
+                w1: [v[0], v[1], v[2]],
+                eq9: [v[3], v[4], v[5]],
+                eq10: [v[6], v[7]],
+            })
+            .collect())
     }
 }

@@ -13,8 +13,11 @@ mod volume_path_pass;
 
 pub use closed_form_pass::{ClosedFormParams, ClosedFormPass};
 pub use estimator_pass::{EstimatorPass, RayResult};
-pub use image_pass::{ImagePass, ImageParams, PASS};
-pub use mis_pass::{MisParams, MisPass};
+pub use image_pass::{ImageParams, ImagePass, PASS};
 pub use medium::{GpuMedium, MAX_MEDIA, MediumParams, RaySegment};
+pub use mis_pass::{MisParams, MisPass};
 pub use shaders::{modules, modules_at, program};
-pub use volume_path_pass::{Combination, MediumOptics, MisWeight, ShadowTransmittance, VolumeImage, VolumePathParams, VolumePathPass, VolumePathSettings, VOLUME_PATH_PASS};
+pub use volume_path_pass::{
+    Combination, MediumOptics, MisWeight, ShadowTransmittance, VOLUME_PATH_PASS, VolumeImage,
+    VolumePathParams, VolumePathPass, VolumePathSettings,
+};

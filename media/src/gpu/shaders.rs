@@ -17,7 +17,12 @@ pub fn modules() -> Vec<Module> {
 /// scene, which holds groups 0 and 1).
 pub fn modules_at(group: u32) -> Vec<Module> {
     let types = Module::generated("package::media::types", &[MediumParams::WGSL, RaySegment::WGSL]);
-    let bindings = render::compute::group_module("package::media::medium_bindings", group, &super::medium::BINDINGS, &[&types]);
+    let bindings = render::compute::group_module(
+        "package::media::medium_bindings",
+        group,
+        &super::medium::BINDINGS,
+        &[&types],
+    );
     vec![
         types,
         bindings,
@@ -38,6 +43,11 @@ pub fn program(name: &str, params_wgsl: &str, own: &[BufferBinding], entry: Modu
     let library = modules();
     let types = Module::generated(&format!("package::media::{name}_types"), &[params_wgsl]);
     // Its bindings may name the library's structs too (`array<RaySegment>`).
-    let bindings = render::compute::group_module(&format!("package::media::{name}_bindings"), 1, own, &[&types, &library[0]]);
+    let bindings = render::compute::group_module(
+        &format!("package::media::{name}_bindings"),
+        1,
+        own,
+        &[&types, &library[0]],
+    );
     Program::new(library).with([types, bindings]).entry(entry)
 }

@@ -8,14 +8,37 @@ use render::readback::read_buffer;
 use wgpu::util::DeviceExt;
 
 /// Runs `pipeline` over `seeds`; `T` is one trial's result as the shader writes it.
-pub(super) fn run_trials<T: bytemuck::Pod>(gpu: &Gpu, label: &str, layout: &wgpu::BindGroupLayout, pipeline: &wgpu::ComputePipeline, params: &[u8], seeds: &[u32]) -> Result<Vec<T>, String> {
+pub(super) fn run_trials<T: bytemuck::Pod>(
+    gpu: &Gpu,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    pipeline: &wgpu::ComputePipeline,
+    params: &[u8],
+    seeds: &[u32],
+) -> Result<Vec<T>, String> {
     let device = &gpu.device;
-    let init = |contents: &[u8], usage| device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage });
+    let init = |contents: &[u8], usage| {
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents,
+            usage,
+        })
+    };
     let params = init(params, wgpu::BufferUsages::UNIFORM);
     let seeds_buf = init(bytemuck::cast_slice(seeds), wgpu::BufferUsages::STORAGE);
     let size = (seeds.len() * std::mem::size_of::<T>()) as u64;
-    let results = device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
-    let staging = device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
+    let results = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
     let group = buffer_group(gpu, label, layout, &[&params, &seeds_buf, &results]);
     let mut enc = device.create_command_encoder(&Default::default());
     {

@@ -13,8 +13,8 @@ use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::pass_library::PassLibrary;
 use render::path_tracer::PathTracer;
-use render::scene_features::SceneFeatures;
 use render::readback::read_buffer;
+use render::scene_features::SceneFeatures;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming, merge};
 use serde::{Deserialize, Serialize};
@@ -80,7 +80,12 @@ pub struct VolumePathSettings {
 
 impl Default for VolumePathSettings {
     fn default() -> Self {
-        Self { mis: MisWeight::None, combination: Combination::Eq9, shadow: ShadowTransmittance::RatioTracking, samples: 4 }
+        Self {
+            mis: MisWeight::None,
+            combination: Combination::Eq9,
+            shadow: ShadowTransmittance::RatioTracking,
+            samples: 4,
+        }
     }
 }
 
@@ -138,8 +143,14 @@ impl VolumePathPass {
     /// The pass's program: the path tracer's library, the media library with the medium as
     /// @group(3), its own @group(2), media_path.wgsl.
     pub fn program() -> Program {
-        let types = Module::generated("package::media::volume_path_types", &[VolumePathParams::WGSL]);
-        let bindings = render::compute::group_module("package::media::volume_path_bindings", 2, &BINDINGS, &[&types]);
+        let types =
+            Module::generated("package::media::volume_path_types", &[VolumePathParams::WGSL]);
+        let bindings = render::compute::group_module(
+            "package::media::volume_path_bindings",
+            2,
+            &BINDINGS,
+            &[&types],
+        );
         let mut own = super::shaders::modules_at(3);
         own.extend([types, bindings, render::wgsl_file!("media_path.wgsl")]);
         PassLibrary::program(own, [render::wgsl_file!("media_volume_path.wgsl")])
@@ -155,18 +166,39 @@ impl VolumePathPass {
         let layout = binding_layout(gpu, "media volume path", &BINDINGS);
         let features = tracer.scene().features();
         let pipeline = Self::compile(gpu, tracer, &layout, medium, features)?;
-        Ok(Self { layout, pipeline: Mutex::new((features, pipeline)), timer: PassTimer::new(gpu, &[VOLUME_PATH_PASS]) })
+        Ok(Self {
+            layout,
+            pipeline: Mutex::new((features, pipeline)),
+            timer: PassTimer::new(gpu, &[VOLUME_PATH_PASS]),
+        })
     }
 
-    fn compile(gpu: &Gpu, tracer: &PathTracer, layout: &wgpu::BindGroupLayout, medium: &GpuMedium, features: SceneFeatures) -> Result<wgpu::ComputePipeline, RenderError> {
+    fn compile(
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        layout: &wgpu::BindGroupLayout,
+        medium: &GpuMedium,
+        features: SceneFeatures,
+    ) -> Result<wgpu::ComputePipeline, RenderError> {
         let program = Self::program().replacing(&features.module());
         let scene = tracer.scene();
-        let [pipeline] = pipelines(gpu, "media volume path", &program, &[scene.layout(), scene.geometry().bind_group_layout(), layout, &medium.layout], ["volume_path"])?;
+        let [pipeline] = pipelines(
+            gpu,
+            "media volume path",
+            &program,
+            &[scene.layout(), scene.geometry().bind_group_layout(), layout, &medium.layout],
+            ["volume_path"],
+        )?;
         Ok(pipeline)
     }
 
     /// The pipeline for the tracer's scene as it is now.
-    fn pipeline(&self, gpu: &Gpu, tracer: &PathTracer, medium: &GpuMedium) -> Result<wgpu::ComputePipeline, RenderError> {
+    fn pipeline(
+        &self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        medium: &GpuMedium,
+    ) -> Result<wgpu::ComputePipeline, RenderError> {
         let features = tracer.scene().features();
         let mut held = self.pipeline.lock().unwrap_or_else(|e| e.into_inner());
         if held.0 != features {
@@ -183,22 +215,49 @@ impl VolumePathPass {
     /// `spp` paths per pixel of the tracer's current scene and camera (seed and frame as the path
     /// tracer's), in the media of `medium` with the given albedo and emission, one per medium.
     #[allow(clippy::too_many_arguments)]
-    pub fn render(&self, gpu: &Gpu, tracer: &PathTracer, medium: &GpuMedium, optics: &[MediumOptics], settings: &VolumePathSettings, spp: u32, seed: u64, frame: u32) -> Result<VolumeImage, String> {
+    pub fn render(
+        &self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        medium: &GpuMedium,
+        optics: &[MediumOptics],
+        settings: &VolumePathSettings,
+        spp: u32,
+        seed: u64,
+        frame: u32,
+    ) -> Result<VolumeImage, String> {
         if optics.len() != medium.count {
-            return Err(format!("{} media bound but {} optics given; expected one albedo and emission per medium", medium.count, optics.len()));
+            return Err(format!(
+                "{} media bound but {} optics given; expected one albedo and emission per medium",
+                medium.count,
+                optics.len()
+            ));
         }
         let mut packed = [[0f32; 4]; 2 * super::medium::MAX_MEDIA];
         for (i, o) in optics.iter().enumerate() {
             packed[2 * i] = o.albedo.extend(0.0).into();
             packed[2 * i + 1] = o.emission.extend(0.0).into();
         }
-        let (width, height) = { let s = tracer.settings(); (s.width, s.height) };
+        let (width, height) = {
+            let s = tracer.settings();
+            (s.width, s.height)
+        };
         let pixels = width * height;
         let batch = (PATHS_PER_DISPATCH / pixels).clamp(1, spp.max(1));
         let device = &gpu.device;
         let size = u64::from(pixels * batch) * 16;
-        let samples = device.create_buffer(&wgpu::BufferDescriptor { label: Some("volume path samples"), size, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false });
-        let staging = device.create_buffer(&wgpu::BufferDescriptor { label: Some("volume path staging"), size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
+        let samples = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("volume path samples"),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("volume path staging"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         let mut sum = vec![[0f64; 3]; pixels as usize];
         let mut lum = vec![(0f64, 0f64); pixels as usize];
         let mut first = 0;
@@ -215,10 +274,19 @@ impl VolumePathPass {
                 first_sample: first,
                 _pad0: 0,
             };
-            let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("volume path params"), contents: bytemuck::bytes_of(&params), usage: wgpu::BufferUsages::UNIFORM });
+            let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("volume path params"),
+                contents: bytemuck::bytes_of(&params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
             tracer.prepare_frame(gpu, spp, 0, seed, frame);
-            let optics = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("volume path optics"), contents: bytemuck::cast_slice(&packed), usage: wgpu::BufferUsages::UNIFORM });
-            let group = buffer_group(gpu, "media volume path", &self.layout, &[&params, &optics, &samples]);
+            let optics = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("volume path optics"),
+                contents: bytemuck::cast_slice(&packed),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let group =
+                buffer_group(gpu, "media volume path", &self.layout, &[&params, &optics, &samples]);
             let mut timed = self.timer.begin(gpu, VOLUME_PATH_PASS);
             timed
                 .pass(0, |pass| {
@@ -239,7 +307,8 @@ impl VolumePathPass {
                 for c in 0..3 {
                     sum[p][c] += f64::from(v[c]);
                 }
-                let l = 0.2126 * f64::from(v[0]) + 0.7152 * f64::from(v[1]) + 0.0722 * f64::from(v[2]);
+                let l =
+                    0.2126 * f64::from(v[0]) + 0.7152 * f64::from(v[1]) + 0.0722 * f64::from(v[2]);
                 lum[p].0 += l;
                 lum[p].1 += l * l;
             }
@@ -247,7 +316,17 @@ impl VolumePathPass {
         }
         let k = f64::from(spp);
         let mean = sum.iter().map(|s| s.map(|c| (c / k) as f32)).collect();
-        let var_of_mean = lum.iter().map(|&(s1, s2)| ((s2 / k - (s1 / k).powi(2)) * k / (k - 1.0).max(1.0)).max(0.0) / k).collect();
-        Ok(VolumeImage { width, height, mean, var_of_mean, timings, paths: u64::from(pixels) * u64::from(spp) })
+        let var_of_mean = lum
+            .iter()
+            .map(|&(s1, s2)| ((s2 / k - (s1 / k).powi(2)) * k / (k - 1.0).max(1.0)).max(0.0) / k)
+            .collect();
+        Ok(VolumeImage {
+            width,
+            height,
+            mean,
+            var_of_mean,
+            timings,
+            paths: u64::from(pixels) * u64::from(spp),
+        })
     }
 }

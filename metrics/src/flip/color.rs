@@ -28,7 +28,8 @@ fn mat_mul(m: &[[f32; 3]; 3], v: [f32; 3]) -> [f32; 3] {
 }
 
 fn invert(m: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
     // inv[r][c] = cofactor(c, r) / det; cyclic indices give the cofactor's sign for free.
     std::array::from_fn(|r| {
@@ -64,7 +65,8 @@ impl ColorSpace {
 
     /// YCxCz: the linear analogue of CIELAB (no cube root), used for spatial filtering.
     pub fn xyz_to_ycxcz(&self, xyz: [f32; 3]) -> [f32; 3] {
-        let [x, y, z] = [xyz[0] * self.inv_white[0], xyz[1] * self.inv_white[1], xyz[2] * self.inv_white[2]];
+        let [x, y, z] =
+            [xyz[0] * self.inv_white[0], xyz[1] * self.inv_white[1], xyz[2] * self.inv_white[2]];
         [116.0 * y - 16.0, 500.0 * (x - y), 200.0 * (y - z)]
     }
 
@@ -83,7 +85,11 @@ impl ColorSpace {
     pub fn xyz_to_lab(&self, xyz: [f32; 3]) -> [f32; 3] {
         const DELTA: f32 = 6.0 / 29.0;
         let f = |t: f32| {
-            if t > DELTA * DELTA * DELTA { t.powf(1.0 / 3.0) } else { t / (3.0 * DELTA * DELTA) + 4.0 / 29.0 }
+            if t > DELTA * DELTA * DELTA {
+                t.powf(1.0 / 3.0)
+            } else {
+                t / (3.0 * DELTA * DELTA) + 4.0 / 29.0
+            }
         };
         let fx = f(xyz[0] * self.inv_white[0]);
         let fy = f(xyz[1] * self.inv_white[1]);
@@ -122,7 +128,10 @@ mod tests {
     fn white_is_lab_100_and_round_trips() {
         let cs = ColorSpace::default();
         let lab = cs.xyz_to_lab(cs.linear_rgb_to_xyz([1.0, 1.0, 1.0]));
-        assert!((lab[0] - 100.0).abs() < 1e-3 && lab[1].abs() < 1e-3 && lab[2].abs() < 1e-3, "{lab:?}");
+        assert!(
+            (lab[0] - 100.0).abs() < 1e-3 && lab[1].abs() < 1e-3 && lab[2].abs() < 1e-3,
+            "{lab:?}"
+        );
         assert!((cs.white[1] - 1.0).abs() < 1e-6);
         for rgb in [[0.2, 0.5, 0.9], [1.0, 0.0, 0.0], [0.01, 0.02, 0.0]] {
             let back = cs.xyz_to_linear_rgb(cs.ycxcz_to_xyz(cs.linear_rgb_to_ycxcz(rgb)));
@@ -138,10 +147,14 @@ mod tests {
         // Hunt-adjusted green-blue distance is the largest pair among primaries.
         let cs = ColorSpace::default();
         let cmax = cs.max_color_distance(1.0);
-        let prim = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0], [0.0, 0.0, 0.0]];
+        let prim =
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0], [0.0, 0.0, 0.0]];
         for a in prim {
             for b in prim {
-                let d = hyab(hunt(cs.xyz_to_lab(cs.linear_rgb_to_xyz(a))), hunt(cs.xyz_to_lab(cs.linear_rgb_to_xyz(b))));
+                let d = hyab(
+                    hunt(cs.xyz_to_lab(cs.linear_rgb_to_xyz(a))),
+                    hunt(cs.xyz_to_lab(cs.linear_rgb_to_xyz(b))),
+                );
                 assert!(d <= cmax + 1e-3, "{a:?} {b:?} {d} > {cmax}");
             }
         }

@@ -46,8 +46,12 @@ impl SpatialFilters {
             y.push(gauss(d2, Y_AB.0, Y_AB.1));
             cx.push(gauss(d2, CX_AB.0, CX_AB.1));
             // sqrt(a sqrt(π/b)) per axis, so the product of the two axes has amplitude a sqrt(π/b).
-            cz1.push(gauss(d2, CZ_AB[0].0, CZ_AB[0].1) / (CZ_AB[0].0 * (pi / CZ_AB[0].1).sqrt()).sqrt());
-            cz2.push(gauss(d2, CZ_AB[1].0, CZ_AB[1].1) / (CZ_AB[1].0 * (pi / CZ_AB[1].1).sqrt()).sqrt());
+            cz1.push(
+                gauss(d2, CZ_AB[0].0, CZ_AB[0].1) / (CZ_AB[0].0 * (pi / CZ_AB[0].1).sqrt()).sqrt(),
+            );
+            cz2.push(
+                gauss(d2, CZ_AB[1].0, CZ_AB[1].1) / (CZ_AB[1].0 * (pi / CZ_AB[1].1).sqrt()).sqrt(),
+            );
         }
         let normalise = |v: &mut Vec<f32>, s: f32| v.iter_mut().for_each(|w| *w /= s);
         let sy: f32 = y.iter().sum();

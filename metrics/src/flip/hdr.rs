@@ -15,7 +15,8 @@ const ACES_DEN: [f32; 3] = [0.6 * 0.6 * 2.43, 0.6 * 0.59, 0.14];
 const TARGET: f32 = 0.85;
 
 pub fn aces(x: f32) -> f32 {
-    (x * x * ACES_NUM[0] + x * ACES_NUM[1] + ACES_NUM[2]) / (x * x * ACES_DEN[0] + x * ACES_DEN[1] + ACES_DEN[2])
+    (x * x * ACES_NUM[0] + x * ACES_NUM[1] + ACES_NUM[2])
+        / (x * x * ACES_DEN[0] + x * ACES_DEN[1] + ACES_DEN[2])
 }
 
 /// Luminance of linear sRGB (Rec. 709 weights).
@@ -73,14 +74,22 @@ impl ExposureRange {
 }
 
 /// HDR-FLIP map: maximum over exposures of LDR-FLIP between the tone-mapped images.
-pub fn hdr_flip_map(reference: &[[f32; 3]], test: &[[f32; 3]], width: usize, height: usize, ppd: f32, range: &ExposureRange) -> Vec<f32> {
+pub fn hdr_flip_map(
+    reference: &[[f32; 3]],
+    test: &[[f32; 3]],
+    width: usize,
+    height: usize,
+    ppd: f32,
+    range: &ExposureRange,
+) -> Vec<f32> {
     let mut out = vec![0.0f32; width * height];
     let tonemap = |img: &[[f32; 3]], scale: f32| -> Vec<[f32; 3]> {
         img.par_iter().map(|p| p.map(|c| aces(c * scale).clamp(0.0, 1.0))).collect()
     };
     for exposure in range.exposures() {
         let scale = 2.0f32.powf(exposure);
-        let map = ldr_flip_map(&tonemap(reference, scale), &tonemap(test, scale), width, height, ppd);
+        let map =
+            ldr_flip_map(&tonemap(reference, scale), &tonemap(test, scale), width, height, ppd);
         out.par_iter_mut().zip(map.par_iter()).for_each(|(o, &m)| *o = o.max(m));
     }
     out

@@ -30,7 +30,13 @@ fn clamped(i: usize, k: usize, radius: usize, len: usize) -> usize {
 }
 
 /// Computes the LDR-FLIP map of `test` against `reference`, both linear RGB clamped to [0, 1].
-pub fn ldr_flip_map(reference: &[[f32; 3]], test: &[[f32; 3]], width: usize, height: usize, ppd: f32) -> Vec<f32> {
+pub fn ldr_flip_map(
+    reference: &[[f32; 3]],
+    test: &[[f32; 3]],
+    width: usize,
+    height: usize,
+    ppd: f32,
+) -> Vec<f32> {
     assert_eq!(reference.len(), width * height);
     assert_eq!(test.len(), width * height);
     let cs = ColorSpace::default();
@@ -44,7 +50,14 @@ pub fn ldr_flip_map(reference: &[[f32; 3]], test: &[[f32; 3]], width: usize, hei
 }
 
 /// CSF-filtered HyAB colour difference, redistributed to [0, 1].
-fn color_difference(cs: &ColorSpace, r: &[[f32; 3]], t: &[[f32; 3]], w: usize, h: usize, ppd: f32) -> Vec<f32> {
+fn color_difference(
+    cs: &ColorSpace,
+    r: &[[f32; 3]],
+    t: &[[f32; 3]],
+    w: usize,
+    h: usize,
+    ppd: f32,
+) -> Vec<f32> {
     let f = SpatialFilters::new(ppd);
     let n = f.y.len();
     // Horizontal pass: per pixel (Y, Cx, Cz·cz1, Cz·cz2) for reference and test.
@@ -84,18 +97,31 @@ fn color_difference(cs: &ColorSpace, r: &[[f32; 3]], t: &[[f32; 3]], w: usize, h
             }
             // Filtered colours may leave the gamut: clamp in linear RGB, then go to Hunt-adjusted CIELAB.
             let perceptual = |a: [f32; 4]| {
-                let rgb = cs.xyz_to_linear_rgb(cs.ycxcz_to_xyz([a[0], a[1], a[2] + a[3]])).map(|c| c.clamp(0.0, 1.0));
+                let rgb = cs
+                    .xyz_to_linear_rgb(cs.ycxcz_to_xyz([a[0], a[1], a[2] + a[3]]))
+                    .map(|c| c.clamp(0.0, 1.0));
                 hunt(cs.xyz_to_lab(cs.linear_rgb_to_xyz(rgb)))
             };
             let de = hyab(perceptual(acc[0]), perceptual(acc[1])).powf(QC);
-            *o = if de < pccmax { de * (PT / pccmax) } else { PT + ((de - pccmax) / (cmax - pccmax)) * (1.0 - PT) };
+            *o = if de < pccmax {
+                de * (PT / pccmax)
+            } else {
+                PT + ((de - pccmax) / (cmax - pccmax)) * (1.0 - PT)
+            };
         }
     });
     out
 }
 
 /// Edge/point feature difference, combined with the colour difference into the FLIP value.
-fn feature_difference_and_combine(r: &[[f32; 3]], t: &[[f32; 3]], color: Vec<f32>, w: usize, h: usize, ppd: f32) -> Vec<f32> {
+fn feature_difference_and_combine(
+    r: &[[f32; 3]],
+    t: &[[f32; 3]],
+    color: Vec<f32>,
+    w: usize,
+    h: usize,
+    ppd: f32,
+) -> Vec<f32> {
     let f = FeatureFilters::new(ppd);
     let n = f.g.len();
     // Achromatic channel normalised to [0, 1].

@@ -39,7 +39,14 @@ impl Percentiles {
         let mut v = map.to_vec();
         v.sort_unstable_by(|a, b| a.total_cmp(b));
         let at = |q: f64| v[((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1];
-        Self { p25: at(0.25), p50: at(0.5), p75: at(0.75), p95: at(0.95), p99: at(0.99), max: v[v.len() - 1] }
+        Self {
+            p25: at(0.25),
+            p50: at(0.5),
+            p75: at(0.75),
+            p95: at(0.95),
+            p99: at(0.99),
+            max: v[v.len() - 1],
+        }
     }
 }
 
@@ -64,7 +71,13 @@ impl FlipResult {
 pub fn flip_ldr(reference: &Image, test: &Image, ppd: f32) -> FlipResult {
     reference.assert_same_size(test, "flip_ldr");
     assert!(ppd > 0.0, "flip_ldr: pixels per degree must be positive, got {ppd}");
-    let map = ldr::ldr_flip_map(&reference.rgb, &test.rgb, reference.width as usize, reference.height as usize, ppd);
+    let map = ldr::ldr_flip_map(
+        &reference.rgb,
+        &test.rgb,
+        reference.width as usize,
+        reference.height as usize,
+        ppd,
+    );
     FlipResult::new(map, None)
 }
 
@@ -76,11 +89,26 @@ pub fn flip_hdr(reference: &Image, test: &Image, ppd: f32) -> FlipResult {
 }
 
 /// HDR-FLIP with an explicit exposure range.
-pub fn flip_hdr_with_range(reference: &Image, test: &Image, ppd: f32, range: ExposureRange) -> FlipResult {
+pub fn flip_hdr_with_range(
+    reference: &Image,
+    test: &Image,
+    ppd: f32,
+    range: ExposureRange,
+) -> FlipResult {
     reference.assert_same_size(test, "flip_hdr");
     assert!(ppd > 0.0, "flip_hdr: pixels per degree must be positive, got {ppd}");
-    assert!(range.count >= 2 && range.start <= range.stop, "flip_hdr: invalid exposure range {range:?}");
-    let map = hdr::hdr_flip_map(&reference.rgb, &test.rgb, reference.width as usize, reference.height as usize, ppd, &range);
+    assert!(
+        range.count >= 2 && range.start <= range.stop,
+        "flip_hdr: invalid exposure range {range:?}"
+    );
+    let map = hdr::hdr_flip_map(
+        &reference.rgb,
+        &test.rgb,
+        reference.width as usize,
+        reference.height as usize,
+        ppd,
+        &range,
+    );
     FlipResult::new(map, Some(range))
 }
 

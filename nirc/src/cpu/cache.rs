@@ -36,8 +36,15 @@ fn xyz(v: [f32; 4]) -> [f32; 3] {
 }
 
 /// Forward of one query through the network with parameters `params`.
-pub fn predict<T: Real>(config: &NircConfig, layout: &ParameterLayout, params: &[T], state: &CacheState, q: &CacheQuery) -> ([T; 3], Activations<T>, Vec<crate::cpu::encoding::LevelCorners>) {
-    let (input, corners) = encode(layout, config.direction, params, &state.bounds, xyz(q.position), xyz(q.direction));
+pub fn predict<T: Real>(
+    config: &NircConfig,
+    layout: &ParameterLayout,
+    params: &[T],
+    state: &CacheState,
+    q: &CacheQuery,
+) -> ([T; 3], Activations<T>, Vec<crate::cpu::encoding::LevelCorners>) {
+    let (input, corners) =
+        encode(layout, config.direction, params, &state.bounds, xyz(q.position), xyz(q.direction));
     let acts = forward(layout, params, input);
     (acts.output, acts, corners)
 }
@@ -59,11 +66,23 @@ impl CpuCache {
         queries
             .iter()
             .map(|q| {
-                let cell = reliability::cell_index(cfg, &self.state.bounds, xyz(q.position)) as usize;
-                let moments = &self.state.reliability[cell * MOMENTS_PER_CELL..(cell + 1) * MOMENTS_PER_CELL];
-                let sigma = reliability::high_lr_weight(cfg, mode, self.state.counters.grid_updates, moments);
-                let f_ema = if mode == PredictorMode::HighLrOnly { [0.0; 3] } else { self.predict(q, true) };
-                let f_cur = if mode == PredictorMode::EmaOnly { [0.0; 3] } else { self.predict(q, false) };
+                let cell =
+                    reliability::cell_index(cfg, &self.state.bounds, xyz(q.position)) as usize;
+                let moments =
+                    &self.state.reliability[cell * MOMENTS_PER_CELL..(cell + 1) * MOMENTS_PER_CELL];
+                let sigma = reliability::high_lr_weight(
+                    cfg,
+                    mode,
+                    self.state.counters.grid_updates,
+                    moments,
+                );
+                let f_ema = if mode == PredictorMode::HighLrOnly {
+                    [0.0; 3]
+                } else {
+                    self.predict(q, true)
+                };
+                let f_cur =
+                    if mode == PredictorMode::EmaOnly { [0.0; 3] } else { self.predict(q, false) };
                 CacheAnswer { radiance: reliability::combine(sigma, f_cur, f_ema), sigma }
             })
             .collect()
@@ -71,7 +90,12 @@ impl CpuCache {
 
     /// Mean loss and its gradient (w.r.t. every parameter) of a batch in precision T, with the
     /// loss denominators frozen at `denominators` (stop-gradient) if given. For gradient checks.
-    pub fn loss_and_gradient<T: Real>(&self, params: &[T], records: &[TrainingRecord], frozen: Option<&[[T; 3]]>) -> (T, Vec<T>) {
+    pub fn loss_and_gradient<T: Real>(
+        &self,
+        params: &[T],
+        records: &[TrainingRecord],
+        frozen: Option<&[[T; 3]]>,
+    ) -> (T, Vec<T>) {
         let cfg = &self.state.config;
         let mut grad = vec![T::zero(); params.len()];
         let mut total = T::zero();
@@ -85,7 +109,8 @@ impl CpuCache {
             for (k, m) in self.layout.matrices.iter().enumerate() {
                 for i in 0..m.rows as usize {
                     for j in 0..m.cols as usize {
-                        grad[m.offset as usize + i * m.cols as usize + j] += deltas[k][i] * acts.layers[k][j];
+                        grad[m.offset as usize + i * m.cols as usize + j] +=
+                            deltas[k][i] * acts.layers[k][j];
                     }
                 }
             }
@@ -95,12 +120,20 @@ impl CpuCache {
     }
 
     /// Distributes dL/d(feature) to the 8 table entries of every level.
-    fn scatter_grid<T: Real>(&self, corners: &[crate::cpu::encoding::LevelCorners], d_input: &[T], mut add: impl FnMut(usize, T)) {
+    fn scatter_grid<T: Real>(
+        &self,
+        corners: &[crate::cpu::encoding::LevelCorners],
+        d_input: &[T],
+        mut add: impl FnMut(usize, T),
+    ) {
         let f = self.layout.features_per_level as usize;
         for (l, level) in corners.iter().enumerate() {
             for c in 0..8 {
                 for k in 0..f {
-                    add(level.param_index[c] as usize + k, T::from_f32(level.weight[c]) * d_input[l * f + k]);
+                    add(
+                        level.param_index[c] as usize + k,
+                        T::from_f32(level.weight[c]) * d_input[l * f + k],
+                    );
                 }
             }
         }
@@ -130,8 +163,15 @@ impl CpuCache {
             finite &= loss.is_finite();
             loss_sum += loss as f64;
             let (deltas, d_input) = backward(layout, &self.state.params, &acts, d_out);
-            self.scatter_grid(&corners, &d_input, |index, g| finite &= grid_sums[index - grid_base].add(g));
-            samples.push(ReliabilitySample { position: rec.position, target_rgb: rec.target_rgb, f_cur: [f[0], f[1], f[2], 0.0], f_ema: [f_ema[0], f_ema[1], f_ema[2], 0.0] });
+            self.scatter_grid(&corners, &d_input, |index, g| {
+                finite &= grid_sums[index - grid_base].add(g)
+            });
+            samples.push(ReliabilitySample {
+                position: rec.position,
+                target_rgb: rec.target_rgb,
+                f_cur: [f[0], f[1], f[2], 0.0],
+                f_ema: [f_ema[0], f_ema[1], f_ema[2], 0.0],
+            });
             acts_all.push(acts);
             deltas_all.push(deltas);
         }
@@ -161,13 +201,24 @@ impl CpuCache {
         let mut updated = Vec::with_capacity(grad.len());
         if finite {
             for (i, &g) in grad.iter().enumerate() {
-                let u = adam_ema_update(&cfg.optimizer, &cfg.ema, powers, st.counters.alpha_pow, st.params[i], st.adam_m[i], st.adam_v[i], st.ema[i], g);
+                let u = adam_ema_update(
+                    &cfg.optimizer,
+                    &cfg.ema,
+                    powers,
+                    st.counters.alpha_pow,
+                    st.params[i],
+                    st.adam_m[i],
+                    st.adam_v[i],
+                    st.ema[i],
+                    g,
+                );
                 finite &= u.0.is_finite() && u.1.is_finite() && u.2.is_finite() && u.3.is_finite();
                 updated.push(u);
             }
         }
         let mut moments = st.reliability.clone();
-        finite = finite && reliability::update(&cfg.reliability, &st.bounds, &mut moments, &samples);
+        finite =
+            finite && reliability::update(&cfg.reliability, &st.bounds, &mut moments, &samples);
         if !finite {
             st.counters.rejected_steps += 1;
             return StepReport { loss: loss_sum / n as f64, committed: false };

@@ -13,7 +13,9 @@ pub fn denominators<T: Real>(config: &LossConfig, f: [T; 3]) -> [T; 3] {
     match config.normalization {
         LossNormalization::PerChannel => [f[0] * f[0] + eps, f[1] * f[1] + eps, f[2] * f[2] + eps],
         LossNormalization::Luminance => {
-            let l = T::from_f32(LUMINANCE[0]) * f[0] + T::from_f32(LUMINANCE[1]) * f[1] + T::from_f32(LUMINANCE[2]) * f[2];
+            let l = T::from_f32(LUMINANCE[0]) * f[0]
+                + T::from_f32(LUMINANCE[1]) * f[1]
+                + T::from_f32(LUMINANCE[2]) * f[2];
             [l * l + eps; 3]
         }
     }

@@ -44,7 +44,12 @@ pub fn forward<T: Real>(layout: &ParameterLayout, params: &[T], input: Vec<T>) -
 /// Back-propagates dL/d(output). Returns the gradient of the pre-activation of every layer
 /// (deltas[k] belongs to matrix k: hidden layers first, the output last) and dL/d(input).
 /// The weight gradient of matrix k is deltas[k][i] * acts.layers[k][j].
-pub fn backward<T: Real>(layout: &ParameterLayout, params: &[T], acts: &Activations<T>, d_output: [T; 3]) -> (Vec<Vec<T>>, Vec<T>) {
+pub fn backward<T: Real>(
+    layout: &ParameterLayout,
+    params: &[T],
+    acts: &Activations<T>,
+    d_output: [T; 3],
+) -> (Vec<Vec<T>>, Vec<T>) {
     let n = layout.matrices.len();
     let mut deltas: Vec<Vec<T>> = vec![Vec::new(); n];
     deltas[n - 1] = d_output.to_vec();

@@ -28,12 +28,25 @@ render::gpu_struct! {
 /// `Counters` with an atomic `flag`, for the passes that raise it (the same layout).
 pub fn counters_atomic_wgsl() -> String {
     use render::gpu_struct::GpuStruct;
-    Counters::WGSL.replacen("struct Counters", "struct CountersAtomic", 1).replacen("flag: u32", "flag: atomic<u32>", 1)
+    Counters::WGSL.replacen("struct Counters", "struct CountersAtomic", 1).replacen(
+        "flag: u32",
+        "flag: atomic<u32>",
+        1,
+    )
 }
 
 impl Default for Counters {
     fn default() -> Self {
-        Self { step: 0, rejected_steps: 0, grid_updates: 0, flag: 0, beta1_pow: 1.0, beta2_pow: 1.0, alpha_pow: 1.0, _pad: 0 }
+        Self {
+            step: 0,
+            rejected_steps: 0,
+            grid_updates: 0,
+            flag: 0,
+            beta1_pow: 1.0,
+            beta2_pow: 1.0,
+            alpha_pow: 1.0,
+            _pad: 0,
+        }
     }
 }
 
@@ -72,7 +85,8 @@ pub fn adam_ema_update(
     // w̄_t = (α w̄_{t-1} (1 - α^{t-1}) + (1 - α) w_t) / (1 - α^t) written as the convex
     // combination w̄_{t-1} + β_t (w_t - w̄_{t-1}), β_t = (1 - α) / (1 - α^t): algebraically the
     // same, and exact on a constant sequence. At t = 1 (β = 1, α^{t-1} = 1) it is w_1 itself.
-    let e1 = if alpha_pow_prev == 1.0 { w1 } else { w_ema + ema_weight(ema.alpha, at) * (w1 - w_ema) };
+    let e1 =
+        if alpha_pow_prev == 1.0 { w1 } else { w_ema + ema_weight(ema.alpha, at) * (w1 - w_ema) };
     (w1, m1, v1, e1)
 }
 
@@ -92,7 +106,8 @@ mod tests {
             for t in 1..=2000 {
                 let powers = next_powers(&c, &adam, &ema);
                 // g = 0 with m = v = 0 keeps w fixed, so the EMA sees a constant sequence.
-                let (w1, _, _, e1) = adam_ema_update(&adam, &ema, powers, c.alpha_pow, w, 0.0, 0.0, e, 0.0);
+                let (w1, _, _, e1) =
+                    adam_ema_update(&adam, &ema, powers, c.alpha_pow, w, 0.0, 0.0, e, 0.0);
                 assert_eq!(w1, w);
                 assert_eq!(e1, w, "α={alpha} t={t}");
                 e = e1;
@@ -116,7 +131,11 @@ mod tests {
             c.step += 1;
             (c.beta1_pow, c.beta2_pow, c.alpha_pow) = powers;
             let a = 0.9f64;
-            let num: f64 = ws[..=t].iter().enumerate().map(|(s, &x)| (1.0 - a) * a.powi((t - s) as i32) * x as f64).sum();
+            let num: f64 = ws[..=t]
+                .iter()
+                .enumerate()
+                .map(|(s, &x)| (1.0 - a) * a.powi((t - s) as i32) * x as f64)
+                .sum();
             let expected = num / (1.0 - a.powi(t as i32 + 1));
             assert!((e as f64 - expected).abs() < 1e-5, "t={t}: {e} vs {expected}");
         }

@@ -4,7 +4,15 @@
 use std::ops::{Add, AddAssign, Div, Mul, Neg, Sub};
 
 pub trait Real:
-    Copy + PartialOrd + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + Neg<Output = Self> + AddAssign + std::fmt::Debug
+    Copy
+    + PartialOrd
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + std::fmt::Debug
 {
     fn from_f32(x: f32) -> Self;
     fn to_f64(self) -> f64;

@@ -43,8 +43,13 @@ pub fn width_for(gpu: &Gpu, layout: &ParameterLayout, placement: WeightPlacement
     let max = gpu.limits.max_texture_dimension_2d;
     let width = MAX_WIDTH.min(max);
     let fits = texels(layout).div_ceil(width) <= max;
-    let storage = gpu.adapter.get_texture_format_features(wgpu::TextureFormat::Rgba32Float).allowed_usages.contains(wgpu::TextureUsages::STORAGE_BINDING);
-    (placement == WeightPlacement::Registers && layout.features_per_level == 2 && fits && storage).then_some(width)
+    let storage = gpu
+        .adapter
+        .get_texture_format_features(wgpu::TextureFormat::Rgba32Float)
+        .allowed_usages
+        .contains(wgpu::TextureUsages::STORAGE_BINDING);
+    (placement == WeightPlacement::Registers && layout.features_per_level == 2 && fits && storage)
+        .then_some(width)
 }
 
 impl GridTextures {
@@ -53,7 +58,11 @@ impl GridTextures {
         let n = texels(layout);
         let height = n.div_ceil(width);
         let grid = layout.mlp_params as usize..layout.total_params as usize;
-        let views = [("nirc grid mirror (High-LR)", &state.params[grid.clone()]), ("nirc grid mirror (EMA)", &state.ema[grid])].map(|(label, values)| {
+        let views = [
+            ("nirc grid mirror (High-LR)", &state.params[grid.clone()]),
+            ("nirc grid mirror (EMA)", &state.ema[grid]),
+        ]
+        .map(|(label, values)| {
             let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
                 size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
@@ -70,10 +79,23 @@ impl GridTextures {
             let full = n / width;
             let write = |y: u32, texels: u32, data: &[u8]| {
                 gpu.queue.write_texture(
-                    wgpu::TexelCopyTextureInfo { texture: &texture, mip_level: 0, origin: wgpu::Origin3d { x: 0, y, z: 0 }, aspect: wgpu::TextureAspect::All },
+                    wgpu::TexelCopyTextureInfo {
+                        texture: &texture,
+                        mip_level: 0,
+                        origin: wgpu::Origin3d { x: 0, y, z: 0 },
+                        aspect: wgpu::TextureAspect::All,
+                    },
                     data,
-                    wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(texels * 16), rows_per_image: None },
-                    wgpu::Extent3d { width: texels, height: if y < full { full } else { 1 }, depth_or_array_layers: 1 },
+                    wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(texels * 16),
+                        rows_per_image: None,
+                    },
+                    wgpu::Extent3d {
+                        width: texels,
+                        height: if y < full { full } else { 1 },
+                        depth_or_array_layers: 1,
+                    },
                 );
             };
             if full > 0 {
@@ -124,6 +146,9 @@ pub fn write_module(width: Option<u32>) -> String {
              fn mirror_ema(q: u32, v: vec4<f32>) {{\n    let t = q - MLP_PARAMS / 4u;\n    textureStore(grid_ema_out, vec2<u32>(t % {w}u, t / {w}u), v);\n}}\n",
             WRITE_BINDINGS[0], WRITE_BINDINGS[1]
         ),
-        None => "fn mirror_params(q: u32, v: vec4<f32>) {}\nfn mirror_ema(q: u32, v: vec4<f32>) {}\n".to_string(),
+        None => {
+            "fn mirror_params(q: u32, v: vec4<f32>) {}\nfn mirror_ema(q: u32, v: vec4<f32>) {}\n"
+                .to_string()
+        }
     }
 }

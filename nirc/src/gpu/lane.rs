@@ -44,7 +44,9 @@ pub fn uniform_bytes(layout: &ParameterLayout) -> u32 {
 pub fn module(layout: &ParameterLayout, grid_textures: bool) -> String {
     let in_vec4 = layout.input_dims.div_ceil(4);
     let (bases, total) = lane_w_layout(layout);
-    let mut s = String::from("import package::nirc::encoding::{corners_at, corner_sum, direction_feature};\nimport package::nirc::grid::{corner_pair};\n\n");
+    let mut s = String::from(
+        "import package::nirc::encoding::{corners_at, corner_sum, direction_feature};\nimport package::nirc::grid::{corner_pair};\n\n",
+    );
     let bases_text: Vec<String> = bases.iter().map(|b| format!("{b}u")).collect();
     s.push_str(&format!(
         "const LANE_W_VEC4: u32 = {total}u;\nconst LANE_BASE = array<u32, {}>({});\n@group(0) @binding(8) var<uniform> lane_w: array<vec4<f32>, {}>;\nstruct LaneIn {{ {} }}\nstruct LanePair {{ a: LaneIn, b: LaneIn }}\n\n",
@@ -65,9 +67,14 @@ pub fn module(layout: &ParameterLayout, grid_textures: bool) -> String {
 fn inputs(layout: &ParameterLayout, grid_textures: bool) -> String {
     let f = layout.features_per_level;
     let slot = |i: u32| format!("v{}.{}", i / 4, XYZW[(i % 4) as usize]);
-    let mut s = String::from("fn lane_inputs(p: vec3<f32>, dir: vec3<f32>, first_net: u32, both: bool) -> LanePair {\n    var x: LanePair;\n");
+    let mut s = String::from(
+        "fn lane_inputs(p: vec3<f32>, dir: vec3<f32>, first_net: u32, both: bool) -> LanePair {\n    var x: LanePair;\n",
+    );
     for (l, level) in layout.levels.iter().enumerate() {
-        s.push_str(&format!("    {{\n        let c = corners_at(p, {}u, {}, {}u, {}u);\n", level.resolution, level.dense, level.table_size, level.offset));
+        s.push_str(&format!(
+            "    {{\n        let c = corners_at(p, {}u, {}, {}u, {}u);\n",
+            level.resolution, level.dense, level.table_size, level.offset
+        ));
         if grid_textures {
             let (i, j) = (slot(l as u32 * f), slot(l as u32 * f + 1));
             s.push_str(&format!("        let a = corner_pair(first_net, c);\n        x.a.{i} = a.x;\n        x.a.{j} = a.y;\n        if both {{\n            let b = corner_pair(0u, c);\n            x.b.{i} = b.x;\n            x.b.{j} = b.y;\n        }}\n"));
@@ -80,7 +87,12 @@ fn inputs(layout: &ParameterLayout, grid_textures: bool) -> String {
     }
     let base = layout.levels.len() as u32 * f;
     for i in 0..layout.direction_dims {
-        s.push_str(&format!("    x.a.{} = direction_feature(dir, {i}u);\n    x.b.{} = x.a.{};\n", slot(base + i), slot(base + i), slot(base + i)));
+        s.push_str(&format!(
+            "    x.a.{} = direction_feature(dir, {i}u);\n    x.b.{} = x.a.{};\n",
+            slot(base + i),
+            slot(base + i),
+            slot(base + i)
+        ));
     }
     s.push_str("    return x;\n}\n\n");
     s
@@ -94,11 +106,17 @@ fn net(layout: &ParameterLayout, bases: &[u32]) -> String {
     let kq = LANE_QUERIES;
     let fields: Vec<String> = (0..kq).map(|j| format!("o{j}: vec4<f32>")).collect();
     let params: Vec<String> = (0..kq).map(|j| format!("x{j}: LaneIn")).collect();
-    let mut s = format!("struct LaneOut {{ {} }}\n\nfn lane_net(net_base: u32, {}) -> LaneOut {{\n", fields.join(", "), params.join(", "));
+    let mut s = format!(
+        "struct LaneOut {{ {} }}\n\nfn lane_net(net_base: u32, {}) -> LaneOut {{\n",
+        fields.join(", "),
+        params.join(", ")
+    );
     let last = layout.matrices.len() - 1;
     for (m, (matrix, base)) in layout.matrices.iter().zip(bases).enumerate() {
         let quads = matrix.rows.div_ceil(4);
-        let input = |k: u32, j: u32| if m == 0 { format!("x{j}.v{}", k / 4) } else { format!("h{j}_{}_{}", m - 1, k / 4) };
+        let input = |k: u32, j: u32| {
+            if m == 0 { format!("x{j}.v{}", k / 4) } else { format!("h{j}_{}_{}", m - 1, k / 4) }
+        };
         if m < last {
             for q in 0..quads {
                 for j in 0..kq {
@@ -113,13 +131,18 @@ fn net(layout: &ParameterLayout, bases: &[u32]) -> String {
         for k in 0..matrix.cols {
             s.push_str(&format!("        let w{k} = lane_w[row + {}u];\n", k * quads));
             for j in 0..kq {
-                s.push_str(&format!("        acc{j} += {}.{} * w{k};\n", input(k, j), XYZW[(k % 4) as usize]));
+                s.push_str(&format!(
+                    "        acc{j} += {}.{} * w{k};\n",
+                    input(k, j),
+                    XYZW[(k % 4) as usize]
+                ));
             }
         }
         if m < last {
             s.push_str("        switch q {\n");
             for q in 0..quads {
-                let sets: String = (0..kq).map(|j| format!(" h{j}_{m}_{q} = lane_relu(acc{j});")).collect();
+                let sets: String =
+                    (0..kq).map(|j| format!(" h{j}_{m}_{q} = lane_relu(acc{j});")).collect();
                 s.push_str(&format!("            case {q}u: {{{sets} }}\n"));
             }
             s.push_str("            default: {}\n        }\n    }\n");
@@ -127,7 +150,11 @@ fn net(layout: &ParameterLayout, bases: &[u32]) -> String {
             // The output layer has one quad.
             let accs: Vec<String> = (0..kq).map(|j| format!("acc{j}")).collect();
             let zeros: Vec<String> = (0..kq).map(|_| "vec4<f32>(0.0)".to_string()).collect();
-            s.push_str(&format!("        return LaneOut({});\n    }}\n    return LaneOut({});\n", accs.join(", "), zeros.join(", ")));
+            s.push_str(&format!(
+                "        return LaneOut({});\n    }}\n    return LaneOut({});\n",
+                accs.join(", "),
+                zeros.join(", ")
+            ));
         }
     }
     s.push_str("}\n");
@@ -151,8 +178,15 @@ pub fn queries_module() -> String {
             j * wg
         ));
     }
-    s.push_str(&format!("    let f = lane_net(pr.first_net * LANE_W_VEC4, {});\n", list(&|j| format!("x{j}.a"))));
-    s.push_str(&format!("    var g = LaneOut({});\n    if pr.both {{\n        g = lane_net(0u, {});\n    }}\n", list(&|_| "vec4<f32>(0.0)".into()), list(&|j| format!("x{j}.b"))));
+    s.push_str(&format!(
+        "    let f = lane_net(pr.first_net * LANE_W_VEC4, {});\n",
+        list(&|j| format!("x{j}.a"))
+    ));
+    s.push_str(&format!(
+        "    var g = LaneOut({});\n    if pr.both {{\n        g = lane_net(0u, {});\n    }}\n",
+        list(&|_| "vec4<f32>(0.0)".into()),
+        list(&|j| format!("x{j}.b"))
+    ));
     for j in 0..kq {
         s.push_str(&format!("    if first + {}u <= last {{\n        write_predictions(i{j}, r{j}.position.xyz, mode, pr, f.o{j}.xyz, g.o{j}.xyz);\n    }}\n", j * wg));
     }

@@ -15,10 +15,10 @@
 //! 6. finish_step             commit the counters, or count the rolled-back step
 //! Every sum has a fixed order or is exact, so a step is deterministic.
 
+pub mod grid_textures;
+pub mod lane;
 pub mod readback;
 pub mod shaders;
-pub mod lane;
-pub mod grid_textures;
 
 use crate::bounds::SceneBounds;
 use crate::config::{NircConfig, PredictorMode};
@@ -83,7 +83,16 @@ render::gpu_struct! {
 
 impl Call {
     fn new(n: u32, mode: u32, num_chunks: u32) -> Self {
-        Self { n, inv_n: 1.0 / n as f32, mode, num_chunks, fixed_sigma: 0.0, pad0: 0, pad1: 0, pad2: 0 }
+        Self {
+            n,
+            inv_n: 1.0 / n as f32,
+            mode,
+            num_chunks,
+            fixed_sigma: 0.0,
+            pad0: 0,
+            pad1: 0,
+            pad2: 0,
+        }
     }
 }
 
@@ -178,7 +187,9 @@ fn storage(gpu: &Gpu, label: &str, bytes: u64) -> Result<wgpu::Buffer, NircError
     Ok(gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size: bytes.max(16),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     }))
 }
@@ -188,25 +199,50 @@ fn storage_init(gpu: &Gpu, label: &str, data: &[u8]) -> Result<wgpu::Buffer, Nir
     Ok(gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some(label),
         contents: data,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
     }))
 }
 
-fn bind(gpu: &Gpu, label: &str, pipeline: &wgpu::ComputePipeline, entries: &[(u32, &wgpu::Buffer)]) -> wgpu::BindGroup {
+fn bind(
+    gpu: &Gpu,
+    label: &str,
+    pipeline: &wgpu::ComputePipeline,
+    entries: &[(u32, &wgpu::Buffer)],
+) -> wgpu::BindGroup {
     bind_with_views(gpu, label, pipeline, entries, &[])
 }
 
 /// `bind` with storage-texture views as well (the grid mirror, grid_textures.rs).
-fn bind_with_views(gpu: &Gpu, label: &str, pipeline: &wgpu::ComputePipeline, entries: &[(u32, &wgpu::Buffer)], views: &[(u32, &wgpu::TextureView)]) -> wgpu::BindGroup {
+fn bind_with_views(
+    gpu: &Gpu,
+    label: &str,
+    pipeline: &wgpu::ComputePipeline,
+    entries: &[(u32, &wgpu::Buffer)],
+    views: &[(u32, &wgpu::TextureView)],
+) -> wgpu::BindGroup {
     let entries: Vec<wgpu::BindGroupEntry> = entries
         .iter()
         .map(|&(binding, b)| wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() })
-        .chain(views.iter().map(|&(binding, v)| wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) }))
+        .chain(views.iter().map(|&(binding, v)| wgpu::BindGroupEntry {
+            binding,
+            resource: wgpu::BindingResource::TextureView(v),
+        }))
         .collect();
-    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout: &pipeline.get_bind_group_layout(0), entries: &entries })
+    gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    })
 }
 
-fn dispatch(pass: &mut wgpu::ComputePass, pipeline: &wgpu::ComputePipeline, group: &wgpu::BindGroup, workgroups: u32) {
+fn dispatch(
+    pass: &mut wgpu::ComputePass,
+    pipeline: &wgpu::ComputePipeline,
+    group: &wgpu::BindGroup,
+    workgroups: u32,
+) {
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, group, &[]);
     pass.dispatch_workgroups(workgroups, 1, 1);
@@ -217,12 +253,18 @@ pub fn upload<T: Pod>(gpu: &Gpu, label: &str, items: &[T]) -> wgpu::Buffer {
     gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some(label),
         contents: bytemuck::cast_slice(items),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
     })
 }
 
 /// The first `n` answers of an answer buffer, read back.
-pub fn read_answers(gpu: &Gpu, answers: &wgpu::Buffer, n: u32) -> Result<Vec<CacheAnswer>, NircError> {
+pub fn read_answers(
+    gpu: &Gpu,
+    answers: &wgpu::Buffer,
+    n: u32,
+) -> Result<Vec<CacheAnswer>, NircError> {
     let mut all: Vec<CacheAnswer> = readback::read_pod(gpu, answers, "nirc answers")?;
     all.truncate(n as usize);
     Ok(all)
@@ -240,23 +282,36 @@ pub fn answer_buffer(gpu: &Gpu, n: u32) -> wgpu::Buffer {
 
 impl NeuralCache {
     /// A fresh cache (initial weights from `config.seed`) over `scene_bounds`.
-    pub fn new(gpu: &Gpu, config: &NircConfig, scene_bounds: SceneBounds) -> Result<Self, NircError> {
+    pub fn new(
+        gpu: &Gpu,
+        config: &NircConfig,
+        scene_bounds: SceneBounds,
+    ) -> Result<Self, NircError> {
         Self::from_state(gpu, &CacheState::initial(config, scene_bounds)?, None)
     }
 
     /// Uploads a whole state. `placement` None takes `FLICKER_NIRC_MLP` if set, else chooses the
     /// register-form inference on a CPU adapter and the tiled MLP on others where the network
     /// and the adapter allow them, else the per-record passes.
-    pub fn from_state(gpu: &Gpu, state: &CacheState, placement: Option<WeightPlacement>) -> Result<Self, NircError> {
+    pub fn from_state(
+        gpu: &Gpu,
+        state: &CacheState,
+        placement: Option<WeightPlacement>,
+    ) -> Result<Self, NircError> {
         let config = state.config.clone();
         config.validate()?;
         let layout = ParameterLayout::new(&config);
         let tiled = || -> Result<(), NircError> {
             if let Some(why) = shaders::tiled_unsupported(&layout) {
-                return Err(NircError::Config(format!("the tiled MLP cannot run this network: {why}")));
+                return Err(NircError::Config(format!(
+                    "the tiled MLP cannot run this network: {why}"
+                )));
             }
             // Only a network the tiles take has a tile shape (a width of 5 has none).
-            Ok(gpu.check_workgroup_memory("nirc tiled MLP (tiles in workgroup memory)", shaders::workgroup_bytes(&layout))?)
+            Ok(gpu.check_workgroup_memory(
+                "nirc tiled MLP (tiles in workgroup memory)",
+                shaders::workgroup_bytes(&layout),
+            )?)
         };
         // The register form trains with the tiled pass, so it also needs `tiled`.
         let registers = || -> Result<(), NircError> {
@@ -273,7 +328,9 @@ impl NeuralCache {
                 WeightPlacement::Registers
             }
             Some(WeightPlacement::Storage) => WeightPlacement::Storage,
-            None if gpu.summary.device_type == "Cpu" && registers().is_ok() => WeightPlacement::Registers,
+            None if gpu.summary.device_type == "Cpu" && registers().is_ok() => {
+                WeightPlacement::Registers
+            }
             None if tiled().is_ok() => WeightPlacement::Tiled,
             None => WeightPlacement::Storage,
         };
@@ -281,12 +338,20 @@ impl NeuralCache {
             // A network too large for the driver's per-invocation loop cap would come out wrong
             // silently (llvmpipe); refuse it with the numbers instead.
             gpu.check_loop_iterations(
-                &format!("nirc training/inference (width {}, {} hidden layers)", config.network.width, config.network.hidden_layers),
+                &format!(
+                    "nirc training/inference (width {}, {} hidden layers)",
+                    config.network.width, config.network.hidden_layers
+                ),
                 layout.loop_iterations_per_invocation(WORKGROUP_SIZE),
             )?;
         }
-        if config.max_batch.div_ceil(WORKGROUP_SIZE) > gpu.limits.max_compute_workgroups_per_dimension {
-            return Err(NircError::Config(format!("max_batch {} needs more workgroups than this adapter dispatches", config.max_batch)));
+        if config.max_batch.div_ceil(WORKGROUP_SIZE)
+            > gpu.limits.max_compute_workgroups_per_dimension
+        {
+            return Err(NircError::Config(format!(
+                "max_batch {} needs more workgroups than this adapter dispatches",
+                config.max_batch
+            )));
         }
         let grid_width = grid_textures::width_for(gpu, &layout, placement);
         let pipelines = Self::pipelines(gpu, &config, &layout, placement, grid_width)?;
@@ -297,20 +362,43 @@ impl NeuralCache {
 
     /// Every pass's pipelines, validated (render::compute): a shader the driver refuses is an
     /// error naming the pass.
-    fn pipelines(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, placement: WeightPlacement, grid_width: Option<u32>) -> Result<Pipelines, NircError> {
-        let build = |pass: &str, entries: &[&str]| -> Result<Vec<wgpu::ComputePipeline>, NircError> {
+    fn pipelines(
+        gpu: &Gpu,
+        config: &NircConfig,
+        layout: &ParameterLayout,
+        placement: WeightPlacement,
+        grid_width: Option<u32>,
+    ) -> Result<Pipelines, NircError> {
+        let build = |pass: &str,
+                     entries: &[&str]|
+         -> Result<Vec<wgpu::ComputePipeline>, NircError> {
             let source = shaders::program(config, layout, pass, grid_width);
             let label = format!("nirc {pass}");
             Ok(match entries {
                 [a] => render::compute::pipelines_auto_layout(gpu, &label, &source, [*a])?.to_vec(),
-                [a, b] => render::compute::pipelines_auto_layout(gpu, &label, &source, [*a, *b])?.to_vec(),
-                [a, b, c] => render::compute::pipelines_auto_layout(gpu, &label, &source, [*a, *b, *c])?.to_vec(),
+                [a, b] => {
+                    render::compute::pipelines_auto_layout(gpu, &label, &source, [*a, *b])?.to_vec()
+                }
+                [a, b, c] => {
+                    render::compute::pipelines_auto_layout(gpu, &label, &source, [*a, *b, *c])?
+                        .to_vec()
+                }
                 _ => unreachable!("one to three entry points per module"),
             })
         };
-        let one = |pass: &str| -> Result<wgpu::ComputePipeline, NircError> { Ok(build(pass, &["main"])?.remove(0)) };
-        let [weight_partial, weight_reduce] = <[wgpu::ComputePipeline; 2]>::try_from(build("weight_gradient", &["partial_sums", "reduce"])?).expect("two pipelines");
-        let [adam_check, adam_apply, ema_update] = <[wgpu::ComputePipeline; 3]>::try_from(build("adam_ema", &["check", "apply", "ema_update"])?).expect("three pipelines");
+        let one = |pass: &str| -> Result<wgpu::ComputePipeline, NircError> {
+            Ok(build(pass, &["main"])?.remove(0))
+        };
+        let [weight_partial, weight_reduce] = <[wgpu::ComputePipeline; 2]>::try_from(build(
+            "weight_gradient",
+            &["partial_sums", "reduce"],
+        )?)
+        .expect("two pipelines");
+        let [adam_check, adam_apply, ema_update] = <[wgpu::ComputePipeline; 3]>::try_from(build(
+            "adam_ema",
+            &["check", "apply", "ema_update"],
+        )?)
+        .expect("three pipelines");
         let tiled = placement.tiled_training();
         Ok(Pipelines {
             train: one(if tiled { "train_tile" } else { "train_forward_backward" })?,
@@ -328,7 +416,9 @@ impl NeuralCache {
                 WeightPlacement::Registers => "infer_lane",
                 WeightPlacement::Storage => "infer",
             })?,
-            lane_stage: (placement == WeightPlacement::Registers).then(|| one("lane_stage")).transpose()?,
+            lane_stage: (placement == WeightPlacement::Registers)
+                .then(|| one("lane_stage"))
+                .transpose()?,
         })
     }
 
@@ -348,25 +438,40 @@ impl NeuralCache {
             kappa: config.reliability.kappa,
             warmup: config.reliability.warmup,
             reliability_resolution: config.reliability.resolution,
-            loss_luminance: (config.loss.normalization == crate::config::LossNormalization::Luminance) as u32,
-            moments_per_sample: (config.reliability.update == crate::config::MomentUpdate::PerSample) as u32,
+            loss_luminance: (config.loss.normalization
+                == crate::config::LossNormalization::Luminance) as u32,
+            moments_per_sample: (config.reliability.update
+                == crate::config::MomentUpdate::PerSample) as u32,
             pad0: 0,
             pad1: 0,
             pad2: 0,
         }
     }
 
-    fn buffers(gpu: &Gpu, config: &NircConfig, layout: &ParameterLayout, state: &CacheState, placement: WeightPlacement, grid_width: Option<u32>) -> Result<Buffers, NircError> {
+    fn buffers(
+        gpu: &Gpu,
+        config: &NircConfig,
+        layout: &ParameterLayout,
+        state: &CacheState,
+        placement: WeightPlacement,
+        grid_width: Option<u32>,
+    ) -> Result<Buffers, NircError> {
         let n = layout.total_params as usize;
         for (name, len, expected) in [
             ("params", state.params.len(), n),
             ("ema", state.ema.len(), n),
             ("adam_m", state.adam_m.len(), n),
             ("adam_v", state.adam_v.len(), n),
-            ("reliability", state.reliability.len(), cell_count(&config.reliability) as usize * MOMENTS_PER_CELL),
+            (
+                "reliability",
+                state.reliability.len(),
+                cell_count(&config.reliability) as usize * MOMENTS_PER_CELL,
+            ),
         ] {
             if len != expected {
-                return Err(NircError::Config(format!("state.{name} has {len} values, the config needs {expected}")));
+                return Err(NircError::Config(format!(
+                    "state.{name} has {len} values, the config needs {expected}"
+                )));
             }
         }
         let max_batch = config.max_batch as u64;
@@ -387,14 +492,38 @@ impl NeuralCache {
             adam_m: storage_init(gpu, "nirc adam m", bytemuck::cast_slice(&state.adam_m))?,
             adam_v: storage_init(gpu, "nirc adam v", bytemuck::cast_slice(&state.adam_v))?,
             grad: storage(gpu, "nirc mlp gradient", layout.mlp_params as u64 * 4)?,
-            partials: storage(gpu, "nirc gradient partial sums", chunks * layout.mlp_params as u64 * 4)?,
-            scratch: storage(gpu, "nirc training scratch", max_batch * layout.scratch_stride() as u64 * 4)?,
-            grid_accum: storage(gpu, "nirc hash-grid gradient sums", layout.grid_params() as u64 * 12)?,
-            samples: storage(gpu, "nirc reliability samples", max_batch * std::mem::size_of::<ReliabilitySample>() as u64)?,
+            partials: storage(
+                gpu,
+                "nirc gradient partial sums",
+                chunks * layout.mlp_params as u64 * 4,
+            )?,
+            scratch: storage(
+                gpu,
+                "nirc training scratch",
+                max_batch * layout.scratch_stride() as u64 * 4,
+            )?,
+            grid_accum: storage(
+                gpu,
+                "nirc hash-grid gradient sums",
+                layout.grid_params() as u64 * 12,
+            )?,
+            samples: storage(
+                gpu,
+                "nirc reliability samples",
+                max_batch * std::mem::size_of::<ReliabilitySample>() as u64,
+            )?,
             sample_cells: storage(gpu, "nirc reliability sample cells and links", max_batch * 8)?,
             losses: storage(gpu, "nirc losses", max_batch * 4)?,
-            reliability_accum: storage(gpu, "nirc reliability sums", cell_count(&config.reliability) as u64 * ACCUM_PER_CELL * 4)?,
-            moments: storage_init(gpu, "nirc reliability moments", bytemuck::cast_slice(&state.reliability))?,
+            reliability_accum: storage(
+                gpu,
+                "nirc reliability sums",
+                cell_count(&config.reliability) as u64 * ACCUM_PER_CELL * 4,
+            )?,
+            moments: storage_init(
+                gpu,
+                "nirc reliability moments",
+                bytemuck::cast_slice(&state.reliability),
+            )?,
             counters: storage_init(gpu, "nirc counters", bytemuck::bytes_of(&counters))?,
             lane_staged: (placement == WeightPlacement::Registers).then(|| {
                 gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -410,21 +539,37 @@ impl NeuralCache {
 
     fn fixed_groups(gpu: &Gpu, p: &Pipelines, b: &Buffers) -> FixedBindGroups {
         FixedBindGroups {
-            reliability_update: bind(gpu, "nirc reliability update", &p.reliability_update, &[(1, &b.hyper), (2, &b.reliability_accum), (3, &b.moments), (4, &b.counters)]),
-            lane_stage: p.lane_stage.as_ref().zip(b.lane_staged.as_ref()).map(|(stage, staged)| bind(gpu, "nirc lane stage", stage, &[(3, &b.params), (4, &b.ema), (9, staged)])),
+            reliability_update: bind(
+                gpu,
+                "nirc reliability update",
+                &p.reliability_update,
+                &[(1, &b.hyper), (2, &b.reliability_accum), (3, &b.moments), (4, &b.counters)],
+            ),
+            lane_stage: p.lane_stage.as_ref().zip(b.lane_staged.as_ref()).map(|(stage, staged)| {
+                bind(gpu, "nirc lane stage", stage, &[(3, &b.params), (4, &b.ema), (9, staged)])
+            }),
         }
     }
 
     /// The per-call uniforms live in their own small buffer, so that several calls can be
     /// recorded into one command encoder.
     fn call_buffer(gpu: &Gpu, call: Call) -> wgpu::Buffer {
-        gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("nirc call"), contents: bytemuck::bytes_of(&call), usage: wgpu::BufferUsages::UNIFORM })
+        gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("nirc call"),
+            contents: bytemuck::bytes_of(&call),
+            usage: wgpu::BufferUsages::UNIFORM,
+        })
     }
 
     fn check_items(what: &str, buffer: &wgpu::Buffer, n: u32, item: u64) -> Result<(), NircError> {
         let needed = n as u64 * item;
         if buffer.size() < needed {
-            return Err(NircError::BufferTooSmall { what: what.into(), bytes: buffer.size(), needed, count: n });
+            return Err(NircError::BufferTooSmall {
+                what: what.into(),
+                bytes: buffer.size(),
+                needed,
+                count: n,
+            });
         }
         Ok(())
     }
@@ -433,7 +578,9 @@ impl NeuralCache {
     /// submitted at once. A step with a non-finite loss, gradient or weight is rolled back on
     /// the GPU and counted in `Counters::rejected_steps`.
     pub fn train(&self, gpu: &Gpu, records: &wgpu::Buffer, n: u32) -> Result<(), NircError> {
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc train") });
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc train") });
         self.encode_train(gpu, &mut encoder, records, n)?;
         gpu.queue.submit([encoder.finish()]);
         Ok(())
@@ -442,10 +589,19 @@ impl NeuralCache {
     /// Records one training step into the caller's encoder (e.g. after the path tracer's pass
     /// that wrote `records`): Adam, the EMA of the weights, the reliability grid, the step's
     /// commit. Steps recorded in order run in order.
-    pub fn encode_train(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, records: &wgpu::Buffer, n: u32) -> Result<(), NircError> {
+    pub fn encode_train(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        records: &wgpu::Buffer,
+        n: u32,
+    ) -> Result<(), NircError> {
         let Some(step) = self.prepare_step(gpu, records, n)? else { return Ok(()) };
         self.clear_step(encoder);
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc train"), timestamp_writes: None });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("nirc train"),
+            timestamp_writes: None,
+        });
         self.dispatch_adam(&mut pass, &step);
         self.dispatch_ema(&mut pass, &step);
         self.dispatch_reliability(&mut pass, &step);
@@ -456,58 +612,140 @@ impl NeuralCache {
     /// no records. Then [`Self::adam_timed`], [`Self::ema_timed`], [`Self::reliability_timed`]
     /// in this order, each its own pass (the frame's `nirc::train`, `nirc::ema` and
     /// `nirc::reliability_update` systems).
-    pub fn prepare_step(&self, gpu: &Gpu, records: &wgpu::Buffer, n: u32) -> Result<Option<TrainStep>, NircError> {
+    pub fn prepare_step(
+        &self,
+        gpu: &Gpu,
+        records: &wgpu::Buffer,
+        n: u32,
+    ) -> Result<Option<TrainStep>, NircError> {
         if n == 0 {
             return Ok(None);
         }
         if n > self.config.max_batch {
             return Err(NircError::BatchTooLarge { requested: n, max: self.config.max_batch });
         }
-        Self::check_items("training records", records, n, std::mem::size_of::<TrainingRecord>() as u64)?;
+        Self::check_items(
+            "training records",
+            records,
+            n,
+            std::mem::size_of::<TrainingRecord>() as u64,
+        )?;
         let b = &self.buffers;
         let p = &self.pipelines;
         let num_chunks = n.div_ceil(CHUNK);
         let call = Self::call_buffer(gpu, Call::new(n, 0, num_chunks));
-        let mut fb_entries: Vec<(u32, &wgpu::Buffer)> =
-            vec![(0, &call), (1, &b.hyper), (2, records), (3, &b.params), (4, &b.ema), (5, &b.scratch), (6, &b.grid_accum), (7, &b.samples), (8, &b.losses), (9, &b.counters)];
+        let mut fb_entries: Vec<(u32, &wgpu::Buffer)> = vec![
+            (0, &call),
+            (1, &b.hyper),
+            (2, records),
+            (3, &b.params),
+            (4, &b.ema),
+            (5, &b.scratch),
+            (6, &b.grid_accum),
+            (7, &b.samples),
+            (8, &b.losses),
+            (9, &b.counters),
+        ];
         if self.placement.tiled_training() {
             fb_entries.push((10, &b.partials));
         }
-        let fb = bind_with_views(gpu, "nirc train", &p.train, &fb_entries, &self.grid_views(grid_textures::READ_BINDINGS));
+        let fb = bind_with_views(
+            gpu,
+            "nirc train",
+            &p.train,
+            &fb_entries,
+            &self.grid_views(grid_textures::READ_BINDINGS),
+        );
         let (accumulate, walk) = self.reliability_groups(gpu, &call, &b.samples);
-        let partial = p.weight_partial.as_ref().map(|wp| bind(gpu, "nirc weight partial", wp, &[(0, &call), (1, &b.scratch), (2, &b.partials)]));
-        let reduce = bind(gpu, "nirc weight reduce", &p.weight_reduce, &[(0, &call), (2, &b.partials), (3, &b.grad)]);
-        let adam_entries: &[(u32, &wgpu::Buffer)] =
-            &[(0, &call), (1, &b.hyper), (2, &b.params), (3, &b.ema), (4, &b.adam_m), (5, &b.adam_v), (6, &b.grad), (7, &b.grid_accum), (8, &b.counters)];
+        let partial = p.weight_partial.as_ref().map(|wp| {
+            bind(gpu, "nirc weight partial", wp, &[(0, &call), (1, &b.scratch), (2, &b.partials)])
+        });
+        let reduce = bind(
+            gpu,
+            "nirc weight reduce",
+            &p.weight_reduce,
+            &[(0, &call), (2, &b.partials), (3, &b.grad)],
+        );
+        let adam_entries: &[(u32, &wgpu::Buffer)] = &[
+            (0, &call),
+            (1, &b.hyper),
+            (2, &b.params),
+            (3, &b.ema),
+            (4, &b.adam_m),
+            (5, &b.adam_v),
+            (6, &b.grad),
+            (7, &b.grid_accum),
+            (8, &b.counters),
+        ];
         let check = bind(gpu, "nirc adam check", &p.adam_check, adam_entries);
         // `apply` does not read the EMA (adam_ema.wgsl), so its layout has no binding 3.
-        let apply_entries: Vec<(u32, &wgpu::Buffer)> = adam_entries.iter().copied().filter(|&(binding, _)| binding != 3).collect();
+        let apply_entries: Vec<(u32, &wgpu::Buffer)> =
+            adam_entries.iter().copied().filter(|&(binding, _)| binding != 3).collect();
         // The grid mirror's write views, if any: apply writes the High-LR one, the EMA pass the other.
         let mirror = self.grid_views(grid_textures::WRITE_BINDINGS);
         let (params_out, ema_out) = mirror.split_at(mirror.len() / 2);
-        let apply = bind_with_views(gpu, "nirc adam apply", &p.adam_apply, &apply_entries, params_out);
-        let ema = bind_with_views(gpu, "nirc ema update", &p.ema_update, &[(1, &b.hyper), (2, &b.params), (3, &b.ema), (8, &b.counters)], ema_out);
-        let finish = bind(gpu, "nirc finish", &p.finish_step, &[(0, &call), (1, &b.hyper), (2, &b.counters)]);
-        Ok(Some(TrainStep { n, num_chunks, fb, accumulate, walk, partial, reduce, check, apply, ema, finish }))
+        let apply =
+            bind_with_views(gpu, "nirc adam apply", &p.adam_apply, &apply_entries, params_out);
+        let ema = bind_with_views(
+            gpu,
+            "nirc ema update",
+            &p.ema_update,
+            &[(1, &b.hyper), (2, &b.params), (3, &b.ema), (8, &b.counters)],
+            ema_out,
+        );
+        let finish = bind(
+            gpu,
+            "nirc finish",
+            &p.finish_step,
+            &[(0, &call), (1, &b.hyper), (2, &b.counters)],
+        );
+        Ok(Some(TrainStep {
+            n,
+            num_chunks,
+            fb,
+            accumulate,
+            walk,
+            partial,
+            reduce,
+            check,
+            apply,
+            ema,
+            finish,
+        }))
     }
 
     /// Forward and backward passes, gradients and the Adam step of the High-LR weights (with the
     /// step's reliability samples accumulated), as pass `index` of a timed frame.
-    pub fn adam_timed(&self, timed: &mut TimedFrame, index: usize, step: &TrainStep) -> Result<(), NircError> {
+    pub fn adam_timed(
+        &self,
+        timed: &mut TimedFrame,
+        index: usize,
+        step: &TrainStep,
+    ) -> Result<(), NircError> {
         self.clear_step(timed.encoder());
         timed.pass(index, |pass| self.dispatch_adam(pass, step))?;
         Ok(())
     }
 
     /// The debiased EMA of the weights after the Adam step, as pass `index` of a timed frame.
-    pub fn ema_timed(&self, timed: &mut TimedFrame, index: usize, step: &TrainStep) -> Result<(), NircError> {
+    pub fn ema_timed(
+        &self,
+        timed: &mut TimedFrame,
+        index: usize,
+        step: &TrainStep,
+    ) -> Result<(), NircError> {
         timed.pass(index, |pass| self.dispatch_ema(pass, step))?;
         Ok(())
     }
 
     /// The reliability grid's moments from the step's samples, then the step's commit (or
     /// roll-back count), as pass `index` of a timed frame.
-    pub fn reliability_timed(&self, timed: &mut TimedFrame, index: usize, step: &TrainStep) -> Result<(), NircError> {
+    pub fn reliability_timed(
+        &self,
+        timed: &mut TimedFrame,
+        index: usize,
+        step: &TrainStep,
+    ) -> Result<(), NircError> {
         timed.pass(index, |pass| self.dispatch_reliability(pass, step))?;
         Ok(())
     }
@@ -524,12 +762,27 @@ impl NeuralCache {
         let all = self.param_groups();
         let mut stages: Vec<Stage> = vec![
             ("train (forward, backward)", &p.train, &s.fb, s.n.div_ceil(WORKGROUP_SIZE)),
-            ("reliability accumulate", &p.reliability_accumulate, &s.accumulate, groups_for(s.n as u64)),
+            (
+                "reliability accumulate",
+                &p.reliability_accumulate,
+                &s.accumulate,
+                groups_for(s.n as u64),
+            ),
         ];
         if let (Some(pipeline), Some(group)) = (&p.weight_partial, &s.partial) {
-            stages.push(("weight gradient partials", pipeline, group, groups_for(self.layout.mlp_params as u64 * s.num_chunks as u64)));
+            stages.push((
+                "weight gradient partials",
+                pipeline,
+                group,
+                groups_for(self.layout.mlp_params as u64 * s.num_chunks as u64),
+            ));
         }
-        stages.push(("weight gradient reduce", &p.weight_reduce, &s.reduce, groups_for(self.layout.mlp_params as u64)));
+        stages.push((
+            "weight gradient reduce",
+            &p.weight_reduce,
+            &s.reduce,
+            groups_for(self.layout.mlp_params as u64),
+        ));
         stages.push(("adam check (every parameter)", &p.adam_check, &s.check, all));
         stages.push(("adam apply (every parameter)", &p.adam_apply, &s.apply, all));
         stages
@@ -542,7 +795,12 @@ impl NeuralCache {
 
     /// The `nirc::ema` part: the debiased EMA of every parameter.
     fn ema_stages<'a>(&'a self, s: &'a TrainStep) -> Vec<Stage<'a>> {
-        vec![("ema update (every parameter)", &self.pipelines.ema_update, &s.ema, self.param_groups())]
+        vec![(
+            "ema update (every parameter)",
+            &self.pipelines.ema_update,
+            &s.ema,
+            self.param_groups(),
+        )]
     }
 
     /// The `nirc::reliability_update` part: the per-sample moment walk (not for the batch-mean
@@ -553,7 +811,12 @@ impl NeuralCache {
         if self.config.reliability.update == crate::config::MomentUpdate::PerSample {
             stages.push(("reliability walk", &p.reliability_walk, &s.walk, groups_for(s.n as u64)));
         }
-        stages.push(("reliability update", &p.reliability_update, &self.groups.reliability_update, groups_for(cell_count(&self.config.reliability) as u64)));
+        stages.push((
+            "reliability update",
+            &p.reliability_update,
+            &self.groups.reliability_update,
+            groups_for(cell_count(&self.config.reliability) as u64),
+        ));
         stages.push(("finish step", &p.finish_step, &s.finish, 1));
         stages
     }
@@ -570,11 +833,21 @@ impl NeuralCache {
 
     /// Seconds per dispatch of one training step on `n` of `records`, each stage submitted and
     /// waited for alone, `reps` times after a warm-up: the profile `flicker bench --nirc` prints.
-    pub fn train_stage_seconds(&self, gpu: &Gpu, records: &wgpu::Buffer, n: u32, reps: u32) -> Result<Vec<(&'static str, f64)>, NircError> {
+    pub fn train_stage_seconds(
+        &self,
+        gpu: &Gpu,
+        records: &wgpu::Buffer,
+        n: u32,
+        reps: u32,
+    ) -> Result<Vec<(&'static str, f64)>, NircError> {
         let Some(s) = self.prepare_step(gpu, records, n)? else { return Ok(Vec::new()) };
-        let timed = |name: &'static str, record: &dyn Fn(&mut wgpu::CommandEncoder)| -> Result<f64, NircError> {
+        let timed = |name: &'static str,
+                     record: &dyn Fn(&mut wgpu::CommandEncoder)|
+         -> Result<f64, NircError> {
             let run = || {
-                let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(name) });
+                let mut encoder = gpu
+                    .device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(name) });
                 record(&mut encoder);
                 gpu.queue.submit([encoder.finish()]);
                 readback::wait_idle(gpu)
@@ -587,14 +860,25 @@ impl NeuralCache {
             Ok(t.elapsed().as_secs_f64() / reps.max(1) as f64)
         };
         let mut out = Vec::new();
-        for stage in self.adam_stages(&s).into_iter().chain(self.ema_stages(&s)).chain(self.reliability_stages(&s)) {
+        for stage in self
+            .adam_stages(&s)
+            .into_iter()
+            .chain(self.ema_stages(&s))
+            .chain(self.reliability_stages(&s))
+        {
             let seconds = timed(stage.0, &|encoder| {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(stage.0), timestamp_writes: None });
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(stage.0),
+                    timestamp_writes: None,
+                });
                 Self::dispatch_stages(&mut pass, &[stage]);
             })?;
             out.push((stage.0, seconds));
         }
-        out.push(("clear the step's accumulators", timed("clear", &|encoder| self.clear_step(encoder))?));
+        out.push((
+            "clear the step's accumulators",
+            timed("clear", &|encoder| self.clear_step(encoder))?,
+        ));
         Ok(out)
     }
 
@@ -607,11 +891,40 @@ impl NeuralCache {
     }
 
     /// The bind groups of the reliability accumulation and walk over `samples`.
-    fn reliability_groups(&self, gpu: &Gpu, call: &wgpu::Buffer, samples: &wgpu::Buffer) -> (wgpu::BindGroup, wgpu::BindGroup) {
+    fn reliability_groups(
+        &self,
+        gpu: &Gpu,
+        call: &wgpu::Buffer,
+        samples: &wgpu::Buffer,
+    ) -> (wgpu::BindGroup, wgpu::BindGroup) {
         let b = &self.buffers;
         let p = &self.pipelines;
-        let accumulate = bind(gpu, "nirc reliability accumulate", &p.reliability_accumulate, &[(0, call), (1, &b.hyper), (2, samples), (3, &b.reliability_accum), (4, &b.counters), (5, &b.sample_cells)]);
-        let walk = bind(gpu, "nirc reliability walk", &p.reliability_walk, &[(0, call), (1, &b.hyper), (2, samples), (3, &b.reliability_accum), (4, &b.moments), (5, &b.sample_cells)]);
+        let accumulate = bind(
+            gpu,
+            "nirc reliability accumulate",
+            &p.reliability_accumulate,
+            &[
+                (0, call),
+                (1, &b.hyper),
+                (2, samples),
+                (3, &b.reliability_accum),
+                (4, &b.counters),
+                (5, &b.sample_cells),
+            ],
+        );
+        let walk = bind(
+            gpu,
+            "nirc reliability walk",
+            &p.reliability_walk,
+            &[
+                (0, call),
+                (1, &b.hyper),
+                (2, samples),
+                (3, &b.reliability_accum),
+                (4, &b.moments),
+                (5, &b.sample_cells),
+            ],
+        );
         (accumulate, walk)
     }
 
@@ -624,11 +937,21 @@ impl NeuralCache {
 
     /// One update of the reliability grid from explicit samples (no training): what a training
     /// step does with its own samples. For tests and for callers that score other predictors.
-    pub fn update_reliability(&self, gpu: &Gpu, samples: &wgpu::Buffer, n: u32) -> Result<(), NircError> {
+    pub fn update_reliability(
+        &self,
+        gpu: &Gpu,
+        samples: &wgpu::Buffer,
+        n: u32,
+    ) -> Result<(), NircError> {
         if n == 0 {
             return Ok(());
         }
-        Self::check_items("reliability samples", samples, n, std::mem::size_of::<ReliabilitySample>() as u64)?;
+        Self::check_items(
+            "reliability samples",
+            samples,
+            n,
+            std::mem::size_of::<ReliabilitySample>() as u64,
+        )?;
         if n > self.config.max_batch {
             return Err(NircError::BatchTooLarge { requested: n, max: self.config.max_batch });
         }
@@ -636,14 +959,29 @@ impl NeuralCache {
         let p = &self.pipelines;
         let call = Self::call_buffer(gpu, Call::new(n, 1, 0));
         let (acc, walk) = self.reliability_groups(gpu, &call, samples);
-        let finish = bind(gpu, "nirc finish", &p.finish_step, &[(0, &call), (1, &b.hyper), (2, &b.counters)]);
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc reliability") });
+        let finish = bind(
+            gpu,
+            "nirc finish",
+            &p.finish_step,
+            &[(0, &call), (1, &b.hyper), (2, &b.counters)],
+        );
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("nirc reliability"),
+        });
         encoder.clear_buffer(&b.reliability_accum, 0, None);
         {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc reliability"), timestamp_writes: None });
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("nirc reliability"),
+                timestamp_writes: None,
+            });
             dispatch(&mut pass, &p.reliability_accumulate, &acc, groups_for(n as u64));
             self.dispatch_walk(&mut pass, &walk, n);
-            dispatch(&mut pass, &p.reliability_update, &self.groups.reliability_update, groups_for(cell_count(&self.config.reliability) as u64));
+            dispatch(
+                &mut pass,
+                &p.reliability_update,
+                &self.groups.reliability_update,
+                groups_for(cell_count(&self.config.reliability) as u64),
+            );
             dispatch(&mut pass, &p.finish_step, &finish, 1);
         }
         gpu.queue.submit([encoder.finish()]);
@@ -652,35 +990,83 @@ impl NeuralCache {
 
     /// Answers the first `n` queries of `queries` (array of `CacheQuery`) into `out` (array of
     /// `CacheAnswer`): radiance max(0, (1 - σ) f_EMA + σ f_cur) and σ. Submitted at once.
-    pub fn infer(&self, gpu: &Gpu, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: PredictorMode) -> Result<(), NircError> {
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc infer") });
+    pub fn infer(
+        &self,
+        gpu: &Gpu,
+        queries: &wgpu::Buffer,
+        n: u32,
+        out: &wgpu::Buffer,
+        mode: PredictorMode,
+    ) -> Result<(), NircError> {
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc infer") });
         self.encode_infer(gpu, &mut encoder, queries, n, out, mode)?;
         gpu.queue.submit([encoder.finish()]);
         Ok(())
     }
 
     /// [`Self::encode_infer`] as pass `index` of a timed frame.
-    pub fn infer_timed(&self, gpu: &Gpu, timed: &mut TimedFrame, index: usize, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: PredictorMode) -> Result<(), NircError> {
-        let Some(group) = self.infer_group(gpu, queries, n, out, (mode.code(), mode.fixed_sigma()))? else { return Ok(()) };
+    pub fn infer_timed(
+        &self,
+        gpu: &Gpu,
+        timed: &mut TimedFrame,
+        index: usize,
+        queries: &wgpu::Buffer,
+        n: u32,
+        out: &wgpu::Buffer,
+        mode: PredictorMode,
+    ) -> Result<(), NircError> {
+        let Some(group) =
+            self.infer_group(gpu, queries, n, out, (mode.code(), mode.fixed_sigma()))?
+        else {
+            return Ok(());
+        };
         timed.pass(index, |pass| self.dispatch_infer(pass, &group, n))?;
         Ok(())
     }
 
     /// Records the inference of `n` queries into the caller's encoder.
-    pub fn encode_infer(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: PredictorMode) -> Result<(), NircError> {
+    pub fn encode_infer(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        queries: &wgpu::Buffer,
+        n: u32,
+        out: &wgpu::Buffer,
+        mode: PredictorMode,
+    ) -> Result<(), NircError> {
         self.encode_infer_code(gpu, encoder, queries, n, out, (mode.code(), mode.fixed_sigma()))
     }
 
     /// Records a diagnostic look-up of the reliability grid at `n` queries (no network): each
     /// answer is (r̄_cur, r̄_EMA, σ of the blend, 1 once the grid is past its warm-up else 0),
     /// the signal behind preference maps and the mean reliability per frame.
-    pub fn encode_reliability(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer) -> Result<(), NircError> {
+    pub fn encode_reliability(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        queries: &wgpu::Buffer,
+        n: u32,
+        out: &wgpu::Buffer,
+    ) -> Result<(), NircError> {
         self.encode_infer_code(gpu, encoder, queries, n, out, (RELIABILITY_MODE, 0.0))
     }
 
-    fn encode_infer_code(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: (u32, f32)) -> Result<(), NircError> {
+    fn encode_infer_code(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        queries: &wgpu::Buffer,
+        n: u32,
+        out: &wgpu::Buffer,
+        mode: (u32, f32),
+    ) -> Result<(), NircError> {
         let Some(group) = self.infer_group(gpu, queries, n, out, mode)? else { return Ok(()) };
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("nirc infer"), timestamp_writes: None });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("nirc infer"),
+            timestamp_writes: None,
+        });
         self.dispatch_infer(&mut pass, &group, n);
         Ok(())
     }
@@ -688,8 +1074,15 @@ impl NeuralCache {
     /// Every inference goes through here: the register form first stages the weights as this
     /// inference must see them (the last committed step's), then the inference pass.
     fn dispatch_infer(&self, pass: &mut wgpu::ComputePass, group: &wgpu::BindGroup, n: u32) {
-        if let (Some(stage), Some(stage_group)) = (&self.pipelines.lane_stage, &self.groups.lane_stage) {
-            dispatch(pass, stage, stage_group, (lane::uniform_bytes(&self.layout) / 16).div_ceil(WORKGROUP_SIZE));
+        if let (Some(stage), Some(stage_group)) =
+            (&self.pipelines.lane_stage, &self.groups.lane_stage)
+        {
+            dispatch(
+                pass,
+                stage,
+                stage_group,
+                (lane::uniform_bytes(&self.layout) / 16).div_ceil(WORKGROUP_SIZE),
+            );
         }
         dispatch(pass, &self.pipelines.infer, group, self.infer_groups(n));
     }
@@ -705,7 +1098,14 @@ impl NeuralCache {
     }
 
     /// The bind group of an inference of `n` queries; `None` for no queries.
-    fn infer_group(&self, gpu: &Gpu, queries: &wgpu::Buffer, n: u32, out: &wgpu::Buffer, mode: (u32, f32)) -> Result<Option<wgpu::BindGroup>, NircError> {
+    fn infer_group(
+        &self,
+        gpu: &Gpu,
+        queries: &wgpu::Buffer,
+        n: u32,
+        out: &wgpu::Buffer,
+        mode: (u32, f32),
+    ) -> Result<Option<wgpu::BindGroup>, NircError> {
         if n == 0 {
             return Ok(None);
         }
@@ -713,11 +1113,22 @@ impl NeuralCache {
         Self::check_items("cache answers", out, n, std::mem::size_of::<CacheAnswer>() as u64)?;
         let groups = self.infer_groups(n);
         if groups > gpu.limits.max_compute_workgroups_per_dimension {
-            return Err(NircError::Config(format!("{n} queries need {groups} workgroups, over this adapter's limit")));
+            return Err(NircError::Config(format!(
+                "{n} queries need {groups} workgroups, over this adapter's limit"
+            )));
         }
         let b = &self.buffers;
         let call = Self::call_buffer(gpu, Call { fixed_sigma: mode.1, ..Call::new(n, mode.0, 0) });
-        let mut entries = vec![(0, &call), (1, &b.hyper), (2, queries), (3, &b.params), (4, &b.ema), (5, &b.moments), (6, &b.counters), (7, out)];
+        let mut entries = vec![
+            (0, &call),
+            (1, &b.hyper),
+            (2, queries),
+            (3, &b.params),
+            (4, &b.ema),
+            (5, &b.moments),
+            (6, &b.counters),
+            (7, out),
+        ];
         if let Some(staged) = &b.lane_staged {
             entries.push((8, staged));
         }
@@ -726,7 +1137,13 @@ impl NeuralCache {
             // staged uniform: the parameter buffers are not in its layout.
             entries.retain(|&(binding, _)| binding != 3 && binding != 4);
         }
-        Ok(Some(bind_with_views(gpu, "nirc infer", &self.pipelines.infer, &entries, &self.grid_views(grid_textures::READ_BINDINGS))))
+        Ok(Some(bind_with_views(
+            gpu,
+            "nirc infer",
+            &self.pipelines.infer,
+            &entries,
+            &self.grid_views(grid_textures::READ_BINDINGS),
+        )))
     }
 
     /// Whether the passes read the hash grid from its texture mirror (grid_textures.rs).
@@ -736,12 +1153,20 @@ impl NeuralCache {
 
     /// The grid mirror's two views at `bindings` ([High-LR, EMA]); none without the mirror.
     fn grid_views(&self, bindings: [u32; 2]) -> Vec<(u32, &wgpu::TextureView)> {
-        self.buffers.grid.iter().flat_map(|g| [(bindings[0], &g.views[0]), (bindings[1], &g.views[1])]).collect()
+        self.buffers
+            .grid
+            .iter()
+            .flat_map(|g| [(bindings[0], &g.views[0]), (bindings[1], &g.views[1])])
+            .collect()
     }
 
     pub fn counters(&self, gpu: &Gpu) -> Result<Counters, NircError> {
-        let counters: Vec<Counters> = readback::read_pod(gpu, &self.buffers.counters, "nirc counters")?;
-        counters.first().copied().ok_or_else(|| NircError::Readback { what: "nirc counters".into(), reason: "the buffer is smaller than Counters".into() })
+        let counters: Vec<Counters> =
+            readback::read_pod(gpu, &self.buffers.counters, "nirc counters")?;
+        counters.first().copied().ok_or_else(|| NircError::Readback {
+            what: "nirc counters".into(),
+            reason: "the buffer is smaller than Counters".into(),
+        })
     }
 
     /// Mean loss of the last training step's first `n` records (before that step's update).
@@ -755,7 +1180,9 @@ impl NeuralCache {
     pub fn download_state(&self, gpu: &Gpu) -> Result<CacheState, NircError> {
         let b = &self.buffers;
         let n = self.layout.total_params as usize;
-        let read = |buf: &wgpu::Buffer, what: &str, len: usize| -> Result<Vec<f32>, NircError> { Ok(readback::read_f32(gpu, buf, what)?[..len].to_vec()) };
+        let read = |buf: &wgpu::Buffer, what: &str, len: usize| -> Result<Vec<f32>, NircError> {
+            Ok(readback::read_f32(gpu, buf, what)?[..len].to_vec())
+        };
         Ok(CacheState {
             config: self.config.clone(),
             bounds: self.bounds,
@@ -764,7 +1191,11 @@ impl NeuralCache {
             adam_m: read(&b.adam_m, "nirc adam m", n)?,
             adam_v: read(&b.adam_v, "nirc adam v", n)?,
             counters: self.counters(gpu)?,
-            reliability: read(&b.moments, "nirc reliability moments", cell_count(&self.config.reliability) as usize * MOMENTS_PER_CELL)?,
+            reliability: read(
+                &b.moments,
+                "nirc reliability moments",
+                cell_count(&self.config.reliability) as usize * MOMENTS_PER_CELL,
+            )?,
         })
     }
 
@@ -784,7 +1215,12 @@ impl NeuralCache {
     }
 
     /// Convenience: uploads queries, infers and reads the answers back.
-    pub fn infer_queries(&self, gpu: &Gpu, queries: &[CacheQuery], mode: PredictorMode) -> Result<Vec<CacheAnswer>, NircError> {
+    pub fn infer_queries(
+        &self,
+        gpu: &Gpu,
+        queries: &[CacheQuery],
+        mode: PredictorMode,
+    ) -> Result<Vec<CacheAnswer>, NircError> {
         let n = queries.len() as u32;
         let out = answer_buffer(gpu, n);
         self.infer(gpu, &upload(gpu, "nirc queries", queries), n, &out, mode)?;

@@ -11,7 +11,9 @@ pub fn read_bytes(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<u8
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc readback") });
+    let mut encoder = gpu
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("nirc readback") });
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
     gpu.queue.submit([encoder.finish()]);
     let (tx, rx) = std::sync::mpsc::channel();
@@ -29,7 +31,11 @@ pub fn read_bytes(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<u8
 /// The buffer as whole values of `T` (trailing bytes that make no whole value are dropped). A
 /// `Vec<u8>` carries no alignment guarantee for `T`, so the bytes are copied into a `Vec<T>`
 /// rather than cast in place.
-pub fn read_pod<T: bytemuck::Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<T>, NircError> {
+pub fn read_pod<T: bytemuck::Pod>(
+    gpu: &Gpu,
+    buffer: &wgpu::Buffer,
+    what: &str,
+) -> Result<Vec<T>, NircError> {
     let bytes = read_bytes(gpu, buffer, what)?;
     let size = std::mem::size_of::<T>();
     let n = bytes.len() / size;
@@ -44,5 +50,8 @@ pub fn read_f32(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<f32>
 
 /// Blocks until the GPU has finished everything submitted (for timing).
 pub fn wait_idle(gpu: &Gpu) -> Result<(), NircError> {
-    gpu.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ()).map_err(|e| NircError::Readback { what: "device idle".into(), reason: e.to_string() })
+    gpu.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map(|_| ())
+        .map_err(|e| NircError::Readback { what: "device idle".into(), reason: e.to_string() })
 }

@@ -42,7 +42,9 @@ impl WeightPlacement {
             "tiled" => Ok(Some(Self::Tiled)),
             "registers" => Ok(Some(Self::Registers)),
             "storage" => Ok(Some(Self::Storage)),
-            other => Err(crate::NircError::Config(format!("FLICKER_NIRC_MLP is '{other}'; expected tiled, registers or storage"))),
+            other => Err(crate::NircError::Config(format!(
+                "FLICKER_NIRC_MLP is '{other}'; expected tiled, registers or storage"
+            ))),
         }
     }
 
@@ -75,7 +77,9 @@ fn tile_w_vec4(layout: &ParameterLayout, shape: &TileShape, training: bool) -> u
     for m in &layout.matrices {
         need = need.max(block_stride(m.rows, shape.opt) * m.cols);
         if training {
-            need = need.max(block_stride(m.cols, shape.opt) * m.rows).max(shape.tile * block_stride(m.cols, shape.opt));
+            need = need
+                .max(block_stride(m.cols, shape.opt) * m.rows)
+                .max(shape.tile * block_stride(m.cols, shape.opt));
         }
     }
     need
@@ -87,7 +91,10 @@ pub fn tiled_unsupported(layout: &ParameterLayout) -> Option<String> {
         return Some(format!("width {} (the tiled MLP takes 32 or 64)", layout.width));
     }
     if layout.input_dims > 64 {
-        return Some(format!("{} network inputs (the tiled MLP takes at most 64)", layout.input_dims));
+        return Some(format!(
+            "{} network inputs (the tiled MLP takes at most 64)",
+            layout.input_dims
+        ));
     }
     None
 }
@@ -95,7 +102,14 @@ pub fn tiled_unsupported(layout: &ParameterLayout) -> Option<String> {
 /// The structs declared once for Rust and WGSL (`render::gpu_struct!`) that the passes use.
 pub fn structs() -> String {
     use render::gpu_struct::GpuStruct;
-    [super::Hyper::WGSL.to_string(), super::Call::WGSL.to_string(), crate::records::wgsl(), crate::cpu::optimizer::Counters::WGSL.to_string(), crate::cpu::optimizer::counters_atomic_wgsl()].concat()
+    [
+        super::Hyper::WGSL.to_string(),
+        super::Call::WGSL.to_string(),
+        crate::records::wgsl(),
+        crate::cpu::optimizer::Counters::WGSL.to_string(),
+        crate::cpu::optimizer::counters_atomic_wgsl(),
+    ]
+    .concat()
 }
 
 /// The network's sizes, level tables and grid constants (`package::nirc::config`).
@@ -123,7 +137,10 @@ fn config_constants(config: &NircConfig, layout: &ParameterLayout) -> String {
     c("DIR_DIMS", layout.direction_dims);
     let table = |name: &str, f: &dyn Fn(&crate::layout::GridLevel) -> u32| {
         let values: Vec<String> = layout.levels.iter().map(|l| format!("{}u", f(l))).collect();
-        format!("var<private> {name}: array<u32, LEVELS> = array<u32, LEVELS>({});\n", values.join(", "))
+        format!(
+            "var<private> {name}: array<u32, LEVELS> = array<u32, LEVELS>({});\n",
+            values.join(", ")
+        )
     };
     s.push_str(&table("level_resolution", &|l| l.resolution));
     s.push_str(&table("level_table_size", &|l| l.table_size));
@@ -152,7 +169,8 @@ fn tile_constants(layout: &ParameterLayout, shape: &TileShape, training: bool) -
 
 /// The tiled matrix product of mlp_tile.wgsl, unrolled over the OPT outputs of a block.
 fn tile_matmul(opt: u32) -> String {
-    let mut s = String::from("fn tile_matmul(reduce_len: u32, stride: u32, o0: u32, rq: u32) -> Block {\n");
+    let mut s =
+        String::from("fn tile_matmul(reduce_len: u32, stride: u32, o0: u32, rq: u32) -> Block {\n");
     for j in 0..opt {
         s.push_str(&format!("    var acc{j} = vec4<f32>(0.0);\n"));
     }
@@ -173,7 +191,8 @@ pub fn workgroup_bytes(layout: &ParameterLayout) -> u32 {
     let train = tile_shape(layout, TRAIN_TILE_RECORDS);
     let infer = tile_shape(layout, INFER_TILE_QUERIES);
     let train_bytes = (64 * train.rq + tile_w_vec4(layout, &train, true)) * 16;
-    let infer_bytes = (64 * infer.rq + tile_w_vec4(layout, &infer, false) + layout.input_dims * infer.rq) * 16;
+    let infer_bytes =
+        (64 * infer.rq + tile_w_vec4(layout, &infer, false) + layout.input_dims * infer.rq) * 16;
     train_bytes.max(infer_bytes)
 }
 
@@ -190,12 +209,20 @@ macro_rules! nirc_file {
 /// `package::nirc::keep` (the shared files import both by those names), the shared files, and
 /// the pass's entry-point file. `grid_width`: the grid mirror's texture width where the
 /// passes read and write it (grid_textures.rs).
-pub fn program(config: &NircConfig, layout: &ParameterLayout, pass: &str, grid_width: Option<u32>) -> Program {
+pub fn program(
+    config: &NircConfig,
+    layout: &ParameterLayout,
+    pass: &str,
+    grid_width: Option<u32>,
+) -> Program {
     let mut modules = vec![
         Module::generated("package::nirc::types", &[&structs()]),
         Module::generated("package::nirc::config", &[&config_constants(config, layout)]),
         Module::generated("package::nirc::grid", &[&super::grid_textures::read_module(grid_width)]),
-        Module::generated("package::nirc::grid_write", &[&super::grid_textures::write_module(grid_width)]),
+        Module::generated(
+            "package::nirc::grid_write",
+            &[&super::grid_textures::write_module(grid_width)],
+        ),
     ];
     let tile = match pass {
         "train_tile" => Some((TRAIN_TILE_RECORDS, true)),
@@ -203,13 +230,22 @@ pub fn program(config: &NircConfig, layout: &ParameterLayout, pass: &str, grid_w
         _ => None,
     };
     if let Some((records, training)) = tile {
-        modules.push(Module::generated("package::nirc::tile", &[&tile_constants(layout, &tile_shape(layout, records), training)]));
+        modules.push(Module::generated(
+            "package::nirc::tile",
+            &[&tile_constants(layout, &tile_shape(layout, records), training)],
+        ));
     }
     if pass == "infer_lane" || pass == "lane_stage" {
-        modules.push(Module::generated("package::nirc::lane", &[&super::lane::module(layout, grid_width.is_some())]));
+        modules.push(Module::generated(
+            "package::nirc::lane",
+            &[&super::lane::module(layout, grid_width.is_some())],
+        ));
     }
     if pass == "infer_lane" {
-        modules.push(Module::generated("package::nirc::lane_queries", &[&super::lane::queries_module()]));
+        modules.push(Module::generated(
+            "package::nirc::lane_queries",
+            &[&super::lane::queries_module()],
+        ));
     }
     let (own, entry) = pass_files(pass);
     modules.extend(own);
@@ -218,7 +254,20 @@ pub fn program(config: &NircConfig, layout: &ParameterLayout, pass: &str, grid_w
 }
 
 /// The passes, by name.
-const PASSES: [&str; 12] = ["train_tile", "infer_tile", "infer_lane", "lane_stage", "train_forward_backward", "infer", "reliability_accumulate", "reliability_update", "reliability_walk", "weight_gradient", "adam_ema", "finish_step"];
+const PASSES: [&str; 12] = [
+    "train_tile",
+    "infer_tile",
+    "infer_lane",
+    "lane_stage",
+    "train_forward_backward",
+    "infer",
+    "reliability_accumulate",
+    "reliability_update",
+    "reliability_walk",
+    "weight_gradient",
+    "adam_ema",
+    "finish_step",
+];
 
 /// A pass's own files: its bindings (`package::nirc::bindings`), the tiled passes' activation hook
 /// (`package::nirc::keep`), and its entry-point file.
@@ -226,15 +275,37 @@ fn pass_files(pass: &str) -> (Vec<Module>, Module) {
     let bindings = |m: Module| m.at("package::nirc::bindings");
     let keep = |m: Module| m.at("package::nirc::keep");
     match pass {
-        "train_tile" => (vec![bindings(nirc_file!("train_bindings.wgsl")), keep(nirc_file!("train_keep.wgsl"))], nirc_file!("train_tile.wgsl")),
-        "infer_tile" => (vec![bindings(nirc_file!("infer_bindings.wgsl")), keep(nirc_file!("keep_none.wgsl"))], nirc_file!("infer_tile.wgsl")),
-        "infer_lane" => (vec![bindings(nirc_file!("infer_bindings.wgsl"))], nirc_file!("infer_lane.wgsl")),
-        "lane_stage" => (vec![bindings(nirc_file!("infer_bindings.wgsl"))], nirc_file!("lane_stage.wgsl")),
-        "train_forward_backward" => (vec![bindings(nirc_file!("train_bindings.wgsl"))], nirc_file!("train_forward_backward.wgsl")),
+        "train_tile" => (
+            vec![bindings(nirc_file!("train_bindings.wgsl")), keep(nirc_file!("train_keep.wgsl"))],
+            nirc_file!("train_tile.wgsl"),
+        ),
+        "infer_tile" => (
+            vec![bindings(nirc_file!("infer_bindings.wgsl")), keep(nirc_file!("keep_none.wgsl"))],
+            nirc_file!("infer_tile.wgsl"),
+        ),
+        "infer_lane" => {
+            (vec![bindings(nirc_file!("infer_bindings.wgsl"))], nirc_file!("infer_lane.wgsl"))
+        }
+        "lane_stage" => {
+            (vec![bindings(nirc_file!("infer_bindings.wgsl"))], nirc_file!("lane_stage.wgsl"))
+        }
+        "train_forward_backward" => (
+            vec![bindings(nirc_file!("train_bindings.wgsl"))],
+            nirc_file!("train_forward_backward.wgsl"),
+        ),
         "infer" => (vec![bindings(nirc_file!("infer_bindings.wgsl"))], nirc_file!("infer.wgsl")),
-        "reliability_accumulate" => (vec![bindings(nirc_file!("reliability_accumulate_bindings.wgsl"))], nirc_file!("reliability_accumulate.wgsl")),
-        "reliability_update" => (vec![bindings(nirc_file!("reliability_update_bindings.wgsl"))], nirc_file!("reliability_update.wgsl")),
-        "reliability_walk" => (vec![bindings(nirc_file!("reliability_walk_bindings.wgsl"))], nirc_file!("reliability_walk.wgsl")),
+        "reliability_accumulate" => (
+            vec![bindings(nirc_file!("reliability_accumulate_bindings.wgsl"))],
+            nirc_file!("reliability_accumulate.wgsl"),
+        ),
+        "reliability_update" => (
+            vec![bindings(nirc_file!("reliability_update_bindings.wgsl"))],
+            nirc_file!("reliability_update.wgsl"),
+        ),
+        "reliability_walk" => (
+            vec![bindings(nirc_file!("reliability_walk_bindings.wgsl"))],
+            nirc_file!("reliability_walk.wgsl"),
+        ),
         "weight_gradient" => (vec![], nirc_file!("weight_gradient.wgsl")),
         "adam_ema" => (vec![], nirc_file!("adam_ema.wgsl")),
         "finish_step" => (vec![], nirc_file!("finish_step.wgsl")),

@@ -28,10 +28,22 @@ impl Rng {
 /// Width 16, 2 hidden layers, 4 levels (two dense, two hashed into 2^10 entries).
 pub fn small_config() -> NircConfig {
     NircConfig {
-        encoding: HashGridConfig { levels: 4, features_per_level: 2, log2_table_size: 10, base_resolution: 4, growth_factor: 1.5, init_scale: 1e-4 },
+        encoding: HashGridConfig {
+            levels: 4,
+            features_per_level: 2,
+            log2_table_size: 10,
+            base_resolution: 4,
+            growth_factor: 1.5,
+            init_scale: 1e-4,
+        },
         direction: DirectionEncoding::SphericalHarmonics { bands: 3 },
         network: NetworkConfig { width: 32, hidden_layers: 2 },
-        reliability: ReliabilityConfig { resolution: 8, log2_cells: 8, warmup: 2, ..Default::default() },
+        reliability: ReliabilityConfig {
+            resolution: 8,
+            log2_cells: 8,
+            warmup: 2,
+            ..Default::default()
+        },
         max_batch: 512,
         ..Default::default()
     }
@@ -54,7 +66,11 @@ pub fn records(rng: &mut Rng, n: usize) -> Vec<TrainingRecord> {
     let b = bounds();
     (0..n)
         .map(|_| {
-            let p = [rng.range(b.min[0], b.max[0]), rng.range(b.min[1], b.max[1]), rng.range(b.min[2], b.max[2])];
+            let p = [
+                rng.range(b.min[0], b.max[0]),
+                rng.range(b.min[1], b.max[1]),
+                rng.range(b.min[2], b.max[2]),
+            ];
             let d = rng.direction();
             TrainingRecord::new(p, d, field(p, d))
         })

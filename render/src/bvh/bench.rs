@@ -9,7 +9,9 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::ray_order::sort_for_coherence;
-use super::{Bvh2Geometry, Bvh2Traversal, BvhError, RayBatch, RayQuery, SceneGeometry, SplitMix64, TraceKind};
+use super::{
+    Bvh2Geometry, Bvh2Traversal, BvhError, RayBatch, RayQuery, SceneGeometry, SplitMix64, TraceKind,
+};
 use crate::gpu::Gpu;
 use crate::scene::{Mesh, SceneDesc};
 
@@ -85,7 +87,12 @@ impl std::fmt::Display for TraversalBench {
 
 /// Measures closest-hit traversal of `rays` random rays (origins inside the scene bounds,
 /// uniform directions; seeded) on the GPU and on the CPU, after one warm-up run each.
-pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -> Result<TraversalBench, BvhError> {
+pub fn traversal_benchmark(
+    gpu: &Gpu,
+    scene: &SceneDesc,
+    rays: u32,
+    seed: u64,
+) -> Result<TraversalBench, BvhError> {
     let start = Instant::now();
     let geometry = SceneGeometry::new(gpu, scene)?;
     gpu.device
@@ -108,21 +115,35 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
     let traversal = Bvh2Traversal { geometry: &geometry, bvh2: &bvh2 };
     let bvh2_batch = RayBatch::new_bvh2(gpu, &traversal);
     bvh2_batch.dispatch(gpu, &traversal, &buffers, TraceKind::Closest)?; // warm-up
-    let (reps, elapsed) = repeat_until(MIN_TIMED, || bvh2_batch.dispatch(gpu, &traversal, &buffers, TraceKind::Closest))?;
+    let (reps, elapsed) = repeat_until(MIN_TIMED, || {
+        bvh2_batch.dispatch(gpu, &traversal, &buffers, TraceKind::Closest)
+    })?;
     let gpu_bvh2_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
     let bvh2_hits = bvh2_batch.read_closest(gpu, &buffers)?;
     let (reps, elapsed) = repeat_until(MIN_TIMED, || {
-        std::hint::black_box(queries.par_iter().map(|r| bvh2.cpu().trace_closest(r.origin, r.direction, r.t_max)).collect::<Vec<_>>());
+        std::hint::black_box(
+            queries
+                .par_iter()
+                .map(|r| bvh2.cpu().trace_closest(r.origin, r.direction, r.t_max))
+                .collect::<Vec<_>>(),
+        );
         Ok(())
     })?;
     let cpu_bvh2_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
 
     let cpu = geometry.cpu();
-    let trace_all = || queries.par_iter().map(|r| cpu.trace_closest(r.origin, r.direction, r.t_max)).collect::<Vec<_>>();
+    let trace_all = || {
+        queries
+            .par_iter()
+            .map(|r| cpu.trace_closest(r.origin, r.direction, r.t_max))
+            .collect::<Vec<_>>()
+    };
     let cpu_hits = trace_all(); // warm-up
     let (mut gpu_rates, mut cpu_rates, mut paired_ratios) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..PAIRED_ROUNDS {
-        let (reps, elapsed) = repeat_until(MIN_TIMED, || batch.dispatch(gpu, &geometry, &buffers, TraceKind::Closest))?;
+        let (reps, elapsed) = repeat_until(MIN_TIMED, || {
+            batch.dispatch(gpu, &geometry, &buffers, TraceKind::Closest)
+        })?;
         let gpu_rate = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
         let (reps, elapsed) = repeat_until(MIN_TIMED, || {
             std::hint::black_box(trace_all());
@@ -138,21 +159,38 @@ pub fn traversal_benchmark(gpu: &Gpu, scene: &SceneDesc, rays: u32, seed: u64) -
     let sorted = sort_for_coherence(geometry.bounds(), &queries);
     let sorted_buffers = batch.upload(gpu, &sorted)?;
     batch.dispatch(gpu, &geometry, &sorted_buffers, TraceKind::Closest)?;
-    let (reps, elapsed) = repeat_until(MIN_TIMED, || batch.dispatch(gpu, &geometry, &sorted_buffers, TraceKind::Closest))?;
+    let (reps, elapsed) = repeat_until(MIN_TIMED, || {
+        batch.dispatch(gpu, &geometry, &sorted_buffers, TraceKind::Closest)
+    })?;
     let gpu_sorted_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
     let (reps, elapsed) = repeat_until(MIN_TIMED, || {
-        std::hint::black_box(sorted.par_iter().map(|r| cpu.trace_closest(r.origin, r.direction, r.t_max)).collect::<Vec<_>>());
+        std::hint::black_box(
+            sorted
+                .par_iter()
+                .map(|r| cpu.trace_closest(r.origin, r.direction, r.t_max))
+                .collect::<Vec<_>>(),
+        );
         Ok(())
     })?;
     let cpu_sorted_rays_per_second = (reps as f64 * rays as f64) / elapsed.as_secs_f64();
 
     let n = queries.len().max(1) as f64;
     let hit_fraction = cpu_hits.iter().filter(|h| h.is_hit()).count() as f64 / n;
-    let agree = |hits: &[super::Hit]| hits.iter().zip(&cpu_hits).filter(|(g, c)| g.instance == c.instance && g.primitive == c.primitive).count() as f64 / n;
+    let agree = |hits: &[super::Hit]| {
+        hits.iter()
+            .zip(&cpu_hits)
+            .filter(|(g, c)| g.instance == c.instance && g.primitive == c.primitive)
+            .count() as f64
+            / n
+    };
     let (agreement, bvh2_agreement) = (agree(&gpu_hits), agree(&bvh2_hits));
     Ok(TraversalBench {
         adapter: gpu.summary.name.clone(),
-        triangles: scene.instances.iter().map(|i| scene.meshes[i.mesh as usize].indices.len() as u64).sum(),
+        triangles: scene
+            .instances
+            .iter()
+            .map(|i| scene.meshes[i.mesh as usize].indices.len() as u64)
+            .sum(),
         instances: scene.instances.len() as u32,
         stack_entries: batch.stack_entries(),
         rays,
@@ -183,7 +221,10 @@ pub fn median(values: &[f64]) -> f64 {
     if n % 2 == 1 { v[n / 2] } else { 0.5 * (v[n / 2 - 1] + v[n / 2]) }
 }
 
-fn repeat_until(min: Duration, mut f: impl FnMut() -> Result<(), BvhError>) -> Result<(u32, Duration), BvhError> {
+fn repeat_until(
+    min: Duration,
+    mut f: impl FnMut() -> Result<(), BvhError>,
+) -> Result<(u32, Duration), BvhError> {
     let start = Instant::now();
     let mut reps = 0;
     while reps == 0 || start.elapsed() < min {
@@ -201,7 +242,8 @@ pub fn random_rays(bounds: (Vec3, Vec3), count: usize, t_max: f32, seed: u64) ->
     let (lo, hi) = (bounds.0 - margin, bounds.1 + margin);
     (0..count)
         .map(|_| {
-            let origin = Vec3::new(rng.range(lo.x, hi.x), rng.range(lo.y, hi.y), rng.range(lo.z, hi.z));
+            let origin =
+                Vec3::new(rng.range(lo.x, hi.x), rng.range(lo.y, hi.y), rng.range(lo.z, hi.z));
             RayQuery { origin, direction: rng.unit_vector(), t_max }
         })
         .collect()
@@ -218,8 +260,12 @@ pub fn displaced_sphere(min_triangles: u32, seed: u64) -> Mesh {
     }
     let slices = 2 * stacks;
     let mut rng = SplitMix64::new(seed);
-    let waves: Vec<(Vec3, f32, f32)> = (0..6).map(|_| (rng.unit_vector(), rng.range(3.0, 12.0), rng.range(0.0, std::f32::consts::TAU))).collect();
-    let radius = |d: Vec3| 1.0 + waves.iter().map(|&(k, f, phase)| 0.02 * (f * k.dot(d) + phase).sin()).sum::<f32>();
+    let waves: Vec<(Vec3, f32, f32)> = (0..6)
+        .map(|_| (rng.unit_vector(), rng.range(3.0, 12.0), rng.range(0.0, std::f32::consts::TAU)))
+        .collect();
+    let radius = |d: Vec3| {
+        1.0 + waves.iter().map(|&(k, f, phase)| 0.02 * (f * k.dot(d) + phase).sin()).sum::<f32>()
+    };
 
     let mut positions = Vec::new();
     let mut uvs = Vec::new();
@@ -258,7 +304,13 @@ pub fn displaced_sphere(min_triangles: u32, seed: u64) -> Mesh {
     for n in &mut normals {
         *n = n.normalize_or(Vec3::Y);
     }
-    Mesh { name: format!("displaced sphere ({} triangles)", indices.len()), positions, normals, uvs, indices }
+    Mesh {
+        name: format!("displaced sphere ({} triangles)", indices.len()),
+        positions,
+        normals,
+        uvs,
+        indices,
+    }
 }
 
 #[cfg(test)]
@@ -276,7 +328,11 @@ mod tests {
                 outward += 1;
             }
         }
-        assert!(outward as f64 > 0.999 * m.indices.len() as f64, "{outward} of {}", m.indices.len());
+        assert!(
+            outward as f64 > 0.999 * m.indices.len() as f64,
+            "{outward} of {}",
+            m.indices.len()
+        );
         assert_eq!(m.positions, displaced_sphere(100_000, 3).positions, "deterministic");
     }
 

@@ -3,7 +3,10 @@
 use std::time::Duration;
 
 use glam::{Vec3, Vec3A};
-use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh_from_tris, triangle::Triangle};
+use obvhs::{
+    BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh_from_tris,
+    triangle::Triangle,
+};
 
 use super::BvhError;
 use crate::scene::Mesh;
@@ -27,9 +30,16 @@ impl Blas {
     pub fn build(index: usize, mesh: &Mesh) -> Result<Self, BvhError> {
         let tris = mesh_triangles(index, mesh)?;
         if tris.is_empty() {
-            return Ok(Self { bvh: CwBvh::default(), triangles: Vec::new(), bounds: Aabb::empty(), depth: 0, stack_need: 0 });
+            return Ok(Self {
+                bvh: CwBvh::default(),
+                triangles: Vec::new(),
+                bounds: Aabb::empty(),
+                depth: 0,
+                stack_need: 0,
+            });
         }
-        let bvh = build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
+        let bvh =
+            build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
         let triangles = leaf_order(&bvh.primitive_indices, &tris);
         let depth = cwbvh_depth(&bvh);
         let stack_need = super::stack_need::blas_stack_need(&bvh);
@@ -48,16 +58,26 @@ pub(crate) fn mesh_triangles(index: usize, mesh: &Mesh) -> Result<Vec<Triangle>,
     let mut tris = Vec::with_capacity(mesh.indices.len());
     for (t, idx) in mesh.indices.iter().enumerate() {
         if let Some(&bad) = idx.iter().find(|&&i| i >= n) {
-            return Err(err(format!("triangle {t} uses vertex {bad}, but the mesh has {n} positions")));
+            return Err(err(format!(
+                "triangle {t} uses vertex {bad}, but the mesh has {n} positions"
+            )));
         }
         let [a, b, c] = idx.map(|i| Vec3A::from(mesh.positions[i as usize]));
         tris.push(Triangle { v0: a, v1: b, v2: c });
     }
     if !mesh.normals.is_empty() && mesh.normals.len() != mesh.positions.len() {
-        return Err(err(format!("{} normals for {} positions (expected one per position, or none)", mesh.normals.len(), n)));
+        return Err(err(format!(
+            "{} normals for {} positions (expected one per position, or none)",
+            mesh.normals.len(),
+            n
+        )));
     }
     if !mesh.uvs.is_empty() && mesh.uvs.len() != mesh.positions.len() {
-        return Err(err(format!("{} uvs for {} positions (expected one per position, or none)", mesh.uvs.len(), n)));
+        return Err(err(format!(
+            "{} uvs for {} positions (expected one per position, or none)",
+            mesh.uvs.len(),
+            n
+        )));
     }
     Ok(tris)
 }
@@ -65,7 +85,12 @@ pub(crate) fn mesh_triangles(index: usize, mesh: &Mesh) -> Result<Vec<Triangle>,
 /// The triangles' vertices in leaf order (`primitive_indices[i]` is the triangle of slot `i`), so
 /// that traversal reads them without an indirection.
 pub(crate) fn leaf_order(primitive_indices: &[u32], tris: &[Triangle]) -> Vec<[Vec3; 3]> {
-    primitive_indices.iter().map(|&p| [tris[p as usize].v0.into(), tris[p as usize].v1.into(), tris[p as usize].v2.into()]).collect()
+    primitive_indices
+        .iter()
+        .map(|&p| {
+            [tris[p as usize].v0.into(), tris[p as usize].v1.into(), tris[p as usize].v2.into()]
+        })
+        .collect()
 }
 
 /// Node levels of a CWBVH: the bound on traversal stack entries one level of traversal needs.
@@ -86,4 +111,3 @@ pub(crate) fn cwbvh_depth(bvh: &CwBvh) -> u32 {
     }
     deepest
 }
-

@@ -11,7 +11,13 @@
 use std::time::Duration;
 
 use glam::{Vec2, Vec3};
-use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::Bvh2, bvh2::builder::{build_bvh2, build_bvh2_from_tris}, ray::RayHit};
+use obvhs::{
+    BvhBuildParams,
+    aabb::Aabb,
+    bvh2::Bvh2,
+    bvh2::builder::{build_bvh2, build_bvh2_from_tris},
+    ray::RayHit,
+};
 
 use super::blas::{leaf_order, mesh_triangles};
 use super::cpu_traversal::{instance_transforms, obvhs_ray};
@@ -48,9 +54,15 @@ impl Bvh2Blas {
     pub fn build(index: usize, mesh: &crate::scene::Mesh) -> Result<Self, BvhError> {
         let tris = mesh_triangles(index, mesh)?;
         if tris.is_empty() {
-            return Ok(Self { bvh: Bvh2::default(), triangles: Vec::new(), bounds: Aabb::empty(), depth: 0 });
+            return Ok(Self {
+                bvh: Bvh2::default(),
+                triangles: Vec::new(),
+                bounds: Aabb::empty(),
+                depth: 0,
+            });
         }
-        let bvh = build_bvh2_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
+        let bvh =
+            build_bvh2_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
         let triangles = leaf_order(&bvh.primitive_indices, &tris);
         let depth = bvh2_depth(&bvh);
         Ok(Self { bounds: *bvh.nodes[0].aabb(), bvh, triangles, depth })
@@ -61,7 +73,12 @@ impl SceneBvh2 {
     /// Builds one BVH2 per mesh and one over the instances (the same instances, checked the same
     /// way, as [`SceneBvh::new`](super::SceneBvh::new)).
     pub fn new(scene: &SceneDesc) -> Result<Self, BvhError> {
-        let blas = scene.meshes.iter().enumerate().map(|(i, m)| Bvh2Blas::build(i, m)).collect::<Result<Vec<_>, _>>()?;
+        let blas = scene
+            .meshes
+            .iter()
+            .enumerate()
+            .map(|(i, m)| Bvh2Blas::build(i, m))
+            .collect::<Result<Vec<_>, _>>()?;
         let instances = instance_transforms(&scene.instances, blas.len())?;
         let mut ids = Vec::new();
         let mut boxes = Vec::new();
@@ -85,10 +102,19 @@ impl SceneBvh2 {
         if let Some((i, b)) = deepest
             && tlas_depth + b.depth > BVH2_STACK_SIZE
         {
-            return Err(BvhError::TooDeep { needed: tlas_depth + b.depth, limit: BVH2_STACK_SIZE, tlas: tlas_depth, blas: b.depth, mesh: scene.meshes[i].name.clone() });
+            return Err(BvhError::TooDeep {
+                needed: tlas_depth + b.depth,
+                limit: BVH2_STACK_SIZE,
+                tlas: tlas_depth,
+                blas: b.depth,
+                mesh: scene.meshes[i].name.clone(),
+            });
         }
         // The GPU layout stores a TLAS leaf's instance in place of its first primitive slot.
-        assert!(tlas.nodes.iter().all(|n| !n.is_leaf() || n.prim_count == 1), "a BVH2 TLAS leaf with more than one instance");
+        assert!(
+            tlas.nodes.iter().all(|n| !n.is_leaf() || n.prim_count == 1),
+            "a BVH2 TLAS leaf with more than one instance"
+        );
         Ok(Self { blas, tlas, tlas_depth, instances })
     }
 
@@ -99,16 +125,20 @@ impl SceneBvh2 {
         if self.tlas.nodes.is_empty() || !(t_max > 0.0) {
             return best;
         }
-        self.tlas.ray_traverse(obvhs_ray(origin, direction, t_max), &mut RayHit::none(), |r, slot| {
-            let instance = self.tlas.primitive_indices[slot];
-            match self.closest_in_instance(instance, origin, direction, r.tmax) {
-                Some((t, primitive, barycentrics)) => {
-                    best = Hit { t, instance, primitive, barycentrics };
-                    t
+        self.tlas.ray_traverse(
+            obvhs_ray(origin, direction, t_max),
+            &mut RayHit::none(),
+            |r, slot| {
+                let instance = self.tlas.primitive_indices[slot];
+                match self.closest_in_instance(instance, origin, direction, r.tmax) {
+                    Some((t, primitive, barycentrics)) => {
+                        best = Hit { t, instance, primitive, barycentrics };
+                        t
+                    }
+                    None => f32::INFINITY,
                 }
-                None => f32::INFINITY,
-            }
-        });
+            },
+        );
         best
     }
 
@@ -119,11 +149,21 @@ impl SceneBvh2 {
         }
         !self.tlas.ray_traverse_miss(obvhs_ray(origin, direction, t_max), |_, slot| {
             let instance = self.tlas.primitive_indices[slot];
-            if self.closest_in_instance(instance, origin, direction, t_max).is_some() { 0.0 } else { f32::INFINITY }
+            if self.closest_in_instance(instance, origin, direction, t_max).is_some() {
+                0.0
+            } else {
+                f32::INFINITY
+            }
         })
     }
 
-    fn closest_in_instance(&self, instance: u32, origin: Vec3, direction: Vec3, t_max: f32) -> Option<(f32, u32, Vec2)> {
+    fn closest_in_instance(
+        &self,
+        instance: u32,
+        origin: Vec3,
+        direction: Vec3,
+        t_max: f32,
+    ) -> Option<(f32, u32, Vec2)> {
         let inst = &self.instances[instance as usize];
         let blas = &self.blas[inst.mesh as usize];
         let o = inst.world_to_object.transform_point3(origin);

@@ -47,7 +47,13 @@ impl Bvh2Geometry {
     /// (`bvh2_trace_closest`, `bvh2_trace_any`), after [`SceneGeometry::modules`].
     pub fn modules() -> Vec<Module> {
         let types = Module::generated("package::bvh2_types", &[SgBvh2Node::WGSL]);
-        let bindings = crate::texel_table::group_module("package::bvh2_bindings", 2, &GROUP, &TABLES, &[&types, &SceneGeometry::types()]);
+        let bindings = crate::texel_table::group_module(
+            "package::bvh2_bindings",
+            2,
+            &GROUP,
+            &TABLES,
+            &[&types, &SceneGeometry::types()],
+        );
         vec![types, bindings, crate::wgsl_file!("bvh2_traversal.wgsl")]
     }
 
@@ -60,7 +66,11 @@ impl Bvh2Geometry {
             return Err(BvhError::StorageBuffers { needed, limit });
         }
         let bvh = SceneBvh2::new(scene)?;
-        assert_eq!(bvh.instances, geometry.instances(), "the BVH2 and the scene geometry must come from the same scene");
+        assert_eq!(
+            bvh.instances,
+            geometry.instances(),
+            "the BVH2 and the scene geometry must come from the same scene"
+        );
         // The traversal marks a TLAS leaf's instance with bit 31 (BVH2_ENTER).
         assert!(bvh.instances.len() < 1 << 31, "{} instances", bvh.instances.len());
         let node = |n: &obvhs::bvh2::node::Bvh2Node, first_index: u32| SgBvh2Node {
@@ -75,14 +85,25 @@ impl Bvh2Geometry {
         for blas in &bvh.blas {
             let (node_offset, triangle_offset) = (nodes.len() as u32, triangles.len() as u32);
             roots.push(if blas.bvh.nodes.is_empty() { NO_HIT } else { node_offset });
-            nodes.extend(blas.bvh.nodes.iter().map(|n| node(n, n.first_index + if n.is_leaf() { triangle_offset } else { node_offset })));
+            nodes.extend(blas.bvh.nodes.iter().map(|n| {
+                node(n, n.first_index + if n.is_leaf() { triangle_offset } else { node_offset })
+            }));
             triangles.extend(sg_triangles(&blas.triangles, &blas.bvh.primitive_indices));
         }
         if !bvh.tlas.nodes.is_empty() {
             let node_offset = nodes.len() as u32;
             roots[0] = node_offset;
             let tlas = &bvh.tlas;
-            nodes.extend(tlas.nodes.iter().map(|n| node(n, if n.is_leaf() { tlas.primitive_indices[n.first_index as usize] } else { n.first_index + node_offset })));
+            nodes.extend(tlas.nodes.iter().map(|n| {
+                node(
+                    n,
+                    if n.is_leaf() {
+                        tlas.primitive_indices[n.first_index as usize]
+                    } else {
+                        n.first_index + node_offset
+                    },
+                )
+            }));
         }
         let roots = storage(gpu, "BVH2 roots", bytemuck::cast_slice(&roots), 4)?;
         let tables = [
@@ -90,7 +111,8 @@ impl Bvh2Geometry {
             TexelTable::new(gpu, "BVH2 triangles", 3, bytemuck::cast_slice(&triangles), 0)?,
         ];
         let layout = crate::texel_table::group_layout(gpu, "BVH2 geometry", &GROUP, TABLES.len());
-        let bind_group = crate::texel_table::group(gpu, "BVH2 geometry", &layout, &[&roots], &tables.each_ref());
+        let bind_group =
+            crate::texel_table::group(gpu, "BVH2 geometry", &layout, &[&roots], &tables.each_ref());
         Ok(Self { bvh, layout, bind_group, _roots: roots, _tables: tables })
     }
 

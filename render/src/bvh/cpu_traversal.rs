@@ -30,7 +30,12 @@ pub enum InstanceUpdate {
 impl SceneBvh {
     /// Builds one BLAS per mesh and the TLAS over the scene's instances.
     pub fn new(scene: &SceneDesc) -> Result<Self, BvhError> {
-        let blas = scene.meshes.iter().enumerate().map(|(i, m)| Blas::build(i, m)).collect::<Result<Vec<_>, _>>()?;
+        let blas = scene
+            .meshes
+            .iter()
+            .enumerate()
+            .map(|(i, m)| Blas::build(i, m))
+            .collect::<Result<Vec<_>, _>>()?;
         let instances = instance_transforms(&scene.instances, blas.len())?;
         let tlas = Tlas::build(&instances, &blas);
         let mesh_names = scene.meshes.iter().map(|m| m.name.clone()).collect();
@@ -48,7 +53,11 @@ impl SceneBvh {
         for (n, o) in next.iter_mut().zip(&self.instances) {
             n.previous_object_to_world = o.object_to_world;
         }
-        let moved = !same_list || next.iter().zip(&self.instances).any(|(n, o)| n.object_to_world != o.object_to_world);
+        let moved = !same_list
+            || next
+                .iter()
+                .zip(&self.instances)
+                .any(|(n, o)| n.object_to_world != o.object_to_world);
         let table_changed = next != self.instances;
         self.instances = next;
         if moved {
@@ -69,7 +78,13 @@ impl SceneBvh {
     }
 
     fn check_stack_depth(&self) -> Result<(), BvhError> {
-        let (deepest, depth) = self.blas.iter().enumerate().map(|(i, b)| (i, b.depth)).max_by_key(|&(_, d)| d).unwrap_or((0, 0));
+        let (deepest, depth) = self
+            .blas
+            .iter()
+            .enumerate()
+            .map(|(i, b)| (i, b.depth))
+            .max_by_key(|&(_, d)| d)
+            .unwrap_or((0, 0));
         let needed = self.stack_entries();
         if needed > TRAVERSAL_STACK_SIZE {
             return Err(BvhError::TooDeep {
@@ -98,16 +113,20 @@ impl SceneBvh {
             return best;
         }
         let mut tlas_hit = RayHit::none();
-        self.tlas.bvh.ray_traverse(obvhs_ray(origin, direction, t_max), &mut tlas_hit, |ray, slot| {
-            let instance = self.tlas.bvh.primitive_indices[slot];
-            match self.closest_in_instance(instance, origin, direction, ray.tmax) {
-                Some((t, primitive, barycentrics)) => {
-                    best = Hit { t, instance, primitive, barycentrics };
-                    t
+        self.tlas.bvh.ray_traverse(
+            obvhs_ray(origin, direction, t_max),
+            &mut tlas_hit,
+            |ray, slot| {
+                let instance = self.tlas.bvh.primitive_indices[slot];
+                match self.closest_in_instance(instance, origin, direction, ray.tmax) {
+                    Some((t, primitive, barycentrics)) => {
+                        best = Hit { t, instance, primitive, barycentrics };
+                        t
+                    }
+                    None => f32::INFINITY,
                 }
-                None => f32::INFINITY,
-            }
-        });
+            },
+        );
         best
     }
 
@@ -116,10 +135,15 @@ impl SceneBvh {
         if self.tlas.bvh.nodes.is_empty() || !(t_max > 0.0) {
             return false;
         }
-        let missed = self.tlas.bvh.ray_traverse_miss(obvhs_ray(origin, direction, t_max), |_, slot| {
-            let instance = self.tlas.bvh.primitive_indices[slot];
-            if self.any_in_instance(instance, origin, direction, t_max) { 0.0 } else { f32::INFINITY }
-        });
+        let missed =
+            self.tlas.bvh.ray_traverse_miss(obvhs_ray(origin, direction, t_max), |_, slot| {
+                let instance = self.tlas.bvh.primitive_indices[slot];
+                if self.any_in_instance(instance, origin, direction, t_max) {
+                    0.0
+                } else {
+                    f32::INFINITY
+                }
+            });
         !missed
     }
 
@@ -131,7 +155,13 @@ impl SceneBvh {
         (&self.blas[inst.mesh as usize], o, d)
     }
 
-    fn closest_in_instance(&self, instance: u32, origin: Vec3, direction: Vec3, t_max: f32) -> Option<(f32, u32, Vec2)> {
+    fn closest_in_instance(
+        &self,
+        instance: u32,
+        origin: Vec3,
+        direction: Vec3,
+        t_max: f32,
+    ) -> Option<(f32, u32, Vec2)> {
         let (blas, o, d) = self.object_ray(instance, origin, direction);
         let tri_ray = WatertightRay::new(o, d);
         let mut found = None;
@@ -159,8 +189,15 @@ impl SceneBvh {
     }
 }
 
-pub(super) fn instance_transforms(instances: &[Instance], mesh_count: usize) -> Result<Vec<InstanceTransforms>, BvhError> {
-    instances.iter().enumerate().map(|(i, inst)| InstanceTransforms::new(i, inst, mesh_count)).collect()
+pub(super) fn instance_transforms(
+    instances: &[Instance],
+    mesh_count: usize,
+) -> Result<Vec<InstanceTransforms>, BvhError> {
+    instances
+        .iter()
+        .enumerate()
+        .map(|(i, inst)| InstanceTransforms::new(i, inst, mesh_count))
+        .collect()
 }
 
 /// obvhs's ray; `+ 0.0` turns a -0.0 direction component into +0.0 so that obvhs's octant (sign
@@ -180,12 +217,21 @@ mod tests {
 
     /// The WGSL's (7 - octant) in every byte.
     fn octant_inv4(d: Vec3) -> u32 {
-        (if d.x < 0.0 { 0 } else { 0x0404_0404 }) | (if d.y < 0.0 { 0 } else { 0x0202_0202 }) | (if d.z < 0.0 { 0 } else { 0x0101_0101 })
+        (if d.x < 0.0 { 0 } else { 0x0404_0404 })
+            | (if d.y < 0.0 { 0 } else { 0x0202_0202 })
+            | (if d.z < 0.0 { 0 } else { 0x0101_0101 })
     }
 
     /// One trip of `sg_trip`: the nearest inner child of `group` is intersected (the rest of the
     /// group pushed), or a group without inner children is returned as the primitive group.
-    fn trip(bvh: &CwBvh, stack: &mut Vec<(u32, u32)>, deepest: &mut usize, group: (u32, u32), ray: &Ray, oct: u32) -> ((u32, u32), (u32, u32)) {
+    fn trip(
+        bvh: &CwBvh,
+        stack: &mut Vec<(u32, u32)>,
+        deepest: &mut usize,
+        group: (u32, u32),
+        ray: &Ray,
+        oct: u32,
+    ) -> ((u32, u32), (u32, u32)) {
         let (base, mut bits) = group;
         if bits & 0xff00_0000 == 0 {
             return ((0, 0), group);
@@ -200,7 +246,10 @@ mod tests {
         let slot = (child_bit - 24) ^ (oct & 0xff);
         let node = &bvh.nodes[(base + (hits_imask & !(u32::MAX << slot)).count_ones()) as usize];
         let hitmask = node.intersect_ray(ray, oct);
-        ((node.child_base_idx, (hitmask & 0xff00_0000) | u32::from(node.imask)), (node.primitive_base_idx, hitmask & 0x00ff_ffff))
+        (
+            (node.child_base_idx, (hitmask & 0xff00_0000) | u32::from(node.imask)),
+            (node.primitive_base_idx, hitmask & 0x00ff_ffff),
+        )
     }
 
     /// The most entries `sg_traverse`'s stack holds for this ray, replayed on the CPU without
@@ -213,7 +262,8 @@ mod tests {
             return 0;
         }
         loop {
-            let (next, mut instances) = trip(&bvh.tlas.bvh, &mut stack, &mut deepest, node_group, &world, oct);
+            let (next, mut instances) =
+                trip(&bvh.tlas.bvh, &mut stack, &mut deepest, node_group, &world, oct);
             node_group = next;
             if instances.1 != 0 {
                 let local = 31 - instances.1.leading_zeros();
@@ -252,10 +302,17 @@ mod tests {
         let mut rng = SplitMix64::new(9);
         // A deep BLAS over a floor; then hundreds of small instances, so that the TLAS is a few
         // levels deep and its leaf groups hold several instances each.
-        let sphere = scene(vec![displaced_sphere(20_000, 1), Mesh::plane(4.0)], vec![
-            Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY },
-            Instance { mesh: 1, material: 0, transform: Mat4::from_translation(Vec3::new(0.0, -1.2, 0.0)) },
-        ]);
+        let sphere = scene(
+            vec![displaced_sphere(20_000, 1), Mesh::plane(4.0)],
+            vec![
+                Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY },
+                Instance {
+                    mesh: 1,
+                    material: 0,
+                    transform: Mat4::from_translation(Vec3::new(0.0, -1.2, 0.0)),
+                },
+            ],
+        );
         let crowd = scene(
             vec![displaced_sphere(300, 2), Mesh::plane(0.5)],
             (0..600)
@@ -273,9 +330,19 @@ mod tests {
         for (name, desc) in [("sphere and floor", sphere), ("600 instances", crowd)] {
             let bvh = SceneBvh::new(&desc).expect("bvh");
             let bound = bvh.stack_entries() as usize;
-            let deepest = random_rays(bvh.bounds(), 20_000, 1e30, 3).iter().map(|r| deepest_stack(&bvh, r.origin, r.direction)).max().unwrap_or(0);
-            eprintln!("{name}: TLAS depth {}, bound {bound}, deepest replayed stack {deepest}", bvh.tlas.depth);
-            assert!(deepest <= bound, "{name}: a ray's traversal held {deepest} entries, the bound is {bound}");
+            let deepest = random_rays(bvh.bounds(), 20_000, 1e30, 3)
+                .iter()
+                .map(|r| deepest_stack(&bvh, r.origin, r.direction))
+                .max()
+                .unwrap_or(0);
+            eprintln!(
+                "{name}: TLAS depth {}, bound {bound}, deepest replayed stack {deepest}",
+                bvh.tlas.depth
+            );
+            assert!(
+                deepest <= bound,
+                "{name}: a ray's traversal held {deepest} entries, the bound is {bound}"
+            );
             assert!(deepest > 0, "{name}: the rays push groups");
         }
     }

@@ -26,15 +26,22 @@ mod stack_need;
 mod tlas;
 mod triangle;
 
-pub use bench::{PAIRED_ROUNDS, TraversalBench, displaced_sphere, median, random_rays, traversal_benchmark};
+pub use bench::{
+    PAIRED_ROUNDS, TraversalBench, displaced_sphere, median, random_rays, traversal_benchmark,
+};
 pub use blas::Blas;
 pub use bvh2::{BVH2_STACK_SIZE, Bvh2Blas, SceneBvh2};
 pub use bvh2_geometry::{Bvh2Geometry, SgBvh2Node};
 pub use cpu_traversal::{InstanceUpdate, SceneBvh};
-pub use tlas::InstanceTransforms;
-pub use ray_batch::{BatchGeometry, Bvh2Traversal, RayBatch, RayBuffers, RayQuery, SurfaceRecord, TraceKind, struct_layout_mismatches as ray_batch_struct_mismatches};
+pub use ray_batch::{
+    BatchGeometry, Bvh2Traversal, RayBatch, RayBuffers, RayQuery, SurfaceRecord, TraceKind,
+    struct_layout_mismatches as ray_batch_struct_mismatches,
+};
 pub use scene::rng::{SplitMix64, mix64};
-pub use scene_geometry::{SceneGeometry, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTlasLeaf, SgTriangle, SgVertex};
+pub use scene_geometry::{
+    SceneGeometry, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTlasLeaf, SgTriangle, SgVertex,
+};
+pub use tlas::InstanceTransforms;
 pub use tlas::Tlas;
 pub use triangle::{WatertightRay, intersect_triangle};
 
@@ -82,11 +89,17 @@ pub enum BvhError {
     InstanceMesh { instance: usize, mesh: u32, meshes: usize },
     #[error("instance {instance} has a non-invertible or non-finite transform {transform}")]
     InstanceTransform { instance: usize, transform: String },
-    #[error("BVH too deep for the GPU traversal stack: it can need {needed} entries (TLAS depth {tlas}, deepest BLAS depth {blas} in mesh '{mesh}'), more than the {limit} the stack holds")]
+    #[error(
+        "BVH too deep for the GPU traversal stack: it can need {needed} entries (TLAS depth {tlas}, deepest BLAS depth {blas} in mesh '{mesh}'), more than the {limit} the stack holds"
+    )]
     TooDeep { needed: u32, limit: u32, tlas: u32, blas: u32, mesh: String },
-    #[error("this ray batch's traversal stack holds {compiled} entries, and the geometry's BVH can need {needed} (it grew deeper): build a new batch on it")]
+    #[error(
+        "this ray batch's traversal stack holds {compiled} entries, and the geometry's BVH can need {needed} (it grew deeper): build a new batch on it"
+    )]
     StackTooSmall { compiled: u32, needed: u32 },
-    #[error("the adapter allows {limit} storage buffers per shader stage; the scene geometry alone needs {needed}")]
+    #[error(
+        "the adapter allows {limit} storage buffers per shader stage; the scene geometry alone needs {needed}"
+    )]
     StorageBuffers { needed: u32, limit: u32 },
     #[error("reading back '{what}' from the GPU failed: {reason}")]
     Readback { what: String, reason: String },

@@ -85,7 +85,13 @@ const GROUP: [BufferBinding; 4] = [
 /// The structs of the pass, for the layout test.
 pub fn struct_layout_mismatches() -> Vec<String> {
     use crate::gpu_struct::layout_mismatches;
-    [layout_mismatches::<GpuRay>(""), layout_mismatches::<GpuHit>(""), layout_mismatches::<GpuPoint>(""), layout_mismatches::<BatchParams>("")].concat()
+    [
+        layout_mismatches::<GpuRay>(""),
+        layout_mismatches::<GpuHit>(""),
+        layout_mismatches::<GpuPoint>(""),
+        layout_mismatches::<BatchParams>(""),
+    ]
+    .concat()
 }
 
 /// Which kernel [`RayBatch::dispatch`] runs.
@@ -153,32 +159,61 @@ impl RayBatch {
     /// The batch of the CWBVH traversal (scene_geometry.wgsl), its stack sized for `geometry`:
     /// it traces geometry whose BVH needs no more ([`Self::dispatch`] checks).
     pub fn new(gpu: &Gpu, geometry: &SceneGeometry) -> Self {
-        Self::with_traversal(gpu, SceneGeometry::modules(), crate::wgsl_file!("ray_batch/cwbvh.wgsl"), &[geometry.bind_group_layout()], geometry.stack_entries())
+        Self::with_traversal(
+            gpu,
+            SceneGeometry::modules(),
+            crate::wgsl_file!("ray_batch/cwbvh.wgsl"),
+            &[geometry.bind_group_layout()],
+            geometry.stack_entries(),
+        )
     }
 
     /// The batch of the BVH2 traversal (bvh2_traversal.wgsl).
     pub fn new_bvh2(gpu: &Gpu, traversal: &Bvh2Traversal) -> Self {
         let modules = [SceneGeometry::modules(), Bvh2Geometry::modules()].concat();
         let layouts = [traversal.geometry.bind_group_layout(), traversal.bvh2.bind_group_layout()];
-        Self::with_traversal(gpu, modules, crate::wgsl_file!("ray_batch/bvh2.wgsl"), &layouts, traversal.geometry.stack_entries())
+        Self::with_traversal(
+            gpu,
+            modules,
+            crate::wgsl_file!("ray_batch/bvh2.wgsl"),
+            &layouts,
+            traversal.geometry.stack_entries(),
+        )
     }
 
     /// bvh_ray_batch.wgsl's kernels with `trace` as `package::ray_batch::trace`, on the
     /// geometry's `modules` bound at @group(1), ... (`layouts`), with a CWBVH stack for
     /// `stack_entries`. Only the stack is specialised: the kernels do not shade.
-    fn with_traversal(gpu: &Gpu, modules: Vec<Module>, trace: Module, layouts: &[&wgpu::BindGroupLayout], stack_entries: u32) -> Self {
+    fn with_traversal(
+        gpu: &Gpu,
+        modules: Vec<Module>,
+        trace: Module,
+        layouts: &[&wgpu::BindGroupLayout],
+        stack_entries: u32,
+    ) -> Self {
         let stack = SceneFeatures::stack_for(stack_entries);
         let features = SceneFeatures { traversal_stack: stack, ..SceneFeatures::ALL };
         let layout = crate::compute::binding_layout(gpu, "ray batch", &GROUP);
-        let types = Module::generated("package::ray_batch_types", &[GpuRay::WGSL, GpuHit::WGSL, GpuPoint::WGSL, BatchParams::WGSL]);
-        let bindings = crate::compute::group_module("package::ray_batch_bindings", 0, &GROUP, &[&types]);
+        let types = Module::generated(
+            "package::ray_batch_types",
+            &[GpuRay::WGSL, GpuHit::WGSL, GpuPoint::WGSL, BatchParams::WGSL],
+        );
+        let bindings =
+            crate::compute::group_module("package::ray_batch_bindings", 0, &GROUP, &[&types]);
         let program = crate::shader::Program::new(modules)
             .with([types, bindings, trace.at("package::ray_batch::trace")])
             .entry(crate::wgsl_file!("bvh_ray_batch.wgsl"))
             .replacing(&features.module());
-        let groups: Vec<&wgpu::BindGroupLayout> = [&layout].into_iter().chain(layouts.iter().copied()).collect();
-        let [closest, any, points] = crate::compute::pipelines(gpu, "bvh_ray_batch.wgsl", &program, &groups, ["trace_closest_rays", "trace_any_rays", "surface_points"])
-            .unwrap_or_else(|e| panic!("the ray batch's WGSL: {e}"));
+        let groups: Vec<&wgpu::BindGroupLayout> =
+            [&layout].into_iter().chain(layouts.iter().copied()).collect();
+        let [closest, any, points] = crate::compute::pipelines(
+            gpu,
+            "bvh_ray_batch.wgsl",
+            &program,
+            &groups,
+            ["trace_closest_rays", "trace_any_rays", "surface_points"],
+        )
+        .unwrap_or_else(|e| panic!("the ray batch's WGSL: {e}"));
         Self { closest, any, points, layout, stack }
     }
 
@@ -191,7 +226,11 @@ impl RayBatch {
     pub fn upload(&self, gpu: &Gpu, rays: &[RayQuery]) -> Result<RayBuffers, BvhError> {
         let count = rays.len() as u32;
         let n = rays.len().max(1) as u64;
-        for (what, stride) in [("ray buffer", 32u64), ("hit buffer", 32), ("surface point buffer", size_of::<GpuPoint>() as u64)] {
+        for (what, stride) in [
+            ("ray buffer", 32u64),
+            ("hit buffer", 32),
+            ("surface point buffer", size_of::<GpuPoint>() as u64),
+        ] {
             gpu.check_buffer_size(what, n * stride)?;
         }
         let groups_needed = count.div_ceil(WORKGROUP_SIZE).max(1);
@@ -200,17 +239,33 @@ impl RayBatch {
         let groups = (groups_x, groups_needed.div_ceil(groups_x));
         let gpu_rays: Vec<GpuRay> = rays
             .iter()
-            .map(|r| GpuRay { origin: r.origin.into(), t_max: r.t_max, direction: r.direction.into(), pad: 0 })
+            .map(|r| GpuRay {
+                origin: r.origin.into(),
+                t_max: r.t_max,
+                direction: r.direction.into(),
+                pad: 0,
+            })
             .collect();
         let buffer = |label, size: u64, usage| {
-            gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
         };
-        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
+        let storage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC;
         let ray_buffer = buffer("rays", n * 32, storage);
         gpu.queue.write_buffer(&ray_buffer, 0, bytemuck::cast_slice(&gpu_rays));
         let hits = buffer("hits", n * 32, storage);
         let points = buffer("surface points", n * size_of::<GpuPoint>() as u64, storage);
-        let params = buffer("ray batch params", 16, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+        let params = buffer(
+            "ray batch params",
+            16,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
         let p = BatchParams { count, row_pitch: groups_x * WORKGROUP_SIZE, pad: [0; 2] };
         gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&p));
         let bind_group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -219,25 +274,42 @@ impl RayBatch {
             entries: &[&ray_buffer, &hits, &points, &params]
                 .iter()
                 .enumerate()
-                .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+                .map(|(i, b)| wgpu::BindGroupEntry {
+                    binding: i as u32,
+                    resource: b.as_entire_binding(),
+                })
                 .collect::<Vec<_>>(),
         });
         Ok(RayBuffers { count, groups, hits, points, bind_group })
     }
 
     /// Runs one kernel over all rays and waits for the GPU to finish.
-    pub fn dispatch(&self, gpu: &Gpu, geometry: &impl BatchGeometry, buffers: &RayBuffers, kind: TraceKind) -> Result<(), BvhError> {
+    pub fn dispatch(
+        &self,
+        gpu: &Gpu,
+        geometry: &impl BatchGeometry,
+        buffers: &RayBuffers,
+        kind: TraceKind,
+    ) -> Result<(), BvhError> {
         if geometry.stack_entries() > self.stack {
-            return Err(BvhError::StackTooSmall { compiled: self.stack, needed: geometry.stack_entries() });
+            return Err(BvhError::StackTooSmall {
+                compiled: self.stack,
+                needed: geometry.stack_entries(),
+            });
         }
         let pipeline = match kind {
             TraceKind::Closest => &self.closest,
             TraceKind::Any => &self.any,
             TraceKind::SurfacePoints => &self.points,
         };
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ray batch") });
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ray batch") });
         {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("ray batch"), timestamp_writes: None });
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("ray batch"),
+                timestamp_writes: None,
+            });
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &buffers.bind_group, &[]);
             for (i, group) in geometry.bind_groups().into_iter().enumerate() {
@@ -257,19 +329,34 @@ impl RayBatch {
         let hits: Vec<GpuHit> = read(gpu, &buffers.hits, buffers.count as u64 * 32, "hits")?;
         Ok(hits
             .iter()
-            .map(|h| Hit { t: h.t, instance: h.instance, primitive: h.primitive, barycentrics: Vec2::from(h.barycentrics) })
+            .map(|h| Hit {
+                t: h.t,
+                instance: h.instance,
+                primitive: h.primitive,
+                barycentrics: Vec2::from(h.barycentrics),
+            })
             .collect())
     }
 
     /// Any-hit flags of the last `Any` dispatch.
     pub fn read_any(&self, gpu: &Gpu, buffers: &RayBuffers) -> Result<Vec<bool>, BvhError> {
-        let hits: Vec<GpuHit> = read(gpu, &buffers.hits, buffers.count as u64 * 32, "any-hit flags")?;
+        let hits: Vec<GpuHit> =
+            read(gpu, &buffers.hits, buffers.count as u64 * 32, "any-hit flags")?;
         Ok(hits.iter().map(|h| h.any_hit != 0).collect())
     }
 
     /// Surface records of the last `SurfacePoints` dispatch (meaningless for missed rays).
-    pub fn read_surface_points(&self, gpu: &Gpu, buffers: &RayBuffers) -> Result<Vec<SurfaceRecord>, BvhError> {
-        let points: Vec<GpuPoint> = read(gpu, &buffers.points, buffers.count as u64 * size_of::<GpuPoint>() as u64, "surface points")?;
+    pub fn read_surface_points(
+        &self,
+        gpu: &Gpu,
+        buffers: &RayBuffers,
+    ) -> Result<Vec<SurfaceRecord>, BvhError> {
+        let points: Vec<GpuPoint> = read(
+            gpu,
+            &buffers.points,
+            buffers.count as u64 * size_of::<GpuPoint>() as u64,
+            "surface points",
+        )?;
         let v3 = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
         Ok(points
             .iter()
@@ -286,14 +373,24 @@ impl RayBatch {
     }
 
     /// Convenience: closest hits of `rays`.
-    pub fn trace_closest(&self, gpu: &Gpu, geometry: &impl BatchGeometry, rays: &[RayQuery]) -> Result<Vec<Hit>, BvhError> {
+    pub fn trace_closest(
+        &self,
+        gpu: &Gpu,
+        geometry: &impl BatchGeometry,
+        rays: &[RayQuery],
+    ) -> Result<Vec<Hit>, BvhError> {
         let buffers = self.upload(gpu, rays)?;
         self.dispatch(gpu, geometry, &buffers, TraceKind::Closest)?;
         self.read_closest(gpu, &buffers)
     }
 
     /// Convenience: any-hit flags of `rays`.
-    pub fn trace_any(&self, gpu: &Gpu, geometry: &impl BatchGeometry, rays: &[RayQuery]) -> Result<Vec<bool>, BvhError> {
+    pub fn trace_any(
+        &self,
+        gpu: &Gpu,
+        geometry: &impl BatchGeometry,
+        rays: &[RayQuery],
+    ) -> Result<Vec<bool>, BvhError> {
         let buffers = self.upload(gpu, rays)?;
         self.dispatch(gpu, geometry, &buffers, TraceKind::Any)?;
         self.read_any(gpu, &buffers)
@@ -301,7 +398,12 @@ impl RayBatch {
 }
 
 /// Copies `size` bytes of `buffer` to a mappable buffer and reads them as `T`s.
-fn read<T: bytemuck::Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, size: u64, what: &str) -> Result<Vec<T>, BvhError> {
+fn read<T: bytemuck::Pod>(
+    gpu: &Gpu,
+    buffer: &wgpu::Buffer,
+    size: u64,
+    what: &str,
+) -> Result<Vec<T>, BvhError> {
     if size == 0 {
         return Ok(Vec::new());
     }
@@ -311,7 +413,9 @@ fn read<T: bytemuck::Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, size: u64, what: &st
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
+    let mut encoder = gpu
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback") });
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
     gpu.queue.submit([encoder.finish()]);
     let (tx, rx) = std::sync::mpsc::channel();

@@ -15,17 +15,23 @@ const CELL_BITS: u32 = 10;
 /// The sort key: octant of the direction (3 bits, most significant) then the 30-bit Morton code
 /// of the origin's cell in `bounds` (origins outside are clamped to the border cells).
 pub fn coherence_key(bounds: (Vec3, Vec3), ray: &RayQuery) -> u64 {
-    let octant = (ray.direction.x < 0.0) as u64 | ((ray.direction.y < 0.0) as u64) << 1 | ((ray.direction.z < 0.0) as u64) << 2;
+    let octant = (ray.direction.x < 0.0) as u64
+        | ((ray.direction.y < 0.0) as u64) << 1
+        | ((ray.direction.z < 0.0) as u64) << 2;
     let extent = (bounds.1 - bounds.0).max(Vec3::splat(f32::MIN_POSITIVE));
     let cells = (1u32 << CELL_BITS) as f32;
-    let cell = ((ray.origin - bounds.0) / extent * cells).clamp(Vec3::ZERO, Vec3::splat(cells - 1.0));
-    let morton = spread_bits(cell.x as u32) | spread_bits(cell.y as u32) << 1 | spread_bits(cell.z as u32) << 2;
+    let cell =
+        ((ray.origin - bounds.0) / extent * cells).clamp(Vec3::ZERO, Vec3::splat(cells - 1.0));
+    let morton = spread_bits(cell.x as u32)
+        | spread_bits(cell.y as u32) << 1
+        | spread_bits(cell.z as u32) << 2;
     octant << (3 * CELL_BITS) | morton
 }
 
 /// The rays in coherence-key order (a stable sort: equal keys keep their order).
 pub fn sort_for_coherence(bounds: (Vec3, Vec3), rays: &[RayQuery]) -> Vec<RayQuery> {
-    let mut keyed: Vec<(u64, RayQuery)> = rays.iter().map(|r| (coherence_key(bounds, r), *r)).collect();
+    let mut keyed: Vec<(u64, RayQuery)> =
+        rays.iter().map(|r| (coherence_key(bounds, r), *r)).collect();
     keyed.sort_by_key(|(k, _)| *k);
     keyed.into_iter().map(|(_, r)| r).collect()
 }
@@ -68,11 +74,21 @@ mod tests {
         // bounds grown by 10% (volume ~2.5), 4096 per octant: their spacing is ~0.08, and Morton
         // order's jumps between cells keep its mean step at a small multiple of that, while
         // consecutive random points lie ~0.9 apart.
-        let mean_step = |rs: &[RayQuery]| rs.windows(2).map(|w| w[0].origin.distance(w[1].origin)).sum::<f32>() / (rs.len() - 1) as f32;
-        assert!(mean_step(&sorted) < 0.25 * mean_step(&rays), "{} vs {}", mean_step(&sorted), mean_step(&rays));
+        let mean_step = |rs: &[RayQuery]| {
+            rs.windows(2).map(|w| w[0].origin.distance(w[1].origin)).sum::<f32>()
+                / (rs.len() - 1) as f32
+        };
+        assert!(
+            mean_step(&sorted) < 0.25 * mean_step(&rays),
+            "{} vs {}",
+            mean_step(&sorted),
+            mean_step(&rays)
+        );
         // The same multiset of rays.
-        let mut a: Vec<[u32; 3]> = rays.iter().map(|r| r.origin.to_array().map(f32::to_bits)).collect();
-        let mut b: Vec<[u32; 3]> = sorted.iter().map(|r| r.origin.to_array().map(f32::to_bits)).collect();
+        let mut a: Vec<[u32; 3]> =
+            rays.iter().map(|r| r.origin.to_array().map(f32::to_bits)).collect();
+        let mut b: Vec<[u32; 3]> =
+            sorted.iter().map(|r| r.origin.to_array().map(f32::to_bits)).collect();
         a.sort();
         b.sort();
         assert_eq!(a, b);

@@ -8,15 +8,15 @@ use glam::{Mat4, Vec3};
 use obvhs::cwbvh::node::CwBvhNode;
 
 use super::cpu_traversal::InstanceUpdate;
-use crate::texel_table::{TexelTable, whole_rows};
 use super::tlas::InstanceTransforms;
 use super::{BvhError, SceneBvh};
 use crate::compute::BufferBinding;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
+use crate::scene::{Instance, SceneDesc};
 use crate::scene_features::SceneFeatures;
 use crate::shader::Module;
-use crate::scene::{Instance, SceneDesc};
+use crate::texel_table::{TexelTable, whole_rows};
 
 /// Storage buffers the bind group holds (a pass adds its own to the per-stage count).
 pub const STORAGE_BUFFERS: u32 = 1;
@@ -47,10 +47,23 @@ const _: () = {
     use obvhs::cwbvh::node::CwBvhNode as N;
     use std::mem::offset_of;
     assert!(size_of::<N>() == size_of::<SgNode>());
-    assert!(offset_of!(N, p) == offset_of!(SgNode, origin) && offset_of!(N, e) == offset_of!(SgNode, exponents_imask) && offset_of!(N, imask) == offset_of!(SgNode, exponents_imask) + 3);
-    assert!(offset_of!(N, child_base_idx) == offset_of!(SgNode, child_base) && offset_of!(N, primitive_base_idx) == offset_of!(SgNode, primitive_base));
-    assert!(offset_of!(N, child_meta) == offset_of!(SgNode, child_meta) && offset_of!(N, child_min_x) == offset_of!(SgNode, bounds_x));
-    assert!(offset_of!(N, child_min_y) == offset_of!(SgNode, bounds_y) && offset_of!(N, child_min_z) == offset_of!(SgNode, bounds_z));
+    assert!(
+        offset_of!(N, p) == offset_of!(SgNode, origin)
+            && offset_of!(N, e) == offset_of!(SgNode, exponents_imask)
+            && offset_of!(N, imask) == offset_of!(SgNode, exponents_imask) + 3
+    );
+    assert!(
+        offset_of!(N, child_base_idx) == offset_of!(SgNode, child_base)
+            && offset_of!(N, primitive_base_idx) == offset_of!(SgNode, primitive_base)
+    );
+    assert!(
+        offset_of!(N, child_meta) == offset_of!(SgNode, child_meta)
+            && offset_of!(N, child_min_x) == offset_of!(SgNode, bounds_x)
+    );
+    assert!(
+        offset_of!(N, child_min_y) == offset_of!(SgNode, bounds_y)
+            && offset_of!(N, child_min_z) == offset_of!(SgNode, bounds_z)
+    );
 };
 
 crate::gpu_struct! {
@@ -132,7 +145,8 @@ crate::gpu_struct! {
 }
 
 /// The geometry's storage buffer, @group(1) binding 0, declared once (WGSL and layout).
-pub const GROUP: [BufferBinding; 1] = [BufferBinding::read("sg_instance_header", "SgInstanceHeader")];
+pub const GROUP: [BufferBinding; 1] =
+    [BufferBinding::read("sg_instance_header", "SgInstanceHeader")];
 const _: () = assert!(crate::compute::storage_buffers(&GROUP) == STORAGE_BUFFERS);
 
 /// The texel tables after the buffer, each record a struct of whole 16-byte texels: (WGSL
@@ -158,8 +172,17 @@ const fn record_bytes(table: usize) -> usize {
 }
 const _: () = {
     let t = record_bytes;
-    assert!(size_of::<SgNode>() == t(NODES) && size_of::<SgTriangle>() == t(TRIANGLES) && size_of::<SgTlasLeaf>() == t(TLAS_LEAVES));
-    assert!(size_of::<SgInstance>() == t(INSTANCES) && size_of::<SgMesh>() == t(MESHES) && size_of::<SgVertex>() == t(VERTICES) && t(INDICES) == 16);
+    assert!(
+        size_of::<SgNode>() == t(NODES)
+            && size_of::<SgTriangle>() == t(TRIANGLES)
+            && size_of::<SgTlasLeaf>() == t(TLAS_LEAVES)
+    );
+    assert!(
+        size_of::<SgInstance>() == t(INSTANCES)
+            && size_of::<SgMesh>() == t(MESHES)
+            && size_of::<SgVertex>() == t(VERTICES)
+            && t(INDICES) == 16
+    );
 };
 
 const fn texels(table: usize) -> u32 {
@@ -187,15 +210,35 @@ impl SceneGeometry {
     pub fn modules() -> Vec<Module> {
         let types = Self::types();
         let names: Vec<&str> = TABLES.iter().map(|t| t.0).collect();
-        let bindings = crate::texel_table::group_module("package::scene_geometry_bindings", 1, &GROUP, &names, &[&types]);
-        vec![SceneFeatures::ALL.module(), crate::texel_table::module(), types, bindings, crate::wgsl_file!("scene_geometry.wgsl")]
+        let bindings = crate::texel_table::group_module(
+            "package::scene_geometry_bindings",
+            1,
+            &GROUP,
+            &names,
+            &[&types],
+        );
+        vec![
+            SceneFeatures::ALL.module(),
+            crate::texel_table::module(),
+            types,
+            bindings,
+            crate::wgsl_file!("scene_geometry.wgsl"),
+        ]
     }
 
     /// `package::scene_geometry_types`: the structs of the bind group.
     pub(crate) fn types() -> Module {
         Module::generated(
             "package::scene_geometry_types",
-            &[SgNode::WGSL, SgTriangle::WGSL, SgTlasLeaf::WGSL, SgMesh::WGSL, SgVertex::WGSL, SgInstance::WGSL, SgInstanceHeader::WGSL],
+            &[
+                SgNode::WGSL,
+                SgTriangle::WGSL,
+                SgTlasLeaf::WGSL,
+                SgMesh::WGSL,
+                SgVertex::WGSL,
+                SgInstance::WGSL,
+                SgInstanceHeader::WGSL,
+            ],
         )
     }
 
@@ -228,7 +271,8 @@ impl SceneGeometry {
         for ((mesh, blas), &node_offset) in scene.meshes.iter().zip(&bvh.blas).zip(&blas_roots) {
             let triangle_offset = triangles.len() as u32;
             triangles.extend(sg_triangles(&blas.triangles, &blas.bvh.primitive_indices));
-            let flags = if mesh.normals.is_empty() { 0 } else { HAS_NORMALS } | if mesh.uvs.is_empty() { 0 } else { HAS_UVS };
+            let flags = if mesh.normals.is_empty() { 0 } else { HAS_NORMALS }
+                | if mesh.uvs.is_empty() { 0 } else { HAS_UVS };
             meshes.push(SgMesh {
                 node_offset,
                 node_count: blas.bvh.nodes.len() as u32,
@@ -247,12 +291,27 @@ impl SceneGeometry {
             indices.extend(mesh.indices.iter().map(|t| [t[0], t[1], t[2], 0]));
         }
 
-        let triangles = TexelTable::new(gpu, "BLAS triangles", texels(TRIANGLES), bytemuck::cast_slice(&triangles), 0)?;
-        let meshes = TexelTable::new(gpu, "mesh table", texels(MESHES), bytemuck::cast_slice(&meshes), 0)?;
-        let vertices = TexelTable::new(gpu, "vertices", texels(VERTICES), bytemuck::cast_slice(&vertices), 0)?;
-        let indices = TexelTable::new(gpu, "triangle indices", texels(INDICES), bytemuck::cast_slice(&indices), 0)?;
+        let triangles = TexelTable::new(
+            gpu,
+            "BLAS triangles",
+            texels(TRIANGLES),
+            bytemuck::cast_slice(&triangles),
+            0,
+        )?;
+        let meshes =
+            TexelTable::new(gpu, "mesh table", texels(MESHES), bytemuck::cast_slice(&meshes), 0)?;
+        let vertices =
+            TexelTable::new(gpu, "vertices", texels(VERTICES), bytemuck::cast_slice(&vertices), 0)?;
+        let indices = TexelTable::new(
+            gpu,
+            "triangle indices",
+            texels(INDICES),
+            bytemuck::cast_slice(&indices),
+            0,
+        )?;
         let tlas_root = whole_rows(nodes.len() as u32);
-        let [node_table, tlas_leaves, instances] = Self::instance_tables(gpu, &bvh, &nodes, tlas_root)?;
+        let [node_table, tlas_leaves, instances] =
+            Self::instance_tables(gpu, &bvh, &nodes, tlas_root)?;
         let header = storage(gpu, "instance table header", &instance_header(&bvh, tlas_root), 0)?;
 
         let layout = crate::texel_table::group_layout(gpu, "scene geometry", &GROUP, TABLES.len());
@@ -271,7 +330,11 @@ impl SceneGeometry {
     }
 
     /// [`Self::update_instances`], returning what it did or why the instances are invalid.
-    pub fn try_update_instances(&mut self, gpu: &Gpu, instances: &[Instance]) -> Result<InstanceUpdate, BvhError> {
+    pub fn try_update_instances(
+        &mut self,
+        gpu: &Gpu,
+        instances: &[Instance],
+    ) -> Result<InstanceUpdate, BvhError> {
         let update = self.bvh.update_instances(instances)?;
         match update {
             InstanceUpdate::Unchanged => {}
@@ -281,21 +344,37 @@ impl SceneGeometry {
             }
             InstanceUpdate::Rebuilt => {
                 let instances = self.bvh.instances.len() as u32;
-                let fits = self.tlas_root + self.bvh.tlas.bvh.nodes.len() as u32 <= self.tables[NODES].capacity()
-                    && self.bvh.tlas.bvh.primitive_indices.len() as u32 <= self.tables[TLAS_LEAVES].capacity()
+                let fits = self.tlas_root + self.bvh.tlas.bvh.nodes.len() as u32
+                    <= self.tables[NODES].capacity()
+                    && self.bvh.tlas.bvh.primitive_indices.len() as u32
+                        <= self.tables[TLAS_LEAVES].capacity()
                     && instances <= self.tables[INSTANCES].capacity();
                 if fits {
-                    self.tables[NODES].write(gpu, self.tlas_root, &tlas_nodes(&self.bvh, self.tlas_root));
+                    self.tables[NODES].write(
+                        gpu,
+                        self.tlas_root,
+                        &tlas_nodes(&self.bvh, self.tlas_root),
+                    );
                     self.tables[TLAS_LEAVES].write(gpu, 0, &tlas_leaves(&self.bvh));
                     self.tables[INSTANCES].write(gpu, 0, &instance_records(&self.bvh));
                 } else {
                     // More instances than the tables hold: new ones, so a new bind group
                     // (passes must fetch `bind_group()` each frame).
-                    let [n, l, i] = Self::instance_tables(gpu, &self.bvh, &blas_nodes(&self.bvh), self.tlas_root)?;
-                    (self.tables[NODES], self.tables[TLAS_LEAVES], self.tables[INSTANCES]) = (n, l, i);
+                    let [n, l, i] = Self::instance_tables(
+                        gpu,
+                        &self.bvh,
+                        &blas_nodes(&self.bvh),
+                        self.tlas_root,
+                    )?;
+                    (self.tables[NODES], self.tables[TLAS_LEAVES], self.tables[INSTANCES]) =
+                        (n, l, i);
                     self.bind_group = bind_group(gpu, &self.layout, &self.header, &self.tables);
                 }
-                gpu.queue.write_buffer(&self.header, 0, &instance_header(&self.bvh, self.tlas_root));
+                gpu.queue.write_buffer(
+                    &self.header,
+                    0,
+                    &instance_header(&self.bvh, self.tlas_root),
+                );
             }
         }
         Ok(update)
@@ -304,15 +383,33 @@ impl SceneGeometry {
     /// The node table (the BLAS nodes, then the TLAS from `tlas_root`), the TLAS leaves and the
     /// instance records, with room for twice the current instances so that a growing scene does
     /// not reallocate every frame.
-    fn instance_tables(gpu: &Gpu, bvh: &SceneBvh, blas: &[CwBvhNode], tlas_root: u32) -> Result<[TexelTable; 3], BvhError> {
+    fn instance_tables(
+        gpu: &Gpu,
+        bvh: &SceneBvh,
+        blas: &[CwBvhNode],
+        tlas_root: u32,
+    ) -> Result<[TexelTable; 3], BvhError> {
         let room = 2 * bvh.instances.len().max(1) as u64;
         // A CWBVH over n boxes has at most n nodes (every inner node has two or more children).
         let mut nodes = bytemuck::cast_slice(blas).to_vec();
         nodes.resize(tlas_root as usize * size_of::<SgNode>(), 0);
         nodes.extend(tlas_nodes(bvh, tlas_root));
-        let nodes = TexelTable::new(gpu, "BVH nodes", texels(NODES), &nodes, tlas_root + room as u32)?;
-        let leaves = TexelTable::new(gpu, "TLAS leaves", texels(TLAS_LEAVES), &tlas_leaves(bvh), room as u32)?;
-        let instances = TexelTable::new(gpu, "instance table", texels(INSTANCES), &instance_records(bvh), room as u32)?;
+        let nodes =
+            TexelTable::new(gpu, "BVH nodes", texels(NODES), &nodes, tlas_root + room as u32)?;
+        let leaves = TexelTable::new(
+            gpu,
+            "TLAS leaves",
+            texels(TLAS_LEAVES),
+            &tlas_leaves(bvh),
+            room as u32,
+        )?;
+        let instances = TexelTable::new(
+            gpu,
+            "instance table",
+            texels(INSTANCES),
+            &instance_records(bvh),
+            room as u32,
+        )?;
         Ok([nodes, leaves, instances])
     }
 
@@ -387,7 +484,12 @@ fn tlas_nodes(bvh: &SceneBvh, tlas_root: u32) -> Vec<u8> {
 }
 
 /// The bind group: the header, then the texel tables in [`TABLES`]' order.
-fn bind_group(gpu: &Gpu, layout: &wgpu::BindGroupLayout, header: &wgpu::Buffer, tables: &[TexelTable; 7]) -> wgpu::BindGroup {
+fn bind_group(
+    gpu: &Gpu,
+    layout: &wgpu::BindGroupLayout,
+    header: &wgpu::Buffer,
+    tables: &[TexelTable; 7],
+) -> wgpu::BindGroup {
     crate::texel_table::group(gpu, "scene geometry", layout, &[header], &tables.each_ref())
 }
 
@@ -415,7 +517,12 @@ fn tlas_leaves(bvh: &SceneBvh) -> Vec<u8> {
 }
 
 fn instance_header(bvh: &SceneBvh, tlas_root: u32) -> Vec<u8> {
-    let header = SgInstanceHeader { count: bvh.instances.len() as u32, tlas_node_count: bvh.tlas.bvh.nodes.len() as u32, tlas_root, pad: 0 };
+    let header = SgInstanceHeader {
+        count: bvh.instances.len() as u32,
+        tlas_node_count: bvh.tlas.bvh.nodes.len() as u32,
+        tlas_root,
+        pad: 0,
+    };
     bytemuck::bytes_of(&header).to_vec()
 }
 
@@ -437,12 +544,27 @@ fn instance_records(bvh: &SceneBvh) -> Vec<u8> {
 }
 
 /// Leaf-order triangles as the GPU reads them, each with its mesh triangle index.
-pub(super) fn sg_triangles<'a>(triangles: &'a [[Vec3; 3]], primitive_indices: &'a [u32]) -> impl Iterator<Item = SgTriangle> + 'a {
-    triangles.iter().zip(primitive_indices).map(|(t, &p)| SgTriangle { v0: t[0].into(), primitive: p, v1: t[1].into(), pad1: 0, v2: t[2].into(), pad2: 0 })
+pub(super) fn sg_triangles<'a>(
+    triangles: &'a [[Vec3; 3]],
+    primitive_indices: &'a [u32],
+) -> impl Iterator<Item = SgTriangle> + 'a {
+    triangles.iter().zip(primitive_indices).map(|(t, &p)| SgTriangle {
+        v0: t[0].into(),
+        primitive: p,
+        v1: t[1].into(),
+        pad1: 0,
+        v2: t[2].into(),
+        pad2: 0,
+    })
 }
 
 /// A read-only storage buffer holding `data`, at least `min_size` bytes (bindings cannot be empty).
-pub(super) fn storage(gpu: &Gpu, what: &str, data: &[u8], min_size: u64) -> Result<wgpu::Buffer, BvhError> {
+pub(super) fn storage(
+    gpu: &Gpu,
+    what: &str,
+    data: &[u8],
+    min_size: u64,
+) -> Result<wgpu::Buffer, BvhError> {
     let size = (data.len() as u64).max(min_size).next_multiple_of(16);
     gpu.check_buffer_size(what, size)?;
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -454,4 +576,3 @@ pub(super) fn storage(gpu: &Gpu, what: &str, data: &[u8], min_size: u64) -> Resu
     gpu.queue.write_buffer(&buffer, 0, data);
     Ok(buffer)
 }
-

@@ -24,12 +24,19 @@ impl InstanceTransforms {
     /// Checks the mesh index and that the transform is finite and invertible.
     pub fn new(index: usize, instance: &Instance, mesh_count: usize) -> Result<Self, BvhError> {
         if instance.mesh as usize >= mesh_count {
-            return Err(BvhError::InstanceMesh { instance: index, mesh: instance.mesh, meshes: mesh_count });
+            return Err(BvhError::InstanceMesh {
+                instance: index,
+                mesh: instance.mesh,
+                meshes: mesh_count,
+            });
         }
         let m = instance.transform;
         let det = m.determinant();
         if !m.is_finite() || !det.is_finite() || det == 0.0 {
-            return Err(BvhError::InstanceTransform { instance: index, transform: format!("{m:?}") });
+            return Err(BvhError::InstanceTransform {
+                instance: index,
+                transform: format!("{m:?}"),
+            });
         }
         Ok(Self {
             object_to_world: m,
@@ -74,7 +81,10 @@ impl Tlas {
         }
         let bounds = boxes.iter().fold(Aabb::empty(), |acc, b| acc.union(b));
         let depth = cwbvh_depth(&bvh);
-        let stack_need = super::stack_need::tlas_stack_need(&bvh, blas.iter().map(|b| b.stack_need).max().unwrap_or(0));
+        let stack_need = super::stack_need::tlas_stack_need(
+            &bvh,
+            blas.iter().map(|b| b.stack_need).max().unwrap_or(0),
+        );
         Self { bvh, bounds, depth, stack_need }
     }
 }

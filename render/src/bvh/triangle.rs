@@ -35,13 +35,23 @@ impl WatertightRay {
             std::mem::swap(&mut kx, &mut ky);
         }
         let inv = 1.0 / direction[kz];
-        Self { origin, axes: [kx, ky, kz], shear: Vec3::new(direction[kx] * inv, direction[ky] * inv, inv) }
+        Self {
+            origin,
+            axes: [kx, ky, kz],
+            shear: Vec3::new(direction[kx] * inv, direction[ky] * inv, inv),
+        }
     }
 }
 
 /// The hit `(t, (u, v))` with `0 < t < t_max`, where `u`, `v` weight vertices 1 and 2; `t` is in
 /// units of the ray direction the [`WatertightRay`] was made from.
-pub fn intersect_triangle(ray: &WatertightRay, v0: Vec3, v1: Vec3, v2: Vec3, t_max: f32) -> Option<(f32, Vec2)> {
+pub fn intersect_triangle(
+    ray: &WatertightRay,
+    v0: Vec3,
+    v1: Vec3,
+    v2: Vec3,
+    t_max: f32,
+) -> Option<(f32, Vec2)> {
     let [kx, ky, kz] = ray.axes;
     let s = ray.shear;
     let a = v0 - ray.origin;
@@ -104,7 +114,10 @@ mod tests {
         let v3 = Vec3::new(1.0, 1.0, 0.0);
         for i in 1..100 {
             let x = i as f32 / 100.0;
-            let ray = WatertightRay::new(Vec3::new(x, 1.0 - x, 1.0) + Vec3::new(0.3, -0.2, 0.0), Vec3::new(-0.3, 0.2, -1.0));
+            let ray = WatertightRay::new(
+                Vec3::new(x, 1.0 - x, 1.0) + Vec3::new(0.3, -0.2, 0.0),
+                Vec3::new(-0.3, 0.2, -1.0),
+            );
             let a = intersect_triangle(&ray, V0, V1, V2, 10.0);
             let b = intersect_triangle(&ray, V1, v3, V2, 10.0);
             assert!(a.is_some() || b.is_some(), "crack at x = {x}");

@@ -102,7 +102,9 @@ pub fn key(p: &KeyParams, x: Vec3, n: Vec3, level: i32, jitter: Vec2) -> VoxelKe
     h = hash_mix(h ^ cy);
     h = hash_mix(h ^ cz);
     h = hash_mix(h ^ tag);
-    let mut c = pcg_hash(cx.wrapping_add(pcg_hash(cy.wrapping_add(pcg_hash(cz.wrapping_add(pcg_hash(tag)))))));
+    let mut c = pcg_hash(
+        cx.wrapping_add(pcg_hash(cy.wrapping_add(pcg_hash(cz.wrapping_add(pcg_hash(tag)))))),
+    );
     if c == EMPTY {
         c = 1;
     }
@@ -119,7 +121,13 @@ mod tests {
     use super::*;
 
     fn params() -> KeyParams {
-        KeyParams { capacity: 1 << 16, pixel_angle: 0.01, lod_scale: 1.0, normal_lod: true, jitter: false }
+        KeyParams {
+            capacity: 1 << 16,
+            pixel_angle: 0.01,
+            lod_scale: 1.0,
+            normal_lod: true,
+            jitter: false,
+        }
     }
 
     #[test]

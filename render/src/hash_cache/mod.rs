@@ -53,10 +53,10 @@ use crate::compute::BufferBinding;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
+use crate::pass_library::PassLibrary;
 use crate::path_tracer::PathTracer;
 use crate::readback::read_buffer;
 use crate::scene::Camera;
-use crate::pass_library::PassLibrary;
 use crate::shader::{Module, Program};
 use crate::taa::{Taa, TaaPrimary, halton_jitter};
 use crate::timing::{PassTimer, PassTiming};
@@ -82,7 +82,6 @@ const OWN_GROUP: [BufferBinding; 7] = [
 ];
 
 const PASSES: [&str; 4] = [HC_AGE_PASS, HC_TRACE_PASS, HC_UPDATE_PASS, HC_RESOLVE_PASS];
-
 
 /// Where the path terminates into the cache.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -140,10 +139,16 @@ impl HashCacheSettings {
     pub fn validate(&self) -> Result<(), RenderError> {
         let bad = |m: String| Err(RenderError::Settings(m));
         if self.capacity == 0 || self.capacity >= u32::MAX / 4 {
-            return bad(format!("hash cache capacity must be in 1..2^30 slots, got {}", self.capacity));
+            return bad(format!(
+                "hash cache capacity must be in 1..2^30 slots, got {}",
+                self.capacity
+            ));
         }
         if self.probe_limit == 0 || self.probe_limit > self.capacity {
-            return bad(format!("hash cache probe_limit must be in 1..=capacity, got {}", self.probe_limit));
+            return bad(format!(
+                "hash cache probe_limit must be in 1..=capacity, got {}",
+                self.probe_limit
+            ));
         }
         if self.max_samples == 0 || !(self.lod_scale > 0.0) {
             return bad("hash cache max_samples must be at least 1 and lod_scale positive".into());
@@ -153,7 +158,13 @@ impl HashCacheSettings {
 
     /// Key parameters for a camera and image height.
     pub fn key_params(&self, camera: &Camera, height: u32) -> KeyParams {
-        KeyParams { capacity: self.capacity, pixel_angle: 2.0 * (0.5 * camera.vfov).tan() / height as f32, lod_scale: self.lod_scale, normal_lod: self.normal_lod, jitter: self.jitter }
+        KeyParams {
+            capacity: self.capacity,
+            pixel_angle: 2.0 * (0.5 * camera.vfov).tan() / height as f32,
+            lod_scale: self.lod_scale,
+            normal_lod: self.normal_lod,
+            jitter: self.jitter,
+        }
     }
 }
 
@@ -268,7 +279,11 @@ pub struct HashCache {
 }
 
 impl HashCache {
-    pub fn new(gpu: &Gpu, tracer: &PathTracer, settings: HashCacheSettings) -> Result<Self, RenderError> {
+    pub fn new(
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        settings: HashCacheSettings,
+    ) -> Result<Self, RenderError> {
         settings.validate()?;
         let s = tracer.settings();
         let (width, height) = (s.width, s.height);
@@ -279,9 +294,22 @@ impl HashCache {
         gpu.check_workgroup_memory(HC_TRACE_PASS, 0)?;
         let device = &gpu.device;
         let pixels = width as u64 * height as u64;
-        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false });
-        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let params = buffer("hash cache params", size_of::<HashCacheParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let rw = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
+        let params = buffer(
+            "hash cache params",
+            size_of::<HashCacheParams>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
         let slots = buffer("hash cache slots", settings.capacity as u64 * 16, rw);
         let cells = buffer("hash cache cells", settings.capacity as u64 * 16, rw);
         let records = buffer("hash cache records", pixels * size_of::<HcRecord>() as u64, rw);
@@ -290,9 +318,30 @@ impl HashCache {
         let colour = buffer("hash cache colour", pixels * 16, rw);
 
         let own = OWN_GROUP;
-        let (layout, pipelines) = tracer.library_pass(gpu, "hash_cache.wgsl", Self::program(), &own, PASSES)?;
-        let group = crate::compute::buffer_group(gpu, "hash cache", &layout, &[&params, &slots, &cells, &records, &counters, &primary, &colour]);
-        Ok(Self { settings, width, height, params, slots, cells, records, counters, primary, colour, group, pipelines, timer: PassTimer::new(gpu, &PASSES), frames: 0 })
+        let (layout, pipelines) =
+            tracer.library_pass(gpu, "hash_cache.wgsl", Self::program(), &own, PASSES)?;
+        let group = crate::compute::buffer_group(
+            gpu,
+            "hash cache",
+            &layout,
+            &[&params, &slots, &cells, &records, &counters, &primary, &colour],
+        );
+        Ok(Self {
+            settings,
+            width,
+            height,
+            params,
+            slots,
+            cells,
+            records,
+            counters,
+            primary,
+            colour,
+            group,
+            pipelines,
+            timer: PassTimer::new(gpu, &PASSES),
+            frames: 0,
+        })
     }
 
     /// The passes' program: the shading library, TAA's structs and primary attributes, the
@@ -302,8 +351,22 @@ impl HashCache {
         PROGRAM.get_or_init(|| {
             let taa_types = crate::taa::types_module();
             let types = types_module();
-            let bindings = crate::compute::group_module("package::hash_cache_bindings", 2, &OWN_GROUP, &[&taa_types, &types]);
-            PassLibrary::program([taa_types, crate::taa::primary_module(), types, bindings, crate::wgsl_file!("hash_cache/hash_key.wgsl")], [crate::wgsl_file!("hash_cache/hash_cache.wgsl")])
+            let bindings = crate::compute::group_module(
+                "package::hash_cache_bindings",
+                2,
+                &OWN_GROUP,
+                &[&taa_types, &types],
+            );
+            PassLibrary::program(
+                [
+                    taa_types,
+                    crate::taa::primary_module(),
+                    types,
+                    bindings,
+                    crate::wgsl_file!("hash_cache/hash_key.wgsl"),
+                ],
+                [crate::wgsl_file!("hash_cache/hash_cache.wgsl")],
+            )
         })
     }
 
@@ -318,14 +381,29 @@ impl HashCache {
 
     /// One frame; `camera` is the scene's camera of this frame (its field of view sets the LOD),
     /// `taa` an optional resolve over the result (the paper applies TAA to HashCache).
-    pub fn render(&mut self, gpu: &Gpu, tracer: &PathTracer, camera: &Camera, seed: u64, frame: u32, taa: Option<&mut Taa>) -> Result<HashCacheOutput, RenderError> {
+    pub fn render(
+        &mut self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        camera: &Camera,
+        seed: u64,
+        frame: u32,
+        taa: Option<&mut Taa>,
+    ) -> Result<HashCacheOutput, RenderError> {
         let (timings, jitter) = self.update(gpu, tracer, camera, seed, frame)?;
         self.resolve(gpu, taa, timings, jitter)
     }
 
     /// The cache's own passes in one timed submission: age (eviction), then the frame's lookups
     /// and updates. Returns their times and the frame's primary jitter (for [`Self::resolve`]).
-    pub fn update(&mut self, gpu: &Gpu, tracer: &PathTracer, camera: &Camera, seed: u64, frame: u32) -> Result<(Vec<PassTiming>, [f32; 2]), RenderError> {
+    pub fn update(
+        &mut self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        camera: &Camera,
+        seed: u64,
+        frame: u32,
+    ) -> Result<(Vec<PassTiming>, [f32; 2]), RenderError> {
         let jitter = halton_jitter(frame, self.settings.jitter_length);
         let stamp = self.frames + 1;
         let k = self.settings.key_params(camera, self.height);
@@ -367,12 +445,24 @@ impl HashCache {
     }
 
     /// The frame's image after [`Self::update`]: the cache's colour, or `taa`'s resolve of it.
-    pub fn resolve(&mut self, gpu: &Gpu, taa: Option<&mut Taa>, mut timings: Vec<PassTiming>, jitter: [f32; 2]) -> Result<HashCacheOutput, RenderError> {
+    pub fn resolve(
+        &mut self,
+        gpu: &Gpu,
+        taa: Option<&mut Taa>,
+        mut timings: Vec<PassTiming>,
+        jitter: [f32; 2],
+    ) -> Result<HashCacheOutput, RenderError> {
         let radiance = match taa {
             Some(taa) => {
                 let out = taa.resolve_external(gpu, jitter, |encoder, colour, primary| {
                     encoder.copy_buffer_to_buffer(&self.colour, 0, colour, 0, self.colour.size());
-                    encoder.copy_buffer_to_buffer(&self.primary, 0, primary, 0, self.primary.size());
+                    encoder.copy_buffer_to_buffer(
+                        &self.primary,
+                        0,
+                        primary,
+                        0,
+                        self.primary.size(),
+                    );
                 })?;
                 timings.extend(out.timings);
                 out.radiance
@@ -382,16 +472,33 @@ impl HashCache {
         let c: Vec<u32> = read(gpu, &self.counters, "hash cache counters")?;
         let primary: Vec<TaaPrimary> = read(gpu, &self.primary, "hash cache primary hits")?;
         self.frames += 1;
-        let stats =
-            HashCacheStats { capacity: self.settings.capacity, occupied: c[0] + c[2], evicted: c[1], inserted: c[2], insert_failures: c[3], update_paths: c[4], rays: c[5] };
+        let stats = HashCacheStats {
+            capacity: self.settings.capacity,
+            occupied: c[0] + c[2],
+            evicted: c[1],
+            inserted: c[2],
+            insert_failures: c[3],
+            update_paths: c[4],
+            rays: c[5],
+        };
         let shaded = self.width as u64 * self.height as u64 + stats.update_paths as u64;
-        Ok(HashCacheOutput { radiance, motion: primary.iter().map(|p| p.motion).collect(), stats, timings, rays: stats.rays as u64, shaded })
+        Ok(HashCacheOutput {
+            radiance,
+            motion: primary.iter().map(|p| p.motion).collect(),
+            stats,
+            timings,
+            rays: stats.rays as u64,
+            shaded,
+        })
     }
 
     /// The table as stored: (checksum, last access, claim, home) per slot → [`CpuSlot`]s.
     pub fn read_slots(&self, gpu: &Gpu) -> Result<Vec<CpuSlot>, RenderError> {
         let raw: Vec<[u32; 4]> = read(gpu, &self.slots, "hash cache slots")?;
-        Ok(raw.into_iter().map(|s| CpuSlot { checksum: s[0], last_access: s[1], home: s[3] }).collect())
+        Ok(raw
+            .into_iter()
+            .map(|s| CpuSlot { checksum: s[0], last_access: s[1], home: s[3] })
+            .collect())
     }
 
     /// Each slot's radiance (rgb) and sample count (w).
@@ -406,9 +513,19 @@ impl HashCache {
 }
 
 /// A copy of `buffer` read back (other methods' state readers use it too).
-pub(crate) fn read<T: Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<T>, RenderError> {
-    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(what), size: buffer.size(), usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
-    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
+pub(crate) fn read<T: Pod>(
+    gpu: &Gpu,
+    buffer: &wgpu::Buffer,
+    what: &str,
+) -> Result<Vec<T>, RenderError> {
+    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(what),
+        size: buffer.size(),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder =
+        gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
     gpu.queue.submit([encoder.finish()]);
     read_buffer(gpu, &staging).map_err(|reason| RenderError::Readback { what: what.into(), reason })

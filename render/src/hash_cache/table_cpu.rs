@@ -54,8 +54,11 @@ impl CpuHashTable {
         let slot = match self.find(key) {
             Some(s) => s,
             None => {
-                let s = (0..self.probe_limit).map(window).find(|&s| self.slots[s as usize].checksum == EMPTY)?;
-                self.slots[s as usize] = CpuSlot { checksum: key.checksum, last_access: 0, home: key.home };
+                let s = (0..self.probe_limit)
+                    .map(window)
+                    .find(|&s| self.slots[s as usize].checksum == EMPTY)?;
+                self.slots[s as usize] =
+                    CpuSlot { checksum: key.checksum, last_access: 0, home: key.home };
                 s
             }
         };
@@ -65,13 +68,19 @@ impl CpuHashTable {
 
     /// Slot holding `key`, without inserting.
     pub fn find(&self, key: VoxelKey) -> Option<u32> {
-        (0..self.probe_limit).map(|i| (key.home + i) % self.capacity()).find(|&s| self.slots[s as usize].checksum == key.checksum)
+        (0..self.probe_limit)
+            .map(|i| (key.home + i) % self.capacity())
+            .find(|&s| self.slots[s as usize].checksum == key.checksum)
     }
 
     /// The occupied slots as (checksum, home, last access), sorted: what two tables holding the
     /// same keys agree on whatever the slots they landed in.
     pub fn contents(slots: impl IntoIterator<Item = CpuSlot>) -> Vec<(u32, u32, u32)> {
-        let mut v: Vec<_> = slots.into_iter().filter(|s| s.checksum != EMPTY).map(|s| (s.checksum, s.home, s.last_access)).collect();
+        let mut v: Vec<_> = slots
+            .into_iter()
+            .filter(|s| s.checksum != EMPTY)
+            .map(|s| (s.checksum, s.home, s.last_access))
+            .collect();
         v.sort_unstable();
         v
     }
@@ -88,7 +97,10 @@ pub fn check_invariants(slots: &[CpuSlot], probe_limit: u32) -> Result<(), Strin
         }
         let distance = (i as u32 + capacity - s.home) % capacity;
         if distance >= probe_limit {
-            return Err(format!("slot {i}: key {:#x} is {distance} slots from its home {} (probe limit {probe_limit})", s.checksum, s.home));
+            return Err(format!(
+                "slot {i}: key {:#x} is {distance} slots from its home {} (probe limit {probe_limit})",
+                s.checksum, s.home
+            ));
         }
         if !seen.insert((s.checksum, s.home)) {
             return Err(format!("slot {i}: key {:#x} (home {}) stored twice", s.checksum, s.home));

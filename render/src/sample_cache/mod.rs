@@ -31,16 +31,15 @@ pub mod storage;
 pub use settings::{Retrace, SampleCacheSettings, ShadingMode};
 pub use storage::{GpuSlot, SscSlot};
 
-
-use crate::pass_library::LibraryPipeline;
 use crate::compute::BufferBinding;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
+use crate::pass_library::LibraryPipeline;
 use crate::pass_library::PassLibrary;
 use crate::path_tracer::PathTracer;
-use crate::shader::{Module, Program};
 use crate::readback::read_buffer;
+use crate::shader::{Module, Program};
 use crate::timing::{PassTimer, PassTiming};
 
 /// Pass names in [`CacheFrame::timings`]: the stages of a frame, each one submission
@@ -111,11 +110,27 @@ const OWN_GROUP: [BufferBinding; 10] = [
 pub fn program() -> &'static Program {
     static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
     PROGRAM.get_or_init(|| {
-        let types = Module::generated("package::sample_cache_types", &[SscParams::WGSL, storage::SscSlot::WGSL, SscPixel::WGSL]);
+        let types = Module::generated(
+            "package::sample_cache_types",
+            &[SscParams::WGSL, storage::SscSlot::WGSL, SscPixel::WGSL],
+        );
         let taa_types = crate::taa::types_module();
-        let bindings = crate::compute::group_module("package::sample_cache_bindings", 2, &OWN_GROUP, &[&types, &taa_types]);
+        let bindings = crate::compute::group_module(
+            "package::sample_cache_bindings",
+            2,
+            &OWN_GROUP,
+            &[&types, &taa_types],
+        );
         PassLibrary::program(
-            [types, taa_types, crate::taa::primary_module(), bindings, crate::wgsl_file!("sample_cache/storage.wgsl"), crate::wgsl_file!("sample_cache/slope.wgsl"), crate::wgsl_file!("sample_cache/selection.wgsl")],
+            [
+                types,
+                taa_types,
+                crate::taa::primary_module(),
+                bindings,
+                crate::wgsl_file!("sample_cache/storage.wgsl"),
+                crate::wgsl_file!("sample_cache/slope.wgsl"),
+                crate::wgsl_file!("sample_cache/selection.wgsl"),
+            ],
             [
                 crate::wgsl_file!("sample_cache/reproject.wgsl"),
                 crate::wgsl_file!("sample_cache/retrace.wgsl"),
@@ -282,7 +297,11 @@ struct Pipelines {
 }
 
 impl SampleCache {
-    pub fn new(gpu: &Gpu, tracer: &PathTracer, settings: SampleCacheSettings) -> Result<Self, RenderError> {
+    pub fn new(
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        settings: SampleCacheSettings,
+    ) -> Result<Self, RenderError> {
         settings.validate().map_err(|e| RenderError::Settings(format!("sample cache: {e}")))?;
         let (width, height) = (tracer.settings().width, tracer.settings().height);
         let n = settings.slots as u64;
@@ -295,27 +314,68 @@ impl SampleCache {
         }
         let pixels = width as u64 * height as u64;
         let device = &gpu.device;
-        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| -> Result<wgpu::Buffer, RenderError> {
+        let buffer = |label: &str,
+                      size: u64,
+                      usage: wgpu::BufferUsages|
+         -> Result<wgpu::Buffer, RenderError> {
             gpu.check_buffer_size(label, size)?;
-            Ok(device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false }))
+            Ok(device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            }))
         };
-        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let rw = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
         let readback = wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST;
         let caches = [
-            Cache { mask: buffer("ssc mask a", pixels * 4, rw)?, slots: buffer("ssc slots a", pixels * n * 32, rw)? },
-            Cache { mask: buffer("ssc mask b", pixels * 4, rw)?, slots: buffer("ssc slots b", pixels * n * 32, rw)? },
+            Cache {
+                mask: buffer("ssc mask a", pixels * 4, rw)?,
+                slots: buffer("ssc slots a", pixels * n * 32, rw)?,
+            },
+            Cache {
+                mask: buffer("ssc mask b", pixels * 4, rw)?,
+                slots: buffer("ssc slots b", pixels * n * 32, rw)?,
+            },
         ];
         let pixel_atomics = buffer("ssc pixel atomics", pixels * 12, rw)?;
         let work = buffer("ssc work", (HEADER_WORDS + pixels * n) * 4, rw)?;
-        let list_args = buffer("ssc list dispatch", 24, wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST)?;
+        let list_args = buffer(
+            "ssc list dispatch",
+            24,
+            wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+        )?;
         let out = buffer("ssc out", pixels * 32, rw)?;
         let colour = buffer("ssc colour", pixels * 16, rw)?;
-        let primary = buffer("ssc primary", pixels * size_of::<crate::taa::TaaPrimary>() as u64, rw)?;
+        let primary =
+            buffer("ssc primary", pixels * size_of::<crate::taa::TaaPrimary>() as u64, rw)?;
         let out_readback = buffer("ssc out readback", pixels * 32, readback)?;
         let header_readback = buffer("ssc header readback", HEADER_WORDS * 4, readback)?;
-        let params = buffer("ssc params", size_of::<SscParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST)?;
+        let params = buffer(
+            "ssc params",
+            size_of::<SscParams>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        )?;
 
-        let (layout, [begin, reserve, retrace, retrace_args, retrace_list, finish, rates, select, shade_args, shade, reconstruct, audit]) = tracer.library_pass(
+        let (
+            layout,
+            [
+                begin,
+                reserve,
+                retrace,
+                retrace_args,
+                retrace_list,
+                finish,
+                rates,
+                select,
+                shade_args,
+                shade,
+                reconstruct,
+                audit,
+            ],
+        ) = tracer.library_pass(
             gpu,
             "shaders/sample_cache/*.wgsl",
             program(),
@@ -335,9 +395,38 @@ impl SampleCache {
                 "audit_main",
             ],
         )?;
-        let pipelines = Pipelines { begin, reserve, retrace, retrace_args, retrace_list, finish, rates, select, shade_args, shade, reconstruct, audit };
+        let pipelines = Pipelines {
+            begin,
+            reserve,
+            retrace,
+            retrace_args,
+            retrace_list,
+            finish,
+            rates,
+            select,
+            shade_args,
+            shade,
+            reconstruct,
+            audit,
+        };
         let make = |src: &Cache, dst: &Cache| {
-            crate::compute::buffer_group(gpu, "sample cache", &layout, &[&params, &src.mask, &src.slots, &pixel_atomics, &dst.slots, &dst.mask, &work, &out, &colour, &primary])
+            crate::compute::buffer_group(
+                gpu,
+                "sample cache",
+                &layout,
+                &[
+                    &params,
+                    &src.mask,
+                    &src.slots,
+                    &pixel_atomics,
+                    &dst.slots,
+                    &dst.mask,
+                    &work,
+                    &out,
+                    &colour,
+                    &primary,
+                ],
+            )
         };
         // bind_groups[i]: reproject cache i into cache 1 - i.
         let bind_groups = [make(&caches[0], &caches[1]), make(&caches[1], &caches[0])];
@@ -360,7 +449,10 @@ impl SampleCache {
             header_readback,
             bind_groups,
             current: 0,
-            timers: STAGE_DISPATCHES.iter().map(|r| PassTimer::new(gpu, &DISPATCHES[r.clone()])).collect(),
+            timers: STAGE_DISPATCHES
+                .iter()
+                .map(|r| PassTimer::new(gpu, &DISPATCHES[r.clone()]))
+                .collect(),
             frames: 0,
             pending: None,
         })
@@ -379,7 +471,13 @@ impl SampleCache {
     /// Renders one frame: call after `tracer.update` for this frame's scene. `frame` seeds the
     /// frame's randomness (with `seed`) and drives the round robins. The four stages of
     /// [`PASSES`] in order; the frame's systems call [`Self::stage`] one by one instead.
-    pub fn render(&mut self, gpu: &Gpu, tracer: &PathTracer, seed: u64, frame: u32) -> Result<CacheFrame, RenderError> {
+    pub fn render(
+        &mut self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        seed: u64,
+        frame: u32,
+    ) -> Result<CacheFrame, RenderError> {
         self.begin_frame(seed, frame);
         for stage in 0..PASSES.len() {
             self.stage(gpu, tracer, stage)?;
@@ -395,10 +493,19 @@ impl SampleCache {
     /// Stage `stage` of [`PASSES`] (reserve = reprojection, trace, shade, reconstruct) as one
     /// timed submission. Each stage sets the tracer's frame uniform itself, so other methods may
     /// run between stages.
-    pub fn stage(&mut self, gpu: &Gpu, tracer: &PathTracer, stage: usize) -> Result<(), RenderError> {
+    pub fn stage(
+        &mut self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        stage: usize,
+    ) -> Result<(), RenderError> {
         let (w, h) = (self.width, self.height);
         if tracer.settings().width != w || tracer.settings().height != h {
-            return Err(RenderError::Settings(format!("sample cache is {w}x{h}, the path tracer {}x{}", tracer.settings().width, tracer.settings().height)));
+            return Err(RenderError::Settings(format!(
+                "sample cache is {w}x{h}, the path tracer {}x{}",
+                tracer.settings().width,
+                tracer.settings().height
+            )));
         }
         let Some((seed, frame, _)) = self.pending else {
             return Err(RenderError::Settings("sample cache: stage before begin_frame".into()));
@@ -473,7 +580,13 @@ impl SampleCache {
             let (pipeline, [x, y, z], list) = dispatches[d];
             let indirect = list.filter(|_| self.indirect);
             if let Some((offset, word)) = indirect {
-                timed.encoder().copy_buffer_to_buffer(&self.work, word * 4, &self.list_args, offset, 12);
+                timed.encoder().copy_buffer_to_buffer(
+                    &self.work,
+                    word * 4,
+                    &self.list_args,
+                    offset,
+                    12,
+                );
             }
             timed.pass(i, |pass| {
                 pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
@@ -489,7 +602,13 @@ impl SampleCache {
         if stage == PASSES.len() - 1 {
             let encoder = timed.encoder();
             encoder.copy_buffer_to_buffer(&self.out, 0, &self.out_readback, 0, self.out.size());
-            encoder.copy_buffer_to_buffer(&self.work, 0, &self.header_readback, 0, HEADER_WORDS * 4);
+            encoder.copy_buffer_to_buffer(
+                &self.work,
+                0,
+                &self.header_readback,
+                0,
+                HEADER_WORDS * 4,
+            );
         }
         let times = timed.submit()?;
         if let Some((_, _, all)) = &mut self.pending {
@@ -501,7 +620,9 @@ impl SampleCache {
     /// Ends the frame after its four stages: swaps the caches and reads the image and counters.
     pub fn finish_frame(&mut self, gpu: &Gpu) -> Result<CacheFrame, RenderError> {
         let Some((_, _, dispatch_timings)) = self.pending.take() else {
-            return Err(RenderError::Settings("sample cache: finish_frame before begin_frame".into()));
+            return Err(RenderError::Settings(
+                "sample cache: finish_frame before begin_frame".into(),
+            ));
         };
         let s = &self.settings;
         let mut timings = Vec::new();
@@ -512,8 +633,10 @@ impl SampleCache {
         self.current = 1 - self.current;
         self.frames += 1;
 
-        let out: Vec<GpuPixel> = read_buffer(gpu, &self.out_readback).map_err(|r| readback_error("sample cache output", r))?;
-        let header: Vec<u32> = read_buffer(gpu, &self.header_readback).map_err(|r| readback_error("sample cache counters", r))?;
+        let out: Vec<GpuPixel> = read_buffer(gpu, &self.out_readback)
+            .map_err(|r| readback_error("sample cache output", r))?;
+        let header: Vec<u32> = read_buffer(gpu, &self.header_readback)
+            .map_err(|r| readback_error("sample cache counters", r))?;
         let stats = CacheStats {
             shaded: header[0],
             rays: header[1],
@@ -556,13 +679,17 @@ impl SampleCache {
                 usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             });
-            let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ssc state") });
+            let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("ssc state"),
+            });
             encoder.copy_buffer_to_buffer(src, 0, &dst, 0, src.size());
             gpu.queue.submit([encoder.finish()]);
             Ok(dst)
         };
-        let masks = read_buffer(gpu, &copy(&cache.mask)?).map_err(|reason| RenderError::Readback { what: "ssc masks".into(), reason })?;
-        let slots = read_buffer(gpu, &copy(&cache.slots)?).map_err(|reason| RenderError::Readback { what: "ssc slots".into(), reason })?;
+        let masks = read_buffer(gpu, &copy(&cache.mask)?)
+            .map_err(|reason| RenderError::Readback { what: "ssc masks".into(), reason })?;
+        let slots = read_buffer(gpu, &copy(&cache.slots)?)
+            .map_err(|reason| RenderError::Readback { what: "ssc slots".into(), reason })?;
         Ok(CacheState { masks, slots })
     }
 
@@ -570,20 +697,30 @@ impl SampleCache {
     /// retrace from the current camera finds occluded (what `Multi` would correct). Traces one
     /// ray per visible sample; for tests and diagnostics, outside the timed passes.
     pub fn audit(&self, gpu: &Gpu, tracer: &PathTracer) -> Result<u32, RenderError> {
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ssc audit") });
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ssc audit") });
         encoder.clear_buffer(&self.work, AUDIT_WORD * 4, Some(4));
         {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("audit"), timestamp_writes: None });
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("audit"),
+                timestamp_writes: None,
+            });
             pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
             pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
             // The bind group whose destination is the cache the last frame wrote.
             pass.set_bind_group(2, &self.bind_groups[1 - self.current], &[]);
             pass.set_pipeline(&self.pipelines.audit.get());
-            pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), self.settings.slots);
+            pass.dispatch_workgroups(
+                self.width.div_ceil(8),
+                self.height.div_ceil(8),
+                self.settings.slots,
+            );
         }
         encoder.copy_buffer_to_buffer(&self.work, 0, &self.header_readback, 0, HEADER_WORDS * 4);
         gpu.queue.submit([encoder.finish()]);
-        let header: Vec<u32> = read_buffer(gpu, &self.header_readback).map_err(|reason| RenderError::Readback { what: "ssc audit".into(), reason })?;
+        let header: Vec<u32> = read_buffer(gpu, &self.header_readback)
+            .map_err(|reason| RenderError::Readback { what: "ssc audit".into(), reason })?;
         Ok(header[AUDIT_WORD as usize])
     }
 
@@ -591,7 +728,11 @@ impl SampleCache {
     /// closest visible sample's primary attributes (reconstruct.wgsl) for its reprojection and
     /// history rejection: the paper applies TAA to every method for its error figures. The
     /// resolve reads no jitter: the cache's samples lie anywhere in their pixels.
-    pub fn resolve_taa(&self, gpu: &Gpu, taa: &mut crate::taa::Taa) -> Result<crate::taa::TaaOutput, RenderError> {
+    pub fn resolve_taa(
+        &self,
+        gpu: &Gpu,
+        taa: &mut crate::taa::Taa,
+    ) -> Result<crate::taa::TaaOutput, RenderError> {
         let (colour, primary) = (&self.colour, &self.primary);
         taa.resolve_external(gpu, [0.5; 2], |encoder, current, taa_primary| {
             encoder.copy_buffer_to_buffer(colour, 0, current, 0, colour.size());
@@ -611,4 +752,3 @@ fn readback_error(what: &str, reason: String) -> RenderError {
 fn tracer_tan_half_fov(tracer: &PathTracer) -> f32 {
     (0.5 * tracer.camera().vfov).tan()
 }
-

@@ -82,10 +82,16 @@ impl SampleCacheSettings {
     /// Refuses settings the passes cannot honour, naming the field and the accepted range.
     pub fn validate(&self) -> Result<(), String> {
         if !(1..=16).contains(&self.slots) {
-            return Err(format!("slots must be in 1..=16 (two mask bits per slot in 32 bits), got {}", self.slots));
+            return Err(format!(
+                "slots must be in 1..=16 (two mask bits per slot in 32 bits), got {}",
+                self.slots
+            ));
         }
         if !(self.n_target >= 1.0 && self.n_target <= self.slots as f32) {
-            return Err(format!("n_target must be in [1, slots = {}], got {}", self.slots, self.n_target));
+            return Err(format!(
+                "n_target must be in [1, slots = {}], got {}",
+                self.slots, self.n_target
+            ));
         }
         if !(self.delta >= 0.0 && self.delta.is_finite()) {
             return Err(format!("delta must be >= 0, got {}", self.delta));
@@ -110,7 +116,10 @@ impl SampleCacheSettings {
         // Uniform shading shades one visible sample per pixel by construction (section 3.3); a
         // rate there would be ignored and the reported samples per pixel would be wrong.
         if self.shading == ShadingMode::Uniform && self.shading_rate != 1.0 {
-            return Err(format!("shading_rate {} needs shading: Adaptive (Uniform shades one sample per pixel: rate 1)", self.shading_rate));
+            return Err(format!(
+                "shading_rate {} needs shading: Adaptive (Uniform shades one sample per pixel: rate 1)",
+                self.shading_rate
+            ));
         }
         Ok(())
     }
@@ -139,7 +148,9 @@ mod tests {
         let uniform = SampleCacheSettings { shading_rate: 0.7, ..Default::default() };
         let e = uniform.validate().unwrap_err();
         assert!(e.contains("shading_rate 0.7 needs shading: Adaptive"), "{e}");
-        assert!(SampleCacheSettings { shading: ShadingMode::Adaptive, ..uniform }.validate().is_ok());
+        assert!(
+            SampleCacheSettings { shading: ShadingMode::Adaptive, ..uniform }.validate().is_ok()
+        );
         assert!(SampleCacheSettings::default().validate().is_ok());
     }
 }

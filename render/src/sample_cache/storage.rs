@@ -38,9 +38,19 @@ impl SscSlot {
     pub fn decode(&self) -> CachedHit {
         let h = self.hit;
         if h[0] == NO_HIT {
-            CachedHit::Background { direction: Vec3::new(f32::from_bits(h[1]), f32::from_bits(h[2]), f32::from_bits(h[3])) }
+            CachedHit::Background {
+                direction: Vec3::new(
+                    f32::from_bits(h[1]),
+                    f32::from_bits(h[2]),
+                    f32::from_bits(h[3]),
+                ),
+            }
         } else {
-            CachedHit::Surface { instance: h[0], primitive: h[1], barycentrics: Vec2::new(f32::from_bits(h[2]), f32::from_bits(h[3])) }
+            CachedHit::Surface {
+                instance: h[0],
+                primitive: h[1],
+                barycentrics: Vec2::new(f32::from_bits(h[2]), f32::from_bits(h[3])),
+            }
         }
     }
 

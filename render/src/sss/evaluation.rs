@@ -73,7 +73,12 @@ pub struct Accumulator {
 
 impl Accumulator {
     /// Adds a frame; `reference` where this frame is measured against one.
-    pub fn add(&mut self, frame: &SssFrame, result: Vec<PixelResult>, reference: Option<(&[[f32; 3]], f64)>) {
+    pub fn add(
+        &mut self,
+        frame: &SssFrame,
+        result: Vec<PixelResult>,
+        reference: Option<(&[[f32; 3]], f64)>,
+    ) {
         if self.counts.is_empty() {
             self.counts = vec![0.0; result.len()];
         }
@@ -95,12 +100,18 @@ impl Accumulator {
     }
 
     pub fn finish(self) -> RunMeasures {
-        let mean = |v: &[f64]| if v.is_empty() { f64::NAN } else { v.iter().sum::<f64>() / v.len() as f64 };
+        let mean = |v: &[f64]| {
+            if v.is_empty() { f64::NAN } else { v.iter().sum::<f64>() / v.len() as f64 }
+        };
         RunMeasures {
             mean_spp: self.spp_sum / self.spp_n.max(1) as f64,
             psnr_db: mean(&self.psnr),
             smape: mean(&self.smape),
-            count_image: self.counts.iter().map(|c| (c / self.frames.max(1) as f64) as f32).collect(),
+            count_image: self
+                .counts
+                .iter()
+                .map(|c| (c / self.frames.max(1) as f64) as f32)
+                .collect(),
         }
     }
 }

@@ -5,13 +5,13 @@
 
 use super::control_variates::EmCovariance;
 use super::prefilter;
-use super::separable;
 use super::screen_pass::{PixelHistory, PixelResult, SssFrame, SssSettings, SssVariant};
+use super::separable;
 use super::spvg::SpvgHistory;
 use crate::error::RenderError;
 use crate::gpu::Gpu;
-use crate::readback::read_buffer;
 use crate::gpu_struct::GpuStruct;
+use crate::readback::read_buffer;
 use crate::shader::{Module, Program};
 use crate::timing::{PassTimer, PassTiming};
 use wgpu::util::DeviceExt;
@@ -58,10 +58,16 @@ const _: () = assert!(prefilter::MAX_LEVELS == 8);
 /// The pass's WGSL program: the Monte Carlo pass and the separable baseline's two passes.
 pub fn program() -> Program {
     let types = Module::generated("package::sss_types", &[SssParams::WGSL]);
-    Program::new(vec![types, crate::wgsl_file!("pt_sampling.wgsl"), crate::wgsl_file!("sss/sampling.wgsl"), crate::wgsl_file!("sss/spvg.wgsl"), crate::wgsl_file!("sss/mip.wgsl")])
-        .entry(crate::wgsl_file!("sss/sss_pass.wgsl"))
-        .entry(crate::wgsl_file!("sss/separable.wgsl"))
-        .entry(crate::wgsl_file!("sss/prefilter.wgsl"))
+    Program::new(vec![
+        types,
+        crate::wgsl_file!("pt_sampling.wgsl"),
+        crate::wgsl_file!("sss/sampling.wgsl"),
+        crate::wgsl_file!("sss/spvg.wgsl"),
+        crate::wgsl_file!("sss/mip.wgsl"),
+    ])
+    .entry(crate::wgsl_file!("sss/sss_pass.wgsl"))
+    .entry(crate::wgsl_file!("sss/separable.wgsl"))
+    .entry(crate::wgsl_file!("sss/prefilter.wgsl"))
 }
 
 /// The pass for one image size, with its buffers and two history sets (read one, write the other).
@@ -90,47 +96,126 @@ pub struct SssPass {
 }
 
 fn storage(gpu: &Gpu, label: &str, size: u64) -> wgpu::Buffer {
-    gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC, mapped_at_creation: false })
+    gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    })
 }
 
 impl SssPass {
     pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self, RenderError> {
         if width == 0 || height == 0 {
-            return Err(RenderError::Settings(format!("SSS pass size {width}x{height} must be non-zero")));
+            return Err(RenderError::Settings(format!(
+                "SSS pass size {width}x{height} must be non-zero"
+            )));
         }
-        let [pipeline, horizontal, vertical, prefilter_pipeline] = crate::compute::pipelines_auto_layout(gpu, "sss_scatter", &program(), ["sss_scatter", "sss_separable_h", "sss_separable_v", "sss_prefilter"])?;
+        let [pipeline, horizontal, vertical, prefilter_pipeline] =
+            crate::compute::pipelines_auto_layout(
+                gpu,
+                "sss_scatter",
+                &program(),
+                ["sss_scatter", "sss_separable_h", "sss_separable_v", "sss_prefilter"],
+            )?;
         let size = width as u64 * height as u64 * 16;
-        let params = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("sss params"), contents: bytemuck::bytes_of(&<SssParams as bytemuck::Zeroable>::zeroed()), usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST });
+        let params = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("sss params"),
+            contents: bytemuck::bytes_of(&<SssParams as bytemuck::Zeroable>::zeroed()),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
         let irradiance = storage(gpu, "sss irradiance", size);
         let history = [storage(gpu, "sss history 0", size), storage(gpu, "sss history 1", size)];
         let cv = [storage(gpu, "sss cv 0", size), storage(gpu, "sss cv 1", size)];
         let scattered = storage(gpu, "sss scattered", size);
-        let mips = storage(gpu, "sss mips", prefilter::level_offset(width, height, prefilter::MAX_LEVELS) * 16);
+        let mips = storage(
+            gpu,
+            "sss mips",
+            prefilter::level_offset(width, height, prefilter::MAX_LEVELS) * 16,
+        );
         let layout = pipeline.get_bind_group_layout(0);
         let group = |k: usize| {
-            let buffers = [&params, &irradiance, &history[k], &cv[k], &scattered, &history[1 - k], &cv[1 - k], &mips];
-            let entries: Vec<_> = buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
-            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("sss pass"), layout: &layout, entries: &entries })
+            let buffers = [
+                &params,
+                &irradiance,
+                &history[k],
+                &cv[k],
+                &scattered,
+                &history[1 - k],
+                &cv[1 - k],
+                &mips,
+            ];
+            let entries: Vec<_> = buffers
+                .iter()
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry {
+                    binding: i as u32,
+                    resource: b.as_entire_binding(),
+                })
+                .collect();
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("sss pass"),
+                layout: &layout,
+                entries: &entries,
+            })
         };
         let groups = [group(0), group(1)];
         let kernel = storage(gpu, "sss separable kernel", separable::MAX_TAPS as u64 * 16);
         let intermediate = storage(gpu, "sss separable intermediate", size);
         // Auto layouts hold only what each entry uses: the horizontal pass never sees `scattered`.
         let separable_group = |pipeline: &wgpu::ComputePipeline, buffers: &[&wgpu::Buffer]| {
-            let entries: Vec<_> = buffers.iter().enumerate().map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() }).collect();
-            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("sss separable"), layout: &pipeline.get_bind_group_layout(0), entries: &entries })
+            let entries: Vec<_> = buffers
+                .iter()
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry {
+                    binding: i as u32,
+                    resource: b.as_entire_binding(),
+                })
+                .collect();
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("sss separable"),
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &entries,
+            })
         };
         let h_group = separable_group(&horizontal, &[&params, &irradiance, &kernel, &intermediate]);
-        let v_group = separable_group(&vertical, &[&params, &irradiance, &kernel, &intermediate, &scattered]);
+        let v_group =
+            separable_group(&vertical, &[&params, &irradiance, &kernel, &intermediate, &scattered]);
         let separable = [(horizontal, h_group), (vertical, v_group)];
         let level_groups = (0..prefilter::MAX_LEVELS)
             .map(|k| {
-                let level = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("sss mip level"), contents: bytemuck::cast_slice(&[k, 0, 0, 0]), usage: wgpu::BufferUsages::UNIFORM });
+                let level = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("sss mip level"),
+                    contents: bytemuck::cast_slice(&[k, 0, 0, 0]),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
                 separable_group(&prefilter_pipeline, &[&params, &irradiance, &mips, &level])
             })
             .collect();
-        let timer = PassTimer::new(gpu, &["sss_scatter", "sss_separable_h", "sss_separable_v", "sss_prefilter"]);
-        Ok(Self { width, height, pipeline, separable, kernel, kernel_for: None, params, irradiance, history, cv, scattered, groups, mips, prefilter: (prefilter_pipeline, level_groups), current: 0, timer })
+        let timer = PassTimer::new(
+            gpu,
+            &["sss_scatter", "sss_separable_h", "sss_separable_v", "sss_prefilter"],
+        );
+        Ok(Self {
+            width,
+            height,
+            pipeline,
+            separable,
+            kernel,
+            kernel_for: None,
+            params,
+            irradiance,
+            history,
+            cv,
+            scattered,
+            groups,
+            mips,
+            prefilter: (prefilter_pipeline, level_groups),
+            current: 0,
+            timer,
+        })
     }
 
     /// Replaces the latest history (empty = cold start everywhere).
@@ -140,7 +225,10 @@ impl SssPass {
             .map(|i| {
                 let p = history.get(i).copied().unwrap_or_default();
                 let s = p.spvg;
-                ([s.mu, s.sigma2, s.nbar, if s.valid { 1.0 } else { 0.0 }], [p.cv.mean_f, p.cv.mean_g, p.cv.cov_fg, p.cv.var_g])
+                (
+                    [s.mu, s.sigma2, s.nbar, if s.valid { 1.0 } else { 0.0 }],
+                    [p.cv.mean_f, p.cv.mean_g, p.cv.cov_fg, p.cv.var_g],
+                )
             })
             .unzip();
         gpu.queue.write_buffer(&self.history[self.current], 0, bytemuck::cast_slice(&h));
@@ -148,12 +236,28 @@ impl SssPass {
     }
 
     /// One frame: uploads the irradiance, runs `sss_scatter`, flips the histories.
-    pub fn dispatch(&mut self, gpu: &Gpu, frame: &SssFrame, settings: &SssSettings, frame_index: u32) -> Result<Vec<PassTiming>, RenderError> {
-        if (frame.width, frame.height) != (self.width, self.height) || frame.irradiance.len() != (self.width * self.height) as usize {
-            return Err(RenderError::Settings(format!("SSS frame {}x{} ({} texels) does not match the pass's {}x{}", frame.width, frame.height, frame.irradiance.len(), self.width, self.height)));
+    pub fn dispatch(
+        &mut self,
+        gpu: &Gpu,
+        frame: &SssFrame,
+        settings: &SssSettings,
+        frame_index: u32,
+    ) -> Result<Vec<PassTiming>, RenderError> {
+        if (frame.width, frame.height) != (self.width, self.height)
+            || frame.irradiance.len() != (self.width * self.height) as usize
+        {
+            return Err(RenderError::Settings(format!(
+                "SSS frame {}x{} ({} texels) does not match the pass's {}x{}",
+                frame.width,
+                frame.height,
+                frame.irradiance.len(),
+                self.width,
+                self.height
+            )));
         }
         settings.spvg.validate().map_err(RenderError::Settings)?;
-        let mip_levels = settings.mip_levels().map_err(|e| RenderError::Settings(format!("SSS {e}")))?;
+        let mip_levels =
+            settings.mip_levels().map_err(|e| RenderError::Settings(format!("SSS {e}")))?;
         let (fixed, taps) = match settings.variant {
             SssVariant::Fixed { count } => (count, 0),
             SssVariant::Separable { taps } => (0, taps),
@@ -166,7 +270,9 @@ impl SssPass {
         }
         let most = fixed.max(settings.spvg.n_max);
         if most == 0 || most > MAX_COUNT {
-            return Err(RenderError::Settings(format!("SSS sample count {most} must be in [1, {MAX_COUNT}]")));
+            return Err(RenderError::Settings(format!(
+                "SSS sample count {most} must be in [1, {MAX_COUNT}]"
+            )));
         }
         gpu.check_loop_iterations("sss_scatter", most as u64)?;
         let s = &settings.spvg;
@@ -233,19 +339,37 @@ impl SssPass {
         Ok(times)
     }
 
-    fn read(&self, gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<[f32; 4]>, RenderError> {
+    fn read(
+        &self,
+        gpu: &Gpu,
+        buffer: &wgpu::Buffer,
+        what: &str,
+    ) -> Result<Vec<[f32; 4]>, RenderError> {
         let mut all = self.read_all(gpu, buffer, what)?;
         all.truncate((self.width * self.height) as usize);
         Ok(all)
     }
 
-    fn read_all(&self, gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<[f32; 4]>, RenderError> {
+    fn read_all(
+        &self,
+        gpu: &Gpu,
+        buffer: &wgpu::Buffer,
+        what: &str,
+    ) -> Result<Vec<[f32; 4]>, RenderError> {
         let size = buffer.size();
-        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some("sss staging"), size, usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sss readback") });
+        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sss staging"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("sss readback"),
+        });
         encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
         gpu.queue.submit([encoder.finish()]);
-        read_buffer(gpu, &staging).map_err(|reason| RenderError::Readback { what: what.into(), reason })
+        read_buffer(gpu, &staging)
+            .map_err(|reason| RenderError::Readback { what: what.into(), reason })
     }
 
     /// The last frame's MIP chain, `levels` levels (rgb, share of SSS texels per texel).
@@ -262,7 +386,11 @@ impl SssPass {
 
     /// The last frame's results (scattered rgb, count).
     pub fn results(&self, gpu: &Gpu) -> Result<Vec<PixelResult>, RenderError> {
-        Ok(self.read(gpu, &self.scattered, "sss scattered")?.into_iter().map(|v| PixelResult { rgb: [v[0], v[1], v[2]], count: v[3] as u32 }).collect())
+        Ok(self
+            .read(gpu, &self.scattered, "sss scattered")?
+            .into_iter()
+            .map(|v| PixelResult { rgb: [v[0], v[1], v[2]], count: v[3] as u32 })
+            .collect())
     }
 
     /// The latest histories.
@@ -271,7 +399,10 @@ impl SssPass {
         let c = self.read(gpu, &self.cv[self.current], "sss cv history")?;
         Ok(h.into_iter()
             .zip(c)
-            .map(|(h, c)| PixelHistory { spvg: SpvgHistory { mu: h[0], sigma2: h[1], nbar: h[2], valid: h[3] > 0.5 }, cv: EmCovariance { mean_f: c[0], mean_g: c[1], cov_fg: c[2], var_g: c[3] } })
+            .map(|(h, c)| PixelHistory {
+                spvg: SpvgHistory { mu: h[0], sigma2: h[1], nbar: h[2], valid: h[3] > 0.5 },
+                cv: EmCovariance { mean_f: c[0], mean_g: c[1], cov_fg: c[2], var_g: c[3] },
+            })
             .collect())
     }
 }

@@ -16,7 +16,11 @@ pub fn numeric_inverse(u: f64, d: f64) -> f64 {
     }
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
-        if cdf(mid, d) < u { lo = mid } else { hi = mid }
+        if cdf(mid, d) < u {
+            lo = mid
+        } else {
+            hi = mid
+        }
         if hi - lo <= 1e-15 * hi.max(1e-300) {
             break;
         }

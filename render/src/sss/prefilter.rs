@@ -36,7 +36,10 @@ impl Default for Prefilter {
 impl Prefilter {
     pub fn validate(&self) -> Result<(), String> {
         if !(self.a > 0.0 && self.a.is_finite()) {
-            return Err(format!("prefilter a {}; expected a positive number (the thesis's 1/16)", self.a));
+            return Err(format!(
+                "prefilter a {}; expected a positive number (the thesis's 1/16)",
+                self.a
+            ));
         }
         if !(1..=MAX_LEVELS).contains(&self.levels) {
             return Err(format!("prefilter levels {}; expected 1 to {MAX_LEVELS}", self.levels));
@@ -78,7 +81,10 @@ pub struct MipChain {
 impl MipChain {
     /// Builds `levels` levels from (rgb, w) texels; w > 0 marks an SSS texel.
     pub fn build(width: u32, height: u32, irradiance: &[[f32; 4]], levels: u32) -> Self {
-        let base: Vec<[f32; 4]> = irradiance.iter().map(|t| if t[3] > 0.0 { [t[0], t[1], t[2], 1.0] } else { [0.0; 4] }).collect();
+        let base: Vec<[f32; 4]> = irradiance
+            .iter()
+            .map(|t| if t[3] > 0.0 { [t[0], t[1], t[2], 1.0] } else { [0.0; 4] })
+            .collect();
         let mut chain = vec![base];
         for k in 1..levels {
             let (pw, ph) = level_size(width, height, k - 1);
@@ -127,7 +133,12 @@ impl MipChain {
 
 /// Bilinear at q (texel centres at +0.5) over a w x h grid of `texel(i, j)`, indices clamped to
 /// the grid: the fetch of level 0 (`screen_pass`) and of every MIP level.
-pub(crate) fn bilinear(w: i32, h: i32, q: [f32; 2], texel: impl Fn(i32, i32) -> [f32; 3]) -> [f32; 3] {
+pub(crate) fn bilinear(
+    w: i32,
+    h: i32,
+    q: [f32; 2],
+    texel: impl Fn(i32, i32) -> [f32; 3],
+) -> [f32; 3] {
     let (x, y) = (q[0] - 0.5, q[1] - 0.5);
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);
@@ -135,7 +146,9 @@ pub(crate) fn bilinear(w: i32, h: i32, q: [f32; 2], texel: impl Fn(i32, i32) -> 
     // Clamp before the cast: radii in the far tail are huge.
     let (xi, yi) = (x0.clamp(-2.0, w as f32 + 1.0) as i32, y0.clamp(-2.0, h as f32 + 1.0) as i32);
     let (a, b, c, d) = (at(xi, yi), at(xi + 1, yi), at(xi, yi + 1), at(xi + 1, yi + 1));
-    std::array::from_fn(|i| (1.0 - fy) * ((1.0 - fx) * a[i] + fx * b[i]) + fy * ((1.0 - fx) * c[i] + fx * d[i]))
+    std::array::from_fn(|i| {
+        (1.0 - fy) * ((1.0 - fx) * a[i] + fx * b[i]) + fy * ((1.0 - fx) * c[i] + fx * d[i])
+    })
 }
 
 /// The 2x2 mean over SSS texels: Σ s·L / Σ s, with share Σ s / 4 (s = each child's share).
@@ -164,7 +177,12 @@ mod tests {
     #[test]
     fn the_mean_is_over_sss_texels_only() {
         // A 2x2 image: three SSS texels and one other surface (w = 0), which must not bleed in.
-        let img = [[1.0, 2.0, 3.0, 1.0], [3.0, 2.0, 1.0, 0.5], [100.0, 100.0, 100.0, 0.0], [2.0, 2.0, 2.0, 2.0]];
+        let img = [
+            [1.0, 2.0, 3.0, 1.0],
+            [3.0, 2.0, 1.0, 0.5],
+            [100.0, 100.0, 100.0, 0.0],
+            [2.0, 2.0, 2.0, 2.0],
+        ];
         let chain = MipChain::build(2, 2, &img, 2);
         assert_eq!(chain.levels[1], vec![[2.0, 2.0, 2.0, 0.75]]);
         // A texel with no SSS under it reads as the centre.

@@ -116,7 +116,14 @@ pub const MAX_EVENTS: u32 = 100_000;
 /// One analogue walk entering at `p` (z = 0) along `dir` (dir.z < 0): free flights
 /// Exp(σ_t), scattering with probability α (isotropic), absorption otherwise; leaving through
 /// z = 0 is tallied at its radius from `centre`.
-fn walk(medium: &Medium, mut p: [f64; 3], mut dir: [f64; 3], centre: [f64; 2], rng: &mut SplitMix64, tally: &mut ExitTally) {
+fn walk(
+    medium: &Medium,
+    mut p: [f64; 3],
+    mut dir: [f64; 3],
+    centre: [f64; 2],
+    rng: &mut SplitMix64,
+    tally: &mut ExitTally,
+) {
     let (sigma_t, alpha) = (medium.sigma_t(), medium.albedo());
     for events in 0..=MAX_EVENTS {
         let t = -(1.0 - uniform(rng)).ln() / sigma_t;
@@ -137,7 +144,13 @@ fn walk(medium: &Medium, mut p: [f64; 3], mut dir: [f64; 3], centre: [f64; 2], r
 }
 
 /// A normally incident pencil beam at the origin (the searchlight: R(r)'s definition).
-pub fn searchlight(medium: &Medium, paths: u64, seed: u64, bin_width: f64, bins: usize) -> ExitTally {
+pub fn searchlight(
+    medium: &Medium,
+    paths: u64,
+    seed: u64,
+    bin_width: f64,
+    bins: usize,
+) -> ExitTally {
     let mut rng = SplitMix64::seeded(seed);
     let mut tally = ExitTally::new(bin_width, bins);
     for _ in 0..paths {
@@ -160,7 +173,14 @@ fn point_light_entry(height: f64, rng: &mut SplitMix64) -> ([f64; 3], [f64; 3]) 
 
 /// An isotropic point light at `height` over the half-space: each photon of its lower
 /// hemisphere enters where it hits (index-matched: no refraction) and walks.
-pub fn point_light(medium: &Medium, height: f64, paths: u64, seed: u64, bin_width: f64, bins: usize) -> ExitTally {
+pub fn point_light(
+    medium: &Medium,
+    height: f64,
+    paths: u64,
+    seed: u64,
+    bin_width: f64,
+    bins: usize,
+) -> ExitTally {
     let mut rng = SplitMix64::seeded(seed);
     let mut tally = ExitTally::new(bin_width, bins);
     for _ in 0..paths {
@@ -175,7 +195,15 @@ pub fn point_light(medium: &Medium, height: f64, paths: u64, seed: u64, bin_widt
 /// from where it entered drawn from Burley's radial density (shape d, numeric inverse) in a
 /// uniform direction, with weight A: the screen-space pass's convolution of the irradiance
 /// with R (eq. 5.2), estimated by the same tally.
-pub fn point_light_burley(albedo: f64, d: f64, height: f64, paths: u64, seed: u64, bin_width: f64, bins: usize) -> ExitTally {
+pub fn point_light_burley(
+    albedo: f64,
+    d: f64,
+    height: f64,
+    paths: u64,
+    seed: u64,
+    bin_width: f64,
+    bins: usize,
+) -> ExitTally {
     let mut rng = SplitMix64::seeded(seed);
     let mut tally = ExitTally::new(bin_width, bins);
     for _ in 0..paths {
@@ -197,7 +225,17 @@ pub fn h_function(alpha: f64, mu: f64) -> f64 {
     assert!((0.0..1.0).contains(&alpha), "H-function albedo {alpha}; expected [0, 1)");
     let (nodes, weights) = gauss_legendre_unit(64);
     let mut h = vec![1.0; nodes.len()];
-    let at = |h: &[f64], m: f64| 1.0 / ((1.0 - alpha).sqrt() + 0.5 * alpha * nodes.iter().zip(&weights).zip(h).map(|((x, w), hx)| w * x * hx / (m + x)).sum::<f64>());
+    let at = |h: &[f64], m: f64| {
+        1.0 / ((1.0 - alpha).sqrt()
+            + 0.5
+                * alpha
+                * nodes
+                    .iter()
+                    .zip(&weights)
+                    .zip(h)
+                    .map(|((x, w), hx)| w * x * hx / (m + x))
+                    .sum::<f64>())
+    };
     for _ in 0..2000 {
         let next: Vec<f64> = nodes.iter().map(|&m| at(&h, m)).collect();
         let change = next.iter().zip(&h).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);

@@ -5,8 +5,8 @@
 
 use super::control_variates::EmCovariance;
 use super::prefilter::{self, MipChain, Prefilter};
-use super::separable;
 use super::sampling::{luminance, pixel_offset, r2_point, radial_pdf, sample_radius};
+use super::separable;
 use super::spvg::{self, SpvgHistory, SpvgSettings};
 use serde::{Deserialize, Serialize};
 
@@ -69,7 +69,16 @@ impl SssSettings {
 
 impl Default for SssSettings {
     fn default() -> Self {
-        Self { variant: SssVariant::Adaptive, spvg: SpvgSettings::default(), fast_inverse: true, eps_a: 1e-6, a0: 1000.0, a_cv: 0.005, seed: 1, prefilter: None }
+        Self {
+            variant: SssVariant::Adaptive,
+            spvg: SpvgSettings::default(),
+            fast_inverse: true,
+            eps_a: 1e-6,
+            a0: 1000.0,
+            a_cv: 0.005,
+            seed: 1,
+            prefilter: None,
+        }
     }
 }
 
@@ -117,12 +126,22 @@ fn fetch(frame: &SssFrame, q: [f32; 2], centre: [f32; 3]) -> [f32; 3] {
 
 /// The frame's MIP chain when the settings prefilter.
 pub fn mip_chain(frame: &SssFrame, settings: &SssSettings) -> Option<MipChain> {
-    settings.prefilter.map(|p| MipChain::build(frame.width, frame.height, &frame.irradiance, p.levels))
+    settings
+        .prefilter
+        .map(|p| MipChain::build(frame.width, frame.height, &frame.irradiance, p.levels))
 }
 
 /// n Burley samples around pixel (x, y): (1/n) Σ L(q_j) pdf_c(r_j)/pdf_s(r_j) per channel c, L
 /// read from `chain` at eq. 5.12's level when given (AFIS, Algorithm 2), else bilinear.
-pub fn scatter(frame: &SssFrame, settings: &SssSettings, chain: Option<&MipChain>, frame_index: u32, x: u32, y: u32, n: u32) -> [f32; 3] {
+pub fn scatter(
+    frame: &SssFrame,
+    settings: &SssSettings,
+    chain: Option<&MipChain>,
+    frame_index: u32,
+    x: u32,
+    y: u32,
+    n: u32,
+) -> [f32; 3] {
     let pixel = y * frame.width + x;
     let t = frame.irradiance[pixel as usize];
     let centre = [t[0], t[1], t[2]];
@@ -137,7 +156,9 @@ pub fn scatter(frame: &SssFrame, settings: &SssSettings, chain: Option<&MipChain
         let q = [x as f32 + 0.5 + r * phi.cos(), y as f32 + 0.5 + r * phi.sin()];
         let ps = radial_pdf(r, ds);
         let l = match (chain, settings.prefilter) {
-            (Some(chain), Some(p)) => chain.fetch(prefilter::level(r, ps, n, p.a, p.levels), q, centre),
+            (Some(chain), Some(p)) => {
+                chain.fetch(prefilter::level(r, ps, n, p.a, p.levels), q, centre)
+            }
             _ => fetch(frame, q, centre),
         };
         for c in 0..3 {
@@ -148,7 +169,15 @@ pub fn scatter(frame: &SssFrame, settings: &SssSettings, chain: Option<&MipChain
 }
 
 /// One pixel's step: count, samples, histories (the Monte Carlo variants).
-fn pixel_step(frame: &SssFrame, settings: &SssSettings, chain: Option<&MipChain>, frame_index: u32, x: u32, y: u32, prev: &PixelHistory) -> (PixelResult, PixelHistory) {
+fn pixel_step(
+    frame: &SssFrame,
+    settings: &SssSettings,
+    chain: Option<&MipChain>,
+    frame_index: u32,
+    x: u32,
+    y: u32,
+    prev: &PixelHistory,
+) -> (PixelResult, PixelHistory) {
     let t = frame.irradiance[(y * frame.width + x) as usize];
     if t[3] <= 0.0 {
         return (PixelResult { rgb: [t[0], t[1], t[2]], count: 0 }, PixelHistory::default());
@@ -156,7 +185,9 @@ fn pixel_step(frame: &SssFrame, settings: &SssSettings, chain: Option<&MipChain>
     let st = spvg::state(&prev.spvg, &settings.spvg);
     let n = match settings.variant {
         SssVariant::Fixed { count } => count,
-        SssVariant::Separable { .. } => unreachable!("the separable variant runs as two 1-D passes in `step`"),
+        SssVariant::Separable { .. } => {
+            unreachable!("the separable variant runs as two 1-D passes in `step`")
+        }
         _ => spvg::sample_count(&st, &settings.spvg),
     };
     let rgb = scatter(frame, settings, chain, frame_index, x, y, n);
@@ -169,12 +200,20 @@ fn pixel_step(frame: &SssFrame, settings: &SssSettings, chain: Option<&MipChain>
     };
     let monitored = f - a * g;
     let cv = if st.valid { prev.cv.update(settings.a_cv, f, g) } else { EmCovariance::start(f, g) };
-    (PixelResult { rgb, count: n }, PixelHistory { spvg: spvg::update(&st, &settings.spvg, monitored, n), cv })
+    (
+        PixelResult { rgb, count: n },
+        PixelHistory { spvg: spvg::update(&st, &settings.spvg, monitored, n), cv },
+    )
 }
 
 /// The whole image: results and the next frame's histories (`history` empty = cold start;
 /// the separable variant keeps none). Errors: a separable kernel that cannot be built.
-pub fn step(frame: &SssFrame, settings: &SssSettings, frame_index: u32, history: &[PixelHistory]) -> (Vec<PixelResult>, Vec<PixelHistory>) {
+pub fn step(
+    frame: &SssFrame,
+    settings: &SssSettings,
+    frame_index: u32,
+    history: &[PixelHistory],
+) -> (Vec<PixelResult>, Vec<PixelHistory>) {
     let count = (frame.width * frame.height) as usize;
     if let SssVariant::Separable { taps } = settings.variant {
         let kernel = separable::kernel(taps, frame.d_px).unwrap_or_else(|e| panic!("{e}"));
@@ -187,7 +226,15 @@ pub fn step(frame: &SssFrame, settings: &SssSettings, frame_index: u32, history:
     for y in 0..frame.height {
         for x in 0..frame.width {
             let i = (y * frame.width + x) as usize;
-            let (r, h) = pixel_step(frame, settings, chain.as_ref(), frame_index, x, y, history.get(i).unwrap_or(&empty));
+            let (r, h) = pixel_step(
+                frame,
+                settings,
+                chain.as_ref(),
+                frame_index,
+                x,
+                y,
+                history.get(i).unwrap_or(&empty),
+            );
             results.push(r);
             next.push(h);
         }

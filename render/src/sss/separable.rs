@@ -51,10 +51,12 @@ pub fn kernel_cdf(x: f64, d: f64) -> f64 {
 /// Jimenez's tap offsets in units of the sampled d: o_i = −R + 2Ri/(n−1), offset = sign(o) o²/R.
 pub fn tap_offsets(taps: u32) -> Vec<f64> {
     let step = 2.0 * RANGE / (taps - 1) as f64;
-    (0..taps).map(|i| {
-        let o = -RANGE + i as f64 * step;
-        o.signum() * o * o / RANGE
-    }).collect()
+    (0..taps)
+        .map(|i| {
+            let o = -RANGE + i as f64 * step;
+            o.signum() * o * o / RANGE
+        })
+        .collect()
 }
 
 /// The kernel: per tap (offset in units of d_px[widest], weight r, g, b), the weights being
@@ -69,7 +71,15 @@ pub fn kernel(taps: u32, d_px: [f32; 3]) -> Result<Vec<[f32; 4]>, String> {
     let ds = d_px[0].max(d_px[1]).max(d_px[2]) as f64;
     let o = tap_offsets(taps);
     let n = o.len();
-    let edge = |i: usize| if i == 0 { f64::NEG_INFINITY } else if i == n { f64::INFINITY } else { 0.5 * (o[i - 1] + o[i]) };
+    let edge = |i: usize| {
+        if i == 0 {
+            f64::NEG_INFINITY
+        } else if i == n {
+            f64::INFINITY
+        } else {
+            0.5 * (o[i - 1] + o[i])
+        }
+    };
     Ok((0..n)
         .map(|i| {
             let w = d_px.map(|d| {
@@ -83,7 +93,17 @@ pub fn kernel(taps: u32, d_px: [f32; 3]) -> Result<Vec<[f32; 4]>, String> {
 
 /// Linear fetch at position p along one axis (x when `horizontal`), texel centres at +0.5,
 /// clamped to the image; texels outside the SSS mask read as the centre (no bleeding).
-fn fetch_1d(texels: &[[f32; 4]], mask: &[[f32; 4]], width: u32, height: u32, x: u32, y: u32, p: f32, horizontal: bool, centre: [f32; 3]) -> [f32; 3] {
+fn fetch_1d(
+    texels: &[[f32; 4]],
+    mask: &[[f32; 4]],
+    width: u32,
+    height: u32,
+    x: u32,
+    y: u32,
+    p: f32,
+    horizontal: bool,
+    centre: [f32; 3],
+) -> [f32; 3] {
     let (w, h) = (width as i32, height as i32);
     let len = if horizontal { w } else { h };
     let s = (p - 0.5).clamp(-2.0, len as f32 + 1.0);
@@ -100,7 +120,12 @@ fn fetch_1d(texels: &[[f32; 4]], mask: &[[f32; 4]], width: u32, height: u32, x: 
 
 /// One 1-D pass: per SSS pixel Σ_i w_i L(centre + o_i d_s w e), e the pass's axis; other
 /// pixels pass through. `source` is the irradiance (first pass) or the first pass's output.
-fn pass(frame: &SssFrame, source: &[[f32; 4]], kernel: &[[f32; 4]], horizontal: bool) -> Vec<[f32; 4]> {
+fn pass(
+    frame: &SssFrame,
+    source: &[[f32; 4]],
+    kernel: &[[f32; 4]],
+    horizontal: bool,
+) -> Vec<[f32; 4]> {
     let ds = frame.d_sample();
     (0..frame.height)
         .flat_map(|y| (0..frame.width).map(move |x| (x, y)))
@@ -115,7 +140,17 @@ fn pass(frame: &SssFrame, source: &[[f32; 4]], kernel: &[[f32; 4]], horizontal: 
             let scale = ds * w;
             let mut sum = [0.0f32; 3];
             for k in kernel {
-                let l = fetch_1d(source, &frame.irradiance, frame.width, frame.height, x, y, base + k[0] * scale, horizontal, centre);
+                let l = fetch_1d(
+                    source,
+                    &frame.irradiance,
+                    frame.width,
+                    frame.height,
+                    x,
+                    y,
+                    base + k[0] * scale,
+                    horizontal,
+                    centre,
+                );
                 for c in 0..3 {
                     sum[c] += k[c + 1] * l[c];
                 }
@@ -131,6 +166,9 @@ pub fn step(frame: &SssFrame, kernel: &[[f32; 4]]) -> Vec<PixelResult> {
     let both = pass(frame, &horizontal, kernel, false);
     both.iter()
         .zip(&frame.irradiance)
-        .map(|(v, t)| PixelResult { rgb: [v[0], v[1], v[2]], count: if t[3] > 0.0 { 2 * kernel.len() as u32 } else { 0 } })
+        .map(|(v, t)| PixelResult {
+            rgb: [v[0], v[1], v[2]],
+            count: if t[3] > 0.0 { 2 * kernel.len() as u32 } else { 0 },
+        })
         .collect()
 }

@@ -39,7 +39,10 @@ impl SpvgSettings {
             return Err(format!("SPVG sigma0_sq {} must be > 0", self.sigma0_sq));
         }
         if self.n_min == 0 || self.n_min > self.n_max {
-            return Err(format!("SPVG counts [{}, {}] must satisfy 1 <= n_min <= n_max", self.n_min, self.n_max));
+            return Err(format!(
+                "SPVG counts [{}, {}] must satisfy 1 <= n_min <= n_max",
+                self.n_min, self.n_max
+            ));
         }
         Ok(())
     }

@@ -3,8 +3,8 @@
 //! non-SSS strip on the left (mask 0), and per test what changes over time. The irradiance is
 //! computed in closed form (cos θ / dist², hard disc and bar occluders), not path traced.
 
-use super::screen_pass::SssFrame;
 use super::sampling::pcg_hash;
+use super::screen_pass::SssFrame;
 
 /// Which of the thesis's dynamic tests.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,20 +46,37 @@ pub fn frame(test: DynamicTest, width: u32, height: u32, frame: u32, d_rel: [f32
         DynamicTest::Toggle => (frame / TOGGLE_FRAMES) % 2 == 0,
         _ => true,
     };
-    let main = Light { pos: [0.35 * aspect, 0.3, 0.6], intensity: if test == DynamicTest::Flash { flash_intensity(frame) } else if main_on { 1.0 } else { 0.0 } };
+    let main = Light {
+        pos: [0.35 * aspect, 0.3, 0.6],
+        intensity: if test == DynamicTest::Flash {
+            flash_intensity(frame)
+        } else if main_on {
+            1.0
+        } else {
+            0.0
+        },
+    };
     let mut lights = vec![main];
     if test == DynamicTest::Toggle {
-        lights.push(Light { pos: [0.75 * aspect, 0.7, 0.12], intensity: 0.05 * candle_flicker(0, frame) });
-        lights.push(Light { pos: [0.55 * aspect, 0.85, 0.1], intensity: 0.04 * candle_flicker(1, frame) });
+        lights.push(Light {
+            pos: [0.75 * aspect, 0.7, 0.12],
+            intensity: 0.05 * candle_flicker(0, frame),
+        });
+        lights.push(Light {
+            pos: [0.55 * aspect, 0.85, 0.1],
+            intensity: 0.04 * candle_flicker(1, frame),
+        });
     }
     // Boids: discs at height 0.3 on circles around (0.5 aspect, 0.5), radius 0.05.
     let t = frame as f32 * DT;
     let boids: Vec<[f32; 3]> = if test == DynamicTest::Boids {
-        (0..6).map(|k| {
-            let phase = k as f32 * 1.047 + 2.0 * t * (1.0 + 0.1 * k as f32);
-            let radius = 0.15 + 0.03 * k as f32;
-            [0.5 * aspect + radius * phase.cos(), 0.5 + 0.6 * radius * phase.sin(), 0.3]
-        }).collect()
+        (0..6)
+            .map(|k| {
+                let phase = k as f32 * 1.047 + 2.0 * t * (1.0 + 0.1 * k as f32);
+                let radius = 0.15 + 0.03 * k as f32;
+                [0.5 * aspect + radius * phase.cos(), 0.5 + 0.6 * radius * phase.sin(), 0.3]
+            })
+            .collect()
     } else {
         vec![]
     };

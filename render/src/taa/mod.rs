@@ -39,8 +39,8 @@ use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
 use crate::pass_library::PassLibrary;
 use crate::path_tracer::PathTracer;
-use crate::shader::{Module, Program};
 use crate::readback::read_buffer;
+use crate::shader::{Module, Program};
 use crate::timing::{PassTimer, PassTiming};
 use bytemuck::Pod;
 
@@ -91,27 +91,47 @@ pub struct TaaSettings {
 
 impl Default for TaaSettings {
     fn default() -> Self {
-        Self { alpha: 0.1, clamp: TaaClamp::Variance { gamma: 1.0 }, jitter_length: 8, depth_tolerance: 0.05, normal_threshold: 0.8, max_history: 256.0 }
+        Self {
+            alpha: 0.1,
+            clamp: TaaClamp::Variance { gamma: 1.0 },
+            jitter_length: 8,
+            depth_tolerance: 0.05,
+            normal_threshold: 0.8,
+            max_history: 256.0,
+        }
     }
 }
 
 impl TaaSettings {
     pub fn validate(&self) -> Result<(), RenderError> {
         if !(self.alpha > 0.0 && self.alpha <= 1.0) {
-            return Err(RenderError::Settings(format!("TAA alpha must be in (0, 1], got {}", self.alpha)));
+            return Err(RenderError::Settings(format!(
+                "TAA alpha must be in (0, 1], got {}",
+                self.alpha
+            )));
         }
         if let TaaClamp::Variance { gamma } = self.clamp
             && !(gamma > 0.0)
         {
-            return Err(RenderError::Settings(format!("TAA variance clipping gamma must be positive, got {gamma}")));
+            return Err(RenderError::Settings(format!(
+                "TAA variance clipping gamma must be positive, got {gamma}"
+            )));
         }
         if !(self.depth_tolerance > 0.0) || !(self.max_history >= 1.0) {
-            return Err(RenderError::Settings("TAA depth_tolerance must be positive and max_history at least 1".into()));
+            return Err(RenderError::Settings(
+                "TAA depth_tolerance must be positive and max_history at least 1".into(),
+            ));
         }
         Ok(())
     }
 
-    pub(crate) fn params(&self, width: u32, height: u32, jitter: [f32; 2], history_valid: bool) -> TaaParams {
+    pub(crate) fn params(
+        &self,
+        width: u32,
+        height: u32,
+        jitter: [f32; 2],
+        history_valid: bool,
+    ) -> TaaParams {
         let (clamp_mode, gamma) = match self.clamp {
             TaaClamp::None => (0, 0.0),
             TaaClamp::MinMax => (1, 0.0),
@@ -256,20 +276,52 @@ impl Taa {
         gpu.check_workgroup_memory(TAA_RESOLVE_PASS, 0)?;
         let device = &gpu.device;
         let pixels = width as u64 * height as u64;
-        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false });
-        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let params = buffer("taa params", size_of::<TaaParams>() as u64, wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST);
+        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let rw = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
+        let params = buffer(
+            "taa params",
+            size_of::<TaaParams>() as u64,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
         let current = buffer("taa current", pixels * 16, rw);
-        let primary = [buffer("taa primary 0", pixels * 32, rw), buffer("taa primary 1", pixels * 32, rw)];
-        let history = [buffer("taa history 0", pixels * 16, rw), buffer("taa history 1", pixels * 16, rw)];
+        let primary =
+            [buffer("taa primary 0", pixels * 32, rw), buffer("taa primary 1", pixels * 32, rw)];
+        let history =
+            [buffer("taa history 0", pixels * 16, rw), buffer("taa history 1", pixels * 16, rw)];
         let counters = buffer("taa ray counter", 16, rw);
 
-        let (trace_layout, [trace_pipeline]) = tracer.library_pass(gpu, "taa_trace.wgsl", Self::trace_program(), &TRACE_GROUP, ["taa_trace"])?;
+        let (trace_layout, [trace_pipeline]) = tracer.library_pass(
+            gpu,
+            "taa_trace.wgsl",
+            Self::trace_program(),
+            &TRACE_GROUP,
+            ["taa_trace"],
+        )?;
         let resolve_layout = crate::compute::binding_layout(gpu, "taa resolve", &RESOLVE_GROUP);
-        let [resolve_pipeline] = crate::compute::pipelines(gpu, "taa_resolve.wgsl", &Self::resolve_program(), &[&resolve_layout], ["taa_resolve"])?;
+        let [resolve_pipeline] = crate::compute::pipelines(
+            gpu,
+            "taa_resolve.wgsl",
+            &Self::resolve_program(),
+            &[&resolve_layout],
+            ["taa_resolve"],
+        )?;
         let resolve_group = |p: usize| {
             let q = 1 - p;
-            crate::compute::buffer_group(gpu, "taa resolve", &resolve_layout, &[&params, &current, &primary[p], &primary[q], &history[q], &history[p]])
+            crate::compute::buffer_group(
+                gpu,
+                "taa resolve",
+                &resolve_layout,
+                &[&params, &current, &primary[p], &primary[q], &history[q], &history[p]],
+            )
         };
         let resolve_groups = [resolve_group(0), resolve_group(1)];
         Ok(Self {
@@ -296,7 +348,12 @@ impl Taa {
     /// The resolve pass's program: TAA's structs, its @group(0), taa_resolve.wgsl.
     fn resolve_program() -> Program {
         let types = types_module();
-        let bindings = crate::compute::group_module("package::taa_resolve_bindings", 0, &RESOLVE_GROUP, &[&types]);
+        let bindings = crate::compute::group_module(
+            "package::taa_resolve_bindings",
+            0,
+            &RESOLVE_GROUP,
+            &[&types],
+        );
         Program::new(vec![types, bindings]).entry(crate::wgsl_file!("taa_resolve.wgsl"))
     }
 
@@ -306,8 +363,16 @@ impl Taa {
         static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
         PROGRAM.get_or_init(|| {
             let types = types_module();
-            let bindings = crate::compute::group_module("package::taa_trace_bindings", 2, &TRACE_GROUP, &[&types]);
-            PassLibrary::program([types, primary_module(), bindings], [crate::wgsl_file!("taa_trace.wgsl")])
+            let bindings = crate::compute::group_module(
+                "package::taa_trace_bindings",
+                2,
+                &TRACE_GROUP,
+                &[&types],
+            );
+            PassLibrary::program(
+                [types, primary_module(), bindings],
+                [crate::wgsl_file!("taa_trace.wgsl")],
+            )
         })
     }
 
@@ -321,13 +386,25 @@ impl Taa {
     }
 
     /// Jittered 1 spp path tracing + resolve. `tracer` must be updated to this frame's scene.
-    pub fn render(&mut self, gpu: &Gpu, tracer: &PathTracer, seed: u64, frame: u32) -> Result<TaaOutput, RenderError> {
+    pub fn render(
+        &mut self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        seed: u64,
+        frame: u32,
+    ) -> Result<TaaOutput, RenderError> {
         let trace = self.trace(gpu, tracer, seed, frame)?;
         self.resolve(gpu, trace)
     }
 
     /// The trace pass (its own submission): jittered 1 spp path tracing into the current colour.
-    pub fn trace(&mut self, gpu: &Gpu, tracer: &PathTracer, seed: u64, frame: u32) -> Result<Vec<PassTiming>, RenderError> {
+    pub fn trace(
+        &mut self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        seed: u64,
+        frame: u32,
+    ) -> Result<Vec<PassTiming>, RenderError> {
         let jitter = halton_jitter(frame, self.settings.jitter_length);
         tracer.prepare_frame(gpu, 1, 0, seed, frame);
         self.write_params(gpu, jitter);
@@ -339,7 +416,11 @@ impl Taa {
             pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
             pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
             pass.set_bind_group(2, &group, &[]);
-            pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
+            pass.dispatch_workgroups(
+                self.width.div_ceil(WORKGROUP),
+                self.height.div_ceil(WORKGROUP),
+                1,
+            );
         })?;
         timed.submit()
     }
@@ -359,8 +440,18 @@ impl Taa {
 
     /// The bind group of the trace pass's @group(2) writing `current` and `primary`; other
     /// passes that feed the resolve (the hash cache) bind the same layout.
-    fn trace_group(&self, gpu: &Gpu, current: &wgpu::Buffer, primary: &wgpu::Buffer) -> wgpu::BindGroup {
-        crate::compute::buffer_group(gpu, "taa trace", &self.trace_layout, &[&self.params, current, primary, &self.counters])
+    fn trace_group(
+        &self,
+        gpu: &Gpu,
+        current: &wgpu::Buffer,
+        primary: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        crate::compute::buffer_group(
+            gpu,
+            "taa trace",
+            &self.trace_layout,
+            &[&self.params, current, primary, &self.counters],
+        )
     }
 
     /// Resolves a colour another pass produced: `write` gets an encoder, the buffer to write the
@@ -383,16 +474,35 @@ impl Taa {
 
     /// Resolves a colour and primary hits held on the CPU (a pass that reads its image back,
     /// e.g. the SSS method): uploads both and runs [`Self::resolve_external`].
-    pub fn resolve_colour(&mut self, gpu: &Gpu, jitter: [f32; 2], colour: &[[f32; 4]], primary: &[TaaPrimary]) -> Result<TaaOutput, RenderError> {
+    pub fn resolve_colour(
+        &mut self,
+        gpu: &Gpu,
+        jitter: [f32; 2],
+        colour: &[[f32; 4]],
+        primary: &[TaaPrimary],
+    ) -> Result<TaaOutput, RenderError> {
         let pixels = (self.width * self.height) as usize;
         if colour.len() != pixels || primary.len() != pixels {
-            return Err(RenderError::Settings(format!("TAA resolve of {} colours and {} primary hits; expected {pixels} ({}x{})", colour.len(), primary.len(), self.width, self.height)));
+            return Err(RenderError::Settings(format!(
+                "TAA resolve of {} colours and {} primary hits; expected {pixels} ({}x{})",
+                colour.len(),
+                primary.len(),
+                self.width,
+                self.height
+            )));
         }
         let init = |label: &str, contents: &[u8]| {
             use wgpu::util::DeviceExt;
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage: wgpu::BufferUsages::COPY_SRC })
+            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::COPY_SRC,
+            })
         };
-        let (c, p) = (init("taa external colour", bytemuck::cast_slice(colour)), init("taa external primary", bytemuck::cast_slice(primary)));
+        let (c, p) = (
+            init("taa external colour", bytemuck::cast_slice(colour)),
+            init("taa external primary", bytemuck::cast_slice(primary)),
+        );
         self.resolve_external(gpu, jitter, |encoder, colour, primary| {
             encoder.copy_buffer_to_buffer(&c, 0, colour, 0, c.size());
             encoder.copy_buffer_to_buffer(&p, 0, primary, 0, p.size());
@@ -408,13 +518,19 @@ impl Taa {
     fn encode_resolve(&self, pass: &mut wgpu::ComputePass<'_>) {
         pass.set_pipeline(&self.resolve_pipeline);
         pass.set_bind_group(0, &self.resolve_groups[self.parity], &[]);
-        pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
+        pass.dispatch_workgroups(
+            self.width.div_ceil(WORKGROUP),
+            self.height.div_ceil(WORKGROUP),
+            1,
+        );
     }
 
     /// Reads the resolved frame and motion, then swaps the ping-pong buffers.
     fn finish(&mut self, gpu: &Gpu, timings: Vec<PassTiming>) -> Result<TaaOutput, RenderError> {
-        let resolved: Vec<[f32; 4]> = self.read(gpu, &self.history[self.parity], "TAA resolved colour")?;
-        let primary: Vec<TaaPrimary> = self.read(gpu, &self.primary[self.parity], "TAA primary hits")?;
+        let resolved: Vec<[f32; 4]> =
+            self.read(gpu, &self.history[self.parity], "TAA resolved colour")?;
+        let primary: Vec<TaaPrimary> =
+            self.read(gpu, &self.primary[self.parity], "TAA primary hits")?;
         self.parity = 1 - self.parity;
         self.history_valid = true;
         Ok(TaaOutput {
@@ -440,11 +556,24 @@ impl Taa {
         })
     }
 
-    fn read<T: Pod>(&self, gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<T>, RenderError> {
-        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(what), size: buffer.size(), usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST, mapped_at_creation: false });
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
+    fn read<T: Pod>(
+        &self,
+        gpu: &Gpu,
+        buffer: &wgpu::Buffer,
+        what: &str,
+    ) -> Result<Vec<T>, RenderError> {
+        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(what),
+            size: buffer.size(),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
         encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
         gpu.queue.submit([encoder.finish()]);
-        read_buffer(gpu, &staging).map_err(|reason| RenderError::Readback { what: what.into(), reason })
+        read_buffer(gpu, &staging)
+            .map_err(|reason| RenderError::Readback { what: what.into(), reason })
     }
 }

@@ -59,7 +59,8 @@ pub fn resolve(
             let mut hc = bilinear(pos);
             let length = history[at(q)][3];
             if settings.clamp != TaaClamp::None {
-                let (mut lo, mut hi, mut m1, mut m2, mut n) = (c, c, Vec3::ZERO, Vec3::ZERO, 0.0f32);
+                let (mut lo, mut hi, mut m1, mut m2, mut n) =
+                    (c, c, Vec3::ZERO, Vec3::ZERO, 0.0f32);
                 for dy in -1..=1 {
                     for dx in -1..=1 {
                         let t = IVec2::new(x + dx, y + dy);
@@ -117,7 +118,13 @@ mod tests {
     #[test]
     fn a_static_pixel_averages_uniformly_then_exponentially() {
         let s = TaaSettings { clamp: TaaClamp::None, alpha: 0.1, ..Default::default() };
-        let p = TaaPrimary { normal: [0.0, 1.0, 0.0], depth: 2.0, motion: [0.0, 0.0], instance: 0, previous_depth: 2.0 };
+        let p = TaaPrimary {
+            normal: [0.0, 1.0, 0.0],
+            depth: 2.0,
+            motion: [0.0, 0.0],
+            instance: 0,
+            previous_depth: 2.0,
+        };
         let mut history = vec![[0.0; 4]];
         let mut prev = vec![p];
         let mut valid = false;

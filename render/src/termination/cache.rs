@@ -3,21 +3,21 @@
 //! store. One frame = propagate, fold, trace, store, each its own timed pass.
 
 use super::gpu_decision::{decision_module, rule_words};
+use super::moments::RecordMoments;
 use super::settings::{BYTES_PER_RECORD, TerminationSettings, VERTICES_PER_RECORD};
 use crate::compute::{self, BufferBinding};
 use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
+use crate::hash_cache::read;
 use crate::hash_cache::{HashCacheParams, HashCacheSettings};
+use crate::lights::luminance;
 use crate::pass_library::PassLibrary;
 use crate::path_tracer::PathTracer;
-use crate::shader::{Module, Program};
 use crate::scene::Camera;
+use crate::shader::{Module, Program};
 use crate::taa::TaaPrimary;
 use crate::timing::{PassTimer, PassTiming};
-use crate::hash_cache::read;
-use crate::lights::luminance;
-use super::moments::RecordMoments;
 use glam::Vec3;
 
 pub const TC_PROPAGATE_PASS: &str = "tc_propagate";
@@ -96,7 +96,9 @@ crate::gpu_struct! {
     }
 }
 
-const _: () = assert!(size_of::<TcParams>() == 48 && size_of::<TcRecord>() == 32 && size_of::<TcVertex>() == 32);
+const _: () = assert!(
+    size_of::<TcParams>() == 48 && size_of::<TcRecord>() == 32 && size_of::<TcVertex>() == 32
+);
 const _: () = assert!(BYTES_PER_RECORD == 16 + 32 + 4 * 32 + 4 * 32 + 4 * 32);
 
 /// Counters of one frame (counted on the GPU).
@@ -139,7 +141,12 @@ impl CacheStatistics {
         let filled: Vec<RecordMoments> = records
             .iter()
             .filter(|r| r.vertices > 0.0)
-            .map(|r| RecordMoments { vertices: r.vertices as f64, mean: luminance(Vec3::from(r.mean)) as f64, second: r.second as f64, marginal: r.marginal as f64 })
+            .map(|r| RecordMoments {
+                vertices: r.vertices as f64,
+                mean: luminance(Vec3::from(r.mean)) as f64,
+                second: r.second as f64,
+                marginal: r.marginal as f64,
+            })
             .collect();
         let n = filled.len().max(1) as f64;
         Self {
@@ -189,19 +196,42 @@ pub struct TerminationCache {
 
 impl TerminationCache {
     /// Builds the cache; refuses a capacity or resolution over the adapter's buffer limits.
-    pub fn new(gpu: &Gpu, tracer: &PathTracer, settings: TerminationSettings) -> Result<Self, RenderError> {
+    pub fn new(
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        settings: TerminationSettings,
+    ) -> Result<Self, RenderError> {
         settings.validate()?;
         let s = tracer.settings();
         let (width, height) = (s.width, s.height);
         let pixels = width as u64 * height as u64;
         let cap = settings.capacity as u64;
-        gpu.check_resolution(width, height, size_of::<TaaPrimary>() as u64 + 16 + 4 + size_of::<TcVertex>() as u64)?;
-        gpu.check_buffer_size("termination cache records (moments + vertex estimates)", cap * (1 + VERTICES_PER_RECORD) * 32)?;
-        gpu.check_buffer_size("termination cache vertices (stored + candidates)", (cap * 2 * VERTICES_PER_RECORD + pixels) * 32)?;
+        gpu.check_resolution(
+            width,
+            height,
+            size_of::<TaaPrimary>() as u64 + 16 + 4 + size_of::<TcVertex>() as u64,
+        )?;
+        gpu.check_buffer_size(
+            "termination cache records (moments + vertex estimates)",
+            cap * (1 + VERTICES_PER_RECORD) * 32,
+        )?;
+        gpu.check_buffer_size(
+            "termination cache vertices (stored + candidates)",
+            (cap * 2 * VERTICES_PER_RECORD + pixels) * 32,
+        )?;
         gpu.check_workgroup_memory(TC_TRACE_PASS, 0)?;
         let device = &gpu.device;
-        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false });
-        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let rw = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
         let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
         let hc = buffer("termination hc", size_of::<HashCacheParams>() as u64, uniform);
         let tc = buffer("termination tc", size_of::<TcParams>() as u64, uniform);
@@ -210,14 +240,37 @@ impl TerminationCache {
         let empty: Vec<[u32; 4]> = vec![[0, u32::MAX, 0, 0]; cap as usize];
         gpu.queue.write_buffer(&slots, 0, bytemuck::cast_slice(&empty));
         let records = buffer("termination records", cap * (1 + VERTICES_PER_RECORD) * 32, rw);
-        let vertices = buffer("termination vertices", (cap * 2 * VERTICES_PER_RECORD + pixels) * 32, rw);
+        let vertices =
+            buffer("termination vertices", (cap * 2 * VERTICES_PER_RECORD + pixels) * 32, rw);
         let counters = buffer("termination counters", COUNTERS * 4, rw);
         let primary = buffer("termination primary", pixels * size_of::<TaaPrimary>() as u64, rw);
         let colour = buffer("termination colour", pixels * 16, rw);
         let path_length = buffer("termination path length", pixels * 4, rw);
-        let (layout, pipelines) = tracer.library_pass(gpu, "termination.wgsl", Self::program(), &OWN_GROUP, PASSES)?;
-        let group = crate::compute::buffer_group(gpu, "termination", &layout, &[&hc, &tc, &slots, &records, &vertices, &counters, &primary, &colour, &path_length]);
-        Ok(Self { settings, width, height, hc, tc, slots, records, counters, primary, colour, path_length, group, pipelines, timer: PassTimer::new(gpu, &PASSES), frames: 0 })
+        let (layout, pipelines) =
+            tracer.library_pass(gpu, "termination.wgsl", Self::program(), &OWN_GROUP, PASSES)?;
+        let group = crate::compute::buffer_group(
+            gpu,
+            "termination",
+            &layout,
+            &[&hc, &tc, &slots, &records, &vertices, &counters, &primary, &colour, &path_length],
+        );
+        Ok(Self {
+            settings,
+            width,
+            height,
+            hc,
+            tc,
+            slots,
+            records,
+            counters,
+            primary,
+            colour,
+            path_length,
+            group,
+            pipelines,
+            timer: PassTimer::new(gpu, &PASSES),
+            frames: 0,
+        })
     }
 
     /// The passes' program: the shading library, TAA's primary attributes, the hash cache's
@@ -229,11 +282,35 @@ impl TerminationCache {
         PROGRAM.get_or_init(|| {
             let taa_types = crate::taa::types_module();
             let hc_types = crate::hash_cache::types_module();
-            let types = Module::generated("package::termination_types", &[TcParams::WGSL, TcRecord::WGSL, TcVertex::WGSL]);
-            let hc = compute::group_module_range("package::hash_cache_bindings", 2, &OWN_GROUP, 0..1, &[&hc_types]);
-            let bindings = compute::group_module_range("package::termination_bindings", 2, &OWN_GROUP, 1..OWN_GROUP.len(), &[&taa_types, &types]);
+            let types = Module::generated(
+                "package::termination_types",
+                &[TcParams::WGSL, TcRecord::WGSL, TcVertex::WGSL],
+            );
+            let hc = compute::group_module_range(
+                "package::hash_cache_bindings",
+                2,
+                &OWN_GROUP,
+                0..1,
+                &[&hc_types],
+            );
+            let bindings = compute::group_module_range(
+                "package::termination_bindings",
+                2,
+                &OWN_GROUP,
+                1..OWN_GROUP.len(),
+                &[&taa_types, &types],
+            );
             PassLibrary::program(
-                [taa_types, crate::taa::primary_module(), hc_types, hc, types, bindings, crate::wgsl_file!("hash_cache/hash_key.wgsl"), decision_module()],
+                [
+                    taa_types,
+                    crate::taa::primary_module(),
+                    hc_types,
+                    hc,
+                    types,
+                    bindings,
+                    crate::wgsl_file!("hash_cache/hash_key.wgsl"),
+                    decision_module(),
+                ],
                 [crate::wgsl_file!("termination/termination.wgsl")],
             )
         })
@@ -249,7 +326,14 @@ impl TerminationCache {
     }
 
     /// One frame. On the first call the cache is first filled for `warmup_frames` frames.
-    pub fn render(&mut self, gpu: &Gpu, tracer: &PathTracer, camera: &Camera, seed: u64, frame: u32) -> Result<TerminationOutput, RenderError> {
+    pub fn render(
+        &mut self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        camera: &Camera,
+        seed: u64,
+        frame: u32,
+    ) -> Result<TerminationOutput, RenderError> {
         if self.frames == 0 {
             for k in 0..self.settings.warmup_frames {
                 // Warm-up frames draw their own random numbers (frame indices no run reaches).
@@ -261,7 +345,18 @@ impl TerminationCache {
         let primary: Vec<TaaPrimary> = read(gpu, &self.primary, "termination primary hits")?;
         let path_length: Vec<f32> = read(gpu, &self.path_length, "termination path length")?;
         let c: Vec<u32> = read(gpu, &self.counters, "termination counters")?;
-        let stats = TerminationStats { path_vertices: c[0], trace_rays: c[1], propagate_rays: c[2], inserted: c[3], insert_failures: c[4], stored: c[5], unknown: c[6], propagated: c[7], incomplete: c[8], filled: c[9] };
+        let stats = TerminationStats {
+            path_vertices: c[0],
+            trace_rays: c[1],
+            propagate_rays: c[2],
+            inserted: c[3],
+            insert_failures: c[4],
+            stored: c[5],
+            unknown: c[6],
+            propagated: c[7],
+            incomplete: c[8],
+            filled: c[9],
+        };
         let pixels = self.width as u64 * self.height as u64;
         Ok(TerminationOutput {
             radiance,
@@ -276,12 +371,27 @@ impl TerminationCache {
         })
     }
 
-    fn passes(&mut self, gpu: &Gpu, tracer: &PathTracer, camera: &Camera, seed: u64, frame: u32, max_vertices: u32) -> Result<Vec<PassTiming>, RenderError> {
+    fn passes(
+        &mut self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        camera: &Camera,
+        seed: u64,
+        frame: u32,
+        max_vertices: u32,
+    ) -> Result<Vec<PassTiming>, RenderError> {
         let s = &self.settings;
         // The hash cache's keys round the voxel down to a power of two (sub-pixel voxels, the
         // paper's HashCache); twice the scale keeps this cache's rounding up (voxels of at least
         // lod_scale footprints), as it was tuned.
-        let keys = HashCacheSettings { capacity: s.capacity, probe_limit: s.probe_limit, lod_scale: 2.0 * s.lod_scale, jitter: s.jitter, ..Default::default() }.key_params(camera, self.height);
+        let keys = HashCacheSettings {
+            capacity: s.capacity,
+            probe_limit: s.probe_limit,
+            lod_scale: 2.0 * s.lod_scale,
+            jitter: s.jitter,
+            ..Default::default()
+        }
+        .key_params(camera, self.height);
         let hc = HashCacheParams {
             capacity: s.capacity,
             probe_limit: s.probe_limit,

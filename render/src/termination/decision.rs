@@ -79,7 +79,9 @@ impl Decision {
 /// The absolute variance threshold of a path from the cache value at its first hit.
 pub fn path_threshold(rule: &TerminationRule, first_radiance: f64) -> f64 {
     match *rule {
-        TerminationRule::VarianceBounding { t, relative: true } => t * first_radiance * first_radiance,
+        TerminationRule::VarianceBounding { t, relative: true } => {
+            t * first_radiance * first_radiance
+        }
         TerminationRule::VarianceBounding { t, relative: false } => t,
         _ => 0.0,
     }
@@ -98,7 +100,12 @@ pub fn arrive_area_spread(state: &mut PathState, dist2: f64, pdf: f64, cos: f64)
 
 /// The decision at `state.vertex` with the record's `stats`; updates the path variance.
 /// `survival` is the Russian roulette's survival probability of the continuation (1 = none).
-pub fn decide(rule: &TerminationRule, survival: f64, state: &mut PathState, stats: &LocalStats) -> Decision {
+pub fn decide(
+    rule: &TerminationRule,
+    survival: f64,
+    state: &mut PathState,
+    stats: &LocalStats,
+) -> Decision {
     let local_variance = stats.variance_with_roulette(survival);
     let prefixed = state.throughput2 * local_variance; // P_l
     match *rule {
@@ -121,7 +128,8 @@ pub fn decide(rule: &TerminationRule, survival: f64, state: &mut PathState, stat
             // the margin factor lets the prefix weigh in.
             let current = state.path_variance / s + state.throughput2 * stats.bias2;
             let deferred_bias2 = stats.deferred_bias2.min(bias_clamp * stats.bias2 / margin);
-            let deferred = (state.path_variance + prefixed) / s + state.throughput2 * deferred_bias2;
+            let deferred =
+                (state.path_variance + prefixed) / s + state.throughput2 * deferred_bias2;
             if current <= margin * deferred {
                 Decision::Terminate
             } else {
@@ -131,7 +139,11 @@ pub fn decide(rule: &TerminationRule, survival: f64, state: &mut PathState, stat
         }
         TerminationRule::AreaSpread { c } => {
             let spread = state.spread_sqrt * state.spread_sqrt;
-            if state.vertex >= 2 && spread > c * state.spread0 { Decision::Terminate } else { Decision::Continue }
+            if state.vertex >= 2 && spread > c * state.spread0 {
+                Decision::Terminate
+            } else {
+                Decision::Continue
+            }
         }
     }
 }

@@ -46,7 +46,13 @@ pub fn default_bias_clamp() -> f64 {
 impl TerminationRule {
     /// Input errors in the rule's parameters.
     pub fn validate(&self) -> Result<(), String> {
-        let finite_nonneg = |name: &str, v: f64| if v.is_finite() && v >= 0.0 { Ok(()) } else { Err(format!("{name} must be a finite number >= 0, got {v}")) };
+        let finite_nonneg = |name: &str, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{name} must be a finite number >= 0, got {v}"))
+            }
+        };
         match *self {
             TerminationRule::VarianceBounding { t, .. } => finite_nonneg("VarianceBounding t", t),
             TerminationRule::MseMinimisation { s, margin, bias_clamp } => {
@@ -57,7 +63,9 @@ impl TerminationRule {
                     return Err(format!("MseMinimisation margin must be >= 1, got {margin}"));
                 }
                 if !(bias_clamp > 0.0 && bias_clamp < 1.0) {
-                    return Err(format!("MseMinimisation bias_clamp must be in (0, 1), got {bias_clamp}"));
+                    return Err(format!(
+                        "MseMinimisation bias_clamp must be in (0, 1), got {bias_clamp}"
+                    ));
                 }
                 Ok(())
             }
@@ -69,7 +77,9 @@ impl TerminationRule {
     /// Short label: `vb_0.1`, `vb_rel_1`, `mse_100`, `spread_0.01`, `first_vertex`, `pt`.
     pub fn label(&self) -> String {
         match *self {
-            TerminationRule::VarianceBounding { t, relative } => format!("vb_{}{t}", if relative { "rel_" } else { "" }),
+            TerminationRule::VarianceBounding { t, relative } => {
+                format!("vb_{}{t}", if relative { "rel_" } else { "" })
+            }
             TerminationRule::MseMinimisation { s, .. } => format!("mse_{s}"),
             TerminationRule::AreaSpread { c } => format!("spread_{c}"),
             TerminationRule::FirstVertex => "first_vertex".into(),

@@ -36,7 +36,12 @@ impl Moments {
 impl SamplingTree {
     /// Fig. 4: exact caches (every inner node holds its true value).
     pub fn exact(depth: u32, albedo: f64) -> Self {
-        let mut tree = Self { depth, p_left: 0.9, edge_weight: albedo / 2.0, cache: vec![0.0; (1usize << (depth + 1)) - 1] };
+        let mut tree = Self {
+            depth,
+            p_left: 0.9,
+            edge_weight: albedo / 2.0,
+            cache: vec![0.0; (1usize << (depth + 1)) - 1],
+        };
         for i in 0..tree.cache.len() {
             tree.cache[i] = tree.value(i);
         }
@@ -79,18 +84,36 @@ impl SamplingTree {
             deferred += p * (w / p) * (w / p) * bias_c * bias_c;
         }
         let bias = self.cache[i] - self.value(i);
-        LocalStats { radiance: self.cache[i], variance: second - mean * mean, marginal: mean * mean, bias2: bias * bias, deferred_bias2: deferred }
+        LocalStats {
+            radiance: self.cache[i],
+            variance: second - mean * mean,
+            marginal: mean * mean,
+            bias2: bias * bias,
+            deferred_bias2: deferred,
+        }
     }
 
     /// Exact moments of the radiance caching estimator at the root under `rule`, with Russian
     /// roulette of survival `survival` on every continued segment.
     pub fn estimator(&self, rule: &TerminationRule, survival: f64) -> Moments {
         let stats = self.local_stats(0);
-        let state = PathState { throughput2: 1.0, threshold: path_threshold(rule, stats.radiance), vertex: 1, ..Default::default() };
+        let state = PathState {
+            throughput2: 1.0,
+            threshold: path_threshold(rule, stats.radiance),
+            vertex: 1,
+            ..Default::default()
+        };
         self.moments_from(0, 1.0, state, rule, survival)
     }
 
-    fn moments_from(&self, i: usize, throughput: f64, mut state: PathState, rule: &TerminationRule, q: f64) -> Moments {
+    fn moments_from(
+        &self,
+        i: usize,
+        throughput: f64,
+        mut state: PathState,
+        rule: &TerminationRule,
+        q: f64,
+    ) -> Moments {
         if self.is_leaf(i) {
             let y = throughput * self.cache[i];
             return Moments { mean: y, second: y * y };
@@ -111,13 +134,19 @@ impl SamplingTree {
                         self.moments_from(c, t, next, rule, q)
                     }
                     // The blended segment terminates into the cache at its hit.
-                    _ => Moments { mean: t * self.cache[c], second: t * t * self.cache[c] * self.cache[c] },
+                    _ => Moments {
+                        mean: t * self.cache[c],
+                        second: t * t * self.cache[c] * self.cache[c],
+                    },
                 };
                 cont.mean += p * q * m.mean;
                 cont.second += p * q * m.second;
             }
         }
-        Moments { mean: base + cont.mean, second: base * base + 2.0 * base * cont.mean + cont.second }
+        Moments {
+            mean: base + cont.mean,
+            second: base * base + 2.0 * base * cont.mean + cont.second,
+        }
     }
 
     /// Closed form of the variance under variance bounding with exact caches: every path's
@@ -154,7 +183,10 @@ impl SamplingTree {
             return sum;
         }
         let s = sum + throughput * throughput * self.local_stats(i).variance;
-        self.children(i).iter().map(|&(c, p)| self.min_path_sum(c, throughput * self.edge_weight / p, s)).fold(f64::INFINITY, f64::min)
+        self.children(i)
+            .iter()
+            .map(|&(c, p)| self.min_path_sum(c, throughput * self.edge_weight / p, s))
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Plain path tracing's moments from the leaves alone: Σ_paths p · (Π w/p)², no cache.

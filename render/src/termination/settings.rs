@@ -63,15 +63,27 @@ impl TerminationSettings {
         }
         if self.capacity == 0 || self.capacity > (1 << 20) {
             // 4 propagation invocations per record in one dispatch dimension (65535 × 64).
-            return bad(format!("Termination capacity must be in 1..=2^20 records, got {}", self.capacity));
+            return bad(format!(
+                "Termination capacity must be in 1..=2^20 records, got {}",
+                self.capacity
+            ));
         }
         if self.probe_limit == 0 || self.probe_limit > self.capacity {
-            return bad(format!("Termination probe_limit must be in 1..=capacity, got {}", self.probe_limit));
+            return bad(format!(
+                "Termination probe_limit must be in 1..=capacity, got {}",
+                self.probe_limit
+            ));
         }
         if self.samples_per_vertex < 2 || self.samples_per_vertex > 32 {
-            return bad(format!("Termination samples_per_vertex must be in 2..=32 (pairs for the marginal moment), got {}", self.samples_per_vertex));
+            return bad(format!(
+                "Termination samples_per_vertex must be in 2..=32 (pairs for the marginal moment), got {}",
+                self.samples_per_vertex
+            ));
         }
-        if self.max_vertices == 0 || !(self.lod_scale > 0.0) || !(0.0..=1.0).contains(&self.store_probability) {
+        if self.max_vertices == 0
+            || !(self.lod_scale > 0.0)
+            || !(0.0..=1.0).contains(&self.store_probability)
+        {
             return bad("Termination max_vertices must be >= 1, lod_scale > 0 and store_probability in [0, 1]".into());
         }
         Ok(())

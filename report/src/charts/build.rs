@@ -34,7 +34,18 @@ fn label(column: &str) -> String {
 /// are the termination cache's (render::termination): how termination and the records'
 /// statistics move around an event.
 const FRAME_COLUMNS: [&str; 12] = [
-    "flip", "smape", "smape_reprojected", "psnr", "rel_mse", "gpu_ms_total", "wall_ms_total", "cpu_ms", "path_length", "cache_mean", "cache_variance", "cache_bias2",
+    "flip",
+    "smape",
+    "smape_reprojected",
+    "psnr",
+    "rel_mse",
+    "gpu_ms_total",
+    "wall_ms_total",
+    "cpu_ms",
+    "path_length",
+    "cache_mean",
+    "cache_variance",
+    "cache_bias2",
 ];
 
 fn mean(v: &[(f64, f64)]) -> Option<f64> {
@@ -44,15 +55,29 @@ fn mean(v: &[(f64, f64)]) -> Option<f64> {
 
 pub fn frame_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)> {
     let methods = frames.methods();
-    let last_frame = frames.rows.iter().map(|r| r.frame).max().unwrap_or(0).max(manifest.frames.unwrap_or(1).saturating_sub(1)) as f64;
-    let events: Vec<(f64, String)> = manifest.events.iter().map(|e| (e.frame as f64, e.label.clone())).collect();
-    let region_columns = manifest.regions.iter().flat_map(|r| [format!("{}_flip", r.name), format!("{}_smape", r.name)]);
-    let columns: Vec<String> = FRAME_COLUMNS.iter().map(|s| s.to_string()).chain(region_columns).collect();
+    let last_frame = frames
+        .rows
+        .iter()
+        .map(|r| r.frame)
+        .max()
+        .unwrap_or(0)
+        .max(manifest.frames.unwrap_or(1).saturating_sub(1)) as f64;
+    let events: Vec<(f64, String)> =
+        manifest.events.iter().map(|e| (e.frame as f64, e.label.clone())).collect();
+    let region_columns = manifest
+        .regions
+        .iter()
+        .flat_map(|r| [format!("{}_flip", r.name), format!("{}_smape", r.name)]);
+    let columns: Vec<String> =
+        FRAME_COLUMNS.iter().map(|s| s.to_string()).chain(region_columns).collect();
     columns
         .into_iter()
         .filter_map(|name| {
             let c = frames.column(&name).filter(|&c| frames.has_data(c))?;
-            let series = methods.iter().map(|m| Series { name: m.clone(), points: frames.series(m, c) }).collect();
+            let series = methods
+                .iter()
+                .map(|m| Series { name: m.clone(), points: frames.series(m, c) })
+                .collect();
             let chart = Chart {
                 title: format!("{} — {}", label(&name), manifest.scenario),
                 x_label: "frame".into(),
@@ -74,7 +99,10 @@ pub fn frame_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)
 pub fn reliability_chart(manifest: &Manifest, frames: &Frames) -> Option<(String, Chart)> {
     let cur = frames.column("reliability_high_lr").filter(|&c| frames.has_data(c))?;
     let ema = frames.column("reliability_ema").filter(|&c| frames.has_data(c))?;
-    let method = frames.methods().into_iter().find(|m| frames.series(m, cur).iter().any(|p| p.1.is_finite()))?;
+    let method = frames
+        .methods()
+        .into_iter()
+        .find(|m| frames.series(m, cur).iter().any(|p| p.1.is_finite()))?;
     let last_frame = frames.rows.iter().map(|r| r.frame).max().unwrap_or(0) as f64;
     let chart = Chart {
         title: format!("Mean reliability per predictor ({method}) — {}", manifest.scenario),
@@ -97,13 +125,23 @@ pub fn reliability_chart(manifest: &Manifest, frames: &Frames) -> Option<(String
 /// the even mixture σ = 0.5 as a reference line.
 pub fn sigma_chart(manifest: &Manifest, frames: &Frames) -> Option<(String, Chart)> {
     let sigma = frames.column("blend_sigma").filter(|&c| frames.has_data(c))?;
-    let method = frames.methods().into_iter().find(|m| frames.series(m, sigma).iter().any(|p| p.1.is_finite()))?;
+    let method = frames
+        .methods()
+        .into_iter()
+        .find(|m| frames.series(m, sigma).iter().any(|p| p.1.is_finite()))?;
     let last_frame = frames.rows.iter().map(|r| r.frame).max().unwrap_or(0) as f64;
-    let mut series = vec![Series { name: "mean σ (blend rule)".into(), points: frames.series(&method, sigma) }];
+    let mut series =
+        vec![Series { name: "mean σ (blend rule)".into(), points: frames.series(&method, sigma) }];
     if let Some(prefer) = frames.column("prefer_high_lr").filter(|&c| frames.has_data(c)) {
-        series.push(Series { name: "share of queries with σ > 0.5".into(), points: frames.series(&method, prefer) });
+        series.push(Series {
+            name: "share of queries with σ > 0.5".into(),
+            points: frames.series(&method, prefer),
+        });
     }
-    series.push(Series { name: "σ = 0.5 (even mixture)".into(), points: vec![(0.0, 0.5), (last_frame, 0.5)] });
+    series.push(Series {
+        name: "σ = 0.5 (even mixture)".into(),
+        points: vec![(0.0, 0.5), (last_frame, 0.5)],
+    });
     let chart = Chart {
         title: format!("Weight σ of the High-LR predictor ({method}) — {}", manifest.scenario),
         x_label: "frame".into(),
@@ -122,10 +160,18 @@ pub fn sigma_chart(manifest: &Manifest, frames: &Frames) -> Option<(String, Char
 /// (stats `reliability_diff_p10/p50/p90`), and the share of queries with |σ − 0.5| > 0.1.
 pub fn reliability_spread_chart(manifest: &Manifest, frames: &Frames) -> Option<(String, Chart)> {
     let p50 = frames.column("reliability_diff_p50").filter(|&c| frames.has_data(c))?;
-    let method = frames.methods().into_iter().find(|m| frames.series(m, p50).iter().any(|p| p.1.is_finite()))?;
+    let method = frames
+        .methods()
+        .into_iter()
+        .find(|m| frames.series(m, p50).iter().any(|p| p.1.is_finite()))?;
     let last_frame = frames.rows.iter().map(|r| r.frame).max().unwrap_or(0) as f64;
     let mut series = Vec::new();
-    for (col, name) in [("reliability_diff_p10", "10th percentile of r̄_cur − r̄_EMA"), ("reliability_diff_p50", "median"), ("reliability_diff_p90", "90th percentile"), ("sigma_far_from_even", "share of queries with |σ − 0.5| > 0.1")] {
+    for (col, name) in [
+        ("reliability_diff_p10", "10th percentile of r̄_cur − r̄_EMA"),
+        ("reliability_diff_p50", "median"),
+        ("reliability_diff_p90", "90th percentile"),
+        ("sigma_far_from_even", "share of queries with |σ − 0.5| > 0.1"),
+    ] {
         if let Some(c) = frames.column(col).filter(|&c| frames.has_data(c)) {
             series.push(Series { name: name.into(), points: frames.series(&method, c) });
         }
@@ -145,26 +191,45 @@ pub fn reliability_spread_chart(manifest: &Manifest, frames: &Frames) -> Option<
 }
 
 pub fn speed_accuracy_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)> {
-    let time_col = ["gpu_ms_total", "wall_ms_total", "cpu_ms"].into_iter().find(|c| frames.column(c).is_some_and(|i| frames.has_data(i)));
+    let time_col = ["gpu_ms_total", "wall_ms_total", "cpu_ms"]
+        .into_iter()
+        .find(|c| frames.column(c).is_some_and(|i| frames.has_data(i)));
     let Some(time_col) = time_col else { return vec![] };
     let t = frames.column(time_col).unwrap();
-    let mut out = scatter_charts(manifest, frames, "", &format!("mean {}", label(time_col)), |method| mean(&frames.series(method, t)));
+    let mut out =
+        scatter_charts(manifest, frames, "", &format!("mean {}", label(time_col)), |method| {
+            mean(&frames.series(method, t))
+        });
     // variance-trading-termination.txt's Table 1 separates the tracer from the cache's
     // propagation: their sum is the cost a termination rule trades against accuracy (the
     // record fold and the vertex store are per record, the same for every rule).
     let trace = frames.column("gpu_ms_tc_trace").filter(|&c| frames.has_data(c));
     let propagate = frames.column("gpu_ms_tc_propagate").filter(|&c| frames.has_data(c));
     if let (Some(trace), Some(propagate)) = (trace, propagate) {
-        out.extend(scatter_charts(manifest, frames, "_tracer_propagation", "mean tracer + propagation GPU time (ms)", |method| {
-            Some(mean(&frames.series(method, trace))? + mean(&frames.series(method, propagate))?)
-        }));
+        out.extend(scatter_charts(
+            manifest,
+            frames,
+            "_tracer_propagation",
+            "mean tracer + propagation GPU time (ms)",
+            |method| {
+                Some(
+                    mean(&frames.series(method, trace))? + mean(&frames.series(method, propagate))?,
+                )
+            },
+        ));
     }
     out
 }
 
 /// One scatter chart per accuracy metric: every method with a cost (`cost`, the x axis) and
 /// the metric's mean, and the Pareto front of those points.
-fn scatter_charts(manifest: &Manifest, frames: &Frames, suffix: &str, x_label: &str, cost: impl Fn(&str) -> Option<f64>) -> Vec<(String, Chart)> {
+fn scatter_charts(
+    manifest: &Manifest,
+    frames: &Frames,
+    suffix: &str,
+    x_label: &str,
+    cost: impl Fn(&str) -> Option<f64>,
+) -> Vec<(String, Chart)> {
     let mut out = Vec::new();
     for metric in ["flip", "smape"] {
         let Some(m) = frames.column(metric).filter(|&m| frames.has_data(m)) else { continue };
@@ -184,7 +249,11 @@ fn scatter_charts(manifest: &Manifest, frames: &Frames, suffix: &str, x_label: &
         out.push((
             format!("speed_vs_{metric}{suffix}"),
             Chart {
-                title: format!("Speed vs accuracy ({}{what}) — {}", metric.to_uppercase(), manifest.scenario),
+                title: format!(
+                    "Speed vs accuracy ({}{what}) — {}",
+                    metric.to_uppercase(),
+                    manifest.scenario
+                ),
                 x_label: x_label.into(),
                 y_label: format!("mean {}", label(metric)),
                 kind: Kind::Scatter,
@@ -207,16 +276,28 @@ pub struct WrittenChart {
     pub frame_axis: Option<XMap>,
 }
 
-pub fn write_charts(run_dir: &Path, manifest: &Manifest, frames: &Frames) -> anyhow::Result<Vec<WrittenChart>> {
+pub fn write_charts(
+    run_dir: &Path,
+    manifest: &Manifest,
+    frames: &Frames,
+) -> anyhow::Result<Vec<WrittenChart>> {
     let dir = run_dir.join("charts");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut out = Vec::new();
-    for (stem, chart) in frame_charts(manifest, frames).into_iter().chain(reliability_chart(manifest, frames)).chain(sigma_chart(manifest, frames)).chain(reliability_spread_chart(manifest, frames)).chain(speed_accuracy_charts(manifest, frames)) {
+    for (stem, chart) in frame_charts(manifest, frames)
+        .into_iter()
+        .chain(reliability_chart(manifest, frames))
+        .chain(sigma_chart(manifest, frames))
+        .chain(reliability_spread_chart(manifest, frames))
+        .chain(speed_accuracy_charts(manifest, frames))
+    {
         let (svg, map) = plot::to_svg(&chart)?;
         let svg_path = dir.join(format!("{stem}.svg"));
-        std::fs::write(&svg_path, &svg).with_context(|| format!("cannot write {}", svg_path.display()))?;
+        std::fs::write(&svg_path, &svg)
+            .with_context(|| format!("cannot write {}", svg_path.display()))?;
         let png_path = dir.join(format!("{stem}.png"));
-        std::fs::write(&png_path, plot::to_png(&chart)?).with_context(|| format!("cannot write {}", png_path.display()))?;
+        std::fs::write(&png_path, plot::to_png(&chart)?)
+            .with_context(|| format!("cannot write {}", png_path.display()))?;
         let frame_axis = (chart.kind == Kind::Lines && chart.x_label == "frame").then_some(map);
         out.push(WrittenChart { stem, title: chart.title, svg, frame_axis });
     }
@@ -241,7 +322,10 @@ mod tests {
         assert_eq!(chart.series[2].points, vec![(0.0, 0.5), (1.0, 0.5)]);
         let (_, r) = reliability_chart(&manifest, &frames).expect("a reliability chart");
         assert_eq!(r.series[1].points, vec![(0.0, 0.6), (1.0, 0.3)]);
-        assert!(reliability_spread_chart(&manifest, &frames).is_none(), "no spread columns, no chart");
+        assert!(
+            reliability_spread_chart(&manifest, &frames).is_none(),
+            "no spread columns, no chart"
+        );
         let spread = "method,frame,cpu_ms,reliability_diff_p10,reliability_diff_p50,reliability_diff_p90,sigma_far_from_even\n\
                       pt_1spp,0,1,,,,\nnirc_blend_1spp,0,2,-0.1,0.0,0.2,0.3\nnirc_blend_1spp,1,2,-0.2,0.1,0.3,0.4\n";
         let spread = Frames::parse(spread, Path::new("frames.csv")).unwrap();
@@ -251,8 +335,12 @@ mod tests {
         assert_eq!(chart.series[2].points, vec![(0.0, 0.2), (1.0, 0.3)]);
         assert_eq!(chart.series[3].points, vec![(0.0, 0.3), (1.0, 0.4)]);
         // A run without NIRC methods has neither chart.
-        let plain = Frames::parse("method,frame,cpu_ms\npt_1spp,0,1\n", Path::new("frames.csv")).unwrap();
-        assert!(sigma_chart(&manifest, &plain).is_none() && reliability_chart(&manifest, &plain).is_none());
+        let plain =
+            Frames::parse("method,frame,cpu_ms\npt_1spp,0,1\n", Path::new("frames.csv")).unwrap();
+        assert!(
+            sigma_chart(&manifest, &plain).is_none()
+                && reliability_chart(&manifest, &plain).is_none()
+        );
     }
 
     #[test]
@@ -268,9 +356,18 @@ mod tests {
         let manifest: Manifest = serde_json::from_str(r#"{"scenario": "s", "frames": 2}"#).unwrap();
         let charts = speed_accuracy_charts(&manifest, &frames);
         let stems: Vec<&str> = charts.iter().map(|c| c.0.as_str()).collect();
-        assert_eq!(stems, ["speed_vs_flip", "speed_vs_smape", "speed_vs_flip_tracer_propagation", "speed_vs_smape_tracer_propagation"]);
+        assert_eq!(
+            stems,
+            [
+                "speed_vs_flip",
+                "speed_vs_smape",
+                "speed_vs_flip_tracer_propagation",
+                "speed_vs_smape_tracer_propagation"
+            ]
+        );
         let flip = &charts[2].1;
-        let pts: Vec<(&str, (f64, f64))> = flip.series.iter().map(|s| (s.name.as_str(), s.points[0])).collect();
+        let pts: Vec<(&str, (f64, f64))> =
+            flip.series.iter().map(|s| (s.name.as_str(), s.points[0])).collect();
         assert_eq!(pts, [("vb", (8.0, 0.5)), ("mse", (6.0, 0.6)), ("spread", (8.0, 0.7))]);
         // spread costs as much as vb with a larger error: dominated.
         assert_eq!(flip.pareto, vec![(6.0, 0.6), (8.0, 0.5)]);

@@ -39,15 +39,23 @@ pub struct Chart {
 
 /// Distinguishable colours (Okabe-Ito, colour-blind safe), cycled.
 pub fn color(i: usize) -> [u8; 3] {
-    const C: [[u8; 3]; 7] =
-        [[0, 114, 178], [230, 159, 0], [0, 158, 115], [204, 121, 167], [86, 180, 233], [213, 94, 0], [120, 120, 120]];
+    const C: [[u8; 3]; 7] = [
+        [0, 114, 178],
+        [230, 159, 0],
+        [0, 158, 115],
+        [204, 121, 167],
+        [86, 180, 233],
+        [213, 94, 0],
+        [120, 120, 120],
+    ];
     C[i % C.len()]
 }
 
 /// Points not dominated by any other when both coordinates are minimised (cost and error),
 /// sorted by x.
 pub fn pareto_front(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
-    let mut p: Vec<(f64, f64)> = points.iter().copied().filter(|(x, y)| x.is_finite() && y.is_finite()).collect();
+    let mut p: Vec<(f64, f64)> =
+        points.iter().copied().filter(|(x, y)| x.is_finite() && y.is_finite()).collect();
     p.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     let mut front: Vec<(f64, f64)> = Vec::new();
     for q in p {
@@ -70,7 +78,9 @@ impl Axis {
     /// A padded range with "nice" ticks (1, 2, 5 × 10^k) covering `values`; starts at 0 when
     /// the data are non-negative and reach well above it.
     pub fn fit(values: impl Iterator<Item = f64>, include_zero: bool) -> Self {
-        let (mut lo, mut hi) = values.filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+        let (mut lo, mut hi) = values
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
         if !lo.is_finite() {
             (lo, hi) = (0.0, 1.0);
         }
@@ -83,7 +93,11 @@ impl Axis {
         }
         let raw = (hi - lo) / 5.0;
         let mag = 10f64.powf(raw.log10().floor());
-        let step = [1.0, 2.0, 5.0, 10.0].into_iter().map(|m| m * mag).find(|s| *s >= raw).unwrap_or(10.0 * mag);
+        let step = [1.0, 2.0, 5.0, 10.0]
+            .into_iter()
+            .map(|m| m * mag)
+            .find(|s| *s >= raw)
+            .unwrap_or(10.0 * mag);
         let min = (lo / step).floor() * step;
         let max = (hi / step).ceil() * step;
         let n = ((max - min) / step).round() as usize;
@@ -102,7 +116,10 @@ pub struct Frame {
 impl Frame {
     pub fn of(chart: &Chart) -> Self {
         let pts = || chart.series.iter().flat_map(|s| s.points.iter().copied());
-        let xs = pts().map(|p| p.0).chain(chart.events.iter().map(|e| e.0)).chain(chart.x_extent.iter().copied());
+        let xs = pts()
+            .map(|p| p.0)
+            .chain(chart.events.iter().map(|e| e.0))
+            .chain(chart.x_extent.iter().copied());
         let x = Axis::fit(xs, chart.kind == Kind::Scatter);
         let y = Axis::fit(pts().map(|p| p.1), true);
         Self { x, y }

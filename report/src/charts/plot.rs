@@ -30,7 +30,8 @@ fn register_font() {
     static FONT_ONCE: Once = Once::new();
     FONT_ONCE.call_once(|| {
         let bytes: &'static [u8] = include_bytes!("../../fonts/DejaVuSans.ttf");
-        plotters::style::register_font(FONT, FontStyle::Normal, bytes).unwrap_or_else(|_| panic!("the shipped DejaVu Sans is a valid font"));
+        plotters::style::register_font(FONT, FontStyle::Normal, bytes)
+            .unwrap_or_else(|_| panic!("the shipped DejaVu Sans is a valid font"));
     });
 }
 
@@ -49,11 +50,15 @@ fn rgb(i: usize) -> RGBColor {
     RGBColor(r, g, b)
 }
 
-fn draw<DB: DrawingBackend>(chart: &Chart, root: &DrawingArea<DB, Shift>) -> Result<XMap, DrawingAreaErrorKind<DB::ErrorType>> {
+fn draw<DB: DrawingBackend>(
+    chart: &Chart,
+    root: &DrawingArea<DB, Shift>,
+) -> Result<XMap, DrawingAreaErrorKind<DB::ErrorType>> {
     let f = Frame::of(chart);
     root.fill(&WHITE)?;
     // Long titles get a smaller font rather than being clipped (a glyph is about half an em wide).
-    let caption_size = 21.0f64.min((WIDTH - LEGEND_WIDTH) as f64 / (0.5 * chart.title.chars().count().max(1) as f64));
+    let caption_size = 21.0f64
+        .min((WIDTH - LEGEND_WIDTH) as f64 / (0.5 * chart.title.chars().count().max(1) as f64));
     let mut cc = ChartBuilder::on(root)
         .caption(&chart.title, (FONT, caption_size))
         .margin(12)
@@ -72,18 +77,29 @@ fn draw<DB: DrawingBackend>(chart: &Chart, root: &DrawingArea<DB, Shift>) -> Res
         .bold_line_style(RGBColor(228, 228, 228))
         .draw()?;
     for (x, label) in &chart.events {
-        cc.draw_series(DashedLineSeries::new([(*x, f.y.min), (*x, f.y.max)], 5, 4, EVENT_RED.stroke_width(1)))?;
+        cc.draw_series(DashedLineSeries::new(
+            [(*x, f.y.min), (*x, f.y.max)],
+            5,
+            4,
+            EVENT_RED.stroke_width(1),
+        ))?;
         let text = Text::new(label.clone(), (4, 4), (FONT, 14).into_font().color(&EVENT_RED));
         cc.draw_series(std::iter::once(EmptyElement::at((*x, f.y.max)) + text))?;
     }
     if chart.pareto.len() > 1 {
-        cc.draw_series(DashedLineSeries::new(chart.pareto.iter().copied(), 3, 3, BLACK.stroke_width(1)))?;
+        cc.draw_series(DashedLineSeries::new(
+            chart.pareto.iter().copied(),
+            3,
+            3,
+            BLACK.stroke_width(1),
+        ))?;
     }
     // Scatter points' names: (marker's pixel, name), placed once all are known.
     let mut labels: Vec<((i32, i32), String, RGBColor)> = Vec::new();
     for (i, series) in chart.series.iter().enumerate() {
         let c = rgb(i);
-        let pts: Vec<(f64, f64)> = series.points.iter().copied().filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
+        let pts: Vec<(f64, f64)> =
+            series.points.iter().copied().filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
         match chart.kind {
             Kind::Lines => {
                 if pts.len() <= SPARSE {
@@ -111,7 +127,8 @@ fn draw<DB: DrawingBackend>(chart: &Chart, root: &DrawingArea<DB, Shift>) -> Res
         root.draw(&PathElement::new([(x, y), (x + 12, y)], BLACK.stroke_width(2)))?;
         root.draw(&Text::new("Pareto front", (x + 18, y - 8), font))?;
     }
-    let (x0, x1) = (cc.backend_coord(&(f.x.min, f.y.min)).0, cc.backend_coord(&(f.x.max, f.y.min)).0);
+    let (x0, x1) =
+        (cc.backend_coord(&(f.x.min, f.y.min)).0, cc.backend_coord(&(f.x.max, f.y.min)).0);
     root.present()?;
     Ok(XMap { v0: f.x.min, v1: f.x.max, x0, x1 })
 }
@@ -123,7 +140,11 @@ const GLYPH_WIDTH: f64 = 8.5;
 /// Writes each name beside its marker, in its colour, on the side facing the plot's centre (so it is not
 /// clipped), moving a label to the nearest line where it overlaps none placed before (methods
 /// with near-equal results).
-fn place_labels<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, labels: &[((i32, i32), String, RGBColor)], area: (std::ops::Range<i32>, std::ops::Range<i32>)) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+fn place_labels<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    labels: &[((i32, i32), String, RGBColor)],
+    area: (std::ops::Range<i32>, std::ops::Range<i32>),
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     let mid_x = (area.0.start + area.0.end) / 2;
     let mut order: Vec<&((i32, i32), String, RGBColor)> = labels.iter().collect();
     order.sort_by_key(|((x, y), ..)| (*y, *x));
@@ -132,11 +153,20 @@ fn place_labels<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, labels: &[((i
         let w = (GLYPH_WIDTH * name.chars().count() as f64) as i32;
         let x0 = if *x > mid_x { x - 10 - w } else { x + 10 };
         let start = (y - 8 - LABEL_HEIGHT).max(area.1.start);
-        let free = |y0: i32| !placed.iter().any(|&(a, b, c, d)| x0 < c && a < x0 + w && y0 < d && b < y0 + LABEL_HEIGHT);
+        let free = |y0: i32| {
+            !placed
+                .iter()
+                .any(|&(a, b, c, d)| x0 < c && a < x0 + w && y0 < d && b < y0 + LABEL_HEIGHT)
+        };
         let inside = |y0: i32| y0 >= area.1.start && y0 + LABEL_HEIGHT <= area.1.end;
         // Nearest free line: below, above, two below, ...; inside the plot when possible.
-        let tries = (0..labels.len() as i32 * 2 + 1).map(|k| start + LABEL_HEIGHT * if k % 2 == 1 { (k + 1) / 2 } else { -(k / 2) });
-        let y0 = tries.clone().find(|&t| inside(t) && free(t)).or_else(|| tries.clone().find(|&t| free(t))).unwrap_or(start);
+        let tries = (0..labels.len() as i32 * 2 + 1)
+            .map(|k| start + LABEL_HEIGHT * if k % 2 == 1 { (k + 1) / 2 } else { -(k / 2) });
+        let y0 = tries
+            .clone()
+            .find(|&t| inside(t) && free(t))
+            .or_else(|| tries.clone().find(|&t| free(t)))
+            .unwrap_or(start);
         placed.push((x0, y0, x0 + w, y0 + LABEL_HEIGHT));
         // In the series' colour, so a displaced name still points to its marker.
         root.draw(&Text::new(name.clone(), (x0, y0), (FONT, 15).into_font().color(color)))?;
@@ -150,7 +180,8 @@ pub fn to_svg(chart: &Chart) -> anyhow::Result<(String, XMap)> {
     let mut s = String::new();
     let map = {
         let root = SVGBackend::with_string(&mut s, (WIDTH, HEIGHT)).into_drawing_area();
-        draw(chart, &root).map_err(|e| anyhow::anyhow!("drawing the SVG chart `{}`: {e}", chart.title))?
+        draw(chart, &root)
+            .map_err(|e| anyhow::anyhow!("drawing the SVG chart `{}`: {e}", chart.title))?
     };
     Ok((s, map))
 }
@@ -161,7 +192,8 @@ pub fn to_image(chart: &Chart) -> anyhow::Result<image::RgbImage> {
     let mut buf = vec![255u8; (WIDTH * HEIGHT * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (WIDTH, HEIGHT)).into_drawing_area();
-        draw(chart, &root).map_err(|e| anyhow::anyhow!("drawing the PNG chart `{}`: {e}", chart.title))?;
+        draw(chart, &root)
+            .map_err(|e| anyhow::anyhow!("drawing the PNG chart `{}`: {e}", chart.title))?;
     }
     Ok(image::RgbImage::from_raw(WIDTH, HEIGHT, buf).expect("buffer of WIDTH * HEIGHT RGB pixels"))
 }
@@ -184,7 +216,10 @@ mod tests {
             y_label: y_label.into(),
             kind: Kind::Lines,
             series: vec![
-                Series { name: "alpha".into(), points: (0..=10).map(|i| (i as f64 * 3.0, i as f64 * 0.1)).collect() },
+                Series {
+                    name: "alpha".into(),
+                    points: (0..=10).map(|i| (i as f64 * 3.0, i as f64 * 0.1)).collect(),
+                },
                 Series { name: "beta".into(), points: vec![(12.0, 0.5)] },
             ],
             events: vec![(20.0, "light turns".into())],
@@ -195,12 +230,18 @@ mod tests {
 
     /// The contents of the SVG's <text> elements.
     pub fn svg_texts(svg: &str) -> Vec<String> {
-        svg.split("<text").skip(1).filter_map(|t| Some(t.split_once('>')?.1.split("</text>").next()?.trim().to_string())).collect()
+        svg.split("<text")
+            .skip(1)
+            .filter_map(|t| Some(t.split_once('>')?.1.split("</text>").next()?.trim().to_string()))
+            .collect()
     }
 
     /// Pixels darker than light grey in a rectangle of the image.
     fn ink(img: &image::RgbImage, x0: u32, y0: u32, x1: u32, y1: u32) -> usize {
-        (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).filter(|&(x, y)| img.get_pixel(x, y).0.iter().all(|&c| c < 120)).count()
+        (y0..y1)
+            .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y).0.iter().all(|&c| c < 120))
+            .count()
     }
 
     #[test]
@@ -208,7 +249,10 @@ mod tests {
         let (svg, map) = to_svg(&chart("FLIP vs reference", "frame", "mean FLIP")).unwrap();
         let texts = svg_texts(&svg);
         for text in ["FLIP vs reference", "frame", "mean FLIP", "alpha", "beta", "light turns"] {
-            assert!(texts.iter().any(|t| t == text), "{text} missing from the SVG's texts {texts:?}");
+            assert!(
+                texts.iter().any(|t| t == text),
+                "{text} missing from the SVG's texts {texts:?}"
+            );
         }
         // The one-point series is a marker (a circle), not an invisible one-point line.
         assert!(svg.contains("<circle"), "no marker for the one-point series");
@@ -220,10 +264,14 @@ mod tests {
         // The same chart with and without text: title band, y-label band and x-label band gain ink.
         let with = to_image(&chart("A title in the PNG", "frame number", "value axis")).unwrap();
         let without = to_image(&chart("", "", "")).unwrap();
-        let bands = [(0, 0, WIDTH, 28), (0, 40, 22, HEIGHT - 60), (200, HEIGHT - 20, WIDTH - 200, HEIGHT)];
+        let bands =
+            [(0, 0, WIDTH, 28), (0, 40, 22, HEIGHT - 60), (200, HEIGHT - 20, WIDTH - 200, HEIGHT)];
         for (x0, y0, x1, y1) in bands {
             let (a, b) = (ink(&with, x0, y0, x1, y1), ink(&without, x0, y0, x1, y1));
-            assert!(a > 40 && b < a / 4, "band {x0},{y0}..{x1},{y1}: {a} dark pixels with text, {b} without");
+            assert!(
+                a > 40 && b < a / 4,
+                "band {x0},{y0}..{x1},{y1}: {a} dark pixels with text, {b} without"
+            );
         }
         // Series colours (lines, legend swatches, the one-point marker) are present.
         let count = |c: [u8; 3]| with.pixels().filter(|p| p.0 == c).count();
@@ -238,7 +286,10 @@ mod tests {
             x_label: "ms".into(),
             y_label: "FLIP".into(),
             kind: Kind::Scatter,
-            series: vec![Series { name: "taa".into(), points: vec![(1.0, 0.2)] }, Series { name: "pt_4spp".into(), points: vec![(4.0, 0.1)] }],
+            series: vec![
+                Series { name: "taa".into(), points: vec![(1.0, 0.2)] },
+                Series { name: "pt_4spp".into(), points: vec![(4.0, 0.1)] },
+            ],
             events: vec![],
             pareto: vec![(1.0, 0.2), (4.0, 0.1)],
             x_extent: vec![],
@@ -252,8 +303,19 @@ mod tests {
 
     #[test]
     fn names_of_coinciding_points_do_not_overlap() {
-        let series = ["nirc_ema", "nirc_blend", "nirc_switch"].map(|n| Series { name: n.into(), points: vec![(2.0, 0.3)] }).to_vec();
-        let c = Chart { title: "t".into(), x_label: "x".into(), y_label: "y".into(), kind: Kind::Scatter, series, events: vec![], pareto: vec![], x_extent: vec![] };
+        let series = ["nirc_ema", "nirc_blend", "nirc_switch"]
+            .map(|n| Series { name: n.into(), points: vec![(2.0, 0.3)] })
+            .to_vec();
+        let c = Chart {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            kind: Kind::Scatter,
+            series,
+            events: vec![],
+            pareto: vec![],
+            x_extent: vec![],
+        };
         let (svg, _) = to_svg(&c).unwrap();
         // The y of each label beside the markers (the legend's copies sit right of the plot).
         let ys: Vec<f64> = svg
@@ -261,7 +323,9 @@ mod tests {
             .skip(1)
             .filter(|t| t.contains(">nirc_") || t.contains("\nnirc_"))
             .filter_map(|t| {
-                let num = |k: &str| t.split(&format!("{k}=\"")).nth(1)?.split('"').next()?.parse::<f64>().ok();
+                let num = |k: &str| {
+                    t.split(&format!("{k}=\"")).nth(1)?.split('"').next()?.parse::<f64>().ok()
+                };
                 (num("x")? < (WIDTH - LEGEND_WIDTH) as f64).then(|| num("y")).flatten()
             })
             .collect();

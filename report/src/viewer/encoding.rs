@@ -55,8 +55,11 @@ pub const MOTION_STEPS: f32 = 8.0;
 
 /// Motion vectors (pixels) as zlib-compressed little-endian i16 planes dx, dy in 1/8 pixel.
 pub fn encode_motion(img: &Image) -> Vec<u8> {
-    let q = |v: f32| if v.is_finite() { (v * MOTION_STEPS).round().clamp(-32767.0, 32767.0) as i16 } else { 0 };
-    let bytes: Vec<u8> = (0..2).flat_map(|c| img.rgb.iter().flat_map(move |p| q(p[c]).to_le_bytes())).collect();
+    let q = |v: f32| {
+        if v.is_finite() { (v * MOTION_STEPS).round().clamp(-32767.0, 32767.0) as i16 } else { 0 }
+    };
+    let bytes: Vec<u8> =
+        (0..2).flat_map(|c| img.rgb.iter().flat_map(move |p| q(p[c]).to_le_bytes())).collect();
     zlib(&bytes)
 }
 
@@ -71,7 +74,13 @@ mod tests {
 
     #[test]
     fn round_trip_keeps_about_eight_bits_of_the_largest_channel() {
-        for rgb in [[1.0, 0.5, 0.25], [1e-4, 3e-4, 2e-4], [123.0, 0.0, 7.5], [0.999, 0.999, 0.999], [2.0, 2.0, 2.0]] {
+        for rgb in [
+            [1.0, 0.5, 0.25],
+            [1e-4, 3e-4, 2e-4],
+            [123.0, 0.0, 7.5],
+            [0.999, 0.999, 0.999],
+            [2.0, 2.0, 2.0],
+        ] {
             let back = decode_pixel(encode_pixel(rgb));
             let max = rgb.iter().cloned().fold(0.0f32, f32::max);
             for c in 0..3 {
@@ -91,7 +100,8 @@ mod tests {
         assert_eq!(planes.len(), 4 * 15);
         let px = |i: usize| [planes[i], planes[15 + i], planes[30 + i], planes[45 + i]];
         assert_eq!(px(7), encode_pixel(img.rgb[7]));
-        let map = miniz_oxide::inflate::decompress_to_vec_zlib(&encode_map(&[0.0, 0.5, 1.0, 2.0])).unwrap();
+        let map = miniz_oxide::inflate::decompress_to_vec_zlib(&encode_map(&[0.0, 0.5, 1.0, 2.0]))
+            .unwrap();
         assert_eq!(map, [0, 128, 255, 255]);
         let motion = Image::new(2, 1, vec![[1.5, -0.25, 0.0], [-3.0, 10000.0, 0.0]]);
         let m = miniz_oxide::inflate::decompress_to_vec_zlib(&encode_motion(&motion)).unwrap();

@@ -56,8 +56,15 @@ pub struct Panel {
 impl Panel {
     /// The reference, then every method, of one run.
     pub fn of_run(run_dir: &Path, methods: &[String]) -> Vec<Panel> {
-        let reference = Panel { label: "reference".into(), run_dir: run_dir.to_path_buf(), method: None };
-        std::iter::once(reference).chain(methods.iter().map(|m| Panel { label: m.clone(), run_dir: run_dir.to_path_buf(), method: Some(m.clone()) })).collect()
+        let reference =
+            Panel { label: "reference".into(), run_dir: run_dir.to_path_buf(), method: None };
+        std::iter::once(reference)
+            .chain(methods.iter().map(|m| Panel {
+                label: m.clone(),
+                run_dir: run_dir.to_path_buf(),
+                method: Some(m.clone()),
+            }))
+            .collect()
     }
 }
 
@@ -69,7 +76,8 @@ pub struct Output<'a> {
 
 /// One frame's data, as the page receives it.
 fn chunk_js(frame: u32, entries: &[(String, String)]) -> String {
-    let map: serde_json::Map<String, serde_json::Value> = entries.iter().map(|(k, v)| (k.clone(), json!(v))).collect();
+    let map: serde_json::Map<String, serde_json::Value> =
+        entries.iter().map(|(k, v)| (k.clone(), json!(v))).collect();
     format!("flickerFrame({frame},{});\n", serde_json::Value::Object(map))
 }
 
@@ -87,7 +95,13 @@ fn load(run_dir: &Path, method: Option<&str>, frame: u32) -> anyhow::Result<Opti
 /// Builds a viewer of `frame_count` frames over `panels`, or `None` when no frame is on disk.
 /// `flip_maps` holds the FLIP map of (frame, panel label) where a reference exists; `manifest`
 /// gives the events, reference frames and settings (frame rate, SMAPE's epsilon).
-pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manifest, flip_maps: &HashMap<(u32, String), Vec<f32>>) -> anyhow::Result<Option<Viewer>> {
+pub fn build(
+    out: &Output,
+    panels: &[Panel],
+    frame_count: u32,
+    manifest: &Manifest,
+    flip_maps: &HashMap<(u32, String), Vec<f32>>,
+) -> anyhow::Result<Option<Viewer>> {
     let size = std::sync::Mutex::new(None::<(u32, u32)>);
     let any_motion = std::sync::atomic::AtomicBool::new(false);
     let chunks: Vec<Option<String>> = (0..frame_count)
@@ -100,21 +114,36 @@ pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manife
                 match *s {
                     None => *s = Some((img.width, img.height)),
                     Some(wh) if wh != (img.width, img.height) => {
-                        bail!("{}: frame {f} of {} is {}x{}, other frames are {}x{}", p.run_dir.display(), p.label, img.width, img.height, wh.0, wh.1)
+                        bail!(
+                            "{}: frame {f} of {} is {}x{}, other frames are {}x{}",
+                            p.run_dir.display(),
+                            p.label,
+                            img.width,
+                            img.height,
+                            wh.0,
+                            wh.1
+                        )
                     }
                     Some(_) => {}
                 }
                 drop(s);
                 entries.push((p.label.clone(), base64::encode(&encoding::encode(&img))));
                 if let Some(m) = &p.method {
-                    let motion = p.run_dir.join("frames").join(m).join(MOTION).join(format!("{f:04}.exr"));
+                    let motion =
+                        p.run_dir.join("frames").join(m).join(MOTION).join(format!("{f:04}.exr"));
                     if motion.exists() {
-                        entries.push((format!("motion:{}", p.label), base64::encode(&encoding::encode_motion(&load_image(&motion)?))));
+                        entries.push((
+                            format!("motion:{}", p.label),
+                            base64::encode(&encoding::encode_motion(&load_image(&motion)?)),
+                        ));
                         any_motion.store(true, std::sync::atomic::Ordering::Relaxed);
                     }
                 }
                 if let Some(map) = flip_maps.get(&(f, p.label.clone())) {
-                    entries.push((format!("flip:{}", p.label), base64::encode(&encoding::encode_map(map))));
+                    entries.push((
+                        format!("flip:{}", p.label),
+                        base64::encode(&encoding::encode_map(map)),
+                    ));
                 }
             }
             Ok((!entries.is_empty()).then(|| chunk_js(f, &entries)))
@@ -125,10 +154,12 @@ pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manife
     let linked = encoded_bytes > EMBED_LIMIT_BYTES;
     let dir = out.dir.join(out.linked_dir);
     if dir.exists() {
-        std::fs::remove_dir_all(&dir).with_context(|| format!("cannot remove {}", dir.display()))?;
+        std::fs::remove_dir_all(&dir)
+            .with_context(|| format!("cannot remove {}", dir.display()))?;
     }
     if linked {
-        std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        std::fs::create_dir_all(&dir)
+            .with_context(|| format!("cannot create {}", dir.display()))?;
         for (f, js) in chunks.iter().enumerate() {
             if let Some(js) = js {
                 let p = dir.join(format!("{f:04}.js"));
@@ -138,9 +169,13 @@ pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manife
     }
 
     let settings = manifest.raw.get("settings");
-    let time_step = settings.and_then(|s| s.get("time_step")).and_then(|v| v.as_f64()).filter(|&t| t > 0.0);
+    let time_step =
+        settings.and_then(|s| s.get("time_step")).and_then(|v| v.as_f64()).filter(|&t| t > 0.0);
     let fps = time_step.map(|t| 1.0 / t).unwrap_or(30.0);
-    let smape_epsilon = settings.and_then(|s| s.get("smape_epsilon").or(s.get("smape_eps"))).and_then(|v| v.as_f64()).unwrap_or(0.01);
+    let smape_epsilon = settings
+        .and_then(|s| s.get("smape_epsilon").or(s.get("smape_eps")))
+        .and_then(|v| v.as_f64())
+        .unwrap_or(0.01);
     let magma: Vec<u8> = (0..256).flat_map(|i| metrics::magma(i as f32 / 255.0)).collect();
     let names: Vec<&str> = panels.iter().map(|p| p.label.as_str()).collect();
     let config = json!({
@@ -151,13 +186,28 @@ pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manife
     let mut h = String::new();
     h.push_str("<section id=\"viewer\">\n<div class=\"controls\">");
     h.push_str("<button id=\"play\" type=\"button\">play</button>");
-    let _ = write!(h, "<div class=\"timeline\"><input type=\"range\" id=\"frame-slider\" min=\"0\" max=\"{}\" value=\"0\" step=\"1\" aria-label=\"frame\">", frame_count.saturating_sub(1));
+    let _ = write!(
+        h,
+        "<div class=\"timeline\"><input type=\"range\" id=\"frame-slider\" min=\"0\" max=\"{}\" value=\"0\" step=\"1\" aria-label=\"frame\">",
+        frame_count.saturating_sub(1)
+    );
     let pos = |f: u32| 100.0 * f as f64 / frame_count.saturating_sub(1).max(1) as f64;
     for e in &manifest.events {
-        let _ = write!(h, "<span class=\"event-mark\" data-frame=\"{}\" style=\"left:{:.3}%\" title=\"frame {}: {}\">▼</span>", e.frame, pos(e.frame), e.frame, esc(&e.label));
+        let _ = write!(
+            h,
+            "<span class=\"event-mark\" data-frame=\"{}\" style=\"left:{:.3}%\" title=\"frame {}: {}\">▼</span>",
+            e.frame,
+            pos(e.frame),
+            e.frame,
+            esc(&e.label)
+        );
     }
     for &f in &manifest.reference.frames {
-        let _ = write!(h, "<span class=\"reference-mark\" style=\"left:{:.3}%\" title=\"reference at frame {f}\"></span>", pos(f));
+        let _ = write!(
+            h,
+            "<span class=\"reference-mark\" style=\"left:{:.3}%\" title=\"reference at frame {f}\"></span>",
+            pos(f)
+        );
     }
     h.push_str("</div><span id=\"frame-label\">frame 0</span>");
     h.push_str("<label>exposure <input type=\"range\" id=\"exposure\" min=\"-10\" max=\"10\" step=\"0.25\" value=\"0\"></label><span id=\"exposure-label\">0 EV</span>");
@@ -172,7 +222,11 @@ pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manife
     }
     h.push_str("</span>");
     h.push_str("<button id=\"fit\" type=\"button\">fit</button></div>\n<div id=\"panels\">");
-    let scale = if (width as f64) < PANEL_WIDTH { (PANEL_WIDTH / width as f64).floor() } else { PANEL_WIDTH / width as f64 };
+    let scale = if (width as f64) < PANEL_WIDTH {
+        (PANEL_WIDTH / width as f64).floor()
+    } else {
+        PANEL_WIDTH / width as f64
+    };
     let (vw, vh) = ((width as f64 * scale).round(), (height as f64 * scale).round());
     for p in panels {
         let _ = write!(
@@ -193,14 +247,29 @@ pub fn build(out: &Output, panels: &[Panel], frame_count: u32, manifest: &Manife
          Frames are decoded from RGBE (HDR) in the page; the exposure scales radiance before sRGB. SMAPE maps are computed in the page against the previous frame (ε = {eps_text}); \
          FLIP maps exist at reference frames (grey ticks on the slider), scripted events are marked ▼. {} \
          Frames: {:.1} MB, {} (frames are embedded up to {:.0} MB, linked from <code>{}/</code> beyond).</p>",
-        if any_motion { "Motion vectors: hue gives the direction, brightness the length (brightest = the longest of the panel), values in pixels to the previous frame." } else { "This run records no motion vectors." },
+        if any_motion {
+            "Motion vectors: hue gives the direction, brightness the length (brightest = the longest of the panel), values in pixels to the previous frame."
+        } else {
+            "This run records no motion vectors."
+        },
         mb(encoded_bytes),
-        if linked { format!("linked from <code>{}/</code>: keep the folder next to this page", out.linked_dir) } else { "embedded in this file".into() },
+        if linked {
+            format!(
+                "linked from <code>{}/</code>: keep the folder next to this page",
+                out.linked_dir
+            )
+        } else {
+            "embedded in this file".into()
+        },
         mb(EMBED_LIMIT_BYTES),
         out.linked_dir,
     );
     // `</` would end the script element early.
-    let _ = writeln!(h, "<script type=\"application/json\" id=\"flicker-config\">{}</script>", config.to_string().replace("</", "<\\/"));
+    let _ = writeln!(
+        h,
+        "<script type=\"application/json\" id=\"flicker-config\">{}</script>",
+        config.to_string().replace("</", "<\\/")
+    );
     h.push_str("<script>window.flickerChunks={};function flickerFrame(f,d){window.flickerChunks[f]=d;}</script>\n");
     if !linked {
         for js in chunks.iter().flatten() {

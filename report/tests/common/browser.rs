@@ -63,5 +63,11 @@ pub fn file_url(page: &Path) -> String {
 pub fn element_text(dom: &str, id: &str) -> Option<String> {
     let start = dom.split(&format!("id=\"{id}\">")).nth(1)?;
     let text = start.split('<').next()?;
-    Some(text.replace("&lt;", "<").replace("&gt;", ">").replace("&quot;", "\"").replace("&#39;", "'").replace("&amp;", "&"))
+    Some(
+        text.replace("&lt;", "<")
+            .replace("&gt;", ">")
+            .replace("&quot;", "\"")
+            .replace("&#39;", "'")
+            .replace("&amp;", "&"),
+    )
 }

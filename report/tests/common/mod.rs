@@ -10,7 +10,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use metrics::bench::hash01;
-use metrics::{DEFAULT_PPD, Image, Region, flip_hdr, mse, psnr, relative_mse, smape, write_exr, write_png_srgb};
+use metrics::{
+    DEFAULT_PPD, Image, Region, flip_hdr, mse, psnr, relative_mse, smape, write_exr, write_png_srgb,
+};
 
 pub const W: u32 = 64;
 pub const H: u32 = 36;
@@ -73,7 +75,9 @@ fn render(run: &FakeRun, m: usize, f: u32) -> Image {
     let clean = scene(run.width, run.height, adapt);
     let amp = [0.5, 0.1, 0.3, 0.05, 0.2, 0.15][m % 6];
     let seed = if run.static_noise { 0 } else { f * 7 } + m as u32;
-    Image::from_fn(run.width, run.height, |x, y| clean.get(x, y).map(|c| c * (1.0 + amp * (hash01(x, y, seed) - 0.5))))
+    Image::from_fn(run.width, run.height, |x, y| {
+        clean.get(x, y).map(|c| c * (1.0 + amp * (hash01(x, y, seed) - 0.5)))
+    })
 }
 
 pub fn regions() -> Vec<Region> {
@@ -104,7 +108,9 @@ pub fn fake_run_with(name: &str, run: &FakeRun) -> PathBuf {
         write_exr(&r, dir.join(format!("reference/{f:04}.exr"))).unwrap();
         write_png_srgb(&r, dir.join(format!("reference/{f:04}.png"))).unwrap();
     }
-    let mut csv = String::from("method,frame,cpu_ms,gpu_ms_total,gpu_ms_trace,smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr");
+    let mut csv = String::from(
+        "method,frame,cpu_ms,gpu_ms_total,gpu_ms_trace,smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr",
+    );
     for r in regions() {
         write!(csv, ",{0}_flip,{0}_smape", r.name).unwrap();
     }
@@ -127,13 +133,21 @@ pub fn fake_run_with(name: &str, run: &FakeRun) -> PathBuf {
             let s = prev.as_ref().map(|p| smape(&img, p, 0.01));
             let gpu = [1.0, 2.5, 1.5, 4.0, 0.7, 3.0][m % 6] + 0.01 * f as f64;
             write!(csv, "{method},{f},{:.3},{gpu:.4},{gpu:.4},", gpu + 0.5).unwrap();
-            write!(csv, "{},,,", s.as_ref().map(|s| format!("{:.6}", s.mean)).unwrap_or_default()).unwrap();
+            write!(csv, "{},,,", s.as_ref().map(|s| format!("{:.6}", s.mean)).unwrap_or_default())
+                .unwrap();
             let flip = reference_frames.contains(&f).then(|| {
                 let r = scene(w, h, if f >= event { 1.0 } else { 0.0 });
-                (flip_hdr(&r, &img, DEFAULT_PPD), mse(&r, &img), relative_mse(&r, &img), psnr(&r, &img))
+                (
+                    flip_hdr(&r, &img, DEFAULT_PPD),
+                    mse(&r, &img),
+                    relative_mse(&r, &img),
+                    psnr(&r, &img),
+                )
             });
             match &flip {
-                Some((fl, e, rel, p)) => write!(csv, "{:.6},{e:.6},{rel:.6},{p:.4}", fl.mean).unwrap(),
+                Some((fl, e, rel, p)) => {
+                    write!(csv, "{:.6},{e:.6},{rel:.6},{p:.4}", fl.mean).unwrap()
+                }
                 None => csv.push_str(",,,"),
             }
             for r in regions() {
@@ -154,7 +168,8 @@ pub fn fake_run_with(name: &str, run: &FakeRun) -> PathBuf {
         "events": [{"frame": event, "label": "rotate light 'sun' by 30°"}],
         "regions": regions(), "settings": {"smape_epsilon": 0.01, "time_step": run.time_step}
     });
-    std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
+    std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&manifest).unwrap())
+        .unwrap();
     dir
 }
 

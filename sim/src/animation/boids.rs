@@ -83,7 +83,8 @@ pub fn step_flock(params: &FlockParams, positions: &mut [Vec3], velocities: &mut
     let margin = (0.2 * (hi - lo).min_element()).max(1e-3);
     let mut accel = vec![Vec3::ZERO; n];
     for i in 0..n {
-        let (mut sep, mut vel_sum, mut pos_sum, mut seen) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, 0u32);
+        let (mut sep, mut vel_sum, mut pos_sum, mut seen) =
+            (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, 0u32);
         for j in 0..n {
             if i == j {
                 continue;
@@ -124,7 +125,11 @@ pub fn step_flock(params: &FlockParams, positions: &mut [Vec3], velocities: &mut
         if speed > params.max_speed {
             v *= params.max_speed / speed;
         } else if speed < params.min_speed {
-            v = if speed > 1e-6 { v * (params.min_speed / speed) } else { Vec3::X * params.min_speed };
+            v = if speed > 1e-6 {
+                v * (params.min_speed / speed)
+            } else {
+                Vec3::X * params.min_speed
+            };
         }
         velocities[i] = v;
         positions[i] += v * dt;
@@ -176,7 +181,11 @@ pub fn heading(velocity: Vec3) -> Quat {
     Transform::looking_at(Vec3::ZERO, dir, up).rotation
 }
 
-pub fn flock(clock: Res<Clock>, flocks: Query<(Entity, &Flock)>, mut boids: Query<(&mut Boid, &mut Transform)>) {
+pub fn flock(
+    clock: Res<Clock>,
+    flocks: Query<(Entity, &Flock)>,
+    mut boids: Query<(&mut Boid, &mut Transform)>,
+) {
     let dt = clock.delta();
     if dt == 0.0 {
         return;
@@ -222,12 +231,16 @@ mod tests {
             for (i, a) in p.iter().enumerate() {
                 let eps = Vec3::splat(1e-5);
                 assert!(
-                    a.cmpge(params.bounds_min - eps).all() && a.cmple(params.bounds_max + eps).all(),
+                    a.cmpge(params.bounds_min - eps).all()
+                        && a.cmple(params.bounds_max + eps).all(),
                     "step {step}: boid {i} left the box at {a}"
                 );
                 for (j, b) in p.iter().enumerate().skip(i + 1) {
                     let d = a.distance(*b);
-                    assert!(d >= params.separation * 0.999, "step {step}: boids {i},{j} only {d} apart");
+                    assert!(
+                        d >= params.separation * 0.999,
+                        "step {step}: boids {i},{j} only {d} apart"
+                    );
                 }
             }
         }
@@ -238,12 +251,19 @@ mod tests {
     #[test]
     fn flocking_aligns_velocities() {
         // With alignment alone, the spread of headings shrinks.
-        let params = FlockParams { separation_weight: 0.0, cohesion_weight: 0.0, alignment_weight: 4.0, view_radius: 10.0, ..Default::default() };
+        let params = FlockParams {
+            separation_weight: 0.0,
+            cohesion_weight: 0.0,
+            alignment_weight: 4.0,
+            view_radius: 10.0,
+            ..Default::default()
+        };
         let mut rng = Rng::seeded(5);
         let init = initial_boids(&params, 20, &mut rng);
         let mut p: Vec<Vec3> = init.iter().map(|b| b.0).collect();
         let mut v: Vec<Vec3> = init.iter().map(|b| b.1).collect();
-        let order = |v: &[Vec3]| v.iter().map(|x| x.normalize()).sum::<Vec3>().length() / v.len() as f32;
+        let order =
+            |v: &[Vec3]| v.iter().map(|x| x.normalize()).sum::<Vec3>().length() / v.len() as f32;
         let before = order(&v);
         for _ in 0..30 {
             step_flock(&params, &mut p, &mut v, 1.0 / 60.0);

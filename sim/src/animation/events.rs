@@ -10,11 +10,23 @@ use crate::transform::Transform;
 #[derive(Clone, Debug, PartialEq)]
 pub enum EventAction {
     /// Rotate the entity (a light's entity rotates the light) by `angle` radians.
-    Rotate { entity: Entity, axis: Vec3, angle: f32 },
+    Rotate {
+        entity: Entity,
+        axis: Vec3,
+        angle: f32,
+    },
     /// Switch a light or emissive mesh on/off.
-    Toggle { entity: Entity },
-    MoveTo { entity: Entity, translation: Vec3 },
-    MoveBy { entity: Entity, offset: Vec3 },
+    Toggle {
+        entity: Entity,
+    },
+    MoveTo {
+        entity: Entity,
+        translation: Vec3,
+    },
+    MoveBy {
+        entity: Entity,
+        offset: Vec3,
+    },
     /// Overwrite some fields of a material.
     SetMaterial {
         material: u32,

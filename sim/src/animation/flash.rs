@@ -69,7 +69,8 @@ mod tests {
         let w = Waveform::Square { period: 1.0 };
         let dt = 0.1;
         let values: Vec<f32> = (0..20).map(|f| w.value(f as f32 * dt, f, 0, 0)).collect();
-        let expected: Vec<f32> = (0..20).map(|f| if (f / 5) % 2 == 0 { 1.0 } else { 0.0 }).collect();
+        let expected: Vec<f32> =
+            (0..20).map(|f| if (f / 5) % 2 == 0 { 1.0 } else { 0.0 }).collect();
         assert_eq!(values, expected);
     }
 

@@ -84,7 +84,10 @@ pub fn keyframes(clock: Res<Clock>, mut query: Query<(&Keyframes, &mut Transform
     }
 }
 
-pub fn camera_path(clock: Res<Clock>, mut query: Query<(&CameraPath, &mut Transform, &mut Camera)>) {
+pub fn camera_path(
+    clock: Res<Clock>,
+    mut query: Query<(&CameraPath, &mut Transform, &mut Camera)>,
+) {
     for (path, mut t, mut camera) in &mut query {
         let (sampled, vfov) = path.sample(clock.frame as f32);
         if *t != sampled {
@@ -108,7 +111,11 @@ mod tests {
                 Keyframe { frame: 0.0, transform: Transform::IDENTITY },
                 Keyframe {
                     frame: 10.0,
-                    transform: Transform::from_trs(Vec3::new(2.0, 0.0, 0.0), Quat::from_rotation_y(1.0), Vec3::splat(3.0)),
+                    transform: Transform::from_trs(
+                        Vec3::new(2.0, 0.0, 0.0),
+                        Quat::from_rotation_y(1.0),
+                        Vec3::splat(3.0),
+                    ),
                 },
             ],
             repeat: false,
@@ -130,7 +137,12 @@ mod tests {
         let path = CameraPath {
             keys: vec![
                 CameraKey { frame: 0.0, position: Vec3::ZERO, target: Vec3::NEG_Z, vfov: 1.0 },
-                CameraKey { frame: 4.0, position: Vec3::new(4.0, 0.0, 0.0), target: Vec3::new(4.0, 0.0, -1.0), vfov: 0.5 },
+                CameraKey {
+                    frame: 4.0,
+                    position: Vec3::new(4.0, 0.0, 0.0),
+                    target: Vec3::new(4.0, 0.0, -1.0),
+                    vfov: 0.5,
+                },
             ],
             repeat: false,
         };

@@ -26,7 +26,8 @@ pub struct RotateOnce {
 
 /// Turns `transform` by `angle` about `axis` (parent space), keeping its position.
 pub fn turn(transform: &mut Transform, axis: Vec3, angle: f32) {
-    transform.rotation = (Quat::from_axis_angle(axis.normalize(), angle) * transform.rotation).normalize();
+    transform.rotation =
+        (Quat::from_axis_angle(axis.normalize(), angle) * transform.rotation).normalize();
 }
 
 pub fn rotate(clock: Res<Clock>, mut query: Query<(&Rotate, &mut Transform)>) {

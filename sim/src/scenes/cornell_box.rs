@@ -26,7 +26,11 @@ pub fn build() -> WorldTemplate {
     let green = t.add_material("green", diffuse(0.12, 0.45, 0.15));
     let light = t.add_material(
         "light",
-        Material { base_color: Vec3::splat(0.78), emission: Vec3::new(17.0, 12.0, 4.0), ..Default::default() },
+        Material {
+            base_color: Vec3::splat(0.78),
+            emission: Vec3::new(17.0, 12.0, 4.0),
+            ..Default::default()
+        },
     );
 
     t.add_object("floor", quad, white, wall(Vec3::ZERO, Vec3::Y, 2.0, 2.0));
@@ -34,18 +38,31 @@ pub fn build() -> WorldTemplate {
     t.add_object("back_wall", quad, white, wall(Vec3::new(0.0, 1.0, -1.0), Vec3::Z, 2.0, 2.0));
     t.add_object("left_wall", quad, red, wall(Vec3::new(-1.0, 1.0, 0.0), Vec3::X, 2.0, 2.0));
     t.add_object("right_wall", quad, green, wall(Vec3::new(1.0, 1.0, 0.0), Vec3::NEG_X, 2.0, 2.0));
-    t.add_object("ceiling_light", quad, light, wall(Vec3::new(0.0, 1.995, 0.0), Vec3::NEG_Y, 0.5, 0.4));
+    t.add_object(
+        "ceiling_light",
+        quad,
+        light,
+        wall(Vec3::new(0.0, 1.995, 0.0), Vec3::NEG_Y, 0.5, 0.4),
+    );
     t.add_object(
         "tall_box",
         cube,
         white,
-        Transform::from_trs(Vec3::new(-0.33, 0.6, -0.3), Quat::from_rotation_y(17f32.to_radians()), Vec3::new(0.6, 1.2, 0.6)),
+        Transform::from_trs(
+            Vec3::new(-0.33, 0.6, -0.3),
+            Quat::from_rotation_y(17f32.to_radians()),
+            Vec3::new(0.6, 1.2, 0.6),
+        ),
     );
     t.add_object(
         "short_box",
         cube,
         white,
-        Transform::from_trs(Vec3::new(0.35, 0.3, 0.3), Quat::from_rotation_y(-17f32.to_radians()), Vec3::splat(0.6)),
+        Transform::from_trs(
+            Vec3::new(0.35, 0.3, 0.3),
+            Quat::from_rotation_y(-17f32.to_radians()),
+            Vec3::splat(0.6),
+        ),
     );
     t.add_camera("camera", Vec3::new(0.0, 1.0, 3.9), Vec3::new(0.0, 1.0, 0.0), 38.0);
     t

@@ -35,18 +35,56 @@ pub fn build() -> WorldTemplate {
     let quad = t.add_mesh(unit_quad("quad"));
     let cube = t.add_mesh(unit_cube("cube"));
     let bird = t.add_mesh(bird_mesh());
-    let paving = t.add_material("paving", Material { base_color: Vec3::new(0.55, 0.52, 0.48), ..Default::default() });
-    let walls = t.add_material("walls", Material { base_color: Vec3::new(0.8, 0.7, 0.55), ..Default::default() });
-    let stone = t.add_material("stone", Material { base_color: Vec3::splat(0.65), roughness: 0.4, ..Default::default() });
-    let feathers = t.add_material("feathers", Material { base_color: Vec3::new(0.15, 0.15, 0.18), ..Default::default() });
+    let paving = t.add_material(
+        "paving",
+        Material { base_color: Vec3::new(0.55, 0.52, 0.48), ..Default::default() },
+    );
+    let walls = t.add_material(
+        "walls",
+        Material { base_color: Vec3::new(0.8, 0.7, 0.55), ..Default::default() },
+    );
+    let stone = t.add_material(
+        "stone",
+        Material { base_color: Vec3::splat(0.65), roughness: 0.4, ..Default::default() },
+    );
+    let feathers = t.add_material(
+        "feathers",
+        Material { base_color: Vec3::new(0.15, 0.15, 0.18), ..Default::default() },
+    );
 
-    t.add_object("ground", quad, paving, Transform::from_trs(Vec3::ZERO, Quat::IDENTITY, Vec3::new(30.0, 1.0, 30.0)));
+    t.add_object(
+        "ground",
+        quad,
+        paving,
+        Transform::from_trs(Vec3::ZERO, Quat::IDENTITY, Vec3::new(30.0, 1.0, 30.0)),
+    );
     // Four buildings leave the corners open so the sun reaches in at low angles.
-    let building = |c: Vec3, s: Vec3| Transform::from_trs(c + Vec3::Y * (0.5 * s.y), Quat::IDENTITY, s);
-    t.add_object("building_north", cube, walls, building(Vec3::new(0.0, 0.0, -7.0), Vec3::new(10.0, 6.0, 3.0)));
-    t.add_object("building_south", cube, walls, building(Vec3::new(0.0, 0.0, 7.0), Vec3::new(10.0, 4.0, 3.0)));
-    t.add_object("building_east", cube, walls, building(Vec3::new(7.0, 0.0, 0.0), Vec3::new(3.0, 8.0, 9.0)));
-    t.add_object("building_west", cube, walls, building(Vec3::new(-7.0, 0.0, 0.0), Vec3::new(3.0, 5.0, 9.0)));
+    let building =
+        |c: Vec3, s: Vec3| Transform::from_trs(c + Vec3::Y * (0.5 * s.y), Quat::IDENTITY, s);
+    t.add_object(
+        "building_north",
+        cube,
+        walls,
+        building(Vec3::new(0.0, 0.0, -7.0), Vec3::new(10.0, 6.0, 3.0)),
+    );
+    t.add_object(
+        "building_south",
+        cube,
+        walls,
+        building(Vec3::new(0.0, 0.0, 7.0), Vec3::new(10.0, 4.0, 3.0)),
+    );
+    t.add_object(
+        "building_east",
+        cube,
+        walls,
+        building(Vec3::new(7.0, 0.0, 0.0), Vec3::new(3.0, 8.0, 9.0)),
+    );
+    t.add_object(
+        "building_west",
+        cube,
+        walls,
+        building(Vec3::new(-7.0, 0.0, 0.0), Vec3::new(3.0, 5.0, 9.0)),
+    );
     for i in 0..8 {
         let x = -3.5 + i as f32;
         t.add_object(
@@ -62,9 +100,16 @@ pub fn build() -> WorldTemplate {
     let to_sun = Vec3::new(el.cos() * az.cos(), el.sin(), el.cos() * az.sin());
     t.add_light(
         "sun",
-        Light::Directional { direction: -to_sun, irradiance: Vec3::new(3.0, 2.8, 2.5), angular_radius: 0.0047 },
+        Light::Directional {
+            direction: -to_sun,
+            irradiance: Vec3::new(3.0, 2.8, 2.5),
+            angular_radius: 0.0047,
+        },
     );
-    t.add_light("lamp", Light::Point { position: Vec3::new(2.0, 2.5, 2.0), intensity: Vec3::new(4.0, 3.0, 1.5) });
+    t.add_light(
+        "lamp",
+        Light::Point { position: Vec3::new(2.0, 2.5, 2.0), intensity: Vec3::new(4.0, 3.0, 1.5) },
+    );
     t.add_camera("camera", Vec3::new(0.0, 3.0, 5.0), Vec3::new(0.0, 1.0, -2.0), 65.0);
     t
 }

@@ -30,8 +30,10 @@ impl MeshBuilder {
 
     /// A flat quad given its corners in order around the boundary.
     pub fn quad(&mut self, corners: [Vec3; 4], normal: Vec3) {
-        let uvs = [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)];
-        let v: Vec<u32> = corners.iter().zip(uvs).map(|(p, uv)| self.vertex(*p, normal, uv)).collect();
+        let uvs =
+            [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)];
+        let v: Vec<u32> =
+            corners.iter().zip(uvs).map(|(p, uv)| self.vertex(*p, normal, uv)).collect();
         self.triangle(v[0], v[1], v[2], normal);
         self.triangle(v[0], v[2], v[3], normal);
     }
@@ -57,14 +59,21 @@ impl MeshBuilder {
     /// UV sphere of radius `radius` centred at the origin, outward faces.
     pub fn sphere(&mut self, radius: f32, segments: u32, rings: u32) {
         let point = |k: u32, j: u32| {
-            let (phi, theta) = (std::f32::consts::TAU * k as f32 / segments as f32, std::f32::consts::PI * j as f32 / rings as f32);
+            let (phi, theta) = (
+                std::f32::consts::TAU * k as f32 / segments as f32,
+                std::f32::consts::PI * j as f32 / rings as f32,
+            );
             Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
         };
         let mut index = vec![0u32; ((segments + 1) * (rings + 1)) as usize];
         for j in 0..=rings {
             for k in 0..=segments {
                 let n = point(k, j);
-                index[(j * (segments + 1) + k) as usize] = self.vertex(radius * n, n, Vec2::new(k as f32 / segments as f32, j as f32 / rings as f32));
+                index[(j * (segments + 1) + k) as usize] = self.vertex(
+                    radius * n,
+                    n,
+                    Vec2::new(k as f32 / segments as f32, j as f32 / rings as f32),
+                );
             }
         }
         let at = |k: u32, j: u32| index[(j * (segments + 1) + k) as usize];
@@ -99,8 +108,10 @@ impl MeshBuilder {
             let i1 = self.vertex(p1, side_normal(a1), Vec2::new(u1, 1.0));
             let ia = self.vertex(apex, side_normal(am), Vec2::new(0.5 * (u0 + u1), 0.0));
             self.triangle(i0, i1, ia, side_normal(am));
-            let b0 = self.vertex(p0, Vec3::NEG_Y, Vec2::new(0.5 + 0.5 * a0.cos(), 0.5 + 0.5 * a0.sin()));
-            let b1 = self.vertex(p1, Vec3::NEG_Y, Vec2::new(0.5 + 0.5 * a1.cos(), 0.5 + 0.5 * a1.sin()));
+            let b0 =
+                self.vertex(p0, Vec3::NEG_Y, Vec2::new(0.5 + 0.5 * a0.cos(), 0.5 + 0.5 * a0.sin()));
+            let b1 =
+                self.vertex(p1, Vec3::NEG_Y, Vec2::new(0.5 + 0.5 * a1.cos(), 0.5 + 0.5 * a1.sin()));
             self.triangle(center, b0, b1, Vec3::NEG_Y);
         }
     }
@@ -110,7 +121,8 @@ impl MeshBuilder {
         const SIDES: usize = 3;
         let mut rings: Vec<[u32; SIDES]> = Vec::with_capacity(points.len());
         for (k, p) in points.iter().enumerate() {
-            let t = if k + 1 < points.len() { points[k + 1] - *p } else { *p - points[k - 1] }.normalize();
+            let t = if k + 1 < points.len() { points[k + 1] - *p } else { *p - points[k - 1] }
+                .normalize();
             let helper = if t.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
             let n1 = t.cross(helper).normalize();
             let n2 = t.cross(n1);
@@ -128,7 +140,8 @@ impl MeshBuilder {
                 let (c, d) = (w[1][s], w[1][(s + 1) % SIDES]);
                 let mid = |i: u32| self.mesh.positions[i as usize];
                 let center = 0.25 * (mid(a) + mid(b) + mid(c) + mid(d));
-                let axis_point = 0.5 * (points_center(&self.mesh, w[0]) + points_center(&self.mesh, w[1]));
+                let axis_point =
+                    0.5 * (points_center(&self.mesh, w[0]) + points_center(&self.mesh, w[1]));
                 let outward = center - axis_point;
                 self.triangle(a, b, d, outward);
                 self.triangle(a, d, c, outward);
@@ -149,7 +162,12 @@ fn points_center(mesh: &Mesh, ring: [u32; 3]) -> Vec3 {
 pub fn unit_quad(name: &str) -> Mesh {
     let mut b = MeshBuilder::new(name);
     b.quad(
-        [Vec3::new(-0.5, 0.0, -0.5), Vec3::new(0.5, 0.0, -0.5), Vec3::new(0.5, 0.0, 0.5), Vec3::new(-0.5, 0.0, 0.5)],
+        [
+            Vec3::new(-0.5, 0.0, -0.5),
+            Vec3::new(0.5, 0.0, -0.5),
+            Vec3::new(0.5, 0.0, 0.5),
+            Vec3::new(-0.5, 0.0, 0.5),
+        ],
         Vec3::Y,
     );
     b.build()
@@ -175,7 +193,11 @@ mod tests {
             let n = (b - a).cross(c - a);
             total += n;
             let shading: Vec3 = t.iter().map(|&i| mesh.normals[i as usize]).sum();
-            assert!(n.dot(shading) > 0.0, "{}: triangle {t:?} wound against its normals", mesh.name);
+            assert!(
+                n.dot(shading) > 0.0,
+                "{}: triangle {t:?} wound against its normals",
+                mesh.name
+            );
         }
         assert!(total.length() < 1e-3, "{}: not closed, net area vector {total}", mesh.name);
     }

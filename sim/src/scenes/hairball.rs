@@ -37,13 +37,26 @@ pub fn build() -> WorldTemplate {
     t.environment = Vec3::splat(0.6);
     let hair = t.add_mesh(b.build());
     let quad = t.add_mesh(unit_quad("quad"));
-    let fibre = t.add_material("fibre", Material { base_color: Vec3::new(0.8, 0.6, 0.35), roughness: 0.5, ..Default::default() });
-    let floor = t.add_material("floor", Material { base_color: Vec3::splat(0.5), ..Default::default() });
+    let fibre = t.add_material(
+        "fibre",
+        Material { base_color: Vec3::new(0.8, 0.6, 0.35), roughness: 0.5, ..Default::default() },
+    );
+    let floor =
+        t.add_material("floor", Material { base_color: Vec3::splat(0.5), ..Default::default() });
     t.add_object("hairball", hair, fibre, Transform::from_translation(Vec3::new(0.0, 1.0, 0.0)));
-    t.add_object("floor", quad, floor, Transform::from_trs(Vec3::ZERO, glam::Quat::IDENTITY, Vec3::new(8.0, 1.0, 8.0)));
+    t.add_object(
+        "floor",
+        quad,
+        floor,
+        Transform::from_trs(Vec3::ZERO, glam::Quat::IDENTITY, Vec3::new(8.0, 1.0, 8.0)),
+    );
     t.add_light(
         "key",
-        Light::Directional { direction: Vec3::new(-0.4, -1.0, -0.3).normalize(), irradiance: Vec3::splat(2.0), angular_radius: 0.02 },
+        Light::Directional {
+            direction: Vec3::new(-0.4, -1.0, -0.3).normalize(),
+            irradiance: Vec3::splat(2.0),
+            angular_radius: 0.02,
+        },
     );
     t.add_camera("camera", Vec3::new(0.0, 1.3, 3.2), Vec3::new(0.0, 1.0, 0.0), 40.0);
     t

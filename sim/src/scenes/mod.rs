@@ -81,16 +81,36 @@ mod tests {
         for s in SCENES {
             let t = (s.build)();
             assert!(t.nodes.iter().any(|n| n.camera.is_some()), "{}: no camera", s.name);
-            let emissive = t.nodes.iter().filter_map(|n| n.mesh).any(|m| t.materials.materials[m.material as usize].emission.max_element() > 0.0);
-            assert!(emissive || t.nodes.iter().any(|n| n.light.is_some()) || t.environment.max_element() > 0.0, "{}: unlit", s.name);
+            let emissive =
+                t.nodes.iter().filter_map(|n| n.mesh).any(|m| {
+                    t.materials.materials[m.material as usize].emission.max_element() > 0.0
+                });
+            assert!(
+                emissive
+                    || t.nodes.iter().any(|n| n.light.is_some())
+                    || t.environment.max_element() > 0.0,
+                "{}: unlit",
+                s.name
+            );
             for n in &t.nodes {
                 if let Some(m) = n.mesh {
-                    assert!((m.mesh as usize) < t.meshes.len() && (m.material as usize) < t.materials.materials.len(), "{}: bad node {}", s.name, n.name);
+                    assert!(
+                        (m.mesh as usize) < t.meshes.len()
+                            && (m.material as usize) < t.materials.materials.len(),
+                        "{}: bad node {}",
+                        s.name,
+                        n.name
+                    );
                 }
             }
             for m in &t.meshes {
                 assert!(!m.indices.is_empty(), "{}: empty mesh {}", s.name, m.name);
-                assert!(m.indices.iter().flatten().all(|&i| (i as usize) < m.positions.len()), "{}: mesh {} index out of range", s.name, m.name);
+                assert!(
+                    m.indices.iter().flatten().all(|&i| (i as usize) < m.positions.len()),
+                    "{}: mesh {} index out of range",
+                    s.name,
+                    m.name
+                );
             }
             let mut names: Vec<&str> = t.nodes.iter().map(|n| n.name.as_str()).collect();
             names.sort();

@@ -30,7 +30,11 @@ fn base64(bytes: &[u8]) -> String {
 /// A 4x4 red/white checkerboard, PNG-encoded.
 fn checker_png() -> Vec<u8> {
     let img = image::RgbaImage::from_fn(4, 4, |x, y| {
-        if (x + y) % 2 == 0 { image::Rgba([220, 30, 30, 255]) } else { image::Rgba([255, 255, 255, 255]) }
+        if (x + y) % 2 == 0 {
+            image::Rgba([220, 30, 30, 255])
+        } else {
+            image::Rgba([255, 255, 255, 255])
+        }
     });
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
@@ -88,7 +92,12 @@ pub fn gltf_text() -> String {
     let mut accessors = Vec::new();
     let mut gltf_meshes = Vec::new();
     for (name, g, material) in &meshes {
-        let mut attribute = |bytes: Vec<u8>, count: usize, kind: &str, component: u32, target: u32, extra: Value| {
+        let mut attribute = |bytes: Vec<u8>,
+                             count: usize,
+                             kind: &str,
+                             component: u32,
+                             target: u32,
+                             extra: Value| {
             while bin.len() % 4 != 0 {
                 bin.push(0);
             }
@@ -110,7 +119,14 @@ pub fn gltf_text() -> String {
                 hi[k] = hi[k].max(p[k]);
             }
         }
-        let pos = attribute(f32s(&flat), g.positions.len(), "VEC3", 5126, 34962, json!({"min": lo, "max": hi}));
+        let pos = attribute(
+            f32s(&flat),
+            g.positions.len(),
+            "VEC3",
+            5126,
+            34962,
+            json!({"min": lo, "max": hi}),
+        );
         let nflat: Vec<f32> = g.normals.iter().flatten().copied().collect();
         let nor = attribute(f32s(&nflat), g.normals.len(), "VEC3", 5126, 34962, json!({}));
         let uflat: Vec<f32> = g.uvs.iter().flatten().copied().collect();

@@ -13,7 +13,12 @@ pub fn frame_number(mut clock: ResMut<FrameClock>, sim_clock: Res<sim::resources
 
 /// Uploads the extracted scene's changes. Runs every frame: the tracer's camera and instance
 /// transforms of the last frame become the previous ones of motion vectors.
-pub fn upload_scene(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, scene: Res<ExtractedScene>, clock: Res<FrameClock>) -> Result {
+pub fn upload_scene(
+    gpu: Res<GpuDevice>,
+    mut tracer: ResMut<Tracer>,
+    scene: Res<ExtractedScene>,
+    clock: Res<FrameClock>,
+) -> Result {
     let changes = if scene.is_changed() { scene.changes } else { Default::default() };
     tracer
         .0

@@ -7,7 +7,11 @@ use super::resources::{FrameClock, MethodFrame, MethodInfo, References, Run};
 use crate::measure;
 
 /// The method's output as a frame to measure; the record starts with its label and counters.
-pub fn prepare(run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&MethodInfo, &mut MethodFrame)>) {
+pub fn prepare(
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&MethodInfo, &mut MethodFrame)>,
+) {
     for (info, mut m) in &mut methods {
         let Some(out) = m.output.as_ref() else { continue };
         let motion = (!out.motion.is_empty()).then_some(out.motion.as_slice());
@@ -33,7 +37,12 @@ pub fn smape_vs_previous(run: Res<Run>, mut methods: Query<&mut MethodFrame>) {
     for mut m in &mut methods {
         let m = &mut *m;
         let Some(current) = &m.current else { continue };
-        m.smape_map = measure::smape_vs_previous(&mut m.record, current, m.previous.as_ref(), run.scenario.smape_epsilon);
+        m.smape_map = measure::smape_vs_previous(
+            &mut m.record,
+            current,
+            m.previous.as_ref(),
+            run.scenario.smape_epsilon,
+        );
     }
 }
 
@@ -54,6 +63,12 @@ pub fn regions(run: Res<Run>, mut methods: Query<&mut MethodFrame>) {
         if m.current.is_none() {
             continue;
         }
-        measure::regions(&mut m.record, &run.scenario, run.width, m.flip_map.as_deref(), m.smape_map.as_deref());
+        measure::regions(
+            &mut m.record,
+            &run.scenario,
+            run.width,
+            m.flip_map.as_deref(),
+            m.smape_map.as_deref(),
+        );
     }
 }

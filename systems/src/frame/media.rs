@@ -47,18 +47,30 @@ impl SceneMedium {
     pub fn new(gpu: &render::gpu::Gpu, descs: &[MediumDesc]) -> Self {
         let states: Vec<MediumState> = descs.iter().map(|d| d.at(0.0)).collect();
         let bounds: Vec<Option<MeshInside>> = descs.iter().map(DensityGrid::bound_of).collect();
-        let baked: Vec<Medium> = descs.iter().zip(&states).zip(&bounds).map(|((d, s), b)| bake(d, s, b.as_ref())).collect();
+        let baked: Vec<Medium> = descs
+            .iter()
+            .zip(&states)
+            .zip(&bounds)
+            .map(|((d, s), b)| bake(d, s, b.as_ref()))
+            .collect();
         let gpu = GpuMedium::several(gpu, &baked.iter().collect::<Vec<_>>());
         Self { descs: descs.to_vec(), states, bounds, baked, gpu, pass: None }
     }
 
     /// Albedo and emission (none: zero) of each declared medium.
     pub fn optics(&self) -> Vec<MediumOptics> {
-        self.descs.iter().map(|d| MediumOptics { albedo: d.albedo, emission: d.emission.unwrap_or(Vec3::ZERO) }).collect()
+        self.descs
+            .iter()
+            .map(|d| MediumOptics { albedo: d.albedo, emission: d.emission.unwrap_or(Vec3::ZERO) })
+            .collect()
     }
 
     /// The volumetric path tracing pass, compiled on first use.
-    pub fn pass(&mut self, gpu: &render::gpu::Gpu, tracer: &render::path_tracer::PathTracer) -> anyhow::Result<&VolumePathPass> {
+    pub fn pass(
+        &mut self,
+        gpu: &render::gpu::Gpu,
+        tracer: &render::path_tracer::PathTracer,
+    ) -> anyhow::Result<&VolumePathPass> {
         if self.pass.is_none() {
             self.pass = Some(VolumePathPass::new(gpu, tracer, &self.gpu)?);
         }
@@ -67,19 +79,28 @@ impl SceneMedium {
 
     /// What the reference cache keys a frame's media by: their declarations and current states.
     pub fn cache_key(&self) -> String {
-        let media: Vec<String> = self.descs.iter().zip(&self.states).map(|(d, s)| format!("{d:?} {s:?}")).collect();
+        let media: Vec<String> =
+            self.descs.iter().zip(&self.states).map(|(d, s)| format!("{d:?} {s:?}")).collect();
         format!("{} {:?}", media.join(" "), REFERENCE_SETTINGS)
     }
 }
 
 /// Extract stage: the media at the simulated time, rebaked and uploaded when one changed.
-pub fn upload_medium(gpu: Res<GpuDevice>, medium: Option<ResMut<SceneMedium>>, clock: Res<sim::resources::Clock>) -> Result {
+pub fn upload_medium(
+    gpu: Res<GpuDevice>,
+    medium: Option<ResMut<SceneMedium>>,
+    clock: Res<sim::resources::Clock>,
+) -> Result {
     let Some(mut medium) = medium else { return Ok(()) };
     let states: Vec<MediumState> = medium.descs.iter().map(|d| d.at(clock.time())).collect();
     if states != medium.states {
         for (d, state) in medium.descs.iter().zip(&states) {
             if !(state.box_min.cmplt(state.box_max).all() && state.sigma_t.is_finite()) {
-                return Err(failed(anyhow::anyhow!("medium '{}' at frame {}: degenerate state {state:?}", d.name, clock.frame)));
+                return Err(failed(anyhow::anyhow!(
+                    "medium '{}' at frame {}: degenerate state {state:?}",
+                    d.name,
+                    clock.frame
+                )));
             }
         }
         let medium = &mut *medium;
@@ -107,6 +128,8 @@ pub fn render_volume(
     let optics = medium.optics();
     medium.pass(gpu, &tracer.0)?;
     let pass = medium.pass.as_ref().expect("built above");
-    let image = pass.render(gpu, &tracer.0, &medium.gpu, &optics, settings, spp, seed, frame).map_err(|e| anyhow::anyhow!(e))?;
+    let image = pass
+        .render(gpu, &tracer.0, &medium.gpu, &optics, settings, spp, seed, frame)
+        .map_err(|e| anyhow::anyhow!(e))?;
     Ok((image.mean.iter().map(|c| [c[0], c[1], c[2], 1.0]).collect(), image.timings, image.paths))
 }

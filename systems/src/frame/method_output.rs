@@ -26,7 +26,13 @@ pub struct MethodOutput {
 
 impl MethodOutput {
     /// The common part of every method's output: image, motion, pass times and the counters.
-    pub fn timed(radiance: Vec<[f32; 4]>, motion: Vec<[f32; 2]>, timings: &[render::timing::PassTiming], rays: u64, shaded: u64) -> Self {
+    pub fn timed(
+        radiance: Vec<[f32; 4]>,
+        motion: Vec<[f32; 2]>,
+        timings: &[render::timing::PassTiming],
+        rays: u64,
+        shaded: u64,
+    ) -> Self {
         Self {
             radiance,
             motion,

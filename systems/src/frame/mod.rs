@@ -5,8 +5,8 @@
 //! recording are systems in them. `flicker schedule` prints what runs.
 
 pub mod extract;
-pub mod media;
 pub mod measure;
+pub mod media;
 pub mod method_output;
 pub mod record;
 pub mod reference;
@@ -16,9 +16,12 @@ pub mod stage;
 use bevy_ecs::prelude::*;
 
 pub use method_output::{MethodImage, MethodOutput};
-pub use resources::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Progress, References, Run, RunOutput, Tracer};
-pub use stage::{Stage, catch_failures, describe, failed, listing, method_failed, new_schedule, take_failure};
-
+pub use resources::{
+    FrameClock, GpuDevice, MethodFrame, MethodInfo, Progress, References, Run, RunOutput, Tracer,
+};
+pub use stage::{
+    Stage, catch_failures, describe, failed, listing, method_failed, new_schedule, take_failure,
+};
 
 fn started(clock: Res<FrameClock>) -> bool {
     clock.started
@@ -30,15 +33,39 @@ fn recorded(clock: Res<FrameClock>) -> bool {
 
 /// The systems every frame has, whatever its methods.
 pub fn add_core_systems(schedule: &mut Schedule) {
-    schedule.add_systems((sim::advance_clock, sim::animation_systems()).chain().run_if(started).in_set(Stage::Simulate));
-    schedule.add_systems((sim::extract_scene.run_if(started), extract::frame_number, extract::upload_scene, media::upload_medium).chain().in_set(Stage::Extract));
-    schedule.add_systems(reference::render_reference.in_set(Stage::Render));
     schedule.add_systems(
-        (measure::prepare, measure::smape_vs_previous, measure::flip_vs_reference, measure::regions).chain().run_if(recorded).in_set(Stage::Measure),
+        (sim::advance_clock, sim::animation_systems())
+            .chain()
+            .run_if(started)
+            .in_set(Stage::Simulate),
     );
     schedule.add_systems(
         (
-            (record::write_reference, record::write_method_images, record::write_frames_csv).chain().run_if(recorded),
+            sim::extract_scene.run_if(started),
+            extract::frame_number,
+            extract::upload_scene,
+            media::upload_medium,
+        )
+            .chain()
+            .in_set(Stage::Extract),
+    );
+    schedule.add_systems(reference::render_reference.in_set(Stage::Render));
+    schedule.add_systems(
+        (
+            measure::prepare,
+            measure::smape_vs_previous,
+            measure::flip_vs_reference,
+            measure::regions,
+        )
+            .chain()
+            .run_if(recorded)
+            .in_set(Stage::Measure),
+    );
+    schedule.add_systems(
+        (
+            (record::write_reference, record::write_method_images, record::write_frames_csv)
+                .chain()
+                .run_if(recorded),
             record::end_frame,
         )
             .chain()

@@ -9,35 +9,68 @@ use crate::run_folder::MOTION;
 use crate::{frame_record, output};
 
 /// The reference's EXR and PNG.
-pub fn write_reference(run: Res<Run>, clock: Res<FrameClock>, out: Res<RunOutput>, references: Res<References>) -> Result {
+pub fn write_reference(
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    out: Res<RunOutput>,
+    references: Res<References>,
+) -> Result {
     let Some((pixels, _)) = &references.current else { return Ok(()) };
     let (w, h) = (run.width, run.height);
     output::write_exr(&out.folder.reference(clock.frame, "exr"), w, h, pixels).map_err(failed)?;
-    output::write_png(&out.folder.reference(clock.frame, "png"), w, h, pixels, 1.0).map_err(failed)?;
+    output::write_png(&out.folder.reference(clock.frame, "png"), w, h, pixels, 1.0)
+        .map_err(failed)?;
     Ok(())
 }
 
 /// Each method's EXR and PNG, its motion vectors (`frames/METHOD/motion/NNNN.exr`: R, G = pixels
 /// from this frame to the previous, for the report's viewer) and its extra images
 /// (`frames/METHOD/NAME/NNNN.png`).
-pub fn write_method_images(run: Res<Run>, clock: Res<FrameClock>, out: Res<RunOutput>, methods: Query<(&MethodInfo, &MethodFrame)>) -> Result {
+pub fn write_method_images(
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    out: Res<RunOutput>,
+    methods: Query<(&MethodInfo, &MethodFrame)>,
+) -> Result {
     let (w, h, frame) = (run.width, run.height, clock.frame);
     let folder = &out.folder;
     for (info, m) in &methods {
         let Some(o) = &m.output else { continue };
         let label = &info.label;
         output::write_exr(&folder.frame(label, frame, "exr"), w, h, &o.radiance).map_err(failed)?;
-        output::write_png(&folder.frame(label, frame, "png"), w, h, &o.radiance, 1.0).map_err(failed)?;
+        output::write_png(&folder.frame(label, frame, "png"), w, h, &o.radiance, 1.0)
+            .map_err(failed)?;
         if !o.motion.is_empty() {
-            let motion: Vec<[f32; 4]> = o.motion.iter().map(|&[dx, dy]| [dx, dy, 0.0, 1.0]).collect();
-            output::write_exr(&folder.method_image(label, MOTION, frame, "exr"), w, h, &motion).map_err(failed)?;
+            let motion: Vec<[f32; 4]> =
+                o.motion.iter().map(|&[dx, dy]| [dx, dy, 0.0, 1.0]).collect();
+            output::write_exr(&folder.method_image(label, MOTION, frame, "exr"), w, h, &motion)
+                .map_err(failed)?;
         }
         for image in &o.images {
             if image.hdr {
-                output::write_exr(&folder.method_image(label, &image.name, frame, "exr"), w, h, &image.pixels).map_err(failed)?;
-                output::write_png(&folder.method_image(label, &image.name, frame, "png"), w, h, &image.pixels, 1.0).map_err(failed)?;
+                output::write_exr(
+                    &folder.method_image(label, &image.name, frame, "exr"),
+                    w,
+                    h,
+                    &image.pixels,
+                )
+                .map_err(failed)?;
+                output::write_png(
+                    &folder.method_image(label, &image.name, frame, "png"),
+                    w,
+                    h,
+                    &image.pixels,
+                    1.0,
+                )
+                .map_err(failed)?;
             } else {
-                output::write_png_linear(&folder.method_image(label, &image.name, frame, "png"), w, h, &image.pixels).map_err(failed)?;
+                output::write_png_linear(
+                    &folder.method_image(label, &image.name, frame, "png"),
+                    w,
+                    h,
+                    &image.pixels,
+                )
+                .map_err(failed)?;
             }
         }
     }
@@ -46,9 +79,15 @@ pub fn write_method_images(run: Res<Run>, clock: Res<FrameClock>, out: Res<RunOu
 
 /// Appends the frame's rows (in the scenario's method order) and rewrites frames.csv, so an
 /// interrupted run still has a complete table of what it did.
-pub fn write_frames_csv(mut out: ResMut<RunOutput>, methods: Query<(&MethodInfo, &MethodFrame)>) -> Result {
-    let mut rows: Vec<(usize, frame_record::FrameRecord)> =
-        methods.iter().filter(|(_, m)| m.current.is_some()).map(|(info, m)| (info.index, m.record.clone())).collect();
+pub fn write_frames_csv(
+    mut out: ResMut<RunOutput>,
+    methods: Query<(&MethodInfo, &MethodFrame)>,
+) -> Result {
+    let mut rows: Vec<(usize, frame_record::FrameRecord)> = methods
+        .iter()
+        .filter(|(_, m)| m.current.is_some())
+        .map(|(info, m)| (info.index, m.record.clone()))
+        .collect();
     rows.sort_by_key(|(i, _)| *i);
     out.records.extend(rows.into_iter().map(|(_, r)| r));
     let path = out.folder.frames_csv();
@@ -56,7 +95,11 @@ pub fn write_frames_csv(mut out: ResMut<RunOutput>, methods: Query<(&MethodInfo,
 }
 
 /// This frame becomes the previous one; the per-frame state is cleared for the next.
-pub fn end_frame(clock: Res<FrameClock>, progress: Res<Progress>, mut methods: Query<&mut MethodFrame>) {
+pub fn end_frame(
+    clock: Res<FrameClock>,
+    progress: Res<Progress>,
+    mut methods: Query<&mut MethodFrame>,
+) {
     for mut m in &mut methods {
         let m = &mut *m;
         if clock.recorded && m.current.is_some() {

@@ -35,7 +35,12 @@ pub fn render_reference(
     // With a medium the volumetric path tracer renders the reference: its shaders, the medium
     // and its state are part of the key.
     let shader_source = match &medium {
-        Some(m) => format!("{}\n{}\n{}", PathTracer::shader_source(), media::gpu::VolumePathPass::shader_source(), m.cache_key()),
+        Some(m) => format!(
+            "{}\n{}\n{}",
+            PathTracer::shader_source(),
+            media::gpu::VolumePathPass::shader_source(),
+            m.cache_key()
+        ),
         None => PathTracer::shader_source().to_string(),
     };
     let key = ReferenceCache::key(
@@ -62,15 +67,29 @@ pub fn render_reference(
             bar.set_message(format!("reference {frame:04}"));
             let spp = scenario.reference.spp;
             let px = match medium.as_deref_mut() {
-                Some(m) => super::media::render_volume(&gpu.0, &tracer, m, &super::media::REFERENCE_SETTINGS, spp, reference_seed(scenario.seed), clock.global)
-                    .map(|(px, _, _)| px)
-                    .map_err(|e| failed(anyhow::anyhow!("reference of frame {frame}: {e}")))?,
-                None => tracer
-                .0
-                .render_reference(&gpu.0, spp, reference_seed(scenario.seed), clock.global, &mut |done, total| {
-                    bar.set_message(format!("reference {frame:04}: {done}/{total} spp"));
-                })
+                Some(m) => super::media::render_volume(
+                    &gpu.0,
+                    &tracer,
+                    m,
+                    &super::media::REFERENCE_SETTINGS,
+                    spp,
+                    reference_seed(scenario.seed),
+                    clock.global,
+                )
+                .map(|(px, _, _)| px)
                 .map_err(|e| failed(anyhow::anyhow!("reference of frame {frame}: {e}")))?,
+                None => tracer
+                    .0
+                    .render_reference(
+                        &gpu.0,
+                        spp,
+                        reference_seed(scenario.seed),
+                        clock.global,
+                        &mut |done, total| {
+                            bar.set_message(format!("reference {frame:04}: {done}/{total} spp"));
+                        },
+                    )
+                    .map_err(|e| failed(anyhow::anyhow!("reference of frame {frame}: {e}")))?,
             };
             references.cache.store(&key, width, height, &px).map_err(failed)?;
             references.rendered += 1;

@@ -10,9 +10,9 @@ use render::gpu::Gpu;
 use render::path_tracer::PathTracer;
 use sim::Scenario;
 
+use super::method_output::MethodOutput;
 use crate::frame_record::FrameRecord;
 use crate::measure;
-use super::method_output::MethodOutput;
 use crate::reference_cache::ReferenceCache;
 use crate::run_folder::RunFolder;
 

@@ -26,7 +26,14 @@ pub enum Stage {
 }
 
 impl Stage {
-    pub const ALL: [Stage; 6] = [Stage::Simulate, Stage::Extract, Stage::Render, Stage::Learn, Stage::Measure, Stage::Record];
+    pub const ALL: [Stage; 6] = [
+        Stage::Simulate,
+        Stage::Extract,
+        Stage::Render,
+        Stage::Learn,
+        Stage::Measure,
+        Stage::Record,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -49,7 +56,17 @@ pub struct Frame;
 pub fn new_schedule() -> Schedule {
     let mut schedule = Schedule::new(Frame);
     schedule.set_executor(SingleThreadedExecutor::default());
-    schedule.configure_sets((Stage::Simulate, Stage::Extract, Stage::Render, Stage::Learn, Stage::Measure, Stage::Record).chain());
+    schedule.configure_sets(
+        (
+            Stage::Simulate,
+            Stage::Extract,
+            Stage::Render,
+            Stage::Learn,
+            Stage::Measure,
+            Stage::Record,
+        )
+            .chain(),
+    );
     // Each stage checks on its own, so a failure stops the stages after it.
     for stage in Stage::ALL {
         schedule.configure_sets(stage.run_if(no_failure));
@@ -120,7 +137,11 @@ pub fn listing(schedule: &mut Schedule, world: &mut World) -> Result<Vec<(Stage,
         if let Some((last, last_name)) = out.last()
             && *last > stage
         {
-            return Err(format!("system {name} ({}) runs after {last_name} ({})", stage.name(), last.name()));
+            return Err(format!(
+                "system {name} ({}) runs after {last_name} ({})",
+                stage.name(),
+                last.name()
+            ));
         }
         out.push((stage, name));
     }

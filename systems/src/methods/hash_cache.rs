@@ -13,12 +13,18 @@ use render::timing::PassTiming;
 pub use render::hash_cache::HashCacheSettings;
 
 use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
-use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use crate::frame::{
+    FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
+};
 
 /// `hash_cache` (the paper's first-hit lookup), `hash_cache_taa` (under TAA, as the paper runs
 /// it), `hash_cache_secondary_hit`, `hash_cache_secondary_hit_taa`.
 pub fn label(s: &HashCacheSettings) -> String {
-    format!("hash_cache{}{}", if s.lookup == HashCacheLookup::SecondaryHit { "_secondary_hit" } else { "" }, if s.taa { "_taa" } else { "" })
+    format!(
+        "hash_cache{}{}",
+        if s.lookup == HashCacheLookup::SecondaryHit { "_secondary_hit" } else { "" },
+        if s.taa { "_taa" } else { "" }
+    )
 }
 
 #[derive(Component)]
@@ -46,7 +52,8 @@ impl MethodPlugin for Plugin {
         settings.validate()?;
         let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
         let cache = HashCache::new(gpu, tracer, *settings)?;
-        let taa = settings.taa.then(|| Taa::new(gpu, tracer, TaaSettings::default())).transpose()?;
+        let taa =
+            settings.taa.then(|| Taa::new(gpu, tracer, TaaSettings::default())).transpose()?;
         world.entity_mut(entity).insert(HashCacheState { cache, taa, updated: None });
         Ok(())
     }
@@ -74,12 +81,19 @@ pub fn age_and_update(
 }
 
 /// The frame's image: TAA's resolve over the cache's colour, or the colour itself.
-pub fn resolve(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut methods: Query<(&mut HashCacheState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+pub fn resolve(
+    gpu: Res<GpuDevice>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&mut HashCacheState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
     for (mut state, info, mut frame) in &mut methods {
         let start = Instant::now();
         let state = &mut *state;
         let (timings, jitter) = state.updated.take().unwrap_or_default();
-        let out = state.cache.resolve(&gpu.0, state.taa.as_mut(), timings, jitter).map_err(|e| method_failed(&info.label, clock.global, e))?;
+        let out = state
+            .cache
+            .resolve(&gpu.0, state.taa.as_mut(), timings, jitter)
+            .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let s = out.stats;
         frame.output = Some(MethodOutput {
             stats: vec![

@@ -12,9 +12,9 @@ pub mod spec;
 pub mod sss;
 pub mod taa;
 pub mod temporal_window;
+pub mod termination;
 pub mod volume;
 pub mod volume_path;
-pub mod termination;
 
 use anyhow::Result;
 use bevy_ecs::prelude::*;
@@ -25,13 +25,13 @@ use hash_cache::HashCacheSettings;
 use nirc::NircSettings;
 use path_tracing::PathTracingSettings;
 use sample_cache::SampleCacheSettings;
-use sss::SssMethodSettings;
 use serde::{Deserialize, Serialize};
 use sim::MethodEntry;
+use sss::SssMethodSettings;
 use taa::TaaSettings;
+use termination::TerminationSettings;
 use volume::VolumeSettings;
 use volume_path::VolumePathMethod;
-use termination::TerminationSettings;
 
 /// A method family: its systems and how to build one instance.
 pub trait MethodPlugin: Sync {
@@ -129,11 +129,25 @@ impl MethodSpec {
     /// length of equal noise variance, nominal); `None` where it is not stated: NIRC and the
     /// termination cache learn over time with no fixed blend.
     pub fn temporal_window(&self) -> Option<f64> {
-        let taa = |window: f64, under: bool| if under { temporal_window::in_series(window, temporal_window::exponential(TaaSettings::default().alpha as f64)) } else { window };
+        let taa = |window: f64, under: bool| {
+            if under {
+                temporal_window::in_series(
+                    window,
+                    temporal_window::exponential(TaaSettings::default().alpha as f64),
+                )
+            } else {
+                window
+            }
+        };
         match self {
-            MethodSpec::PathTracing(_) | MethodSpec::VolumeTransmittance(_) | MethodSpec::VolumePath(_) | MethodSpec::Sss(_) => Some(1.0),
+            MethodSpec::PathTracing(_)
+            | MethodSpec::VolumeTransmittance(_)
+            | MethodSpec::VolumePath(_)
+            | MethodSpec::Sss(_) => Some(1.0),
             MethodSpec::Taa(s) => Some(temporal_window::exponential(s.alpha as f64)),
-            MethodSpec::HashCache(s) => Some(taa(temporal_window::exponential(1.0 / s.max_samples as f64), s.taa)),
+            MethodSpec::HashCache(s) => {
+                Some(taa(temporal_window::exponential(1.0 / s.max_samples as f64), s.taa))
+            }
             MethodSpec::SampleCache(s) => {
                 let alpha = if s.roughness_alpha { 0.1 } else { s.alpha as f64 };
                 let shades = s.n_target as f64 * temporal_window::exponential(alpha);
@@ -152,7 +166,10 @@ impl MethodSpec {
             MethodSpec::VolumeTransmittance(s) => s.spp = spp,
             MethodSpec::VolumePath(s) => s.spp = spp,
             MethodSpec::Sss(s) => s.spp = spp,
-            MethodSpec::SampleCache(_) | MethodSpec::Taa(_) | MethodSpec::HashCache(_) | MethodSpec::Termination(_) => {}
+            MethodSpec::SampleCache(_)
+            | MethodSpec::Taa(_)
+            | MethodSpec::HashCache(_)
+            | MethodSpec::Termination(_) => {}
         }
     }
 }
@@ -177,7 +194,6 @@ impl Method {
         spec::parse_one(text)
     }
 }
-
 
 /// The plugins of `methods`, each once, in order of first use.
 pub fn plugins(methods: &[Method]) -> Vec<&'static dyn MethodPlugin> {
@@ -205,7 +221,8 @@ pub fn schedule_for(methods: &[Method]) -> Schedule {
 /// order. Fails if a system is in no stage or out of stage order.
 pub fn describe_schedule(methods: &[Method]) -> Result<String> {
     let mut schedule = schedule_for(methods);
-    let listing = crate::frame::listing(&mut schedule, &mut World::new()).map_err(|e| anyhow::anyhow!(e))?;
+    let listing =
+        crate::frame::listing(&mut schedule, &mut World::new()).map_err(|e| anyhow::anyhow!(e))?;
     let mut text = String::from("methods\n");
     for m in methods {
         text += &format!("  {} ({})\n", m.label(), m.spec.plugin().name());

@@ -25,7 +25,9 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use bevy_ecs::error::BevyError;
 use bevy_ecs::prelude::{Component, Entity, IntoScheduleConfigs, Query, Res, Schedule, World};
-use nirc::{CacheOutput, CachePathSettings, CachePaths, NeuralCache, NircConfig, PredictorMode, SceneBounds};
+use nirc::{
+    CacheOutput, CachePathSettings, CachePaths, NeuralCache, NircConfig, PredictorMode, SceneBounds,
+};
 use render::gpu::Gpu;
 use render::path_tracer::PathTracer;
 use render::timing::{PassTimer, PassTiming};
@@ -66,7 +68,12 @@ impl NircSettings {
 
     /// Methods with equal keys share one cache: everything but the predictor.
     fn shared_key(&self) -> String {
-        let key = format!("{}|{}|{}", self.spp, serde_json::to_string(&(&self.cache, &self.paths)).expect("settings serialise"), self.pretrain_frames);
+        let key = format!(
+            "{}|{}|{}",
+            self.spp,
+            serde_json::to_string(&(&self.cache, &self.paths)).expect("settings serialise"),
+            self.pretrain_frames
+        );
         // The test-only switch never shares a cache with a working method.
         if self.test_skip_ema { key + "|test_skip_ema" } else { key }
     }
@@ -144,7 +151,11 @@ impl MethodPlugin for Plugin {
 
     fn add_systems(&self, schedule: &mut Schedule) {
         schedule.add_systems((camera_paths, infer).chain().in_set(Stage::Render));
-        schedule.add_systems((reliability, train, ema, reliability_update, frame_output).chain().in_set(Stage::Learn));
+        schedule.add_systems(
+            (reliability, train, ema, reliability_update, frame_output)
+                .chain()
+                .in_set(Stage::Learn),
+        );
     }
 
     fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
@@ -156,10 +167,16 @@ impl MethodPlugin for Plugin {
         if let PredictorMode::Fixed(sigma) = settings.predictor
             && !(0.0..=1.0).contains(&sigma)
         {
-            bail!("Nirc: predictor Fixed({sigma}); expected a weight of the High-LR predictor in [0, 1]");
+            bail!(
+                "Nirc: predictor Fixed({sigma}); expected a weight of the High-LR predictor in [0, 1]"
+            );
         }
         let key = settings.shared_key();
-        let existing = world.query::<(Entity, &NircCache)>().iter(world).find(|(_, c)| c.key == key).map(|(e, _)| e);
+        let existing = world
+            .query::<(Entity, &NircCache)>()
+            .iter(world)
+            .find(|(_, c)| c.key == key)
+            .map(|(e, _)| e);
         let cache = match existing {
             Some(e) => e,
             None => {
@@ -170,9 +187,17 @@ impl MethodPlugin for Plugin {
         let c = world.get::<NircCache>(cache).expect("a cache entity");
         if !c.outputs.iter().any(|(m, _)| *m == settings.predictor) {
             let out = c.paths.output(&world.resource::<GpuDevice>().0)?;
-            world.get_mut::<NircCache>(cache).expect("a cache entity").outputs.push((settings.predictor, out));
+            world
+                .get_mut::<NircCache>(cache)
+                .expect("a cache entity")
+                .outputs
+                .push((settings.predictor, out));
         }
-        world.entity_mut(entity).insert(NircMethod { mode: settings.predictor, cache, inferred: None });
+        world.entity_mut(entity).insert(NircMethod {
+            mode: settings.predictor,
+            cache,
+            inferred: None,
+        });
         Ok(())
     }
 }
@@ -192,11 +217,26 @@ fn scene_bounds(tracer: &PathTracer) -> SceneBounds {
 
 impl NircCache {
     /// Key of a warm start: everything that affects the pre-trained state.
-    fn warm_start_key(settings: &NircSettings, gpu: &Gpu, scene: &scene::SceneDesc, run: &Run, tracer: &PathTracer) -> String {
+    fn warm_start_key(
+        settings: &NircSettings,
+        gpu: &Gpu,
+        scene: &scene::SceneDesc,
+        run: &Run,
+        tracer: &PathTracer,
+    ) -> String {
         let mut h = Sha256::new();
         h.update(format!("{scene:?}").as_bytes());
         h.update(serde_json::to_string(&(&settings.cache, &settings.paths)).unwrap().as_bytes());
-        h.update(format!("{:?}|{}|{}|{}", tracer.settings(), settings.spp, settings.pretrain_frames, run.scenario.seed).as_bytes());
+        h.update(
+            format!(
+                "{:?}|{}|{}|{}",
+                tracer.settings(),
+                settings.spp,
+                settings.pretrain_frames,
+                run.scenario.seed
+            )
+            .as_bytes(),
+        );
         h.update(CachePaths::shader_source().as_bytes());
         h.update(nirc::gpu::shaders::all_sources().as_bytes());
         h.update(gpu.summary.to_string().as_bytes());
@@ -218,9 +258,13 @@ impl NircCache {
         let mut warm_start = None;
         if settings.pretrain_frames > 0 {
             let dir = run.cache_dir.join("nirc");
-            let file = dir.join(format!("{}.nirc", Self::warm_start_key(settings, gpu, scene, run, tracer)));
+            let file = dir
+                .join(format!("{}.nirc", Self::warm_start_key(settings, gpu, scene, run, tracer)));
             if file.exists() {
-                cache = Some(NeuralCache::load(gpu, &file).with_context(|| format!("loading the NIRC warm start {}", file.display()))?);
+                cache =
+                    Some(NeuralCache::load(gpu, &file).with_context(|| {
+                        format!("loading the NIRC warm start {}", file.display())
+                    })?);
             } else {
                 let fresh = NeuralCache::new(gpu, &cache_config, bounds)?;
                 for k in 0..settings.pretrain_frames {
@@ -230,14 +274,24 @@ impl NircCache {
                     paths.encode_queries(gpu, &mut encoder, tracer, run.scenario.seed, frame);
                     gpu.queue.submit([encoder.finish()]);
                     for step in 0..settings.paths.train_steps {
-                        submit_step(gpu, tracer, &paths, &fresh, settings.spp, step_seed(run.scenario.seed, step), frame)?;
+                        submit_step(
+                            gpu,
+                            tracer,
+                            &paths,
+                            &fresh,
+                            settings.spp,
+                            step_seed(run.scenario.seed, step),
+                            frame,
+                        )?;
                     }
                     wait(gpu)?;
                 }
-                std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+                std::fs::create_dir_all(&dir)
+                    .with_context(|| format!("creating {}", dir.display()))?;
                 let tmp = file.with_extension("tmp");
                 fresh.save(gpu, &tmp)?;
-                std::fs::rename(&tmp, &file).with_context(|| format!("writing {}", file.display()))?;
+                std::fs::rename(&tmp, &file)
+                    .with_context(|| format!("writing {}", file.display()))?;
                 cache = Some(fresh);
             }
             warm_start = Some(file);
@@ -283,13 +337,21 @@ fn frame_error(clock: &FrameClock) -> impl Fn(anyhow::Error) -> BevyError + '_ {
 }
 
 /// Camera paths up to the termination vertex: the frame's cache queries and motion vectors.
-pub fn camera_paths(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut caches: Query<&mut NircCache>) -> Result<(), BevyError> {
+pub fn camera_paths(
+    gpu: Res<GpuDevice>,
+    tracer: Res<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    mut caches: Query<&mut NircCache>,
+) -> Result<(), BevyError> {
     let gpu = &gpu.0;
     let err = frame_error(&clock);
     for mut c in &mut caches {
         let c = &mut *c;
         let mut timed = c.paths_timer.begin(gpu, "nirc paths");
-        c.paths.queries_timed(gpu, &mut timed, 0, &tracer.0, run.scenario.seed, clock.global).map_err(|e| err(e.into()))?;
+        c.paths
+            .queries_timed(gpu, &mut timed, 0, &tracer.0, run.scenario.seed, clock.global)
+            .map_err(|e| err(e.into()))?;
         c.paths_times = timed.submit().map_err(|e| err(e.into()))?;
         c.motion = c.paths.read_motion(gpu).map_err(|e| err(e.into()))?;
     }
@@ -310,10 +372,25 @@ pub fn infer(
     for (mut m, mut frame) in &mut methods {
         let start = Instant::now();
         let c = caches.get(m.cache).map_err(|e| err(anyhow::anyhow!("{e}")))?;
-        let out = &c.outputs.iter().find(|(mode, _)| *mode == m.mode).ok_or_else(|| err(anyhow::anyhow!("predictor mode without answers")))?.1;
+        let out = &c
+            .outputs
+            .iter()
+            .find(|(mode, _)| *mode == m.mode)
+            .ok_or_else(|| err(anyhow::anyhow!("predictor mode without answers")))?
+            .1;
         c.prepare(gpu, &tracer.0, run.scenario.seed, clock.global);
         let mut timed = c.infer_timer.begin(gpu, "nirc infer");
-        c.cache.infer_timed(gpu, &mut timed, 0, c.paths.queries(), c.paths.query_count(), &out.answers, m.mode).map_err(|e| err(e.into()))?;
+        c.cache
+            .infer_timed(
+                gpu,
+                &mut timed,
+                0,
+                c.paths.queries(),
+                c.paths.query_count(),
+                &out.answers,
+                m.mode,
+            )
+            .map_err(|e| err(e.into()))?;
         c.paths.resolve_timed(gpu, &mut timed, 1, &tracer.0, out).map_err(|e| err(e.into()))?;
         let times = timed.submit().map_err(|e| err(e.into()))?;
         let (radiance, sigma) = c.paths.read_image(gpu, out).map_err(|e| err(e.into()))?;
@@ -325,12 +402,24 @@ pub fn infer(
 
 /// The reliability grid at this frame's queries, before the frame's training step: r̄_cur,
 /// r̄_EMA, the blend's σ (frames.csv statistics, preference maps).
-pub fn reliability(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut caches: Query<&mut NircCache>) -> Result<(), BevyError> {
+pub fn reliability(
+    gpu: Res<GpuDevice>,
+    clock: Res<FrameClock>,
+    mut caches: Query<&mut NircCache>,
+) -> Result<(), BevyError> {
     let gpu = &gpu.0;
     let err = frame_error(&clock);
     for mut c in &mut caches {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        c.cache.encode_reliability(gpu, &mut encoder, c.paths.queries(), c.paths.query_count(), &c.diagnostics.answers).map_err(|e| err(e.into()))?;
+        c.cache
+            .encode_reliability(
+                gpu,
+                &mut encoder,
+                c.paths.queries(),
+                c.paths.query_count(),
+                &c.diagnostics.answers,
+            )
+            .map_err(|e| err(e.into()))?;
         gpu.queue.submit([encoder.finish()]);
         let diag = c.paths.read_answers(gpu, &c.diagnostics).map_err(|e| err(e.into()))?;
         let valid = c.paths.read_query_valid(gpu).map_err(|e| err(e.into()))?;
@@ -346,7 +435,15 @@ fn step_seed(seed: u64, step: u32) -> u64 {
 
 /// One whole training step (records from the frame's queries, Adam, EMA, reliability, commit)
 /// with `seed` for the record picks and targets, submitted untimed.
-fn submit_step(gpu: &Gpu, tracer: &PathTracer, paths: &CachePaths, cache: &NeuralCache, spp: u32, seed: u64, frame: u32) -> Result<(), nirc::NircError> {
+fn submit_step(
+    gpu: &Gpu,
+    tracer: &PathTracer,
+    paths: &CachePaths,
+    cache: &NeuralCache,
+    spp: u32,
+    seed: u64,
+    frame: u32,
+) -> Result<(), nirc::NircError> {
     tracer.prepare_frame(gpu, spp, 0, seed, frame);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     paths.encode_records(gpu, &mut encoder, tracer);
@@ -359,7 +456,13 @@ fn submit_step(gpu: &Gpu, tracer: &PathTracer, paths: &CachePaths, cache: &Neura
 /// `train_steps` > 1 the earlier steps (records, Adam, EMA, reliability) run first, their wall
 /// time in the statistic `nirc_steps_wall_ms`; the last step is split over this system, `ema` and
 /// `reliability_update` as with one step.
-pub fn train(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut caches: Query<&mut NircCache>) -> Result<(), BevyError> {
+pub fn train(
+    gpu: Res<GpuDevice>,
+    tracer: Res<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    mut caches: Query<&mut NircCache>,
+) -> Result<(), BevyError> {
     let gpu = &gpu.0;
     let err = frame_error(&clock);
     for mut c in &mut caches {
@@ -369,7 +472,16 @@ pub fn train(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res
         if steps > 1 {
             let start = Instant::now();
             for step in 1..steps {
-                submit_step(gpu, &tracer.0, &c.paths, &c.cache, c.settings.spp, step_seed(run.scenario.seed, step), clock.global).map_err(|e| err(e.into()))?;
+                submit_step(
+                    gpu,
+                    &tracer.0,
+                    &c.paths,
+                    &c.cache,
+                    c.settings.spp,
+                    step_seed(run.scenario.seed, step),
+                    clock.global,
+                )
+                .map_err(|e| err(e.into()))?;
             }
             wait(gpu).map_err(|e| err(e))?;
             c.steps_wall_ms = Some(start.elapsed().as_secs_f64() * 1e3);
@@ -377,7 +489,10 @@ pub fn train(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res
         c.prepare(gpu, &tracer.0, run.scenario.seed, clock.global);
         let mut timed = c.train_timer.begin(gpu, "nirc train");
         c.paths.records_timed(gpu, &mut timed, 0, &tracer.0).map_err(|e| err(e.into()))?;
-        c.step = c.cache.prepare_step(gpu, c.paths.records(), c.paths.record_count()).map_err(|e| err(e.into()))?;
+        c.step = c
+            .cache
+            .prepare_step(gpu, c.paths.records(), c.paths.record_count())
+            .map_err(|e| err(e.into()))?;
         if let Some(step) = &c.step {
             c.cache.adam_timed(&mut timed, 1, step).map_err(|e| err(e.into()))?;
         }
@@ -389,7 +504,11 @@ pub fn train(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res
 }
 
 /// The debiased EMA of the weights after this frame's Adam step (nothing on a rejected step).
-pub fn ema(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut caches: Query<&mut NircCache>) -> Result<(), BevyError> {
+pub fn ema(
+    gpu: Res<GpuDevice>,
+    clock: Res<FrameClock>,
+    mut caches: Query<&mut NircCache>,
+) -> Result<(), BevyError> {
     let gpu = &gpu.0;
     let err = frame_error(&clock);
     for mut c in &mut caches {
@@ -407,7 +526,11 @@ pub fn ema(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut caches: Query<&mut N
 
 /// The reliability grid's moments from the step's samples and the step's commit; then the
 /// step's loss and the count of rejected steps.
-pub fn reliability_update(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut caches: Query<&mut NircCache>) -> Result<(), BevyError> {
+pub fn reliability_update(
+    gpu: Res<GpuDevice>,
+    clock: Res<FrameClock>,
+    mut caches: Query<&mut NircCache>,
+) -> Result<(), BevyError> {
     let gpu = &gpu.0;
     let err = frame_error(&clock);
     for mut c in &mut caches {
@@ -427,19 +550,30 @@ pub fn reliability_update(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut cache
 
 /// Each NIRC method's frame: its image, the shared motion, paths + its inference + training
 /// times, the cache's statistics, and the preference map of blend and switch.
-pub fn frame_output(caches: Query<&NircCache>, mut methods: Query<(&mut NircMethod, &mut MethodFrame)>) -> Result<(), BevyError> {
+pub fn frame_output(
+    caches: Query<&NircCache>,
+    mut methods: Query<(&mut NircMethod, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
     for (mut m, mut frame) in &mut methods {
         let c = caches.get(m.cache).map_err(|e| failed(anyhow::anyhow!("{e}")))?;
         let Some(r) = m.inferred.take() else { continue };
-        let times: Vec<&PassTiming> = c.paths_times.iter().chain(&r.times).chain(&c.train_times).collect();
+        let times: Vec<&PassTiming> =
+            c.paths_times.iter().chain(&r.times).chain(&c.train_times).collect();
         let mut stats = c.stats.clone();
-        stats.push(("nirc_ms".into(), times.iter().map(|t| t.ms).sum::<f64>() + c.steps_wall_ms.unwrap_or(0.0)));
+        stats.push((
+            "nirc_ms".into(),
+            times.iter().map(|t| t.ms).sum::<f64>() + c.steps_wall_ms.unwrap_or(0.0),
+        ));
         if let Some(ms) = c.steps_wall_ms {
             stats.push(("nirc_steps_wall_ms".into(), ms));
         }
         let mut images = Vec::new();
         if matches!(m.mode, PredictorMode::Blend | PredictorMode::Switch) {
-            images.push(MethodImage { name: "preference".into(), pixels: preference_map(&r.sigma), hdr: false });
+            images.push(MethodImage {
+                name: "preference".into(),
+                pixels: preference_map(&r.sigma),
+                hdr: false,
+            });
         }
         frame.output = Some(MethodOutput {
             radiance: r.radiance,
@@ -463,7 +597,8 @@ pub fn frame_output(caches: Query<&NircCache>, mut methods: Query<(&mut NircMeth
 /// whose σ is more than 0.1 from the even mixture (|d| > ln(1.5)/κ ≈ 0.1 at κ = 4): how much of
 /// the image the reliability weighting actually moves.
 fn reliability_stats(diag: &[[f32; 4]], valid: &[bool]) -> Vec<(String, f64)> {
-    let (mut n, mut r_cur, mut r_ema, mut sigma, mut prefer, mut far) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mut n, mut r_cur, mut r_ema, mut sigma, mut prefer, mut far) =
+        (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     let mut diff = Vec::new();
     for (d, &v) in diag.iter().zip(valid) {
         if !v || !d.iter().all(|x| x.is_finite()) {
@@ -501,7 +636,10 @@ fn reliability_stats(diag: &[[f32; 4]], valid: &[bool]) -> Vec<(String, f64)> {
 /// Figure 3's colours: green where High-LR is preferred (σ), red where EMA is (1 - σ); black
 /// where no query was answered.
 pub fn preference_map(sigma: &[[f32; 4]]) -> Vec<[f32; 4]> {
-    sigma.iter().map(|s| if s[3] > 0.0 { [1.0 - s[0], s[0], 0.0, 1.0] } else { [0.0, 0.0, 0.0, 1.0] }).collect()
+    sigma
+        .iter()
+        .map(|s| if s[3] > 0.0 { [1.0 - s[0], s[0], 0.0, 1.0] } else { [0.0, 0.0, 0.0, 1.0] })
+        .collect()
 }
 
 #[cfg(test)]
@@ -513,7 +651,8 @@ mod tests {
     #[test]
     fn reliability_stats_give_the_spread_of_the_difference_past_warm_up() {
         // (r̄_cur, r̄_EMA, σ, past warm-up)
-        let mut diag: Vec<[f32; 4]> = (0..11).map(|i| [0.5 + 0.01 * i as f32, 0.5, 0.5, 1.0]).collect();
+        let mut diag: Vec<[f32; 4]> =
+            (0..11).map(|i| [0.5 + 0.01 * i as f32, 0.5, 0.5, 1.0]).collect();
         diag[10][2] = 0.7; // one query far from the even mixture
         diag.push([0.9, 0.1, 0.0, 0.0]); // in warm-up: no difference counted
         diag.push([0.9, 0.1, 0.9, 1.0]); // not answered
@@ -527,6 +666,10 @@ mod tests {
         assert!((get("sigma_far_from_even") - 1.0 / 11.0).abs() < 1e-9, "{stats:?}");
         // All in warm-up: the spread is not reported at all.
         let warm: Vec<[f32; 4]> = diag.iter().map(|d| [d[0], d[1], 0.0, 0.0]).collect();
-        assert!(reliability_stats(&warm, &valid).iter().all(|s| !s.0.starts_with("reliability_diff") && s.0 != "sigma_far_from_even"));
+        assert!(
+            reliability_stats(&warm, &valid)
+                .iter()
+                .all(|s| !s.0.starts_with("reliability_diff") && s.0 != "sigma_far_from_even")
+        );
     }
 }

@@ -7,7 +7,9 @@ use bevy_ecs::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
-use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use crate::frame::{
+    FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
+};
 
 /// `PathTracing(spp: 4)`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -50,11 +52,26 @@ impl MethodPlugin for Plugin {
 }
 
 /// G-buffer and `spp` paths per pixel.
-pub fn render(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&PathTracing, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+pub fn render(
+    gpu: Res<GpuDevice>,
+    mut tracer: ResMut<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&PathTracing, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
     for (pt, info, mut frame) in &mut methods {
         let start = Instant::now();
-        let out = tracer.0.render(&gpu.0, pt.spp, run.scenario.seed, clock.global).map_err(|e| method_failed(&info.label, clock.global, e))?;
-        frame.output = Some(MethodOutput::timed(out.radiance, out.gbuffer.motion, &out.timings, out.rays, out.shaded));
+        let out = tracer
+            .0
+            .render(&gpu.0, pt.spp, run.scenario.seed, clock.global)
+            .map_err(|e| method_failed(&info.label, clock.global, e))?;
+        frame.output = Some(MethodOutput::timed(
+            out.radiance,
+            out.gbuffer.motion,
+            &out.timings,
+            out.rays,
+            out.shaded,
+        ));
         frame.add_cpu(start);
     }
     Ok(())

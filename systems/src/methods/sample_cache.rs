@@ -13,7 +13,9 @@ use render::taa::{Taa, TaaSettings};
 pub use render::sample_cache::SampleCacheSettings;
 
 use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
-use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use crate::frame::{
+    FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
+};
 
 #[derive(Component)]
 pub struct SampleCacheState(SampleCache, Option<Taa>);
@@ -27,58 +29,101 @@ impl MethodPlugin for Plugin {
     }
 
     fn add_systems(&self, schedule: &mut Schedule) {
-        schedule.add_systems((reproject, retrace, shade, reconstruct).chain().in_set(Stage::Render));
+        schedule
+            .add_systems((reproject, retrace, shade, reconstruct).chain().in_set(Stage::Render));
     }
 
     fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
-        let MethodSpec::SampleCache(settings) = &method.spec else { bail!("not a SampleCache method") };
+        let MethodSpec::SampleCache(settings) = &method.spec else {
+            bail!("not a SampleCache method")
+        };
         settings.validate().map_err(|e| anyhow::anyhow!("SampleCache: {e}"))?;
         let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
         let cache = SampleCache::new(gpu, tracer, *settings)?;
-        let taa = settings.taa.then(|| Taa::new(gpu, tracer, TaaSettings::default())).transpose()?;
+        let taa =
+            settings.taa.then(|| Taa::new(gpu, tracer, TaaSettings::default())).transpose()?;
         world.entity_mut(entity).insert(SampleCacheState(cache, taa));
         Ok(())
     }
 }
 
 /// Runs stage `stage` of every sample cache.
-fn stage(stage: usize, gpu: &GpuDevice, tracer: &Tracer, seed: u64, clock: &FrameClock, methods: &mut Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+fn stage(
+    stage: usize,
+    gpu: &GpuDevice,
+    tracer: &Tracer,
+    seed: u64,
+    clock: &FrameClock,
+    methods: &mut Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
     for (mut state, info, mut frame) in methods.iter_mut() {
         let start = Instant::now();
         if stage == 0 {
             state.0.begin_frame(seed, clock.global);
         }
-        state.0.stage(&gpu.0, &tracer.0, stage).map_err(|e| method_failed(&info.label, clock.global, e))?;
+        state
+            .0
+            .stage(&gpu.0, &tracer.0, stage)
+            .map_err(|e| method_failed(&info.label, clock.global, e))?;
         frame.add_cpu(start);
     }
     Ok(())
 }
 
 /// Forward reprojection of last frame's samples and reservation of their slots.
-pub fn reproject(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+pub fn reproject(
+    gpu: Res<GpuDevice>,
+    tracer: Res<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
     stage(0, &gpu, &tracer, run.scenario.seed, &clock, &mut methods)
 }
 
 /// Retracing: holes, the slope test's pixels and the base rate (single, multi or adaptive).
-pub fn retrace(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+pub fn retrace(
+    gpu: Res<GpuDevice>,
+    tracer: Res<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
     stage(1, &gpu, &tracer, run.scenario.seed, &clock, &mut methods)
 }
 
 /// Shading of the selected samples (uniform or adaptive rate).
-pub fn shade(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+pub fn shade(
+    gpu: Res<GpuDevice>,
+    tracer: Res<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
     stage(2, &gpu, &tracer, run.scenario.seed, &clock, &mut methods)
 }
 
 /// The image: each pixel's visible samples averaged; counters and the trace mask.
-pub fn reconstruct(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+pub fn reconstruct(
+    gpu: Res<GpuDevice>,
+    tracer: Res<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
     stage(3, &gpu, &tracer, run.scenario.seed, &clock, &mut methods)?;
     for (mut state, info, mut frame) in &mut methods {
         let start = Instant::now();
         let slots = state.0.settings().slots as f64;
-        let mut out = state.0.finish_frame(&gpu.0).map_err(|e| method_failed(&info.label, clock.global, e))?;
+        let mut out = state
+            .0
+            .finish_frame(&gpu.0)
+            .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let SampleCacheState(cache, taa) = &mut *state;
         if let Some(taa) = taa {
-            let resolved = cache.resolve_taa(&gpu.0, taa).map_err(|e| method_failed(&info.label, clock.global, e))?;
+            let resolved = cache
+                .resolve_taa(&gpu.0, taa)
+                .map_err(|e| method_failed(&info.label, clock.global, e))?;
             out.radiance = resolved.radiance;
             out.timings.extend(resolved.timings);
         }
@@ -100,13 +145,24 @@ pub fn reconstruct(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, cloc
             .iter()
             .map(|f| {
                 let on = |bit: u32| if f & bit != 0 { 1.0 } else { 0.0 };
-                [on(render::sample_cache::FLAG_SLOPE), on(render::sample_cache::FLAG_BASE), on(render::sample_cache::FLAG_HOLE), 1.0]
+                [
+                    on(render::sample_cache::FLAG_SLOPE),
+                    on(render::sample_cache::FLAG_BASE),
+                    on(render::sample_cache::FLAG_HOLE),
+                    1.0,
+                ]
             })
             .collect();
         frame.output = Some(MethodOutput {
             stats,
             images: vec![MethodImage { name: "trace_mask".into(), pixels: trace_mask, hdr: false }],
-            ..MethodOutput::timed(out.radiance, out.motion, &out.timings, s.all_rays as u64, s.shaded as u64)
+            ..MethodOutput::timed(
+                out.radiance,
+                out.motion,
+                &out.timings,
+                s.all_rays as u64,
+                s.shaded as u64,
+            )
         });
         frame.add_cpu(start);
     }

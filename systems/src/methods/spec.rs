@@ -11,7 +11,13 @@ pub fn parse_methods(scenario: &Scenario) -> Result<Vec<Method>, ScenarioError> 
     let methods = scenario
         .methods
         .iter()
-        .map(|entry| parse_entry(entry).map_err(|(pos, message)| ScenarioError { file: scenario.origin.clone(), position: Some(pos), message }))
+        .map(|entry| {
+            parse_entry(entry).map_err(|(pos, message)| ScenarioError {
+                file: scenario.origin.clone(),
+                position: Some(pos),
+                message,
+            })
+        })
         .collect::<Result<Vec<_>, _>>()?;
     check_labels(scenario, &methods)?;
     Ok(methods)
@@ -53,11 +59,20 @@ fn parse_entry(entry: &MethodEntry) -> Result<Method, ((usize, usize), String)> 
     let options = ron::Options::default()
         .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
         .with_default_extension(ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES);
-    let spec: MethodSpec = options.from_str(&text).map_err(|e| (at(e.span.start.line, e.span.start.col), format!("method `{}`: {}", entry.text, e.code)))?;
+    let spec: MethodSpec = options.from_str(&text).map_err(|e| {
+        (at(e.span.start.line, e.span.start.col), format!("method `{}`: {}", entry.text, e.code))
+    })?;
     if let Some(n) = &name {
-        let ok = !n.is_empty() && n.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.')) && !n.starts_with('.');
+        let ok = !n.is_empty()
+            && n.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
+            && !n.starts_with('.');
         if !ok {
-            return Err((at(1, 1), format!("method name '{n}'; expected letters, digits, '_', '-' or '.' (it names a folder)")));
+            return Err((
+                at(1, 1),
+                format!(
+                    "method name '{n}'; expected letters, digits, '_', '-' or '.' (it names a folder)"
+                ),
+            ));
         }
     }
     Ok(Method { spec, name, entry: entry.clone() })
@@ -78,7 +93,10 @@ fn take_name(text: &str) -> Result<(String, Option<String>), String> {
             }
             b'(' | b'[' | b'{' => depth += 1,
             b')' | b']' | b'}' => depth -= 1,
-            b'n' if depth == 1 && text[i..].starts_with("name") && (i == 0 || !is_ident(bytes[i - 1])) => {
+            b'n' if depth == 1
+                && text[i..].starts_with("name")
+                && (i == 0 || !is_ident(bytes[i - 1])) =>
+            {
                 let mut j = i + 4;
                 while j < bytes.len() && bytes[j].is_ascii_whitespace() {
                     j += 1;
@@ -89,10 +107,14 @@ fn take_name(text: &str) -> Result<(String, Option<String>), String> {
                         j += 1;
                     }
                     if j >= bytes.len() || bytes[j] != b'"' {
-                        return Err("`name:` must be followed by a string, e.g. name: \"blend_fixed\"".into());
+                        return Err(
+                            "`name:` must be followed by a string, e.g. name: \"blend_fixed\""
+                                .into(),
+                        );
                     }
                     let end = skip_string(bytes, j);
-                    let name: String = ron::from_str(&text[j..end]).map_err(|e| format!("method name: {e}"))?;
+                    let name: String =
+                        ron::from_str(&text[j..end]).map_err(|e| format!("method name: {e}"))?;
                     let mut k = end;
                     while k < bytes.len() && bytes[k].is_ascii_whitespace() {
                         k += 1;
@@ -116,7 +138,8 @@ fn take_name(text: &str) -> Result<(String, Option<String>), String> {
         None => Ok((text.to_string(), None)),
         Some((start, end, name)) => {
             // Newlines kept, everything else blanked: line and column of what follows stay.
-            let blank: String = text[start..end].chars().map(|c| if c == '\n' { '\n' } else { ' ' }).collect();
+            let blank: String =
+                text[start..end].chars().map(|c| if c == '\n' { '\n' } else { ' ' }).collect();
             Ok((format!("{}{}{}", &text[..start], blank, &text[end..]), Some(name)))
         }
     }
@@ -145,7 +168,8 @@ mod tests {
 
     #[test]
     fn name_is_taken_out_and_positions_stay() {
-        let (text, name) = take_name("Nirc(name: \"blend_fixed\", spp: 1, cache: (name: 3))").unwrap();
+        let (text, name) =
+            take_name("Nirc(name: \"blend_fixed\", spp: 1, cache: (name: 3))").unwrap();
         assert_eq!(name.as_deref(), Some("blend_fixed"));
         assert_eq!(text.len(), "Nirc(name: \"blend_fixed\", spp: 1, cache: (name: 3))".len());
         assert!(text.starts_with("Nirc(") && text.contains("spp: 1, cache: (name: 3))"));

@@ -12,13 +12,15 @@ use bevy_ecs::prelude::*;
 use glam::Vec3;
 use render::path_tracer::NO_HIT;
 use render::sss::gpu::SssPass;
-use render::taa::{Taa, TaaPrimary, TaaSettings};
 use render::sss::profile::scaling_from_dmfp;
 use render::sss::{Prefilter, SpvgSettings, SssFrame, SssSettings, SssVariant};
+use render::taa::{Taa, TaaPrimary, TaaSettings};
 use serde::{Deserialize, Serialize};
 
 use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
-use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use crate::frame::{
+    FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
+};
 
 /// `Sss(variant: Adaptive, spp: 1)`; the thesis's parameters by default.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -48,7 +50,17 @@ pub struct SssMethodSettings {
 impl Default for SssMethodSettings {
     fn default() -> Self {
         let s = SssSettings::default();
-        Self { variant: s.variant, spp: 1, fast_inverse: s.fast_inverse, spvg: s.spvg, eps_a: s.eps_a, a0: s.a0, a_cv: s.a_cv, taa: None, prefilter: None }
+        Self {
+            variant: s.variant,
+            spp: 1,
+            fast_inverse: s.fast_inverse,
+            spvg: s.spvg,
+            eps_a: s.eps_a,
+            a0: s.a0,
+            a_cv: s.a_cv,
+            taa: None,
+            prefilter: None,
+        }
     }
 }
 
@@ -66,7 +78,16 @@ impl SssMethodSettings {
     }
 
     fn pass_settings(&self, seed: u64) -> SssSettings {
-        SssSettings { variant: self.variant, spvg: self.spvg, fast_inverse: self.fast_inverse, eps_a: self.eps_a, a0: self.a0, a_cv: self.a_cv, seed: seed as u32, prefilter: self.prefilter }
+        SssSettings {
+            variant: self.variant,
+            spvg: self.spvg,
+            fast_inverse: self.fast_inverse,
+            eps_a: self.eps_a,
+            a0: self.a0,
+            a_cv: self.a_cv,
+            seed: seed as u32,
+            prefilter: self.prefilter,
+        }
     }
 }
 
@@ -117,16 +138,30 @@ impl MethodPlugin for Plugin {
         if let SssVariant::Separable { taps } = s.variant
             && (taps < 3 || taps % 2 == 0 || taps > render::sss::separable::MAX_TAPS)
         {
-            bail!("Sss: Separable taps {taps}; expected an odd count in [3, {}]", render::sss::separable::MAX_TAPS);
+            bail!(
+                "Sss: Separable taps {taps}; expected an odd count in [3, {}]",
+                render::sss::separable::MAX_TAPS
+            );
         }
         s.pass_settings(0).mip_levels().map_err(|e| anyhow::anyhow!("Sss: {e}"))?;
         let scene = &world.resource::<sim::ExtractedScene>().scene;
-        let subsurface: Vec<(u32, scene::Material)> = scene.materials.iter().enumerate().filter(|(_, m)| m.subsurface.is_some()).map(|(i, m)| (i as u32, *m)).collect();
+        let subsurface: Vec<(u32, scene::Material)> = scene
+            .materials
+            .iter()
+            .enumerate()
+            .filter(|(_, m)| m.subsurface.is_some())
+            .map(|(i, m)| (i as u32, *m))
+            .collect();
         if subsurface.is_empty() {
-            bail!("Sss: the scene has no subsurface material; expected a material override in the scenario, e.g. materials: [(material: \"skin\", subsurface: (dmfp: (0.3, 0.12, 0.06)))]");
+            bail!(
+                "Sss: the scene has no subsurface material; expected a material override in the scenario, e.g. materials: [(material: \"skin\", subsurface: (dmfp: (0.3, 0.12, 0.06)))]"
+            );
         }
         if subsurface.len() > MAX_SSS_MATERIALS {
-            bail!("Sss: {} subsurface materials; expected at most {MAX_SSS_MATERIALS} (a pass each)", subsurface.len());
+            bail!(
+                "Sss: {} subsurface materials; expected at most {MAX_SSS_MATERIALS} (a pass each)",
+                subsurface.len()
+            );
         }
         let (width, height) = {
             let run = world.resource::<Run>();
@@ -137,7 +172,8 @@ impl MethodPlugin for Plugin {
             .iter()
             .map(|&(material, m)| {
                 let dmfp = m.subsurface.expect("filtered").dmfp;
-                let d = [0, 1, 2].map(|c| (dmfp[c] as f64 / scaling_from_dmfp(m.base_color[c] as f64)) as f32);
+                let d = [0, 1, 2]
+                    .map(|c| (dmfp[c] as f64 / scaling_from_dmfp(m.base_color[c] as f64)) as f32);
                 Ok(SssProfile { material, d, pass: SssPass::new(gpu, width, height)? })
             })
             .collect::<Result<Vec<_>>>()?;
@@ -148,11 +184,21 @@ impl MethodPlugin for Plugin {
 }
 
 /// Path tracing, demodulation, the SSS pass, modulation.
-pub fn render(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, run: Res<Run>, clock: Res<FrameClock>, scene: Res<sim::ExtractedScene>, mut methods: Query<(&mut SssState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+pub fn render(
+    gpu: Res<GpuDevice>,
+    mut tracer: ResMut<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    scene: Res<sim::ExtractedScene>,
+    mut methods: Query<(&mut SssState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
     for (mut state, info, mut frame) in &mut methods {
         let start = Instant::now();
         let fail = |e: &dyn std::fmt::Display| method_failed(&info.label, clock.global, e);
-        let out = tracer.0.render(&gpu.0, state.settings.spp, run.scenario.seed, clock.global).map_err(|e| fail(&e))?;
+        let out = tracer
+            .0
+            .render(&gpu.0, state.settings.spp, run.scenario.seed, clock.global)
+            .map_err(|e| fail(&e))?;
         // Pixels per scene unit at distance t: height / (2 t tan(vfov / 2)) (on the axis).
         let focal = out.height as f32 / (2.0 * (0.5 * tracer.0.camera().vfov).tan());
         let g = &out.gbuffer;
@@ -161,7 +207,9 @@ pub fn render(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, run: Res<Run>, cl
             .instance_id
             .iter()
             .map(|&inst| {
-                let material = (inst != NO_HIT).then(|| scene.scene.instances.get(inst as usize).map(|x| x.material)).flatten()?;
+                let material = (inst != NO_HIT)
+                    .then(|| scene.scene.instances.get(inst as usize).map(|x| x.material))
+                    .flatten()?;
                 state.profiles.iter().position(|p| p.material == material)
             })
             .collect();
@@ -180,8 +228,15 @@ pub fn render(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, run: Res<Run>, cl
                     [l[0] / a.x, l[1] / a.y, l[2] / a.z, focal / g.depth[i].max(1e-6)]
                 })
                 .collect();
-            let sss_frame = SssFrame { width: out.width, height: out.height, irradiance, d_px: profile.d };
-            render::timing::merge(&mut timings, profile.pass.dispatch(&gpu.0, &sss_frame, &settings, clock.global).map_err(|e| fail(&e))?);
+            let sss_frame =
+                SssFrame { width: out.width, height: out.height, irradiance, d_px: profile.d };
+            render::timing::merge(
+                &mut timings,
+                profile
+                    .pass
+                    .dispatch(&gpu.0, &sss_frame, &settings, clock.global)
+                    .map_err(|e| fail(&e))?,
+            );
             for (i, r) in profile.pass.results(&gpu.0).map_err(|e| fail(&e))?.iter().enumerate() {
                 if profile_of[i] == Some(k) {
                     let a = g.albedo[i];
@@ -200,12 +255,27 @@ pub fn render(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, run: Res<Run>, cl
             }
             None => radiance,
         };
-        let counts: Vec<[f32; 4]> = counts.iter().map(|&c| { let v = c as f32 / 64.0; [v, v, v, 1.0] }).collect();
+        let counts: Vec<[f32; 4]> = counts
+            .iter()
+            .map(|&c| {
+                let v = c as f32 / 64.0;
+                [v, v, v, 1.0]
+            })
+            .collect();
         let mean_spp = count_sum as f64 / sss_pixels.max(1) as f64;
         frame.output = Some(MethodOutput {
-            stats: vec![("sss_mean_spp".into(), mean_spp), ("sss_pixels".into(), sss_pixels as f64)],
+            stats: vec![
+                ("sss_mean_spp".into(), mean_spp),
+                ("sss_pixels".into(), sss_pixels as f64),
+            ],
             images: vec![MethodImage { name: "sample_count".into(), pixels: counts, hdr: false }],
-            ..MethodOutput::timed(radiance, out.gbuffer.motion.clone(), &timings, out.rays, out.shaded)
+            ..MethodOutput::timed(
+                radiance,
+                out.gbuffer.motion.clone(),
+                &timings,
+                out.rays,
+                out.shaded,
+            )
         });
         frame.add_cpu(start);
     }
@@ -216,11 +286,22 @@ pub fn render(gpu: Res<GpuDevice>, mut tracer: ResMut<Tracer>, run: Res<Run>, cl
 /// the G-buffer (rays through pixel centres: jitter (0.5, 0.5)). The G-buffer has no depth
 /// from the previous camera: `previous_depth` is this frame's depth (exact for the static
 /// camera and sphere of the SSS scenes; the boids' own pixels are not subsurface).
-fn resolve_taa(gpu: &render::gpu::Gpu, taa: &mut Taa, radiance: &[[f32; 4]], g: &render::path_tracer::GBuffer) -> Result<render::taa::TaaOutput, render::error::RenderError> {
+fn resolve_taa(
+    gpu: &render::gpu::Gpu,
+    taa: &mut Taa,
+    radiance: &[[f32; 4]],
+    g: &render::path_tracer::GBuffer,
+) -> Result<render::taa::TaaOutput, render::error::RenderError> {
     let primary: Vec<TaaPrimary> = (0..radiance.len())
         .map(|i| {
             let depth = if g.depth[i].is_finite() { g.depth[i] } else { 0.0 };
-            TaaPrimary { normal: g.normal[i], depth, motion: g.motion[i], instance: g.instance_id[i], previous_depth: depth }
+            TaaPrimary {
+                normal: g.normal[i],
+                depth,
+                motion: g.motion[i],
+                instance: g.instance_id[i],
+                previous_depth: depth,
+            }
         })
         .collect();
     taa.resolve_colour(gpu, [0.5, 0.5], radiance, &primary)

@@ -11,7 +11,9 @@ use render::timing::PassTiming;
 pub use render::taa::TaaSettings;
 
 use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
-use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use crate::frame::{
+    FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
+};
 
 #[derive(Component)]
 pub struct TaaState {
@@ -35,17 +37,27 @@ impl MethodPlugin for Plugin {
     fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
         let MethodSpec::Taa(settings) = &method.spec else { bail!("not a Taa method") };
         settings.validate()?;
-        let taa = Taa::new(&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0, *settings)?;
+        let taa =
+            Taa::new(&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0, *settings)?;
         world.entity_mut(entity).insert(TaaState { taa, traced: None });
         Ok(())
     }
 }
 
 /// Jittered 1 spp path tracing into the current colour.
-pub fn trace(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res<FrameClock>, mut methods: Query<(&mut TaaState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+pub fn trace(
+    gpu: Res<GpuDevice>,
+    tracer: Res<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&mut TaaState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
     for (mut state, info, mut frame) in &mut methods {
         let start = Instant::now();
-        let t = state.taa.trace(&gpu.0, &tracer.0, run.scenario.seed, clock.global).map_err(|e| method_failed(&info.label, clock.global, e))?;
+        let t = state
+            .taa
+            .trace(&gpu.0, &tracer.0, run.scenario.seed, clock.global)
+            .map_err(|e| method_failed(&info.label, clock.global, e))?;
         state.traced = Some(t);
         frame.add_cpu(start);
     }
@@ -53,16 +65,26 @@ pub fn trace(gpu: Res<GpuDevice>, tracer: Res<Tracer>, run: Res<Run>, clock: Res
 }
 
 /// Reprojection of the history, neighbourhood clamp, exponential blend.
-pub fn resolve(gpu: Res<GpuDevice>, clock: Res<FrameClock>, mut methods: Query<(&mut TaaState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+pub fn resolve(
+    gpu: Res<GpuDevice>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&mut TaaState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
     for (mut state, info, mut frame) in &mut methods {
         let start = Instant::now();
         let traced = state.traced.take().unwrap_or_default();
-        let out = state.taa.resolve(&gpu.0, traced).map_err(|e| method_failed(&info.label, clock.global, e))?;
+        let out = state
+            .taa
+            .resolve(&gpu.0, traced)
+            .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let n = out.history_length.len().max(1) as f64;
         let rejected = out.history_length.iter().filter(|&&l| l <= 1.0).count() as f64 / n;
         let mean_length = out.history_length.iter().map(|&l| l as f64).sum::<f64>() / n;
         frame.output = Some(MethodOutput {
-            stats: vec![("history_rejected".into(), rejected), ("history_length_mean".into(), mean_length)],
+            stats: vec![
+                ("history_rejected".into(), rejected),
+                ("history_length_mean".into(), mean_length),
+            ],
             ..MethodOutput::timed(out.radiance, out.motion, &out.timings, out.rays, out.shaded)
         });
         frame.add_cpu(start);

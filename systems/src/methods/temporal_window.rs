@@ -33,7 +33,9 @@ pub fn in_series(a: f64, b: f64) -> f64 {
     let len = ((-27.6 / (1.0 - wa).ln()).max(-27.6 / (1.0 - wb).ln()).ceil() as usize + 1).max(1);
     let ha: Vec<f64> = (0..len).map(|k| wa * (1.0 - wa).powi(k as i32)).collect();
     let hb: Vec<f64> = (0..len).map(|k| wb * (1.0 - wb).powi(k as i32)).collect();
-    let h: Vec<f64> = (0..2 * len).map(|n| (n.saturating_sub(len - 1)..=n.min(len - 1)).map(|k| ha[k] * hb[n - k]).sum()).collect();
+    let h: Vec<f64> = (0..2 * len)
+        .map(|n| (n.saturating_sub(len - 1)..=n.min(len - 1)).map(|k| ha[k] * hb[n - k]).sum())
+        .collect();
     let total: f64 = h.iter().sum();
     total * total / h.iter().map(|v| v * v).sum::<f64>()
 }
@@ -50,7 +52,10 @@ mod tests {
     #[test]
     fn an_exponential_blend_has_the_closed_form_window() {
         for alpha in [1.0, 0.5, 0.1, 1.0 / 32.0] {
-            assert!((exponential(alpha) - direct(alpha)).abs() < 1e-6 * direct(alpha), "alpha {alpha}");
+            assert!(
+                (exponential(alpha) - direct(alpha)).abs() < 1e-6 * direct(alpha),
+                "alpha {alpha}"
+            );
         }
         assert_eq!(exponential(1.0), 1.0);
         assert!((weight_of(exponential(0.1)) - 0.1).abs() < 1e-12);
@@ -65,7 +70,11 @@ mod tests {
         let a: f64 = 0.1;
         let b2 = (1.0 - a).powi(2);
         let expected = (1.0 - b2).powi(3) / (a.powi(4) * (1.0 + b2));
-        assert!((in_series(19.0, 19.0) - expected).abs() < 1e-6 * expected, "{} vs {expected}", in_series(19.0, 19.0));
+        assert!(
+            (in_series(19.0, 19.0) - expected).abs() < 1e-6 * expected,
+            "{} vs {expected}",
+            in_series(19.0, 19.0)
+        );
         let (x, y) = (in_series(76.0, 19.0), in_series(19.0, 76.0));
         assert!((x - y).abs() < 1e-6 * x && x > 76.0, "{x} {y}");
     }

@@ -14,7 +14,9 @@ use render::termination::TerminationCache;
 pub use render::termination::TerminationSettings;
 
 use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
-use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use crate::frame::{
+    FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
+};
 
 /// `termination_vb_0.1`, `termination_mse_100`, ...
 pub fn label(s: &TerminationSettings) -> String {
@@ -39,7 +41,9 @@ impl MethodPlugin for Plugin {
     }
 
     fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
-        let MethodSpec::Termination(settings) = &method.spec else { bail!("not a Termination method") };
+        let MethodSpec::Termination(settings) = &method.spec else {
+            bail!("not a Termination method")
+        };
         let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
         // Validates the settings and checks the cache's buffers against the adapter's limits.
         let cache = TerminationCache::new(gpu, tracer, *settings)?;
@@ -59,7 +63,10 @@ pub fn render(
 ) -> Result<(), BevyError> {
     for (mut state, info, mut frame) in &mut methods {
         let start = Instant::now();
-        let out = state.cache.render(&gpu.0, &tracer.0, &scene.scene.camera, run.scenario.seed, clock.global).map_err(|e| method_failed(&info.label, clock.global, e))?;
+        let out = state
+            .cache
+            .render(&gpu.0, &tracer.0, &scene.scene.camera, run.scenario.seed, clock.global)
+            .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let s = out.stats;
         frame.output = Some(MethodOutput {
             stats: vec![
@@ -75,7 +82,11 @@ pub fn render(
             ],
             // The paper's Fig. 11: vertices of each pixel's path (grey value = path length; the
             // EXR holds the exact values).
-            images: vec![MethodImage { name: "path_length".into(), pixels: out.path_length.iter().map(|&l| [l, l, l, 1.0]).collect(), hdr: true }],
+            images: vec![MethodImage {
+                name: "path_length".into(),
+                pixels: out.path_length.iter().map(|&l| [l, l, l, 1.0]).collect(),
+                hdr: true,
+            }],
             ..MethodOutput::timed(out.radiance, out.motion, &out.timings, out.rays, out.shaded)
         });
         frame.add_cpu(start);
@@ -93,11 +104,15 @@ mod tests {
         let m = Method::parse("Termination(rule: MseMinimisation(s: 100.0))").unwrap();
         assert_eq!(m.label(), "termination_mse_100");
         let super::super::MethodSpec::Termination(s) = m.spec else { panic!("not Termination") };
-        assert_eq!(s.rule, TerminationRule::MseMinimisation { s: 100.0, margin: 1.1, bias_clamp: 0.1 });
+        assert_eq!(
+            s.rule,
+            TerminationRule::MseMinimisation { s: 100.0, margin: 1.1, bias_clamp: 0.1 }
+        );
         assert_eq!((s.store_probability, s.survival), (0.01, 1.0));
         let e = Method::parse("Termination(rule: VarianceBounding(t: 0.1, tt: 1.0))").unwrap_err();
         assert!(e.contains("tt"), "{e}");
-        let e = Method::parse("Termination(rule: VarianceBounding(t: 0.1), samples: 4)").unwrap_err();
+        let e =
+            Method::parse("Termination(rule: VarianceBounding(t: 0.1), samples: 4)").unwrap_err();
         assert!(e.contains("samples"), "{e}");
     }
 }

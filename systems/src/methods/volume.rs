@@ -67,7 +67,9 @@ impl MethodPlugin for Plugin {
     }
 
     fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
-        let MethodSpec::VolumeTransmittance(settings) = &method.spec else { bail!("not a VolumeTransmittance method") };
+        let MethodSpec::VolumeTransmittance(settings) = &method.spec else {
+            bail!("not a VolumeTransmittance method")
+        };
         if settings.spp == 0 {
             bail!("VolumeTransmittance: spp 0; expected at least 1 estimate per pixel");
         }
@@ -80,19 +82,45 @@ impl MethodPlugin for Plugin {
         let gpu = &world.resource::<GpuDevice>().0;
         let gpu_medium = GpuMedium::new(gpu, &medium);
         let pass = ImagePass::new(gpu, &gpu_medium)?;
-        world.entity_mut(entity).insert(VolumeState { medium, gpu_medium, pass, settings: settings.clone() });
+        world.entity_mut(entity).insert(VolumeState {
+            medium,
+            gpu_medium,
+            pass,
+            settings: settings.clone(),
+        });
         Ok(())
     }
 }
 
-pub fn render(gpu: Res<GpuDevice>, run: Res<Run>, scene: Res<sim::ExtractedScene>, clock: Res<FrameClock>, mut methods: Query<(&VolumeState, &MethodInfo, &mut MethodFrame)>) -> Result<(), BevyError> {
+pub fn render(
+    gpu: Res<GpuDevice>,
+    run: Res<Run>,
+    scene: Res<sim::ExtractedScene>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&VolumeState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
     let (w, h) = run.scenario.resolution;
     let camera = CameraBasis::new(&scene.scene.camera, w, h);
     let dirs = directions(&camera, w, h);
     for (state, info, mut frame) in &mut methods {
         let start = Instant::now();
-        let key = ImageKey { seed: run.scenario.seed as u32, frame: clock.global, spp: state.settings.spp };
-        let (estimates, timings) = state.pass.run(&gpu.0, &state.gpu_medium, camera.position, &dirs, w, state.settings.estimator, key).map_err(|e| method_failed(&info.label, clock.global, e))?;
+        let key = ImageKey {
+            seed: run.scenario.seed as u32,
+            frame: clock.global,
+            spp: state.settings.spp,
+        };
+        let (estimates, timings) = state
+            .pass
+            .run(
+                &gpu.0,
+                &state.gpu_medium,
+                camera.position,
+                &dirs,
+                w,
+                state.settings.estimator,
+                key,
+            )
+            .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let stats = reduce(&estimates, key.spp);
         let reference = exact(&state.medium, camera.position, &dirs);
         let n = dirs.len() as f64;
@@ -103,13 +131,35 @@ pub fn render(gpu: Res<GpuDevice>, run: Res<Run>, scene: Res<sim::ExtractedScene
         let lookups = stats.lookups.iter().map(|&l| f64::from(l)).sum::<f64>() / n;
         let rays = estimates.len() as u64;
         frame.output = Some(MethodOutput {
-            stats: vec![("lookups_per_estimate".into(), lookups), ("mean_abs_bias".into(), mean_abs_bias), ("mean_std".into(), mean_std)],
-            images: vec![
-                MethodImage { name: "bias".into(), pixels: bias.iter().map(|&b| gray(b)).collect(), hdr: true },
-                MethodImage { name: "std".into(), pixels: stats.std.iter().map(|&s| gray(s)).collect(), hdr: true },
-                MethodImage { name: "exact".into(), pixels: reference.iter().map(|&r| gray(r)).collect(), hdr: true },
+            stats: vec![
+                ("lookups_per_estimate".into(), lookups),
+                ("mean_abs_bias".into(), mean_abs_bias),
+                ("mean_std".into(), mean_std),
             ],
-            ..MethodOutput::timed(stats.mean.iter().map(|&m| gray(m)).collect(), vec![[0.0; 2]; dirs.len()], &timings, rays, rays)
+            images: vec![
+                MethodImage {
+                    name: "bias".into(),
+                    pixels: bias.iter().map(|&b| gray(b)).collect(),
+                    hdr: true,
+                },
+                MethodImage {
+                    name: "std".into(),
+                    pixels: stats.std.iter().map(|&s| gray(s)).collect(),
+                    hdr: true,
+                },
+                MethodImage {
+                    name: "exact".into(),
+                    pixels: reference.iter().map(|&r| gray(r)).collect(),
+                    hdr: true,
+                },
+            ],
+            ..MethodOutput::timed(
+                stats.mean.iter().map(|&m| gray(m)).collect(),
+                vec![[0.0; 2]; dirs.len()],
+                &timings,
+                rays,
+                rays,
+            )
         });
         frame.add_cpu(start);
     }

@@ -15,7 +15,9 @@ use serde::{Deserialize, Serialize};
 
 use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
 use crate::frame::media::{SceneMedium, render_volume};
-use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use crate::frame::{
+    FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
+};
 
 /// `VolumePath(spp: 4, mis: Jackknife, combination: Eq9)`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -39,13 +41,22 @@ impl VolumePathMethod {
     pub fn label(&self) -> String {
         let mis = match self.mis {
             MisWeight::None => "free_flight".to_string(),
-            w => format!("{}_{}", format!("{w:?}").to_lowercase(), format!("{:?}", self.combination).to_lowercase()),
+            w => format!(
+                "{}_{}",
+                format!("{w:?}").to_lowercase(),
+                format!("{:?}", self.combination).to_lowercase()
+            ),
         };
         format!("volume_pt_{mis}_{}spp", self.spp)
     }
 
     fn settings(&self) -> VolumePathSettings {
-        VolumePathSettings { mis: self.mis, combination: self.combination, samples: self.samples, ..Default::default() }
+        VolumePathSettings {
+            mis: self.mis,
+            combination: self.combination,
+            samples: self.samples,
+            ..Default::default()
+        }
     }
 }
 
@@ -77,7 +88,9 @@ impl MethodPlugin for Plugin {
             bail!("VolumePath: samples 0; expected at least 1 sample per optical-depth estimate");
         }
         if !world.contains_resource::<SceneMedium>() {
-            bail!("VolumePath: the scenario declares no media; expected media: [(name: ..., kind: ..., ...)]");
+            bail!(
+                "VolumePath: the scenario declares no media; expected media: [(name: ..., kind: ..., ...)]"
+            );
         }
         world.entity_mut(entity).insert(VolumePath(s.clone()));
         Ok(())
@@ -94,8 +107,16 @@ pub fn render(
 ) -> Result<(), BevyError> {
     for (method, info, mut frame) in &mut methods {
         let start = Instant::now();
-        let (radiance, timings, paths) =
-            render_volume(&gpu.0, &tracer, &mut medium, &method.0.settings(), method.0.spp, run.scenario.seed, clock.global).map_err(|e| method_failed(&info.label, clock.global, e))?;
+        let (radiance, timings, paths) = render_volume(
+            &gpu.0,
+            &tracer,
+            &mut medium,
+            &method.0.settings(),
+            method.0.spp,
+            run.scenario.seed,
+            clock.global,
+        )
+        .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let motion = vec![[0.0; 2]; radiance.len()];
         frame.output = Some(MethodOutput::timed(radiance, motion, &timings, paths, paths));
         frame.add_cpu(start);

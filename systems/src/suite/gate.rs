@@ -36,7 +36,13 @@ impl GateResult {
 }
 
 /// Judges `gate` for `method` of `case`; `baseline` is the blessed runs of the same case.
-pub fn judge(gate: &Gate, case: &str, method: &str, new: &CaseRuns, baseline: Option<&CaseRuns>) -> GateResult {
+pub fn judge(
+    gate: &Gate,
+    case: &str,
+    method: &str,
+    new: &CaseRuns,
+    baseline: Option<&CaseRuns>,
+) -> GateResult {
     let mut result = GateResult {
         case: case.into(),
         method: method.into(),
@@ -75,9 +81,16 @@ pub fn judge(gate: &Gate, case: &str, method: &str, new: &CaseRuns, baseline: Op
             let se = d.standard_error();
             let df = (d.n.max(2) - 1) as f64;
             // P(mean difference >= 0) under the t model; no spread: the sign decides.
-            let p_value = if se > 0.0 { 1.0 - super::student_t::cdf(-d.mean / se, df) } else if d.mean < 0.0 { 0.0 } else { 1.0 };
+            let p_value = if se > 0.0 {
+                1.0 - super::student_t::cdf(-d.mean / se, df)
+            } else if d.mean < 0.0 {
+                0.0
+            } else {
+                1.0
+            };
             result.p_value = Some(p_value);
-            result.verdict = if p_value < 1.0 - gate.confidence { Verdict::Pass } else { Verdict::Fail };
+            result.verdict =
+                if p_value < 1.0 - gate.confidence { Verdict::Pass } else { Verdict::Fail };
             result.detail = format!(
                 "{method} {:.5} vs {than} {:.5}; paired difference {:+.5} ± {se:.5} (standard error, {} seeds), p = {p_value:.4} (pass below {:.2})",
                 sample.mean,
@@ -91,7 +104,8 @@ pub fn judge(gate: &Gate, case: &str, method: &str, new: &CaseRuns, baseline: Op
             let limit = *limit;
             let worse = sign * (sample.mean - limit) > 0.0;
             result.verdict = if worse { Verdict::Fail } else { Verdict::Pass };
-            result.detail = format!("mean {:.5} over {} seeds, limit {limit}", sample.mean, sample.n);
+            result.detail =
+                format!("mean {:.5} over {} seeds, limit {limit}", sample.mean, sample.n);
         }
         Bound::Relative { tolerance } => {
             let tolerance = *tolerance;
@@ -99,7 +113,8 @@ pub fn judge(gate: &Gate, case: &str, method: &str, new: &CaseRuns, baseline: Op
                 Some(Ok(v)) => Sample::of(&v),
                 Some(Err(e)) => {
                     result.verdict = Verdict::Error(format!("baseline: {e}"));
-                    result.detail = format!("baseline: {e}; bless the suite again if the case changed");
+                    result.detail =
+                        format!("baseline: {e}; bless the suite again if the case changed");
                     return result;
                 }
                 None => {
@@ -113,7 +128,8 @@ pub fn judge(gate: &Gate, case: &str, method: &str, new: &CaseRuns, baseline: Op
             let margin = tolerance * base.mean.abs();
             let test = welch::one_sided(&signed(sample), &signed(base), margin);
             result.p_value = Some(test.p_value);
-            result.verdict = if test.worse(gate.confidence) { Verdict::Fail } else { Verdict::Pass };
+            result.verdict =
+                if test.worse(gate.confidence) { Verdict::Fail } else { Verdict::Pass };
             result.detail = format!(
                 "new {:.5} ± {:.5} vs baseline {:.5} ± {:.5} (standard errors); worse by {:+.5}, allowed {margin:.5}; Welch t = {:.2}, df = {:.1}, p = {:.4} (fail below {:.2})",
                 sample.mean,

@@ -4,13 +4,18 @@
 use super::gate::{GateResult, Verdict};
 
 fn escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;").replace('\'', "&apos;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+        .replace('\'', "&apos;")
 }
 
 pub fn report(suite: &str, results: &[GateResult]) -> String {
     let mut cases: Vec<&str> = results.iter().map(|r| r.case.as_str()).collect();
     cases.dedup();
-    let count = |v: &[&GateResult], f: fn(&Verdict) -> bool| v.iter().filter(|r| f(&r.verdict)).count();
+    let count =
+        |v: &[&GateResult], f: fn(&Verdict) -> bool| v.iter().filter(|r| f(&r.verdict)).count();
     let fail = |v: &Verdict| *v == Verdict::Fail;
     let error = |v: &Verdict| matches!(v, Verdict::Error(_));
     let all: Vec<&GateResult> = results.iter().collect();
@@ -32,11 +37,26 @@ pub fn report(suite: &str, results: &[GateResult]) -> String {
             count(&rows, error)
         ));
         for r in rows {
-            let head = format!("    <testcase classname=\"{}.{}.{}\" name=\"{}\"", escape(suite), escape(case), escape(&r.method), escape(&r.gate));
+            let head = format!(
+                "    <testcase classname=\"{}.{}.{}\" name=\"{}\"",
+                escape(suite),
+                escape(case),
+                escape(&r.method),
+                escape(&r.gate)
+            );
             match &r.verdict {
-                Verdict::Pass => out.push_str(&format!("{head}>\n      <system-out>{}</system-out>\n    </testcase>\n", escape(&r.detail))),
-                Verdict::Fail => out.push_str(&format!("{head}>\n      <failure message=\"{}\"/>\n    </testcase>\n", escape(&r.detail))),
-                Verdict::Error(e) => out.push_str(&format!("{head}>\n      <error message=\"{}\"/>\n    </testcase>\n", escape(e))),
+                Verdict::Pass => out.push_str(&format!(
+                    "{head}>\n      <system-out>{}</system-out>\n    </testcase>\n",
+                    escape(&r.detail)
+                )),
+                Verdict::Fail => out.push_str(&format!(
+                    "{head}>\n      <failure message=\"{}\"/>\n    </testcase>\n",
+                    escape(&r.detail)
+                )),
+                Verdict::Error(e) => out.push_str(&format!(
+                    "{head}>\n      <error message=\"{}\"/>\n    </testcase>\n",
+                    escape(e)
+                )),
             }
         }
         out.push_str("  </testsuite>\n");

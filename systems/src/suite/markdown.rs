@@ -2,12 +2,26 @@
 
 use super::gate::{GateResult, Verdict};
 
-pub fn summary(suite: &str, adapter: &str, baseline: Option<(&str, &str)>, results: &[GateResult]) -> String {
+pub fn summary(
+    suite: &str,
+    adapter: &str,
+    baseline: Option<(&str, &str)>,
+    results: &[GateResult],
+) -> String {
     let failed = results.iter().filter(|r| !r.passed()).count();
-    let mut out = format!("# Suite {suite}: {}\n\n", if failed == 0 { "passed".to_string() } else { format!("{failed} of {} checks failed", results.len()) });
+    let mut out = format!(
+        "# Suite {suite}: {}\n\n",
+        if failed == 0 {
+            "passed".to_string()
+        } else {
+            format!("{failed} of {} checks failed", results.len())
+        }
+    );
     out.push_str(&format!("Adapter: {adapter}\n\n"));
     match baseline {
-        Some((commit, date)) => out.push_str(&format!("Baseline: commit {commit}, blessed {date}\n\n")),
+        Some((commit, date)) => {
+            out.push_str(&format!("Baseline: commit {commit}, blessed {date}\n\n"))
+        }
         None => out.push_str("Baseline: none for this adapter (absolute gates only)\n\n"),
     }
     out.push_str("| result | case | method | gate | new mean | baseline mean | p | detail |\n|---|---|---|---|---:|---:|---:|---|\n");
@@ -19,7 +33,9 @@ pub fn summary(suite: &str, adapter: &str, baseline: Option<(&str, &str)>, resul
             Verdict::Fail => "**FAIL**",
             Verdict::Error(_) => "**ERROR**",
         };
-        let mean = |s: Option<super::welch::Sample>| s.map(|s| format!("{:.5}", s.mean)).unwrap_or_default();
+        let mean = |s: Option<super::welch::Sample>| {
+            s.map(|s| format!("{:.5}", s.mean)).unwrap_or_default()
+        };
         out.push_str(&format!(
             "| {verdict} | {} | {} | {} | {} | {} | {} | {} |\n",
             r.case,

@@ -35,9 +35,17 @@ impl SeedRun {
     }
 
     /// The mean of `metric` over the window's frames; `None` when no frame of it has a value.
-    pub fn window_mean(&self, method: &str, metric: Metric, range: std::ops::Range<u32>) -> Option<f64> {
+    pub fn window_mean(
+        &self,
+        method: &str,
+        metric: Metric,
+        range: std::ops::Range<u32>,
+    ) -> Option<f64> {
         let series = self.methods.get(method)?.get(metric.name())?;
-        let values: Vec<f64> = range.filter_map(|f| series.get(f as usize).copied().flatten()).filter(|v| v.is_finite()).collect();
+        let values: Vec<f64> = range
+            .filter_map(|f| series.get(f as usize).copied().flatten())
+            .filter(|v| v.is_finite())
+            .collect();
         (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
     }
 }
@@ -53,19 +61,34 @@ pub struct CaseRuns {
 
 impl CaseRuns {
     pub fn methods(&self) -> Vec<String> {
-        let mut out: Vec<String> = self.seeds.iter().flat_map(|s| s.methods.keys().cloned()).collect();
+        let mut out: Vec<String> =
+            self.seeds.iter().flat_map(|s| s.methods.keys().cloned()).collect();
         out.sort();
         out.dedup();
         out
     }
 
     /// One value per seed: the window mean of `metric` for `method`; an error says what is missing.
-    pub fn per_seed(&self, method: &str, metric: Metric, window: &Window) -> Result<Vec<f64>, String> {
-        let range = window
-            .frames(self.frames, &self.events)
-            .ok_or_else(|| format!("window {} needs event {:?}, but the case has {} event(s)", window.name(), window.event(), self.events.len()))?;
+    pub fn per_seed(
+        &self,
+        method: &str,
+        metric: Metric,
+        window: &Window,
+    ) -> Result<Vec<f64>, String> {
+        let range = window.frames(self.frames, &self.events).ok_or_else(|| {
+            format!(
+                "window {} needs event {:?}, but the case has {} event(s)",
+                window.name(),
+                window.event(),
+                self.events.len()
+            )
+        })?;
         if range.is_empty() {
-            return Err(format!("window {} holds no frames ({range:?} of {} frames)", window.name(), self.frames));
+            return Err(format!(
+                "window {} holds no frames ({range:?} of {} frames)",
+                window.name(),
+                self.frames
+            ));
         }
         self.seeds
             .iter()

@@ -24,8 +24,16 @@ pub enum Metric {
 }
 
 impl Metric {
-    pub const ALL: [Metric; 8] =
-        [Metric::Flip, Metric::Smape, Metric::SmapeReprojected, Metric::Mse, Metric::RelMse, Metric::Psnr, Metric::PathLength, Metric::MeanAbsBias];
+    pub const ALL: [Metric; 8] = [
+        Metric::Flip,
+        Metric::Smape,
+        Metric::SmapeReprojected,
+        Metric::Mse,
+        Metric::RelMse,
+        Metric::Psnr,
+        Metric::PathLength,
+        Metric::MeanAbsBias,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -54,7 +62,9 @@ impl Metric {
             Metric::RelMse => r.rel_mse,
             Metric::Psnr => r.psnr,
             // Method stats, by the name the method reports them under.
-            Metric::PathLength | Metric::MeanAbsBias => r.stats.iter().find(|(n, _)| n == self.name()).map(|s| s.1),
+            Metric::PathLength | Metric::MeanAbsBias => {
+                r.stats.iter().find(|(n, _)| n == self.name()).map(|s| s.1)
+            }
         }
     }
 }

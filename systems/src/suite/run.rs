@@ -49,7 +49,10 @@ struct Prepared {
 
 fn prepare(opts: &SuiteOptions) -> Result<Prepared> {
     let suite = Suite::load(&opts.suite)?;
-    let folder = opts.out.clone().unwrap_or_else(|| PathBuf::from("runs").join(format!("suite_{}", suite.name)));
+    let folder = opts
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("runs").join(format!("suite_{}", suite.name)));
     let baselines = opts.baselines.clone().unwrap_or_else(|| suite.baseline_file());
     // The adapter keys the baseline; asked before anything plays so that a missing baseline
     // is reported at once.
@@ -59,16 +62,32 @@ fn prepare(opts: &SuiteOptions) -> Result<Prepared> {
 
 /// A case's run at one seed, its methods filtered; input errors point at the case's line in
 /// `origin` (the suite or sweep file).
-pub(crate) fn case_spec(origin: &Path, case: &Case, seed: u64, out: &Path) -> Result<(RunSpec, Overrides)> {
+pub(crate) fn case_spec(
+    origin: &Path,
+    case: &Case,
+    seed: u64,
+    out: &Path,
+) -> Result<(RunSpec, Overrides)> {
     let (line, column) = case.entry.as_ref().map_or((1, 1), |e| (e.line, e.column));
     let at = format!("{}:{line}:{column}: case '{}'", origin.display(), case.name);
-    let overrides = Overrides { frames: case.frames, resolution: case.resolution, spp: case.spp, seed: Some(seed), out: Some(out.to_path_buf()) };
+    let overrides = Overrides {
+        frames: case.frames,
+        resolution: case.resolution,
+        spp: case.spp,
+        seed: Some(seed),
+        out: Some(out.to_path_buf()),
+    };
     let scenario = sim::Scenario::load(&case.scenario).map_err(|e| anyhow!("{at}: {e}"))?;
-    let mut spec = RunSpec::from_scenario(scenario, &overrides).map_err(|e| anyhow!("{at}: {e}"))?;
+    let mut spec =
+        RunSpec::from_scenario(scenario, &overrides).map_err(|e| anyhow!("{at}: {e}"))?;
     if let Some(keep) = &case.methods {
         let labels: Vec<String> = spec.methods.iter().map(|m| m.label()).collect();
         if let Some(unknown) = keep.iter().find(|k| !labels.contains(k)) {
-            bail!("{at}: no method labelled '{unknown}' in {}; its methods are: {}", case.scenario.display(), labels.join(", "));
+            bail!(
+                "{at}: no method labelled '{unknown}' in {}; its methods are: {}",
+                case.scenario.display(),
+                labels.join(", ")
+            );
         }
         spec.methods.retain(|m| keep.contains(&m.label()));
     }
@@ -78,7 +97,12 @@ pub(crate) fn case_spec(origin: &Path, case: &Case, seed: u64, out: &Path) -> Re
 /// Event frames in recorded frames: warm-up subtracted, events at one frame counted once.
 fn event_frames(spec: &RunSpec) -> Vec<u32> {
     let s = &spec.scenario;
-    let mut frames: Vec<u32> = s.events_summary().into_iter().filter_map(|(f, _)| f.checked_sub(s.warmup_frames)).filter(|&f| f < s.frames).collect();
+    let mut frames: Vec<u32> = s
+        .events_summary()
+        .into_iter()
+        .filter_map(|(f, _)| f.checked_sub(s.warmup_frames))
+        .filter(|&f| f < s.frames)
+        .collect();
     frames.sort_unstable();
     frames.dedup();
     frames
@@ -98,8 +122,14 @@ fn play(p: &Prepared, opts: &SuiteOptions) -> Result<BTreeMap<String, CaseRuns>>
     let mut cases: BTreeMap<String, CaseRuns> = BTreeMap::new();
     for (case, seed, spec, overrides) in specs {
         eprintln!("suite {}: case {} seed {seed}", p.suite.name, case.name);
-        let run_opts = RunOptions { scenario: case.scenario.clone(), overrides, cache_dir: opts.cache_dir.clone(), progress: opts.progress };
-        let summary = run_spec(&spec, &run_opts).map_err(|e| anyhow!("case '{}' seed {seed}: {e:#}", case.name))?;
+        let run_opts = RunOptions {
+            scenario: case.scenario.clone(),
+            overrides,
+            cache_dir: opts.cache_dir.clone(),
+            progress: opts.progress,
+        };
+        let summary = run_spec(&spec, &run_opts)
+            .map_err(|e| anyhow!("case '{}' seed {seed}: {e:#}", case.name))?;
         let runs = cases.entry(case.name.clone()).or_default();
         runs.frames = spec.scenario.frames;
         runs.events = event_frames(&spec);
@@ -109,7 +139,11 @@ fn play(p: &Prepared, opts: &SuiteOptions) -> Result<BTreeMap<String, CaseRuns>>
 }
 
 fn bless_hint(p: &Prepared, opts: &SuiteOptions) -> String {
-    format!("record one with `flicker suite bless {}` on this adapter and commit {}", opts.suite.display(), p.baselines.display())
+    format!(
+        "record one with `flicker suite bless {}` on this adapter and commit {}",
+        opts.suite.display(),
+        p.baselines.display()
+    )
 }
 
 /// `flicker suite run`: plays the suite and judges its gates; writes summary.md and junit.xml.
@@ -134,14 +168,22 @@ pub fn run(opts: &SuiteOptions) -> Result<SuiteOutcome> {
     for gate in &p.suite.gates {
         for (name, runs) in &cases {
             for method in runs.methods().iter().filter(|m| gate.applies_to(name, m)) {
-                results.push(judge(gate, name, method, runs, baseline.and_then(|b| b.cases.get(name))));
+                results.push(judge(
+                    gate,
+                    name,
+                    method,
+                    runs,
+                    baseline.and_then(|b| b.cases.get(name)),
+                ));
             }
         }
     }
     // A gate that names a method no case ran would otherwise pass silently.
     for gate in &p.suite.gates {
         for method in gate.methods.iter().flatten() {
-            if !cases.iter().any(|(name, runs)| gate.applies_to(name, method) && runs.methods().contains(method)) {
+            if !cases.iter().any(|(name, runs)| {
+                gate.applies_to(name, method) && runs.methods().contains(method)
+            }) {
                 let (line, _) = gate.entry.as_ref().map_or((1, 1), |e| (e.line, e.column));
                 results.push(GateResult {
                     case: "-".into(),
@@ -150,13 +192,24 @@ pub fn run(opts: &SuiteOptions) -> Result<SuiteOutcome> {
                     new: None,
                     baseline: None,
                     p_value: None,
-                    verdict: super::gate::Verdict::Error(format!("{}:{line}: no case ran method '{method}'", opts.suite.display())),
-                    detail: format!("{}:{line}: no case ran method '{method}'", opts.suite.display()),
+                    verdict: super::gate::Verdict::Error(format!(
+                        "{}:{line}: no case ran method '{method}'",
+                        opts.suite.display()
+                    )),
+                    detail: format!(
+                        "{}:{line}: no case ran method '{method}'",
+                        opts.suite.display()
+                    ),
                 });
             }
         }
     }
-    let md = markdown::summary(&p.suite.name, &key, baseline.map(|b| (b.commit.as_str(), b.date.as_str())), &results);
+    let md = markdown::summary(
+        &p.suite.name,
+        &key,
+        baseline.map(|b| (b.commit.as_str(), b.date.as_str())),
+        &results,
+    );
     let summary = p.folder.join("summary.md");
     let junit_path = p.folder.join("junit.xml");
     crate::output::write_text(&summary, &md)?;

@@ -75,15 +75,20 @@ impl Gate {
     /// A short name: `flip after_event_0(2) relative 10%`.
     pub fn describe(&self) -> String {
         let bound = match self.bound {
-            Bound::Absolute { limit } => format!("{} {limit}", if self.metric.higher_is_better() { ">=" } else { "<=" }),
-            Bound::Relative { tolerance } => format!("within {:.1}% of baseline", tolerance * 100.0),
+            Bound::Absolute { limit } => {
+                format!("{} {limit}", if self.metric.higher_is_better() { ">=" } else { "<=" })
+            }
+            Bound::Relative { tolerance } => {
+                format!("within {:.1}% of baseline", tolerance * 100.0)
+            }
             Bound::Better { ref than } => format!("better than {than}"),
         };
         format!("{} {} {bound}", self.metric.name(), self.window.name())
     }
 
     pub fn applies_to(&self, case: &str, method: &str) -> bool {
-        self.cases.as_ref().is_none_or(|c| c.iter().any(|n| n == case)) && self.methods.as_ref().is_none_or(|m| m.iter().any(|n| n == method))
+        self.cases.as_ref().is_none_or(|c| c.iter().any(|n| n == case))
+            && self.methods.as_ref().is_none_or(|m| m.iter().any(|n| n == method))
     }
 }
 
@@ -111,21 +116,47 @@ fn options() -> ron::Options {
 
 /// The `cases` of a suite or sweep file: each parsed at its place in the file, seeds checked,
 /// names distinct, scenario paths resolved against the file's folder.
-pub(crate) fn parse_cases(text: &str, raw: &[Box<ron::value::RawValue>], origin: &Path) -> Result<Vec<Case>, ScenarioError> {
-    let error = |position: Option<(usize, usize)>, message: String| ScenarioError { file: origin.to_path_buf(), position, message };
+pub(crate) fn parse_cases(
+    text: &str,
+    raw: &[Box<ron::value::RawValue>],
+    origin: &Path,
+) -> Result<Vec<Case>, ScenarioError> {
+    let error = |position: Option<(usize, usize)>, message: String| ScenarioError {
+        file: origin.to_path_buf(),
+        position,
+        message,
+    };
     let at = |entry: &MethodEntry| Some((entry.line, entry.column));
     let folder = origin.parent().unwrap_or(Path::new(""));
     let mut cases: Vec<Case> = Vec::new();
     for entry in raw_entries(text, "cases", raw) {
-        let mut case: Case = options().from_str(&entry.text).map_err(|e| error(Some(entry.position_in_file(e.span.start.line, e.span.start.col)), e.code.to_string()))?;
+        let mut case: Case = options().from_str(&entry.text).map_err(|e| {
+            error(
+                Some(entry.position_in_file(e.span.start.line, e.span.start.col)),
+                e.code.to_string(),
+            )
+        })?;
         if case.seeds.is_empty() {
-            return Err(error(at(&entry), format!("case '{}' has no seeds; expected e.g. seeds: [1, 2, 3]", case.name)));
+            return Err(error(
+                at(&entry),
+                format!("case '{}' has no seeds; expected e.g. seeds: [1, 2, 3]", case.name),
+            ));
         }
-        if let Some(dup) = case.seeds.iter().enumerate().find(|(i, s)| case.seeds[..*i].contains(s)) {
-            return Err(error(at(&entry), format!("case '{}' lists seed {} twice; expected distinct seeds", case.name, dup.1)));
+        if let Some(dup) = case.seeds.iter().enumerate().find(|(i, s)| case.seeds[..*i].contains(s))
+        {
+            return Err(error(
+                at(&entry),
+                format!("case '{}' lists seed {} twice; expected distinct seeds", case.name, dup.1),
+            ));
         }
         if cases.iter().any(|c| c.name == case.name) {
-            return Err(error(at(&entry), format!("two cases are named '{}'; expected distinct names (they name run folders and baselines)", case.name)));
+            return Err(error(
+                at(&entry),
+                format!(
+                    "two cases are named '{}'; expected distinct names (they name run folders and baselines)",
+                    case.name
+                ),
+            ));
         }
         if case.scenario.is_relative() {
             case.scenario = folder.join(&case.scenario);
@@ -141,17 +172,30 @@ pub(crate) fn parse_cases(text: &str, raw: &[Box<ron::value::RawValue>], origin:
 
 impl Suite {
     pub fn load(path: &Path) -> Result<Suite, ScenarioError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| ScenarioError { file: path.to_path_buf(), position: None, message: format!("cannot read suite file: {e}") })?;
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
+            file: path.to_path_buf(),
+            position: None,
+            message: format!("cannot read suite file: {e}"),
+        })?;
         Self::from_ron(&text, path)
     }
 
     pub fn from_ron(text: &str, origin: &Path) -> Result<Suite, ScenarioError> {
-        let error = |position: Option<(usize, usize)>, message: String| ScenarioError { file: origin.to_path_buf(), position, message };
-        let file: SuiteFile = options().from_str(text).map_err(|e| error(Some((e.span.start.line, e.span.start.col)), e.code.to_string()))?;
+        let error = |position: Option<(usize, usize)>, message: String| ScenarioError {
+            file: origin.to_path_buf(),
+            position,
+            message,
+        };
+        let file: SuiteFile = options()
+            .from_str(text)
+            .map_err(|e| error(Some((e.span.start.line, e.span.start.col)), e.code.to_string()))?;
         // An entry's own errors: positions inside the entry moved to the file's.
-        fn parse<T: serde::de::DeserializeOwned>(entry: &MethodEntry) -> Result<T, ((usize, usize), String)> {
-            options().from_str(&entry.text).map_err(|e| (entry.position_in_file(e.span.start.line, e.span.start.col), e.code.to_string()))
+        fn parse<T: serde::de::DeserializeOwned>(
+            entry: &MethodEntry,
+        ) -> Result<T, ((usize, usize), String)> {
+            options().from_str(&entry.text).map_err(|e| {
+                (entry.position_in_file(e.span.start.line, e.span.start.col), e.code.to_string())
+            })
         }
         let at = |entry: &MethodEntry| Some((entry.line, entry.column));
         let cases = parse_cases(text, &file.cases, origin)?;
@@ -160,21 +204,53 @@ impl Suite {
         for entry in raw_entries(text, "gates", &file.gates) {
             let mut gate: Gate = parse(&entry).map_err(|(pos, m)| error(Some(pos), m))?;
             if !(gate.confidence > 0.5 && gate.confidence < 1.0) {
-                return Err(error(at(&entry), format!("confidence {}; expected a probability between 0.5 and 1, e.g. 0.95", gate.confidence)));
+                return Err(error(
+                    at(&entry),
+                    format!(
+                        "confidence {}; expected a probability between 0.5 and 1, e.g. 0.95",
+                        gate.confidence
+                    ),
+                ));
             }
             match gate.bound {
-                Bound::Relative { tolerance: t } if !(t.is_finite() && t >= 0.0) => return Err(error(at(&entry), format!("tolerance {t}; expected a fraction >= 0, e.g. 0.05 for 5%"))),
-                Bound::Absolute { limit: l } if !l.is_finite() => return Err(error(at(&entry), format!("limit {l}; expected a finite number"))),
+                Bound::Relative { tolerance: t } if !(t.is_finite() && t >= 0.0) => {
+                    return Err(error(
+                        at(&entry),
+                        format!("tolerance {t}; expected a fraction >= 0, e.g. 0.05 for 5%"),
+                    ));
+                }
+                Bound::Absolute { limit: l } if !l.is_finite() => {
+                    return Err(error(at(&entry), format!("limit {l}; expected a finite number")));
+                }
                 _ => {}
             }
-            if let Some(unknown) = gate.cases.iter().flatten().find(|c| !names.contains(c.as_str())) {
-                return Err(error(at(&entry), format!("gate names case '{unknown}'; the suite's cases are: {}", names.iter().copied().collect::<Vec<_>>().join(", "))));
+            if let Some(unknown) = gate.cases.iter().flatten().find(|c| !names.contains(c.as_str()))
+            {
+                return Err(error(
+                    at(&entry),
+                    format!(
+                        "gate names case '{unknown}'; the suite's cases are: {}",
+                        names.iter().copied().collect::<Vec<_>>().join(", ")
+                    ),
+                ));
             }
             if matches!(gate.bound, Bound::Relative { .. } | Bound::Better { .. })
-                && let Some(case) = cases.iter().find(|c| c.seeds.len() < 2 && gate.cases.as_ref().is_none_or(|g| g.contains(&c.name)))
+                && let Some(case) = cases.iter().find(|c| {
+                    c.seeds.len() < 2 && gate.cases.as_ref().is_none_or(|g| g.contains(&c.name))
+                })
             {
-                let kind = if matches!(gate.bound, Bound::Better { .. }) { "relation" } else { "relative" };
-                return Err(error(at(&entry), format!("a {kind} gate needs the spread over seeds, but case '{}' has one seed; expected at least 2", case.name)));
+                let kind = if matches!(gate.bound, Bound::Better { .. }) {
+                    "relation"
+                } else {
+                    "relative"
+                };
+                return Err(error(
+                    at(&entry),
+                    format!(
+                        "a {kind} gate needs the spread over seeds, but case '{}' has one seed; expected at least 2",
+                        case.name
+                    ),
+                ));
             }
             gate.entry = Some(entry);
             gates.push(gate);
@@ -182,12 +258,21 @@ impl Suite {
         if gates.is_empty() {
             return Err(error(None, "no gates; expected e.g. gates: [(metric: Flip, window: Overall, bound: Relative(tolerance: 0.05))]".into()));
         }
-        let name = file.name.unwrap_or_else(|| origin.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "suite".into()));
+        let name = file.name.unwrap_or_else(|| {
+            origin
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "suite".into())
+        });
         Ok(Suite { name, cases, gates, origin: origin.to_path_buf() })
     }
 
     /// Where baselines of this suite live: `baselines/NAME.json` next to the suite file.
     pub fn baseline_file(&self) -> PathBuf {
-        self.origin.parent().unwrap_or(Path::new("")).join("baselines").join(format!("{}.json", self.name))
+        self.origin
+            .parent()
+            .unwrap_or(Path::new(""))
+            .join("baselines")
+            .join(format!("{}.json", self.name))
     }
 }

@@ -36,7 +36,10 @@ fn beta_continued_fraction(a: f64, b: f64, x: f64) -> f64 {
     for m in 1..=300 {
         let m = m as f64;
         let m2 = 2.0 * m;
-        for aa in [m * (b - m) * x / ((qam + m2) * (a + m2)), -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2))] {
+        for aa in [
+            m * (b - m) * x / ((qam + m2) * (a + m2)),
+            -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2)),
+        ] {
             d = 1.0 + aa * d;
             d = if d.abs() < TINY { TINY } else { d };
             c = 1.0 + aa / c;
@@ -60,9 +63,14 @@ pub fn incomplete_beta(a: f64, b: f64, x: f64) -> f64 {
     if x >= 1.0 {
         return 1.0;
     }
-    let front = (ln_gamma(a + b) - ln_gamma(a) - ln_gamma(b) + a * x.ln() + b * (1.0 - x).ln()).exp();
+    let front =
+        (ln_gamma(a + b) - ln_gamma(a) - ln_gamma(b) + a * x.ln() + b * (1.0 - x).ln()).exp();
     // The fraction converges fast for x < (a + 1) / (a + b + 2); use the symmetry otherwise.
-    if x < (a + 1.0) / (a + b + 2.0) { front * beta_continued_fraction(a, b, x) / a } else { 1.0 - front * beta_continued_fraction(b, a, 1.0 - x) / b }
+    if x < (a + 1.0) / (a + b + 2.0) {
+        front * beta_continued_fraction(a, b, x) / a
+    } else {
+        1.0 - front * beta_continued_fraction(b, a, 1.0 - x) / b
+    }
 }
 
 /// P(T <= t) for Student's t with `df` degrees of freedom (df may be fractional, as Welch's is).
@@ -101,7 +109,15 @@ mod tests {
     // Quantiles from the standard t table (e.g. NIST/SEMATECH e-Handbook, table 1.3.6.7.2).
     #[test]
     fn quantiles_match_the_t_table() {
-        for (p, df, t) in [(0.95, 1.0, 6.314), (0.95, 2.0, 2.920), (0.95, 4.0, 2.132), (0.95, 10.0, 1.812), (0.975, 5.0, 2.571), (0.99, 20.0, 2.528), (0.95, 100.0, 1.660)] {
+        for (p, df, t) in [
+            (0.95, 1.0, 6.314),
+            (0.95, 2.0, 2.920),
+            (0.95, 4.0, 2.132),
+            (0.95, 10.0, 1.812),
+            (0.975, 5.0, 2.571),
+            (0.99, 20.0, 2.528),
+            (0.95, 100.0, 1.660),
+        ] {
             let q = quantile(p, df);
             assert!((q - t).abs() < 5e-4, "t quantile p={p} df={df}: {q}, table {t}");
         }

@@ -16,7 +16,11 @@ impl Sample {
     pub fn of(values: &[f64]) -> Sample {
         let n = values.len();
         let mean = values.iter().sum::<f64>() / n as f64;
-        let variance = if n > 1 { values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1) as f64 } else { 0.0 };
+        let variance = if n > 1 {
+            values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1) as f64
+        } else {
+            0.0
+        };
         Sample { mean, variance, n }
     }
 
@@ -56,7 +60,13 @@ pub fn one_sided(new: &Sample, baseline: &Sample, margin: f64) -> Welch {
         // No spread in either group (a deterministic adapter, the same seeds): the difference is
         // known exactly.
         let p_value = if excess > 0.0 { 0.0 } else { 1.0 };
-        return Welch { difference, standard_error: 0.0, df: f64::INFINITY, t: if excess > 0.0 { f64::INFINITY } else { f64::NEG_INFINITY }, p_value };
+        return Welch {
+            difference,
+            standard_error: 0.0,
+            df: f64::INFINITY,
+            t: if excess > 0.0 { f64::INFINITY } else { f64::NEG_INFINITY },
+            p_value,
+        };
     }
     let term = |v: f64, n: usize| if n > 1 { v * v / (n - 1) as f64 } else { 0.0 };
     let df = se2 * se2 / (term(a, new.n) + term(b, baseline.n)).max(f64::MIN_POSITIVE);

@@ -36,7 +36,9 @@ impl Window {
     pub fn event(&self) -> Option<usize> {
         match self {
             Window::Overall | Window::Steady { event: None, .. } => None,
-            Window::Before { event: e } | Window::After { event: e, .. } | Window::Steady { event: Some(e), .. } => Some(*e),
+            Window::Before { event: e }
+            | Window::After { event: e, .. }
+            | Window::Steady { event: Some(e), .. } => Some(*e),
         }
     }
 
@@ -49,7 +51,9 @@ impl Window {
             Window::Overall => 0..frames,
             Window::Before { event: e } => 0..event(e)?,
             Window::After { event: e, frames: n } => event(e)?..(event(e)? + n).min(frames),
-            Window::Steady { event: None, skip } => skip.min(frames)..events.first().copied().unwrap_or(frames),
+            Window::Steady { event: None, skip } => {
+                skip.min(frames)..events.first().copied().unwrap_or(frames)
+            }
             Window::Steady { event: Some(e), skip } => (event(e)? + skip).min(frames)..next(e),
         };
         Some(range)

@@ -57,7 +57,10 @@ pub fn numbers(records: &[FrameRecord]) -> BTreeMap<String, MethodNumbers> {
         .into_iter()
         .map(|(label, mut rows)| {
             rows.sort_by_key(|r| r.frame);
-            let metrics = Metric::ALL.iter().map(|m| (m.name().to_string(), mean(rows.iter().map(|r| m.of(r))))).collect();
+            let metrics = Metric::ALL
+                .iter()
+                .map(|m| (m.name().to_string(), mean(rows.iter().map(|r| m.of(r)))))
+                .collect();
             let numbers = MethodNumbers {
                 metrics,
                 rays_per_frame: mean(rows.iter().map(|r| r.rays.map(|x| x as f64))),
@@ -70,16 +73,32 @@ pub fn numbers(records: &[FrameRecord]) -> BTreeMap<String, MethodNumbers> {
 
 pub fn run_job(dir: &Path, index: usize, progress: bool) -> Result<JobRecord> {
     let plan = Plan::load(dir)?;
-    let job = plan.jobs.get(index).ok_or_else(|| anyhow!("{}: no job {index}; the plan has jobs 0-{}", dir.display(), plan.jobs.len().saturating_sub(1)))?;
+    let job = plan.jobs.get(index).ok_or_else(|| {
+        anyhow!(
+            "{}: no job {index}; the plan has jobs 0-{}",
+            dir.display(),
+            plan.jobs.len().saturating_sub(1)
+        )
+    })?;
     let done = done_file(dir, index);
     if done.exists() {
         std::fs::remove_file(&done)?;
     }
     let (spec, overrides) = job.spec(&plan, dir)?;
-    eprintln!("sweep {}: job {index}: case {} {} seed {}", plan.sweep, job.case, job.point, job.seed);
+    eprintln!(
+        "sweep {}: job {index}: case {} {} seed {}",
+        plan.sweep, job.case, job.point, job.seed
+    );
     let start = Instant::now();
-    let opts = RunOptions { scenario: job.scenario.clone(), overrides, cache_dir: Some(plan.cache_dir(dir)), progress };
-    let summary = run_spec(&spec, &opts).map_err(|e| anyhow!("job {index} (case {} {} seed {}): {e:#}", job.case, job.point, job.seed))?;
+    let opts = RunOptions {
+        scenario: job.scenario.clone(),
+        overrides,
+        cache_dir: Some(plan.cache_dir(dir)),
+        progress,
+    };
+    let summary = run_spec(&spec, &opts).map_err(|e| {
+        anyhow!("job {index} (case {} {} seed {}): {e:#}", job.case, job.point, job.seed)
+    })?;
     let record = JobRecord {
         index,
         case: job.case.clone(),

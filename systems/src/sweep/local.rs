@@ -18,7 +18,12 @@ pub struct LocalOutcome {
 /// Runs the jobs without a record (all of them with `again`), `jobs` processes at a time.
 pub fn run_local(dir: &Path, exe: &Path, jobs: usize, again: bool) -> Result<LocalOutcome> {
     let plan = Plan::load(dir)?;
-    let pending: Vec<usize> = plan.jobs.iter().map(|j| j.index).filter(|&i| again || !done_file(dir, i).exists()).collect();
+    let pending: Vec<usize> = plan
+        .jobs
+        .iter()
+        .map(|j| j.index)
+        .filter(|&i| again || !done_file(dir, i).exists())
+        .collect();
     std::fs::create_dir_all(dir.join("logs"))?;
     let next = AtomicUsize::new(0);
     let failed = Mutex::new(Vec::new());
@@ -42,7 +47,11 @@ pub fn run_local(dir: &Path, exe: &Path, jobs: usize, again: bool) -> Result<Loc
                         Ok(status.success())
                     })()
                     .unwrap_or(false);
-                    eprintln!("sweep {}: job {index} {}", plan.sweep, if ok { "done" } else { "FAILED" });
+                    eprintln!(
+                        "sweep {}: job {index} {}",
+                        plan.sweep,
+                        if ok { "done" } else { "FAILED" }
+                    );
                     if !ok {
                         failed.lock().unwrap().push(index);
                     }

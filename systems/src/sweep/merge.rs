@@ -29,7 +29,11 @@ impl Stat {
         }
         let n = values.len() as f64;
         let mean = values.iter().sum::<f64>() / n;
-        let sd = if values.len() > 1 { (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt() } else { 0.0 };
+        let sd = if values.len() > 1 {
+            (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+        } else {
+            0.0
+        };
         Some(Stat { mean, sd, per_seed: values })
     }
 }
@@ -77,7 +81,8 @@ pub struct Merged {
 
 /// The records of every job; a missing one is an error naming the commands that rerun it.
 fn records(dir: &Path, plan: &Plan) -> Result<Vec<JobRecord>> {
-    let missing: Vec<usize> = plan.jobs.iter().map(|j| j.index).filter(|&i| !done_file(dir, i).exists()).collect();
+    let missing: Vec<usize> =
+        plan.jobs.iter().map(|j| j.index).filter(|&i| !done_file(dir, i).exists()).collect();
     if !missing.is_empty() {
         let list = missing.iter().map(usize::to_string).collect::<Vec<_>>().join(",");
         bail!(
@@ -91,7 +96,8 @@ fn records(dir: &Path, plan: &Plan) -> Result<Vec<JobRecord>> {
         .iter()
         .map(|j| {
             let path = done_file(dir, j.index);
-            let r: JobRecord = serde_json::from_str(&std::fs::read_to_string(&path)?).with_context(|| format!("parsing {}", path.display()))?;
+            let r: JobRecord = serde_json::from_str(&std::fs::read_to_string(&path)?)
+                .with_context(|| format!("parsing {}", path.display()))?;
             Ok(r)
         })
         .collect()
@@ -102,7 +108,10 @@ pub fn merge(dir: &Path) -> Result<Merged> {
     let records = records(dir, &plan)?;
     // Configurations in job order.
     let mut order: Vec<(String, String, String)> = Vec::new();
-    let mut groups: BTreeMap<(String, String, String), Vec<(&JobRecord, &super::job::MethodNumbers)>> = BTreeMap::new();
+    let mut groups: BTreeMap<
+        (String, String, String),
+        Vec<(&JobRecord, &super::job::MethodNumbers)>,
+    > = BTreeMap::new();
     for r in &records {
         for (method, numbers) in &r.methods {
             let key = (r.case.clone(), r.point.clone(), method.clone());
@@ -122,11 +131,14 @@ pub fn merge(dir: &Path) -> Result<Merged> {
             let metrics = metric_names
                 .into_iter()
                 .map(|m| {
-                    let values: Option<Vec<f64>> = rows.iter().map(|(_, n)| n.metrics.get(&m).copied().flatten()).collect();
+                    let values: Option<Vec<f64>> =
+                        rows.iter().map(|(_, n)| n.metrics.get(&m).copied().flatten()).collect();
                     (m, values.and_then(Stat::of))
                 })
                 .collect();
-            let all = |f: fn(&super::job::MethodNumbers) -> Option<f64>| rows.iter().map(|(_, n)| f(n)).collect::<Option<Vec<f64>>>().and_then(Stat::of);
+            let all = |f: fn(&super::job::MethodNumbers) -> Option<f64>| {
+                rows.iter().map(|(_, n)| f(n)).collect::<Option<Vec<f64>>>().and_then(Stat::of)
+            };
             let mut label = Vec::new();
             if many_cases {
                 label.push(key.0.clone());
@@ -150,10 +162,15 @@ pub fn merge(dir: &Path) -> Result<Merged> {
         })
         .collect();
     // Accuracy: FLIP against the reference where every configuration has it.
-    let has = |m: &str| configurations.iter().all(|c| c.metrics.get(m).is_some_and(Option::is_some));
-    let accuracy = ["flip", "mse", "smape"].into_iter().find(|m| has(m)).unwrap_or("flip").to_string();
+    let has =
+        |m: &str| configurations.iter().all(|c| c.metrics.get(m).is_some_and(Option::is_some));
+    let accuracy =
+        ["flip", "mse", "smape"].into_iter().find(|m| has(m)).unwrap_or("flip").to_string();
     let point_of = |c: &Configuration| -> (f64, f64) {
-        (c.timing.ms_per_frame.as_ref().map_or(f64::NAN, |s| s.mean), c.metrics.get(&accuracy).cloned().flatten().map_or(f64::NAN, |s| s.mean))
+        (
+            c.timing.ms_per_frame.as_ref().map_or(f64::NAN, |s| s.mean),
+            c.metrics.get(&accuracy).cloned().flatten().map_or(f64::NAN, |s| s.mean),
+        )
     };
     let points: Vec<(f64, f64)> = configurations.iter().map(point_of).collect();
     let front = pareto_front(&points);
@@ -161,7 +178,13 @@ pub fn merge(dir: &Path) -> Result<Merged> {
         let p = point_of(c);
         c.timing.on_pareto_front = front.contains(&p);
     }
-    let summary = SweepSummary { sweep: plan.sweep.clone(), file: plan.file.clone(), jobs: plan.jobs.len(), accuracy: accuracy.clone(), configurations };
+    let summary = SweepSummary {
+        sweep: plan.sweep.clone(),
+        file: plan.file.clone(),
+        jobs: plan.jobs.len(),
+        accuracy: accuracy.clone(),
+        configurations,
+    };
     let summary_file = dir.join("summary.json");
     crate::output::write_json(&summary_file, &summary)?;
 
@@ -170,7 +193,12 @@ pub fn merge(dir: &Path) -> Result<Merged> {
         x_label: "mean ms per frame".into(),
         y_label: format!("mean {accuracy}"),
         kind: Kind::Scatter,
-        series: summary.configurations.iter().zip(&points).map(|(c, p)| Series { name: c.label.clone(), points: vec![*p] }).collect(),
+        series: summary
+            .configurations
+            .iter()
+            .zip(&points)
+            .map(|(c, p)| Series { name: c.label.clone(), points: vec![*p] })
+            .collect(),
         events: vec![],
         pareto: front,
         x_extent: vec![],

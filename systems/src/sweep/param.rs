@@ -11,12 +11,18 @@ use crate::methods::{Method, MethodSpec};
 pub fn set(method: &mut Method, path: &[&str], value: &Value) -> Result<(), String> {
     let mut tree = serde_json::to_value(&method.spec).map_err(|e| e.to_string())?;
     // The settings must survive the round trip unchanged, or a sweep would change more than it says.
-    let back: MethodSpec = serde_json::from_value(tree.clone()).map_err(|e| format!("settings of '{}' do not round-trip: {e}", method.label()))?;
+    let back: MethodSpec = serde_json::from_value(tree.clone())
+        .map_err(|e| format!("settings of '{}' do not round-trip: {e}", method.label()))?;
     if back != method.spec {
-        return Err(format!("settings of '{}' do not round-trip through their serde form", method.label()));
+        return Err(format!(
+            "settings of '{}' do not round-trip through their serde form",
+            method.label()
+        ));
     }
     let (variant, settings) = match &mut tree {
-        Value::Object(map) if map.len() == 1 => map.iter_mut().next().map(|(k, v)| (k.clone(), v)).unwrap(),
+        Value::Object(map) if map.len() == 1 => {
+            map.iter_mut().next().map(|(k, v)| (k.clone(), v)).unwrap()
+        }
         _ => return Err(format!("method '{}' has no settings to sweep", method.label())),
     };
     let mut at = settings;
@@ -26,7 +32,9 @@ pub fn set(method: &mut Method, path: &[&str], value: &Value) -> Result<(), Stri
             return Err(format!("{walked} is not a struct of fields, so it has no '{field}'"));
         };
         let known: Vec<String> = map.keys().cloned().collect();
-        at = map.get_mut(*field).ok_or_else(|| format!("{walked} has no field '{field}'; its fields are: {}", known.join(", ")))?;
+        at = map.get_mut(*field).ok_or_else(|| {
+            format!("{walked} has no field '{field}'; its fields are: {}", known.join(", "))
+        })?;
         walked = format!("{walked}.{field}");
     }
     *at = value.clone();
@@ -40,10 +48,12 @@ pub fn apply(methods: &mut [Method], param: &str, value: &Value) -> Result<(), S
     let label = parts.next().unwrap_or_default();
     let path: Vec<&str> = parts.collect();
     let labels: Vec<String> = methods.iter().map(Method::label).collect();
-    let method = methods
-        .iter_mut()
-        .find(|m| m.label() == label)
-        .ok_or_else(|| format!("parameter '{param}': no method labelled '{label}' in the case; its methods are: {}", labels.join(", ")))?;
+    let method = methods.iter_mut().find(|m| m.label() == label).ok_or_else(|| {
+        format!(
+            "parameter '{param}': no method labelled '{label}' in the case; its methods are: {}",
+            labels.join(", ")
+        )
+    })?;
     set(method, &path, value).map_err(|e| format!("parameter '{param}': {e}"))
 }
 

@@ -57,7 +57,13 @@ pub fn log_file(dir: &Path, index: usize) -> PathBuf {
 impl Plan {
     pub fn load(dir: &Path) -> Result<Plan> {
         let path = dir.join(PLAN_FILE);
-        let text = std::fs::read_to_string(&path).with_context(|| format!("reading {} (plan the sweep first: `flicker sweep plan SWEEP.ron --out {}`)", path.display(), dir.display()))?;
+        let text = std::fs::read_to_string(&path).with_context(|| {
+            format!(
+                "reading {} (plan the sweep first: `flicker sweep plan SWEEP.ron --out {}`)",
+                path.display(),
+                dir.display()
+            )
+        })?;
         serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))
     }
 
@@ -82,9 +88,11 @@ impl Job {
 
     /// The job's run: the case's overrides, then its parameters; output in `dir/folder`.
     pub fn spec(&self, plan: &Plan, dir: &Path) -> Result<(RunSpec, Overrides)> {
-        let (mut spec, overrides) = case_spec(&plan.file, &self.case(), self.seed, &dir.join(&self.folder))?;
+        let (mut spec, overrides) =
+            case_spec(&plan.file, &self.case(), self.seed, &dir.join(&self.folder))?;
         for (p, v) in &self.params {
-            param::apply(&mut spec.methods, p, v).map_err(|e| anyhow!("{}: job {}: {e}", plan.file.display(), self.index))?;
+            param::apply(&mut spec.methods, p, v)
+                .map_err(|e| anyhow!("{}: job {}: {e}", plan.file.display(), self.index))?;
         }
         Ok((spec, overrides))
     }
@@ -100,7 +108,8 @@ fn check_point(sweep: &Sweep, case: &Case, point: &Point) -> Result<()> {
             bail!("{}:{line}:{col}: case '{}': {e}", sweep.origin.display(), case.name);
         }
     }
-    crate::methods::check_labels(&spec.scenario, &spec.methods).map_err(|e| anyhow!("{}: point {}: {e}", sweep.origin.display(), point.label()))?;
+    crate::methods::check_labels(&spec.scenario, &spec.methods)
+        .map_err(|e| anyhow!("{}: point {}: {e}", sweep.origin.display(), point.label()))?;
     Ok(())
 }
 
@@ -110,7 +119,12 @@ pub fn jobs(sweep: &Sweep) -> Result<Vec<Job>> {
     for case in &sweep.cases {
         let scenario = std::fs::canonicalize(&case.scenario).map_err(|e| {
             let (line, col) = case.entry.as_ref().map_or((1, 1), |e| (e.line, e.column));
-            anyhow!("{}:{line}:{col}: case '{}': scenario {}: {e}", sweep.origin.display(), case.name, case.scenario.display())
+            anyhow!(
+                "{}:{line}:{col}: case '{}': scenario {}: {e}",
+                sweep.origin.display(),
+                case.name,
+                case.scenario.display()
+            )
         })?;
         for point in &sweep.points {
             check_point(sweep, case, point)?;
@@ -126,7 +140,11 @@ pub fn jobs(sweep: &Sweep) -> Result<Vec<Job>> {
                     spp: case.spp,
                     methods: case.methods.clone(),
                     point: point.label(),
-                    params: point.settings.iter().map(|s| (s.param.clone(), s.value.clone())).collect(),
+                    params: point
+                        .settings
+                        .iter()
+                        .map(|s| (s.param.clone(), s.value.clone()))
+                        .collect(),
                     folder: PathBuf::from("runs").join(format!("job_{index:04}")),
                 });
             }
@@ -153,15 +171,26 @@ pub fn plan(sweep_file: &Path, dir: &Path, cache_dir: Option<PathBuf>, exe: &Pat
     if let Ok(old) = std::fs::read_to_string(&path)
         && old != text
     {
-        bail!("{} holds another sweep's plan; choose another --out or remove the folder", dir.display());
+        bail!(
+            "{} holds another sweep's plan; choose another --out or remove the folder",
+            dir.display()
+        );
     }
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let dir = std::fs::canonicalize(dir)?;
     crate::output::write_text(&path, &text)?;
     let exe = std::fs::canonicalize(exe).unwrap_or_else(|_| exe.to_path_buf());
-    let job_line = |i: usize| format!("{} sweep job {} --index {i} --quiet", shell_quote(&exe), shell_quote(&dir));
+    let job_line = |i: usize| {
+        format!("{} sweep job {} --index {i} --quiet", shell_quote(&exe), shell_quote(&dir))
+    };
     // GNU parallel: `parallel --jobs N < jobs.txt`, or over hosts with `--sshloginfile`.
-    let lines: String = plan.jobs.iter().map(|j| format!("{} > {} 2>&1\n", job_line(j.index), shell_quote(&log_file(&dir, j.index)))).collect();
+    let lines: String = plan
+        .jobs
+        .iter()
+        .map(|j| {
+            format!("{} > {} 2>&1\n", job_line(j.index), shell_quote(&log_file(&dir, j.index)))
+        })
+        .collect();
     crate::output::write_text(&dir.join("jobs.txt"), &lines)?;
     std::fs::create_dir_all(dir.join("logs"))?;
     crate::output::write_text(&dir.join("sweep.sbatch"), &sbatch(&plan, &dir, &exe))?;

@@ -39,7 +39,11 @@ impl Point {
         if self.settings.is_empty() {
             return "default".into();
         }
-        self.settings.iter().map(|s| format!("{}={}", s.param, value_text(&s.value))).collect::<Vec<_>>().join(" ")
+        self.settings
+            .iter()
+            .map(|s| format!("{}={}", s.param, value_text(&s.value)))
+            .collect::<Vec<_>>()
+            .join(" ")
     }
 }
 
@@ -86,23 +90,38 @@ fn to_json(v: &ron::Value) -> Result<serde_json::Value, String> {
 fn check_param(p: &str) -> Result<(), String> {
     let parts: Vec<&str> = p.split('.').collect();
     if parts.len() < 2 || parts.iter().any(|s| s.is_empty()) {
-        return Err(format!("parameter '{p}'; expected METHOD_LABEL.field (e.g. \"taa.alpha\" or \"nirc_blend_1spp.cache.reliability.kappa\")"));
+        return Err(format!(
+            "parameter '{p}'; expected METHOD_LABEL.field (e.g. \"taa.alpha\" or \"nirc_blend_1spp.cache.reliability.kappa\")"
+        ));
     }
     Ok(())
 }
 
 impl Sweep {
     pub fn load(path: &Path) -> Result<Sweep, ScenarioError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| ScenarioError { file: path.to_path_buf(), position: None, message: format!("cannot read sweep file: {e}") })?;
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
+            file: path.to_path_buf(),
+            position: None,
+            message: format!("cannot read sweep file: {e}"),
+        })?;
         Self::from_ron(&text, path)
     }
 
     pub fn from_ron(text: &str, origin: &Path) -> Result<Sweep, ScenarioError> {
-        let error = |position: Option<(usize, usize)>, message: String| ScenarioError { file: origin.to_path_buf(), position, message };
-        let file: SweepFile = options().from_str(text).map_err(|e| error(Some((e.span.start.line, e.span.start.col)), e.code.to_string()))?;
-        fn parse<T: serde::de::DeserializeOwned>(entry: &MethodEntry) -> Result<T, ((usize, usize), String)> {
-            options().from_str(&entry.text).map_err(|e| (entry.position_in_file(e.span.start.line, e.span.start.col), e.code.to_string()))
+        let error = |position: Option<(usize, usize)>, message: String| ScenarioError {
+            file: origin.to_path_buf(),
+            position,
+            message,
+        };
+        let file: SweepFile = options()
+            .from_str(text)
+            .map_err(|e| error(Some((e.span.start.line, e.span.start.col)), e.code.to_string()))?;
+        fn parse<T: serde::de::DeserializeOwned>(
+            entry: &MethodEntry,
+        ) -> Result<T, ((usize, usize), String)> {
+            options().from_str(&entry.text).map_err(|e| {
+                (entry.position_in_file(e.span.start.line, e.span.start.col), e.code.to_string())
+            })
         }
         let at = |entry: &MethodEntry| Some((entry.line, entry.column));
         let cases = crate::suite::spec::parse_cases(text, &file.cases, origin)?;
@@ -118,16 +137,31 @@ impl Sweep {
                         .map_err(|(pos, m)| error(Some(pos), format!("{m}; expected a grid axis (\"METHOD_LABEL.field\", [value, ...])")))?;
                     check_param(&param).map_err(|m| error(at(&entry), m))?;
                     if values.is_empty() {
-                        return Err(error(at(&entry), format!("grid axis '{param}' has no values; expected e.g. (\"{param}\", [0.5, 1.0])")));
+                        return Err(error(
+                            at(&entry),
+                            format!(
+                                "grid axis '{param}' has no values; expected e.g. (\"{param}\", [0.5, 1.0])"
+                            ),
+                        ));
                     }
                     if axes.iter().any(|(_, p, _)| *p == param) {
-                        return Err(error(at(&entry), format!("grid names '{param}' twice; expected one axis per parameter")));
+                        return Err(error(
+                            at(&entry),
+                            format!("grid names '{param}' twice; expected one axis per parameter"),
+                        ));
                     }
-                    let values = values.iter().map(to_json).collect::<Result<Vec<_>, _>>().map_err(|m| error(at(&entry), m))?;
+                    let values = values
+                        .iter()
+                        .map(to_json)
+                        .collect::<Result<Vec<_>, _>>()
+                        .map_err(|m| error(at(&entry), m))?;
                     axes.push((entry, param, values));
                 }
                 if axes.is_empty() {
-                    return Err(error(None, "`grid` is empty; expected e.g. grid: [(\"taa.alpha\", [0.1, 0.2])]".into()));
+                    return Err(error(
+                        None,
+                        "`grid` is empty; expected e.g. grid: [(\"taa.alpha\", [0.1, 0.2])]".into(),
+                    ));
                 }
                 // Row-major: the last axis varies fastest.
                 let mut points = vec![Point { settings: vec![], entries: vec![] }];
@@ -149,29 +183,53 @@ impl Sweep {
             (None, Some(list)) => {
                 let mut points = Vec::new();
                 for entry in raw_entries(text, "list", list) {
-                    let settings: Vec<(String, ron::Value)> = parse(&entry)
-                        .map_err(|(pos, m)| error(Some(pos), format!("{m}; expected a point [(\"METHOD_LABEL.field\", value), ...]")))?;
+                    let settings: Vec<(String, ron::Value)> =
+                        parse(&entry).map_err(|(pos, m)| {
+                            error(
+                                Some(pos),
+                                format!(
+                                    "{m}; expected a point [(\"METHOD_LABEL.field\", value), ...]"
+                                ),
+                            )
+                        })?;
                     let mut point = Point { settings: vec![], entries: vec![entry.clone()] };
                     for (param, value) in settings {
                         check_param(&param).map_err(|m| error(at(&entry), m))?;
                         if point.settings.iter().any(|s| s.param == param) {
-                            return Err(error(at(&entry), format!("the point sets '{param}' twice")));
+                            return Err(error(
+                                at(&entry),
+                                format!("the point sets '{param}' twice"),
+                            ));
                         }
-                        point.settings.push(Setting { param, value: to_json(&value).map_err(|m| error(at(&entry), m))? });
+                        point.settings.push(Setting {
+                            param,
+                            value: to_json(&value).map_err(|m| error(at(&entry), m))?,
+                        });
                     }
                     if points.iter().any(|p: &Point| p.settings == point.settings) {
-                        return Err(error(at(&entry), format!("point {} is listed twice", point.label())));
+                        return Err(error(
+                            at(&entry),
+                            format!("point {} is listed twice", point.label()),
+                        ));
                     }
                     points.push(point);
                 }
                 if points.is_empty() {
-                    return Err(error(None, "`list` is empty; expected e.g. list: [[(\"taa.alpha\", 0.1)]]".into()));
+                    return Err(error(
+                        None,
+                        "`list` is empty; expected e.g. list: [[(\"taa.alpha\", 0.1)]]".into(),
+                    ));
                 }
                 points
             }
             (None, None) => vec![Point { settings: vec![], entries: vec![] }],
         };
-        let name = file.name.unwrap_or_else(|| origin.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "sweep".into()));
+        let name = file.name.unwrap_or_else(|| {
+            origin
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "sweep".into())
+        });
         Ok(Sweep { name, cases, points, origin: origin.to_path_buf() })
     }
 }
@@ -185,7 +243,15 @@ mod tests {
         let text = "Sweep(cases: [(name: \"a\", scenario: \"s.ron\", seeds: [1])],\n grid: [(\"taa.alpha\", [0.1, 0.2]), (\"taa.jitter_length\", [8, 16])])";
         let s = Sweep::from_ron(text, Path::new("x/sw.ron")).unwrap();
         let labels: Vec<String> = s.points.iter().map(Point::label).collect();
-        assert_eq!(labels, ["taa.alpha=0.1 taa.jitter_length=8", "taa.alpha=0.1 taa.jitter_length=16", "taa.alpha=0.2 taa.jitter_length=8", "taa.alpha=0.2 taa.jitter_length=16"]);
+        assert_eq!(
+            labels,
+            [
+                "taa.alpha=0.1 taa.jitter_length=8",
+                "taa.alpha=0.1 taa.jitter_length=16",
+                "taa.alpha=0.2 taa.jitter_length=8",
+                "taa.alpha=0.2 taa.jitter_length=16"
+            ]
+        );
         assert_eq!(s.name, "sw");
         assert_eq!(s.cases[0].scenario, Path::new("x/s.ron"));
         let text = "Sweep(cases: [(name: \"a\", scenario: \"s.ron\", seeds: [1])],\n list: [[(\"taa.alpha\", 0.5)], [(\"taa.alpha\", 0.1), (\"taa.clamp\", \"None\")]])";

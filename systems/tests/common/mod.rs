@@ -11,5 +11,8 @@ pub fn assert_positive(what: &str, d: &[f64]) {
     let sd = (d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)).sqrt();
     let lower = m - T95_DF2 * sd / n.sqrt();
     eprintln!("{what}: per seed {d:.4?}, mean {m:.4}, lower 95% bound {lower:.4}");
-    assert!(lower > 0.0, "{what}: per-seed differences {d:.4?}, mean {m:.4}, one-sided 95% lower bound {lower:.4} is not above 0");
+    assert!(
+        lower > 0.0,
+        "{what}: per-seed differences {d:.4?}, mean {m:.4}, one-sided 95% lower bound {lower:.4} is not above 0"
+    );
 }
