@@ -15,7 +15,6 @@ use crate::frame::{
     Tracer,
 };
 use crate::frame_record::FrameRecord;
-use crate::methods::MethodSpec;
 use crate::output;
 use crate::reference_cache::ReferenceCache;
 use crate::run_folder::RunFolder;
@@ -65,7 +64,8 @@ fn check_media_support(spec: &RunSpec, origin: &str) -> Result<()> {
         }
     }
     let references = (0..scenario.frames).any(|f| scenario.reference.wants(f, scenario.frames));
-    let volume_path = spec.methods.iter().any(|m| matches!(m.spec, MethodSpec::VolumePath(_)));
+    let volume_path =
+        spec.methods.iter().any(|m| m.spec.is::<crate::methods::volume_path::VolumePathMethod>());
     if let (Some(extra), true) =
         (scenario.media.get(media::gpu::MAX_MEDIA), references || volume_path)
     {
@@ -131,7 +131,7 @@ impl FrameWorld {
             let entity = world
                 .spawn((MethodInfo { index, label: label.clone() }, MethodFrame::default()))
                 .id();
-            method.spec.plugin().spawn(&mut world, entity, method).with_context(|| {
+            method.spec.spawn(&mut world, entity).with_context(|| {
                 format!(
                     "{origin}:{}:{}: preparing method {label}",
                     method.entry.line, method.entry.column

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use bevy_ecs::prelude::*;
 use systems::frame::{self, Stage};
-use systems::methods::{Method, MethodSpec};
+use systems::methods::Method;
 use systems::scenario::{Overrides, RunSpec};
 
 fn spec(methods: &str) -> RunSpec {
@@ -184,8 +184,8 @@ fn methods_take_their_settings_defaults_and_names() {
         "Taa(), Taa(name: \"taa_fast\", alpha: 0.2, clamp: MinMax), HashCache(), HashCache(lookup: SecondaryHit, taa: true, capacity: 1024), SampleCache(retrace: Multi)",
     );
     let d = render::taa::TaaSettings::default();
-    assert_eq!(s.methods[0].spec, MethodSpec::Taa(d));
-    let MethodSpec::Taa(t) = &s.methods[1].spec else { panic!("{:?}", s.methods[1]) };
+    assert_eq!(s.methods[0].spec.get::<render::taa::TaaSettings>(), Some(&d));
+    let t = s.methods[1].spec.get::<render::taa::TaaSettings>().expect("Taa settings");
     assert_eq!(
         (t.alpha, t.clamp, t.jitter_length),
         (0.2, render::taa::TaaClamp::MinMax, d.jitter_length)
@@ -196,7 +196,10 @@ fn methods_take_their_settings_defaults_and_names() {
         ["taa", "taa_fast", "hash_cache", "hash_cache_secondary_hit_taa", "ssc_multi"]
     );
     assert!(s.methods[..4].iter().all(|m| m.spec.spp() == 1.0));
-    let MethodSpec::HashCache(h) = &s.methods[3].spec else { panic!() };
+    let h = s.methods[3]
+        .spec
+        .get::<render::hash_cache::HashCacheSettings>()
+        .expect("HashCache settings");
     assert_eq!((h.capacity, h.probe_limit, h.taa), (1024, 8, true));
 }
 
@@ -269,7 +272,7 @@ fn paper_scale_scenarios_parse_with_the_controls_and_the_nrc_batch() {
             path.display()
         );
         for m in &spec.methods {
-            if let MethodSpec::Nirc(n) = &m.spec {
+            if let Some(n) = m.spec.get::<systems::methods::nirc::NircSettings>() {
                 assert_eq!(
                     (n.pretrain_frames, n.paths.train_records),
                     (5000, 16384),

@@ -19,7 +19,6 @@ use std::path::{Path, PathBuf};
 
 use sim::ReferenceFrames;
 use systems::frame_record::FrameRecord;
-use systems::methods::MethodSpec;
 use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};
 
@@ -52,7 +51,7 @@ fn play(
     spec.methods.retain(|m| keep.contains(&m.label().as_str()));
     assert_eq!(spec.methods.len(), keep.len(), "{scenario}: methods {keep:?}");
     for m in &mut spec.methods {
-        if let MethodSpec::Termination(t) = &mut m.spec {
+        if let Some(t) = m.spec.get_mut::<render::termination::TerminationSettings>() {
             t.store_probability = 0.1;
             t.warmup_frames = 24;
         }
@@ -110,7 +109,7 @@ fn cache_follows_a_flash_and_forgets_it_slower_than_its_memory() {
     let setup = |s: &mut RunSpec| {
         s.scenario.reference.frames = ReferenceFrames::None;
         for m in &mut s.methods {
-            if let MethodSpec::Termination(t) = &mut m.spec {
+            if let Some(t) = m.spec.get_mut::<render::termination::TerminationSettings>() {
                 t.warmup_frames = WARMUP;
             }
         }

@@ -22,7 +22,6 @@
 use std::path::{Path, PathBuf};
 
 use systems::frame_record::FrameRecord;
-use systems::methods::MethodSpec;
 use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};
 
@@ -49,7 +48,7 @@ fn play(scenario: &str, keep: &[&str], seed: u64) -> Vec<FrameRecord> {
     let mut spec = RunSpec::load(&file, &overrides).expect("scenario");
     spec.methods.retain(|m| keep.contains(&m.label().as_str()));
     for m in &mut spec.methods {
-        if let MethodSpec::Termination(t) = &mut m.spec {
+        if let Some(t) = m.spec.get_mut::<render::termination::TerminationSettings>() {
             t.store_probability = 0.1;
             t.warmup_frames = 24;
         }

@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use bevy_ecs::prelude::*;
 use render::hash_cache::{HashCache, HashCacheLookup};
 use render::taa::{Taa, TaaSettings};
@@ -12,7 +12,7 @@ use render::timing::PassTiming;
 
 pub use render::hash_cache::HashCacheSettings;
 
-use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
+use super::{MethodOutput, MethodPlugin, temporal_window};
 use crate::frame::{
     FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
 };
@@ -36,19 +36,31 @@ pub struct HashCacheState {
 }
 
 pub struct Plugin;
-pub static PLUGIN: Plugin = Plugin;
 
 impl MethodPlugin for Plugin {
-    fn name(&self) -> &'static str {
-        "HashCache"
+    type Settings = HashCacheSettings;
+    const NAME: &'static str = "HashCache";
+
+    fn label(settings: &HashCacheSettings) -> String {
+        label(settings)
     }
 
-    fn add_systems(&self, schedule: &mut Schedule) {
+    fn spp(_settings: &HashCacheSettings) -> f64 {
+        1.0
+    }
+
+    fn temporal_window(settings: &HashCacheSettings) -> Option<f64> {
+        Some(temporal_window::under_taa(
+            temporal_window::exponential(1.0 / settings.max_samples as f64),
+            settings.taa,
+        ))
+    }
+
+    fn add_systems(schedule: &mut Schedule) {
         schedule.add_systems((age_and_update, resolve).chain().in_set(Stage::Render));
     }
 
-    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
-        let MethodSpec::HashCache(settings) = &method.spec else { bail!("not a HashCache method") };
+    fn spawn(world: &mut World, entity: Entity, settings: &HashCacheSettings) -> Result<()> {
         settings.validate()?;
         let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
         let cache = HashCache::new(gpu, tracer, *settings)?;

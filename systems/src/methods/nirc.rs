@@ -34,7 +34,7 @@ use render::timing::{PassTimer, PassTiming};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
+use super::{MethodImage, MethodOutput, MethodPlugin};
 use crate::frame::{FrameClock, GpuDevice, MethodFrame, Run, Stage, Tracer, failed};
 
 /// `Nirc(spp: 1, predictor: Blend, cache: (...), paths: (...), pretrain_frames: 0)`.
@@ -142,14 +142,28 @@ struct ModeFrame {
 }
 
 pub struct Plugin;
-pub static PLUGIN: Plugin = Plugin;
 
 impl MethodPlugin for Plugin {
-    fn name(&self) -> &'static str {
-        "Nirc"
+    type Settings = NircSettings;
+    const NAME: &'static str = "Nirc";
+
+    fn label(settings: &NircSettings) -> String {
+        settings.label()
     }
 
-    fn add_systems(&self, schedule: &mut Schedule) {
+    fn spp(settings: &NircSettings) -> f64 {
+        settings.spp as f64
+    }
+
+    fn temporal_window(_settings: &NircSettings) -> Option<f64> {
+        None
+    }
+
+    fn set_spp(settings: &mut NircSettings, spp: u32) {
+        settings.spp = spp;
+    }
+
+    fn add_systems(schedule: &mut Schedule) {
         schedule.add_systems((camera_paths, infer).chain().in_set(Stage::Render));
         schedule.add_systems(
             (reliability, train, ema, reliability_update, frame_output)
@@ -158,8 +172,7 @@ impl MethodPlugin for Plugin {
         );
     }
 
-    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
-        let MethodSpec::Nirc(settings) = &method.spec else { bail!("not a Nirc method") };
+    fn spawn(world: &mut World, entity: Entity, settings: &NircSettings) -> Result<()> {
         settings.cache.validate()?;
         if settings.spp == 0 {
             bail!("Nirc: spp 0; expected at least 1 path per pixel");

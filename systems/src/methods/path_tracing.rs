@@ -6,7 +6,7 @@ use anyhow::{Result, bail};
 use bevy_ecs::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
+use super::{MethodOutput, MethodPlugin};
 use crate::frame::{
     FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
 };
@@ -30,19 +30,32 @@ pub struct PathTracing {
 }
 
 pub struct Plugin;
-pub static PLUGIN: Plugin = Plugin;
 
 impl MethodPlugin for Plugin {
-    fn name(&self) -> &'static str {
-        "PathTracing"
+    type Settings = PathTracingSettings;
+    const NAME: &'static str = "PathTracing";
+
+    fn label(settings: &PathTracingSettings) -> String {
+        settings.label()
     }
 
-    fn add_systems(&self, schedule: &mut Schedule) {
+    fn spp(settings: &PathTracingSettings) -> f64 {
+        settings.spp as f64
+    }
+
+    fn temporal_window(_settings: &PathTracingSettings) -> Option<f64> {
+        Some(1.0)
+    }
+
+    fn set_spp(settings: &mut PathTracingSettings, spp: u32) {
+        settings.spp = spp;
+    }
+
+    fn add_systems(schedule: &mut Schedule) {
         schedule.add_systems(render.in_set(Stage::Render));
     }
 
-    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
-        let MethodSpec::PathTracing(s) = &method.spec else { bail!("not a PathTracing method") };
+    fn spawn(world: &mut World, entity: Entity, s: &PathTracingSettings) -> Result<()> {
         if s.spp == 0 {
             bail!("PathTracing: spp 0; expected at least 1 sample per pixel");
         }

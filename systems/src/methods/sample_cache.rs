@@ -5,14 +5,14 @@
 
 use std::time::Instant;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use bevy_ecs::prelude::*;
 use render::sample_cache::SampleCache;
 use render::taa::{Taa, TaaSettings};
 
 pub use render::sample_cache::SampleCacheSettings;
 
-use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
+use super::{MethodImage, MethodOutput, MethodPlugin, temporal_window};
 use crate::frame::{
     FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
 };
@@ -21,22 +21,33 @@ use crate::frame::{
 pub struct SampleCacheState(SampleCache, Option<Taa>);
 
 pub struct Plugin;
-pub static PLUGIN: Plugin = Plugin;
 
 impl MethodPlugin for Plugin {
-    fn name(&self) -> &'static str {
-        "SampleCache"
+    type Settings = SampleCacheSettings;
+    const NAME: &'static str = "SampleCache";
+
+    fn label(settings: &SampleCacheSettings) -> String {
+        settings.label()
     }
 
-    fn add_systems(&self, schedule: &mut Schedule) {
+    fn spp(settings: &SampleCacheSettings) -> f64 {
+        // Uniform shading: one path per pixel (validate refuses another rate); adaptive:
+        // the budget's rate.
+        settings.shading_rate as f64
+    }
+
+    fn temporal_window(settings: &SampleCacheSettings) -> Option<f64> {
+        let alpha = if settings.roughness_alpha { 0.1 } else { settings.alpha as f64 };
+        let shades = settings.n_target as f64 * temporal_window::exponential(alpha);
+        Some(temporal_window::under_taa(shades / settings.shading_rate as f64, settings.taa))
+    }
+
+    fn add_systems(schedule: &mut Schedule) {
         schedule
             .add_systems((reproject, retrace, shade, reconstruct).chain().in_set(Stage::Render));
     }
 
-    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
-        let MethodSpec::SampleCache(settings) = &method.spec else {
-            bail!("not a SampleCache method")
-        };
+    fn spawn(world: &mut World, entity: Entity, settings: &SampleCacheSettings) -> Result<()> {
         settings.validate().map_err(|e| anyhow::anyhow!("SampleCache: {e}"))?;
         let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
         let cache = SampleCache::new(gpu, tracer, *settings)?;

@@ -4,7 +4,7 @@
 
 use sim::{MethodEntry, Scenario, ScenarioError};
 
-use super::{Method, MethodSpec};
+use super::{Method, MethodSpec, registry};
 
 /// Parses every method of the scenario; errors name the file, line and column.
 pub fn parse_methods(scenario: &Scenario) -> Result<Vec<Method>, ScenarioError> {
@@ -59,7 +59,26 @@ fn parse_entry(entry: &MethodEntry) -> Result<Method, ((usize, usize), String)> 
     let options = ron::Options::default()
         .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
         .with_default_extension(ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES);
-    let spec: MethodSpec = options.from_str(&text).map_err(|e| {
+    // `Name(fields)`: the registry's plugin called Name parses `(fields)`, the name blanked so
+    // that positions stay the entry's.
+    let start = skip_blank(&text);
+    let name_len = text[start..]
+        .find(|c: char| !is_ident(c as u8) || !c.is_ascii())
+        .unwrap_or(text.len() - start);
+    let method_name = &text[start..start + name_len];
+    let (line, col) = line_col(&text, start);
+    let plugin = registry::find(method_name).ok_or_else(|| {
+        (
+            at(line, col),
+            format!(
+                "method `{}`: unknown method `{method_name}`; expected one of: {}",
+                entry.text,
+                registry::names().join(", ")
+            ),
+        )
+    })?;
+    let body = format!("{}{}{}", &text[..start], " ".repeat(name_len), &text[start + name_len..]);
+    let spec: MethodSpec = plugin.parse(&body, &options).map_err(|e| {
         (at(e.span.start.line, e.span.start.col), format!("method `{}`: {}", entry.text, e.code))
     })?;
     if let Some(n) = &name {
@@ -145,6 +164,31 @@ fn take_name(text: &str) -> Result<(String, Option<String>), String> {
     }
 }
 
+/// Byte offset of the first character of `text` that is not white space or a comment.
+fn skip_blank(text: &str) -> usize {
+    let mut i = 0;
+    loop {
+        let rest = &text[i..];
+        let trimmed = rest.trim_start();
+        i += rest.len() - trimmed.len();
+        if trimmed.starts_with("//") {
+            i += trimmed.find('\n').unwrap_or(trimmed.len());
+        } else if let Some(block) = trimmed.strip_prefix("/*") {
+            i += 2 + block.find("*/").map_or(block.len(), |e| e + 2);
+        } else {
+            return i;
+        }
+    }
+}
+
+/// 1-based line and column of byte `offset` of `text`.
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, col)
+}
+
 fn is_ident(b: u8) -> bool {
     b.is_ascii_alphanumeric() || b == b'_'
 }
@@ -175,5 +219,14 @@ mod tests {
         assert!(text.starts_with("Nirc(") && text.contains("spp: 1, cache: (name: 3))"));
         assert_eq!(take_name("Taa(alpha: 0.2)").unwrap(), ("Taa(alpha: 0.2)".to_string(), None));
         assert!(take_name("Taa(name: 3)").is_err());
+    }
+
+    #[test]
+    fn the_method_name_follows_comments_and_unknown_names_list_the_registry() {
+        assert_eq!(skip_blank("  // a control\n  /* x */ Taa()"), 25);
+        let m = parse_one("// the baseline\n  PathTracing(spp: 2)").unwrap();
+        assert_eq!(m.label(), "pt_2spp");
+        let e = parse_one("Tea(alpha: 0.2)").unwrap_err();
+        assert!(e.contains("unknown method `Tea`") && e.contains("Taa, HashCache"), "{e}");
     }
 }

@@ -17,7 +17,7 @@ use render::sss::{Prefilter, SpvgSettings, SssFrame, SssSettings, SssVariant};
 use render::taa::{Taa, TaaPrimary, TaaSettings};
 use serde::{Deserialize, Serialize};
 
-use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
+use super::{MethodImage, MethodOutput, MethodPlugin};
 use crate::frame::{
     FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
 };
@@ -113,19 +113,32 @@ pub struct SssState {
 }
 
 pub struct Plugin;
-pub static PLUGIN: Plugin = Plugin;
 
 impl MethodPlugin for Plugin {
-    fn name(&self) -> &'static str {
-        "Sss"
+    type Settings = SssMethodSettings;
+    const NAME: &'static str = "Sss";
+
+    fn label(settings: &SssMethodSettings) -> String {
+        settings.label()
     }
 
-    fn add_systems(&self, schedule: &mut Schedule) {
+    fn spp(settings: &SssMethodSettings) -> f64 {
+        settings.spp as f64
+    }
+
+    fn temporal_window(_settings: &SssMethodSettings) -> Option<f64> {
+        Some(1.0)
+    }
+
+    fn set_spp(settings: &mut SssMethodSettings, spp: u32) {
+        settings.spp = spp;
+    }
+
+    fn add_systems(schedule: &mut Schedule) {
         schedule.add_systems(render.in_set(Stage::Render));
     }
 
-    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
-        let MethodSpec::Sss(s) = &method.spec else { bail!("not an Sss method") };
+    fn spawn(world: &mut World, entity: Entity, s: &SssMethodSettings) -> Result<()> {
         if s.spp == 0 {
             bail!("Sss: spp 0; expected at least 1 path-traced sample per pixel");
         }

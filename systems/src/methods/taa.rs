@@ -3,14 +3,14 @@
 
 use std::time::Instant;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use bevy_ecs::prelude::*;
 use render::taa::Taa;
 use render::timing::PassTiming;
 
 pub use render::taa::TaaSettings;
 
-use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
+use super::{MethodOutput, MethodPlugin, temporal_window};
 use crate::frame::{
     FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
 };
@@ -23,19 +23,28 @@ pub struct TaaState {
 }
 
 pub struct Plugin;
-pub static PLUGIN: Plugin = Plugin;
 
 impl MethodPlugin for Plugin {
-    fn name(&self) -> &'static str {
-        "Taa"
+    type Settings = TaaSettings;
+    const NAME: &'static str = "Taa";
+
+    fn label(_settings: &TaaSettings) -> String {
+        "taa".into()
     }
 
-    fn add_systems(&self, schedule: &mut Schedule) {
+    fn spp(_settings: &TaaSettings) -> f64 {
+        1.0
+    }
+
+    fn temporal_window(settings: &TaaSettings) -> Option<f64> {
+        Some(temporal_window::exponential(settings.alpha as f64))
+    }
+
+    fn add_systems(schedule: &mut Schedule) {
         schedule.add_systems((trace, resolve).chain().in_set(Stage::Render));
     }
 
-    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
-        let MethodSpec::Taa(settings) = &method.spec else { bail!("not a Taa method") };
+    fn spawn(world: &mut World, entity: Entity, settings: &TaaSettings) -> Result<()> {
         settings.validate()?;
         let taa =
             Taa::new(&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0, *settings)?;

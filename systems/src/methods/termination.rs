@@ -7,13 +7,13 @@
 
 use std::time::Instant;
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use bevy_ecs::prelude::*;
 use render::termination::TerminationCache;
 
 pub use render::termination::TerminationSettings;
 
-use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
+use super::{MethodImage, MethodOutput, MethodPlugin};
 use crate::frame::{
     FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
 };
@@ -29,21 +29,28 @@ pub struct TerminationState {
 }
 
 pub struct Plugin;
-pub static PLUGIN: Plugin = Plugin;
 
 impl MethodPlugin for Plugin {
-    fn name(&self) -> &'static str {
-        "Termination"
+    type Settings = TerminationSettings;
+    const NAME: &'static str = "Termination";
+
+    fn label(settings: &TerminationSettings) -> String {
+        label(settings)
     }
 
-    fn add_systems(&self, schedule: &mut Schedule) {
+    fn spp(_settings: &TerminationSettings) -> f64 {
+        1.0
+    }
+
+    fn temporal_window(_settings: &TerminationSettings) -> Option<f64> {
+        None
+    }
+
+    fn add_systems(schedule: &mut Schedule) {
         schedule.add_systems(render.in_set(Stage::Render));
     }
 
-    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
-        let MethodSpec::Termination(settings) = &method.spec else {
-            bail!("not a Termination method")
-        };
+    fn spawn(world: &mut World, entity: Entity, settings: &TerminationSettings) -> Result<()> {
         let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
         // Validates the settings and checks the cache's buffers against the adapter's limits.
         let cache = TerminationCache::new(gpu, tracer, *settings)?;
@@ -103,7 +110,8 @@ mod tests {
     fn scenario_text_parses_with_the_paper_defaults_and_refuses_unknown_fields() {
         let m = Method::parse("Termination(rule: MseMinimisation(s: 100.0))").unwrap();
         assert_eq!(m.label(), "termination_mse_100");
-        let super::super::MethodSpec::Termination(s) = m.spec else { panic!("not Termination") };
+        let s =
+            m.spec.get::<render::termination::TerminationSettings>().expect("Termination settings");
         assert_eq!(
             s.rule,
             TerminationRule::MseMinimisation { s: 100.0, margin: 1.1, bias_clamp: 0.1 }

@@ -17,7 +17,7 @@ use media::{DensityGrid, Estimator, Medium};
 use render::frame::CameraBasis;
 use serde::{Deserialize, Serialize};
 
-use super::{Method, MethodImage, MethodOutput, MethodPlugin, MethodSpec};
+use super::{MethodImage, MethodOutput, MethodPlugin};
 use crate::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, method_failed};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -51,25 +51,36 @@ pub struct VolumeState {
 }
 
 pub struct Plugin;
-pub static PLUGIN: Plugin = Plugin;
 
 impl MethodPlugin for Plugin {
-    fn name(&self) -> &'static str {
-        "VolumeTransmittance"
+    type Settings = VolumeSettings;
+    const NAME: &'static str = "VolumeTransmittance";
+
+    fn label(settings: &VolumeSettings) -> String {
+        settings.label()
     }
 
-    fn sees_media(&self) -> bool {
+    fn spp(settings: &VolumeSettings) -> f64 {
+        settings.spp as f64
+    }
+
+    fn temporal_window(_settings: &VolumeSettings) -> Option<f64> {
+        Some(1.0)
+    }
+
+    fn set_spp(settings: &mut VolumeSettings, spp: u32) {
+        settings.spp = spp;
+    }
+
+    fn sees_media() -> bool {
         true
     }
 
-    fn add_systems(&self, schedule: &mut Schedule) {
+    fn add_systems(schedule: &mut Schedule) {
         schedule.add_systems(render.in_set(Stage::Render));
     }
 
-    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
-        let MethodSpec::VolumeTransmittance(settings) = &method.spec else {
-            bail!("not a VolumeTransmittance method")
-        };
+    fn spawn(world: &mut World, entity: Entity, settings: &VolumeSettings) -> Result<()> {
         if settings.spp == 0 {
             bail!("VolumeTransmittance: spp 0; expected at least 1 estimate per pixel");
         }

@@ -13,7 +13,7 @@ use bevy_ecs::prelude::*;
 use media::gpu::{Combination, MisWeight, VolumePathSettings};
 use serde::{Deserialize, Serialize};
 
-use super::{Method, MethodOutput, MethodPlugin, MethodSpec};
+use super::{MethodOutput, MethodPlugin};
 use crate::frame::media::{SceneMedium, render_volume};
 use crate::frame::{
     FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
@@ -64,23 +64,36 @@ impl VolumePathMethod {
 pub struct VolumePath(VolumePathMethod);
 
 pub struct Plugin;
-pub static PLUGIN: Plugin = Plugin;
 
 impl MethodPlugin for Plugin {
-    fn name(&self) -> &'static str {
-        "VolumePath"
+    type Settings = VolumePathMethod;
+    const NAME: &'static str = "VolumePath";
+
+    fn label(settings: &VolumePathMethod) -> String {
+        settings.label()
     }
 
-    fn sees_media(&self) -> bool {
+    fn spp(settings: &VolumePathMethod) -> f64 {
+        settings.spp as f64
+    }
+
+    fn temporal_window(_settings: &VolumePathMethod) -> Option<f64> {
+        Some(1.0)
+    }
+
+    fn set_spp(settings: &mut VolumePathMethod, spp: u32) {
+        settings.spp = spp;
+    }
+
+    fn sees_media() -> bool {
         true
     }
 
-    fn add_systems(&self, schedule: &mut Schedule) {
+    fn add_systems(schedule: &mut Schedule) {
         schedule.add_systems(render.in_set(Stage::Render));
     }
 
-    fn spawn(&self, world: &mut World, entity: Entity, method: &Method) -> Result<()> {
-        let MethodSpec::VolumePath(s) = &method.spec else { bail!("not a VolumePath method") };
+    fn spawn(world: &mut World, entity: Entity, s: &VolumePathMethod) -> Result<()> {
         if s.spp == 0 {
             bail!("VolumePath: spp 0; expected at least 1 sample per pixel");
         }

@@ -5,13 +5,15 @@
 
 use serde_json::Value;
 
-use crate::methods::{Method, MethodSpec};
+use crate::methods::Method;
 
 /// Sets `path` (after the method label) of `method` to `value`.
 pub fn set(method: &mut Method, path: &[&str], value: &Value) -> Result<(), String> {
-    let mut tree = serde_json::to_value(&method.spec).map_err(|e| e.to_string())?;
+    let mut tree = method.spec.settings_json().map_err(|e| e.to_string())?;
     // The settings must survive the round trip unchanged, or a sweep would change more than it says.
-    let back: MethodSpec = serde_json::from_value(tree.clone())
+    let back = method
+        .spec
+        .with_settings_json(tree.clone())
         .map_err(|e| format!("settings of '{}' do not round-trip: {e}", method.label()))?;
     if back != method.spec {
         return Err(format!(
@@ -19,14 +21,8 @@ pub fn set(method: &mut Method, path: &[&str], value: &Value) -> Result<(), Stri
             method.label()
         ));
     }
-    let (variant, settings) = match &mut tree {
-        Value::Object(map) if map.len() == 1 => {
-            map.iter_mut().next().map(|(k, v)| (k.clone(), v)).unwrap()
-        }
-        _ => return Err(format!("method '{}' has no settings to sweep", method.label())),
-    };
-    let mut at = settings;
-    let mut walked = variant.clone();
+    let mut at = &mut tree;
+    let mut walked = method.spec.name().to_string();
     for field in path {
         let Value::Object(map) = at else {
             return Err(format!("{walked} is not a struct of fields, so it has no '{field}'"));
@@ -38,7 +34,8 @@ pub fn set(method: &mut Method, path: &[&str], value: &Value) -> Result<(), Stri
         walked = format!("{walked}.{field}");
     }
     *at = value.clone();
-    method.spec = serde_json::from_value(tree).map_err(|e| format!("{walked} = {value}: {e}"))?;
+    method.spec =
+        method.spec.with_settings_json(tree).map_err(|e| format!("{walked} = {value}: {e}"))?;
     Ok(())
 }
 
@@ -67,11 +64,12 @@ mod tests {
         let mut m = Method::parse("Nirc(spp: 1, predictor: Blend)").unwrap();
         set(&mut m, &["cache", "reliability", "kappa"], &json!(2.0)).unwrap();
         set(&mut m, &["cache", "ema", "alpha"], &json!(0.9)).unwrap();
-        let MethodSpec::Nirc(s) = &m.spec else { panic!() };
+        let s = m.spec.get::<crate::methods::nirc::NircSettings>().expect("Nirc settings");
         assert_eq!((s.cache.reliability.kappa, s.cache.ema.alpha), (2.0, 0.9));
         // Everything else as parsed.
         let mut expected = Method::parse("Nirc(spp: 1, predictor: Blend)").unwrap();
-        let MethodSpec::Nirc(e) = &mut expected.spec else { panic!() };
+        let e =
+            expected.spec.get_mut::<crate::methods::nirc::NircSettings>().expect("Nirc settings");
         e.cache.reliability.kappa = 2.0;
         e.cache.ema.alpha = 0.9;
         assert_eq!(m.spec, expected.spec);
@@ -82,7 +80,7 @@ mod tests {
         assert!(e.contains("Nirc.spp = 1.5"), "{e}");
         let mut taa = vec![Method::parse("Taa()").unwrap()];
         apply(&mut taa, "taa.alpha", &json!(0.25)).unwrap();
-        let MethodSpec::Taa(t) = &taa[0].spec else { panic!() };
+        let t = taa[0].spec.get::<render::taa::TaaSettings>().expect("Taa settings");
         assert_eq!(t.alpha, 0.25);
         let e = apply(&mut taa, "pt_1spp.spp", &json!(2)).unwrap_err();
         assert!(e.contains("no method labelled 'pt_1spp'") && e.contains("taa"), "{e}");

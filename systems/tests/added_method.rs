@@ -1,0 +1,183 @@
+//! A method added through the registry alone: an exponential moving average of 1-spp path
+//! tracing, defined here, registered with `systems::methods::register`, named in a scenario,
+//! played, and seen in the schedule, frames.csv and the report like a shipped method.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Result;
+use bevy_ecs::prelude::*;
+use serde::{Deserialize, Serialize};
+use systems::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer};
+use systems::methods::{MethodOutput, MethodPlugin, register};
+use systems::playback::{RunOptions, run_spec};
+use systems::scenario::{Overrides, RunSpec};
+
+/// `EmaPathTracing(alpha: 0.5)`: each frame's 1-spp image blended into the last with weight α.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+struct EmaSettings {
+    alpha: f32,
+}
+
+impl Default for EmaSettings {
+    fn default() -> Self {
+        Self { alpha: 0.5 }
+    }
+}
+
+#[derive(Component)]
+struct EmaState {
+    alpha: f32,
+    average: Option<Vec<[f32; 4]>>,
+}
+
+struct EmaPlugin;
+
+impl MethodPlugin for EmaPlugin {
+    type Settings = EmaSettings;
+    const NAME: &'static str = "EmaPathTracing";
+
+    fn label(settings: &EmaSettings) -> String {
+        format!("ema_pt_{}", settings.alpha)
+    }
+
+    fn spp(_settings: &EmaSettings) -> f64 {
+        1.0
+    }
+
+    fn temporal_window(settings: &EmaSettings) -> Option<f64> {
+        Some(systems::methods::temporal_window::exponential(settings.alpha as f64))
+    }
+
+    fn add_systems(schedule: &mut Schedule) {
+        schedule.add_systems(ema_render.in_set(Stage::Render));
+    }
+
+    fn spawn(world: &mut World, entity: Entity, settings: &EmaSettings) -> Result<()> {
+        anyhow::ensure!(settings.alpha > 0.0 && settings.alpha <= 1.0, "alpha in (0, 1]");
+        world.entity_mut(entity).insert(EmaState { alpha: settings.alpha, average: None });
+        Ok(())
+    }
+}
+
+fn ema_render(
+    gpu: Res<GpuDevice>,
+    mut tracer: ResMut<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&mut EmaState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
+    for (mut state, _info, mut frame) in &mut methods {
+        let start = Instant::now();
+        let out = tracer.0.render(&gpu.0, 1, run.scenario.seed, clock.global)?;
+        let alpha = state.alpha;
+        let average = match state.average.take() {
+            None => out.radiance.clone(),
+            Some(previous) => previous
+                .iter()
+                .zip(&out.radiance)
+                .map(|(p, c)| std::array::from_fn(|k| alpha * c[k] + (1.0 - alpha) * p[k]))
+                .collect(),
+        };
+        state.average = Some(average.clone());
+        frame.output = Some(MethodOutput::timed(
+            average,
+            out.gbuffer.motion,
+            &out.timings,
+            out.rays,
+            out.shaded,
+        ));
+        frame.add_cpu(start);
+    }
+    Ok(())
+}
+
+fn read_exr(path: &Path) -> Vec<[f32; 4]> {
+    let image = image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    image.to_rgba32f().pixels().map(|p| p.0).collect()
+}
+
+#[test]
+fn a_method_added_through_the_registry_plays_like_a_shipped_one() {
+    register::<EmaPlugin>().unwrap();
+    // A second registration under the same name is refused, as is a shipped name.
+    assert!(register::<EmaPlugin>().is_err());
+
+    let dir: PathBuf =
+        std::env::temp_dir().join(format!("flicker-added-method-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("ema.ron");
+    std::fs::write(
+        &file,
+        "Scenario(scene: Builtin(\"cornell_box\"), resolution: (16, 9), frames: 3,\n  reference: (spp: 4, frames: List([2])),\n  methods: [PathTracing(spp: 1), EmaPathTracing(alpha: 0.5)])",
+    )
+    .unwrap();
+    let overrides = Overrides { out: Some(dir.join("run")), ..Default::default() };
+    let spec = RunSpec::load(&file, &overrides).expect("scenario with the added method");
+    assert_eq!(spec.methods[1].label(), "ema_pt_0.5");
+    assert_eq!(spec.methods[1].spec.temporal_window(), Some(3.0));
+
+    // `flicker schedule`: the method and its system in Render.
+    let listing = systems::methods::describe_schedule(&spec.methods).unwrap();
+    assert!(listing.contains("ema_pt_0.5 (EmaPathTracing)"), "{listing}");
+    let render = listing.find("\nRender\n").expect(&listing);
+    let learn = listing.find("\nLearn\n").expect(&listing);
+    let system = listing.find("ema_render").expect(&listing);
+    assert!(render < system && system < learn, "{listing}");
+
+    // An unknown field is an error at the entry's place in the file, as for a shipped method.
+    let bad = dir.join("bad.ron");
+    std::fs::write(
+        &bad,
+        "Scenario(scene: Builtin(\"cornell_box\"), resolution: (16, 9), frames: 1,\n  methods: [EmaPathTracing(beta: 0.5)])",
+    )
+    .unwrap();
+    let e = RunSpec::load(&bad, &Overrides::default()).unwrap_err().to_string();
+    assert!(e.contains("bad.ron:2:") && e.contains("beta"), "{e}");
+
+    let opts = RunOptions {
+        scenario: file.clone(),
+        overrides,
+        cache_dir: Some(dir.join("cache")),
+        progress: false,
+    };
+    let summary = run_spec(&spec, &opts).expect("run");
+    let run = dir.join("run");
+
+    // frames.csv: a row per frame, measured against the reference like the others.
+    let csv = std::fs::read_to_string(run.join("frames.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().filter(|l| l.contains("ema_pt_0.5")).collect();
+    assert_eq!(rows.len(), 3, "{csv}");
+    assert!(summary.records.iter().any(|r| r.method == "ema_pt_0.5" && r.frame == 2));
+
+    // The report names it.
+    let html = std::fs::read_to_string(run.join("report.html")).unwrap();
+    assert!(html.contains("ema_pt_0.5"));
+
+    // And it computes what it says: frame 0 is the 1-spp image (same seeds as PathTracing), each
+    // later frame α·current + (1 − α)·previous.
+    let frames = |label: &str| -> Vec<Vec<[f32; 4]>> {
+        (0..3).map(|f| read_exr(&run.join(format!("frames/{label}/{f:04}.exr")))).collect()
+    };
+    let (pt, ema) = (frames("pt_1spp"), frames("ema_pt_0.5"));
+    assert_eq!(ema[0], pt[0]);
+    let mut expected = pt[0].clone();
+    for f in 1..3 {
+        expected = expected
+            .iter()
+            .zip(&pt[f])
+            .map(|(p, c)| std::array::from_fn(|k| 0.5 * c[k] + 0.5 * p[k]))
+            .collect();
+        for (e, g) in expected.iter().zip(&ema[f]) {
+            for k in 0..3 {
+                assert!(
+                    (e[k] - g[k]).abs() <= 1e-6 * e[k].abs().max(1.0),
+                    "frame {f}: {e:?} {g:?}"
+                );
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
