@@ -3,17 +3,16 @@
 
 pub mod bench;
 pub mod bench_nirc_frames;
-pub mod frame;
-pub mod frame_record;
 pub mod manifest;
-pub mod measure;
 pub mod methods;
 pub mod mitsuba;
-pub mod output;
 pub mod playback;
-pub mod reference_cache;
-pub mod run_folder;
 pub mod scenario;
 pub mod suite;
 pub mod sweep;
-pub mod tonemap;
+
+/// The frame (its own crate, which knows no method) and what a run writes, under the names the
+/// rest of this crate and its users know them by.
+pub use ::frame;
+pub use frame::frame_metrics as measure;
+pub use frame::{frame_record, output, reference_cache, run_folder, tonemap};

@@ -121,7 +121,7 @@ impl FrameWorld {
         // all that use it.
         if !scenario.media.is_empty() && scenario.media.len() <= media::gpu::MAX_MEDIA {
             let gpu = &world.resource::<GpuDevice>().0;
-            let medium = frame::media::SceneMedium::new(gpu, &scenario.media);
+            let medium = frame::scene_medium::SceneMedium::new(gpu, &scenario.media);
             world.insert_resource(medium);
         }
         frame::catch_failures(&mut world);

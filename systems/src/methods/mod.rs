@@ -7,13 +7,11 @@
 pub mod hash_cache;
 pub mod nirc;
 pub mod path_tracing;
-pub mod plugin;
 pub mod registry;
 pub mod sample_cache;
 pub mod spec;
 pub mod sss;
 pub mod taa;
-pub mod temporal_window;
 pub mod termination;
 pub mod volume;
 pub mod volume_path;
@@ -21,7 +19,8 @@ pub mod volume_path;
 use anyhow::Result;
 use bevy_ecs::prelude::*;
 
-pub use plugin::{MethodPlugin, MethodSpec, RegisteredMethod};
+pub use frame::method::{MethodPlugin, MethodSpec, RegisteredMethod};
+pub use frame::temporal_window;
 pub use registry::register;
 pub use spec::{check_labels, parse_methods};
 

@@ -4,10 +4,10 @@
 
 use std::sync::RwLock;
 
-use super::plugin::{MethodPlugin, Registered, RegisteredMethod};
 use super::{
     hash_cache, nirc, path_tracing, sample_cache, sss, taa, termination, volume, volume_path,
 };
+use frame::method::{MethodPlugin, Registered, RegisteredMethod};
 
 /// Every shipped method, in the order `flicker` lists them.
 pub static REGISTRY: &[&dyn RegisteredMethod] = &[

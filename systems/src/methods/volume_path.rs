@@ -14,7 +14,7 @@ use media::gpu::{Combination, MisWeight, VolumePathSettings};
 use serde::{Deserialize, Serialize};
 
 use super::{MethodOutput, MethodPlugin};
-use crate::frame::media::{SceneMedium, render_volume};
+use crate::frame::scene_medium::{SceneMedium, render_volume};
 use crate::frame::{
     FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
 };

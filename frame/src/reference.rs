@@ -5,7 +5,7 @@ use bevy_ecs::prelude::*;
 
 use super::resources::{FrameClock, GpuDevice, Progress, References, Run, Tracer};
 use super::stage::failed;
-use crate::measure;
+use crate::frame_metrics as measure;
 use crate::reference_cache::{ReferenceCache, ReferenceKey};
 use render::path_tracer::PathTracer;
 
@@ -23,7 +23,7 @@ pub fn render_reference(
     scene: Res<sim::ExtractedScene>,
     progress: Res<Progress>,
     mut references: ResMut<References>,
-    mut medium: Option<ResMut<super::media::SceneMedium>>,
+    mut medium: Option<ResMut<super::scene_medium::SceneMedium>>,
 ) -> Result {
     references.current = None;
     let scenario = &run.scenario;
@@ -67,11 +67,11 @@ pub fn render_reference(
             bar.set_message(format!("reference {frame:04}"));
             let spp = scenario.reference.spp;
             let px = match medium.as_deref_mut() {
-                Some(m) => super::media::render_volume(
+                Some(m) => super::scene_medium::render_volume(
                     &gpu.0,
                     &tracer,
                     m,
-                    &super::media::REFERENCE_SETTINGS,
+                    &super::scene_medium::REFERENCE_SETTINGS,
                     spp,
                     reference_seed(scenario.seed),
                     clock.global,

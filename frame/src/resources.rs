@@ -11,8 +11,8 @@ use render::path_tracer::PathTracer;
 use sim::Scenario;
 
 use super::method_output::MethodOutput;
+use crate::frame_metrics as measure;
 use crate::frame_record::FrameRecord;
-use crate::measure;
 use crate::reference_cache::ReferenceCache;
 use crate::run_folder::RunFolder;
 

@@ -4,7 +4,7 @@
 use bevy_ecs::prelude::*;
 
 use super::resources::{FrameClock, MethodFrame, MethodInfo, References, Run};
-use crate::measure;
+use crate::frame_metrics as measure;
 
 /// The method's output as a frame to measure; the record starts with its label and counters.
 pub fn prepare(

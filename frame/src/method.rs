@@ -2,7 +2,7 @@
 //! a method (its scenario name, label, samples per pixel, temporal window, the `--spp`
 //! override, its systems and how to build an instance), so that nothing outside its own file
 //! matches on which method it is. [`MethodSpec`] holds one method's settings behind that trait;
-//! [`super::registry::REGISTRY`] lists the plugins.
+//! the registry (`systems::methods::registry`) lists the plugins.
 
 use std::any::Any;
 use std::fmt;
@@ -36,7 +36,7 @@ pub trait MethodPlugin: Sync + Send + 'static {
     /// a share of the pixels.
     fn spp(settings: &Self::Settings) -> f64;
 
-    /// Its effective temporal window in frames (`super::temporal_window`); `None` where it is
+    /// Its effective temporal window in frames (`crate::temporal_window`); `None` where it is
     /// not stated (methods that learn over time with no fixed blend).
     fn temporal_window(settings: &Self::Settings) -> Option<f64>;
 

@@ -1,20 +1,30 @@
 //! The frame as a bevy_ecs schedule. Its stages (Simulate, Extract, Render, Learn, Measure,
 //! Record) are ordered system sets; the simulation's animation systems, the upload of the
-//! scene, each method's systems (added by its plugin from `crate::methods`, which builds on this
-//! module; this module knows no method), the metrics and the
-//! recording are systems in them. `flicker schedule` prints what runs.
+//! scene, each method's systems (added by its [`method::MethodPlugin`]; this crate knows no
+//! method), the metrics and the recording are systems in them. `flicker schedule` prints what
+//! runs. Also here: what the stages write (the run folder, frames.csv rows, the reference
+//! cache, atomic output) and what a method is to the frame (`method`).
 
 pub mod extract;
+pub mod frame_metrics;
+pub mod frame_record;
 pub mod measure;
-pub mod media;
+pub mod method;
 pub mod method_output;
+pub mod output;
 pub mod record;
 pub mod reference;
+pub mod reference_cache;
 pub mod resources;
+pub mod run_folder;
+pub mod scene_medium;
 pub mod stage;
+pub mod temporal_window;
+pub mod tonemap;
 
 use bevy_ecs::prelude::*;
 
+pub use method::{MethodPlugin, MethodSpec, Registered, RegisteredMethod};
 pub use method_output::{MethodImage, MethodOutput};
 pub use resources::{
     FrameClock, GpuDevice, MethodFrame, MethodInfo, Progress, References, Run, RunOutput, Tracer,
@@ -44,7 +54,7 @@ pub fn add_core_systems(schedule: &mut Schedule) {
             sim::extract_scene.run_if(started),
             extract::frame_number,
             extract::upload_scene,
-            media::upload_medium,
+            scene_medium::upload_medium,
         )
             .chain()
             .in_set(Stage::Extract),
