@@ -148,11 +148,14 @@ pub fn listing(schedule: &mut Schedule, world: &mut World) -> Result<Vec<(Stage,
     Ok(out)
 }
 
-/// `systems::methods::taa::resolve` -> `taa::resolve`: the module and the function.
+/// `sim::animation::rotate::rotate` -> `rotate::rotate`: the module and the function; a
+/// method's systems, in its crate's `plugin` module, by the crate (`taa::plugin::resolve` ->
+/// `taa::resolve`).
 fn short_name(full: &str) -> String {
     let parts: Vec<&str> = full.split("::").collect();
     match parts.len() {
         0 | 1 => full.to_string(),
+        n if parts[n - 2] == "plugin" => format!("{}::{}", parts[0], parts[n - 1]),
         n => format!("{}::{}", parts[n - 2], parts[n - 1]),
     }
 }

@@ -20,16 +20,6 @@ pub fn exponential(alpha: f64) -> f64 {
     (2.0 - alpha) / alpha
 }
 
-/// The window of a method's filter of `window` frames, then, `under` TAA, TAA's default blend in
-/// series (the caches that run under TAA use its default settings).
-pub fn under_taa(window: f64, under: bool) -> f64 {
-    if under {
-        in_series(window, exponential(render::taa::TaaSettings::default().alpha as f64))
-    } else {
-        window
-    }
-}
-
 /// The per-frame blend weight whose exponential window is `window` frames.
 fn weight_of(window: f64) -> f64 {
     2.0 / (window + 1.0)

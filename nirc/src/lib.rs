@@ -17,6 +17,7 @@ pub mod fixed_sum;
 pub mod gpu;
 pub mod integrator;
 pub mod layout;
+pub mod plugin;
 pub mod records;
 pub mod reliability;
 pub mod state;

@@ -144,6 +144,16 @@ impl PassLibrary {
         })
     }
 
+    /// One of the library's modules by its path (`package::pt_sampling`), for a pass that
+    /// imports it without the rest of the library.
+    pub fn module(path: &str) -> Module {
+        Self::modules()
+            .iter()
+            .find(|m| m.path == path)
+            .cloned()
+            .unwrap_or_else(|| panic!("the pass library has no module {path}"))
+    }
+
     /// A program on the library: its modules, then `own` (the pass's structs, bindings and
     /// files it imports), with the pass's entry-point files.
     pub fn program(

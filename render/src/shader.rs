@@ -132,6 +132,18 @@ impl Program {
             .collect()
     }
 
+    /// Links every entry-point file and parses the result with naga: the first failure as
+    /// "FILE: message" (tests of each pass's program, without a device).
+    pub fn check_links(&self) -> Result<(), String> {
+        let sources = self.compose().map_err(|e| e.to_string())?;
+        for (wgsl, file) in sources.iter().zip(&self.entry_files) {
+            if let Err(e) = naga::front::wgsl::parse_str(wgsl) {
+                return Err(format!("{}: {}", file.file, e.emit_to_string(wgsl)));
+            }
+        }
+        Ok(())
+    }
+
     /// Each entry-point file linked with the modules it imports: one WGSL source per file.
     pub fn compose(&self) -> Result<Vec<String>, RenderError> {
         let mut resolver = VirtualResolver::new();

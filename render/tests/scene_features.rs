@@ -1,44 +1,17 @@
 //! Passes compiled for the features a scene has (render/src/scene_features.rs): the same images
 //! as passes compiled for every feature and the largest traversal stack, and compiled again when
-//! the scene gains a feature.
+//! the scene gains a feature (a held pass recompiled: methods/taa/tests/scene_features.rs).
 
-mod common;
+use render::test_scenes as common;
 
 use common::{H, W, gpu, room_scene};
 use glam::{Mat4, Vec3};
-use render::compute::BufferBinding;
 use render::path_tracer::{PathTracer, PathTracerSettings};
-use render::scene::{Instance, Light, SceneDesc, Texture};
+use render::scene::Instance;
 use render::scene_features::SceneFeatures;
-use render::taa::Taa;
 
 fn settings() -> PathTracerSettings {
     PathTracerSettings { width: W, height: H, max_depth: 4, rr_start_depth: 2 }
-}
-
-/// The room without its walls: the red box under the panel, open to the environment.
-fn open_scene() -> SceneDesc {
-    let mut scene = room_scene();
-    scene.instances.remove(0);
-    scene
-}
-
-/// [`open_scene`] with an environment, a point light and a checker texture on the box.
-fn lit_open_scene() -> SceneDesc {
-    let mut scene = open_scene();
-    scene.environment = Vec3::splat(0.3);
-    scene
-        .lights
-        .push(Light::Point { position: Vec3::new(1.0, 1.0, 1.0), intensity: Vec3::splat(2.0) });
-    let (dark, light) = ([40u8, 40, 40, 255], [220u8, 220, 220, 255]);
-    scene.textures.push(Texture {
-        name: "checker".into(),
-        width: 2,
-        height: 2,
-        rgba8: [dark, light, light, dark].concat(),
-    });
-    scene.materials[1].base_color_texture = Some(0);
-    scene
 }
 
 #[test]
@@ -73,45 +46,6 @@ fn passes_for_the_scene_s_lights_render_what_passes_for_every_light_do() {
         own.radiance, every.radiance,
         "the estimators of absent lights draw no random numbers and add nothing, and the stack holds what the BVH needs"
     );
-}
-
-#[test]
-fn a_scene_that_gains_features_gets_passes_compiled_for_them() {
-    let mut tracer = PathTracer::new(gpu(), &open_scene(), settings()).expect("tracer");
-    // Any pass on the library: TAA's trace pass, as a method holds it.
-    let own = [
-        BufferBinding::uniform("taa", "TaaParams"),
-        BufferBinding::read_write("taa_current", "array<vec4f>"),
-        BufferBinding::read_write("taa_primary", "array<TaaPrimary>"),
-        BufferBinding::read_write("taa_counters", "array<atomic<u32>>"),
-    ];
-    let (_, [before]) = tracer
-        .library_pass(gpu(), "taa_trace.wgsl", Taa::trace_program(), &own, ["taa_trace"])
-        .expect("pass");
-    let held = before.get();
-    let dark = tracer.render(gpu(), 4, 7, 0).expect("frame");
-
-    tracer.try_update(gpu(), &lit_open_scene()).expect("update");
-    let stack = SceneFeatures::stack_for(tracer.geometry().stack_entries());
-    assert_eq!(
-        tracer.library().features(),
-        SceneFeatures { traversal_stack: stack, ..SceneFeatures::ALL }
-    );
-    assert!(
-        before.get() != held,
-        "the held pipeline was swapped for one compiled with the new features"
-    );
-    let updated = tracer.render(gpu(), 4, 7, 0).expect("frame");
-    // A tracer built on the lit scene from the start: its passes were compiled for its features.
-    let fresh = PathTracer::new(gpu(), &lit_open_scene(), settings())
-        .expect("tracer")
-        .render(gpu(), 4, 7, 0)
-        .expect("frame");
-    assert_eq!(
-        updated.radiance, fresh.radiance,
-        "after the update the passes sample the environment and the point light, and read the texture"
-    );
-    assert!(updated.radiance != dark.radiance);
 }
 
 #[test]

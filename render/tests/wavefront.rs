@@ -2,7 +2,7 @@
 //! megakernel: same samples, same random numbers, same order of sums, so the same image when
 //! both run the same batches.
 
-mod common;
+use render::test_scenes as common;
 
 use common::{H, W, gpu, room_scene};
 use glam::Vec3;

@@ -78,7 +78,7 @@ pub struct Material {
     /// 0 leaves a pure Lambertian diffuse (furnace tests); glTF's default is 1.
     #[serde(default = "one")]
     pub specular: f32,
-    /// Screen-space subsurface scattering (render::sss): set by a scenario's material override.
+    /// Screen-space subsurface scattering (sss): set by a scenario's material override.
     /// The path tracer shades the surface as its diffuse base; the SSS method scatters the
     /// demodulated diffuse irradiance of its pixels.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -310,7 +310,7 @@ struct ScenarioFile {
 #[serde(deny_unknown_fields)]
 pub struct MaterialOverride {
     pub material: String,
-    /// Makes the material a subsurface material (render::sss).
+    /// Makes the material a subsurface material (sss).
     #[serde(default)]
     pub subsurface: Option<scene::Subsurface>,
 }

@@ -1,4 +1,4 @@
-//! A scenario's material overrides (subsurface parameters for render::sss): applied to the named
+//! A scenario's material overrides (subsurface parameters for sss): applied to the named
 //! material of the spawned scene; bad values and unknown names are errors at file:line.
 
 use std::path::Path;

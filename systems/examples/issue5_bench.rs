@@ -10,13 +10,13 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use hash_cache::{HashCache, HashCacheSettings};
 use render::gpu::Gpu;
-use render::hash_cache::{HashCache, HashCacheSettings};
 use render::path_tracer::{PathTracer, PathTracerSettings};
-use render::sample_cache::{DISPATCHES, Retrace, SampleCache, SampleCacheSettings};
-use render::taa::{Taa, TaaSettings};
 use render::timing::PassTiming;
+use sample_cache::{DISPATCHES, Retrace, SampleCache, SampleCacheSettings};
 use sim::{Scenario, Simulation};
+use taa::{Taa, TaaSettings};
 
 /// Frames rendered before timing starts (the caches fill, pipelines warm up).
 const WARM_UP: u32 = 2;

@@ -11,8 +11,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
-use render::sss::evaluation::{psnr_luminance, smape_luminance};
-use render::sss::sampling::luminance;
+use sss::evaluation::{psnr_luminance, smape_luminance};
+use sss::sampling::luminance;
 use systems::output::read_exr;
 use systems::run_folder::RunFolder;
 

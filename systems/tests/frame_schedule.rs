@@ -183,23 +183,17 @@ fn methods_take_their_settings_defaults_and_names() {
     let s = spec(
         "Taa(), Taa(name: \"taa_fast\", alpha: 0.2, clamp: MinMax), HashCache(), HashCache(lookup: SecondaryHit, taa: true, capacity: 1024), SampleCache(retrace: Multi)",
     );
-    let d = render::taa::TaaSettings::default();
-    assert_eq!(s.methods[0].spec.get::<render::taa::TaaSettings>(), Some(&d));
-    let t = s.methods[1].spec.get::<render::taa::TaaSettings>().expect("Taa settings");
-    assert_eq!(
-        (t.alpha, t.clamp, t.jitter_length),
-        (0.2, render::taa::TaaClamp::MinMax, d.jitter_length)
-    );
+    let d = taa::TaaSettings::default();
+    assert_eq!(s.methods[0].spec.get::<taa::TaaSettings>(), Some(&d));
+    let t = s.methods[1].spec.get::<taa::TaaSettings>().expect("Taa settings");
+    assert_eq!((t.alpha, t.clamp, t.jitter_length), (0.2, taa::TaaClamp::MinMax, d.jitter_length));
     let labels: Vec<String> = s.methods.iter().map(|m| m.label()).collect();
     assert_eq!(
         labels,
         ["taa", "taa_fast", "hash_cache", "hash_cache_secondary_hit_taa", "ssc_multi"]
     );
     assert!(s.methods[..4].iter().all(|m| m.spec.spp() == 1.0));
-    let h = s.methods[3]
-        .spec
-        .get::<render::hash_cache::HashCacheSettings>()
-        .expect("HashCache settings");
+    let h = s.methods[3].spec.get::<hash_cache::HashCacheSettings>().expect("HashCache settings");
     assert_eq!((h.capacity, h.probe_limit, h.taa), (1024, 8, true));
 }
 
@@ -272,7 +266,7 @@ fn paper_scale_scenarios_parse_with_the_controls_and_the_nrc_batch() {
             path.display()
         );
         for m in &spec.methods {
-            if let Some(n) = m.spec.get::<systems::methods::nirc::NircSettings>() {
+            if let Some(n) = m.spec.get::<nirc::plugin::NircSettings>() {
                 assert_eq!(
                     (n.pretrain_frames, n.paths.train_records),
                     (5000, 16384),
@@ -284,4 +278,18 @@ fn paper_scale_scenarios_parse_with_the_controls_and_the_nrc_batch() {
         count += 1;
     }
     assert_eq!(count, 3);
+}
+
+#[test]
+fn termination_text_parses_with_the_paper_defaults_and_refuses_unknown_fields() {
+    use termination::TerminationRule;
+    let m = Method::parse("Termination(rule: MseMinimisation(s: 100.0))").unwrap();
+    assert_eq!(m.label(), "termination_mse_100");
+    let s = m.spec.get::<termination::TerminationSettings>().expect("Termination settings");
+    assert_eq!(s.rule, TerminationRule::MseMinimisation { s: 100.0, margin: 1.1, bias_clamp: 0.1 });
+    assert_eq!((s.store_probability, s.survival), (0.01, 1.0));
+    let e = Method::parse("Termination(rule: VarianceBounding(t: 0.1, tt: 1.0))").unwrap_err();
+    assert!(e.contains("tt"), "{e}");
+    let e = Method::parse("Termination(rule: VarianceBounding(t: 0.1), samples: 4)").unwrap_err();
+    assert!(e.contains("samples"), "{e}");
 }

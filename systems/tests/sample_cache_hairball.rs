@@ -10,9 +10,9 @@ use std::path::Path;
 use metrics::Image;
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
-use render::sample_cache::{Retrace, SampleCache, SampleCacheSettings};
-use render::taa::{Taa, TaaSettings};
+use sample_cache::{Retrace, SampleCache, SampleCacheSettings};
 use sim::{Scenario, Simulation};
+use taa::{Taa, TaaSettings};
 
 fn image(w: u32, h: u32, rgba: &[[f32; 4]]) -> Image {
     Image::new(w, h, rgba.iter().map(|p| [p[0], p[1], p[2]]).collect())

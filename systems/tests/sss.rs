@@ -136,7 +136,7 @@ fn play_with_materials(
     (run_spec(&spec, &opts).expect("run").records, dir)
 }
 
-/// TAA after the pass (render::taa's resolve, Sec. 4.3): the first frame has no history and is
+/// TAA after the pass (taa's resolve, Sec. 4.3): the first frame has no history and is
 /// the pass's own image; later frames blend the history, so in a still scene the frame-to-frame
 /// flicker (SMAPE) falls below the pass without TAA: a one-sided 95% Student-t bound over 3
 /// seeds. The separable baseline runs beside them: 2 x 25 fetches per SSS pixel, its two passes

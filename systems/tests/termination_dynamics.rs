@@ -51,7 +51,7 @@ fn play(
     spec.methods.retain(|m| keep.contains(&m.label().as_str()));
     assert_eq!(spec.methods.len(), keep.len(), "{scenario}: methods {keep:?}");
     for m in &mut spec.methods {
-        if let Some(t) = m.spec.get_mut::<render::termination::TerminationSettings>() {
+        if let Some(t) = m.spec.get_mut::<termination::TerminationSettings>() {
             t.store_probability = 0.1;
             t.warmup_frames = 24;
         }
@@ -109,7 +109,7 @@ fn cache_follows_a_flash_and_forgets_it_slower_than_its_memory() {
     let setup = |s: &mut RunSpec| {
         s.scenario.reference.frames = ReferenceFrames::None;
         for m in &mut s.methods {
-            if let Some(t) = m.spec.get_mut::<render::termination::TerminationSettings>() {
+            if let Some(t) = m.spec.get_mut::<termination::TerminationSettings>() {
                 t.warmup_frames = WARMUP;
             }
         }

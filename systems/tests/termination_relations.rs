@@ -48,7 +48,7 @@ fn play(scenario: &str, keep: &[&str], seed: u64) -> Vec<FrameRecord> {
     let mut spec = RunSpec::load(&file, &overrides).expect("scenario");
     spec.methods.retain(|m| keep.contains(&m.label().as_str()));
     for m in &mut spec.methods {
-        if let Some(t) = m.spec.get_mut::<render::termination::TerminationSettings>() {
+        if let Some(t) = m.spec.get_mut::<termination::TerminationSettings>() {
             t.store_probability = 0.1;
             t.warmup_frames = 24;
         }

@@ -31,7 +31,7 @@ fn label(column: &str) -> String {
 }
 
 /// Columns charted against frame, in this order, then per-region FLIP and SMAPE. The last four
-/// are the termination cache's (render::termination): how termination and the records'
+/// are the termination cache's (termination): how termination and the records'
 /// statistics move around an event.
 const FRAME_COLUMNS: [&str; 12] = [
     "flip",

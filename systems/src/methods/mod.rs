@@ -4,17 +4,8 @@
 //! on the instance's entity. `registry.rs` lists them, one line each. Adding a method: its file
 //! (or folder) here with its settings, components, systems and plugin, and its registry line.
 
-pub mod hash_cache;
-pub mod nirc;
-pub mod path_tracing;
 pub mod registry;
-pub mod sample_cache;
 pub mod spec;
-pub mod sss;
-pub mod taa;
-pub mod termination;
-pub mod volume;
-pub mod volume_path;
 
 use anyhow::Result;
 use bevy_ecs::prelude::*;

@@ -4,20 +4,17 @@
 
 use std::sync::RwLock;
 
-use super::{
-    hash_cache, nirc, path_tracing, sample_cache, sss, taa, termination, volume, volume_path,
-};
 use frame::method::{MethodPlugin, Registered, RegisteredMethod};
 
 /// Every shipped method, in the order `flicker` lists them.
 pub static REGISTRY: &[&dyn RegisteredMethod] = &[
     &Registered::<path_tracing::Plugin>::ENTRY,
-    &Registered::<nirc::Plugin>::ENTRY,
+    &Registered::<nirc::plugin::Plugin>::ENTRY,
     &Registered::<sample_cache::Plugin>::ENTRY,
     &Registered::<taa::Plugin>::ENTRY,
     &Registered::<hash_cache::Plugin>::ENTRY,
-    &Registered::<volume::Plugin>::ENTRY,
-    &Registered::<volume_path::Plugin>::ENTRY,
+    &Registered::<volume::transmittance::Plugin>::ENTRY,
+    &Registered::<volume::path::Plugin>::ENTRY,
     &Registered::<termination::Plugin>::ENTRY,
     &Registered::<sss::Plugin>::ENTRY,
 ];

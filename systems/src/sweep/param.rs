@@ -64,12 +64,11 @@ mod tests {
         let mut m = Method::parse("Nirc(spp: 1, predictor: Blend)").unwrap();
         set(&mut m, &["cache", "reliability", "kappa"], &json!(2.0)).unwrap();
         set(&mut m, &["cache", "ema", "alpha"], &json!(0.9)).unwrap();
-        let s = m.spec.get::<crate::methods::nirc::NircSettings>().expect("Nirc settings");
+        let s = m.spec.get::<nirc::plugin::NircSettings>().expect("Nirc settings");
         assert_eq!((s.cache.reliability.kappa, s.cache.ema.alpha), (2.0, 0.9));
         // Everything else as parsed.
         let mut expected = Method::parse("Nirc(spp: 1, predictor: Blend)").unwrap();
-        let e =
-            expected.spec.get_mut::<crate::methods::nirc::NircSettings>().expect("Nirc settings");
+        let e = expected.spec.get_mut::<nirc::plugin::NircSettings>().expect("Nirc settings");
         e.cache.reliability.kappa = 2.0;
         e.cache.ema.alpha = 0.9;
         assert_eq!(m.spec, expected.spec);
@@ -80,7 +79,7 @@ mod tests {
         assert!(e.contains("Nirc.spp = 1.5"), "{e}");
         let mut taa = vec![Method::parse("Taa()").unwrap()];
         apply(&mut taa, "taa.alpha", &json!(0.25)).unwrap();
-        let t = taa[0].spec.get::<render::taa::TaaSettings>().expect("Taa settings");
+        let t = taa[0].spec.get::<taa::TaaSettings>().expect("Taa settings");
         assert_eq!(t.alpha, 0.25);
         let e = apply(&mut taa, "pt_1spp.spp", &json!(2)).unwrap_err();
         assert!(e.contains("no method labelled 'pt_1spp'") && e.contains("taa"), "{e}");

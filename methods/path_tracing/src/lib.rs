@@ -1,0 +1,89 @@
+//! Plain path tracing at k samples per pixel: the baseline every cache is measured against.
+
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use bevy_ecs::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use frame::{MethodOutput, MethodPlugin};
+
+/// `PathTracing(spp: 4)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PathTracingSettings {
+    pub spp: u32,
+}
+
+impl PathTracingSettings {
+    pub fn label(&self) -> String {
+        format!("pt_{}spp", self.spp)
+    }
+}
+
+#[derive(Component)]
+pub struct PathTracing {
+    spp: u32,
+}
+
+pub struct Plugin;
+
+impl MethodPlugin for Plugin {
+    type Settings = PathTracingSettings;
+    const NAME: &'static str = "PathTracing";
+
+    fn label(settings: &PathTracingSettings) -> String {
+        settings.label()
+    }
+
+    fn spp(settings: &PathTracingSettings) -> f64 {
+        settings.spp as f64
+    }
+
+    fn temporal_window(_settings: &PathTracingSettings) -> Option<f64> {
+        Some(1.0)
+    }
+
+    fn set_spp(settings: &mut PathTracingSettings, spp: u32) {
+        settings.spp = spp;
+    }
+
+    fn add_systems(schedule: &mut Schedule) {
+        schedule.add_systems(render.in_set(Stage::Render));
+    }
+
+    fn spawn(world: &mut World, entity: Entity, s: &PathTracingSettings) -> Result<()> {
+        if s.spp == 0 {
+            bail!("PathTracing: spp 0; expected at least 1 sample per pixel");
+        }
+        world.entity_mut(entity).insert(PathTracing { spp: s.spp });
+        Ok(())
+    }
+}
+
+/// G-buffer and `spp` paths per pixel.
+pub fn render(
+    gpu: Res<GpuDevice>,
+    mut tracer: ResMut<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&PathTracing, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
+    for (pt, info, mut frame) in &mut methods {
+        let start = Instant::now();
+        let out = tracer
+            .0
+            .render(&gpu.0, pt.spp, run.scenario.seed, clock.global)
+            .map_err(|e| method_failed(&info.label, clock.global, e))?;
+        frame.output = Some(MethodOutput::timed(
+            out.radiance,
+            out.gbuffer.motion,
+            &out.timings,
+            out.rays,
+            out.shaded,
+        ));
+        frame.add_cpu(start);
+    }
+    Ok(())
+}

@@ -1,0 +1,22 @@
+//! The structs the stable sample cache shares with WGSL (gpu_struct!) have each field at the same byte offset and
+//! the same size on both sides, as naga lays the WGSL declaration out; its program links to valid
+//! WGSL.
+
+use render::gpu_struct::layout_mismatches;
+use sample_cache::{SscParams, SscPixel, SscSlot};
+
+#[test]
+fn shared_structs_have_one_layout() {
+    for (name, found) in [
+        ("SscParams", layout_mismatches::<SscParams>("")),
+        ("SscPixel", layout_mismatches::<SscPixel>("")),
+        ("SscSlot", layout_mismatches::<SscSlot>("")),
+    ] {
+        assert!(found.is_empty(), "{name}: {found:?}");
+    }
+}
+
+#[test]
+fn the_program_links_to_valid_wgsl() {
+    sample_cache::program().check_links().unwrap_or_else(|e| panic!("{e}"));
+}

@@ -1,0 +1,408 @@
+//! The screen-space SSS pass in WGSL (shaders/sss/sss_pass.wgsl, entry `sss_scatter`): the
+//! same per-pixel step as `screen_pass::pixel_step`, one invocation per pixel, with ping-pong
+//! histories on the GPU; the separable variant runs shaders/sss/separable.wgsl's two 1-D passes
+//! instead. Timed per pass (`sss_scatter`, `sss_separable_h`, `sss_separable_v`) by `PassTimer`.
+
+use super::control_variates::EmCovariance;
+use super::prefilter;
+use super::screen_pass::{PixelHistory, PixelResult, SssFrame, SssSettings, SssVariant};
+use super::separable;
+use super::spvg::SpvgHistory;
+use render::error::RenderError;
+use render::gpu::Gpu;
+use render::gpu_struct::GpuStruct;
+use render::readback::read_buffer;
+use render::shader::{Module, Program};
+use render::timing::{PassTimer, PassTiming};
+use wgpu::util::DeviceExt;
+
+/// The largest count one invocation may take (a bounded per-invocation loop; the 2048-spp
+/// reference of the thesis fits).
+pub const MAX_COUNT: u32 = 4096;
+
+render::gpu_struct! {
+    /// The pass's uniform: image size, frame and seed, the variant (0 fixed, 1 AS, 2 OCV,
+    /// 3 CCV, 4 separable), SPVG's and the control variates' parameters, the separable
+    /// kernel's tap count, AFIS's level count (0: no prefiltering) and eq. 5.12's a, d per
+    /// channel in pixels (w: the sampled d), and per MIP level (offset in the chain's buffer,
+    /// width, height, 0), computed once here rather than per fetch in the shader.
+    pub struct SssParams {
+        pub width: u32 => "u32",
+        pub height: u32 => "u32",
+        pub frame: u32 => "u32",
+        pub seed: u32 => "u32",
+        pub variant: u32 => "u32",
+        pub fixed_count: u32 => "u32",
+        pub n_min: u32 => "u32",
+        pub n_max: u32 => "u32",
+        pub alpha0: f32 => "f32",
+        pub kappa: f32 => "f32",
+        pub sigma0_sq: f32 => "f32",
+        pub eps_a: f32 => "f32",
+        pub a0: f32 => "f32",
+        pub a_cv: f32 => "f32",
+        pub fast_inverse: u32 => "u32",
+        pub taps: u32 => "u32",
+        pub mip_levels: u32 => "u32",
+        pub mip_a: f32 => "f32",
+        pub pad0: u32 => "u32",
+        pub pad1: u32 => "u32",
+        pub d_px: [f32; 4] => "vec4f",
+        pub mip: [[u32; 4]; 8] => "array<vec4u, 8>",
+    }
+}
+const _: () = assert!(std::mem::size_of::<SssParams>() == 224);
+// The WGSL array length above is the chain's level bound.
+const _: () = assert!(prefilter::MAX_LEVELS == 8);
+
+/// The pass's WGSL program: the Monte Carlo pass and the separable baseline's two passes.
+pub fn program() -> Program {
+    let types = Module::generated("package::sss_types", &[SssParams::WGSL]);
+    Program::new(vec![
+        types,
+        render::pass_library::PassLibrary::module("package::pt_sampling"),
+        render::wgsl_file!("sampling.wgsl"),
+        render::wgsl_file!("spvg.wgsl"),
+        render::wgsl_file!("mip.wgsl"),
+    ])
+    .entry(render::wgsl_file!("sss_pass.wgsl"))
+    .entry(render::wgsl_file!("separable.wgsl"))
+    .entry(render::wgsl_file!("prefilter.wgsl"))
+}
+
+/// The pass for one image size, with its buffers and two history sets (read one, write the other).
+pub struct SssPass {
+    width: u32,
+    height: u32,
+    pipeline: wgpu::ComputePipeline,
+    /// The separable baseline's horizontal and vertical passes, and their bind groups.
+    separable: [(wgpu::ComputePipeline, wgpu::BindGroup); 2],
+    kernel: wgpu::Buffer,
+    /// The separable kernel last uploaded: (taps, d_px).
+    kernel_for: Option<(u32, [f32; 3])>,
+    params: wgpu::Buffer,
+    irradiance: wgpu::Buffer,
+    history: [wgpu::Buffer; 2],
+    cv: [wgpu::Buffer; 2],
+    scattered: wgpu::Buffer,
+    groups: [wgpu::BindGroup; 2],
+    /// AFIS's MIP chain (`prefilter::MAX_LEVELS` levels' room) and the prefiltering pass, one
+    /// bind group per level (each with its level's uniform).
+    mips: wgpu::Buffer,
+    prefilter: (wgpu::ComputePipeline, Vec<wgpu::BindGroup>),
+    /// Which history set holds the latest history.
+    current: usize,
+    timer: PassTimer,
+}
+
+fn storage(gpu: &Gpu, label: &str, size: u64) -> wgpu::Buffer {
+    gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    })
+}
+
+impl SssPass {
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self, RenderError> {
+        if width == 0 || height == 0 {
+            return Err(RenderError::Settings(format!(
+                "SSS pass size {width}x{height} must be non-zero"
+            )));
+        }
+        let [pipeline, horizontal, vertical, prefilter_pipeline] =
+            render::compute::pipelines_auto_layout(
+                gpu,
+                "sss_scatter",
+                &program(),
+                ["sss_scatter", "sss_separable_h", "sss_separable_v", "sss_prefilter"],
+            )?;
+        let size = width as u64 * height as u64 * 16;
+        let params = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("sss params"),
+            contents: bytemuck::bytes_of(&<SssParams as bytemuck::Zeroable>::zeroed()),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        let irradiance = storage(gpu, "sss irradiance", size);
+        let history = [storage(gpu, "sss history 0", size), storage(gpu, "sss history 1", size)];
+        let cv = [storage(gpu, "sss cv 0", size), storage(gpu, "sss cv 1", size)];
+        let scattered = storage(gpu, "sss scattered", size);
+        let mips = storage(
+            gpu,
+            "sss mips",
+            prefilter::level_offset(width, height, prefilter::MAX_LEVELS) * 16,
+        );
+        let layout = pipeline.get_bind_group_layout(0);
+        let group = |k: usize| {
+            let buffers = [
+                &params,
+                &irradiance,
+                &history[k],
+                &cv[k],
+                &scattered,
+                &history[1 - k],
+                &cv[1 - k],
+                &mips,
+            ];
+            let entries: Vec<_> = buffers
+                .iter()
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry {
+                    binding: i as u32,
+                    resource: b.as_entire_binding(),
+                })
+                .collect();
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("sss pass"),
+                layout: &layout,
+                entries: &entries,
+            })
+        };
+        let groups = [group(0), group(1)];
+        let kernel = storage(gpu, "sss separable kernel", separable::MAX_TAPS as u64 * 16);
+        let intermediate = storage(gpu, "sss separable intermediate", size);
+        // Auto layouts hold only what each entry uses: the horizontal pass never sees `scattered`.
+        let separable_group = |pipeline: &wgpu::ComputePipeline, buffers: &[&wgpu::Buffer]| {
+            let entries: Vec<_> = buffers
+                .iter()
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry {
+                    binding: i as u32,
+                    resource: b.as_entire_binding(),
+                })
+                .collect();
+            gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("sss separable"),
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &entries,
+            })
+        };
+        let h_group = separable_group(&horizontal, &[&params, &irradiance, &kernel, &intermediate]);
+        let v_group =
+            separable_group(&vertical, &[&params, &irradiance, &kernel, &intermediate, &scattered]);
+        let separable = [(horizontal, h_group), (vertical, v_group)];
+        let level_groups = (0..prefilter::MAX_LEVELS)
+            .map(|k| {
+                let level = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("sss mip level"),
+                    contents: bytemuck::cast_slice(&[k, 0, 0, 0]),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+                separable_group(&prefilter_pipeline, &[&params, &irradiance, &mips, &level])
+            })
+            .collect();
+        let timer = PassTimer::new(
+            gpu,
+            &["sss_scatter", "sss_separable_h", "sss_separable_v", "sss_prefilter"],
+        );
+        Ok(Self {
+            width,
+            height,
+            pipeline,
+            separable,
+            kernel,
+            kernel_for: None,
+            params,
+            irradiance,
+            history,
+            cv,
+            scattered,
+            groups,
+            mips,
+            prefilter: (prefilter_pipeline, level_groups),
+            current: 0,
+            timer,
+        })
+    }
+
+    /// Replaces the latest history (empty = cold start everywhere).
+    pub fn set_history(&mut self, gpu: &Gpu, history: &[PixelHistory]) {
+        let n = (self.width * self.height) as usize;
+        let (h, c): (Vec<[f32; 4]>, Vec<[f32; 4]>) = (0..n)
+            .map(|i| {
+                let p = history.get(i).copied().unwrap_or_default();
+                let s = p.spvg;
+                (
+                    [s.mu, s.sigma2, s.nbar, if s.valid { 1.0 } else { 0.0 }],
+                    [p.cv.mean_f, p.cv.mean_g, p.cv.cov_fg, p.cv.var_g],
+                )
+            })
+            .unzip();
+        gpu.queue.write_buffer(&self.history[self.current], 0, bytemuck::cast_slice(&h));
+        gpu.queue.write_buffer(&self.cv[self.current], 0, bytemuck::cast_slice(&c));
+    }
+
+    /// One frame: uploads the irradiance, runs `sss_scatter`, flips the histories.
+    pub fn dispatch(
+        &mut self,
+        gpu: &Gpu,
+        frame: &SssFrame,
+        settings: &SssSettings,
+        frame_index: u32,
+    ) -> Result<Vec<PassTiming>, RenderError> {
+        if (frame.width, frame.height) != (self.width, self.height)
+            || frame.irradiance.len() != (self.width * self.height) as usize
+        {
+            return Err(RenderError::Settings(format!(
+                "SSS frame {}x{} ({} texels) does not match the pass's {}x{}",
+                frame.width,
+                frame.height,
+                frame.irradiance.len(),
+                self.width,
+                self.height
+            )));
+        }
+        settings.spvg.validate().map_err(RenderError::Settings)?;
+        let mip_levels =
+            settings.mip_levels().map_err(|e| RenderError::Settings(format!("SSS {e}")))?;
+        let (fixed, taps) = match settings.variant {
+            SssVariant::Fixed { count } => (count, 0),
+            SssVariant::Separable { taps } => (0, taps),
+            _ => (0, 0),
+        };
+        if taps > 0 && self.kernel_for != Some((taps, frame.d_px)) {
+            let kernel = separable::kernel(taps, frame.d_px).map_err(RenderError::Settings)?;
+            gpu.queue.write_buffer(&self.kernel, 0, bytemuck::cast_slice(&kernel));
+            self.kernel_for = Some((taps, frame.d_px));
+        }
+        let most = fixed.max(settings.spvg.n_max);
+        if most == 0 || most > MAX_COUNT {
+            return Err(RenderError::Settings(format!(
+                "SSS sample count {most} must be in [1, {MAX_COUNT}]"
+            )));
+        }
+        gpu.check_loop_iterations("sss_scatter", most as u64)?;
+        let s = &settings.spvg;
+        let p = SssParams {
+            width: self.width,
+            height: self.height,
+            frame: frame_index,
+            seed: settings.seed,
+            variant: settings.variant.code(),
+            fixed_count: fixed,
+            n_min: s.n_min,
+            n_max: s.n_max,
+            alpha0: s.alpha0,
+            kappa: s.kappa,
+            sigma0_sq: s.sigma0_sq,
+            eps_a: settings.eps_a,
+            a0: settings.a0,
+            a_cv: settings.a_cv,
+            fast_inverse: settings.fast_inverse as u32,
+            taps,
+            mip_levels,
+            mip_a: settings.prefilter.map_or(0.0, |p| p.a),
+            pad0: 0,
+            pad1: 0,
+            d_px: [frame.d_px[0], frame.d_px[1], frame.d_px[2], frame.d_sample()],
+            mip: std::array::from_fn(|k| {
+                let (w, h) = prefilter::level_size(self.width, self.height, k as u32);
+                [prefilter::level_offset(self.width, self.height, k as u32) as u32, w, h, 0]
+            }),
+        };
+        gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
+        gpu.queue.write_buffer(&self.irradiance, 0, bytemuck::cast_slice(&frame.irradiance));
+        let mut timed = self.timer.begin(gpu, "sss frame");
+        let (gx, gy) = (self.width.div_ceil(8), self.height.div_ceil(8));
+        if mip_levels > 0 {
+            let (pipeline, groups) = &self.prefilter;
+            timed.pass(3, |pass| {
+                pass.set_pipeline(pipeline);
+                // One dispatch per level, each reading the last (wgpu orders them).
+                for (k, group) in groups.iter().enumerate().take(mip_levels as usize) {
+                    let (w, h) = prefilter::level_size(self.width, self.height, k as u32);
+                    pass.set_bind_group(0, group, &[]);
+                    pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+                }
+            })?;
+        }
+        let passes: Vec<(usize, &wgpu::ComputePipeline, &wgpu::BindGroup)> = if taps > 0 {
+            self.separable.iter().enumerate().map(|(k, (p, g))| (1 + k, p, g)).collect()
+        } else {
+            vec![(0, &self.pipeline, &self.groups[self.current])]
+        };
+        for (index, pipeline, group) in passes {
+            timed.pass(index, |pass| {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, group, &[]);
+                pass.dispatch_workgroups(gx, gy, 1);
+            })?;
+        }
+        let times = timed.submit()?;
+        // The separable passes keep no history: the Monte Carlo histories stay as they were.
+        if taps == 0 {
+            self.current = 1 - self.current;
+        }
+        Ok(times)
+    }
+
+    fn read(
+        &self,
+        gpu: &Gpu,
+        buffer: &wgpu::Buffer,
+        what: &str,
+    ) -> Result<Vec<[f32; 4]>, RenderError> {
+        let mut all = self.read_all(gpu, buffer, what)?;
+        all.truncate((self.width * self.height) as usize);
+        Ok(all)
+    }
+
+    fn read_all(
+        &self,
+        gpu: &Gpu,
+        buffer: &wgpu::Buffer,
+        what: &str,
+    ) -> Result<Vec<[f32; 4]>, RenderError> {
+        let size = buffer.size();
+        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sss staging"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("sss readback"),
+        });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        gpu.queue.submit([encoder.finish()]);
+        read_buffer(gpu, &staging)
+            .map_err(|reason| RenderError::Readback { what: what.into(), reason })
+    }
+
+    /// The last frame's MIP chain, `levels` levels (rgb, share of SSS texels per texel).
+    pub fn mips(&self, gpu: &Gpu, levels: u32) -> Result<Vec<Vec<[f32; 4]>>, RenderError> {
+        let all = self.read_all(gpu, &self.mips, "sss mips")?;
+        Ok((0..levels.min(prefilter::MAX_LEVELS))
+            .map(|k| {
+                let start = prefilter::level_offset(self.width, self.height, k) as usize;
+                let (w, h) = prefilter::level_size(self.width, self.height, k);
+                all[start..start + (w * h) as usize].to_vec()
+            })
+            .collect())
+    }
+
+    /// The last frame's results (scattered rgb, count).
+    pub fn results(&self, gpu: &Gpu) -> Result<Vec<PixelResult>, RenderError> {
+        Ok(self
+            .read(gpu, &self.scattered, "sss scattered")?
+            .into_iter()
+            .map(|v| PixelResult { rgb: [v[0], v[1], v[2]], count: v[3] as u32 })
+            .collect())
+    }
+
+    /// The latest histories.
+    pub fn history(&self, gpu: &Gpu) -> Result<Vec<PixelHistory>, RenderError> {
+        let h = self.read(gpu, &self.history[self.current], "sss history")?;
+        let c = self.read(gpu, &self.cv[self.current], "sss cv history")?;
+        Ok(h.into_iter()
+            .zip(c)
+            .map(|(h, c)| PixelHistory {
+                spvg: SpvgHistory { mu: h[0], sigma2: h[1], nbar: h[2], valid: h[3] > 0.5 },
+                cv: EmCovariance { mean_f: c[0], mean_g: c[1], cov_fg: c[2], var_g: c[3] },
+            })
+            .collect())
+    }
+}

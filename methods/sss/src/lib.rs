@@ -1,0 +1,29 @@
+//! Screen-space subsurface scattering (../shared/seeds/realtime-sss-thesis.txt, Xie 2022):
+//! Burley's profile (`profile`) and its inverse cdfs (`inverse`), the pass's f32 sample math
+//! (`sampling`), single pass variance guiding (`spvg`), control variates in the sample-count
+//! domain (`control_variates`), the pass on the CPU (`screen_pass`) and in WGSL (`gpu`), the
+//! separable baseline (`separable`), prefiltered irradiance MIPs for AFIS (`prefilter`), the
+//! random-walk reference (`random_walk`).
+//! README inside.
+
+pub mod control_variates;
+pub mod evaluation;
+pub mod gpu;
+pub mod inverse;
+pub mod prefilter;
+pub mod profile;
+pub mod random_walk;
+pub mod sampling;
+pub mod screen_pass;
+pub mod separable;
+pub mod spvg;
+pub mod synthetic;
+
+pub use control_variates::EmCovariance;
+pub use prefilter::Prefilter;
+pub use profile::BurleyProfile;
+pub use screen_pass::{PixelHistory, PixelResult, SssFrame, SssSettings, SssVariant};
+pub use spvg::{SpvgHistory, SpvgSettings};
+
+pub mod plugin;
+pub use plugin::Plugin;

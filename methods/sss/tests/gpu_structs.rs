@@ -1,0 +1,12 @@
+//! The structs the SSS pass shares with WGSL (gpu_struct!) have each field at the same byte offset and
+//! the same size on both sides, as naga lays the WGSL declaration out.
+
+use render::gpu_struct::layout_mismatches;
+use sss::gpu::SssParams;
+
+#[test]
+fn shared_structs_have_one_layout() {
+    for (name, found) in [("SssParams", layout_mismatches::<SssParams>(""))] {
+        assert!(found.is_empty(), "{name}: {found:?}");
+    }
+}

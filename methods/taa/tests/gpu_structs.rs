@@ -1,0 +1,21 @@
+//! The structs TAA shares with WGSL (gpu_struct!) have each field at the same byte offset and
+//! the same size on both sides, as naga lays the WGSL declaration out; its program links to valid
+//! WGSL.
+
+use render::gpu_struct::layout_mismatches;
+use taa::{TaaParams, TaaPrimary};
+
+#[test]
+fn shared_structs_have_one_layout() {
+    for (name, found) in [
+        ("TaaParams", layout_mismatches::<TaaParams>("")),
+        ("TaaPrimary", layout_mismatches::<TaaPrimary>("")),
+    ] {
+        assert!(found.is_empty(), "{name}: {found:?}");
+    }
+}
+
+#[test]
+fn the_program_links_to_valid_wgsl() {
+    taa::Taa::trace_program().check_links().unwrap_or_else(|e| panic!("{e}"));
+}

@@ -1,0 +1,463 @@
+//! The method's GPU state and passes (shaders/termination/termination.wgsl): the hashed grid of
+//! records, the propagation dispatch, the tracer with the termination decision, and the vertex
+//! store. One frame = propagate, fold, trace, store, each its own timed pass.
+
+use super::gpu_decision::{decision_module, rule_words};
+use super::moments::RecordMoments;
+use super::settings::{BYTES_PER_RECORD, TerminationSettings, VERTICES_PER_RECORD};
+use glam::Vec3;
+use hash_cache::read;
+use hash_cache::{HashCacheParams, HashCacheSettings};
+use render::compute::{self, BufferBinding};
+use render::error::RenderError;
+use render::gpu::Gpu;
+use render::gpu_struct::GpuStruct;
+use render::lights::luminance;
+use render::pass_library::PassLibrary;
+use render::path_tracer::PathTracer;
+use render::scene::Camera;
+use render::shader::{Module, Program};
+use render::timing::{PassTimer, PassTiming};
+use taa::TaaPrimary;
+
+pub const TC_PROPAGATE_PASS: &str = "tc_propagate";
+pub const TC_FOLD_PASS: &str = "tc_fold";
+pub const TC_TRACE_PASS: &str = "tc_trace";
+pub const TC_STORE_PASS: &str = "tc_store";
+/// During the warm-up a record averages only its last few estimates: the propagation is an
+/// iteration from an empty cache, and its early, darker values must not linger.
+const WARMUP_MAX_VERTICES: u32 = 4;
+/// Words of `counters` (termination.wgsl's TC_COUNTER_*).
+const COUNTERS: u64 = 10;
+const PASSES: [&str; 4] = [TC_PROPAGATE_PASS, TC_FOLD_PASS, TC_TRACE_PASS, TC_STORE_PASS];
+
+const OWN_GROUP: [BufferBinding; 9] = [
+    // The hash cache's uniform: its voxel keys (capacity, probe limit, LOD, jitter).
+    BufferBinding::uniform("hc", "HashCacheParams"),
+    BufferBinding::uniform("tc", "TcParams"),
+    BufferBinding::read_write("slots", "array<atomic<u32>>"),
+    BufferBinding::read_write("records", "array<TcRecord>"),
+    BufferBinding::read_write("vertices", "array<TcVertex>"),
+    BufferBinding::read_write("counters", "array<atomic<u32>>"),
+    BufferBinding::read_write("primary_out", "array<TaaPrimary>"),
+    BufferBinding::read_write("colour_out", "array<vec4f>"),
+    // Surface vertices of each pixel's path (the vertex after a blend counts α).
+    BufferBinding::read_write("path_length", "array<f32>"),
+];
+
+render::gpu_struct! {
+    /// The method's uniform (`tc`).
+    pub struct TcParams {
+        pub rule_kind: u32 => "u32",
+        pub relative: u32 => "u32",
+        pub param: f32 => "f32",
+        pub margin: f32 => "f32",
+        pub bias_clamp: f32 => "f32",
+        pub survival: f32 => "f32",
+        pub samples_per_vertex: u32 => "u32",
+        pub max_vertices: f32 => "f32",
+        pub store_probability: f32 => "f32",
+        /// Pixels: propagation candidates follow the pixels' in the candidate list.
+        pub pixels: u32 => "u32",
+        /// XOR of the candidate indices this frame: the lowest permuted index wins a record.
+        pub candidate_mask: u32 => "u32",
+        pub pad: u32 => "u32",
+    }
+}
+
+render::gpu_struct! {
+    /// A record's moments (luminance for the second and marginal moments), or one stored
+    /// vertex's estimates of this frame (`vertices` = 1 valid, 0 none).
+    #[derive(Default, PartialEq)]
+    pub struct TcRecord {
+        /// E[Y] (rgb): the cache value.
+        pub mean: [f32; 3] => "vec3f",
+        pub vertices: f32 => "f32",
+        /// E[Y²].
+        pub second: f32 => "f32",
+        /// E[E[Y|y]²] (U-statistic over pairs).
+        pub marginal: f32 => "f32",
+        /// E[(f cos / p)² B²] at the segment's hit.
+        pub deferred_bias2: f32 => "f32",
+        /// A vertex estimate: 1 if every sample's hit had a filled record (else it may only
+        /// start an empty record).
+        pub complete: f32 => "f32",
+    }
+}
+
+render::gpu_struct! {
+    /// A stored vertex: the ray that hits it (propagation re-traces it for the surface).
+    #[derive(Default, PartialEq)]
+    pub struct TcVertex {
+        pub origin: [f32; 3] => "vec3f",
+        pub pad0: f32 => "f32",
+        pub dir: [f32; 3] => "vec3f",
+        pub pad1: f32 => "f32",
+    }
+}
+
+const _: () = assert!(
+    size_of::<TcParams>() == 48 && size_of::<TcRecord>() == 32 && size_of::<TcVertex>() == 32
+);
+const _: () = assert!(BYTES_PER_RECORD == 16 + 32 + 4 * 32 + 4 * 32 + 4 * 32);
+
+/// Counters of one frame (counted on the GPU).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TerminationStats {
+    /// Surface vertices of the tracer's paths, all pixels, in 1/256 vertex (the vertex after a
+    /// blend counts α).
+    pub path_vertices: u32,
+    pub trace_rays: u32,
+    pub propagate_rays: u32,
+    pub inserted: u32,
+    pub insert_failures: u32,
+    pub stored: u32,
+    /// Decisions at a vertex whose record was absent or empty (the path continued).
+    pub unknown: u32,
+    /// Stored vertices propagated whose samples all read a filled record.
+    pub propagated: u32,
+    /// Stored vertices propagated with a sample that read no filled record (they only start
+    /// empty records).
+    pub incomplete: u32,
+    /// Records holding moments after this frame's fold.
+    pub filled: u32,
+}
+
+/// Means over the filled records (luminance) of the statistics the rules read: how fast the
+/// cache follows a change in the scene, and why termination moves meanwhile.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CacheStatistics {
+    /// E[Y]: the cache value.
+    pub mean: f64,
+    /// E[Y²] − E[E[Y|y]²]: average variance of one more segment.
+    pub variance: f64,
+    /// E[E[Y|y]²] − E[Y]²: average squared bias of terminating into the record.
+    pub bias2: f64,
+}
+
+impl CacheStatistics {
+    /// Over the records holding moments; zeros for an empty cache.
+    pub fn of(records: &[TcRecord]) -> Self {
+        let filled: Vec<RecordMoments> = records
+            .iter()
+            .filter(|r| r.vertices > 0.0)
+            .map(|r| RecordMoments {
+                vertices: r.vertices as f64,
+                mean: luminance(Vec3::from(r.mean)) as f64,
+                second: r.second as f64,
+                marginal: r.marginal as f64,
+            })
+            .collect();
+        let n = filled.len().max(1) as f64;
+        Self {
+            mean: filled.iter().map(|m| m.mean).sum::<f64>() / n,
+            variance: filled.iter().map(|m| m.average_variance()).sum::<f64>() / n,
+            bias2: filled.iter().map(|m| m.squared_bias()).sum::<f64>() / n,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct TerminationOutput {
+    pub radiance: Vec<[f32; 4]>,
+    pub motion: Vec<[f32; 2]>,
+    /// Surface vertices of each pixel's path, the vertex after a blend counting α (the paper's
+    /// Fig. 11 image).
+    pub path_length: Vec<f32>,
+    /// Mean vertices per path.
+    pub mean_path_length: f64,
+    pub stats: TerminationStats,
+    /// The records after this frame's passes.
+    pub cache: CacheStatistics,
+    pub timings: Vec<PassTiming>,
+    pub rays: u64,
+    /// One path per pixel plus the propagated vertices.
+    pub shaded: u64,
+}
+
+pub struct TerminationCache {
+    settings: TerminationSettings,
+    width: u32,
+    height: u32,
+    hc: wgpu::Buffer,
+    tc: wgpu::Buffer,
+    slots: wgpu::Buffer,
+    records: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    primary: wgpu::Buffer,
+    colour: wgpu::Buffer,
+    path_length: wgpu::Buffer,
+    group: wgpu::BindGroup,
+    pipelines: [render::pass_library::LibraryPipeline; 4],
+    timer: PassTimer,
+    /// Frames (warm-up included) run so far.
+    frames: u32,
+}
+
+impl TerminationCache {
+    /// Builds the cache; refuses a capacity or resolution over the adapter's buffer limits.
+    pub fn new(
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        settings: TerminationSettings,
+    ) -> Result<Self, RenderError> {
+        settings.validate()?;
+        let s = tracer.settings();
+        let (width, height) = (s.width, s.height);
+        let pixels = width as u64 * height as u64;
+        let cap = settings.capacity as u64;
+        gpu.check_resolution(
+            width,
+            height,
+            size_of::<TaaPrimary>() as u64 + 16 + 4 + size_of::<TcVertex>() as u64,
+        )?;
+        gpu.check_buffer_size(
+            "termination cache records (moments + vertex estimates)",
+            cap * (1 + VERTICES_PER_RECORD) * 32,
+        )?;
+        gpu.check_buffer_size(
+            "termination cache vertices (stored + candidates)",
+            (cap * 2 * VERTICES_PER_RECORD + pixels) * 32,
+        )?;
+        gpu.check_workgroup_memory(TC_TRACE_PASS, 0)?;
+        let device = &gpu.device;
+        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let rw = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST;
+        let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+        let hc = buffer("termination hc", size_of::<HashCacheParams>() as u64, uniform);
+        let tc = buffer("termination tc", size_of::<TcParams>() as u64, uniform);
+        let slots = buffer("termination slots", cap * 16, rw);
+        // Empty slots with no claim (claim = NONE).
+        let empty: Vec<[u32; 4]> = vec![[0, u32::MAX, 0, 0]; cap as usize];
+        gpu.queue.write_buffer(&slots, 0, bytemuck::cast_slice(&empty));
+        let records = buffer("termination records", cap * (1 + VERTICES_PER_RECORD) * 32, rw);
+        let vertices =
+            buffer("termination vertices", (cap * 2 * VERTICES_PER_RECORD + pixels) * 32, rw);
+        let counters = buffer("termination counters", COUNTERS * 4, rw);
+        let primary = buffer("termination primary", pixels * size_of::<TaaPrimary>() as u64, rw);
+        let colour = buffer("termination colour", pixels * 16, rw);
+        let path_length = buffer("termination path length", pixels * 4, rw);
+        let (layout, pipelines) =
+            tracer.library_pass(gpu, "termination.wgsl", Self::program(), &OWN_GROUP, PASSES)?;
+        let group = render::compute::buffer_group(
+            gpu,
+            "termination",
+            &layout,
+            &[&hc, &tc, &slots, &records, &vertices, &counters, &primary, &colour, &path_length],
+        );
+        Ok(Self {
+            settings,
+            width,
+            height,
+            hc,
+            tc,
+            slots,
+            records,
+            counters,
+            primary,
+            colour,
+            path_length,
+            group,
+            pipelines,
+            timer: PassTimer::new(gpu, &PASSES),
+            frames: 0,
+        })
+    }
+
+    /// The passes' program: the shading library, TAA's primary attributes, the hash cache's
+    /// keys and its `hc` uniform (binding 0 of this @group(2), its own module because
+    /// hash_key.wgsl imports it from there), this cache's structs and other bindings, the
+    /// decision, termination.wgsl.
+    pub fn program() -> &'static Program {
+        static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
+        PROGRAM.get_or_init(|| {
+            let taa_types = taa::types_module();
+            let hc_types = hash_cache::types_module();
+            let types = Module::generated(
+                "package::termination_types",
+                &[TcParams::WGSL, TcRecord::WGSL, TcVertex::WGSL],
+            );
+            let hc = compute::group_module_range(
+                "package::hash_cache_bindings",
+                2,
+                &OWN_GROUP,
+                0..1,
+                &[&hc_types],
+            );
+            let bindings = compute::group_module_range(
+                "package::termination_bindings",
+                2,
+                &OWN_GROUP,
+                1..OWN_GROUP.len(),
+                &[&taa_types, &types],
+            );
+            PassLibrary::program(
+                [
+                    taa_types,
+                    taa::primary_module(),
+                    hc_types,
+                    hc,
+                    types,
+                    bindings,
+                    hash_cache::key_module(),
+                    decision_module(),
+                ],
+                [render::wgsl_file!("termination.wgsl")],
+            )
+        })
+    }
+
+    pub fn settings(&self) -> TerminationSettings {
+        self.settings
+    }
+
+    /// Bytes of the cache (records × bytes per record), as checked against the adapter.
+    pub fn cache_bytes(&self) -> u64 {
+        self.settings.cache_bytes()
+    }
+
+    /// One frame. On the first call the cache is first filled for `warmup_frames` frames.
+    pub fn render(
+        &mut self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        camera: &Camera,
+        seed: u64,
+        frame: u32,
+    ) -> Result<TerminationOutput, RenderError> {
+        if self.frames == 0 {
+            for k in 0..self.settings.warmup_frames {
+                // Warm-up frames draw their own random numbers (frame indices no run reaches).
+                self.passes(gpu, tracer, camera, seed, 0x8000_0000 + k, WARMUP_MAX_VERTICES)?;
+            }
+        }
+        let timings = self.passes(gpu, tracer, camera, seed, frame, self.settings.max_vertices)?;
+        let radiance = read(gpu, &self.colour, "termination colour")?;
+        let primary: Vec<TaaPrimary> = read(gpu, &self.primary, "termination primary hits")?;
+        let path_length: Vec<f32> = read(gpu, &self.path_length, "termination path length")?;
+        let c: Vec<u32> = read(gpu, &self.counters, "termination counters")?;
+        let stats = TerminationStats {
+            path_vertices: c[0],
+            trace_rays: c[1],
+            propagate_rays: c[2],
+            inserted: c[3],
+            insert_failures: c[4],
+            stored: c[5],
+            unknown: c[6],
+            propagated: c[7],
+            incomplete: c[8],
+            filled: c[9],
+        };
+        let pixels = self.width as u64 * self.height as u64;
+        Ok(TerminationOutput {
+            radiance,
+            motion: primary.iter().map(|p| p.motion).collect(),
+            path_length,
+            mean_path_length: stats.path_vertices as f64 / 256.0 / pixels as f64,
+            stats,
+            cache: CacheStatistics::of(&self.read_records(gpu)?),
+            timings,
+            rays: stats.trace_rays as u64 + stats.propagate_rays as u64,
+            shaded: pixels + stats.propagated as u64 + stats.incomplete as u64,
+        })
+    }
+
+    fn passes(
+        &mut self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        camera: &Camera,
+        seed: u64,
+        frame: u32,
+        max_vertices: u32,
+    ) -> Result<Vec<PassTiming>, RenderError> {
+        let s = &self.settings;
+        // The hash cache's keys round the voxel down to a power of two (sub-pixel voxels, the
+        // paper's HashCache); twice the scale keeps this cache's rounding up (voxels of at least
+        // lod_scale footprints), as it was tuned.
+        let keys = HashCacheSettings {
+            capacity: s.capacity,
+            probe_limit: s.probe_limit,
+            lod_scale: 2.0 * s.lod_scale,
+            jitter: s.jitter,
+            ..Default::default()
+        }
+        .key_params(camera, self.height);
+        let hc = HashCacheParams {
+            capacity: s.capacity,
+            probe_limit: s.probe_limit,
+            frame: 0,
+            max_age: 0,
+            pixel_angle: keys.pixel_angle,
+            lod_scale: keys.lod_scale,
+            normal_lod: keys.normal_lod as u32,
+            jitter: keys.jitter as u32,
+            lookup: 0,
+            max_samples: 0.0,
+            voxel_jitter_seed: 0,
+            pad: 0,
+            primary_jitter: [0.0; 2],
+            pad2: [0.0; 2],
+        };
+        let (rule_kind, relative, param, margin, bias_clamp) = rule_words(&s.rule);
+        let tc = TcParams {
+            rule_kind,
+            relative,
+            param,
+            margin,
+            bias_clamp,
+            survival: s.survival as f32,
+            samples_per_vertex: s.samples_per_vertex,
+            max_vertices: max_vertices.min(s.max_vertices) as f32,
+            store_probability: s.store_probability as f32,
+            pixels: self.width * self.height,
+            candidate_mask: scene::mix64(seed ^ ((frame as u64) << 32)) as u32 & 0x0fff_ffff,
+            pad: 0,
+        };
+        tracer.prepare_frame(gpu, 1, 0, seed, frame);
+        gpu.queue.write_buffer(&self.hc, 0, bytemuck::bytes_of(&hc));
+        gpu.queue.write_buffer(&self.tc, 0, bytemuck::bytes_of(&tc));
+        gpu.queue.write_buffer(&self.counters, 0, &[0u8; COUNTERS as usize * 4]);
+        let mut timed = self.timer.begin(gpu, "termination");
+        for (i, pipeline) in self.pipelines.iter().enumerate() {
+            let groups = match i {
+                0 => (s.capacity * VERTICES_PER_RECORD as u32).div_ceil(64),
+                1 | 3 => s.capacity.div_ceil(64),
+                _ => 0,
+            };
+            timed.pass(i, |pass| {
+                pass.set_pipeline(&pipeline.get());
+                pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
+                pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+                pass.set_bind_group(2, &self.group, &[]);
+                if groups > 0 {
+                    pass.dispatch_workgroups(groups, 1, 1);
+                } else {
+                    pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
+                }
+            })?;
+        }
+        self.frames += 1;
+        timed.submit()
+    }
+
+    /// Each record's moments (slot order), for tests.
+    pub fn read_records(&self, gpu: &Gpu) -> Result<Vec<TcRecord>, RenderError> {
+        let all: Vec<TcRecord> = read(gpu, &self.records, "termination records")?;
+        Ok(all[..self.settings.capacity as usize].to_vec())
+    }
+
+    /// Slot words (checksum, claim, stored vertices, -), for tests.
+    pub fn read_slots(&self, gpu: &Gpu) -> Result<Vec<[u32; 4]>, RenderError> {
+        read(gpu, &self.slots, "termination slots")
+    }
+}

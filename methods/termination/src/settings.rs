@@ -1,0 +1,96 @@
+//! The `Termination(...)` method's scenario settings and the cache's memory.
+
+use super::rule::TerminationRule;
+use render::error::RenderError;
+
+/// Every field but `rule` defaults to the paper's value where it gives one (§5), else to the
+/// value stated in render/src/termination/README.md.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TerminationSettings {
+    pub rule: TerminationRule,
+    /// Russian roulette survival probability of every continued segment (Fig. 7: 1, 0.6, 0.2).
+    pub survival: f64,
+    /// Slots of the hashed grid (records).
+    pub capacity: u32,
+    /// Slots probed from the home slot before an insertion fails.
+    pub probe_limit: u32,
+    /// Voxel size in pixel footprints at the point's camera distance (rounded up to 2^k).
+    pub lod_scale: f32,
+    /// Jittered lookups: stochastic interpolation between neighbouring records (§5).
+    pub jitter: bool,
+    /// Samples per stored vertex and propagation (the U-statistic's K; the paper: a subgroup, 32).
+    pub samples_per_vertex: u32,
+    /// Vertex estimates a record averages before its mean turns exponential.
+    pub max_vertices: u32,
+    /// Probability that the tracer offers a primary vertex to its record (§5: 1%).
+    pub store_probability: f64,
+    /// Frames of propagation (and primary storing) before the first frame: the paper fills the
+    /// cache to equilibrium before timing (§6).
+    pub warmup_frames: u32,
+}
+
+impl Default for TerminationSettings {
+    fn default() -> Self {
+        Self {
+            rule: TerminationRule::VarianceBounding { t: 0.1, relative: false },
+            survival: 1.0,
+            capacity: 1 << 16,
+            probe_limit: 8,
+            lod_scale: 8.0,
+            jitter: true,
+            samples_per_vertex: 4,
+            max_vertices: 64,
+            store_probability: 0.01,
+            warmup_frames: 16,
+        }
+    }
+}
+
+/// Stored vertices per record (§5).
+pub const VERTICES_PER_RECORD: u64 = 4;
+
+/// The cache's buffers per record: slot words (16), record moments (32), 4 per-vertex estimates
+/// (4 × 32), 4 stored vertices (4 × 32) and 4 propagation candidates (4 × 32).
+pub const BYTES_PER_RECORD: u64 = 16 + 32 + VERTICES_PER_RECORD * (32 + 32 + 32);
+
+impl TerminationSettings {
+    pub fn validate(&self) -> Result<(), RenderError> {
+        let bad = |m: String| Err(RenderError::Settings(m));
+        self.rule.validate().map_err(RenderError::Settings)?;
+        if !(self.survival > 0.0 && self.survival <= 1.0) {
+            return bad(format!("Termination survival must be in (0, 1], got {}", self.survival));
+        }
+        if self.capacity == 0 || self.capacity > (1 << 20) {
+            // 4 propagation invocations per record in one dispatch dimension (65535 × 64).
+            return bad(format!(
+                "Termination capacity must be in 1..=2^20 records, got {}",
+                self.capacity
+            ));
+        }
+        if self.probe_limit == 0 || self.probe_limit > self.capacity {
+            return bad(format!(
+                "Termination probe_limit must be in 1..=capacity, got {}",
+                self.probe_limit
+            ));
+        }
+        if self.samples_per_vertex < 2 || self.samples_per_vertex > 32 {
+            return bad(format!(
+                "Termination samples_per_vertex must be in 2..=32 (pairs for the marginal moment), got {}",
+                self.samples_per_vertex
+            ));
+        }
+        if self.max_vertices == 0
+            || !(self.lod_scale > 0.0)
+            || !(0.0..=1.0).contains(&self.store_probability)
+        {
+            return bad("Termination max_vertices must be >= 1, lod_scale > 0 and store_probability in [0, 1]".into());
+        }
+        Ok(())
+    }
+
+    /// Bytes of the cache's records (what `Gpu::check_buffer_size` sees per buffer is less).
+    pub fn cache_bytes(&self) -> u64 {
+        self.capacity as u64 * BYTES_PER_RECORD
+    }
+}

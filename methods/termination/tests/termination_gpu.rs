@@ -1,0 +1,88 @@
+//! The termination decision on the GPU (shaders/termination/decision.wgsl) against the CPU
+//! reference (termination::decide) on the same inputs.
+
+use render::gpu::Gpu;
+use render::scene::SplitMix64;
+use termination::gpu_decision::{DecisionCase, decide_on_gpu};
+use termination::{LocalStats, PathState, TerminationRule, decide};
+
+fn rules() -> Vec<TerminationRule> {
+    vec![
+        TerminationRule::VarianceBounding { t: 0.01, relative: false },
+        TerminationRule::VarianceBounding { t: 1.0, relative: false },
+        TerminationRule::VarianceBounding { t: 0.1, relative: true },
+        TerminationRule::MseMinimisation { s: 100.0, margin: 1.1, bias_clamp: 0.1 },
+        TerminationRule::MseMinimisation { s: 1.0, margin: 1.5, bias_clamp: 0.1 },
+        TerminationRule::AreaSpread { c: 0.01 },
+        TerminationRule::AreaSpread { c: 100.0 },
+        TerminationRule::FirstVertex,
+        TerminationRule::PathTracing,
+    ]
+}
+
+#[test]
+fn gpu_decision_matches_the_cpu_reference() {
+    let gpu = Gpu::new().expect("a wgpu adapter (lavapipe on CI)");
+    let mut rng = SplitMix64::new(7);
+    // Log-uniform magnitudes over 6 decades: the cases straddle every rule's boundary.
+    let mut mag = |lo: f64| lo * 10f64.powf(6.0 * rng.next_f32() as f64);
+    let mut cases = Vec::new();
+    for rule in rules() {
+        for survival in [1.0, 0.6, 0.2] {
+            for _ in 0..200 {
+                let stats = LocalStats {
+                    radiance: mag(1e-3),
+                    variance: mag(1e-4),
+                    marginal: mag(1e-4),
+                    bias2: mag(1e-5),
+                    deferred_bias2: mag(1e-6),
+                };
+                let threshold = match rule {
+                    TerminationRule::VarianceBounding { .. } => {
+                        termination::path_threshold(&rule, stats.radiance)
+                    }
+                    _ => 0.0,
+                };
+                let state = PathState {
+                    throughput2: mag(1e-3),
+                    path_variance: threshold * 0.5 * (mag(1e-6) / 1e0).min(1.0),
+                    threshold,
+                    spread_sqrt: mag(1e-3),
+                    spread0: mag(1e-3),
+                    vertex: 1 + (mag(1.0) as u32 % 4),
+                };
+                cases.push(DecisionCase { rule, survival, state, stats });
+            }
+        }
+    }
+    let gpu_out = decide_on_gpu(&gpu, &cases).unwrap();
+    let (mut kinds, mut mismatches) = ([0usize; 3], Vec::new());
+    for (c, g) in cases.iter().zip(&gpu_out) {
+        let mut state = c.state;
+        let alpha = decide(&c.rule, c.survival, &mut state, &c.stats).alpha();
+        kinds[if alpha == 1.0 {
+            0
+        } else if alpha == 0.0 {
+            1
+        } else {
+            2
+        }] += 1;
+        let close = |a: f64, b: f32| (a - b as f64).abs() <= 1e-4 * a.abs().max(1e-6);
+        if !close(alpha, g[0]) || !close(state.path_variance, g[1]) {
+            mismatches.push(format!(
+                "{:?}: cpu ({alpha}, {}) gpu ({}, {})",
+                c, state.path_variance, g[0], g[1]
+            ));
+        }
+    }
+    // The batch must exercise every outcome: continue, terminate and blend.
+    assert!(kinds.iter().all(|&k| k > 50), "outcomes continue/terminate/blend: {kinds:?}");
+    // f32 against f64: a case within rounding of a boundary may flip; allow at most 0.5%.
+    assert!(
+        mismatches.len() * 200 <= cases.len(),
+        "{} of {} cases differ:\n{}",
+        mismatches.len(),
+        cases.len(),
+        mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
+    );
+}

@@ -1,0 +1,136 @@
+//! Volumetric path tracing of a scenario with a medium (issue 13; media::gpu::VolumePathPass):
+//! delta tracking, ratio-tracked shadow rays and, with `mis` set, equiangular sampling of
+//! positional lights combined with free-flight sampling by Eq. 9 or Eq. 10 of the
+//! jackknife-transmittance paper with the naive, jackknife or Miller et al.'s weights. What the
+//! MIS comparison (scenarios/volume_mis.ron) and the dynamic-media scenarios measure against the
+//! references (rendered by the same pass with Eq. 9 and jackknife weights at the reference spp).
+//! Its motion vectors are zero (the scenarios' cameras are still).
+
+use std::time::Instant;
+
+use anyhow::{Result, bail};
+use bevy_ecs::prelude::*;
+use media::gpu::{Combination, MisWeight, VolumePathSettings};
+use serde::{Deserialize, Serialize};
+
+use frame::scene_medium::{SceneMedium, render_volume};
+use frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use frame::{MethodOutput, MethodPlugin};
+
+/// `VolumePath(spp: 4, mis: Jackknife, combination: Eq9)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct VolumePathMethod {
+    pub spp: u32,
+    pub mis: MisWeight,
+    pub combination: Combination,
+    /// Samples N of each optical-depth estimate of a naive or jackknife weight.
+    pub samples: u32,
+}
+
+impl Default for VolumePathMethod {
+    fn default() -> Self {
+        let d = VolumePathSettings::default();
+        Self { spp: 4, mis: d.mis, combination: d.combination, samples: d.samples }
+    }
+}
+
+impl VolumePathMethod {
+    pub fn label(&self) -> String {
+        let mis = match self.mis {
+            MisWeight::None => "free_flight".to_string(),
+            w => format!(
+                "{}_{}",
+                format!("{w:?}").to_lowercase(),
+                format!("{:?}", self.combination).to_lowercase()
+            ),
+        };
+        format!("volume_pt_{mis}_{}spp", self.spp)
+    }
+
+    fn settings(&self) -> VolumePathSettings {
+        VolumePathSettings {
+            mis: self.mis,
+            combination: self.combination,
+            samples: self.samples,
+            ..Default::default()
+        }
+    }
+}
+
+#[derive(Component)]
+pub struct VolumePath(VolumePathMethod);
+
+pub struct Plugin;
+
+impl MethodPlugin for Plugin {
+    type Settings = VolumePathMethod;
+    const NAME: &'static str = "VolumePath";
+
+    fn label(settings: &VolumePathMethod) -> String {
+        settings.label()
+    }
+
+    fn spp(settings: &VolumePathMethod) -> f64 {
+        settings.spp as f64
+    }
+
+    fn temporal_window(_settings: &VolumePathMethod) -> Option<f64> {
+        Some(1.0)
+    }
+
+    fn set_spp(settings: &mut VolumePathMethod, spp: u32) {
+        settings.spp = spp;
+    }
+
+    fn sees_media() -> bool {
+        true
+    }
+
+    fn add_systems(schedule: &mut Schedule) {
+        schedule.add_systems(render.in_set(Stage::Render));
+    }
+
+    fn spawn(world: &mut World, entity: Entity, s: &VolumePathMethod) -> Result<()> {
+        if s.spp == 0 {
+            bail!("VolumePath: spp 0; expected at least 1 sample per pixel");
+        }
+        if s.samples == 0 {
+            bail!("VolumePath: samples 0; expected at least 1 sample per optical-depth estimate");
+        }
+        if !world.contains_resource::<SceneMedium>() {
+            bail!(
+                "VolumePath: the scenario declares no media; expected media: [(name: ..., kind: ..., ...)]"
+            );
+        }
+        world.entity_mut(entity).insert(VolumePath(s.clone()));
+        Ok(())
+    }
+}
+
+pub fn render(
+    gpu: Res<GpuDevice>,
+    tracer: Res<Tracer>,
+    mut medium: ResMut<SceneMedium>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&VolumePath, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
+    for (method, info, mut frame) in &mut methods {
+        let start = Instant::now();
+        let (radiance, timings, paths) = render_volume(
+            &gpu.0,
+            &tracer,
+            &mut medium,
+            &method.0.settings(),
+            method.0.spp,
+            run.scenario.seed,
+            clock.global,
+        )
+        .map_err(|e| method_failed(&info.label, clock.global, e))?;
+        let motion = vec![[0.0; 2]; radiance.len()];
+        frame.output = Some(MethodOutput::timed(radiance, motion, &timings, paths, paths));
+        frame.add_cpu(start);
+    }
+    Ok(())
+}
