@@ -33,15 +33,16 @@ impl MethodOutput {
         rays: u64,
         shaded: u64,
     ) -> Self {
-        Self {
-            radiance,
-            motion,
-            passes: timings.iter().map(|t| (t.pass.clone(), Some(t.ms))).collect(),
-            clock: timings.first().map(|t| t.clock),
-            rays: Some(rays),
-            shaded: Some(shaded),
-            ..Default::default()
-        }
+        let mut output =
+            Self { radiance, motion, rays: Some(rays), shaded: Some(shaded), ..Default::default() };
+        output.add_timed(timings);
+        output
+    }
+
+    /// Appends the times of passes run after the output was made (a method's Learn systems).
+    pub fn add_timed(&mut self, timings: &[render::timing::PassTiming]) {
+        self.passes.extend(timings.iter().map(|t| (t.pass.clone(), Some(t.ms))));
+        self.clock = self.clock.or(timings.first().map(|t| t.clock));
     }
 }
 

@@ -80,7 +80,7 @@ fn every_method_system_runs_in_its_stage_in_order() {
         "sample_cache::reconstruct",
         "taa::trace",
         "taa::resolve",
-        "hash_cache::age_and_update",
+        "hash_cache::update",
         "hash_cache::resolve",
     ] {
         assert!(render.contains(&name.to_string()), "{name} not in Render: {render:?}");
@@ -120,7 +120,7 @@ fn every_method_system_runs_in_its_stage_in_order() {
         ("sample_cache::retrace", "sample_cache::shade"),
         ("sample_cache::shade", "sample_cache::reconstruct"),
         ("taa::trace", "taa::resolve"),
-        ("hash_cache::age_and_update", "hash_cache::resolve"),
+        ("hash_cache::update", "hash_cache::resolve"),
         ("nirc::camera_paths", "nirc::infer"),
         ("nirc::infer", "nirc::train"),
         ("nirc::train", "nirc::ema"),
@@ -132,6 +132,40 @@ fn every_method_system_runs_in_its_stage_in_order() {
             pair.0,
             pair.1
         );
+    }
+}
+
+/// The caches' upkeep is named systems: what the image reads in Render before it, what the next
+/// frame reads in Learn after it.
+#[test]
+fn cache_upkeep_runs_in_its_stage() {
+    let before_in_render = |l: &[(Stage, String)], first: &str, then: &str| {
+        let render = in_stage(l, Stage::Render);
+        let at = |n: &str| render.iter().position(|r| r == n);
+        assert!(
+            at(first).is_some() && at(first) < at(then),
+            "{first}, {then} in Render: {render:?}"
+        );
+    };
+    let l = listing(&spec("Termination(rule: VarianceBounding(t: 0.1))").methods);
+    before_in_render(&l, "termination::update", "termination::trace");
+    assert_eq!(in_stage(&l, Stage::Learn), ["termination::store"]);
+
+    // The hash cache's update feeds its image, so all of it runs in Render, before the resolve.
+    let l = listing(&spec("HashCache(taa: true)").methods);
+    before_in_render(&l, "hash_cache::update", "hash_cache::resolve");
+    assert_eq!(in_stage(&l, Stage::Learn), Vec::<String>::new());
+
+    // `flicker schedule` lists them under their stages.
+    let text = systems::methods::describe_schedule(
+        &spec("HashCache(), Termination(rule: FirstVertex)").methods,
+    )
+    .unwrap();
+    let at = |s: &str| text.find(s).unwrap_or_else(|| panic!("{s} missing from:\n{text}"));
+    let (render, learn, measure) = (at("\nRender\n"), at("\nLearn\n"), at("\nMeasure\n"));
+    assert!(learn < at("termination::store") && at("termination::store") < measure, "{text}");
+    for name in ["hash_cache::update", "termination::update", "termination::trace"] {
+        assert!(render < at(name) && at(name) < learn, "{text}");
     }
 }
 

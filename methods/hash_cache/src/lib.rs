@@ -81,7 +81,30 @@ const OWN_GROUP: [BufferBinding; 7] = [
     BufferBinding::read_write("colour_out", "array<vec4f>"),
 ];
 
+/// Entry points, in the order of [`HcPass`] (its discriminant indexes the pipelines).
 const PASSES: [&str; 4] = [HC_AGE_PASS, HC_TRACE_PASS, HC_UPDATE_PASS, HC_RESOLVE_PASS];
+
+/// The cache's passes in frame order; each is timed under its name (frames.csv's column).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HcPass {
+    /// Per slot: eviction, claims reset.
+    Age,
+    /// Per pixel: primary ray, key point, find-or-insert, claim.
+    Trace,
+    /// Per pixel: each cell's claimant folds one path into it.
+    Update,
+    /// Per pixel: the colour from the updated cells (the image).
+    Resolve,
+}
+
+impl HcPass {
+    /// The cache's upkeep before the image, in one submission ([`HashCache::update`]).
+    pub const UPDATE: [HcPass; 3] = [HcPass::Age, HcPass::Trace, HcPass::Update];
+
+    pub fn name(self) -> &'static str {
+        PASSES[self as usize]
+    }
+}
 
 /// Where the path terminates into the cache.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -272,8 +295,11 @@ pub struct HashCache {
     primary: wgpu::Buffer,
     colour: wgpu::Buffer,
     group: wgpu::BindGroup,
+    /// Indexed by [`HcPass`].
     pipelines: [render::pass_library::LibraryPipeline; 4],
-    timer: PassTimer,
+    /// One timer per submission: [`HcPass::UPDATE`], the resolve.
+    update_timer: PassTimer,
+    resolve_timer: PassTimer,
     /// Frames rendered so far; the stamp of the next one is `frames + 1`.
     frames: u32,
 }
@@ -339,7 +365,8 @@ impl HashCache {
             colour,
             group,
             pipelines,
-            timer: PassTimer::new(gpu, &PASSES),
+            update_timer: PassTimer::new(gpu, &HcPass::UPDATE.map(HcPass::name)),
+            resolve_timer: PassTimer::new(gpu, &[HC_RESOLVE_PASS]),
             frames: 0,
         })
     }
@@ -385,11 +412,11 @@ impl HashCache {
         taa: Option<&mut Taa>,
     ) -> Result<HashCacheOutput, RenderError> {
         let (timings, jitter) = self.update(gpu, tracer, camera, seed, frame)?;
-        self.resolve(gpu, taa, timings, jitter)
+        self.resolve(gpu, tracer, taa, timings, jitter)
     }
 
-    /// The cache's own passes in one timed submission: age (eviction), then the frame's lookups
-    /// and updates. Returns their times and the frame's primary jitter (for [`Self::resolve`]).
+    /// The cache's upkeep in one timed submission: age (eviction), then the frame's lookups and
+    /// updates. Returns their times and the frame's primary jitter (for [`Self::resolve`]).
     pub fn update(
         &mut self,
         gpu: &Gpu,
@@ -420,32 +447,22 @@ impl HashCache {
         tracer.prepare_frame(gpu, 1, 0, seed, frame);
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         gpu.queue.write_buffer(&self.counters, 0, &[0u8; 32]);
-        // The cache's own passes in one timed submission; TAA's resolve (its own timing) after.
-        let mut timed = self.timer.begin(gpu, "hash cache");
-        for (i, pipeline) in self.pipelines.iter().enumerate() {
-            timed.pass(i, |pass| {
-                pass.set_pipeline(&pipeline.get());
-                pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
-                pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
-                pass.set_bind_group(2, &self.group, &[]);
-                if i == 0 {
-                    pass.dispatch_workgroups(self.settings.capacity.div_ceil(64), 1, 1);
-                } else {
-                    pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
-                }
-            })?;
-        }
-        Ok((timed.submit()?, jitter))
+        Ok((self.submit(gpu, tracer, &self.update_timer, &HcPass::UPDATE)?, jitter))
     }
 
-    /// The frame's image after [`Self::update`]: the cache's colour, or `taa`'s resolve of it.
+    /// The frame's image after [`Self::update`] (`timings`: its times, reported first): the
+    /// cache's colour (`hc_resolve`, its own submission), or `taa`'s resolve of it after.
     pub fn resolve(
         &mut self,
         gpu: &Gpu,
+        tracer: &PathTracer,
         taa: Option<&mut Taa>,
         mut timings: Vec<PassTiming>,
         jitter: [f32; 2],
     ) -> Result<HashCacheOutput, RenderError> {
+        // hc_resolve reads only the cache's buffers and the frame's size from the shared frame
+        // uniform, which every method sets alike: no need to set it again after `update`.
+        timings.extend(self.submit(gpu, tracer, &self.resolve_timer, &[HcPass::Resolve])?);
         let radiance = match taa {
             Some(taa) => {
                 let out = taa.resolve_external(gpu, jitter, |encoder, colour, primary| {
@@ -484,6 +501,35 @@ impl HashCache {
             rays: stats.rays as u64,
             shaded,
         })
+    }
+
+    /// `passes` in order as one submission timed by `timer` (whose names are theirs).
+    fn submit(
+        &self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        timer: &PassTimer,
+        passes: &[HcPass],
+    ) -> Result<Vec<PassTiming>, RenderError> {
+        let mut timed = timer.begin(gpu, "hash cache");
+        for (index, &p) in passes.iter().enumerate() {
+            debug_assert_eq!(timer.names()[index], p.name());
+            let pipeline = &self.pipelines[p as usize];
+            let [x, y] = match p {
+                HcPass::Age => [self.settings.capacity.div_ceil(64), 1],
+                HcPass::Trace | HcPass::Update | HcPass::Resolve => {
+                    [self.width.div_ceil(8), self.height.div_ceil(8)]
+                }
+            };
+            timed.pass(index, |pass| {
+                pass.set_pipeline(&pipeline.get());
+                pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
+                pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+                pass.set_bind_group(2, &self.group, &[]);
+                pass.dispatch_workgroups(x, y, 1);
+            })?;
+        }
+        timed.submit()
     }
 
     /// The table as stored: (checksum, last access, claim, home) per slot → [`CpuSlot`]s.

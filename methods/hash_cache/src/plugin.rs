@@ -1,6 +1,8 @@
 //! World-space hash cache (render::hash_cache), optionally under TAA as the paper runs it. Two
-//! systems: the cache's passes (age = eviction, then lookups and updates), then the resolve of
-//! the image (TAA's, or the cache's colour as is).
+//! systems, both in Render: the cache's upkeep (`update`: age = eviction, then lookups and
+//! updates), then the image (`resolve`: the cache's colour, and TAA's resolve of it). Nothing of
+//! the cache runs after the image: the image reads the cells this frame's update wrote, and the
+//! eviction is stamped with the frame it starts.
 
 use std::time::Instant;
 
@@ -29,7 +31,7 @@ pub fn label(s: &HashCacheSettings) -> String {
 pub struct HashCacheState {
     cache: HashCache,
     taa: Option<Taa>,
-    /// This frame's pass times and primary jitter, from `age_and_update` to `resolve`.
+    /// This frame's pass times and primary jitter, from `update` to `resolve`.
     updated: Option<(Vec<PassTiming>, [f32; 2])>,
 }
 
@@ -55,7 +57,7 @@ impl MethodPlugin for Plugin {
     }
 
     fn add_systems(schedule: &mut Schedule) {
-        schedule.add_systems((age_and_update, resolve).chain().in_set(Stage::Render));
+        schedule.add_systems((update, resolve).chain().in_set(Stage::Render));
     }
 
     fn spawn(world: &mut World, entity: Entity, settings: &HashCacheSettings) -> Result<()> {
@@ -69,8 +71,8 @@ impl MethodPlugin for Plugin {
     }
 }
 
-/// The cache's passes: age (eviction), trace, update, resolve into its colour.
-pub fn age_and_update(
+/// The cache's upkeep before the image: age (eviction), trace (lookups, claims), update.
+pub fn update(
     gpu: Res<GpuDevice>,
     tracer: Res<Tracer>,
     run: Res<Run>,
@@ -90,9 +92,10 @@ pub fn age_and_update(
     Ok(())
 }
 
-/// The frame's image: TAA's resolve over the cache's colour, or the colour itself.
+/// The frame's image: the cache's colour, or TAA's resolve over it.
 pub fn resolve(
     gpu: Res<GpuDevice>,
+    tracer: Res<Tracer>,
     clock: Res<FrameClock>,
     mut methods: Query<(&mut HashCacheState, &MethodInfo, &mut MethodFrame)>,
 ) -> Result<(), BevyError> {
@@ -102,7 +105,7 @@ pub fn resolve(
         let (timings, jitter) = state.updated.take().unwrap_or_default();
         let out = state
             .cache
-            .resolve(&gpu.0, state.taa.as_mut(), timings, jitter)
+            .resolve(&gpu.0, &tracer.0, state.taa.as_mut(), timings, jitter)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let s = out.stats;
         frame.output = Some(MethodOutput {

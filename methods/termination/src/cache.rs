@@ -1,6 +1,9 @@
 //! The method's GPU state and passes (shaders/termination/termination.wgsl): the hashed grid of
 //! records, the propagation dispatch, the tracer with the termination decision, and the vertex
-//! store. One frame = propagate, fold, trace, store, each its own timed pass.
+//! store. One frame = propagate, fold, trace, store ([`TcPass`]), each its own timed pass, in
+//! three submissions: [`TerminationCache::update`] (propagate, fold: the records the image
+//! reads), [`TerminationCache::trace`] (the image), [`TerminationCache::store`] (after the image:
+//! the vertices the next frame propagates).
 
 use super::gpu_decision::{decision_module, rule_words};
 use super::moments::RecordMoments;
@@ -29,7 +32,30 @@ pub const TC_STORE_PASS: &str = "tc_store";
 const WARMUP_MAX_VERTICES: u32 = 4;
 /// Words of `counters` (termination.wgsl's TC_COUNTER_*).
 const COUNTERS: u64 = 10;
+/// Entry points, in the order of [`TcPass`] (its discriminant indexes the pipelines).
 const PASSES: [&str; 4] = [TC_PROPAGATE_PASS, TC_FOLD_PASS, TC_TRACE_PASS, TC_STORE_PASS];
+
+/// The cache's passes in frame order; each is timed under its name (frames.csv's column).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TcPass {
+    /// Per stored vertex: new estimates at the stored vertices.
+    Propagate,
+    /// Per record: the estimates folded into the record's moments.
+    Fold,
+    /// Per pixel: the image, the rule deciding at every vertex over the folded records.
+    Trace,
+    /// Per record: the winning candidate becomes a stored vertex, for the next frame.
+    Store,
+}
+
+impl TcPass {
+    /// The passes before the image, in one submission.
+    pub const UPDATE: [TcPass; 2] = [TcPass::Propagate, TcPass::Fold];
+
+    pub fn name(self) -> &'static str {
+        PASSES[self as usize]
+    }
+}
 
 const OWN_GROUP: [BufferBinding; 9] = [
     // The hash cache's uniform: its voxel keys (capacity, probe limit, LOD, jitter).
@@ -111,6 +137,8 @@ pub struct TerminationStats {
     pub propagate_rays: u32,
     pub inserted: u32,
     pub insert_failures: u32,
+    /// Vertices `tc_store` kept. It runs after the image ([`TerminationCache::store`]): 0 in
+    /// [`TerminationCache::trace`]'s output, counted in [`TerminationCache::render`]'s.
     pub stored: u32,
     /// Decisions at a vertex whose record was absent or empty (the path continued).
     pub unknown: u32,
@@ -188,8 +216,12 @@ pub struct TerminationCache {
     colour: wgpu::Buffer,
     path_length: wgpu::Buffer,
     group: wgpu::BindGroup,
+    /// Indexed by [`TcPass`].
     pipelines: [render::pass_library::LibraryPipeline; 4],
-    timer: PassTimer,
+    /// One timer per submission: [`TcPass::UPDATE`], the trace, the store.
+    update_timer: PassTimer,
+    trace_timer: PassTimer,
+    store_timer: PassTimer,
     /// Frames (warm-up included) run so far.
     frames: u32,
 }
@@ -268,7 +300,9 @@ impl TerminationCache {
             path_length,
             group,
             pipelines,
-            timer: PassTimer::new(gpu, &PASSES),
+            update_timer: PassTimer::new(gpu, &TcPass::UPDATE.map(TcPass::name)),
+            trace_timer: PassTimer::new(gpu, &[TC_TRACE_PASS]),
+            store_timer: PassTimer::new(gpu, &[TC_STORE_PASS]),
             frames: 0,
         })
     }
@@ -325,7 +359,8 @@ impl TerminationCache {
         self.settings.cache_bytes()
     }
 
-    /// One frame. On the first call the cache is first filled for `warmup_frames` frames.
+    /// One whole frame: [`Self::update`], [`Self::trace`], [`Self::store`]; the output holds
+    /// the four passes' times and the store's count.
     pub fn render(
         &mut self,
         gpu: &Gpu,
@@ -334,29 +369,56 @@ impl TerminationCache {
         seed: u64,
         frame: u32,
     ) -> Result<TerminationOutput, RenderError> {
+        let updated = self.update(gpu, tracer, camera, seed, frame)?;
+        let mut out = self.trace(gpu, tracer, seed, frame, updated)?;
+        out.timings.extend(self.store(gpu, tracer)?);
+        out.stats.stored = self.read_counters(gpu)?.stored;
+        Ok(out)
+    }
+
+    /// The records the image reads: on the first call the cache is first filled for
+    /// `warmup_frames` whole frames, then this frame's propagation and fold (one submission).
+    /// Returns their times, for [`Self::trace`].
+    pub fn update(
+        &mut self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        camera: &Camera,
+        seed: u64,
+        frame: u32,
+    ) -> Result<Vec<PassTiming>, RenderError> {
         if self.frames == 0 {
             for k in 0..self.settings.warmup_frames {
                 // Warm-up frames draw their own random numbers (frame indices no run reaches).
-                self.passes(gpu, tracer, camera, seed, 0x8000_0000 + k, WARMUP_MAX_VERTICES)?;
+                let frame = 0x8000_0000 + k;
+                self.begin_frame(gpu, tracer, camera, seed, frame, WARMUP_MAX_VERTICES);
+                self.submit(gpu, tracer, &self.update_timer, &TcPass::UPDATE)?;
+                self.submit(gpu, tracer, &self.trace_timer, &[TcPass::Trace])?;
+                self.store(gpu, tracer)?;
             }
         }
-        let timings = self.passes(gpu, tracer, camera, seed, frame, self.settings.max_vertices)?;
+        self.begin_frame(gpu, tracer, camera, seed, frame, self.settings.max_vertices);
+        self.submit(gpu, tracer, &self.update_timer, &TcPass::UPDATE)
+    }
+
+    /// The frame's image after [`Self::update`] (`updated`: its times, reported first): the
+    /// tracer with the rule's decision over the folded records, and the frame's read-back.
+    pub fn trace(
+        &mut self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        seed: u64,
+        frame: u32,
+        updated: Vec<PassTiming>,
+    ) -> Result<TerminationOutput, RenderError> {
+        // Other methods' passes may have set the shared frame uniform since `update`.
+        tracer.prepare_frame(gpu, 1, 0, seed, frame);
+        let mut timings = updated;
+        timings.extend(self.submit(gpu, tracer, &self.trace_timer, &[TcPass::Trace])?);
         let radiance = read(gpu, &self.colour, "termination colour")?;
         let primary: Vec<TaaPrimary> = read(gpu, &self.primary, "termination primary hits")?;
         let path_length: Vec<f32> = read(gpu, &self.path_length, "termination path length")?;
-        let c: Vec<u32> = read(gpu, &self.counters, "termination counters")?;
-        let stats = TerminationStats {
-            path_vertices: c[0],
-            trace_rays: c[1],
-            propagate_rays: c[2],
-            inserted: c[3],
-            insert_failures: c[4],
-            stored: c[5],
-            unknown: c[6],
-            propagated: c[7],
-            incomplete: c[8],
-            filled: c[9],
-        };
+        let stats = self.read_counters(gpu)?;
         let pixels = self.width as u64 * self.height as u64;
         Ok(TerminationOutput {
             radiance,
@@ -371,15 +433,29 @@ impl TerminationCache {
         })
     }
 
-    fn passes(
+    /// After the frame's image: the winning candidates become stored vertices, which the next
+    /// frame propagates. Reads only the cache's own buffers and uniforms (no ray, no frame
+    /// uniform), so other methods' work since [`Self::trace`] changes nothing. Ends the frame.
+    pub fn store(
         &mut self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+    ) -> Result<Vec<PassTiming>, RenderError> {
+        let timings = self.submit(gpu, tracer, &self.store_timer, &[TcPass::Store])?;
+        self.frames += 1;
+        Ok(timings)
+    }
+
+    /// Writes the frame's uniforms (the tracer's, `hc`, `tc`) and clears the counters.
+    fn begin_frame(
+        &self,
         gpu: &Gpu,
         tracer: &PathTracer,
         camera: &Camera,
         seed: u64,
         frame: u32,
         max_vertices: u32,
-    ) -> Result<Vec<PassTiming>, RenderError> {
+    ) {
         let s = &self.settings;
         // The hash cache's keys round the voxel down to a power of two (sub-pixel voxels, the
         // paper's HashCache); twice the scale keeps this cache's rounding up (voxels of at least
@@ -427,27 +503,57 @@ impl TerminationCache {
         gpu.queue.write_buffer(&self.hc, 0, bytemuck::bytes_of(&hc));
         gpu.queue.write_buffer(&self.tc, 0, bytemuck::bytes_of(&tc));
         gpu.queue.write_buffer(&self.counters, 0, &[0u8; COUNTERS as usize * 4]);
-        let mut timed = self.timer.begin(gpu, "termination");
-        for (i, pipeline) in self.pipelines.iter().enumerate() {
-            let groups = match i {
-                0 => (s.capacity * VERTICES_PER_RECORD as u32).div_ceil(64),
-                1 | 3 => s.capacity.div_ceil(64),
-                _ => 0,
-            };
-            timed.pass(i, |pass| {
+    }
+
+    /// `passes` in order as one submission timed by `timer` (whose names are theirs).
+    fn submit(
+        &self,
+        gpu: &Gpu,
+        tracer: &PathTracer,
+        timer: &PassTimer,
+        passes: &[TcPass],
+    ) -> Result<Vec<PassTiming>, RenderError> {
+        let mut timed = timer.begin(gpu, "termination");
+        for (index, &p) in passes.iter().enumerate() {
+            debug_assert_eq!(timer.names()[index], p.name());
+            let pipeline = &self.pipelines[p as usize];
+            let [x, y, z] = self.workgroups(p);
+            timed.pass(index, |pass| {
                 pass.set_pipeline(&pipeline.get());
                 pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
                 pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
                 pass.set_bind_group(2, &self.group, &[]);
-                if groups > 0 {
-                    pass.dispatch_workgroups(groups, 1, 1);
-                } else {
-                    pass.dispatch_workgroups(self.width.div_ceil(8), self.height.div_ceil(8), 1);
-                }
+                pass.dispatch_workgroups(x, y, z);
             })?;
         }
-        self.frames += 1;
         timed.submit()
+    }
+
+    /// Workgroups of `pass`: per stored vertex, per record, or per 8x8 pixels.
+    fn workgroups(&self, pass: TcPass) -> [u32; 3] {
+        let records = self.settings.capacity;
+        match pass {
+            TcPass::Propagate => [(records * VERTICES_PER_RECORD as u32).div_ceil(64), 1, 1],
+            TcPass::Fold | TcPass::Store => [records.div_ceil(64), 1, 1],
+            TcPass::Trace => [self.width.div_ceil(8), self.height.div_ceil(8), 1],
+        }
+    }
+
+    /// The frame's counters so far.
+    fn read_counters(&self, gpu: &Gpu) -> Result<TerminationStats, RenderError> {
+        let c: Vec<u32> = read(gpu, &self.counters, "termination counters")?;
+        Ok(TerminationStats {
+            path_vertices: c[0],
+            trace_rays: c[1],
+            propagate_rays: c[2],
+            inserted: c[3],
+            insert_failures: c[4],
+            stored: c[5],
+            unknown: c[6],
+            propagated: c[7],
+            incomplete: c[8],
+            filled: c[9],
+        })
     }
 
     /// Each record's moments (slot order), for tests.

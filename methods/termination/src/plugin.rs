@@ -1,15 +1,19 @@
 //! Path tracing terminated into a hashed radiance cache by variance trading
-//! (render::termination, ../shared/seeds/variance-trading-termination.txt): one system per
-//! frame runs the cache's passes (propagation, fold, the tracer with the rule's decision, the
-//! vertex store) and reports the image, the pass times (tc_trace and tc_propagate separately)
-//! and the mean path length (`path_length`, vertices per path counted on the GPU), with the
-//! per-pixel path length as the image `path_length` (the paper's Fig. 11).
+//! (render::termination, ../shared/seeds/variance-trading-termination.txt). Three systems: in
+//! Render the records' update (`update`: propagation and fold, after the warm-up on the first
+//! frame) and the image (`trace`: the tracer with the rule's decision), which reports the image,
+//! the pass times (tc_trace and tc_propagate separately) and the mean path length
+//! (`path_length`, vertices per path counted on the GPU), with the per-pixel path length as the
+//! image `path_length` (the paper's Fig. 11); in Learn the vertex store (`store`), whose time
+//! joins the frame's. Propagation traces the frame's scene from its camera and the fold feeds
+//! the image, so both stay before it.
 
 use std::time::Instant;
 
 use crate::TerminationCache;
 use anyhow::Result;
 use bevy_ecs::prelude::*;
+use render::timing::PassTiming;
 
 pub use crate::TerminationSettings;
 
@@ -24,6 +28,8 @@ pub fn label(s: &TerminationSettings) -> String {
 #[derive(Component)]
 pub struct TerminationState {
     cache: TerminationCache,
+    /// This frame's update times, from `update` to `trace`.
+    updated: Option<Vec<PassTiming>>,
 }
 
 pub struct Plugin;
@@ -45,20 +51,21 @@ impl MethodPlugin for Plugin {
     }
 
     fn add_systems(schedule: &mut Schedule) {
-        schedule.add_systems(render.in_set(Stage::Render));
+        schedule.add_systems((update, trace).chain().in_set(Stage::Render));
+        schedule.add_systems(store.in_set(Stage::Learn));
     }
 
     fn spawn(world: &mut World, entity: Entity, settings: &TerminationSettings) -> Result<()> {
         let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
         // Validates the settings and checks the cache's buffers against the adapter's limits.
         let cache = TerminationCache::new(gpu, tracer, *settings)?;
-        world.entity_mut(entity).insert(TerminationState { cache });
+        world.entity_mut(entity).insert(TerminationState { cache, updated: None });
         Ok(())
     }
 }
 
-/// The cache's passes and the frame's image (one path per pixel).
-pub fn render(
+/// The records the image reads: the warm-up on the first frame, then propagation and fold.
+pub fn update(
     gpu: Res<GpuDevice>,
     tracer: Res<Tracer>,
     run: Res<Run>,
@@ -68,9 +75,30 @@ pub fn render(
 ) -> Result<(), BevyError> {
     for (mut state, info, mut frame) in &mut methods {
         let start = Instant::now();
+        let updated = state
+            .cache
+            .update(&gpu.0, &tracer.0, &scene.scene.camera, run.scenario.seed, clock.global)
+            .map_err(|e| method_failed(&info.label, clock.global, e))?;
+        state.updated = Some(updated);
+        frame.add_cpu(start);
+    }
+    Ok(())
+}
+
+/// The frame's image (one path per pixel, the rule deciding at every vertex) and its output.
+pub fn trace(
+    gpu: Res<GpuDevice>,
+    tracer: Res<Tracer>,
+    run: Res<Run>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&mut TerminationState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
+    for (mut state, info, mut frame) in &mut methods {
+        let start = Instant::now();
+        let updated = state.updated.take().unwrap_or_default();
         let out = state
             .cache
-            .render(&gpu.0, &tracer.0, &scene.scene.camera, run.scenario.seed, clock.global)
+            .trace(&gpu.0, &tracer.0, run.scenario.seed, clock.global, updated)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let s = out.stats;
         frame.output = Some(MethodOutput {
@@ -94,6 +122,33 @@ pub fn render(
             }],
             ..MethodOutput::timed(out.radiance, out.motion, &out.timings, out.rays, out.shaded)
         });
+        frame.add_cpu(start);
+    }
+    Ok(())
+}
+
+/// After the image: the frame's candidates become the stored vertices the next frame
+/// propagates; the pass time joins the frame's output.
+pub fn store(
+    gpu: Res<GpuDevice>,
+    tracer: Res<Tracer>,
+    clock: Res<FrameClock>,
+    mut methods: Query<(&mut TerminationState, &MethodInfo, &mut MethodFrame)>,
+) -> Result<(), BevyError> {
+    for (mut state, info, mut frame) in &mut methods {
+        let start = Instant::now();
+        let timings = state
+            .cache
+            .store(&gpu.0, &tracer.0)
+            .map_err(|e| method_failed(&info.label, clock.global, e))?;
+        let Some(output) = frame.output.as_mut() else {
+            return Err(method_failed(
+                &info.label,
+                clock.global,
+                "the vertex store ran before the frame's image",
+            ));
+        };
+        output.add_timed(&timings);
         frame.add_cpu(start);
     }
     Ok(())
