@@ -64,7 +64,7 @@ fn every_method_system_runs_in_its_stage_in_order() {
             "simulation::extract_scene",
             "extract::frame_number",
             "extract::upload_scene",
-            "media::upload_medium"
+            "scene_medium::upload_medium"
         ]
     );
 
