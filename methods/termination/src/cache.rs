@@ -6,7 +6,6 @@ use super::gpu_decision::{decision_module, rule_words};
 use super::moments::RecordMoments;
 use super::settings::{BYTES_PER_RECORD, TerminationSettings, VERTICES_PER_RECORD};
 use glam::Vec3;
-use hash_cache::read;
 use hash_cache::{HashCacheParams, HashCacheSettings};
 use render::compute::{self, BufferBinding};
 use render::error::RenderError;
@@ -15,6 +14,7 @@ use render::gpu_struct::GpuStruct;
 use render::lights::luminance;
 use render::pass_library::PassLibrary;
 use render::path_tracer::PathTracer;
+use render::readback::{copy_all, read_pod};
 use render::scene::Camera;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming};
@@ -341,10 +341,19 @@ impl TerminationCache {
             }
         }
         let timings = self.passes(gpu, tracer, camera, seed, frame, self.settings.max_vertices)?;
-        let radiance = read(gpu, &self.colour, "termination colour")?;
-        let primary: Vec<TaaPrimary> = read(gpu, &self.primary, "termination primary hits")?;
-        let path_length: Vec<f32> = read(gpu, &self.path_length, "termination path length")?;
-        let c: Vec<u32> = read(gpu, &self.counters, "termination counters")?;
+        let [colour, primary, path_length, counters] = copy_all(
+            gpu,
+            [
+                (&self.colour, "termination colour"),
+                (&self.primary, "termination primary hits"),
+                (&self.path_length, "termination path length"),
+                (&self.counters, "termination counters"),
+            ],
+        );
+        let radiance = colour.read(gpu)?;
+        let primary: Vec<TaaPrimary> = primary.read(gpu)?;
+        let path_length: Vec<f32> = path_length.read(gpu)?;
+        let c: Vec<u32> = counters.read(gpu)?;
         let stats = TerminationStats {
             path_vertices: c[0],
             trace_rays: c[1],
@@ -452,12 +461,12 @@ impl TerminationCache {
 
     /// Each record's moments (slot order), for tests.
     pub fn read_records(&self, gpu: &Gpu) -> Result<Vec<TcRecord>, RenderError> {
-        let all: Vec<TcRecord> = read(gpu, &self.records, "termination records")?;
+        let all: Vec<TcRecord> = read_pod(gpu, &self.records, "termination records")?;
         Ok(all[..self.settings.capacity as usize].to_vec())
     }
 
     /// Slot words (checksum, claim, stored vertices, -), for tests.
     pub fn read_slots(&self, gpu: &Gpu) -> Result<Vec<[u32; 4]>, RenderError> {
-        read(gpu, &self.slots, "termination slots")
+        read_pod(gpu, &self.slots, "termination slots")
     }
 }
