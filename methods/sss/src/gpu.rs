@@ -60,6 +60,7 @@ pub fn program() -> Program {
     let types = Module::generated("package::sss_types", &[SssParams::WGSL]);
     Program::new(vec![
         types,
+        render::pass_library::PassLibrary::module("package::kernel"),
         render::pass_library::PassLibrary::module("package::pt_sampling"),
         render::wgsl_file!("sampling.wgsl"),
         render::wgsl_file!("spvg.wgsl"),

@@ -353,7 +353,8 @@ impl Taa {
             &RESOLVE_GROUP,
             &[&types],
         );
-        Program::new(vec![types, bindings]).entry(render::wgsl_file!("resolve.wgsl"))
+        Program::new(vec![types, bindings, PassLibrary::module("package::kernel")])
+            .entry(render::wgsl_file!("resolve.wgsl"))
     }
 
     /// The trace pass's program: the shading library, TAA's structs, the primary attributes, its
