@@ -1,5 +1,7 @@
 //! `flicker`: play scenarios of dynamic scenes, measure how light-transport caches behave.
 
+mod compare_args;
+mod report_args;
 mod runtime_dir;
 
 use std::path::PathBuf;
@@ -55,9 +57,9 @@ enum Command {
     /// List the built-in scenes.
     Scenes,
     /// Compare a test image with a reference (PNG or EXR): mean FLIP, SMAPE, PSNR, error map.
-    Compare(metrics::CompareArgs),
+    Compare(compare_args::CompareArgs),
     /// Rebuild summary.json, the charts and report.html of a run folder.
-    Report(report::ReportArgs),
+    Report(report_args::ReportArgs),
     /// Regression suites: play cases over seeds and judge gates against a blessed baseline.
     Suite {
         #[command(subcommand)]
@@ -458,9 +460,9 @@ fn main() -> ExitCode {
             }
             Ok(())
         }
-        Command::Compare(args) => metrics::compare(&args),
+        Command::Compare(args) => metrics::compare(&args.options()),
         Command::Report(args) => {
-            report::report(&args).map(|path| println!("wrote {}", path.display()))
+            report::report(&args.options()).map(|path| println!("wrote {}", path.display()))
         }
         Command::Bench {
             out,

@@ -5,38 +5,52 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use serde::Serialize;
 
-use crate::flip::{DEFAULT_PPD, ExposureRange, Percentiles, flip_hdr, flip_ldr};
+use crate::flip::{ExposureRange, Percentiles, flip_hdr, flip_ldr};
 use crate::image::load_image;
-use crate::smape::{DEFAULT_EPS, smape};
+use crate::smape::smape;
 use crate::{colormap, error};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum FlipMode {
     Ldr,
     Hdr,
 }
 
-#[derive(Clone, Debug, clap::Args)]
-pub struct CompareArgs {
+impl FlipMode {
+    /// Each mode's name, as `FromStr` reads it and the JSON writes it.
+    pub const NAMES: [&str; 2] = ["ldr", "hdr"];
+}
+
+impl std::str::FromStr for FlipMode {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "ldr" => Ok(Self::Ldr),
+            "hdr" => Ok(Self::Hdr),
+            _ => Err(format!("expected one of {}, got '{s}'", Self::NAMES.join(", "))),
+        }
+    }
+}
+
+/// What [`compare`] reads, measures and writes (`flicker compare`'s options).
+#[derive(Clone, Debug)]
+pub struct CompareOptions {
     /// Reference image (.png = sRGB, .exr = linear).
     pub reference: PathBuf,
     /// Test image, same size as the reference.
     pub test: PathBuf,
-    /// LDR-FLIP or HDR-FLIP; default: hdr for EXR references, ldr for PNG.
-    #[arg(long, value_enum)]
+    /// LDR-FLIP or HDR-FLIP; `None`: hdr for EXR references, ldr for PNG.
     pub mode: Option<FlipMode>,
-    /// Pixels per degree of the viewing setup (default: 0.7 m from a 0.7 m wide 3840 px monitor).
-    #[arg(long, default_value_t = DEFAULT_PPD)]
+    /// Pixels per degree of the viewing setup ([`crate::DEFAULT_PPD`]: 0.7 m from a 0.7 m wide
+    /// 3840 px monitor).
     pub ppd: f32,
     /// Write the FLIP error map here as a magma PNG.
-    #[arg(long)]
     pub map: Option<PathBuf>,
     /// Print JSON instead of text.
-    #[arg(long)]
     pub json: bool,
-    /// ε of SMAPE's denominator.
-    #[arg(long, default_value_t = DEFAULT_EPS)]
+    /// ε of SMAPE's denominator ([`crate::smape::DEFAULT_EPS`] by default).
     pub eps: f32,
 }
 
@@ -117,7 +131,7 @@ pub fn compare_files(
 }
 
 /// Runs `compare`: prints the metrics (text or JSON) and writes the error map if asked.
-pub fn compare(args: &CompareArgs) -> anyhow::Result<()> {
+pub fn compare(args: &CompareOptions) -> anyhow::Result<()> {
     let c = compare_files(&args.reference, &args.test, args.mode, args.ppd, args.eps)?;
     if let Some(path) = &args.map {
         colormap::write_map_png(&c.flip_map, c.width, c.height, path)?;

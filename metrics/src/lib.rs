@@ -18,7 +18,7 @@ pub mod smape;
 
 pub use crate::image::{Image, load_image, write_exr, write_png_srgb};
 pub use colormap::{magma, write_map_png};
-pub use compare::{CompareArgs, compare};
+pub use compare::{CompareOptions, compare};
 pub use error::{mse, psnr, psnr_from_mse, relative_mse};
 pub use flip::{DEFAULT_PPD, FlipResult, Percentiles, flip_hdr, flip_ldr, pixels_per_degree};
 pub use region::Region;

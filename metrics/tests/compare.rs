@@ -1,7 +1,7 @@
 //! `compare REFERENCE TEST` on files: the numbers equal the library's, the map is written, and
 //! bad input is reported with the file name.
 
-use metrics::compare::{CompareArgs, FlipMode, compare, compare_files};
+use metrics::compare::{CompareOptions, FlipMode, compare, compare_files};
 use metrics::{
     DEFAULT_PPD, Image, flip_hdr, flip_ldr, load_image, psnr, smape, write_exr, write_png_srgb,
 };
@@ -30,7 +30,7 @@ fn compare_matches_library_and_writes_map() {
         compare_files(&d.join("r.exr"), &d.join("t.exr"), Some(FlipMode::Ldr), 40.0, 0.01).unwrap();
     assert_eq!(ldr.flip_mean, flip_ldr(&r, &t, 40.0).mean);
 
-    let args = CompareArgs {
+    let args = CompareOptions {
         reference: d.join("r.exr"),
         test: d.join("t.exr"),
         mode: None,

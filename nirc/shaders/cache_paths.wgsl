@@ -36,6 +36,7 @@ import package::pt_integrator::{next_event, next_event_analytic, next_event_emit
 import package::nirc::cache_path_types::{CacheQuery, TrainingRecord};
 import package::nirc::query_meta::{QueryMeta};
 import package::nirc::cache_path_bindings::{answers, image, motion, params, queries, query_meta, ray_counters, records};
+import package::kernel::{outside_image};
 
 // CacheParams, CacheQuery and TrainingRecord (position.w: 1 = valid) are declared once for Rust
 // and WGSL (src/integrator.rs, src/records.rs).
@@ -115,7 +116,7 @@ fn trace_query(pixel: vec2u, sample_index: u32, q: u32) {
 // Per pixel: `spp` camera paths, queries at pixel * spp + s.
 @compute @workgroup_size(8, 8, 1)
 fn queries_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.width || id.y >= frame.height {
+    if outside_image(id, frame.width, frame.height) {
         return;
     }
     let pixel = id.y * frame.width + id.x;
@@ -211,7 +212,7 @@ fn oracle_main(@builtin(global_invocation_id) id: vec3u) {
 // mean σ (weight of the High-LR predictor) of the pixel's answered queries, w = their count.
 @compute @workgroup_size(8, 8, 1)
 fn resolve_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.width || id.y >= frame.height {
+    if outside_image(id, frame.width, frame.height) {
         return;
     }
     let pixel = id.y * frame.width + id.x;

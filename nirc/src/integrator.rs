@@ -15,6 +15,7 @@ use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::pass_library::{LibraryPipeline, PassLibrary};
 use render::path_tracer::PathTracer;
+use render::readback::read_pod;
 use render::shader::{Module, Program};
 use render::timing::TimedFrame;
 use serde::{Deserialize, Serialize};
@@ -496,7 +497,7 @@ impl CachePaths {
         gpu: &Gpu,
         out: &CacheOutput,
     ) -> Result<(Vec<[f32; 4]>, Vec<[f32; 4]>), NircError> {
-        let texels: Vec<[f32; 4]> = crate::gpu::readback::read_pod(gpu, &out.image, "nirc image")?;
+        let texels: Vec<[f32; 4]> = read_pod(gpu, &out.image, "nirc image")?;
         let n = self.pixels() as usize;
         Ok((texels[..n].to_vec(), texels[n..2 * n].to_vec()))
     }
@@ -504,8 +505,7 @@ impl CachePaths {
     /// Per pixel motion (previous image position - current, pixels) of the last
     /// `encode_queries`, from the pixel-centre primary hit as the path tracer's G-buffer.
     pub fn read_motion(&self, gpu: &Gpu) -> Result<Vec<[f32; 2]>, NircError> {
-        let mut motion: Vec<[f32; 2]> =
-            crate::gpu::readback::read_pod(gpu, &self.motion, "nirc motion")?;
+        let mut motion: Vec<[f32; 2]> = read_pod(gpu, &self.motion, "nirc motion")?;
         motion.truncate(self.pixels() as usize);
         Ok(motion)
     }
@@ -513,23 +513,20 @@ impl CachePaths {
     /// Rays traced since the last `encode_queries` (camera paths, training targets), counted on
     /// the GPU as every other method's.
     pub fn read_rays(&self, gpu: &Gpu) -> Result<[u64; 2], NircError> {
-        let c: Vec<u32> =
-            crate::gpu::readback::read_pod(gpu, &self.ray_counters, "nirc ray counters")?;
+        let c: Vec<u32> = read_pod(gpu, &self.ray_counters, "nirc ray counters")?;
         Ok([c[0] as u64, c[1] as u64])
     }
 
     /// Reads `out.answers` back (e.g. after `NeuralCache::encode_reliability`).
     pub fn read_answers(&self, gpu: &Gpu, out: &CacheOutput) -> Result<Vec<[f32; 4]>, NircError> {
-        let mut answers: Vec<[f32; 4]> =
-            crate::gpu::readback::read_pod(gpu, &out.answers, "nirc answers")?;
+        let mut answers: Vec<[f32; 4]> = read_pod(gpu, &out.answers, "nirc answers")?;
         answers.truncate(self.query_count() as usize);
         Ok(answers)
     }
 
     /// Per query of the last `encode_queries`: whether the path reached its termination vertex.
     pub fn read_query_valid(&self, gpu: &Gpu) -> Result<Vec<bool>, NircError> {
-        let floats: Vec<[f32; 4]> =
-            crate::gpu::readback::read_pod(gpu, &self.meta, "nirc query weights")?;
+        let floats: Vec<[f32; 4]> = read_pod(gpu, &self.meta, "nirc query weights")?;
         Ok(floats
             .chunks_exact(3)
             .take(self.query_count() as usize)
@@ -540,7 +537,7 @@ impl CachePaths {
     /// The training records of the last frame (tests, diagnostics).
     pub fn read_records(&self, gpu: &Gpu) -> Result<Vec<TrainingRecord>, NircError> {
         let mut records: Vec<TrainingRecord> =
-            crate::gpu::readback::read_pod(gpu, &self.records, "nirc training records")?;
+            read_pod(gpu, &self.records, "nirc training records")?;
         records.truncate(self.record_count() as usize);
         Ok(records)
     }

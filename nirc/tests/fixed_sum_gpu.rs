@@ -74,8 +74,8 @@ fn gpu_sums(gpu: &Gpu, values: &[f32]) -> (Vec<[u32; 3]>, Vec<bool>) {
         pass.dispatch_workgroups((values.len() as u32).div_ceil(64), 1, 1);
     }
     gpu.queue.submit([encoder.finish()]);
-    let words: Vec<u32> = nirc::gpu::readback::read_pod(gpu, &accum, "accum").unwrap();
-    let flags: Vec<u32> = nirc::gpu::readback::read_pod(gpu, &accepted, "accepted").unwrap();
+    let words: Vec<u32> = render::readback::read_pod(gpu, &accum, "accum").unwrap();
+    let flags: Vec<u32> = render::readback::read_pod(gpu, &accepted, "accepted").unwrap();
     (words.chunks(3).map(|w| [w[0], w[1], w[2]]).collect(), flags.iter().map(|&f| f == 1).collect())
 }
 

@@ -542,8 +542,7 @@ fn steps_recorded_in_one_encoder_equal_separate_submissions() {
         .encode_infer(gpu(), &mut encoder, &qb, q.len() as u32, &out, PredictorMode::Blend)
         .unwrap();
     gpu().queue.submit([encoder.finish()]);
-    let got: Vec<nirc::CacheAnswer> =
-        nirc::gpu::readback::read_pod(gpu(), &out, "answers").unwrap();
+    let got: Vec<nirc::CacheAnswer> = render::readback::read_pod(gpu(), &out, "answers").unwrap();
     assert_eq!(&got[..q.len()], &want[..]);
     assert_eq!(together.download_state(gpu()).unwrap(), separate.download_state(gpu()).unwrap());
 }

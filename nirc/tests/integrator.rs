@@ -251,7 +251,7 @@ fn training_records_are_queries_with_finite_targets() {
         "rays: camera {camera}, training {training}"
     );
     let queries: Vec<nirc::CacheQuery> =
-        nirc::gpu::readback::read_pod(g, paths.queries(), "queries").unwrap();
+        render::readback::read_pod(g, paths.queries(), "queries").unwrap();
     let mut distinct = std::collections::HashSet::new();
     for r in &records {
         assert_eq!(r.position[3], 1.0, "every slot holds a valid record: {r:?}");

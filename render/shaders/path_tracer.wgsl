@@ -10,6 +10,7 @@ import package::pt_scene::{base_color_at, camera_ray_direction, orient, primary_
 import package::pt_integrator::{NO_STOP, PathPrefix, PathState, path_start, path_vertex};
 import package::path_tracer_types::{GBufferTexel, SAMPLES_PER_THREAD};
 import package::path_tracer_bindings::{gbuffer, pt_counters, radiance_sum, sample_partials};
+import package::kernel::{outside_image};
 
 // Sample `sample_index` of `pixel`: its camera path, and its random-number stream in `rng`.
 fn camera_path(pixel: vec2u, sample_index: u32, rng: ptr<function, u32>) -> PathState {
@@ -29,7 +30,7 @@ fn camera_path(pixel: vec2u, sample_index: u32, rng: ptr<function, u32>) -> Path
 // dispatch runs too long; spreading samples over z also keeps small images parallel.
 @compute @workgroup_size(8, 8, 1)
 fn trace_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.width || id.y >= frame.height {
+    if outside_image(id, frame.width, frame.height) {
         return;
     }
     let first = id.z * SAMPLES_PER_THREAD;
@@ -60,7 +61,7 @@ fn trace_main(@builtin(global_invocation_id) id: vec3u) {
 // Adds a dispatch's chunks to the running sum in a fixed order (deterministic); w counts samples.
 @compute @workgroup_size(8, 8, 1)
 fn accumulate_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.width || id.y >= frame.height {
+    if outside_image(id, frame.width, frame.height) {
         return;
     }
     let pixels = frame.width * frame.height;
@@ -81,7 +82,7 @@ fn accumulate_main(@builtin(global_invocation_id) id: vec3u) {
 // zero normal and albedo, NO_HIT ids, motion of the direction at infinity.
 @compute @workgroup_size(8, 8, 1)
 fn gbuffer_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.width || id.y >= frame.height {
+    if outside_image(id, frame.width, frame.height) {
         return;
     }
     let centre = vec2f(id.xy) + 0.5;

@@ -114,8 +114,9 @@ impl PassLibrary {
 
     /// The library's modules, each after those it imports: the scene's structs and its
     /// @group(0) (generated), the geometry's modules (first the scene's features, all of them:
-    /// [`Self::pass`] compiles for the scene's own), its @group(1) and traversal, sampling, BSDFs, lights,
-    /// the scene's shading helpers and the path integrator. A pass's program starts with them.
+    /// [`Self::pass`] compiles for the scene's own), its @group(1) and traversal, the kernel
+    /// opening (`package::kernel`), sampling, BSDFs, lights, the scene's shading helpers and the
+    /// path integrator. A pass's program starts with them.
     pub fn modules() -> &'static [Module] {
         static MODULES: std::sync::OnceLock<Vec<Module>> = std::sync::OnceLock::new();
         MODULES.get_or_init(|| {
@@ -133,6 +134,7 @@ impl PassLibrary {
             let mut modules = vec![types, bindings];
             modules.extend(SceneGeometry::modules());
             modules.extend([
+                crate::wgsl_file!("kernel.wgsl"),
                 crate::wgsl_file!("scene_tables.wgsl"),
                 crate::wgsl_file!("pt_sampling.wgsl"),
                 crate::wgsl_file!("pt_bsdf.wgsl"),

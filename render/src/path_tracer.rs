@@ -12,7 +12,7 @@ use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
 use crate::pass_library::{LibraryPipeline, PassLibrary};
-use crate::readback::read_buffer;
+use crate::readback::Staging;
 use crate::scene::{Camera, SceneChanges, SceneDesc};
 use crate::scene_bindings::SceneBindings;
 use crate::shader::{Module, Program};
@@ -115,12 +115,12 @@ pub struct PathTracer {
     sample_partials: wgpu::Buffer,
     accumulate_pipeline: LibraryPipeline,
     max_chunks: u32,
-    radiance_readback: wgpu::Buffer,
-    gbuffer_readback: wgpu::Buffer,
+    radiance_readback: Staging,
+    gbuffer_readback: Staging,
     timer: PassTimer,
     /// Rays traced (atomic, flushed once per invocation), cleared per frame.
     counters: wgpu::Buffer,
-    counters_readback: wgpu::Buffer,
+    counters_readback: Staging,
     paths_per_dispatch: u64,
 }
 
@@ -153,13 +153,12 @@ impl PathTracer {
             })
         };
         let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-        let readback = wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST;
         let radiance_size = pixels * 16;
         let gbuffer_size = pixels * size_of::<GBufferTexel>() as u64;
         let radiance_sum = per_pixel("radiance sum", radiance_size, rw);
         let gbuffer = per_pixel("gbuffer", gbuffer_size, rw);
-        let radiance_readback = per_pixel("radiance readback", radiance_size, readback);
-        let gbuffer_readback = per_pixel("gbuffer readback", gbuffer_size, readback);
+        let radiance_readback = Staging::new(gpu, "radiance", radiance_size);
+        let gbuffer_readback = Staging::new(gpu, "gbuffer", gbuffer_size);
         let max_chunks = MAX_CHUNKS.min(gpu.limits.max_compute_workgroups_per_dimension);
         let sample_partials = Self::partials_buffer(
             gpu,
@@ -171,8 +170,7 @@ impl PathTracer {
             COUNTER_WORDS * 4,
             rw | wgpu::BufferUsages::COPY_DST,
         );
-        let counters_readback =
-            per_pixel("path tracer ray counter readback", COUNTER_WORDS * 4, readback);
+        let counters_readback = Staging::new(gpu, "ray counter", COUNTER_WORDS * 4);
 
         let library = PassLibrary::new(scene.features());
         let (layout, [trace_pipeline, gbuffer_pipeline, accumulate_pipeline]) = library.pass(
@@ -460,19 +458,7 @@ impl PathTracer {
 
     /// Rays the passes since the last clear traced (the frame's G-buffer and paths).
     fn read_rays(&self, gpu: &Gpu) -> Result<u64, RenderError> {
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("ray counter readback"),
-        });
-        encoder.copy_buffer_to_buffer(
-            &self.counters,
-            0,
-            &self.counters_readback,
-            0,
-            COUNTER_WORDS * 4,
-        );
-        gpu.queue.submit([encoder.finish()]);
-        let words: Vec<u32> = read_buffer(gpu, &self.counters_readback)
-            .map_err(|reason| RenderError::Readback { what: "ray counter".into(), reason })?;
+        let words: Vec<u32> = self.counters_readback.read_from(gpu, &self.counters)?;
         Ok(words[0] as u64)
     }
 
@@ -492,19 +478,7 @@ impl PathTracer {
     }
 
     fn read_radiance(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, RenderError> {
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("radiance readback"),
-        });
-        encoder.copy_buffer_to_buffer(
-            &self.radiance_sum,
-            0,
-            &self.radiance_readback,
-            0,
-            self.radiance_sum.size(),
-        );
-        gpu.queue.submit([encoder.finish()]);
-        let sums: Vec<[f32; 4]> = read_buffer(gpu, &self.radiance_readback)
-            .map_err(|reason| RenderError::Readback { what: "radiance".into(), reason })?;
+        let sums: Vec<[f32; 4]> = self.radiance_readback.read_from(gpu, &self.radiance_sum)?;
         // w holds the sample count: the mean is sum / count.
         Ok(sums
             .into_iter()
@@ -519,19 +493,7 @@ impl PathTracer {
     }
 
     fn read_gbuffer(&self, gpu: &Gpu) -> Result<GBuffer, RenderError> {
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("gbuffer readback"),
-        });
-        encoder.copy_buffer_to_buffer(
-            &self.gbuffer,
-            0,
-            &self.gbuffer_readback,
-            0,
-            self.gbuffer.size(),
-        );
-        gpu.queue.submit([encoder.finish()]);
-        let texels: Vec<GBufferTexel> = read_buffer(gpu, &self.gbuffer_readback)
-            .map_err(|reason| RenderError::Readback { what: "gbuffer".into(), reason })?;
+        let texels: Vec<GBufferTexel> = self.gbuffer_readback.read_from(gpu, &self.gbuffer)?;
         let mut g = GBuffer::default();
         for t in texels {
             g.depth.push(if t.instance == NO_HIT { f32::INFINITY } else { t.depth });

@@ -4,6 +4,7 @@
 
 use crate::error::RenderError;
 use crate::gpu::Gpu;
+use crate::readback::Staging;
 use std::time::Instant;
 
 /// Which clock measured a [`PassTiming`].
@@ -38,7 +39,7 @@ pub struct PassTiming {
 pub struct PassTimestamps {
     query_set: wgpu::QuerySet,
     resolve: wgpu::Buffer,
-    readback: wgpu::Buffer,
+    readback: Staging,
     passes: u32,
     period_ns: f64,
 }
@@ -62,12 +63,7 @@ impl PassTimestamps {
             usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let readback = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("timestamp readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let readback = Staging::new(gpu, "timestamps", size);
         Some(Self {
             query_set,
             resolve,
@@ -90,12 +86,12 @@ impl PassTimestamps {
     /// Records the resolve and the copy to the readback buffer; call after the last pass.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
         encoder.resolve_query_set(&self.query_set, 0..2 * self.passes, &self.resolve, 0);
-        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, self.resolve.size());
+        self.readback.record(encoder, &self.resolve, 0);
     }
 
     /// Milliseconds of each pass; call after the submission holding `resolve` has completed.
-    pub fn read(&self, gpu: &Gpu) -> Result<Vec<f64>, String> {
-        let ticks: Vec<u64> = crate::readback::read_buffer(gpu, &self.readback)?;
+    pub fn read(&self, gpu: &Gpu) -> Result<Vec<f64>, RenderError> {
+        let ticks: Vec<u64> = self.readback.read(gpu)?;
         Ok(ticks
             .chunks_exact(2)
             .map(|p| p[1].saturating_sub(p[0]) as f64 * self.period_ns * 1e-6)
@@ -218,14 +214,10 @@ impl TimedFrame<'_> {
         }
         self.gpu.queue.submit([self.encoder.finish()]);
         wait(self.gpu)?;
-        let gpu_ms =
-            match &self.timer.timestamps {
-                Some(t) => Some(t.read(self.gpu).map_err(|reason| RenderError::Readback {
-                    what: "timestamps".into(),
-                    reason,
-                })?),
-                None => None,
-            };
+        let gpu_ms = match &self.timer.timestamps {
+            Some(t) => Some(t.read(self.gpu)?),
+            None => None,
+        };
         let clock = self.timer.clock();
         Ok((0..self.timer.names.len())
             .filter(|&i| self.used[i])

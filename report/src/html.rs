@@ -9,8 +9,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use crate::base64::data_uri;
 use crate::charts::build::{WrittenChart, write_charts};
+use crate::data_uri::data_uri;
 use crate::images::write_frame_images;
 use crate::run::{Frames, Manifest};
 use crate::summary::{DEFAULT_WINDOW, summarize};

@@ -438,8 +438,11 @@ fn compare_puts_two_runs_in_one_viewer_with_a_table_of_differences() {
     let a = fake_run_with("compare-a", &FakeRun::default());
     // B: the same scene with noise that holds still from frame to frame (less flicker).
     let b = fake_run_with("compare-b", &FakeRun { static_noise: true, ..FakeRun::default() });
-    let args =
-        report::ReportArgs { run_dir: None, compare: Some(vec![a.clone(), b.clone()]), out: None };
+    let args = report::ReportOptions {
+        run_dir: None,
+        compare: Some(vec![a.clone(), b.clone()]),
+        out: None,
+    };
     let page = report::report(&args).unwrap();
     assert_eq!(page, b.join("compare.html"));
     let html = std::fs::read_to_string(&page).unwrap();

@@ -4,7 +4,7 @@
 use render::compute::{BufferBinding, binding_layout, buffer_group, pipelines};
 use render::error::RenderError;
 use render::gpu::Gpu;
-use render::readback::read_buffer;
+use render::readback::Staging;
 use wgpu::util::DeviceExt;
 
 use super::medium::{GpuMedium, RaySegment};
@@ -82,12 +82,6 @@ impl EstimatorPass {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("results staging"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         let group = buffer_group(
             gpu,
             "media rays",
@@ -102,9 +96,9 @@ impl EstimatorPass {
             pass.set_bind_group(1, &group, &[]);
             pass.dispatch_workgroups((rays.len() as u32).div_ceil(64), 1, 1);
         }
-        enc.copy_buffer_to_buffer(&results, 0, &staging, 0, size);
+        let staging = Staging::copy_of(gpu, &mut enc, &results, "media ray results");
         gpu.queue.submit([enc.finish()]);
-        let raw: Vec<[u32; 2]> = read_buffer(gpu, &staging)?;
+        let raw: Vec<[u32; 2]> = staging.read(gpu).map_err(|e| e.to_string())?;
         Ok(raw
             .into_iter()
             .map(|[v, l]| RayResult { value: f32::from_bits(v), lookups: l })

@@ -7,7 +7,7 @@ use render::compute::{BufferBinding, binding_layout, buffer_group, pipelines};
 use render::error::RenderError;
 use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
-use render::readback::read_buffer;
+use render::readback::Staging;
 use render::timing::{PassTimer, PassTiming};
 use wgpu::util::DeviceExt;
 
@@ -113,12 +113,6 @@ impl ImagePass {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("media image staging"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         let group = buffer_group(gpu, "media image", &self.layout, &[&params, &dirs_buf, &results]);
         let groups = (count as u32).div_ceil(64);
         let mut timed = self.timer.begin(gpu, "media image");
@@ -130,9 +124,9 @@ impl ImagePass {
                 pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
             })
             .map_err(|e| e.to_string())?;
-        timed.encoder().copy_buffer_to_buffer(&results, 0, &staging, 0, size);
+        let staging = Staging::copy_of(gpu, timed.encoder(), &results, "media image results");
         let timings = timed.submit().map_err(|e| e.to_string())?;
-        let raw: Vec<[u32; 2]> = read_buffer(gpu, &staging)?;
+        let raw: Vec<[u32; 2]> = staging.read(gpu).map_err(|e| e.to_string())?;
         Ok((
             raw.into_iter()
                 .map(|[v, l]| Estimate { value: f32::from_bits(v), lookups: l })

@@ -4,7 +4,7 @@
 
 use render::compute::buffer_group;
 use render::gpu::Gpu;
-use render::readback::read_buffer;
+use render::readback::Staging;
 use wgpu::util::DeviceExt;
 
 /// Runs `pipeline` over `seeds`; `T` is one trial's result as the shader writes it.
@@ -33,12 +33,6 @@ pub(super) fn run_trials<T: bytemuck::Pod>(
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
-    let staging = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
     let group = buffer_group(gpu, label, layout, &[&params, &seeds_buf, &results]);
     let mut enc = device.create_command_encoder(&Default::default());
     {
@@ -50,7 +44,7 @@ pub(super) fn run_trials<T: bytemuck::Pod>(
         let max = gpu.device.limits().max_compute_workgroups_per_dimension;
         pass.dispatch_workgroups(groups.min(max), groups.div_ceil(max), 1);
     }
-    enc.copy_buffer_to_buffer(&results, 0, &staging, 0, size);
+    let staging = Staging::copy_of(gpu, &mut enc, &results, label);
     gpu.queue.submit([enc.finish()]);
-    read_buffer(gpu, &staging)
+    staging.read(gpu).map_err(|e| e.to_string())
 }

@@ -13,7 +13,7 @@ use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::pass_library::PassLibrary;
 use render::path_tracer::PathTracer;
-use render::readback::read_buffer;
+use render::readback::Staging;
 use render::scene_features::SceneFeatures;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming, merge};
@@ -252,12 +252,7 @@ impl VolumePathPass {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("volume path staging"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let staging = Staging::new(gpu, "volume path samples", size);
         let mut sum = vec![[0f64; 3]; pixels as usize];
         let mut lum = vec![(0f64, 0f64); pixels as usize];
         let mut first = 0;
@@ -299,9 +294,9 @@ impl VolumePathPass {
                     pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
                 })
                 .map_err(|e| e.to_string())?;
-            timed.encoder().copy_buffer_to_buffer(&samples, 0, &staging, 0, size);
+            staging.record(timed.encoder(), &samples, 0);
             merge(&mut timings, timed.submit().map_err(|e| e.to_string())?);
-            let raw: Vec<[f32; 4]> = read_buffer(gpu, &staging)?;
+            let raw: Vec<[f32; 4]> = staging.read(gpu).map_err(|e| e.to_string())?;
             for (i, v) in raw.iter().take((pixels * n) as usize).enumerate() {
                 let p = i / n as usize;
                 for c in 0..3 {

@@ -27,6 +27,7 @@ import package::taa::primary::{primary_attributes};
 import package::hash_cache_types::{HcRecord};
 import package::hash_cache_bindings::{cell_radiance, colour_out, counters, hc, primary_out, records, slots};
 import package::hash_cache::hash_key::{HC_EMPTY, HC_NONE, VoxelKey, hc_key, hc_level};
+import package::kernel::{outside_image};
 
 const HC_NEEDS_SAMPLE: u32 = 1u;
 const HC_COUNTER_OCCUPIED: u32 = 0u;
@@ -96,7 +97,7 @@ fn hc_store_record(index: u32, r: HcRecord) {
 
 @compute @workgroup_size(8, 8, 1)
 fn hc_trace(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.width || id.y >= frame.height {
+    if outside_image(id, frame.width, frame.height) {
         return;
     }
     let index = id.y * frame.width + id.x;
@@ -212,7 +213,7 @@ fn hc_demodulate(l: vec3f, albedo: vec3f) -> vec3f {
 
 @compute @workgroup_size(8, 8, 1)
 fn hc_update(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.width || id.y >= frame.height {
+    if outside_image(id, frame.width, frame.height) {
         return;
     }
     let index = id.y * frame.width + id.x;
@@ -242,7 +243,7 @@ fn hc_update(@builtin(global_invocation_id) id: vec3u) {
 
 @compute @workgroup_size(8, 8, 1)
 fn hc_resolve(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.width || id.y >= frame.height {
+    if outside_image(id, frame.width, frame.height) {
         return;
     }
     let index = id.y * frame.width + id.x;

@@ -49,14 +49,13 @@
 pub mod key;
 pub mod table_cpu;
 
-use bytemuck::Pod;
 use render::compute::BufferBinding;
 use render::error::RenderError;
 use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::pass_library::PassLibrary;
 use render::path_tracer::PathTracer;
-use render::readback::read_buffer;
+use render::readback::{copy_all, read_pod};
 use render::scene::Camera;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming};
@@ -478,10 +477,14 @@ impl HashCache {
                 timings.extend(out.timings);
                 out.radiance
             }
-            None => read(gpu, &self.colour, "hash cache colour")?,
+            None => read_pod(gpu, &self.colour, "hash cache colour")?,
         };
-        let c: Vec<u32> = read(gpu, &self.counters, "hash cache counters")?;
-        let primary: Vec<TaaPrimary> = read(gpu, &self.primary, "hash cache primary hits")?;
+        let [counters, primary] = copy_all(
+            gpu,
+            [(&self.counters, "hash cache counters"), (&self.primary, "hash cache primary hits")],
+        );
+        let c: Vec<u32> = counters.read(gpu)?;
+        let primary: Vec<TaaPrimary> = primary.read(gpu)?;
         self.frames += 1;
         let stats = HashCacheStats {
             capacity: self.settings.capacity,
@@ -534,7 +537,7 @@ impl HashCache {
 
     /// The table as stored: (checksum, last access, claim, home) per slot → [`CpuSlot`]s.
     pub fn read_slots(&self, gpu: &Gpu) -> Result<Vec<CpuSlot>, RenderError> {
-        let raw: Vec<[u32; 4]> = read(gpu, &self.slots, "hash cache slots")?;
+        let raw: Vec<[u32; 4]> = read_pod(gpu, &self.slots, "hash cache slots")?;
         Ok(raw
             .into_iter()
             .map(|s| CpuSlot { checksum: s[0], last_access: s[1], home: s[3] })
@@ -543,28 +546,13 @@ impl HashCache {
 
     /// Each slot's radiance (rgb) and sample count (w).
     pub fn read_cells(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, RenderError> {
-        read(gpu, &self.cells, "hash cache cells")
+        read_pod(gpu, &self.cells, "hash cache cells")
     }
 
     /// The per-pixel records of the last frame.
     pub fn read_records(&self, gpu: &Gpu) -> Result<Vec<HcRecord>, RenderError> {
-        read(gpu, &self.records, "hash cache records")
+        read_pod(gpu, &self.records, "hash cache records")
     }
-}
-
-/// A copy of `buffer` read back (other methods' state readers use it too).
-pub fn read<T: Pod>(gpu: &Gpu, buffer: &wgpu::Buffer, what: &str) -> Result<Vec<T>, RenderError> {
-    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(what),
-        size: buffer.size(),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut encoder =
-        gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
-    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
-    gpu.queue.submit([encoder.finish()]);
-    read_buffer(gpu, &staging).map_err(|reason| RenderError::Readback { what: what.into(), reason })
 }
 
 /// The cache's structs (`package::hash_cache_types`), also imported by the termination cache,

@@ -10,10 +10,11 @@ import package::taa::primary::{primary_attributes};
 import package::sample_cache_bindings::{dst_mask, dst_slots, ssc, ssc_colour, ssc_out, ssc_primary, ssc_work};
 import package::sample_cache::storage::{SSC_AUDIT, SSC_BACKGROUND_DEPTH, ssc_background_dir, ssc_hit, ssc_is_background, ssc_pixels, ssc_surface, ssc_visible_slots};
 import package::sample_cache::selection::{ssc_verify};
+import package::kernel::{outside_image};
 
 @compute @workgroup_size(8, 8, 1)
 fn reconstruct_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.width || id.y >= ssc.height {
+    if outside_image(id, ssc.width, ssc.height) {
         return;
     }
     let pixels = ssc_pixels();
@@ -70,7 +71,7 @@ fn reconstruct_main(@builtin(global_invocation_id) id: vec3u) {
 // visible that a retrace finds occluded: stale visibility, the ghosting of section 5.
 @compute @workgroup_size(8, 8, 1)
 fn audit_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.width || id.y >= ssc.height || id.z >= ssc.slots {
+    if outside_image(id, ssc.width, ssc.height) || id.z >= ssc.slots {
         return;
     }
     let p = id.y * ssc.width + id.x;

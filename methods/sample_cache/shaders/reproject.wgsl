@@ -6,6 +6,7 @@ import package::scene_geometry::{NO_HIT};
 import package::pt_scene::{project_offset};
 import package::sample_cache_bindings::{dst_slots, pixel_atomics, src_mask, src_slots, ssc, ssc_work};
 import package::sample_cache::storage::{SSC_ATOMICS, SSC_BACKGROUND_DEPTH, SSC_DROPPED, SSC_REPROJECTED, SSC_WMAX, SSC_WMAX_ACC, SSC_WMIN, SSC_WMIN_ACC, ssc_background_dir, ssc_full, ssc_is_background, ssc_pixels, ssc_surface};
+import package::kernel::{outside_image};
 
 // Listing 2 as printed `break`s after the first try whatever its outcome; the text says a lost
 // race retries on another slot while any remain. Here the loop only ends on success or when no
@@ -52,7 +53,7 @@ fn begin_main() {
 
 @compute @workgroup_size(8, 8, 1)
 fn reserve_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.width || id.y >= ssc.height || id.z >= ssc.slots {
+    if outside_image(id, ssc.width, ssc.height) || id.z >= ssc.slots {
         return;
     }
     let source = id.y * ssc.width + id.x;

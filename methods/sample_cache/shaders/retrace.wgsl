@@ -15,6 +15,7 @@ import package::sample_cache_bindings::{dst_mask, dst_slots, pixel_atomics, ssc,
 import package::sample_cache::storage::{SSC_ALL_RAYS, SSC_ATOMICS, SSC_BACKGROUND_DEPTH, SSC_BASE, SSC_FLAGGED, SSC_FLAG_BASE, SSC_FLAG_HOLE, SSC_FLAG_SLOPE, SSC_HISTOGRAM, SSC_LIST, SSC_MAX_SLOTS, SSC_NEW, SSC_OCCUPIED, SSC_PURGED, SSC_RAYS, SSC_RETRACE_COUNT, SSC_VISIBLE, SSC_WMAX_ACC, SSC_WMIN_ACC, ssc_full, ssc_is_background, ssc_less, ssc_list_index, ssc_pack_background, ssc_pack_hit, ssc_pixels, ssc_surface, ssc_visible_slots};
 import package::sample_cache::slope::{ssc_consistent, ssc_slope};
 import package::sample_cache::selection::{ssc_base_index, ssc_bucket, ssc_forced_shade, ssc_importance, ssc_is_base_pixel, ssc_nth_bit, ssc_verify};
+import package::kernel::{outside_image};
 
 // Jitter stays this far inside the pixel so that round-off never reprojects a sample of a static
 // view into a neighbour (a sample exactly on a pixel border would flip sides).
@@ -39,7 +40,7 @@ fn ssc_swap_bits(bits: u32, i: u32, j: u32) -> u32 {
 
 @compute @workgroup_size(8, 8, 1)
 fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.width || id.y >= ssc.height {
+    if outside_image(id, ssc.width, ssc.height) {
         return;
     }
     let width = ssc.width;
@@ -227,7 +228,7 @@ fn retrace_list_main(@builtin(global_invocation_id) id: vec3u, @builtin(num_work
 // add the samples the density control asked for, write the final mask and the histogram.
 @compute @workgroup_size(8, 8, 1)
 fn finish_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.width || id.y >= ssc.height {
+    if outside_image(id, ssc.width, ssc.height) {
         return;
     }
     let pixels = ssc_pixels();

@@ -10,6 +10,7 @@ import package::pt_sampling::{rng_next, rng_seed};
 import package::sample_cache_bindings::{dst_mask, dst_slots, ssc, ssc_work};
 import package::sample_cache::storage::{SSC_BASE, SSC_COIN, SSC_HISTOGRAM, SSC_LIST, SSC_SHADE_COUNT, SSC_THRESHOLD, ssc_pixels, ssc_visible_slots};
 import package::sample_cache::selection::{ssc_bucket, ssc_forced_shade, ssc_importance, ssc_nth_bit};
+import package::kernel::{outside_image};
 
 // One thread: the threshold bucket and its coin probability from the histogram and the budget
 // (twin of sample_cache/shading_rate.rs `threshold`).
@@ -41,7 +42,7 @@ fn ssc_push_shade(entry: u32) {
 
 @compute @workgroup_size(8, 8, 1)
 fn select_main(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= ssc.width || id.y >= ssc.height {
+    if outside_image(id, ssc.width, ssc.height) {
         return;
     }
     let pixels = ssc_pixels();

@@ -38,7 +38,7 @@ use render::gpu_struct::GpuStruct;
 use render::pass_library::LibraryPipeline;
 use render::pass_library::PassLibrary;
 use render::path_tracer::PathTracer;
-use render::readback::read_buffer;
+use render::readback::{Staging, read_pod};
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming};
 
@@ -269,8 +269,8 @@ pub struct SampleCache {
     /// The image and its primary attributes for a TAA resolve ([`Self::taa_inputs`]).
     colour: wgpu::Buffer,
     primary: wgpu::Buffer,
-    out_readback: wgpu::Buffer,
-    header_readback: wgpu::Buffer,
+    out_readback: Staging,
+    header_readback: Staging,
     bind_groups: [wgpu::BindGroup; 2],
     /// Index of the cache holding the last frame (the source of the next reprojection).
     current: usize,
@@ -329,7 +329,6 @@ impl SampleCache {
         let rw = wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_SRC
             | wgpu::BufferUsages::COPY_DST;
-        let readback = wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST;
         let caches = [
             Cache {
                 mask: buffer("ssc mask a", pixels * 4, rw)?,
@@ -350,8 +349,8 @@ impl SampleCache {
         let out = buffer("ssc out", pixels * 32, rw)?;
         let colour = buffer("ssc colour", pixels * 16, rw)?;
         let primary = buffer("ssc primary", pixels * size_of::<taa::TaaPrimary>() as u64, rw)?;
-        let out_readback = buffer("ssc out readback", pixels * 32, readback)?;
-        let header_readback = buffer("ssc header readback", HEADER_WORDS * 4, readback)?;
+        let out_readback = Staging::new(gpu, "sample cache output", out.size());
+        let header_readback = Staging::new(gpu, "sample cache counters", HEADER_WORDS * 4);
         let params = buffer(
             "ssc params",
             size_of::<SscParams>() as u64,
@@ -600,14 +599,8 @@ impl SampleCache {
         }
         if stage == PASSES.len() - 1 {
             let encoder = timed.encoder();
-            encoder.copy_buffer_to_buffer(&self.out, 0, &self.out_readback, 0, self.out.size());
-            encoder.copy_buffer_to_buffer(
-                &self.work,
-                0,
-                &self.header_readback,
-                0,
-                HEADER_WORDS * 4,
-            );
+            self.out_readback.record(encoder, &self.out, 0);
+            self.header_readback.record(encoder, &self.work, 0);
         }
         let times = timed.submit()?;
         if let Some((_, _, all)) = &mut self.pending {
@@ -635,10 +628,8 @@ impl SampleCache {
         self.current = 1 - self.current;
         self.frames += 1;
 
-        let out: Vec<GpuPixel> = read_buffer(gpu, &self.out_readback)
-            .map_err(|r| readback_error("sample cache output", r))?;
-        let header: Vec<u32> = read_buffer(gpu, &self.header_readback)
-            .map_err(|r| readback_error("sample cache counters", r))?;
+        let out: Vec<GpuPixel> = self.out_readback.read(gpu)?;
+        let header: Vec<u32> = self.header_readback.read(gpu)?;
         let stats = CacheStats {
             shaded: header[0],
             rays: header[1],
@@ -674,24 +665,8 @@ impl SampleCache {
     /// Reads back the cache the last frame produced.
     pub fn read_state(&self, gpu: &Gpu) -> Result<CacheState, RenderError> {
         let cache = &self.caches[self.current];
-        let copy = |src: &wgpu::Buffer| -> Result<wgpu::Buffer, RenderError> {
-            let dst = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("ssc state readback"),
-                size: src.size(),
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("ssc state"),
-            });
-            encoder.copy_buffer_to_buffer(src, 0, &dst, 0, src.size());
-            gpu.queue.submit([encoder.finish()]);
-            Ok(dst)
-        };
-        let masks = read_buffer(gpu, &copy(&cache.mask)?)
-            .map_err(|reason| RenderError::Readback { what: "ssc masks".into(), reason })?;
-        let slots = read_buffer(gpu, &copy(&cache.slots)?)
-            .map_err(|reason| RenderError::Readback { what: "ssc slots".into(), reason })?;
+        let masks = read_pod(gpu, &cache.mask, "ssc masks")?;
+        let slots = read_pod(gpu, &cache.slots, "ssc slots")?;
         Ok(CacheState { masks, slots })
     }
 
@@ -719,10 +694,9 @@ impl SampleCache {
                 self.settings.slots,
             );
         }
-        encoder.copy_buffer_to_buffer(&self.work, 0, &self.header_readback, 0, HEADER_WORDS * 4);
+        self.header_readback.record(&mut encoder, &self.work, 0);
         gpu.queue.submit([encoder.finish()]);
-        let header: Vec<u32> = read_buffer(gpu, &self.header_readback)
-            .map_err(|reason| RenderError::Readback { what: "ssc audit".into(), reason })?;
+        let header: Vec<u32> = self.header_readback.read(gpu)?;
         Ok(header[AUDIT_WORD as usize])
     }
 
@@ -745,10 +719,6 @@ impl SampleCache {
     pub fn layout(&self) -> &wgpu::BindGroupLayout {
         &self.layout
     }
-}
-
-fn readback_error(what: &str, reason: String) -> RenderError {
-    RenderError::Readback { what: what.into(), reason }
 }
 
 fn tracer_tan_half_fov(tracer: &PathTracer) -> f32 {

@@ -3,6 +3,7 @@
 // mask as its share; level k is the 2x2 mean of level k-1 over SSS texels, with their share.
 
 import package::sss_types::SssParams;
+import package::kernel::{outside_image};
 
 struct MipLevel {
     k: u32,
@@ -20,7 +21,7 @@ struct MipLevel {
 fn sss_prefilter(@builtin(global_invocation_id) id: vec3u) {
     let k = mip_level.k;
     let level = params.mip[k];
-    if id.x >= level.y || id.y >= level.z {
+    if outside_image(id, level.y, level.z) {
         return;
     }
     let out = level.x + id.y * level.y + id.x;

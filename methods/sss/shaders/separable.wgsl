@@ -3,6 +3,7 @@
 // the pre-integrated Burley kernel's taps (offset in units of the widest d, weight rgb).
 
 import package::sss_types::SssParams;
+import package::kernel::{outside_image};
 
 @group(0) @binding(0) var<uniform> params: SssParams;
 @group(0) @binding(1) var<storage, read> irradiance: array<vec4f>;
@@ -58,7 +59,7 @@ fn filter_1d(x: u32, y: u32, horizontal: bool, centre: vec3f, w: f32) -> vec3f {
 
 @compute @workgroup_size(8, 8, 1)
 fn sss_separable_h(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= params.width || id.y >= params.height {
+    if outside_image(id, params.width, params.height) {
         return;
     }
     let pixel = id.y * params.width + id.x;
@@ -72,7 +73,7 @@ fn sss_separable_h(@builtin(global_invocation_id) id: vec3u) {
 
 @compute @workgroup_size(8, 8, 1)
 fn sss_separable_v(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= params.width || id.y >= params.height {
+    if outside_image(id, params.width, params.height) {
         return;
     }
     let pixel = id.y * params.width + id.x;

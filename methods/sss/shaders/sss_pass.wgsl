@@ -6,6 +6,7 @@ import package::sss_types::SssParams;
 import package::sss::sampling::{sss_pixel_offset, sss_r2_point, sss_sample_radius, sss_radial_pdf, sss_luminance};
 import package::sss::mip::sss_mip_level;
 import package::sss::spvg::{SpvgParams, spvg_state, spvg_sample_count, spvg_update, cv_update, cv_coefficient};
+import package::kernel::{outside_image};
 
 @group(0) @binding(0) var<uniform> params: SssParams;
 @group(0) @binding(1) var<storage, read> irradiance: array<vec4f>;
@@ -74,7 +75,7 @@ fn fetch_lod(l: f32, q: vec2f, centre: vec3f) -> vec3f {
 
 @compute @workgroup_size(8, 8, 1)
 fn sss_scatter(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= params.width || id.y >= params.height {
+    if outside_image(id, params.width, params.height) {
         return;
     }
     let pixel = id.y * params.width + id.x;

@@ -11,7 +11,7 @@ use super::spvg::SpvgHistory;
 use render::error::RenderError;
 use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
-use render::readback::read_buffer;
+use render::readback::read_pod;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming};
 use wgpu::util::DeviceExt;
@@ -60,6 +60,7 @@ pub fn program() -> Program {
     let types = Module::generated("package::sss_types", &[SssParams::WGSL]);
     Program::new(vec![
         types,
+        render::pass_library::PassLibrary::module("package::kernel"),
         render::pass_library::PassLibrary::module("package::pt_sampling"),
         render::wgsl_file!("sampling.wgsl"),
         render::wgsl_file!("spvg.wgsl"),
@@ -345,36 +346,14 @@ impl SssPass {
         buffer: &wgpu::Buffer,
         what: &str,
     ) -> Result<Vec<[f32; 4]>, RenderError> {
-        let mut all = self.read_all(gpu, buffer, what)?;
+        let mut all: Vec<[f32; 4]> = read_pod(gpu, buffer, what)?;
         all.truncate((self.width * self.height) as usize);
         Ok(all)
     }
 
-    fn read_all(
-        &self,
-        gpu: &Gpu,
-        buffer: &wgpu::Buffer,
-        what: &str,
-    ) -> Result<Vec<[f32; 4]>, RenderError> {
-        let size = buffer.size();
-        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("sss staging"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("sss readback"),
-        });
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
-        gpu.queue.submit([encoder.finish()]);
-        read_buffer(gpu, &staging)
-            .map_err(|reason| RenderError::Readback { what: what.into(), reason })
-    }
-
     /// The last frame's MIP chain, `levels` levels (rgb, share of SSS texels per texel).
     pub fn mips(&self, gpu: &Gpu, levels: u32) -> Result<Vec<Vec<[f32; 4]>>, RenderError> {
-        let all = self.read_all(gpu, &self.mips, "sss mips")?;
+        let all: Vec<[f32; 4]> = read_pod(gpu, &self.mips, "sss mips")?;
         Ok((0..levels.min(prefilter::MAX_LEVELS))
             .map(|k| {
                 let start = prefilter::level_offset(self.width, self.height, k) as usize;

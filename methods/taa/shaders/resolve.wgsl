@@ -8,6 +8,7 @@
 
 import package::taa_types::{TaaPrimary};
 import package::taa_resolve_bindings::{current, history, previous_primary, primary, resolved, taa};
+import package::kernel::{outside_image};
 
 const NO_HIT: u32 = 0xffffffffu;
 
@@ -61,7 +62,7 @@ fn clip_to_box(lo: vec3f, hi: vec3f, h: vec3f) -> vec3f {
 
 @compute @workgroup_size(8, 8, 1)
 fn taa_resolve(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= taa.size.x || id.y >= taa.size.y {
+    if outside_image(id, taa.size.x, taa.size.y) {
         return;
     }
     let index = id.y * taa.size.x + id.x;

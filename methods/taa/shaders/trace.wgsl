@@ -10,10 +10,11 @@ import package::pt_scene::{camera_ray_direction};
 import package::pt_integrator::{path_radiance};
 import package::taa::primary::{primary_attributes};
 import package::taa_trace_bindings::{taa, taa_counters, taa_current, taa_primary};
+import package::kernel::{outside_image};
 
 @compute @workgroup_size(8, 8, 1)
 fn taa_trace(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.width || id.y >= frame.height {
+    if outside_image(id, frame.width, frame.height) {
         return;
     }
     let index = id.y * frame.width + id.x;

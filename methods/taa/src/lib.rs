@@ -33,14 +33,13 @@
 pub mod jitter;
 pub mod resolve_cpu;
 
-use bytemuck::Pod;
 use render::compute::BufferBinding;
 use render::error::RenderError;
 use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::pass_library::PassLibrary;
 use render::path_tracer::PathTracer;
-use render::readback::read_buffer;
+use render::readback::{copy_all, read_pod};
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming};
 
@@ -354,7 +353,8 @@ impl Taa {
             &RESOLVE_GROUP,
             &[&types],
         );
-        Program::new(vec![types, bindings]).entry(render::wgsl_file!("resolve.wgsl"))
+        Program::new(vec![types, bindings, PassLibrary::module("package::kernel")])
+            .entry(render::wgsl_file!("resolve.wgsl"))
     }
 
     /// The trace pass's program: the shading library, TAA's structs, the primary attributes, its
@@ -433,7 +433,7 @@ impl Taa {
         let mut timings = trace;
         timings.extend(timed.submit()?);
         let mut out = self.finish(gpu, timings)?;
-        out.rays = self.read::<u32>(gpu, &self.counters, "TAA ray counter")?[0] as u64;
+        out.rays = read_pod::<u32>(gpu, &self.counters, "TAA ray counter")?[0] as u64;
         out.shaded = self.width as u64 * self.height as u64;
         Ok(out)
     }
@@ -527,10 +527,15 @@ impl Taa {
 
     /// Reads the resolved frame and motion, then swaps the ping-pong buffers.
     fn finish(&mut self, gpu: &Gpu, timings: Vec<PassTiming>) -> Result<TaaOutput, RenderError> {
-        let resolved: Vec<[f32; 4]> =
-            self.read(gpu, &self.history[self.parity], "TAA resolved colour")?;
-        let primary: Vec<TaaPrimary> =
-            self.read(gpu, &self.primary[self.parity], "TAA primary hits")?;
+        let [resolved, primary] = copy_all(
+            gpu,
+            [
+                (&self.history[self.parity], "TAA resolved colour"),
+                (&self.primary[self.parity], "TAA primary hits"),
+            ],
+        );
+        let resolved: Vec<[f32; 4]> = resolved.read(gpu)?;
+        let primary: Vec<TaaPrimary> = primary.read(gpu)?;
         self.parity = 1 - self.parity;
         self.history_valid = true;
         Ok(TaaOutput {
@@ -548,33 +553,12 @@ impl Taa {
         let last = 1 - self.parity;
         Ok(TaaInspection {
             params_history_valid: self.last_history_valid,
-            current: self.read(gpu, &self.current, "TAA current")?,
-            primary: self.read(gpu, &self.primary[last], "TAA primary")?,
-            previous_primary: self.read(gpu, &self.primary[self.parity], "TAA previous primary")?,
-            history: self.read(gpu, &self.history[self.parity], "TAA history")?,
-            resolved: self.read(gpu, &self.history[last], "TAA resolved")?,
+            current: read_pod(gpu, &self.current, "TAA current")?,
+            primary: read_pod(gpu, &self.primary[last], "TAA primary")?,
+            previous_primary: read_pod(gpu, &self.primary[self.parity], "TAA previous primary")?,
+            history: read_pod(gpu, &self.history[self.parity], "TAA history")?,
+            resolved: read_pod(gpu, &self.history[last], "TAA resolved")?,
         })
-    }
-
-    fn read<T: Pod>(
-        &self,
-        gpu: &Gpu,
-        buffer: &wgpu::Buffer,
-        what: &str,
-    ) -> Result<Vec<T>, RenderError> {
-        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(what),
-            size: buffer.size(),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = gpu
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(what) });
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
-        gpu.queue.submit([encoder.finish()]);
-        read_buffer(gpu, &staging)
-            .map_err(|reason| RenderError::Readback { what: what.into(), reason })
     }
 }
 

@@ -31,6 +31,7 @@ import package::termination_bindings::{colour_out, counters, path_length, primar
 import package::hash_cache_bindings::{hc};
 import package::hash_cache::hash_key::{HC_EMPTY, HC_NONE, VoxelKey, hc_key, hc_level};
 import package::termination::decision::{TC_PATH_TRACING, TcLocalStats, TcPathState, TcRule, tc_arrive_area_spread, tc_decide, tc_threshold};
+import package::kernel::{outside_image};
 
 const TC_COUNTER_VERTICES: u32 = 0u;   // path vertices of the tracer's paths, x TC_LENGTH_SCALE
 // Path length is counted in 1/256 vertex: the vertex after a blend counts alpha (the paper's
@@ -219,7 +220,7 @@ fn tc_fold(@builtin(global_invocation_id) id: vec3u) {
 
 @compute @workgroup_size(8, 8, 1)
 fn tc_trace(@builtin(global_invocation_id) id: vec3u) {
-    if id.x >= frame.width || id.y >= frame.height {
+    if outside_image(id, frame.width, frame.height) {
         return;
     }
     let index = id.y * frame.width + id.x;

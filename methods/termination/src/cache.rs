@@ -9,7 +9,6 @@ use super::gpu_decision::{decision_module, rule_words};
 use super::moments::RecordMoments;
 use super::settings::{BYTES_PER_RECORD, TerminationSettings, VERTICES_PER_RECORD};
 use glam::Vec3;
-use hash_cache::read;
 use hash_cache::{HashCacheParams, HashCacheSettings};
 use render::compute::{self, BufferBinding};
 use render::error::RenderError;
@@ -18,6 +17,7 @@ use render::gpu_struct::GpuStruct;
 use render::lights::luminance;
 use render::pass_library::PassLibrary;
 use render::path_tracer::PathTracer;
+use render::readback::{copy_all, read_pod};
 use render::scene::Camera;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming};
@@ -415,10 +415,19 @@ impl TerminationCache {
         tracer.prepare_frame(gpu, 1, 0, seed, frame);
         let mut timings = updated;
         timings.extend(self.submit(gpu, tracer, &self.trace_timer, &[TcPass::Trace])?);
-        let radiance = read(gpu, &self.colour, "termination colour")?;
-        let primary: Vec<TaaPrimary> = read(gpu, &self.primary, "termination primary hits")?;
-        let path_length: Vec<f32> = read(gpu, &self.path_length, "termination path length")?;
-        let stats = self.read_counters(gpu)?;
+        let [colour, primary, path_length, counters] = copy_all(
+            gpu,
+            [
+                (&self.colour, "termination colour"),
+                (&self.primary, "termination primary hits"),
+                (&self.path_length, "termination path length"),
+                (&self.counters, "termination counters"),
+            ],
+        );
+        let radiance = colour.read(gpu)?;
+        let primary: Vec<TaaPrimary> = primary.read(gpu)?;
+        let path_length: Vec<f32> = path_length.read(gpu)?;
+        let stats = stats_of(&counters.read(gpu)?);
         let pixels = self.width as u64 * self.height as u64;
         Ok(TerminationOutput {
             radiance,
@@ -541,29 +550,35 @@ impl TerminationCache {
 
     /// The frame's counters so far.
     fn read_counters(&self, gpu: &Gpu) -> Result<TerminationStats, RenderError> {
-        let c: Vec<u32> = read(gpu, &self.counters, "termination counters")?;
-        Ok(TerminationStats {
-            path_vertices: c[0],
-            trace_rays: c[1],
-            propagate_rays: c[2],
-            inserted: c[3],
-            insert_failures: c[4],
-            stored: c[5],
-            unknown: c[6],
-            propagated: c[7],
-            incomplete: c[8],
-            filled: c[9],
-        })
+        Ok(stats_of(&read_pod::<u32>(gpu, &self.counters, "termination counters")?))
     }
+}
 
+/// The counters' words as statistics.
+fn stats_of(c: &[u32]) -> TerminationStats {
+    TerminationStats {
+        path_vertices: c[0],
+        trace_rays: c[1],
+        propagate_rays: c[2],
+        inserted: c[3],
+        insert_failures: c[4],
+        stored: c[5],
+        unknown: c[6],
+        propagated: c[7],
+        incomplete: c[8],
+        filled: c[9],
+    }
+}
+
+impl TerminationCache {
     /// Each record's moments (slot order), for tests.
     pub fn read_records(&self, gpu: &Gpu) -> Result<Vec<TcRecord>, RenderError> {
-        let all: Vec<TcRecord> = read(gpu, &self.records, "termination records")?;
+        let all: Vec<TcRecord> = read_pod(gpu, &self.records, "termination records")?;
         Ok(all[..self.settings.capacity as usize].to_vec())
     }
 
     /// Slot words (checksum, claim, stored vertices, -), for tests.
     pub fn read_slots(&self, gpu: &Gpu) -> Result<Vec<[u32; 4]>, RenderError> {
-        read(gpu, &self.slots, "termination slots")
+        read_pod(gpu, &self.slots, "termination slots")
     }
 }

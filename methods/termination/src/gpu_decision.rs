@@ -5,7 +5,7 @@ use super::decision::{LocalStats, PathState};
 use super::rule::TerminationRule;
 use render::error::RenderError;
 use render::gpu::Gpu;
-use render::readback::read_buffer;
+use render::readback::Staging;
 use render::shader::{Module, Program};
 use wgpu::util::DeviceExt;
 
@@ -77,12 +77,6 @@ pub fn decide_on_gpu(gpu: &Gpu, cases: &[DecisionCase]) -> Result<Vec<[f32; 2]>,
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         mapped_at_creation: false,
     });
-    let staging = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("decisions staging"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
     let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("decision probe"),
         layout: &pipeline.get_bind_group_layout(0),
@@ -102,9 +96,8 @@ pub fn decide_on_gpu(gpu: &Gpu, cases: &[DecisionCase]) -> Result<Vec<[f32; 2]>,
         pass.set_bind_group(0, &group, &[]);
         pass.dispatch_workgroups((cases.len() as u32).div_ceil(64), 1, 1);
     }
-    encoder.copy_buffer_to_buffer(&output, 0, &staging, 0, size);
+    let staging = Staging::copy_of(gpu, &mut encoder, &output, "decisions");
     gpu.queue.submit([encoder.finish()]);
-    let out: Vec<[f32; 4]> = read_buffer(gpu, &staging)
-        .map_err(|reason| RenderError::Readback { what: "decisions".into(), reason })?;
+    let out: Vec<[f32; 4]> = staging.read(gpu)?;
     Ok(out.into_iter().take(cases.len()).map(|v| [v[0], v[1]]).collect())
 }

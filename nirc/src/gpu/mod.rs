@@ -30,6 +30,7 @@ use crate::reliability::{MOMENTS_PER_CELL, cell_count};
 use crate::state::CacheState;
 use bytemuck::Pod;
 use render::gpu::Gpu;
+use render::readback::read_pod;
 use render::timing::TimedFrame;
 use shaders::{CHUNK, WORKGROUP_SIZE, WeightPlacement};
 use std::path::Path;
@@ -265,7 +266,7 @@ pub fn read_answers(
     answers: &wgpu::Buffer,
     n: u32,
 ) -> Result<Vec<CacheAnswer>, NircError> {
-    let mut all: Vec<CacheAnswer> = readback::read_pod(gpu, answers, "nirc answers")?;
+    let mut all: Vec<CacheAnswer> = read_pod(gpu, answers, "nirc answers")?;
     all.truncate(n as usize);
     Ok(all)
 }
@@ -1161,8 +1162,7 @@ impl NeuralCache {
     }
 
     pub fn counters(&self, gpu: &Gpu) -> Result<Counters, NircError> {
-        let counters: Vec<Counters> =
-            readback::read_pod(gpu, &self.buffers.counters, "nirc counters")?;
+        let counters: Vec<Counters> = read_pod(gpu, &self.buffers.counters, "nirc counters")?;
         counters.first().copied().ok_or_else(|| NircError::Readback {
             what: "nirc counters".into(),
             reason: "the buffer is smaller than Counters".into(),
@@ -1171,7 +1171,7 @@ impl NeuralCache {
 
     /// Mean loss of the last training step's first `n` records (before that step's update).
     pub fn last_loss(&self, gpu: &Gpu, n: u32) -> Result<f64, NircError> {
-        let losses: Vec<f32> = readback::read_f32(gpu, &self.buffers.losses, "nirc losses")?;
+        let losses: Vec<f32> = read_pod(gpu, &self.buffers.losses, "nirc losses")?;
         let n = (n as usize).min(losses.len());
         Ok(losses[..n].iter().map(|&l| l as f64).sum::<f64>() / n.max(1) as f64)
     }
@@ -1181,7 +1181,7 @@ impl NeuralCache {
         let b = &self.buffers;
         let n = self.layout.total_params as usize;
         let read = |buf: &wgpu::Buffer, what: &str, len: usize| -> Result<Vec<f32>, NircError> {
-            Ok(readback::read_f32(gpu, buf, what)?[..len].to_vec())
+            Ok(read_pod(gpu, buf, what)?[..len].to_vec())
         };
         Ok(CacheState {
             config: self.config.clone(),

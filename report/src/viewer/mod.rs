@@ -14,11 +14,12 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
+use base64::Engine;
+use base64::engine::general_purpose::STANDARD;
 use metrics::{Image, load_image};
 use rayon::prelude::*;
 use serde_json::json;
 
-use crate::base64;
 use crate::html::esc;
 use crate::run::{MOTION, Manifest, frame_file};
 
@@ -127,14 +128,14 @@ pub fn build(
                     Some(_) => {}
                 }
                 drop(s);
-                entries.push((p.label.clone(), base64::encode(&encoding::encode(&img))));
+                entries.push((p.label.clone(), STANDARD.encode(encoding::encode(&img))));
                 if let Some(m) = &p.method {
                     let motion =
                         p.run_dir.join("frames").join(m).join(MOTION).join(format!("{f:04}.exr"));
                     if motion.exists() {
                         entries.push((
                             format!("motion:{}", p.label),
-                            base64::encode(&encoding::encode_motion(&load_image(&motion)?)),
+                            STANDARD.encode(encoding::encode_motion(&load_image(&motion)?)),
                         ));
                         any_motion.store(true, std::sync::atomic::Ordering::Relaxed);
                     }
@@ -142,7 +143,7 @@ pub fn build(
                 if let Some(map) = flip_maps.get(&(f, p.label.clone())) {
                     entries.push((
                         format!("flip:{}", p.label),
-                        base64::encode(&encoding::encode_map(map)),
+                        STANDARD.encode(encoding::encode_map(map)),
                     ));
                 }
             }
