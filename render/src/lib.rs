@@ -23,4 +23,3 @@ pub mod taa;
 pub mod termination;
 pub mod texel_table;
 pub mod timing;
-pub mod wavefront;

@@ -1,9 +1,7 @@
 //! Every struct shared by Rust and WGSL (gpu_struct!) has each field at the same byte offset and
 //! the same size on both sides, as naga lays the WGSL declaration out.
 
-use render::bvh::{
-    SgBvh2Node, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTlasLeaf, SgTriangle, SgVertex,
-};
+use render::bvh::{SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTlasLeaf, SgTriangle, SgVertex};
 use render::frame::{CameraFrame, Frame};
 use render::gpu_struct::GpuStruct;
 use render::hash_cache::{HashCacheParams, HcRecord};
@@ -37,7 +35,6 @@ fn shared_structs_have_one_layout() {
         ("SgNode", mismatches::<SgNode>("")),
         ("SgTriangle", mismatches::<SgTriangle>("")),
         ("SgTlasLeaf", mismatches::<SgTlasLeaf>("")),
-        ("SgBvh2Node", mismatches::<SgBvh2Node>("")),
         ("SgMesh", mismatches::<SgMesh>("")),
         ("SgVertex", mismatches::<SgVertex>("")),
         ("SgInstance", mismatches::<SgInstance>("")),

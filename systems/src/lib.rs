@@ -1,8 +1,6 @@
 //! The frame as a bevy_ecs schedule (`frame`), the rendering methods as plugins (`methods`),
 //! measurement, recording, and scenario playback.
 
-pub mod bench;
-pub mod bench_nirc_frames;
 pub mod frame;
 pub mod frame_record;
 pub mod manifest;
@@ -14,6 +12,4 @@ pub mod playback;
 pub mod reference_cache;
 pub mod run_folder;
 pub mod scenario;
-pub mod suite;
-pub mod sweep;
 pub mod tonemap;
