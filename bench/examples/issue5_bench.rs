@@ -4,7 +4,7 @@
 //! times (GPU timestamps where the adapter has them, else per-pass wall time), rays and shaded
 //! paths per frame, the sample cache's per-dispatch times, and the paper's figure-7 ratios.
 //!
-//! cargo run -j2 -p systems --example issue5_bench -- [WIDTH HEIGHT FRAMES]
+//! cargo run -j2 -p bench --example issue5_bench -- [WIDTH HEIGHT FRAMES]
 //! (run it on an idle machine: on llvmpipe, concurrent load distorts the pass times)
 
 use std::collections::BTreeMap;

@@ -4,7 +4,7 @@
 //! a chain of loads whose next address depends on the last value, as BVH traversal does. A fourth variant
 //! adds a branch that almost no invocation takes: on lavapipe its body still costs (a divergent
 //! branch is run under a mask, not jumped over), which is why work for a few lanes is not free.
-//! `cargo run -p render --example load_probe`
+//! `cargo run -p bench --example load_probe`
 use std::time::Instant;
 
 const TEXELS_LOG2: u32 = 16; // 65 536 texels of 16 bytes: about a 100k-triangle BVH's size

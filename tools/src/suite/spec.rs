@@ -1,15 +1,16 @@
 //! Suite files (RON): cases to play over seeds and gates their metrics must pass. Errors carry
 //! the file, line and column, as scenario files' do (sim::scenario): `cases` and `gates` are
-//! kept as raw entries with their place in the file and parsed one by one.
+//! kept as raw entries with their place in the file and parsed one by one (`crate::ron_file`).
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
-use sim::scenario::{MethodEntry, ScenarioError, raw_entries};
+use sim::scenario::{MethodEntry, ScenarioError};
 
 use super::metric::Metric;
 use super::window::Window;
+use crate::ron_file::{self, RonFile};
 
 /// One scenario played once per seed.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
@@ -110,48 +111,32 @@ pub struct Suite {
     pub origin: PathBuf,
 }
 
-fn options() -> ron::Options {
-    ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
-}
-
 /// The `cases` of a suite or sweep file: each parsed at its place in the file, seeds checked,
 /// names distinct, scenario paths resolved against the file's folder.
 pub(crate) fn parse_cases(
-    text: &str,
+    file: RonFile,
     raw: &[Box<ron::value::RawValue>],
-    origin: &Path,
 ) -> Result<Vec<Case>, ScenarioError> {
-    let error = |position: Option<(usize, usize)>, message: String| ScenarioError {
-        file: origin.to_path_buf(),
-        position,
-        message,
-    };
-    let at = |entry: &MethodEntry| Some((entry.line, entry.column));
-    let folder = origin.parent().unwrap_or(Path::new(""));
+    let folder = file.origin.parent().unwrap_or(Path::new(""));
     let mut cases: Vec<Case> = Vec::new();
-    for entry in raw_entries(text, "cases", raw) {
-        let mut case: Case = options().from_str(&entry.text).map_err(|e| {
-            error(
-                Some(entry.position_in_file(e.span.start.line, e.span.start.col)),
-                e.code.to_string(),
-            )
-        })?;
+    for entry in file.entries("cases", raw) {
+        let mut case: Case = file.entry(&entry)?;
         if case.seeds.is_empty() {
-            return Err(error(
-                at(&entry),
+            return Err(file.error_at(
+                &entry,
                 format!("case '{}' has no seeds; expected e.g. seeds: [1, 2, 3]", case.name),
             ));
         }
         if let Some(dup) = case.seeds.iter().enumerate().find(|(i, s)| case.seeds[..*i].contains(s))
         {
-            return Err(error(
-                at(&entry),
+            return Err(file.error_at(
+                &entry,
                 format!("case '{}' lists seed {} twice; expected distinct seeds", case.name, dup.1),
             ));
         }
         if cases.iter().any(|c| c.name == case.name) {
-            return Err(error(
-                at(&entry),
+            return Err(file.error_at(
+                &entry,
                 format!(
                     "two cases are named '{}'; expected distinct names (they name run folders and baselines)",
                     case.name
@@ -165,47 +150,27 @@ pub(crate) fn parse_cases(
         cases.push(case);
     }
     if cases.is_empty() {
-        return Err(error(None, "no cases; expected e.g. cases: [(name: \"cornell\", scenario: \"scenarios/cornell_box.ron\", seeds: [1, 2])]".into()));
+        return Err(file.error(None, "no cases; expected e.g. cases: [(name: \"cornell\", scenario: \"scenarios/cornell_box.ron\", seeds: [1, 2])]".into()));
     }
     Ok(cases)
 }
 
 impl Suite {
     pub fn load(path: &Path) -> Result<Suite, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
-            file: path.to_path_buf(),
-            position: None,
-            message: format!("cannot read suite file: {e}"),
-        })?;
-        Self::from_ron(&text, path)
+        Self::from_ron(&ron_file::read(path, "suite file")?, path)
     }
 
     pub fn from_ron(text: &str, origin: &Path) -> Result<Suite, ScenarioError> {
-        let error = |position: Option<(usize, usize)>, message: String| ScenarioError {
-            file: origin.to_path_buf(),
-            position,
-            message,
-        };
-        let file: SuiteFile = options()
-            .from_str(text)
-            .map_err(|e| error(Some((e.span.start.line, e.span.start.col)), e.code.to_string()))?;
-        // An entry's own errors: positions inside the entry moved to the file's.
-        fn parse<T: serde::de::DeserializeOwned>(
-            entry: &MethodEntry,
-        ) -> Result<T, ((usize, usize), String)> {
-            options().from_str(&entry.text).map_err(|e| {
-                (entry.position_in_file(e.span.start.line, e.span.start.col), e.code.to_string())
-            })
-        }
-        let at = |entry: &MethodEntry| Some((entry.line, entry.column));
-        let cases = parse_cases(text, &file.cases, origin)?;
+        let file = RonFile { text, origin };
+        let parsed: SuiteFile = file.parse()?;
+        let cases = parse_cases(file, &parsed.cases)?;
         let names: BTreeSet<&str> = cases.iter().map(|c| c.name.as_str()).collect();
         let mut gates = Vec::new();
-        for entry in raw_entries(text, "gates", &file.gates) {
-            let mut gate: Gate = parse(&entry).map_err(|(pos, m)| error(Some(pos), m))?;
+        for entry in file.entries("gates", &parsed.gates) {
+            let mut gate: Gate = file.entry(&entry)?;
             if !(gate.confidence > 0.5 && gate.confidence < 1.0) {
-                return Err(error(
-                    at(&entry),
+                return Err(file.error_at(
+                    &entry,
                     format!(
                         "confidence {}; expected a probability between 0.5 and 1, e.g. 0.95",
                         gate.confidence
@@ -214,20 +179,22 @@ impl Suite {
             }
             match gate.bound {
                 Bound::Relative { tolerance: t } if !(t.is_finite() && t >= 0.0) => {
-                    return Err(error(
-                        at(&entry),
+                    return Err(file.error_at(
+                        &entry,
                         format!("tolerance {t}; expected a fraction >= 0, e.g. 0.05 for 5%"),
                     ));
                 }
                 Bound::Absolute { limit: l } if !l.is_finite() => {
-                    return Err(error(at(&entry), format!("limit {l}; expected a finite number")));
+                    return Err(
+                        file.error_at(&entry, format!("limit {l}; expected a finite number"))
+                    );
                 }
                 _ => {}
             }
             if let Some(unknown) = gate.cases.iter().flatten().find(|c| !names.contains(c.as_str()))
             {
-                return Err(error(
-                    at(&entry),
+                return Err(file.error_at(
+                    &entry,
                     format!(
                         "gate names case '{unknown}'; the suite's cases are: {}",
                         names.iter().copied().collect::<Vec<_>>().join(", ")
@@ -244,8 +211,8 @@ impl Suite {
                 } else {
                     "relative"
                 };
-                return Err(error(
-                    at(&entry),
+                return Err(file.error_at(
+                    &entry,
                     format!(
                         "a {kind} gate needs the spread over seeds, but case '{}' has one seed; expected at least 2",
                         case.name
@@ -256,14 +223,9 @@ impl Suite {
             gates.push(gate);
         }
         if gates.is_empty() {
-            return Err(error(None, "no gates; expected e.g. gates: [(metric: Flip, window: Overall, bound: Relative(tolerance: 0.05))]".into()));
+            return Err(file.error(None, "no gates; expected e.g. gates: [(metric: Flip, window: Overall, bound: Relative(tolerance: 0.05))]".into()));
         }
-        let name = file.name.unwrap_or_else(|| {
-            origin
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_else(|| "suite".into())
-        });
+        let name = file.name_or_stem(parsed.name, "suite");
         Ok(Suite { name, cases, gates, origin: origin.to_path_buf() })
     }
 

@@ -1,5 +1,6 @@
 //! Sweep files (RON). Errors carry the file, line and column, as suite files' do: `cases`,
-//! `grid` and `list` are kept as raw entries with their place in the file and parsed one by one.
+//! `grid` and `list` are kept as raw entries with their place in the file and parsed one by one
+//! (`crate::ron_file`).
 //!
 //! ```ron
 //! Sweep(
@@ -14,8 +15,9 @@
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
-use sim::scenario::{MethodEntry, ScenarioError, raw_entries};
+use sim::scenario::{MethodEntry, ScenarioError};
 
+use crate::ron_file::{self, RonFile};
 use crate::suite::spec::Case;
 
 /// One parameter: `METHOD_LABEL.field.subfield` of a case's method, and its value.
@@ -78,10 +80,6 @@ pub struct Sweep {
     pub origin: PathBuf,
 }
 
-fn options() -> ron::Options {
-    ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
-}
-
 /// A RON value as JSON (what method settings are set through, `param`).
 fn to_json(v: &ron::Value) -> Result<serde_json::Value, String> {
     serde_json::to_value(v).map_err(|e| format!("value {v:?}: {e}"))
@@ -99,54 +97,44 @@ fn check_param(p: &str) -> Result<(), String> {
 
 impl Sweep {
     pub fn load(path: &Path) -> Result<Sweep, ScenarioError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
-            file: path.to_path_buf(),
-            position: None,
-            message: format!("cannot read sweep file: {e}"),
-        })?;
-        Self::from_ron(&text, path)
+        Self::from_ron(&ron_file::read(path, "sweep file")?, path)
     }
 
     pub fn from_ron(text: &str, origin: &Path) -> Result<Sweep, ScenarioError> {
-        let error = |position: Option<(usize, usize)>, message: String| ScenarioError {
-            file: origin.to_path_buf(),
-            position,
-            message,
+        let file = RonFile { text, origin };
+        let parsed: SweepFile = file.parse()?;
+        // An entry's parse error, with what the entry should have looked like.
+        let expected = |hint: &str| {
+            let hint = hint.to_string();
+            move |mut e: ScenarioError| {
+                e.message = format!("{}; expected {hint}", e.message);
+                e
+            }
         };
-        let file: SweepFile = options()
-            .from_str(text)
-            .map_err(|e| error(Some((e.span.start.line, e.span.start.col)), e.code.to_string()))?;
-        fn parse<T: serde::de::DeserializeOwned>(
-            entry: &MethodEntry,
-        ) -> Result<T, ((usize, usize), String)> {
-            options().from_str(&entry.text).map_err(|e| {
-                (entry.position_in_file(e.span.start.line, e.span.start.col), e.code.to_string())
-            })
-        }
-        let at = |entry: &MethodEntry| Some((entry.line, entry.column));
-        let cases = crate::suite::spec::parse_cases(text, &file.cases, origin)?;
-        let points = match (&file.grid, &file.list) {
+        let cases = crate::suite::spec::parse_cases(file, &parsed.cases)?;
+        let points = match (&parsed.grid, &parsed.list) {
             (Some(_), Some(_)) => {
                 let (line, col) = sim::scenario::line_col(text, text.find("list").unwrap_or(0));
-                return Err(error(Some((line, col)), "both `grid` and `list`; expected one of them (a grid of every combination, or a list of points)".into()));
+                return Err(file.error(Some((line, col)), "both `grid` and `list`; expected one of them (a grid of every combination, or a list of points)".into()));
             }
             (Some(grid), None) => {
                 let mut axes: Vec<(MethodEntry, String, Vec<serde_json::Value>)> = Vec::new();
-                for entry in raw_entries(text, "grid", grid) {
-                    let (param, values): (String, Vec<ron::Value>) = parse(&entry)
-                        .map_err(|(pos, m)| error(Some(pos), format!("{m}; expected a grid axis (\"METHOD_LABEL.field\", [value, ...])")))?;
-                    check_param(&param).map_err(|m| error(at(&entry), m))?;
+                for entry in file.entries("grid", grid) {
+                    let (param, values): (String, Vec<ron::Value>) = file
+                        .entry(&entry)
+                        .map_err(expected("a grid axis (\"METHOD_LABEL.field\", [value, ...])"))?;
+                    check_param(&param).map_err(|m| file.error_at(&entry, m))?;
                     if values.is_empty() {
-                        return Err(error(
-                            at(&entry),
+                        return Err(file.error_at(
+                            &entry,
                             format!(
                                 "grid axis '{param}' has no values; expected e.g. (\"{param}\", [0.5, 1.0])"
                             ),
                         ));
                     }
                     if axes.iter().any(|(_, p, _)| *p == param) {
-                        return Err(error(
-                            at(&entry),
+                        return Err(file.error_at(
+                            &entry,
                             format!("grid names '{param}' twice; expected one axis per parameter"),
                         ));
                     }
@@ -154,11 +142,11 @@ impl Sweep {
                         .iter()
                         .map(to_json)
                         .collect::<Result<Vec<_>, _>>()
-                        .map_err(|m| error(at(&entry), m))?;
+                        .map_err(|m| file.error_at(&entry, m))?;
                     axes.push((entry, param, values));
                 }
                 if axes.is_empty() {
-                    return Err(error(
+                    return Err(file.error(
                         None,
                         "`grid` is empty; expected e.g. grid: [(\"taa.alpha\", [0.1, 0.2])]".into(),
                     ));
@@ -182,40 +170,31 @@ impl Sweep {
             }
             (None, Some(list)) => {
                 let mut points = Vec::new();
-                for entry in raw_entries(text, "list", list) {
-                    let settings: Vec<(String, ron::Value)> =
-                        parse(&entry).map_err(|(pos, m)| {
-                            error(
-                                Some(pos),
-                                format!(
-                                    "{m}; expected a point [(\"METHOD_LABEL.field\", value), ...]"
-                                ),
-                            )
-                        })?;
+                for entry in file.entries("list", list) {
+                    let settings: Vec<(String, ron::Value)> = file
+                        .entry(&entry)
+                        .map_err(expected("a point [(\"METHOD_LABEL.field\", value), ...]"))?;
                     let mut point = Point { settings: vec![], entries: vec![entry.clone()] };
                     for (param, value) in settings {
-                        check_param(&param).map_err(|m| error(at(&entry), m))?;
+                        check_param(&param).map_err(|m| file.error_at(&entry, m))?;
                         if point.settings.iter().any(|s| s.param == param) {
-                            return Err(error(
-                                at(&entry),
-                                format!("the point sets '{param}' twice"),
-                            ));
+                            return Err(
+                                file.error_at(&entry, format!("the point sets '{param}' twice"))
+                            );
                         }
                         point.settings.push(Setting {
                             param,
-                            value: to_json(&value).map_err(|m| error(at(&entry), m))?,
+                            value: to_json(&value).map_err(|m| file.error_at(&entry, m))?,
                         });
                     }
                     if points.iter().any(|p: &Point| p.settings == point.settings) {
-                        return Err(error(
-                            at(&entry),
-                            format!("point {} is listed twice", point.label()),
-                        ));
+                        return Err(file
+                            .error_at(&entry, format!("point {} is listed twice", point.label())));
                     }
                     points.push(point);
                 }
                 if points.is_empty() {
-                    return Err(error(
+                    return Err(file.error(
                         None,
                         "`list` is empty; expected e.g. list: [[(\"taa.alpha\", 0.1)]]".into(),
                     ));
@@ -224,12 +203,7 @@ impl Sweep {
             }
             (None, None) => vec![Point { settings: vec![], entries: vec![] }],
         };
-        let name = file.name.unwrap_or_else(|| {
-            origin
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_else(|| "sweep".into())
-        });
+        let name = file.name_or_stem(parsed.name, "sweep");
         Ok(Sweep { name, cases, points, origin: origin.to_path_buf() })
     }
 }
