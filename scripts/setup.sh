@@ -24,7 +24,7 @@ if [ ${#need_apt[@]} -gt 0 ]; then
     apt-get install -y -qq --no-install-recommends "${need_apt[@]}" >/dev/null
     if [ $own_policy = 1 ]; then rm -f /usr/sbin/policy-rc.d; fi
 fi
-# The same probe the FLIP tests use (metrics::bench::reference_flip_available).
+# The same probe the FLIP tests use (metrics::reference_flip::reference_flip_available).
 python3 -m flip_evaluator.flip_python_api -h >/dev/null 2>&1 || python3 -m pip install --quiet flip-evaluator
 python3 -m flip_evaluator.flip_python_api -h >/dev/null
 # Mitsuba 3's scalar CPU path tracer: the independent renderer of systems/tests/mitsuba_agreement.rs and

@@ -140,8 +140,8 @@ struct SuiteArgs {
 }
 
 impl SuiteArgs {
-    fn options(self) -> systems::suite::SuiteOptions {
-        systems::suite::SuiteOptions {
+    fn options(self) -> tools::suite::SuiteOptions {
+        tools::suite::SuiteOptions {
             suite: self.suite,
             out: self.out,
             cache_dir: self.cache_dir,
@@ -154,12 +154,12 @@ impl SuiteArgs {
 /// `flicker suite`: its own exit codes (1 = a gate failed, 2 = could not run).
 fn suite(action: SuiteAction) -> ExitCode {
     let result = match action {
-        SuiteAction::Run(args) => systems::suite::run(&args.options()).map(|outcome| {
+        SuiteAction::Run(args) => tools::suite::run(&args.options()).map(|outcome| {
             print!("{}", outcome.markdown);
             println!("\nwrote {} and {}", outcome.summary.display(), outcome.junit.display());
             outcome.passed()
         }),
-        SuiteAction::Bless(args) => systems::suite::bless(&args.options()).map(|file| {
+        SuiteAction::Bless(args) => tools::suite::bless(&args.options()).map(|file| {
             println!("wrote {}", file.display());
             true
         }),
@@ -226,7 +226,7 @@ enum SweepAction {
 
 /// `flicker sweep`: exit code 1 when a job failed, 2 when the sweep could not be run.
 fn sweep(action: SweepAction) -> ExitCode {
-    use systems::sweep;
+    use tools::sweep;
     let cores = || std::thread::available_parallelism().map_or(1, |n| n.get());
     let result = (|| -> anyhow::Result<bool> {
         let exe = std::env::current_exe()?;
@@ -310,121 +310,6 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// `flicker bench --nirc`: the cache's throughput (nirc::bench) as a table, and as JSON.
-fn bench_nirc(
-    out: Option<PathBuf>,
-    json: Option<PathBuf>,
-    batch: u32,
-    queries: u32,
-    repeats: u32,
-    frames: u32,
-    resolution: (u32, u32),
-) -> anyhow::Result<()> {
-    let gpu = render::gpu::Gpu::new()?;
-    eprintln!(
-        "bench: NIRC at width 64, {batch} training records, {queries} queries, {repeats} repetitions"
-    );
-    let r = nirc::bench::run(&gpu, &nirc::NircConfig::default(), None, batch, queries, repeats)?;
-    let md = format!(
-        "Adapter: {}; MLP form: {:?} (width {}, {} hidden layers)\n\n| measure | value |\n|---|---:|\n\
-         | FMA ceiling (GFLOP/s) | {:.1} |\n| training (records/s) | {:.0} |\n| training (GFLOP/s, % of ceiling) | {:.2} ({:.1}%) |\n\
-         | EMA-only inference (queries/s) | {:.0} |\n| inference (GFLOP/s, % of ceiling) | {:.2} ({:.1}%) |\n| blend (queries/s) | {:.0} |\n\
-         | blend overhead (% of a training step + EMA-only inference) | {:.1} |\n| blend overhead (% of EMA-only inference) | {:.1} |\n\
-         | one 64x64 layer, 4x16 blocks (GFLOP/s) | {:.2} |\n| one 64x64 layer, 16x16 blocks (GFLOP/s) | {:.2} |\n",
-        r.adapter,
-        r.placement,
-        r.width,
-        r.hidden_layers,
-        r.peak_gflops,
-        r.train_records_per_s,
-        r.train_gflops,
-        r.train_percent_of_peak,
-        r.ema_only_queries_per_s,
-        r.infer_gflops,
-        r.infer_percent_of_peak,
-        r.blend_queries_per_s,
-        r.blend_overhead_step_percent,
-        r.blend_overhead_infer_percent,
-        r.layer_probe_4x16_gflops,
-        r.layer_probe_16x16_gflops
-    );
-    let mut md = md;
-    md.push_str("\n| training step, stage by stage (each submitted alone) | ms |\n|---|---:|\n");
-    for (name, ms) in &r.train_stages_ms {
-        md.push_str(&format!("| {name} | {ms:.2} |\n"));
-    }
-    use anyhow::Context as _;
-    drop(gpu);
-    // The throughput is printed first, and written even if the frames fail.
-    print!("{md}");
-    let frames = if frames > 0 {
-        let scratch =
-            std::env::temp_dir().join(format!("flicker-bench-nirc-frames-{}", std::process::id()));
-        systems::bench_nirc_frames::run(resolution, 2, frames, &scratch).map(Some)
-    } else {
-        Ok(None)
-    };
-    let table = frames.as_ref().ok().and_then(|t| t.clone());
-    if let Some(t) = &table {
-        let section = format!("\n{}", systems::bench_nirc_frames::markdown(t));
-        print!("{section}");
-        md.push_str(&section);
-    }
-    if let Some(path) = out {
-        systems::output::write_text(&path, &md)?;
-    }
-    if let Some(path) = json {
-        let j = systems::bench_nirc_frames::BenchJson {
-            throughput: r,
-            blend_overhead_frame_percent: table.as_ref().map(|t| t.blend_overhead_frame_percent),
-            frames: table,
-        };
-        systems::output::write_text(&path, &serde_json::to_string_pretty(&j)?)?;
-    }
-    frames
-        .map(|_| ())
-        .context("the whole-frame part of the NIRC bench (the throughput above was kept)")
-}
-
-fn bench(
-    out: Option<PathBuf>,
-    json: Option<PathBuf>,
-    rays: u32,
-    frames: u32,
-    no_metrics: bool,
-    repeats: u32,
-) -> anyhow::Result<()> {
-    let opts = systems::bench::BenchOptions { rays, frames, ..Default::default() };
-    let report = systems::bench::run(&opts, |step| eprintln!("bench: {step}"))?;
-    let mut md = report.markdown;
-    if !no_metrics {
-        eprintln!("bench: image metrics at 1280x720");
-        let args = metrics::bench::BenchArgs {
-            width: 1280,
-            height: 720,
-            repeats,
-            no_reference: false,
-            smape_only: false,
-        };
-        let r = metrics::bench::bench(&args)?;
-        md.push_str(&format!(
-            "\n## Image metrics, {}x{} HDR pair ({} threads)\n\n| metric | ms |\n|---|---:|\n| SMAPE | {:.2} |\n| HDR-FLIP (flicker) | {:.1} |\n",
-            r.width, r.height, r.threads, r.smape_ms, r.flip_hdr_ms.unwrap_or(f64::NAN)
-        ));
-        if let (Some(ms), Some(speedup)) = (r.reference_flip_ms, r.speedup) {
-            md.push_str(&format!("| HDR-FLIP (flip-evaluator) | {ms:.1} |\n\nflip-evaluator time / flicker time: {speedup:.2}\n"));
-        }
-    }
-    print!("{md}");
-    if let Some(path) = out {
-        systems::output::write_text(&path, &md)?;
-    }
-    if let Some(path) = json {
-        systems::output::write_text(&path, &serde_json::to_string_pretty(&report.json)?)?;
-    }
-    Ok(())
-}
-
 fn main() -> ExitCode {
     runtime_dir::ensure();
     let cli = Cli::parse();
@@ -474,9 +359,17 @@ fn main() -> ExitCode {
             nirc_resolution,
             json,
             ..
-        } => bench_nirc(out, json, nirc_batch, nirc_queries, repeats, nirc_frames, nirc_resolution),
+        } => bench::command::nirc(
+            out,
+            json,
+            nirc_batch,
+            nirc_queries,
+            repeats,
+            nirc_frames,
+            nirc_resolution,
+        ),
         Command::Bench { out, rays, frames, no_metrics, repeats, json, .. } => {
-            bench(out, json, rays, frames, no_metrics, repeats)
+            bench::command::speed(out, json, rays, frames, no_metrics, repeats)
         }
     };
     match result {

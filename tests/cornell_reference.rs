@@ -9,7 +9,7 @@ use render::path_tracer::{PathTracer, PathTracerSettings};
 fn cornell_box_reference_is_stable_under_seed_change() {
     let gpu = Gpu::new().expect("a wgpu adapter (lavapipe on CI)");
     let (width, height) = (16, 9);
-    let scene = systems::bench::builtin_scene("cornell_box", (width, height)).unwrap();
+    let scene = systems::scenario::builtin_scene("cornell_box", (width, height)).unwrap();
     let settings = PathTracerSettings { width, height, max_depth: 8, rr_start_depth: 3 };
     let mut tracer = PathTracer::new(&gpu, &scene, settings).unwrap();
     tracer.update(&gpu, &scene);

@@ -5,16 +5,18 @@
 //! - [`error`]: MSE, relative MSE, PSNR.
 //! - [`region`]: named rectangles of interest; any per-pixel map can be averaged over one.
 //! - [`compare`]: the `compare REFERENCE TEST` command.
+//! - [`reference_flip`]: NVIDIA's FLIP as a subprocess; [`synthetic`]: test images.
 
-pub mod bench;
 pub mod colormap;
 pub mod compare;
 pub mod error;
 pub mod flip;
 pub mod image;
 pub mod ordered_sum;
+pub mod reference_flip;
 pub mod region;
 pub mod smape;
+pub mod synthetic;
 
 pub use crate::image::{Image, load_image, write_exr, write_png_srgb};
 pub use colormap::{magma, write_map_png};

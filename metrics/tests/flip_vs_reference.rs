@@ -5,9 +5,8 @@
 
 use std::path::{Path, PathBuf};
 
-use metrics::bench::{
-    hash01, reference_flip_available, reference_flip_command, synthetic_hdr_pair,
-};
+use metrics::reference_flip::{reference_flip_available, reference_flip_command};
+use metrics::synthetic::{hash01, synthetic_hdr_pair};
 use metrics::{DEFAULT_PPD, Image, flip_hdr, flip_ldr, load_image, write_exr, write_png_srgb};
 
 const W: u32 = 80;

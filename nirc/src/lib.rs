@@ -8,7 +8,6 @@
 //! - `gpu`: the same in WGSL compute passes (`NeuralCache`), shaders in `nirc/shaders/`.
 //! - `state`: the whole cache state and its file format (warm starts).
 
-pub mod bench;
 pub mod bounds;
 pub mod config;
 pub mod cpu;

@@ -1,7 +1,7 @@
 // Traces a buffer of rays through the scene geometry (imported from scene_geometry.wgsl):
 // closest hits, any-hit flags and hit attributes, for tests and the traversal benchmark. The
-// traversal is package::ray_batch::trace, which each batch fills: ray_batch/cwbvh.wgsl or
-// ray_batch/bvh2.wgsl.
+// traversal is package::ray_batch::trace, which each batch fills: ray_batch/cwbvh.wgsl, or the
+// bench's bench/shaders/ray_batch/bvh2.wgsl.
 
 import package::ray_batch_bindings::{rays, hits, points, params};
 import package::ray_batch::trace::{batch_any, batch_closest};

@@ -19,4 +19,3 @@ pub mod shader;
 pub mod test_scenes;
 pub mod texel_table;
 pub mod timing;
-pub mod wavefront;

@@ -462,18 +462,18 @@ impl PathTracer {
         Ok(words[0] as u64)
     }
 
-    /// The radiance sum (w: samples) that [`crate::wavefront::Wavefront`] also accumulates into.
-    pub(crate) fn radiance_sum_buffer(&self) -> &wgpu::Buffer {
+    /// The radiance sum (w: samples) that the bench's wavefront tracer also accumulates into.
+    pub fn radiance_sum_buffer(&self) -> &wgpu::Buffer {
         &self.radiance_sum
     }
 
     /// The ray counter ([0]: rays traced since the last clear).
-    pub(crate) fn counters_buffer(&self) -> &wgpu::Buffer {
+    pub fn counters_buffer(&self) -> &wgpu::Buffer {
         &self.counters
     }
 
     /// The radiance sum as per-pixel means.
-    pub(crate) fn read_radiance_mean(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, RenderError> {
+    pub fn read_radiance_mean(&self, gpu: &Gpu) -> Result<Vec<[f32; 4]>, RenderError> {
         self.read_radiance(gpu)
     }
 

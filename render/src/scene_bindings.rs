@@ -194,7 +194,7 @@ impl SceneBindings {
 
     /// [`Self::prepare_frame`] with `accumulate`: the path tracer's later batches add to the
     /// radiance sum instead of replacing it.
-    pub(crate) fn write_frame(
+    pub fn write_frame(
         &self,
         gpu: &Gpu,
         spp: u32,

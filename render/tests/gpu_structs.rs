@@ -2,9 +2,7 @@
 //! offset and the same size on both sides, as naga lays the WGSL declaration out (each method
 //! crate checks its own structs the same way, in its tests/gpu_structs.rs).
 
-use render::bvh::{
-    SgBvh2Node, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTlasLeaf, SgTriangle, SgVertex,
-};
+use render::bvh::{SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTlasLeaf, SgTriangle, SgVertex};
 use render::frame::{CameraFrame, Frame};
 use render::gpu_struct::GpuStruct;
 use render::lights::GpuLight;
@@ -27,7 +25,6 @@ fn shared_structs_have_one_layout() {
         ("SgNode", mismatches::<SgNode>("")),
         ("SgTriangle", mismatches::<SgTriangle>("")),
         ("SgTlasLeaf", mismatches::<SgTlasLeaf>("")),
-        ("SgBvh2Node", mismatches::<SgBvh2Node>("")),
         ("SgMesh", mismatches::<SgMesh>("")),
         ("SgVertex", mismatches::<SgVertex>("")),
         ("SgInstance", mismatches::<SgInstance>("")),

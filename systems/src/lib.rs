@@ -1,15 +1,11 @@
 //! The frame as a bevy_ecs schedule (`frame`), the rendering methods as plugins (`methods`),
 //! measurement, recording, and scenario playback.
 
-pub mod bench;
-pub mod bench_nirc_frames;
 pub mod manifest;
 pub mod methods;
 pub mod mitsuba;
 pub mod playback;
 pub mod scenario;
-pub mod suite;
-pub mod sweep;
 
 /// The frame (its own crate, which knows no method) and what a run writes, under the names the
 /// rest of this crate and its users know them by.

@@ -14,6 +14,17 @@ use anyhow::{Context, Result, bail};
 use glam::{Mat3, Vec3};
 use render::scene::{Light, SceneDesc};
 
+/// The built-in Cornell box with every material Lambertian (specular 0): the scene both our
+/// path tracer and Mitsuba's `diffuse` BSDF render exactly (the bench's reference measurement
+/// and systems/tests/mitsuba_agreement.rs).
+pub fn lambertian_cornell_box(resolution: (u32, u32)) -> Result<SceneDesc> {
+    let mut scene = crate::scenario::builtin_scene("cornell_box", resolution)?;
+    for m in &mut scene.materials {
+        m.specular = 0.0;
+    }
+    Ok(scene)
+}
+
 /// Path-tracer settings shared by both renderers.
 pub struct Integrator {
     /// Longest path in vertices; `None` is unlimited (Mitsuba's -1).

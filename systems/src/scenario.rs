@@ -75,3 +75,14 @@ impl RunSpec {
         Ok(RunSpec { scenario, methods })
     }
 }
+
+/// The scene a built-in name builds, at frame 0.
+pub fn builtin_scene(name: &str, resolution: (u32, u32)) -> Result<render::scene::SceneDesc> {
+    let text = format!(
+        "Scenario(scene: Builtin(\"{name}\"), resolution: ({}, {}), frames: 1, methods: [PathTracing(spp: 1)])",
+        resolution.0, resolution.1
+    );
+    let scenario = Scenario::from_ron(&text, Path::new("<bench>"))?;
+    let sim = sim::Simulation::new(&scenario)?;
+    Ok(sim.scene().clone())
+}

@@ -10,7 +10,7 @@ use systems::mitsuba::{Integrator, python, render, write_scene};
 #[test]
 fn lambertian_cornell_box_matches_mitsuba() {
     let (size, spp) = (16u32, 2048u32);
-    let scene = systems::bench::lambertian_cornell_box((size, size)).unwrap();
+    let scene = systems::mitsuba::lambertian_cornell_box((size, size)).unwrap();
     let gpu = Gpu::new().expect("a wgpu adapter (lavapipe on CI)");
     let mut tracer = PathTracer::new(
         &gpu,

@@ -41,7 +41,7 @@
 //! for 57.6k pixels); first-hit lookup 6.6 / 152 / 503 / 4.3 (occupancy 0.07); TAA trace 1034,
 //! resolve 11. fast_turn.ron at 64x36: mean frame-to-frame SMAPE 1 spp 0.46, hash cache 0.39,
 //! TAA 0.15, hash cache + TAA 0.13; relMSE at the reference frames 0.072, 0.052, 0.015-0.027,
-//! 0.010-0.023. Hairball 320x180, max depth 3, idle machine (`cargo run -j2 -p systems --example
+//! 0.010-0.023. Hairball 320x180, max depth 3, idle machine (`cargo run -j2 -p bench --example
 //! issue5_bench -- 320 180 12`, table in render/src/sample_cache/README.md): hc_age 7.5,
 //! hc_trace 537, hc_update 399, hc_resolve 3.5 ms; 141 027 rays and 64 211 shaded paths
 //! (57 600 pixels + update paths) per frame.

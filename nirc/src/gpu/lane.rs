@@ -3,9 +3,9 @@
 //! invocation on a newer lavapipe machine; nirc/README.md), their inputs and activations in named
 //! registers, both predictors' MLP weights in one uniform buffer (`lane_stage.wgsl` copies them
 //! there, transposed, before each inference; `infer_lane.wgsl`).
-//! Why this shape, from `nirc::bench::register_layer_probe` on lavapipe (Mesa 22.3): a storage or
-//! workgroup load whose address is not a constant becomes a loop over the SIMD lanes, a private
-//! array indexed at run time a scatter/gather, while a uniform-buffer load at a dynamically
+//! Why this shape, from `bench::nirc_throughput::register_layer_probe` on lavapipe (Mesa 22.3): a
+//! storage or workgroup load whose address is not a constant becomes a loop over the SIMD lanes, a
+//! private array indexed at run time a scatter/gather, while a uniform-buffer load at a dynamically
 //! uniform address is one scalar load; and a workgroup barrier is compiled as a coroutine
 //! suspension, which made LLVM's coroutine splitting run for many minutes on a fully unrolled
 //! network, so this form has no barrier. Each layer loops over its output quads with the inputs

@@ -49,7 +49,7 @@ impl Blas {
 
 /// A mesh's triangles for obvhs, after checking its indices, positions, and per-vertex
 /// attribute counts (`index` only for error messages).
-pub(crate) fn mesh_triangles(index: usize, mesh: &Mesh) -> Result<Vec<Triangle>, BvhError> {
+pub fn mesh_triangles(index: usize, mesh: &Mesh) -> Result<Vec<Triangle>, BvhError> {
     let err = |reason: String| BvhError::Mesh { index, name: mesh.name.clone(), reason };
     if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(err(format!("position {i} is not finite: {}", mesh.positions[i])));
@@ -84,7 +84,7 @@ pub(crate) fn mesh_triangles(index: usize, mesh: &Mesh) -> Result<Vec<Triangle>,
 
 /// The triangles' vertices in leaf order (`primitive_indices[i]` is the triangle of slot `i`), so
 /// that traversal reads them without an indirection.
-pub(crate) fn leaf_order(primitive_indices: &[u32], tris: &[Triangle]) -> Vec<[Vec3; 3]> {
+pub fn leaf_order(primitive_indices: &[u32], tris: &[Triangle]) -> Vec<[Vec3; 3]> {
     primitive_indices
         .iter()
         .map(|&p| {

@@ -189,7 +189,8 @@ impl SceneBvh {
     }
 }
 
-pub(super) fn instance_transforms(
+/// Each instance's transforms, its mesh index checked against `mesh_count`.
+pub fn instance_transforms(
     instances: &[Instance],
     mesh_count: usize,
 ) -> Result<Vec<InstanceTransforms>, BvhError> {
@@ -202,7 +203,7 @@ pub(super) fn instance_transforms(
 
 /// obvhs's ray; `+ 0.0` turns a -0.0 direction component into +0.0 so that obvhs's octant (sign
 /// test) and its reciprocal (sign bit) agree, as they do in the WGSL.
-pub(super) fn obvhs_ray(origin: Vec3, direction: Vec3, t_max: f32) -> Ray {
+pub fn obvhs_ray(origin: Vec3, direction: Vec3, t_max: f32) -> Ray {
     Ray::new(Vec3A::from(origin), Vec3A::from(direction + Vec3::ZERO), 0.0, t_max)
 }
 

@@ -8,41 +8,31 @@
 //! - [`SceneGeometry`]: the same structures in texel tables (one bind group, `@group(1)`) and
 //!   the WGSL interface `scene_geometry.wgsl` that passes import (`SceneGeometry::modules`).
 //! - [`RayBatch`]: a compute pass tracing a buffer of rays (tests, benchmark).
-//! - [`SceneBvh2`], [`Bvh2Geometry`]: the same two levels as obvhs binary BVHs (BVH2) with
-//!   their CPU reference and WGSL traversal (`bvh2_traversal.wgsl`), measured against the CWBVH
-//!   in the benchmark; the path tracer does not use them.
-//! - [`traversal_benchmark`]: rays/s of the WGSL traversal against obvhs on all CPU cores, on
-//!   random rays and on the same rays sorted for coherence ([`ray_order`]).
+//! - [`random_rays`], [`displaced_sphere`]: seeded rays and a procedural mesh (tests, benchmark).
 
-mod bench;
 mod blas;
-mod bvh2;
-mod bvh2_geometry;
 mod cpu_traversal;
+mod procedural;
 mod ray_batch;
-pub mod ray_order;
 mod scene_geometry;
 mod stack_need;
 mod tlas;
 mod triangle;
 
-pub use bench::{
-    PAIRED_ROUNDS, TraversalBench, displaced_sphere, median, random_rays, traversal_benchmark,
-};
-pub use blas::Blas;
-pub use bvh2::{BVH2_STACK_SIZE, Bvh2Blas, SceneBvh2};
-pub use bvh2_geometry::{Bvh2Geometry, SgBvh2Node};
-pub use cpu_traversal::{InstanceUpdate, SceneBvh};
+pub use blas::{Blas, leaf_order, mesh_triangles};
+pub use cpu_traversal::{InstanceUpdate, SceneBvh, instance_transforms, obvhs_ray};
+pub use procedural::{displaced_sphere, random_rays};
 pub use ray_batch::{
-    BatchGeometry, Bvh2Traversal, RayBatch, RayBuffers, RayQuery, SurfaceRecord, TraceKind,
+    BatchGeometry, RayBatch, RayBuffers, RayQuery, SurfaceRecord, TraceKind,
     struct_layout_mismatches as ray_batch_struct_mismatches,
 };
 pub use scene::rng::{SplitMix64, mix64};
 pub use scene_geometry::{
     SceneGeometry, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTlasLeaf, SgTriangle, SgVertex,
+    sg_triangles, storage_buffer,
 };
 pub use tlas::InstanceTransforms;
-pub use tlas::Tlas;
+pub use tlas::{Tlas, world_bounds};
 pub use triangle::{WatertightRay, intersect_triangle};
 
 use crate::gpu::GpuError;

@@ -1,9 +1,10 @@
 //! A compute pass that traces a buffer of rays through [`SceneGeometry`]: the WGSL traversal
-//! made observable, for the traversal tests and the benchmark.
+//! made observable, for the traversal tests and the benchmark (which fills in another traversal
+//! through [`RayBatch::with_traversal`]).
 
 use glam::{Vec2, Vec3};
 
-use super::{Bvh2Geometry, BvhError, Hit, SceneGeometry};
+use super::{BvhError, Hit, SceneGeometry};
 use crate::compute::BufferBinding;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
@@ -129,23 +130,6 @@ impl BatchGeometry for SceneGeometry {
     }
 }
 
-/// The BVH2 traversal's geometry: the scene's (@group(1): instances, ray set-up, triangle test)
-/// and its BVH2s (@group(2)).
-pub struct Bvh2Traversal<'a> {
-    pub geometry: &'a SceneGeometry,
-    pub bvh2: &'a Bvh2Geometry,
-}
-
-impl BatchGeometry for Bvh2Traversal<'_> {
-    fn bind_groups(&self) -> Vec<&wgpu::BindGroup> {
-        vec![self.geometry.bind_group(), self.bvh2.bind_group()]
-    }
-
-    fn stack_entries(&self) -> u32 {
-        self.geometry.stack_entries()
-    }
-}
-
 /// Rays uploaded once, traced any number of times.
 pub struct RayBuffers {
     count: u32,
@@ -168,23 +152,10 @@ impl RayBatch {
         )
     }
 
-    /// The batch of the BVH2 traversal (bvh2_traversal.wgsl).
-    pub fn new_bvh2(gpu: &Gpu, traversal: &Bvh2Traversal) -> Self {
-        let modules = [SceneGeometry::modules(), Bvh2Geometry::modules()].concat();
-        let layouts = [traversal.geometry.bind_group_layout(), traversal.bvh2.bind_group_layout()];
-        Self::with_traversal(
-            gpu,
-            modules,
-            crate::wgsl_file!("ray_batch/bvh2.wgsl"),
-            &layouts,
-            traversal.geometry.stack_entries(),
-        )
-    }
-
     /// bvh_ray_batch.wgsl's kernels with `trace` as `package::ray_batch::trace`, on the
     /// geometry's `modules` bound at @group(1), ... (`layouts`), with a CWBVH stack for
     /// `stack_entries`. Only the stack is specialised: the kernels do not shade.
-    fn with_traversal(
+    pub fn with_traversal(
         gpu: &Gpu,
         modules: Vec<Module>,
         trace: Module,

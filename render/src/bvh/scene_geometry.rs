@@ -227,7 +227,7 @@ impl SceneGeometry {
     }
 
     /// `package::scene_geometry_types`: the structs of the bind group.
-    pub(crate) fn types() -> Module {
+    pub fn types() -> Module {
         Module::generated(
             "package::scene_geometry_types",
             &[
@@ -312,7 +312,8 @@ impl SceneGeometry {
         let tlas_root = whole_rows(nodes.len() as u32);
         let [node_table, tlas_leaves, instances] =
             Self::instance_tables(gpu, &bvh, &nodes, tlas_root)?;
-        let header = storage(gpu, "instance table header", &instance_header(&bvh, tlas_root), 0)?;
+        let header =
+            storage_buffer(gpu, "instance table header", &instance_header(&bvh, tlas_root), 0)?;
 
         let layout = crate::texel_table::group_layout(gpu, "scene geometry", &GROUP, TABLES.len());
         let tables = [node_table, triangles, tlas_leaves, instances, meshes, vertices, indices];
@@ -544,7 +545,7 @@ fn instance_records(bvh: &SceneBvh) -> Vec<u8> {
 }
 
 /// Leaf-order triangles as the GPU reads them, each with its mesh triangle index.
-pub(super) fn sg_triangles<'a>(
+pub fn sg_triangles<'a>(
     triangles: &'a [[Vec3; 3]],
     primitive_indices: &'a [u32],
 ) -> impl Iterator<Item = SgTriangle> + 'a {
@@ -559,7 +560,7 @@ pub(super) fn sg_triangles<'a>(
 }
 
 /// A read-only storage buffer holding `data`, at least `min_size` bytes (bindings cannot be empty).
-pub(super) fn storage(
+pub fn storage_buffer(
     gpu: &Gpu,
     what: &str,
     data: &[u8],

@@ -9,7 +9,7 @@ pub mod browser;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use metrics::bench::hash01;
+use metrics::synthetic::hash01;
 use metrics::{
     DEFAULT_PPD, Image, Region, flip_hdr, mse, psnr, relative_mse, smape, write_exr, write_png_srgb,
 };

@@ -1,0 +1,129 @@
+//! `flicker bench`'s two forms as the command line runs them: the tables printed (and written
+//! with `--out`) and the JSON (`--json`).
+
+use std::path::PathBuf;
+
+/// `flicker bench --nirc`: the cache's throughput (crate::nirc_throughput) as a table, then
+/// whole frames (crate::nirc_frames); `json` gets both.
+pub fn nirc(
+    out: Option<PathBuf>,
+    json: Option<PathBuf>,
+    batch: u32,
+    queries: u32,
+    repeats: u32,
+    frames: u32,
+    resolution: (u32, u32),
+) -> anyhow::Result<()> {
+    let gpu = render::gpu::Gpu::new()?;
+    eprintln!(
+        "bench: NIRC at width 64, {batch} training records, {queries} queries, {repeats} repetitions"
+    );
+    let r = crate::nirc_throughput::run(
+        &gpu,
+        &nirc::NircConfig::default(),
+        None,
+        batch,
+        queries,
+        repeats,
+    )?;
+    let md = format!(
+        "Adapter: {}; MLP form: {:?} (width {}, {} hidden layers)\n\n| measure | value |\n|---|---:|\n\
+         | FMA ceiling (GFLOP/s) | {:.1} |\n| training (records/s) | {:.0} |\n| training (GFLOP/s, % of ceiling) | {:.2} ({:.1}%) |\n\
+         | EMA-only inference (queries/s) | {:.0} |\n| inference (GFLOP/s, % of ceiling) | {:.2} ({:.1}%) |\n| blend (queries/s) | {:.0} |\n\
+         | blend overhead (% of a training step + EMA-only inference) | {:.1} |\n| blend overhead (% of EMA-only inference) | {:.1} |\n\
+         | one 64x64 layer, 4x16 blocks (GFLOP/s) | {:.2} |\n| one 64x64 layer, 16x16 blocks (GFLOP/s) | {:.2} |\n",
+        r.adapter,
+        r.placement,
+        r.width,
+        r.hidden_layers,
+        r.peak_gflops,
+        r.train_records_per_s,
+        r.train_gflops,
+        r.train_percent_of_peak,
+        r.ema_only_queries_per_s,
+        r.infer_gflops,
+        r.infer_percent_of_peak,
+        r.blend_queries_per_s,
+        r.blend_overhead_step_percent,
+        r.blend_overhead_infer_percent,
+        r.layer_probe_4x16_gflops,
+        r.layer_probe_16x16_gflops
+    );
+    let mut md = md;
+    md.push_str("\n| training step, stage by stage (each submitted alone) | ms |\n|---|---:|\n");
+    for (name, ms) in &r.train_stages_ms {
+        md.push_str(&format!("| {name} | {ms:.2} |\n"));
+    }
+    use anyhow::Context as _;
+    drop(gpu);
+    // The throughput is printed first, and written even if the frames fail.
+    print!("{md}");
+    let frames = if frames > 0 {
+        let scratch =
+            std::env::temp_dir().join(format!("flicker-bench-nirc-frames-{}", std::process::id()));
+        crate::nirc_frames::run(resolution, 2, frames, &scratch).map(Some)
+    } else {
+        Ok(None)
+    };
+    let table = frames.as_ref().ok().and_then(|t| t.clone());
+    if let Some(t) = &table {
+        let section = format!("\n{}", crate::nirc_frames::markdown(t));
+        print!("{section}");
+        md.push_str(&section);
+    }
+    if let Some(path) = out {
+        systems::output::write_text(&path, &md)?;
+    }
+    if let Some(path) = json {
+        let j = crate::nirc_frames::BenchJson {
+            throughput: r,
+            blend_overhead_frame_percent: table.as_ref().map(|t| t.blend_overhead_frame_percent),
+            frames: table,
+        };
+        systems::output::write_text(&path, &serde_json::to_string_pretty(&j)?)?;
+    }
+    frames
+        .map(|_| ())
+        .context("the whole-frame part of the NIRC bench (the throughput above was kept)")
+}
+
+/// `flicker bench`: the speed tables (crate::speed) and, unless `no_metrics`, the image metrics'
+/// timings (crate::image_metrics).
+pub fn speed(
+    out: Option<PathBuf>,
+    json: Option<PathBuf>,
+    rays: u32,
+    frames: u32,
+    no_metrics: bool,
+    repeats: u32,
+) -> anyhow::Result<()> {
+    let opts = crate::speed::BenchOptions { rays, frames, ..Default::default() };
+    let report = crate::speed::run(&opts, |step| eprintln!("bench: {step}"))?;
+    let mut md = report.markdown;
+    if !no_metrics {
+        eprintln!("bench: image metrics at 1280x720");
+        let args = crate::image_metrics::BenchArgs {
+            width: 1280,
+            height: 720,
+            repeats,
+            no_reference: false,
+            smape_only: false,
+        };
+        let r = crate::image_metrics::bench(&args)?;
+        md.push_str(&format!(
+            "\n## Image metrics, {}x{} HDR pair ({} threads)\n\n| metric | ms |\n|---|---:|\n| SMAPE | {:.2} |\n| HDR-FLIP (flicker) | {:.1} |\n",
+            r.width, r.height, r.threads, r.smape_ms, r.flip_hdr_ms.unwrap_or(f64::NAN)
+        ));
+        if let (Some(ms), Some(speedup)) = (r.reference_flip_ms, r.speedup) {
+            md.push_str(&format!("| HDR-FLIP (flip-evaluator) | {ms:.1} |\n\nflip-evaluator time / flicker time: {speedup:.2}\n"));
+        }
+    }
+    print!("{md}");
+    if let Some(path) = out {
+        systems::output::write_text(&path, &md)?;
+    }
+    if let Some(path) = json {
+        systems::output::write_text(&path, &serde_json::to_string_pretty(&report.json)?)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,95 @@
+//! Speed benchmark: SMAPE and FLIP at 1280x720 on a synthetic HDR pair, and NVIDIA's reference
+//! FLIP (`flip` from the `flip-evaluator` Python package) on the same pair when installed.
+//! Run it from a release build; it is a measurement, not a test.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use metrics::reference_flip::run_reference_flip;
+use metrics::smape::DEFAULT_EPS;
+use metrics::synthetic::synthetic_hdr_pair;
+use metrics::{DEFAULT_PPD, flip_hdr, smape, write_exr};
+use serde::Serialize;
+
+#[derive(Clone, Debug, clap::Args)]
+pub struct BenchArgs {
+    #[arg(long, default_value_t = 1280)]
+    pub width: u32,
+    #[arg(long, default_value_t = 720)]
+    pub height: u32,
+    /// Timed repetitions; the best is reported.
+    #[arg(long, default_value_t = 5)]
+    pub repeats: u32,
+    /// Skip NVIDIA's reference implementation.
+    #[arg(long)]
+    pub no_reference: bool,
+    /// Time SMAPE only.
+    #[arg(long)]
+    pub smape_only: bool,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchReport {
+    pub width: u32,
+    pub height: u32,
+    pub threads: usize,
+    pub smape_ms: f64,
+    pub flip_hdr_ms: Option<f64>,
+    pub flip_hdr_mean: Option<f64>,
+    /// NVIDIA's FLIP on the same pair: its own reported evaluation time, and its mean.
+    pub reference_flip_ms: Option<f64>,
+    pub reference_flip_mean: Option<f64>,
+    /// reference time / our time (> 1: we are faster).
+    pub speedup: Option<f64>,
+}
+
+fn best_ms(repeats: u32, mut f: impl FnMut()) -> f64 {
+    (0..repeats.max(1))
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64() * 1e3
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+pub fn bench(args: &BenchArgs) -> anyhow::Result<BenchReport> {
+    let (reference, test) = synthetic_hdr_pair(args.width, args.height, 7);
+    let smape_ms = best_ms(args.repeats.max(10), || {
+        std::hint::black_box(smape(&test, &reference, DEFAULT_EPS));
+    });
+    let (mut flip_hdr_ms, mut flip_hdr_mean) = (None, None);
+    if !args.smape_only {
+        flip_hdr_ms = Some(best_ms(args.repeats, || {
+            flip_hdr_mean = Some(flip_hdr(&reference, &test, DEFAULT_PPD).mean)
+        }));
+    }
+    let (mut reference_flip_ms, mut reference_flip_mean) = (None, None);
+    if !args.no_reference && !args.smape_only {
+        let dir: PathBuf =
+            std::env::temp_dir().join(format!("flicker-bench-{}", std::process::id()));
+        std::fs::create_dir_all(&dir)?;
+        write_exr(&reference, dir.join("reference.exr"))?;
+        write_exr(&test, dir.join("test.exr"))?;
+        let mut best = f64::INFINITY;
+        for _ in 0..args.repeats.max(1) {
+            let (ms, mean) =
+                run_reference_flip(&dir.join("reference.exr"), &dir.join("test.exr"), DEFAULT_PPD)?;
+            best = best.min(ms);
+            reference_flip_mean = Some(mean);
+        }
+        reference_flip_ms = Some(best);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+    Ok(BenchReport {
+        width: args.width,
+        height: args.height,
+        threads: rayon::current_num_threads(),
+        smape_ms,
+        flip_hdr_ms,
+        flip_hdr_mean,
+        speedup: reference_flip_ms.zip(flip_hdr_ms).map(|(r, ours)| r / ours),
+        reference_flip_ms,
+        reference_flip_mean,
+    })
+}

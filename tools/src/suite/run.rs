@@ -1,0 +1,236 @@
+//! Playing a suite: every case once per seed through `playback`, then each gate judged for
+//! each (case, method) it applies to; `bless` stores the measurements as the adapter's baseline.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Result, anyhow, bail};
+use render::gpu::Gpu;
+
+use super::baseline::{Baseline, BaselineFile, adapter_key, now};
+use super::gate::{GateResult, judge};
+use super::measurement::{CaseRuns, SeedRun};
+use super::spec::{Bound, Case, Suite};
+use super::{junit, markdown};
+use systems::playback::{Overrides, RunOptions, RunSpec, run_spec};
+
+pub struct SuiteOptions {
+    pub suite: PathBuf,
+    /// Where case runs, summary.md and junit.xml go [default: runs/suite_NAME].
+    pub out: Option<PathBuf>,
+    /// Reference cache [default: the usual location].
+    pub cache_dir: Option<PathBuf>,
+    /// The baseline file [default: baselines/NAME.json next to the suite file].
+    pub baselines: Option<PathBuf>,
+    pub progress: bool,
+}
+
+pub struct SuiteOutcome {
+    pub results: Vec<GateResult>,
+    pub folder: PathBuf,
+    pub summary: PathBuf,
+    pub junit: PathBuf,
+    /// The summary's text.
+    pub markdown: String,
+}
+
+impl SuiteOutcome {
+    pub fn passed(&self) -> bool {
+        self.results.iter().all(GateResult::passed)
+    }
+}
+
+struct Prepared {
+    suite: Suite,
+    folder: PathBuf,
+    baselines: PathBuf,
+    adapter: render::gpu::AdapterSummary,
+}
+
+fn prepare(opts: &SuiteOptions) -> Result<Prepared> {
+    let suite = Suite::load(&opts.suite)?;
+    let folder = opts
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("runs").join(format!("suite_{}", suite.name)));
+    let baselines = opts.baselines.clone().unwrap_or_else(|| suite.baseline_file());
+    // The adapter keys the baseline; asked before anything plays so that a missing baseline
+    // is reported at once.
+    let adapter = Gpu::new()?.summary;
+    Ok(Prepared { suite, folder, baselines, adapter })
+}
+
+/// A case's run at one seed, its methods filtered; input errors point at the case's line in
+/// `origin` (the suite or sweep file).
+pub(crate) fn case_spec(
+    origin: &Path,
+    case: &Case,
+    seed: u64,
+    out: &Path,
+) -> Result<(RunSpec, Overrides)> {
+    let (line, column) = case.entry.as_ref().map_or((1, 1), |e| (e.line, e.column));
+    let at = format!("{}:{line}:{column}: case '{}'", origin.display(), case.name);
+    let overrides = Overrides {
+        frames: case.frames,
+        resolution: case.resolution,
+        spp: case.spp,
+        seed: Some(seed),
+        out: Some(out.to_path_buf()),
+    };
+    let scenario = sim::Scenario::load(&case.scenario).map_err(|e| anyhow!("{at}: {e}"))?;
+    let mut spec =
+        RunSpec::from_scenario(scenario, &overrides).map_err(|e| anyhow!("{at}: {e}"))?;
+    if let Some(keep) = &case.methods {
+        let labels: Vec<String> = spec.methods.iter().map(|m| m.label()).collect();
+        if let Some(unknown) = keep.iter().find(|k| !labels.contains(k)) {
+            bail!(
+                "{at}: no method labelled '{unknown}' in {}; its methods are: {}",
+                case.scenario.display(),
+                labels.join(", ")
+            );
+        }
+        spec.methods.retain(|m| keep.contains(&m.label()));
+    }
+    Ok((spec, overrides))
+}
+
+/// Event frames in recorded frames: warm-up subtracted, events at one frame counted once.
+fn event_frames(spec: &RunSpec) -> Vec<u32> {
+    let s = &spec.scenario;
+    let mut frames: Vec<u32> = s
+        .events_summary()
+        .into_iter()
+        .filter_map(|(f, _)| f.checked_sub(s.warmup_frames))
+        .filter(|&f| f < s.frames)
+        .collect();
+    frames.sort_unstable();
+    frames.dedup();
+    frames
+}
+
+/// Plays every case at every seed; run folders go to `FOLDER/CASE/seed_N`.
+fn play(p: &Prepared, opts: &SuiteOptions) -> Result<BTreeMap<String, CaseRuns>> {
+    // Every case's input is checked before the first one plays.
+    let mut specs = Vec::new();
+    for case in &p.suite.cases {
+        for &seed in &case.seeds {
+            let out = p.folder.join(&case.name).join(format!("seed_{seed}"));
+            let (spec, overrides) = case_spec(&p.suite.origin, case, seed, &out)?;
+            specs.push((case, seed, spec, overrides));
+        }
+    }
+    let mut cases: BTreeMap<String, CaseRuns> = BTreeMap::new();
+    for (case, seed, spec, overrides) in specs {
+        eprintln!("suite {}: case {} seed {seed}", p.suite.name, case.name);
+        let run_opts = RunOptions {
+            scenario: case.scenario.clone(),
+            overrides,
+            cache_dir: opts.cache_dir.clone(),
+            progress: opts.progress,
+        };
+        let summary = run_spec(&spec, &run_opts)
+            .map_err(|e| anyhow!("case '{}' seed {seed}: {e:#}", case.name))?;
+        let runs = cases.entry(case.name.clone()).or_default();
+        runs.frames = spec.scenario.frames;
+        runs.events = event_frames(&spec);
+        runs.seeds.push(SeedRun::from_records(seed, &summary.records));
+    }
+    Ok(cases)
+}
+
+fn bless_hint(p: &Prepared, opts: &SuiteOptions) -> String {
+    format!(
+        "record one with `flicker suite bless {}` on this adapter and commit {}",
+        opts.suite.display(),
+        p.baselines.display()
+    )
+}
+
+/// `flicker suite run`: plays the suite and judges its gates; writes summary.md and junit.xml.
+pub fn run(opts: &SuiteOptions) -> Result<SuiteOutcome> {
+    let p = prepare(opts)?;
+    let key = adapter_key(&p.adapter);
+    let file = BaselineFile::load(&p.baselines)?;
+    let baseline = file.adapters.get(&key);
+    let relative = p.suite.gates.iter().any(|g| matches!(g.bound, Bound::Relative { .. }));
+    if relative && baseline.is_none() {
+        let known: Vec<&str> = file.adapters.keys().map(String::as_str).collect();
+        bail!(
+            "{}: no baseline for adapter '{key}' in {} (it has: {}); {}",
+            opts.suite.display(),
+            p.baselines.display(),
+            if known.is_empty() { "none".to_string() } else { known.join(", ") },
+            bless_hint(&p, opts)
+        );
+    }
+    let cases = play(&p, opts)?;
+    let mut results = Vec::new();
+    for gate in &p.suite.gates {
+        for (name, runs) in &cases {
+            for method in runs.methods().iter().filter(|m| gate.applies_to(name, m)) {
+                results.push(judge(
+                    gate,
+                    name,
+                    method,
+                    runs,
+                    baseline.and_then(|b| b.cases.get(name)),
+                ));
+            }
+        }
+    }
+    // A gate that names a method no case ran would otherwise pass silently.
+    for gate in &p.suite.gates {
+        for method in gate.methods.iter().flatten() {
+            if !cases.iter().any(|(name, runs)| {
+                gate.applies_to(name, method) && runs.methods().contains(method)
+            }) {
+                let (line, _) = gate.entry.as_ref().map_or((1, 1), |e| (e.line, e.column));
+                results.push(GateResult {
+                    case: "-".into(),
+                    method: method.clone(),
+                    gate: gate.describe(),
+                    new: None,
+                    baseline: None,
+                    p_value: None,
+                    verdict: super::gate::Verdict::Error(format!(
+                        "{}:{line}: no case ran method '{method}'",
+                        opts.suite.display()
+                    )),
+                    detail: format!(
+                        "{}:{line}: no case ran method '{method}'",
+                        opts.suite.display()
+                    ),
+                });
+            }
+        }
+    }
+    let md = markdown::summary(
+        &p.suite.name,
+        &key,
+        baseline.map(|b| (b.commit.as_str(), b.date.as_str())),
+        &results,
+    );
+    let summary = p.folder.join("summary.md");
+    let junit_path = p.folder.join("junit.xml");
+    systems::output::write_text(&summary, &md)?;
+    systems::output::write_text(&junit_path, &junit::report(&p.suite.name, &results))?;
+    Ok(SuiteOutcome { results, folder: p.folder, summary, junit: junit_path, markdown: md })
+}
+
+/// `flicker suite bless`: plays the suite and stores its measurements as this adapter's
+/// baseline (other adapters' entries are kept). Returns the baseline file.
+pub fn bless(opts: &SuiteOptions) -> Result<PathBuf> {
+    let p = prepare(opts)?;
+    let cases = play(&p, opts)?;
+    let mut file = BaselineFile::load(&p.baselines)?;
+    file.suite = p.suite.name.clone();
+    let baseline = Baseline {
+        commit: systems::manifest::commit(&opts.suite),
+        date: now(),
+        adapter: serde_json::to_value(&p.adapter)?,
+        cases,
+    };
+    file.adapters.insert(adapter_key(&p.adapter), baseline);
+    file.save(&p.baselines)?;
+    Ok(p.baselines)
+}

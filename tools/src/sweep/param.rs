@@ -1,0 +1,87 @@
+//! Setting one method parameter by path (`taa.alpha`, `nirc_blend_1spp.cache.reliability.kappa`):
+//! the method's settings go through their serde form (JSON), the field is replaced and the
+//! settings are parsed back by the method's own struct, so every check a scenario gets (types,
+//! unknown fields, enums) applies to a sweep's values too.
+
+use serde_json::Value;
+
+use systems::methods::Method;
+
+/// Sets `path` (after the method label) of `method` to `value`.
+pub fn set(method: &mut Method, path: &[&str], value: &Value) -> Result<(), String> {
+    let mut tree = method.spec.settings_json().map_err(|e| e.to_string())?;
+    // The settings must survive the round trip unchanged, or a sweep would change more than it says.
+    let back = method
+        .spec
+        .with_settings_json(tree.clone())
+        .map_err(|e| format!("settings of '{}' do not round-trip: {e}", method.label()))?;
+    if back != method.spec {
+        return Err(format!(
+            "settings of '{}' do not round-trip through their serde form",
+            method.label()
+        ));
+    }
+    let mut at = &mut tree;
+    let mut walked = method.spec.name().to_string();
+    for field in path {
+        let Value::Object(map) = at else {
+            return Err(format!("{walked} is not a struct of fields, so it has no '{field}'"));
+        };
+        let known: Vec<String> = map.keys().cloned().collect();
+        at = map.get_mut(*field).ok_or_else(|| {
+            format!("{walked} has no field '{field}'; its fields are: {}", known.join(", "))
+        })?;
+        walked = format!("{walked}.{field}");
+    }
+    *at = value.clone();
+    method.spec =
+        method.spec.with_settings_json(tree).map_err(|e| format!("{walked} = {value}: {e}"))?;
+    Ok(())
+}
+
+/// Applies `param = value` to the method of `methods` whose label is the parameter's first part.
+pub fn apply(methods: &mut [Method], param: &str, value: &Value) -> Result<(), String> {
+    let mut parts = param.split('.');
+    let label = parts.next().unwrap_or_default();
+    let path: Vec<&str> = parts.collect();
+    let labels: Vec<String> = methods.iter().map(Method::label).collect();
+    let method = methods.iter_mut().find(|m| m.label() == label).ok_or_else(|| {
+        format!(
+            "parameter '{param}': no method labelled '{label}' in the case; its methods are: {}",
+            labels.join(", ")
+        )
+    })?;
+    set(method, &path, value).map_err(|e| format!("parameter '{param}': {e}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn sets_nested_fields_and_refuses_unknown_ones() {
+        let mut m = Method::parse("Nirc(spp: 1, predictor: Blend)").unwrap();
+        set(&mut m, &["cache", "reliability", "kappa"], &json!(2.0)).unwrap();
+        set(&mut m, &["cache", "ema", "alpha"], &json!(0.9)).unwrap();
+        let s = m.spec.get::<nirc::plugin::NircSettings>().expect("Nirc settings");
+        assert_eq!((s.cache.reliability.kappa, s.cache.ema.alpha), (2.0, 0.9));
+        // Everything else as parsed.
+        let mut expected = Method::parse("Nirc(spp: 1, predictor: Blend)").unwrap();
+        let e = expected.spec.get_mut::<nirc::plugin::NircSettings>().expect("Nirc settings");
+        e.cache.reliability.kappa = 2.0;
+        e.cache.ema.alpha = 0.9;
+        assert_eq!(m.spec, expected.spec);
+
+        let e = set(&mut m, &["cache", "kapa"], &json!(1.0)).unwrap_err();
+        assert!(e.contains("Nirc.cache has no field 'kapa'") && e.contains("reliability"), "{e}");
+        let e = set(&mut m, &["spp"], &json!(1.5)).unwrap_err();
+        assert!(e.contains("Nirc.spp = 1.5"), "{e}");
+        let mut taa = vec![Method::parse("Taa()").unwrap()];
+        apply(&mut taa, "taa.alpha", &json!(0.25)).unwrap();
+        let t = taa[0].spec.get::<taa::TaaSettings>().expect("Taa settings");
+        assert_eq!(t.alpha, 0.25);
+        let e = apply(&mut taa, "pt_1spp.spp", &json!(2)).unwrap_err();
+        assert!(e.contains("no method labelled 'pt_1spp'") && e.contains("taa"), "{e}");
+    }
+}
