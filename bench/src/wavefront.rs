@@ -81,9 +81,8 @@ impl Wavefront {
         let pixels = settings.width as u64 * settings.height as u64;
         let light_samples = Self::light_samples(tracer);
         let per_path = 16 * (VEC4S_PER_PATH + VEC4S_PER_LIGHT_SAMPLE * light_samples);
-        let max_paths = (gpu.limits.max_storage_buffer_binding_size as u64)
-            .min(gpu.limits.max_buffer_size)
-            / per_path;
+        let max_paths =
+            gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size) / per_path;
         let chunk_paths = pixels * SAMPLES_PER_THREAD as u64;
         let chunks = (wave_paths.min(max_paths) / chunk_paths).max(1);
         let capacity = chunks * chunk_paths;

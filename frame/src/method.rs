@@ -169,7 +169,7 @@ impl MethodSpec {
 
     /// The same method with settings read from their serde form.
     pub fn with_settings_json(&self, value: serde_json::Value) -> serde_json::Result<MethodSpec> {
-        self.0.from_json(value)
+        self.0.json_to_spec(value)
     }
 }
 
@@ -216,7 +216,7 @@ trait AnySettings: Send + Sync {
     fn settings_mut(&mut self) -> &mut dyn Any;
     fn settings_debug(&self) -> &dyn fmt::Debug;
     fn to_json(&self) -> serde_json::Result<serde_json::Value>;
-    fn from_json(&self, value: serde_json::Value) -> serde_json::Result<MethodSpec>;
+    fn json_to_spec(&self, value: serde_json::Value) -> serde_json::Result<MethodSpec>;
     fn clone_box(&self) -> Box<dyn AnySettings>;
     fn eq_dyn(&self, other: &dyn AnySettings) -> bool;
 }
@@ -272,7 +272,7 @@ impl<P: MethodPlugin> AnySettings for Typed<P> {
         serde_json::to_value(&self.settings)
     }
 
-    fn from_json(&self, value: serde_json::Value) -> serde_json::Result<MethodSpec> {
+    fn json_to_spec(&self, value: serde_json::Value) -> serde_json::Result<MethodSpec> {
         Ok(MethodSpec::new::<P>(serde_json::from_value(value)?))
     }
 

@@ -11,7 +11,7 @@ use render::path_tracer::PathTracer;
 
 /// References use their own random sequence, so they never share noise with a method.
 pub fn reference_seed(seed: u64) -> u64 {
-    seed ^ 0x5eed_0f_4e_fe_4e_9ce
+    seed ^ 0x05ee_d0f4_efe4_e9ce
 }
 
 /// Render stage: this frame's reference into [`References::current`] (or `None`).

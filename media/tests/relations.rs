@@ -4,6 +4,7 @@
 //! - the jackknife's bias is at most half the naive exp(−X̄)'s at equal mN (one-sided, paired);
 //! - track-length's per-pixel variance is (1 − T)T (two-sided, within noise);
 //! - ratio tracking and unbiased ray marching are unbiased (two-sided, within noise).
+//!
 //! The exact T is regular tracking (exact for nearest-neighbour voxels).
 //!
 //! Bias per image is the RMS over pixels of the noise-corrected bias: per pixel

@@ -34,7 +34,7 @@ impl Default for NircConfig {
             reliability: ReliabilityConfig::default(),
             // NRC trains on 4 batches of 16384 records per frame.
             max_batch: 16384,
-            seed: 0x5eed_0f_c0ffee,
+            seed: 0x5eed_0fc0_ffee,
         }
     }
 }

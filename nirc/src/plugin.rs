@@ -496,7 +496,7 @@ pub fn train(
                 )
                 .map_err(|e| err(e.into()))?;
             }
-            wait(gpu).map_err(|e| err(e))?;
+            wait(gpu).map_err(&err)?;
             c.steps_wall_ms = Some(start.elapsed().as_secs_f64() * 1e3);
         }
         c.prepare(gpu, &tracer.0, run.scenario.seed, clock.global);

@@ -97,14 +97,13 @@ pub fn update(
             }
         }
     }
-    for cell in 0..cells {
-        if counts[cell] == 0 {
+    for (cell, &count) in counts.iter().enumerate().take(cells) {
+        if count == 0 {
             continue;
         }
         for k in 0..MOMENTS_PER_CELL {
             let i = cell * MOMENTS_PER_CELL + k;
-            moments[i] =
-                ema_step(config.lambda, moments[i], sums[i].to_f32() / counts[cell] as f32);
+            moments[i] = ema_step(config.lambda, moments[i], sums[i].to_f32() / count as f32);
         }
     }
     true

@@ -52,7 +52,7 @@ fn gpu_sums(gpu: &Gpu, values: &[f32]) -> (Vec<[u32; 3]>, Vec<bool>) {
     });
     let accum = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("accum"),
-        contents: &vec![0u8; ACCUMULATORS * 12],
+        contents: &[0u8; ACCUMULATORS * 12],
         usage,
     });
     let accepted = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

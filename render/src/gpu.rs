@@ -137,8 +137,7 @@ impl Gpu {
 
     /// Refuses a storage buffer larger than the adapter binds.
     pub fn check_buffer_size(&self, what: &str, bytes: u64) -> Result<(), GpuError> {
-        let limit =
-            (self.limits.max_storage_buffer_binding_size as u64).min(self.limits.max_buffer_size);
+        let limit = self.limits.max_storage_buffer_binding_size.min(self.limits.max_buffer_size);
         if bytes > limit {
             return Err(self.over(&format!("{what} size in bytes"), bytes, limit));
         }
@@ -147,7 +146,7 @@ impl Gpu {
 
     /// Refuses a uniform binding larger than the adapter binds.
     pub fn check_uniform_size(&self, what: &str, bytes: u64) -> Result<(), GpuError> {
-        let limit = self.limits.max_uniform_buffer_binding_size as u64;
+        let limit = self.limits.max_uniform_buffer_binding_size;
         if bytes > limit {
             return Err(self.over(&format!("{what} size in bytes"), bytes, limit));
         }

@@ -45,7 +45,7 @@ impl TexelTable {
     ) -> Result<Self, GpuError> {
         let record_bytes = texels as usize * TEXEL_BYTES;
         assert!(
-            records.len() % record_bytes == 0,
+            records.len().is_multiple_of(record_bytes),
             "{what}: {} bytes is not a whole number of {record_bytes}-byte records",
             records.len()
         );
@@ -94,7 +94,7 @@ impl TexelTable {
     /// Writes `records` from record `first`, a multiple of [`RECORDS_PER_ROW`]; the rest of the
     /// last row written is zeroed. Panics if they do not fit (callers check [`Self::capacity`]).
     pub fn write(&self, gpu: &Gpu, first: u32, records: &[u8]) {
-        assert!(first % RECORDS_PER_ROW == 0, "texel table writes start on a row");
+        assert!(first.is_multiple_of(RECORDS_PER_ROW), "texel table writes start on a row");
         let row_bytes = self.texels as usize * TEXEL_BYTES * RECORDS_PER_ROW as usize;
         let rows = records.len().div_ceil(row_bytes) as u32;
         if rows == 0 {

@@ -220,8 +220,7 @@ fn empty_scene_and_bad_input() {
     );
     let err = batch
         .trace_closest(&gpu, &deep, &rays)
-        .err()
-        .expect("a deeper BVH than the stack holds is refused")
+        .expect_err("a deeper BVH than the stack holds is refused")
         .to_string();
     assert!(err.contains("build a new batch"), "{err}");
     assert!(RayBatch::new(&gpu, &deep).trace_closest(&gpu, &deep, &rays).is_ok());

@@ -256,13 +256,10 @@ impl MediumDesc {
                 self.name, m.pulse_amplitude, m.pulse_period
             ));
         }
-        if let Some(e) = self.emission {
-            if !(e.is_finite() && e.cmpge(Vec3::ZERO).all()) {
-                return Some(format!(
-                    "medium '{}': emission {e} must be finite and >= 0",
-                    self.name
-                ));
-            }
+        if let Some(e) = self.emission
+            && !(e.is_finite() && e.cmpge(Vec3::ZERO).all())
+        {
+            return Some(format!("medium '{}': emission {e} must be finite and >= 0", self.name));
         }
         None
     }

@@ -52,10 +52,10 @@ impl MediumBound {
 
     /// Resolves a relative OBJ path against `folder` (the scenario's).
     pub fn resolve(&mut self, folder: &Path) {
-        if let MediumBound::Obj { file } = self {
-            if file.is_relative() {
-                *file = folder.join(&*file);
-            }
+        if let MediumBound::Obj { file } = self
+            && file.is_relative()
+        {
+            *file = folder.join(&*file);
         }
     }
 }
@@ -63,7 +63,7 @@ impl MediumBound {
 impl ClosedMesh {
     /// The UV sphere of [`MediumBound::Sphere`] in [0, 1]³ (centre 0.5, radius 0.5).
     pub fn sphere(segments: u32) -> Result<ClosedMesh, String> {
-        if !(4..=256).contains(&segments) || segments % 2 != 0 {
+        if !(4..=256).contains(&segments) || !segments.is_multiple_of(2) {
             return Err(format!(
                 "sphere segments {segments}; expected an even number from 4 to 256"
             ));

@@ -117,7 +117,7 @@ fn read_primitive(
         Some(i) => i.into_u32().collect(),
         None => (0..positions.len() as u32).collect(),
     };
-    if flat.len() % 3 != 0 {
+    if !flat.len().is_multiple_of(3) {
         return Err(format!("{} indices; expected a multiple of 3", flat.len()));
     }
     if let Some(bad) = flat.iter().find(|&&i| i as usize >= positions.len()) {

@@ -90,7 +90,7 @@ impl ReferenceSpec {
         match &self.frames {
             ReferenceFrames::None => false,
             ReferenceFrames::List(list) => list.contains(&frame),
-            ReferenceFrames::Every(n) => *n > 0 && frame % n == 0,
+            ReferenceFrames::Every(n) => *n > 0 && frame.is_multiple_of(*n),
         }
     }
 }

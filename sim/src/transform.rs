@@ -82,10 +82,10 @@ pub fn propagate_transforms(
     while let Some((entity, parent)) = stack.pop() {
         let Ok(local) = locals.get(entity) else { continue };
         let world = parent * local.matrix();
-        if let Ok(mut global) = globals.get_mut(entity) {
-            if global.0 != world {
-                global.0 = world;
-            }
+        if let Ok(mut global) = globals.get_mut(entity)
+            && global.0 != world
+        {
+            global.0 = world;
         }
         if let Ok(kids) = children.get(entity) {
             stack.extend(kids.iter().map(|c| (c, world)));

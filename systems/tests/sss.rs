@@ -87,7 +87,7 @@ fn sss_without_a_subsurface_material_is_refused() {
     assert!(e.contains("no subsurface material") && e.contains("materials:"), "{e}");
     let bad = "Scenario(scene: Builtin(\"sss_sphere\"), resolution: (16, 9), frames: 1,\n methods: [Sss(variant: Adaptive, kappa: 0.2)])";
     std::fs::write(&file, bad).unwrap();
-    let e = RunSpec::load(&file, &Overrides::default()).err().expect("unknown field").to_string();
+    let e = RunSpec::load(&file, &Overrides::default()).expect_err("unknown field").to_string();
     assert!(e.contains("plain.ron:2:") && e.contains("kappa"), "{e}");
     let separable_afis = "Scenario(scene: Builtin(\"sss_sphere\"), resolution: (16, 9), frames: 1,\n methods: [Sss(variant: Separable(taps: 5), prefilter: ())],\n materials: [(material: \"skin\", subsurface: (dmfp: (0.1, 0.05, 0.02)))])";
     std::fs::write(&file, separable_afis).unwrap();
@@ -204,7 +204,7 @@ fn two_subsurface_materials_scatter_apart() {
     let last =
         |dir: &Path| systems::output::read_exr(&dir.join("run/frames/as/0002.exr")).unwrap().2;
     let counts = |dir: &Path| {
-        metrics::load_image(&dir.join("run/frames/as/sample_count/0002.png")).unwrap().rgb
+        metrics::load_image(dir.join("run/frames/as/sample_count/0002.png")).unwrap().rgb
     };
     let (image_one, image_two) = (last(&dir_one), last(&dir_two));
     let (counts_one, counts_two) = (counts(&dir_one), counts(&dir_two));

@@ -111,7 +111,7 @@ fn a_missing_baseline_says_how_to_bless_one() {
 }
 
 fn load_error(text: &str) -> String {
-    Suite::from_ron(text, Path::new("bad.ron")).err().expect("refused").to_string()
+    Suite::from_ron(text, Path::new("bad.ron")).expect_err("refused").to_string()
 }
 
 #[test]

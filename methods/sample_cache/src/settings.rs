@@ -97,7 +97,7 @@ impl SampleCacheSettings {
             return Err(format!("delta must be >= 0, got {}", self.delta));
         }
         for (name, v) in [("epsilon0", self.epsilon0), ("epsilon1", self.epsilon1)] {
-            if !(v >= 0.0 && v < 1.0) {
+            if !(0.0..1.0).contains(&v) {
                 return Err(format!("{name} must be in [0, 1), got {v}"));
             }
         }

@@ -279,7 +279,7 @@ fn slope_test_flags_the_pixels_along_a_depth_step() {
     );
     let mut on_edge = 0;
     let mut on_edge_flagged = 0u32;
-    for p in 0..(W * H) as usize {
+    for (p, &flag) in flags.iter().enumerate().take((W * H) as usize) {
         let c = Vec2::new((p as u32 % W) as f32 + 0.5, (p as u32 / W) as f32 + 0.5);
         // Chebyshev distance (pixels) from the pixel centre to the square's outline.
         let inside = c.cmpge(lo).all() && c.cmple(hi).all();
@@ -288,7 +288,7 @@ fn slope_test_flags_the_pixels_along_a_depth_step() {
         } else {
             (lo - c).max(c - hi).max(Vec2::ZERO).max_element()
         };
-        let flagged = flags[p] & FLAG_SLOPE != 0;
+        let flagged = flag & FLAG_SLOPE != 0;
         if flagged {
             assert!(d <= 2.5, "pixel {p} flagged {d} pixels from the step");
         }

@@ -62,7 +62,7 @@ pub fn tap_offsets(taps: u32) -> Vec<f64> {
 /// The kernel: per tap (offset in units of d_px[widest], weight r, g, b), the weights being
 /// each channel's mass over the tap's cell (from the midpoints to its neighbours; ±∞ outside).
 pub fn kernel(taps: u32, d_px: [f32; 3]) -> Result<Vec<[f32; 4]>, String> {
-    if taps < 3 || taps % 2 == 0 || taps > MAX_TAPS {
+    if taps < 3 || taps.is_multiple_of(2) || taps > MAX_TAPS {
         return Err(format!("separable SSS taps {taps}; expected an odd count in [3, {MAX_TAPS}]"));
     }
     if d_px.iter().any(|d| !(*d > 0.0)) {

@@ -43,7 +43,7 @@ fn candle_flicker(candle: u32, frame: u32) -> f32 {
 pub fn frame(test: DynamicTest, width: u32, height: u32, frame: u32, d_rel: [f32; 3]) -> SssFrame {
     let aspect = width as f32 / height as f32;
     let main_on = match test {
-        DynamicTest::Toggle => (frame / TOGGLE_FRAMES) % 2 == 0,
+        DynamicTest::Toggle => (frame / TOGGLE_FRAMES).is_multiple_of(2),
         _ => true,
     };
     let main = Light {

@@ -7,7 +7,8 @@ use sss::gpu::SssParams;
 
 #[test]
 fn shared_structs_have_one_layout() {
-    for (name, found) in [("SssParams", layout_mismatches::<SssParams>(""))] {
+    {
+        let (name, found) = ("SssParams", layout_mismatches::<SssParams>(""));
         assert!(found.is_empty(), "{name}: {found:?}");
     }
 }

@@ -2,6 +2,8 @@
 //! tracer makes (`train` on a buffer of training records, `infer` on a buffer of queries).
 //!
 //! A training step is one submission of these passes (nirc/shaders/):
+//!
+//! ```text
 //! 1. train_forward_backward  per record: both forwards, loss, backward; hash-grid gradients as
 //!                            exact fixed-point sums; reliability samples (y, f_cur, f_ema)
 //! 2. reliability_accumulate  per sample: its reliability cell, the cell's count and list of
@@ -13,6 +15,8 @@
 //!                            record order
 //!    reliability_update      per cell: keep the new moments (or the batch-mean step)
 //! 6. finish_step             commit the counters, or count the rolled-back step
+//! ```
+//!
 //! Every sum has a fixed order or is exact, so a step is deterministic.
 
 pub mod grid_textures;

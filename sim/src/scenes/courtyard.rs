@@ -30,8 +30,7 @@ pub(crate) fn bird_mesh() -> scene::Mesh {
 }
 
 pub fn build() -> WorldTemplate {
-    let mut t = WorldTemplate::default();
-    t.environment = Vec3::new(0.25, 0.32, 0.45);
+    let mut t = WorldTemplate { environment: Vec3::new(0.25, 0.32, 0.45), ..Default::default() };
     let quad = t.add_mesh(unit_quad("quad"));
     let cube = t.add_mesh(unit_cube("cube"));
     let bird = t.add_mesh(bird_mesh());

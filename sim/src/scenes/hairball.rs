@@ -33,8 +33,7 @@ pub fn build() -> WorldTemplate {
         }
         b.strand(&points, 0.004);
     }
-    let mut t = WorldTemplate::default();
-    t.environment = Vec3::splat(0.6);
+    let mut t = WorldTemplate { environment: Vec3::splat(0.6), ..Default::default() };
     let hair = t.add_mesh(b.build());
     let quad = t.add_mesh(unit_quad("quad"));
     let fibre = t.add_material(

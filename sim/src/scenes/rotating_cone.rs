@@ -13,8 +13,7 @@ pub const RADIUS: f32 = 0.4;
 pub const HEIGHT: f32 = 1.2;
 
 pub fn build() -> WorldTemplate {
-    let mut t = WorldTemplate::default();
-    t.environment = Vec3::splat(0.05);
+    let mut t = WorldTemplate { environment: Vec3::splat(0.05), ..Default::default() };
     let mut b = MeshBuilder::new("cone");
     b.cone(RADIUS, HEIGHT, 48);
     let cone = t.add_mesh(b.build());

@@ -15,8 +15,7 @@ use crate::transform::Transform;
 pub const RADIUS: f32 = 0.5;
 
 pub fn build() -> WorldTemplate {
-    let mut t = WorldTemplate::default();
-    t.environment = Vec3::splat(0.02);
+    let mut t = WorldTemplate { environment: Vec3::splat(0.02), ..Default::default() };
     let mut b = MeshBuilder::new("sphere");
     b.sphere(RADIUS, 48, 24);
     let sphere = t.add_mesh(b.build());

@@ -98,7 +98,7 @@ pub fn gltf_text() -> String {
                              component: u32,
                              target: u32,
                              extra: Value| {
-            while bin.len() % 4 != 0 {
+            while !bin.len().is_multiple_of(4) {
                 bin.push(0);
             }
             views.push(json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len(), "target": target}));
