@@ -111,17 +111,17 @@ fn a_method_added_through_the_registry_plays_like_a_shipped_one() {
     let file = dir.join("ema.ron");
     std::fs::write(
         &file,
-        "Scenario(scene: Builtin(\"cornell_box\"), resolution: (16, 9), frames: 3,\n  reference: (spp: 4, frames: List([2])),\n  methods: [PathTracing(spp: 1), EmaPathTracing(alpha: 0.5)])",
+        "Scenario(scene: Builtin(\"cornell_box\"), resolution: (16, 9), frames: 3,\n  reference: (spp: 4, frames: List([2])),\n  methods: [PathTracing(spp: 1), EmaPathTracing(alpha: 0.25)])",
     )
     .unwrap();
     let overrides = Overrides { out: Some(dir.join("run")), ..Default::default() };
     let spec = RunSpec::load(&file, &overrides).expect("scenario with the added method");
-    assert_eq!(spec.methods[1].label(), "ema_pt_0.5");
-    assert_eq!(spec.methods[1].spec.temporal_window(), Some(3.0));
+    assert_eq!(spec.methods[1].label(), "ema_pt_0.25");
+    assert_eq!(spec.methods[1].spec.temporal_window(), Some(7.0));
 
     // `flicker schedule`: the method and its system in Render.
     let listing = systems::methods::describe_schedule(&spec.methods).unwrap();
-    assert!(listing.contains("ema_pt_0.5 (EmaPathTracing)"), "{listing}");
+    assert!(listing.contains("ema_pt_0.25 (EmaPathTracing)"), "{listing}");
     let render = listing.find("\nRender\n").expect(&listing);
     let learn = listing.find("\nLearn\n").expect(&listing);
     let system = listing.find("ema_render").expect(&listing);
@@ -148,27 +148,27 @@ fn a_method_added_through_the_registry_plays_like_a_shipped_one() {
 
     // frames.csv: a row per frame, measured against the reference like the others.
     let csv = std::fs::read_to_string(run.join("frames.csv")).unwrap();
-    let rows: Vec<&str> = csv.lines().filter(|l| l.contains("ema_pt_0.5")).collect();
+    let rows: Vec<&str> = csv.lines().filter(|l| l.contains("ema_pt_0.25")).collect();
     assert_eq!(rows.len(), 3, "{csv}");
-    assert!(summary.records.iter().any(|r| r.method == "ema_pt_0.5" && r.frame == 2));
+    assert!(summary.records.iter().any(|r| r.method == "ema_pt_0.25" && r.frame == 2));
 
     // The report names it.
     let html = std::fs::read_to_string(run.join("report.html")).unwrap();
-    assert!(html.contains("ema_pt_0.5"));
+    assert!(html.contains("ema_pt_0.25"));
 
     // And it computes what it says: frame 0 is the 1-spp image (same seeds as PathTracing), each
     // later frame α·current + (1 − α)·previous.
     let frames = |label: &str| -> Vec<Vec<[f32; 4]>> {
         (0..3).map(|f| read_exr(&run.join(format!("frames/{label}/{f:04}.exr")))).collect()
     };
-    let (pt, ema) = (frames("pt_1spp"), frames("ema_pt_0.5"));
+    let (pt, ema) = (frames("pt_1spp"), frames("ema_pt_0.25"));
     assert_eq!(ema[0], pt[0]);
     let mut expected = pt[0].clone();
     for f in 1..3 {
         expected = expected
             .iter()
             .zip(&pt[f])
-            .map(|(p, c)| std::array::from_fn(|k| 0.5 * c[k] + 0.5 * p[k]))
+            .map(|(p, c)| std::array::from_fn(|k| 0.25 * c[k] + 0.75 * p[k]))
             .collect();
         for (e, g) in expected.iter().zip(&ema[f]) {
             for k in 0..3 {
