@@ -17,8 +17,8 @@ import package::nirc::bindings_common::{is_finite4};
 import package::nirc::fixed_sum_read::{fixed_to_f32};
 import package::nirc::grid_write::{mirror_ema, mirror_params};
 
-@group(0) @binding(0) var<uniform> call: Call;
-@group(0) @binding(1) var<uniform> hyper: Hyper;
+@group(0) @binding(0) var<storage, read> call: Call;
+@group(0) @binding(1) var<storage, read> hyper: Hyper;
 @group(0) @binding(2) var<storage, read_write> params: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> ema: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read_write> adam_m: array<vec4<f32>>;

@@ -3,8 +3,8 @@
 
 import package::nirc::types::{Call, Counters, Hyper};
 
-@group(0) @binding(0) var<uniform> call: Call;
-@group(0) @binding(1) var<uniform> hyper: Hyper;
+@group(0) @binding(0) var<storage, read> call: Call;
+@group(0) @binding(1) var<storage, read> hyper: Hyper;
 @group(0) @binding(2) var<storage, read_write> counters: Counters;
 
 @compute @workgroup_size(1)

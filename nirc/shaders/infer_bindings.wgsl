@@ -3,8 +3,8 @@
 
 import package::nirc::types::{CacheQuery, Call, Counters, Hyper};
 
-@group(0) @binding(0) var<uniform> call: Call;
-@group(0) @binding(1) var<uniform> hyper: Hyper;
+@group(0) @binding(0) var<storage, read> call: Call;
+@group(0) @binding(1) var<storage, read> hyper: Hyper;
 @group(0) @binding(2) var<storage, read> queries: array<CacheQuery>;
 @group(0) @binding(3) var<storage, read> params: array<f32>;
 @group(0) @binding(4) var<storage, read> ema: array<f32>;

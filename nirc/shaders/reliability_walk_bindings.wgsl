@@ -3,8 +3,8 @@
 
 import package::nirc::types::{Call, Hyper, ReliabilitySample};
 
-@group(0) @binding(0) var<uniform> call: Call;
-@group(0) @binding(1) var<uniform> hyper: Hyper;
+@group(0) @binding(0) var<storage, read> call: Call;
+@group(0) @binding(1) var<storage, read> hyper: Hyper;
 @group(0) @binding(2) var<storage, read> samples: array<ReliabilitySample>;
 @group(0) @binding(3) var<storage, read_write> accum: array<u32>;
 @group(0) @binding(4) var<storage, read> moments: array<f32>;

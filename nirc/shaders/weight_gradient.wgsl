@@ -7,7 +7,7 @@ import package::nirc::types::{Call};
 import package::nirc::config::{ACT_FLOATS, CHUNK, HIDDEN, MLP_PARAMS, MLP_WEIGHTS, SCRATCH_STRIDE};
 import package::nirc::mlp_layout::{act_base, delta_base, mat_cols, mat_offset};
 
-@group(0) @binding(0) var<uniform> call: Call;
+@group(0) @binding(0) var<storage, read> call: Call;
 @group(0) @binding(1) var<storage, read> scratch: array<f32>;
 @group(0) @binding(2) var<storage, read_write> partials: array<f32>;
 @group(0) @binding(3) var<storage, read_write> grad: array<f32>;

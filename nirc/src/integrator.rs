@@ -46,7 +46,7 @@ impl Default for CachePathSettings {
 }
 
 render::gpu_struct! {
-    /// The cache-paths passes' uniform.
+    /// The cache-paths passes' parameters.
     pub struct CacheParams {
         /// Pixels x spp.
         pub query_count: u32 => "u32",
@@ -63,7 +63,7 @@ const META_BYTES: u64 = 48;
 /// This pass's own @group(2): params, then queries, meta, records, answers, image, motion, ray
 /// counters.
 const OWN_GROUP: [BufferBinding; 8] = [
-    BufferBinding::uniform("params", "CacheParams"),
+    BufferBinding::read("params", "CacheParams"),
     BufferBinding::read_write("queries", "array<CacheQuery>"),
     BufferBinding::read_write("query_meta", "array<QueryMeta>"),
     // [0, record_count): the compacted training records handed to the cache;
@@ -215,7 +215,7 @@ impl CachePaths {
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("nirc cache params"),
             contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: wgpu::BufferUsages::STORAGE,
         });
         let queries = buffer("nirc cache queries", query_count * size_of::<CacheQuery>() as u64)?;
         let meta = buffer("nirc query weights", query_count * META_BYTES)?;

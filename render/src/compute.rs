@@ -6,10 +6,12 @@ use crate::error::RenderError;
 use crate::gpu::Gpu;
 use crate::shader::{Module, Program};
 
-/// How a pass may access a buffer of its bind group.
+/// How a pass may access a buffer of its bind group. There is no uniform access: a pass's
+/// parameters are a read-only storage buffer, because Mesa 22.3's lavapipe compiles a shader
+/// anew on every bind of a pipeline whose branches or loops read a uniform at a constant offset
+/// (it inlines the values) and never frees the one before: 1.5 MB and tens of ms per bind.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Access {
-    Uniform,
     Read,
     ReadWrite,
 }
@@ -25,10 +27,6 @@ pub struct BufferBinding {
 }
 
 impl BufferBinding {
-    pub const fn uniform(name: &'static str, wgsl_type: &'static str) -> Self {
-        Self { name, access: Access::Uniform, wgsl_type }
-    }
-
     pub const fn read(name: &'static str, wgsl_type: &'static str) -> Self {
         Self { name, access: Access::Read, wgsl_type }
     }
@@ -39,24 +37,15 @@ impl BufferBinding {
 
     pub const fn kind(&self) -> wgpu::BufferBindingType {
         match self.access {
-            Access::Uniform => wgpu::BufferBindingType::Uniform,
             Access::Read => wgpu::BufferBindingType::Storage { read_only: true },
             Access::ReadWrite => wgpu::BufferBindingType::Storage { read_only: false },
         }
     }
 }
 
-/// Storage buffers among `bindings` (what counts against the adapter's per-stage limit).
+/// Storage buffers among `bindings` (what counts against the adapter's per-stage limit): all.
 pub const fn storage_buffers(bindings: &[BufferBinding]) -> u32 {
-    let mut n = 0;
-    let mut i = 0;
-    while i < bindings.len() {
-        if !matches!(bindings[i].access, Access::Uniform) {
-            n += 1;
-        }
-        i += 1;
-    }
-    n
+    bindings.len() as u32
 }
 
 /// The WGSL declarations of `bindings` as @group(`group`), binding i = `bindings[i]`.
@@ -76,7 +65,6 @@ pub fn declare_range(
         .filter(|(i, _)| range.contains(i))
         .map(|(i, b)| {
             let space = match b.access {
-                Access::Uniform => "<uniform>",
                 Access::Read => "<storage, read>",
                 Access::ReadWrite => "<storage, read_write>",
             };

@@ -1,5 +1,5 @@
 //! The scene as every pass built on the shading library binds it: @group(0) holds the `Frame`
-//! uniform (camera, previous camera, lights, seed, spp, depth), the texture atlas, and the
+//! parameters (camera, previous camera, lights, seed, spp, depth), the texture atlas, and the
 //! materials and the light table as texel tables (read per hit at per-ray addresses:
 //! `crate::texel_table` says why), all read only; @group(1) is the geometry (BLAS, TLAS,
 //! instances). One per run, updated once per frame; methods read it and never write it.
@@ -19,7 +19,7 @@ use wgpu::util::DeviceExt;
 
 /// @group(0)'s buffers: frame uniform, texels (declared into the library's WGSL).
 pub const GROUP: [BufferBinding; 2] =
-    [BufferBinding::uniform("frame", "Frame"), BufferBinding::read("texels", "array<u32>")];
+    [BufferBinding::read("frame", "Frame"), BufferBinding::read("texels", "array<u32>")];
 /// Its texel tables after the buffers: `GpuMaterial`s (3 texels) and `GpuLight`s (4 texels),
 /// read through scene_tables.wgsl.
 pub const TABLES: [&str; 2] = ["material_table", "light_table"];
@@ -102,7 +102,7 @@ impl SceneBindings {
         let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame uniform"),
             size: size_of::<Frame>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let layout = crate::texel_table::group_layout(gpu, "scene", &GROUP, TABLES.len());

@@ -44,7 +44,7 @@ fn a_group_module_imports_the_structs_its_bindings_name() {
     let types =
         module("package::types", "struct Params { n: u32, p0: f32 }\nstruct Slot { v: vec4f }\n");
     let group = [
-        BufferBinding::uniform("params", "Params"),
+        BufferBinding::read("params", "Params"),
         BufferBinding::read_write("slots", "array<Slot>"),
         BufferBinding::read_write("counts", "array<atomic<u32>>"),
     ];

@@ -20,7 +20,7 @@ render::gpu_struct! {
 }
 
 const BINDINGS: [BufferBinding; 3] = [
-    BufferBinding::uniform("cf_params", "ClosedFormParams"),
+    BufferBinding::read("cf_params", "ClosedFormParams"),
     BufferBinding::read("seeds", "array<u32>"),
     BufferBinding::read_write("trials", "array<vec2f>"),
 ];

@@ -20,7 +20,7 @@ render::gpu_struct! {
 }
 
 const BINDINGS: [BufferBinding; 4] = [
-    BufferBinding::uniform("ray_params", "RayParams"),
+    BufferBinding::read("ray_params", "RayParams"),
     BufferBinding::read("rays", "array<RaySegment>"),
     BufferBinding::read("seeds", "array<u32>"),
     BufferBinding::read_write("results", "array<vec2u>"),
@@ -72,7 +72,7 @@ impl EstimatorPass {
                 usage,
             })
         };
-        let params = init("ray params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
+        let params = init("ray params", bytemuck::bytes_of(&params), wgpu::BufferUsages::STORAGE);
         let rays_buf = init("rays", bytemuck::cast_slice(rays), wgpu::BufferUsages::STORAGE);
         let seeds_buf = init("seeds", bytemuck::cast_slice(seeds), wgpu::BufferUsages::STORAGE);
         let size = (rays.len() * 8) as u64;

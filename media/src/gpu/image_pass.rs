@@ -32,7 +32,7 @@ render::gpu_struct! {
 }
 
 const BINDINGS: [BufferBinding; 3] = [
-    BufferBinding::uniform("image", "ImageParams"),
+    BufferBinding::read("image", "ImageParams"),
     BufferBinding::read("directions", "array<vec4f>"),
     BufferBinding::read_write("results", "array<vec2u>"),
 ];
@@ -100,7 +100,7 @@ impl ImagePass {
             })
         };
         let params =
-            init("media image params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
+            init("media image params", bytemuck::bytes_of(&params), wgpu::BufferUsages::STORAGE);
         let d4: Vec<[f32; 4]> = dirs.iter().map(|d| [d.x, d.y, d.z, 0.0]).collect();
         let dirs_buf =
             init("media image directions", bytemuck::cast_slice(&d4), wgpu::BufferUsages::STORAGE);

@@ -1,4 +1,4 @@
-//! A medium on the GPU: its parameters (uniform), voxel densities and super-voxels (storage),
+//! A medium on the GPU: its parameters, voxel densities and super-voxels (storage),
 //! bound as @group(0) of every media pass.
 
 use bytemuck::Zeroable;
@@ -10,7 +10,7 @@ use crate::medium::{Medium, Segment};
 
 render::gpu_struct! {
     /// One medium's grid shape and box, and where its voxels and super-voxels start in the
-    /// shared buffers (several media bound at once: `MAX_MEDIA` of these in a uniform array).
+    /// shared buffers (several media bound at once: `MAX_MEDIA` of these in one array).
     pub struct MediumParams {
         pub res: [u32; 3] => "vec3u",
         pub density_offset: u32 => "u32",
@@ -42,15 +42,15 @@ impl From<&Segment> for RaySegment {
     }
 }
 
-/// The most media one pass binds (a uniform array; a scenario with more is refused).
+/// The most media one pass binds (an array of fixed length; a scenario with more is refused).
 pub const MAX_MEDIA: usize = 8;
 
 const _: () =
-    assert!(MAX_MEDIA == 8, "update the WGSL array lengths of the media and optics uniforms");
+    assert!(MAX_MEDIA == 8, "update the WGSL array lengths of the media and optics parameters");
 
 pub const BINDINGS: [BufferBinding; 3] = [
     // 8 = MAX_MEDIA (a const string cannot be formatted; the assertion above keeps them equal).
-    BufferBinding::uniform("media", "array<MediumParams, 8>"),
+    BufferBinding::read("media", "array<MediumParams, 8>"),
     // every medium's voxels, one after the other
     BufferBinding::read("density", "array<f32>"),
     // min, max, mean, RMS of μ − μ_min, every medium's one after the other
@@ -104,7 +104,7 @@ impl GpuMedium {
             })
         };
         let params =
-            buffer("media params", bytemuck::cast_slice(&params), wgpu::BufferUsages::UNIFORM);
+            buffer("media params", bytemuck::cast_slice(&params), wgpu::BufferUsages::STORAGE);
         let density =
             buffer("media density", bytemuck::cast_slice(&density), wgpu::BufferUsages::STORAGE);
         let super_voxels =

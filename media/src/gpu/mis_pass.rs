@@ -24,7 +24,7 @@ render::gpu_struct! {
 }
 
 const BINDINGS: [BufferBinding; 3] = [
-    BufferBinding::uniform("mis_params", "MisParams"),
+    BufferBinding::read("mis_params", "MisParams"),
     BufferBinding::read("seeds", "array<u32>"),
     BufferBinding::read_write("trials", "array<vec4f>"),
 ];

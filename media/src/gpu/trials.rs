@@ -1,5 +1,5 @@
 //! What the trial passes share (`MisPass`, `ClosedFormPass`): one invocation per seed of a
-//! pipeline whose @group(0) is (params uniform, seeds, results), a 2D dispatch, the results read
+//! pipeline whose @group(0) is (params, seeds, results), a 2D dispatch, the results read
 //! back.
 
 use render::compute::buffer_group;
@@ -24,7 +24,7 @@ pub(super) fn run_trials<T: bytemuck::Pod>(
             usage,
         })
     };
-    let params = init(params, wgpu::BufferUsages::UNIFORM);
+    let params = init(params, wgpu::BufferUsages::STORAGE);
     let seeds_buf = init(bytemuck::cast_slice(seeds), wgpu::BufferUsages::STORAGE);
     let size = (seeds.len() * std::mem::size_of::<T>()) as u64;
     let results = device.create_buffer(&wgpu::BufferDescriptor {

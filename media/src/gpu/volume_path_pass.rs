@@ -103,10 +103,10 @@ render::gpu_struct! {
 }
 
 const BINDINGS: [BufferBinding; 3] = [
-    BufferBinding::uniform("vp", "VolumePathParams"),
+    BufferBinding::read("vp", "VolumePathParams"),
     // per medium of the GpuMedium: albedo at 2i, emission (radiance per unit extinction) at 2i + 1
     // 2 × MAX_MEDIA (asserted in medium.rs): albedo and emission per medium.
-    BufferBinding::uniform("optics", "array<vec4f, 16>"),
+    BufferBinding::read("optics", "array<vec4f, 16>"),
     BufferBinding::read_write("samples", "array<vec4f>"),
 ];
 
@@ -272,13 +272,13 @@ impl VolumePathPass {
             let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("volume path params"),
                 contents: bytemuck::bytes_of(&params),
-                usage: wgpu::BufferUsages::UNIFORM,
+                usage: wgpu::BufferUsages::STORAGE,
             });
             tracer.prepare_frame(gpu, spp, 0, seed, frame);
             let optics = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("volume path optics"),
                 contents: bytemuck::cast_slice(&packed),
-                usage: wgpu::BufferUsages::UNIFORM,
+                usage: wgpu::BufferUsages::STORAGE,
             });
             let group =
                 buffer_group(gpu, "media volume path", &self.layout, &[&params, &optics, &samples]);

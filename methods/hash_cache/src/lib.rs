@@ -70,7 +70,7 @@ pub const HC_UPDATE_PASS: &str = "hc_update";
 pub const HC_RESOLVE_PASS: &str = "hc_resolve";
 /// The cache's own @group(2) (declared into its WGSL).
 const OWN_GROUP: [BufferBinding; 7] = [
-    BufferBinding::uniform("hc", "HashCacheParams"),
+    BufferBinding::read("hc", "HashCacheParams"),
     BufferBinding::read_write("slots", "array<atomic<u32>>"),
     // rgb mean, w samples.
     BufferBinding::read_write("cell_radiance", "array<vec4f>"),
@@ -191,7 +191,7 @@ impl HashCacheSettings {
 }
 
 render::gpu_struct! {
-    /// The cache's uniform (`hc`, its @group(2) binding 0).
+    /// The cache's parameters (`hc`, its @group(2) binding 0).
     pub struct HashCacheParams {
         pub capacity: u32 => "u32",
         pub probe_limit: u32 => "u32",
@@ -333,7 +333,7 @@ impl HashCache {
         let params = buffer(
             "hash cache params",
             size_of::<HashCacheParams>() as u64,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         );
         let slots = buffer("hash cache slots", settings.capacity as u64 * 16, rw);
         let cells = buffer("hash cache cells", settings.capacity as u64 * 16, rw);

@@ -90,7 +90,7 @@ const AUDIT_WORD: u64 = 32;
 /// then pixel atomics, destination slots and mask, work lists, output, and the inputs of a TAA
 /// resolve over the image (colour, closest visible sample's primary attributes).
 const OWN_GROUP: [BufferBinding; 10] = [
-    BufferBinding::uniform("ssc", "SscParams"),
+    BufferBinding::read("ssc", "SscParams"),
     BufferBinding::read("src_mask", "array<u32>"),
     BufferBinding::read("src_slots", "array<SscSlot>"),
     // SSC_ATOMICS words per pixel: the mask being reserved (atomicOr), the farthest visible depth
@@ -144,7 +144,7 @@ pub fn program() -> &'static Program {
 }
 
 render::gpu_struct! {
-    /// The cache's uniform (`ssc`, @group(2) binding 0).
+    /// The cache's parameters (`ssc`, @group(2) binding 0).
     pub struct SscParams {
         pub width: u32 => "u32",
         pub height: u32 => "u32",
@@ -354,7 +354,7 @@ impl SampleCache {
         let params = buffer(
             "ssc params",
             size_of::<SscParams>() as u64,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         )?;
 
         let (

@@ -12,10 +12,10 @@ struct MipLevel {
     _pad2: u32,
 }
 
-@group(0) @binding(0) var<uniform> params: SssParams;
+@group(0) @binding(0) var<storage, read> params: SssParams;
 @group(0) @binding(1) var<storage, read> irradiance: array<vec4f>;
 @group(0) @binding(2) var<storage, read_write> mips: array<vec4f>;
-@group(0) @binding(3) var<uniform> mip_level: MipLevel;
+@group(0) @binding(3) var<storage, read> mip_level: MipLevel;
 
 @compute @workgroup_size(8, 8, 1)
 fn sss_prefilter(@builtin(global_invocation_id) id: vec3u) {

@@ -5,7 +5,7 @@
 import package::sss_types::SssParams;
 import package::kernel::{outside_image};
 
-@group(0) @binding(0) var<uniform> params: SssParams;
+@group(0) @binding(0) var<storage, read> params: SssParams;
 @group(0) @binding(1) var<storage, read> irradiance: array<vec4f>;
 @group(0) @binding(2) var<storage, read> sss_kernel: array<vec4f>;
 @group(0) @binding(3) var<storage, read_write> intermediate: array<vec4f>;

@@ -8,7 +8,7 @@ import package::sss::mip::sss_mip_level;
 import package::sss::spvg::{SpvgParams, spvg_state, spvg_sample_count, spvg_update, cv_update, cv_coefficient};
 import package::kernel::{outside_image};
 
-@group(0) @binding(0) var<uniform> params: SssParams;
+@group(0) @binding(0) var<storage, read> params: SssParams;
 @group(0) @binding(1) var<storage, read> irradiance: array<vec4f>;
 @group(0) @binding(2) var<storage, read> history_in: array<vec4f>;
 @group(0) @binding(3) var<storage, read> cv_in: array<vec4f>;

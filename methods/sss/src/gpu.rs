@@ -21,7 +21,7 @@ use wgpu::util::DeviceExt;
 pub const MAX_COUNT: u32 = 4096;
 
 render::gpu_struct! {
-    /// The pass's uniform: image size, frame and seed, the variant (0 fixed, 1 AS, 2 OCV,
+    /// The pass's parameters: image size, frame and seed, the variant (0 fixed, 1 AS, 2 OCV,
     /// 3 CCV, 4 separable), SPVG's and the control variates' parameters, the separable
     /// kernel's tap count, AFIS's level count (0: no prefiltering) and eq. 5.12's a, d per
     /// channel in pixels (w: the sampled d), and per MIP level (offset in the chain's buffer,
@@ -88,7 +88,7 @@ pub struct SssPass {
     scattered: wgpu::Buffer,
     groups: [wgpu::BindGroup; 2],
     /// AFIS's MIP chain (`prefilter::MAX_LEVELS` levels' room) and the prefiltering pass, one
-    /// bind group per level (each with its level's uniform).
+    /// bind group per level (each with its level's number).
     mips: wgpu::Buffer,
     prefilter: (wgpu::ComputePipeline, Vec<wgpu::BindGroup>),
     /// Which history set holds the latest history.
@@ -125,7 +125,7 @@ impl SssPass {
         let params = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("sss params"),
             contents: bytemuck::bytes_of(&<SssParams as bytemuck::Zeroable>::zeroed()),
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         });
         let irradiance = storage(gpu, "sss irradiance", size);
         let history = [storage(gpu, "sss history 0", size), storage(gpu, "sss history 1", size)];
@@ -190,7 +190,7 @@ impl SssPass {
                 let level = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("sss mip level"),
                     contents: bytemuck::cast_slice(&[k, 0, 0, 0]),
-                    usage: wgpu::BufferUsages::UNIFORM,
+                    usage: wgpu::BufferUsages::STORAGE,
                 });
                 separable_group(&prefilter_pipeline, &[&params, &irradiance, &mips, &level])
             })

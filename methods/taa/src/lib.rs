@@ -153,7 +153,7 @@ impl TaaSettings {
 
 /// The trace pass's own @group(2) (declared into its WGSL).
 const TRACE_GROUP: [BufferBinding; 4] = [
-    BufferBinding::uniform("taa", "TaaParams"),
+    BufferBinding::read("taa", "TaaParams"),
     BufferBinding::read_write("taa_current", "array<vec4f>"),
     BufferBinding::read_write("taa_primary", "array<TaaPrimary>"),
     // [0]: rays traced by this pass (sg_rays_traced of every invocation).
@@ -162,7 +162,7 @@ const TRACE_GROUP: [BufferBinding; 4] = [
 
 /// The resolve pass's @group(0) (declared into its WGSL).
 const RESOLVE_GROUP: [BufferBinding; 6] = [
-    BufferBinding::uniform("taa", "TaaParams"),
+    BufferBinding::read("taa", "TaaParams"),
     BufferBinding::read("current", "array<vec4f>"),
     BufferBinding::read("primary", "array<TaaPrimary>"),
     BufferBinding::read("previous_primary", "array<TaaPrimary>"),
@@ -171,7 +171,7 @@ const RESOLVE_GROUP: [BufferBinding; 6] = [
 ];
 
 render::gpu_struct! {
-    /// TAA's uniform, shared by its trace and resolve passes (and the hash cache's).
+    /// TAA's parameters, shared by its trace and resolve passes (and the hash cache's).
     pub struct TaaParams {
         /// Position of the primary ray inside its pixel, [0, 1)^2.
         pub jitter: [f32; 2] => "vec2f",
@@ -289,7 +289,7 @@ impl Taa {
         let params = buffer(
             "taa params",
             size_of::<TaaParams>() as u64,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         );
         let current = buffer("taa current", pixels * 16, rw);
         let primary =

@@ -16,7 +16,7 @@ fn a_scene_that_gains_features_gets_passes_compiled_for_them() {
     let mut tracer = PathTracer::new(gpu(), &open_scene(), settings()).expect("tracer");
     // Any pass on the library: TAA's trace pass, as a method holds it.
     let own = [
-        BufferBinding::uniform("taa", "TaaParams"),
+        BufferBinding::read("taa", "TaaParams"),
         BufferBinding::read_write("taa_current", "array<vec4f>"),
         BufferBinding::read_write("taa_primary", "array<TaaPrimary>"),
         BufferBinding::read_write("taa_counters", "array<atomic<u32>>"),

@@ -377,7 +377,7 @@ fn equal_passes_share_their_pipelines() {
     let t = tracer(&feature_scene(0.0), 2);
     use render::compute::BufferBinding;
     let own = [
-        BufferBinding::uniform("taa", "TaaParams"),
+        BufferBinding::read("taa", "TaaParams"),
         BufferBinding::read_write("taa_current", "array<vec4f>"),
         BufferBinding::read_write("taa_primary", "array<TaaPrimary>"),
         BufferBinding::read_write("taa_counters", "array<atomic<u32>>"),

@@ -58,9 +58,9 @@ impl TcPass {
 }
 
 const OWN_GROUP: [BufferBinding; 9] = [
-    // The hash cache's uniform: its voxel keys (capacity, probe limit, LOD, jitter).
-    BufferBinding::uniform("hc", "HashCacheParams"),
-    BufferBinding::uniform("tc", "TcParams"),
+    // The hash cache's parameters: its voxel keys (capacity, probe limit, LOD, jitter).
+    BufferBinding::read("hc", "HashCacheParams"),
+    BufferBinding::read("tc", "TcParams"),
     BufferBinding::read_write("slots", "array<atomic<u32>>"),
     BufferBinding::read_write("records", "array<TcRecord>"),
     BufferBinding::read_write("vertices", "array<TcVertex>"),
@@ -72,7 +72,7 @@ const OWN_GROUP: [BufferBinding; 9] = [
 ];
 
 render::gpu_struct! {
-    /// The method's uniform (`tc`).
+    /// The method's parameters (`tc`).
     pub struct TcParams {
         pub rule_kind: u32 => "u32",
         pub relative: u32 => "u32",
@@ -264,9 +264,9 @@ impl TerminationCache {
         let rw = wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_SRC
             | wgpu::BufferUsages::COPY_DST;
-        let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
-        let hc = buffer("termination hc", size_of::<HashCacheParams>() as u64, uniform);
-        let tc = buffer("termination tc", size_of::<TcParams>() as u64, uniform);
+        let parameters = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        let hc = buffer("termination hc", size_of::<HashCacheParams>() as u64, parameters);
+        let tc = buffer("termination tc", size_of::<TcParams>() as u64, parameters);
         let slots = buffer("termination slots", cap * 16, rw);
         // Empty slots with no claim (claim = NONE).
         let empty: Vec<[u32; 4]> = vec![[0, u32::MAX, 0, 0]; cap as usize];
@@ -308,7 +308,7 @@ impl TerminationCache {
     }
 
     /// The passes' program: the shading library, TAA's primary attributes, the hash cache's
-    /// keys and its `hc` uniform (binding 0 of this @group(2), its own module because
+    /// keys and its `hc` parameters (binding 0 of this @group(2), its own module because
     /// hash_key.wgsl imports it from there), this cache's structs and other bindings, the
     /// decision, termination.wgsl.
     pub fn program() -> &'static Program {

@@ -47,7 +47,7 @@ const RELIABILITY_MODE: u32 = 4;
 const ACCUM_PER_CELL: u64 = 73;
 
 render::gpu_struct! {
-    /// Settings that do not change during a cache's life (a uniform of every pass).
+    /// Settings that do not change during a cache's life (parameters of every pass).
     pub struct Hyper {
         pub bounds_min: [f32; 4] => "vec4<f32>",
         pub inv_extent: [f32; 4] => "vec4<f32>",
@@ -72,7 +72,7 @@ render::gpu_struct! {
 }
 
 render::gpu_struct! {
-    /// What one train/infer call works on (its own small uniform buffer).
+    /// What one train/infer call works on (its own small parameter buffer).
     pub struct Call {
         pub n: u32 => "u32",
         pub inv_n: f32 => "f32",
@@ -160,7 +160,7 @@ pub struct TrainStep {
 /// One dispatch of a training step: name (for the profile), pipeline, bind group, workgroups.
 type Stage<'a> = (&'static str, &'a wgpu::ComputePipeline, &'a wgpu::BindGroup, u32);
 
-/// Bind groups that depend on neither the caller's buffers nor the call's uniforms.
+/// Bind groups that depend on neither the caller's buffers nor the call's parameters.
 struct FixedBindGroups {
     reliability_update: wgpu::BindGroup,
     lane_stage: Option<wgpu::BindGroup>,
@@ -481,17 +481,20 @@ impl NeuralCache {
         }
         let max_batch = config.max_batch as u64;
         let chunks = max_batch.div_ceil(CHUNK as u64);
-        let uniform = |label: &str, data: &[u8]| {
+        let parameters = |label: &str, data: &[u8]| {
             gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
                 contents: data,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             })
         };
         let mut counters = state.counters;
         counters.flag = 0;
         Ok(Buffers {
-            hyper: uniform("nirc hyper", bytemuck::bytes_of(&Self::hyper(config, &state.bounds))),
+            hyper: parameters(
+                "nirc hyper",
+                bytemuck::bytes_of(&Self::hyper(config, &state.bounds)),
+            ),
             params: storage_init(gpu, "nirc params", bytemuck::cast_slice(&state.params))?,
             ema: storage_init(gpu, "nirc ema params", bytemuck::cast_slice(&state.ema))?,
             adam_m: storage_init(gpu, "nirc adam m", bytemuck::cast_slice(&state.adam_m))?,
@@ -556,13 +559,13 @@ impl NeuralCache {
         }
     }
 
-    /// The per-call uniforms live in their own small buffer, so that several calls can be
+    /// The per-call parameters live in their own small buffer, so that several calls can be
     /// recorded into one command encoder.
     fn call_buffer(gpu: &Gpu, call: Call) -> wgpu::Buffer {
         gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("nirc call"),
             contents: bytemuck::bytes_of(&call),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: wgpu::BufferUsages::STORAGE,
         })
     }
 

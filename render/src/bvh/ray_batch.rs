@@ -80,7 +80,7 @@ const GROUP: [BufferBinding; 4] = [
     BufferBinding::read("rays", "array<GpuRay>"),
     BufferBinding::read_write("hits", "array<GpuHit>"),
     BufferBinding::read_write("points", "array<GpuPoint>"),
-    BufferBinding::uniform("params", "BatchParams"),
+    BufferBinding::read("params", "BatchParams"),
 ];
 
 /// The structs of the pass, for the layout test.
@@ -235,7 +235,7 @@ impl RayBatch {
         let params = buffer(
             "ray batch params",
             16,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         );
         let p = BatchParams { count, row_pitch: groups_x * WORKGROUP_SIZE, pad: [0; 2] };
         gpu.queue.write_buffer(&params, 0, bytemuck::bytes_of(&p));
