@@ -51,12 +51,13 @@ pub mod table_cpu;
 
 use crate::compute::BufferBinding;
 use crate::error::RenderError;
+use crate::frame_bindings::FrameBindings;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
 use crate::pass_library::PassLibrary;
-use crate::path_tracer::PathTracer;
 use crate::readback::read_buffer;
 use crate::scene::Camera;
+use crate::scene_gpu::SceneGpu;
 use crate::shader::{Module, Program};
 use crate::taa::{Taa, TaaPrimary, halton_jitter};
 use crate::timing::{PassTimer, PassTiming};
@@ -271,6 +272,7 @@ pub struct HashCache {
     counters: wgpu::Buffer,
     primary: wgpu::Buffer,
     colour: wgpu::Buffer,
+    frame: FrameBindings,
     group: wgpu::BindGroup,
     pipelines: [crate::pass_library::LibraryPipeline; 4],
     timer: PassTimer,
@@ -281,11 +283,11 @@ pub struct HashCache {
 impl HashCache {
     pub fn new(
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         settings: HashCacheSettings,
     ) -> Result<Self, RenderError> {
         settings.validate()?;
-        let s = tracer.settings();
+        let s = scene.settings();
         let (width, height) = (s.width, s.height);
         gpu.check_resolution(width, height, size_of::<HcRecord>() as u64 + 32 + 16)?;
         gpu.check_buffer_size("hash cache slots", settings.capacity as u64 * 16)?;
@@ -319,7 +321,7 @@ impl HashCache {
 
         let own = OWN_GROUP;
         let (layout, pipelines) =
-            tracer.library_pass(gpu, "hash_cache.wgsl", Self::program(), &own, PASSES)?;
+            scene.library_pass(gpu, "hash_cache.wgsl", Self::program(), &own, PASSES)?;
         let group = crate::compute::buffer_group(
             gpu,
             "hash cache",
@@ -337,6 +339,7 @@ impl HashCache {
             counters,
             primary,
             colour,
+            frame: FrameBindings::new(gpu, scene),
             group,
             pipelines,
             timer: PassTimer::new(gpu, &PASSES),
@@ -384,13 +387,13 @@ impl HashCache {
     pub fn render(
         &mut self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         camera: &Camera,
         seed: u64,
         frame: u32,
         taa: Option<&mut Taa>,
     ) -> Result<HashCacheOutput, RenderError> {
-        let (timings, jitter) = self.update(gpu, tracer, camera, seed, frame)?;
+        let (timings, jitter) = self.update(gpu, scene, camera, seed, frame)?;
         self.resolve(gpu, taa, timings, jitter)
     }
 
@@ -399,7 +402,7 @@ impl HashCache {
     pub fn update(
         &mut self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         camera: &Camera,
         seed: u64,
         frame: u32,
@@ -423,7 +426,7 @@ impl HashCache {
             primary_jitter: jitter,
             pad2: [0.0; 2],
         };
-        tracer.prepare_frame(gpu, 1, 0, seed, frame);
+        self.frame.prepare(gpu, scene, 1, 0, seed, frame);
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         gpu.queue.write_buffer(&self.counters, 0, &[0u8; 32]);
         // The cache's own passes in one timed submission; TAA's resolve (its own timing) after.
@@ -431,8 +434,7 @@ impl HashCache {
         for (i, pipeline) in self.pipelines.iter().enumerate() {
             timed.pass(i, |pass| {
                 pass.set_pipeline(&pipeline.get());
-                pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
-                pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+                self.frame.bind(gpu, scene, pass);
                 pass.set_bind_group(2, &self.group, &[]);
                 if i == 0 {
                     pass.dispatch_workgroups(self.settings.capacity.div_ceil(64), 1, 1);

@@ -7,14 +7,15 @@ use super::moments::RecordMoments;
 use super::settings::{BYTES_PER_RECORD, TerminationSettings, VERTICES_PER_RECORD};
 use crate::compute::{self, BufferBinding};
 use crate::error::RenderError;
+use crate::frame_bindings::FrameBindings;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
 use crate::hash_cache::read;
 use crate::hash_cache::{HashCacheParams, HashCacheSettings};
 use crate::lights::luminance;
 use crate::pass_library::PassLibrary;
-use crate::path_tracer::PathTracer;
 use crate::scene::Camera;
+use crate::scene_gpu::SceneGpu;
 use crate::shader::{Module, Program};
 use crate::taa::TaaPrimary;
 use crate::timing::{PassTimer, PassTiming};
@@ -187,6 +188,7 @@ pub struct TerminationCache {
     primary: wgpu::Buffer,
     colour: wgpu::Buffer,
     path_length: wgpu::Buffer,
+    frame: FrameBindings,
     group: wgpu::BindGroup,
     pipelines: [crate::pass_library::LibraryPipeline; 4],
     timer: PassTimer,
@@ -198,11 +200,11 @@ impl TerminationCache {
     /// Builds the cache; refuses a capacity or resolution over the adapter's buffer limits.
     pub fn new(
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         settings: TerminationSettings,
     ) -> Result<Self, RenderError> {
         settings.validate()?;
-        let s = tracer.settings();
+        let s = scene.settings();
         let (width, height) = (s.width, s.height);
         let pixels = width as u64 * height as u64;
         let cap = settings.capacity as u64;
@@ -247,7 +249,7 @@ impl TerminationCache {
         let colour = buffer("termination colour", pixels * 16, rw);
         let path_length = buffer("termination path length", pixels * 4, rw);
         let (layout, pipelines) =
-            tracer.library_pass(gpu, "termination.wgsl", Self::program(), &OWN_GROUP, PASSES)?;
+            scene.library_pass(gpu, "termination.wgsl", Self::program(), &OWN_GROUP, PASSES)?;
         let group = crate::compute::buffer_group(
             gpu,
             "termination",
@@ -266,6 +268,7 @@ impl TerminationCache {
             primary,
             colour,
             path_length,
+            frame: FrameBindings::new(gpu, scene),
             group,
             pipelines,
             timer: PassTimer::new(gpu, &PASSES),
@@ -329,7 +332,7 @@ impl TerminationCache {
     pub fn render(
         &mut self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         camera: &Camera,
         seed: u64,
         frame: u32,
@@ -337,10 +340,10 @@ impl TerminationCache {
         if self.frames == 0 {
             for k in 0..self.settings.warmup_frames {
                 // Warm-up frames draw their own random numbers (frame indices no run reaches).
-                self.passes(gpu, tracer, camera, seed, 0x8000_0000 + k, WARMUP_MAX_VERTICES)?;
+                self.passes(gpu, scene, camera, seed, 0x8000_0000 + k, WARMUP_MAX_VERTICES)?;
             }
         }
-        let timings = self.passes(gpu, tracer, camera, seed, frame, self.settings.max_vertices)?;
+        let timings = self.passes(gpu, scene, camera, seed, frame, self.settings.max_vertices)?;
         let radiance = read(gpu, &self.colour, "termination colour")?;
         let primary: Vec<TaaPrimary> = read(gpu, &self.primary, "termination primary hits")?;
         let path_length: Vec<f32> = read(gpu, &self.path_length, "termination path length")?;
@@ -374,7 +377,7 @@ impl TerminationCache {
     fn passes(
         &mut self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         camera: &Camera,
         seed: u64,
         frame: u32,
@@ -423,7 +426,7 @@ impl TerminationCache {
             candidate_mask: scene::mix64(seed ^ ((frame as u64) << 32)) as u32 & 0x0fff_ffff,
             pad: 0,
         };
-        tracer.prepare_frame(gpu, 1, 0, seed, frame);
+        self.frame.prepare(gpu, scene, 1, 0, seed, frame);
         gpu.queue.write_buffer(&self.hc, 0, bytemuck::bytes_of(&hc));
         gpu.queue.write_buffer(&self.tc, 0, bytemuck::bytes_of(&tc));
         gpu.queue.write_buffer(&self.counters, 0, &[0u8; COUNTERS as usize * 4]);
@@ -436,8 +439,7 @@ impl TerminationCache {
             };
             timed.pass(i, |pass| {
                 pass.set_pipeline(&pipeline.get());
-                pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
-                pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+                self.frame.bind(gpu, scene, pass);
                 pass.set_bind_group(2, &self.group, &[]);
                 if groups > 0 {
                     pass.dispatch_workgroups(groups, 1, 1);

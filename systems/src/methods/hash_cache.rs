@@ -14,7 +14,7 @@ pub use render::hash_cache::HashCacheSettings;
 
 use super::{MethodOutput, MethodPlugin, temporal_window};
 use crate::frame::{
-    FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
+    FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage, method_failed,
 };
 
 /// `hash_cache` (the paper's first-hit lookup), `hash_cache_taa` (under TAA, as the paper runs
@@ -62,10 +62,10 @@ impl MethodPlugin for Plugin {
 
     fn spawn(world: &mut World, entity: Entity, settings: &HashCacheSettings) -> Result<()> {
         settings.validate()?;
-        let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
-        let cache = HashCache::new(gpu, tracer, *settings)?;
+        let (gpu, gpu_scene) = (&world.resource::<GpuDevice>().0, &world.resource::<GpuScene>().0);
+        let cache = HashCache::new(gpu, gpu_scene, *settings)?;
         let taa =
-            settings.taa.then(|| Taa::new(gpu, tracer, TaaSettings::default())).transpose()?;
+            settings.taa.then(|| Taa::new(gpu, gpu_scene, TaaSettings::default())).transpose()?;
         world.entity_mut(entity).insert(HashCacheState { cache, taa, updated: None });
         Ok(())
     }
@@ -74,7 +74,7 @@ impl MethodPlugin for Plugin {
 /// The cache's passes: age (eviction), trace, update, resolve into its colour.
 pub fn age_and_update(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     scene: Res<sim::ExtractedScene>,
@@ -84,7 +84,7 @@ pub fn age_and_update(
         let start = Instant::now();
         let updated = state
             .cache
-            .update(&gpu.0, &tracer.0, &scene.scene.camera, run.scenario.seed, clock.global)
+            .update(&gpu.0, &gpu_scene.0, &scene.scene.camera, run.scenario.seed, clock.global)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         state.updated = Some(updated);
         frame.add_cpu(start);

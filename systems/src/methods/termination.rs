@@ -15,7 +15,7 @@ pub use render::termination::TerminationSettings;
 
 use super::{MethodImage, MethodOutput, MethodPlugin};
 use crate::frame::{
-    FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
+    FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage, method_failed,
 };
 
 /// `termination_vb_0.1`, `termination_mse_100`, ...
@@ -51,9 +51,9 @@ impl MethodPlugin for Plugin {
     }
 
     fn spawn(world: &mut World, entity: Entity, settings: &TerminationSettings) -> Result<()> {
-        let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
+        let (gpu, gpu_scene) = (&world.resource::<GpuDevice>().0, &world.resource::<GpuScene>().0);
         // Validates the settings and checks the cache's buffers against the adapter's limits.
-        let cache = TerminationCache::new(gpu, tracer, *settings)?;
+        let cache = TerminationCache::new(gpu, gpu_scene, *settings)?;
         world.entity_mut(entity).insert(TerminationState { cache });
         Ok(())
     }
@@ -62,7 +62,7 @@ impl MethodPlugin for Plugin {
 /// The cache's passes and the frame's image (one path per pixel).
 pub fn render(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     scene: Res<sim::ExtractedScene>,
@@ -72,7 +72,7 @@ pub fn render(
         let start = Instant::now();
         let out = state
             .cache
-            .render(&gpu.0, &tracer.0, &scene.scene.camera, run.scenario.seed, clock.global)
+            .render(&gpu.0, &gpu_scene.0, &scene.scene.camera, run.scenario.seed, clock.global)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let s = out.stats;
         frame.output = Some(MethodOutput {

@@ -11,12 +11,13 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use bevy_ecs::prelude::*;
 use media::gpu::{Combination, MisWeight, VolumePathSettings};
+use render::frame_bindings::FrameBindings;
 use serde::{Deserialize, Serialize};
 
 use super::{MethodOutput, MethodPlugin};
 use crate::frame::scene_medium::{SceneMedium, render_volume};
 use crate::frame::{
-    FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed,
+    FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage, method_failed,
 };
 
 /// `VolumePath(spp: 4, mis: Jackknife, combination: Eq9)`.
@@ -60,8 +61,9 @@ impl VolumePathMethod {
     }
 }
 
+/// The method's settings and its frame uniform.
 #[derive(Component)]
-pub struct VolumePath(VolumePathMethod);
+pub struct VolumePath(VolumePathMethod, FrameBindings);
 
 pub struct Plugin;
 
@@ -105,14 +107,16 @@ impl MethodPlugin for Plugin {
                 "VolumePath: the scenario declares no media; expected media: [(name: ..., kind: ..., ...)]"
             );
         }
-        world.entity_mut(entity).insert(VolumePath(s.clone()));
+        let uniform =
+            FrameBindings::new(&world.resource::<GpuDevice>().0, &world.resource::<GpuScene>().0);
+        world.entity_mut(entity).insert(VolumePath(s.clone(), uniform));
         Ok(())
     }
 }
 
 pub fn render(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     mut medium: ResMut<SceneMedium>,
     run: Res<Run>,
     clock: Res<FrameClock>,
@@ -122,7 +126,8 @@ pub fn render(
         let start = Instant::now();
         let (radiance, timings, paths) = render_volume(
             &gpu.0,
-            &tracer,
+            &gpu_scene.0,
+            &method.1,
             &mut medium,
             &method.0.settings(),
             method.0.spp,
