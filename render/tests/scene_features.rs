@@ -10,6 +10,7 @@ use render::compute::BufferBinding;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::{Instance, Light, SceneDesc, Texture};
 use render::scene_features::SceneFeatures;
+use render::scene_gpu::SceneGpu;
 use render::taa::Taa;
 
 fn settings() -> PathTracerSettings {
@@ -43,8 +44,9 @@ fn lit_open_scene() -> SceneDesc {
 
 #[test]
 fn passes_for_the_scene_s_lights_render_what_passes_for_every_light_do() {
-    let mut tracer = PathTracer::new(gpu(), &room_scene(), settings()).expect("tracer");
-    let stack = SceneFeatures::stack_for(tracer.geometry().stack_entries());
+    let sg = SceneGpu::new(gpu(), &room_scene(), settings()).expect("scene");
+    let mut tracer = PathTracer::new(gpu(), &sg).expect("tracer");
+    let stack = SceneFeatures::stack_for(sg.geometry().stack_entries());
     assert!(
         stack < SceneFeatures::ALL.traversal_stack,
         "the room's BVH is shallow: {stack} entries"
@@ -57,17 +59,14 @@ fn passes_for_the_scene_s_lights_render_what_passes_for_every_light_do() {
         traversal_stack: stack,
     };
     assert_eq!(
-        tracer.library().features(),
+        sg.library().features(),
         room,
         "the room has only its emissive panel, and no textures"
     );
-    let own = tracer.render(gpu(), 4, 7, 0).expect("frame");
-    tracer
-        .library()
-        .specialise(gpu(), tracer.scene(), SceneFeatures::ALL)
-        .expect("compile for every feature");
-    assert_eq!(tracer.library().features(), SceneFeatures::ALL);
-    let every = tracer.render(gpu(), 4, 7, 0).expect("frame");
+    let own = tracer.render(gpu(), &sg, 4, 7, 0).expect("frame");
+    sg.library().specialise(gpu(), &sg, SceneFeatures::ALL).expect("compile for every feature");
+    assert_eq!(sg.library().features(), SceneFeatures::ALL);
+    let every = tracer.render(gpu(), &sg, 4, 7, 0).expect("frame");
     assert!(own.radiance.iter().any(|p| p[0] > 0.0), "the room is lit");
     assert_eq!(
         own.radiance, every.radiance,
@@ -77,7 +76,8 @@ fn passes_for_the_scene_s_lights_render_what_passes_for_every_light_do() {
 
 #[test]
 fn a_scene_that_gains_features_gets_passes_compiled_for_them() {
-    let mut tracer = PathTracer::new(gpu(), &open_scene(), settings()).expect("tracer");
+    let mut sg = SceneGpu::new(gpu(), &open_scene(), settings()).expect("scene");
+    let mut tracer = PathTracer::new(gpu(), &sg).expect("tracer");
     // Any pass on the library: TAA's trace pass, as a method holds it.
     let own = [
         BufferBinding::uniform("taa", "TaaParams"),
@@ -85,28 +85,27 @@ fn a_scene_that_gains_features_gets_passes_compiled_for_them() {
         BufferBinding::read_write("taa_primary", "array<TaaPrimary>"),
         BufferBinding::read_write("taa_counters", "array<atomic<u32>>"),
     ];
-    let (_, [before]) = tracer
+    let (_, [before]) = sg
         .library_pass(gpu(), "taa_trace.wgsl", Taa::trace_program(), &own, ["taa_trace"])
         .expect("pass");
     let held = before.get();
-    let dark = tracer.render(gpu(), 4, 7, 0).expect("frame");
+    let dark = tracer.render(gpu(), &sg, 4, 7, 0).expect("frame");
 
-    tracer.try_update(gpu(), &lit_open_scene()).expect("update");
-    let stack = SceneFeatures::stack_for(tracer.geometry().stack_entries());
+    sg.try_update(gpu(), &lit_open_scene()).expect("update");
+    let stack = SceneFeatures::stack_for(sg.geometry().stack_entries());
     assert_eq!(
-        tracer.library().features(),
+        sg.library().features(),
         SceneFeatures { traversal_stack: stack, ..SceneFeatures::ALL }
     );
     assert!(
         before.get() != held,
         "the held pipeline was swapped for one compiled with the new features"
     );
-    let updated = tracer.render(gpu(), 4, 7, 0).expect("frame");
-    // A tracer built on the lit scene from the start: its passes were compiled for its features.
-    let fresh = PathTracer::new(gpu(), &lit_open_scene(), settings())
-        .expect("tracer")
-        .render(gpu(), 4, 7, 0)
-        .expect("frame");
+    let updated = tracer.render(gpu(), &sg, 4, 7, 0).expect("frame");
+    // A scene uploaded lit from the start: its passes were compiled for its features.
+    let lit = SceneGpu::new(gpu(), &lit_open_scene(), settings()).expect("scene");
+    let fresh =
+        PathTracer::new(gpu(), &lit).expect("tracer").render(gpu(), &lit, 4, 7, 0).expect("frame");
     assert_eq!(
         updated.radiance, fresh.radiance,
         "after the update the passes sample the environment and the point light, and read the texture"
@@ -125,20 +124,21 @@ fn the_traversal_stack_never_shrinks_within_a_run() {
             transform: Mat4::from_translation(Vec3::new(i as f32 * 3.0, 0.0, -4.0)),
         })
         .collect();
-    let mut tracer = PathTracer::new(gpu(), &crowd, settings()).expect("tracer");
-    let deep = tracer.geometry().stack_entries();
-    assert_eq!(tracer.library().features().traversal_stack, SceneFeatures::stack_for(deep));
-    tracer.try_update(gpu(), &room_scene()).expect("update");
+    let mut sg = SceneGpu::new(gpu(), &crowd, settings()).expect("scene");
+    let mut tracer = PathTracer::new(gpu(), &sg).expect("tracer");
+    let deep = sg.geometry().stack_entries();
+    assert_eq!(sg.library().features().traversal_stack, SceneFeatures::stack_for(deep));
+    sg.try_update(gpu(), &room_scene()).expect("update");
     assert!(
-        tracer.geometry().stack_entries() < deep,
+        sg.geometry().stack_entries() < deep,
         "fewer instances, a shallower TLAS: {} against {deep}",
-        tracer.geometry().stack_entries()
+        sg.geometry().stack_entries()
     );
     assert_eq!(
-        tracer.library().features().traversal_stack,
+        sg.library().features().traversal_stack,
         SceneFeatures::stack_for(deep),
         "kept: a TLAS that deepens again needs no new pipelines"
     );
-    let frame = tracer.render(gpu(), 1, 7, 0).expect("frame");
+    let frame = tracer.render(gpu(), &sg, 1, 7, 0).expect("frame");
     assert!(frame.radiance.iter().any(|p| p[0] > 0.0));
 }
