@@ -13,6 +13,7 @@ use std::path::Path;
 use hash_cache::{HashCache, HashCacheSettings};
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
+use render::scene_gpu::SceneGpu;
 use render::timing::PassTiming;
 use sample_cache::{DISPATCHES, Retrace, SampleCache, SampleCacheSettings};
 use sim::{Scenario, Simulation};
@@ -70,18 +71,19 @@ fn main() -> anyhow::Result<()> {
         max_depth: scenario.max_depth,
         rr_start_depth: 3,
     };
-    let mut tracer = PathTracer::new(&gpu, sim.scene(), settings)?;
-    let mut taa = Taa::new(&gpu, &tracer, TaaSettings::default())?;
-    let mut hc = HashCache::new(&gpu, &tracer, HashCacheSettings::default())?;
+    let mut sg = SceneGpu::new(&gpu, sim.scene(), settings)?;
+    let mut tracer = PathTracer::new(&gpu, &sg)?;
+    let mut taa = Taa::new(&gpu, &sg, TaaSettings::default())?;
+    let mut hc = HashCache::new(&gpu, &sg, HashCacheSettings::default())?;
     let mut hc_taa = (
-        HashCache::new(&gpu, &tracer, HashCacheSettings::default())?,
-        Taa::new(&gpu, &tracer, TaaSettings::default())?,
+        HashCache::new(&gpu, &sg, HashCacheSettings::default())?,
+        Taa::new(&gpu, &sg, TaaSettings::default())?,
     );
     let strategies = [Retrace::Single, Retrace::Multi, Retrace::Adaptive];
     let mut caches: Vec<SampleCache> = strategies
         .iter()
         .map(|&retrace| {
-            SampleCache::new(&gpu, &tracer, SampleCacheSettings { retrace, ..Default::default() })
+            SampleCache::new(&gpu, &sg, SampleCacheSettings { retrace, ..Default::default() })
         })
         .collect::<Result<_, _>>()?;
     let labels = [
@@ -98,7 +100,7 @@ fn main() -> anyhow::Result<()> {
     let mut primary_rays = [0u64; 3];
     let mut clock = None;
     for f in 0..frames {
-        tracer.update(&gpu, sim.scene());
+        sg.update(&gpu, sim.scene());
         let frame = sim.frame();
         let timed = f >= WARM_UP;
         let mut record = |label: &'static str, timings: &[PassTiming], rays: u64, shaded: u64| {
@@ -107,15 +109,15 @@ fn main() -> anyhow::Result<()> {
                 sums.entry(label).or_default().add(timings, rays, shaded);
             }
         };
-        let pt = tracer.render(&gpu, 1, scenario.seed, frame)?;
+        let pt = tracer.render(&gpu, &sg, 1, scenario.seed, frame)?;
         record("pt_1spp", &pt.timings, pt.rays, pt.shaded);
-        let t = taa.render(&gpu, &tracer, scenario.seed, frame)?;
+        let t = taa.render(&gpu, &sg, scenario.seed, frame)?;
         record("taa", &t.timings, t.rays, t.shaded);
-        let o = hc.render(&gpu, &tracer, &sim.scene().camera, scenario.seed, frame, None)?;
+        let o = hc.render(&gpu, &sg, &sim.scene().camera, scenario.seed, frame, None)?;
         record("hash_cache", &o.timings, o.rays, o.shaded);
         let o = hc_taa.0.render(
             &gpu,
-            &tracer,
+            &sg,
             &sim.scene().camera,
             scenario.seed,
             frame,
@@ -123,7 +125,7 @@ fn main() -> anyhow::Result<()> {
         )?;
         record("hash_cache_taa", &o.timings, o.rays, o.shaded);
         for (i, cache) in caches.iter_mut().enumerate() {
-            let o = cache.render(&gpu, &tracer, scenario.seed, frame)?;
+            let o = cache.render(&gpu, &sg, scenario.seed, frame)?;
             record(labels[4 + i], &o.timings, o.stats.all_rays as u64, o.stats.shaded as u64);
             if timed {
                 for (d, t) in o.dispatch_timings.iter().enumerate() {

@@ -10,6 +10,7 @@ use render::bvh::displaced_sphere;
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::{Instance, Material, SceneDesc};
+use render::scene_gpu::SceneGpu;
 use systems::mitsuba::{self, lambertian_cornell_box};
 use systems::scenario::builtin_scene;
 
@@ -239,14 +240,15 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
             let scene = builtin_scene(name, (w, h))?;
             let settings =
                 PathTracerSettings { width: w, height: h, max_depth: 8, rr_start_depth: 3 };
-            let mut tracer = PathTracer::new(&gpu, &scene, settings)?;
-            tracer.update(&gpu, &scene);
-            tracer.render(&gpu, 1, 1, 0)?;
+            let mut gpu_scene = SceneGpu::new(&gpu, &scene, settings)?;
+            let mut tracer = PathTracer::new(&gpu, &gpu_scene)?;
+            gpu_scene.update(&gpu, &scene);
+            tracer.render(&gpu, &gpu_scene, 1, 1, 0)?;
             let mut gpu_ms: Vec<(String, f64, u32)> = Vec::new();
             let mut rays = 0u64;
             let start = Instant::now();
             for f in 0..opts.frames {
-                let out = tracer.render(&gpu, 1, 1, f + 1)?;
+                let out = tracer.render(&gpu, &gpu_scene, 1, 1, f + 1)?;
                 rays += out.rays;
                 for t in &out.timings {
                     let entry = match gpu_ms.iter_mut().find(|(p, _, _)| *p == t.pass) {
@@ -365,21 +367,30 @@ fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
         max_depth: REFERENCE_MAX_DEPTH,
         rr_start_depth: REFERENCE_INTEGRATOR.rr_depth,
     };
-    let mut tracer = PathTracer::new(gpu, &scene, settings)?;
-    tracer.update(gpu, &scene);
-    tracer.render_reference(gpu, 1, 1, 0, &mut |_, _| {})?;
+    let mut gpu_scene = SceneGpu::new(gpu, &scene, settings)?;
+    let mut tracer = PathTracer::new(gpu, &gpu_scene)?;
+    gpu_scene.update(gpu, &scene);
+    tracer.render_reference(gpu, &gpu_scene, 1, 1, 0, &mut |_, _| {})?;
     let start = Instant::now();
-    let image = tracer.render_reference(gpu, spp, 1, 0, &mut |_, _| {})?;
+    let image = tracer.render_reference(gpu, &gpu_scene, spp, 1, 0, &mut |_, _| {})?;
     let seconds = start.elapsed().as_secs_f64();
     let paths_per_s = (size * size) as f64 * spp as f64 / seconds;
-    let wavefront = Wavefront::new(gpu, &tracer)?;
-    wavefront.render_reference(gpu, &tracer, 1, 1, 0)?;
+    let wavefront = Wavefront::new(gpu, &gpu_scene)?;
+    wavefront.render_reference(gpu, &gpu_scene, &tracer, 1, 1, 0)?;
     let start = Instant::now();
-    let wf_image = wavefront.render_reference(gpu, &tracer, spp, 1, 0)?;
+    let wf_image = wavefront.render_reference(gpu, &gpu_scene, &tracer, spp, 1, 0)?;
     let wavefront_paths_per_s = (size * size) as f64 * spp as f64 / start.elapsed().as_secs_f64();
     // Where its time goes: each kernel waited for alone (slower than the timed run above).
     let mut kernel_times = KernelTimes::default();
-    wavefront.render_reference_per_kernel(gpu, &tracer, spp, 1, 0, &mut kernel_times)?;
+    wavefront.render_reference_per_kernel(
+        gpu,
+        &gpu_scene,
+        &tracer,
+        spp,
+        1,
+        0,
+        &mut kernel_times,
+    )?;
     let wavefront_kernel_seconds: Vec<(String, f64)> = Kernel::ALL
         .iter()
         .map(|k| (k.name().to_string(), kernel_times.seconds[*k as usize]))
@@ -418,16 +429,17 @@ fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
 /// so that every timed section starts at working clocks.
 fn warm_up(gpu: &Gpu) -> Result<()> {
     let scene = builtin_scene("cornell_box", (320, 180))?;
-    let mut tracer = PathTracer::new(
+    let mut gpu_scene = SceneGpu::new(
         gpu,
         &scene,
         PathTracerSettings { width: 320, height: 180, max_depth: 8, rr_start_depth: 3 },
     )?;
-    tracer.update(gpu, &scene);
+    let mut tracer = PathTracer::new(gpu, &gpu_scene)?;
+    gpu_scene.update(gpu, &scene);
     let start = Instant::now();
     let mut frame = 0;
     while frame < 2 || start.elapsed().as_secs_f64() < 1.0 {
-        tracer.render(gpu, 1, 1, frame)?;
+        tracer.render(gpu, &gpu_scene, 1, 1, frame)?;
         frame += 1;
     }
     Ok(())

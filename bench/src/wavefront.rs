@@ -4,14 +4,17 @@
 //! indirectly over them. Each sample's value is the megakernel's (same random numbers, same
 //! order of sums); bench/shaders/wavefront.wgsl says how.
 //!
-//! It renders into the [`PathTracer`]'s radiance sum, so `PathTracer::read_radiance` reads it.
+//! It renders into a [`PathTracer`]'s radiance sum, so `PathTracer::read_radiance` reads it, with
+//! its own frame parameters.
 
 use render::compute::{self, BufferBinding};
 use render::error::RenderError;
+use render::frame_bindings::FrameBindings;
 use render::gpu::Gpu;
 use render::pass_library::LibraryPipeline;
 use render::path_tracer::{PathTracer, SAMPLES_PER_THREAD};
 use render::readback::read_buffer;
+use render::scene_gpu::SceneGpu;
 use render::shader::{Module, Program};
 
 /// Invocations per workgroup of the queue kernels.
@@ -40,6 +43,7 @@ const OWN_GROUP: [BufferBinding; 4] = [
 ];
 
 pub struct Wavefront {
+    frame: FrameBindings,
     layout: wgpu::BindGroupLayout,
     generate: LibraryPipeline,
     extend: LibraryPipeline,
@@ -59,27 +63,27 @@ pub struct Wavefront {
 
 impl Wavefront {
     /// Waves of about [`WAVE_PATHS`] paths.
-    pub fn new(gpu: &Gpu, tracer: &PathTracer) -> Result<Self, RenderError> {
-        Self::with_wave_paths(gpu, tracer, WAVE_PATHS)
+    pub fn new(gpu: &Gpu, scene: &SceneGpu) -> Result<Self, RenderError> {
+        Self::with_wave_paths(gpu, scene, WAVE_PATHS)
     }
 
     /// Waves of whole chunks of [`SAMPLES_PER_THREAD`] samples per pixel, as many as fit in
     /// `wave_paths` paths (at least one chunk) and in the adapter's largest storage binding.
     pub fn with_wave_paths(
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         wave_paths: u64,
     ) -> Result<Self, RenderError> {
-        let (layout, [generate, extend, shade, shadow, advance, reduce]) = tracer.library_pass(
+        let (layout, [generate, extend, shade, shadow, advance, reduce]) = scene.library_pass(
             gpu,
             "wavefront.wgsl",
             Self::program(),
             &OWN_GROUP,
             ["wf_generate", "wf_extend", "wf_shade", "wf_shadow", "wf_advance", "wf_reduce"],
         )?;
-        let settings = tracer.settings();
+        let settings = scene.settings();
         let pixels = settings.width as u64 * settings.height as u64;
-        let light_samples = Self::light_samples(tracer);
+        let light_samples = Self::light_samples(scene);
         let per_path = 16 * (VEC4S_PER_PATH + VEC4S_PER_LIGHT_SAMPLE * light_samples);
         let max_paths =
             gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size) / per_path;
@@ -123,6 +127,7 @@ impl Wavefront {
             mapped_at_creation: false,
         });
         Ok(Self {
+            frame: FrameBindings::new(gpu, scene),
             layout,
             generate,
             extend,
@@ -140,9 +145,9 @@ impl Wavefront {
     }
 
     /// Light samples per shading point, as wavefront.wgsl's `light_samples` counts them.
-    fn light_samples(tracer: &PathTracer) -> u64 {
-        let features = tracer.library().features();
-        tracer.scene().analytic_lights() as u64 * features.analytic_lights as u64
+    fn light_samples(scene: &SceneGpu) -> u64 {
+        let features = scene.library().features();
+        scene.analytic_lights() as u64 * features.analytic_lights as u64
             + features.emitters as u64
             + features.environment as u64
     }
@@ -160,41 +165,46 @@ impl Wavefront {
     }
 
     /// Samples per pixel of one wave.
-    pub fn samples_per_wave(&self, tracer: &PathTracer) -> u32 {
-        let settings = tracer.settings();
+    pub fn samples_per_wave(&self, scene: &SceneGpu) -> u32 {
+        let settings = scene.settings();
         (self.capacity / (settings.width as u64 * settings.height as u64)) as u32
     }
 
     /// [`PathTracer::render_reference`] as a wavefront: `spp` samples per pixel in waves of
-    /// [`Self::samples_per_wave`].
+    /// [`Self::samples_per_wave`], into `tracer`'s radiance sum.
     pub fn render_reference(
         &self,
         gpu: &Gpu,
+        scene: &SceneGpu,
         tracer: &PathTracer,
         spp: u32,
         seed: u64,
         frame: u32,
     ) -> Result<Vec<[f32; 4]>, RenderError> {
-        self.trace(gpu, tracer, spp, seed, frame, None)
+        self.trace(gpu, scene, tracer, spp, seed, frame, None)
     }
 
     /// [`Self::render_reference`] with each kernel submitted alone and waited for, its wall time
     /// added to `times`: slower, for seeing where a wavefront's time goes.
+    #[allow(clippy::too_many_arguments)]
     pub fn render_reference_per_kernel(
         &self,
         gpu: &Gpu,
+        scene: &SceneGpu,
         tracer: &PathTracer,
         spp: u32,
         seed: u64,
         frame: u32,
         times: &mut KernelTimes,
     ) -> Result<Vec<[f32; 4]>, RenderError> {
-        self.trace(gpu, tracer, spp, seed, frame, Some(times))
+        self.trace(gpu, scene, tracer, spp, seed, frame, Some(times))
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn trace(
         &self,
         gpu: &Gpu,
+        scene: &SceneGpu,
         tracer: &PathTracer,
         spp: u32,
         seed: u64,
@@ -204,14 +214,14 @@ impl Wavefront {
         if spp == 0 {
             return Err(RenderError::Settings("reference spp must be at least 1".into()));
         }
-        if Self::light_samples(tracer) > self.light_samples {
+        if Self::light_samples(scene) > self.light_samples {
             return Err(RenderError::Settings(format!(
                 "the scene has {} light samples per shading point, the wavefront was sized for {}: build it again",
-                Self::light_samples(tracer),
+                Self::light_samples(scene),
                 self.light_samples
             )));
         }
-        let settings = tracer.settings();
+        let settings = scene.settings();
         let pixels = settings.width as u64 * settings.height as u64;
         let bind_group = compute::buffer_group(
             gpu,
@@ -219,7 +229,7 @@ impl Wavefront {
             &self.layout,
             &[tracer.radiance_sum_buffer(), tracer.counters_buffer(), &self.state, &self.control],
         );
-        let per_wave = self.samples_per_wave(tracer);
+        let per_wave = self.samples_per_wave(scene);
         let new_encoder = || {
             gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("wavefront"),
@@ -235,8 +245,7 @@ impl Wavefront {
                     label: Some(kernel.name()),
                     timestamp_writes: None,
                 });
-                pass.set_bind_group(0, tracer.scene().bind_group(), &[]);
-                pass.set_bind_group(1, tracer.scene().geometry().bind_group(), &[]);
+                self.frame.bind(gpu, scene, &mut pass);
                 pass.set_bind_group(2, &bind_group, &[]);
                 pass.set_pipeline(&self.pipeline(kernel).get());
                 match dispatch {
@@ -254,7 +263,7 @@ impl Wavefront {
         let mut done = 0;
         while done < spp {
             let batch = per_wave.min(spp - done);
-            tracer.scene().write_frame(gpu, batch, done, seed, frame, done > 0);
+            self.frame.write(gpu, scene, batch, done, seed, frame, done > 0);
             let paths = pixels as u32 * batch;
             let groups = paths.div_ceil(WF_GROUP);
             let control: [u32; CONTROL_WORDS as usize] =

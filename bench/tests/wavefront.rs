@@ -10,6 +10,7 @@ use glam::Vec3;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::{Light, SceneDesc, Texture};
 use render::scene_features::SceneFeatures;
+use render::scene_gpu::SceneGpu;
 
 fn settings() -> PathTracerSettings {
     PathTracerSettings { width: W, height: H, max_depth: 6, rr_start_depth: 2 }
@@ -42,15 +43,16 @@ fn lit_room() -> SceneDesc {
 /// Both forms at `spp`, the megakernel's dispatches cut to the wavefront's waves (two chunks of
 /// 8 samples per pixel), so that both add the same partial sums.
 fn both(scene: &SceneDesc, spp: u32) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
-    let mut tracer = PathTracer::new(gpu(), scene, settings()).expect("tracer");
-    tracer.update(gpu(), scene);
+    let mut sg = SceneGpu::new(gpu(), scene, settings()).expect("scene");
+    let mut tracer = PathTracer::new(gpu(), &sg).expect("tracer");
+    sg.update(gpu(), scene);
     let pixels = (W * H) as u64;
-    let wavefront = Wavefront::with_wave_paths(gpu(), &tracer, pixels * 16).expect("wavefront");
-    assert_eq!(wavefront.samples_per_wave(&tracer), 16);
+    let wavefront = Wavefront::with_wave_paths(gpu(), &sg, pixels * 16).expect("wavefront");
+    assert_eq!(wavefront.samples_per_wave(&sg), 16);
     tracer.set_paths_per_dispatch(gpu(), pixels * 16).expect("dispatch size");
     assert_eq!(tracer.samples_per_dispatch(), 16);
-    let mega = tracer.render_reference(gpu(), spp, 5, 3, &mut |_, _| {}).expect("megakernel");
-    let wave = wavefront.render_reference(gpu(), &tracer, spp, 5, 3).expect("wavefront");
+    let mega = tracer.render_reference(gpu(), &sg, spp, 5, 3, &mut |_, _| {}).expect("megakernel");
+    let wave = wavefront.render_reference(gpu(), &sg, &tracer, spp, 5, 3).expect("wavefront");
     (mega, wave)
 }
 
@@ -88,16 +90,14 @@ fn the_wavefront_renders_the_megakernel_s_image_with_every_kind_of_light() {
 fn the_wavefront_follows_passes_compiled_for_every_feature() {
     // The light samples per shading point follow the features the library compiled for.
     let scene = room_scene();
-    let mut tracer = PathTracer::new(gpu(), &scene, settings()).expect("tracer");
-    tracer.update(gpu(), &scene);
-    tracer
-        .library()
-        .specialise(gpu(), tracer.scene(), SceneFeatures::ALL)
-        .expect("compile for every feature");
+    let mut sg = SceneGpu::new(gpu(), &scene, settings()).expect("scene");
+    let mut tracer = PathTracer::new(gpu(), &sg).expect("tracer");
+    sg.update(gpu(), &scene);
+    sg.library().specialise(gpu(), &sg, SceneFeatures::ALL).expect("compile for every feature");
     let pixels = (W * H) as u64;
-    let wavefront = Wavefront::with_wave_paths(gpu(), &tracer, pixels * 8).expect("wavefront");
+    let wavefront = Wavefront::with_wave_paths(gpu(), &sg, pixels * 8).expect("wavefront");
     tracer.set_paths_per_dispatch(gpu(), pixels * 8).expect("dispatch size");
-    let mega = tracer.render_reference(gpu(), 8, 1, 0, &mut |_, _| {}).expect("megakernel");
-    let wave = wavefront.render_reference(gpu(), &tracer, 8, 1, 0).expect("wavefront");
+    let mega = tracer.render_reference(gpu(), &sg, 8, 1, 0, &mut |_, _| {}).expect("megakernel");
+    let wave = wavefront.render_reference(gpu(), &sg, &tracer, 8, 1, 0).expect("wavefront");
     assert_same(&mega, &wave);
 }

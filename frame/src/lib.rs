@@ -27,7 +27,7 @@ use bevy_ecs::prelude::*;
 pub use method::{MethodPlugin, MethodSpec, Registered, RegisteredMethod};
 pub use method_output::{MethodImage, MethodOutput};
 pub use resources::{
-    FrameClock, GpuDevice, MethodFrame, MethodInfo, Progress, References, Run, RunOutput, Tracer,
+    FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Progress, References, Run, RunOutput,
 };
 pub use stage::{
     Stage, catch_failures, describe, failed, listing, method_failed, new_schedule, take_failure,

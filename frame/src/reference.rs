@@ -3,11 +3,33 @@
 
 use bevy_ecs::prelude::*;
 
-use super::resources::{FrameClock, GpuDevice, Progress, References, Run, Tracer};
+use super::resources::{FrameClock, GpuDevice, GpuScene, Progress, References, Run};
 use super::stage::failed;
 use crate::frame_metrics as measure;
 use crate::reference_cache::{ReferenceCache, ReferenceKey};
+use render::frame_bindings::FrameBindings;
+use render::gpu::Gpu;
 use render::path_tracer::PathTracer;
+use render::scene_gpu::SceneGpu;
+
+/// What renders the references, with its own frame parameters and outputs.
+pub enum ReferenceRenderer {
+    /// A scenario without media: the path tracer.
+    Path(Box<PathTracer>),
+    /// A scenario with media: the volumetric path tracer (the pass is `SceneMedium`'s, shared
+    /// with the VolumePath methods), with the references' frame parameters.
+    Volume(FrameBindings),
+}
+
+impl ReferenceRenderer {
+    pub fn new(gpu: &Gpu, scene: &SceneGpu, media: bool) -> anyhow::Result<Self> {
+        Ok(if media {
+            Self::Volume(FrameBindings::new(gpu, scene))
+        } else {
+            Self::Path(Box::new(PathTracer::new(gpu, scene)?))
+        })
+    }
+}
 
 /// References use their own random sequence, so they never share noise with a method.
 pub fn reference_seed(seed: u64) -> u64 {
@@ -17,7 +39,7 @@ pub fn reference_seed(seed: u64) -> u64 {
 /// Render stage: this frame's reference into [`References::current`] (or `None`).
 pub fn render_reference(
     gpu: Res<GpuDevice>,
-    mut tracer: ResMut<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     scene: Res<sim::ExtractedScene>,
@@ -31,7 +53,7 @@ pub fn render_reference(
         return Ok(());
     }
     let (width, height) = (run.width, run.height);
-    let settings = tracer.0.settings();
+    let settings = gpu_scene.0.settings();
     // With a medium the volumetric path tracer renders the reference: its shaders, the medium
     // and its state are part of the key.
     let shader_source = match &medium {
@@ -57,6 +79,7 @@ pub fn render_reference(
         },
     );
     let frame = clock.frame;
+    let references = &mut *references;
     let pixels = match references.cache.load(&key, width, height) {
         Some(px) => {
             references.cached += 1;
@@ -66,22 +89,28 @@ pub fn render_reference(
             let bar = &progress.0;
             bar.set_message(format!("reference {frame:04}"));
             let spp = scenario.reference.spp;
-            let px = match medium.as_deref_mut() {
-                Some(m) => super::scene_medium::render_volume(
-                    &gpu.0,
-                    &tracer,
-                    m,
-                    &super::scene_medium::REFERENCE_SETTINGS,
-                    spp,
-                    reference_seed(scenario.seed),
-                    clock.global,
-                )
-                .map(|(px, _, _)| px)
-                .map_err(|e| failed(anyhow::anyhow!("reference of frame {frame}: {e}")))?,
-                None => tracer
-                    .0
+            let fail = |e: &dyn std::fmt::Display| {
+                failed(anyhow::anyhow!("reference of frame {frame}: {e}"))
+            };
+            let px = match (references.renderer.as_mut(), medium.as_deref_mut()) {
+                (Some(ReferenceRenderer::Volume(bindings)), Some(m)) => {
+                    super::scene_medium::render_volume(
+                        &gpu.0,
+                        &gpu_scene.0,
+                        bindings,
+                        m,
+                        &super::scene_medium::REFERENCE_SETTINGS,
+                        spp,
+                        reference_seed(scenario.seed),
+                        clock.global,
+                    )
+                    .map(|(px, _, _)| px)
+                    .map_err(|e| fail(&e))?
+                }
+                (Some(ReferenceRenderer::Path(tracer)), None) => tracer
                     .render_reference(
                         &gpu.0,
+                        &gpu_scene.0,
                         spp,
                         reference_seed(scenario.seed),
                         clock.global,
@@ -89,7 +118,8 @@ pub fn render_reference(
                             bar.set_message(format!("reference {frame:04}: {done}/{total} spp"));
                         },
                     )
-                    .map_err(|e| failed(anyhow::anyhow!("reference of frame {frame}: {e}")))?,
+                    .map_err(|e| fail(&e))?,
+                _ => return Err(fail(&"no reference renderer for this scenario")),
             };
             references.cache.store(&key, width, height, &px).map_err(failed)?;
             references.rendered += 1;

@@ -1,4 +1,4 @@
-//! What the frame's systems share: the GPU, the scene bindings, the run, the frame's number,
+//! What the frame's systems share: the GPU, the scene on it, the run, the frame's number,
 //! the references and the records (resources), and each method instance's frame (components
 //! of the method's entity).
 
@@ -7,10 +7,11 @@ use std::path::PathBuf;
 use bevy_ecs::prelude::*;
 use indicatif::ProgressBar;
 use render::gpu::Gpu;
-use render::path_tracer::PathTracer;
+use render::scene_gpu::SceneGpu;
 use sim::Scenario;
 
 use super::method_output::MethodOutput;
+use super::reference::ReferenceRenderer;
 use crate::frame_metrics as measure;
 use crate::frame_record::FrameRecord;
 use crate::reference_cache::ReferenceCache;
@@ -20,10 +21,11 @@ use crate::run_folder::RunFolder;
 #[derive(Resource)]
 pub struct GpuDevice(pub Gpu);
 
-/// The path tracer: scene bindings (frame uniform, materials, lights, camera, TLAS), the pass
-/// library every method's passes are built on, and its own outputs.
+/// The scene on the GPU (geometry and BVH, materials, textures, lights, camera, its features)
+/// and the pass library every method's passes are built on; updated once per frame in Extract.
+/// Every method reads it with its own frame parameters.
 #[derive(Resource)]
-pub struct Tracer(pub PathTracer);
+pub struct GpuScene(pub SceneGpu);
 
 /// The run: its scenario and where its cached state lives.
 #[derive(Resource)]
@@ -55,10 +57,13 @@ pub struct RunOutput {
     pub records: Vec<FrameRecord>,
 }
 
-/// The reference of this frame, where the scenario wants one, and the reference cache.
+/// The reference of this frame, where the scenario wants one, the reference cache and what
+/// renders the references.
 #[derive(Resource)]
 pub struct References {
     pub cache: ReferenceCache,
+    /// None when the scenario wants no reference.
+    pub renderer: Option<ReferenceRenderer>,
     /// Linear radiance of this frame's reference and the same ready to measure.
     pub current: Option<(Vec<[f32; 4]>, measure::Frame)>,
     pub rendered: u32,

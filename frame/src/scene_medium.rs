@@ -12,7 +12,7 @@ use media::mesh_inside::MeshInside;
 use media::{DensityGrid, Medium};
 use scene::{MediumDesc, MediumState};
 
-use super::resources::{GpuDevice, Tracer};
+use super::resources::GpuDevice;
 use super::stage::failed;
 
 /// The references' settings: Eq. 9 with the jackknife weights (unbiased, Appendix D) and
@@ -69,10 +69,10 @@ impl SceneMedium {
     pub fn pass(
         &mut self,
         gpu: &render::gpu::Gpu,
-        tracer: &render::path_tracer::PathTracer,
+        scene: &render::scene_gpu::SceneGpu,
     ) -> anyhow::Result<&VolumePathPass> {
         if self.pass.is_none() {
-            self.pass = Some(VolumePathPass::new(gpu, tracer, &self.gpu)?);
+            self.pass = Some(VolumePathPass::new(gpu, scene, &self.gpu)?);
         }
         Ok(self.pass.as_ref().expect("built above"))
     }
@@ -115,10 +115,13 @@ pub fn upload_medium(
     Ok(())
 }
 
-/// `spp` paths per pixel of the current scene and medium: (radiance with alpha 1, timings, paths).
+/// `spp` paths per pixel of the current scene and medium with the caller's frame parameters:
+/// (radiance with alpha 1, timings, paths).
+#[allow(clippy::too_many_arguments)]
 pub fn render_volume(
     gpu: &render::gpu::Gpu,
-    tracer: &Tracer,
+    scene: &render::scene_gpu::SceneGpu,
+    bindings: &render::frame_bindings::FrameBindings,
     medium: &mut SceneMedium,
     settings: &VolumePathSettings,
     spp: u32,
@@ -126,10 +129,10 @@ pub fn render_volume(
     frame: u32,
 ) -> anyhow::Result<(Vec<[f32; 4]>, Vec<render::timing::PassTiming>, u64)> {
     let optics = medium.optics();
-    medium.pass(gpu, &tracer.0)?;
+    medium.pass(gpu, scene)?;
     let pass = medium.pass.as_ref().expect("built above");
     let image = pass
-        .render(gpu, &tracer.0, &medium.gpu, &optics, settings, spp, seed, frame)
+        .render(gpu, scene, bindings, &medium.gpu, &optics, settings, spp, seed, frame)
         .map_err(|e| anyhow::anyhow!(e))?;
     Ok((image.mean.iter().map(|c| [c[0], c[1], c[2], 1.0]).collect(), image.timings, image.paths))
 }

@@ -31,9 +31,11 @@ use media::gpu::{
 };
 use media::{DensityGrid, DensityKind, Medium};
 use render::frame::CameraBasis;
+use render::frame_bindings::FrameBindings;
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::{Camera, Instance, Light, Material, Mesh, SceneDesc, Texture};
+use render::scene_gpu::SceneGpu;
 
 const W: u32 = 32;
 const H: u32 = 18;
@@ -41,6 +43,26 @@ const H: u32 = 18;
 fn gpu() -> &'static Gpu {
     static GPU: OnceLock<Gpu> = OnceLock::new();
     GPU.get_or_init(|| Gpu::new().expect("a wgpu adapter (lavapipe on CI)"))
+}
+
+/// A scene on the GPU and the frame parameters the tests render it with.
+struct Uploaded {
+    scene: SceneGpu,
+    bindings: FrameBindings,
+}
+
+fn upload(scene: &SceneDesc, settings: PathTracerSettings) -> Uploaded {
+    let scene = SceneGpu::new(gpu(), scene, settings).expect("scene");
+    let bindings = FrameBindings::new(gpu(), &scene);
+    Uploaded { scene, bindings }
+}
+
+impl Uploaded {
+    /// The path tracer's image of the scene.
+    fn path_traced(&self, spp: u32, seed: u64, frame: u32) -> Vec<[f32; 4]> {
+        let mut tracer = PathTracer::new(gpu(), &self.scene).expect("path tracer");
+        tracer.render(gpu(), &self.scene, spp, seed, frame).expect("render").radiance
+    }
 }
 
 fn ground(camera: Camera, lights: Vec<Light>) -> SceneDesc {
@@ -121,8 +143,8 @@ fn absorbing_slab_attenuates_the_path_tracer_image_by_its_closed_form() {
     };
     let scene = ground(camera, vec![sun]);
     let settings = PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 8 };
-    let mut tracer = PathTracer::new(gpu(), &scene, settings).expect("path tracer");
-    let plain = tracer.render(gpu(), 4, 3, 0).expect("render").radiance;
+    let up = upload(&scene, settings);
+    let plain = up.path_traced(4, 3, 0);
     let slab = medium(
         DensityKind::Homogeneous,
         8,
@@ -135,7 +157,8 @@ fn absorbing_slab_attenuates_the_path_tracer_image_by_its_closed_form() {
         .pass
         .render(
             gpu(),
-            &tracer,
+            &up.scene,
+            &up.bindings,
             &slab,
             &[MediumOptics::scattering(Vec3::ZERO)],
             &VolumePathSettings::default(),
@@ -171,12 +194,10 @@ fn medium_emission_matches_its_closed_forms() {
     let mut scene = ground(camera, vec![]);
     scene.materials[0].base_color = Vec3::ZERO;
     let depth = 3;
-    let tracer = PathTracer::new(
-        gpu(),
+    let up = upload(
         &scene,
         PathTracerSettings { width: W, height: H, max_depth: depth, rr_start_depth: 8 },
-    )
-    .expect("path tracer");
+    );
     let emission = Vec3::new(1.5, 1.0, 0.5);
 
     let sigma = 0.8;
@@ -191,7 +212,17 @@ fn medium_emission_matches_its_closed_forms() {
     let pass = &setup.pass;
     let optics = MediumOptics { albedo: Vec3::ZERO, emission };
     let image = pass
-        .render(gpu(), &tracer, &slab, &[optics], &VolumePathSettings::default(), 128, 7, 0)
+        .render(
+            gpu(),
+            &up.scene,
+            &up.bindings,
+            &slab,
+            &[optics],
+            &VolumePathSettings::default(),
+            128,
+            7,
+            0,
+        )
         .expect("render");
     let transmitted = slab_image(&camera, f64::from(sigma), 1.0, 1.0);
     let expected: Vec<f64> =
@@ -210,7 +241,8 @@ fn medium_emission_matches_its_closed_forms() {
     let image = pass
         .render(
             gpu(),
-            &tracer,
+            &up.scene,
+            &up.bindings,
             &fog,
             &[MediumOptics { albedo, emission }],
             &VolumePathSettings::default(),
@@ -257,14 +289,14 @@ fn cloud_scene() -> (SceneDesc, GpuMedium) {
     (ground(camera, vec![light]), cloud)
 }
 
-/// The cloud scene's tracer (direct light, max depth 1: single scattering in the medium and the
-/// lit ground, each shadow ray through the cloud; deeper paths start segments next to the light,
-/// whose estimates are heavy-tailed for every strategy), two media in the same box (the cloud
-/// and a sparse explosion field) and the pass, compiled once (~24 s on lavapipe) and used by
-/// every test with its own tracer and medium (their layouts are the same). Tests take turns
-/// (the pass's timestamp readback, a tracer's frame uniform).
+/// The cloud scene on the GPU (direct light, max depth 1: single scattering in the medium and
+/// the lit ground, each shadow ray through the cloud; deeper paths start segments next to the
+/// light, whose estimates are heavy-tailed for every strategy), two media in the same box (the
+/// cloud and a sparse explosion field) and the pass, compiled once (~24 s on lavapipe) and used
+/// by every test with its own scene and medium (their layouts are the same). Tests take turns
+/// (the pass's timestamp readback, the frame parameters).
 struct CloudSetup {
-    tracer: PathTracer,
+    up: Uploaded,
     pass: VolumePathPass,
     cloud: GpuMedium,
     explosion: GpuMedium,
@@ -275,14 +307,12 @@ fn cloud_setup() -> std::sync::MutexGuard<'static, CloudSetup> {
     SETUP
         .get_or_init(|| {
             let (scene, cloud) = cloud_scene();
-            let tracer = PathTracer::new(
-                gpu(),
+            let up = upload(
                 &scene,
                 PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 2 },
-            )
-            .expect("path tracer");
+            );
             let pass =
-                VolumePathPass::new(gpu(), &tracer, &cloud).expect("volume path pass compiles");
+                VolumePathPass::new(gpu(), &up.scene, &cloud).expect("volume path pass compiles");
             let explosion = medium(
                 DensityKind::Explosion { frequency: 8.0, seed: 3 },
                 48,
@@ -290,24 +320,24 @@ fn cloud_setup() -> std::sync::MutexGuard<'static, CloudSetup> {
                 Vec3::new(-1.0, 0.0, -1.0),
                 Vec3::new(1.0, 3.0, 1.0),
             );
-            std::sync::Mutex::new(CloudSetup { tracer, pass, cloud, explosion })
+            std::sync::Mutex::new(CloudSetup { up, pass, cloud, explosion })
         })
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 fn render_cloud(
-    tracer: &PathTracer,
+    up: &Uploaded,
     pass: &VolumePathPass,
     cloud: &GpuMedium,
     s: VolumePathSettings,
     seed: u64,
 ) -> VolumeImage {
-    render_spp(tracer, pass, cloud, s, 256, seed)
+    render_spp(up, pass, cloud, s, 256, seed)
 }
 
 fn render_spp(
-    tracer: &PathTracer,
+    up: &Uploaded,
     pass: &VolumePathPass,
     medium: &GpuMedium,
     s: VolumePathSettings,
@@ -316,7 +346,8 @@ fn render_spp(
 ) -> VolumeImage {
     pass.render(
         gpu(),
-        tracer,
+        &up.scene,
+        &up.bindings,
         medium,
         &[MediumOptics::scattering(Vec3::splat(0.8))],
         &s,
@@ -341,11 +372,11 @@ fn agree(what: &str, a: &VolumeImage, b: &VolumeImage) {
 #[test]
 fn shadow_ratio_tracking_equals_delta_tracking_and_mis_is_unbiased_in_a_cloud() {
     let setup = cloud_setup();
-    let (tracer, pass, cloud) = (&setup.tracer, &setup.pass, &setup.cloud);
+    let (up, pass, cloud) = (&setup.up, &setup.pass, &setup.cloud);
     let base = VolumePathSettings::default();
-    let ratio = render_cloud(tracer, pass, cloud, base, 11);
+    let ratio = render_cloud(up, pass, cloud, base, 11);
     let track = render_cloud(
-        tracer,
+        up,
         pass,
         cloud,
         VolumePathSettings { shadow: ShadowTransmittance::TrackLength, ..base },
@@ -357,7 +388,7 @@ fn shadow_ratio_tracking_equals_delta_tracking_and_mis_is_unbiased_in_a_cloud() 
     println!("mean variance of a pixel's mean: free-flight only {:.3e}", mean_var(&ratio));
     for mis in [MisWeight::Naive, MisWeight::Jackknife, MisWeight::Miller] {
         let im = render_cloud(
-            tracer,
+            up,
             pass,
             cloud,
             VolumePathSettings { mis, combination: Combination::Eq9, ..base },
@@ -391,10 +422,10 @@ fn mis_errors(
     samples: u32,
     spp: u32,
 ) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
-    let (tracer, pass) = (&setup.tracer, &setup.pass);
+    let (up, pass) = (&setup.up, &setup.pass);
     let base = VolumePathSettings { samples, ..VolumePathSettings::default() };
     let reference = render_spp(
-        tracer,
+        up,
         pass,
         medium,
         VolumePathSettings { mis: MisWeight::Jackknife, ..base },
@@ -410,7 +441,7 @@ fn mis_errors(
         let (mut m, mut b) = (Vec::new(), Vec::new());
         for &seed in &SEEDS {
             let im = render_spp(
-                tracer,
+                up,
                 pass,
                 medium,
                 VolumePathSettings { mis, combination, ..base },
@@ -539,13 +570,9 @@ fn two_disjoint_absorbing_slabs_multiply_their_transmittances() {
         angular_radius: 0.0,
     };
     let scene = ground(camera, vec![sun]);
-    let mut tracer = PathTracer::new(
-        gpu(),
-        &scene,
-        PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 8 },
-    )
-    .expect("path tracer");
-    let plain = tracer.render(gpu(), 4, 3, 0).expect("render").radiance;
+    let up =
+        upload(&scene, PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 8 });
+    let plain = up.path_traced(4, 3, 0);
     // σ 0.5 in y ∈ [1, 1.4] and σ 1.0 in y ∈ [1.6, 2]: optical depth (0.2 + 0.4) / |d.y| along a
     // camera ray, 0.6 along the sun's.
     let bake = |sigma: f32, y0: f32, y1: f32| {
@@ -565,7 +592,8 @@ fn two_disjoint_absorbing_slabs_multiply_their_transmittances() {
         .pass
         .render(
             gpu(),
-            &tracer,
+            &up.scene,
+            &up.bindings,
             &both,
             &[absorbing, absorbing],
             &VolumePathSettings::default(),
@@ -589,7 +617,17 @@ fn two_disjoint_absorbing_slabs_multiply_their_transmittances() {
     assert!(
         setup
             .pass
-            .render(gpu(), &tracer, &both, &[absorbing], &VolumePathSettings::default(), 1, 5, 0)
+            .render(
+                gpu(),
+                &up.scene,
+                &up.bindings,
+                &both,
+                &[absorbing],
+                &VolumePathSettings::default(),
+                1,
+                5,
+                0
+            )
             .is_err(),
         "one optics for two media is refused"
     );
@@ -598,7 +636,7 @@ fn two_disjoint_absorbing_slabs_multiply_their_transmittances() {
 #[test]
 fn two_media_in_one_box_render_as_the_medium_of_their_summed_extinction() {
     let setup = cloud_setup();
-    let (tracer, pass) = (&setup.tracer, &setup.pass);
+    let (up, pass) = (&setup.up, &setup.pass);
     let (lo, hi) = (Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 3.0, 1.0));
     let bake =
         |kind: &DensityKind, sigma: f32| DensityGrid::bake(kind, UVec3::splat(32), sigma, lo, hi);
@@ -645,10 +683,30 @@ fn two_media_in_one_box_render_as_the_medium_of_their_summed_extinction() {
             let mut zs = Vec::new();
             for seed in [1u64, 2, 3] {
                 let a = pass
-                    .render(gpu(), tracer, &several, &optics, &s, 64, 100 + seed, 0)
+                    .render(
+                        gpu(),
+                        &up.scene,
+                        &up.bindings,
+                        &several,
+                        &optics,
+                        &s,
+                        64,
+                        100 + seed,
+                        0,
+                    )
                     .expect("render");
                 let b = pass
-                    .render(gpu(), tracer, &single, &[one_optics], &s, 64, 200 + seed, 0)
+                    .render(
+                        gpu(),
+                        &up.scene,
+                        &up.bindings,
+                        &single,
+                        &[one_optics],
+                        &s,
+                        64,
+                        200 + seed,
+                        0,
+                    )
                     .expect("render");
                 agree(&format!("{what}, {mis:?}, seed {seed}: two media vs one"), &a, &b);
                 zs.push(compare(&a, &b.mean.iter().map(lum).collect::<Vec<_>>(), &b.var_of_mean).0);
@@ -669,10 +727,10 @@ fn two_media_in_one_box_render_as_the_medium_of_their_summed_extinction() {
 fn the_pass_follows_the_scene_s_features() {
     let (scene, cloud) = cloud_scene();
     let settings = PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 2 };
-    let mut tracer = PathTracer::new(gpu(), &scene, settings).expect("path tracer");
-    let pass = VolumePathPass::new(gpu(), &tracer, &cloud).expect("volume path pass compiles");
+    let mut up = upload(&scene, settings);
+    let pass = VolumePathPass::new(gpu(), &up.scene, &cloud).expect("volume path pass compiles");
     assert!(!pass.features().textures, "the cloud scene has no textures");
-    let before = render_spp(&tracer, &pass, &cloud, VolumePathSettings::default(), 4, 3);
+    let before = render_spp(&up, &pass, &cloud, VolumePathSettings::default(), 4, 3);
 
     let mut lit = scene.clone();
     lit.textures.push(Texture {
@@ -682,14 +740,14 @@ fn the_pass_follows_the_scene_s_features() {
         rgba8: vec![40, 40, 40, 255],
     });
     lit.materials[0].base_color_texture = Some(0);
-    tracer.try_update(gpu(), &lit).expect("update");
-    let after = render_spp(&tracer, &pass, &cloud, VolumePathSettings::default(), 4, 3);
+    up.scene.try_update(gpu(), &lit).expect("update");
+    let after = render_spp(&up, &pass, &cloud, VolumePathSettings::default(), 4, 3);
     assert!(pass.features().textures, "compiled again for the texture");
 
-    let fresh_tracer = PathTracer::new(gpu(), &lit, settings).expect("path tracer");
+    let fresh_up = upload(&lit, settings);
     let fresh =
-        VolumePathPass::new(gpu(), &fresh_tracer, &cloud).expect("volume path pass compiles");
-    let expected = render_spp(&fresh_tracer, &fresh, &cloud, VolumePathSettings::default(), 4, 3);
+        VolumePathPass::new(gpu(), &fresh_up.scene, &cloud).expect("volume path pass compiles");
+    let expected = render_spp(&fresh_up, &fresh, &cloud, VolumePathSettings::default(), 4, 3);
     assert_eq!(after.mean, expected.mean);
     assert!(after.mean != before.mean, "the texture darkens the ground");
 }

@@ -1,5 +1,5 @@
 //! Cache-terminated path tracing (NIRC): the passes of nirc/shaders/cache_paths.wgsl, which
-//! run on the path tracer's scene and geometry bind groups.
+//! run on the scene on the GPU (`SceneGpu`) with their own frame parameters (`FrameBindings`).
 //!
 //! Per frame: `encode_paths` traces `spp` camera paths per pixel up to the termination vertex
 //! and writes one `CacheQuery` per path (plus its weight and the radiance gathered before it),
@@ -11,11 +11,12 @@
 use crate::error::NircError;
 use crate::records::{CacheAnswer, CacheQuery, TrainingRecord};
 use render::compute::BufferBinding;
+use render::frame_bindings::FrameBindings;
 use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::pass_library::{LibraryPipeline, PassLibrary};
-use render::path_tracer::PathTracer;
 use render::readback::read_pod;
+use render::scene_gpu::SceneGpu;
 use render::shader::{Module, Program};
 use render::timing::TimedFrame;
 use serde::{Deserialize, Serialize};
@@ -93,6 +94,8 @@ pub struct CachePaths {
     width: u32,
     height: u32,
     spp: u32,
+    /// The camera paths' frame parameters and scene group.
+    frame: FrameBindings,
     layout: wgpu::BindGroupLayout,
     queries_pipeline: LibraryPipeline,
     targets_pipeline: LibraryPipeline,
@@ -137,10 +140,10 @@ impl CachePaths {
         SOURCE.get_or_init(|| Self::program().fingerprint())
     }
 
-    /// Passes for `tracer`'s resolution at `spp` paths per pixel.
+    /// Passes for `scene`'s resolution at `spp` paths per pixel.
     pub fn new(
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         spp: u32,
         settings: CachePathSettings,
     ) -> Result<Self, NircError> {
@@ -158,7 +161,7 @@ impl CachePaths {
                 settings.train_records, settings.train_steps
             )));
         }
-        let s = tracer.settings();
+        let s = scene.settings();
         let (width, height) = (s.width, s.height);
         let query_count = width as u64 * height as u64 * spp as u64;
         if query_count > u32::MAX as u64 / 2 {
@@ -188,7 +191,7 @@ impl CachePaths {
                 oracle_pipeline,
                 resolve_pipeline,
             ],
-        ) = tracer.library_pass(
+        ) = scene.library_pass(
             gpu,
             "cache_paths.wgsl",
             Self::program(),
@@ -230,6 +233,7 @@ impl CachePaths {
             width,
             height,
             spp,
+            frame: FrameBindings::new(gpu, scene),
             layout,
             queries_pipeline,
             targets_pipeline,
@@ -297,7 +301,15 @@ impl CachePaths {
         self.settings.train_records
     }
 
-    fn bind_group(&self, gpu: &Gpu, out: &CacheOutput) -> wgpu::BindGroup {
+    /// Writes the frame parameters of this pass's camera paths (`spp`, seed, frame) on the scene as
+    /// last uploaded. Written at the next submission: submit before preparing another frame.
+    pub fn prepare(&self, gpu: &Gpu, scene: &SceneGpu, seed: u64, frame: u32) {
+        self.frame.prepare(gpu, scene, self.spp, 0, seed, frame);
+    }
+
+    /// @group(0) (this pass's frame parameters and the scene's tables), the geometry's @group(1) and
+    /// this pass's @group(2) over `out`.
+    fn bind_groups(&self, gpu: &Gpu, scene: &SceneGpu, out: &CacheOutput) -> [wgpu::BindGroup; 3] {
         let buffers = [
             &self.params,
             &self.queries,
@@ -308,14 +320,17 @@ impl CachePaths {
             &self.motion,
             &self.ray_counters,
         ];
-        render::compute::buffer_group(gpu, "nirc cache paths", &self.layout, &buffers)
+        [
+            self.frame.bind_group(gpu, scene),
+            scene.geometry().bind_group().clone(),
+            render::compute::buffer_group(gpu, "nirc cache paths", &self.layout, &buffers),
+        ]
     }
 
     fn pass(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        tracer: &PathTracer,
-        group: &wgpu::BindGroup,
+        groups: &[wgpu::BindGroup; 3],
         pipeline: &LibraryPipeline,
         label: &str,
         workgroups: (u32, u32),
@@ -324,7 +339,7 @@ impl CachePaths {
             label: Some(label),
             timestamp_writes: None,
         });
-        record(&mut pass, tracer, group, &[(pipeline, workgroups)]);
+        record(&mut pass, groups, &[(pipeline, workgroups)]);
     }
 
     /// One timed pass (pass `index` of `timed`) of `pipelines`, in order, each over its workgroups.
@@ -332,11 +347,10 @@ impl CachePaths {
         &self,
         timed: &mut TimedFrame,
         index: usize,
-        tracer: &PathTracer,
-        group: &wgpu::BindGroup,
+        groups: &[wgpu::BindGroup; 3],
         pipelines: &[(&LibraryPipeline, (u32, u32))],
     ) -> Result<(), NircError> {
-        timed.pass(index, |pass| record(pass, tracer, group, pipelines))?;
+        timed.pass(index, |pass| record(pass, groups, pipelines))?;
         Ok(())
     }
 
@@ -346,20 +360,14 @@ impl CachePaths {
         gpu: &Gpu,
         timed: &mut TimedFrame,
         index: usize,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         seed: u64,
         frame: u32,
     ) -> Result<(), NircError> {
-        tracer.prepare_frame(gpu, self.spp, 0, seed, frame);
+        self.prepare(gpu, scene, seed, frame);
         timed.encoder().clear_buffer(&self.ray_counters, 0, None);
-        let group = self.bind_group(gpu, &self.scratch);
-        self.timed_pass(
-            timed,
-            index,
-            tracer,
-            &group,
-            &[(&self.queries_pipeline, self.image_groups())],
-        )
+        let groups = self.bind_groups(gpu, scene, &self.scratch);
+        self.timed_pass(timed, index, &groups, &[(&self.queries_pipeline, self.image_groups())])
     }
 
     /// [`Self::encode_records`] (targets, then compaction) as pass `index` of a timed frame.
@@ -368,15 +376,14 @@ impl CachePaths {
         gpu: &Gpu,
         timed: &mut TimedFrame,
         index: usize,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
     ) -> Result<(), NircError> {
-        let group = self.bind_group(gpu, &self.scratch);
+        let groups = self.bind_groups(gpu, scene, &self.scratch);
         let targets = (self.settings.train_records.div_ceil(WORKGROUP_1D), 1);
         self.timed_pass(
             timed,
             index,
-            tracer,
-            &group,
+            &groups,
             &[(&self.targets_pipeline, targets), (&self.compact_pipeline, (1, 1))],
         )
     }
@@ -387,70 +394,44 @@ impl CachePaths {
         gpu: &Gpu,
         timed: &mut TimedFrame,
         index: usize,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         out: &CacheOutput,
     ) -> Result<(), NircError> {
-        let group = self.bind_group(gpu, out);
-        self.timed_pass(
-            timed,
-            index,
-            tracer,
-            &group,
-            &[(&self.resolve_pipeline, self.image_groups())],
-        )
+        let groups = self.bind_groups(gpu, scene, out);
+        self.timed_pass(timed, index, &groups, &[(&self.resolve_pipeline, self.image_groups())])
     }
 
     fn image_groups(&self) -> (u32, u32) {
         (self.width.div_ceil(WORKGROUP_2D), self.height.div_ceil(WORKGROUP_2D))
     }
 
-    /// Writes the frame uniform (seed, frame) and records the camera paths into `encoder`.
-    /// The uniform is written at the next submission: submit before preparing another frame.
+    /// Writes the frame parameters (seed, frame) and records the camera paths into `encoder`.
+    /// They are written at the next submission: submit before preparing another frame.
     pub fn encode_queries(
         &self,
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         seed: u64,
         frame: u32,
     ) {
-        tracer.prepare_frame(gpu, self.spp, 0, seed, frame);
+        self.prepare(gpu, scene, seed, frame);
         encoder.clear_buffer(&self.ray_counters, 0, None);
-        let group = self.bind_group(gpu, &self.scratch);
-        self.pass(
-            encoder,
-            tracer,
-            &group,
-            &self.queries_pipeline,
-            "nirc queries",
-            self.image_groups(),
-        );
+        let groups = self.bind_groups(gpu, scene, &self.scratch);
+        self.pass(encoder, &groups, &self.queries_pipeline, "nirc queries", self.image_groups());
     }
 
-    /// Records the training targets of the queries of `encode_queries` (same frame uniform).
-    pub fn encode_records(
-        &self,
-        gpu: &Gpu,
-        encoder: &mut wgpu::CommandEncoder,
-        tracer: &PathTracer,
-    ) {
-        let group = self.bind_group(gpu, &self.scratch);
+    /// Records the training targets of the queries of `encode_queries` (same frame parameters).
+    pub fn encode_records(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, scene: &SceneGpu) {
+        let groups = self.bind_groups(gpu, scene, &self.scratch);
         self.pass(
             encoder,
-            tracer,
-            &group,
+            &groups,
             &self.targets_pipeline,
             "nirc training targets",
             (self.settings.train_records.div_ceil(WORKGROUP_1D), 1),
         );
-        self.pass(
-            encoder,
-            tracer,
-            &group,
-            &self.compact_pipeline,
-            "nirc record compaction",
-            (1, 1),
-        );
+        self.pass(encoder, &groups, &self.compact_pipeline, "nirc record compaction", (1, 1));
     }
 
     /// Test oracle: answers every query with its own Monte Carlo target of Lc.
@@ -458,14 +439,13 @@ impl CachePaths {
         &self,
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         out: &CacheOutput,
     ) {
-        let group = self.bind_group(gpu, out);
+        let groups = self.bind_groups(gpu, scene, out);
         self.pass(
             encoder,
-            tracer,
-            &group,
+            &groups,
             &self.oracle_pipeline,
             "nirc oracle",
             (self.query_count().div_ceil(WORKGROUP_1D), 1),
@@ -477,18 +457,11 @@ impl CachePaths {
         &self,
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         out: &CacheOutput,
     ) {
-        let group = self.bind_group(gpu, out);
-        self.pass(
-            encoder,
-            tracer,
-            &group,
-            &self.resolve_pipeline,
-            "nirc resolve",
-            self.image_groups(),
-        );
+        let groups = self.bind_groups(gpu, scene, out);
+        self.pass(encoder, &groups, &self.resolve_pipeline, "nirc resolve", self.image_groups());
     }
 
     /// Reads `out.image` back: the radiance (alpha 1) and per pixel (mean σ, answered samples).
@@ -543,17 +516,16 @@ impl CachePaths {
     }
 }
 
-/// Binds the scene (@group(0)), the geometry (@group(1)) and `group` (@group(2)), then dispatches
-/// each of `pipelines` over its workgroups.
+/// Binds `groups` (the scene with the frame parameters, the geometry, the pass's own), then
+/// dispatches each of `pipelines` over its workgroups.
 fn record(
     pass: &mut wgpu::ComputePass,
-    tracer: &PathTracer,
-    group: &wgpu::BindGroup,
+    groups: &[wgpu::BindGroup; 3],
     pipelines: &[(&LibraryPipeline, (u32, u32))],
 ) {
-    pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
-    pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
-    pass.set_bind_group(2, group, &[]);
+    for (index, group) in groups.iter().enumerate() {
+        pass.set_bind_group(index as u32, group, &[]);
+    }
     for (pipeline, groups) in pipelines {
         pass.set_pipeline(&pipeline.get());
         pass.dispatch_workgroups(groups.0, groups.1, 1);

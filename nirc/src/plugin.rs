@@ -29,12 +29,12 @@ use anyhow::{Context, Result, bail};
 use bevy_ecs::error::BevyError;
 use bevy_ecs::prelude::{Component, Entity, IntoScheduleConfigs, Query, Res, Schedule, World};
 use render::gpu::Gpu;
-use render::path_tracer::PathTracer;
+use render::scene_gpu::SceneGpu;
 use render::timing::{PassTimer, PassTiming};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
-use frame::{FrameClock, GpuDevice, MethodFrame, Run, Stage, Tracer, failed};
+use frame::{FrameClock, GpuDevice, GpuScene, MethodFrame, Run, Stage, failed};
 use frame::{MethodImage, MethodOutput, MethodPlugin};
 
 /// `Nirc(spp: 1, predictor: Blend, cache: (...), paths: (...), pretrain_frames: 0)`.
@@ -222,8 +222,8 @@ fn wait(gpu: &Gpu) -> Result<()> {
 
 /// Scene bounds of the cache's grids, padded a little so that points on the box faces stay
 /// inside.
-fn scene_bounds(tracer: &PathTracer) -> SceneBounds {
-    let (lo, hi) = tracer.geometry().bounds();
+fn scene_bounds(scene: &SceneGpu) -> SceneBounds {
+    let (lo, hi) = scene.geometry().bounds();
     let pad = (hi - lo).max_element().max(1e-3) * 1e-3;
     SceneBounds::new((lo - pad).to_array(), (hi + pad).to_array())
 }
@@ -235,7 +235,7 @@ impl NircCache {
         gpu: &Gpu,
         scene: &render::scene::SceneDesc,
         run: &Run,
-        tracer: &PathTracer,
+        gpu_scene: &SceneGpu,
     ) -> String {
         let mut h = Sha256::new();
         h.update(format!("{scene:?}").as_bytes());
@@ -243,7 +243,7 @@ impl NircCache {
         h.update(
             format!(
                 "{:?}|{}|{}|{}",
-                tracer.settings(),
+                gpu_scene.settings(),
                 settings.spp,
                 settings.pretrain_frames,
                 run.scenario.seed
@@ -260,19 +260,21 @@ impl NircCache {
     /// file when one exists, else trained and saved).
     fn build(world: &World, settings: &NircSettings, key: String) -> Result<Self> {
         let gpu = &world.resource::<GpuDevice>().0;
-        let tracer = &world.resource::<Tracer>().0;
+        let gpu_scene = &world.resource::<GpuScene>().0;
         let run = world.resource::<Run>();
         let scene = &world.resource::<sim::ExtractedScene>().scene;
-        let paths = CachePaths::new(gpu, tracer, settings.spp, settings.paths.clone())?;
-        let bounds = scene_bounds(tracer);
+        let paths = CachePaths::new(gpu, gpu_scene, settings.spp, settings.paths.clone())?;
+        let bounds = scene_bounds(gpu_scene);
         let mut cache_config = settings.cache.clone();
         cache_config.max_batch = cache_config.max_batch.max(paths.record_count());
         let mut cache = None;
         let mut warm_start = None;
         if settings.pretrain_frames > 0 {
             let dir = run.cache_dir.join("nirc");
-            let file = dir
-                .join(format!("{}.nirc", Self::warm_start_key(settings, gpu, scene, run, tracer)));
+            let file = dir.join(format!(
+                "{}.nirc",
+                Self::warm_start_key(settings, gpu, scene, run, gpu_scene)
+            ));
             if file.exists() {
                 cache =
                     Some(NeuralCache::load(gpu, &file).with_context(|| {
@@ -284,15 +286,14 @@ impl NircCache {
                     // Frame numbers of their own, so pre-training samples differ from the run's.
                     let frame = u32::MAX - k;
                     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                    paths.encode_queries(gpu, &mut encoder, tracer, run.scenario.seed, frame);
+                    paths.encode_queries(gpu, &mut encoder, gpu_scene, run.scenario.seed, frame);
                     gpu.queue.submit([encoder.finish()]);
                     for step in 0..settings.paths.train_steps {
                         submit_step(
                             gpu,
-                            tracer,
+                            gpu_scene,
                             &paths,
                             &fresh,
-                            settings.spp,
                             step_seed(run.scenario.seed, step),
                             frame,
                         )?;
@@ -338,10 +339,10 @@ impl NircCache {
         })
     }
 
-    /// The frame uniform of this cache's camera paths (set again by each system that traces or
-    /// resolves: other methods' passes may have run in between).
-    fn prepare(&self, gpu: &Gpu, tracer: &PathTracer, seed: u64, frame: u32) {
-        tracer.prepare_frame(gpu, self.settings.spp, 0, seed, frame);
+    /// The frame parameters of this cache's camera paths (set again by each system that traces or
+    /// resolves: a training step of another seed may have written them in between).
+    fn prepare(&self, gpu: &Gpu, scene: &SceneGpu, seed: u64, frame: u32) {
+        self.paths.prepare(gpu, scene, seed, frame);
     }
 }
 
@@ -352,7 +353,7 @@ fn frame_error(clock: &FrameClock) -> impl Fn(anyhow::Error) -> BevyError + '_ {
 /// Camera paths up to the termination vertex: the frame's cache queries and motion vectors.
 pub fn camera_paths(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     mut caches: Query<&mut NircCache>,
@@ -363,7 +364,7 @@ pub fn camera_paths(
         let c = &mut *c;
         let mut timed = c.paths_timer.begin(gpu, "nirc paths");
         c.paths
-            .queries_timed(gpu, &mut timed, 0, &tracer.0, run.scenario.seed, clock.global)
+            .queries_timed(gpu, &mut timed, 0, &gpu_scene.0, run.scenario.seed, clock.global)
             .map_err(|e| err(e.into()))?;
         c.paths_times = timed.submit().map_err(|e| err(e.into()))?;
         c.motion = c.paths.read_motion(gpu).map_err(|e| err(e.into()))?;
@@ -374,7 +375,7 @@ pub fn camera_paths(
 /// Each method's inference (its predictor mode) and the resolve of its answers into an image.
 pub fn infer(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     caches: Query<&NircCache>,
@@ -391,7 +392,7 @@ pub fn infer(
             .find(|(mode, _)| *mode == m.mode)
             .ok_or_else(|| err(anyhow::anyhow!("predictor mode without answers")))?
             .1;
-        c.prepare(gpu, &tracer.0, run.scenario.seed, clock.global);
+        c.prepare(gpu, &gpu_scene.0, run.scenario.seed, clock.global);
         let mut timed = c.infer_timer.begin(gpu, "nirc infer");
         c.cache
             .infer_timed(
@@ -404,7 +405,7 @@ pub fn infer(
                 m.mode,
             )
             .map_err(|e| err(e.into()))?;
-        c.paths.resolve_timed(gpu, &mut timed, 1, &tracer.0, out).map_err(|e| err(e.into()))?;
+        c.paths.resolve_timed(gpu, &mut timed, 1, &gpu_scene.0, out).map_err(|e| err(e.into()))?;
         let times = timed.submit().map_err(|e| err(e.into()))?;
         let (radiance, sigma) = c.paths.read_image(gpu, out).map_err(|e| err(e.into()))?;
         m.inferred = Some(ModeFrame { radiance, sigma, times });
@@ -450,16 +451,15 @@ fn step_seed(seed: u64, step: u32) -> u64 {
 /// with `seed` for the record picks and targets, submitted untimed.
 fn submit_step(
     gpu: &Gpu,
-    tracer: &PathTracer,
+    scene: &SceneGpu,
     paths: &CachePaths,
     cache: &NeuralCache,
-    spp: u32,
     seed: u64,
     frame: u32,
 ) -> Result<(), crate::NircError> {
-    tracer.prepare_frame(gpu, spp, 0, seed, frame);
+    paths.prepare(gpu, scene, seed, frame);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    paths.encode_records(gpu, &mut encoder, tracer);
+    paths.encode_records(gpu, &mut encoder, scene);
     cache.encode_train(gpu, &mut encoder, paths.records(), paths.record_count())?;
     gpu.queue.submit([encoder.finish()]);
     Ok(())
@@ -471,7 +471,7 @@ fn submit_step(
 /// `reliability_update` as with one step.
 pub fn train(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     mut caches: Query<&mut NircCache>,
@@ -487,10 +487,9 @@ pub fn train(
             for step in 1..steps {
                 submit_step(
                     gpu,
-                    &tracer.0,
+                    &gpu_scene.0,
                     &c.paths,
                     &c.cache,
-                    c.settings.spp,
                     step_seed(run.scenario.seed, step),
                     clock.global,
                 )
@@ -499,9 +498,9 @@ pub fn train(
             wait(gpu).map_err(&err)?;
             c.steps_wall_ms = Some(start.elapsed().as_secs_f64() * 1e3);
         }
-        c.prepare(gpu, &tracer.0, run.scenario.seed, clock.global);
+        c.prepare(gpu, &gpu_scene.0, run.scenario.seed, clock.global);
         let mut timed = c.train_timer.begin(gpu, "nirc train");
-        c.paths.records_timed(gpu, &mut timed, 0, &tracer.0).map_err(|e| err(e.into()))?;
+        c.paths.records_timed(gpu, &mut timed, 0, &gpu_scene.0).map_err(|e| err(e.into()))?;
         c.step = c
             .cache
             .prepare_step(gpu, c.paths.records(), c.paths.record_count())

@@ -15,6 +15,7 @@ use nirc::{CacheOutput, CachePathSettings, CachePaths, NeuralCache, SceneBounds}
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::{Camera, Instance, Light, Material, Mesh, SceneDesc};
+use render::scene_gpu::SceneGpu;
 use std::sync::OnceLock;
 
 const W: u32 = 32;
@@ -169,15 +170,11 @@ enum Answer {
     Zero,
 }
 
-fn cache_images(
-    tracer: &PathTracer,
-    termination_vertex: u32,
-    answer: Answer,
-) -> Vec<Vec<[f32; 4]>> {
+fn cache_images(sg: &SceneGpu, termination_vertex: u32, answer: Answer) -> Vec<Vec<[f32; 4]>> {
     let g = gpu();
     let paths = CachePaths::new(
         g,
-        tracer,
+        sg,
         SPP,
         CachePathSettings { termination_vertex, train_records: 64, train_steps: 1 },
     )
@@ -186,20 +183,20 @@ fn cache_images(
     (0..SEEDS)
         .map(|seed| {
             let mut encoder = g.device.create_command_encoder(&Default::default());
-            paths.encode_queries(g, &mut encoder, tracer, 100 + seed, 0);
+            paths.encode_queries(g, &mut encoder, sg, 100 + seed, 0);
             match answer {
-                Answer::Oracle => paths.encode_oracle(g, &mut encoder, tracer, &out),
+                Answer::Oracle => paths.encode_oracle(g, &mut encoder, sg, &out),
                 Answer::Zero => encoder.clear_buffer(&out.answers, 0, None),
             }
-            paths.encode_resolve(g, &mut encoder, tracer, &out);
+            paths.encode_resolve(g, &mut encoder, sg, &out);
             g.queue.submit([encoder.finish()]);
             paths.read_image(g, &out).unwrap().0
         })
         .collect()
 }
 
-fn tracer(max_depth: u32) -> PathTracer {
-    PathTracer::new(
+fn scene_gpu(max_depth: u32) -> SceneGpu {
+    SceneGpu::new(
         gpu(),
         &scene(),
         PathTracerSettings { width: W, height: H, max_depth, rr_start_depth: 3 },
@@ -207,14 +204,15 @@ fn tracer(max_depth: u32) -> PathTracer {
     .unwrap()
 }
 
-fn pt_images(tracer: &mut PathTracer) -> Vec<Vec<[f32; 4]>> {
-    (0..SEEDS).map(|seed| tracer.render(gpu(), SPP, 200 + seed, 0).unwrap().radiance).collect()
+fn pt_images(sg: &SceneGpu) -> Vec<Vec<[f32; 4]>> {
+    let mut tracer = PathTracer::new(gpu(), sg).unwrap();
+    (0..SEEDS).map(|seed| tracer.render(gpu(), sg, SPP, 200 + seed, 0).unwrap().radiance).collect()
 }
 
 #[test]
 fn oracle_answers_reproduce_the_path_tracer() {
-    let mut t = tracer(5);
-    let pt = pt_images(&mut t);
+    let t = scene_gpu(5);
+    let pt = pt_images(&t);
     for k in [1, 2] {
         let oracle = cache_images(&t, k, Answer::Oracle);
         let z = max_z(&pt, &oracle);
@@ -231,7 +229,7 @@ fn oracle_answers_reproduce_the_path_tracer() {
 #[test]
 fn training_records_are_queries_with_finite_targets() {
     let g = gpu();
-    let t = tracer(4);
+    let t = scene_gpu(4);
     let paths = CachePaths::new(
         g,
         &t,
@@ -290,13 +288,13 @@ fn training_records_are_queries_with_finite_targets() {
 fn cache_frame(
     paths: &CachePaths,
     cache: &NeuralCache,
-    tracer: &PathTracer,
+    sg: &SceneGpu,
     out: &CacheOutput,
     frame: u32,
 ) -> Vec<[f32; 4]> {
     let g = gpu();
     let mut encoder = g.device.create_command_encoder(&Default::default());
-    paths.encode_queries(g, &mut encoder, tracer, 5, frame);
+    paths.encode_queries(g, &mut encoder, sg, 5, frame);
     cache
         .encode_infer(
             g,
@@ -307,8 +305,8 @@ fn cache_frame(
             PredictorMode::Blend,
         )
         .unwrap();
-    paths.encode_resolve(g, &mut encoder, tracer, out);
-    paths.encode_records(g, &mut encoder, tracer);
+    paths.encode_resolve(g, &mut encoder, sg, out);
+    paths.encode_records(g, &mut encoder, sg);
     cache.encode_train(g, &mut encoder, paths.records(), paths.record_count()).unwrap();
     g.queue.submit([encoder.finish()]);
     paths.read_image(g, out).unwrap().0
@@ -317,7 +315,7 @@ fn cache_frame(
 #[test]
 fn saved_and_loaded_cache_renders_the_next_frames_identically() {
     let g = gpu();
-    let t = tracer(3);
+    let t = scene_gpu(3);
     let (lo, hi) = t.geometry().bounds();
     let config = common::small_config();
     let paths = CachePaths::new(
@@ -382,13 +380,13 @@ fn motion_vectors_match_the_path_tracers_gbuffer() {
     // Camera moved and an instance moved between two updates: the cache paths' per-pixel motion
     // is the path tracer's G-buffer motion of the same frame.
     let g = gpu();
-    let mut t = tracer(2);
+    let mut t = scene_gpu(2);
     let mut moved = scene();
     moved.camera.position += Vec3::new(0.15, -0.05, 0.1);
     moved.instances[1].transform =
         Mat4::from_translation(Vec3::new(0.1, 0.0, 0.05)) * moved.instances[1].transform;
     t.update(g, &moved);
-    let expected = t.render(g, 1, 3, 1).unwrap().gbuffer.motion;
+    let expected = PathTracer::new(g, &t).unwrap().render(g, &t, 1, 3, 1).unwrap().gbuffer.motion;
     let paths = CachePaths::new(g, &t, 1, CachePathSettings::default()).unwrap();
     let mut encoder = g.device.create_command_encoder(&Default::default());
     paths.encode_queries(g, &mut encoder, &t, 3, 1);
@@ -416,7 +414,7 @@ fn ray_counters_count_every_ray_when_all_escape() {
     let g = gpu();
     let mut up = scene();
     up.camera.target = up.camera.position + Vec3::new(0.0, 10.0, 0.01);
-    let mut t = tracer(3);
+    let mut t = scene_gpu(3);
     t.update(g, &up);
     let spp = 2;
     let paths = CachePaths::new(

@@ -15,18 +15,18 @@ use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
 use crate::lights::GpuLight;
 use crate::materials::GpuMaterial;
-use crate::scene_bindings::SceneBindings;
 use crate::scene_features::SceneFeatures;
+use crate::scene_gpu::SceneGpu;
 use crate::shader::{Module, Program};
 
 /// Storage buffers a pass built on the library binds before its own: @group(0) (scene) and
 /// @group(1) (geometry). Add the pass's own to check the adapter limit.
 pub const LIBRARY_STORAGE_BUFFERS: u32 =
-    crate::scene_bindings::STORAGE_BUFFERS + SceneGeometry::STORAGE_BUFFERS;
+    crate::scene_gpu::STORAGE_BUFFERS + SceneGeometry::STORAGE_BUFFERS;
 
 /// Texel tables (read-only storage textures) of the same two groups.
 pub const LIBRARY_TEXEL_TABLES: u32 =
-    crate::scene_bindings::TABLES.len() as u32 + SceneGeometry::TEXEL_TABLES;
+    crate::scene_gpu::TABLES.len() as u32 + SceneGeometry::TEXEL_TABLES;
 
 /// A pipeline of the library, compiled for the features the scene has now. Fetch it with
 /// [`Self::get`] each time a pass is recorded: [`PassLibrary::specialise`] replaces it when the
@@ -48,7 +48,7 @@ impl PartialEq for LibraryPipeline {
 }
 
 type Compile = Box<
-    dyn Fn(&Gpu, &SceneBindings, SceneFeatures) -> Result<Vec<wgpu::ComputePipeline>, RenderError>
+    dyn Fn(&Gpu, &SceneGpu, SceneFeatures) -> Result<Vec<wgpu::ComputePipeline>, RenderError>
         + Send,
 >;
 
@@ -90,7 +90,7 @@ impl PassLibrary {
     pub fn specialise(
         &self,
         gpu: &Gpu,
-        scene: &SceneBindings,
+        scene: &SceneGpu,
         features: SceneFeatures,
     ) -> Result<(), RenderError> {
         let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
@@ -127,8 +127,8 @@ impl PassLibrary {
             let bindings = crate::texel_table::group_module(
                 "package::scene_bindings",
                 0,
-                &crate::scene_bindings::GROUP,
-                &crate::scene_bindings::TABLES,
+                &crate::scene_gpu::GROUP,
+                &crate::scene_gpu::TABLES,
                 &[&types],
             );
             let mut modules = vec![types, bindings];
@@ -205,7 +205,7 @@ impl PassLibrary {
     pub fn pass<const N: usize>(
         &self,
         gpu: &Gpu,
-        scene: &SceneBindings,
+        scene: &SceneGpu,
         pass: &str,
         program: &Program,
         own: &[BufferBinding],
@@ -231,7 +231,7 @@ impl PassLibrary {
         let compile: Compile = {
             let (name, program, layout, entries) =
                 (pass.to_string(), program.clone(), layout.clone(), entries.map(String::from));
-            Box::new(move |gpu: &Gpu, scene: &SceneBindings, features: SceneFeatures| {
+            Box::new(move |gpu: &Gpu, scene: &SceneGpu, features: SceneFeatures| {
                 let specialised = program.replacing(&features.module());
                 let groups = [scene.layout(), scene.geometry().bind_group_layout(), &layout];
                 Ok(compute::pipelines(

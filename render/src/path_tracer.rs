@@ -1,20 +1,20 @@
 //! The WGSL path tracer: per frame, HDR radiance and a primary-hit G-buffer read back to the
 //! CPU, GPU time per pass; and converged references accumulated in bounded batches.
 //!
-//! Three parts: the scene bindings (`SceneBindings`: @group(0) frame uniform, materials, texels,
-//! lights, read only; @group(1) geometry), the pass library (`PassLibrary`: the shading library's
-//! WGSL and the run's shared pipelines) and the path tracer's own outputs (@group(2) of
-//! render/shaders/path_tracer.wgsl: radiance sum, G-buffer, sample partials, ray counter).
+//! A method like the others: it reads the scene on the GPU (`SceneGpu`: the tables, the geometry
+//! and the pass library), binds them at @group(0) and @group(1) with its own frame parameters
+//! (`FrameBindings`), and owns its outputs (@group(2) of render/shaders/path_tracer.wgsl: radiance
+//! sum, G-buffer, sample partials, ray counter). Whoever renders with it (the path tracing
+//! method, the references, the SSS method) holds its own.
 
-use crate::bvh::SceneGeometry;
 use crate::compute::{self, BufferBinding};
 use crate::error::RenderError;
+use crate::frame_bindings::FrameBindings;
 use crate::gpu::Gpu;
 use crate::gpu_struct::GpuStruct;
 use crate::pass_library::{LibraryPipeline, PassLibrary};
 use crate::readback::Staging;
-use crate::scene::{Camera, SceneChanges, SceneDesc};
-use crate::scene_bindings::SceneBindings;
+use crate::scene_gpu::SceneGpu;
 use crate::shader::{Module, Program};
 use crate::timing::{PassTimer, PassTiming, merge};
 
@@ -45,7 +45,7 @@ const COUNTER_WORDS: u64 = 4;
 
 pub use crate::pass_library::LIBRARY_STORAGE_BUFFERS;
 
-pub use crate::scene_bindings::PathTracerSettings;
+pub use crate::scene_gpu::PathTracerSettings;
 
 /// Primary-hit attributes of the pixel-centre ray, row-major, `width * height` each.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -102,8 +102,7 @@ const BYTES_PER_PIXEL: u64 = 16 + size_of::<GBufferTexel>() as u64;
 
 pub struct PathTracer {
     settings: PathTracerSettings,
-    scene: SceneBindings,
-    library: PassLibrary,
+    frame: FrameBindings,
     /// The path tracer's own @group(2) and its buffers.
     layout: wgpu::BindGroupLayout,
     bind_group: wgpu::BindGroup,
@@ -125,23 +124,15 @@ pub struct PathTracer {
 }
 
 impl PathTracer {
-    pub fn new(
-        gpu: &Gpu,
-        scene: &SceneDesc,
-        settings: PathTracerSettings,
-    ) -> Result<Self, RenderError> {
-        if settings.max_depth == 0 {
-            return Err(RenderError::Settings(
-                "max_depth must be at least 1 (1 = direct lighting)".into(),
-            ));
-        }
+    /// Its outputs at the scene's resolution and its passes from the scene's library.
+    pub fn new(gpu: &Gpu, scene: &SceneGpu) -> Result<Self, RenderError> {
+        let settings = scene.settings();
         gpu.check_resolution(settings.width, settings.height, BYTES_PER_PIXEL)?;
-        // Before the scene is uploaded; `PassLibrary::pass` checks again when it builds the pass.
+        // Before any buffer is made; `PassLibrary::pass` checks again when it builds the pass.
         PassLibrary::check_storage_bindings(gpu, "path_tracer.wgsl", &OWN_GROUP)?;
         // No workgroup memory is declared (var<workgroup>): nothing to check against the budget.
         gpu.check_workgroup_memory("path_trace", 0)?;
 
-        let scene = SceneBindings::new(gpu, scene, settings)?;
         let device = &gpu.device;
         let pixels = settings.width as u64 * settings.height as u64;
         let per_pixel = |label: &str, size: u64, usage: wgpu::BufferUsages| {
@@ -172,15 +163,14 @@ impl PathTracer {
         );
         let counters_readback = Staging::new(gpu, "ray counter", COUNTER_WORDS * 4);
 
-        let library = PassLibrary::new(scene.features());
-        let (layout, [trace_pipeline, gbuffer_pipeline, accumulate_pipeline]) = library.pass(
-            gpu,
-            &scene,
-            "path_tracer.wgsl",
-            Self::program(),
-            &OWN_GROUP,
-            ["trace_main", "gbuffer_main", "accumulate_main"],
-        )?;
+        let (layout, [trace_pipeline, gbuffer_pipeline, accumulate_pipeline]) = scene
+            .library_pass(
+                gpu,
+                "path_tracer.wgsl",
+                Self::program(),
+                &OWN_GROUP,
+                ["trace_main", "gbuffer_main", "accumulate_main"],
+            )?;
         let bind_group = compute::buffer_group(
             gpu,
             "path tracer",
@@ -189,8 +179,7 @@ impl PathTracer {
         );
         Ok(Self {
             settings,
-            scene,
-            library,
+            frame: FrameBindings::new(gpu, scene),
             layout,
             bind_group,
             trace_pipeline,
@@ -207,16 +196,6 @@ impl PathTracer {
             counters_readback,
             paths_per_dispatch: PATHS_PER_DISPATCH,
         })
-    }
-
-    /// The scene bindings (@group(0) and the geometry's @group(1)) every method's passes bind.
-    pub fn scene(&self) -> &SceneBindings {
-        &self.scene
-    }
-
-    /// The pass library: the shading library's source and the run's shared pipelines.
-    pub fn library(&self) -> &PassLibrary {
-        &self.library
     }
 
     /// The path tracer's program: the library, its own structs and @group(2), path_tracer.wgsl.
@@ -252,78 +231,15 @@ impl PathTracer {
         );
     }
 
-    /// [`PassLibrary::pass`] on this run's scene bindings.
-    pub fn library_pass<const N: usize>(
-        &self,
-        gpu: &Gpu,
-        pass: &str,
-        program: &Program,
-        own: &[BufferBinding],
-        entries: [&str; N],
-    ) -> Result<(wgpu::BindGroupLayout, [LibraryPipeline; N]), RenderError> {
-        self.library.pass(gpu, &self.scene, pass, program, own, entries)
-    }
-
-    /// Layout of @group(0) of [`Self::library_source`].
-    pub fn scene_bind_group_layout(&self) -> &wgpu::BindGroupLayout {
-        self.scene.layout()
-    }
-
-    /// @group(0) of [`Self::library_source`] ([`SceneBindings::bind_group`]).
-    pub fn scene_bind_group(&self) -> &wgpu::BindGroup {
-        self.scene.bind_group()
-    }
-
-    /// [`SceneBindings::prepare_frame`].
-    pub fn prepare_frame(&self, gpu: &Gpu, spp: u32, first_sample: u32, seed: u64, frame: u32) {
-        self.scene.prepare_frame(gpu, spp, first_sample, seed, frame);
-    }
-
-    /// The camera of the current frame (after the last `update`).
-    pub fn camera(&self) -> &Camera {
-        self.scene.camera()
-    }
-
     pub fn settings(&self) -> PathTracerSettings {
         self.settings
-    }
-
-    pub fn geometry(&self) -> &SceneGeometry {
-        self.scene.geometry()
-    }
-
-    /// Refreshes the dynamic parts: instance transforms, materials (and textures), lights
-    /// (emissive triangles follow their instances), camera, environment. Meshes are fixed at
-    /// `new`. Call once per simulated frame: the camera and instance transforms it replaces become
-    /// the previous ones of motion vectors.
-    pub fn update(&mut self, gpu: &Gpu, scene: &SceneDesc) {
-        if let Err(e) = self.try_update(gpu, scene) {
-            panic!("PathTracer::update: {e}");
-        }
-    }
-
-    /// [`Self::update`] that reports an inconsistent scene instead of panicking.
-    pub fn try_update(&mut self, gpu: &Gpu, scene: &SceneDesc) -> Result<(), RenderError> {
-        self.update_changed(gpu, scene, SceneChanges::ALL)
-    }
-
-    /// [`Self::try_update`] uploading only what `changes` names ([`SceneBindings::update_changed`]).
-    /// When the scene gains or loses a feature (a kind of light, textures), every pass of the
-    /// library is compiled again for its features ([`PassLibrary::specialise`]).
-    pub fn update_changed(
-        &mut self,
-        gpu: &Gpu,
-        scene: &SceneDesc,
-        changes: SceneChanges,
-    ) -> Result<(), RenderError> {
-        self.scene.update_changed(gpu, scene, changes)?;
-        self.library.specialise(gpu, &self.scene, self.scene.features())
     }
 
     /// One frame: G-buffer of the pixel-centre rays, then `spp` jittered paths per pixel.
     pub fn render(
         &mut self,
         gpu: &Gpu,
+        scene: &SceneGpu,
         spp: u32,
         seed: u64,
         frame: u32,
@@ -332,13 +248,12 @@ impl PathTracer {
             return Err(RenderError::Settings("spp must be at least 1".into()));
         }
         // G-buffer pass.
-        self.scene.write_frame(gpu, 0, 0, seed, frame, false);
+        self.frame.prepare(gpu, scene, 0, 0, seed, frame);
         let mut timed = self.timer.begin(gpu, "gbuffer");
         timed.encoder().clear_buffer(&self.counters, 0, None);
         timed.pass(0, |pass| {
             pass.set_pipeline(&self.gbuffer_pipeline.get());
-            pass.set_bind_group(0, self.scene.bind_group(), &[]);
-            pass.set_bind_group(1, self.scene.geometry().bind_group(), &[]);
+            self.frame.bind(gpu, scene, pass);
             pass.set_bind_group(2, &self.bind_group, &[]);
             pass.dispatch_workgroups(
                 self.settings.width.div_ceil(WORKGROUP),
@@ -349,7 +264,7 @@ impl PathTracer {
         let mut timings = timed.submit()?;
 
         // Path-trace pass, in batches of bounded work.
-        merge(&mut timings, self.trace_batches(gpu, spp, seed, frame, &mut |_, _| {})?);
+        merge(&mut timings, self.trace_batches(gpu, scene, spp, seed, frame, &mut |_, _| {})?);
 
         let radiance = self.read_radiance(gpu)?;
         let gbuffer = self.read_gbuffer(gpu)?;
@@ -372,6 +287,7 @@ impl PathTracer {
     pub fn render_reference(
         &mut self,
         gpu: &Gpu,
+        scene: &SceneGpu,
         spp: u32,
         seed: u64,
         frame: u32,
@@ -380,7 +296,7 @@ impl PathTracer {
         if spp == 0 {
             return Err(RenderError::Settings("reference spp must be at least 1".into()));
         }
-        self.trace_batches(gpu, spp, seed, frame, progress)?;
+        self.trace_batches(gpu, scene, spp, seed, frame, progress)?;
         self.read_radiance(gpu)
     }
 
@@ -424,6 +340,7 @@ impl PathTracer {
     fn trace_batches(
         &self,
         gpu: &Gpu,
+        scene: &SceneGpu,
         spp: u32,
         seed: u64,
         frame: u32,
@@ -434,15 +351,14 @@ impl PathTracer {
         let mut timings = Vec::new();
         while done < spp {
             let batch = per_dispatch.min(spp - done);
-            self.scene.write_frame(gpu, batch, done, seed, frame, done > 0);
+            self.frame.write(gpu, scene, batch, done, seed, frame, done > 0);
             let mut timed = self.timer.begin(gpu, "path trace");
             timed.pass(1, |pass| {
                 let (x, y) = (
                     self.settings.width.div_ceil(WORKGROUP),
                     self.settings.height.div_ceil(WORKGROUP),
                 );
-                pass.set_bind_group(0, self.scene.bind_group(), &[]);
-                pass.set_bind_group(1, self.scene.geometry().bind_group(), &[]);
+                self.frame.bind(gpu, scene, pass);
                 pass.set_bind_group(2, &self.bind_group, &[]);
                 pass.set_pipeline(&self.trace_pipeline.get());
                 pass.dispatch_workgroups(x, y, batch.div_ceil(SAMPLES_PER_THREAD));

@@ -12,6 +12,7 @@ use render::frame::CameraBasis;
 use render::gpu::Gpu;
 use render::path_tracer::{FrameOutput, NO_HIT, PathTracer, PathTracerSettings};
 use render::scene::{Camera, Instance, Light, Material, Mesh, SceneDesc, Texture};
+use render::scene_gpu::SceneGpu;
 use std::f64::consts::PI;
 use std::sync::OnceLock;
 
@@ -73,8 +74,9 @@ fn settings(max_depth: u32) -> PathTracerSettings {
 }
 
 fn render(scene: &SceneDesc, s: PathTracerSettings, spp: u32, seed: u64) -> FrameOutput {
-    let mut pt = PathTracer::new(gpu(), scene, s).expect("path tracer");
-    pt.render(gpu(), spp, seed, 0).expect("render")
+    let sg = SceneGpu::new(gpu(), scene, s).expect("scene");
+    let mut pt = PathTracer::new(gpu(), &sg).expect("path tracer");
+    pt.render(gpu(), &sg, spp, seed, 0).expect("render")
 }
 
 /// With ANALYTIC_DUMP=dir set, writes `values` (W x H f64, row-major) as raw little-endian f64
@@ -94,10 +96,16 @@ fn mean_rgb(p: &[f32; 4]) -> f64 {
 const RENDERS: u64 = 8;
 
 fn renders(scene: &SceneDesc, s: PathTracerSettings, spp: u32, seed: u64) -> Vec<Vec<f64>> {
-    let mut pt = PathTracer::new(gpu(), scene, s).expect("path tracer");
+    let sg = SceneGpu::new(gpu(), scene, s).expect("scene");
+    let mut pt = PathTracer::new(gpu(), &sg).expect("path tracer");
     (seed..seed + RENDERS)
         .map(|k| {
-            pt.render(gpu(), spp, k, 0).expect("render").radiance.iter().map(mean_rgb).collect()
+            pt.render(gpu(), &sg, spp, k, 0)
+                .expect("render")
+                .radiance
+                .iter()
+                .map(mean_rgb)
+                .collect()
         })
         .collect()
 }
@@ -227,11 +235,12 @@ fn long_dispatch_keeps_every_sample() {
     // the image came out several times too dark. The furnace must stay at 1.
     let scene = white_furnace();
     let s = PathTracerSettings { width: 8, height: 6, max_depth: 64, rr_start_depth: 64 };
-    let mut pt = PathTracer::new(gpu(), &scene, s).unwrap();
+    let sg = SceneGpu::new(gpu(), &scene, s).unwrap();
+    let mut pt = PathTracer::new(gpu(), &sg).unwrap();
     let spp = 2048;
     assert!(pt.samples_per_dispatch() >= spp, "the test needs all samples in one dispatch");
     let mut dispatches = 0;
-    let image = pt.render_reference(gpu(), spp, 5, 0, &mut |_, _| dispatches += 1).unwrap();
+    let image = pt.render_reference(gpu(), &sg, spp, 5, 0, &mut |_, _| dispatches += 1).unwrap();
     assert_eq!(dispatches, 1);
     let mean = image.iter().map(mean_rgb).sum::<f64>() / image.len() as f64;
     let worst = image.iter().map(|p| (mean_rgb(p) - 1.0).abs()).fold(0.0, f64::max);
@@ -654,15 +663,16 @@ fn same_seed_same_bytes_other_seed_other_bytes() {
 fn reference_is_stable_under_seed_change() {
     let scene = small_scene();
     let s = PathTracerSettings { width: 16, height: 12, max_depth: 6, rr_start_depth: 3 };
-    let mut pt = PathTracer::new(gpu(), &scene, s).unwrap();
+    let sg = SceneGpu::new(gpu(), &scene, s).unwrap();
+    let mut pt = PathTracer::new(gpu(), &sg).unwrap();
     let spp = 16384;
     let mut calls = vec![];
     let a = pt
-        .render_reference(gpu(), spp, 1, 0, &mut |done, total| calls.push((done, total)))
+        .render_reference(gpu(), &sg, spp, 1, 0, &mut |done, total| calls.push((done, total)))
         .unwrap();
     assert_eq!(calls.last(), Some(&(spp, spp)));
     assert!(calls.windows(2).all(|w| w[0].0 < w[1].0), "progress must grow: {calls:?}");
-    let b = pt.render_reference(gpu(), spp, 2, 0, &mut |_, _| {}).unwrap();
+    let b = pt.render_reference(gpu(), &sg, spp, 2, 0, &mut |_, _| {}).unwrap();
     let diff: f64 = a
         .iter()
         .zip(&b)
@@ -680,12 +690,13 @@ fn reference_batches_sum_the_same_samples() {
     // samples (same sample indices), so the means agree to float summation order.
     let scene = small_scene();
     let s = PathTracerSettings { width: 16, height: 12, max_depth: 4, rr_start_depth: 2 };
-    let mut pt = PathTracer::new(gpu(), &scene, s).unwrap();
-    let one = pt.render_reference(gpu(), 64, 9, 3, &mut |_, _| {}).unwrap();
+    let sg = SceneGpu::new(gpu(), &scene, s).unwrap();
+    let mut pt = PathTracer::new(gpu(), &sg).unwrap();
+    let one = pt.render_reference(gpu(), &sg, 64, 9, 3, &mut |_, _| {}).unwrap();
     pt.set_paths_per_dispatch(gpu(), 16 * 12 * 16).unwrap();
     assert_eq!(pt.samples_per_dispatch(), 16);
     let mut batches = 0;
-    let four = pt.render_reference(gpu(), 64, 9, 3, &mut |_, _| batches += 1).unwrap();
+    let four = pt.render_reference(gpu(), &sg, 64, 9, 3, &mut |_, _| batches += 1).unwrap();
     assert_eq!(batches, 4);
     for (x, y) in one.iter().zip(&four) {
         for c in 0..3 {
@@ -723,8 +734,9 @@ fn gbuffer_of_a_known_plane_and_motion_of_a_moved_instance() {
         ..Default::default()
     };
     let s = settings(1);
-    let mut pt = PathTracer::new(gpu(), &scene, s).unwrap();
-    let f0 = pt.render(gpu(), 1, 0, 0).unwrap();
+    let mut sg = SceneGpu::new(gpu(), &scene, s).unwrap();
+    let mut pt = PathTracer::new(gpu(), &sg).unwrap();
+    let f0 = pt.render(gpu(), &sg, 1, 0, 0).unwrap();
     let basis = CameraBasis::new(&camera, W, H);
     let srgb_188 = ((188.0 / 255.0 + 0.055) / 1.055f64).powf(2.4);
     let mut counts = [0usize; 3];
@@ -784,8 +796,8 @@ fn gbuffer_of_a_known_plane_and_motion_of_a_moved_instance() {
     // Frame 1: the quad moves by delta; its pixels must point back to where it was.
     let delta = Vec3::new(0.2, 0.0, -0.1);
     scene.instances[1].transform = Mat4::from_translation(Vec3::new(0.3, 0.5, 0.0) + delta);
-    pt.update(gpu(), &scene);
-    let f1 = pt.render(gpu(), 1, 0, 1).unwrap();
+    sg.update(gpu(), &scene);
+    let f1 = pt.render(gpu(), &sg, 1, 0, 1).unwrap();
     let mut moved = 0;
     for i in 0..(W * H) as usize {
         let g = &f1.gbuffer;
@@ -812,8 +824,8 @@ fn gbuffer_of_a_known_plane_and_motion_of_a_moved_instance() {
     moved_camera.position += Vec3::new(0.1, 0.2, 0.05);
     moved_camera.target += Vec3::new(0.1, 0.0, 0.05);
     scene.camera = moved_camera;
-    pt.update(gpu(), &scene); // the quad stays where frame 1 had it
-    let f2 = pt.render(gpu(), 1, 0, 2).unwrap();
+    sg.update(gpu(), &scene); // the quad stays where frame 1 had it
+    let f2 = pt.render(gpu(), &sg, 1, 0, 2).unwrap();
     let now = CameraBasis::new(&moved_camera, W, H);
     let mut checked = 0;
     for i in 0..(W * H) as usize {
@@ -839,7 +851,7 @@ fn gbuffer_of_a_known_plane_and_motion_of_a_moved_instance() {
 fn bad_settings_and_scenes_are_refused() {
     let scene = ground_scene(0.5, top_down_camera(2.0));
     let huge = gpu().limits.max_texture_dimension_2d + 1;
-    let err = PathTracer::new(
+    let err = SceneGpu::new(
         gpu(),
         &scene,
         PathTracerSettings { width: huge, height: 4, max_depth: 1, rr_start_depth: 1 },
@@ -848,14 +860,14 @@ fn bad_settings_and_scenes_are_refused() {
     .expect("oversize refused")
     .to_string();
     assert!(err.contains("image width"), "{err}");
-    let err = PathTracer::new(gpu(), &scene, PathTracerSettings { max_depth: 0, ..settings(1) })
+    let err = SceneGpu::new(gpu(), &scene, PathTracerSettings { max_depth: 0, ..settings(1) })
         .err()
         .expect("depth 0 refused")
         .to_string();
     assert!(err.contains("max_depth"), "{err}");
     let mut bad = scene.clone();
     bad.materials[0].base_color_texture = Some(3);
-    let err = PathTracer::new(gpu(), &bad, settings(1))
+    let err = SceneGpu::new(gpu(), &bad, settings(1))
         .err()
         .expect("dangling texture refused")
         .to_string();

@@ -9,6 +9,7 @@ use glam::{Mat4, Vec3};
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::Instance;
 use render::scene_features::SceneFeatures;
+use render::scene_gpu::SceneGpu;
 
 fn settings() -> PathTracerSettings {
     PathTracerSettings { width: W, height: H, max_depth: 4, rr_start_depth: 2 }
@@ -16,8 +17,9 @@ fn settings() -> PathTracerSettings {
 
 #[test]
 fn passes_for_the_scene_s_lights_render_what_passes_for_every_light_do() {
-    let mut tracer = PathTracer::new(gpu(), &room_scene(), settings()).expect("tracer");
-    let stack = SceneFeatures::stack_for(tracer.geometry().stack_entries());
+    let sg = SceneGpu::new(gpu(), &room_scene(), settings()).expect("scene");
+    let mut tracer = PathTracer::new(gpu(), &sg).expect("tracer");
+    let stack = SceneFeatures::stack_for(sg.geometry().stack_entries());
     assert!(
         stack < SceneFeatures::ALL.traversal_stack,
         "the room's BVH is shallow: {stack} entries"
@@ -30,17 +32,14 @@ fn passes_for_the_scene_s_lights_render_what_passes_for_every_light_do() {
         traversal_stack: stack,
     };
     assert_eq!(
-        tracer.library().features(),
+        sg.library().features(),
         room,
         "the room has only its emissive panel, and no textures"
     );
-    let own = tracer.render(gpu(), 4, 7, 0).expect("frame");
-    tracer
-        .library()
-        .specialise(gpu(), tracer.scene(), SceneFeatures::ALL)
-        .expect("compile for every feature");
-    assert_eq!(tracer.library().features(), SceneFeatures::ALL);
-    let every = tracer.render(gpu(), 4, 7, 0).expect("frame");
+    let own = tracer.render(gpu(), &sg, 4, 7, 0).expect("frame");
+    sg.library().specialise(gpu(), &sg, SceneFeatures::ALL).expect("compile for every feature");
+    assert_eq!(sg.library().features(), SceneFeatures::ALL);
+    let every = tracer.render(gpu(), &sg, 4, 7, 0).expect("frame");
     assert!(own.radiance.iter().any(|p| p[0] > 0.0), "the room is lit");
     assert_eq!(
         own.radiance, every.radiance,
@@ -59,20 +58,21 @@ fn the_traversal_stack_never_shrinks_within_a_run() {
             transform: Mat4::from_translation(Vec3::new(i as f32 * 3.0, 0.0, -4.0)),
         })
         .collect();
-    let mut tracer = PathTracer::new(gpu(), &crowd, settings()).expect("tracer");
-    let deep = tracer.geometry().stack_entries();
-    assert_eq!(tracer.library().features().traversal_stack, SceneFeatures::stack_for(deep));
-    tracer.try_update(gpu(), &room_scene()).expect("update");
+    let mut sg = SceneGpu::new(gpu(), &crowd, settings()).expect("scene");
+    let mut tracer = PathTracer::new(gpu(), &sg).expect("tracer");
+    let deep = sg.geometry().stack_entries();
+    assert_eq!(sg.library().features().traversal_stack, SceneFeatures::stack_for(deep));
+    sg.try_update(gpu(), &room_scene()).expect("update");
     assert!(
-        tracer.geometry().stack_entries() < deep,
+        sg.geometry().stack_entries() < deep,
         "fewer instances, a shallower TLAS: {} against {deep}",
-        tracer.geometry().stack_entries()
+        sg.geometry().stack_entries()
     );
     assert_eq!(
-        tracer.library().features().traversal_stack,
+        sg.library().features().traversal_stack,
         SceneFeatures::stack_for(deep),
         "kept: a TLAS that deepens again needs no new pipelines"
     );
-    let frame = tracer.render(gpu(), 1, 7, 0).expect("frame");
+    let frame = tracer.render(gpu(), &sg, 1, 7, 0).expect("frame");
     assert!(frame.radiance.iter().any(|p| p[0] > 0.0));
 }

@@ -7,12 +7,13 @@ use anyhow::{Context, Result, anyhow};
 use bevy_ecs::prelude::{Schedule, World};
 use indicatif::{ProgressBar, ProgressStyle};
 use render::gpu::Gpu;
-use render::path_tracer::{PathTracer, PathTracerSettings};
+use render::path_tracer::PathTracerSettings;
+use render::scene_gpu::SceneGpu;
 use sim::Simulation;
 
 use crate::frame::{
-    self, FrameClock, GpuDevice, MethodFrame, MethodInfo, Progress, References, Run, RunOutput,
-    Tracer,
+    self, FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Progress, References, Run,
+    RunOutput,
 };
 use crate::frame_record::FrameRecord;
 use crate::output;
@@ -94,12 +95,24 @@ impl FrameWorld {
         let (width, height) = scenario.resolution;
         let settings =
             PathTracerSettings { width, height, max_depth: scenario.max_depth, rr_start_depth: 3 };
-        let tracer = PathTracer::new(&gpu, sim.scene(), settings)
-            .with_context(|| format!("{origin}: preparing the path tracer"))?;
+        let gpu_scene = SceneGpu::new(&gpu, sim.scene(), settings)
+            .with_context(|| format!("{origin}: uploading the scene"))?;
+        let wants_references =
+            (0..scenario.frames).any(|f| scenario.reference.wants(f, scenario.frames));
+        let reference_renderer = wants_references
+            .then(|| {
+                frame::reference::ReferenceRenderer::new(
+                    &gpu,
+                    &gpu_scene,
+                    !scenario.media.is_empty(),
+                )
+            })
+            .transpose()
+            .with_context(|| format!("{origin}: preparing the reference renderer"))?;
 
         let mut world = sim.into_world();
         world.insert_resource(GpuDevice(gpu));
-        world.insert_resource(Tracer(tracer));
+        world.insert_resource(GpuScene(gpu_scene));
         world.insert_resource(Run {
             scenario: scenario.clone(),
             width,
@@ -110,6 +123,7 @@ impl FrameWorld {
         world.insert_resource(RunOutput { folder, records: Vec::new() });
         world.insert_resource(References {
             cache: ReferenceCache::new(cache_dir),
+            renderer: reference_renderer,
             current: None,
             rendered: 0,
             cached: 0,

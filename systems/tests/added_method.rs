@@ -7,8 +7,9 @@ use std::time::Instant;
 
 use anyhow::Result;
 use bevy_ecs::prelude::*;
+use render::path_tracer::PathTracer;
 use serde::{Deserialize, Serialize};
-use systems::frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer};
+use systems::frame::{FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage};
 use systems::methods::{MethodOutput, MethodPlugin, register};
 use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};
@@ -30,6 +31,7 @@ impl Default for EmaSettings {
 struct EmaState {
     alpha: f32,
     average: Option<Vec<[f32; 4]>>,
+    tracer: PathTracer,
 }
 
 struct EmaPlugin;
@@ -56,21 +58,23 @@ impl MethodPlugin for EmaPlugin {
 
     fn spawn(world: &mut World, entity: Entity, settings: &EmaSettings) -> Result<()> {
         anyhow::ensure!(settings.alpha > 0.0 && settings.alpha <= 1.0, "alpha in (0, 1]");
-        world.entity_mut(entity).insert(EmaState { alpha: settings.alpha, average: None });
+        let tracer =
+            PathTracer::new(&world.resource::<GpuDevice>().0, &world.resource::<GpuScene>().0)?;
+        world.entity_mut(entity).insert(EmaState { alpha: settings.alpha, average: None, tracer });
         Ok(())
     }
 }
 
 fn ema_render(
     gpu: Res<GpuDevice>,
-    mut tracer: ResMut<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     mut methods: Query<(&mut EmaState, &MethodInfo, &mut MethodFrame)>,
 ) -> Result<(), BevyError> {
     for (mut state, _info, mut frame) in &mut methods {
         let start = Instant::now();
-        let out = tracer.0.render(&gpu.0, 1, run.scenario.seed, clock.global)?;
+        let out = state.tracer.render(&gpu.0, &gpu_scene.0, 1, run.scenario.seed, clock.global)?;
         let alpha = state.alpha;
         let average = match state.average.take() {
             None => out.radiance.clone(),

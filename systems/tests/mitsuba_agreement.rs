@@ -5,6 +5,7 @@
 
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
+use render::scene_gpu::SceneGpu;
 use systems::mitsuba::{Integrator, python, render, write_scene};
 
 #[test]
@@ -12,14 +13,15 @@ fn lambertian_cornell_box_matches_mitsuba() {
     let (size, spp) = (16u32, 2048u32);
     let scene = systems::mitsuba::lambertian_cornell_box((size, size)).unwrap();
     let gpu = Gpu::new().expect("a wgpu adapter (lavapipe on CI)");
-    let mut tracer = PathTracer::new(
+    let mut sg = SceneGpu::new(
         &gpu,
         &scene,
         PathTracerSettings { width: size, height: size, max_depth: 1000, rr_start_depth: 3 },
     )
     .unwrap();
-    tracer.update(&gpu, &scene);
-    let ours = tracer.render_reference(&gpu, spp, 7, 0, &mut |_, _| {}).unwrap();
+    let mut tracer = PathTracer::new(&gpu, &sg).unwrap();
+    sg.update(&gpu, &scene);
+    let ours = tracer.render_reference(&gpu, &sg, spp, 7, 0, &mut |_, _| {}).unwrap();
 
     let python = python().expect("python3 with the mitsuba package (scripts/setup.sh installs it)");
     let dir = std::env::temp_dir().join(format!("flicker-mitsuba-{}", std::process::id()));

@@ -10,6 +10,7 @@ use std::path::Path;
 use metrics::Image;
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
+use render::scene_gpu::SceneGpu;
 use sample_cache::{Retrace, SampleCache, SampleCacheSettings};
 use sim::{Scenario, Simulation};
 use taa::{Taa, TaaSettings};
@@ -33,16 +34,17 @@ fn sample_cache_on_a_moving_hairball_camera() {
         max_depth: scenario.max_depth,
         rr_start_depth: 3,
     };
-    let mut tracer = PathTracer::new(&gpu, sim.scene(), settings).expect("path tracer");
+    let mut sg = SceneGpu::new(&gpu, sim.scene(), settings).expect("scene");
+    let mut tracer = PathTracer::new(&gpu, &sg).expect("path tracer");
     let variants = [Retrace::Single, Retrace::Multi, Retrace::Adaptive];
     let mut caches: Vec<SampleCache> = variants
         .iter()
         .map(|&retrace| {
-            SampleCache::new(&gpu, &tracer, SampleCacheSettings { retrace, ..Default::default() })
+            SampleCache::new(&gpu, &sg, SampleCacheSettings { retrace, ..Default::default() })
                 .expect("sample cache")
         })
         .collect();
-    let mut taa = Taa::new(&gpu, &tracer, TaaSettings::default()).expect("taa");
+    let mut taa = Taa::new(&gpu, &sg, TaaSettings::default()).expect("taa");
     // Per method (pt_1spp, single, multi, adaptive, taa): previous frame and SMAPE sum; per cache
     // (single, multi, adaptive): rays traced and stale visible samples.
     let mut previous: Vec<Option<Image>> = vec![None; 5];
@@ -52,23 +54,23 @@ fn sample_cache_on_a_moving_hairball_camera() {
     let mut stale = [0u64; 3];
     let eps = scenario.smape_epsilon;
     for f in 0..frames {
-        tracer.update(&gpu, sim.scene());
+        sg.update(&gpu, sim.scene());
         let frame = sim.frame();
-        let pt = tracer.render(&gpu, 1, scenario.seed, frame).expect("pt frame");
+        let pt = tracer.render(&gpu, &sg, 1, scenario.seed, frame).expect("pt frame");
         let mut outputs = vec![(pt.radiance, pt.gbuffer.motion)];
         for (i, cache) in caches.iter_mut().enumerate() {
-            let out = cache.render(&gpu, &tracer, scenario.seed, frame).expect("cache frame");
+            let out = cache.render(&gpu, &sg, scenario.seed, frame).expect("cache frame");
             // From frame 2 on: the caches have filled.
             if f >= 2 {
                 rays[i] += out.stats.rays as u64;
-                stale[i] += cache.audit(&gpu, &tracer).expect("audit") as u64;
+                stale[i] += cache.audit(&gpu, &sg).expect("audit") as u64;
             }
             outputs.push((out.radiance, out.motion));
             if f >= 2 {
                 shaded[i + 1] += out.stats.shaded as u64;
             }
         }
-        let t = taa.render(&gpu, &tracer, scenario.seed, frame).expect("taa frame");
+        let t = taa.render(&gpu, &sg, scenario.seed, frame).expect("taa frame");
         if f >= 2 {
             shaded[0] += pt.shaded;
             shaded[4] += t.shaded;

@@ -1,20 +1,21 @@
-//! Volumetric path tracing on the path tracer's scene (media/shaders/media_path.wgsl): unbiased
+//! Volumetric path tracing on the scene on the GPU (media/shaders/media_path.wgsl): unbiased
 //! references of a scene with one or several media (their extinctions add). Groups: 0 and 1 the
-//! path tracer's scene and geometry, 2 this pass's parameters, the media's optics and
-//! per-sample radiance, 3 the media (`GpuMedium`). A scene without media never builds this
-//! pass: the path tracer and its shaders are unchanged.
+//! scene (with the caller's frame parameters) and geometry, 2 this pass's parameters, the media's
+//! optics and per-sample radiance, 3 the media (`GpuMedium`). A scene without media never builds
+//! this pass: the path tracer and its shaders are unchanged.
 
 use std::sync::Mutex;
 
 use glam::Vec3;
 use render::compute::{BufferBinding, binding_layout, buffer_group, pipelines};
 use render::error::RenderError;
+use render::frame_bindings::FrameBindings;
 use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::pass_library::PassLibrary;
-use render::path_tracer::PathTracer;
 use render::readback::Staging;
 use render::scene_features::SceneFeatures;
+use render::scene_gpu::SceneGpu;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming, merge};
 use serde::{Deserialize, Serialize};
@@ -131,8 +132,8 @@ pub const VOLUME_PATH_PASS: &str = "volume_path";
 
 pub struct VolumePathPass {
     layout: wgpu::BindGroupLayout,
-    /// The pipeline and the scene features it was compiled for: compiled again when the tracer's
-    /// scene has others (a light kind gained or lost, a deeper BVH), as the library's passes are
+    /// The pipeline and the scene features it was compiled for: compiled again when the scene
+    /// has others (a light kind gained or lost, a deeper BVH), as the library's passes are
     /// (`PassLibrary::specialise`; this pass binds a fourth group, which the library's passes do
     /// not, so it holds its own).
     pipeline: Mutex<(SceneFeatures, wgpu::ComputePipeline)>,
@@ -162,10 +163,10 @@ impl VolumePathPass {
         SOURCE.get_or_init(|| Self::program().fingerprint())
     }
 
-    pub fn new(gpu: &Gpu, tracer: &PathTracer, medium: &GpuMedium) -> Result<Self, RenderError> {
+    pub fn new(gpu: &Gpu, scene: &SceneGpu, medium: &GpuMedium) -> Result<Self, RenderError> {
         let layout = binding_layout(gpu, "media volume path", &BINDINGS);
-        let features = tracer.scene().features();
-        let pipeline = Self::compile(gpu, tracer, &layout, medium, features)?;
+        let features = scene.features();
+        let pipeline = Self::compile(gpu, scene, &layout, medium, features)?;
         Ok(Self {
             layout,
             pipeline: Mutex::new((features, pipeline)),
@@ -175,13 +176,12 @@ impl VolumePathPass {
 
     fn compile(
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         layout: &wgpu::BindGroupLayout,
         medium: &GpuMedium,
         features: SceneFeatures,
     ) -> Result<wgpu::ComputePipeline, RenderError> {
         let program = Self::program().replacing(&features.module());
-        let scene = tracer.scene();
         let [pipeline] = pipelines(
             gpu,
             "media volume path",
@@ -192,17 +192,17 @@ impl VolumePathPass {
         Ok(pipeline)
     }
 
-    /// The pipeline for the tracer's scene as it is now.
+    /// The pipeline for the scene as it is now.
     fn pipeline(
         &self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         medium: &GpuMedium,
     ) -> Result<wgpu::ComputePipeline, RenderError> {
-        let features = tracer.scene().features();
+        let features = scene.features();
         let mut held = self.pipeline.lock().unwrap_or_else(|e| e.into_inner());
         if held.0 != features {
-            *held = (features, Self::compile(gpu, tracer, &self.layout, medium, features)?);
+            *held = (features, Self::compile(gpu, scene, &self.layout, medium, features)?);
         }
         Ok(held.1.clone())
     }
@@ -212,13 +212,15 @@ impl VolumePathPass {
         self.pipeline.lock().unwrap_or_else(|e| e.into_inner()).0
     }
 
-    /// `spp` paths per pixel of the tracer's current scene and camera (seed and frame as the path
+    /// `spp` paths per pixel of the current scene and camera (seed and frame as the path
     /// tracer's), in the media of `medium` with the given albedo and emission, one per medium.
+    /// `bindings` holds the caller's frame parameters (the references', a method's).
     #[allow(clippy::too_many_arguments)]
     pub fn render(
         &self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
+        bindings: &FrameBindings,
         medium: &GpuMedium,
         optics: &[MediumOptics],
         settings: &VolumePathSettings,
@@ -239,7 +241,7 @@ impl VolumePathPass {
             packed[2 * i + 1] = o.emission.extend(0.0).into();
         }
         let (width, height) = {
-            let s = tracer.settings();
+            let s = scene.settings();
             (s.width, s.height)
         };
         let pixels = width * height;
@@ -257,7 +259,7 @@ impl VolumePathPass {
         let mut lum = vec![(0f64, 0f64); pixels as usize];
         let mut first = 0;
         let mut timings = Vec::new();
-        let pipeline = self.pipeline(gpu, tracer, medium).map_err(|e| e.to_string())?;
+        let pipeline = self.pipeline(gpu, scene, medium).map_err(|e| e.to_string())?;
         while first < spp {
             let n = batch.min(spp - first);
             let params = VolumePathParams {
@@ -274,7 +276,7 @@ impl VolumePathPass {
                 contents: bytemuck::bytes_of(&params),
                 usage: wgpu::BufferUsages::STORAGE,
             });
-            tracer.prepare_frame(gpu, spp, 0, seed, frame);
+            bindings.prepare(gpu, scene, spp, 0, seed, frame);
             let optics = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("volume path optics"),
                 contents: bytemuck::cast_slice(&packed),
@@ -286,8 +288,7 @@ impl VolumePathPass {
             timed
                 .pass(0, |pass| {
                     pass.set_pipeline(&pipeline);
-                    pass.set_bind_group(0, tracer.scene().bind_group(), &[]);
-                    pass.set_bind_group(1, tracer.scene().geometry().bind_group(), &[]);
+                    bindings.bind(gpu, scene, pass);
                     pass.set_bind_group(2, &group, &[]);
                     pass.set_bind_group(3, &medium.group, &[]);
                     let groups = (pixels * n).div_ceil(64);

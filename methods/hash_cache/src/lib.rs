@@ -51,12 +51,13 @@ pub mod table_cpu;
 
 use render::compute::BufferBinding;
 use render::error::RenderError;
+use render::frame_bindings::FrameBindings;
 use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::pass_library::PassLibrary;
-use render::path_tracer::PathTracer;
 use render::readback::{copy_all, read_pod};
 use render::scene::Camera;
+use render::scene_gpu::SceneGpu;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming};
 use taa::{Taa, TaaPrimary, halton_jitter};
@@ -293,6 +294,7 @@ pub struct HashCache {
     counters: wgpu::Buffer,
     primary: wgpu::Buffer,
     colour: wgpu::Buffer,
+    frame: FrameBindings,
     group: wgpu::BindGroup,
     /// Indexed by [`HcPass`].
     pipelines: [render::pass_library::LibraryPipeline; 4],
@@ -306,11 +308,11 @@ pub struct HashCache {
 impl HashCache {
     pub fn new(
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         settings: HashCacheSettings,
     ) -> Result<Self, RenderError> {
         settings.validate()?;
-        let s = tracer.settings();
+        let s = scene.settings();
         let (width, height) = (s.width, s.height);
         gpu.check_resolution(width, height, size_of::<HcRecord>() as u64 + 32 + 16)?;
         gpu.check_buffer_size("hash cache slots", settings.capacity as u64 * 16)?;
@@ -344,7 +346,7 @@ impl HashCache {
 
         let own = OWN_GROUP;
         let (layout, pipelines) =
-            tracer.library_pass(gpu, "hash_cache.wgsl", Self::program(), &own, PASSES)?;
+            scene.library_pass(gpu, "hash_cache.wgsl", Self::program(), &own, PASSES)?;
         let group = render::compute::buffer_group(
             gpu,
             "hash cache",
@@ -362,6 +364,7 @@ impl HashCache {
             counters,
             primary,
             colour,
+            frame: FrameBindings::new(gpu, scene),
             group,
             pipelines,
             update_timer: PassTimer::new(gpu, &HcPass::UPDATE.map(HcPass::name)),
@@ -404,14 +407,14 @@ impl HashCache {
     pub fn render(
         &mut self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         camera: &Camera,
         seed: u64,
         frame: u32,
         taa: Option<&mut Taa>,
     ) -> Result<HashCacheOutput, RenderError> {
-        let (timings, jitter) = self.update(gpu, tracer, camera, seed, frame)?;
-        self.resolve(gpu, tracer, taa, timings, jitter)
+        let (timings, jitter) = self.update(gpu, scene, camera, seed, frame)?;
+        self.resolve(gpu, scene, taa, timings, jitter)
     }
 
     /// The cache's upkeep in one timed submission: age (eviction), then the frame's lookups and
@@ -419,7 +422,7 @@ impl HashCache {
     pub fn update(
         &mut self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         camera: &Camera,
         seed: u64,
         frame: u32,
@@ -443,10 +446,10 @@ impl HashCache {
             primary_jitter: jitter,
             pad2: [0.0; 2],
         };
-        tracer.prepare_frame(gpu, 1, 0, seed, frame);
+        self.frame.prepare(gpu, scene, 1, 0, seed, frame);
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
         gpu.queue.write_buffer(&self.counters, 0, &[0u8; 32]);
-        Ok((self.submit(gpu, tracer, &self.update_timer, &HcPass::UPDATE)?, jitter))
+        Ok((self.submit(gpu, scene, &self.update_timer, &HcPass::UPDATE)?, jitter))
     }
 
     /// The frame's image after [`Self::update`] (`timings`: its times, reported first): the
@@ -454,14 +457,14 @@ impl HashCache {
     pub fn resolve(
         &mut self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         taa: Option<&mut Taa>,
         mut timings: Vec<PassTiming>,
         jitter: [f32; 2],
     ) -> Result<HashCacheOutput, RenderError> {
-        // hc_resolve reads only the cache's buffers and the frame's size from the shared frame
-        // uniform, which every method sets alike: no need to set it again after `update`.
-        timings.extend(self.submit(gpu, tracer, &self.resolve_timer, &[HcPass::Resolve])?);
+        // hc_resolve reads only the cache's buffers and the frame's size from the cache's frame
+        // parameters, written by `update`: no need to write them again.
+        timings.extend(self.submit(gpu, scene, &self.resolve_timer, &[HcPass::Resolve])?);
         let radiance = match taa {
             Some(taa) => {
                 let out = taa.resolve_external(gpu, jitter, |encoder, colour, primary| {
@@ -510,7 +513,7 @@ impl HashCache {
     fn submit(
         &self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         timer: &PassTimer,
         passes: &[HcPass],
     ) -> Result<Vec<PassTiming>, RenderError> {
@@ -526,8 +529,7 @@ impl HashCache {
             };
             timed.pass(index, |pass| {
                 pass.set_pipeline(&pipeline.get());
-                pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
-                pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+                self.frame.bind(gpu, scene, pass);
                 pass.set_bind_group(2, &self.group, &[]);
                 pass.dispatch_workgroups(x, y, 1);
             })?;

@@ -14,7 +14,7 @@ use taa::{Taa, TaaSettings};
 
 pub use crate::HashCacheSettings;
 
-use frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use frame::{FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage, method_failed};
 use frame::{MethodOutput, MethodPlugin, temporal_window};
 
 /// `hash_cache` (the paper's first-hit lookup), `hash_cache_taa` (under TAA, as the paper runs
@@ -62,10 +62,10 @@ impl MethodPlugin for Plugin {
 
     fn spawn(world: &mut World, entity: Entity, settings: &HashCacheSettings) -> Result<()> {
         settings.validate()?;
-        let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
-        let cache = HashCache::new(gpu, tracer, *settings)?;
+        let (gpu, gpu_scene) = (&world.resource::<GpuDevice>().0, &world.resource::<GpuScene>().0);
+        let cache = HashCache::new(gpu, gpu_scene, *settings)?;
         let taa =
-            settings.taa.then(|| Taa::new(gpu, tracer, TaaSettings::default())).transpose()?;
+            settings.taa.then(|| Taa::new(gpu, gpu_scene, TaaSettings::default())).transpose()?;
         world.entity_mut(entity).insert(HashCacheState { cache, taa, updated: None });
         Ok(())
     }
@@ -74,7 +74,7 @@ impl MethodPlugin for Plugin {
 /// The cache's upkeep before the image: age (eviction), trace (lookups, claims), update.
 pub fn update(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     scene: Res<sim::ExtractedScene>,
@@ -84,7 +84,7 @@ pub fn update(
         let start = Instant::now();
         let updated = state
             .cache
-            .update(&gpu.0, &tracer.0, &scene.scene.camera, run.scenario.seed, clock.global)
+            .update(&gpu.0, &gpu_scene.0, &scene.scene.camera, run.scenario.seed, clock.global)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         state.updated = Some(updated);
         frame.add_cpu(start);
@@ -95,7 +95,7 @@ pub fn update(
 /// The frame's image: the cache's colour, or TAA's resolve over it.
 pub fn resolve(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     clock: Res<FrameClock>,
     mut methods: Query<(&mut HashCacheState, &MethodInfo, &mut MethodFrame)>,
 ) -> Result<(), BevyError> {
@@ -105,7 +105,7 @@ pub fn resolve(
         let (timings, jitter) = state.updated.take().unwrap_or_default();
         let out = state
             .cache
-            .resolve(&gpu.0, &tracer.0, state.taa.as_mut(), timings, jitter)
+            .resolve(&gpu.0, &gpu_scene.0, state.taa.as_mut(), timings, jitter)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let s = out.stats;
         frame.output = Some(MethodOutput {

@@ -8,25 +8,26 @@ use hash_cache::table_cpu::{CpuHashTable, check_invariants};
 use hash_cache::{HC_NEEDS_SAMPLE, HashCache, HashCacheLookup, HashCacheSettings};
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::SceneDesc;
+use render::scene_gpu::SceneGpu;
 use taa::{Taa, TaaSettings, resolve_cpu};
 
 use common::{H, W, furnace, gpu, room_scene};
 use render::test_scenes as common;
 
-fn tracer(scene: &SceneDesc, max_depth: u32) -> PathTracer {
-    PathTracer::new(
+fn scene_gpu(scene: &SceneDesc, max_depth: u32) -> SceneGpu {
+    SceneGpu::new(
         gpu(),
         scene,
         PathTracerSettings { width: W, height: H, max_depth, rr_start_depth: 3 },
     )
-    .expect("path tracer")
+    .expect("scene")
 }
 
 #[test]
 fn keys_table_and_eviction_match_the_cpu_reference() {
     for lookup in [HashCacheLookup::FirstHit, HashCacheLookup::SecondaryHit] {
         let mut scene = room_scene();
-        let mut pt = tracer(&scene, 3);
+        let mut sg = scene_gpu(&scene, 3);
         // A small table (load around a quarter) so that home windows overlap, and max_age 1 so
         // that a moving camera evicts.
         let settings = HashCacheSettings {
@@ -36,13 +37,13 @@ fn keys_table_and_eviction_match_the_cpu_reference() {
             lookup,
             ..Default::default()
         };
-        let mut cache = HashCache::new(gpu(), &pt, settings).expect("hash cache");
+        let mut cache = HashCache::new(gpu(), &sg, settings).expect("hash cache");
         let mut cpu = CpuHashTable::new(settings.capacity, settings.probe_limit, settings.max_age);
         let mut evictions = 0;
         for frame in 0..4u32 {
             scene.camera.position.x = 0.3 * frame as f32;
-            pt.update(gpu(), &scene);
-            let out = cache.render(gpu(), &pt, &scene.camera, 3, frame, None).expect("render");
+            sg.update(gpu(), &scene);
+            let out = cache.render(gpu(), &sg, &scene.camera, 3, frame, None).expect("render");
             let stamp = frame + 1;
             let records = cache.read_records(gpu()).unwrap();
             let slots = cache.read_slots(gpu()).unwrap();
@@ -127,10 +128,11 @@ fn mean_relative_error(img: &[[f32; 4]], expected: f32) -> f64 {
 #[test]
 fn furnace_converges_to_the_analytic_radiance_through_the_cache() {
     let (scene, expected) = furnace();
-    let mut pt = tracer(&scene, 40);
+    let sg = scene_gpu(&scene, 40);
+    let mut pt = PathTracer::new(gpu(), &sg).expect("path tracer");
     let frames = 16;
     let pt_error = (0..4)
-        .map(|f| mean_relative_error(&pt.render(gpu(), 1, 11, f).unwrap().radiance, expected))
+        .map(|f| mean_relative_error(&pt.render(gpu(), &sg, 1, 11, f).unwrap().radiance, expected))
         .sum::<f64>()
         / 4.0;
     for (lookup, seeds) in [
@@ -140,12 +142,12 @@ fn furnace_converges_to_the_analytic_radiance_through_the_cache() {
         let mut ratios = vec![];
         for &seed in seeds {
             let mut cache =
-                HashCache::new(gpu(), &pt, HashCacheSettings { lookup, ..Default::default() })
+                HashCache::new(gpu(), &sg, HashCacheSettings { lookup, ..Default::default() })
                     .expect("hash cache");
             let mut errors = vec![];
             let mut last = vec![];
             for frame in 0..frames {
-                let out = cache.render(gpu(), &pt, &scene.camera, seed, frame, None).unwrap();
+                let out = cache.render(gpu(), &sg, &scene.camera, seed, frame, None).unwrap();
                 errors.push(mean_relative_error(&out.radiance, expected));
                 last = out.radiance;
             }
@@ -199,10 +201,11 @@ fn smape(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
 #[test]
 fn static_scene_flickers_less_than_1spp_and_is_deterministic() {
     let scene = room_scene();
-    let mut pt = tracer(&scene, 4);
+    let sg = scene_gpu(&scene, 4);
+    let mut pt = PathTracer::new(gpu(), &sg).expect("path tracer");
     let frames = 12;
     let pt_frames: Vec<_> =
-        (0..frames).map(|f| pt.render(gpu(), 1, 5, f).unwrap().radiance).collect();
+        (0..frames).map(|f| pt.render(gpu(), &sg, 1, 5, f).unwrap().radiance).collect();
     let flicker = |v: &[Vec<[f32; 4]>]| {
         (6..frames as usize).map(|f| smape(&v[f], &v[f - 1])).sum::<f64>() / (frames as f64 - 6.0)
     };
@@ -210,10 +213,10 @@ fn static_scene_flickers_less_than_1spp_and_is_deterministic() {
     for lookup in [HashCacheLookup::FirstHit, HashCacheLookup::SecondaryHit] {
         let run = || {
             let mut cache =
-                HashCache::new(gpu(), &pt, HashCacheSettings { lookup, ..Default::default() })
+                HashCache::new(gpu(), &sg, HashCacheSettings { lookup, ..Default::default() })
                     .expect("hash cache");
             (0..frames)
-                .map(|f| cache.render(gpu(), &pt, &scene.camera, 5, f, None).unwrap().radiance)
+                .map(|f| cache.render(gpu(), &sg, &scene.camera, 5, f, None).unwrap().radiance)
                 .collect::<Vec<_>>()
         };
         let a = run();
@@ -232,16 +235,16 @@ fn static_scene_flickers_less_than_1spp_and_is_deterministic() {
 #[test]
 fn taa_resolves_the_cache_colour() {
     let mut scene = room_scene();
-    let mut pt = tracer(&scene, 3);
+    let mut sg = scene_gpu(&scene, 3);
     let settings = HashCacheSettings::default();
-    let mut plain = HashCache::new(gpu(), &pt, settings).expect("hash cache");
-    let mut under_taa = HashCache::new(gpu(), &pt, settings).expect("hash cache");
-    let mut taa = Taa::new(gpu(), &pt, TaaSettings::default()).expect("taa");
+    let mut plain = HashCache::new(gpu(), &sg, settings).expect("hash cache");
+    let mut under_taa = HashCache::new(gpu(), &sg, settings).expect("hash cache");
+    let mut taa = Taa::new(gpu(), &sg, TaaSettings::default()).expect("taa");
     for frame in 0..3 {
         scene.camera.position.x = 0.05 * frame as f32;
-        pt.update(gpu(), &scene);
-        let a = plain.render(gpu(), &pt, &scene.camera, 9, frame, None).unwrap();
-        let b = under_taa.render(gpu(), &pt, &scene.camera, 9, frame, Some(&mut taa)).unwrap();
+        sg.update(gpu(), &scene);
+        let a = plain.render(gpu(), &sg, &scene.camera, 9, frame, None).unwrap();
+        let b = under_taa.render(gpu(), &sg, &scene.camera, 9, frame, Some(&mut taa)).unwrap();
         let i = taa.inspect(gpu()).unwrap();
         // TAA's input is the cache's colour and primary hits of this frame ...
         assert_eq!(i.current, a.radiance, "frame {frame}");
@@ -297,15 +300,15 @@ fn update_paths_start_at_the_traced_key_point() {
         },
         ..Default::default()
     };
-    let pt = tracer(&scene, 1);
+    let sg = scene_gpu(&scene, 1);
     let mut cache = HashCache::new(
         gpu(),
-        &pt,
+        &sg,
         HashCacheSettings { lookup: HashCacheLookup::FirstHit, ..Default::default() },
     )
     .expect("hash cache");
     for frame in 0..2 {
-        let s = cache.render(gpu(), &pt, &scene.camera, 3, frame, None).unwrap().stats;
+        let s = cache.render(gpu(), &sg, &scene.camera, 3, frame, None).unwrap().stats;
         assert!(s.update_paths > 0);
         assert_eq!(s.rays, W * H + 2 * s.update_paths, "frame {frame}: {s:?}");
     }
@@ -318,22 +321,23 @@ fn update_paths_start_at_the_traced_key_point() {
 #[test]
 fn still_view_converges_to_the_path_traced_reference() {
     let scene = room_scene();
-    let mut pt = tracer(&scene, 3);
+    let sg = scene_gpu(&scene, 3);
+    let mut pt = PathTracer::new(gpu(), &sg).expect("path tracer");
     let image = |rgba: &[[f32; 4]]| {
         metrics::Image::new(W, H, rgba.iter().map(|p| [p[0], p[1], p[2]]).collect())
     };
     let flip = |reference: &metrics::Image, rgba: &[[f32; 4]]| {
         metrics::flip_hdr(reference, &image(rgba), metrics::DEFAULT_PPD).mean
     };
-    let reference = image(&pt.render(gpu(), 1024, 1, 0).expect("reference").radiance);
+    let reference = image(&pt.render(gpu(), &sg, 1024, 1, 0).expect("reference").radiance);
     let checkpoints = [2usize, 8, 32];
     let mut per_seed: Vec<[f64; 3]> = vec![];
     for seed in [3u64, 4, 5] {
         let mut cache =
-            HashCache::new(gpu(), &pt, HashCacheSettings::default()).expect("hash cache");
+            HashCache::new(gpu(), &sg, HashCacheSettings::default()).expect("hash cache");
         let mut at = [0.0; 3];
         for f in 0..32u32 {
-            let out = cache.render(gpu(), &pt, &scene.camera, seed, f, None).unwrap();
+            let out = cache.render(gpu(), &sg, &scene.camera, seed, f, None).unwrap();
             if let Some(i) = checkpoints.iter().position(|&c| c == f as usize + 1) {
                 at[i] = flip(&reference, &out.radiance);
             }

@@ -4,9 +4,10 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use bevy_ecs::prelude::*;
+use render::path_tracer::PathTracer;
 use serde::{Deserialize, Serialize};
 
-use frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use frame::{FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage, method_failed};
 use frame::{MethodOutput, MethodPlugin};
 
 /// `PathTracing(spp: 4)`.
@@ -22,9 +23,11 @@ impl PathTracingSettings {
     }
 }
 
+/// Its spp and its path tracer (frame parameters, radiance sum, G-buffer, ray counter).
 #[derive(Component)]
 pub struct PathTracing {
     spp: u32,
+    tracer: PathTracer,
 }
 
 pub struct Plugin;
@@ -57,7 +60,9 @@ impl MethodPlugin for Plugin {
         if s.spp == 0 {
             bail!("PathTracing: spp 0; expected at least 1 sample per pixel");
         }
-        world.entity_mut(entity).insert(PathTracing { spp: s.spp });
+        let tracer =
+            PathTracer::new(&world.resource::<GpuDevice>().0, &world.resource::<GpuScene>().0)?;
+        world.entity_mut(entity).insert(PathTracing { spp: s.spp, tracer });
         Ok(())
     }
 }
@@ -65,16 +70,17 @@ impl MethodPlugin for Plugin {
 /// G-buffer and `spp` paths per pixel.
 pub fn render(
     gpu: Res<GpuDevice>,
-    mut tracer: ResMut<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
-    mut methods: Query<(&PathTracing, &MethodInfo, &mut MethodFrame)>,
+    mut methods: Query<(&mut PathTracing, &MethodInfo, &mut MethodFrame)>,
 ) -> Result<(), BevyError> {
-    for (pt, info, mut frame) in &mut methods {
+    for (mut pt, info, mut frame) in &mut methods {
         let start = Instant::now();
-        let out = tracer
-            .0
-            .render(&gpu.0, pt.spp, run.scenario.seed, clock.global)
+        let spp = pt.spp;
+        let out = pt
+            .tracer
+            .render(&gpu.0, &gpu_scene.0, spp, run.scenario.seed, clock.global)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         frame.output = Some(MethodOutput::timed(
             out.radiance,

@@ -33,12 +33,13 @@ pub use storage::{GpuSlot, SscSlot};
 
 use render::compute::BufferBinding;
 use render::error::RenderError;
+use render::frame_bindings::FrameBindings;
 use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::pass_library::LibraryPipeline;
 use render::pass_library::PassLibrary;
-use render::path_tracer::PathTracer;
 use render::readback::{Staging, read_pod};
+use render::scene_gpu::SceneGpu;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming};
 
@@ -271,6 +272,7 @@ pub struct SampleCache {
     primary: wgpu::Buffer,
     out_readback: Staging,
     header_readback: Staging,
+    frame: FrameBindings,
     bind_groups: [wgpu::BindGroup; 2],
     /// Index of the cache holding the last frame (the source of the next reprojection).
     current: usize,
@@ -299,11 +301,11 @@ struct Pipelines {
 impl SampleCache {
     pub fn new(
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         settings: SampleCacheSettings,
     ) -> Result<Self, RenderError> {
         settings.validate().map_err(|e| RenderError::Settings(format!("sample cache: {e}")))?;
-        let (width, height) = (tracer.settings().width, tracer.settings().height);
+        let (width, height) = (scene.settings().width, scene.settings().height);
         let n = settings.slots as u64;
         // The adapter's limit is per binding: check the largest per-pixel buffer (one cache's
         // slots) here; `buffer` below checks every buffer on its own.
@@ -373,7 +375,7 @@ impl SampleCache {
                 reconstruct,
                 audit,
             ],
-        ) = tracer.library_pass(
+        ) = scene.library_pass(
             gpu,
             "shaders/sample_cache/*.wgsl",
             program(),
@@ -445,6 +447,7 @@ impl SampleCache {
             primary,
             out_readback,
             header_readback,
+            frame: FrameBindings::new(gpu, scene),
             bind_groups,
             current: 0,
             timers: STAGE_DISPATCHES
@@ -466,19 +469,19 @@ impl SampleCache {
         self.indirect = indirect;
     }
 
-    /// Renders one frame: call after `tracer.update` for this frame's scene. `frame` seeds the
+    /// Renders one frame: call after `scene.update` for this frame's scene. `frame` seeds the
     /// frame's randomness (with `seed`) and drives the round robins. The four stages of
     /// [`PASSES`] in order; the frame's systems call [`Self::stage`] one by one instead.
     pub fn render(
         &mut self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         seed: u64,
         frame: u32,
     ) -> Result<CacheFrame, RenderError> {
         self.begin_frame(seed, frame);
         for stage in 0..PASSES.len() {
-            self.stage(gpu, tracer, stage)?;
+            self.stage(gpu, scene, stage)?;
         }
         self.finish_frame(gpu)
     }
@@ -489,29 +492,24 @@ impl SampleCache {
     }
 
     /// Stage `stage` of [`PASSES`] (reserve = reprojection, trace, shade, reconstruct) as one
-    /// timed submission. Each stage sets the tracer's frame uniform itself, so other methods may
-    /// run between stages.
-    pub fn stage(
-        &mut self,
-        gpu: &Gpu,
-        tracer: &PathTracer,
-        stage: usize,
-    ) -> Result<(), RenderError> {
+    /// timed submission. Each stage writes the cache's own frame parameters from the scene as
+    /// it is then.
+    pub fn stage(&mut self, gpu: &Gpu, scene: &SceneGpu, stage: usize) -> Result<(), RenderError> {
         let (w, h) = (self.width, self.height);
-        if tracer.settings().width != w || tracer.settings().height != h {
+        if scene.settings().width != w || scene.settings().height != h {
             return Err(RenderError::Settings(format!(
-                "sample cache is {w}x{h}, the path tracer {}x{}",
-                tracer.settings().width,
-                tracer.settings().height
+                "sample cache is {w}x{h}, the scene {}x{}",
+                scene.settings().width,
+                scene.settings().height
             )));
         }
         let Some((seed, frame, _)) = self.pending else {
             return Err(RenderError::Settings("sample cache: stage before begin_frame".into()));
         };
-        tracer.prepare_frame(gpu, 1, 0, seed, frame);
+        self.frame.prepare(gpu, scene, 1, 0, seed, frame);
         let s = &self.settings;
         if stage == 0 {
-            let vfov = 2.0 * tracer_tan_half_fov(tracer).atan();
+            let vfov = 2.0 * tan_half_fov(scene).atan();
             let pixels = w * h;
             let params = SscParams {
                 width: w,
@@ -587,8 +585,7 @@ impl SampleCache {
                 );
             }
             timed.pass(i, |pass| {
-                pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
-                pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+                self.frame.bind(gpu, scene, pass);
                 pass.set_bind_group(2, bind_group, &[]);
                 pass.set_pipeline(&pipeline.get());
                 match indirect {
@@ -673,7 +670,7 @@ impl SampleCache {
     /// Stale visibility of the last frame: how many samples the cache holds as visible that a
     /// retrace from the current camera finds occluded (what `Multi` would correct). Traces one
     /// ray per visible sample; for tests and diagnostics, outside the timed passes.
-    pub fn audit(&self, gpu: &Gpu, tracer: &PathTracer) -> Result<u32, RenderError> {
+    pub fn audit(&self, gpu: &Gpu, scene: &SceneGpu) -> Result<u32, RenderError> {
         let mut encoder = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("ssc audit") });
@@ -683,8 +680,7 @@ impl SampleCache {
                 label: Some("audit"),
                 timestamp_writes: None,
             });
-            pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
-            pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+            self.frame.bind(gpu, scene, &mut pass);
             // The bind group whose destination is the cache the last frame wrote.
             pass.set_bind_group(2, &self.bind_groups[1 - self.current], &[]);
             pass.set_pipeline(&self.pipelines.audit.get());
@@ -721,8 +717,8 @@ impl SampleCache {
     }
 }
 
-fn tracer_tan_half_fov(tracer: &PathTracer) -> f32 {
-    (0.5 * tracer.camera().vfov).tan()
+fn tan_half_fov(scene: &SceneGpu) -> f32 {
+    (0.5 * scene.camera().vfov).tan()
 }
 
 pub mod plugin;

@@ -12,7 +12,7 @@ use taa::{Taa, TaaSettings};
 
 pub use crate::SampleCacheSettings;
 
-use frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use frame::{FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage, method_failed};
 use frame::{MethodImage, MethodOutput, MethodPlugin, temporal_window};
 
 #[derive(Component)]
@@ -47,10 +47,10 @@ impl MethodPlugin for Plugin {
 
     fn spawn(world: &mut World, entity: Entity, settings: &SampleCacheSettings) -> Result<()> {
         settings.validate().map_err(|e| anyhow::anyhow!("SampleCache: {e}"))?;
-        let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
-        let cache = SampleCache::new(gpu, tracer, *settings)?;
+        let (gpu, gpu_scene) = (&world.resource::<GpuDevice>().0, &world.resource::<GpuScene>().0);
+        let cache = SampleCache::new(gpu, gpu_scene, *settings)?;
         let taa =
-            settings.taa.then(|| Taa::new(gpu, tracer, TaaSettings::default())).transpose()?;
+            settings.taa.then(|| Taa::new(gpu, gpu_scene, TaaSettings::default())).transpose()?;
         world.entity_mut(entity).insert(SampleCacheState(cache, taa));
         Ok(())
     }
@@ -60,7 +60,7 @@ impl MethodPlugin for Plugin {
 fn stage(
     stage: usize,
     gpu: &GpuDevice,
-    tracer: &Tracer,
+    gpu_scene: &GpuScene,
     seed: u64,
     clock: &FrameClock,
     methods: &mut Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>,
@@ -72,7 +72,7 @@ fn stage(
         }
         state
             .0
-            .stage(&gpu.0, &tracer.0, stage)
+            .stage(&gpu.0, &gpu_scene.0, stage)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         frame.add_cpu(start);
     }
@@ -82,45 +82,45 @@ fn stage(
 /// Forward reprojection of last frame's samples and reservation of their slots.
 pub fn reproject(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>,
 ) -> Result<(), BevyError> {
-    stage(0, &gpu, &tracer, run.scenario.seed, &clock, &mut methods)
+    stage(0, &gpu, &gpu_scene, run.scenario.seed, &clock, &mut methods)
 }
 
 /// Retracing: holes, the slope test's pixels and the base rate (single, multi or adaptive).
 pub fn retrace(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>,
 ) -> Result<(), BevyError> {
-    stage(1, &gpu, &tracer, run.scenario.seed, &clock, &mut methods)
+    stage(1, &gpu, &gpu_scene, run.scenario.seed, &clock, &mut methods)
 }
 
 /// Shading of the selected samples (uniform or adaptive rate).
 pub fn shade(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>,
 ) -> Result<(), BevyError> {
-    stage(2, &gpu, &tracer, run.scenario.seed, &clock, &mut methods)
+    stage(2, &gpu, &gpu_scene, run.scenario.seed, &clock, &mut methods)
 }
 
 /// The image: each pixel's visible samples averaged; counters and the trace mask.
 pub fn reconstruct(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     mut methods: Query<(&mut SampleCacheState, &MethodInfo, &mut MethodFrame)>,
 ) -> Result<(), BevyError> {
-    stage(3, &gpu, &tracer, run.scenario.seed, &clock, &mut methods)?;
+    stage(3, &gpu, &gpu_scene, run.scenario.seed, &clock, &mut methods)?;
     for (mut state, info, mut frame) in &mut methods {
         let start = Instant::now();
         let slots = state.0.settings().slots as f64;

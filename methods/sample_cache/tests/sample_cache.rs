@@ -11,6 +11,7 @@ use render::frame::CameraBasis;
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::{Camera, Instance, Light, Material, Mesh, SceneDesc};
+use render::scene_gpu::SceneGpu;
 use sample_cache::storage::{CachedHit, check_mask, occupancy, visibility};
 use sample_cache::{
     CacheFrame, CacheState, FLAG_BASE, FLAG_HOLE, FLAG_SLOPE, LIST_WORKGROUP, MAX_GROUPS_X,
@@ -80,7 +81,7 @@ fn scene(camera: Camera, step: bool) -> SceneDesc {
 }
 
 struct Rig {
-    tracer: PathTracer,
+    scene: SceneGpu,
     cache: SampleCache,
     frame: u32,
 }
@@ -88,14 +89,14 @@ struct Rig {
 impl Rig {
     fn new(scene: &SceneDesc, settings: SampleCacheSettings) -> Self {
         let s = PathTracerSettings { width: W, height: H, max_depth: 1, rr_start_depth: 3 };
-        let tracer = PathTracer::new(gpu(), scene, s).expect("path tracer");
-        let cache = SampleCache::new(gpu(), &tracer, settings).expect("sample cache");
-        Self { tracer, cache, frame: 0 }
+        let gpu_scene = SceneGpu::new(gpu(), scene, s).expect("scene");
+        let cache = SampleCache::new(gpu(), &gpu_scene, settings).expect("sample cache");
+        Self { scene: gpu_scene, cache, frame: 0 }
     }
 
     fn step(&mut self, scene: &SceneDesc) -> CacheFrame {
-        self.tracer.update(gpu(), scene);
-        let out = self.cache.render(gpu(), &self.tracer, SEED, self.frame).expect("cache frame");
+        self.scene.update(gpu(), scene);
+        let out = self.cache.render(gpu(), &self.scene, SEED, self.frame).expect("cache frame");
         self.frame += 1;
         out
     }
@@ -512,33 +513,34 @@ fn adaptive_shading_dispatches_the_budget_to_low_counts_first() {
 fn still_view_converges_to_the_path_traced_reference() {
     let (w, h) = (common::W, common::H);
     let scene = common::room_scene();
-    let mut tracer = PathTracer::new(
+    let sg = SceneGpu::new(
         gpu(),
         &scene,
         PathTracerSettings { width: w, height: h, max_depth: 3, rr_start_depth: 3 },
     )
-    .expect("path tracer");
+    .expect("scene");
+    let mut tracer = PathTracer::new(gpu(), &sg).expect("path tracer");
     let image = |rgba: &[[f32; 4]]| {
         metrics::Image::new(w, h, rgba.iter().map(|p| [p[0], p[1], p[2]]).collect())
     };
     let flip = |reference: &metrics::Image, rgba: &[[f32; 4]]| {
         metrics::flip_hdr(reference, &image(rgba), metrics::DEFAULT_PPD).mean
     };
-    let reference = image(&tracer.render(gpu(), 1024, 1, 0).expect("reference").radiance);
+    let reference = image(&tracer.render(gpu(), &sg, 1024, 1, 0).expect("reference").radiance);
     let checkpoints = [2usize, 8, 32];
     let mut per_seed: Vec<[f64; 3]> = vec![];
     let mut pt4 = vec![];
     for seed in [3u64, 4, 5] {
         let mut cache =
-            SampleCache::new(gpu(), &tracer, SampleCacheSettings::default()).expect("sample cache");
+            SampleCache::new(gpu(), &sg, SampleCacheSettings::default()).expect("sample cache");
         let mut at = [0.0; 3];
         for f in 0..32u32 {
-            let out = cache.render(gpu(), &tracer, seed, f).expect("cache frame");
+            let out = cache.render(gpu(), &sg, seed, f).expect("cache frame");
             if let Some(i) = checkpoints.iter().position(|&c| c == f as usize + 1) {
                 at[i] = flip(&reference, &out.radiance);
             }
         }
-        pt4.push(flip(&reference, &tracer.render(gpu(), 4, seed, 0).expect("4 spp").radiance));
+        pt4.push(flip(&reference, &tracer.render(gpu(), &sg, 4, seed, 0).expect("4 spp").radiance));
         per_seed.push(at);
     }
     eprintln!(
@@ -623,19 +625,19 @@ fn roughness_sets_the_minimum_blend_weight() {
 fn taa_resolves_the_cache_image_with_its_closest_samples() {
     let (w, h) = (common::W, common::H);
     let mut scene = common::room_scene();
-    let mut tracer = PathTracer::new(
+    let mut sg = SceneGpu::new(
         gpu(),
         &scene,
         PathTracerSettings { width: w, height: h, max_depth: 3, rr_start_depth: 3 },
     )
-    .expect("path tracer");
+    .expect("scene");
     let settings = SampleCacheSettings { taa: true, ..Default::default() };
-    let mut cache = SampleCache::new(gpu(), &tracer, settings).expect("sample cache");
-    let mut taa = Taa::new(gpu(), &tracer, TaaSettings::default()).expect("taa");
+    let mut cache = SampleCache::new(gpu(), &sg, settings).expect("sample cache");
+    let mut taa = Taa::new(gpu(), &sg, TaaSettings::default()).expect("taa");
     for frame in 0..4u32 {
         scene.camera.position.x = 0.05 * frame as f32;
-        tracer.update(gpu(), &scene);
-        let out = cache.render(gpu(), &tracer, 9, frame).expect("cache frame");
+        sg.update(gpu(), &scene);
+        let out = cache.render(gpu(), &sg, 9, frame).expect("cache frame");
         let resolved = cache.resolve_taa(gpu(), &mut taa).expect("resolve");
         assert_eq!(resolved.timings.last().map(|t| t.pass.as_str()), Some(taa::TAA_RESOLVE_PASS));
         let i = taa.inspect(gpu()).expect("inspect");
@@ -713,12 +715,13 @@ fn taa_resolves_the_cache_image_with_its_closest_samples() {
 fn moving_camera_keeps_the_caches_near_the_per_frame_references() {
     let (w, h) = (common::W, common::H);
     let mut scene = common::room_scene();
-    let mut tracer = PathTracer::new(
+    let mut sg = SceneGpu::new(
         gpu(),
         &scene,
         PathTracerSettings { width: w, height: h, max_depth: 3, rr_start_depth: 3 },
     )
-    .expect("path tracer");
+    .expect("scene");
+    let mut tracer = PathTracer::new(gpu(), &sg).expect("path tracer");
     let image = |rgba: &[[f32; 4]]| {
         metrics::Image::new(w, h, rgba.iter().map(|p| [p[0], p[1], p[2]]).collect())
     };
@@ -737,50 +740,44 @@ fn moving_camera_keeps_the_caches_near_the_per_frame_references() {
     let mut per_seed: Vec<[f64; 5]> = vec![];
     for seed in [3u64, 4, 5] {
         let mut ssc =
-            SampleCache::new(gpu(), &tracer, SampleCacheSettings::default()).expect("sample cache");
+            SampleCache::new(gpu(), &sg, SampleCacheSettings::default()).expect("sample cache");
         let mut ssc_taa = (
-            SampleCache::new(
-                gpu(),
-                &tracer,
-                SampleCacheSettings { taa: true, ..Default::default() },
-            )
-            .expect("sample cache"),
-            Taa::new(gpu(), &tracer, TaaSettings::default()).expect("taa"),
+            SampleCache::new(gpu(), &sg, SampleCacheSettings { taa: true, ..Default::default() })
+                .expect("sample cache"),
+            Taa::new(gpu(), &sg, TaaSettings::default()).expect("taa"),
         );
-        let mut hc =
-            HashCache::new(gpu(), &tracer, HashCacheSettings::default()).expect("hash cache");
+        let mut hc = HashCache::new(gpu(), &sg, HashCacheSettings::default()).expect("hash cache");
         let mut hc_taa = (
-            HashCache::new(gpu(), &tracer, HashCacheSettings { taa: true, ..Default::default() })
+            HashCache::new(gpu(), &sg, HashCacheSettings { taa: true, ..Default::default() })
                 .expect("hash cache"),
-            Taa::new(gpu(), &tracer, TaaSettings::default()).expect("taa"),
+            Taa::new(gpu(), &sg, TaaSettings::default()).expect("taa"),
         );
         // Frame 0 twice: no motion into the first frame.
         move_camera(&mut scene, 0);
-        tracer.update(gpu(), &scene);
+        sg.update(gpu(), &scene);
         let mut sum = [0.0; 5];
         for f in 0..=checkpoints[2] {
             move_camera(&mut scene, f);
-            tracer.update(gpu(), &scene);
+            sg.update(gpu(), &scene);
             let images = [
-                tracer.render(gpu(), 1, seed, f).expect("1 spp").radiance,
-                ssc.render(gpu(), &tracer, seed, f).expect("ssc").radiance,
+                tracer.render(gpu(), &sg, 1, seed, f).expect("1 spp").radiance,
+                ssc.render(gpu(), &sg, seed, f).expect("ssc").radiance,
                 {
-                    ssc_taa.0.render(gpu(), &tracer, seed, f).expect("ssc");
+                    ssc_taa.0.render(gpu(), &sg, seed, f).expect("ssc");
                     ssc_taa.0.resolve_taa(gpu(), &mut ssc_taa.1).expect("ssc taa").radiance
                 },
-                hc.render(gpu(), &tracer, &scene.camera, seed, f, None)
-                    .expect("hash cache")
-                    .radiance,
+                hc.render(gpu(), &sg, &scene.camera, seed, f, None).expect("hash cache").radiance,
                 hc_taa
                     .0
-                    .render(gpu(), &tracer, &scene.camera, seed, f, Some(&mut hc_taa.1))
+                    .render(gpu(), &sg, &scene.camera, seed, f, Some(&mut hc_taa.1))
                     .expect("hash cache taa")
                     .radiance,
             ];
             let Some(k) = checkpoints.iter().position(|&c| c == f) else { continue };
             if references.len() == k {
-                references
-                    .push(image(&tracer.render(gpu(), 256, 1000, f).expect("reference").radiance));
+                references.push(image(
+                    &tracer.render(gpu(), &sg, 256, 1000, f).expect("reference").radiance,
+                ));
             }
             for (m, img) in images.iter().enumerate() {
                 sum[m] += flip(&references[k], img) / checkpoints.len() as f64;

@@ -13,11 +13,11 @@ use crate::{Prefilter, SpvgSettings, SssFrame, SssSettings, SssVariant};
 use anyhow::{Result, bail};
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use render::path_tracer::NO_HIT;
+use render::path_tracer::{NO_HIT, PathTracer};
 use serde::{Deserialize, Serialize};
 use taa::{Taa, TaaPrimary, TaaSettings};
 
-use frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use frame::{FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage, method_failed};
 use frame::{MethodImage, MethodOutput, MethodPlugin};
 
 /// `Sss(variant: Adaptive, spp: 1)`; the thesis's parameters by default.
@@ -106,6 +106,8 @@ pub struct SssProfile {
 #[derive(Component)]
 pub struct SssState {
     settings: SssMethodSettings,
+    /// The path tracer whose image and G-buffer the passes scatter.
+    tracer: PathTracer,
     profiles: Vec<SssProfile>,
     taa: Option<Taa>,
 }
@@ -188,8 +190,10 @@ impl MethodPlugin for Plugin {
                 Ok(SssProfile { material, d, pass: SssPass::new(gpu, width, height)? })
             })
             .collect::<Result<Vec<_>>>()?;
-        let taa = s.taa.map(|t| Taa::new(gpu, &world.resource::<Tracer>().0, t)).transpose()?;
-        world.entity_mut(entity).insert(SssState { settings: s.clone(), profiles, taa });
+        let gpu_scene = &world.resource::<GpuScene>().0;
+        let taa = s.taa.map(|t| Taa::new(gpu, gpu_scene, t)).transpose()?;
+        let tracer = PathTracer::new(gpu, gpu_scene)?;
+        world.entity_mut(entity).insert(SssState { settings: s.clone(), tracer, profiles, taa });
         Ok(())
     }
 }
@@ -197,7 +201,7 @@ impl MethodPlugin for Plugin {
 /// Path tracing, demodulation, the SSS pass, modulation.
 pub fn render(
     gpu: Res<GpuDevice>,
-    mut tracer: ResMut<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     scene: Res<sim::ExtractedScene>,
@@ -206,12 +210,13 @@ pub fn render(
     for (mut state, info, mut frame) in &mut methods {
         let start = Instant::now();
         let fail = |e: &dyn std::fmt::Display| method_failed(&info.label, clock.global, e);
-        let out = tracer
-            .0
-            .render(&gpu.0, state.settings.spp, run.scenario.seed, clock.global)
+        let state = &mut *state;
+        let out = state
+            .tracer
+            .render(&gpu.0, &gpu_scene.0, state.settings.spp, run.scenario.seed, clock.global)
             .map_err(|e| fail(&e))?;
         // Pixels per scene unit at distance t: height / (2 t tan(vfov / 2)) (on the axis).
-        let focal = out.height as f32 / (2.0 * (0.5 * tracer.0.camera().vfov).tan());
+        let focal = out.height as f32 / (2.0 * (0.5 * gpu_scene.0.camera().vfov).tan());
         let g = &out.gbuffer;
         // Per pixel: which profile's material it shows (None: not subsurface).
         let profile_of: Vec<Option<usize>> = g

@@ -35,11 +35,12 @@ pub mod resolve_cpu;
 
 use render::compute::BufferBinding;
 use render::error::RenderError;
+use render::frame_bindings::FrameBindings;
 use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::pass_library::PassLibrary;
-use render::path_tracer::PathTracer;
 use render::readback::{copy_all, read_pod};
+use render::scene_gpu::SceneGpu;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming};
 
@@ -250,6 +251,8 @@ pub struct Taa {
     /// Ping-pong: `primary[parity]` and `history[parity]` are written this frame.
     primary: [wgpu::Buffer; 2],
     history: [wgpu::Buffer; 2],
+    /// The trace pass's frame parameters and scene group.
+    frame: FrameBindings,
     trace_layout: wgpu::BindGroupLayout,
     trace_pipeline: render::pass_library::LibraryPipeline,
     resolve_groups: [wgpu::BindGroup; 2],
@@ -265,10 +268,10 @@ pub struct Taa {
 }
 
 impl Taa {
-    /// Passes at the tracer's resolution, bound to its scene and geometry layouts.
-    pub fn new(gpu: &Gpu, tracer: &PathTracer, settings: TaaSettings) -> Result<Self, RenderError> {
+    /// Passes at the scene's resolution, bound to its scene and geometry layouts.
+    pub fn new(gpu: &Gpu, scene: &SceneGpu, settings: TaaSettings) -> Result<Self, RenderError> {
         settings.validate()?;
-        let s = tracer.settings();
+        let s = scene.settings();
         let (width, height) = (s.width, s.height);
         gpu.check_resolution(width, height, 16 * 3 + 32 * 2)?;
         // Neither pass declares var<workgroup>.
@@ -298,7 +301,7 @@ impl Taa {
             [buffer("taa history 0", pixels * 16, rw), buffer("taa history 1", pixels * 16, rw)];
         let counters = buffer("taa ray counter", 16, rw);
 
-        let (trace_layout, [trace_pipeline]) = tracer.library_pass(
+        let (trace_layout, [trace_pipeline]) = scene.library_pass(
             gpu,
             "taa_trace.wgsl",
             Self::trace_program(),
@@ -331,6 +334,7 @@ impl Taa {
             current,
             primary,
             history,
+            frame: FrameBindings::new(gpu, scene),
             trace_layout,
             trace_pipeline,
             resolve_groups,
@@ -385,15 +389,15 @@ impl Taa {
         self.history_valid = false;
     }
 
-    /// Jittered 1 spp path tracing + resolve. `tracer` must be updated to this frame's scene.
+    /// Jittered 1 spp path tracing + resolve. `scene` must be updated to this frame's scene.
     pub fn render(
         &mut self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         seed: u64,
         frame: u32,
     ) -> Result<TaaOutput, RenderError> {
-        let trace = self.trace(gpu, tracer, seed, frame)?;
+        let trace = self.trace(gpu, scene, seed, frame)?;
         self.resolve(gpu, trace)
     }
 
@@ -401,20 +405,19 @@ impl Taa {
     pub fn trace(
         &mut self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         seed: u64,
         frame: u32,
     ) -> Result<Vec<PassTiming>, RenderError> {
         let jitter = halton_jitter(frame, self.settings.jitter_length);
-        tracer.prepare_frame(gpu, 1, 0, seed, frame);
+        self.frame.prepare(gpu, scene, 1, 0, seed, frame);
         self.write_params(gpu, jitter);
         let group = self.trace_group(gpu, &self.current, &self.primary[self.parity]);
         let mut timed = self.timer.begin(gpu, "taa trace");
         timed.encoder().clear_buffer(&self.counters, 0, None);
         timed.pass(0, |pass| {
             pass.set_pipeline(&self.trace_pipeline.get());
-            pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
-            pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+            self.frame.bind(gpu, scene, pass);
             pass.set_bind_group(2, &group, &[]);
             pass.dispatch_workgroups(
                 self.width.div_ceil(WORKGROUP),

@@ -10,7 +10,7 @@ use render::timing::PassTiming;
 
 pub use crate::TaaSettings;
 
-use frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use frame::{FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage, method_failed};
 use frame::{MethodOutput, MethodPlugin, temporal_window};
 
 #[derive(Component)]
@@ -45,7 +45,7 @@ impl MethodPlugin for Plugin {
     fn spawn(world: &mut World, entity: Entity, settings: &TaaSettings) -> Result<()> {
         settings.validate()?;
         let taa =
-            Taa::new(&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0, *settings)?;
+            Taa::new(&world.resource::<GpuDevice>().0, &world.resource::<GpuScene>().0, *settings)?;
         world.entity_mut(entity).insert(TaaState { taa, traced: None });
         Ok(())
     }
@@ -54,7 +54,7 @@ impl MethodPlugin for Plugin {
 /// Jittered 1 spp path tracing into the current colour.
 pub fn trace(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     mut methods: Query<(&mut TaaState, &MethodInfo, &mut MethodFrame)>,
@@ -63,7 +63,7 @@ pub fn trace(
         let start = Instant::now();
         let t = state
             .taa
-            .trace(&gpu.0, &tracer.0, run.scenario.seed, clock.global)
+            .trace(&gpu.0, &gpu_scene.0, run.scenario.seed, clock.global)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         state.traced = Some(t);
         frame.add_cpu(start);

@@ -5,6 +5,7 @@ use glam::{Mat4, Vec2, Vec3};
 use render::gpu::Gpu;
 use render::path_tracer::{NO_HIT, PathTracer, PathTracerSettings};
 use render::scene::{Camera, Instance, Material, Mesh, SceneDesc};
+use render::scene_gpu::SceneGpu;
 use std::sync::OnceLock;
 use taa::{Taa, TaaClamp, TaaSettings, resolve_cpu};
 
@@ -74,13 +75,13 @@ fn feature_scene(square_x: f32) -> SceneDesc {
     }
 }
 
-fn tracer(scene: &SceneDesc, max_depth: u32) -> PathTracer {
-    PathTracer::new(
+fn scene_gpu(scene: &SceneDesc, max_depth: u32) -> SceneGpu {
+    SceneGpu::new(
         gpu(),
         scene,
         PathTracerSettings { width: W, height: H, max_depth, rr_start_depth: 3 },
     )
-    .expect("path tracer")
+    .expect("scene")
 }
 
 fn assert_matches_cpu(taa: &Taa, what: &str) {
@@ -109,16 +110,16 @@ fn reprojection_follows_a_camera_translation_and_matches_the_cpu_resolve() {
     let shift = 8.0;
     for clamp in [TaaClamp::None, TaaClamp::MinMax, TaaClamp::Variance { gamma: 1.0 }] {
         let mut scene = feature_scene(0.0);
-        let mut pt = tracer(&scene, 1);
+        let mut sg = scene_gpu(&scene, 1);
         let settings = TaaSettings { clamp, ..Default::default() };
-        let mut taa = Taa::new(gpu(), &pt, settings).expect("taa");
-        let f0 = taa.render(gpu(), &pt, 1, 0).expect("frame 0");
+        let mut taa = Taa::new(gpu(), &sg, settings).expect("taa");
+        let f0 = taa.render(gpu(), &sg, 1, 0).expect("frame 0");
         assert!(f0.history_length.iter().all(|&l| l == 1.0));
         assert_matches_cpu(&taa, "frame 0");
         // The camera moves right by `shift` pixels' worth: the ground moves left in the image.
         scene.camera = camera_at(shift * pixel_size());
-        pt.update(gpu(), &scene);
-        let f1 = taa.render(gpu(), &pt, 1, 1).expect("frame 1");
+        sg.update(gpu(), &scene);
+        let f1 = taa.render(gpu(), &sg, 1, 1).expect("frame 1");
         assert_matches_cpu(&taa, &format!("frame 1, {clamp:?}"));
         let i = taa.inspect(gpu()).unwrap();
         for (k, p) in i.primary.iter().enumerate() {
@@ -163,14 +164,14 @@ fn reprojection_follows_a_camera_translation_and_matches_the_cpu_resolve() {
 #[test]
 fn history_is_rejected_where_the_ground_is_disoccluded() {
     let mut scene = feature_scene(0.0);
-    let mut pt = tracer(&scene, 1);
-    let mut taa = Taa::new(gpu(), &pt, TaaSettings { clamp: TaaClamp::None, ..Default::default() })
+    let mut sg = scene_gpu(&scene, 1);
+    let mut taa = Taa::new(gpu(), &sg, TaaSettings { clamp: TaaClamp::None, ..Default::default() })
         .expect("taa");
-    taa.render(gpu(), &pt, 1, 0).unwrap();
+    taa.render(gpu(), &sg, 1, 0).unwrap();
     // The square moves 4 px right; the camera stays.
     scene.instances[1].transform = Mat4::from_translation(Vec3::new(4.0 * pixel_size(), 0.01, 0.0));
-    pt.update(gpu(), &scene);
-    let f1 = taa.render(gpu(), &pt, 1, 1).unwrap();
+    sg.update(gpu(), &scene);
+    let f1 = taa.render(gpu(), &sg, 1, 1).unwrap();
     assert_matches_cpu(&taa, "moving square");
     let (cx, cy) = (W as i32 / 2, H as i32 / 2);
     let mut disoccluded = 0;
@@ -273,14 +274,15 @@ fn smape(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
 #[test]
 fn static_scene_converges_and_flickers_less_than_1spp() {
     let scene = lit_scene();
-    let mut pt = tracer(&scene, 4);
-    let reference = pt.render_reference(gpu(), 1024, 99, 0, &mut |_, _| {}).unwrap();
-    let mut taa = Taa::new(gpu(), &pt, TaaSettings::default()).expect("taa");
+    let sg = scene_gpu(&scene, 4);
+    let mut pt = PathTracer::new(gpu(), &sg).expect("path tracer");
+    let reference = pt.render_reference(gpu(), &sg, 1024, 99, 0, &mut |_, _| {}).unwrap();
+    let mut taa = Taa::new(gpu(), &sg, TaaSettings::default()).expect("taa");
     let frames = 16;
     let (mut taa_frames, mut pt_frames) = (vec![], vec![]);
     for f in 0..frames {
-        taa_frames.push(taa.render(gpu(), &pt, 5, f).unwrap().radiance);
-        pt_frames.push(pt.render(gpu(), 1, 5, f).unwrap().radiance);
+        taa_frames.push(taa.render(gpu(), &sg, 5, f).unwrap().radiance);
+        pt_frames.push(pt.render(gpu(), &sg, 1, 5, f).unwrap().radiance);
     }
     assert_matches_cpu(&taa, "static scene, last frame");
     let errors: Vec<f64> = taa_frames.iter().map(|img| mse(img, &reference)).collect();
@@ -303,9 +305,9 @@ fn static_scene_converges_and_flickers_less_than_1spp() {
 fn same_inputs_give_identical_bytes() {
     let scene = lit_scene();
     let run = || {
-        let pt = tracer(&scene, 3);
-        let mut taa = Taa::new(gpu(), &pt, TaaSettings::default()).expect("taa");
-        (0..3).map(|f| taa.render(gpu(), &pt, 7, f).unwrap().radiance).collect::<Vec<_>>()
+        let sg = scene_gpu(&scene, 3);
+        let mut taa = Taa::new(gpu(), &sg, TaaSettings::default()).expect("taa");
+        (0..3).map(|f| taa.render(gpu(), &sg, 7, f).unwrap().radiance).collect::<Vec<_>>()
     };
     assert_eq!(run(), run());
 }
@@ -321,10 +323,11 @@ fn ray_counters_are_exact_when_every_ray_escapes() {
         up: Vec3::NEG_Z,
         vfov: VFOV,
     };
-    let mut pt = tracer(&scene, 4);
-    pt.update(gpu(), &scene);
+    let mut sg = scene_gpu(&scene, 4);
+    let mut pt = PathTracer::new(gpu(), &sg).expect("path tracer");
+    sg.update(gpu(), &scene);
     let pixels = (W * H) as u64;
-    let out = pt.render(gpu(), 3, 5, 0).expect("pt frame");
+    let out = pt.render(gpu(), &sg, 3, 5, 0).expect("pt frame");
     assert!(out.gbuffer.instance_id.iter().all(|&i| i == NO_HIT), "the view must see only sky");
     // G-buffer ray + 3 camera rays per pixel.
     assert_eq!((out.rays, out.shaded), (4 * pixels, 3 * pixels));
@@ -332,9 +335,9 @@ fn ray_counters_are_exact_when_every_ray_escapes() {
         out.timings.iter().map(|t| t.pass.as_str()).collect::<Vec<_>>(),
         ["gbuffer", "path_trace"]
     );
-    let mut taa = Taa::new(gpu(), &pt, TaaSettings::default()).expect("taa");
+    let mut taa = Taa::new(gpu(), &sg, TaaSettings::default()).expect("taa");
     for f in 0..2 {
-        let t = taa.render(gpu(), &pt, 5, f).expect("taa frame");
+        let t = taa.render(gpu(), &sg, 5, f).expect("taa frame");
         // The primary-attribute ray + the path's camera ray, per pixel, every frame (cleared).
         assert_eq!((t.rays, t.shaded), (2 * pixels, pixels), "frame {f}");
         assert_eq!(
@@ -342,8 +345,8 @@ fn ray_counters_are_exact_when_every_ray_escapes() {
             ["taa_trace", "taa_resolve"]
         );
     }
-    let mut cache = hash_cache::HashCache::new(gpu(), &pt, Default::default()).expect("hash cache");
-    let h = cache.render(gpu(), &pt, &scene.camera, 5, 0, None).expect("hash cache frame");
+    let mut cache = hash_cache::HashCache::new(gpu(), &sg, Default::default()).expect("hash cache");
+    let h = cache.render(gpu(), &sg, &scene.camera, 5, 0, None).expect("hash cache frame");
     // One camera ray per pixel, no cache update path (nothing was hit).
     assert_eq!((h.rays, h.shaded, h.stats.update_paths), (pixels, pixels, 0));
 }
@@ -373,8 +376,8 @@ fn wall_clock_times_each_pass_on_its_own() {
 
 #[test]
 fn equal_passes_share_their_pipelines() {
-    // Two TAA instances on one tracer compile the trace pass once; another pass does not alias.
-    let t = tracer(&feature_scene(0.0), 2);
+    // Two TAA instances on one scene compile the trace pass once; another pass does not alias.
+    let sg = scene_gpu(&feature_scene(0.0), 2);
     use render::compute::BufferBinding;
     let own = [
         BufferBinding::read("taa", "TaaParams"),
@@ -382,20 +385,22 @@ fn equal_passes_share_their_pipelines() {
         BufferBinding::read_write("taa_primary", "array<TaaPrimary>"),
         BufferBinding::read_write("taa_counters", "array<atomic<u32>>"),
     ];
-    let (layout_a, [a]) =
-        t.library_pass(gpu(), "taa_trace.wgsl", Taa::trace_program(), &own, ["taa_trace"]).unwrap();
-    let (layout_b, [b]) =
-        t.library_pass(gpu(), "taa_trace.wgsl", Taa::trace_program(), &own, ["taa_trace"]).unwrap();
+    let (layout_a, [a]) = sg
+        .library_pass(gpu(), "taa_trace.wgsl", Taa::trace_program(), &own, ["taa_trace"])
+        .unwrap();
+    let (layout_b, [b]) = sg
+        .library_pass(gpu(), "taa_trace.wgsl", Taa::trace_program(), &own, ["taa_trace"])
+        .unwrap();
     assert!(a == b && layout_a == layout_b, "the same pass was compiled twice");
-    let (_, [c]) = t
+    let (_, [c]) = sg
         .library_pass(gpu(), "taa_trace.wgsl (copy)", Taa::trace_program(), &own, ["taa_trace"])
         .unwrap();
     assert!(a != c, "a pass of another name must get its own pipeline");
     // Both TAA instances still render (they bind their own buffers to the shared pipeline).
     let (mut one, mut two) = (
-        Taa::new(gpu(), &t, TaaSettings::default()).unwrap(),
-        Taa::new(gpu(), &t, TaaSettings::default()).unwrap(),
+        Taa::new(gpu(), &sg, TaaSettings::default()).unwrap(),
+        Taa::new(gpu(), &sg, TaaSettings::default()).unwrap(),
     );
-    let (x, y) = (one.render(gpu(), &t, 1, 0).unwrap(), two.render(gpu(), &t, 1, 0).unwrap());
+    let (x, y) = (one.render(gpu(), &sg, 1, 0).unwrap(), two.render(gpu(), &sg, 1, 0).unwrap());
     assert_eq!(x.radiance, y.radiance, "the same frame through a shared pipeline");
 }

@@ -12,13 +12,14 @@ use glam::Vec3;
 use hash_cache::{HashCacheParams, HashCacheSettings};
 use render::compute::{self, BufferBinding};
 use render::error::RenderError;
+use render::frame_bindings::FrameBindings;
 use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::lights::luminance;
 use render::pass_library::PassLibrary;
-use render::path_tracer::PathTracer;
 use render::readback::{copy_all, read_pod};
 use render::scene::Camera;
+use render::scene_gpu::SceneGpu;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming};
 use taa::TaaPrimary;
@@ -215,6 +216,7 @@ pub struct TerminationCache {
     primary: wgpu::Buffer,
     colour: wgpu::Buffer,
     path_length: wgpu::Buffer,
+    frame: FrameBindings,
     group: wgpu::BindGroup,
     /// Indexed by [`TcPass`].
     pipelines: [render::pass_library::LibraryPipeline; 4],
@@ -230,11 +232,11 @@ impl TerminationCache {
     /// Builds the cache; refuses a capacity or resolution over the adapter's buffer limits.
     pub fn new(
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         settings: TerminationSettings,
     ) -> Result<Self, RenderError> {
         settings.validate()?;
-        let s = tracer.settings();
+        let s = scene.settings();
         let (width, height) = (s.width, s.height);
         let pixels = width as u64 * height as u64;
         let cap = settings.capacity as u64;
@@ -279,7 +281,7 @@ impl TerminationCache {
         let colour = buffer("termination colour", pixels * 16, rw);
         let path_length = buffer("termination path length", pixels * 4, rw);
         let (layout, pipelines) =
-            tracer.library_pass(gpu, "termination.wgsl", Self::program(), &OWN_GROUP, PASSES)?;
+            scene.library_pass(gpu, "termination.wgsl", Self::program(), &OWN_GROUP, PASSES)?;
         let group = render::compute::buffer_group(
             gpu,
             "termination",
@@ -298,6 +300,7 @@ impl TerminationCache {
             primary,
             colour,
             path_length,
+            frame: FrameBindings::new(gpu, scene),
             group,
             pipelines,
             update_timer: PassTimer::new(gpu, &TcPass::UPDATE.map(TcPass::name)),
@@ -364,14 +367,14 @@ impl TerminationCache {
     pub fn render(
         &mut self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         camera: &Camera,
         seed: u64,
         frame: u32,
     ) -> Result<TerminationOutput, RenderError> {
-        let updated = self.update(gpu, tracer, camera, seed, frame)?;
-        let mut out = self.trace(gpu, tracer, seed, frame, updated)?;
-        out.timings.extend(self.store(gpu, tracer)?);
+        let updated = self.update(gpu, scene, camera, seed, frame)?;
+        let mut out = self.trace(gpu, scene, updated)?;
+        out.timings.extend(self.store(gpu, scene)?);
         out.stats.stored = self.read_counters(gpu)?.stored;
         Ok(out)
     }
@@ -382,7 +385,7 @@ impl TerminationCache {
     pub fn update(
         &mut self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         camera: &Camera,
         seed: u64,
         frame: u32,
@@ -391,30 +394,27 @@ impl TerminationCache {
             for k in 0..self.settings.warmup_frames {
                 // Warm-up frames draw their own random numbers (frame indices no run reaches).
                 let frame = 0x8000_0000 + k;
-                self.begin_frame(gpu, tracer, camera, seed, frame, WARMUP_MAX_VERTICES);
-                self.submit(gpu, tracer, &self.update_timer, &TcPass::UPDATE)?;
-                self.submit(gpu, tracer, &self.trace_timer, &[TcPass::Trace])?;
-                self.store(gpu, tracer)?;
+                self.begin_frame(gpu, scene, camera, seed, frame, WARMUP_MAX_VERTICES);
+                self.submit(gpu, scene, &self.update_timer, &TcPass::UPDATE)?;
+                self.submit(gpu, scene, &self.trace_timer, &[TcPass::Trace])?;
+                self.store(gpu, scene)?;
             }
         }
-        self.begin_frame(gpu, tracer, camera, seed, frame, self.settings.max_vertices);
-        self.submit(gpu, tracer, &self.update_timer, &TcPass::UPDATE)
+        self.begin_frame(gpu, scene, camera, seed, frame, self.settings.max_vertices);
+        self.submit(gpu, scene, &self.update_timer, &TcPass::UPDATE)
     }
 
     /// The frame's image after [`Self::update`] (`updated`: its times, reported first): the
-    /// tracer with the rule's decision over the folded records, and the frame's read-back.
+    /// tracer with the rule's decision over the folded records, and the frame's read-back. The
+    /// frame parameters are the cache's own, written by [`Self::update`].
     pub fn trace(
         &mut self,
         gpu: &Gpu,
-        tracer: &PathTracer,
-        seed: u64,
-        frame: u32,
+        scene: &SceneGpu,
         updated: Vec<PassTiming>,
     ) -> Result<TerminationOutput, RenderError> {
-        // Other methods' passes may have set the shared frame uniform since `update`.
-        tracer.prepare_frame(gpu, 1, 0, seed, frame);
         let mut timings = updated;
-        timings.extend(self.submit(gpu, tracer, &self.trace_timer, &[TcPass::Trace])?);
+        timings.extend(self.submit(gpu, scene, &self.trace_timer, &[TcPass::Trace])?);
         let [colour, primary, path_length, counters] = copy_all(
             gpu,
             [
@@ -443,23 +443,19 @@ impl TerminationCache {
     }
 
     /// After the frame's image: the winning candidates become stored vertices, which the next
-    /// frame propagates. Reads only the cache's own buffers and uniforms (no ray, no frame
-    /// uniform), so other methods' work since [`Self::trace`] changes nothing. Ends the frame.
-    pub fn store(
-        &mut self,
-        gpu: &Gpu,
-        tracer: &PathTracer,
-    ) -> Result<Vec<PassTiming>, RenderError> {
-        let timings = self.submit(gpu, tracer, &self.store_timer, &[TcPass::Store])?;
+    /// frame propagates. Reads only the cache's own buffers and parameters (no ray), so other
+    /// methods' work since [`Self::trace`] changes nothing. Ends the frame.
+    pub fn store(&mut self, gpu: &Gpu, scene: &SceneGpu) -> Result<Vec<PassTiming>, RenderError> {
+        let timings = self.submit(gpu, scene, &self.store_timer, &[TcPass::Store])?;
         self.frames += 1;
         Ok(timings)
     }
 
-    /// Writes the frame's uniforms (the tracer's, `hc`, `tc`) and clears the counters.
+    /// Writes the frame's parameters (the cache's frame, `hc`, `tc`) and clears the counters.
     fn begin_frame(
         &self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         camera: &Camera,
         seed: u64,
         frame: u32,
@@ -508,7 +504,7 @@ impl TerminationCache {
             candidate_mask: scene::mix64(seed ^ ((frame as u64) << 32)) as u32 & 0x0fff_ffff,
             pad: 0,
         };
-        tracer.prepare_frame(gpu, 1, 0, seed, frame);
+        self.frame.prepare(gpu, scene, 1, 0, seed, frame);
         gpu.queue.write_buffer(&self.hc, 0, bytemuck::bytes_of(&hc));
         gpu.queue.write_buffer(&self.tc, 0, bytemuck::bytes_of(&tc));
         gpu.queue.write_buffer(&self.counters, 0, &[0u8; COUNTERS as usize * 4]);
@@ -518,7 +514,7 @@ impl TerminationCache {
     fn submit(
         &self,
         gpu: &Gpu,
-        tracer: &PathTracer,
+        scene: &SceneGpu,
         timer: &PassTimer,
         passes: &[TcPass],
     ) -> Result<Vec<PassTiming>, RenderError> {
@@ -529,8 +525,7 @@ impl TerminationCache {
             let [x, y, z] = self.workgroups(p);
             timed.pass(index, |pass| {
                 pass.set_pipeline(&pipeline.get());
-                pass.set_bind_group(0, tracer.scene_bind_group(), &[]);
-                pass.set_bind_group(1, tracer.geometry().bind_group(), &[]);
+                self.frame.bind(gpu, scene, pass);
                 pass.set_bind_group(2, &self.group, &[]);
                 pass.dispatch_workgroups(x, y, z);
             })?;

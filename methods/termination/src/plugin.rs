@@ -17,7 +17,7 @@ use render::timing::PassTiming;
 
 pub use crate::TerminationSettings;
 
-use frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use frame::{FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage, method_failed};
 use frame::{MethodImage, MethodOutput, MethodPlugin};
 
 /// `termination_vb_0.1`, `termination_mse_100`, ...
@@ -56,9 +56,9 @@ impl MethodPlugin for Plugin {
     }
 
     fn spawn(world: &mut World, entity: Entity, settings: &TerminationSettings) -> Result<()> {
-        let (gpu, tracer) = (&world.resource::<GpuDevice>().0, &world.resource::<Tracer>().0);
+        let (gpu, gpu_scene) = (&world.resource::<GpuDevice>().0, &world.resource::<GpuScene>().0);
         // Validates the settings and checks the cache's buffers against the adapter's limits.
-        let cache = TerminationCache::new(gpu, tracer, *settings)?;
+        let cache = TerminationCache::new(gpu, gpu_scene, *settings)?;
         world.entity_mut(entity).insert(TerminationState { cache, updated: None });
         Ok(())
     }
@@ -67,7 +67,7 @@ impl MethodPlugin for Plugin {
 /// The records the image reads: the warm-up on the first frame, then propagation and fold.
 pub fn update(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     scene: Res<sim::ExtractedScene>,
@@ -77,7 +77,7 @@ pub fn update(
         let start = Instant::now();
         let updated = state
             .cache
-            .update(&gpu.0, &tracer.0, &scene.scene.camera, run.scenario.seed, clock.global)
+            .update(&gpu.0, &gpu_scene.0, &scene.scene.camera, run.scenario.seed, clock.global)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         state.updated = Some(updated);
         frame.add_cpu(start);
@@ -88,8 +88,7 @@ pub fn update(
 /// The frame's image (one path per pixel, the rule deciding at every vertex) and its output.
 pub fn trace(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
-    run: Res<Run>,
+    gpu_scene: Res<GpuScene>,
     clock: Res<FrameClock>,
     mut methods: Query<(&mut TerminationState, &MethodInfo, &mut MethodFrame)>,
 ) -> Result<(), BevyError> {
@@ -98,7 +97,7 @@ pub fn trace(
         let updated = state.updated.take().unwrap_or_default();
         let out = state
             .cache
-            .trace(&gpu.0, &tracer.0, run.scenario.seed, clock.global, updated)
+            .trace(&gpu.0, &gpu_scene.0, updated)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let s = out.stats;
         frame.output = Some(MethodOutput {
@@ -131,7 +130,7 @@ pub fn trace(
 /// propagates; the pass time joins the frame's output.
 pub fn store(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     clock: Res<FrameClock>,
     mut methods: Query<(&mut TerminationState, &MethodInfo, &mut MethodFrame)>,
 ) -> Result<(), BevyError> {
@@ -139,7 +138,7 @@ pub fn store(
         let start = Instant::now();
         let timings = state
             .cache
-            .store(&gpu.0, &tracer.0)
+            .store(&gpu.0, &gpu_scene.0)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let Some(output) = frame.output.as_mut() else {
             return Err(method_failed(

@@ -4,18 +4,19 @@
 
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::SceneDesc;
+use render::scene_gpu::SceneGpu;
 use termination::{TerminationCache, TerminationOutput, TerminationRule, TerminationSettings};
 
 use common::{H, W, furnace, gpu, room_scene};
 use render::test_scenes as common;
 
-fn tracer(scene: &SceneDesc, max_depth: u32) -> PathTracer {
-    PathTracer::new(
+fn scene_gpu(scene: &SceneDesc, max_depth: u32) -> SceneGpu {
+    SceneGpu::new(
         gpu(),
         scene,
         PathTracerSettings { width: W, height: H, max_depth, rr_start_depth: max_depth + 1 },
     )
-    .expect("path tracer")
+    .expect("scene")
 }
 
 fn settings(rule: TerminationRule) -> TerminationSettings {
@@ -24,13 +25,13 @@ fn settings(rule: TerminationRule) -> TerminationSettings {
 
 /// `frames` frames of one rule (the first after the warm-up).
 fn run(
-    pt: &PathTracer,
+    sg: &SceneGpu,
     scene: &SceneDesc,
     rule: TerminationRule,
     frames: u32,
 ) -> Vec<TerminationOutput> {
-    let mut cache = TerminationCache::new(gpu(), pt, settings(rule)).expect("termination cache");
-    (0..frames).map(|f| cache.render(gpu(), pt, &scene.camera, 5, f).expect("render")).collect()
+    let mut cache = TerminationCache::new(gpu(), sg, settings(rule)).expect("termination cache");
+    (0..frames).map(|f| cache.render(gpu(), sg, &scene.camera, 5, f).expect("render")).collect()
 }
 
 fn image_mean(img: &[[f32; 4]]) -> f64 {
@@ -44,7 +45,7 @@ const VB_ZERO: TerminationRule = TerminationRule::VarianceBounding { t: 0.0, rel
 fn furnace_radiance_through_the_cache_for_every_rule() {
     // Walls of albedo 0.5 emitting 0.5: L = 1 everywhere; the cache holds 0.5 (emission apart).
     let (scene, expected) = furnace();
-    let pt = tracer(&scene, 12);
+    let sg = scene_gpu(&scene, 12);
     let rules = [
         TerminationRule::FirstVertex,
         TerminationRule::VarianceBounding { t: 0.01, relative: false },
@@ -52,7 +53,7 @@ fn furnace_radiance_through_the_cache_for_every_rule() {
         TerminationRule::AreaSpread { c: 0.01 },
     ];
     for rule in rules {
-        let out = run(&pt, &scene, rule, 2);
+        let out = run(&sg, &scene, rule, 2);
         let mean = image_mean(&out[1].radiance);
         eprintln!("{rule:?}: furnace image mean {mean}");
         // 12 bounces of path tracing lose 0.5^12 of L; the cache converges to the same within
@@ -71,8 +72,8 @@ fn furnace_radiance_through_the_cache_for_every_rule() {
     }
     // Uniform lighting: the record's squared bias is noise around zero, small next to E[Y]².
     let mut cache =
-        TerminationCache::new(gpu(), &pt, settings(TerminationRule::FirstVertex)).unwrap();
-    cache.render(gpu(), &pt, &scene.camera, 5, 0).unwrap();
+        TerminationCache::new(gpu(), &sg, settings(TerminationRule::FirstVertex)).unwrap();
+    cache.render(gpu(), &sg, &scene.camera, 5, 0).unwrap();
     let records: Vec<_> =
         cache.read_records(gpu()).unwrap().into_iter().filter(|r| r.vertices > 0.0).collect();
     assert!(records.len() > 20, "only {} filled records", records.len());
@@ -89,11 +90,11 @@ fn furnace_radiance_through_the_cache_for_every_rule() {
 #[test]
 fn the_ends_path_tracing_and_first_vertex() {
     let scene = room_scene();
-    let pt = tracer(&scene, 6);
+    let sg = scene_gpu(&scene, 6);
     // t = ∞ never terminates: the same paths, bit for bit, as the path tracing rule (the cache's
     // lookups draw from their own random stream).
-    let a = run(&pt, &scene, TerminationRule::PathTracing, 2);
-    let b = run(&pt, &scene, VB_HUGE, 2);
+    let a = run(&sg, &scene, TerminationRule::PathTracing, 2);
+    let b = run(&sg, &scene, VB_HUGE, 2);
     for f in 0..2 {
         assert_eq!(a[f].radiance, b[f].radiance, "frame {f}: t = 1e30 differs from path tracing");
         assert_eq!(a[f].path_length, b[f].path_length);
@@ -101,12 +102,12 @@ fn the_ends_path_tracing_and_first_vertex() {
     // ... and the path tracing rule is the lab's path tracer within noise: mean image over 8
     // frames against 8 spp of PathTracer, within 4 standard errors of the difference.
     let mut ours = vec![0.0f64; (W * H) as usize];
-    let theirs = pt_mean_image(&pt, 8);
+    let theirs = pt_mean_image(&sg, 8);
     let mut cache =
-        TerminationCache::new(gpu(), &pt, settings(TerminationRule::PathTracing)).unwrap();
+        TerminationCache::new(gpu(), &sg, settings(TerminationRule::PathTracing)).unwrap();
     let mut per_frame = Vec::new();
     for f in 0..8 {
-        let out = cache.render(gpu(), &pt, &scene.camera, 5, 100 + f).unwrap();
+        let out = cache.render(gpu(), &sg, &scene.camera, 5, 100 + f).unwrap();
         per_frame.push(image_mean(&out.radiance));
         for (o, c) in ours.iter_mut().zip(&out.radiance) {
             *o += (c[0] + c[1] + c[2]) as f64 / 3.0 / 8.0;
@@ -125,8 +126,8 @@ fn the_ends_path_tracing_and_first_vertex() {
     );
     // t = 0 terminates at the first vertex: the first-vertex image, path length 1 where a
     // record exists.
-    let first = run(&pt, &scene, TerminationRule::FirstVertex, 2);
-    let zero = run(&pt, &scene, VB_ZERO, 2);
+    let first = run(&sg, &scene, TerminationRule::FirstVertex, 2);
+    let zero = run(&sg, &scene, VB_ZERO, 2);
     let same = first[1].radiance.iter().zip(&zero[1].radiance).filter(|(x, y)| x == y).count();
     assert!(
         same as f64 >= 0.99 * (W * H) as f64,
@@ -141,10 +142,9 @@ fn the_ends_path_tracing_and_first_vertex() {
     assert!(a[1].mean_path_length > 2.0, "path tracing path length {}", a[1].mean_path_length);
 }
 
-fn pt_mean_image(pt: &PathTracer, spp: u32) -> Vec<f64> {
-    let mut pt2 = tracer(&room_scene(), 6);
-    let _ = pt;
-    pt2.render(gpu(), spp, 77, 0)
+fn pt_mean_image(sg: &SceneGpu, spp: u32) -> Vec<f64> {
+    let mut pt = PathTracer::new(gpu(), sg).expect("path tracer");
+    pt.render(gpu(), sg, spp, 77, 0)
         .unwrap()
         .radiance
         .iter()
@@ -155,12 +155,12 @@ fn pt_mean_image(pt: &PathTracer, spp: u32) -> Vec<f64> {
 #[test]
 fn path_length_grows_with_the_variance_threshold() {
     let scene = room_scene();
-    let pt = tracer(&scene, 6);
+    let sg = scene_gpu(&scene, 6);
     // The room's records have a local variance around 1e-4 (radiance around 0.1).
     let lengths: Vec<f64> = [1e-6, 1e-5, 1e-4, 1e-3, 1e-2]
         .iter()
         .map(|&t| {
-            let out = run(&pt, &scene, TerminationRule::VarianceBounding { t, relative: false }, 2);
+            let out = run(&sg, &scene, TerminationRule::VarianceBounding { t, relative: false }, 2);
             out[1].mean_path_length
         })
         .collect();
@@ -176,9 +176,9 @@ fn two_runs_give_the_same_images() {
     // Deterministic: the vertex a record keeps is the lowest permuted candidate, sums are per
     // invocation; only the slot a key lands in may differ, which changes no value.
     let scene = room_scene();
-    let pt = tracer(&scene, 6);
+    let sg = scene_gpu(&scene, 6);
     let rule = TerminationRule::MseMinimisation { s: 100.0, margin: 1.1, bias_clamp: 0.1 };
-    let (a, b) = (run(&pt, &scene, rule, 2), run(&pt, &scene, rule, 2));
+    let (a, b) = (run(&sg, &scene, rule, 2), run(&sg, &scene, rule, 2));
     for f in 0..2 {
         assert_eq!(a[f].radiance, b[f].radiance, "frame {f}");
         assert_eq!(a[f].path_length, b[f].path_length, "frame {f}");

@@ -11,10 +11,11 @@ use std::time::Instant;
 use anyhow::{Result, bail};
 use bevy_ecs::prelude::*;
 use media::gpu::{Combination, MisWeight, VolumePathSettings};
+use render::frame_bindings::FrameBindings;
 use serde::{Deserialize, Serialize};
 
 use frame::scene_medium::{SceneMedium, render_volume};
-use frame::{FrameClock, GpuDevice, MethodFrame, MethodInfo, Run, Stage, Tracer, method_failed};
+use frame::{FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage, method_failed};
 use frame::{MethodOutput, MethodPlugin};
 
 /// `VolumePath(spp: 4, mis: Jackknife, combination: Eq9)`.
@@ -58,8 +59,9 @@ impl VolumePathMethod {
     }
 }
 
+/// The method's settings and its frame parameters.
 #[derive(Component)]
-pub struct VolumePath(VolumePathMethod);
+pub struct VolumePath(VolumePathMethod, FrameBindings);
 
 pub struct Plugin;
 
@@ -103,14 +105,16 @@ impl MethodPlugin for Plugin {
                 "VolumePath: the scenario declares no media; expected media: [(name: ..., kind: ..., ...)]"
             );
         }
-        world.entity_mut(entity).insert(VolumePath(s.clone()));
+        let bindings =
+            FrameBindings::new(&world.resource::<GpuDevice>().0, &world.resource::<GpuScene>().0);
+        world.entity_mut(entity).insert(VolumePath(s.clone(), bindings));
         Ok(())
     }
 }
 
 pub fn render(
     gpu: Res<GpuDevice>,
-    tracer: Res<Tracer>,
+    gpu_scene: Res<GpuScene>,
     mut medium: ResMut<SceneMedium>,
     run: Res<Run>,
     clock: Res<FrameClock>,
@@ -120,7 +124,8 @@ pub fn render(
         let start = Instant::now();
         let (radiance, timings, paths) = render_volume(
             &gpu.0,
-            &tracer,
+            &gpu_scene.0,
+            &method.1,
             &mut medium,
             &method.0.settings(),
             method.0.spp,

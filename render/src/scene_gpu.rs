@@ -1,23 +1,28 @@
-//! The scene as every pass built on the shading library binds it: @group(0) holds the `Frame`
-//! parameters (camera, previous camera, lights, seed, spp, depth), the texture atlas, and the
-//! materials and the light table as texel tables (read per hit at per-ray addresses:
-//! `crate::texel_table` says why), all read only; @group(1) is the geometry (BLAS, TLAS,
-//! instances). One per run, updated once per frame; methods read it and never write it.
+//! The scene on the GPU, as every pass built on the shading library reads it: the geometry's
+//! @group(1) (BLAS, TLAS, instances), the texture atlas, the materials and the light table as
+//! texel tables (read per hit at per-ray addresses: `crate::texel_table` says why), the camera,
+//! the scene's features and the pass library compiled for them. One per run, updated once per
+//! frame; methods read it and never write it. Each method binds the shared tables at @group(0)
+//! next to its own `Frame` parameters (camera, previous camera, lights, seed, spp, depth):
+//! [`crate::frame_bindings::FrameBindings`], which rebuilds its group when [`SceneGpu::generation`]
+//! says the tables were reallocated.
 
 use crate::bvh::SceneGeometry;
 use crate::compute::{self, BufferBinding};
 use crate::error::RenderError;
-use crate::frame::{CameraBasis, Frame, FrameParams};
+use crate::frame::{CameraBasis, FrameParams};
 use crate::gpu::Gpu;
 use crate::lights::{LightTable, build_light_table};
 use crate::materials::{GpuMaterial, NO_TEXTURE, pack_materials};
+use crate::pass_library::{LibraryPipeline, PassLibrary};
 use crate::scene::{Camera, SceneChanges, SceneDesc};
 use crate::scene_features::SceneFeatures;
+use crate::shader::Program;
 use crate::texel_table::TexelTable;
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-/// @group(0)'s buffers: frame uniform, texels (declared into the library's WGSL).
+/// @group(0)'s buffers: frame parameters, texels (declared into the library's WGSL).
 pub const GROUP: [BufferBinding; 2] =
     [BufferBinding::read("frame", "Frame"), BufferBinding::read("texels", "array<u32>")];
 /// Its texel tables after the buffers: `GpuMaterial`s (3 texels) and `GpuLight`s (4 texels),
@@ -31,7 +36,7 @@ const _: () = assert!(size_of::<crate::lights::GpuLight>() == 16 * LIGHT_TEXELS 
 /// Storage buffers of @group(0).
 pub const STORAGE_BUFFERS: u32 = compute::storage_buffers(&GROUP);
 
-/// Image size and path depth: what every pass's frame uniform carries besides the scene (the
+/// Image size and path depth: what every pass's frame parameters carry besides the scene (the
 /// path tracer's settings; `render::path_tracer` re-exports it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct PathTracerSettings {
@@ -43,12 +48,15 @@ pub struct PathTracerSettings {
     pub rr_start_depth: u32,
 }
 
-pub struct SceneBindings {
+pub struct SceneGpu {
     settings: PathTracerSettings,
     geometry: SceneGeometry,
+    /// Layout of @group(0): a method's frame parameters, then the tables below.
     layout: wgpu::BindGroupLayout,
-    bind_group: wgpu::BindGroup,
-    frame_buffer: wgpu::Buffer,
+    /// Bumped whenever an update reallocates the texels or a texel table: every method's
+    /// @group(0) made before then binds the old ones.
+    generation: u64,
+    library: PassLibrary,
     texels: wgpu::Buffer,
     materials: TexelTable,
     lights: TexelTable,
@@ -66,12 +74,20 @@ pub struct SceneBindings {
     traversal_stack: u32,
 }
 
-impl SceneBindings {
+impl SceneGpu {
+    /// The scene uploaded, and a pass library for its features. Refuses settings no method can
+    /// render with (no bounce, an image larger than the adapter's textures).
     pub fn new(
         gpu: &Gpu,
         scene: &SceneDesc,
         settings: PathTracerSettings,
     ) -> Result<Self, RenderError> {
+        if settings.max_depth == 0 {
+            return Err(RenderError::Settings(
+                "max_depth must be at least 1 (1 = direct lighting)".into(),
+            ));
+        }
+        gpu.check_resolution(settings.width, settings.height, 0)?;
         let geometry = SceneGeometry::new(gpu, scene)?;
         let (materials_cpu, texels) = pack_materials(scene)?;
         let light_table = build_light_table(scene)?;
@@ -99,21 +115,16 @@ impl SceneBindings {
             bytemuck::cast_slice(&light_table.lights),
             0,
         )?;
-        let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("frame uniform"),
-            size: size_of::<Frame>() as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         let layout = crate::texel_table::group_layout(gpu, "scene", &GROUP, TABLES.len());
-        let bind_group = bind_group(gpu, &layout, &frame_buffer, &texels, &materials, &lights);
-        let geometry_stack = geometry.stack_entries();
+        let traversal_stack = geometry.stack_entries();
+        let textured = textured(&materials_cpu);
+        let features = scene_features(&light_table, scene.environment, textured, traversal_stack);
         Ok(Self {
             settings,
             geometry,
             layout,
-            bind_group,
-            frame_buffer,
+            generation: 0,
+            library: PassLibrary::new(features),
             materials,
             texels,
             lights,
@@ -121,16 +132,42 @@ impl SceneBindings {
             camera: scene.camera,
             previous_camera: scene.camera,
             environment: scene.environment,
-            textured: textured(&materials_cpu),
-            traversal_stack: geometry_stack,
+            textured,
+            traversal_stack,
         })
+    }
+
+    /// [`Self::update_changed`] with everything changed, panicking on an inconsistent scene.
+    /// Call once per simulated frame: the camera and instance transforms it replaces become the
+    /// previous ones of motion vectors.
+    pub fn update(&mut self, gpu: &Gpu, scene: &SceneDesc) {
+        if let Err(e) = self.try_update(gpu, scene) {
+            panic!("SceneGpu::update: {e}");
+        }
+    }
+
+    /// [`Self::update`] that reports an inconsistent scene instead of panicking.
+    pub fn try_update(&mut self, gpu: &Gpu, scene: &SceneDesc) -> Result<(), RenderError> {
+        self.update_changed(gpu, scene, SceneChanges::ALL)
     }
 
     /// Uploads what `changes` names: materials and texels when materials changed, the light
     /// table when lights, instances (emissive triangles follow them) or materials changed.
     /// Instance transforms and the camera are taken every frame: they become the previous ones
-    /// of motion vectors.
+    /// of motion vectors. Meshes are fixed at `new`. When the scene gains or loses a feature (a
+    /// kind of light, textures), every pass of the library is compiled again for its features
+    /// ([`PassLibrary::specialise`]).
     pub fn update_changed(
+        &mut self,
+        gpu: &Gpu,
+        scene: &SceneDesc,
+        changes: SceneChanges,
+    ) -> Result<(), RenderError> {
+        self.upload_changed(gpu, scene, changes)?;
+        self.library.specialise(gpu, self, self.features())
+    }
+
+    fn upload_changed(
         &mut self,
         gpu: &Gpu,
         scene: &SceneDesc,
@@ -144,15 +181,15 @@ impl SceneBindings {
                 .transpose()?;
         self.geometry.try_update_instances(gpu, &scene.instances)?;
         self.traversal_stack = self.traversal_stack.max(self.geometry.stack_entries());
-        let mut rebind = false;
+        let mut reallocated = false;
         let mut uploads: Vec<(&mut wgpu::Buffer, &str, &[u8])> = Vec::new();
         if let Some((materials, texels)) = &materials {
-            rebind |= self.materials.replace(gpu, bytemuck::cast_slice(materials))?;
+            reallocated |= self.materials.replace(gpu, bytemuck::cast_slice(materials))?;
             uploads.push((&mut self.texels, "base-colour texels", bytemuck::cast_slice(texels)));
             self.textured = textured(materials);
         }
         if let Some(table) = &light_table {
-            rebind |= self.lights.replace(gpu, bytemuck::cast_slice(&table.lights))?;
+            reallocated |= self.lights.replace(gpu, bytemuck::cast_slice(&table.lights))?;
         }
         for (buffer, label, bytes) in uploads {
             if buffer.size() == bytes.len() as u64 {
@@ -164,18 +201,11 @@ impl SceneBindings {
                     contents: bytes,
                     usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 });
-                rebind = true;
+                reallocated = true;
             }
         }
-        if rebind {
-            self.bind_group = bind_group(
-                gpu,
-                &self.layout,
-                &self.frame_buffer,
-                &self.texels,
-                &self.materials,
-                &self.lights,
-            );
+        if reallocated {
+            self.generation += 1;
         }
         if let Some(table) = light_table {
             self.light_table = table;
@@ -186,25 +216,19 @@ impl SceneBindings {
         Ok(())
     }
 
-    /// Writes the frame uniform for a pass (camera, previous camera, lights, `spp` and the first
-    /// sample index, seed, frame, max depth), as the path tracer's own passes see it.
-    pub fn prepare_frame(&self, gpu: &Gpu, spp: u32, first_sample: u32, seed: u64, frame: u32) {
-        self.write_frame(gpu, spp, first_sample, seed, frame, false);
-    }
-
-    /// [`Self::prepare_frame`] with `accumulate`: the path tracer's later batches add to the
-    /// radiance sum instead of replacing it.
-    pub fn write_frame(
+    /// A pass's frame parameters (camera, previous camera, lights, `spp` and the first sample
+    /// index, seed, frame, max depth) on the scene as last uploaded; `accumulate`: the path
+    /// tracer's later batches add to the radiance sum instead of replacing it.
+    pub(crate) fn frame_params(
         &self,
-        gpu: &Gpu,
         spp: u32,
         first_sample: u32,
         seed: u64,
         frame: u32,
         accumulate: bool,
-    ) {
+    ) -> FrameParams {
         let (w, h) = (self.settings.width, self.settings.height);
-        let params = FrameParams {
+        FrameParams {
             camera: CameraBasis::new(&self.camera, w, h),
             previous_camera: CameraBasis::new(&self.previous_camera, w, h),
             environment: self.environment,
@@ -220,20 +244,30 @@ impl SceneBindings {
             analytic_lights: self.light_table.analytic,
             emitters: self.light_table.emitters,
             accumulate,
-        };
-        gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(&params.gpu()));
+        }
+    }
+
+    /// @group(0) over `frame` (a method's frame parameters) and the tables as they are now.
+    pub(crate) fn bind_group(&self, gpu: &Gpu, frame: &wgpu::Buffer) -> wgpu::BindGroup {
+        crate::texel_table::group(
+            gpu,
+            "scene",
+            &self.layout,
+            &[frame, &self.texels],
+            &[&self.materials, &self.lights],
+        )
+    }
+
+    /// Counts the updates that reallocated a table: a method's @group(0) made at another
+    /// generation binds tables the scene no longer uses.
+    pub fn generation(&self) -> u64 {
+        self.generation
     }
 
     /// The scene's features as last uploaded: what the library's passes are compiled for
-    /// ([`crate::pass_library::PassLibrary::specialise`]).
+    /// ([`PassLibrary::specialise`]).
     pub fn features(&self) -> SceneFeatures {
-        SceneFeatures {
-            analytic_lights: self.light_table.analytic > 0,
-            emitters: self.light_table.emitters > 0,
-            environment: self.environment.max_element() > 0.0,
-            textures: self.textured,
-            traversal_stack: SceneFeatures::stack_for(self.traversal_stack),
-        }
+        scene_features(&self.light_table, self.environment, self.textured, self.traversal_stack)
     }
 
     /// Point, spot and directional lights as last uploaded (`frame.analytic_lights`).
@@ -241,11 +275,24 @@ impl SceneBindings {
         self.light_table.analytic
     }
 
-    /// @group(0). It changes when an update had to grow a buffer: fetch it every frame.
-    pub fn bind_group(&self) -> &wgpu::BindGroup {
-        &self.bind_group
+    /// The pass library: the shading library's source and the run's shared pipelines.
+    pub fn library(&self) -> &PassLibrary {
+        &self.library
     }
 
+    /// [`PassLibrary::pass`] on this scene.
+    pub fn library_pass<const N: usize>(
+        &self,
+        gpu: &Gpu,
+        pass: &str,
+        program: &Program,
+        own: &[BufferBinding],
+        entries: [&str; N],
+    ) -> Result<(wgpu::BindGroupLayout, [LibraryPipeline; N]), RenderError> {
+        self.library.pass(gpu, self, pass, program, own, entries)
+    }
+
+    /// Layout of @group(0) (a method's frame parameters and the scene's tables).
     pub fn layout(&self) -> &wgpu::BindGroupLayout {
         &self.layout
     }
@@ -265,21 +312,24 @@ impl SceneBindings {
     }
 }
 
+fn scene_features(
+    lights: &LightTable,
+    environment: Vec3,
+    textured: bool,
+    traversal_stack: u32,
+) -> SceneFeatures {
+    SceneFeatures {
+        analytic_lights: lights.analytic > 0,
+        emitters: lights.emitters > 0,
+        environment: environment.max_element() > 0.0,
+        textures: textured,
+        traversal_stack: SceneFeatures::stack_for(traversal_stack),
+    }
+}
+
 /// Whether a material's base colour is read from a texture (base_color_at in pt_scene.wgsl).
 fn textured(materials: &[GpuMaterial]) -> bool {
     materials
         .iter()
         .any(|m| m.texture_offset != NO_TEXTURE && m.texture_width > 0 && m.texture_height > 0)
-}
-
-/// @group(0): [`GROUP`]'s buffers, then [`TABLES`].
-fn bind_group(
-    gpu: &Gpu,
-    layout: &wgpu::BindGroupLayout,
-    frame: &wgpu::Buffer,
-    texels: &wgpu::Buffer,
-    materials: &TexelTable,
-    lights: &TexelTable,
-) -> wgpu::BindGroup {
-    crate::texel_table::group(gpu, "scene", layout, &[frame, texels], &[materials, lights])
 }
