@@ -36,7 +36,7 @@ fn resident_memory_is_flat_over_frames() {
     let dir = std::env::temp_dir().join(format!("flicker-soak-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(
-        &dir.join("soak.ron"),
+        dir.join("soak.ron"),
         "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, seed: 3,
             methods: [PathTracing(spp: 1), Taa(), HashCache(), SampleCache(), Termination()],
             reference: (spp: 0, frames: None),
