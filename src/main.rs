@@ -88,6 +88,10 @@ enum Command {
         /// Timed repetitions of each image metric (the best is reported).
         #[arg(long, default_value_t = 3)]
         repeats: u32,
+        /// Measure device memory instead: each method's buffers and textures at 160x90 and
+        /// 320x180, the scene's share, and one NIRC cache's buffers.
+        #[arg(long, conflicts_with = "nirc")]
+        memory: bool,
         /// Measure the neural incident radiance cache instead: training and inference GFLOP/s
         /// against this adapter's FMA ceiling, and the blend's overhead.
         #[arg(long)]
@@ -368,6 +372,7 @@ fn main() -> ExitCode {
             nirc_frames,
             nirc_resolution,
         ),
+        Command::Bench { out, json, memory: true, .. } => bench::command::memory(out, json),
         Command::Bench { out, rays, frames, no_metrics, repeats, json, .. } => {
             bench::command::speed(out, json, rays, frames, no_metrics, repeats)
         }
