@@ -105,9 +105,18 @@ render::gpu_struct! {
         pub marginal: f32 => "f32",
         /// E[(f cos / p)² B²] at the segment's hit.
         pub deferred_bias2: f32 => "f32",
+        /// E[B²]: the second moment of the segment's part after next-event estimation (the
+        /// BSDF sample's hit), the part Russian roulette keeps with probability q.
+        pub continuation2: f32 => "f32",
+        /// Mean over vertices of the squared luminance of the vertex mean (a vertex estimate:
+        /// its own squared luminance).
+        pub mean_sq: f32 => "f32",
+        /// Σ wᵢ² of the running mean's weights (moments.rs): with `mean_sq`, Var(mean).
+        pub weight2: f32 => "f32",
         /// A vertex estimate: 1 if every sample's hit had a filled record (else it may only
         /// start an empty record).
         pub complete: f32 => "f32",
+        pub pad: f32 => "f32",
     }
 }
 
@@ -123,9 +132,9 @@ render::gpu_struct! {
 }
 
 const _: () = assert!(
-    size_of::<TcParams>() == 48 && size_of::<TcRecord>() == 32 && size_of::<TcVertex>() == 32
+    size_of::<TcParams>() == 48 && size_of::<TcRecord>() == 48 && size_of::<TcVertex>() == 32
 );
-const _: () = assert!(BYTES_PER_RECORD == 16 + 32 + 4 * 32 + 4 * 32 + 4 * 32);
+const _: () = assert!(BYTES_PER_RECORD == 16 + 48 + 4 * 48 + 4 * 32 + 4 * 32);
 
 /// Counters of one frame (counted on the GPU).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -174,6 +183,8 @@ impl CacheStatistics {
                 mean: luminance(Vec3::from(r.mean)) as f64,
                 second: r.second as f64,
                 marginal: r.marginal as f64,
+                mean_sq: r.mean_sq as f64,
+                weight2: r.weight2 as f64,
             })
             .collect();
         let n = filled.len().max(1) as f64;
@@ -245,7 +256,7 @@ impl TerminationCache {
         )?;
         gpu.check_buffer_size(
             "termination cache records (moments + vertex estimates)",
-            cap * (1 + VERTICES_PER_RECORD) * 32,
+            cap * (1 + VERTICES_PER_RECORD) * size_of::<TcRecord>() as u64,
         )?;
         gpu.check_buffer_size(
             "termination cache vertices (stored + candidates)",
@@ -271,7 +282,11 @@ impl TerminationCache {
         // Empty slots with no claim (claim = NONE).
         let empty: Vec<[u32; 4]> = vec![[0, u32::MAX, 0, 0]; cap as usize];
         gpu.queue.write_buffer(&slots, 0, bytemuck::cast_slice(&empty));
-        let records = buffer("termination records", cap * (1 + VERTICES_PER_RECORD) * 32, rw);
+        let records = buffer(
+            "termination records",
+            cap * (1 + VERTICES_PER_RECORD) * size_of::<TcRecord>() as u64,
+            rw,
+        );
         let vertices =
             buffer("termination vertices", (cap * 2 * VERTICES_PER_RECORD + pixels) * 32, rw);
         let counters = buffer("termination counters", COUNTERS * 4, rw);

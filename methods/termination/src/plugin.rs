@@ -111,6 +111,9 @@ pub fn trace(
                 ("cache_bytes".into(), state.cache.cache_bytes() as f64),
                 ("cache_unknown_vertices".into(), s.unknown as f64),
                 ("cache_propagated_vertices".into(), s.propagated as f64),
+                // Propagated vertices with a sample that read no filled record: left out of
+                // filled records' moments (their share measures what that leaves out).
+                ("cache_incomplete_vertices".into(), s.incomplete as f64),
                 ("cache_insert_failures".into(), s.insert_failures as f64),
             ],
             // The paper's Fig. 11: vertices of each pixel's path (grey value = path length; the

@@ -50,9 +50,9 @@ impl Default for TerminationSettings {
 /// Stored vertices per record (§5).
 pub const VERTICES_PER_RECORD: u64 = 4;
 
-/// The cache's buffers per record: slot words (16), record moments (32), 4 per-vertex estimates
-/// (4 × 32), 4 stored vertices (4 × 32) and 4 propagation candidates (4 × 32).
-pub const BYTES_PER_RECORD: u64 = 16 + 32 + VERTICES_PER_RECORD * (32 + 32 + 32);
+/// The cache's buffers per record: slot words (16), record moments (48), 4 per-vertex estimates
+/// (4 × 48), 4 stored vertices (4 × 32) and 4 propagation candidates (4 × 32).
+pub const BYTES_PER_RECORD: u64 = 16 + 48 + VERTICES_PER_RECORD * (48 + 32 + 32);
 
 impl TerminationSettings {
     pub fn validate(&self) -> Result<(), RenderError> {
