@@ -7,6 +7,7 @@
 
 use super::gpu_decision::{decision_module, rule_words};
 use super::moments::RecordMoments;
+use super::rule::TerminationRule;
 use super::settings::{BYTES_PER_RECORD, TerminationSettings, VERTICES_PER_RECORD};
 use glam::Vec3;
 use hash_cache::{HashCacheParams, HashCacheSettings};
@@ -170,6 +171,11 @@ pub struct CacheStatistics {
     pub variance: f64,
     /// E[E[Y|y]²] − E[Y]²: average squared bias of terminating into the record.
     pub bias2: f64,
+    /// Quantiles over the filled records of their variance (10%, 50%, 90%): where an absolute
+    /// threshold lies against the scene's local variances.
+    pub variance_quantiles: [f64; 3],
+    /// Quantiles over the filled records of their value E[Y] (10%, 50%, 90%).
+    pub mean_quantiles: [f64; 3],
 }
 
 impl CacheStatistics {
@@ -188,10 +194,17 @@ impl CacheStatistics {
             })
             .collect();
         let n = filled.len().max(1) as f64;
+        let quantiles = |value: fn(&RecordMoments) -> f64| {
+            let mut v: Vec<f64> = filled.iter().map(value).collect();
+            v.sort_by(f64::total_cmp);
+            [0.1, 0.5, 0.9].map(|q| v.get((q * v.len() as f64) as usize).copied().unwrap_or(0.0))
+        };
         Self {
             mean: filled.iter().map(|m| m.mean).sum::<f64>() / n,
             variance: filled.iter().map(|m| m.average_variance()).sum::<f64>() / n,
             bias2: filled.iter().map(|m| m.squared_bias()).sum::<f64>() / n,
+            variance_quantiles: quantiles(RecordMoments::average_variance),
+            mean_quantiles: quantiles(|m| m.mean),
         }
     }
 }
@@ -509,6 +522,12 @@ impl TerminationCache {
             pad2: [0.0; 2],
         };
         let (rule_kind, relative, param, margin, bias_clamp) = rule_words(&s.rule);
+        let param = match s.rule {
+            TerminationRule::VarianceBounding { t, relative: false } => {
+                (t * s.radiance_unit * s.radiance_unit) as f32
+            }
+            _ => param,
+        };
         let tc = TcParams {
             rule_kind,
             relative,
