@@ -670,6 +670,25 @@ impl SampleCache {
         Ok(CacheState { masks, slots })
     }
 
+    /// Replaces the cache the next frame reprojects (tests: a state built to exercise one
+    /// decision). `state` must hold one mask per pixel and `slots` slots per pixel.
+    pub fn write_state(&mut self, gpu: &Gpu, state: &CacheState) -> Result<(), RenderError> {
+        let pixels = (self.width * self.height) as usize;
+        let n = self.settings.slots as usize;
+        if state.masks.len() != pixels || state.slots.len() != n * pixels {
+            return Err(RenderError::Settings(format!(
+                "sample cache state: {} masks and {} slots, expected {pixels} and {}",
+                state.masks.len(),
+                state.slots.len(),
+                n * pixels
+            )));
+        }
+        let cache = &self.caches[self.current];
+        gpu.queue.write_buffer(&cache.mask, 0, bytemuck::cast_slice(&state.masks));
+        gpu.queue.write_buffer(&cache.slots, 0, bytemuck::cast_slice(&state.slots));
+        Ok(())
+    }
+
     /// Stale visibility of the last frame: how many samples the cache holds as visible that a
     /// retrace from the current camera finds occluded (what `Multi` would correct). Traces one
     /// ray per visible sample; for tests and diagnostics, outside the timed passes.
