@@ -97,7 +97,10 @@ fn holds_paired(name: &str, pairs: &[(f64, f64)]) {
     let sd = (d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
     let margin = T95_DF2 * sd / n.sqrt();
     eprintln!("{name}: differences {d:?}, mean {mean:.4}, margin {margin:.4}");
-    assert!(mean > margin, "{name}: mean difference {mean} within {margin} (t·SE); pairs {pairs:?}");
+    assert!(
+        mean > margin,
+        "{name}: mean difference {mean} within {margin} (t·SE); pairs {pairs:?}"
+    );
 }
 
 #[test]
@@ -115,12 +118,19 @@ fn sample_cache_on_a_moving_hairball_camera() {
         );
         // Equal shading budget: the uniform-shading caches shade one path per pixel, like 1 spp
         // and TAA.
-        assert!(r.shaded.iter().all(|&s| s == r.shaded[0]), "seed {seed}: budgets differ: {:?}", r.shaded);
+        assert!(
+            r.shaded.iter().all(|&s| s == r.shaded[0]),
+            "seed {seed}: budgets differ: {:?}",
+            r.shaded
+        );
         // Multi retraces every sample every frame, so none can be stale after its trace pass.
         assert_eq!(r.stale[1], 0, "seed {seed}: multi leaves {} stale visible samples", r.stale[1]);
     }
     let pairs = |f: &dyn Fn(&Run) -> (f64, f64)| runs.iter().map(f).collect::<Vec<_>>();
-    holds_paired("1 spp flickers more than the adaptive cache", &pairs(&|r| (r.smape[0], r.smape[3])));
+    holds_paired(
+        "1 spp flickers more than the adaptive cache",
+        &pairs(&|r| (r.smape[0], r.smape[3])),
+    );
     for (i, name) in ["single", "multi", "adaptive"].iter().enumerate() {
         holds_paired(
             &format!("1 spp + TAA flickers more than the {name} cache"),
@@ -128,7 +138,10 @@ fn sample_cache_on_a_moving_hairball_camera() {
         );
     }
     // Adaptive traces clearly fewer rays than multi: at most 60% of them.
-    holds_paired("adaptive traces fewer rays than 0.6 multi", &pairs(&|r| (0.6 * r.rays[1] as f64, r.rays[2] as f64)));
+    holds_paired(
+        "adaptive traces fewer rays than 0.6 multi",
+        &pairs(&|r| (0.6 * r.rays[1] as f64, r.rays[2] as f64)),
+    );
     holds_paired(
         "adaptive leaves less stale visibility than single",
         &pairs(&|r| (r.stale[0] as f64, r.stale[2] as f64)),
