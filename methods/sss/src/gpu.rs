@@ -23,7 +23,9 @@ pub const MAX_COUNT: u32 = 4096;
 render::gpu_struct! {
     /// The pass's parameters: image size, frame and seed, the variant (0 fixed, 1 AS, 2 OCV,
     /// 3 CCV, 4 separable), SPVG's and the control variates' parameters, the separable
-    /// kernel's tap count, AFIS's level count (0: no prefiltering) and eq. 5.12's a, d per
+    /// kernel's tap count, AFIS's level count (0: no prefiltering) and eq. 5.12's a, the
+    /// direct/distant split (on, γ or −1 for Burley's, ε_u), the focal length in pixels (eq.
+    /// 7.1's depth), the monitored luminance's gamma, d per
     /// channel in pixels (w: the sampled d), and per MIP level (offset in the chain's buffer,
     /// width, height, 0), computed once here rather than per fetch in the shader.
     pub struct SssParams {
@@ -45,13 +47,17 @@ render::gpu_struct! {
         pub taps: u32 => "u32",
         pub mip_levels: u32 => "u32",
         pub mip_a: f32 => "f32",
+        pub split: u32 => "u32",
+        pub gamma: f32 => "f32",
+        pub eps_u: f32 => "f32",
+        pub focal_px: f32 => "f32",
+        pub monitor_gamma: f32 => "f32",
         pub pad0: u32 => "u32",
-        pub pad1: u32 => "u32",
         pub d_px: [f32; 4] => "vec4f",
         pub mip: [[u32; 4]; 8] => "array<vec4u, 8>",
     }
 }
-const _: () = assert!(std::mem::size_of::<SssParams>() == 224);
+const _: () = assert!(std::mem::size_of::<SssParams>() == 240);
 // The WGSL array length above is the chain's level bound.
 const _: () = assert!(prefilter::MAX_LEVELS == 8);
 
@@ -256,7 +262,7 @@ impl SssPass {
                 self.height
             )));
         }
-        settings.spvg.validate().map_err(RenderError::Settings)?;
+        settings.validate().map_err(|e| RenderError::Settings(format!("SSS {e}")))?;
         let mip_levels =
             settings.mip_levels().map_err(|e| RenderError::Settings(format!("SSS {e}")))?;
         let (fixed, taps) = match settings.variant {
@@ -296,8 +302,13 @@ impl SssPass {
             taps,
             mip_levels,
             mip_a: settings.prefilter.map_or(0.0, |p| p.a),
+            split: settings.split.is_some() as u32,
+            // Negative: Table 5.1's Burley γ = 1 − cdf(r0) per channel.
+            gamma: settings.split.and_then(|s| s.gamma).unwrap_or(-1.0),
+            eps_u: settings.split.map_or(0.0, |s| s.eps_u),
+            focal_px: frame.focal_px,
+            monitor_gamma: settings.monitor_gamma,
             pad0: 0,
-            pad1: 0,
             d_px: [frame.d_px[0], frame.d_px[1], frame.d_px[2], frame.d_sample()],
             mip: std::array::from_fn(|k| {
                 let (w, h) = prefilter::level_size(self.width, self.height, k as u32);

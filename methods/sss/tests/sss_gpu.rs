@@ -8,7 +8,7 @@ use sss::gpu::SssPass;
 use sss::prefilter::MipChain;
 use sss::screen_pass::step;
 use sss::{
-    EmCovariance, PixelHistory, PixelResult, Prefilter, SpvgHistory, SpvgSettings, SssFrame,
+    EmCovariance, PixelHistory, PixelResult, Prefilter, Split, SpvgHistory, SpvgSettings, SssFrame,
     SssSettings, SssVariant,
 };
 
@@ -23,11 +23,19 @@ fn frame() -> SssFrame {
             let lit = if x + 0.5 * y < 11.0 { 1.0 } else { 0.15 };
             let fall = 1.0 - 0.03 * y;
             // w: pixels per unit of d, varying as depth would; 0 off the SSS mask.
-            let scale = if x >= 16.0 && y < 4.0 { 0.0 } else { 0.8 + 0.03 * x };
+            // The last row's tiny w puts γ under ε_u (eq. 5.20: no distant samples).
+            let scale = if x >= 16.0 && y < 4.0 {
+                0.0
+            } else if y == 11.0 {
+                0.02
+            } else {
+                0.8 + 0.03 * x
+            };
             [lit * fall, 0.8 * lit * fall, 0.6 * lit, scale]
         })
         .collect();
-    SssFrame { width: W, height: H, irradiance, d_px: [1.5, 0.8, 0.4] }
+    // focal_px: depth = focal/w varies with x, so eq. 7.1's depth term is exercised.
+    SssFrame { width: W, height: H, irradiance, d_px: [1.5, 0.8, 0.4], focal_px: 6.0 }
 }
 
 /// The unrounded n̂ of eq. 4.9 in f64, to keep away from rounding ties in the test data.
@@ -108,16 +116,26 @@ fn gpu_pass_matches_the_cpu_reference() {
     let gpu = Gpu::new().expect("a wgpu adapter (lavapipe on CI)");
     let frame = frame();
     let mut pass = SssPass::new(&gpu, W, H).unwrap();
+    let thesis = Some(Split::default());
     let variants = [
-        (SssVariant::Fixed { count: 64 }, false),
-        (SssVariant::Adaptive, true),
-        (SssVariant::OnlineCv, true),
-        (SssVariant::ConstantCv, true),
-        (SssVariant::Adaptive, false),
+        (SssVariant::Fixed { count: 64 }, false, thesis, 2.2),
+        (SssVariant::Adaptive, true, thesis, 2.2),
+        (SssVariant::OnlineCv, true, thesis, 2.2),
+        (SssVariant::ConstantCv, true, thesis, 2.2),
+        (SssVariant::Adaptive, false, thesis, 2.2),
+        (SssVariant::Adaptive, true, None, 1.0),
+        (SssVariant::OnlineCv, true, Some(Split { gamma: Some(0.4), eps_u: 0.3 }), 1.0),
     ];
-    for (variant, fast_inverse) in variants {
-        let settings = SssSettings { variant, fast_inverse, seed: 3, ..Default::default() };
-        let what = format!("{variant:?} fast {fast_inverse}");
+    for (variant, fast_inverse, split, monitor_gamma) in variants {
+        let settings = SssSettings {
+            variant,
+            fast_inverse,
+            seed: 3,
+            split,
+            monitor_gamma,
+            ..Default::default()
+        };
+        let what = format!("{variant:?} fast {fast_inverse} {split:?} gamma {monitor_gamma}");
         let start = histories(&settings.spvg);
         pass.set_history(&gpu, &start);
         pass.dispatch(&gpu, &frame, &settings, 5).unwrap();
@@ -211,7 +229,13 @@ fn bad_sizes_and_counts_are_refused() {
         )
         .unwrap_err();
     assert!(e.to_string().contains("5000"), "{e}");
-    let small = SssFrame { width: 4, height: 4, irradiance: vec![[0.0; 4]; 16], d_px: [1.0; 3] };
+    let small = SssFrame {
+        width: 4,
+        height: 4,
+        irradiance: vec![[0.0; 4]; 16],
+        d_px: [1.0; 3],
+        focal_px: 0.0,
+    };
     assert!(
         pass.dispatch(&gpu, &small, &SssSettings::default(), 0)
             .unwrap_err()
