@@ -6,7 +6,9 @@
 //! inverse) on every 6th frame after frame 10, frame-to-frame SMAPE. Prints the per-seed rows,
 //! the means, and each relation with its per-seed values; writes OUT/relations.md.
 //!
-//! cargo run --release -p sss --example sss_relations -- [WIDTH HEIGHT FRAMES SEEDS OUT]
+//! cargo run --release -p sss --example sss_relations -- [WIDTH HEIGHT FRAMES SEEDS OUT [D_SCALE]]
+//! (D_SCALE multiplies the profiles' d, relative to the image height: default 1, d = (0.15, 0.08,
+//! 0.04) of the height).
 
 use sss::evaluation::Accumulator;
 use sss::sampling::luminance;
@@ -30,10 +32,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (width, height, frames, seeds): (u32, u32, u32, u32) =
         (arg(0, "64").parse()?, arg(1, "36").parse()?, arg(2, "60").parse()?, arg(3, "3").parse()?);
     let out = std::path::PathBuf::from(arg(4, "sss_relations"));
+    let d_scale: f32 = arg(5, "1").parse()?;
+    let d_rel = D_REL.map(|d| d * d_scale);
     std::fs::create_dir_all(&out)?;
     let measured = |t: u32| t >= 10 && t % 6 == 4;
     let mut rows = format!(
-        "{width}x{height}, {frames} frames, seeds 1..={seeds}, CPU twin\n\n| test | seed | variant | mean spp | CPU ms/frame | PSNR dB | SMAPE |\n|---|---|---|---|---|---|---|\n"
+        "{width}x{height}, {frames} frames, seeds 1..={seeds}, d = {d_rel:?} of the height, CPU twin\n\n| test | seed | variant | mean spp | CPU ms/frame | PSNR dB | SMAPE |\n|---|---|---|---|---|---|---|\n"
     );
     let mut means = String::from(
         "| test | variant | mean spp | CPU ms/frame | PSNR dB | SMAPE |\n|---|---|---|---|---|---|\n",
@@ -49,7 +53,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut references = vec![None; frames as usize];
         let mut peak = 0.0f64;
         for t in (0..frames).filter(|&t| measured(t)) {
-            let f = frame(test, width, height, t, D_REL);
+            let f = frame(test, width, height, t, d_rel);
             let r: Vec<[f32; 3]> =
                 step(&f, &reference_settings, t, &[]).0.iter().map(|p| p.rgb).collect();
             peak = r.iter().map(|c| luminance(*c) as f64).fold(peak, f64::max);
@@ -62,7 +66,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let settings = SssSettings { variant: *variant, seed, ..Default::default() };
                 let (mut acc, mut history, mut ms) = (Accumulator::default(), vec![], 0.0);
                 for t in 0..frames {
-                    let f = frame(test, width, height, t, D_REL);
+                    let f = frame(test, width, height, t, d_rel);
                     let start = Instant::now();
                     let (results, next) = step(&f, &settings, t, &history);
                     ms += start.elapsed().as_secs_f64() * 1e3;
