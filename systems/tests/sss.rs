@@ -1,5 +1,5 @@
 //! The Sss method (systems::methods::sss) end to end through playback on the shipped scenarios
-//! sss_flash.ron, sss_toggle.ron and sss_boids.ron at 32x18: counts within SPVG's clamp, a cold
+//! sss_flash.ron, sss_toggle.ron, sss_boids.ron and sss_moving.ron at 32x18: counts within SPVG's clamp, a cold
 //! start at n_min, the fixed variant at its count, the count image written; and its input errors.
 
 use std::path::{Path, PathBuf};
@@ -37,7 +37,7 @@ fn stat(r: &FrameRecord, name: &str) -> f64 {
 
 #[test]
 fn sss_scenarios_play_with_clamped_counts() {
-    for scenario in ["sss_flash.ron", "sss_toggle.ron", "sss_boids.ron"] {
+    for scenario in ["sss_flash.ron", "sss_toggle.ron", "sss_boids.ron", "sss_moving.ron"] {
         let (records, dir) = play(scenario, 5, &["as", "ocv", "fixed64"]);
         assert_eq!(records.len(), 15, "{scenario}");
         for r in &records {

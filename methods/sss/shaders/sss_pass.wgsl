@@ -16,6 +16,35 @@ import package::kernel::{outside_image};
 @group(0) @binding(5) var<storage, read_write> history_out: array<vec4f>;
 @group(0) @binding(6) var<storage, read_write> cv_out: array<vec4f>;
 @group(0) @binding(7) var<storage, read> mips: array<vec4f>;
+@group(0) @binding(8) var<storage, read> motion: array<vec2f>;
+
+// The previous frame's histories for pixel `id` (render's reproject.rs): point-sampled at
+// id + ½ + motion (the TAA resolve's convention); C_s = 0 (eqs. 4.11-4.12: an invalid history,
+// w = 0) off screen, without an SSS history there, or where the depth it was written at
+// (h.w = 1 + w, depth = focal/w) differs from this pixel's by more than the tolerance.
+struct Reprojected {
+    h: vec4f,
+    j: vec4f,
+}
+
+fn reprojected(id: vec2u, w: f32) -> Reprojected {
+    let none = Reprojected(vec4f(0.0), vec4f(0.0));
+    let pos = vec2f(id) + 0.5 + motion[id.y * params.width + id.x];
+    if !(pos.x >= 0.0 && pos.y >= 0.0 && pos.x < f32(params.width) && pos.y < f32(params.height)) {
+        return none;
+    }
+    let q = vec2u(pos);
+    let i = q.y * params.width + q.x;
+    let h = history_in[i];
+    if h.w <= 0.5 {
+        return none;
+    }
+    let w_prev = h.w - 1.0;
+    if w_prev > 0.0 && abs(w_prev - w) > params.depth_tolerance * w_prev {
+        return none;
+    }
+    return Reprojected(h, cv_in[i]);
+}
 
 // A texel of the irradiance (from_mips false) or of the MIP chain at `base` (a level of `size`
 // texels), clamped to the image; texels without SSS read as the centre.
@@ -159,7 +188,8 @@ fn sss_scatter(@builtin(global_invocation_id) id: vec3u) {
         }
     }
     let sp = SpvgParams(params.alpha0, params.kappa, params.sigma0_sq, params.n_min, params.n_max);
-    let st = spvg_state(history_in[pixel], sp);
+    let prev = reprojected(id.xy, t.w);
+    let st = spvg_state(prev.h, sp);
     var n = params.fixed_count;
     if params.variant != 0u {
         n = spvg_sample_count(st, sp);
@@ -197,13 +227,13 @@ fn sss_scatter(@builtin(global_invocation_id) id: vec3u) {
     let g = encode(sss_luminance(gamma * t.xyz));
     var a = 0.0;
     if params.variant == 2u && st.valid {
-        a = cv_coefficient(cv_in[pixel], params.eps_a, params.a0, f, g);
+        a = cv_coefficient(prev.j, params.eps_a, params.a0, f, g);
     } else if params.variant == 2u || params.variant == 3u {
         a = 1.0;
     }
-    history_out[pixel] = spvg_update(st, sp, f - a * g, n);
+    history_out[pixel] = spvg_update(st, sp, f - a * g, n) + vec4f(0.0, 0.0, 0.0, t.w);
     if st.valid {
-        cv_out[pixel] = cv_update(cv_in[pixel], params.a_cv, f, g);
+        cv_out[pixel] = cv_update(prev.j, params.a_cv, f, g);
     } else {
         cv_out[pixel] = vec4f(f, g, 0.0, 0.0);
     }

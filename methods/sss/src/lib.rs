@@ -13,6 +13,7 @@ pub mod inverse;
 pub mod prefilter;
 pub mod profile;
 pub mod random_walk;
+pub mod reproject;
 pub mod sampling;
 pub mod screen_pass;
 pub mod separable;

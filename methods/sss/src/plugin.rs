@@ -95,6 +95,7 @@ impl SssMethodSettings {
             prefilter: self.prefilter,
             split: self.split,
             monitor_gamma: self.monitor_gamma,
+            ..Default::default()
         }
     }
 }
@@ -254,6 +255,7 @@ pub fn render(
                 irradiance,
                 d_px: profile.d,
                 focal_px: focal,
+                motion: g.motion.clone(),
             };
             render::timing::merge(
                 &mut timings,

@@ -5,6 +5,7 @@
 
 use super::control_variates::EmCovariance;
 use super::prefilter::{self, MipChain, Prefilter};
+use super::reproject;
 use super::sampling::{luminance, pixel_offset, r2_point, radial_pdf, sample_radius};
 use super::separable;
 use super::split::{self, Split};
@@ -58,6 +59,9 @@ pub struct SssSettings {
     pub split: Option<Split>,
     /// The monitored luminance's encoding Y^(1/γ_m) (Sec. 4.4: gamma-corrected; 1 = linear).
     pub monitor_gamma: f32,
+    /// The reprojected history is reset where its depth and this pixel's differ by more than
+    /// this share (the TAA resolve's rejection test and default).
+    pub depth_tolerance: f32,
 }
 
 impl SssSettings {
@@ -71,6 +75,12 @@ impl SssSettings {
             return Err(format!(
                 "monitor_gamma {}; expected a positive number (1: linear luminance)",
                 self.monitor_gamma
+            ));
+        }
+        if !(self.depth_tolerance > 0.0) {
+            return Err(format!(
+                "depth_tolerance {}; expected a positive share of the depth",
+                self.depth_tolerance
             ));
         }
         self.mip_levels().map(|_| ())
@@ -104,6 +114,7 @@ impl Default for SssSettings {
             prefilter: None,
             split: Some(Split::default()),
             monitor_gamma: MONITOR_GAMMA,
+            depth_tolerance: taa::TaaSettings::default().depth_tolerance,
         }
     }
 }
@@ -120,6 +131,9 @@ pub struct SssFrame {
     /// Pixels per scene unit at unit depth (depth = focal_px / w): eq. 7.1's depth difference;
     /// 0 where depth is unknown (no depth term).
     pub focal_px: f32,
+    /// Per pixel, where it was in the previous frame minus where it is (pixels, x right, y
+    /// down; the G-buffer's motion): the histories are read there. Empty: a still view.
+    pub motion: Vec<[f32; 2]>,
 }
 
 impl SssFrame {
@@ -129,11 +143,13 @@ impl SssFrame {
     }
 }
 
-/// A pixel's histories: SPVG's H and the control variates' J.
+/// A pixel's histories: SPVG's H and the control variates' J, and the w (pixels per scene
+/// unit, depth = focal/w) they were written at, for the reprojection's depth test (0: unknown).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PixelHistory {
     pub spvg: SpvgHistory,
     pub cv: EmCovariance,
+    pub w: f32,
 }
 
 /// A pixel's result: the scattered irradiance and the count it took.
@@ -305,7 +321,7 @@ fn pixel_step(
     let cv = if st.valid { prev.cv.update(settings.a_cv, f, g) } else { EmCovariance::start(f, g) };
     (
         PixelResult { rgb: s.rgb, count: m },
-        PixelHistory { spvg: spvg::update(&st, &settings.spvg, monitored, m), cv },
+        PixelHistory { spvg: spvg::update(&st, &settings.spvg, monitored, m), cv, w: t[3] },
     )
 }
 
@@ -323,21 +339,20 @@ pub fn step(
         return (separable::step(frame, &kernel), vec![PixelHistory::default(); count]);
     }
     let chain = mip_chain(frame, settings);
-    let empty = PixelHistory::default();
     let mut results = Vec::with_capacity(count);
     let mut next = Vec::with_capacity(count);
     for y in 0..frame.height {
         for x in 0..frame.width {
             let i = (y * frame.width + x) as usize;
-            let (r, h) = pixel_step(
-                frame,
-                settings,
-                chain.as_ref(),
-                frame_index,
-                x,
-                y,
-                history.get(i).unwrap_or(&empty),
+            let prev = reproject::reproject(
+                history,
+                frame.motion.get(i).copied(),
+                (x, y),
+                (frame.width, frame.height),
+                frame.irradiance[i][3],
+                settings.depth_tolerance,
             );
+            let (r, h) = pixel_step(frame, settings, chain.as_ref(), frame_index, x, y, &prev);
             results.push(r);
             next.push(h);
         }

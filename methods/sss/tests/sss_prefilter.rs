@@ -18,7 +18,7 @@ fn frame(f: impl Fn(f32, f32) -> f32) -> SssFrame {
         })
         .collect();
     // One d for all channels: each sample's weight is 1, the estimate a plain mean of fetches.
-    SssFrame { width: W, height: H, irradiance, d_px: [0.6; 3], focal_px: 0.0 }
+    SssFrame { width: W, height: H, irradiance, d_px: [0.6; 3], focal_px: 0.0, motion: Vec::new() }
 }
 
 #[test]

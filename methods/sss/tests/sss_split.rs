@@ -15,6 +15,7 @@ fn flat(b: [f32; 3], d_px: [f32; 3]) -> SssFrame {
         irradiance: vec![[b[0], b[1], b[2], 1.0]; (W * H) as usize],
         d_px,
         focal_px: 0.0,
+        motion: Vec::new(),
     }
 }
 
@@ -117,6 +118,7 @@ fn bilateral_weights_stop_at_a_depth_edge() {
             .collect(),
         d_px: [2.0, 1.5, 1.0],
         focal_px,
+        motion: Vec::new(),
     };
     let s = SssSettings { variant: SssVariant::Fixed { count: 64 }, ..Default::default() };
     let (x, y) = (W / 2 - 1, H / 2);

@@ -82,6 +82,7 @@ fn disocclusion_resets_the_history() {
         irradiance: vec![[1.0, 1.0, 1.0, 1.0]; 4],
         d_px: [0.5; 3],
         focal_px: 0.0,
+        motion: Vec::new(),
     };
     let settings = SssSettings::default();
     let hot = PixelHistory { spvg: busy, ..Default::default() };
