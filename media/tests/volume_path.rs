@@ -24,6 +24,9 @@
 //! - Jackknife shadow rays (Eq. 3 for m = 2 and 3, fixed and importance-tied N, super-voxels of
 //!   16 and 8) through a layered medium: the image is the path tracer's times E[K], which the
 //!   CPU twin gives (its bias included).
+//! - Eq. 9 with its T̃(t0) by ratio tracking and by the exact transmittance, against free flight
+//!   (a measurement for media/README.md; asserted: the exact-T̃ variant is unbiased); bad
+//!   jackknife settings refused by the pass.
 
 mod common;
 
