@@ -9,4 +9,4 @@ pub mod run;
 
 pub use claims::{Claim, Claims, Comparison, Scale};
 pub use judge::{Judged, Verdict, judge};
-pub use run::{ReproduceOptions, reproduce};
+pub use run::{ReproduceOptions, ReproduceOutcome, reproduce};
