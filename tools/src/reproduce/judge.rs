@@ -104,7 +104,7 @@ pub fn judge(
         Comparison::Ratio { method, to, value, tolerance, confidence } => {
             match (values(method), values(to)) {
                 (Ok(a), Ok(b)) if a.len() == b.len() => {
-                    if b.iter().any(|x| *x == 0.0) {
+                    if b.contains(&0.0) {
                         return not_comparable(format!("{to} is 0 in a seed; no ratio"));
                     }
                     let r: Vec<f64> = a.iter().zip(&b).map(|(x, y)| x / y).collect();
