@@ -65,6 +65,31 @@ enum Command {
         #[command(subcommand)]
         action: SuiteAction,
     },
+    /// Play what a seed paper's claims need (claims/PAPER.ron) over seeds and judge each claim:
+    /// reproduced, not reproduced or not comparable; writes reproduce.md and reproduce.html.
+    Reproduce {
+        /// A paper (the stem of its claims file, e.g. reliability-weighted-nirc) or `all`.
+        paper: String,
+        /// smoke (tiny: about two minutes a paper on 2 cores), lab (the scenarios as shipped) or
+        /// paper (the paper's sizes where the claims file gives them).
+        #[arg(long, default_value = "lab", value_parser = tools::reproduce::Scale::parse)]
+        scale: tools::reproduce::Scale,
+        /// Seeds per case (at least 2) [default: each case's own list].
+        #[arg(long)]
+        seeds: Option<usize>,
+        /// Output folder [default: runs/reproduce_PAPER_SCALE].
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// The folder of claims files.
+        #[arg(long, default_value = "claims")]
+        claims: PathBuf,
+        /// Cache folder for references [default: $FLICKER_CACHE_DIR or ~/.cache/flicker].
+        #[arg(long)]
+        cache_dir: Option<PathBuf>,
+        /// Do not draw progress bars.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Parameter sweeps: a grid or list over method parameters, cases and seeds, one run folder
     /// per job, run here, with GNU parallel or as a Slurm array, merged into one summary.
     Sweep {
@@ -88,6 +113,10 @@ enum Command {
         /// Timed repetitions of each image metric (the best is reported).
         #[arg(long, default_value_t = 3)]
         repeats: u32,
+        /// Measure device memory instead: each method's buffers and textures at 160x90 and
+        /// 320x180, the scene's share, and one NIRC cache's buffers.
+        #[arg(long, conflicts_with = "nirc")]
+        memory: bool,
         /// Measure the neural incident radiance cache instead: training and inference GFLOP/s
         /// against this adapter's FMA ceiling, and the blend's overhead.
         #[arg(long)]
@@ -316,6 +345,21 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Suite { action } => return suite(action),
         Command::Sweep { action } => return sweep(action),
+        Command::Reproduce { paper, scale, seeds, out, claims, cache_dir, quiet } => {
+            let opts = tools::reproduce::ReproduceOptions {
+                paper,
+                claims_dir: claims,
+                scale,
+                seeds,
+                out,
+                cache_dir,
+                progress: !quiet,
+            };
+            tools::reproduce::reproduce(&opts).map(|outcome| {
+                print!("{}", outcome.markdown);
+                println!("\nwrote {}", outcome.folder.join("reproduce.md").display());
+            })
+        }
         Command::Run { scenario, frames, resolution, spp, seed, out, cache_dir, quiet } => {
             let opts = RunOptions {
                 scenario,
@@ -368,6 +412,7 @@ fn main() -> ExitCode {
             nirc_frames,
             nirc_resolution,
         ),
+        Command::Bench { out, json, memory: true, .. } => bench::command::memory(out, json),
         Command::Bench { out, rays, frames, no_metrics, repeats, json, .. } => {
             bench::command::speed(out, json, rays, frames, no_metrics, repeats)
         }

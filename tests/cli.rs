@@ -251,6 +251,25 @@ fn duplicate_method_labels_are_refused_before_anything_is_written() {
 }
 
 #[test]
+fn termination_survival_outside_0_1_is_refused_at_its_line() {
+    for (setting, expected) in [
+        ("survival: 1.5", "survival must be in (0, 1], got 1.5"),
+        ("survival: 0.0", "survival must be in (0, 1], got 0"),
+        ("radiance_unit: 0.0", "radiance_unit must be positive"),
+    ] {
+        let dir = scratch("survival");
+        let path = tiny_scenario(
+            &dir,
+            &format!(
+                "Scenario(scene: Builtin(\"cornell_box\"), resolution: (16, 9), frames: 1,\n  methods: [PathTracing(spp: 1),\n    Termination(rule: FirstVertex, {setting})],\n  reference: (spp: 4, frames: List([])))"
+            ),
+        );
+        let err = run_fails(&path, &[], &dir.join("out"));
+        assert!(err.contains("scenario.ron:3:5") && err.contains(expected), "{setting}: {err}");
+    }
+}
+
+#[test]
 fn no_xdg_runtime_dir_message_when_it_is_unset_or_invalid() {
     let dir = scratch("xdg");
     let scenario = tiny_scenario(

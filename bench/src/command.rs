@@ -89,6 +89,21 @@ pub fn nirc(
 
 /// `flicker bench`: the speed tables (crate::speed) and, unless `no_metrics`, the image metrics'
 /// timings (crate::image_metrics).
+/// `flicker bench --memory`: the device memory table of every method (systems::memory).
+pub fn memory(out: Option<PathBuf>, json: Option<PathBuf>) -> anyhow::Result<()> {
+    let resolutions = crate::speed::BenchOptions::default().resolutions;
+    let scratch = std::env::temp_dir().join(format!("flicker-bench-memory-{}", std::process::id()));
+    let (md, rows) = systems::memory::table(&resolutions, &scratch)?;
+    print!("{md}");
+    if let Some(path) = out {
+        systems::output::write_text(&path, &md)?;
+    }
+    if let Some(path) = json {
+        systems::output::write_text(&path, &serde_json::to_string_pretty(&rows)?)?;
+    }
+    Ok(())
+}
+
 pub fn speed(
     out: Option<PathBuf>,
     json: Option<PathBuf>,

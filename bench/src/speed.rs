@@ -311,6 +311,10 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
             alone.map_or("n/a".into(), |a| format!("{:.2}", rate / a))
         )?;
     }
+    log("device memory per method");
+    let scratch = std::env::temp_dir().join(format!("flicker-bench-memory-{}", std::process::id()));
+    let (memory_md, memory_rows) = systems::memory::table(&opts.resolutions, &scratch)?;
+    write!(md, "\n{memory_md}")?;
     let json = serde_json::json!({
         "adapter": gpu.summary,
         "cpu_threads": rayon_threads(),
@@ -329,6 +333,7 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         "mitsuba_mean_rgb": reference.mitsuba.as_ref().map(|m| m.mean_rgb),
         "reference_paths_ratio_vs_mitsuba": mitsuba_ratio,
         "frames": frame_rows,
+        "memory": memory_rows,
     });
     Ok(BenchReport { markdown: md, json })
 }

@@ -22,6 +22,10 @@ pub const REFERENCE_SETTINGS: VolumePathSettings = VolumePathSettings {
     combination: media::gpu::Combination::Eq9,
     shadow: media::gpu::ShadowTransmittance::RatioTracking,
     samples: 4,
+    shadow_samples: 10,
+    shadow_estimates: 2,
+    shadow_step: None,
+    eq9_transmittance: media::gpu::Eq9Transmittance::RatioTracking,
 };
 
 #[derive(Resource)]
@@ -39,7 +43,7 @@ pub struct SceneMedium {
 }
 
 fn bake(desc: &MediumDesc, state: &MediumState, bound: Option<&MeshInside>) -> Medium {
-    Medium::new(DensityGrid::from_state_within(desc, state, bound))
+    Medium::with_super_voxel(DensityGrid::from_state_within(desc, state, bound), desc.super_voxel)
 }
 
 impl SceneMedium {

@@ -9,7 +9,8 @@
 //! - The stable sample cache: each visible sample blends its shades with weight α (the settings'
 //!   `alpha`; with App. C's roughness α_min, its diffuse bound 0.1, the longest), a pixel
 //!   averages n_target visible samples, and `shading_rate` samples of it are shaded per frame:
-//!   n_target · (2 − α) / α shades, shading_rate per frame (defaults: 4 · 19 = 76 frames).
+//!   n_target · (2 − α) / α shades, shading_rate per frame (α 0.1: 4 · 19 = 76 frames). Its
+//!   default, α = 0, is a running mean: no fixed window, none stated.
 //! - The hash cache: each cell is updated once per frame with weight 1 / max_samples: 63 frames
 //!   at 32.
 //! - Under TAA, the two filters in series: each modelled as the exponential blend of its own

@@ -1,4 +1,4 @@
-// A medium's voxel densities (nearest neighbour) and super-voxels (16³ voxels: min, max, mean,
+// A medium's voxel densities (nearest neighbour) and super-voxels (size³ voxels, 16 by default: min, max, mean,
 // RMS of μ − μ_min), in texel space with the ray parameter t in world units (media::medium).
 // Several media may be bound (`media`, their voxels and super-voxels concatenated): every
 // function here reads the one `media_index` selects (select_medium), the first by default.
@@ -6,7 +6,6 @@
 import package::media::types::{RaySegment};
 import package::media::medium_bindings::{density, media, super_voxels};
 
-const SUPER_VOXEL: u32 = 16u;
 // Relative floor of the variance-aware importance in non-empty super-voxels (IMPORTANCE_FLOOR).
 const IMPORTANCE_FLOOR: f32 = 1e-3;
 const BIG: f32 = 3.4e38;
@@ -21,6 +20,22 @@ fn select_medium(i: u32) {
 // Super-voxels per axis of the selected medium.
 fn media_dims() -> vec3u {
     return media[media_index].dims;
+}
+
+// Voxels per axis of the selected medium.
+fn media_res() -> vec3u {
+    return media[media_index].res;
+}
+
+// The selected medium's extinction in voxel v (no lookup counted: regular tracking's).
+fn voxel_density(v: vec3u) -> f32 {
+    let medium = media[media_index];
+    return density[medium.density_offset + v.x + medium.res.x * (v.y + medium.res.y * v.z)];
+}
+
+// Voxels per super-voxel edge of the selected medium.
+fn super_voxel_size() -> u32 {
+    return media[media_index].super_voxel;
 }
 
 fn media_count() -> u32 {
@@ -60,15 +75,15 @@ fn super_voxel(c: vec3i) -> vec4f {
 fn mu_at(s: RaySegment, t: f32, cell: vec3i) -> f32 {
     media_lookups += 1u;
     let medium = media[media_index];
-    let lo = vec3u(cell) * SUPER_VOXEL;
-    let hi = min(lo + vec3u(SUPER_VOXEL - 1u), medium.res - vec3u(1u));
+    let lo = vec3u(cell) * medium.super_voxel;
+    let hi = min(lo + vec3u(medium.super_voxel - 1u), medium.res - vec3u(1u));
     let v = clamp(vec3u(max(floor(seg_at(s, t)), vec3f(0.0))), lo, hi);
     return density[medium.density_offset + v.x + medium.res.x * (v.y + medium.res.y * v.z)];
 }
 
 // μ at t anywhere on the segment (its super-voxel found from the point).
 fn mu_point(s: RaySegment, t: f32) -> f32 {
-    let cell = clamp(vec3i(floor(seg_at(s, t) / f32(SUPER_VOXEL))), vec3i(0), vec3i(media[media_index].dims) - vec3i(1));
+    let cell = clamp(vec3i(floor(seg_at(s, t) / f32(super_voxel_size()))), vec3i(0), vec3i(media[media_index].dims) - vec3i(1));
     return mu_at(s, t, cell);
 }
 

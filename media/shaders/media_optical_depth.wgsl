@@ -4,14 +4,14 @@
 
 import package::media::types::{RaySegment};
 import package::media::media_rng::{media_rand};
-import package::media::media_grid::{media_dims, BIG, SUPER_VOXEL, importance, mu_at, super_voxel};
+import package::media::media_grid::{media_dims, BIG, super_voxel_size, importance, mu_at, super_voxel};
 import package::media::media_dda::{dda_advance, dda_exit, dda_new};
 
 const MAX_ESTIMATES: u32 = 9u;
 
 // x: F, y: t'_min, z: t'_max.
 fn od_prepare(s: RaySegment, variance_aware: bool) -> vec3f {
-    var dda = dda_new(s, media_dims(), f32(SUPER_VOXEL));
+    var dda = dda_new(s, media_dims(), f32(super_voxel_size()));
     var out = vec3f(0.0, s.t1, s.t0);
     var t = s.t0;
     let bound = media_dims().x + media_dims().y + media_dims().z + 1u;
@@ -57,7 +57,7 @@ fn od_estimate(s: RaySegment, prep: vec3f, count: u32, samples: u32, variance_aw
     }
     let f_delta = prep.x / f32(samples);
     let tight = RaySegment(s.origin, prep.y, s.dir, prep.z);
-    var dda = dda_new(tight, media_dims(), f32(SUPER_VOXEL));
+    var dda = dda_new(tight, media_dims(), f32(super_voxel_size()));
     var imp = importance(super_voxel(dda.cell), variance_aware);
     var t_exit = dda_exit(dda);
     var f = (t_exit - tight.t0) * imp.x;
@@ -101,4 +101,10 @@ fn od_estimate(s: RaySegment, prep: vec3f, count: u32, samples: u32, variance_aw
 fn kettunen_sample_count(x: f32, multiplier: f32) -> u32 {
     let n_cmf = ceil(pow((x + 0.015) * (x + 0.65) * (x + 60.3), 1.0 / 3.0));
     return max(u32(round(multiplier * n_cmf / (1.0 + 0.31945))), 1u);
+}
+
+// N tied to the importance along the ray (Fig. 8d; media::optical_depth::tied_sample_count):
+// ceil(F / step) in [1, 64].
+fn tied_sample_count(total: f32, step: f32) -> u32 {
+    return max(u32(min(ceil(total / step), 64.0)), 1u);
 }

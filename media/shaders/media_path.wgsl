@@ -2,7 +2,8 @@
 // tracer's loop (render/shaders/pt_integrator.wgsl: Lambert + GGX, NEE + MIS with the power
 // heuristic, Russian roulette) with one or several media (isotropic phase, albedo per medium,
 // optics[2i]): delta tracking samples free paths, every shadow ray (surface and medium
-// vertices) is attenuated by ratio tracking (or the track-length estimate, vp.shadow), and
+// vertices) is attenuated by ratio tracking (or the track-length estimate, or the jackknife:
+// Eq. 3 from vp.shadow_estimates optical depths summed over the media, vp.shadow), and
 // positional lights (point, spot) are also sampled by equiangular sampling on the part of every
 // segment inside media, combined with the free-flight sample by MIS (Sec. 5.2): weights naive
 // g(X̄), jackknife Re g(X̄ + iS) or Miller et al.'s, combined by Eq. 9 (unbiased) or Eq. 10.
@@ -28,8 +29,9 @@ import package::pt_scene::{Shading, base_color_at, environment_pdf, escaped_radi
 import package::pt_integrator::{emitted_radiance};
 import package::media::types::{RaySegment};
 import package::media::media_grid::{BIG, media_count, medium_segment, mu_point, select_medium};
-import package::media::media_tracking::{delta_tracking, ratio_tracking, track_length};
-import package::media::media_optical_depth::{od_estimate, od_prepare, od_x};
+import package::media::media_tracking::{delta_tracking, ratio_tracking, regular_tracking, track_length};
+import package::media::media_optical_depth::{od_estimate, od_prepare, od_x, tied_sample_count};
+import package::media::media_jackknife::{jackknife_estimates};
 import package::media::media_mis::{equiangular_new, equiangular_pdf, equiangular_sample, mis_free_flight, mis_jackknife, mis_miller, mis_naive, mis_other};
 import package::media::volume_path_bindings::{optics, vp};
 
@@ -39,6 +41,7 @@ const MIS_NAIVE: u32 = 1u;
 const MIS_JACKKNIFE: u32 = 2u;
 const MIS_MILLER: u32 = 3u;
 const SHADOW_TRACK_LENGTH: u32 = 1u;
+const SHADOW_JACKKNIFE: u32 = 2u;
 
 // A scattering vertex: on a surface (sh, bsdf) or in the medium (isotropic phase).
 struct Vertex {
@@ -122,8 +125,46 @@ fn ratio_tracking_to(r: MediaRay, t: f32, rng: ptr<function, u32>) -> f32 {
     return tr;
 }
 
+// Exact transmittance of the ray from its origin to t: regular tracking through every medium's
+// voxels (Eq. 9's T̃ when vp.eq9_exact is set).
+fn exact_transmittance_to(r: MediaRay, t: f32) -> f32 {
+    var tau = 0.0;
+    for (var i = 0u; i < media_count(); i++) {
+        let s = segment_in(i, r.origin, r.dir, min(t, r.t_max));
+        if s.t0 < s.t1 {
+            tau += regular_tracking(s);
+        }
+    }
+    return exp(-tau);
+}
+
+// The jackknife estimate of the transmittance of the parts of a shadow ray inside the media:
+// m optical-depth estimates, each a sum over the media (their extinctions add), then Eq. 3.
+fn jackknife_shadow(o: vec3f, wi: vec3f, dist: f32, rng: ptr<function, u32>) -> f32 {
+    var x: array<f32, 9>;
+    for (var i = 0u; i < media_count(); i++) {
+        let s = segment_in(i, o, wi, dist);
+        if s.t0 >= s.t1 {
+            continue;
+        }
+        let prep = od_prepare(s, true);
+        var n = vp.shadow_samples;
+        if vp.shadow_step > 0.0 {
+            n = tied_sample_count(prep.x, vp.shadow_step);
+        }
+        od_estimate(s, prep, vp.shadow_estimates, n, true, true, rng);
+        for (var k = 0u; k < vp.shadow_estimates; k++) {
+            x[k] += od_x[k];
+        }
+    }
+    return jackknife_estimates(x, vp.shadow_estimates);
+}
+
 // Transmittance of the parts of a shadow ray inside the media (a product over them).
 fn shadow_transmittance(o: vec3f, wi: vec3f, dist: f32, rng: ptr<function, u32>) -> f32 {
+    if vp.shadow == SHADOW_JACKKNIFE {
+        return jackknife_shadow(o, wi, dist, rng);
+    }
     var tr = 1.0;
     for (var i = 0u; i < media_count(); i++) {
         let s = segment_in(i, o, wi, dist);
@@ -201,7 +242,12 @@ fn equiangular_lights(ray: MediaRay, span: vec2f, rng: ptr<function, u32>) -> ve
             sum += mis_weight(ray, t, mu, p0, false, rng) * inscattered;
         } else {
             let w0 = mis_weight(ray, t, mu, p0, true, rng);
-            let tr = ratio_tracking_to(ray, t, rng);
+            var tr: f32;
+            if vp.eq9_exact != 0u {
+                tr = exact_transmittance_to(ray, t);
+            } else {
+                tr = ratio_tracking_to(ray, t, rng);
+            }
             sum += (w0 * tr * mu / p0) * inscattered;
         }
     }

@@ -3,7 +3,7 @@
 
 import package::media::types::{RaySegment};
 import package::media::media_rng::{media_rand};
-import package::media::media_grid::{media_dims, BIG, SUPER_VOXEL, mu_at, super_voxel};
+import package::media::media_grid::{media_dims, media_res, voxel_density, BIG, super_voxel_size, mu_at, super_voxel};
 import package::media::media_dda::{Dda, dda_advance, dda_exit, dda_new};
 
 const MAX_COLLISIONS: u32 = 1024u;
@@ -35,7 +35,7 @@ fn track_length(s: RaySegment, rng: ptr<function, u32>) -> f32 {
 }
 
 fn ratio_tracking(s: RaySegment, rng: ptr<function, u32>) -> f32 {
-    var dda = dda_new(s, media_dims(), f32(SUPER_VOXEL));
+    var dda = dda_new(s, media_dims(), f32(super_voxel_size()));
     var t = s.t0;
     var value = 1.0;
     for (var n = 0u; n < MAX_COLLISIONS; n++) {
@@ -52,7 +52,7 @@ fn ratio_tracking(s: RaySegment, rng: ptr<function, u32>) -> f32 {
 // Delta tracking (free-flight sampling, density T(t) μ(t)): the parameter of the first real
 // collision on the segment, or BIG when the ray leaves it. The same walk as track_length.
 fn delta_tracking(s: RaySegment, rng: ptr<function, u32>) -> f32 {
-    var dda = dda_new(s, media_dims(), f32(SUPER_VOXEL));
+    var dda = dda_new(s, media_dims(), f32(super_voxel_size()));
     var t = s.t0;
     for (var n = 0u; n < MAX_COLLISIONS; n++) {
         let c = next_collision(s, &dda, t, rng);
@@ -66,4 +66,23 @@ fn delta_tracking(s: RaySegment, rng: ptr<function, u32>) -> f32 {
         t = c.x;
     }
     return BIG;
+}
+
+// Regular tracking (media::regular_tracking): the exact optical depth of the segment through
+// the nearest-neighbour voxels, voxel by voxel (not an estimator; no lookups counted).
+fn regular_tracking(s: RaySegment) -> f32 {
+    let res = media_res();
+    var dda = dda_new(s, res, 1.0);
+    var t = s.t0;
+    var tau = 0.0;
+    let bound = res.x + res.y + res.z + 1u;
+    for (var n = 0u; n < bound; n++) {
+        let exit = dda_exit(dda);
+        tau += (exit - t) * voxel_density(vec3u(dda.cell));
+        t = exit;
+        if !dda_advance(&dda) {
+            break;
+        }
+    }
+    return tau;
 }

@@ -5,7 +5,8 @@
 //! (`density`), super-voxels (`supervoxel`), grid traversal (`dda`), the segment of a ray in a
 //! medium (`medium`), exact optical depth (`regular_tracking`), track-length, ratio tracking,
 //! ray marching (Alg. 1 and 2: `optical_depth`), naive and Kettunen's biased exp(−X)
-//! (`ray_marching`), unbiased ray marching, the jackknife, their selection (`transmittance`),
+//! (`ray_marching`), unbiased ray marching, the jackknife (Eq. 4; Eq. 3 and Eq. 6 for any m in
+//! `jackknife_function`), their selection (`transmittance`),
 //! MIS weights (`mis`), equiangular sampling (`equiangular`), the closed-form MIS setting of
 //! Eqs. 9/10 (`mis_trial`) and the 1-D stratified sampling of Sec. 4.1 (`stratified`).
 
@@ -16,6 +17,7 @@ pub mod equiangular;
 pub mod gpu;
 pub mod image;
 pub mod jackknife;
+pub mod jackknife_function;
 pub mod majorant_tracking;
 pub mod medium;
 pub mod mesh_inside;

@@ -38,6 +38,17 @@ impl Medium {
         Self { density, super_voxels }
     }
 
+    /// With super-voxels of `size`³ voxels (the paper's 16 by `new`).
+    pub fn with_super_voxel(density: DensityGrid, size: u32) -> Self {
+        let super_voxels = SuperVoxelGrid::build_sized(&density, size);
+        Self { density, super_voxels }
+    }
+
+    /// The super-voxel edge in voxels, as the traversals' cell size.
+    pub fn super_voxel_size(&self) -> f32 {
+        self.super_voxels.size as f32
+    }
+
     /// The part of the world-space ray (origin, unit direction) in [0, t_max] inside the box,
     /// or None when it misses.
     pub fn segment(&self, origin: Vec3, dir: Vec3, t_max: f32) -> Option<Segment> {
@@ -59,7 +70,8 @@ impl Medium {
 impl Medium {
     /// μ at parameter t, inside super-voxel `cell` (the DDA's current one).
     pub fn mu(&self, seg: &Segment, t: f32, cell: glam::UVec3) -> f32 {
-        let (lo, hi) = crate::supervoxel::voxel_range(self.density.res, cell);
+        let (lo, hi) =
+            crate::supervoxel::voxel_range(self.density.res, self.super_voxels.size, cell);
         self.density.lookup(seg.at(t), lo, hi)
     }
 }

@@ -14,7 +14,7 @@
 use crate::dda::Dda;
 use crate::medium::{Medium, Segment};
 use crate::rng::Pcg;
-use crate::supervoxel::{SUPER_VOXEL, SuperVoxel};
+use crate::supervoxel::SuperVoxel;
 
 /// Estimates one call produces at most: unbiased ray marching with power-series degree ≤ 8.
 pub const MAX_ESTIMATES: usize = 9;
@@ -43,6 +43,33 @@ impl Importance {
     }
 }
 
+/// Samples N per estimate: fixed (the paper's choice, Sec. 4.3: F_Δ = F / N) or tied to the
+/// importance along the ray (Fig. 8d: F_Δ = `step` set manually, N = ceil(F / step), at least 1
+/// and at most [`MAX_TIED_SAMPLES`], so that a shader's loop stays bounded).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SampleCount {
+    Fixed(u32),
+    PerImportance { step: f32 },
+}
+
+/// The most samples per estimate of an importance-tied count.
+pub const MAX_TIED_SAMPLES: u32 = 64;
+
+impl SampleCount {
+    /// N for a ray whose integral of importance (Alg. 2) is `total`.
+    pub fn count(self, total: f32) -> u32 {
+        match self {
+            SampleCount::Fixed(n) => n,
+            SampleCount::PerImportance { step } => tied_sample_count(total, step),
+        }
+    }
+}
+
+/// ceil(F / F_Δ) clamped to [1, MAX_TIED_SAMPLES] (media_optical_depth.wgsl's twin).
+pub fn tied_sample_count(total: f32, step: f32) -> u32 {
+    ((total / step).ceil().min(MAX_TIED_SAMPLES as f32) as u32).max(1)
+}
+
 /// Alg. 2's output: F and the tight segment [t_min, t_max] of non-empty importance.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Prepared {
@@ -53,7 +80,7 @@ pub struct Prepared {
 
 /// Alg. 2: regular tracking of the super-voxel grid.
 pub fn prepare(medium: &Medium, seg: &Segment, importance: Importance) -> Prepared {
-    let mut dda = Dda::new(seg, medium.super_voxels.dims, SUPER_VOXEL as f32);
+    let mut dda = Dda::new(seg, medium.super_voxels.dims, medium.super_voxel_size());
     let mut out = Prepared { total: 0.0, t_min: seg.t1, t_max: seg.t0 };
     let mut t = seg.t0;
     loop {
@@ -96,7 +123,7 @@ pub fn estimate(
     }
     let f_delta = prep.total / samples as f32;
     let tight = Segment { t0: prep.t_min, t1: prep.t_max, ..*seg };
-    let mut dda = Dda::new(&tight, medium.super_voxels.dims, SUPER_VOXEL as f32);
+    let mut dda = Dda::new(&tight, medium.super_voxels.dims, medium.super_voxel_size());
     let (mut p, mut mu_min) = importance.of(medium.super_voxels.cell(dda.ucell()));
     let mut t_exit = dda.exit();
     let mut f = (t_exit - tight.t0) * p;

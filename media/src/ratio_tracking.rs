@@ -5,10 +5,9 @@ use crate::dda::Dda;
 use crate::majorant_tracking::{MAX_COLLISIONS, next_collision};
 use crate::medium::{Estimate, Medium, Segment};
 use crate::rng::Pcg;
-use crate::supervoxel::SUPER_VOXEL;
 
 pub fn ratio_tracking(medium: &Medium, seg: &Segment, rng: &mut Pcg) -> Estimate {
-    let mut dda = Dda::new(seg, medium.super_voxels.dims, SUPER_VOXEL as f32);
+    let mut dda = Dda::new(seg, medium.super_voxels.dims, medium.super_voxel_size());
     let mut t = seg.t0;
     let mut value = 1.0;
     let mut lookups = 0;

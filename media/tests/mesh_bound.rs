@@ -41,6 +41,7 @@ fn desc(
         albedo: Vec3::splat(0.8),
         emission: None,
         motion: Default::default(),
+        super_voxel: scene::medium::DEFAULT_SUPER_VOXEL,
     }
 }
 

@@ -11,6 +11,7 @@ pub mod gpu;
 pub mod gpu_struct;
 pub mod lights;
 pub mod materials;
+pub mod memory;
 pub mod pass_library;
 pub mod path_tracer;
 pub mod readback;

@@ -127,6 +127,10 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
         summary.window_frames
     );
     h.push_str(&table::html(&summary, &frames));
+    if let Some(memory) = &summary.memory {
+        h.push_str("<h2>Memory</h2><p>Device memory of buffers and textures (wgpu's allocator report) and the process's peak resident memory over the frames.</p>\n");
+        h.push_str(&table::memory_html(memory));
+    }
     if !per_frame.is_empty() {
         h.push_str("<h2>Charts</h2><div class=\"charts\">\n");
         per_frame.iter().for_each(|c| h.push_str(&chart_html(c)));

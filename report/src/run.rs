@@ -38,6 +38,35 @@ pub struct Settings {
     pub methods: Vec<MethodSettings>,
 }
 
+/// One method's device memory (the manifest's `memory.methods`).
+#[derive(Clone, Debug, Default, Deserialize, serde::Serialize)]
+pub struct MethodMemory {
+    #[serde(default)]
+    pub label: String,
+    #[serde(default)]
+    pub device_bytes: Option<i64>,
+}
+
+/// The run's memory (the manifest's `memory`, written by systems::memory after the frames);
+/// absent in older runs and in runs that did not finish.
+#[derive(Clone, Debug, Default, Deserialize, serde::Serialize)]
+pub struct Memory {
+    #[serde(default)]
+    pub scene_device_bytes: Option<i64>,
+    #[serde(default)]
+    pub methods: Vec<MethodMemory>,
+    #[serde(default)]
+    pub device_bytes_built: Option<u64>,
+    #[serde(default)]
+    pub device_bytes_end: Option<u64>,
+    #[serde(default)]
+    pub device_reserved_bytes_end: Option<u64>,
+    #[serde(default)]
+    pub peak_resident_bytes: Option<u64>,
+    #[serde(default)]
+    pub resident_bytes_end: Option<u64>,
+}
+
 /// The fields of manifest.json the report uses; the whole JSON is kept in `raw`.
 #[derive(Clone, Debug, Deserialize)]
 pub struct Manifest {
@@ -57,6 +86,8 @@ pub struct Manifest {
     pub regions: Vec<Region>,
     #[serde(default)]
     pub settings: Settings,
+    #[serde(default)]
+    pub memory: Option<Memory>,
     #[serde(skip)]
     pub raw: serde_json::Value,
 }

@@ -8,7 +8,7 @@ use std::path::Path;
 use anyhow::Context;
 use serde::Serialize;
 
-use crate::run::{Frames, Manifest};
+use crate::run::{Frames, Manifest, Memory};
 
 /// Frames after an event counted as its transient.
 pub const DEFAULT_WINDOW: u32 = 10;
@@ -39,6 +39,9 @@ pub struct Summary {
     pub window_frames: u32,
     pub windows: Vec<Window>,
     pub methods: Vec<MethodSummary>,
+    /// The run's memory, from the manifest.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub memory: Option<Memory>,
 }
 
 /// The named windows of a run of `frame_count` frames.
@@ -119,7 +122,13 @@ pub fn summarize(manifest: &Manifest, frames: &Frames, n: u32) -> Summary {
             MethodSummary { method, means, temporal_window }
         })
         .collect();
-    Summary { scenario: manifest.scenario.clone(), window_frames: n, windows, methods }
+    Summary {
+        scenario: manifest.scenario.clone(),
+        window_frames: n,
+        windows,
+        methods,
+        memory: manifest.memory.clone(),
+    }
 }
 
 /// Writes RUN/summary.json with the default transient length.
@@ -172,5 +181,37 @@ mod temporal_window_tests {
             serde_json::from_str(r#"{"scenario": "s", "methods": ["taa", "ssc", "pt"]}"#).unwrap();
         let html = crate::table::html(&summarize(&old, &frames, DEFAULT_WINDOW), &frames);
         assert!(!html.contains("temporal window"), "{html}");
+    }
+}
+
+#[cfg(test)]
+mod memory_tests {
+    use super::*;
+
+    #[test]
+    fn the_manifest_memory_reaches_the_summary_and_its_table() {
+        let frames =
+            Frames::parse("method,frame,flip\npt,0,0.3\n", Path::new("frames.csv")).unwrap();
+        let manifest: Manifest = serde_json::from_str(
+            r#"{"scenario": "s", "methods": ["pt"], "memory": {"scene_device_bytes": 2097152,
+                "methods": [{"label": "pt", "device_bytes": 1048576}], "device_bytes_built": 3145728,
+                "device_bytes_end": 3145728, "peak_resident_bytes": 104857600}}"#,
+        )
+        .unwrap();
+        let summary = summarize(&manifest, &frames, DEFAULT_WINDOW);
+        let json = serde_json::to_value(&summary).unwrap();
+        assert_eq!(json["memory"]["methods"][0]["device_bytes"], 1048576);
+        assert_eq!(json["memory"]["peak_resident_bytes"], 104857600);
+        let html = crate::table::memory_html(summary.memory.as_ref().unwrap());
+        assert!(html.contains(">device: pt</td><td>1.00</td>"), "{html}");
+        assert!(html.contains(">process: peak resident</td><td>100.00</td>"), "{html}");
+        let old: Manifest =
+            serde_json::from_str(r#"{"scenario": "s", "methods": ["pt"]}"#).unwrap();
+        assert!(
+            serde_json::to_value(summarize(&old, &frames, DEFAULT_WINDOW))
+                .unwrap()
+                .get("memory")
+                .is_none()
+        );
     }
 }

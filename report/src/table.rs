@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 
 use crate::html::esc;
-use crate::run::Frames;
+use crate::run::{Frames, Memory};
 use crate::summary::Summary;
 
 /// Columns of the table, when present: (frames.csv column, heading, which way is better).
@@ -106,6 +106,27 @@ pub fn html(summary: &Summary, frames: &Frames) -> String {
             h.push_str("</tr>\n");
         }
     }
+    h.push_str("</table>\n");
+    h
+}
+
+/// The run's memory: each method's device MiB, the scene's, the device MiB when the world was
+/// built and after the last frame, and the process's peak resident MiB.
+pub fn memory_html(memory: &Memory) -> String {
+    let mib =
+        |b: Option<f64>| b.map(|b| format!("{:.2}", b / (1024.0 * 1024.0))).unwrap_or_default();
+    let mut h = String::from("<table id=\"memory\"><tr><th>what</th><th>MiB</th></tr>\n");
+    let mut row = |what: &str, bytes: Option<f64>| {
+        let _ = writeln!(h, "<tr><td class=\"m\">{}</td><td>{}</td></tr>", esc(what), mib(bytes));
+    };
+    for m in &memory.methods {
+        row(&format!("device: {}", m.label), m.device_bytes.map(|b| b as f64));
+    }
+    row("device: scene", memory.scene_device_bytes.map(|b| b as f64));
+    row("device: all, built", memory.device_bytes_built.map(|b| b as f64));
+    row("device: all, after the last frame", memory.device_bytes_end.map(|b| b as f64));
+    row("process: peak resident", memory.peak_resident_bytes.map(|b| b as f64));
+    row("process: resident after the last frame", memory.resident_bytes_end.map(|b| b as f64));
     h.push_str("</table>\n");
     h
 }

@@ -32,6 +32,12 @@ fn subsurface_override_reaches_the_named_material() {
 fn bad_overrides_are_errors_at_file_line() {
     let e = load("(material: \"skin\", subsurface: (dmfp: (0.3, -1.0, 0.06)))").unwrap_err();
     assert!(e.starts_with("inline.ron:6:") && e.contains("dmfp") && e.contains("positive"), "{e}");
+    // Zero and non-finite dmfp: refused at the same line (nothing is played).
+    for bad in ["0.0", "inf", "NaN"] {
+        let e = load(&format!("(material: \"skin\", subsurface: (dmfp: (0.3, {bad}, 0.06)))"))
+            .unwrap_err();
+        assert!(e.starts_with("inline.ron:6:") && e.contains("dmfp"), "{bad}: {e}");
+    }
     let e = load("(material: \"skin\", subsurface: (mfp: (0.3, 0.1, 0.06)))").unwrap_err();
     assert!(e.starts_with("inline.ron:6:") && e.contains("mfp"), "{e}");
     let scenario = load("(material: \"skn\", subsurface: (dmfp: (0.3, 0.1, 0.06)))").unwrap();

@@ -64,6 +64,10 @@ fn bad_media_name_the_file_and_line() {
             r#"(name: "r", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0, motion: (spin: 3))"#,
             "spin",
         ),
+        (
+            r#"(name: "s", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0, super_voxel: 0)"#,
+            "super_voxel 0",
+        ),
     ];
     for (medium, word) in cases {
         let e = parse(&scenario(medium)).unwrap_err();
@@ -219,4 +223,9 @@ fn a_medium_without_a_bound_keeps_its_debug_form() {
     );
     let b = parse(&scenario(r#"(name: "b", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), bound: Sphere(segments: 8), sigma_t: 1.0)"#)).unwrap();
     assert!(format!("{:?}", b.media[0]).contains("bound: Sphere { segments: 8 }"));
+    // So does the super-voxel edge: only when it is not the default 16.
+    assert!(!format!("{:?}", s.media[0]).contains("super_voxel"));
+    let c = parse(&scenario(r#"(name: "c", kind: Homogeneous, box_min: (0, 0, 0), box_max: (1, 1, 1), sigma_t: 1.0, super_voxel: 12)"#)).unwrap();
+    assert_eq!(c.media[0].super_voxel, 12);
+    assert!(format!("{:?}", c.media[0]).ends_with("super_voxel: 12 }"));
 }

@@ -2,6 +2,7 @@
 //! measurement, recording, and scenario playback.
 
 pub mod manifest;
+pub mod memory;
 pub mod methods;
 pub mod mitsuba;
 pub mod playback;

@@ -16,6 +16,7 @@ use crate::frame::{
     RunOutput,
 };
 use crate::frame_record::FrameRecord;
+use crate::memory::{MethodMemory, RunMemory};
 use crate::output;
 use crate::reference_cache::ReferenceCache;
 use crate::run_folder::RunFolder;
@@ -95,6 +96,7 @@ impl FrameWorld {
         let (width, height) = scenario.resolution;
         let settings =
             PathTracerSettings { width, height, max_depth: scenario.max_depth, rr_start_depth: 3 };
+        let mut ledger = render::memory::DeviceLedger::start(&gpu);
         let gpu_scene = SceneGpu::new(&gpu, sim.scene(), settings)
             .with_context(|| format!("{origin}: uploading the scene"))?;
         let wants_references =
@@ -138,6 +140,10 @@ impl FrameWorld {
             world.insert_resource(medium);
         }
         frame::catch_failures(&mut world);
+        let mut memory = RunMemory {
+            scene_device_bytes: ledger.take(&world.resource::<GpuDevice>().0),
+            ..Default::default()
+        };
 
         for (index, method) in spec.methods.iter().enumerate() {
             let label = method.label();
@@ -150,7 +156,12 @@ impl FrameWorld {
                     method.entry.line, method.entry.column
                 )
             })?;
+            let taken = ledger.take_buffers(&world.resource::<GpuDevice>().0);
+            let (device_bytes, buffers) = taken.map_or((None, Vec::new()), |(d, b)| (Some(d), b));
+            memory.methods.push(MethodMemory { label, device_bytes, buffers });
         }
+        memory.device_bytes_built = render::memory::device_bytes(&world.resource::<GpuDevice>().0);
+        world.insert_resource(memory);
         let schedule = crate::methods::schedule_for(&spec.methods);
         Ok(FrameWorld { world, schedule })
     }
@@ -202,6 +213,10 @@ pub fn run_spec(spec: &RunSpec, opts: &RunOptions) -> Result<RunSummary> {
     }
     bar.finish_with_message("done");
     let world = &mut frames.world;
+    RunMemory::finish(world);
+    let mut manifest = manifest;
+    manifest["memory"] = serde_json::to_value(world.resource::<RunMemory>())?;
+    output::write_json(&folder.manifest(), &manifest)?;
     let records = std::mem::take(&mut world.resource_mut::<RunOutput>().records);
     let references = world.resource::<References>();
     let (rendered, cached) = (references.rendered, references.cached);

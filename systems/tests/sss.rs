@@ -1,5 +1,5 @@
 //! The Sss method (systems::methods::sss) end to end through playback on the shipped scenarios
-//! sss_flash.ron, sss_toggle.ron and sss_boids.ron at 32x18: counts within SPVG's clamp, a cold
+//! sss_flash.ron, sss_toggle.ron, sss_boids.ron and sss_moving.ron at 32x18: counts within SPVG's clamp, a cold
 //! start at n_min, the fixed variant at its count, the count image written; and its input errors.
 
 use std::path::{Path, PathBuf};
@@ -37,7 +37,7 @@ fn stat(r: &FrameRecord, name: &str) -> f64 {
 
 #[test]
 fn sss_scenarios_play_with_clamped_counts() {
-    for scenario in ["sss_flash.ron", "sss_toggle.ron", "sss_boids.ron"] {
+    for scenario in ["sss_flash.ron", "sss_toggle.ron", "sss_boids.ron", "sss_moving.ron"] {
         let (records, dir) = play(scenario, 5, &["as", "ocv", "fixed64"]);
         assert_eq!(records.len(), 15, "{scenario}");
         for r in &records {
@@ -101,6 +101,34 @@ fn sss_without_a_subsurface_material_is_refused() {
     };
     let e = format!("{:#}", run_spec(&spec, &opts).err().expect("separable with prefilter"));
     assert!(e.contains("prefilter with Separable"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// γ or ε_u outside [0, 1]: an error at the method's file:line naming the setting, and no run
+/// folder written.
+#[test]
+fn split_settings_outside_the_unit_interval_are_refused_at_file_line() {
+    let dir = std::env::temp_dir().join(format!("sss-e2e-{}-split", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("split.ron");
+    for (bad, what) in [("(eps_u: 1.5)", "eps_u"), ("(gamma: Some(-0.2))", "gamma")] {
+        let text = format!(
+            "Scenario(scene: Builtin(\"sss_sphere\"), resolution: (16, 9), frames: 1,\n methods: [Sss(variant: Adaptive, split: {bad})],\n materials: [{SKIN}])"
+        );
+        std::fs::write(&file, text).unwrap();
+        let out = dir.join("run");
+        let overrides = Overrides { out: Some(out.clone()), ..Default::default() };
+        let spec = RunSpec::load(&file, &overrides).expect("scenario");
+        let opts = RunOptions {
+            scenario: file.clone(),
+            overrides,
+            cache_dir: Some(dir.join("cache")),
+            progress: false,
+        };
+        let e = format!("{:#}", run_spec(&spec, &opts).err().expect("bad split"));
+        assert!(e.contains("split.ron:2:") && e.contains(what) && e.contains("[0, 1]"), "{e}");
+        assert!(!out.exists(), "{bad}: the run folder was written");
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -2,10 +2,11 @@
 //! through `flicker run`'s playback on the shipped scenarios (scenarios/termination_*.ron) at
 //! 32x18, one recorded frame after the cache's warm-up, over three seeds:
 //!
-//! - mean path length grows with the variance threshold t (relative thresholds; the absolute
-//!   ones of Table 1 exceed every path's variance in these scenes and saturate at max depth):
-//!   in every seed, and in the log ratio over t = 0.01 .. 1 with a margin from the seeds;
-//! - MSE minimisation's mean path length is below variance bounding's at t = 0.01 (Table 1);
+//! - mean path length grows with the relative variance threshold t: in every seed, and in the
+//!   log ratio over t = 0.01 .. 1 with a margin from the seeds;
+//! - MSE minimisation's mean path length is below variance bounding's at absolute t = 0.01 in
+//!   the paper's radiance unit (Table 1): NOT reproduced here; the test asserts the measured
+//!   relations (corridor: MSE longer; door: no difference within the seeds' 95% interval);
 //! - at equal samples, variance bounding (relative t = 1, as in Fig. 10) has lower FLIP than
 //!   area spread at c = 0.01 in the door scene: NOT reproduced here; the test asserts the
 //!   measured relation (no difference within the seeds' 95% interval).
@@ -94,10 +95,27 @@ fn path_length_relations(scenario: &str, runs: &[Vec<FrameRecord>]) {
     // multiplicatively, and the seeds' caches differ in scale, so the log ratio.
     let log_ratio: Vec<f64> = r1.iter().zip(&r001).map(|(a, b)| (a / b).ln()).collect();
     assert_positive(&format!("{scenario}: ln(path length at relative t 1 / at 0.01)"), &log_ratio);
-    // Table 1: MSE minimisation (s = 100) ends paths earlier than variance bounding at t = 0.01
-    // (absolute; here it runs nearly every path to max depth).
-    let d: Vec<f64> = pl("vb_0.01").iter().zip(pl("mse_100")).map(|(a, b)| a - b).collect();
-    assert_positive(&format!("{scenario}: path length, variance bounding t 0.01 - MSE s 100"), &d);
+}
+
+/// Per seed, `a`'s path length minus `b`'s.
+fn path_length_difference(runs: &[Vec<FrameRecord>], a: &str, b: &str) -> Vec<f64> {
+    runs.iter().map(|r| value(r, a, path_length) - value(r, b, path_length)).collect()
+}
+
+/// Asserts that the two-sided 95% interval of the mean of `d` (over 3 seeds) contains zero:
+/// no difference measured; fails when one appears.
+fn assert_no_difference(what: &str, d: &[f64]) {
+    let n = d.len() as f64;
+    let m = d.iter().sum::<f64>() / n;
+    let sd = (d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)).sqrt();
+    let half = T975_DF2 * sd / n.sqrt();
+    eprintln!("{what}: per seed {d:.4?}, 95% interval [{:.4}, {:.4}]", m - half, m + half);
+    assert!(
+        m - half < 0.0 && m + half > 0.0,
+        "{what}: {d:.4?}: interval [{:.4}, {:.4}] no longer contains 0; update the README and this test",
+        m - half,
+        m + half
+    );
 }
 
 #[test]
@@ -121,21 +139,13 @@ fn door_relations() {
     let flip = |m: &str| runs.iter().map(|r| value(r, m, |r| r.flip)).collect::<Vec<f64>>();
     let d: Vec<f64> =
         flip("spread_0.01").iter().zip(flip("vb_rel_1")).map(|(a, b)| a - b).collect();
-    let n = d.len() as f64;
-    let m = d.iter().sum::<f64>() / n;
-    let sd = (d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)).sqrt();
-    let half = T975_DF2 * sd / n.sqrt();
-    eprintln!(
-        "door: FLIP area spread c 0.01 - variance bounding relative t 1: per seed {d:.4?}, 95% interval [{:.4}, {:.4}]",
-        m - half,
-        m + half
-    );
-    assert!(
-        m - half < 0.0 && m + half > 0.0,
-        "door: FLIP difference {d:.4?}: interval [{:.4}, {:.4}] no longer contains 0; update the README and this test",
-        m - half,
-        m + half
-    );
+    assert_no_difference("door: FLIP area spread c 0.01 - variance bounding relative t 1", &d);
+    // Table 1: MSE minimisation (s = 100) ends paths earlier than variance bounding at absolute
+    // t = 0.01 (in the paper's radiance unit). Not reproduced (README "Relations (tests)"): the
+    // lab's coarse records look biased, so the MSE rule defers, and the door's seeds spread
+    // widely. Asserted as measured: no difference.
+    let d = path_length_difference(&runs, "vb_0.01", "mse_100");
+    assert_no_difference("door: path length, variance bounding t 0.01 - MSE s 100", &d);
 }
 
 #[test]
@@ -148,4 +158,8 @@ fn corridor_relations() {
         }
     }
     path_length_relations("corridor", &runs);
+    // Table 1's relation (MSE minimisation shorter than variance bounding at absolute t = 0.01)
+    // is reversed here (README "Relations (tests)"): asserted as measured, MSE is longer.
+    let d = path_length_difference(&runs, "mse_100", "vb_0.01");
+    assert_positive("corridor: path length, MSE s 100 - variance bounding t 0.01", &d);
 }

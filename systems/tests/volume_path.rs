@@ -186,3 +186,62 @@ fn more_media_than_the_path_tracer_binds_play_without_references() {
     let _ = std::fs::remove_dir_all(&out);
     summary.unwrap_or_else(|e| panic!("{e:#}"));
 }
+
+/// Bad jackknife settings of VolumePath (m < 2, N < 1, a non-positive step) and a super-voxel
+/// edge of 0 are refused with the scenario's file and line, before anything is written.
+#[test]
+fn bad_jackknife_settings_and_super_voxel_size_are_refused_where_they_stand() {
+    let fog = |extra: &str| {
+        format!(
+            "(name: \"fog\", kind: Homogeneous, box_min: (-1, -1, -1), box_max: (1, 1, 1), sigma_t: 1.0, resolution: (8, 8, 8){extra})"
+        )
+    };
+    let cases = [
+        (
+            "VolumePath(spp: 1, shadow: Jackknife, shadow_estimates: 1)",
+            fog(""),
+            "inline.ron:2:",
+            "shadow_estimates 1",
+        ),
+        (
+            "VolumePath(spp: 1, shadow: Jackknife, shadow_samples: 0)",
+            fog(""),
+            "inline.ron:2:",
+            "shadow_samples 0",
+        ),
+        ("VolumePath(spp: 1, shadow_step: Some(0.0))", fog(""), "inline.ron:2:", "shadow_step 0"),
+        ("VolumePath(spp: 1, samples: 0)", fog(""), "inline.ron:2:", "samples 0"),
+        ("VolumePath(spp: 1)", fog(", super_voxel: 0"), "inline.ron:3:", "super_voxel 0"),
+    ];
+    for (i, (method, medium, at, what)) in cases.iter().enumerate() {
+        let text = format!(
+            "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1,\n methods: [{method}],\n media: [{medium}])"
+        );
+        let out = std::env::temp_dir()
+            .join(format!("flicker_volume_path_bad_{i}_{}", std::process::id()));
+        let e = match sim::Scenario::from_ron(&text, Path::new("inline.ron")) {
+            Err(e) => e.to_string(),
+            Ok(scenario) => {
+                let spec = RunSpec::from_scenario(
+                    scenario,
+                    &Overrides { out: Some(out.clone()), ..Default::default() },
+                )
+                .unwrap();
+                let e = run_spec(
+                    &spec,
+                    &RunOptions {
+                        scenario: "inline.ron".into(),
+                        overrides: Overrides::default(),
+                        cache_dir: Some(out.join("cache")),
+                        progress: false,
+                    },
+                )
+                .err()
+                .expect("refused");
+                format!("{e:#}")
+            }
+        };
+        assert!(e.contains(at) && e.contains(what), "{method} {medium}: {e}");
+        assert!(!out.exists(), "{method}: {} written", out.display());
+    }
+}

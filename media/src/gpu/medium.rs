@@ -21,7 +21,8 @@ render::gpu_struct! {
         /// Media bound (the same in every element).
         pub count: u32 => "u32",
         pub box_max: [f32; 3] => "vec3f",
-        pub _pad: f32 => "f32",
+        /// Voxels per super-voxel edge.
+        pub super_voxel: u32 => "u32",
     }
 }
 
@@ -89,7 +90,7 @@ impl GpuMedium {
                 box_min: g.box_min.into(),
                 count: media.len() as u32,
                 box_max: g.box_max.into(),
-                _pad: 0.0,
+                super_voxel: medium.super_voxels.size,
             };
             density.extend_from_slice(&g.data);
             sv.extend(

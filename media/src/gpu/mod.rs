@@ -18,6 +18,6 @@ pub use medium::{GpuMedium, MAX_MEDIA, MediumParams, RaySegment};
 pub use mis_pass::{MisParams, MisPass};
 pub use shaders::{modules, modules_at, program};
 pub use volume_path_pass::{
-    Combination, MediumOptics, MisWeight, ShadowTransmittance, VOLUME_PATH_PASS, VolumeImage,
-    VolumePathParams, VolumePathPass, VolumePathSettings,
+    Combination, Eq9Transmittance, MediumOptics, MisWeight, ShadowTransmittance, VOLUME_PATH_PASS,
+    VolumeImage, VolumePathParams, VolumePathPass, VolumePathSettings,
 };

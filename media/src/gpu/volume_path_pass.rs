@@ -67,6 +67,19 @@ pub enum ShadowTransmittance {
     #[default]
     RatioTracking,
     TrackLength,
+    /// Eq. 3 from `shadow_estimates` (m) optical-depth estimates of `shadow_samples` (N) samples
+    /// each, summed over the media (the paper's Figs. 1 and 12: m = 2, N = 10).
+    Jackknife,
+}
+
+/// The unbiased transmittance T̃(t0) of Eq. 9's equiangular sample: ratio tracking (the
+/// default), or regular tracking through the voxels, exact for the nearest-neighbour grids (an
+/// experiment: whether T̃'s noise is what makes Eq. 9 worse than free flight here).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Eq9Transmittance {
+    #[default]
+    RatioTracking,
+    Exact,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -77,6 +90,14 @@ pub struct VolumePathSettings {
     pub shadow: ShadowTransmittance,
     /// Samples N of each of the two optical-depth estimates of a naive or jackknife weight.
     pub samples: u32,
+    /// N of each optical-depth estimate of a jackknife shadow ray (the paper's 10).
+    pub shadow_samples: u32,
+    /// m, the optical-depth estimates of a jackknife shadow ray (2 to 9; the paper's 2).
+    pub shadow_estimates: u32,
+    /// When set, a jackknife shadow ray's N is tied to its importance (Fig. 8d): N =
+    /// ceil(F / step) in [1, 64], F Alg. 2's integral of importance; `shadow_samples` unused.
+    pub shadow_step: Option<f32>,
+    pub eq9_transmittance: Eq9Transmittance,
 }
 
 impl Default for VolumePathSettings {
@@ -86,7 +107,41 @@ impl Default for VolumePathSettings {
             combination: Combination::Eq9,
             shadow: ShadowTransmittance::RatioTracking,
             samples: 4,
+            shadow_samples: 10,
+            shadow_estimates: 2,
+            shadow_step: None,
+            eq9_transmittance: Eq9Transmittance::RatioTracking,
         }
+    }
+}
+
+impl VolumePathSettings {
+    /// What the settings must satisfy: N ≥ 1, 2 ≤ m ≤ 9, a positive step.
+    pub fn problem(&self) -> Option<String> {
+        if self.samples == 0 {
+            return Some("samples 0; expected at least 1 sample per optical-depth estimate".into());
+        }
+        if self.shadow_samples == 0 {
+            return Some(
+                "shadow_samples 0; expected at least 1 sample per optical-depth estimate (N)"
+                    .into(),
+            );
+        }
+        if !(2..=crate::optical_depth::MAX_ESTIMATES as u32).contains(&self.shadow_estimates) {
+            return Some(format!(
+                "shadow_estimates {}; expected m from 2 to {} (Eq. 3 needs a sample variance)",
+                self.shadow_estimates,
+                crate::optical_depth::MAX_ESTIMATES
+            ));
+        }
+        if let Some(step) = self.shadow_step
+            && !(step > 0.0 && step.is_finite())
+        {
+            return Some(format!(
+                "shadow_step {step}; expected a positive CDF step size F_Δ (optical depth)"
+            ));
+        }
+        None
     }
 }
 
@@ -99,7 +154,13 @@ render::gpu_struct! {
         /// Samples per pixel in this dispatch, from `first_sample` on.
         pub spp: u32 => "u32",
         pub first_sample: u32 => "u32",
+        pub shadow_samples: u32 => "u32",
+        pub shadow_estimates: u32 => "u32",
+        /// F_Δ of an importance-tied N; 0: N = shadow_samples.
+        pub shadow_step: f32 => "f32",
+        pub eq9_exact: u32 => "u32",
         pub _pad0: u32 => "u32",
+        pub _pad1: u32 => "u32",
     }
 }
 
@@ -228,6 +289,9 @@ impl VolumePathPass {
         seed: u64,
         frame: u32,
     ) -> Result<VolumeImage, String> {
+        if let Some(problem) = settings.problem() {
+            return Err(problem);
+        }
         if optics.len() != medium.count {
             return Err(format!(
                 "{} media bound but {} optics given; expected one albedo and emission per medium",
@@ -269,7 +333,12 @@ impl VolumePathPass {
                 samples: settings.samples,
                 spp: n,
                 first_sample: first,
+                shadow_samples: settings.shadow_samples,
+                shadow_estimates: settings.shadow_estimates,
+                shadow_step: settings.shadow_step.unwrap_or(0.0),
+                eq9_exact: u32::from(settings.eq9_transmittance == Eq9Transmittance::Exact),
                 _pad0: 0,
+                _pad1: 0,
             };
             let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("volume path params"),

@@ -5,7 +5,8 @@ import package::scene_bindings::{frame};
 import package::scene_geometry::{NO_HIT};
 import package::pt_scene::{project_offset};
 import package::sample_cache_bindings::{dst_slots, pixel_atomics, src_mask, src_slots, ssc, ssc_work};
-import package::sample_cache::storage::{SSC_ATOMICS, SSC_BACKGROUND_DEPTH, SSC_DROPPED, SSC_REPROJECTED, SSC_WMAX, SSC_WMAX_ACC, SSC_WMIN, SSC_WMIN_ACC, ssc_background_dir, ssc_full, ssc_is_background, ssc_pixels, ssc_surface};
+import package::sample_cache::storage::{SSC_ATOMICS, SSC_BACKGROUND_DEPTH, SSC_NO_DEPTH, SSC_DROPPED, SSC_REPROJECTED, SSC_WMAX, SSC_WMAX_ACC, SSC_WMIN, SSC_WMIN_ACC, ssc_background_dir, ssc_full, ssc_is_background, ssc_pixels, ssc_surface, ssc_visible_slots};
+import package::sample_cache::slope::{ssc_closer, ssc_slope};
 import package::kernel::{outside_image};
 
 // Listing 2 as printed `break`s after the first try whatever its outcome; the text says a lost
@@ -91,4 +92,39 @@ fn reserve_main(@builtin(global_invocation_id) id: vec3u) {
         atomicMax(&pixel_atomics[SSC_ATOMICS * t + 1u], bitcast<u32>(depth));
     }
     atomicAdd(&ssc_work[SSC_REPROJECTED], 1u);
+}
+
+// The paper's closest-depth texture (section 3.4), per pixel after the reservation: the depth of
+// its closest visible sample and that sample's Δn (eq. 1), which retrace_main reads over 3x3.
+// The paper packs (depth, Δn) into one 64-bit atomicMin during reprojection; WGSL has no 64-bit
+// atomics, so this pass reads the pixel's reserved samples instead (exact, no packing). Ties in
+// depth keep the smaller Δn, so the result does not depend on the slots the race gave.
+@compute @workgroup_size(8, 8, 1)
+fn closest_main(@builtin(global_invocation_id) id: vec3u) {
+    if outside_image(id, ssc.width, ssc.height) || ssc.retrace != 2u {
+        return;
+    }
+    let pixels = ssc_pixels();
+    let p = id.y * ssc.width + id.x;
+    let eye = frame.camera.position;
+    let vis = ssc_visible_slots(atomicLoad(&pixel_atomics[SSC_ATOMICS * p]));
+    var closest = vec2f(SSC_NO_DEPTH, 0.0);
+    for (var s = 0u; s < ssc.slots; s++) {
+        if ((vis >> s) & 1u) == 0u {
+            continue;
+        }
+        let hit = dst_slots[s * pixels + p].hit;
+        var sample = vec2f(SSC_BACKGROUND_DEPTH, 0.0);
+        if !ssc_is_background(hit) {
+            let sp = ssc_surface(hit);
+            let d = sp.position - eye;
+            let t = length(d);
+            sample = vec2f(t, ssc_slope(t, abs(dot(sp.geometric_normal, d / t)), ssc.pixel_diagonal_angle));
+        }
+        if ssc_closer(sample, closest) {
+            closest = sample;
+        }
+    }
+    atomicStore(&pixel_atomics[SSC_ATOMICS * p + 3u], bitcast<u32>(closest.x));
+    atomicStore(&pixel_atomics[SSC_ATOMICS * p + 4u], bitcast<u32>(closest.y));
 }

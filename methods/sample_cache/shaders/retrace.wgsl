@@ -12,8 +12,8 @@ import package::pt_lights::{FAR};
 import package::pt_scene::{camera_ray_direction};
 import package::sample_cache_types::{SscSlot};
 import package::sample_cache_bindings::{dst_mask, dst_slots, pixel_atomics, ssc, ssc_out, ssc_work};
-import package::sample_cache::storage::{SSC_ALL_RAYS, SSC_ATOMICS, SSC_BACKGROUND_DEPTH, SSC_BASE, SSC_FLAGGED, SSC_FLAG_BASE, SSC_FLAG_HOLE, SSC_FLAG_SLOPE, SSC_HISTOGRAM, SSC_LIST, SSC_MAX_SLOTS, SSC_NEW, SSC_OCCUPIED, SSC_PURGED, SSC_RAYS, SSC_RETRACE_COUNT, SSC_VISIBLE, SSC_WMAX_ACC, SSC_WMIN_ACC, ssc_full, ssc_is_background, ssc_less, ssc_list_index, ssc_pack_background, ssc_pack_hit, ssc_pixels, ssc_surface, ssc_visible_slots};
-import package::sample_cache::slope::{ssc_consistent, ssc_slope};
+import package::sample_cache::storage::{SSC_ALL_RAYS, SSC_ATOMICS, SSC_BASE, SSC_FLAGGED, SSC_FLAG_BASE, SSC_FLAG_HOLE, SSC_FLAG_SLOPE, SSC_HISTOGRAM, SSC_LIST, SSC_MAX_SLOTS, SSC_NEW, SSC_OCCUPIED, SSC_PURGED, SSC_RAYS, SSC_RETRACE_COUNT, SSC_VISIBLE, SSC_WMAX_ACC, SSC_WMIN_ACC, ssc_full, ssc_is_background, ssc_less, ssc_list_index, ssc_pack_background, ssc_pack_hit, ssc_pixels, ssc_visible_slots};
+import package::sample_cache::slope::{ssc_consistent};
 import package::sample_cache::selection::{ssc_base_index, ssc_bucket, ssc_forced_shade, ssc_importance, ssc_is_base_pixel, ssc_nth_bit, ssc_verify};
 import package::kernel::{outside_image};
 
@@ -47,7 +47,6 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
     let pixels = ssc_pixels();
     let n = ssc.slots;
     let p = id.y * width + id.x;
-    let eye = frame.camera.position;
     var rng = rng_seed(vec2u(frame.seed_lo, frame.seed_hi), frame.frame, p, 0x55c0u);
 
     // Gather the reserved slots and sort them into the canonical order (the slots a sample won
@@ -78,10 +77,13 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
         }
     }
 
-    // 3x3 neighbourhood: visible-sample density and the farthest visible depth.
+    // 3x3 neighbourhood: visible-sample density, the farthest visible depth, and eq. 2 from each
+    // neighbour's closest visible sample (depth, Δn; closest_main) to this pixel's farthest.
     var neighbour_visible = 0u;
     var neighbours = 0u;
     var t_max_bits = 0u;
+    let own_far = bitcast<f32>(atomicLoad(&pixel_atomics[SSC_ATOMICS * p + 1u]));
+    var far_side = false;
     for (var dy = -1; dy <= 1; dy++) {
         for (var dx = -1; dx <= 1; dx++) {
             let q = vec2i(id.xy) + vec2i(dx, dy);
@@ -93,6 +95,9 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
             neighbour_visible += countOneBits(ssc_visible_slots(mq));
             neighbours++;
             t_max_bits = max(t_max_bits, atomicLoad(&pixel_atomics[SSC_ATOMICS * qi + 1u]));
+            let t_q = bitcast<f32>(atomicLoad(&pixel_atomics[SSC_ATOMICS * qi + 3u]));
+            let slope_q = bitcast<f32>(atomicLoad(&pixel_atomics[SSC_ATOMICS * qi + 4u]));
+            far_side = far_side || !ssc_consistent(t_q, own_far, slope_q, ssc.epsilon1);
         }
     }
     let density = f32(neighbour_visible) / f32(neighbours);
@@ -112,28 +117,15 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
         if vis == 0u {
             flags |= SSC_FLAG_HOLE;
         } else {
-            // t_min and its slope Δn from the pixel's own visible samples (exact; see the
-            // packing note in sample_cache/mod.rs), t_max from the 3x3 atomics.
-            var t_min = 3.0e38;
-            var slope = 0.0;
-            for (var i = 0u; i < k; i++) {
-                if ((vis >> i) & 1u) == 0u {
-                    continue;
-                }
-                var t = SSC_BACKGROUND_DEPTH;
-                var d_n = 0.0;
-                if !ssc_is_background(hits[i]) {
-                    let sp = ssc_surface(hits[i]);
-                    let d = sp.position - eye;
-                    t = length(d);
-                    d_n = ssc_slope(t, abs(dot(sp.geometric_normal, d / t)), ssc.pixel_diagonal_angle);
-                }
-                if t < t_min {
-                    t_min = t;
-                    slope = d_n;
-                }
-            }
-            if !ssc_consistent(t_min, bitcast<f32>(t_max_bits), slope, ssc.epsilon1) {
+            // Eq. 2 between this pixel and each 3x3 neighbour, both ways (section 3.4; each pair
+            // is at most two pixel diagonals apart, the span App. A allows for): this pixel's
+            // closest sample against the neighbourhood's farthest (the raised side of an edge),
+            // and each neighbour's closest against this pixel's farthest (the far side). So a
+            // pixel that holds only far samples beside a raised one is retraced too, and an
+            // occluder's edge spreads one pixel a frame instead of waiting for the base rate.
+            let t_own = bitcast<f32>(atomicLoad(&pixel_atomics[SSC_ATOMICS * p + 3u]));
+            let slope_own = bitcast<f32>(atomicLoad(&pixel_atomics[SSC_ATOMICS * p + 4u]));
+            if far_side || !ssc_consistent(t_own, bitcast<f32>(t_max_bits), slope_own, ssc.epsilon1) {
                 flags |= SSC_FLAG_SLOPE;
             }
         }
@@ -148,8 +140,8 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
     }
 
     // 2. Density control: when the 3x3 density is out of n_target ± δ, the pixel moves its own
-    // visible count to n_target (at least one sample either way): purge randomly, never the last
-    // visible sample, or plan new samples. A pixel above n_target + δ purges even inside a
+    // visible count to n_target (at least one sample either way): purge visible samples at
+    // random (the count is of visible samples), never the last one, or plan new samples. A pixel above n_target + δ purges even inside a
     // tolerable neighbourhood (twin of density.rs, which says why).
     let n_target = ssc.n_target;
     let delta = ssc.delta;
@@ -162,13 +154,9 @@ fn retrace_main(@builtin(global_invocation_id) id: vec3u) {
     } else if density > n_target + delta || own > n_target + delta {
         let to_purge = u32(max(own - round(n_target), 1.0));
         for (var j = 0u; j < to_purge; j++) {
-            let alive_visible = countOneBits(alive & vis);
-            var candidates = alive;
-            if alive_visible <= 1u {
-                candidates = alive & ~vis;
-            }
+            let candidates = alive & vis;
             let c = countOneBits(candidates);
-            if c == 0u {
+            if c <= 1u {
                 break;
             }
             let r = min(u32(rng_next(&rng) * f32(c)), c - 1u);

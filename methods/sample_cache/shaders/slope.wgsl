@@ -14,3 +14,9 @@ fn ssc_slope(t: f32, cos_theta: f32, phi: f32) -> f32 {
 fn ssc_consistent(t_min: f32, t_max: f32, slope: f32, epsilon1: f32) -> bool {
     return t_max < (1.0 + epsilon1) * (t_min + 2.0 * slope);
 }
+
+// Orders (depth, Δn) pairs for the closest sample of a pixel or a neighbourhood: nearer first,
+// on a tie the smaller Δn (the stricter test), so the choice does not depend on slot order.
+fn ssc_closer(a: vec2f, b: vec2f) -> bool {
+    return a.x < b.x || (a.x == b.x && a.y < b.y);
+}

@@ -15,9 +15,13 @@ import package::scene_geometry::{Hit, NO_HIT, SurfacePoint, surface_point};
 import package::sample_cache_bindings::{ssc};
 
 const SSC_MAX_SLOTS: u32 = 16u;
-const SSC_ATOMICS: u32 = 3u;
+// Per pixel: reserved mask, farthest visible depth, retrace results, closest visible depth and
+// its Δn (closest_main).
+const SSC_ATOMICS: u32 = 5u;
 // Depth of a background sample in the slope test (finite: the test multiplies it).
 const SSC_BACKGROUND_DEPTH: f32 = 1.0e30;
+// Closest depth of a pixel with no visible sample: never the closest of a neighbourhood.
+const SSC_NO_DEPTH: f32 = 3.0e38;
 
 // Words of `ssc_work` (header), then the shade list from SSC_LIST.
 const SSC_SHADE_COUNT: u32 = 0u;

@@ -7,7 +7,8 @@
 //! pixel next to sparse ones (whose last visible sample cannot go) keeps their neighbourhoods
 //! above the bound for ever.
 
-/// Positive: samples to add; negative: samples to purge; zero inside n_target ± δ.
+/// Positive: samples to add; negative: visible samples to purge (the count is of visible samples,
+/// so retrace.wgsl purges among them, never the last one); zero inside n_target ± δ.
 pub fn adjustment(density: f32, own_visible: u32, n_target: f32, delta: f32) -> i32 {
     let own = own_visible as f32;
     if density < n_target - delta {

@@ -48,13 +48,14 @@ use render::timing::{PassTimer, PassTiming};
 pub const PASSES: [&str; 4] = ["reserve", "trace", "shade", "reconstruct"];
 
 /// The dispatches (indices into [`DISPATCHES`]) of each of [`PASSES`].
-const STAGE_DISPATCHES: [std::ops::Range<usize>; 4] = [0..2, 2..6, 6..10, 10..11];
+const STAGE_DISPATCHES: [std::ops::Range<usize>; 4] = [0..3, 3..7, 7..11, 11..12];
 
 /// The dispatches of a frame, `PASS/entry`, in order; each is timed on its own
 /// ([`CacheFrame::dispatch_timings`]) and the pass time is the sum of its dispatches'.
-pub const DISPATCHES: [&str; 11] = [
+pub const DISPATCHES: [&str; 12] = [
     "reserve/begin_main",
     "reserve/reserve_main",
+    "reserve/closest_main",
     "trace/retrace_main",
     "trace/retrace_args_main",
     "trace/retrace_list_main",
@@ -86,6 +87,8 @@ const RETRACE_ARGS_WORD: u64 = 35;
 const SHADE_ARGS_WORD: u64 = 38;
 
 const HEADER_WORDS: u64 = 48;
+/// Words per pixel of `pixel_atomics` (`SSC_ATOMICS`).
+const PIXEL_ATOMICS: u64 = 5;
 const AUDIT_WORD: u64 = 32;
 /// The cache's own @group(2), declared into its WGSL: params, source mask and slots (read),
 /// then pixel atomics, destination slots and mask, work lists, output, and the inputs of a TAA
@@ -95,7 +98,8 @@ const OWN_GROUP: [BufferBinding; 10] = [
     BufferBinding::read("src_mask", "array<u32>"),
     BufferBinding::read("src_slots", "array<SscSlot>"),
     // SSC_ATOMICS words per pixel: the mask being reserved (atomicOr), the farthest visible depth
-    // (atomicMax of its float bits), and the retrace results (bits 0-15: visible, 16-31: traced).
+    // (atomicMax of its float bits), the retrace results (bits 0-15: visible, 16-31: traced),
+    // and the closest visible sample's depth and Δn (closest_main).
     BufferBinding::read_write("pixel_atomics", "array<atomic<u32>>"),
     BufferBinding::read_write("dst_slots", "array<SscSlot>"),
     BufferBinding::read_write("dst_mask", "array<u32>"),
@@ -286,6 +290,7 @@ pub struct SampleCache {
 struct Pipelines {
     begin: LibraryPipeline,
     reserve: LibraryPipeline,
+    closest: LibraryPipeline,
     retrace: LibraryPipeline,
     retrace_args: LibraryPipeline,
     retrace_list: LibraryPipeline,
@@ -341,7 +346,7 @@ impl SampleCache {
                 slots: buffer("ssc slots b", pixels * n * 32, rw)?,
             },
         ];
-        let pixel_atomics = buffer("ssc pixel atomics", pixels * 12, rw)?;
+        let pixel_atomics = buffer("ssc pixel atomics", pixels * 4 * PIXEL_ATOMICS, rw)?;
         let work = buffer("ssc work", (HEADER_WORDS + pixels * n) * 4, rw)?;
         let list_args = buffer(
             "ssc list dispatch",
@@ -364,6 +369,7 @@ impl SampleCache {
             [
                 begin,
                 reserve,
+                closest,
                 retrace,
                 retrace_args,
                 retrace_list,
@@ -383,6 +389,7 @@ impl SampleCache {
             [
                 "begin_main",
                 "reserve_main",
+                "closest_main",
                 "retrace_main",
                 "retrace_args_main",
                 "retrace_list_main",
@@ -398,6 +405,7 @@ impl SampleCache {
         let pipelines = Pipelines {
             begin,
             reserve,
+            closest,
             retrace,
             retrace_args,
             retrace_list,
@@ -559,9 +567,10 @@ impl SampleCache {
         let list = |l: u64| Some((12 * l, [RETRACE_ARGS_WORD, SHADE_ARGS_WORD][l as usize]));
         let whole_list = list_dispatch(s.slots * w * h);
         // In the order of DISPATCHES: pipeline, direct workgroups, list.
-        let dispatches: [(&LibraryPipeline, [u32; 3], Option<(u64, u64)>); 11] = [
+        let dispatches: [(&LibraryPipeline, [u32; 3], Option<(u64, u64)>); 12] = [
             (&p.begin, [1, 1, 1], None),
             (&p.reserve, [gx, gy, s.slots], None),
+            (&p.closest, [gx, gy, 1], None),
             (&p.retrace, [gx, gy, 1], None),
             (&p.retrace_args, [1, 1, 1], None),
             (&p.retrace_list, whole_list, list(0)),
@@ -665,6 +674,25 @@ impl SampleCache {
         let masks = read_pod(gpu, &cache.mask, "ssc masks")?;
         let slots = read_pod(gpu, &cache.slots, "ssc slots")?;
         Ok(CacheState { masks, slots })
+    }
+
+    /// Replaces the cache the next frame reprojects (tests: a state built to exercise one
+    /// decision). `state` must hold one mask per pixel and `slots` slots per pixel.
+    pub fn write_state(&mut self, gpu: &Gpu, state: &CacheState) -> Result<(), RenderError> {
+        let pixels = (self.width * self.height) as usize;
+        let n = self.settings.slots as usize;
+        if state.masks.len() != pixels || state.slots.len() != n * pixels {
+            return Err(RenderError::Settings(format!(
+                "sample cache state: {} masks and {} slots, expected {pixels} and {}",
+                state.masks.len(),
+                state.slots.len(),
+                n * pixels
+            )));
+        }
+        let cache = &self.caches[self.current];
+        gpu.queue.write_buffer(&cache.mask, 0, bytemuck::cast_slice(&state.masks));
+        gpu.queue.write_buffer(&cache.slots, 0, bytemuck::cast_slice(&state.slots));
+        Ok(())
     }
 
     /// Stale visibility of the last frame: how many samples the cache holds as visible that a

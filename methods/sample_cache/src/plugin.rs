@@ -35,7 +35,11 @@ impl MethodPlugin for Plugin {
     }
 
     fn temporal_window(settings: &SampleCacheSettings) -> Option<f64> {
+        // The running mean (alpha 0, the default) has no fixed window: it grows with the run.
         let alpha = if settings.roughness_alpha { 0.1 } else { settings.alpha as f64 };
+        if alpha == 0.0 {
+            return None;
+        }
         let shades = settings.n_target as f64 * temporal_window::exponential(alpha);
         Some(taa::plugin::window_under_taa(shades / settings.shading_rate as f64, settings.taa))
     }

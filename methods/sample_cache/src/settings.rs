@@ -41,11 +41,13 @@ pub struct SampleCacheSettings {
     pub base_block: u32,
     /// M, buckets of the log importance histogram.
     pub buckets: u32,
-    /// Minimum blend weight of a new radiance sample (temporal filter). 0.1 is the value of the
-    /// paper's glossy stereo test (§5.2); its main results state none.
+    /// Minimum blend weight of a new radiance sample, max(1 / (c_s + 1), alpha). 0 (default): the
+    /// plain running mean of the paper's main results (§3.3); 0.1 is the fixed α of its glossy
+    /// stereo test (§5.2).
     pub alpha: f32,
-    /// App. C: the minimum blend weight of a surface sample from its material's GGX roughness,
-    /// α_min = (1 − α_GGX)·0.5 + α_GGX·0.1 (view-dependent effects), instead of `alpha`.
+    /// App. C (glossy materials): the minimum blend weight of a surface sample from its
+    /// material's GGX roughness, α_min = (1 − α_GGX)·0.5 + α_GGX·0.1, instead of `alpha`
+    /// (background samples keep `alpha`). Off by default.
     pub roughness_alpha: bool,
     pub retrace: Retrace,
     pub shading: ShadingMode,
@@ -68,7 +70,7 @@ impl Default for SampleCacheSettings {
             epsilon1: 0.005,
             base_block: 4,
             buckets: 13,
-            alpha: 0.1,
+            alpha: 0.0,
             roughness_alpha: false,
             retrace: Retrace::Adaptive,
             shading: ShadingMode::Uniform,

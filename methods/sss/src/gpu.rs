@@ -23,7 +23,9 @@ pub const MAX_COUNT: u32 = 4096;
 render::gpu_struct! {
     /// The pass's parameters: image size, frame and seed, the variant (0 fixed, 1 AS, 2 OCV,
     /// 3 CCV, 4 separable), SPVG's and the control variates' parameters, the separable
-    /// kernel's tap count, AFIS's level count (0: no prefiltering) and eq. 5.12's a, d per
+    /// kernel's tap count, AFIS's level count (0: no prefiltering) and eq. 5.12's a, the
+    /// direct/distant split (on, γ or −1 for Burley's, ε_u), the focal length in pixels (eq.
+    /// 7.1's depth), the monitored luminance's gamma, the reprojection's depth tolerance, d per
     /// channel in pixels (w: the sampled d), and per MIP level (offset in the chain's buffer,
     /// width, height, 0), computed once here rather than per fetch in the shader.
     pub struct SssParams {
@@ -45,13 +47,17 @@ render::gpu_struct! {
         pub taps: u32 => "u32",
         pub mip_levels: u32 => "u32",
         pub mip_a: f32 => "f32",
-        pub pad0: u32 => "u32",
-        pub pad1: u32 => "u32",
+        pub split: u32 => "u32",
+        pub gamma: f32 => "f32",
+        pub eps_u: f32 => "f32",
+        pub focal_px: f32 => "f32",
+        pub monitor_gamma: f32 => "f32",
+        pub depth_tolerance: f32 => "f32",
         pub d_px: [f32; 4] => "vec4f",
         pub mip: [[u32; 4]; 8] => "array<vec4u, 8>",
     }
 }
-const _: () = assert!(std::mem::size_of::<SssParams>() == 224);
+const _: () = assert!(std::mem::size_of::<SssParams>() == 240);
 // The WGSL array length above is the chain's level bound.
 const _: () = assert!(prefilter::MAX_LEVELS == 8);
 
@@ -86,6 +92,8 @@ pub struct SssPass {
     history: [wgpu::Buffer; 2],
     cv: [wgpu::Buffer; 2],
     scattered: wgpu::Buffer,
+    /// Per pixel motion (vec2f, previous minus current position): where the histories are read.
+    motion: wgpu::Buffer,
     groups: [wgpu::BindGroup; 2],
     /// AFIS's MIP chain (`prefilter::MAX_LEVELS` levels' room) and the prefiltering pass, one
     /// bind group per level (each with its level's number).
@@ -131,6 +139,7 @@ impl SssPass {
         let history = [storage(gpu, "sss history 0", size), storage(gpu, "sss history 1", size)];
         let cv = [storage(gpu, "sss cv 0", size), storage(gpu, "sss cv 1", size)];
         let scattered = storage(gpu, "sss scattered", size);
+        let motion = storage(gpu, "sss motion", width as u64 * height as u64 * 8);
         let mips = storage(
             gpu,
             "sss mips",
@@ -147,6 +156,7 @@ impl SssPass {
                 &history[1 - k],
                 &cv[1 - k],
                 &mips,
+                &motion,
             ];
             let entries: Vec<_> = buffers
                 .iter()
@@ -211,6 +221,7 @@ impl SssPass {
             history,
             cv,
             scattered,
+            motion,
             groups,
             mips,
             prefilter: (prefilter_pipeline, level_groups),
@@ -227,7 +238,8 @@ impl SssPass {
                 let p = history.get(i).copied().unwrap_or_default();
                 let s = p.spvg;
                 (
-                    [s.mu, s.sigma2, s.nbar, if s.valid { 1.0 } else { 0.0 }],
+                    // w > 0.5 marks a valid history; 1 + w carries the depth it was written at.
+                    [s.mu, s.sigma2, s.nbar, if s.valid { 1.0 + p.w } else { 0.0 }],
                     [p.cv.mean_f, p.cv.mean_g, p.cv.cov_fg, p.cv.var_g],
                 )
             })
@@ -256,7 +268,7 @@ impl SssPass {
                 self.height
             )));
         }
-        settings.spvg.validate().map_err(RenderError::Settings)?;
+        settings.validate().map_err(|e| RenderError::Settings(format!("SSS {e}")))?;
         let mip_levels =
             settings.mip_levels().map_err(|e| RenderError::Settings(format!("SSS {e}")))?;
         let (fixed, taps) = match settings.variant {
@@ -296,8 +308,13 @@ impl SssPass {
             taps,
             mip_levels,
             mip_a: settings.prefilter.map_or(0.0, |p| p.a),
-            pad0: 0,
-            pad1: 0,
+            split: settings.split.is_some() as u32,
+            // Negative: Table 5.1's Burley γ = 1 − cdf(r0) per channel.
+            gamma: settings.split.and_then(|s| s.gamma).unwrap_or(-1.0),
+            eps_u: settings.split.map_or(0.0, |s| s.eps_u),
+            focal_px: frame.focal_px,
+            monitor_gamma: settings.monitor_gamma,
+            depth_tolerance: settings.depth_tolerance,
             d_px: [frame.d_px[0], frame.d_px[1], frame.d_px[2], frame.d_sample()],
             mip: std::array::from_fn(|k| {
                 let (w, h) = prefilter::level_size(self.width, self.height, k as u32);
@@ -306,6 +323,20 @@ impl SssPass {
         };
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&p));
         gpu.queue.write_buffer(&self.irradiance, 0, bytemuck::cast_slice(&frame.irradiance));
+        let n = (self.width * self.height) as usize;
+        let still;
+        let motion: &[[f32; 2]] = if frame.motion.len() == n {
+            &frame.motion
+        } else if frame.motion.is_empty() {
+            still = vec![[0.0f32; 2]; n];
+            &still
+        } else {
+            return Err(RenderError::Settings(format!(
+                "SSS motion has {} texels; expected {n} or none",
+                frame.motion.len()
+            )));
+        };
+        gpu.queue.write_buffer(&self.motion, 0, bytemuck::cast_slice(motion));
         let mut timed = self.timer.begin(gpu, "sss frame");
         let (gx, gy) = (self.width.div_ceil(8), self.height.div_ceil(8));
         if mip_levels > 0 {
@@ -381,6 +412,7 @@ impl SssPass {
             .map(|(h, c)| PixelHistory {
                 spvg: SpvgHistory { mu: h[0], sigma2: h[1], nbar: h[2], valid: h[3] > 0.5 },
                 cv: EmCovariance { mean_f: c[0], mean_g: c[1], cov_fg: c[2], var_g: c[3] },
+                w: if h[3] > 0.5 { h[3] - 1.0 } else { 0.0 },
             })
             .collect())
     }

@@ -13,9 +13,11 @@ pub mod inverse;
 pub mod prefilter;
 pub mod profile;
 pub mod random_walk;
+pub mod reproject;
 pub mod sampling;
 pub mod screen_pass;
 pub mod separable;
+pub mod split;
 pub mod spvg;
 pub mod synthetic;
 
@@ -23,6 +25,7 @@ pub use control_variates::EmCovariance;
 pub use prefilter::Prefilter;
 pub use profile::BurleyProfile;
 pub use screen_pass::{PixelHistory, PixelResult, SssFrame, SssSettings, SssVariant};
+pub use split::Split;
 pub use spvg::{SpvgHistory, SpvgSettings};
 
 pub mod plugin;

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use crate::gpu::SssPass;
 use crate::profile::scaling_from_dmfp;
-use crate::{Prefilter, SpvgSettings, SssFrame, SssSettings, SssVariant};
+use crate::{Prefilter, Split, SpvgSettings, SssFrame, SssSettings, SssVariant};
 use anyhow::{Result, bail};
 use bevy_ecs::prelude::*;
 use glam::Vec3;
@@ -43,6 +43,12 @@ pub struct SssMethodSettings {
     /// level, `prefilter: (a: 0.0625, levels: 6)` (the thesis's a; `()` takes both defaults).
     /// None: samples read the irradiance itself. Not with Separable.
     pub prefilter: Option<Prefilter>,
+    /// The direct/distant split (Sec. 5.3.1), `split: (gamma: None, eps_u: 0.01)` by default
+    /// (Table 5.1's Burley γ = 1 − cdf(r0), Sec. 7.4's ε_u); `split: None` samples the whole disc.
+    pub split: Option<Split>,
+    /// The monitored luminance's encoding Y^(1/γ_m) (Sec. 4.4's gamma-corrected luminance; 1:
+    /// linear).
+    pub monitor_gamma: f32,
 }
 
 impl Default for SssMethodSettings {
@@ -58,6 +64,8 @@ impl Default for SssMethodSettings {
             a_cv: s.a_cv,
             taa: None,
             prefilter: None,
+            split: s.split,
+            monitor_gamma: s.monitor_gamma,
         }
     }
 }
@@ -85,6 +93,9 @@ impl SssMethodSettings {
             a_cv: self.a_cv,
             seed: seed as u32,
             prefilter: self.prefilter,
+            split: self.split,
+            monitor_gamma: self.monitor_gamma,
+            ..Default::default()
         }
     }
 }
@@ -142,7 +153,7 @@ impl MethodPlugin for Plugin {
         if s.spp == 0 {
             bail!("Sss: spp 0; expected at least 1 path-traced sample per pixel");
         }
-        s.spvg.validate().map_err(|e| anyhow::anyhow!("Sss: {e}"))?;
+        s.pass_settings(0).validate().map_err(|e| anyhow::anyhow!("Sss: {e}"))?;
         if let SssVariant::Fixed { count } = s.variant
             && !(1..=crate::gpu::MAX_COUNT).contains(&count)
         {
@@ -156,7 +167,6 @@ impl MethodPlugin for Plugin {
                 crate::separable::MAX_TAPS
             );
         }
-        s.pass_settings(0).mip_levels().map_err(|e| anyhow::anyhow!("Sss: {e}"))?;
         let scene = &world.resource::<sim::ExtractedScene>().scene;
         let subsurface: Vec<(u32, scene::Material)> = scene
             .materials
@@ -244,8 +254,14 @@ pub fn render(
                     [l[0] / a.x, l[1] / a.y, l[2] / a.z, focal / g.depth[i].max(1e-6)]
                 })
                 .collect();
-            let sss_frame =
-                SssFrame { width: out.width, height: out.height, irradiance, d_px: profile.d };
+            let sss_frame = SssFrame {
+                width: out.width,
+                height: out.height,
+                irradiance,
+                d_px: profile.d,
+                focal_px: focal,
+                motion: g.motion.clone(),
+            };
             render::timing::merge(
                 &mut timings,
                 profile

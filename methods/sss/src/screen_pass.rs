@@ -5,8 +5,10 @@
 
 use super::control_variates::EmCovariance;
 use super::prefilter::{self, MipChain, Prefilter};
+use super::reproject;
 use super::sampling::{luminance, pixel_offset, r2_point, radial_pdf, sample_radius};
 use super::separable;
+use super::split::{self, Split};
 use super::spvg::{self, SpvgHistory, SpvgSettings};
 use serde::{Deserialize, Serialize};
 
@@ -53,9 +55,37 @@ pub struct SssSettings {
     /// AFIS (Sec. 5.2): samples read a prefiltered MIP chain at eq. 5.12's level; None reads
     /// the irradiance itself (level 0). The Monte Carlo variants only.
     pub prefilter: Option<Prefilter>,
+    /// The direct/distant split (Sec. 5.3.1); None samples the whole disc (γ = 1, r0 = 0).
+    pub split: Option<Split>,
+    /// The monitored luminance's encoding Y^(1/γ_m) (Sec. 4.4: gamma-corrected; 1 = linear).
+    pub monitor_gamma: f32,
+    /// The reprojected history is reset where its depth and this pixel's differ by more than
+    /// this share (the TAA resolve's rejection test and default).
+    pub depth_tolerance: f32,
 }
 
 impl SssSettings {
+    /// Every setting the pass reads, with what was expected.
+    pub fn validate(&self) -> Result<(), String> {
+        self.spvg.validate()?;
+        if let Some(split) = &self.split {
+            split.validate()?;
+        }
+        if !(self.monitor_gamma > 0.0 && self.monitor_gamma.is_finite()) {
+            return Err(format!(
+                "monitor_gamma {}; expected a positive number (1: linear luminance)",
+                self.monitor_gamma
+            ));
+        }
+        if !(self.depth_tolerance > 0.0) {
+            return Err(format!(
+                "depth_tolerance {}; expected a positive share of the depth",
+                self.depth_tolerance
+            ));
+        }
+        self.mip_levels().map(|_| ())
+    }
+
     /// The MIP levels the pass reads (0: no prefiltering); errors for a bad prefilter or one
     /// with the separable variant, which takes no samples to prefilter.
     pub fn mip_levels(&self) -> Result<u32, String> {
@@ -67,6 +97,10 @@ impl SssSettings {
     }
 }
 
+/// The thesis monitors "gamma-corrected luminance" (Sec. 4.4) without naming the curve; 2.2
+/// is the display gamma of the SDR output its Table 7.3 runs recorded.
+pub const MONITOR_GAMMA: f32 = 2.2;
+
 impl Default for SssSettings {
     fn default() -> Self {
         Self {
@@ -75,22 +109,31 @@ impl Default for SssSettings {
             fast_inverse: true,
             eps_a: 1e-6,
             a0: 1000.0,
-            a_cv: 0.005,
+            a_cv: 1e-6,
             seed: 1,
             prefilter: None,
+            split: Some(Split::default()),
+            monitor_gamma: MONITOR_GAMMA,
+            depth_tolerance: taa::TaaSettings::default().depth_tolerance,
         }
     }
 }
 
 /// One frame's input, row-major: per pixel the demodulated diffuse irradiance (rgb) and w, the
-/// pixels per unit of d at that pixel (0: not an SSS pixel; 1 when d is given in pixels); and
-/// the profile's d per channel (in pixels where w = 1).
+/// pixels per unit of d at that pixel (0: not an SSS pixel; 1 when d is given in pixels); the
+/// profile's d per channel (in pixels where w = 1); the focal length in pixels.
 #[derive(Clone, Debug)]
 pub struct SssFrame {
     pub width: u32,
     pub height: u32,
     pub irradiance: Vec<[f32; 4]>,
     pub d_px: [f32; 3],
+    /// Pixels per scene unit at unit depth (depth = focal_px / w): eq. 7.1's depth difference;
+    /// 0 where depth is unknown (no depth term).
+    pub focal_px: f32,
+    /// Per pixel, where it was in the previous frame minus where it is (pixels, x right, y
+    /// down; the G-buffer's motion): the histories are read there. Empty: a still view.
+    pub motion: Vec<[f32; 2]>,
 }
 
 impl SssFrame {
@@ -100,11 +143,13 @@ impl SssFrame {
     }
 }
 
-/// A pixel's histories: SPVG's H and the control variates' J.
+/// A pixel's histories: SPVG's H and the control variates' J, and the w (pixels per scene
+/// unit, depth = focal/w) they were written at, for the reprojection's depth test (0: unknown).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PixelHistory {
     pub spvg: SpvgHistory,
     pub cv: EmCovariance,
+    pub w: f32,
 }
 
 /// A pixel's result: the scattered irradiance and the count it took.
@@ -114,14 +159,51 @@ pub struct PixelResult {
     pub count: u32,
 }
 
-/// The irradiance at q (pixel units, texel centres at +0.5), bilinear, clamped to the image;
-/// texels outside the SSS mask read as the centre pixel's (no bleeding across profiles).
-fn fetch(frame: &SssFrame, q: [f32; 2], centre: [f32; 3]) -> [f32; 3] {
-    let w = frame.width as i32;
-    prefilter::bilinear(w, frame.height as i32, q, |i, j| {
+/// Eq. 7.1's sums for one Burley sample at q, radius r (drawn with density ∝ `pdf_s`): per
+/// channel Σ w·L and Σ w over the sample's bilinear taps that are SSS texels, w = the tap's
+/// bilinear weight × R(r')·r'/pdf (∝ pdf_c(r')/pdf_s(r)), r' = √(r² + ΔD²) with ΔD the tap's
+/// depth difference to the centre in pixels. Texels off the mask weigh nothing (no centre
+/// stand-in): the ratio renormalises over what is left.
+fn bilateral_sample(
+    frame: &SssFrame,
+    q: [f32; 2],
+    r: f32,
+    pdf_s: f32,
+    centre_w: f32,
+    d: [f32; 3],
+    num: &mut [f32; 3],
+    den: &mut [f32; 3],
+) {
+    let (w, h) = (frame.width as i32, frame.height as i32);
+    let (x, y) = (q[0] - 0.5, q[1] - 0.5);
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    // Clamp before the cast: radii in the far tail are huge.
+    let (xi, yi) = (x0.clamp(-2.0, w as f32 + 1.0) as i32, y0.clamp(-2.0, h as f32 + 1.0) as i32);
+    for (dx, dy, b) in [
+        (0, 0, (1.0 - fx) * (1.0 - fy)),
+        (1, 0, fx * (1.0 - fy)),
+        (0, 1, (1.0 - fx) * fy),
+        (1, 1, fx * fy),
+    ] {
+        let (i, j) = ((xi + dx).clamp(0, w - 1), (yi + dy).clamp(0, h - 1));
         let t = frame.irradiance[(j * w + i) as usize];
-        if t[3] > 0.0 { [t[0], t[1], t[2]] } else { centre }
-    })
+        if t[3] <= 0.0 || b <= 0.0 {
+            continue;
+        }
+        let dz = depth_difference_px(frame.focal_px, centre_w, t[3]);
+        let rp = (r * r + dz * dz).sqrt();
+        for c in 0..3 {
+            let wc = b * radial_pdf(rp, d[c]) / pdf_s;
+            num[c] += wc * t[c];
+            den[c] += wc;
+        }
+    }
+}
+
+/// ΔD of eq. 7.1 in pixels at the centre: depth = focal/w, scaled by the centre's w.
+pub fn depth_difference_px(focal_px: f32, centre_w: f32, w: f32) -> f32 {
+    if focal_px > 0.0 { focal_px * (centre_w / w - 1.0) } else { 0.0 }
 }
 
 /// The frame's MIP chain when the settings prefilter.
@@ -131,8 +213,19 @@ pub fn mip_chain(frame: &SssFrame, settings: &SssSettings) -> Option<MipChain> {
         .map(|p| MipChain::build(frame.width, frame.height, &frame.irradiance, p.levels))
 }
 
-/// n Burley samples around pixel (x, y): (1/n) Σ L(q_j) pdf_c(r_j)/pdf_s(r_j) per channel c, L
-/// read from `chain` at eq. 5.12's level when given (AFIS, Algorithm 2), else bilinear.
+/// One pixel's scattering: the direct term (1 − γ)·B (eq. 5.16), the distant term γ·L_s from m
+/// Burley samples over r > r0 (eq. 5.17) normalised by eq. 7.1, and their sum.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scattered {
+    pub rgb: [f32; 3],
+    pub direct: [f32; 3],
+    pub distant: [f32; 3],
+}
+
+/// m Burley samples around pixel (x, y) over the distant region (the whole disc without a
+/// split): L_s per channel by eq. 7.1, read from `chain` at eq. 5.12's level when given (AFIS,
+/// Algorithm 2; no bilateral weight there), else bilinear with the bilateral weights; then
+/// eq. 5.18. m = 0 gives the direct term alone.
 pub fn scatter(
     frame: &SssFrame,
     settings: &SssSettings,
@@ -140,32 +233,48 @@ pub fn scatter(
     frame_index: u32,
     x: u32,
     y: u32,
-    n: u32,
-) -> [f32; 3] {
+    m: u32,
+) -> Scattered {
     let pixel = y * frame.width + x;
     let t = frame.irradiance[pixel as usize];
     let centre = [t[0], t[1], t[2]];
     let ds = frame.d_sample() * t[3];
     let d = frame.d_px.map(|d| d * t[3]);
+    let sp = split::pixel_split(settings.split.as_ref(), d, ds);
     let offset = pixel_offset(settings.seed, frame_index, pixel);
-    let mut sum = [0.0f32; 3];
-    for j in 0..n {
+    let (mut num, mut den) = ([0.0f32; 3], [0.0f32; 3]);
+    for j in 0..m {
         let u = r2_point(offset, j);
-        let r = sample_radius(u[0], ds, settings.fast_inverse);
+        let r = sample_radius(split::distant_u(u[0], sp.u0), ds, settings.fast_inverse);
         let phi = 2.0 * std::f32::consts::PI * u[1];
         let q = [x as f32 + 0.5 + r * phi.cos(), y as f32 + 0.5 + r * phi.sin()];
         let ps = radial_pdf(r, ds);
-        let l = match (chain, settings.prefilter) {
+        match (chain, settings.prefilter) {
             (Some(chain), Some(p)) => {
-                chain.fetch(prefilter::level(r, ps, n, p.a, p.levels), q, centre)
+                let l = chain.fetch(prefilter::level(r, ps, m, p.a, p.levels), q, centre);
+                for c in 0..3 {
+                    let w = radial_pdf(r, d[c]) / ps;
+                    num[c] += w * l[c];
+                    den[c] += w;
+                }
             }
-            _ => fetch(frame, q, centre),
-        };
-        for c in 0..3 {
-            sum[c] += l[c] * (radial_pdf(r, d[c]) / ps);
+            _ => bilateral_sample(frame, q, r, ps, t[3], d, &mut num, &mut den),
         }
     }
-    sum.map(|s| s / n as f32)
+    let mut out = Scattered { rgb: [0.0; 3], direct: [0.0; 3], distant: [0.0; 3] };
+    for c in 0..3 {
+        let ls = if m > 0 && den[c] > 0.0 { num[c] / den[c] } else { centre[c] };
+        out.direct[c] = (1.0 - sp.gamma[c]) * centre[c];
+        out.distant[c] = if m > 0 { sp.gamma[c] * ls } else { 0.0 };
+        out.rgb[c] = out.direct[c] + out.distant[c];
+    }
+    out
+}
+
+/// The monitored luminance in the thesis's encoding (Sec. 4.4: gamma-corrected): Y^(1/γ_m),
+/// γ_m = `monitor_gamma` (1: linear).
+pub fn encode(y: f32, monitor_gamma: f32) -> f32 {
+    if monitor_gamma == 1.0 { y } else { y.max(0.0).powf(1.0 / monitor_gamma) }
 }
 
 /// One pixel's step: count, samples, histories (the Monte Carlo variants).
@@ -182,27 +291,37 @@ fn pixel_step(
     if t[3] <= 0.0 {
         return (PixelResult { rgb: [t[0], t[1], t[2]], count: 0 }, PixelHistory::default());
     }
+    let d = frame.d_px.map(|d| d * t[3]);
+    let sp = split::pixel_split(settings.split.as_ref(), d, frame.d_sample() * t[3]);
+    // Algorithm 3, lines 1-2: no distant samples, nothing to track (the history restarts).
+    if settings.split.is_some_and(|s| sp.gamma_s < s.eps_u) {
+        let s = scatter(frame, settings, chain, frame_index, x, y, 0);
+        return (PixelResult { rgb: s.rgb, count: 0 }, PixelHistory::default());
+    }
     let st = spvg::state(&prev.spvg, &settings.spvg);
-    let n = match settings.variant {
+    let m = match settings.variant {
         SssVariant::Fixed { count } => count,
         SssVariant::Separable { .. } => {
             unreachable!("the separable variant runs as two 1-D passes in `step`")
         }
         _ => spvg::sample_count(&st, &settings.spvg),
     };
-    let rgb = scatter(frame, settings, chain, frame_index, x, y, n);
-    let f = luminance(rgb);
-    let g = luminance([t[0], t[1], t[2]]);
+    let s = scatter(frame, settings, chain, frame_index, x, y, m);
+    // f̄ = L_o − (1 − γ)B (eq. 6.22), ḡ = G(t) = γB(t) (eq. 6.14), luminance, encoded.
+    let f = encode(luminance(s.distant), settings.monitor_gamma);
+    let b = [t[0], t[1], t[2]];
+    let g = encode(luminance(std::array::from_fn(|c| sp.gamma[c] * b[c])), settings.monitor_gamma);
     let a = match settings.variant {
         SssVariant::OnlineCv if st.valid => prev.cv.coefficient(settings.eps_a, settings.a0, f, g),
         SssVariant::OnlineCv | SssVariant::ConstantCv => 1.0,
         _ => 0.0,
     };
+    // Res(t) = f̄ − a G(t) (eq. 6.23); AS (a = 0) tracks the distant term alone.
     let monitored = f - a * g;
     let cv = if st.valid { prev.cv.update(settings.a_cv, f, g) } else { EmCovariance::start(f, g) };
     (
-        PixelResult { rgb, count: n },
-        PixelHistory { spvg: spvg::update(&st, &settings.spvg, monitored, n), cv },
+        PixelResult { rgb: s.rgb, count: m },
+        PixelHistory { spvg: spvg::update(&st, &settings.spvg, monitored, m), cv, w: t[3] },
     )
 }
 
@@ -220,21 +339,20 @@ pub fn step(
         return (separable::step(frame, &kernel), vec![PixelHistory::default(); count]);
     }
     let chain = mip_chain(frame, settings);
-    let empty = PixelHistory::default();
     let mut results = Vec::with_capacity(count);
     let mut next = Vec::with_capacity(count);
     for y in 0..frame.height {
         for x in 0..frame.width {
             let i = (y * frame.width + x) as usize;
-            let (r, h) = pixel_step(
-                frame,
-                settings,
-                chain.as_ref(),
-                frame_index,
-                x,
-                y,
-                history.get(i).unwrap_or(&empty),
+            let prev = reproject::reproject(
+                history,
+                frame.motion.get(i).copied(),
+                (x, y),
+                (frame.width, frame.height),
+                frame.irradiance[i][3],
+                settings.depth_tolerance,
             );
+            let (r, h) = pixel_step(frame, settings, chain.as_ref(), frame_index, x, y, &prev);
             results.push(r);
             next.push(h);
         }

@@ -110,5 +110,12 @@ pub fn frame(test: DynamicTest, width: u32, height: u32, frame: u32, d_rel: [f32
             irradiance.push([e, 0.85 * e, 0.7 * e, mask]);
         }
     }
-    SssFrame { width, height, irradiance, d_px: d_rel.map(|d| d * height as f32) }
+    SssFrame {
+        width,
+        height,
+        irradiance,
+        d_px: d_rel.map(|d| d * height as f32),
+        focal_px: 0.0,
+        motion: Vec::new(),
+    }
 }

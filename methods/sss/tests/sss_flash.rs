@@ -85,11 +85,11 @@ fn flash_relations_of_table_7_3() {
     // ... with fewer mean samples.
     let saved: Vec<f64> = per_seed(adaptive, &|m| 64.0 - m.mean_spp);
     assert!(lower_bound(&saved) > 0.0, "64 − AS mean spp per seed: {saved:?}");
-    // OCV needs no more mean samples than AS at equal target.
+    // OCV needs fewer mean samples than AS at equal target (strictly: identical counts fail).
     let ocv_saved: Vec<f64> = per_seed(adaptive, &|m| m.mean_spp)
         .iter()
         .zip(per_seed(ocv, &|m| m.mean_spp))
         .map(|(a, o)| a - o)
         .collect();
-    assert!(lower_bound(&ocv_saved) >= 0.0, "AS − OCV mean spp per seed: {ocv_saved:?}");
+    assert!(lower_bound(&ocv_saved) > 0.0, "AS − OCV mean spp per seed: {ocv_saved:?}");
 }

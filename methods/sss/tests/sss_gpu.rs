@@ -8,7 +8,7 @@ use sss::gpu::SssPass;
 use sss::prefilter::MipChain;
 use sss::screen_pass::step;
 use sss::{
-    EmCovariance, PixelHistory, PixelResult, Prefilter, SpvgHistory, SpvgSettings, SssFrame,
+    EmCovariance, PixelHistory, PixelResult, Prefilter, Split, SpvgHistory, SpvgSettings, SssFrame,
     SssSettings, SssVariant,
 };
 
@@ -23,11 +23,26 @@ fn frame() -> SssFrame {
             let lit = if x + 0.5 * y < 11.0 { 1.0 } else { 0.15 };
             let fall = 1.0 - 0.03 * y;
             // w: pixels per unit of d, varying as depth would; 0 off the SSS mask.
-            let scale = if x >= 16.0 && y < 4.0 { 0.0 } else { 0.8 + 0.03 * x };
+            // The last row's tiny w puts γ under ε_u (eq. 5.20: no distant samples).
+            let scale = if x >= 16.0 && y < 4.0 {
+                0.0
+            } else if y == 11.0 {
+                0.02
+            } else {
+                0.8 + 0.03 * x
+            };
             [lit * fall, 0.8 * lit * fall, 0.6 * lit, scale]
         })
         .collect();
-    SssFrame { width: W, height: H, irradiance, d_px: [1.5, 0.8, 0.4] }
+    // focal_px: depth = focal/w varies with x, so eq. 7.1's depth term is exercised.
+    SssFrame {
+        width: W,
+        height: H,
+        irradiance,
+        d_px: [1.5, 0.8, 0.4],
+        focal_px: 6.0,
+        motion: Vec::new(),
+    }
 }
 
 /// The unrounded n̂ of eq. 4.9 in f64, to keep away from rounding ties in the test data.
@@ -37,7 +52,8 @@ fn count_f64(h: &SpvgHistory, s: &SpvgSettings) -> f64 {
     s.kappa as f64 * (ratio - 1.0) * h.nbar as f64 * (k - 1.0) + ratio * h.nbar as f64
 }
 
-/// Random histories: a quarter invalid (disoccluded), the rest with counts spread over [8, 64].
+/// Random histories: a quarter invalid (disoccluded), the rest with counts spread over [8, 64];
+/// the w they were written at unknown (0), near the frame's (0.8-1.37) or far from it.
 fn histories(s: &SpvgSettings) -> Vec<PixelHistory> {
     let mut rng = SplitMix64::new(7);
     (0..W * H)
@@ -56,9 +72,10 @@ fn histories(s: &SpvgSettings) -> Vec<PixelHistory> {
                     cov_fg: rng.range(-0.01, 0.02),
                     var_g: rng.range(0.0, 0.02),
                 };
+                let w = [0.0, rng.range(0.8, 1.4), 2.5][(rng.next_f32() * 3.0) as usize % 3];
                 let frac = count_f64(&spvg, s).fract();
                 if !valid || (frac - 0.5).abs() > 1e-3 {
-                    break PixelHistory { spvg, cv };
+                    break PixelHistory { spvg, cv, w };
                 }
             }
         })
@@ -89,6 +106,7 @@ fn compare(
         }
         let (a, b) = (hg.spvg, hc.spvg);
         assert_eq!(a.valid, b.valid, "{what} pixel {i}");
+        assert!(close(hg.w, hc.w, 1e-5, 1e-6), "{what} pixel {i}: w {} vs {}", hg.w, hc.w);
         assert!(
             close(a.mu, b.mu, 1e-4, 1e-6) && close(a.nbar, b.nbar, 1e-5, 0.0),
             "{what} pixel {i}: {a:?} vs {b:?}"
@@ -103,25 +121,49 @@ fn compare(
     }
 }
 
+/// Motion for every pixel: whole and fractional shifts up to 3 px, some off screen.
+fn motion() -> Vec<[f32; 2]> {
+    let mut rng = SplitMix64::new(5);
+    (0..W * H).map(|_| [rng.range(-3.0, 3.0), rng.range(-3.0, 3.0)]).collect()
+}
+
 #[test]
 fn gpu_pass_matches_the_cpu_reference() {
     let gpu = Gpu::new().expect("a wgpu adapter (lavapipe on CI)");
-    let frame = frame();
-    let mut pass = SssPass::new(&gpu, W, H).unwrap();
+    for motion in [Vec::new(), motion()] {
+        gpu_pass_matches_with_motion(&gpu, SssFrame { motion, ..frame() });
+    }
+}
+
+fn gpu_pass_matches_with_motion(gpu: &Gpu, frame: SssFrame) {
+    let mut pass = SssPass::new(gpu, W, H).unwrap();
+    let thesis = Some(Split::default());
     let variants = [
-        (SssVariant::Fixed { count: 64 }, false),
-        (SssVariant::Adaptive, true),
-        (SssVariant::OnlineCv, true),
-        (SssVariant::ConstantCv, true),
-        (SssVariant::Adaptive, false),
+        (SssVariant::Fixed { count: 64 }, false, thesis, 2.2),
+        (SssVariant::Adaptive, true, thesis, 2.2),
+        (SssVariant::OnlineCv, true, thesis, 2.2),
+        (SssVariant::ConstantCv, true, thesis, 2.2),
+        (SssVariant::Adaptive, false, thesis, 2.2),
+        (SssVariant::Adaptive, true, None, 1.0),
+        (SssVariant::OnlineCv, true, Some(Split { gamma: Some(0.4), eps_u: 0.3 }), 1.0),
     ];
-    for (variant, fast_inverse) in variants {
-        let settings = SssSettings { variant, fast_inverse, seed: 3, ..Default::default() };
-        let what = format!("{variant:?} fast {fast_inverse}");
+    for (variant, fast_inverse, split, monitor_gamma) in variants {
+        let settings = SssSettings {
+            variant,
+            fast_inverse,
+            seed: 3,
+            split,
+            monitor_gamma,
+            ..Default::default()
+        };
+        let what = format!(
+            "{variant:?} fast {fast_inverse} {split:?} gamma {monitor_gamma} moving {}",
+            !frame.motion.is_empty()
+        );
         let start = histories(&settings.spvg);
-        pass.set_history(&gpu, &start);
-        pass.dispatch(&gpu, &frame, &settings, 5).unwrap();
-        let (results, next) = (pass.results(&gpu).unwrap(), pass.history(&gpu).unwrap());
+        pass.set_history(gpu, &start);
+        pass.dispatch(gpu, &frame, &settings, 5).unwrap();
+        let (results, next) = (pass.results(gpu).unwrap(), pass.history(gpu).unwrap());
         let (cpu_results, cpu_next) = step(&frame, &settings, 5, &start);
         compare(&what, (&results, &next), (&cpu_results, &cpu_next));
         // The variants do differ: counts are not all one value outside Fixed.
@@ -131,8 +173,8 @@ fn gpu_pass_matches_the_cpu_reference() {
             assert!(counts.len() > 5 && counts.contains(&8), "{what}: {counts:?}");
         }
         // Second frame from the GPU's own (flipped) history.
-        pass.dispatch(&gpu, &frame, &settings, 6).unwrap();
-        let (results2, next2) = (pass.results(&gpu).unwrap(), pass.history(&gpu).unwrap());
+        pass.dispatch(gpu, &frame, &settings, 6).unwrap();
+        let (results2, next2) = (pass.results(gpu).unwrap(), pass.history(gpu).unwrap());
         let (cpu2, cpu_next2) = step(&frame, &settings, 6, &next);
         let ties = next
             .iter()
@@ -211,7 +253,14 @@ fn bad_sizes_and_counts_are_refused() {
         )
         .unwrap_err();
     assert!(e.to_string().contains("5000"), "{e}");
-    let small = SssFrame { width: 4, height: 4, irradiance: vec![[0.0; 4]; 16], d_px: [1.0; 3] };
+    let small = SssFrame {
+        width: 4,
+        height: 4,
+        irradiance: vec![[0.0; 4]; 16],
+        d_px: [1.0; 3],
+        focal_px: 0.0,
+        motion: Vec::new(),
+    };
     assert!(
         pass.dispatch(&gpu, &small, &SssSettings::default(), 0)
             .unwrap_err()

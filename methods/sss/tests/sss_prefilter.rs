@@ -18,7 +18,7 @@ fn frame(f: impl Fn(f32, f32) -> f32) -> SssFrame {
         })
         .collect();
     // One d for all channels: each sample's weight is 1, the estimate a plain mean of fetches.
-    SssFrame { width: W, height: H, irradiance, d_px: [0.6; 3] }
+    SssFrame { width: W, height: H, irradiance, d_px: [0.6; 3], focal_px: 0.0, motion: Vec::new() }
 }
 
 #[test]
@@ -35,8 +35,8 @@ fn prefiltering_is_exact_on_a_linear_irradiance() {
     assert!((top[0] - centre).abs() < 1e-5 && top[3] == 1.0, "{top:?} vs {centre}");
     let mut largest_level_gap = 0.0f32;
     for (x, y) in [(48, 40), (40, 36), (55, 45)] {
-        let a = scatter(&ramp, &plain, None, 3, x, y, 32);
-        let b = scatter(&ramp, &afis, Some(&chain), 3, x, y, 32);
+        let a = scatter(&ramp, &plain, None, 3, x, y, 32).rgb;
+        let b = scatter(&ramp, &afis, Some(&chain), 3, x, y, 32).rgb;
         for c in 0..3 {
             assert!(
                 (a[c] - b[c]).abs() <= 2e-5 * a[c].abs(),
@@ -59,7 +59,7 @@ fn prefiltering_blurs_an_edge() {
         SssSettings { variant: SssVariant::Fixed { count: 32 }, seed: 5, ..Default::default() };
     let afis = SssSettings { prefilter: Some(Prefilter::default()), ..plain };
     let chain = mip_chain(&edge, &afis).expect("a chain");
-    let a = scatter(&edge, &plain, None, 3, 46, 40, 32);
-    let b = scatter(&edge, &afis, Some(&chain), 3, 46, 40, 32);
+    let a = scatter(&edge, &plain, None, 3, 46, 40, 32).rgb;
+    let b = scatter(&edge, &afis, Some(&chain), 3, 46, 40, 32).rgb;
     assert!((a[0] - b[0]).abs() > 1e-3, "plain {a:?} afis {b:?}");
 }

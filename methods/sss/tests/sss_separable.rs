@@ -93,7 +93,7 @@ fn edge_frame(width: u32, height: u32, n: [f64; 2], c: f64, d_px: [f32; 3]) -> S
             [v, v, v, 1.0]
         })
         .collect();
-    SssFrame { width, height, irradiance, d_px }
+    SssFrame { width, height, irradiance, d_px, focal_px: 0.0, motion: Vec::new() }
 }
 
 /// E[b(s − T)] for T from the kernel of shape d (pixels): the exact scattering of the edge by
@@ -204,7 +204,14 @@ fn gpu_separable_matches_the_cpu_twin() {
             [lit * fall, 0.8 * lit * fall, 0.6 * lit, scale]
         })
         .collect();
-    let frame = SssFrame { width: w, height: h, irradiance, d_px: [1.5, 0.8, 0.4] };
+    let frame = SssFrame {
+        width: w,
+        height: h,
+        irradiance,
+        d_px: [1.5, 0.8, 0.4],
+        focal_px: 0.0,
+        motion: Vec::new(),
+    };
     let mut pass = SssPass::new(&gpu, w, h).unwrap();
     for taps in [5, 25] {
         let settings =

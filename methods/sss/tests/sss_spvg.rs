@@ -76,8 +76,14 @@ fn disocclusion_resets_the_history() {
     assert_eq!(spvg::sample_count(&spvg::state(&after, &s), &s), 8);
 
     // Through the pass: a pixel that leaves the SSS mask for a frame comes back at n_min.
-    let mut frame =
-        SssFrame { width: 4, height: 1, irradiance: vec![[1.0, 1.0, 1.0, 1.0]; 4], d_px: [0.5; 3] };
+    let mut frame = SssFrame {
+        width: 4,
+        height: 1,
+        irradiance: vec![[1.0, 1.0, 1.0, 1.0]; 4],
+        d_px: [0.5; 3],
+        focal_px: 0.0,
+        motion: Vec::new(),
+    };
     let settings = SssSettings::default();
     let hot = PixelHistory { spvg: busy, ..Default::default() };
     let (r, h) = step(&frame, &settings, 0, &[hot; 4]);

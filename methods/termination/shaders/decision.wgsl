@@ -30,16 +30,24 @@ struct TcPathState {
 struct TcLocalStats {
     radiance: f32,       // luminance of the cache value
     variance: f32,       // E[Y^2] - E[E[Y|y]^2]
-    marginal: f32,       // E[E[Y|y]^2]
+    continuation2: f32,  // E[B^2]: the rouletted part of Y = A (NEE) + B (the BSDF sample's hit)
     bias2: f32,          // E[E[Y|y]^2] - E[Y]^2
     deferred_bias2: f32, // E[(f cos / p)^2 B_next^2]
 }
 
-fn tc_threshold(rule: TcRule, first_radiance: f32) -> f32 {
+// A threshold no path variance reaches: path tracing.
+const TC_NO_THRESHOLD: f32 = 3.0e38;
+
+// The path's absolute threshold from the first hit's record; a relative threshold without a
+// filled record there (`filled` false) has no brightness to scale: the path is path traced.
+fn tc_threshold(rule: TcRule, first_radiance: f32, filled: bool) -> f32 {
     if rule.kind != TC_VARIANCE_BOUNDING {
         return 0.0;
     }
-    return select(rule.param, rule.param * first_radiance * first_radiance, rule.relative != 0u);
+    if rule.relative == 0u {
+        return rule.param;
+    }
+    return select(TC_NO_THRESHOLD, rule.param * first_radiance * first_radiance, filled);
 }
 
 fn tc_arrive_area_spread(state: ptr<function, TcPathState>, dist2: f32, pdf: f32, cos_in: f32) {
@@ -54,9 +62,9 @@ fn tc_arrive_area_spread(state: ptr<function, TcPathState>, dist2: f32, pdf: f32
 // The continuation weight: 1 continue, 0 terminate, alpha in (0, 1) blend (eq. 5). Updates the
 // path variance as decision.rs does.
 fn tc_decide(rule: TcRule, state: ptr<function, TcPathState>, s: TcLocalStats) -> f32 {
-    // Roulette: E[Y'^2] = E[Y^2] / q while E[Y'|y] = E[Y|y].
-    // Written as variance / q + marginal (1/q - 1): no cancellation of two large terms in f32.
-    let local_variance = max(s.variance / rule.survival + s.marginal * (1.0 / rule.survival - 1.0), 0.0);
+    // Roulette keeps only the continuation B (NEE is added before the survival draw):
+    // E[Y'^2] = E[A^2] + 2E[AB] + E[B^2] / q, E[Y'|y] = E[Y|y]: the variance grows by (1/q - 1) E[B^2].
+    let local_variance = max(s.variance + s.continuation2 * (1.0 / rule.survival - 1.0), 0.0);
     let prefixed = (*state).throughput2 * local_variance;
     switch rule.kind {
         case TC_PATH_TRACING: {
@@ -78,7 +86,8 @@ fn tc_decide(rule: TcRule, state: ptr<function, TcPathState>, s: TcLocalStats) -
         case TC_MSE_MINIMISATION: {
             let n = rule.param;
             let current = (*state).path_variance / n + (*state).throughput2 * s.bias2;
-            let deferred_bias2 = min(s.deferred_bias2, rule.bias_clamp * s.bias2 / rule.margin);
+            // The next vertex is reached with probability q and weight 1/q: E[w^2 B^2] / q.
+            let deferred_bias2 = min(s.deferred_bias2 / rule.survival, rule.bias_clamp * s.bias2 / rule.margin);
             let deferred = ((*state).path_variance + prefixed) / n + (*state).throughput2 * deferred_bias2;
             if current <= rule.margin * deferred {
                 return 0.0;

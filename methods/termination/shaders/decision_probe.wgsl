@@ -1,9 +1,10 @@
 // Runs tc_decide on a batch of cases (render::termination::gpu_decision, the GPU-vs-CPU test).
 // A case is 6 vec4f: rule (kind, relative, param, margin),
 // (bias_clamp, survival, -, -), state (throughput2, path_variance, threshold, spread_sqrt),
-// (spread0, vertex, -, -), stats (radiance, variance, marginal, bias2), (deferred_bias2, -, -, -).
+// (spread0, vertex, -, -), stats (radiance, variance, continuation2, bias2),
+// (deferred_bias2, first record filled (1/0), -, -). Output: (alpha, path variance, threshold, -).
 
-import package::termination::decision::{TcLocalStats, TcPathState, TcRule, tc_decide};
+import package::termination::decision::{TcLocalStats, TcPathState, TcRule, tc_decide, tc_threshold};
 
 @group(0) @binding(0) var<storage, read> cases: array<vec4f>;
 @group(0) @binding(1) var<storage, read_write> decisions: array<vec4f>;
@@ -19,5 +20,6 @@ fn tc_decide_probe(@builtin(global_invocation_id) id: vec3u) {
     var state = TcPathState(cases[c + 2u].x, cases[c + 2u].y, cases[c + 2u].z, cases[c + 2u].w, cases[c + 3u].x, bitcast<u32>(cases[c + 3u].y));
     let stats = TcLocalStats(cases[c + 4u].x, cases[c + 4u].y, cases[c + 4u].z, cases[c + 4u].w, cases[c + 5u].x);
     let alpha = tc_decide(rule, &state, stats);
-    decisions[i] = vec4f(alpha, state.path_variance, 0.0, 0.0);
+    let threshold = tc_threshold(rule, cases[c + 4u].x, cases[c + 5u].y > 0.5);
+    decisions[i] = vec4f(alpha, state.path_variance, threshold, 0.0);
 }

@@ -101,17 +101,27 @@ fn tc_offer(slot: u32, candidate: u32, origin: vec3f, dir: vec3f) {
     atomicMin(&slots[4u * slot + 1u], candidate ^ tc.candidate_mask);
 }
 
+// mean^2 - Var(mean) from the running mean, the mean of squared vertex means and the weights'
+// sum of squares (moments.rs mean_squared_unbiased): the squared mean alone is high by Var(mean).
+fn tc_mean_squared(mean: f32, mean_sq: f32, weight2: f32) -> f32 {
+    if weight2 >= 1.0 {
+        return mean * mean;
+    }
+    return mean * mean - (mean_sq - mean * mean) * weight2 / (1.0 - weight2);
+}
+
 // The record's statistics for the decision (luminance).
 fn tc_stats(r: TcRecord) -> TcLocalStats {
     let mean = luminance(r.mean);
-    return TcLocalStats(mean, max(r.second - r.marginal, 0.0), r.marginal, max(r.marginal - mean * mean, 0.0), r.deferred_bias2);
+    let bias2 = max(r.marginal - tc_mean_squared(mean, r.mean_sq, r.weight2), 0.0);
+    return TcLocalStats(mean, max(r.second - r.marginal, 0.0), r.continuation2, bias2, r.deferred_bias2);
 }
 
 // A filled record at the point (jittered lookup), or a record with vertices = 0.
 fn tc_lookup(p: vec3f, n: vec3f, rng: ptr<function, u32>) -> TcRecord {
     let s = tc_find(tc_key(p, n, rng_next2(rng)));
     if s == HC_NONE {
-        return TcRecord(vec3f(0.0), 0.0, 0.0, 0.0, 0.0, 0.0);
+        return TcRecord(vec3f(0.0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     }
     return records[s];
 }
@@ -143,12 +153,14 @@ fn tc_propagate(@builtin(global_invocation_id) id: vec3u) {
     var sum = vec3f(0.0);
     var sum_y = 0.0;
     var sum_y2 = 0.0;
+    var sum_b2 = 0.0; // the continuation's squares: Y = NEE + B, roulette keeps only B
     var deferred = 0.0;
     // A sample whose hit has no filled record yet reads 0, which darkens the record: such an
     // estimate only starts an empty record (the iteration's bootstrap), never updates a filled one.
     var complete = true;
     for (var k = 0u; k < tc.samples_per_vertex; k++) {
-        var y = next_event(sp.position, sh, bsdf, wo, &rng);
+        let nee = next_event(sp.position, sh, bsdf, wo, &rng);
+        var y = nee;
         let bs = bsdf_sample(bsdf, sh.ns, wo, rng_next(&rng), rng_next2(&rng));
         if bs.valid && dot(bs.wi, sh.ng) > 0.0 {
             let w = bs.f * (dot(sh.ns, bs.wi) / bs.pdf);
@@ -185,12 +197,15 @@ fn tc_propagate(@builtin(global_invocation_id) id: vec3u) {
         let ly = luminance(y);
         sum_y += ly;
         sum_y2 += ly * ly;
+        let lb = luminance(y - nee);
+        sum_b2 += lb * lb;
     }
     atomicAdd(&counters[TC_COUNTER_PROPAGATE_RAYS], sg_rays_traced);
     atomicAdd(&counters[select(TC_COUNTER_INCOMPLETE, TC_COUNTER_PROPAGATED, complete)], 1u);
     let n = f32(tc.samples_per_vertex);
     // Mean, mean of squares, and the U-statistic over all pairs ((sum)^2 - sum of squares) / (K(K-1)).
-    records[estimate] = TcRecord(sum / n, 1.0, sum_y2 / n, (sum_y * sum_y - sum_y2) / (n * (n - 1.0)), deferred / n, select(0.0, 1.0, complete));
+    let mean_y = sum_y / n;
+    records[estimate] = TcRecord(sum / n, 1.0, sum_y2 / n, (sum_y * sum_y - sum_y2) / (n * (n - 1.0)), deferred / n, sum_b2 / n, mean_y * mean_y, 1.0, select(0.0, 1.0, complete), 0.0);
 }
 
 @compute @workgroup_size(64, 1, 1)
@@ -205,10 +220,15 @@ fn tc_fold(@builtin(global_invocation_id) id: vec3u) {
         if e.vertices > 0.0 && (e.complete > 0.0 || r.vertices == 0.0) {
             // Running mean over vertices, exponential once max_vertices is reached.
             let n = min(r.vertices + 1.0, tc.max_vertices);
-            r.mean += (e.mean - r.mean) / n;
-            r.second += (e.second - r.second) / n;
-            r.marginal += (e.marginal - r.marginal) / n;
-            r.deferred_bias2 += (e.deferred_bias2 - r.deferred_bias2) / n;
+            let a = 1.0 / n;
+            r.mean += (e.mean - r.mean) * a;
+            r.second += (e.second - r.second) * a;
+            r.marginal += (e.marginal - r.marginal) * a;
+            r.deferred_bias2 += (e.deferred_bias2 - r.deferred_bias2) * a;
+            r.continuation2 += (e.continuation2 - r.continuation2) * a;
+            r.mean_sq += (e.mean_sq - r.mean_sq) * a;
+            // Sum of the squared weights of the vertices in the running mean (moments.rs).
+            r.weight2 = (1.0 - a) * (1.0 - a) * r.weight2 + a * a;
             r.vertices = n;
         }
     }
@@ -270,7 +290,7 @@ fn tc_trace(@builtin(global_invocation_id) id: vec3u) {
             let r = tc_lookup(sp.position, sh.ns, &crng);
             let stats = tc_stats(r);
             if depth == 0u {
-                state.threshold = tc_threshold(rule, stats.radiance);
+                state.threshold = tc_threshold(rule, stats.radiance, r.vertices > 0.0);
             }
             if r.vertices > 0.0 {
                 let lt = luminance(throughput);

@@ -7,6 +7,7 @@
 
 use super::gpu_decision::{decision_module, rule_words};
 use super::moments::RecordMoments;
+use super::rule::TerminationRule;
 use super::settings::{BYTES_PER_RECORD, TerminationSettings, VERTICES_PER_RECORD};
 use glam::Vec3;
 use hash_cache::{HashCacheParams, HashCacheSettings};
@@ -106,9 +107,18 @@ render::gpu_struct! {
         pub marginal: f32 => "f32",
         /// E[(f cos / p)² B²] at the segment's hit.
         pub deferred_bias2: f32 => "f32",
+        /// E[B²]: the second moment of the segment's part after next-event estimation (the
+        /// BSDF sample's hit), the part Russian roulette keeps with probability q.
+        pub continuation2: f32 => "f32",
+        /// Mean over vertices of the squared luminance of the vertex mean (a vertex estimate:
+        /// its own squared luminance).
+        pub mean_sq: f32 => "f32",
+        /// Σ wᵢ² of the running mean's weights (moments.rs): with `mean_sq`, Var(mean).
+        pub weight2: f32 => "f32",
         /// A vertex estimate: 1 if every sample's hit had a filled record (else it may only
         /// start an empty record).
         pub complete: f32 => "f32",
+        pub pad: f32 => "f32",
     }
 }
 
@@ -124,9 +134,9 @@ render::gpu_struct! {
 }
 
 const _: () = assert!(
-    size_of::<TcParams>() == 48 && size_of::<TcRecord>() == 32 && size_of::<TcVertex>() == 32
+    size_of::<TcParams>() == 48 && size_of::<TcRecord>() == 48 && size_of::<TcVertex>() == 32
 );
-const _: () = assert!(BYTES_PER_RECORD == 16 + 32 + 4 * 32 + 4 * 32 + 4 * 32);
+const _: () = assert!(BYTES_PER_RECORD == 16 + 48 + 4 * 48 + 4 * 32 + 4 * 32);
 
 /// Counters of one frame (counted on the GPU).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -162,6 +172,11 @@ pub struct CacheStatistics {
     pub variance: f64,
     /// E[E[Y|y]²] − E[Y]²: average squared bias of terminating into the record.
     pub bias2: f64,
+    /// Quantiles over the filled records of their variance (10%, 50%, 90%): where an absolute
+    /// threshold lies against the scene's local variances.
+    pub variance_quantiles: [f64; 3],
+    /// Quantiles over the filled records of their value E[Y] (10%, 50%, 90%).
+    pub mean_quantiles: [f64; 3],
 }
 
 impl CacheStatistics {
@@ -175,13 +190,22 @@ impl CacheStatistics {
                 mean: luminance(Vec3::from(r.mean)) as f64,
                 second: r.second as f64,
                 marginal: r.marginal as f64,
+                mean_sq: r.mean_sq as f64,
+                weight2: r.weight2 as f64,
             })
             .collect();
         let n = filled.len().max(1) as f64;
+        let quantiles = |value: fn(&RecordMoments) -> f64| {
+            let mut v: Vec<f64> = filled.iter().map(value).collect();
+            v.sort_by(f64::total_cmp);
+            [0.1, 0.5, 0.9].map(|q| v.get((q * v.len() as f64) as usize).copied().unwrap_or(0.0))
+        };
         Self {
             mean: filled.iter().map(|m| m.mean).sum::<f64>() / n,
             variance: filled.iter().map(|m| m.average_variance()).sum::<f64>() / n,
             bias2: filled.iter().map(|m| m.squared_bias()).sum::<f64>() / n,
+            variance_quantiles: quantiles(RecordMoments::average_variance),
+            mean_quantiles: quantiles(|m| m.mean),
         }
     }
 }
@@ -247,7 +271,7 @@ impl TerminationCache {
         )?;
         gpu.check_buffer_size(
             "termination cache records (moments + vertex estimates)",
-            cap * (1 + VERTICES_PER_RECORD) * 32,
+            cap * (1 + VERTICES_PER_RECORD) * size_of::<TcRecord>() as u64,
         )?;
         gpu.check_buffer_size(
             "termination cache vertices (stored + candidates)",
@@ -273,7 +297,11 @@ impl TerminationCache {
         // Empty slots with no claim (claim = NONE).
         let empty: Vec<[u32; 4]> = vec![[0, u32::MAX, 0, 0]; cap as usize];
         gpu.queue.write_buffer(&slots, 0, bytemuck::cast_slice(&empty));
-        let records = buffer("termination records", cap * (1 + VERTICES_PER_RECORD) * 32, rw);
+        let records = buffer(
+            "termination records",
+            cap * (1 + VERTICES_PER_RECORD) * size_of::<TcRecord>() as u64,
+            rw,
+        );
         let vertices =
             buffer("termination vertices", (cap * 2 * VERTICES_PER_RECORD + pixels) * 32, rw);
         let counters = buffer("termination counters", COUNTERS * 4, rw);
@@ -490,6 +518,12 @@ impl TerminationCache {
             pad2: [0.0; 2],
         };
         let (rule_kind, relative, param, margin, bias_clamp) = rule_words(&s.rule);
+        let param = match s.rule {
+            TerminationRule::VarianceBounding { t, relative: false } => {
+                (t * s.radiance_unit * s.radiance_unit) as f32
+            }
+            _ => param,
+        };
         let tc = TcParams {
             rule_kind,
             relative,

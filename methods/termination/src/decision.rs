@@ -17,8 +17,10 @@ pub struct LocalStats {
     pub radiance: f64,
     /// Average local variance E[V[Y|y]] = E[Y²] − E[E[Y|y]²] of one segment, without roulette.
     pub variance: f64,
-    /// E[E[Y|y]²]: with roulette of survival q the segment's second moment is E[Y²]/q.
-    pub marginal: f64,
+    /// E[B²], the second moment of the segment's rouletted part: Y = A + B, A the direct light
+    /// (NEE, added before the survival draw), B the BSDF sample's hit (its emission and the
+    /// cache there), which roulette keeps with probability q and scales by 1/q.
+    pub continuation2: f64,
     /// Average squared local bias E[E[Y|y]²] − E[Y]² (B_l² of eq. 3).
     pub bias2: f64,
     /// Expected squared bias at the next vertex, prefixed by the segment's weight:
@@ -27,12 +29,17 @@ pub struct LocalStats {
 }
 
 impl LocalStats {
-    /// Local variance of continuing under Russian roulette of survival `q`: a killed segment
-    /// estimates 0, a surviving one Y/q, so E[Y'²] = E[Y²]/q while E[Y'|y] = E[Y|y].
+    /// Local variance of continuing under Russian roulette of survival `q`. Only the
+    /// continuation is rouletted: Y' = A + χB/q, so E[Y'²] = E[A²] + 2E[AB] + E[B²]/q = E[Y²] +
+    /// (1/q − 1)E[B²] while E[Y'|y] = E[Y|y]: the variance grows by (1/q − 1)E[B²].
     pub fn variance_with_roulette(&self, q: f64) -> f64 {
-        // (variance + marginal) / q − marginal, written without the cancellation of the two
-        // large terms (f32 on the GPU).
-        (self.variance / q + self.marginal * (1.0 / q - 1.0)).max(0.0)
+        (self.variance + self.continuation2 * (1.0 / q - 1.0)).max(0.0)
+    }
+
+    /// The deferred bias under roulette of survival `q`: the next vertex is reached with
+    /// probability q and weight 1/q, so E[χ (w/q)² B²] = E[w² B²] / q.
+    pub fn deferred_bias2_with_roulette(&self, q: f64) -> f64 {
+        self.deferred_bias2 / q
     }
 }
 
@@ -76,12 +83,15 @@ impl Decision {
     }
 }
 
-/// The absolute variance threshold of a path from the cache value at its first hit.
-pub fn path_threshold(rule: &TerminationRule, first_radiance: f64) -> f64 {
+/// The absolute variance threshold of a path from the cache value at its first hit, `None`
+/// where the first hit has no filled record: the relative threshold then has no brightness to
+/// scale, and the path is path traced (infinite threshold) as at any vertex without a record.
+pub fn path_threshold(rule: &TerminationRule, first_radiance: Option<f64>) -> f64 {
     match *rule {
-        TerminationRule::VarianceBounding { t, relative: true } => {
-            t * first_radiance * first_radiance
-        }
+        TerminationRule::VarianceBounding { t, relative: true } => match first_radiance {
+            Some(c) => t * c * c,
+            None => f64::INFINITY,
+        },
         TerminationRule::VarianceBounding { t, relative: false } => t,
         _ => 0.0,
     }
@@ -127,7 +137,8 @@ pub fn decide(
             // terminate at the next vertex. The accumulated path variance appears in both, so
             // the margin factor lets the prefix weigh in.
             let current = state.path_variance / s + state.throughput2 * stats.bias2;
-            let deferred_bias2 = stats.deferred_bias2.min(bias_clamp * stats.bias2 / margin);
+            let deferred_bias2 =
+                stats.deferred_bias2_with_roulette(survival).min(bias_clamp * stats.bias2 / margin);
             let deferred =
                 (state.path_variance + prefixed) / s + state.throughput2 * deferred_bias2;
             if current <= margin * deferred {

@@ -36,10 +36,14 @@ pub struct DecisionCase {
     pub survival: f64,
     pub state: PathState,
     pub stats: LocalStats,
+    /// Whether the path's first hit had a filled record (the relative threshold's brightness
+    /// is then `stats.radiance`).
+    pub first_filled: bool,
 }
 
-/// (α, path variance after the decision) per case, computed by `tc_decide` in f32.
-pub fn decide_on_gpu(gpu: &Gpu, cases: &[DecisionCase]) -> Result<Vec<[f32; 2]>, RenderError> {
+/// (α, path variance after the decision, the path's threshold from `tc_threshold`) per case,
+/// computed by `tc_decide` in f32.
+pub fn decide_on_gpu(gpu: &Gpu, cases: &[DecisionCase]) -> Result<Vec<[f32; 3]>, RenderError> {
     let mut words: Vec<[f32; 4]> = Vec::with_capacity(cases.len() * 6);
     for c in cases {
         let (kind, relative, param, margin, clamp) = rule_words(&c.rule);
@@ -53,8 +57,13 @@ pub fn decide_on_gpu(gpu: &Gpu, cases: &[DecisionCase]) -> Result<Vec<[f32; 2]>,
             s.spread_sqrt as f32,
         ]);
         words.push([s.spread0 as f32, f32::from_bits(s.vertex), 0.0, 0.0]);
-        words.push([st.radiance as f32, st.variance as f32, st.marginal as f32, st.bias2 as f32]);
-        words.push([st.deferred_bias2 as f32, 0.0, 0.0, 0.0]);
+        words.push([
+            st.radiance as f32,
+            st.variance as f32,
+            st.continuation2 as f32,
+            st.bias2 as f32,
+        ]);
+        words.push([st.deferred_bias2 as f32, c.first_filled as u32 as f32, 0.0, 0.0]);
     }
     let device = &gpu.device;
     let program =
@@ -99,5 +108,5 @@ pub fn decide_on_gpu(gpu: &Gpu, cases: &[DecisionCase]) -> Result<Vec<[f32; 2]>,
     let staging = Staging::copy_of(gpu, &mut encoder, &output, "decisions");
     gpu.queue.submit([encoder.finish()]);
     let out: Vec<[f32; 4]> = staging.read(gpu)?;
-    Ok(out.into_iter().take(cases.len()).map(|v| [v[0], v[1]]).collect())
+    Ok(out.into_iter().take(cases.len()).map(|v| [v[0], v[1], v[2]]).collect())
 }

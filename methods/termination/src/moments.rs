@@ -18,6 +18,12 @@ pub struct RecordMoments {
     pub second: f64,
     /// Mean over vertices of the per-vertex U-statistic over pairs: E[E[Y|y]²].
     pub marginal: f64,
+    /// Mean over vertices of the square of the per-vertex sample mean: with `mean` it gives the
+    /// spread of the vertex means, and so the variance of `mean` itself.
+    pub mean_sq: f64,
+    /// Σ wᵢ² of the weights the running mean gave its vertices (1/n each while n ≤
+    /// max_vertices, then exponential): Var(mean) = σ² Σ wᵢ² for vertex means of variance σ².
+    pub weight2: f64,
 }
 
 /// One vertex's K samples reduced to the three per-vertex estimates (mean, mean of squares,
@@ -44,10 +50,21 @@ impl RecordMoments {
     /// Folds per-vertex estimates (mean, second, pair product) in.
     pub fn add_estimates(&mut self, e: [f64; 3], max_vertices: f64) {
         let n = (self.vertices + 1.0).min(max_vertices);
-        self.mean += (e[0] - self.mean) / n;
-        self.second += (e[1] - self.second) / n;
-        self.marginal += (e[2] - self.marginal) / n;
+        let a = 1.0 / n;
+        self.mean += (e[0] - self.mean) * a;
+        self.second += (e[1] - self.second) * a;
+        self.marginal += (e[2] - self.marginal) * a;
+        self.mean_sq += (e[0] * e[0] - self.mean_sq) * a;
+        self.weight2 = (1.0 - a) * (1.0 - a) * self.weight2 + a * a;
         self.vertices = n;
+    }
+
+    /// An unbiased estimate of E[Y]²: the running mean's square less its own variance,
+    /// mean² − Var(mean). The weighted spread of the vertex means, mean_sq − mean², has
+    /// expectation σ²(1 − Σwᵢ²), so Var(mean) = σ²Σwᵢ² is estimated by
+    /// (mean_sq − mean²) Σwᵢ² / (1 − Σwᵢ²). One vertex (Σwᵢ² = 1) has no spread to measure.
+    pub fn mean_squared(&self) -> f64 {
+        mean_squared_unbiased(self.mean, self.mean_sq, self.weight2)
     }
 
     /// Average variance E[V[Y|y]] = E[Y²] − E[E[Y|y]²] (appendix A), not below zero.
@@ -57,11 +74,26 @@ impl RecordMoments {
 
     /// Average squared bias E[(E[Y|y] − E[Y])²] = E[E[Y|y]²] − E[Y]², not below zero.
     pub fn squared_bias(&self) -> f64 {
-        (self.marginal - self.mean * self.mean).max(0.0)
+        self.squared_bias_estimate().max(0.0)
+    }
+
+    /// The unclamped, unbiased estimate of the average squared bias: E[E[Y|y]²] (mean of
+    /// per-vertex U-statistics) less the unbiased E[Y]² ([`RecordMoments::mean_squared`]).
+    pub fn squared_bias_estimate(&self) -> f64 {
+        self.marginal - self.mean_squared()
     }
 
     /// The plain variance E[Y²] − E[Y]² that overestimates the local variance by the bias.
     pub fn total_variance(&self) -> f64 {
         (self.second - self.mean * self.mean).max(0.0)
     }
+}
+
+/// mean² − Var(mean) from a weighted running mean, the weighted mean of the squared vertex
+/// means and the weights' Σwᵢ² (the WGSL twin is termination.wgsl's `tc_mean_squared`).
+pub fn mean_squared_unbiased(mean: f64, mean_sq: f64, weight2: f64) -> f64 {
+    if weight2 >= 1.0 {
+        return mean * mean;
+    }
+    mean * mean - (mean_sq - mean * mean) * weight2 / (1.0 - weight2)
 }

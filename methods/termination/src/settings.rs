@@ -28,6 +28,10 @@ pub struct TerminationSettings {
     /// Frames of propagation (and primary storing) before the first frame: the paper fills the
     /// cache to equilibrium before timing (§6).
     pub warmup_frames: u32,
+    /// The radiance an absolute threshold t is stated in: the path variance is bounded by
+    /// t · radiance_unit². Variance scales with the square of radiance, and the paper's t
+    /// belongs to its scenes' radiance scale, not to the lab's (README, Table 1).
+    pub radiance_unit: f64,
 }
 
 impl Default for TerminationSettings {
@@ -43,6 +47,7 @@ impl Default for TerminationSettings {
             max_vertices: 64,
             store_probability: 0.01,
             warmup_frames: 16,
+            radiance_unit: 1.0,
         }
     }
 }
@@ -50,9 +55,9 @@ impl Default for TerminationSettings {
 /// Stored vertices per record (§5).
 pub const VERTICES_PER_RECORD: u64 = 4;
 
-/// The cache's buffers per record: slot words (16), record moments (32), 4 per-vertex estimates
-/// (4 × 32), 4 stored vertices (4 × 32) and 4 propagation candidates (4 × 32).
-pub const BYTES_PER_RECORD: u64 = 16 + 32 + VERTICES_PER_RECORD * (32 + 32 + 32);
+/// The cache's buffers per record: slot words (16), record moments (48), 4 per-vertex estimates
+/// (4 × 48), 4 stored vertices (4 × 32) and 4 propagation candidates (4 × 32).
+pub const BYTES_PER_RECORD: u64 = 16 + 48 + VERTICES_PER_RECORD * (48 + 32 + 32);
 
 impl TerminationSettings {
     pub fn validate(&self) -> Result<(), RenderError> {
@@ -60,6 +65,12 @@ impl TerminationSettings {
         self.rule.validate().map_err(RenderError::Settings)?;
         if !(self.survival > 0.0 && self.survival <= 1.0) {
             return bad(format!("Termination survival must be in (0, 1], got {}", self.survival));
+        }
+        if !(self.radiance_unit > 0.0 && self.radiance_unit.is_finite()) {
+            return bad(format!(
+                "Termination radiance_unit must be positive and finite, got {}",
+                self.radiance_unit
+            ));
         }
         if self.capacity == 0 || self.capacity > (1 << 20) {
             // 4 propagation invocations per record in one dispatch dimension (65535 × 64).

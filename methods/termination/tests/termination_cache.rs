@@ -142,6 +142,40 @@ fn the_ends_path_tracing_and_first_vertex() {
     assert!(a[1].mean_path_length > 2.0, "path tracing path length {}", a[1].mean_path_length);
 }
 
+#[test]
+fn relative_threshold_without_a_first_record_path_traces() {
+    // A sparse cache (one warm-up frame, 1% of primary vertices stored: a handful of records at
+    // 32x18): most first hits have no record. A relative threshold has no brightness to scale
+    // there; the path is path traced rather than cut at its first filled vertex (t · 0² = 0).
+    // At a huge relative t every path is path traced: bit for bit the path tracing rule.
+    let scene = room_scene();
+    let sg = scene_gpu(&scene, 6);
+    let sparse = |rule| TerminationSettings {
+        rule,
+        capacity: 1 << 12,
+        warmup_frames: 1,
+        ..Default::default()
+    };
+    let render = |rule| {
+        let mut cache = TerminationCache::new(gpu(), &sg, sparse(rule)).unwrap();
+        (0..2).map(|f| cache.render(gpu(), &sg, &scene.camera, 5, f).unwrap()).collect::<Vec<_>>()
+    };
+    let a = render(TerminationRule::PathTracing);
+    let b = render(TerminationRule::VarianceBounding { t: 1e30, relative: true });
+    for f in 0..2 {
+        let s = b[f].stats;
+        eprintln!("frame {f}: {s:?}");
+        // The case must occur: vertices without a record and filled records both.
+        assert!(s.unknown > 0 && s.filled > 0, "frame {f}: not a sparse cache: {s:?}");
+        let cut = a[f].path_length.iter().zip(&b[f].path_length).filter(|(x, y)| x != y).count();
+        let differ = a[f].radiance.iter().zip(&b[f].radiance).filter(|(x, y)| x != y).count();
+        assert!(
+            cut == 0 && differ == 0,
+            "frame {f}: relative t = 1e30 changed {differ} pixels and {cut} path lengths"
+        );
+    }
+}
+
 fn pt_mean_image(sg: &SceneGpu, spp: u32) -> Vec<f64> {
     let mut pt = PathTracer::new(gpu(), sg).expect("path tracer");
     pt.render(gpu(), sg, spp, 77, 0)

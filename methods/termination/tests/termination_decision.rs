@@ -5,7 +5,7 @@ use termination::{
 };
 
 fn stats(variance: f64, bias2: f64, deferred_bias2: f64) -> LocalStats {
-    LocalStats { radiance: 2.0, variance, marginal: 1.0, bias2, deferred_bias2 }
+    LocalStats { radiance: 2.0, variance, continuation2: 1.0, bias2, deferred_bias2 }
 }
 
 #[test]
@@ -24,20 +24,27 @@ fn variance_bounding_blends_the_overshooting_vertex_with_eq5_alpha() {
     // P = 4 · 0.1 = 0.4 again: 1.3 > 1, α = sqrt(0.1 / 0.4) = 0.5.
     let d = decide(&rule, 1.0, &mut s, &stats(0.1, 0.0, 0.0));
     assert!(matches!(d, Decision::Blend { alpha } if (alpha - 0.5).abs() < 1e-12), "{d:?}");
-    // Roulette of survival 0.5: local variance (0.1 + 1) / 0.5 − 1 = 1.2.
-    assert!((stats(0.1, 0.0, 0.0).variance_with_roulette(0.5) - 1.2).abs() < 1e-12);
+    // Roulette of survival 0.5 on the continuation (E[B²] = 1): 0.1 + (1/0.5 − 1) · 1 = 1.1.
+    assert!((stats(0.1, 0.0, 0.0).variance_with_roulette(0.5) - 1.1).abs() < 1e-12);
 }
 
 #[test]
 fn relative_threshold_scales_with_the_first_cache_value() {
-    assert_eq!(
-        path_threshold(&TerminationRule::VarianceBounding { t: 0.5, relative: true }, 3.0),
-        4.5
-    );
-    assert_eq!(
-        path_threshold(&TerminationRule::VarianceBounding { t: 0.5, relative: false }, 3.0),
-        0.5
-    );
+    let relative = TerminationRule::VarianceBounding { t: 0.5, relative: true };
+    let absolute = TerminationRule::VarianceBounding { t: 0.5, relative: false };
+    assert_eq!(path_threshold(&relative, Some(3.0)), 4.5);
+    assert_eq!(path_threshold(&absolute, Some(3.0)), 0.5);
+    // No filled record at the first hit: no brightness to scale, the path is path traced
+    // (a threshold of 0 would cut it at its first filled vertex).
+    assert_eq!(path_threshold(&relative, None), f64::INFINITY);
+    assert_eq!(path_threshold(&absolute, None), 0.5);
+    let mut s = PathState {
+        throughput2: 1.0,
+        threshold: path_threshold(&relative, None),
+        vertex: 2,
+        ..Default::default()
+    };
+    assert_eq!(decide(&relative, 1.0, &mut s, &stats(1e6, 0.0, 0.0)), Decision::Continue);
 }
 
 #[test]

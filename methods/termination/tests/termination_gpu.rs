@@ -33,25 +33,31 @@ fn gpu_decision_matches_the_cpu_reference() {
                 let stats = LocalStats {
                     radiance: mag(1e-3),
                     variance: mag(1e-4),
-                    marginal: mag(1e-4),
+                    continuation2: mag(1e-4),
                     bias2: mag(1e-5),
                     deferred_bias2: mag(1e-6),
                 };
+                // One case in four has no filled record at the first hit.
+                let first_filled = mag(1.0) > 10.0f64.powf(1.5);
                 let threshold = match rule {
                     TerminationRule::VarianceBounding { .. } => {
-                        termination::path_threshold(&rule, stats.radiance)
+                        termination::path_threshold(&rule, first_filled.then_some(stats.radiance))
                     }
                     _ => 0.0,
                 };
                 let state = PathState {
                     throughput2: mag(1e-3),
-                    path_variance: threshold * 0.5 * (mag(1e-6) / 1e0).min(1.0),
+                    path_variance: if threshold.is_finite() {
+                        threshold * 0.5 * (mag(1e-6) / 1e0).min(1.0)
+                    } else {
+                        mag(1e-6)
+                    },
                     threshold,
                     spread_sqrt: mag(1e-3),
                     spread0: mag(1e-3),
                     vertex: 1 + (mag(1.0) as u32 % 4),
                 };
-                cases.push(DecisionCase { rule, survival, state, stats });
+                cases.push(DecisionCase { rule, survival, state, stats, first_filled });
             }
         }
     }
@@ -68,10 +74,15 @@ fn gpu_decision_matches_the_cpu_reference() {
             2
         }] += 1;
         let close = |a: f64, b: f32| (a - b as f64).abs() <= 1e-4 * a.abs().max(1e-6);
-        if !close(alpha, g[0]) || !close(state.path_variance, g[1]) {
+        // The threshold as tc_trace takes it from the first hit (f32: "infinite" is 3e38).
+        let threshold =
+            termination::path_threshold(&c.rule, c.first_filled.then_some(c.stats.radiance));
+        let same_threshold =
+            if threshold.is_finite() { close(threshold, g[2]) } else { g[2] >= 1e38 };
+        if !close(alpha, g[0]) || !close(state.path_variance, g[1]) || !same_threshold {
             mismatches.push(format!(
-                "{:?}: cpu ({alpha}, {}) gpu ({}, {})",
-                c, state.path_variance, g[0], g[1]
+                "{:?}: cpu ({alpha}, {}, {threshold}) gpu ({}, {}, {})",
+                c, state.path_variance, g[0], g[1], g[2]
             ));
         }
     }

@@ -219,3 +219,98 @@ fn record_moments_separate_variance_from_bias() {
         flat.average_variance()
     );
 }
+
+#[test]
+fn roulette_keeps_the_direct_light_out_of_the_local_variance() {
+    // The tracer adds next-event estimation before the survival draw: roulette keeps only the
+    // continuation B of Y = A + B, so E[Y'²] = E[A²] + 2E[AB] + E[B²]/q. A tree whose inner
+    // nodes receive direct light checks the decision's local variance against the variance of
+    // the rouletted segment enumerated in the tree, and variance bounding against its bound.
+    let tree = SamplingTree::exact_with_direct(DEPTH, ALBEDO, 0.5);
+    let truth = tree.value(0);
+    let inner = (1usize << DEPTH) - 1;
+    for q in [1.0, 0.6, 0.2] {
+        for i in 0..inner {
+            let enumerated = tree.rouletted_segment_variance(i, q);
+            let decided = tree.local_stats(i).variance_with_roulette(q);
+            assert!(
+                (decided - enumerated).abs() <= 1e-12 * enumerated,
+                "q {q} node {i}: local variance {decided}, enumerated {enumerated}"
+            );
+        }
+        let root = tree.rouletted_segment_variance(0, q);
+        for t in thresholds() {
+            let m = tree.estimator(&vb(t), q);
+            assert!((m.mean - truth).abs() < 1e-12 * truth, "q {q} t {t}: biased mean {}", m.mean);
+            let closed = tree.bounded_variance(t, q);
+            assert!(
+                (m.variance() - closed).abs() <= 1e-9 * closed.max(1e-12),
+                "q {q} t {t}: variance {} != closed form {closed}",
+                m.variance()
+            );
+            // While the root's segment alone exceeds t, the root blends and the estimator's
+            // variance is t exactly; an overestimated local variance would leave it below t.
+            if t < root {
+                assert!(
+                    (m.variance() - t).abs() <= 1e-9 * t,
+                    "q {q} t {t} < root's variance {root}: variance {} should equal t",
+                    m.variance()
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn deferred_bias_under_roulette_is_the_next_vertex_bias() {
+    // A continued segment reaches the next vertex with probability q and weight 1/q: the
+    // squared bias it brings there is E[w² B²]/q, enumerated in Fig. 5's tree.
+    let tree = fig5_tree();
+    let inner = (1usize << tree.depth) - 1;
+    for q in [1.0, 0.6, 0.2] {
+        for i in 0..inner {
+            let enumerated = tree.next_vertex_bias2(i, q);
+            let decided = tree.local_stats(i).deferred_bias2_with_roulette(q);
+            assert!(
+                (decided - enumerated).abs() <= 1e-12 * enumerated.max(1e-300),
+                "q {q} node {i}: deferred bias {decided}, enumerated {enumerated}"
+            );
+        }
+    }
+}
+
+#[test]
+fn squared_bias_estimate_is_unbiased_over_few_vertices() {
+    // A record of few vertices: E[Y]² from the square of its running mean is high by
+    // Var(mean) (here σ²/8 ≈ 0.14 while the record holds 8 vertices, σ² a/(2 − a) ≈ 0.15 once
+    // the running mean is exponential with a = 1/4), so marginal − mean² is low by as much.
+    // Half the vertices see Y ~ U(0, 2), half U(2, 4): squared bias 1. Over 20 000 records per
+    // seed the mean estimate must lie within 4 standard errors (from the records' spread) of 1.
+    for (vertices, max_vertices) in [(8, f64::INFINITY), (40, 4.0)] {
+        for seed in [3, 4, 5] {
+            let mut rng = render::scene::SplitMix64::new(seed);
+            let estimates: Vec<f64> = (0..20_000)
+                .map(|_| {
+                    let mut rec = RecordMoments::default();
+                    for _ in 0..vertices {
+                        let lo = if rng.next_f32() < 0.5 { 0.0 } else { 2.0 };
+                        let samples: Vec<f64> =
+                            (0..4).map(|_| lo + 2.0 * rng.next_f32() as f64).collect();
+                        rec.add_vertex(&samples, max_vertices);
+                    }
+                    rec.squared_bias_estimate()
+                })
+                .collect();
+            let n = estimates.len() as f64;
+            let mean = estimates.iter().sum::<f64>() / n;
+            let se =
+                (estimates.iter().map(|e| (e - mean) * (e - mean)).sum::<f64>() / (n - 1.0) / n)
+                    .sqrt();
+            assert!(
+                (mean - 1.0).abs() < 4.0 * se,
+                "{vertices} vertices (memory {max_vertices}), seed {seed}: mean squared-bias \
+                 estimate {mean}, expected 1 (se {se})"
+            );
+        }
+    }
+}

@@ -10,7 +10,9 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use bevy_ecs::prelude::*;
-use media::gpu::{Combination, MisWeight, VolumePathSettings};
+use media::gpu::{
+    Combination, Eq9Transmittance, MisWeight, ShadowTransmittance, VolumePathSettings,
+};
 use render::frame_bindings::FrameBindings;
 use serde::{Deserialize, Serialize};
 
@@ -18,7 +20,9 @@ use frame::scene_medium::{SceneMedium, render_volume};
 use frame::{FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage, method_failed};
 use frame::{MethodOutput, MethodPlugin};
 
-/// `VolumePath(spp: 4, mis: Jackknife, combination: Eq9)`.
+/// `VolumePath(spp: 4, mis: Jackknife, combination: Eq9)`; `shadow: Jackknife` (with
+/// `shadow_samples: 10`, `shadow_estimates: 2`, or `shadow_step: 0.5` for an importance-tied N)
+/// attenuates shadow rays by the jackknife instead of ratio tracking.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct VolumePathMethod {
@@ -27,12 +31,30 @@ pub struct VolumePathMethod {
     pub combination: Combination,
     /// Samples N of each optical-depth estimate of a naive or jackknife weight.
     pub samples: u32,
+    pub shadow: ShadowTransmittance,
+    /// N of each optical-depth estimate of a jackknife shadow ray.
+    pub shadow_samples: u32,
+    /// m of a jackknife shadow ray (Eq. 3).
+    pub shadow_estimates: u32,
+    /// F_Δ of an importance-tied N (Fig. 8d) for jackknife shadow rays.
+    pub shadow_step: Option<f32>,
+    pub eq9_transmittance: Eq9Transmittance,
 }
 
 impl Default for VolumePathMethod {
     fn default() -> Self {
         let d = VolumePathSettings::default();
-        Self { spp: 4, mis: d.mis, combination: d.combination, samples: d.samples }
+        Self {
+            spp: 4,
+            mis: d.mis,
+            combination: d.combination,
+            samples: d.samples,
+            shadow: d.shadow,
+            shadow_samples: d.shadow_samples,
+            shadow_estimates: d.shadow_estimates,
+            shadow_step: d.shadow_step,
+            eq9_transmittance: d.eq9_transmittance,
+        }
     }
 }
 
@@ -46,7 +68,22 @@ impl VolumePathMethod {
                 format!("{:?}", self.combination).to_lowercase()
             ),
         };
-        format!("volume_pt_{mis}_{}spp", self.spp)
+        // Only what differs from the defaults is named, so earlier labels stay.
+        let shadow = match self.shadow {
+            ShadowTransmittance::RatioTracking => String::new(),
+            ShadowTransmittance::TrackLength => "_shadow_track_length".into(),
+            ShadowTransmittance::Jackknife => match self.shadow_step {
+                Some(step) => format!("_shadow_jackknife_m{}_step{step}", self.shadow_estimates),
+                None => {
+                    format!("_shadow_jackknife_m{}_n{}", self.shadow_estimates, self.shadow_samples)
+                }
+            },
+        };
+        let exact = match self.eq9_transmittance {
+            Eq9Transmittance::RatioTracking => "",
+            Eq9Transmittance::Exact => "_exact_t",
+        };
+        format!("volume_pt_{mis}{exact}{shadow}_{}spp", self.spp)
     }
 
     fn settings(&self) -> VolumePathSettings {
@@ -54,7 +91,11 @@ impl VolumePathMethod {
             mis: self.mis,
             combination: self.combination,
             samples: self.samples,
-            ..Default::default()
+            shadow: self.shadow,
+            shadow_samples: self.shadow_samples,
+            shadow_estimates: self.shadow_estimates,
+            shadow_step: self.shadow_step,
+            eq9_transmittance: self.eq9_transmittance,
         }
     }
 }
@@ -97,8 +138,8 @@ impl MethodPlugin for Plugin {
         if s.spp == 0 {
             bail!("VolumePath: spp 0; expected at least 1 sample per pixel");
         }
-        if s.samples == 0 {
-            bail!("VolumePath: samples 0; expected at least 1 sample per optical-depth estimate");
+        if let Some(problem) = s.settings().problem() {
+            bail!("VolumePath: {problem}");
         }
         if !world.contains_resource::<SceneMedium>() {
             bail!(

@@ -89,7 +89,7 @@ impl MethodPlugin for Plugin {
             Some(name) => media.iter().find(|m| &m.name == name).ok_or_else(|| anyhow!("VolumeTransmittance: no medium named '{name}' in the scenario's media"))?,
             None => media.first().ok_or_else(|| anyhow!("VolumeTransmittance: the scenario declares no media; expected media: [(name: ..., kind: ..., ...)]"))?,
         };
-        let medium = Medium::new(DensityGrid::from_desc(desc));
+        let medium = Medium::with_super_voxel(DensityGrid::from_desc(desc), desc.super_voxel);
         let gpu = &world.resource::<GpuDevice>().0;
         let gpu_medium = GpuMedium::new(gpu, &medium);
         let pass = ImagePass::new(gpu, &gpu_medium)?;

@@ -53,6 +53,18 @@ impl Metric {
         self == Metric::Psnr
     }
 
+    /// Whether a method of plugin kind `kind` (`MethodPlugin::NAME`) records this metric in a
+    /// run whose scenario has reference frames (`references`): the image metrics every method
+    /// has (against a reference only where there is one), the stats only their method.
+    pub fn recorded_by(self, kind: &str, references: bool) -> bool {
+        match self {
+            Metric::Smape | Metric::SmapeReprojected => true,
+            Metric::Flip | Metric::Mse | Metric::RelMse | Metric::Psnr => references,
+            Metric::PathLength => kind == "Termination",
+            Metric::MeanAbsBias => kind == "VolumeTransmittance",
+        }
+    }
+
     pub fn of(self, r: &FrameRecord) -> Option<f64> {
         match self {
             Metric::Flip => r.flip,

@@ -110,32 +110,45 @@ fn event_frames(spec: &RunSpec) -> Vec<u32> {
 
 /// Plays every case at every seed; run folders go to `FOLDER/CASE/seed_N`.
 fn play(p: &Prepared, opts: &SuiteOptions) -> Result<BTreeMap<String, CaseRuns>> {
-    // Every case's input is checked before the first one plays.
+    let label = format!("suite {}", p.suite.name);
+    play_cases(&p.suite.origin, &p.suite.cases, &p.folder, &opts.cache_dir, opts.progress, &label)
+}
+
+/// Plays `cases` (read from `origin`) at each of their seeds into `FOLDER/CASE/seed_N`; every
+/// case's input is checked before the first one plays. `label` names the runs in the log.
+pub(crate) fn play_cases(
+    origin: &Path,
+    cases: &[Case],
+    folder: &Path,
+    cache_dir: &Option<PathBuf>,
+    progress: bool,
+    label: &str,
+) -> Result<BTreeMap<String, CaseRuns>> {
     let mut specs = Vec::new();
-    for case in &p.suite.cases {
+    for case in cases {
         for &seed in &case.seeds {
-            let out = p.folder.join(&case.name).join(format!("seed_{seed}"));
-            let (spec, overrides) = case_spec(&p.suite.origin, case, seed, &out)?;
+            let out = folder.join(&case.name).join(format!("seed_{seed}"));
+            let (spec, overrides) = case_spec(origin, case, seed, &out)?;
             specs.push((case, seed, spec, overrides));
         }
     }
-    let mut cases: BTreeMap<String, CaseRuns> = BTreeMap::new();
+    let mut played: BTreeMap<String, CaseRuns> = BTreeMap::new();
     for (case, seed, spec, overrides) in specs {
-        eprintln!("suite {}: case {} seed {seed}", p.suite.name, case.name);
+        eprintln!("{label}: case {} seed {seed}", case.name);
         let run_opts = RunOptions {
             scenario: case.scenario.clone(),
             overrides,
-            cache_dir: opts.cache_dir.clone(),
-            progress: opts.progress,
+            cache_dir: cache_dir.clone(),
+            progress,
         };
         let summary = run_spec(&spec, &run_opts)
             .map_err(|e| anyhow!("case '{}' seed {seed}: {e:#}", case.name))?;
-        let runs = cases.entry(case.name.clone()).or_default();
+        let runs = played.entry(case.name.clone()).or_default();
         runs.frames = spec.scenario.frames;
         runs.events = event_frames(&spec);
         runs.seeds.push(SeedRun::from_records(seed, &summary.records));
     }
-    Ok(cases)
+    Ok(played)
 }
 
 fn bless_hint(p: &Prepared, opts: &SuiteOptions) -> String {

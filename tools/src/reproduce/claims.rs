@@ -1,0 +1,399 @@
+//! Claims files (RON, `claims/PAPER.ron`): a paper's headline claims as data. Each names where
+//! the paper makes it, the paper's numbers, the case (scenario and methods) that tests it here,
+//! the statistic (a suite metric over a window), the comparison and where its tolerance comes
+//! from, and the known departures. Everything is checked before anything plays: an unknown
+//! case, a missing scenario, a method the case does not run and a statistic the method does not
+//! record are errors at the claim's file:line.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+use sim::scenario::{ReferenceFrames, ScenarioError};
+use systems::playback::{Overrides, RunSpec};
+
+use crate::ron_file::{self, RonFile};
+use crate::suite::metric::Metric;
+use crate::suite::spec::Case;
+use crate::suite::window::Window;
+
+/// How big a reproduction runs: `Smoke` (tiny: about two minutes a paper on 2 cores), `Lab`
+/// (the scenarios as shipped) or `Paper` (the paper's sizes where the file gives them).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scale {
+    Smoke,
+    Lab,
+    Paper,
+}
+
+impl Scale {
+    pub fn parse(s: &str) -> Result<Scale, String> {
+        match s {
+            "smoke" => Ok(Scale::Smoke),
+            "lab" => Ok(Scale::Lab),
+            "paper" => Ok(Scale::Paper),
+            _ => Err(format!("scale '{s}'; expected smoke, lab or paper")),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Scale::Smoke => "smoke",
+            Scale::Lab => "lab",
+            Scale::Paper => "paper",
+        }
+    }
+}
+
+/// Overrides of a case at one scale; absent fields keep the scenario's.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Size {
+    #[serde(default)]
+    pub frames: Option<u32>,
+    #[serde(default)]
+    pub resolution: Option<(u32, u32)>,
+    #[serde(default)]
+    pub spp: Option<u32>,
+}
+
+/// A scenario the claims play, at each scale.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClaimCase {
+    pub name: String,
+    /// Relative paths are resolved against the claims file's folder.
+    pub scenario: PathBuf,
+    pub seeds: Vec<u64>,
+    /// Only these method labels of the scenario; all when absent.
+    #[serde(default)]
+    pub methods: Option<Vec<String>>,
+    #[serde(default)]
+    pub smoke: Size,
+    #[serde(default)]
+    pub lab: Size,
+    #[serde(default)]
+    pub paper: Size,
+}
+
+/// The number a claim reads from each seed's run: `metric`'s mean over `window`.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Statistic {
+    pub metric: Metric,
+    pub window: Window,
+}
+
+impl Statistic {
+    pub fn describe(&self) -> String {
+        format!("{} {}", self.metric.name(), self.window.name())
+    }
+}
+
+fn default_confidence() -> f64 {
+    0.95
+}
+
+/// What the paper's claim says about the statistic.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Comparison {
+    /// `Below(method: "a", than: "b")`: a's statistic is lower than b's in the same runs,
+    /// judged by the one-sided upper bound of the paired per-seed differences.
+    Below {
+        method: String,
+        than: String,
+        #[serde(default = "default_confidence")]
+        confidence: f64,
+    },
+    /// `Value(method: "a", value: 0.3, tolerance: 0.05)`: a's mean lies within value ± tolerance
+    /// (its two-sided interval inside the band).
+    Value {
+        method: String,
+        value: f64,
+        tolerance: f64,
+        #[serde(default = "default_confidence")]
+        confidence: f64,
+    },
+    /// `Ratio(method: "a", to: "b", value: 0.5, tolerance: 0.1)`: the per-seed ratio a / b lies
+    /// within value ± tolerance.
+    Ratio {
+        method: String,
+        to: String,
+        value: f64,
+        tolerance: f64,
+        #[serde(default = "default_confidence")]
+        confidence: f64,
+    },
+    /// The lab does not record what the claim needs (yet); `methods` are still checked.
+    NotComparable {
+        #[serde(default)]
+        methods: Vec<String>,
+        reason: String,
+    },
+}
+
+impl Comparison {
+    pub fn methods(&self) -> Vec<&str> {
+        match self {
+            Comparison::Below { method, than, .. } => vec![method, than],
+            Comparison::Value { method, .. } => vec![method],
+            Comparison::Ratio { method, to, .. } => vec![method, to],
+            Comparison::NotComparable { methods, .. } => {
+                methods.iter().map(|m| m.as_str()).collect()
+            }
+        }
+    }
+
+    pub fn describe(&self) -> String {
+        match self {
+            Comparison::Below { method, than, .. } => format!("{method} below {than}"),
+            Comparison::Value { method, value, tolerance, .. } => {
+                format!("{method} = {value} ± {tolerance}")
+            }
+            Comparison::Ratio { method, to, value, tolerance, .. } => {
+                format!("{method} / {to} = {value} ± {tolerance}")
+            }
+            Comparison::NotComparable { .. } => "not comparable".into(),
+        }
+    }
+}
+
+/// One headline claim of the paper.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Claim {
+    /// Short and unique in the file.
+    pub id: String,
+    /// The claim in a sentence.
+    pub claim: String,
+    /// Where the paper makes it: "Table 1", "Section 4, Figure 5".
+    pub source: String,
+    /// The paper's number(s) and their conditions, as the paper states them.
+    pub paper: String,
+    /// The case that tests it; may be absent only for `NotComparable`.
+    #[serde(default)]
+    pub case: Option<String>,
+    #[serde(default)]
+    pub statistic: Option<Statistic>,
+    pub comparison: Comparison,
+    /// Where the tolerance (or the confidence) comes from: the paper, the spread over seeds.
+    pub tolerance_from: String,
+    #[serde(default)]
+    pub departures: Vec<String>,
+    /// The claim's line in its file (filled when loaded).
+    #[serde(skip)]
+    pub line: usize,
+}
+
+#[derive(Deserialize)]
+#[serde(rename = "Claims", deny_unknown_fields)]
+struct ClaimsFile {
+    /// The seed paper's stem: `/work/shared/seeds/PAPER.txt`, `claims/PAPER.ron`.
+    paper: String,
+    title: String,
+    cases: Vec<Box<ron::value::RawValue>>,
+    claims: Vec<Box<ron::value::RawValue>>,
+}
+
+/// A case's method labels and the plugin kind of each, read from its scenario.
+#[derive(Clone, Debug)]
+pub struct CaseMethods {
+    pub kinds: BTreeMap<String, &'static str>,
+    /// The scenario has reference frames (FLIP, MSE, PSNR are measured).
+    pub references: bool,
+}
+
+#[derive(Clone, Debug)]
+pub struct Claims {
+    pub paper: String,
+    pub title: String,
+    pub cases: Vec<ClaimCase>,
+    pub claims: Vec<Claim>,
+    pub origin: PathBuf,
+    /// Each case's line in the file.
+    pub case_lines: BTreeMap<String, (usize, usize)>,
+}
+
+fn check_confidence(file: RonFile, line: usize, c: f64) -> Result<(), ScenarioError> {
+    if c > 0.5 && c < 1.0 {
+        Ok(())
+    } else {
+        Err(file.error(
+            Some((line, 1)),
+            format!("confidence {c}; expected a probability between 0.5 and 1, e.g. 0.95"),
+        ))
+    }
+}
+
+impl Claims {
+    pub fn load(path: &Path) -> Result<Claims, ScenarioError> {
+        Self::from_ron(&ron_file::read(path, "claims file")?, path)
+    }
+
+    pub fn from_ron(text: &str, origin: &Path) -> Result<Claims, ScenarioError> {
+        let file = RonFile { text, origin };
+        let parsed: ClaimsFile = file.parse()?;
+        let folder = origin.parent().unwrap_or(Path::new(""));
+        let mut cases: Vec<ClaimCase> = Vec::new();
+        let mut methods: BTreeMap<String, CaseMethods> = BTreeMap::new();
+        let mut case_lines = BTreeMap::new();
+        for entry in file.entries("cases", &parsed.cases) {
+            let mut case: ClaimCase = file.entry(&entry)?;
+            if case.seeds.is_empty() {
+                return Err(file.error_at(
+                    &entry,
+                    format!("case '{}' has no seeds; expected e.g. seeds: [1, 2, 3]", case.name),
+                ));
+            }
+            if cases.iter().any(|c| c.name == case.name) {
+                return Err(file.error_at(
+                    &entry,
+                    format!("two cases are named '{}'; expected distinct names", case.name),
+                ));
+            }
+            if case.scenario.is_relative() {
+                case.scenario = folder.join(&case.scenario);
+            }
+            let at = |m: String| file.error_at(&entry, format!("case '{}': {m}", case.name));
+            if !case.scenario.is_file() {
+                return Err(at(format!("scenario {} does not exist", case.scenario.display())));
+            }
+            let scenario = sim::Scenario::load(&case.scenario).map_err(|e| at(e.to_string()))?;
+            let spec = RunSpec::from_scenario(scenario, &Overrides::default())
+                .map_err(|e| at(format!("{e:#}")))?;
+            let mut kinds: BTreeMap<String, &'static str> =
+                spec.methods.iter().map(|m| (m.label(), m.spec.name())).collect();
+            if let Some(keep) = &case.methods {
+                if let Some(unknown) = keep.iter().find(|k| !kinds.contains_key(*k)) {
+                    return Err(at(format!(
+                        "no method labelled '{unknown}' in {}; its methods are: {}",
+                        case.scenario.display(),
+                        kinds.keys().cloned().collect::<Vec<_>>().join(", ")
+                    )));
+                }
+                kinds.retain(|label, _| keep.contains(label));
+            }
+            let r = &spec.scenario.reference;
+            let references = r.spp > 0 && r.frames != ReferenceFrames::None;
+            methods.insert(case.name.clone(), CaseMethods { kinds, references });
+            case_lines.insert(case.name.clone(), (entry.line, entry.column));
+            cases.push(case);
+        }
+        let mut claims: Vec<Claim> = Vec::new();
+        for entry in file.entries("claims", &parsed.claims) {
+            let mut claim: Claim = file.entry(&entry)?;
+            claim.line = entry.line;
+            let at = |m: String| file.error_at(&entry, format!("claim '{}': {m}", claim.id));
+            if claims.iter().any(|c| c.id == claim.id) {
+                return Err(at("the id is used twice; expected distinct ids".into()));
+            }
+            match &claim.comparison {
+                Comparison::Below { confidence, .. } => {
+                    check_confidence(file, entry.line, *confidence)?
+                }
+                Comparison::Value { confidence, tolerance, .. }
+                | Comparison::Ratio { confidence, tolerance, .. } => {
+                    check_confidence(file, entry.line, *confidence)?;
+                    if !(tolerance.is_finite() && *tolerance >= 0.0) {
+                        return Err(at(format!("tolerance {tolerance}; expected a number >= 0")));
+                    }
+                }
+                Comparison::NotComparable { .. } => {}
+            }
+            let comparable = !matches!(claim.comparison, Comparison::NotComparable { .. });
+            let case = match &claim.case {
+                Some(name) => Some(methods.get(name).ok_or_else(|| {
+                    at(format!(
+                        "no case '{name}'; the file's cases are: {}",
+                        methods.keys().cloned().collect::<Vec<_>>().join(", ")
+                    ))
+                })?),
+                None if comparable => {
+                    return Err(at("no case; expected e.g. case: \"cornell\"".into()));
+                }
+                None => None,
+            };
+            if comparable && claim.statistic.is_none() {
+                return Err(at(
+                    "no statistic; expected e.g. statistic: (metric: Flip, window: Overall)".into(),
+                ));
+            }
+            if let Some(case) = case {
+                for m in claim.comparison.methods() {
+                    let Some(kind) = case.kinds.get(m) else {
+                        return Err(at(format!(
+                            "unknown method '{m}' in case '{}'; its methods are: {}",
+                            claim.case.as_deref().unwrap_or_default(),
+                            case.kinds.keys().cloned().collect::<Vec<_>>().join(", ")
+                        )));
+                    };
+                    if let Some(s) = &claim.statistic
+                        && !s.metric.recorded_by(kind, case.references)
+                    {
+                        let why = if case.references {
+                            ""
+                        } else {
+                            " (the scenario has no reference frames)"
+                        };
+                        return Err(at(format!(
+                            "method '{m}' ({kind}) does not record the statistic {}{why}",
+                            s.metric.name()
+                        )));
+                    }
+                }
+            }
+            claims.push(claim);
+        }
+        if claims.is_empty() {
+            return Err(file.error(None, "no claims; expected at least one".into()));
+        }
+        Ok(Claims {
+            paper: parsed.paper,
+            title: parsed.title,
+            cases,
+            claims,
+            origin: origin.to_path_buf(),
+            case_lines,
+        })
+    }
+
+    /// The suite cases the comparable claims need, sized for `scale`, each with `seeds` (the
+    /// file's first `n` seeds, continued upwards past its last when `n` is larger).
+    pub fn cases_for(&self, scale: Scale, seeds: Option<usize>) -> Vec<Case> {
+        let needed: Vec<&str> = self
+            .claims
+            .iter()
+            .filter(|c| !matches!(c.comparison, Comparison::NotComparable { .. }))
+            .filter_map(|c| c.case.as_deref())
+            .collect();
+        self.cases
+            .iter()
+            .filter(|c| needed.contains(&c.name.as_str()))
+            .map(|c| {
+                let size = match scale {
+                    Scale::Smoke => &c.smoke,
+                    Scale::Lab => &c.lab,
+                    Scale::Paper => &c.paper,
+                };
+                let mut s = c.seeds.clone();
+                if let Some(n) = seeds {
+                    let last = *s.iter().max().unwrap_or(&0);
+                    s.truncate(n);
+                    s.extend((1..).map(|i| last + i).take(n.saturating_sub(s.len())));
+                }
+                let (line, column) = self.case_lines.get(&c.name).copied().unwrap_or((1, 1));
+                Case {
+                    name: c.name.clone(),
+                    scenario: c.scenario.clone(),
+                    seeds: s,
+                    frames: size.frames,
+                    resolution: size.resolution,
+                    spp: size.spp,
+                    methods: c.methods.clone(),
+                    entry: Some(sim::scenario::MethodEntry { text: String::new(), line, column }),
+                }
+            })
+            .collect()
+    }
+}

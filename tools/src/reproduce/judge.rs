@@ -1,0 +1,122 @@
+//! Judging one claim on per-seed values: a relation between two methods by the one-sided upper
+//! bound of their paired differences, a value or ratio by its two-sided interval against the
+//! claim's band. Too few seeds, a missing value or an interval wider than the band is "not
+//! comparable", with the reason.
+
+use super::claims::Comparison;
+use crate::suite::student_t;
+use crate::suite::welch::Sample;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Verdict {
+    Reproduced,
+    NotReproduced,
+    NotComparable(String),
+}
+
+impl Verdict {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Verdict::Reproduced => "reproduced",
+            Verdict::NotReproduced => "not reproduced",
+            Verdict::NotComparable(_) => "not comparable",
+        }
+    }
+}
+
+/// A claim's outcome: what flicker measured (with its interval) and the verdict.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Judged {
+    pub flicker: String,
+    pub verdict: Verdict,
+}
+
+fn not_comparable(reason: String) -> Judged {
+    Judged { flicker: "-".into(), verdict: Verdict::NotComparable(reason) }
+}
+
+/// The mean of `values` and the half-width of its two-sided `confidence` interval.
+fn interval(values: &[f64], confidence: f64) -> (f64, f64) {
+    let s = Sample::of(values);
+    let t = student_t::quantile(0.5 + confidence / 2.0, (s.n - 1) as f64);
+    (s.mean, t * s.standard_error())
+}
+
+/// Judges `comparison` with `per_seed(method)`: one value per seed (the same seeds, in the same
+/// order, for every method) or why there is none.
+pub fn judge(
+    comparison: &Comparison,
+    per_seed: &dyn Fn(&str) -> Result<Vec<f64>, String>,
+) -> Judged {
+    let values = |m: &str| per_seed(m).map_err(|e| format!("{m}: {e}"));
+    let band = |v: Vec<f64>, value: f64, tolerance: f64, confidence: f64| {
+        if v.len() < 2 {
+            return not_comparable(format!("{} seed(s); an interval needs at least 2", v.len()));
+        }
+        let (mean, half) = interval(&v, confidence);
+        let (lo, hi) = (mean - half, mean + half);
+        let flicker = format!("{mean:.4} [{lo:.4}, {hi:.4}] ({} seeds)", v.len());
+        let verdict = if lo >= value - tolerance && hi <= value + tolerance {
+            Verdict::Reproduced
+        } else if hi < value - tolerance || lo > value + tolerance {
+            Verdict::NotReproduced
+        } else {
+            Verdict::NotComparable(format!(
+                "the {:.0}% interval straddles the band {value} ± {tolerance}; more seeds",
+                confidence * 100.0
+            ))
+        };
+        Judged { flicker, verdict }
+    };
+    match comparison {
+        Comparison::NotComparable { reason, .. } => not_comparable(reason.clone()),
+        Comparison::Below { method, than, confidence } => {
+            let (a, b) = match (values(method), values(than)) {
+                (Ok(a), Ok(b)) => (a, b),
+                (Err(e), _) | (_, Err(e)) => return not_comparable(e),
+            };
+            if a.len() != b.len() || a.len() < 2 {
+                return not_comparable(format!(
+                    "{} and {} seed(s); a paired interval needs the same seeds, at least 2",
+                    a.len(),
+                    b.len()
+                ));
+            }
+            let diffs: Vec<f64> = a.iter().zip(&b).map(|(x, y)| x - y).collect();
+            let d = Sample::of(&diffs);
+            let t = student_t::quantile(*confidence, (d.n - 1) as f64);
+            let upper = d.mean + t * d.standard_error();
+            let flicker = format!(
+                "{:.4} vs {:.4}; difference {:+.4}, {:.0}% upper bound {upper:+.4} ({} seeds)",
+                Sample::of(&a).mean,
+                Sample::of(&b).mean,
+                d.mean,
+                confidence * 100.0,
+                d.n
+            );
+            let verdict = if upper < 0.0 { Verdict::Reproduced } else { Verdict::NotReproduced };
+            Judged { flicker, verdict }
+        }
+        Comparison::Value { method, value, tolerance, confidence } => match values(method) {
+            Ok(v) => band(v, *value, *tolerance, *confidence),
+            Err(e) => not_comparable(e),
+        },
+        Comparison::Ratio { method, to, value, tolerance, confidence } => {
+            match (values(method), values(to)) {
+                (Ok(a), Ok(b)) if a.len() == b.len() => {
+                    if b.contains(&0.0) {
+                        return not_comparable(format!("{to} is 0 in a seed; no ratio"));
+                    }
+                    let r: Vec<f64> = a.iter().zip(&b).map(|(x, y)| x / y).collect();
+                    band(r, *value, *tolerance, *confidence)
+                }
+                (Ok(a), Ok(b)) => not_comparable(format!(
+                    "{} and {} seed(s); a ratio needs the same seeds",
+                    a.len(),
+                    b.len()
+                )),
+                (Err(e), _) | (_, Err(e)) => not_comparable(e),
+            }
+        }
+    }
+}

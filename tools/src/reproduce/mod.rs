@@ -1,0 +1,12 @@
+//! `flicker reproduce PAPER|all`: each seed paper's headline claims (`claims/PAPER.ron`), played
+//! over seeds through the suite machinery, each judged reproduced / not reproduced / not
+//! comparable, written as reproduce.md and reproduce.html beside the paper's numbers.
+
+pub mod claims;
+pub mod judge;
+pub mod report;
+pub mod run;
+
+pub use claims::{Claim, Claims, Comparison, Scale};
+pub use judge::{Judged, Verdict, judge};
+pub use run::{ReproduceOptions, ReproduceOutcome, reproduce};

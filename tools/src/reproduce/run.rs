@@ -1,0 +1,98 @@
+//! Playing what the claims need: each paper's cases over seeds through the suite's
+//! `play_cases`, then every claim judged on its case's per-seed window means.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Result, bail};
+
+use super::claims::{Claims, Scale};
+use super::judge::{Verdict, judge};
+use super::report::{self, PaperResult};
+use crate::suite::run::play_cases;
+
+pub struct ReproduceOptions {
+    /// A paper's stem (`claims/PAPER.ron`) or `all`.
+    pub paper: String,
+    /// The folder of claims files [default: claims].
+    pub claims_dir: PathBuf,
+    pub scale: Scale,
+    /// Seeds per case [default: each case's own list].
+    pub seeds: Option<usize>,
+    /// Where runs, reproduce.md and reproduce.html go [default: runs/reproduce_PAPER_SCALE].
+    pub out: Option<PathBuf>,
+    pub cache_dir: Option<PathBuf>,
+    pub progress: bool,
+}
+
+pub struct ReproduceOutcome {
+    pub folder: PathBuf,
+    pub markdown: String,
+    /// Per paper, per claim: (paper, claim id, verdict).
+    pub verdicts: Vec<(String, String, Verdict)>,
+}
+
+/// The claims files `paper` names, every one loaded (so every error shows before anything plays).
+pub fn load_claims(dir: &Path, paper: &str) -> Result<Vec<Claims>> {
+    let paths: Vec<PathBuf> = if paper == "all" {
+        let mut p: Vec<PathBuf> = std::fs::read_dir(dir)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "ron"))
+            .collect();
+        p.sort();
+        p
+    } else {
+        let p = dir.join(format!("{paper}.ron"));
+        if !p.is_file() {
+            bail!("no claims file {} for paper '{paper}'", p.display());
+        }
+        vec![p]
+    };
+    paths.iter().map(|p| Claims::load(p).map_err(anyhow::Error::from)).collect()
+}
+
+/// `flicker reproduce`: plays, judges, writes reproduce.md and reproduce.html.
+pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
+    if opts.seeds.is_some_and(|n| n < 2) {
+        bail!("--seeds {}: an interval needs at least 2 seeds", opts.seeds.unwrap_or(0));
+    }
+    let all = load_claims(&opts.claims_dir, &opts.paper)?;
+    let folder = opts.out.clone().unwrap_or_else(|| {
+        PathBuf::from("runs").join(format!("reproduce_{}_{}", opts.paper, opts.scale.name()))
+    });
+    let mut papers = Vec::new();
+    let mut verdicts = Vec::new();
+    for claims in &all {
+        let cases = claims.cases_for(opts.scale, opts.seeds);
+        let label = format!("reproduce {}", claims.paper);
+        let runs = play_cases(
+            &claims.origin,
+            &cases,
+            &folder.join(&claims.paper),
+            &opts.cache_dir,
+            opts.progress,
+            &label,
+        )?;
+        let mut judged = Vec::new();
+        for c in &claims.claims {
+            let j = match (c.case.as_ref().and_then(|n| runs.get(n)), &c.statistic) {
+                (Some(r), Some(s)) => judge(&c.comparison, &|m| r.per_seed(m, s.metric, &s.window)),
+                _ => judge(&c.comparison, &|_| Err("not played".into())),
+            };
+            verdicts.push((claims.paper.clone(), c.id.clone(), j.verdict.clone()));
+            judged.push((c, j));
+        }
+        papers.push(PaperResult { claims, judged });
+    }
+    let seeds = opts.seeds.map_or("each case's own".to_string(), |n| n.to_string());
+    let header = format!(
+        "`flicker reproduce {} --scale {}` ({seeds} seeds), commit {}. Relations: the paired one-sided upper bound of the per-seed differences; values and ratios: the two-sided interval of the mean against the claim's band.",
+        opts.paper,
+        opts.scale.name(),
+        systems::manifest::commit(&opts.claims_dir)
+    );
+    let markdown = report::markdown(&header, &papers);
+    systems::output::write_text(&folder.join("reproduce.md"), &markdown)?;
+    systems::output::write_text(&folder.join("reproduce.html"), &report::html(&header, &papers))?;
+    Ok(ReproduceOutcome { folder, markdown, verdicts })
+}

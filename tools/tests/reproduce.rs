@@ -1,0 +1,127 @@
+//! `flicker reproduce`'s claims files: every shipped one parses; bad input is an error at the
+//! claim's file:line before anything plays; the judging of relations, values and ratios on
+//! synthetic per-seed values.
+
+use std::path::{Path, PathBuf};
+
+use tools::reproduce::{Claims, Comparison, Verdict, judge};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
+}
+
+#[test]
+fn every_shipped_claims_file_parses() {
+    let dir = root().join("claims");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "ron") {
+            let claims = Claims::load(&path).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(path.file_stem().unwrap().to_str().unwrap(), claims.paper);
+            n += 1;
+        }
+    }
+    // One per seed paper.
+    assert_eq!(n, 5, "claims files in {}", dir.display());
+}
+
+/// A claims file in the claims folder's place (so `../scenarios/...` resolves) with `claim`.
+fn load_with(case: &str, claim: &str) -> String {
+    let text = format!(
+        "Claims(\n    paper: \"x\",\n    title: \"x\",\n    cases: [\n        {case},\n    ],\n    claims: [\n        {claim},\n    ],\n)\n"
+    );
+    let origin = root().join("claims/bad.ron");
+    Claims::from_ron(&text, &origin).map(|_| ()).unwrap_err().to_string()
+}
+
+const CASE: &str = "(name: \"corridor\", scenario: \"../suites/scenarios/papers_termination_corridor.ron\", seeds: [3, 4])";
+
+fn claim(case: &str, metric: &str, method: &str) -> String {
+    format!(
+        "(id: \"c\", claim: \"c\", source: \"Table 1\", paper: \"1.97\", case: \"{case}\", statistic: (metric: {metric}, window: Overall), comparison: Below(method: \"{method}\", than: \"vb_rel_1\"), tolerance_from: \"seeds\")"
+    )
+}
+
+#[test]
+fn bad_claims_are_errors_at_file_and_line() {
+    // The claim is on line 8, the case on line 5.
+    let e = load_with(CASE, &claim("corridor", "PathLength", "vb_rel_9"));
+    assert!(e.contains("bad.ron:8") && e.contains("unknown method 'vb_rel_9'"), "{e}");
+    let e = load_with(CASE, &claim("corridor", "MeanAbsBias", "vb_rel_0.1"));
+    assert!(
+        e.contains("bad.ron:8") && e.contains("does not record the statistic mean_abs_bias"),
+        "{e}"
+    );
+    let e = load_with(CASE, &claim("hallway", "PathLength", "vb_rel_0.1"));
+    assert!(e.contains("bad.ron:8") && e.contains("no case 'hallway'"), "{e}");
+    let missing = CASE.replace("papers_termination_corridor", "no_such_scenario");
+    let e = load_with(&missing, &claim("corridor", "PathLength", "vb_rel_0.1"));
+    assert!(e.contains("bad.ron:5") && e.contains("does not exist"), "{e}");
+    // The volume cloud has no reference frames: FLIP is not recorded there.
+    let cloud = "(name: \"cloud\", scenario: \"../suites/scenarios/papers_volume_cloud.ron\", seeds: [1, 2])";
+    let flip = "(id: \"c\", claim: \"c\", source: \"s\", paper: \"p\", case: \"cloud\", statistic: (metric: Flip, window: Overall), comparison: Below(method: \"jackknife_8\", than: \"naive_16\"), tolerance_from: \"seeds\")";
+    let e = load_with(cloud, flip);
+    assert!(e.contains("bad.ron:8") && e.contains("no reference frames"), "{e}");
+}
+
+fn below() -> Comparison {
+    Comparison::Below { method: "a".into(), than: "b".into(), confidence: 0.95 }
+}
+
+fn values(a: Vec<f64>, b: Vec<f64>) -> impl Fn(&str) -> Result<Vec<f64>, String> {
+    move |m| match m {
+        "a" => Ok(a.clone()),
+        "b" => Ok(b.clone()),
+        _ => Err("not in the run".into()),
+    }
+}
+
+#[test]
+fn relations_are_judged_by_the_paired_upper_bound() {
+    // a below b by 0.1 in every seed, spread 0.01: reproduced.
+    let holds = judge(&below(), &values(vec![0.30, 0.31, 0.29], vec![0.40, 0.41, 0.40]));
+    assert_eq!(holds.verdict, Verdict::Reproduced, "{}", holds.flicker);
+    // The differences -0.05, +0.04, -0.01: mean -0.0067, standard error 0.0267, t(0.95, 2) =
+    // 2.92, so the upper bound is +0.071 > 0: not shown.
+    let fails = judge(&below(), &values(vec![0.35, 0.44, 0.39], vec![0.40, 0.40, 0.40]));
+    assert_eq!(fails.verdict, Verdict::NotReproduced, "{}", fails.flicker);
+    // One seed: no interval.
+    let one = judge(&below(), &values(vec![0.3], vec![0.4]));
+    assert!(matches!(one.verdict, Verdict::NotComparable(_)), "{:?}", one.verdict);
+    // A method without values.
+    let c = Comparison::Below { method: "a".into(), than: "z".into(), confidence: 0.95 };
+    let missing = judge(&c, &values(vec![0.3, 0.3], vec![0.4, 0.4]));
+    assert!(
+        matches!(missing.verdict, Verdict::NotComparable(ref w) if w.contains("z")),
+        "{:?}",
+        missing.verdict
+    );
+}
+
+#[test]
+fn values_and_ratios_are_judged_by_their_interval_against_the_band() {
+    let value = |v: f64, tolerance: f64| Comparison::Value {
+        method: "a".into(),
+        value: v,
+        tolerance,
+        confidence: 0.95,
+    };
+    // Mean 2.0, standard error 0.0058, t(0.975, 2) = 4.30: interval 2.0 ± 0.025.
+    let a = vec![1.99, 2.00, 2.01];
+    let v = || values(a.clone(), vec![1.0, 1.0, 1.0]);
+    assert_eq!(judge(&value(1.98, 0.25), &v()).verdict, Verdict::Reproduced);
+    assert_eq!(judge(&value(1.0, 0.25), &v()).verdict, Verdict::NotReproduced);
+    // The band's edge inside the interval: more seeds would decide.
+    assert!(matches!(judge(&value(1.76, 0.25), &v()).verdict, Verdict::NotComparable(_)));
+    let ratio = Comparison::Ratio {
+        method: "a".into(),
+        to: "b".into(),
+        value: 2.0,
+        tolerance: 0.1,
+        confidence: 0.95,
+    };
+    assert_eq!(judge(&ratio, &v()).verdict, Verdict::Reproduced);
+    let reason = Comparison::NotComparable { methods: vec![], reason: "needs ms".into() };
+    assert_eq!(judge(&reason, &v()).verdict, Verdict::NotComparable("needs ms".into()));
+}
