@@ -99,6 +99,11 @@ impl DeviceLedger {
         self.take_buffers(gpu).map(|(delta, _)| delta)
     }
 
+    /// Bytes allocated at the last call (or at the start), as counted then.
+    pub fn total(&self) -> Option<u64> {
+        self.last.as_ref().map(|a| a.iter().map(|(_, size)| size).sum())
+    }
+
     /// As [`Self::take`], with the new allocations by label ([`new_allocations`]).
     pub fn take_buffers(&mut self, gpu: &Gpu) -> Option<(i64, Vec<(String, u64)>)> {
         let now = allocations(gpu);

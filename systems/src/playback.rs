@@ -160,7 +160,8 @@ impl FrameWorld {
             let (device_bytes, buffers) = taken.map_or((None, Vec::new()), |(d, b)| (Some(d), b));
             memory.methods.push(MethodMemory { label, device_bytes, buffers });
         }
-        memory.device_bytes_built = render::memory::device_bytes(&world.resource::<GpuDevice>().0);
+        // The ledger's last count is the world as built: no second allocator report.
+        memory.device_bytes_built = ledger.total();
         world.insert_resource(memory);
         let schedule = crate::methods::schedule_for(&spec.methods);
         Ok(FrameWorld { world, schedule })
