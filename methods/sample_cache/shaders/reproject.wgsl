@@ -11,32 +11,27 @@ import package::kernel::{outside_image};
 
 // Listing 2 as printed `break`s after the first try whatever its outcome; the text says a lost
 // race retries on another slot while any remain. Here the loop only ends on success or when no
-// candidate slot is left; every failed try ORs its bit into `m`, so candidates strictly shrink.
-// Candidates: unoccupied slots, and for a visible sample, when none is free, occupied slots whose
-// sample is invisible (it races to set their visibility bit). Returns the slot or NO_HIT.
+// free slot is left; every failed try ORs its bit into `m`, so candidates strictly shrink.
+// Visible samples have priority (listing 2 lets a visible sample overwrite an invisible one in a
+// full pixel): they reserve in a pass of their own before the invisible ones, so an invisible
+// sample only ever takes a slot no visible sample wanted. Listing 2's overwrite within one pass
+// races: a visible sample could take the slot an invisible one had just reserved while free
+// slots remained, and both wrote it. Returns the slot or NO_HIT.
 fn ssc_try_reserve(pixel: u32, visible: bool) -> u32 {
     let n = ssc.slots;
     let full = ssc_full();
     var m = atomicLoad(&pixel_atomics[SSC_ATOMICS * pixel]);
     loop {
-        var candidates = ~m & full;
-        if candidates == 0u && visible {
-            candidates = m & ~(m >> n) & full;
-        }
+        let candidates = ~m & full;
         if candidates == 0u {
             return NO_HIT;
         }
         let i = firstTrailingBit(candidates);
         let o_bit = 1u << i;
-        let v_bit = 1u << (i + n);
-        let s_val = o_bit | select(0u, v_bit, visible);
+        let s_val = o_bit | select(0u, 1u << (i + n), visible);
         let previous = atomicOr(&pixel_atomics[SSC_ATOMICS * pixel], s_val);
-        var success = (previous & o_bit) == 0u;
-        if visible && !success {
-            success = (previous & v_bit) == 0u;
-        }
         m = previous | s_val;
-        if success {
+        if (previous & o_bit) == 0u {
             return i;
         }
     }
@@ -52,8 +47,9 @@ fn begin_main() {
     atomicStore(&ssc_work[SSC_WMAX_ACC], 0u);
 }
 
-@compute @workgroup_size(8, 8, 1)
-fn reserve_main(@builtin(global_invocation_id) id: vec3u) {
+// One thread per (source pixel, slot) of last frame's cache; moves the samples whose visibility
+// bit is `visible_pass` (two passes, visible first: see ssc_try_reserve).
+fn ssc_reserve(id: vec3u, visible_pass: bool) {
     if outside_image(id, ssc.width, ssc.height) || id.z >= ssc.slots {
         return;
     }
@@ -64,6 +60,9 @@ fn reserve_main(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     let visible = ((mask >> (s + ssc.slots)) & 1u) != 0u;
+    if visible != visible_pass {
+        return;
+    }
     let slot = src_slots[s * ssc_pixels() + source];
     let eye = frame.camera.position;
     var image: vec2f;
@@ -92,6 +91,16 @@ fn reserve_main(@builtin(global_invocation_id) id: vec3u) {
         atomicMax(&pixel_atomics[SSC_ATOMICS * t + 1u], bitcast<u32>(depth));
     }
     atomicAdd(&ssc_work[SSC_REPROJECTED], 1u);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn reserve_visible_main(@builtin(global_invocation_id) id: vec3u) {
+    ssc_reserve(id, true);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn reserve_invisible_main(@builtin(global_invocation_id) id: vec3u) {
+    ssc_reserve(id, false);
 }
 
 // The paper's closest-depth texture (section 3.4), per pixel after the reservation: the depth of

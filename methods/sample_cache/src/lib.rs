@@ -4,7 +4,7 @@
 //! sparsely, and averaged into the image. See README.md in this folder for the map and choices.
 //!
 //! Passes per frame (shaders/sample_cache/, one compute pass each, timed):
-//! `reserve` (reproject.wgsl: begin_main + reserve_main), `trace` (retrace.wgsl: retrace_main,
+//! `reserve` (reproject.wgsl: begin_main, reserve_visible_main then reserve_invisible_main, closest_main), `trace` (retrace.wgsl: retrace_main,
 //! list_dispatch.wgsl retrace_args_main, retrace.wgsl retrace_list_main, finish_main),
 //! `shade` (shading_rate.wgsl rates_main + select_main, list_dispatch.wgsl shade_args_main,
 //! shade.wgsl shade_main), `reconstruct` (reconstruct.wgsl).
@@ -48,13 +48,14 @@ use render::timing::{PassTimer, PassTiming};
 pub const PASSES: [&str; 4] = ["reserve", "trace", "shade", "reconstruct"];
 
 /// The dispatches (indices into [`DISPATCHES`]) of each of [`PASSES`].
-const STAGE_DISPATCHES: [std::ops::Range<usize>; 4] = [0..3, 3..7, 7..11, 11..12];
+const STAGE_DISPATCHES: [std::ops::Range<usize>; 4] = [0..4, 4..8, 8..12, 12..13];
 
 /// The dispatches of a frame, `PASS/entry`, in order; each is timed on its own
 /// ([`CacheFrame::dispatch_timings`]) and the pass time is the sum of its dispatches'.
-pub const DISPATCHES: [&str; 12] = [
+pub const DISPATCHES: [&str; 13] = [
     "reserve/begin_main",
-    "reserve/reserve_main",
+    "reserve/reserve_visible_main",
+    "reserve/reserve_invisible_main",
     "reserve/closest_main",
     "trace/retrace_main",
     "trace/retrace_args_main",
@@ -289,7 +290,8 @@ pub struct SampleCache {
 
 struct Pipelines {
     begin: LibraryPipeline,
-    reserve: LibraryPipeline,
+    reserve_visible: LibraryPipeline,
+    reserve_invisible: LibraryPipeline,
     closest: LibraryPipeline,
     retrace: LibraryPipeline,
     retrace_args: LibraryPipeline,
@@ -368,7 +370,8 @@ impl SampleCache {
             layout,
             [
                 begin,
-                reserve,
+                reserve_visible,
+                reserve_invisible,
                 closest,
                 retrace,
                 retrace_args,
@@ -388,7 +391,8 @@ impl SampleCache {
             &OWN_GROUP,
             [
                 "begin_main",
-                "reserve_main",
+                "reserve_visible_main",
+                "reserve_invisible_main",
                 "closest_main",
                 "retrace_main",
                 "retrace_args_main",
@@ -404,7 +408,8 @@ impl SampleCache {
         )?;
         let pipelines = Pipelines {
             begin,
-            reserve,
+            reserve_visible,
+            reserve_invisible,
             closest,
             retrace,
             retrace_args,
@@ -567,9 +572,10 @@ impl SampleCache {
         let list = |l: u64| Some((12 * l, [RETRACE_ARGS_WORD, SHADE_ARGS_WORD][l as usize]));
         let whole_list = list_dispatch(s.slots * w * h);
         // In the order of DISPATCHES: pipeline, direct workgroups, list.
-        let dispatches: [(&LibraryPipeline, [u32; 3], Option<(u64, u64)>); 12] = [
+        let dispatches: [(&LibraryPipeline, [u32; 3], Option<(u64, u64)>); 13] = [
             (&p.begin, [1, 1, 1], None),
-            (&p.reserve, [gx, gy, s.slots], None),
+            (&p.reserve_visible, [gx, gy, s.slots], None),
+            (&p.reserve_invisible, [gx, gy, s.slots], None),
             (&p.closest, [gx, gy, 1], None),
             (&p.retrace, [gx, gy, 1], None),
             (&p.retrace_args, [1, 1, 1], None),

@@ -4,33 +4,48 @@
 //! Listing 2 as printed leaves the loop with `break` after the first try, success or not, so a
 //! sample that loses a race is dropped although free slots remain; the text says it retries.
 //! Here a failed try ORs its bits into the local copy of the mask and the loop picks the next
-//! candidate, ending on success or when no candidate remains.
+//! candidate, ending on success or when no free slot remains.
+//!
+//! Listing 2 also lets a visible sample overwrite an invisible one in a full pixel. On the GPU
+//! the visible samples reserve in a pass before the invisible ones instead ([`reserve_all`]),
+//! which keeps the same samples without two threads ever writing one slot.
 
-/// Reserves a slot for a sample in `mask` (updated as `atomicOr` would); returns the slot index.
-/// Candidates are unoccupied slots (lowest first) and, for a visible sample when the pixel is
-/// full, occupied slots holding an invisible sample (it overwrites them).
+/// Reserves a free slot for a sample in `mask` (updated as `atomicOr` would, setting the
+/// visibility bit for a visible sample); returns the slot index, lowest free first.
 pub fn try_reserve(mask: &mut u32, n: u32, visible: bool) -> Option<u32> {
     let full = (1u32 << n) - 1;
     let mut m = *mask;
     loop {
-        let mut candidates = !m & full;
-        if candidates == 0 && visible {
-            candidates = m & !(m >> n) & full;
-        }
+        let candidates = !m & full;
         if candidates == 0 {
             return None;
         }
         let i = candidates.trailing_zeros();
-        let (o_bit, v_bit) = (1u32 << i, 1u32 << (i + n));
-        let s_val = o_bit | if visible { v_bit } else { 0 };
+        let o_bit = 1u32 << i;
+        let s_val = o_bit | if visible { 1u32 << (i + n) } else { 0 };
         let previous = *mask;
         *mask |= s_val;
-        let success = previous & o_bit == 0 || (visible && previous & v_bit == 0);
         m = previous | s_val;
-        if success {
+        if previous & o_bit == 0 {
             return Some(i);
         }
     }
+}
+
+/// The two reservation passes over one pixel's incoming samples (`true` = visible): visible
+/// samples first, then invisible ones into what is left. Returns the new mask and, per sample,
+/// its slot (None: dropped).
+pub fn reserve_all(samples: &[bool], n: u32) -> (u32, Vec<Option<u32>>) {
+    let mut mask = 0;
+    let mut slots = vec![None; samples.len()];
+    for pass in [true, false] {
+        for (k, &visible) in samples.iter().enumerate() {
+            if visible == pass {
+                slots[k] = try_reserve(&mut mask, n, visible);
+            }
+        }
+    }
+    (mask, slots)
 }
 
 #[cfg(test)]
@@ -38,19 +53,29 @@ mod tests {
     use super::*;
 
     #[test]
-    fn fills_free_slots_then_visible_overwrites_invisible() {
+    fn fills_free_slots_and_drops_when_full() {
         let n = 3;
         let mut m = 0;
         assert_eq!(try_reserve(&mut m, n, false), Some(0));
         assert_eq!(try_reserve(&mut m, n, true), Some(1));
         assert_eq!(try_reserve(&mut m, n, false), Some(2));
         assert_eq!(m, 0b010_111);
-        // Full: an invisible sample is dropped, a visible one takes the first invisible slot.
         assert_eq!(try_reserve(&mut m, n, false), None);
-        assert_eq!(try_reserve(&mut m, n, true), Some(0));
-        assert_eq!(try_reserve(&mut m, n, true), Some(2));
         assert_eq!(try_reserve(&mut m, n, true), None);
-        assert_eq!(m, 0b111_111);
+        assert_eq!(m, 0b010_111);
+    }
+
+    #[test]
+    fn visible_samples_keep_their_slots_in_a_full_pixel() {
+        // Listing 2's priority: 2 invisible samples arrive before 3 visible ones in a pixel of 3
+        // slots; all 3 visible samples are kept, no invisible one, and no slot is written twice.
+        let (mask, slots) = reserve_all(&[false, false, true, true, true], 3);
+        assert_eq!(mask, 0b111_111);
+        assert_eq!(slots, vec![None, None, Some(0), Some(1), Some(2)]);
+        // With room for all, every sample keeps a slot of its own.
+        let (mask, slots) = reserve_all(&[false, true, false, true], 5);
+        assert_eq!(mask, 0b00011_01111);
+        assert_eq!(slots, vec![Some(2), Some(0), Some(3), Some(1)]);
     }
 
     #[test]
