@@ -9,6 +9,7 @@
 pub mod control_variates;
 pub mod evaluation;
 pub mod gpu;
+pub mod hybrid;
 pub mod inverse;
 pub mod prefilter;
 pub mod profile;
@@ -22,6 +23,7 @@ pub mod spvg;
 pub mod synthetic;
 
 pub use control_variates::EmCovariance;
+pub use hybrid::Hybrid;
 pub use prefilter::Prefilter;
 pub use profile::BurleyProfile;
 pub use screen_pass::{PixelHistory, PixelResult, SssFrame, SssSettings, SssVariant};
