@@ -47,8 +47,8 @@ fn main() {
         let mut sum = vec![[0.0f32; 3]; (w * h) as usize];
         for f in 0..8 {
             for (a, r) in sum.iter_mut().zip(step(&frame, &s, f, &[]).0) {
-                for c in 0..3 {
-                    a[c] += r.rgb[c] / 8.0;
+                for (a, v) in a.iter_mut().zip(r.rgb) {
+                    *a += v / 8.0;
                 }
             }
         }
