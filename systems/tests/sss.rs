@@ -320,3 +320,37 @@ fn hybrid_runs_both_techniques_end_to_end() {
     assert!(!out.exists(), "the run folder was written");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// scenarios/sss_hybrid.ron at its own 96x54 (the profile's size in pixels decides): the hybrid
+/// takes both paths in one frame, each pixel's value that of AFIS alone (the near floor's tiles)
+/// or of the separable passes alone (the skin's, the far floor's), each on many pixels.
+#[test]
+fn the_hybrid_scenario_takes_both_paths() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/sss_hybrid.ron");
+    let dir = std::env::temp_dir().join(format!("sss-e2e-{}-hybrid-scenario", std::process::id()));
+    let overrides = Overrides { frames: Some(1), out: Some(dir.join("run")), ..Default::default() };
+    let mut spec = RunSpec::load(&file, &overrides).expect("scenario");
+    spec.methods.retain(|m| m.label() != "pass_2048");
+    let opts = RunOptions {
+        scenario: file.clone(),
+        overrides,
+        cache_dir: Some(dir.join("cache")),
+        progress: false,
+    };
+    run_spec(&spec, &opts).expect("run");
+    let image = |m: &str| {
+        systems::output::read_exr(&dir.join(format!("run/frames/{m}/0000.exr"))).unwrap().2
+    };
+    let (hybrid, afis, separable) = (image("hybrid"), image("afis"), image("separable"));
+    let (mut as_afis, mut as_separable) = (0, 0);
+    for ((h, a), s) in hybrid.iter().zip(&afis).zip(&separable) {
+        if a == s {
+            continue;
+        }
+        as_afis += (h == a) as usize;
+        as_separable += (h == s) as usize;
+    }
+    eprintln!("{as_afis} pixels as AFIS alone, {as_separable} as separable alone");
+    assert!(as_afis > 500 && as_separable > 500, "{as_afis} AFIS, {as_separable} separable pixels");
+    std::fs::remove_dir_all(&dir).ok();
+}
