@@ -257,3 +257,100 @@ fn two_subsurface_materials_scatter_apart() {
     std::fs::remove_dir_all(&dir_one).ok();
     std::fs::remove_dir_all(&dir_two).ok();
 }
+
+/// The hybrid pass (Sec. 5.3.2) end to end: with the default rule every hybrid pass is timed;
+/// a gap no tap reaches gives the separable passes everywhere (2 x 25 fetches per SSS pixel),
+/// a gap every tap exceeds gives AFIS everywhere (SPVG's counts, n_min on frame 0, the same
+/// image as AFIS alone); without a prefilter it is refused.
+#[test]
+fn hybrid_runs_both_techniques_end_to_end() {
+    let methods = "Sss(variant: Adaptive, prefilter: (), hybrid: (), name: \"hybrid\"), Sss(variant: Adaptive, prefilter: (), hybrid: (max_gap_px: 1e9), name: \"all_separable\"), Sss(variant: Adaptive, prefilter: (), hybrid: (max_gap_px: 1e-9), name: \"all_afis\"), Sss(variant: Adaptive, prefilter: (), name: \"afis\")";
+    let (records, dir) = play_inline("hybrid", 2, 3, methods);
+    let image = |m: &str, f: u32| {
+        systems::output::read_exr(&dir.join(format!("run/frames/{m}/{f:04}.exr"))).unwrap().2
+    };
+    for r in &records {
+        let spp = stat(r, "sss_mean_spp");
+        match r.method.as_str() {
+            "hybrid" => {
+                for pass in [
+                    "sss_hybrid_setup",
+                    "sss_prefilter",
+                    "sss_scatter",
+                    "sss_separable_h",
+                    "sss_separable_v",
+                    "sss_hybrid_copy",
+                ] {
+                    assert!(r.passes.iter().any(|(p, _)| p == pass), "{pass}: {:?}", r.passes);
+                }
+            }
+            "all_separable" => assert_eq!(spp, 50.0, "frame {}", r.frame),
+            "all_afis" => {
+                assert!((8.0..=64.0).contains(&spp), "frame {}: {spp}", r.frame);
+                if r.frame == 0 {
+                    assert_eq!(spp, 8.0);
+                }
+                assert_eq!(image("all_afis", r.frame), image("afis", r.frame), "frame {}", r.frame);
+            }
+            _ => {}
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    let (dir, file) = {
+        let dir = std::env::temp_dir().join(format!("sss-e2e-{}-hybrid-bad", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("hybrid.ron");
+        (dir, file)
+    };
+    let text = format!(
+        "Scenario(scene: Builtin(\"sss_sphere\"), resolution: (16, 9), frames: 1,\n methods: [Sss(variant: Adaptive, hybrid: ())],\n materials: [{SKIN}])"
+    );
+    std::fs::write(&file, text).unwrap();
+    let out = dir.join("run");
+    let overrides = Overrides { out: Some(out.clone()), ..Default::default() };
+    let spec = RunSpec::load(&file, &overrides).expect("scenario");
+    let opts = RunOptions {
+        scenario: file.clone(),
+        overrides,
+        cache_dir: Some(dir.join("cache")),
+        progress: false,
+    };
+    let e = format!("{:#}", run_spec(&spec, &opts).err().expect("hybrid without prefilter"));
+    assert!(e.contains("hybrid without prefilter"), "{e}");
+    assert!(!out.exists(), "the run folder was written");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// scenarios/sss_hybrid.ron at its own 96x54 (the profile's size in pixels decides): the hybrid
+/// takes both paths in one frame, each pixel's value that of AFIS alone (the near floor's tiles)
+/// or of the separable passes alone (the skin's, the far floor's), each on many pixels.
+#[test]
+fn the_hybrid_scenario_takes_both_paths() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/sss_hybrid.ron");
+    let dir = std::env::temp_dir().join(format!("sss-e2e-{}-hybrid-scenario", std::process::id()));
+    let overrides = Overrides { frames: Some(1), out: Some(dir.join("run")), ..Default::default() };
+    let mut spec = RunSpec::load(&file, &overrides).expect("scenario");
+    spec.methods.retain(|m| m.label() != "pass_2048");
+    let opts = RunOptions {
+        scenario: file.clone(),
+        overrides,
+        cache_dir: Some(dir.join("cache")),
+        progress: false,
+    };
+    run_spec(&spec, &opts).expect("run");
+    let image = |m: &str| {
+        systems::output::read_exr(&dir.join(format!("run/frames/{m}/0000.exr"))).unwrap().2
+    };
+    let (hybrid, afis, separable) = (image("hybrid"), image("afis"), image("separable"));
+    let (mut as_afis, mut as_separable) = (0, 0);
+    for ((h, a), s) in hybrid.iter().zip(&afis).zip(&separable) {
+        if a == s {
+            continue;
+        }
+        as_afis += (h == a) as usize;
+        as_separable += (h == s) as usize;
+    }
+    eprintln!("{as_afis} pixels as AFIS alone, {as_separable} as separable alone");
+    assert!(as_afis > 500 && as_separable > 500, "{as_afis} AFIS, {as_separable} separable pixels");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,4 +1,5 @@
-// The separable SSS baseline (render::sss::separable, its CPU twin): a horizontal pass from the
+// The separable SSS baseline (render::sss::separable, its CPU twin; P2 and P3 of the hybrid pass,
+// which skip the AFIS tiles): a horizontal pass from the
 // irradiance into `intermediate`, then a vertical pass from it into `scattered`, each a sum of
 // the pre-integrated Burley kernel's taps (offset in units of the widest d, weight rgb).
 
@@ -10,6 +11,12 @@ import package::kernel::{outside_image};
 @group(0) @binding(2) var<storage, read> sss_kernel: array<vec4f>;
 @group(0) @binding(3) var<storage, read_write> intermediate: array<vec4f>;
 @group(0) @binding(4) var<storage, read_write> scattered: array<vec4f>;
+// The hybrid pass's technique per 8x8 tile (1: AFIS, whose pixels P1 and P4 write).
+@group(0) @binding(5) var<storage, read> tiles: array<u32>;
+
+fn afis_tile(tile: vec3u) -> bool {
+    return params.hybrid != 0u && tiles[tile.y * ((params.width + 7u) / 8u) + tile.x] == 1u;
+}
 
 // The texel index at position k along the pass's axis through pixel (x, y), clamped.
 fn axis_index(k: i32, x: u32, y: u32, horizontal: bool) -> u32 {
@@ -58,8 +65,9 @@ fn filter_1d(x: u32, y: u32, horizontal: bool, centre: vec3f, w: f32) -> vec3f {
 }
 
 @compute @workgroup_size(8, 8, 1)
-fn sss_separable_h(@builtin(global_invocation_id) id: vec3u) {
-    if outside_image(id, params.width, params.height) {
+fn sss_separable_h(@builtin(global_invocation_id) id: vec3u, @builtin(workgroup_id) tile: vec3u) {
+    // An AFIS tile's buffer-one texels hold P1's result: the vertical pass's first-pass stand-in.
+    if outside_image(id, params.width, params.height) || afis_tile(tile) {
         return;
     }
     let pixel = id.y * params.width + id.x;
@@ -72,8 +80,8 @@ fn sss_separable_h(@builtin(global_invocation_id) id: vec3u) {
 }
 
 @compute @workgroup_size(8, 8, 1)
-fn sss_separable_v(@builtin(global_invocation_id) id: vec3u) {
-    if outside_image(id, params.width, params.height) {
+fn sss_separable_v(@builtin(global_invocation_id) id: vec3u, @builtin(workgroup_id) tile: vec3u) {
+    if outside_image(id, params.width, params.height) || afis_tile(tile) {
         return;
     }
     let pixel = id.y * params.width + id.x;

@@ -17,6 +17,8 @@ import package::kernel::{outside_image};
 @group(0) @binding(6) var<storage, read_write> cv_out: array<vec4f>;
 @group(0) @binding(7) var<storage, read> mips: array<vec4f>;
 @group(0) @binding(8) var<storage, read> motion: array<vec2f>;
+// The hybrid pass's technique per 8x8 tile (1: AFIS); read only when params.hybrid != 0.
+@group(0) @binding(9) var<storage, read> tiles: array<u32>;
 
 // The previous frame's histories for pixel `id` (render's reproject.rs): point-sampled at
 // id + ½ + motion (the TAA resolve's convention); C_s = 0 (eqs. 4.11-4.12: an invalid history,
@@ -150,11 +152,17 @@ fn encode(y: f32) -> f32 {
 }
 
 @compute @workgroup_size(8, 8, 1)
-fn sss_scatter(@builtin(global_invocation_id) id: vec3u) {
+fn sss_scatter(@builtin(global_invocation_id) id: vec3u, @builtin(workgroup_id) tile: vec3u) {
     if outside_image(id, params.width, params.height) {
         return;
     }
     let pixel = id.y * params.width + id.x;
+    // P1 of the hybrid: AFIS tiles only; a separable pixel keeps no history.
+    if params.hybrid != 0u && tiles[tile.y * ((params.width + 7u) / 8u) + tile.x] != 1u {
+        history_out[pixel] = vec4f(0.0);
+        cv_out[pixel] = vec4f(0.0);
+        return;
+    }
     let t = irradiance[pixel];
     if t.w <= 0.0 {
         scattered[pixel] = vec4f(t.xyz, 0.0);

@@ -25,7 +25,8 @@ render::gpu_struct! {
     /// 3 CCV, 4 separable), SPVG's and the control variates' parameters, the separable
     /// kernel's tap count, AFIS's level count (0: no prefiltering) and eq. 5.12's a, the
     /// direct/distant split (on, γ or −1 for Burley's, ε_u), the focal length in pixels (eq.
-    /// 7.1's depth), the monitored luminance's gamma, the reprojection's depth tolerance, d per
+    /// 7.1's depth), the monitored luminance's gamma, the reprojection's depth tolerance, the
+    /// hybrid pass (on, and the sampled d from which a tile takes AFIS), d per
     /// channel in pixels (w: the sampled d), and per MIP level (offset in the chain's buffer,
     /// width, height, 0), computed once here rather than per fetch in the shader.
     pub struct SssParams {
@@ -53,11 +54,14 @@ render::gpu_struct! {
         pub focal_px: f32 => "f32",
         pub monitor_gamma: f32 => "f32",
         pub depth_tolerance: f32 => "f32",
+        pub hybrid: u32 => "u32",
+        pub hybrid_min_d: f32 => "f32",
+        pub hybrid_pad: [u32; 2] => "vec2u",
         pub d_px: [f32; 4] => "vec4f",
         pub mip: [[u32; 4]; 8] => "array<vec4u, 8>",
     }
 }
-const _: () = assert!(std::mem::size_of::<SssParams>() == 240);
+const _: () = assert!(std::mem::size_of::<SssParams>() == 256);
 // The WGSL array length above is the chain's level bound.
 const _: () = assert!(prefilter::MAX_LEVELS == 8);
 
@@ -75,7 +79,19 @@ pub fn program() -> Program {
     .entry(render::wgsl_file!("sss_pass.wgsl"))
     .entry(render::wgsl_file!("separable.wgsl"))
     .entry(render::wgsl_file!("prefilter.wgsl"))
+    .entry(render::wgsl_file!("hybrid.wgsl"))
+    .entry(render::wgsl_file!("hybrid_copy.wgsl"))
 }
+
+/// The passes' names in `PassTimer`, by the index `dispatch` books them under.
+const PASSES: [&str; 6] = [
+    "sss_scatter",
+    "sss_separable_h",
+    "sss_separable_v",
+    "sss_prefilter",
+    "sss_hybrid_setup",
+    "sss_hybrid_copy",
+];
 
 /// The pass for one image size, with its buffers and two history sets (read one, write the other).
 pub struct SssPass {
@@ -84,6 +100,13 @@ pub struct SssPass {
     pipeline: wgpu::ComputePipeline,
     /// The separable baseline's horizontal and vertical passes, and their bind groups.
     separable: [(wgpu::ComputePipeline, wgpu::BindGroup); 2],
+    /// The hybrid pass (Sec. 5.3.2): its setup (each tile's technique into `tiles`) and P4 (the
+    /// AFIS tiles' copy from buffer one, the separable intermediate, to `scattered`), and P1's
+    /// bind groups per history set, `sss_scatter` writing buffer one.
+    hybrid_setup: (wgpu::ComputePipeline, wgpu::BindGroup),
+    hybrid_copy: (wgpu::ComputePipeline, wgpu::BindGroup),
+    hybrid_groups: [wgpu::BindGroup; 2],
+    tiles: wgpu::Buffer,
     kernel: wgpu::Buffer,
     /// The separable kernel last uploaded: (taps, d_px).
     kernel_for: Option<(u32, [f32; 3])>,
@@ -122,13 +145,8 @@ impl SssPass {
                 "SSS pass size {width}x{height} must be non-zero"
             )));
         }
-        let [pipeline, horizontal, vertical, prefilter_pipeline] =
-            render::compute::pipelines_auto_layout(
-                gpu,
-                "sss_scatter",
-                &program(),
-                ["sss_scatter", "sss_separable_h", "sss_separable_v", "sss_prefilter"],
-            )?;
+        let [pipeline, horizontal, vertical, prefilter_pipeline, setup_pipeline, copy_pipeline] =
+            render::compute::pipelines_auto_layout(gpu, "sss_scatter", &program(), PASSES)?;
         let size = width as u64 * height as u64 * 16;
         let params = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("sss params"),
@@ -145,18 +163,26 @@ impl SssPass {
             "sss mips",
             prefilter::level_offset(width, height, prefilter::MAX_LEVELS) * 16,
         );
+        let tiles = storage(
+            gpu,
+            "sss hybrid tiles",
+            (width.div_ceil(crate::hybrid::TILE) * height.div_ceil(crate::hybrid::TILE)) as u64 * 4,
+        );
+        let intermediate = storage(gpu, "sss separable intermediate", size);
         let layout = pipeline.get_bind_group_layout(0);
-        let group = |k: usize| {
+        // `out`: where sss_scatter writes its result (`scattered`, or buffer one under the hybrid).
+        let group = |k: usize, out: &wgpu::Buffer| {
             let buffers = [
                 &params,
                 &irradiance,
                 &history[k],
                 &cv[k],
-                &scattered,
+                out,
                 &history[1 - k],
                 &cv[1 - k],
                 &mips,
                 &motion,
+                &tiles,
             ];
             let entries: Vec<_> = buffers
                 .iter()
@@ -172,16 +198,15 @@ impl SssPass {
                 entries: &entries,
             })
         };
-        let groups = [group(0), group(1)];
+        let groups = [group(0, &scattered), group(1, &scattered)];
+        let hybrid_groups = [group(0, &intermediate), group(1, &intermediate)];
         let kernel = storage(gpu, "sss separable kernel", separable::MAX_TAPS as u64 * 16);
-        let intermediate = storage(gpu, "sss separable intermediate", size);
         // Auto layouts hold only what each entry uses: the horizontal pass never sees `scattered`.
-        let separable_group = |pipeline: &wgpu::ComputePipeline, buffers: &[&wgpu::Buffer]| {
+        let bound_group = |pipeline: &wgpu::ComputePipeline, buffers: &[(u32, &wgpu::Buffer)]| {
             let entries: Vec<_> = buffers
                 .iter()
-                .enumerate()
-                .map(|(i, b)| wgpu::BindGroupEntry {
-                    binding: i as u32,
+                .map(|&(binding, b)| wgpu::BindGroupEntry {
+                    binding,
                     resource: b.as_entire_binding(),
                 })
                 .collect();
@@ -191,9 +216,22 @@ impl SssPass {
                 entries: &entries,
             })
         };
-        let h_group = separable_group(&horizontal, &[&params, &irradiance, &kernel, &intermediate]);
-        let v_group =
-            separable_group(&vertical, &[&params, &irradiance, &kernel, &intermediate, &scattered]);
+        let separable_group = |pipeline: &wgpu::ComputePipeline, buffers: &[&wgpu::Buffer]| {
+            let numbered: Vec<_> =
+                buffers.iter().enumerate().map(|(i, &b)| (i as u32, b)).collect();
+            bound_group(pipeline, &numbered)
+        };
+        let h_group = bound_group(
+            &horizontal,
+            &[(0, &params), (1, &irradiance), (2, &kernel), (3, &intermediate), (5, &tiles)],
+        );
+        let v_group = separable_group(
+            &vertical,
+            &[&params, &irradiance, &kernel, &intermediate, &scattered, &tiles],
+        );
+        let setup_group = separable_group(&setup_pipeline, &[&params, &irradiance, &tiles]);
+        let copy_group =
+            separable_group(&copy_pipeline, &[&params, &intermediate, &scattered, &tiles]);
         let separable = [(horizontal, h_group), (vertical, v_group)];
         let level_groups = (0..prefilter::MAX_LEVELS)
             .map(|k| {
@@ -205,15 +243,16 @@ impl SssPass {
                 separable_group(&prefilter_pipeline, &[&params, &irradiance, &mips, &level])
             })
             .collect();
-        let timer = PassTimer::new(
-            gpu,
-            &["sss_scatter", "sss_separable_h", "sss_separable_v", "sss_prefilter"],
-        );
+        let timer = PassTimer::new(gpu, &PASSES);
         Ok(Self {
             width,
             height,
             pipeline,
             separable,
+            hybrid_setup: (setup_pipeline, setup_group),
+            hybrid_copy: (copy_pipeline, copy_group),
+            hybrid_groups,
+            tiles,
             kernel,
             kernel_for: None,
             params,
@@ -276,6 +315,9 @@ impl SssPass {
             SssVariant::Separable { taps } => (0, taps),
             _ => (0, 0),
         };
+        // The hybrid's separable tiles take its own taps; its AFIS tiles the variant's count.
+        let taps = settings.hybrid.map_or(taps, |h| h.taps);
+        let hybrid = settings.hybrid.is_some();
         if taps > 0 && self.kernel_for != Some((taps, frame.d_px)) {
             let kernel = separable::kernel(taps, frame.d_px).map_err(RenderError::Settings)?;
             gpu.queue.write_buffer(&self.kernel, 0, bytemuck::cast_slice(&kernel));
@@ -315,6 +357,9 @@ impl SssPass {
             focal_px: frame.focal_px,
             monitor_gamma: settings.monitor_gamma,
             depth_tolerance: settings.depth_tolerance,
+            hybrid: hybrid as u32,
+            hybrid_min_d: settings.hybrid.map_or(0.0, |h| h.min_d_px()),
+            hybrid_pad: [0; 2],
             d_px: [frame.d_px[0], frame.d_px[1], frame.d_px[2], frame.d_sample()],
             mip: std::array::from_fn(|k| {
                 let (w, h) = prefilter::level_size(self.width, self.height, k as u32);
@@ -339,6 +384,15 @@ impl SssPass {
         gpu.queue.write_buffer(&self.motion, 0, bytemuck::cast_slice(motion));
         let mut timed = self.timer.begin(gpu, "sss frame");
         let (gx, gy) = (self.width.div_ceil(8), self.height.div_ceil(8));
+        if hybrid {
+            let (pipeline, group) = &self.hybrid_setup;
+            timed.pass(4, |pass| {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, group, &[]);
+                // One invocation per tile.
+                pass.dispatch_workgroups(gx.div_ceil(8), gy.div_ceil(8), 1);
+            })?;
+        }
         if mip_levels > 0 {
             let (pipeline, groups) = &self.prefilter;
             timed.pass(3, |pass| {
@@ -351,21 +405,31 @@ impl SssPass {
                 }
             })?;
         }
-        let passes: Vec<(usize, &wgpu::ComputePipeline, &wgpu::BindGroup)> = if taps > 0 {
-            self.separable.iter().enumerate().map(|(k, (p, g))| (1 + k, p, g)).collect()
+        // The order of Sec. 5.3.2 under the hybrid: setup, prefilter, P1 (`sss_scatter` into
+        // buffer one), P2 and P3 (the separable passes), P4 (the copy); wgpu orders the passes.
+        let full = (gx, gy);
+        let mut passes: Vec<(usize, &wgpu::ComputePipeline, &wgpu::BindGroup)> = Vec::new();
+        if hybrid {
+            passes.push((0, &self.pipeline, &self.hybrid_groups[self.current]));
+        }
+        if taps > 0 {
+            passes.extend(self.separable.iter().enumerate().map(|(k, (p, g))| (1 + k, p, g)));
         } else {
-            vec![(0, &self.pipeline, &self.groups[self.current])]
-        };
+            passes.push((0, &self.pipeline, &self.groups[self.current]));
+        }
+        if hybrid {
+            passes.push((5, &self.hybrid_copy.0, &self.hybrid_copy.1));
+        }
         for (index, pipeline, group) in passes {
             timed.pass(index, |pass| {
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, group, &[]);
-                pass.dispatch_workgroups(gx, gy, 1);
+                pass.dispatch_workgroups(full.0, full.1, 1);
             })?;
         }
         let times = timed.submit()?;
         // The separable passes keep no history: the Monte Carlo histories stay as they were.
-        if taps == 0 {
+        if taps == 0 || hybrid {
             self.current = 1 - self.current;
         }
         Ok(times)
@@ -392,6 +456,14 @@ impl SssPass {
                 all[start..start + (w * h) as usize].to_vec()
             })
             .collect())
+    }
+
+    /// The hybrid's last technique per tile (row-major ⌈w/8⌉ x ⌈h/8⌉; `hybrid::Technique` codes).
+    pub fn tiles(&self, gpu: &Gpu) -> Result<Vec<u32>, RenderError> {
+        let mut all: Vec<u32> = read_pod(gpu, &self.tiles, "sss hybrid tiles")?;
+        let t = crate::hybrid::TILE;
+        all.truncate((self.width.div_ceil(t) * self.height.div_ceil(t)) as usize);
+        Ok(all)
     }
 
     /// The last frame's results (scattered rgb, count).

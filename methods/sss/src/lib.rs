@@ -3,12 +3,15 @@
 //! (`sampling`), single pass variance guiding (`spvg`), control variates in the sample-count
 //! domain (`control_variates`), the pass on the CPU (`screen_pass`) and in WGSL (`gpu`), the
 //! separable baseline (`separable`), prefiltered irradiance MIPs for AFIS (`prefilter`), the
-//! random-walk reference (`random_walk`).
+//! hybrid of the two (`hybrid`), the random-walk reference (`random_walk`) and the path-traced
+//! ground truth of a flat plane built on it (`ground_truth`).
 //! README inside.
 
 pub mod control_variates;
 pub mod evaluation;
 pub mod gpu;
+pub mod ground_truth;
+pub mod hybrid;
 pub mod inverse;
 pub mod prefilter;
 pub mod profile;
@@ -22,6 +25,7 @@ pub mod spvg;
 pub mod synthetic;
 
 pub use control_variates::EmCovariance;
+pub use hybrid::Hybrid;
 pub use prefilter::Prefilter;
 pub use profile::BurleyProfile;
 pub use screen_pass::{PixelHistory, PixelResult, SssFrame, SssSettings, SssVariant};

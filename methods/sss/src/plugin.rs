@@ -1,7 +1,8 @@
 //! Screen-space subsurface scattering (render::sss, issue 14, realtime-sss-thesis.txt): the path
 //! tracer's image, demodulated by the G-buffer albedo on the pixels of each subsurface material
 //! (up to 8, each with its own profile and pass), is scattered by the thesis's pass (Burley sampling with SPVG counts and control
-//! variates, or a fixed count, or the separable baseline) and modulated back; with `taa` set,
+//! variates, or a fixed count, or the separable baseline, or the hybrid of AFIS and separable)
+//! and modulated back; with `taa` set,
 //! taa's resolve runs over the result, as the thesis's TAA after the pass.
 //! `Sss(variant: OnlineCv, taa: (alpha: 0.1))`.
 
@@ -9,7 +10,7 @@ use std::time::Instant;
 
 use crate::gpu::SssPass;
 use crate::profile::scaling_from_dmfp;
-use crate::{Prefilter, Split, SpvgSettings, SssFrame, SssSettings, SssVariant};
+use crate::{Hybrid, Prefilter, Split, SpvgSettings, SssFrame, SssSettings, SssVariant};
 use anyhow::{Result, bail};
 use bevy_ecs::prelude::*;
 use glam::Vec3;
@@ -49,6 +50,10 @@ pub struct SssMethodSettings {
     /// The monitored luminance's encoding Y^(1/γ_m) (Sec. 4.4's gamma-corrected luminance; 1:
     /// linear).
     pub monitor_gamma: f32,
+    /// The hybrid pass (Sec. 5.3.2), `hybrid: (taps: 25, max_gap_px: 1.0)`: AFIS (the variant
+    /// on the prefiltered chain; needs `prefilter`) on the 8x8 tiles where the separable taps
+    /// would lie more than max_gap_px apart, the separable passes elsewhere. None: the variant.
+    pub hybrid: Option<Hybrid>,
 }
 
 impl Default for SssMethodSettings {
@@ -66,6 +71,7 @@ impl Default for SssMethodSettings {
             prefilter: None,
             split: s.split,
             monitor_gamma: s.monitor_gamma,
+            hybrid: s.hybrid,
         }
     }
 }
@@ -80,6 +86,10 @@ impl SssMethodSettings {
             SssVariant::Separable { taps } => format!("sss_separable{taps}"),
         };
         let base = if self.prefilter.is_some() { format!("{base}_afis") } else { base };
+        let base = match self.hybrid {
+            Some(h) => format!("{base}_hybrid{}", h.taps),
+            None => base,
+        };
         if self.taa.is_some() { format!("{base}_taa") } else { base }
     }
 
@@ -95,6 +105,7 @@ impl SssMethodSettings {
             prefilter: self.prefilter,
             split: self.split,
             monitor_gamma: self.monitor_gamma,
+            hybrid: self.hybrid,
             ..Default::default()
         }
     }

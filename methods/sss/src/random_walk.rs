@@ -118,12 +118,26 @@ pub const MAX_EVENTS: u32 = 100_000;
 /// z = 0 is tallied at its radius from `centre`.
 fn walk(
     medium: &Medium,
-    mut p: [f64; 3],
-    mut dir: [f64; 3],
+    p: [f64; 3],
+    dir: [f64; 3],
     centre: [f64; 2],
     rng: &mut SplitMix64,
     tally: &mut ExitTally,
 ) {
+    if let Some(([x, y], events)) = walk_exit(medium, p, dir, rng) {
+        let (x, y) = (x - centre[0], y - centre[1]);
+        tally.add((x * x + y * y).sqrt(), 1.0, events);
+    }
+}
+
+/// The walk itself: where it leaves through z = 0 and after how many scattering events, or
+/// None when absorbed.
+fn walk_exit(
+    medium: &Medium,
+    mut p: [f64; 3],
+    mut dir: [f64; 3],
+    rng: &mut SplitMix64,
+) -> Option<([f64; 2], u32)> {
     let (sigma_t, alpha) = (medium.sigma_t(), medium.albedo());
     for events in 0..=MAX_EVENTS {
         let t = -(1.0 - uniform(rng)).ln() / sigma_t;
@@ -131,16 +145,25 @@ fn walk(
         if z >= 0.0 {
             // Leaves through the surface at the crossing point.
             let s = -p[2] / dir[2];
-            let (x, y) = (p[0] + s * dir[0] - centre[0], p[1] + s * dir[1] - centre[1]);
-            tally.add((x * x + y * y).sqrt(), 1.0, events);
-            return;
+            return Some(([p[0] + s * dir[0], p[1] + s * dir[1]], events));
         }
         p = [p[0] + t * dir[0], p[1] + t * dir[1], z];
         if uniform(rng) >= alpha {
-            return;
+            return None;
         }
         dir = isotropic(rng);
     }
+    None
+}
+
+/// The searchlight's walks one by one: the exit offset (x, y) of each walk that leaves, and
+/// how many walks were traced (the others were absorbed).
+pub fn searchlight_exits(medium: &Medium, paths: u64, seed: u64) -> (Vec<[f64; 2]>, u64) {
+    let mut rng = SplitMix64::seeded(seed);
+    let exits = (0..paths)
+        .filter_map(|_| walk_exit(medium, [0.0; 3], [0.0, 0.0, -1.0], &mut rng).map(|e| e.0))
+        .collect();
+    (exits, paths)
 }
 
 /// A normally incident pencil beam at the origin (the searchlight: R(r)'s definition).

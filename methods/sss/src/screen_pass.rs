@@ -4,6 +4,7 @@
 //! (eq. 5.2, divided by A: the albedo is applied after the pass), and the histories update.
 
 use super::control_variates::EmCovariance;
+use super::hybrid::{self, Hybrid};
 use super::prefilter::{self, MipChain, Prefilter};
 use super::reproject;
 use super::sampling::{luminance, pixel_offset, r2_point, radial_pdf, sample_radius};
@@ -62,6 +63,9 @@ pub struct SssSettings {
     /// The reprojected history is reset where its depth and this pixel's differ by more than
     /// this share (the TAA resolve's rejection test and default).
     pub depth_tolerance: f32,
+    /// The hybrid pass (Sec. 5.3.2): AFIS (the variant on the prefiltered chain) on some tiles,
+    /// the separable passes on the others; None: the variant alone.
+    pub hybrid: Option<Hybrid>,
 }
 
 impl SssSettings {
@@ -82,6 +86,15 @@ impl SssSettings {
                 "depth_tolerance {}; expected a positive share of the depth",
                 self.depth_tolerance
             ));
+        }
+        if let Some(h) = &self.hybrid {
+            h.validate()?;
+            if matches!(self.variant, SssVariant::Separable { .. }) {
+                return Err("hybrid with the Separable variant; expected the Monte Carlo variant its AFIS tiles run (Adaptive, OnlineCv, ConstantCv, Fixed), the separable taps in hybrid's own taps".into());
+            }
+            if self.prefilter.is_none() {
+                return Err("hybrid without prefilter; the hybrid's Monte Carlo tiles run AFIS, expected e.g. prefilter: ()".into());
+            }
         }
         self.mip_levels().map(|_| ())
     }
@@ -115,6 +128,7 @@ impl Default for SssSettings {
             split: Some(Split::default()),
             monitor_gamma: MONITOR_GAMMA,
             depth_tolerance: taa::TaaSettings::default().depth_tolerance,
+            hybrid: None,
         }
     }
 }
@@ -338,6 +352,21 @@ pub fn step(
         let kernel = separable::kernel(taps, frame.d_px).unwrap_or_else(|e| panic!("{e}"));
         return (separable::step(frame, &kernel), vec![PixelHistory::default(); count]);
     }
+    if let Some(h) = &settings.hybrid {
+        return hybrid::step(frame, settings, h, frame_index, history);
+    }
+    monte_carlo_step(frame, settings, frame_index, history)
+}
+
+/// Every pixel's Monte Carlo step (the variant, AFIS where the settings prefilter) with the
+/// reprojected histories.
+pub(crate) fn monte_carlo_step(
+    frame: &SssFrame,
+    settings: &SssSettings,
+    frame_index: u32,
+    history: &[PixelHistory],
+) -> (Vec<PixelResult>, Vec<PixelHistory>) {
+    let count = (frame.width * frame.height) as usize;
     let chain = mip_chain(frame, settings);
     let mut results = Vec::with_capacity(count);
     let mut next = Vec::with_capacity(count);

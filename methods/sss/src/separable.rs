@@ -120,7 +120,7 @@ fn fetch_1d(
 
 /// One 1-D pass: per SSS pixel Σ_i w_i L(centre + o_i d_s w e), e the pass's axis; other
 /// pixels pass through. `source` is the irradiance (first pass) or the first pass's output.
-fn pass(
+pub(crate) fn pass(
     frame: &SssFrame,
     source: &[[f32; 4]],
     kernel: &[[f32; 4]],
