@@ -97,16 +97,8 @@ pub fn trial(s: &MisSetup, rng: &mut Pcg) -> MisTrial {
     let rt_t0 = homogeneous_ratio_tracking(s.mu, s.majorant, t0, rng);
     let (other, free) = (Ratio::other(s.mu, p0_t0), Ratio::free_flight(s.mu, p0_t1));
     let free_t0 = Ratio::free_flight(s.mu, p0_t0);
-    let w0 = [
-        other.naive(a.0),
-        other.jackknife(a.0, a.1),
-        1.0 - miller_weight(s.mu, p0_t0, rt_w0),
-    ];
-    let w1 = [
-        free.naive(b.0),
-        free.jackknife(b.0, b.1),
-        miller_weight(s.mu, p0_t1, rt_w1),
-    ];
+    let w0 = [other.naive(a.0), other.jackknife(a.0, a.1), 1.0 - miller_weight(s.mu, p0_t0, rt_w0)];
+    let w1 = [free.naive(b.0), free.jackknife(b.0, b.1), miller_weight(s.mu, p0_t1, rt_w1)];
     // Eq. 9's independent unbiased T̃(t0): the jackknife (unbiased on normal inputs), ratio
     // tracking for Miller et al.
     let tr = [jackknife(c.0, c.1), jackknife(c.0, c.1), rt_t0];

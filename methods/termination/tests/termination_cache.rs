@@ -5,7 +5,9 @@
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::SceneDesc;
 use render::scene_gpu::SceneGpu;
-use termination::{Incomplete, TerminationCache, TerminationOutput, TerminationRule, TerminationSettings};
+use termination::{
+    Incomplete, TerminationCache, TerminationOutput, TerminationRule, TerminationSettings,
+};
 
 use common::{H, W, furnace, gpu, room_scene};
 use render::test_scenes as common;
