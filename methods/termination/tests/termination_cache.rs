@@ -233,6 +233,8 @@ fn incomplete_samples_path_traced_make_the_first_estimates_complete() {
         let s = TerminationSettings {
             incomplete,
             warmup_frames: 1,
+            // Every primary vertex offered: many records after one warm-up frame.
+            store_probability: 1.0,
             ..settings(TerminationRule::FirstVertex)
         };
         let mut cache = TerminationCache::new(gpu(), &sg, s).unwrap();
