@@ -26,7 +26,6 @@ const SEEDS: [u64; 3] = [3, 4, 5];
 const SCENARIO: &str = "termination_variance_door.ron";
 const FRAMES: u32 = 16;
 const THRESHOLDS: [&str; 2] = ["0.01", "1"];
-const SURVIVAL: [&str; 3] = ["100", "60", "20"];
 
 /// Per method: mean path length over the frames and the mean over pixels of the per-pixel
 /// variance of luminance over the frames.
