@@ -64,8 +64,8 @@ fn mis_trials(@builtin(global_invocation_id) id: vec3u, @builtin(num_workgroups)
     let other = mis_other(mu, p0_t0);
     let free = mis_free_flight(mu, p0_t1);
     let free_t0 = mis_free_flight(mu, p0_t0);
-    let w0 = vec3f(mis_naive(other, 0.5 * (a.x + a.y)), mis_jackknife(other, a.x, a.y), 1.0 - mis_miller(mu, p0_t0, rt_w0));
-    let w1 = vec3f(mis_naive(free, 0.5 * (b.x + b.y)), mis_jackknife(free, b.x, b.y), mis_miller(mu, p0_t1, rt_w1));
+    let w0 = vec3f(mis_naive(other, a.x), mis_jackknife(other, a.x, a.y), 1.0 - mis_miller(mu, p0_t0, rt_w0));
+    let w1 = vec3f(mis_naive(free, b.x), mis_jackknife(free, b.x, b.y), mis_miller(mu, p0_t1, rt_w1));
     let tr_jack = jackknife(c.x, c.y);
     let eq9 = vec3f(
         mis_eq9(w0.x, tr_jack, mu, p0_t0, ls0, w1.x, ls1),
@@ -73,7 +73,7 @@ fn mis_trials(@builtin(global_invocation_id) id: vec3u, @builtin(num_workgroups)
         mis_eq9(w0.z, rt_t0, mu, p0_t0, ls0, w1.z, ls1),
     );
     let eq10 = vec2f(
-        mis_eq10(mis_naive(free_t0, 0.5 * (a.x + a.y)), ls0, w1.x, ls1),
+        mis_eq10(mis_naive(free_t0, a.x), ls0, w1.x, ls1),
         mis_eq10(mis_jackknife(free_t0, a.x, a.y), ls0, w1.y, ls1),
     );
     trials[2u * i] = vec4f(w1, eq9.x);

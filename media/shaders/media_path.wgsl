@@ -196,17 +196,19 @@ fn mis_weight(ray: MediaRay, t: f32, mu: f32, p0: f32, other: bool, rng: ptr<fun
         return select(w, 1.0 - w, other);
     }
     let r = select(mis_free_flight(mu, p0), mis_other(mu, p0), other);
+    // The naive weight is g(X0) of one estimate (m = 1, Fig. 12d); the jackknife needs two.
+    let m = select(2u, 1u, vp.mis == MIS_NAIVE);
     var x = vec2f(0.0);
     for (var i = 0u; i < media_count(); i++) {
         let h = segment_in(i, ray.origin, ray.dir, min(t, ray.t_max));
         if h.t0 < h.t1 {
             let prep = od_prepare(h, true);
-            od_estimate(h, prep, 2u, vp.samples, true, true, rng);
+            od_estimate(h, prep, m, vp.samples, true, true, rng);
             x += vec2f(od_x[0], od_x[1]);
         }
     }
     if vp.mis == MIS_NAIVE {
-        return mis_naive(r, 0.5 * (x.x + x.y));
+        return mis_naive(r, x.x);
     }
     return mis_jackknife(r, x.x, x.y);
 }

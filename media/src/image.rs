@@ -77,6 +77,21 @@ pub fn reduce(estimates: &[Estimate], spp: u32) -> PixelStats {
     s
 }
 
+/// RMS over pixels of the noise-corrected bias: per pixel (mean − T)² − s²/spp is an unbiased
+/// estimate of the squared bias, so the figure does not drown in the noise of the mean as mean
+/// |mean − T| does at a few dozen estimates per pixel (the paper reads bias from 2^18 spp).
+pub fn rms_bias(stats: &PixelStats, exact: &[f32], spp: u32) -> f64 {
+    let b2: f64 = stats
+        .mean
+        .iter()
+        .zip(&stats.std)
+        .zip(exact)
+        .map(|((m, s), t)| f64::from(m - t).powi(2) - f64::from(*s).powi(2) / f64::from(spp))
+        .sum::<f64>()
+        / exact.len() as f64;
+    b2.max(0.0).sqrt()
+}
+
 /// exp(−τ) per pixel by regular tracking.
 pub fn exact(medium: &Medium, origin: Vec3, dirs: &[Vec3]) -> Vec<f32> {
     dirs.iter()

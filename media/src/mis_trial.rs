@@ -6,7 +6,9 @@
 //! sampling, strategy 1 free-flight sampling (beyond t_max it hits the surface: L_s = 0).
 //! Optical-depth estimates are synthetic normals N(μt, (σ_rel μt)²) (the jackknife's model); the
 //! ratio-tracking estimates of Miller et al.'s weight track the homogeneous medium against a
-//! majorant μ̂ > μ. The WGSL twin is media/shaders/media_mis_trials.wgsl (same draws, same order).
+//! majorant μ̂ > μ. The naive weight g(X0) reads one estimate (m = 1, as the paper's Fig. 12d;
+//! its draws stay those of the pair, so every trial consumes the same numbers); the jackknife's
+//! Re g(X̄ + iS) reads both. The WGSL twin is media/shaders/media_mis_trials.wgsl (same draws, same order).
 
 use crate::equiangular::Equiangular;
 use crate::jackknife::jackknife;
@@ -38,7 +40,7 @@ impl MisSetup {
 /// estimates: Eq. 9 per weight, Eq. 10 for the naive and jackknife g̃.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct MisTrial {
-    /// Naive g(X̄), jackknife Re g(X̄ + iS), Miller et al.'s.
+    /// Naive g(X0) (m = 1), jackknife Re g(X̄ + iS) (m = 2), Miller et al.'s.
     pub w1: [f32; 3],
     pub eq9: [f32; 3],
     pub eq10: [f32; 2],
@@ -95,22 +97,14 @@ pub fn trial(s: &MisSetup, rng: &mut Pcg) -> MisTrial {
     let rt_t0 = homogeneous_ratio_tracking(s.mu, s.majorant, t0, rng);
     let (other, free) = (Ratio::other(s.mu, p0_t0), Ratio::free_flight(s.mu, p0_t1));
     let free_t0 = Ratio::free_flight(s.mu, p0_t0);
-    let w0 = [
-        other.naive(0.5 * (a.0 + a.1)),
-        other.jackknife(a.0, a.1),
-        1.0 - miller_weight(s.mu, p0_t0, rt_w0),
-    ];
-    let w1 = [
-        free.naive(0.5 * (b.0 + b.1)),
-        free.jackknife(b.0, b.1),
-        miller_weight(s.mu, p0_t1, rt_w1),
-    ];
+    let w0 = [other.naive(a.0), other.jackknife(a.0, a.1), 1.0 - miller_weight(s.mu, p0_t0, rt_w0)];
+    let w1 = [free.naive(b.0), free.jackknife(b.0, b.1), miller_weight(s.mu, p0_t1, rt_w1)];
     // Eq. 9's independent unbiased T̃(t0): the jackknife (unbiased on normal inputs), ratio
     // tracking for Miller et al.
     let tr = [jackknife(c.0, c.1), jackknife(c.0, c.1), rt_t0];
     let eq9 = std::array::from_fn(|k| eq9(w0[k], tr[k], s.mu, p0_t0, ls0, w1[k], ls1));
     let eq10 = [
-        eq10(free_t0.naive(0.5 * (a.0 + a.1)), ls0, w1[0], ls1),
+        eq10(free_t0.naive(a.0), ls0, w1[0], ls1),
         eq10(free_t0.jackknife(a.0, a.1), ls0, w1[1], ls1),
     ];
     MisTrial { w1, eq9, eq10 }

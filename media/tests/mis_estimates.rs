@@ -2,7 +2,8 @@
 //! vs free-flight sampling, normal optical-depth estimates), 10^6 trials on the CPU reference and
 //! on the GPU: Eq. 9 is unbiased with the naive, jackknife and Miller weights; Eq. 10's bias
 //! equals its prediction ∫ (E g̃(t) − g(t)) L_s(t) (p0(t) + p1(t)) dt, with E g̃ integrated over the
-//! normal inputs, and is much smaller with the jackknife's g̃ than with the naive one. The WGSL
+//! normal inputs, and is much smaller with the jackknife's g̃ than with the naive one (g(X0) of
+//! one estimate, m = 1, as the paper's Fig. 12d). The WGSL
 //! trial equals the CPU reference trial for trial on the same seeds.
 
 mod common;
@@ -65,12 +66,14 @@ fn closed_forms(s: &MisSetup) -> (f64, f64, f64) {
             e.div(e.add(C::new(p0, 0.0))).re
         };
         let tau = mu * t;
-        // X̄ ~ N(τ, σ²/2), (X0 − X1)/2 ~ N(0, σ²/2) independent; Re g is even in S.
-        let sd = f64::from(s.sigma_rel) * tau / 2f64.sqrt();
+        // The naive weight reads one estimate X0 ~ N(τ, σ²) (m = 1, Fig. 12d); the jackknife's
+        // X̄ ~ N(τ, σ²/2) and (X0 − X1)/2 ~ N(0, σ²/2) are independent; Re g is even in S.
+        let sigma = f64::from(s.sigma_rel) * tau;
+        let sd = sigma / 2f64.sqrt();
         let (mut e_naive, mut e_jack) = (0.0, 0.0);
         for &(z1, w1) in &nodes {
+            e_naive += w1 * g(C::new(tau + sigma * z1, 0.0));
             let x = tau + sd * z1;
-            e_naive += w1 * g(C::new(x, 0.0));
             for &(z2, w2) in &nodes {
                 e_jack += w1 * w2 * g(C::new(x, sd * z2));
             }

@@ -16,7 +16,7 @@ use std::sync::OnceLock;
 
 use glam::{UVec3, Vec3};
 use media::gpu::{GpuMedium, ImagePass};
-use media::image::{ImageKey, PixelStats, directions, exact, reduce};
+use media::image::{ImageKey, PixelStats, directions, exact, reduce, rms_bias};
 use media::{DensityGrid, DensityKind, Estimator, Medium};
 use render::frame::CameraBasis;
 use render::gpu::Gpu;
@@ -89,19 +89,6 @@ fn image(est: Estimator, seed: u32, spp: u32) -> PixelStats {
         )
         .expect("image");
     reduce(&e, spp)
-}
-
-/// RMS over pixels of the noise-corrected bias (see the file's comment).
-fn rms_bias(stats: &PixelStats, exact: &[f32], spp: u32) -> f64 {
-    let b2: f64 = stats
-        .mean
-        .iter()
-        .zip(&stats.std)
-        .zip(exact)
-        .map(|((m, s), t)| f64::from(m - t).powi(2) - f64::from(*s).powi(2) / f64::from(spp))
-        .sum::<f64>()
-        / exact.len() as f64;
-    b2.max(0.0).sqrt()
 }
 
 /// Mean and standard error of per-seed values.

@@ -44,7 +44,7 @@ impl MediumOptics {
 pub enum MisWeight {
     #[default]
     None,
-    /// g(X̄).
+    /// g(X0) of one optical-depth estimate (m = 1, the paper's Fig. 12d).
     Naive,
     /// Re g(X̄ + iS) (Eq. 12, Appendix F).
     Jackknife,
@@ -88,7 +88,8 @@ pub struct VolumePathSettings {
     pub mis: MisWeight,
     pub combination: Combination,
     pub shadow: ShadowTransmittance,
-    /// Samples N of each of the two optical-depth estimates of a naive or jackknife weight.
+    /// Samples N of each optical-depth estimate of a weight (the naive reads one, the jackknife
+    /// two).
     pub samples: u32,
     /// N of each optical-depth estimate of a jackknife shadow ray (the paper's 10).
     pub shadow_samples: u32,

@@ -24,7 +24,7 @@ import package::pt_sampling::{luminance, rng_next, rng_next2, rng_seed};
 import package::pt_bsdf::{bsdf_sample, make_bsdf};
 import package::pt_lights::{FAR};
 import package::pt_scene::{base_color_at, camera_ray_direction, escaped_radiance, offset_origin, orient};
-import package::pt_integrator::{emitted_radiance, next_event};
+import package::pt_integrator::{emitted_radiance, next_event, path_radiance};
 import package::taa::primary::{primary_attributes};
 import package::termination_types::{TcRecord, TcVertex};
 import package::termination_bindings::{colour_out, counters, path_length, primary_out, records, slots, tc, vertices};
@@ -45,7 +45,7 @@ const TC_COUNTER_STORED: u32 = 5u;
 const TC_COUNTER_UNKNOWN: u32 = 6u;    // decisions at a vertex without a filled record
 const TC_COUNTER_PROPAGATED: u32 = 7u; // stored vertices propagated
 const TC_COUNTER_FILLED: u32 = 9u;     // records holding moments after the fold
-const TC_COUNTER_INCOMPLETE: u32 = 8u; // propagated vertices left out: a sample hit no filled record
+const TC_COUNTER_INCOMPLETE: u32 = 8u; // propagated vertices with a sample that hit no filled record
 
 fn tc_rule() -> TcRule {
     return TcRule(tc.rule_kind, tc.relative, tc.param, tc.margin, tc.bias_clamp, tc.survival);
@@ -156,8 +156,11 @@ fn tc_propagate(@builtin(global_invocation_id) id: vec3u) {
     var sum_b2 = 0.0; // the continuation's squares: Y = NEE + B, roulette keeps only B
     var deferred = 0.0;
     // A sample whose hit has no filled record yet reads 0, which darkens the record: such an
-    // estimate only starts an empty record (the iteration's bootstrap), never updates a filled one.
+    // estimate only starts an empty record (the iteration's bootstrap), never updates a filled one;
+    // or (tc.incomplete_path_trace) the sample goes on by path tracing from that hit, which keeps
+    // the estimate unbiased and complete.
     var complete = true;
+    var unknown_hit = false;
     for (var k = 0u; k < tc.samples_per_vertex; k++) {
         let nee = next_event(sp.position, sh, bsdf, wo, &rng);
         var y = nee;
@@ -171,16 +174,23 @@ fn tc_propagate(@builtin(global_invocation_id) id: vec3u) {
             } else {
                 let sp2 = surface_point(hit2, o2, bs.wi);
                 let sh2 = orient(sp2, -bs.wi);
-                y += w * emitted_radiance(sp2, material(sp2.material), bs.wi, hit2.t, bs.pdf);
                 let key2 = tc_key(sp2.position, sh2.ns, rng_next2(&rng));
                 var s2 = tc_find(key2);
                 if s2 != HC_NONE && records[s2].vertices > 0.0 {
+                    y += w * emitted_radiance(sp2, material(sp2.material), bs.wi, hit2.t, bs.pdf);
                     let r2 = records[s2];
                     y += w * r2.mean;
                     let lw = luminance(w);
                     deferred += lw * lw * tc_stats(r2).bias2;
                 } else {
-                    complete = false;
+                    unknown_hit = true;
+                    if tc.incomplete_path_trace != 0u {
+                        // The hit's emission and the path after it, to the frame's max depth.
+                        y += w * path_radiance(o2, bs.wi, bs.pdf, 1u, &rng);
+                    } else {
+                        y += w * emitted_radiance(sp2, material(sp2.material), bs.wi, hit2.t, bs.pdf);
+                        complete = false;
+                    }
                 }
                 if k == 0u {
                     // Exploration: the hit may become a stored vertex of its record.
@@ -201,7 +211,7 @@ fn tc_propagate(@builtin(global_invocation_id) id: vec3u) {
         sum_b2 += lb * lb;
     }
     atomicAdd(&counters[TC_COUNTER_PROPAGATE_RAYS], sg_rays_traced);
-    atomicAdd(&counters[select(TC_COUNTER_INCOMPLETE, TC_COUNTER_PROPAGATED, complete)], 1u);
+    atomicAdd(&counters[select(TC_COUNTER_PROPAGATED, TC_COUNTER_INCOMPLETE, unknown_hit)], 1u);
     let n = f32(tc.samples_per_vertex);
     // Mean, mean of squares, and the U-statistic over all pairs ((sum)^2 - sum of squares) / (K(K-1)).
     let mean_y = sum_y / n;

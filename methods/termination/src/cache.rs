@@ -8,7 +8,7 @@
 use super::gpu_decision::{decision_module, rule_words};
 use super::moments::RecordMoments;
 use super::rule::TerminationRule;
-use super::settings::{BYTES_PER_RECORD, TerminationSettings, VERTICES_PER_RECORD};
+use super::settings::{BYTES_PER_RECORD, Incomplete, TerminationSettings, VERTICES_PER_RECORD};
 use glam::Vec3;
 use hash_cache::{HashCacheParams, HashCacheSettings};
 use render::compute::{self, BufferBinding};
@@ -89,7 +89,9 @@ render::gpu_struct! {
         pub pixels: u32 => "u32",
         /// XOR of the candidate indices this frame: the lowest permuted index wins a record.
         pub candidate_mask: u32 => "u32",
-        pub pad: u32 => "u32",
+        /// 1: a propagation sample whose hit has no filled record goes on by path tracing
+        /// (`Incomplete::PathTrace`); 0: its estimate is left out of filled records.
+        pub incomplete_path_trace: u32 => "u32",
     }
 }
 
@@ -536,7 +538,7 @@ impl TerminationCache {
             store_probability: s.store_probability as f32,
             pixels: self.width * self.height,
             candidate_mask: scene::mix64(seed ^ ((frame as u64) << 32)) as u32 & 0x0fff_ffff,
-            pad: 0,
+            incomplete_path_trace: (s.incomplete == Incomplete::PathTrace) as u32,
         };
         self.frame.prepare(gpu, scene, 1, 0, seed, frame);
         gpu.queue.write_buffer(&self.hc, 0, bytemuck::bytes_of(&hc));

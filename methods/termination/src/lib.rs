@@ -18,7 +18,7 @@ pub use decision::{Decision, LocalStats, PathState, arrive_area_spread, decide, 
 pub use moments::{RecordMoments, vertex_estimates};
 pub use rule::TerminationRule;
 pub use sampling_tree::{Moments, SamplingTree};
-pub use settings::TerminationSettings;
+pub use settings::{Incomplete, TerminationSettings};
 
 pub mod plugin;
 pub use plugin::Plugin;

@@ -32,6 +32,22 @@ pub struct TerminationSettings {
     /// t · radiance_unit². Variance scales with the square of radiance, and the paper's t
     /// belongs to its scenes' radiance scale, not to the lab's (README, Table 1).
     pub radiance_unit: f64,
+    /// A propagation sample whose hit has no filled record yet: its vertex estimate is left
+    /// out of filled records (the default), or the sample goes on by path tracing.
+    pub incomplete: Incomplete,
+}
+
+/// What propagation does with a sample whose BSDF hit has no filled record to end in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Incomplete {
+    /// The vertex estimate (which read 0 there) may start an empty record but never updates a
+    /// filled one: the kept estimates are those whose samples all reached filled records.
+    #[default]
+    LeaveOut,
+    /// The sample continues from that hit by path tracing to the frame's max depth (one more
+    /// ray to the hit, then the path tracer's loop): every estimate is complete and unbiased
+    /// given the records it read.
+    PathTrace,
 }
 
 impl Default for TerminationSettings {
@@ -48,6 +64,7 @@ impl Default for TerminationSettings {
             store_probability: 0.01,
             warmup_frames: 16,
             radiance_unit: 1.0,
+            incomplete: Incomplete::LeaveOut,
         }
     }
 }

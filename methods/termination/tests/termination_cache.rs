@@ -5,7 +5,9 @@
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::SceneDesc;
 use render::scene_gpu::SceneGpu;
-use termination::{TerminationCache, TerminationOutput, TerminationRule, TerminationSettings};
+use termination::{
+    Incomplete, TerminationCache, TerminationOutput, TerminationRule, TerminationSettings,
+};
 
 use common::{H, W, furnace, gpu, room_scene};
 use render::test_scenes as common;
@@ -217,4 +219,43 @@ fn two_runs_give_the_same_images() {
         assert_eq!(a[f].radiance, b[f].radiance, "frame {f}");
         assert_eq!(a[f].path_length, b[f].path_length, "frame {f}");
     }
+}
+
+#[test]
+fn incomplete_samples_path_traced_make_the_first_estimates_complete() {
+    // The furnace's records hold a·L = 0.5 (emission apart). One warm-up frame stores vertices
+    // and the first frame propagates them into an empty cache: every sample's hit lacks a
+    // record. Left out, an estimate reads 0 there and starts its record at the one-bounce
+    // value a·Le = 0.25; path traced from the hit (12 bounces) it is a·L (1 − a^12) ≈ 0.5.
+    let (scene, _) = furnace();
+    let sg = scene_gpu(&scene, 12);
+    let mean_record = |incomplete: Incomplete| {
+        let s = TerminationSettings {
+            incomplete,
+            warmup_frames: 1,
+            // Every primary vertex offered: many records after one warm-up frame.
+            store_probability: 1.0,
+            ..settings(TerminationRule::FirstVertex)
+        };
+        let mut cache = TerminationCache::new(gpu(), &sg, s).unwrap();
+        let out = cache.render(gpu(), &sg, &scene.camera, 5, 0).unwrap();
+        let records: Vec<f64> = cache
+            .read_records(gpu())
+            .unwrap()
+            .into_iter()
+            .filter(|r| r.vertices > 0.0)
+            .map(|r| (r.mean[0] + r.mean[1] + r.mean[2]) as f64 / 3.0)
+            .collect();
+        assert!(records.len() > 20, "{incomplete:?}: only {} filled records", records.len());
+        // Every propagated vertex had a sample without a record: the counter says so.
+        assert_eq!(out.stats.propagated, 0, "{incomplete:?}: {:?}", out.stats);
+        assert!(out.stats.incomplete > 20, "{incomplete:?}: {:?}", out.stats);
+        records.iter().sum::<f64>() / records.len() as f64
+    };
+    let left_out = mean_record(Incomplete::LeaveOut);
+    let traced = mean_record(Incomplete::PathTrace);
+    eprintln!("first records' mean: left out {left_out}, path traced {traced}");
+    // Bounds from the closed forms (0.25 and 0.5 less 0.5^13), halfway between them.
+    assert!((left_out - 0.25).abs() < 0.125, "left out: {left_out}, expected 0.25");
+    assert!((traced - 0.5).abs() < 0.125, "path traced: {traced}, expected 0.5");
 }

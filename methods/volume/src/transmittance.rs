@@ -3,7 +3,7 @@
 //! pixel along the camera ray through the pixel centre. Its image is the mean transmittance;
 //! its extra images are the bias map (mean − exact) and the per-pixel standard deviation of one
 //! estimate; its stats are the density lookups per pixel and estimate (counted on the GPU),
-//! mean |bias| and mean std. The exact transmittance comes from regular tracking on the CPU
+//! mean |bias|, the noise-corrected RMS bias (`media::image::rms_bias`) and mean std. The exact transmittance comes from regular tracking on the CPU
 //! (exact for the nearest-neighbour voxels; the paper uses 2^18 spp). A scenario without
 //! this method builds no medium and runs no media pass.
 
@@ -12,7 +12,7 @@ use std::time::Instant;
 use anyhow::{Result, anyhow, bail};
 use bevy_ecs::prelude::*;
 use media::gpu::{GpuMedium, ImagePass};
-use media::image::{ImageKey, directions, exact, reduce};
+use media::image::{ImageKey, directions, exact, reduce, rms_bias};
 use media::{DensityGrid, Estimator, Medium};
 use render::frame::CameraBasis;
 use serde::{Deserialize, Serialize};
@@ -138,6 +138,7 @@ pub fn render(
         let gray = |v: f32| [v, v, v, 1.0];
         let bias: Vec<f32> = stats.mean.iter().zip(&reference).map(|(m, r)| m - r).collect();
         let mean_abs_bias = bias.iter().map(|b| f64::from(b.abs())).sum::<f64>() / n;
+        let rms_bias = rms_bias(&stats, &reference, key.spp);
         let mean_std = stats.std.iter().map(|&s| f64::from(s)).sum::<f64>() / n;
         let lookups = stats.lookups.iter().map(|&l| f64::from(l)).sum::<f64>() / n;
         let rays = estimates.len() as u64;
@@ -145,6 +146,7 @@ pub fn render(
             stats: vec![
                 ("lookups_per_estimate".into(), lookups),
                 ("mean_abs_bias".into(), mean_abs_bias),
+                ("rms_bias".into(), rms_bias),
                 ("mean_std".into(), mean_std),
             ],
             images: vec![
