@@ -175,6 +175,6 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
     }
     h.push_str("</body></html>\n");
     let path = run_dir.join("report.html");
-    std::fs::write(&path, h).with_context(|| format!("cannot write {}", path.display()))?;
+    crate::atomic::write(&path, h)?;
     Ok(path)
 }
