@@ -6,7 +6,6 @@
 //! width and height, the SHA-256 of the pixels, then the pixels (RGBA f32, little-endian). A
 //! truncated or altered entry fails its checksum and is rendered again, never used.
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Result;
