@@ -118,7 +118,7 @@ mod tests {
 
     #[test]
     fn finds_non_finite_literals_outside_strings_and_comments() {
-        let found = |t: &str| first_non_finite(t).map(|(at, key, lit)| (at, key, lit));
+        let found = first_non_finite;
         assert_eq!(found("(a: 1.0, b: (0, -1e3, 2.5e-3), c: 0x1F, d: 7u8)"), None);
         assert_eq!(found("(name: \"NaN inf\", // inf\n /* NaN /* inf */ */ x: 1)"), None);
         assert_eq!(found("(s: r#\"a \" NaN\"#, x: 1)"), None);
