@@ -190,3 +190,52 @@ fn an_interrupted_run_says_so_and_resumes_to_the_uninterrupted_frames() {
     assert!(!o.status.success() && text(&o.stderr).contains("--frames"), "{}", text(&o.stderr));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_run_stopped_by_an_error_is_marked_failed_and_resumes_once_it_is_fixed() {
+    let dir = std::env::temp_dir().join(format!("flicker-failed-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let scenario = dir.join("late_reference.ron");
+    std::fs::write(
+        &scenario,
+        r#"Scenario(scene: Builtin("cornell_box"), resolution: (8, 8), frames: 5, seed: 1, max_depth: 2,
+    methods: [Taa()], reference: (spp: 2, frames: List([3])))"#,
+    )
+    .unwrap();
+    // The reference cache cannot store frame 3's reference: `references` is a file.
+    let cache = dir.join("cache");
+    std::fs::create_dir_all(&cache).unwrap();
+    std::fs::write(cache.join("references"), "in the way").unwrap();
+    let run = dir.join("run");
+    let mut cmd = flicker();
+    run_args(&mut cmd, &scenario, &run, &cache);
+    let o = cmd.output().unwrap();
+    let stderr = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("reference of frame 3") || stderr.contains("references"), "{stderr}");
+    let manifest = json(&run.join("manifest.json"));
+    assert_eq!(manifest["status"], "failed");
+    assert_eq!(manifest["last_complete_frame"], 2);
+    assert!(manifest["error"].as_str().is_some_and(|e| e.contains("references")), "{manifest}");
+    assert_eq!(results(&run).len(), 1 + 3, "frames 0 to 2 in frames.csv");
+    let page = std::fs::read_to_string(run.join("report.html")).unwrap();
+    assert!(page.contains("Incomplete run") && page.contains("failed"));
+
+    std::fs::remove_file(cache.join("references")).unwrap();
+    ok(flicker()
+        .arg("run")
+        .arg("--resume")
+        .arg(&run)
+        .arg("--quiet")
+        .arg("--cache-dir")
+        .arg(&cache)
+        .output()
+        .unwrap());
+    let manifest = json(&run.join("manifest.json"));
+    assert_eq!(manifest["status"], "complete");
+    assert!(manifest.get("error").is_none(), "{manifest}");
+    assert_eq!(results(&run).len(), 1 + 5);
+    assert!(run.join("reference/0003.exr").exists() && run.join("frames/taa/0004.exr").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
