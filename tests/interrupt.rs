@@ -89,7 +89,9 @@ fn an_interrupted_run_says_so_and_resumes_to_the_uninterrupted_frames() {
         assert!(start.elapsed() < Duration::from_secs(120), "no frames after 120 s");
         std::thread::sleep(Duration::from_millis(10));
     }
-    let kill = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    // The shell's own `kill` (a minimal Debian may lack /usr/bin/kill).
+    let kill =
+        Command::new("sh").arg("-c").arg(format!("kill -INT {}", child.id())).status().unwrap();
     assert!(kill.success());
     let o = child.wait_with_output().unwrap();
     let stderr = text(&o.stderr);
