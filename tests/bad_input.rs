@@ -147,12 +147,12 @@ fn an_unwritable_out_is_named_and_nothing_is_written() {
 
 #[test]
 fn a_resolution_over_the_buffer_limit_is_refused_with_the_limit() {
-    // 8000x8000 is within every adapter's 2D texture limit (8192) and its per-pixel buffers
-    // (64 bytes a pixel: 4 GB) over every storage-buffer binding limit wgpu allows.
+    // 16000x16000 is within lavapipe's 2D texture limit (16384) and its per-pixel buffers
+    // (64 bytes a pixel: 16 GB) over any storage-buffer binding wgpu allows (under 4 GiB).
     let dir = scratch("buffer");
     let path = dir.join("scenario.ron");
     std::fs::write(&path, format!("Scenario({BASE},\n  methods: [PathTracing(spp: 1)], reference: (spp: 1, frames: List([])))")).unwrap();
-    let err = run_fails(&path, &["--resolution", "8000x8000"]);
+    let err = run_fails(&path, &["--resolution", "16000x16000"]);
     assert!(
         err.contains("scenario.ron:2:13:") && err.contains("limit") && err.contains("buffer"),
         "{err}"
