@@ -24,9 +24,19 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Play a scenario: render every frame of every method, the references, timings and metrics.
+    ///
+    /// SIGINT or SIGTERM (Ctrl-C) stops it after the frame on hand: what it has is written,
+    /// manifest.json says `interrupted` with the last complete frame, the exit code is 130, and
+    /// `--resume` continues it. A second signal stops it at once.
     Run {
         /// The scenario file (RON), e.g. scenarios/cornell_box.ron
-        scenario: PathBuf,
+        #[arg(required_unless_present = "resume")]
+        scenario: Option<PathBuf>,
+        /// Continue the interrupted run in this folder from its last complete frame, with its
+        /// own scenario and settings (it is played again unwritten up to there: the frames come
+        /// out as those of an uninterrupted run).
+        #[arg(long, value_name = "RUN", conflicts_with_all = ["scenario", "frames", "resolution", "spp", "seed", "out"])]
+        resume: Option<PathBuf>,
         /// Number of recorded frames (overrides the scenario).
         #[arg(long)]
         frames: Option<u32>,
@@ -342,6 +352,18 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 fn main() -> ExitCode {
     runtime_dir::ensure();
     let cli = Cli::parse();
+    // The commands that play runs stop between frames on SIGINT/SIGTERM; the others end at once.
+    let plays = matches!(
+        cli.command,
+        Command::Run { .. }
+            | Command::Suite { .. }
+            | Command::Reproduce { .. }
+            | Command::Sweep { action: SweepAction::Job { .. } }
+    );
+    if plays && let Err(e) = systems::interrupt::install() {
+        eprintln!("error: cannot catch SIGINT/SIGTERM: {e:#}");
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Command::Suite { action } => return suite(action),
         Command::Sweep { action } => return sweep(action),
@@ -360,14 +382,17 @@ fn main() -> ExitCode {
                 println!("\nwrote {}", outcome.folder.join("reproduce.md").display());
             })
         }
-        Command::Run { scenario, frames, resolution, spp, seed, out, cache_dir, quiet } => {
-            let opts = RunOptions {
-                scenario,
-                overrides: Overrides { frames, resolution, spp, seed, out },
-                cache_dir,
-                progress: !quiet,
+        Command::Run { scenario, resume, frames, resolution, spp, seed, out, cache_dir, quiet } => {
+            let played = match (resume, scenario) {
+                (Some(run), _) => systems::resume::resume(&run, cache_dir, !quiet),
+                (None, scenario) => playback::run(&RunOptions {
+                    scenario: scenario.unwrap_or_default(),
+                    overrides: Overrides { frames, resolution, spp, seed, out },
+                    cache_dir,
+                    progress: !quiet,
+                }),
             };
-            playback::run(&opts).map(|summary| {
+            played.map(|summary| {
                 println!(
                     "wrote {} ({} frames; references: {} rendered, {} from cache)",
                     summary.folder.display(),
@@ -419,6 +444,10 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.is::<systems::interrupt::Interrupted>() => {
+            eprintln!("{e}");
+            ExitCode::from(systems::interrupt::EXIT_CODE)
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE

@@ -16,6 +16,9 @@ pub fn write_reference(
     references: Res<References>,
 ) -> Result {
     let Some((pixels, _)) = &references.current else { return Ok(()) };
+    if clock.frame < out.replay_until {
+        return Ok(());
+    }
     let (w, h) = (run.width, run.height);
     output::write_exr(&out.folder.reference(clock.frame, "exr"), w, h, pixels).map_err(failed)?;
     output::write_png(&out.folder.reference(clock.frame, "png"), w, h, pixels, 1.0)
@@ -33,6 +36,9 @@ pub fn write_method_images(
     methods: Query<(&MethodInfo, &MethodFrame)>,
 ) -> Result {
     let (w, h, frame) = (run.width, run.height, clock.frame);
+    if frame < out.replay_until {
+        return Ok(());
+    }
     let folder = &out.folder;
     for (info, m) in &methods {
         let Some(o) = &m.output else { continue };
@@ -80,6 +86,7 @@ pub fn write_method_images(
 /// Appends the frame's rows (in the scenario's method order) and rewrites frames.csv, so an
 /// interrupted run still has a complete table of what it did.
 pub fn write_frames_csv(
+    clock: Res<FrameClock>,
     mut out: ResMut<RunOutput>,
     methods: Query<(&MethodInfo, &MethodFrame)>,
 ) -> Result {
@@ -90,6 +97,9 @@ pub fn write_frames_csv(
         .collect();
     rows.sort_by_key(|(i, _)| *i);
     out.records.extend(rows.into_iter().map(|(_, r)| r));
+    if clock.frame < out.replay_until {
+        return Ok(());
+    }
     let path = out.folder.frames_csv();
     output::write_text(&path, &frame_record::to_csv(&out.records)).map_err(failed)
 }

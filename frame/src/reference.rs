@@ -6,7 +6,7 @@ use bevy_ecs::prelude::*;
 use super::resources::{FrameClock, GpuDevice, GpuScene, Progress, References, Run};
 use super::stage::failed;
 use crate::frame_metrics as measure;
-use crate::reference_cache::{ReferenceCache, ReferenceKey};
+use crate::reference_cache::{Lookup, ReferenceCache, ReferenceKey};
 use render::frame_bindings::FrameBindings;
 use render::gpu::Gpu;
 use render::path_tracer::PathTracer;
@@ -80,12 +80,18 @@ pub fn render_reference(
     );
     let frame = clock.frame;
     let references = &mut *references;
-    let pixels = match references.cache.load(&key, width, height) {
-        Some(px) => {
+    let lookup = references.cache.lookup(&key, width, height);
+    if let Lookup::Damaged(why) = &lookup {
+        progress.0.suspend(|| {
+            eprintln!("warning: reference cache entry damaged, rendering it again: {why}")
+        });
+    }
+    let pixels = match lookup {
+        Lookup::Hit(px) => {
             references.cached += 1;
             px
         }
-        None => {
+        Lookup::Miss | Lookup::Damaged(_) => {
             let bar = &progress.0;
             bar.set_message(format!("reference {frame:04}"));
             let spp = scenario.reference.spp;

@@ -1,6 +1,10 @@
 //! Path-traced references cached on disk under a hash of everything that affects the image:
 //! the scene as rendered at that frame, resolution, spp, seed, max depth, adapter and shader
 //! sources. A changed shader or scene can never pick up a stale reference.
+//!
+//! An entry is one file, `references/KEY.ref`, written whole through a rename: a magic tag,
+//! width and height, the SHA-256 of the pixels, then the pixels (RGBA f32, little-endian). A
+//! truncated or altered entry fails its checksum and is rendered again, never used.
 
 use std::path::{Path, PathBuf};
 
@@ -61,18 +65,91 @@ impl ReferenceCache {
         h.finalize().iter().map(|b| format!("{b:02x}")).collect()
     }
 
-    fn path(&self, key: &str) -> PathBuf {
-        self.dir.join("references").join(format!("{key}.exr"))
+    /// The file of an entry.
+    pub fn path(&self, key: &str) -> PathBuf {
+        self.dir.join("references").join(format!("{key}.ref"))
+    }
+
+    /// The entry of `key`: its pixels, none, or why it cannot be used.
+    pub fn lookup(&self, key: &str, width: u32, height: u32) -> Lookup {
+        let path = self.path(key);
+        match std::fs::read(&path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Lookup::Miss,
+            Err(e) => Lookup::Damaged(format!("{}: cannot read it: {e}", path.display())),
+            Ok(bytes) => match decode(&bytes, width, height) {
+                Ok(px) => Lookup::Hit(px),
+                Err(why) => Lookup::Damaged(format!("{}: {why}", path.display())),
+            },
+        }
     }
 
     pub fn load(&self, key: &str, width: u32, height: u32) -> Option<Vec<[f32; 4]>> {
-        let (w, h, px) = output::read_exr(&self.path(key)).ok()?;
-        (w == width && h == height).then_some(px)
+        match self.lookup(key, width, height) {
+            Lookup::Hit(px) => Some(px),
+            _ => None,
+        }
     }
 
     pub fn store(&self, key: &str, width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<()> {
-        output::write_exr(&self.path(key), width, height, pixels)
+        anyhow::ensure!(
+            pixels.len() == (width * height) as usize,
+            "image of {width}x{height} has {} pixels",
+            pixels.len()
+        );
+        let data: &[u8] = bytemuck::cast_slice(pixels);
+        output::write_atomic(&self.path(key), |w| {
+            w.write_all(MAGIC)?;
+            w.write_all(&width.to_le_bytes())?;
+            w.write_all(&height.to_le_bytes())?;
+            w.write_all(&Sha256::digest(data))?;
+            // Pixels as little-endian f32 on any host.
+            for v in bytemuck::cast_slice::<_, f32>(pixels) {
+                w.write_all(&v.to_le_bytes())?;
+            }
+            Ok(())
+        })
     }
+}
+
+/// What the cache holds for a key.
+#[derive(Debug, PartialEq)]
+pub enum Lookup {
+    Hit(Vec<[f32; 4]>),
+    Miss,
+    /// An entry that cannot be used (truncated, altered, another size): why, naming the file.
+    Damaged(String),
+}
+
+const MAGIC: &[u8; 8] = b"FLKREF01";
+const HEADER: usize = 8 + 4 + 4 + 32;
+
+fn decode(bytes: &[u8], width: u32, height: u32) -> std::result::Result<Vec<[f32; 4]>, String> {
+    if bytes.len() < HEADER || &bytes[..8] != MAGIC {
+        return Err(format!(
+            "expected a reference cache entry (tag {}), got {} bytes of something else",
+            String::from_utf8_lossy(MAGIC),
+            bytes.len()
+        ));
+    }
+    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"));
+    let (w, h) = (word(8), word(12));
+    if (w, h) != (width, height) {
+        return Err(format!("holds a {w}x{h} image, expected {width}x{height}"));
+    }
+    let data = &bytes[HEADER..];
+    let expected = (w as usize) * (h as usize) * 16;
+    if data.len() != expected {
+        return Err(format!(
+            "has {} bytes of pixels, expected {expected} (truncated?)",
+            data.len()
+        ));
+    }
+    if Sha256::digest(data).as_slice() != &bytes[16..HEADER] {
+        return Err("its pixels do not match its SHA-256 checksum".into());
+    }
+    let floats: Vec<f32> =
+        data.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes"))).collect();
+    Ok(floats.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect())
 }
 
 /// Feeds every field of the scene to the hasher. Floats go in by their bits (or their exact
@@ -149,6 +226,36 @@ mod tests {
         cache.store("k", 8, 4, &px).unwrap();
         assert_eq!(cache.load("k", 8, 4).unwrap(), px);
         assert!(cache.load("k", 4, 8).is_none());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn damaged_entries_are_named_never_used() {
+        let dir = std::env::temp_dir().join(format!("flicker-refcache-bad-{}", std::process::id()));
+        let cache = ReferenceCache::new(&dir);
+        let px: Vec<[f32; 4]> = (0..8 * 4).map(|i| [i as f32, 0.5, -1.0, 1.0]).collect();
+        cache.store("k", 8, 4, &px).unwrap();
+        let path = cache.path("k");
+        let good = std::fs::read(&path).unwrap();
+        assert_eq!(cache.lookup("k", 8, 4), Lookup::Hit(px));
+        let damaged = |bytes: &[u8], why: &str| {
+            std::fs::write(&path, bytes).unwrap();
+            match cache.lookup("k", 8, 4) {
+                Lookup::Damaged(e) => {
+                    assert!(e.contains("k.ref") && e.contains(why), "{e}")
+                }
+                other => panic!("{why}: {other:?}"),
+            }
+        };
+        damaged(&good[..good.len() - 5], "truncated");
+        damaged(&good[..10], "something else");
+        let mut flipped = good.clone();
+        *flipped.last_mut().unwrap() ^= 1; // one bit of the last pixel
+        damaged(&flipped, "checksum");
+        let mut sized = good.clone();
+        sized[8] = 9;
+        damaged(&sized, "9x4");
+        damaged(b"", "something else");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

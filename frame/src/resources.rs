@@ -55,6 +55,9 @@ pub struct FrameClock {
 pub struct RunOutput {
     pub folder: RunFolder,
     pub records: Vec<FrameRecord>,
+    /// A resumed run's recorded frames below this are on disk already: they are played again
+    /// (to rebuild the methods' state) and measured, but not written.
+    pub replay_until: u32,
 }
 
 /// The reference of this frame, where the scenario wants one, the reference cache and what

@@ -111,6 +111,6 @@ pub fn write_comparison(run_a: &Path, run_b: &Path, out: &Path) -> anyhow::Resul
         h.push_str(&viewer::script());
     }
     h.push_str("</body></html>\n");
-    std::fs::write(out, h).with_context(|| format!("cannot write {}", out.display()))?;
+    crate::atomic::write(out, h)?;
     Ok(out.to_path_buf())
 }

@@ -101,6 +101,18 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
         esc(&field("frames")),
         esc(&methods.join(", "))
     );
+    if let Some(status) = raw.get("status").and_then(|s| s.as_str()).filter(|s| *s != "complete") {
+        let last = raw.get("last_complete_frame").and_then(|f| f.as_u64());
+        let _ = writeln!(
+            h,
+            "<p class=\"incomplete\"><strong>Incomplete run</strong> ({}): {}. Continue it with <code>flicker run --resume</code>.</p>",
+            esc(status),
+            last.map_or("no recorded frame was written".into(), |f| format!(
+                "frames 0 to {f} of {} were written",
+                field("frames")
+            ))
+        );
+    }
     if !manifest.events.is_empty() {
         let ev: Vec<String> = manifest
             .events
@@ -163,6 +175,6 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
     }
     h.push_str("</body></html>\n");
     let path = run_dir.join("report.html");
-    std::fs::write(&path, h).with_context(|| format!("cannot write {}", path.display()))?;
+    crate::atomic::write(&path, h)?;
     Ok(path)
 }

@@ -168,9 +168,9 @@ pub fn write_frame_images(
                 bottom.push(upscale(&map_to_rgb8(&values, m.width, m.height), factor));
             }
             let path = charts.join(format!("crops_{}_{frame:04}.png", region.name));
-            tile(&[top, bottom])
-                .save(&path)
-                .with_context(|| format!("cannot write {}", path.display()))?;
+            let mut png = std::io::Cursor::new(Vec::new());
+            tile(&[top, bottom]).write_to(&mut png, image::ImageFormat::Png)?;
+            crate::atomic::write(&path, png.into_inner())?;
             crops.push((region.name.clone(), path));
         }
         out.push(FrameImages { frame, reference: ref_shown, methods: entries, crops });

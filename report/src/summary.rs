@@ -5,7 +5,6 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use anyhow::Context;
 use serde::Serialize;
 
 use crate::run::{Frames, Manifest, Memory};
@@ -141,8 +140,7 @@ pub fn write_summary_with_window(run_dir: &Path, n: u32) -> anyhow::Result<()> {
     let frames = Frames::load(run_dir)?;
     let summary = summarize(&manifest, &frames, n);
     let path = run_dir.join("summary.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&summary)?)
-        .with_context(|| format!("cannot write {}", path.display()))
+    crate::atomic::write(&path, serde_json::to_string_pretty(&summary)?)
 }
 
 #[cfg(test)]

@@ -534,6 +534,15 @@ impl Scenario {
                 }
             }
         }
+        if let Some((at, key, literal)) = crate::finite::first_non_finite(text) {
+            return Err(ScenarioError {
+                file: origin.to_path_buf(),
+                position: Some(line_col(text, at)),
+                message: format!(
+                    "{key}: {literal} is not a finite number; expected a finite number"
+                ),
+            });
+        }
         let name = file.name.unwrap_or_else(|| {
             origin
                 .file_stem()

@@ -35,6 +35,8 @@ pub fn build(
     Ok(json!({
         "scenario": scenario.name,
         "scenario_file": scenario_file.display().to_string(),
+        // Resolves the scenario's relative paths (glTF, grids) when a run is resumed elsewhere.
+        "scenario_origin": std::path::absolute(scenario_file).unwrap_or_else(|_| scenario_file.to_path_buf()).display().to_string(),
         "scenario_text": scenario.source,
         "commit": commit(scenario_file),
         "flicker_version": env!("CARGO_PKG_VERSION"),
@@ -62,6 +64,46 @@ pub fn build(
             },
         },
     }))
+}
+
+/// Where a run stands (`status` in manifest.json). A run killed outright stays `running`;
+/// manifests from before the field count as complete.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Status {
+    Running,
+    /// Stopped by SIGINT or SIGTERM after a whole frame.
+    Interrupted,
+    /// Stopped by an error (`error` holds it).
+    Failed,
+    Complete,
+}
+
+impl Status {
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Running => "running",
+            Status::Interrupted => "interrupted",
+            Status::Failed => "failed",
+            Status::Complete => "complete",
+        }
+    }
+
+    /// The status a manifest records.
+    pub fn of(manifest: &Value) -> Status {
+        match manifest.get("status").and_then(Value::as_str) {
+            Some("running") => Status::Running,
+            Some("interrupted") => Status::Interrupted,
+            Some("failed") => Status::Failed,
+            _ => Status::Complete,
+        }
+    }
+}
+
+/// Records where the run stands: its status and the last recorded frame whose images and
+/// frames.csv rows are all written (`null` before the first).
+pub fn set_status(manifest: &mut Value, status: Status, last_complete_frame: Option<u32>) {
+    manifest["status"] = json!(status.name());
+    manifest["last_complete_frame"] = json!(last_complete_frame);
 }
 
 /// The commit of the checkout the tool runs from, with `-dirty` when it has local changes;

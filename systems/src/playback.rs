@@ -122,7 +122,7 @@ impl FrameWorld {
             cache_dir: cache_dir.clone(),
         });
         world.insert_resource(FrameClock::default());
-        world.insert_resource(RunOutput { folder, records: Vec::new() });
+        world.insert_resource(RunOutput { folder, records: Vec::new(), replay_until: 0 });
         world.insert_resource(References {
             cache: ReferenceCache::new(cache_dir),
             renderer: reference_renderer,
@@ -197,26 +197,94 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary> {
 /// [`run`] of a scenario already loaded, with `opts.overrides` applied (a suite keeps only some
 /// of its methods first); `opts.scenario` names the file in the manifest.
 pub fn run_spec(spec: &RunSpec, opts: &RunOptions) -> Result<RunSummary> {
-    let scenario = &spec.scenario;
     let gpu = Gpu::new()?;
-    let folder = RunFolder::new(&scenario.output);
     let manifest = crate::manifest::build(spec, &opts.scenario, &gpu, &opts.overrides)?;
-    let cache_dir = opts.cache_dir.clone().unwrap_or_else(ReferenceCache::default_location);
-    let bar = progress_bar(opts.progress, (scenario.warmup_frames + scenario.frames) as u64);
+    play(spec, gpu, manifest, opts.cache_dir.clone(), opts.progress, None)
+}
+
+/// Where a resumed run picks up (crate::resume): recorded frames below `from` are on disk; they
+/// are played again, unwritten, to rebuild every method's state, and their frames.csv rows
+/// must come out as `frames_csv` has them.
+pub(crate) struct ResumeAt {
+    pub from: u32,
+    pub frames_csv: String,
+}
+
+/// Plays the run into `spec.scenario.output`, keeping manifest.json's status current: running,
+/// then complete, or interrupted (a signal, after a whole frame) or failed, with the last
+/// complete frame.
+pub(crate) fn play(
+    spec: &RunSpec,
+    gpu: Gpu,
+    mut manifest: serde_json::Value,
+    cache_dir: Option<PathBuf>,
+    progress: bool,
+    resume: Option<ResumeAt>,
+) -> Result<RunSummary> {
+    use crate::manifest::{Status, set_status};
+    let scenario = &spec.scenario;
+    let folder = RunFolder::new(&scenario.output);
+    let cache_dir = cache_dir.unwrap_or_else(ReferenceCache::default_location);
+    let bar = progress_bar(progress, (scenario.warmup_frames + scenario.frames) as u64);
     let mut frames = FrameWorld::build(spec, gpu, cache_dir, folder.clone(), bar.clone())?;
-    folder.prepare()?;
+    let from = resume.as_ref().map_or(0, |r| r.from);
+    if resume.is_none() {
+        folder.prepare()?;
+    }
+    let mut last_complete = from.checked_sub(1);
+    set_status(&mut manifest, Status::Running, last_complete);
     output::write_json(&folder.manifest(), &manifest)?;
+    frames.world.resource_mut::<RunOutput>().replay_until = from;
 
     // Warm-up frames are simulated and rendered (caches learn from them) but not recorded.
-    let total = scenario.warmup_frames + scenario.frames;
+    let (warmup, total) = (scenario.warmup_frames, scenario.warmup_frames + scenario.frames);
     for step in 0..total {
-        frames.run_frame(step, scenario.warmup_frames)?;
+        let stop = match frames.run_frame(step, warmup) {
+            Err(e) => Some((Status::Failed, Some(e))),
+            Ok(()) => {
+                if let Some(frame) = step.checked_sub(warmup).filter(|f| *f >= from) {
+                    last_complete = Some(frame);
+                }
+                let replayed =
+                    resume.as_ref().filter(|r| r.from > 0 && step + 1 == warmup + r.from);
+                match replayed.map(|r| replay_matches(&frames.world, r, &folder)) {
+                    Some(Err(e)) => Some((Status::Failed, Some(e))),
+                    _ if crate::interrupt::requested() && step + 1 < total => {
+                        Some((Status::Interrupted, None))
+                    }
+                    _ => None,
+                }
+            }
+        };
+        if let Some((status, error)) = stop {
+            bar.abandon();
+            set_status(&mut manifest, status, last_complete);
+            if let Some(e) = &error {
+                manifest["error"] = format!("{e:#}").into();
+            }
+            output::write_json(&folder.manifest(), &manifest)?;
+            // What it has: the summary and the page of the frames so far (marked incomplete).
+            let report = report::rebuild(&folder.root);
+            return Err(match error {
+                Some(e) => e,
+                None => {
+                    report.with_context(|| {
+                        format!("writing the report of {}", folder.root.display())
+                    })?;
+                    crate::interrupt::Interrupted {
+                        folder: folder.root.clone(),
+                        last_complete_frame: last_complete,
+                    }
+                    .into()
+                }
+            });
+        }
     }
     bar.finish_with_message("done");
     let world = &mut frames.world;
     RunMemory::finish(world);
-    let mut manifest = manifest;
     manifest["memory"] = serde_json::to_value(world.resource::<RunMemory>())?;
+    set_status(&mut manifest, Status::Complete, last_complete);
     output::write_json(&folder.manifest(), &manifest)?;
     let records = std::mem::take(&mut world.resource_mut::<RunOutput>().records);
     let references = world.resource::<References>();
@@ -229,6 +297,12 @@ pub fn run_spec(spec: &RunSpec, opts: &RunOptions) -> Result<RunSummary> {
         references_rendered: rendered,
         references_cached: cached,
     })
+}
+
+/// The replayed frames' rows against those the interrupted run wrote.
+fn replay_matches(world: &World, resume: &ResumeAt, folder: &RunFolder) -> Result<()> {
+    let replayed = crate::frame_record::to_csv(&world.resource::<RunOutput>().records);
+    crate::resume::same_rows(&folder.frames_csv(), &resume.frames_csv, &replayed)
 }
 
 fn progress_bar(enabled: bool, len: u64) -> ProgressBar {

@@ -293,11 +293,9 @@ pub fn write_charts(
     {
         let (svg, map) = plot::to_svg(&chart)?;
         let svg_path = dir.join(format!("{stem}.svg"));
-        std::fs::write(&svg_path, &svg)
-            .with_context(|| format!("cannot write {}", svg_path.display()))?;
+        crate::atomic::write(&svg_path, &svg)?;
         let png_path = dir.join(format!("{stem}.png"));
-        std::fs::write(&png_path, plot::to_png(&chart)?)
-            .with_context(|| format!("cannot write {}", png_path.display()))?;
+        crate::atomic::write(&png_path, plot::to_png(&chart)?)?;
         let frame_axis = (chart.kind == Kind::Lines && chart.x_label == "frame").then_some(map);
         out.push(WrittenChart { stem, title: chart.title, svg, frame_axis });
     }

@@ -164,7 +164,7 @@ pub fn build(
         for (f, js) in chunks.iter().enumerate() {
             if let Some(js) = js {
                 let p = dir.join(format!("{f:04}.js"));
-                std::fs::write(&p, js).with_context(|| format!("cannot write {}", p.display()))?;
+                crate::atomic::write(&p, js)?;
             }
         }
     }

@@ -34,8 +34,14 @@ impl BaselineFile {
         }
         let text =
             std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-        serde_json::from_str(&text)
-            .with_context(|| format!("{}: not a baseline file", path.display()))
+        serde_json::from_str(&text).map_err(|e| {
+            anyhow::anyhow!(
+                "{}:{}:{}: not a baseline file ({e}); expected the JSON `flicker suite bless` writes",
+                path.display(),
+                e.line(),
+                e.column()
+            )
+        })
     }
 
     pub fn save(&self, path: &Path) -> Result<()> {

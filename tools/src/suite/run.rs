@@ -234,8 +234,9 @@ pub fn run(opts: &SuiteOptions) -> Result<SuiteOutcome> {
 /// baseline (other adapters' entries are kept). Returns the baseline file.
 pub fn bless(opts: &SuiteOptions) -> Result<PathBuf> {
     let p = prepare(opts)?;
-    let cases = play(&p, opts)?;
+    // Read first: a damaged baseline file is reported before anything plays.
     let mut file = BaselineFile::load(&p.baselines)?;
+    let cases = play(&p, opts)?;
     file.suite = p.suite.name.clone();
     let baseline = Baseline {
         commit: systems::manifest::commit(&opts.suite),

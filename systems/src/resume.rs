@@ -1,0 +1,194 @@
+//! `flicker run --resume RUN`: continues an interrupted run from its last complete frame.
+//!
+//! The methods' state at that frame (caches, networks, histories on the GPU) is not saved;
+//! the run is played again from frame 0 with the manifest's scenario text and overrides,
+//! writing nothing for the frames already on disk, and then goes on writing. Play is
+//! deterministic, so the frames are those of an uninterrupted run; the replayed frames.csv
+//! rows are checked against the written ones, so a changed commit or adapter that would mix
+//! two sets of results is refused.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result, anyhow, bail};
+use render::gpu::Gpu;
+use serde_json::Value;
+
+use crate::manifest::Status;
+use crate::playback::{ResumeAt, RunSummary, play};
+use crate::scenario::{Overrides, RunSpec};
+
+/// What must be the same for the replay to give the run's frames.
+const SAME: [&str; 8] =
+    ["seed", "resolution", "frames", "warmup_frames", "methods", "reference", "adapter", "regions"];
+
+pub fn resume(run: &Path, cache_dir: Option<PathBuf>, progress: bool) -> Result<RunSummary> {
+    let manifest_file = run.join("manifest.json");
+    let text = std::fs::read_to_string(&manifest_file).with_context(|| {
+        format!(
+            "{}: cannot read it; expected a run folder of `flicker run`",
+            manifest_file.display()
+        )
+    })?;
+    let stored: Value = serde_json::from_str(&text).map_err(|e| {
+        anyhow!("{}:{}:{}: not valid JSON: {e}", manifest_file.display(), e.line(), e.column())
+    })?;
+    let status = Status::of(&stored);
+    if status == Status::Complete {
+        bail!("{}: the run is complete; nothing to resume", manifest_file.display());
+    }
+    let field = |key: &str| {
+        stored[key]
+            .as_str()
+            .ok_or_else(|| anyhow!("{}: expected a string field `{key}`", manifest_file.display()))
+    };
+    let origin = PathBuf::from(field("scenario_origin").or_else(|_| field("scenario_file"))?);
+    let scenario = sim::Scenario::from_ron(field("scenario_text")?, &origin)?;
+    let overrides = stored_overrides(&stored["settings"]["overrides"], run)
+        .with_context(|| format!("{}: settings.overrides", manifest_file.display()))?;
+    let spec = RunSpec::from_scenario(scenario, &overrides)?;
+    let gpu = Gpu::new()?;
+    let rebuilt = crate::manifest::build(&spec, &origin, &gpu, &overrides)?;
+    let mut differs: Vec<&str> = SAME.into_iter().filter(|k| stored[k] != rebuilt[k]).collect();
+    for key in ["max_depth", "smape_epsilon", "time_step", "methods"] {
+        if stored["settings"][key] != rebuilt["settings"][key] {
+            differs.push(key);
+        }
+    }
+    if !differs.is_empty() {
+        bail!(
+            "{}: {} of the run differ from what its scenario gives here ({}); expected a run of `flicker run` on this adapter (suites and sweeps rerun their own jobs); start it again instead",
+            manifest_file.display(),
+            differs.join(", "),
+            gpu.summary
+        );
+    }
+    let csv_file = run.join("frames.csv");
+    let frames_csv = match std::fs::read_to_string(&csv_file) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+        Err(e) => return Err(e).with_context(|| format!("reading {}", csv_file.display())),
+    };
+    let from = last_frame(&frames_csv, &csv_file)?.map_or(0, |f| f + 1);
+    let mut manifest = stored.clone();
+    if manifest.get("resumed").is_none() {
+        manifest["resumed"] = Value::Array(Vec::new());
+    }
+    if let Some(list) = manifest["resumed"].as_array_mut() {
+        list.push(serde_json::json!({
+            "from_frame": from,
+            "status": status.name(),
+            "commit": rebuilt["commit"],
+        }));
+    }
+    manifest.as_object_mut().map(|m| m.remove("error"));
+    play(&spec, gpu, manifest, cache_dir, progress, Some(ResumeAt { from, frames_csv }))
+}
+
+fn stored_overrides(o: &Value, run: &Path) -> Result<Overrides> {
+    let number = |key: &str| -> Result<Option<u64>> {
+        match &o[key] {
+            Value::Null => Ok(None),
+            v => v.as_u64().map(Some).ok_or_else(|| anyhow!("{key}: expected a number, got {v}")),
+        }
+    };
+    let small = |key: &str| -> Result<Option<u32>> {
+        number(key)?
+            .map(|n| u32::try_from(n).map_err(|_| anyhow!("{key}: {n} is too large")))
+            .transpose()
+    };
+    let resolution = match &o["resolution"] {
+        Value::Null => None,
+        v => {
+            let text = v.as_str().unwrap_or_default();
+            let parsed =
+                text.split_once('x').and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
+            Some(parsed.ok_or_else(|| anyhow!("resolution: expected \"WIDTHxHEIGHT\", got {v}"))?)
+        }
+    };
+    Ok(Overrides {
+        frames: small("frames")?,
+        resolution,
+        spp: small("spp")?,
+        seed: number("seed")?,
+        out: Some(run.to_path_buf()),
+    })
+}
+
+/// The frame of frames.csv's last row (the file is rewritten whole after each frame, so every
+/// frame it has is complete).
+fn last_frame(csv: &str, file: &Path) -> Result<Option<u32>> {
+    let mut lines = csv.lines();
+    let Some(header) = lines.next() else { return Ok(None) };
+    let column = header
+        .split(',')
+        .position(|h| h == "frame")
+        .ok_or_else(|| anyhow!("{}:1: expected a `frame` column", file.display()))?;
+    let Some((n, last)) = lines.enumerate().last() else { return Ok(None) };
+    let cell = last.split(',').nth(column).unwrap_or_default();
+    cell.parse()
+        .map(Some)
+        .map_err(|_| anyhow!("{}:{}: expected a frame number, got '{cell}'", file.display(), n + 2))
+}
+
+/// Times differ from run to run; every other column is a result.
+fn is_time(column: &str) -> bool {
+    column == "cpu_ms" || column.ends_with("_ms") || column.contains("_ms_")
+}
+
+/// Checks that `replayed` (frames.csv text of the replayed frames) has `written`'s rows, cell
+/// for cell in every column but the times.
+pub(crate) fn same_rows(file: &Path, written: &str, replayed: &str) -> Result<()> {
+    let table = |text: &str| -> (Vec<String>, Vec<Vec<String>>) {
+        let mut lines = text.lines().map(|l| l.split(',').map(str::to_string).collect::<Vec<_>>());
+        let header = lines.next().unwrap_or_default();
+        (header, lines.collect())
+    };
+    let ((wh, wrows), (rh, rrows)) = (table(written), table(replayed));
+    if wrows.len() != rrows.len() {
+        bail!(
+            "{}: has {} rows, the replay of its frames gives {}; expected the same (is the run from another commit?); start it again instead",
+            file.display(),
+            wrows.len(),
+            rrows.len()
+        );
+    }
+    for (i, (w, r)) in wrows.iter().zip(&rrows).enumerate() {
+        for (c, name) in wh.iter().enumerate().filter(|(_, n)| !is_time(n)) {
+            let old = w.get(c).map_or("", String::as_str);
+            let new =
+                rh.iter().position(|h| h == name).and_then(|k| r.get(k)).map_or("", String::as_str);
+            if old != new {
+                bail!(
+                    "{}:{}: {} of {} at frame {} was '{old}', the replay gives '{new}'; results differ from the interrupted run's (another commit or adapter?); start it again instead",
+                    file.display(),
+                    i + 2,
+                    name,
+                    w.first().map_or("", String::as_str),
+                    w.get(1).map_or("", String::as_str)
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rows_must_match_except_times() {
+        let file = Path::new("run/frames.csv");
+        let a = "method,frame,cpu_ms,gpu_ms_total,smape,nirc_ms\npt,0,1.0,2.0,0.5,3\npt,1,1.0,2.0,0.25,3\n";
+        let b = "method,frame,cpu_ms,gpu_ms_total,smape,nirc_ms\npt,0,9.0,8.0,0.5,7\npt,1,9.0,8.0,0.25,1\n";
+        same_rows(file, a, b).unwrap();
+        let c = b.replace("0.25", "0.26");
+        let e = same_rows(file, a, &c).unwrap_err().to_string();
+        assert!(e.contains("run/frames.csv:3: smape of pt at frame 1 was '0.25'"), "{e}");
+        let e = same_rows(file, a, "method,frame\npt,0\n").unwrap_err().to_string();
+        assert!(e.contains("has 2 rows"), "{e}");
+        assert_eq!(last_frame(a, file).unwrap(), Some(1));
+        assert_eq!(last_frame("", file).unwrap(), None);
+        assert!(last_frame("method,frame\npt,x\n", file).unwrap_err().to_string().contains(":2:"));
+    }
+}
