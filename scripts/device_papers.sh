@@ -2,16 +2,22 @@
 # The paper-scale part of a GPU session (after scripts/device_check.sh): each paper's scenarios at
 # a size a GPU plays in seconds, with the release binary built at the commit being measured.
 # Usage, on the device machine, from the repository root:
-#   scripts/device_papers.sh target/release/flicker OUT_DIR [SECONDS_FOR_REPRODUCE]
+#   scripts/device_papers.sh target/release/flicker OUT_DIR [SECONDS_FOR_REPRODUCE [TOTAL_SECONDS]]
+# Each step has its own time limit, and none starts past TOTAL_SECONDS (default 420) so that the
+# tarball is always written.
 # Writes OUT_DIR/papers.tar.gz (every run's summary.json, frames.csv and manifest.json, the
 # benches' JSON, the reproduce report) and prints each step's exit status and wall time.
 set -uo pipefail
-bin=${1:?flicker binary}; out=${2:?output folder}; reproduce_s=${3:-150}
+bin=${1:?flicker binary}; out=${2:?output folder}; reproduce_s=${3:-150}; total_s=${4:-420}
+start=$(date +%s)
 mkdir -p "$out"
 work=$(mktemp -d)
 export FLICKER_CACHE_DIR=$work/cache
 step() {
   local name=$1 limit=$2; shift 2
+  local left=$((total_s - ($(date +%s) - start)))
+  if [ "$left" -le 5 ]; then echo "$name: skipped (past the total of $total_s s)"; return; fi
+  [ "$limit" -gt "$left" ] && limit=$left
   local t0=$(date +%s.%N)
   timeout "$limit" "$@" >"$work/$name.log" 2>&1; local rc=$?
   local t1=$(date +%s.%N)

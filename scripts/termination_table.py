@@ -15,7 +15,7 @@ for run in sys.argv[1:]:
         med = lambda k: st.median(float(r[k]) for r in rs if r.get(k))
         flip = [float(r["flip"]) for r in rs if r["flip"]]
         smape = [float(r["smape"]) for r in rs if r["smape"]]
-        print(f"| {m} | {st.mean(float(r['path_length']) for r in rs):.2f} | {med('gpu_ms_tc_trace'):.0f} | {med('gpu_ms_tc_propagate'):.0f} "
-              f"| {med('gpu_ms_tc_fold') + med('gpu_ms_tc_store'):.0f} | {med('gpu_ms_total'):.0f} | {med('rays'):.0f} "
+        print(f"| {m} | {st.mean(float(r['path_length']) for r in rs):.2f} | {med('gpu_ms_tc_trace'):.2f} | {med('gpu_ms_tc_propagate'):.2f} "
+              f"| {med('gpu_ms_tc_fold') + med('gpu_ms_tc_store'):.2f} | {med('gpu_ms_total'):.2f} | {med('rays'):.0f} "
               f"| {flip[0] if flip else float('nan'):.3f} | {st.mean(smape) if smape else float('nan'):.3f} |")
     print(f"\nrecords filled (frame 0): {rows[0]['cache_records']}, cache bytes: {rows[0]['cache_bytes']}")
