@@ -17,6 +17,9 @@ use crate::image::{Image, linear_to_srgb};
 /// monitor of 200 cd/m² seen from 0.6 m in an office (250 lux), the metric's own default.
 pub const DEFAULT_DISPLAY: &str = "standard_fhd";
 
+/// The most memory one prediction may take, bytes (the crate's estimate of its buffers).
+pub const MEMORY_LIMIT: usize = 6 << 30;
+
 /// How JOD sees a run: the display model and the radiance-to-display mapping.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -106,8 +109,11 @@ pub fn jod(
     let (r, t) = (convert(reference)?, convert(test)?);
     let display = DisplayModel::from_name(&settings.display)
         .map_err(|e| anyhow::anyhow!("cvvdp: display '{}': {e}", settings.display))?;
-    let metric = Cvvdp::new(display, Options::default().with_distortion_map(maps))
-        .map_err(|e| anyhow::anyhow!("cvvdp: {e}"))?;
+    // The crate refuses predictions over 1 GiB by default; a run's map of every frame (4 bytes
+    // a pixel a frame) passes that at 1280x720 after about 290 frames.
+    let options =
+        Options::default().with_distortion_map(maps).with_memory_limit_bytes(MEMORY_LIMIT);
+    let metric = Cvvdp::new(display, options).map_err(|e| anyhow::anyhow!("cvvdp: {e}"))?;
     let prediction = if t.len() == 1 {
         metric.predict_image(&t[0], &r[0], Color::Srgb)
     } else {

@@ -20,11 +20,13 @@ pub fn settings(manifest: &Manifest) -> anyhow::Result<CvvdpSettings> {
     }
 }
 
-/// The run's frame rate (manifest `settings.time_step`; 30 fps where absent).
-pub fn fps(manifest: &Manifest) -> f64 {
+/// The run's frame rate (manifest `settings.time_step`; 30 fps where absent). A scenario's step
+/// is an f32, so the rate is taken in f32: a run and its frames measured at `--fps 30` then play
+/// at the same rate.
+pub fn fps(manifest: &Manifest) -> f32 {
     let step =
         manifest.raw.get("settings").and_then(|s| s.get("time_step")).and_then(|v| v.as_f64());
-    step.filter(|&t| t > 0.0).map_or(30.0, |t| 1.0 / t)
+    step.map(|t| t as f32).filter(|&t| t > 0.0).map_or(30.0, |t| 1.0 / t)
 }
 
 /// Frames of `window` with both a reference and a frame of `method` on disk, and their spacing;
@@ -81,18 +83,18 @@ pub fn per_window(
         for w in windows {
             let Some((frames, stride)) = frames_of(run_dir, method, w) else { continue };
             for &f in &frames {
-                if !references.contains_key(&f) {
-                    references.insert(f, load_image(frame_file(run_dir, None, f, "exr"))?);
+                if let std::collections::btree_map::Entry::Vacant(e) = references.entry(f) {
+                    e.insert(load_image(frame_file(run_dir, None, f, "exr"))?);
                 }
-                if !tests.contains_key(&f) {
-                    tests.insert(f, load_image(frame_file(run_dir, Some(method), f, "exr"))?);
+                if let std::collections::btree_map::Entry::Vacant(e) = tests.entry(f) {
+                    e.insert(load_image(frame_file(run_dir, Some(method), f, "exr"))?);
                 }
             }
             let reference: Vec<Image> = frames.iter().map(|f| references[f].clone()).collect();
             let test: Vec<Image> = frames.iter().map(|f| tests[f].clone()).collect();
             // The whole run's maps are the viewer's; a window's would only repeat parts of them.
             let maps = w.name == "overall";
-            match metrics::jod(&reference, &test, (fps / stride as f64) as f32, &settings, maps) {
+            match metrics::jod(&reference, &test, fps / stride as f32, &settings, maps) {
                 Ok(r) => {
                     m.by_window.insert(w.name.clone(), r.jod);
                     if r.maps.is_some() {
@@ -113,4 +115,18 @@ pub fn per_window(
         out.insert(method.clone(), m);
     }
     Ok(out)
+}
+
+/// JOD of `method` over frames `first..=last` of a run folder (a suite's window); `None` where
+/// those frames have no evenly spaced references or JOD is switched off.
+pub fn of_frames(
+    run_dir: &Path,
+    method: &str,
+    first: u32,
+    last: u32,
+) -> anyhow::Result<Option<f64>> {
+    let manifest = Manifest::load(run_dir)?;
+    let window = Window { name: "frames".into(), first, last, event: None };
+    let jod = per_window(run_dir, &manifest, &[method.to_string()], &[window])?;
+    Ok(jod.get(method).and_then(|m| m.by_window.get("frames").copied()))
 }

@@ -69,8 +69,15 @@ impl Sequence {
                     path.display()
                 )
             };
-            if let Some(other) = by_number.insert(n, path.clone()) {
-                bail!("{} and {}: two images of frame {n}", other.display(), path.display());
+            match by_number.get(&n) {
+                Some(other) if other.extension() == path.extension() => {
+                    bail!("{} and {}: two images of frame {n}", other.display(), path.display())
+                }
+                // The EXR holds the radiance, the PNG only its tone-mapped picture.
+                Some(_) if ext == "png" => {}
+                _ => {
+                    by_number.insert(n, path.clone());
+                }
             }
         }
         let (Some((&first, _)), Some((&last, _))) =
