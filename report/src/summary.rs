@@ -1,6 +1,7 @@
 //! summary.json: per method, the mean of every frames.csv column over named frame windows:
 //! before the first event, the N frames after each event (the transient), the rest until the next
-//! event (the steady state), and overall.
+//! event (the steady state), and overall; and per method and window ColorVideoVDP's JOD of
+//! those frames as a video (crate::jod).
 
 use std::collections::BTreeMap;
 use std::path::Path;
