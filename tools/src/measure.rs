@@ -234,6 +234,22 @@ fn write_frame(path_exr: &Path, path_png: &Path, img: &Image) -> anyhow::Result<
     output::write_png(path_png, img.width, img.height, &px, 1.0)
 }
 
+/// frames.csv with the `cpu_ms` cells empty: frames from elsewhere come without their cost, and
+/// a column of zeros would draw speed charts and mark a "fastest" method.
+fn without_times(csv: &str) -> String {
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap_or_default();
+    let Some(col) = header.split(',').position(|c| c == "cpu_ms") else { return csv.to_string() };
+    let mut out = format!("{header}\n");
+    for line in lines {
+        let cells: Vec<&str> =
+            line.split(',').enumerate().map(|(i, c)| if i == col { "" } else { c }).collect();
+        out.push_str(&cells.join(","));
+        out.push('\n');
+    }
+    out
+}
+
 /// Measures the sequences and writes the run folder; returns the report's path.
 pub fn measure(opts: &MeasureOptions) -> anyhow::Result<PathBuf> {
     let inputs = check_options(opts)?;
@@ -279,7 +295,10 @@ pub fn measure(opts: &MeasureOptions) -> anyhow::Result<PathBuf> {
             }
         }
     }
-    output::write_text(&folder.frames_csv(), &systems::frame_record::to_csv(&records))?;
+    output::write_text(
+        &folder.frames_csv(),
+        &without_times(&systems::frame_record::to_csv(&records)),
+    )?;
     output::write_json(&folder.manifest(), &manifest)?;
     report::rebuild(&folder.root)
 }
@@ -288,6 +307,12 @@ pub fn measure(opts: &MeasureOptions) -> anyhow::Result<PathBuf> {
 mod tests {
     use super::frame_number;
     use std::path::Path;
+
+    #[test]
+    fn measured_frames_have_no_times() {
+        let csv = "method,frame,cpu_ms,flip\na,0,0.0000,0.5\n";
+        assert_eq!(super::without_times(csv), "method,frame,cpu_ms,flip\na,0,,0.5\n");
+    }
 
     #[test]
     fn frame_numbers_are_the_last_digits_of_the_stem() {
