@@ -1,6 +1,7 @@
 //! `flicker`: play scenarios of dynamic scenes, measure how light-transport caches behave.
 
 mod compare_args;
+mod measure_args;
 mod report_args;
 mod runtime_dir;
 
@@ -70,6 +71,9 @@ enum Command {
     Compare(compare_args::CompareArgs),
     /// Rebuild summary.json, the charts and report.html of a run folder.
     Report(report_args::ReportArgs),
+    /// Measure frames from any renderer (EXR or PNG sequences) against a reference: a run folder
+    /// with frames.csv, summary.json (with JOD) and the report, as `flicker run` writes.
+    Measure(measure_args::MeasureArgs),
     /// Regression suites: play cases over seeds and judge gates against a blessed baseline.
     Suite {
         #[command(subcommand)]
@@ -415,6 +419,8 @@ fn main() -> ExitCode {
             Ok(())
         }
         Command::Compare(args) => metrics::compare(&args.options()),
+        Command::Measure(args) => tools::measure::measure(&args.options())
+            .map(|path| println!("wrote {}", path.display())),
         Command::Report(args) => {
             report::report(&args.options()).map(|path| println!("wrote {}", path.display()))
         }

@@ -132,6 +132,13 @@ pub fn speed(
         if let (Some(ms), Some(speedup)) = (r.reference_flip_ms, r.speedup) {
             md.push_str(&format!("| HDR-FLIP (flip-evaluator) | {ms:.1} |\n\nflip-evaluator time / flicker time: {speedup:.2}\n"));
         }
+        md.push_str("\nColorVideoVDP (JOD), per frame of a video (the synthetic pair, fresh noise per frame):\n\n| size | frames | ms per frame | JOD |\n|---|---:|---:|---:|\n");
+        for t in &r.jod {
+            md.push_str(&format!(
+                "| {}x{} | {} | {:.1} | {:.3} |\n",
+                t.width, t.height, t.frames, t.ms_per_frame, t.jod
+            ));
+        }
     }
     print!("{md}");
     if let Some(path) = out {

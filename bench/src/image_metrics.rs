@@ -1,5 +1,6 @@
 //! Speed benchmark: SMAPE and FLIP at 1280x720 on a synthetic HDR pair, and NVIDIA's reference
-//! FLIP (`flip` from the `flip-evaluator` Python package) on the same pair when installed.
+//! FLIP (`flip` from the `flip-evaluator` Python package) on the same pair when installed, and
+//! ColorVideoVDP's JOD per frame of a short video of such pairs at 160x90 and at the bench size.
 //! Run it from a release build; it is a measurement, not a test.
 
 use std::path::PathBuf;
@@ -41,6 +42,39 @@ pub struct BenchReport {
     pub reference_flip_mean: Option<f64>,
     /// reference time / our time (> 1: we are faster).
     pub speedup: Option<f64>,
+    /// ColorVideoVDP (metrics::cvvdp): ms per frame of a `JOD_FRAMES`-frame video, per size.
+    pub jod: Vec<JodTiming>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct JodTiming {
+    pub width: u32,
+    pub height: u32,
+    pub frames: u32,
+    pub ms_per_frame: f64,
+    pub jod: f64,
+}
+
+/// Frames of the timed JOD video: enough for its temporal filters to matter, few enough to time.
+pub const JOD_FRAMES: u32 = 8;
+
+/// JOD of a video whose test frames are the synthetic pair with fresh noise in every frame.
+fn time_jod(width: u32, height: u32, repeats: u32) -> anyhow::Result<JodTiming> {
+    let pairs: Vec<_> = (0..JOD_FRAMES).map(|f| synthetic_hdr_pair(width, height, 7 + f)).collect();
+    let reference: Vec<_> = pairs.iter().map(|p| p.0.clone()).collect();
+    let test: Vec<_> = pairs.iter().map(|p| p.1.clone()).collect();
+    let settings = metrics::CvvdpSettings::default();
+    let mut jod = Ok(0.0);
+    let ms = best_ms(repeats, || {
+        jod = metrics::jod(&reference, &test, 30.0, &settings, false).map(|r| r.jod)
+    });
+    Ok(JodTiming {
+        width,
+        height,
+        frames: JOD_FRAMES,
+        ms_per_frame: ms / JOD_FRAMES as f64,
+        jod: jod?,
+    })
 }
 
 fn best_ms(repeats: u32, mut f: impl FnMut()) -> f64 {
@@ -63,6 +97,14 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<BenchReport> {
         flip_hdr_ms = Some(best_ms(args.repeats, || {
             flip_hdr_mean = Some(flip_hdr(&reference, &test, DEFAULT_PPD).mean)
         }));
+    }
+    let mut jod = Vec::new();
+    if !args.smape_only {
+        for (w, h) in [(160, 90), (args.width, args.height)] {
+            if jod.iter().all(|t: &JodTiming| (t.width, t.height) != (w, h)) {
+                jod.push(time_jod(w, h, args.repeats.min(3))?);
+            }
+        }
     }
     let (mut reference_flip_ms, mut reference_flip_mean) = (None, None);
     if !args.no_reference && !args.smape_only {
@@ -91,5 +133,6 @@ pub fn bench(args: &BenchArgs) -> anyhow::Result<BenchReport> {
         speedup: reference_flip_ms.zip(flip_hdr_ms).map(|(r, ours)| r / ours),
         reference_flip_ms,
         reference_flip_mean,
+        jod,
     })
 }

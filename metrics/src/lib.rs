@@ -3,12 +3,14 @@
 //! - [`smape`]: frame-to-frame flicker (SMAPE), optionally after motion-vector reprojection.
 //! - [`flip`]: LDR-FLIP and HDR-FLIP (Andersson et al. 2020, 2021) against a reference.
 //! - [`error`]: MSE, relative MSE, PSNR.
+//! - [`cvvdp`]: ColorVideoVDP's JOD of a sequence against its reference, on a display model.
 //! - [`region`]: named rectangles of interest; any per-pixel map can be averaged over one.
 //! - [`compare`]: the `compare REFERENCE TEST` command.
 //! - [`reference_flip`]: NVIDIA's FLIP as a subprocess; [`synthetic`]: test images.
 
 pub mod colormap;
 pub mod compare;
+pub mod cvvdp;
 pub mod error;
 pub mod flip;
 pub mod image;
@@ -21,6 +23,7 @@ pub mod synthetic;
 pub use crate::image::{Image, load_image, write_exr, write_png_srgb};
 pub use colormap::{magma, write_map_png};
 pub use compare::{CompareOptions, compare};
+pub use cvvdp::{CvvdpSettings, JodResult, jod};
 pub use error::{mse, psnr, psnr_from_mse, relative_mse};
 pub use flip::{DEFAULT_PPD, FlipResult, Percentiles, flip_hdr, flip_ldr, pixels_per_degree};
 pub use region::Region;

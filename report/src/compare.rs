@@ -104,7 +104,10 @@ pub fn write_comparison(run_a: &Path, run_b: &Path, out: &Path) -> anyhow::Resul
         Some(v) => h.push_str(&v.html),
         None => h.push_str("<p>Neither run has frames on disk: nothing to view.</p>\n"),
     }
-    let (sa, sb) = (summarize(&ma, &fa, DEFAULT_WINDOW), summarize(&mb, &fb, DEFAULT_WINDOW));
+    let (mut sa, mut sb) =
+        (summarize(&ma, &fa, DEFAULT_WINDOW), summarize(&mb, &fb, DEFAULT_WINDOW));
+    crate::summary::add_jod_from_file(&mut sa, run_a);
+    crate::summary::add_jod_from_file(&mut sb, run_b);
     h.push_str("<h2>Differences</h2><p>Overall means of each method found in both runs; green where B is better, red where it is worse.</p>\n");
     h.push_str(&crate::table::differences_html(&sa, &sb, &fa, &fb));
     if viewer.is_some() {

@@ -58,7 +58,8 @@ fn chart_html(c: &WrittenChart) -> String {
 pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
     let manifest = Manifest::load(run_dir)?;
     let frames = Frames::load(run_dir)?;
-    let summary = summarize(&manifest, &frames, DEFAULT_WINDOW);
+    let mut summary = summarize(&manifest, &frames, DEFAULT_WINDOW);
+    crate::summary::add_jod_from_file(&mut summary, run_dir);
     let charts = write_charts(run_dir, &manifest, &frames)?;
     let methods =
         if manifest.methods.is_empty() { frames.methods() } else { manifest.methods.clone() };

@@ -1,6 +1,7 @@
 //! summary.json: per method, the mean of every frames.csv column over named frame windows:
 //! before the first event, the N frames after each event (the transient), the rest until the next
-//! event (the steady state), and overall.
+//! event (the steady state), and overall; and per method and window ColorVideoVDP's JOD of
+//! those frames as a video (crate::jod).
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -30,6 +31,13 @@ pub struct MethodSummary {
     /// Effective temporal window, frames, from the manifest (absent where the run states none).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub temporal_window: Option<f64>,
+    /// window name -> ColorVideoVDP's JOD of the window's frames as a video (crate::jod); higher
+    /// is better, 10 = no visible difference from the reference.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub jod: BTreeMap<String, f64>,
+    /// Why a window has no JOD (the metric refused its frames).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub jod_notes: Vec<String>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -41,6 +49,9 @@ pub struct Summary {
     /// The run's memory, from the manifest.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub memory: Option<Memory>,
+    /// The display and exposure JOD was computed for (absent when no JOD was computed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cvvdp: Option<metrics::CvvdpSettings>,
 }
 
 /// The named windows of a run of `frame_count` frames.
@@ -118,7 +129,13 @@ pub fn summarize(manifest: &Manifest, frames: &Frames, n: u32) -> Summary {
                 .iter()
                 .find(|m| m.label == method)
                 .and_then(|m| m.temporal_window);
-            MethodSummary { method, means, temporal_window }
+            MethodSummary {
+                method,
+                means,
+                temporal_window,
+                jod: BTreeMap::new(),
+                jod_notes: Vec::new(),
+            }
         })
         .collect();
     Summary {
@@ -127,7 +144,40 @@ pub fn summarize(manifest: &Manifest, frames: &Frames, n: u32) -> Summary {
         windows,
         methods,
         memory: manifest.memory.clone(),
+        cvvdp: None,
     }
+}
+
+/// Adds each method's JOD per window, computed from the frames on disk (crate::jod).
+pub fn add_jod(summary: &mut Summary, run_dir: &Path, manifest: &Manifest) -> anyhow::Result<()> {
+    let methods: Vec<String> = summary.methods.iter().map(|m| m.method.clone()).collect();
+    let jod = crate::jod::per_window(run_dir, manifest, &methods, &summary.windows)?;
+    for m in &mut summary.methods {
+        if let Some(j) = jod.get(&m.method) {
+            m.jod = j.by_window.clone();
+            m.jod_notes = j.notes.clone();
+        }
+    }
+    if summary.methods.iter().any(|m| !m.jod.is_empty() || !m.jod_notes.is_empty()) {
+        summary.cvvdp = Some(crate::jod::settings(manifest)?);
+    }
+    Ok(())
+}
+
+/// The JOD that write_summary put in RUN/summary.json, added to a summary built again (the
+/// report's), so that the frames are read back and scored once per rebuild.
+pub fn add_jod_from_file(summary: &mut Summary, run_dir: &Path) {
+    let Ok(text) = std::fs::read_to_string(run_dir.join("summary.json")) else { return };
+    let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else { return };
+    for m in &mut summary.methods {
+        let saved =
+            v["methods"].as_array().and_then(|a| a.iter().find(|s| s["method"] == m.method));
+        if let Some(saved) = saved {
+            m.jod = serde_json::from_value(saved["jod"].clone()).unwrap_or_default();
+            m.jod_notes = serde_json::from_value(saved["jod_notes"].clone()).unwrap_or_default();
+        }
+    }
+    summary.cvvdp = serde_json::from_value(v["cvvdp"].clone()).ok();
 }
 
 /// Writes RUN/summary.json with the default transient length.
@@ -138,7 +188,8 @@ pub fn write_summary(run_dir: &Path) -> anyhow::Result<()> {
 pub fn write_summary_with_window(run_dir: &Path, n: u32) -> anyhow::Result<()> {
     let manifest = Manifest::load(run_dir)?;
     let frames = Frames::load(run_dir)?;
-    let summary = summarize(&manifest, &frames, n);
+    let mut summary = summarize(&manifest, &frames, n);
+    add_jod(&mut summary, run_dir, &manifest)?;
     let path = run_dir.join("summary.json");
     crate::atomic::write(&path, serde_json::to_string_pretty(&summary)?)
 }

@@ -7,7 +7,9 @@ use crate::run::{Frames, Memory};
 use crate::summary::Summary;
 
 /// Columns of the table, when present: (frames.csv column, heading, which way is better).
-const COLUMNS: [(&str, &str, Better); 10] = [
+/// `jod` is not a frames.csv column but the summary's JOD of the window (crate::jod).
+const COLUMNS: [(&str, &str, Better); 11] = [
+    ("jod", "JOD", Better::Higher),
     ("flip", "FLIP", Better::Lower),
     ("smape", "SMAPE", Better::Lower),
     ("smape_reprojected", "SMAPE (reproj.)", Better::Lower),
@@ -46,12 +48,26 @@ pub fn best(values: &[Option<f64>], better: Better) -> Option<usize> {
     (finite.iter().filter(|v| v.1 == best.1).count() == 1).then_some(best.0)
 }
 
+/// Whether the table has column `c`: a frames.csv column with data, or JOD where computed.
+fn shown(summary: &Summary, frames: &Frames, c: &str) -> bool {
+    if c == "jod" {
+        return summary.methods.iter().any(|m| !m.jod.is_empty());
+    }
+    frames.column(c).is_some_and(|i| frames.has_data(i))
+}
+
+/// Method `m`'s value of column `c` over window `w`: its mean, or its JOD.
+fn cell(summary: &Summary, m: usize, w: &str, c: &str) -> Option<f64> {
+    let m = &summary.methods[m];
+    if c == "jod" {
+        return m.jod.get(w).copied();
+    }
+    m.means.get(w).and_then(|means| means.get(c)).copied()
+}
+
 pub fn html(summary: &Summary, frames: &Frames) -> String {
-    let cols: Vec<_> = COLUMNS
-        .iter()
-        .copied()
-        .filter(|(c, ..)| frames.column(c).is_some_and(|i| frames.has_data(i)))
-        .collect();
+    let cols: Vec<_> =
+        COLUMNS.iter().copied().filter(|(c, ..)| shown(summary, frames, c)).collect();
     let mut h =
         String::from("<table id=\"summary\"><tr><th>window</th><th>frames</th><th>method</th>");
     // Each method's effective temporal window (issue 15): compare flicker at equal windows.
@@ -69,9 +85,7 @@ pub fn html(summary: &Summary, frames: &Frames) -> String {
     }
     h.push_str("</tr>\n");
     for w in &summary.windows {
-        let value = |m: usize, c: &str| {
-            summary.methods[m].means.get(&w.name).and_then(|means| means.get(c)).copied()
-        };
+        let value = |m: usize, c: &str| cell(summary, m, &w.name, c);
         let bests: Vec<Option<usize>> = cols
             .iter()
             .map(|(c, _, better)| {
@@ -134,14 +148,14 @@ pub fn memory_html(memory: &Memory) -> String {
 /// Two runs side by side: per method present in both, the overall mean of each column in A and
 /// in B, and B − A (relative, in %), coloured by whether B is better.
 pub fn differences_html(a: &Summary, b: &Summary, frames_a: &Frames, frames_b: &Frames) -> String {
-    let has = |f: &Frames, c: &str| f.column(c).is_some_and(|i| f.has_data(i));
-    let cols: Vec<_> =
-        COLUMNS.iter().copied().filter(|(c, ..)| has(frames_a, c) && has(frames_b, c)).collect();
+    let cols: Vec<_> = COLUMNS
+        .iter()
+        .copied()
+        .filter(|(c, ..)| shown(a, frames_a, c) && shown(b, frames_b, c))
+        .collect();
     let overall = |s: &Summary, method: &str, c: &str| {
-        s.methods
-            .iter()
-            .find(|m| m.method == method)
-            .and_then(|m| m.means.get("overall")?.get(c).copied())
+        let m = s.methods.iter().position(|m| m.method == method)?;
+        cell(s, m, "overall", c)
     };
     let mut h = String::from(
         "<table id=\"differences\"><tr><th>method</th><th>column</th><th>A</th><th>B</th><th>B − A</th><th>change</th></tr>\n",

@@ -43,6 +43,16 @@ fn summary_windows_and_means() {
         .unwrap();
         assert!((m["means"]["before_first_event"]["flip"].as_f64().unwrap() - f0).abs() < 1e-9);
     }
+    // JOD where the window has reference frames (frames 0 and 20): a score out of 10 for each.
+    for method in METHODS {
+        let m = s["methods"].as_array().unwrap().iter().find(|m| m["method"] == method).unwrap();
+        for w in ["before_first_event", "after_event_0", "overall"] {
+            let jod = m["jod"][w].as_f64().unwrap_or_else(|| panic!("{method} {w}: {m}"));
+            assert!(jod < 10.0 && jod > -5.0, "{method} {w}: {jod}");
+        }
+        assert!(m["jod"].get("steady_after_event_0").is_none(), "no reference there");
+    }
+    assert_eq!(s["cvvdp"]["display"], "standard_fhd");
     // The slowly adapting method flickers more right after the event than before it.
     let ema = s["methods"].as_array().unwrap().iter().find(|m| m["method"] == "cache_ema").unwrap();
     assert!(
@@ -92,12 +102,19 @@ fn report_is_self_contained_with_charts_maps_and_crops() {
     assert_eq!(imgs, html.matches("src=\"data:image/").count());
     assert_eq!(
         imgs,
-        12 + 2 * 2,
-        "12 charts (7 metrics, 2 regions x 2, 2 speed); 2 region crops per reference frame"
+        14 + 2 * 2,
+        "14 charts (7 metrics, 2 regions x 2, 2 speed, JOD per window and speed vs JOD); 2 region crops per reference frame"
     );
+    for stem in ["windows_jod", "speed_vs_jod"] {
+        assert!(run.join("charts").join(format!("{stem}.svg")).exists(), "{stem}");
+    }
     // The viewer carries every frame once, FLIP maps where a reference exists.
     assert_eq!(html.matches("<script>flickerFrame(").count(), FRAMES as usize);
     assert_eq!(html.matches("\"flip:pt_1spp\"").count(), 2);
+    // JOD: a table column, and a map of each scored frame in the viewer.
+    assert!(html.contains("<th>JOD ↑</th>"), "no JOD column");
+    assert_eq!(html.matches("\"jod:pt_1spp\"").count(), 2);
+    assert!(html.contains("data-mode=\"jod\""));
     assert_eq!(html.matches("class=\"event-mark\"").count(), 1);
     assert!(!run.join("viewer").exists(), "a small run's frames are embedded, not linked");
     assert!(
@@ -105,17 +122,17 @@ fn report_is_self_contained_with_charts_maps_and_crops() {
         "no motion toggle without motion vectors"
     );
     // The best method of each column is marked, once per column and window with data.
-    // 3 windows (before, after the event, overall) x 6 columns with data (FLIP, SMAPE, PSNR,
-    // rel. MSE, GPU ms, CPU ms): no ties in this run.
-    assert_eq!(html.matches("class=\"best\"").count(), 3 * 6);
+    // 3 windows (before, after the event, overall) x 7 columns with data (JOD, FLIP, SMAPE,
+    // PSNR, rel. MSE, GPU ms, CPU ms): no ties in this run.
+    assert_eq!(html.matches("class=\"best\"").count(), 3 * 7);
     // The cheaper method (1 ms against 2.5 ms) is marked in the GPU column of every window.
     let rows: Vec<&str> =
         html.split("<tr>").filter(|r| r.contains("<td class=\"m\">pt_1spp</td>")).collect();
     assert_eq!(rows.len(), 3);
     for r in rows {
         let cells: Vec<&str> = r.split("<td").collect();
-        // window, frames, method, FLIP, SMAPE, PSNR, rel. MSE, GPU ms
-        assert!(cells[8].starts_with(" class=\"best\""), "GPU ms cell of pt_1spp not marked: {r}");
+        // window, frames, method, JOD, FLIP, SMAPE, PSNR, rel. MSE, GPU ms
+        assert!(cells[9].starts_with(" class=\"best\""), "GPU ms cell of pt_1spp not marked: {r}");
     }
     // The Pareto chart comes before the summary table, the table before the frame charts.
     let at = |s: &str| html.find(s).unwrap_or_else(|| panic!("{s} missing"));

@@ -92,6 +92,11 @@ window.addEventListener('load', async () => {
     await V.whenShown();
     out.motion21 = { value: V.valueAt(1, 6, 12), empty: V.view(1).classList.contains('empty'), otherEmpty: V.view(2).classList.contains('empty'),
       pixel: pixels(1).slice(4 * (12 * V.canvas(1).width + 6), 4 * (12 * V.canvas(1).width + 6) + 3) };
+    // The JOD map (ColorVideoVDP) where a reference exists.
+    document.querySelector('[data-mode=jod]').click();
+    input($('frame-slider'), 20);
+    await V.whenShown();
+    out.jod20 = { value: V.valueAt(1, 6, 12), empty: V.view(1).classList.contains('empty') };
     document.querySelector('[data-mode=image]').click();
 
     // Events on the slider; chart cursors follow the frame.
@@ -226,6 +231,14 @@ fn slider_play_exposure_zoom_maps_and_pixel_values() {
         (f(&out["flip20"]["value"][0]) - flip as f64).abs() <= 1.0 / 255.0 + 1e-6,
         "FLIP {} vs {flip}",
         out["flip20"]["value"]
+    );
+    // The JOD map as the report wrote it (frames/METHOD/jod/), quantized to 1/255 in the page.
+    let jod = load_image(run.join("frames/pt_1spp/jod/0020.exr")).unwrap().get(6, 12)[0];
+    assert_eq!(out["jod20"]["empty"], false);
+    assert!(
+        (f(&out["jod20"]["value"][0]) - jod.clamp(0.0, 1.0) as f64).abs() <= 1.0 / 255.0 + 1e-6,
+        "JOD map {} vs {jod}",
+        out["jod20"]["value"]
     );
     assert_eq!(out["flip21"]["empty"], true);
     assert!(out["flip21"]["value"].is_null());

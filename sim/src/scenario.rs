@@ -299,6 +299,8 @@ struct ScenarioFile {
     #[serde(default)]
     events: Vec<EventSpec>,
     #[serde(default)]
+    cvvdp: metrics::CvvdpSettings,
+    #[serde(default)]
     media: Vec<scene::MediumDesc>,
     #[serde(default)]
     materials: Vec<MaterialOverride>,
@@ -342,6 +344,8 @@ pub struct Scenario {
     pub smape_epsilon: f32,
     pub animations: Vec<AnimationSpec>,
     pub events: Vec<EventSpec>,
+    /// How ColorVideoVDP's JOD sees the run: display model, exposure (metrics::cvvdp).
+    pub cvvdp: metrics::CvvdpSettings,
     /// Participating media (scene::medium); none by default, and then nothing is paid for them
     /// (not even a key in the manifest).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -543,6 +547,14 @@ impl Scenario {
                 ),
             });
         }
+        if let Some(message) = file.cvvdp.problem() {
+            return Err(ScenarioError {
+                file: origin.to_path_buf(),
+                position: find_quoted(text, &file.cvvdp.display)
+                    .or_else(|| invalid("cvvdp", String::new()).position),
+                message: format!("cvvdp: {message}"),
+            });
+        }
         let name = file.name.unwrap_or_else(|| {
             origin
                 .file_stem()
@@ -575,6 +587,7 @@ impl Scenario {
             smape_epsilon: file.smape_epsilon,
             animations: file.animations,
             events: file.events,
+            cvvdp: file.cvvdp,
             media: file.media,
             materials: file.materials,
             origin: origin.to_path_buf(),

@@ -458,3 +458,23 @@ fn extraction_reports_what_each_event_changed() {
     assert_eq!(seen[3], SceneChanges { materials: true, ..Default::default() });
     assert!(!seen[4].any());
 }
+
+#[test]
+fn jod_display_and_exposure_have_defaults_and_a_bad_display_names_its_line() {
+    let base = "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 4, methods: [PathTracing(spp: 1)]";
+    let s = Scenario::from_ron(&format!("{base})"), Path::new("d.ron")).unwrap();
+    assert_eq!((s.cvvdp.display.as_str(), s.cvvdp.exposure), ("standard_fhd", 1.0));
+    let s = Scenario::from_ron(
+        &format!("{base}, cvvdp: (display: \"standard_4k\", exposure: 2.0))"),
+        Path::new("d.ron"),
+    )
+    .unwrap();
+    assert_eq!((s.cvvdp.display.as_str(), s.cvvdp.exposure), ("standard_4k", 2.0));
+    let text = format!("{base},\n  cvvdp: (display: \"crt_1985\"),\n)");
+    let e = Scenario::from_ron(&text, Path::new("d.ron")).unwrap_err().to_string();
+    assert!(e.starts_with("d.ron:2:"), "{e}");
+    assert!(e.contains("unknown display 'crt_1985'") && e.contains("standard_fhd"), "{e}");
+    let text = format!("{base},\n  cvvdp: (exposure: 0.0),\n)");
+    let e = Scenario::from_ron(&text, Path::new("d.ron")).unwrap_err().to_string();
+    assert!(e.starts_with("d.ron:2:") && e.contains("exposure"), "{e}");
+}

@@ -54,6 +54,7 @@ pub fn build(
             "max_depth": scenario.max_depth,
             "smape_epsilon": scenario.smape_epsilon,
             "time_step": scenario.time_step,
+            "cvvdp": scenario.cvvdp,
             "methods": spec.methods.iter().map(|m| json!({"label": m.label(), "spp": m.spec.spp(), "temporal_window": m.spec.temporal_window(), "spec": m.spec})).collect::<Vec<_>>(),
             "overrides": {
                 "frames": overrides.frames,

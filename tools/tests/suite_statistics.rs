@@ -37,7 +37,11 @@ fn runs(values: &[f64]) -> CaseRuns {
         .enumerate()
         .map(|(i, &v)| {
             let metrics = BTreeMap::from([(Metric::Flip.name().to_string(), vec![Some(v)])]);
-            SeedRun { seed: i as u64, methods: BTreeMap::from([("m".to_string(), metrics)]) }
+            SeedRun {
+                seed: i as u64,
+                methods: BTreeMap::from([("m".to_string(), metrics)]),
+                ..Default::default()
+            }
         })
         .collect();
     CaseRuns { frames: 1, events: Vec::new(), seeds }
@@ -118,6 +122,7 @@ fn two_methods(a: &[f64], b: &[f64]) -> CaseRuns {
             SeedRun {
                 seed: i as u64,
                 methods: BTreeMap::from([("a".to_string(), one(x)), ("b".to_string(), one(y))]),
+                ..Default::default()
             }
         })
         .collect();

@@ -267,6 +267,114 @@ fn scatter_charts(
     out
 }
 
+/// JOD per method and window as the summary has it (window name -> JOD), with each window's
+/// frames: read from RUN/summary.json, written before the charts (crate::jod).
+pub struct JodTable {
+    pub windows: Vec<(String, u32, u32)>,
+    pub methods: Vec<(String, std::collections::BTreeMap<String, f64>)>,
+}
+
+impl JodTable {
+    pub fn load(run_dir: &Path) -> Option<Self> {
+        let text = std::fs::read_to_string(run_dir.join("summary.json")).ok()?;
+        let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+        let windows = v["windows"]
+            .as_array()?
+            .iter()
+            .filter_map(|w| {
+                Some((
+                    w["name"].as_str()?.to_string(),
+                    w["first"].as_u64()? as u32,
+                    w["last"].as_u64()? as u32,
+                ))
+            })
+            .collect();
+        let methods: Vec<_> = v["methods"]
+            .as_array()?
+            .iter()
+            .filter_map(|m| {
+                let jod = serde_json::from_value(m.get("jod")?.clone()).ok()?;
+                Some((m["method"].as_str()?.to_string(), jod))
+            })
+            .collect();
+        (!methods.is_empty()).then_some(Self { windows, methods })
+    }
+}
+
+/// JOD of each window drawn across the window's frames (one step per window), so a method's
+/// visible error before and after each event reads off one chart.
+pub fn jod_chart(manifest: &Manifest, frames: &Frames, jod: &JodTable) -> Option<(String, Chart)> {
+    let series: Vec<Series> = jod
+        .methods
+        .iter()
+        .map(|(method, by_window)| {
+            let points = jod
+                .windows
+                .iter()
+                .filter(|(name, ..)| name != "overall")
+                .filter_map(|(name, first, last)| {
+                    let v = *by_window.get(name)?;
+                    Some([(*first as f64, v), (*last as f64 + 1.0, v)])
+                })
+                .flatten()
+                .collect();
+            Series { name: method.clone(), points }
+        })
+        .filter(|s: &Series| !s.points.is_empty())
+        .collect();
+    if series.is_empty() {
+        return None;
+    }
+    let last = frames.frame_count(manifest) as f64;
+    let chart = Chart {
+        title: format!("JOD per window (ColorVideoVDP, 10 = invisible) — {}", manifest.scenario),
+        x_label: "frame".into(),
+        y_label: "JOD".into(),
+        kind: Kind::Lines,
+        series,
+        events: manifest.events.iter().map(|e| (e.frame as f64, e.label.clone())).collect(),
+        pareto: vec![],
+        x_extent: vec![0.0, last],
+    };
+    Some(("windows_jod".into(), chart))
+}
+
+/// Speed against JOD over the whole run; the front is of cost and 10 - JOD (both minimised).
+pub fn speed_jod_chart(
+    manifest: &Manifest,
+    frames: &Frames,
+    jod: &JodTable,
+) -> Option<(String, Chart)> {
+    let time_col = ["gpu_ms_total", "wall_ms_total", "cpu_ms"]
+        .into_iter()
+        .find(|c| frames.column(c).is_some_and(|i| frames.has_data(i)))?;
+    let t = frames.column(time_col)?;
+    let series: Vec<Series> = jod
+        .methods
+        .iter()
+        .filter_map(|(method, by_window)| {
+            let x = mean(&frames.series(method, t))?;
+            Some(Series { name: method.clone(), points: vec![(x, *by_window.get("overall")?)] })
+        })
+        .collect();
+    if series.is_empty() {
+        return None;
+    }
+    let lost: Vec<(f64, f64)> =
+        series.iter().map(|s| (s.points[0].0, 10.0 - s.points[0].1)).collect();
+    let chart = Chart {
+        title: format!("Speed vs accuracy (JOD) — {}", manifest.scenario),
+        x_label: format!("mean {}", label(time_col)),
+        y_label: "JOD (higher is better)".into(),
+        kind: Kind::Scatter,
+        pareto: pareto_front(&lost).into_iter().map(|(x, l)| (x, 10.0 - l)).collect(),
+        series,
+        events: vec![],
+        x_extent: vec![],
+    };
+    Some(("speed_vs_jod".into(), chart))
+}
+
 /// A chart written to RUN/charts/<stem>.svg and .png.
 pub struct WrittenChart {
     pub stem: String,
@@ -284,12 +392,17 @@ pub fn write_charts(
     let dir = run_dir.join("charts");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut out = Vec::new();
+    let jod = JodTable::load(run_dir);
+    let jod_charts = jod.iter().flat_map(|j| {
+        jod_chart(manifest, frames, j).into_iter().chain(speed_jod_chart(manifest, frames, j))
+    });
     for (stem, chart) in frame_charts(manifest, frames)
         .into_iter()
         .chain(reliability_chart(manifest, frames))
         .chain(sigma_chart(manifest, frames))
         .chain(reliability_spread_chart(manifest, frames))
         .chain(speed_accuracy_charts(manifest, frames))
+        .chain(jod_charts)
     {
         let (svg, map) = plot::to_svg(&chart)?;
         let svg_path = dir.join(format!("{stem}.svg"));

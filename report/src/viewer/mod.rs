@@ -105,6 +105,7 @@ pub fn build(
 ) -> anyhow::Result<Option<Viewer>> {
     let size = std::sync::Mutex::new(None::<(u32, u32)>);
     let any_motion = std::sync::atomic::AtomicBool::new(false);
+    let any_jod = std::sync::atomic::AtomicBool::new(false);
     let chunks: Vec<Option<String>> = (0..frame_count)
         .into_par_iter()
         .map(|f| {
@@ -138,6 +139,16 @@ pub fn build(
                             STANDARD.encode(encoding::encode_motion(&load_image(&motion)?)),
                         ));
                         any_motion.store(true, std::sync::atomic::Ordering::Relaxed);
+                    }
+                    let jod_map = crate::jod::map_file(&p.run_dir, m, f);
+                    if jod_map.exists() {
+                        let values: Vec<f32> =
+                            load_image(&jod_map)?.rgb.iter().map(|v| v[0]).collect();
+                        entries.push((
+                            format!("jod:{}", p.label),
+                            STANDARD.encode(encoding::encode_map(&values)),
+                        ));
+                        any_jod.store(true, std::sync::atomic::Ordering::Relaxed);
                     }
                 }
                 if let Some(map) = flip_maps.get(&(f, p.label.clone())) {
@@ -215,6 +226,9 @@ pub fn build(
     h.push_str("<span class=\"modes\"><button type=\"button\" data-mode=\"image\" class=\"on\">image</button>");
     if !flip_maps.is_empty() {
         h.push_str("<button type=\"button\" data-mode=\"flip\">FLIP map</button>");
+    }
+    if any_jod.into_inner() {
+        h.push_str("<button type=\"button\" data-mode=\"jod\" title=\"ColorVideoVDP: 1 − JOD of the pixel / 10\">JOD map</button>");
     }
     h.push_str("<button type=\"button\" data-mode=\"smape\">SMAPE to previous frame</button>");
     let any_motion = any_motion.into_inner();

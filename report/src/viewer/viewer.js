@@ -60,7 +60,7 @@
   function decoded(f, key) {
     const k = f + '/' + key;
     if (!cache.has(k)) {
-      const decode = key.startsWith('flip:') ? b => b : key.startsWith('motion:') ? motionToFloat : rgbeToFloat;
+      const decode = key.startsWith('flip:') || key.startsWith('jod:') ? b => b : key.startsWith('motion:') ? motionToFloat : rgbeToFloat;
       cache.set(k, chunk(f).then(c => (c && c[key] ? inflate(c[key]) : null)).then(b => b && decode(b)));
       if (cache.size > CACHE_SIZE) cache.delete(cache.keys().next().value);
     }
@@ -81,8 +81,8 @@
     return out;
   }
   async function content(p, f) {
-    if (state.mode === 'flip' && !p.reference) {
-      const m = await decoded(f, 'flip:' + p.label);
+    if ((state.mode === 'flip' || state.mode === 'jod') && !p.reference) {
+      const m = await decoded(f, state.mode + ':' + p.label);
       return m && { kind: 'map', scale: 1, values: Float32Array.from(m, v => v / 255) };
     }
     if (state.mode === 'motion' && !p.reference) {

@@ -16,6 +16,13 @@ pub struct SeedRun {
     pub seed: u64,
     /// method label -> metric name -> value per recorded frame (`None`: not measured).
     pub methods: BTreeMap<String, BTreeMap<String, Vec<Option<f64>>>>,
+    /// method label -> frames `first..end` -> JOD of those frames (Metric::Cvvdp); kept for
+    /// the windows of the suite's JOD gates when blessed, computed from `folder` otherwise.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub jod: BTreeMap<String, BTreeMap<String, f64>>,
+    /// The run folder these came from (absent in a baseline).
+    #[serde(skip)]
+    pub folder: Option<std::path::PathBuf>,
 }
 
 impl SeedRun {
@@ -25,13 +32,33 @@ impl SeedRun {
         rows.sort_by_key(|r| (r.method.clone(), r.frame));
         for r in rows {
             let metrics = methods.entry(r.method.clone()).or_default();
-            for m in Metric::ALL {
+            for m in Metric::ALL.into_iter().filter(|m| m.per_frame()) {
                 let series = metrics.entry(m.name().to_string()).or_default();
                 series.resize(r.frame as usize, None);
                 series.push(m.of(r));
             }
         }
-        SeedRun { seed, methods }
+        SeedRun { seed, methods, jod: BTreeMap::new(), folder: None }
+    }
+
+    /// JOD of `method` over `range`: kept, or computed from the run folder.
+    pub fn jod(&self, method: &str, range: &std::ops::Range<u32>) -> Option<f64> {
+        let key = format!("{}..{}", range.start, range.end);
+        if let Some(v) = self.jod.get(method).and_then(|j| j.get(&key)) {
+            return Some(*v);
+        }
+        let folder = self.folder.as_ref()?;
+        report::jod::of_frames(folder, method, range.start, range.end.checked_sub(1)?)
+            .ok()
+            .flatten()
+    }
+
+    /// Computes and keeps JOD of `method` over `range` (a baseline holds no run folder).
+    pub fn keep_jod(&mut self, method: &str, range: &std::ops::Range<u32>) {
+        if let Some(v) = self.jod(method, range) {
+            let key = format!("{}..{}", range.start, range.end);
+            self.jod.entry(method.to_string()).or_default().insert(key, v);
+        }
     }
 
     /// The mean of `metric` over the window's frames; `None` when no frame of it has a value.
@@ -41,6 +68,9 @@ impl SeedRun {
         metric: Metric,
         range: std::ops::Range<u32>,
     ) -> Option<f64> {
+        if !metric.per_frame() {
+            return self.jod(method, &range);
+        }
         let series = self.methods.get(method)?.get(metric.name())?;
         let values: Vec<f64> = range
             .filter_map(|f| series.get(f as usize).copied().flatten())
@@ -97,5 +127,25 @@ impl CaseRuns {
                     .ok_or_else(|| format!("seed {}: no {} values for {method} in frames {range:?} (no reference frames there, or the method is not in the run)", s.seed, metric.name()))
             })
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// JOD is read per window (kept at bless time), not averaged over frames; a window without
+    /// it is an error naming the metric, and higher is better.
+    #[test]
+    fn jod_is_one_number_per_window() {
+        let mut seed = SeedRun::from_records(1, &[]);
+        seed.jod.insert("pt".into(), BTreeMap::from([("0..8".to_string(), 7.5)]));
+        let runs = CaseRuns { frames: 8, events: vec![4], seeds: vec![seed] };
+        assert_eq!(runs.per_seed("pt", Metric::Cvvdp, &Window::Overall), Ok(vec![7.5]));
+        let e = runs.per_seed("pt", Metric::Cvvdp, &Window::Before { event: 0 }).unwrap_err();
+        assert!(e.contains("no jod values for pt in frames 0..4"), "{e}");
+        assert!(Metric::Cvvdp.higher_is_better() && !Metric::Cvvdp.per_frame());
+        let json = serde_json::to_value(&runs.seeds[0]).unwrap();
+        assert_eq!(json["jod"]["pt"]["0..8"], 7.5);
     }
 }

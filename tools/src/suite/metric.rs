@@ -15,6 +15,9 @@ pub enum Metric {
     Mse,
     RelMse,
     Psnr,
+    /// ColorVideoVDP's JOD of the window's frames played as a video against the references (not
+    /// a per-frame mean: report::jod). Higher is better; 10 = no visible difference.
+    Cvvdp,
     /// Mean path length in vertices (the termination method's `path_length` stat). Shorter is
     /// "better": `Better(than: M)` on it says the method's paths are shorter than M's.
     PathLength,
@@ -24,8 +27,9 @@ pub enum Metric {
 }
 
 impl Metric {
-    pub const ALL: [Metric; 8] = [
+    pub const ALL: [Metric; 9] = [
         Metric::Flip,
+        Metric::Cvvdp,
         Metric::Smape,
         Metric::SmapeReprojected,
         Metric::Mse,
@@ -43,14 +47,21 @@ impl Metric {
             Metric::Mse => "mse",
             Metric::RelMse => "rel_mse",
             Metric::Psnr => "psnr",
+            Metric::Cvvdp => "jod",
             Metric::PathLength => "path_length",
             Metric::MeanAbsBias => "mean_abs_bias",
         }
     }
 
-    /// Errors get worse upwards, PSNR downwards.
+    /// Errors get worse upwards, PSNR and JOD downwards.
     pub fn higher_is_better(self) -> bool {
-        self == Metric::Psnr
+        matches!(self, Metric::Psnr | Metric::Cvvdp)
+    }
+
+    /// Whether the metric is a per-frame number (its window value is a mean of frames); JOD is
+    /// one number per window.
+    pub fn per_frame(self) -> bool {
+        self != Metric::Cvvdp
     }
 
     /// Whether a method of plugin kind `kind` (`MethodPlugin::NAME`) records this metric in a
@@ -59,7 +70,9 @@ impl Metric {
     pub fn recorded_by(self, kind: &str, references: bool) -> bool {
         match self {
             Metric::Smape | Metric::SmapeReprojected => true,
-            Metric::Flip | Metric::Mse | Metric::RelMse | Metric::Psnr => references,
+            Metric::Flip | Metric::Mse | Metric::RelMse | Metric::Psnr | Metric::Cvvdp => {
+                references
+            }
             Metric::PathLength => kind == "Termination",
             Metric::MeanAbsBias => kind == "VolumeTransmittance",
         }
@@ -73,6 +86,7 @@ impl Metric {
             Metric::Mse => r.mse,
             Metric::RelMse => r.rel_mse,
             Metric::Psnr => r.psnr,
+            Metric::Cvvdp => None,
             // Method stats, by the name the method reports them under.
             Metric::PathLength | Metric::MeanAbsBias => {
                 r.stats.iter().find(|(n, _)| n == self.name()).map(|s| s.1)

@@ -146,7 +146,9 @@ pub(crate) fn play_cases(
         let runs = played.entry(case.name.clone()).or_default();
         runs.frames = spec.scenario.frames;
         runs.events = event_frames(&spec);
-        runs.seeds.push(SeedRun::from_records(seed, &summary.records));
+        let mut seed_run = SeedRun::from_records(seed, &summary.records);
+        seed_run.folder = Some(summary.folder.clone());
+        runs.seeds.push(seed_run);
     }
     Ok(played)
 }
@@ -236,7 +238,18 @@ pub fn bless(opts: &SuiteOptions) -> Result<PathBuf> {
     let p = prepare(opts)?;
     // Read first: a damaged baseline file is reported before anything plays.
     let mut file = BaselineFile::load(&p.baselines)?;
-    let cases = play(&p, opts)?;
+    let mut cases = play(&p, opts)?;
+    // JOD is one number per window, not per frame: the baseline keeps it for each JOD gate.
+    for gate in p.suite.gates.iter().filter(|g| !g.metric.per_frame()) {
+        for (name, runs) in cases.iter_mut() {
+            let Some(range) = gate.window.frames(runs.frames, &runs.events) else { continue };
+            for method in runs.methods().iter().filter(|m| gate.applies_to(name, m)) {
+                for s in &mut runs.seeds {
+                    s.keep_jod(method, &range);
+                }
+            }
+        }
+    }
     file.suite = p.suite.name.clone();
     let baseline = Baseline {
         commit: systems::manifest::commit(&opts.suite),

@@ -71,6 +71,25 @@ pub fn numbers(records: &[FrameRecord]) -> BTreeMap<String, MethodNumbers> {
         .collect()
 }
 
+/// Adds each method's JOD over the whole run, from the run's summary.json (report::jod).
+fn with_jod(
+    mut numbers: BTreeMap<String, MethodNumbers>,
+    run: &Path,
+) -> BTreeMap<String, MethodNumbers> {
+    let summary: Option<serde_json::Value> = std::fs::read_to_string(run.join("summary.json"))
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok());
+    for m in summary.iter().flat_map(|s| s["methods"].as_array().into_iter().flatten()) {
+        let (Some(label), Some(jod)) = (m["method"].as_str(), m["jod"]["overall"].as_f64()) else {
+            continue;
+        };
+        if let Some(n) = numbers.get_mut(label) {
+            n.metrics.insert(Metric::Cvvdp.name().to_string(), Some(jod));
+        }
+    }
+    numbers
+}
+
 pub fn run_job(dir: &Path, index: usize, progress: bool) -> Result<JobRecord> {
     let plan = Plan::load(dir)?;
     let job = plan.jobs.get(index).ok_or_else(|| {
@@ -105,7 +124,7 @@ pub fn run_job(dir: &Path, index: usize, progress: bool) -> Result<JobRecord> {
         point: job.point.clone(),
         params: job.params.clone(),
         seed: job.seed,
-        methods: numbers(&summary.records),
+        methods: with_jod(numbers(&summary.records), &summary.folder),
         wall_s: start.elapsed().as_secs_f64(),
     };
     systems::output::write_json(&done, &record)?;

@@ -1,0 +1,323 @@
+//! `flicker measure`: the run's metrics for frames from any renderer. Reads a reference
+//! sequence and test sequences (EXR or PNG, frame numbers from file names), measures every test
+//! frame as a run's Measure stage does (SMAPE against the previous frame, reprojected where
+//! motion vectors are given, HDR-FLIP, MSE, relative MSE, PSNR against the reference) and writes
+//! a run folder like `flicker run`: frames.csv, the frames, manifest.json, then summary.json
+//! (with JOD), the charts and report.html. Every input is read and checked before anything is
+//! written.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use metrics::{CvvdpSettings, Image, load_image};
+use serde_json::json;
+use systems::frame_record::FrameRecord;
+use systems::measure::{Frame, error_vs_reference, smape_vs_previous};
+use systems::output;
+use systems::run_folder::{MOTION, RunFolder};
+
+/// What to measure and where to write it.
+#[derive(Clone, Debug)]
+pub struct MeasureOptions {
+    pub reference: PathBuf,
+    /// (name, folder) of each test sequence; the name labels it in frames.csv and the report.
+    pub tests: Vec<(String, PathBuf)>,
+    /// (test name, folder) of motion vectors (EXR, R and G: pixels from a frame to the previous).
+    pub motion: Vec<(String, PathBuf)>,
+    pub fps: f64,
+    /// Frames of events (the input's frame numbers), for the summary's windows.
+    pub events: Vec<u32>,
+    pub out: PathBuf,
+    pub cvvdp: CvvdpSettings,
+    pub smape_epsilon: f32,
+}
+
+/// A sequence on disk: its frame files by frame number, consecutive.
+#[derive(Clone, Debug)]
+pub struct Sequence {
+    pub dir: PathBuf,
+    pub frames: Vec<(u32, PathBuf)>,
+}
+
+/// The last run of digits in a file's stem: `frame_0012.exr` is frame 12.
+fn frame_number(path: &Path) -> Option<u32> {
+    let stem = path.file_stem()?.to_str()?;
+    let end = stem.rfind(|c: char| c.is_ascii_digit())? + 1;
+    let start = stem[..end].rfind(|c: char| !c.is_ascii_digit()).map_or(0, |i| i + 1);
+    stem[start..end].parse().ok()
+}
+
+impl Sequence {
+    /// The EXR and PNG files of `dir` (other files are ignored), by frame number; where a frame
+    /// has both (a flicker run's frames), the EXR. Refuses a folder without images, an image
+    /// without a number, two images of one kind for one frame and a gap.
+    pub fn read(dir: &Path) -> anyhow::Result<Self> {
+        let entries = std::fs::read_dir(dir)
+            .with_context(|| format!("{}: cannot read the folder", dir.display()))?;
+        let mut by_number: BTreeMap<u32, PathBuf> = BTreeMap::new();
+        for e in entries {
+            let path =
+                e.with_context(|| format!("{}: cannot list the folder", dir.display()))?.path();
+            let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+            if !path.is_file() || (ext != "exr" && ext != "png") {
+                continue;
+            }
+            let Some(n) = frame_number(&path) else {
+                bail!(
+                    "{}: no frame number in the file name; expected e.g. 0007.{ext}",
+                    path.display()
+                )
+            };
+            match by_number.get(&n) {
+                Some(other) if other.extension() == path.extension() => {
+                    bail!("{} and {}: two images of frame {n}", other.display(), path.display())
+                }
+                // The EXR holds the radiance, the PNG only its tone-mapped picture.
+                Some(_) if ext == "png" => {}
+                _ => {
+                    by_number.insert(n, path.clone());
+                }
+            }
+        }
+        let (Some((&first, _)), Some((&last, _))) =
+            (by_number.first_key_value(), by_number.last_key_value())
+        else {
+            bail!("{}: no .exr or .png frames", dir.display())
+        };
+        if let Some(missing) = (first..=last).find(|n| !by_number.contains_key(n)) {
+            bail!("{}: frame {missing} is missing (frames {first}..={last})", dir.display());
+        }
+        Ok(Self { dir: dir.to_path_buf(), frames: by_number.into_iter().collect() })
+    }
+
+    fn numbers(&self) -> Vec<u32> {
+        self.frames.iter().map(|f| f.0).collect()
+    }
+}
+
+/// One frame of a sequence, checked: readable, of the reference's size, finite.
+fn load_checked(path: &Path, frame: u32, size: Option<(u32, u32)>) -> anyhow::Result<Image> {
+    let img = load_image(path).with_context(|| format!("frame {frame}"))?;
+    if let Some((w, h)) = size
+        && (img.width, img.height) != (w, h)
+    {
+        bail!(
+            "{}: frame {frame} is {}x{}; expected {w}x{h} like the reference",
+            path.display(),
+            img.width,
+            img.height
+        );
+    }
+    if let Some(i) = img.rgb.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+        bail!(
+            "{}: frame {frame} has a non-finite value at pixel ({}, {}); expected finite radiance",
+            path.display(),
+            i as u32 % img.width,
+            i as u32 / img.width
+        );
+    }
+    Ok(img)
+}
+
+fn load_motion(path: &Path, frame: u32, (w, h): (u32, u32)) -> anyhow::Result<Vec<[f32; 2]>> {
+    let (mw, mh, rgba) = output::read_exr(path).with_context(|| format!("frame {frame}"))?;
+    if (mw, mh) != (w, h) {
+        bail!(
+            "{}: frame {frame} is {mw}x{mh}; expected {w}x{h} like the reference",
+            path.display()
+        );
+    }
+    if rgba.iter().any(|p| !(p[0].is_finite() && p[1].is_finite())) {
+        bail!("{}: frame {frame} has a non-finite motion vector", path.display());
+    }
+    Ok(rgba.iter().map(|p| [p[0], p[1]]).collect())
+}
+
+/// The inputs, read and checked: every sequence has the reference's frame numbers.
+struct Inputs {
+    reference: Sequence,
+    tests: Vec<(String, Sequence, Option<Sequence>)>,
+}
+
+fn check_options(opts: &MeasureOptions) -> anyhow::Result<Inputs> {
+    if opts.tests.is_empty() {
+        bail!("no --test NAME=DIR; expected at least one test sequence");
+    }
+    if !(opts.fps.is_finite() && opts.fps > 0.0) {
+        bail!("--fps {}; expected a positive frame rate", opts.fps);
+    }
+    if let Some(p) = opts.cvvdp.problem() {
+        bail!("--display/--exposure: {p}");
+    }
+    let reference = Sequence::read(&opts.reference)?;
+    let numbers = reference.numbers();
+    let mut tests: Vec<(String, Sequence, Option<Sequence>)> = Vec::new();
+    for (name, dir) in &opts.tests {
+        if name.is_empty() || name.contains(['/', '\\', ',']) || name == "reference" {
+            bail!(
+                "--test {name}={}: expected a name without '/', '\\' or ',' (not 'reference')",
+                dir.display()
+            );
+        }
+        if tests.iter().any(|(n, ..)| n == name) {
+            bail!("--test {name}: two test sequences of one name");
+        }
+        let seq = Sequence::read(dir)?;
+        same_frames(&seq, &numbers, &reference.dir)?;
+        tests.push((name.clone(), seq, None));
+    }
+    for (name, dir) in &opts.motion {
+        let Some(t) = tests.iter_mut().find(|(n, ..)| n == name) else {
+            bail!("--motion {name}={}: no --test named {name}", dir.display());
+        };
+        let seq = Sequence::read(dir)?;
+        same_frames(&seq, &numbers, &reference.dir)?;
+        t.2 = Some(seq);
+    }
+    let (first, last) = (numbers[0], numbers[numbers.len() - 1]);
+    if let Some(e) = opts.events.iter().find(|&&e| e < first || e > last) {
+        bail!("--events: frame {e} is outside the sequences' frames {first}..={last}");
+    }
+    Ok(Inputs { reference, tests })
+}
+
+fn same_frames(seq: &Sequence, numbers: &[u32], reference: &Path) -> anyhow::Result<()> {
+    let got = seq.numbers();
+    if let Some(n) = numbers.iter().find(|n| !got.contains(n)) {
+        bail!(
+            "{}: frame {n} is missing (the reference {} has it)",
+            seq.dir.display(),
+            reference.display()
+        );
+    }
+    if let Some(n) = got.iter().find(|n| !numbers.contains(n)) {
+        bail!("{}: frame {n} has no reference frame in {}", seq.dir.display(), reference.display());
+    }
+    Ok(())
+}
+
+/// Reads every frame once, checks it and measures it; the records of all frames (frames
+/// renumbered from 0), and the image size.
+fn measure_all(inputs: &Inputs, eps: f32) -> anyhow::Result<(Vec<FrameRecord>, (u32, u32))> {
+    let mut size = None;
+    let mut previous: Vec<Option<Frame>> = vec![None; inputs.tests.len()];
+    let mut records = Vec::new();
+    for (k, (n, ref_path)) in inputs.reference.frames.iter().enumerate() {
+        let reference = Frame { image: load_checked(ref_path, *n, size)?, motion: None };
+        let wh = *size.get_or_insert((reference.image.width, reference.image.height));
+        for (i, (name, seq, motion)) in inputs.tests.iter().enumerate() {
+            let image = load_checked(&seq.frames[k].1, *n, Some(wh))?;
+            let motion = match motion {
+                Some(m) => Some(load_motion(&m.frames[k].1, *n, wh)?),
+                None => None,
+            };
+            let current = Frame { image, motion };
+            let mut rec =
+                FrameRecord { method: name.clone(), frame: k as u32, ..Default::default() };
+            smape_vs_previous(&mut rec, &current, previous[i].as_ref(), eps);
+            error_vs_reference(&mut rec, &current, Some(&reference));
+            records.push(rec);
+            previous[i] = Some(current);
+        }
+    }
+    Ok((records, size.unwrap_or((0, 0))))
+}
+
+fn rgba(img: &Image) -> Vec<[f32; 4]> {
+    img.rgb.iter().map(|p| [p[0], p[1], p[2], 1.0]).collect()
+}
+
+fn write_frame(path_exr: &Path, path_png: &Path, img: &Image) -> anyhow::Result<()> {
+    let px = rgba(img);
+    output::write_exr(path_exr, img.width, img.height, &px)?;
+    output::write_png(path_png, img.width, img.height, &px, 1.0)
+}
+
+/// frames.csv with the `cpu_ms` cells empty: frames from elsewhere come without their cost, and
+/// a column of zeros would draw speed charts and mark a "fastest" method.
+fn without_times(csv: &str) -> String {
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap_or_default();
+    let Some(col) = header.split(',').position(|c| c == "cpu_ms") else { return csv.to_string() };
+    let mut out = format!("{header}\n");
+    for line in lines {
+        let cells: Vec<&str> =
+            line.split(',').enumerate().map(|(i, c)| if i == col { "" } else { c }).collect();
+        out.push_str(&cells.join(","));
+        out.push('\n');
+    }
+    out
+}
+
+/// Measures the sequences and writes the run folder; returns the report's path.
+pub fn measure(opts: &MeasureOptions) -> anyhow::Result<PathBuf> {
+    let inputs = check_options(opts)?;
+    let (records, (w, h)) = measure_all(&inputs, opts.smape_epsilon)?;
+    let first = inputs.reference.frames[0].0;
+    let folder = RunFolder::new(&opts.out);
+    folder.prepare()?;
+    let count = inputs.reference.frames.len() as u32;
+    let names: Vec<&str> = inputs.tests.iter().map(|t| t.0.as_str()).collect();
+    let manifest = json!({
+        "scenario": "measure",
+        "measured": {
+            "reference": opts.reference.display().to_string(),
+            "tests": opts.tests.iter().map(|(n, d)| json!({"name": n, "dir": d.display().to_string()})).collect::<Vec<_>>(),
+            "motion": opts.motion.iter().map(|(n, d)| json!({"name": n, "dir": d.display().to_string()})).collect::<Vec<_>>(),
+            "first_frame": first,
+        },
+        "flicker_version": env!("CARGO_PKG_VERSION"),
+        "resolution": [w, h],
+        "frames": count,
+        "methods": names,
+        "reference": { "frames": (0..count).collect::<Vec<_>>() },
+        "events": opts.events.iter().map(|e| json!({"frame": e - first, "label": format!("input frame {e}")})).collect::<Vec<_>>(),
+        "regions": [],
+        "settings": {
+            "smape_epsilon": opts.smape_epsilon,
+            "time_step": 1.0 / opts.fps,
+            "cvvdp": opts.cvvdp,
+            "methods": names.iter().map(|n| json!({"label": n})).collect::<Vec<_>>(),
+        },
+    });
+    for (k, (n, path)) in inputs.reference.frames.iter().enumerate() {
+        let k = k as u32;
+        let img = load_checked(path, *n, Some((w, h)))?;
+        write_frame(&folder.reference(k, "exr"), &folder.reference(k, "png"), &img)?;
+        for (name, seq, motion) in &inputs.tests {
+            let img = load_checked(&seq.frames[k as usize].1, *n, Some((w, h)))?;
+            write_frame(&folder.frame(name, k, "exr"), &folder.frame(name, k, "png"), &img)?;
+            if let Some(m) = motion {
+                let mv = load_motion(&m.frames[k as usize].1, *n, (w, h))?;
+                let px: Vec<[f32; 4]> = mv.iter().map(|&[x, y]| [x, y, 0.0, 1.0]).collect();
+                output::write_exr(&folder.method_image(name, MOTION, k, "exr"), w, h, &px)?;
+            }
+        }
+    }
+    output::write_text(
+        &folder.frames_csv(),
+        &without_times(&systems::frame_record::to_csv(&records)),
+    )?;
+    output::write_json(&folder.manifest(), &manifest)?;
+    report::rebuild(&folder.root)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::frame_number;
+    use std::path::Path;
+
+    #[test]
+    fn measured_frames_have_no_times() {
+        let csv = "method,frame,cpu_ms,flip\na,0,0.0000,0.5\n";
+        assert_eq!(super::without_times(csv), "method,frame,cpu_ms,flip\na,0,,0.5\n");
+    }
+
+    #[test]
+    fn frame_numbers_are_the_last_digits_of_the_stem() {
+        assert_eq!(frame_number(Path::new("a/0007.exr")), Some(7));
+        assert_eq!(frame_number(Path::new("render2_frame_0012.png")), Some(12));
+        assert_eq!(frame_number(Path::new("frame.exr")), None);
+    }
+}

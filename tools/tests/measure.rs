@@ -1,0 +1,169 @@
+//! `flicker measure`: a flicker run's frames measured again from disk give the run's own
+//! metrics (the round trip), and bad input is refused naming the file and frame, with nothing
+//! written.
+
+use std::path::{Path, PathBuf};
+
+use metrics::CvvdpSettings;
+use systems::playback::{self, Overrides, RunOptions};
+use tools::measure::{MeasureOptions, measure};
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("flicker-measure-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn options(reference: &Path, tests: &[(&str, PathBuf)], out: PathBuf) -> MeasureOptions {
+    MeasureOptions {
+        reference: reference.to_path_buf(),
+        tests: tests.iter().map(|(n, d)| (n.to_string(), d.clone())).collect(),
+        motion: Vec::new(),
+        fps: 30.0,
+        events: Vec::new(),
+        out,
+        cvvdp: CvvdpSettings::default(),
+        smape_epsilon: 0.01,
+    }
+}
+
+/// frames.csv's metric columns, row by row: (method, frame, column) -> cell text.
+fn metric_cells(run: &Path) -> Vec<(String, String, String, String)> {
+    let text = std::fs::read_to_string(run.join("frames.csv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let wanted = ["smape", "smape_reprojected", "disoccluded", "flip", "mse", "rel_mse", "psnr"];
+    lines
+        .flat_map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            let header = header.clone();
+            wanted.iter().map(move |w| {
+                let i = header.iter().position(|h| h == w).unwrap();
+                (cells[0].to_string(), cells[1].to_string(), w.to_string(), cells[i].to_string())
+            })
+        })
+        .collect()
+}
+
+fn overall_jod(run: &Path, method: &str) -> f64 {
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("summary.json")).unwrap()).unwrap();
+    let m = s["methods"].as_array().unwrap().iter().find(|m| m["method"] == method).unwrap();
+    m["jod"]["overall"].as_f64().unwrap_or_else(|| panic!("no overall JOD for {method}: {m}"))
+}
+
+#[test]
+fn a_runs_frames_measured_again_give_the_runs_metrics() {
+    let dir = temp("round_trip");
+    let scenario = dir.join("still.ron");
+    std::fs::write(
+        &scenario,
+        r#"Scenario(
+    scene: Builtin("cornell_box"),
+    resolution: (24, 16),
+    frames: 5,
+    seed: 3,
+    max_depth: 3,
+    methods: [PathTracing(spp: 1), Taa()],
+    reference: (spp: 8, frames: Every(1)),
+)"#,
+    )
+    .unwrap();
+    let run = dir.join("run");
+    let opts = RunOptions {
+        scenario,
+        overrides: Overrides { out: Some(run.clone()), ..Default::default() },
+        cache_dir: Some(dir.join("cache")),
+        progress: false,
+    };
+    let summary = playback::run(&opts).expect("the run plays");
+    let labels: Vec<String> = {
+        let mut l: Vec<String> = summary.records.iter().map(|r| r.method.clone()).collect();
+        l.dedup();
+        l.sort();
+        l.dedup();
+        l
+    };
+    assert_eq!(labels.len(), 2, "{labels:?}");
+    let tests: Vec<(&str, PathBuf)> =
+        labels.iter().map(|l| (l.as_str(), run.join("frames").join(l))).collect();
+    let mut o = options(&run.join("reference"), &tests, dir.join("measured"));
+    for l in &labels {
+        let motion = run.join("frames").join(l).join("motion");
+        if motion.exists() {
+            o.motion.push((l.clone(), motion));
+        }
+    }
+    assert!(!o.motion.is_empty(), "TAA writes motion vectors: reprojected SMAPE is compared too");
+    measure(&o).expect("measure reads the run's frames");
+    let (ours, theirs) = (metric_cells(&dir.join("measured")), metric_cells(&run));
+    assert_eq!(ours.len(), theirs.len());
+    for (a, b) in ours.iter().zip(&theirs) {
+        assert_eq!(a, b, "measured vs run");
+    }
+    assert!(ours.iter().any(|c| c.2 == "flip" && !c.3.is_empty()));
+    assert!(ours.iter().any(|c| c.2 == "smape_reprojected" && !c.3.is_empty()));
+    for l in &labels {
+        assert_eq!(overall_jod(&dir.join("measured"), l), overall_jod(&run, l), "{l}");
+    }
+    assert!(dir.join("measured/report.html").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A tiny sequence of `n` frames of `w`x`h` in `dir` (EXR), value `v` per frame.
+fn sequence(dir: &Path, n: u32, (w, h): (u32, u32), v: impl Fn(u32) -> f32) {
+    std::fs::create_dir_all(dir).unwrap();
+    for f in 0..n {
+        let img = metrics::Image::filled(w, h, [v(f); 3]);
+        metrics::write_exr(&img, dir.join(format!("frame_{f:03}.exr"))).unwrap();
+    }
+}
+
+#[test]
+fn bad_input_names_the_file_and_frame_and_writes_nothing() {
+    let dir = temp("bad");
+    let reference = dir.join("reference");
+    sequence(&reference, 4, (8, 8), |_| 0.5);
+    sequence(&dir.join("ok"), 4, (8, 8), |f| 0.4 + 0.05 * f as f32);
+    sequence(&dir.join("small"), 4, (8, 6), |_| 0.5);
+    sequence(&dir.join("short"), 3, (8, 8), |_| 0.5);
+    sequence(&dir.join("nan"), 4, (8, 8), |f| if f == 2 { f32::NAN } else { 0.5 });
+    let gap = dir.join("gap");
+    sequence(&gap, 4, (8, 8), |_| 0.5);
+    std::fs::remove_file(gap.join("frame_001.exr")).unwrap();
+    let broken = dir.join("broken");
+    sequence(&broken, 4, (8, 8), |_| 0.5);
+    std::fs::write(broken.join("frame_003.exr"), b"not an exr").unwrap();
+    let out = dir.join("out");
+    let cases: [(&str, &[&str]); 5] = [
+        ("small", &["small/frame_000.exr", "frame 0", "8x6", "8x8"]),
+        ("short", &["short", "frame 3 is missing"]),
+        ("nan", &["nan/frame_002.exr", "frame 2", "non-finite"]),
+        ("gap", &["gap", "frame 1 is missing"]),
+        ("broken", &["broken/frame_003.exr", "frame 3"]),
+    ];
+    for (name, expected) in cases {
+        let o = options(&reference, &[("ok", dir.join("ok")), (name, dir.join(name))], out.clone());
+        let e = format!("{:#}", measure(&o).unwrap_err());
+        for x in expected {
+            assert!(e.contains(x), "{name}: `{x}` not in: {e}");
+        }
+        assert!(!out.exists(), "{name}: something was written");
+    }
+    let mut o = options(&reference, &[("ok", dir.join("ok"))], out.clone());
+    o.cvvdp.display = "crt_1985".into();
+    assert!(format!("{:#}", measure(&o).unwrap_err()).contains("unknown display 'crt_1985'"));
+    assert!(!out.exists());
+    // The good pair alone is measured: an event splits the windows.
+    let mut o = options(&reference, &[("ok", dir.join("ok"))], out.clone());
+    o.events = vec![2];
+    measure(&o).unwrap();
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let jod = &s["methods"][0]["jod"];
+    for w in ["before_first_event", "after_event_0", "overall"] {
+        let v = jod[w].as_f64().unwrap_or_else(|| panic!("no JOD for {w}: {s}"));
+        assert!((0.0..=10.0).contains(&v), "{w}: {v}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
