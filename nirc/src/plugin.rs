@@ -22,6 +22,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use crate::config::ReliabilityStatistic;
 use crate::{
     CacheOutput, CachePathSettings, CachePaths, NeuralCache, NircConfig, PredictorMode, SceneBounds,
 };
@@ -86,6 +87,8 @@ pub fn predictor_label(mode: PredictorMode) -> String {
         PredictorMode::HighLrOnly => "highlr".into(),
         PredictorMode::Blend => "blend".into(),
         PredictorMode::Switch => "switch".into(),
+        PredictorMode::BlendBy(ReliabilityStatistic::Correlation) => "blend".into(),
+        PredictorMode::BlendBy(ReliabilityStatistic::RelativeError) => "blend_relerr".into(),
         PredictorMode::Fixed(sigma) => format!("fixed{}", (sigma * 100.0).round()),
     }
 }
@@ -580,7 +583,10 @@ pub fn frame_output(
             stats.push(("nirc_steps_wall_ms".into(), ms));
         }
         let mut images = Vec::new();
-        if matches!(m.mode, PredictorMode::Blend | PredictorMode::Switch) {
+        if matches!(
+            m.mode,
+            PredictorMode::Blend | PredictorMode::Switch | PredictorMode::BlendBy(_)
+        ) {
             images.push(MethodImage {
                 name: "preference".into(),
                 pixels: preference_map(&r.sigma),

@@ -4,7 +4,7 @@
 mod common;
 
 use common::*;
-use nirc::config::PredictorMode;
+use nirc::config::{PredictorMode, ReliabilityStatistic};
 use nirc::gpu::shaders::WeightPlacement;
 use nirc::gpu::upload;
 use nirc::{CacheState, CpuCache, NeuralCache, ReliabilitySample};
@@ -341,6 +341,30 @@ fn reliability_stream(rule: nirc::config::MomentUpdate, resolution: u32, log2_ce
         }
         assert!(off_half > 100, "{mode:?}: the reliabilities must decide ({off_half})");
     }
+    // The blend by relative errors: σ and the blended radiance as the CPU's, and a statistic
+    // of its own (not eq. 3's σ again).
+    let by_error = PredictorMode::BlendBy(ReliabilityStatistic::RelativeError);
+    let paper = cpu.infer(&queries, PredictorMode::Blend);
+    let mut differs = 0;
+    for ((g, w), p) in cache
+        .infer_queries(gpu(), &queries, by_error)
+        .unwrap()
+        .iter()
+        .zip(cpu.infer(&queries, by_error))
+        .zip(&paper)
+    {
+        assert!(close(g.sigma, w.sigma, 1e-4, 1e-5), "{by_error:?}: σ {} vs {}", g.sigma, w.sigma);
+        for c in 0..3 {
+            assert!(
+                close(g.radiance[c], w.radiance[c], 1e-4, 1e-6),
+                "{:?} vs {:?}",
+                g.radiance,
+                w.radiance
+            );
+        }
+        differs += ((w.sigma - p.sigma).abs() > 0.1) as usize;
+    }
+    assert!(differs > 100, "the relative errors give eq. 3's σ ({differs} of 300 differ)");
     // The fixed blend ignores the grid: σ is the setting, the radiance the blend of both.
     let fixed = PredictorMode::Fixed(0.3);
     for (g, w) in
