@@ -87,7 +87,7 @@ pub fn predictor_label(mode: PredictorMode) -> String {
         PredictorMode::HighLrOnly => "highlr".into(),
         PredictorMode::Blend => "blend".into(),
         PredictorMode::Switch => "switch".into(),
-        PredictorMode::BlendBy(ReliabilityStatistic::Correlation) => "blend".into(),
+        PredictorMode::BlendBy(ReliabilityStatistic::Correlation) => "blend_corr".into(),
         PredictorMode::BlendBy(ReliabilityStatistic::RelativeError) => "blend_relerr".into(),
         PredictorMode::Fixed(sigma) => format!("fixed{}", (sigma * 100.0).round()),
     }
