@@ -6,10 +6,10 @@
 # intervals against the fixed mix and the verdict of each statistic). Usage, from the
 # repository root:
 #   [SCENES="cornell_box courtyard corridor"] [STATISTICS="RelativeError"] [FLAGS="--resolution 32x18"] \
-#   [PRETRAIN=160] [REFERENCE_SPP=N] [JOBS=1] \
+#   [PRETRAIN=160] [REFERENCE_SPP=N] [NIRC_EXTRA="paths: (train_records: 512)"] [JOBS=1] \
 #   nirc/scripts/statistics_experiment.sh FLICKER OUT_DIR [SEED ...]
 # (default seeds 1 2 3 4 5; PRETRAIN and REFERENCE_SPP replace the scenarios' pre-training
-# frames and reference samples, FLAGS is passed to every `flicker run`, JOBS runs that many
+# frames and reference samples, NIRC_EXTRA adds settings to every Nirc method, FLAGS is passed to every `flicker run`, JOBS runs that many
 # seeds side by side). OUT_DIR/scenarios holds the scenarios as played, OUT_DIR/summary.md the
 # tables.
 set -uo pipefail
@@ -30,6 +30,7 @@ for scene in ${SCENES:-cornell_box courtyard corridor}; do
   sed "/predictor: Fixed(0.5)/a\\
 ${extra%\\n}" "$src" >"$played"
   [ -n "${PRETRAIN:-}" ] && sed -i "s/pretrain_frames: [0-9]*/pretrain_frames: $PRETRAIN/" "$played"
+  [ -n "${NIRC_EXTRA:-}" ] && sed -i "s/pretrain_frames:/$NIRC_EXTRA, pretrain_frames:/" "$played"
   [ -n "${REFERENCE_SPP:-}" ] && sed -i "s/reference: (spp: [0-9]*/reference: (spp: $REFERENCE_SPP/" "$played"
   for seed in "${seeds[@]}"; do
     while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n; done
