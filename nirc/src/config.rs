@@ -265,6 +265,11 @@ pub enum ReliabilityStatistic {
     /// (e_cur + e_EMA + 2ε), inverse-error weighting. Sees a predictor's bias (lag) as well
     /// as its noise.
     RelativeError,
+    /// The scale mismatch d = |ln ρ| of ρ = (max(Σ_c C^{y,f}_c, 0) + ε) / (Σ_c Q^f_c + ε), the
+    /// least-squares gain from f to y through the origin (uncentred second moments);
+    /// σ = logistic(κ (d_EMA - d_cur)). Target noise independent of f leaves C^{y,f} unbiased,
+    /// so ρ sees a predictor off by a factor without the targets' noise floor.
+    ScaleRatio,
 }
 
 // σ of `Fixed` is compared and hashed by its bits (methods with equal settings share a cache).
@@ -292,6 +297,7 @@ impl PredictorMode {
             PredictorMode::BlendBy(ReliabilityStatistic::Correlation) => 2,
             PredictorMode::Fixed(_) => 5,
             PredictorMode::BlendBy(ReliabilityStatistic::RelativeError) => 6,
+            PredictorMode::BlendBy(ReliabilityStatistic::ScaleRatio) => 7,
         }
     }
 

@@ -89,6 +89,7 @@ pub fn predictor_label(mode: PredictorMode) -> String {
         PredictorMode::Switch => "switch".into(),
         PredictorMode::BlendBy(ReliabilityStatistic::Correlation) => "blend_corr".into(),
         PredictorMode::BlendBy(ReliabilityStatistic::RelativeError) => "blend_relerr".into(),
+        PredictorMode::BlendBy(ReliabilityStatistic::ScaleRatio) => "blend_scale".into(),
         PredictorMode::Fixed(sigma) => format!("fixed{}", (sigma * 100.0).round()),
     }
 }

@@ -157,6 +157,21 @@ pub fn inverse_error_weight(config: &ReliabilityConfig, e_cur: f32, e_ema: f32) 
     (e_ema + config.epsilon) / (e_cur + e_ema + 2.0 * config.epsilon)
 }
 
+/// (d_cur, d_ema) of one cell: |ln ρ| of each predictor's gain ρ = (max(Σ_c C^{y,f}_c, 0) + ε) /
+/// (Σ_c Q^f_c + ε), the least-squares factor from f to y through the origin.
+pub fn scale_mismatches(config: &ReliabilityConfig, cell_moments: &[f32]) -> (f32, f32) {
+    let m = cell_moments;
+    let d = |p: usize| {
+        let (mut cyf, mut qf) = (0.0f32, 0.0f32);
+        for c in 0..3 {
+            qf += m[p + 3 + c];
+            cyf += m[p + 6 + c];
+        }
+        ((cyf.max(0.0) + config.epsilon) / (qf + config.epsilon)).ln().abs()
+    };
+    (d(CUR), d(EMA))
+}
+
 /// Weight of the High-LR predictor for a query in a cell with these moments.
 pub fn high_lr_weight(
     config: &ReliabilityConfig,
@@ -177,6 +192,10 @@ pub fn high_lr_weight(
         PredictorMode::BlendBy(ReliabilityStatistic::RelativeError) => {
             let (e_cur, e_ema) = relative_errors(config, cell_moments);
             inverse_error_weight(config, e_cur, e_ema)
+        }
+        PredictorMode::BlendBy(ReliabilityStatistic::ScaleRatio) => {
+            let (d_cur, d_ema) = scale_mismatches(config, cell_moments);
+            1.0 / (1.0 + (-config.kappa * (d_ema - d_cur)).exp())
         }
         PredictorMode::Switch => {
             let (r_cur, r_ema) = reliabilities(config, cell_moments);
@@ -353,10 +372,24 @@ mod tests {
             ),
             paper
         );
+        // The gain through the origin sees the factor too: ρ_EMA = 2, so σ ≈ logistic(4 ln 2).
+        let (d_cur, d_ema) = scale_mismatches(&cfg, &m);
+        assert!((d_ema - 2f32.ln()).abs() < 1e-4 && d_cur < 0.01, "{d_cur} {d_ema}");
+        let by_scale = high_lr_weight(
+            &cfg,
+            PredictorMode::BlendBy(ReliabilityStatistic::ScaleRatio),
+            1000,
+            &m,
+        );
+        let expected = 1.0 / (1.0 + (-cfg.kappa * (d_ema - d_cur)).exp());
+        assert!(by_scale > 0.9 && (by_scale - expected).abs() < 1e-6, "σ = {by_scale}");
         // Warm-up holds for it too, and an empty cell is an even blend.
         let warm = PredictorMode::BlendBy(ReliabilityStatistic::RelativeError);
         assert_eq!(high_lr_weight(&cfg, warm, cfg.warmup - 1, &m), 0.0);
         assert_eq!(high_lr_weight(&cfg, warm, 1000, &[0.0; MOMENTS_PER_CELL]), 0.5);
+        let scale = PredictorMode::BlendBy(ReliabilityStatistic::ScaleRatio);
+        assert_eq!(high_lr_weight(&cfg, scale, cfg.warmup - 1, &m), 0.0);
+        assert_eq!(high_lr_weight(&cfg, scale, 1000, &[0.0; MOMENTS_PER_CELL]), 0.5);
     }
 
     #[test]
