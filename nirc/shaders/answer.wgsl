@@ -1,6 +1,6 @@
 // The cache's answer to one query (CPU mirror: CpuCache::infer): σ from the query's
-// reliability cell (mode 5: the call's fixed σ; mode 6: from the relative errors, 7: from the scale mismatches), then max(0, (1 - σ) f_EMA + σ f_cur) with σ
-// in .w. Mode 4 (diagnostics)
+// reliability cell (mode 5: the call's fixed σ; 6: from the relative errors; 7: from the scale
+// mismatches), then max(0, (1 - σ) f_EMA + σ f_cur) with σ in .w. Mode 4 (diagnostics)
 // answers (r̄_cur, r̄_EMA, σ of the blend, 1 once warmed up). Reads the pass's `hyper`,
 // `moments`, `counters` and `answers` (package::nirc::bindings).
 

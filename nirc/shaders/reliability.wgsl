@@ -1,6 +1,6 @@
 // Reliability grid lookups (CPU mirror: src/reliability.rs): the hashed voxel cell of a
-// position, eq. 3 averaged over RGB, the relative squared error, and the blend weight of the
-// High-LR predictor.
+// position, eq. 3 averaged over RGB, the relative squared error, the scale mismatch, and the
+// blend weight of the High-LR predictor.
 
 import package::nirc::config::{CELL_COUNT};
 import package::nirc::bindings::{hyper};
