@@ -54,7 +54,7 @@ for name in sorted(os.listdir(runs)):
     for method, rs in by.items():
         for wname, a, b in windows + [post]:
             w = [r for r in rs if a <= int(r['frame']) <= b]
-            for metric in ('flip', 'smape', 'blend_sigma'):
+            for metric in ('flip', 'smape', 'blend_sigma', 'own_sigma'):
                 per[scene][method][wname][metric].append(mean([f(r.get(metric, '')) for r in w]))
 
 def paired(scene, method, control, window, metric):
@@ -93,6 +93,10 @@ for scene in sorted(per):
     if blend:
         sig = ', '.join('{} {:.3f} ± {:.3f}'.format(w, *interval(per[scene][blend][w]['blend_sigma'])) for w, _, _ in windows)
         print(f"- mean σ of the paper's blend: {sig}")
+    for method in sorted(per[scene]):
+        if not all(math.isnan(x) for x in per[scene][method]['before']['own_sigma']):
+            sig = ', '.join('{} {:.3f} ± {:.3f}'.format(w, *interval(per[scene][method][w]['own_sigma'])) for w, _, _ in windows)
+            print(f'- mean σ of {method}: {sig}')
 
 # The verdict (for every blend and switch): better than the fixed mix when its FLIP after the
 # change (frames change+2 to the end) is below the fixed mix's beyond the 95% interval of the
