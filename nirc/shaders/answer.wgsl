@@ -1,11 +1,11 @@
 // The cache's answer to one query (CPU mirror: CpuCache::infer): σ from the query's
-// reliability cell (mode 5: the call's fixed σ), then max(0, (1 - σ) f_EMA + σ f_cur) with σ
-// in .w. Mode 4 (diagnostics)
+// reliability cell (mode 5: the call's fixed σ; 6: from the relative errors; 7: from the scale
+// mismatches), then max(0, (1 - σ) f_EMA + σ f_cur) with σ in .w. Mode 4 (diagnostics)
 // answers (r̄_cur, r̄_EMA, σ of the blend, 1 once warmed up). Reads the pass's `hyper`,
 // `moments`, `counters` and `answers` (package::nirc::bindings).
 
 import package::nirc::bindings::{answers, call, counters, hyper, moments};
-import package::nirc::reliability::{MOMENTS_CUR, MOMENTS_EMA, MOMENTS_PER_CELL, cell_index, high_lr_weight, mean_correlation};
+import package::nirc::reliability::{MOMENTS_CUR, MOMENTS_EMA, MOMENTS_PER_CELL, cell_index, high_lr_weight, mean_correlation, mean_relative_error, scale_mismatch};
 
 fn moment3(base: u32) -> vec3<f32> {
     return vec3<f32>(moments[base], moments[base + 1u], moments[base + 2u]);
@@ -20,6 +20,17 @@ fn write_answer(qi: u32, pos: vec3<f32>, mode: u32, f_ema: vec3<f32>, f_cur: vec
         let qy = moment3(b + 3u);
         r_cur = mean_correlation(my, qy, moment3(b + MOMENTS_CUR), moment3(b + MOMENTS_CUR + 3u), moment3(b + MOMENTS_CUR + 6u));
         r_ema = mean_correlation(my, qy, moment3(b + MOMENTS_EMA), moment3(b + MOMENTS_EMA + 3u), moment3(b + MOMENTS_EMA + 6u));
+    }
+    if mode == 6u {
+        let b = cell_index(pos) * MOMENTS_PER_CELL;
+        let qy = moment3(b + 3u);
+        r_cur = mean_relative_error(qy, moment3(b + MOMENTS_CUR + 3u), moment3(b + MOMENTS_CUR + 6u));
+        r_ema = mean_relative_error(qy, moment3(b + MOMENTS_EMA + 3u), moment3(b + MOMENTS_EMA + 6u));
+    }
+    if mode == 7u {
+        let b = cell_index(pos) * MOMENTS_PER_CELL;
+        r_cur = scale_mismatch(moment3(b + MOMENTS_CUR + 3u), moment3(b + MOMENTS_CUR + 6u));
+        r_ema = scale_mismatch(moment3(b + MOMENTS_EMA + 3u), moment3(b + MOMENTS_EMA + 6u));
     }
     if mode == 4u {
         let warm = counters.grid_updates >= hyper.warmup;

@@ -1,5 +1,6 @@
 // Reliability grid lookups (CPU mirror: src/reliability.rs): the hashed voxel cell of a
-// position, eq. 3 averaged over RGB, and the blend weight of the High-LR predictor.
+// position, eq. 3 averaged over RGB, the relative squared error, the scale mismatch, and the
+// blend weight of the High-LR predictor.
 
 import package::nirc::config::{CELL_COUNT};
 import package::nirc::bindings::{hyper};
@@ -35,7 +36,38 @@ fn mean_correlation(my: vec3<f32>, qy: vec3<f32>, mf: vec3<f32>, qf: vec3<f32>, 
     return sum / 3.0;
 }
 
-// Modes: 0 EMA-only, 1 High-LR only, 2 blend, 3 switch. Markers are off during warm-up.
+// e = mean over RGB of max(Q^y - 2 C^{y,f} + Q^f, 0) / (Q^y + ε): the EMA of (y - f)², relative.
+fn mean_relative_error(qy: vec3<f32>, qf: vec3<f32>, cyf: vec3<f32>) -> f32 {
+    var sum = 0.0;
+    for (var c = 0u; c < 3u; c++) {
+        let squared_error = max(qy[c] - 2.0 * cyf[c] + qf[c], 0.0);
+        sum += squared_error / (qy[c] + hyper.reliability_epsilon);
+    }
+    return sum / 3.0;
+}
+
+// σ = (e_EMA + ε) / (e_cur + e_EMA + 2ε) (mode 6 once warmed up).
+fn inverse_error_weight(e_cur: f32, e_ema: f32) -> f32 {
+    let eps = hyper.reliability_epsilon;
+    return (e_ema + eps) / (e_cur + e_ema + 2.0 * eps);
+}
+
+// d = |ln ρ|, ρ = (max(Σ_c C^{y,f}_c, 0) + ε) / (Σ_c Q^f_c + ε): the gain from f to y through
+// the origin.
+fn scale_mismatch(qf: vec3<f32>, cyf: vec3<f32>) -> f32 {
+    let eps = hyper.reliability_epsilon;
+    var c_sum = 0.0;
+    var q_sum = 0.0;
+    for (var c = 0u; c < 3u; c++) {
+        q_sum += qf[c];
+        c_sum += cyf[c];
+    }
+    return abs(log((max(c_sum, 0.0) + eps) / (q_sum + eps)));
+}
+
+// Modes: 0 EMA-only, 1 High-LR only, 2 blend, 3 switch, 6 blend by the relative errors (then
+// r_cur, r_ema hold e_cur, e_ema), 7 by the scale mismatches (they hold d_cur, d_ema). Markers
+// are off during warm-up.
 fn high_lr_weight(mode: u32, grid_updates: u32, r_cur: f32, r_ema: f32) -> f32 {
     if mode == 0u {
         return 0.0;
@@ -48,6 +80,12 @@ fn high_lr_weight(mode: u32, grid_updates: u32, r_cur: f32, r_ema: f32) -> f32 {
     }
     if mode == 2u {
         return 1.0 / (1.0 + exp(-hyper.kappa * (r_cur - r_ema)));
+    }
+    if mode == 6u {
+        return inverse_error_weight(r_cur, r_ema);
+    }
+    if mode == 7u {
+        return 1.0 / (1.0 + exp(-hyper.kappa * (r_ema - r_cur)));
     }
     return select(0.0, 1.0, r_cur > r_ema);
 }

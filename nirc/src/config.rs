@@ -245,9 +245,31 @@ pub enum PredictorMode {
     Blend,
     /// The predictor of higher reliability r̄ (ties go to EMA).
     Switch,
+    /// L = (1 - σ) f_EMA + σ f_cur per query with σ from another reliability statistic of the
+    /// same cell (`BlendBy(Correlation)` is `Blend`).
+    BlendBy(ReliabilityStatistic),
     /// L = (1 - σ) f_EMA + σ f_cur with a constant σ in [0, 1] (a control for the blend: the
     /// same two predictors without the reliability grid, warm-up included).
     Fixed(f32),
+}
+
+/// What a blend's σ is computed from, per reliability cell (all from the moments the grid keeps).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+pub enum ReliabilityStatistic {
+    /// The paper's eq. 3: r̄ = mean over RGB of the correlation of y and f;
+    /// σ = logistic(κ (r̄_cur - r̄_EMA)). Blind to a predictor off by a factor or an offset.
+    #[default]
+    Correlation,
+    /// The relative mean squared error e = mean over RGB of E_λ[(y - f)²] / (E_λ[y²] + ε), with
+    /// E_λ[(y - f)²] = Q^y - 2 C^{y,f} + Q^f (the EMA is linear); σ = (e_EMA + ε) /
+    /// (e_cur + e_EMA + 2ε), inverse-error weighting. Sees a predictor's bias (lag) as well
+    /// as its noise.
+    RelativeError,
+    /// The scale mismatch d = |ln ρ| of ρ = (max(Σ_c C^{y,f}_c, 0) + ε) / (Σ_c Q^f_c + ε), the
+    /// least-squares gain from f to y through the origin (uncentred second moments);
+    /// σ = logistic(κ (d_EMA - d_cur)). Target noise independent of f leaves C^{y,f} unbiased,
+    /// so ρ sees a predictor off by a factor without the targets' noise floor.
+    ScaleRatio,
 }
 
 // σ of `Fixed` is compared and hashed by its bits (methods with equal settings share a cache).
@@ -259,6 +281,9 @@ impl std::hash::Hash for PredictorMode {
         if let PredictorMode::Fixed(sigma) = self {
             sigma.to_bits().hash(state);
         }
+        if let PredictorMode::BlendBy(statistic) = self {
+            statistic.hash(state);
+        }
     }
 }
 
@@ -269,7 +294,10 @@ impl PredictorMode {
             PredictorMode::HighLrOnly => 1,
             PredictorMode::Blend => 2,
             PredictorMode::Switch => 3,
+            PredictorMode::BlendBy(ReliabilityStatistic::Correlation) => 2,
             PredictorMode::Fixed(_) => 5,
+            PredictorMode::BlendBy(ReliabilityStatistic::RelativeError) => 6,
+            PredictorMode::BlendBy(ReliabilityStatistic::ScaleRatio) => 7,
         }
     }
 

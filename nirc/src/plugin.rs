@@ -22,6 +22,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
+use crate::config::ReliabilityStatistic;
 use crate::{
     CacheOutput, CachePathSettings, CachePaths, NeuralCache, NircConfig, PredictorMode, SceneBounds,
 };
@@ -86,6 +87,9 @@ pub fn predictor_label(mode: PredictorMode) -> String {
         PredictorMode::HighLrOnly => "highlr".into(),
         PredictorMode::Blend => "blend".into(),
         PredictorMode::Switch => "switch".into(),
+        PredictorMode::BlendBy(ReliabilityStatistic::Correlation) => "blend_corr".into(),
+        PredictorMode::BlendBy(ReliabilityStatistic::RelativeError) => "blend_relerr".into(),
+        PredictorMode::BlendBy(ReliabilityStatistic::ScaleRatio) => "blend_scale".into(),
         PredictorMode::Fixed(sigma) => format!("fixed{}", (sigma * 100.0).round()),
     }
 }
@@ -579,8 +583,16 @@ pub fn frame_output(
         if let Some(ms) = c.steps_wall_ms {
             stats.push(("nirc_steps_wall_ms".into(), ms));
         }
+        // `blend_sigma` is the paper's blend's σ (shared); a blend by another statistic also
+        // reports its own mean σ over the answered pixels.
+        if let PredictorMode::BlendBy(_) = m.mode {
+            stats.push(("own_sigma".into(), mean_answered_sigma(&r.sigma)));
+        }
         let mut images = Vec::new();
-        if matches!(m.mode, PredictorMode::Blend | PredictorMode::Switch) {
+        if matches!(
+            m.mode,
+            PredictorMode::Blend | PredictorMode::Switch | PredictorMode::BlendBy(_)
+        ) {
             images.push(MethodImage {
                 name: "preference".into(),
                 pixels: preference_map(&r.sigma),
@@ -647,6 +659,12 @@ fn reliability_stats(diag: &[[f32; 4]], valid: &[bool]) -> Vec<(String, f64)> {
 
 /// Figure 3's colours: green where High-LR is preferred (σ), red where EMA is (1 - σ); black
 /// where no query was answered.
+/// Mean σ over the pixels that were answered (`.w` > 0), 0 if none.
+fn mean_answered_sigma(sigma: &[[f32; 4]]) -> f64 {
+    let answered: Vec<f64> = sigma.iter().filter(|s| s[3] > 0.0).map(|s| s[0] as f64).collect();
+    answered.iter().sum::<f64>() / f64::max(answered.len() as f64, 1.0)
+}
+
 pub fn preference_map(sigma: &[[f32; 4]]) -> Vec<[f32; 4]> {
     sigma
         .iter()
@@ -657,6 +675,13 @@ pub fn preference_map(sigma: &[[f32; 4]]) -> Vec<[f32; 4]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn own_sigma_is_the_mean_over_answered_pixels() {
+        let sigma = [[0.25, 0.0, 0.0, 1.0], [0.9, 0.0, 0.0, 0.0], [0.75, 0.0, 0.0, 1.0]];
+        assert_eq!(mean_answered_sigma(&sigma), 0.5);
+        assert_eq!(mean_answered_sigma(&[[0.9, 0.0, 0.0, 0.0]]), 0.0);
+    }
 
     /// The spread of d = r̄_cur − r̄_EMA and the share of σ away from 0.5 count only answered
     /// queries past the grid's warm-up.

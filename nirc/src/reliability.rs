@@ -14,7 +14,7 @@
 //! updates (committed steps) for the whole grid.
 
 use crate::bounds::SceneBounds;
-use crate::config::{MomentUpdate, PredictorMode, ReliabilityConfig};
+use crate::config::{MomentUpdate, PredictorMode, ReliabilityConfig, ReliabilityStatistic};
 use crate::fixed_sum::FixedSum;
 use crate::layout::spatial_hash;
 use crate::records::ReliabilitySample;
@@ -132,6 +132,46 @@ pub fn reliabilities(config: &ReliabilityConfig, cell_moments: &[f32]) -> (f32, 
     (r(CUR), r(EMA))
 }
 
+/// (e_cur, e_ema) of one cell: per predictor the mean over RGB of the EMA of its squared error
+/// against the targets, relative to the EMA of the targets' square. The EMA is linear, so
+/// E_λ[(y - f)²] = Q^y - 2 C^{y,f} + Q^f from the moments the grid keeps (clamped at 0 against
+/// rounding).
+pub fn relative_errors(config: &ReliabilityConfig, cell_moments: &[f32]) -> (f32, f32) {
+    let m = cell_moments;
+    let e = |p: usize| {
+        let mut sum = 0.0f32;
+        for c in 0..3 {
+            let qy = m[3 + c];
+            let (qf, cyf) = (m[p + 3 + c], m[p + 6 + c]);
+            let squared_error = (qy - 2.0 * cyf + qf).max(0.0);
+            sum += squared_error / (qy + config.epsilon);
+        }
+        sum / 3.0
+    };
+    (e(CUR), e(EMA))
+}
+
+/// Inverse-error weighting of the High-LR predictor: σ = (e_EMA + ε) / (e_cur + e_EMA + 2ε)
+/// (an even blend where both errors vanish, as in an empty cell).
+pub fn inverse_error_weight(config: &ReliabilityConfig, e_cur: f32, e_ema: f32) -> f32 {
+    (e_ema + config.epsilon) / (e_cur + e_ema + 2.0 * config.epsilon)
+}
+
+/// (d_cur, d_ema) of one cell: |ln ρ| of each predictor's gain ρ = (max(Σ_c C^{y,f}_c, 0) + ε) /
+/// (Σ_c Q^f_c + ε), the least-squares factor from f to y through the origin.
+pub fn scale_mismatches(config: &ReliabilityConfig, cell_moments: &[f32]) -> (f32, f32) {
+    let m = cell_moments;
+    let d = |p: usize| {
+        let (mut cyf, mut qf) = (0.0f32, 0.0f32);
+        for c in 0..3 {
+            qf += m[p + 3 + c];
+            cyf += m[p + 6 + c];
+        }
+        ((cyf.max(0.0) + config.epsilon) / (qf + config.epsilon)).ln().abs()
+    };
+    (d(CUR), d(EMA))
+}
+
 /// Weight of the High-LR predictor for a query in a cell with these moments.
 pub fn high_lr_weight(
     config: &ReliabilityConfig,
@@ -145,9 +185,17 @@ pub fn high_lr_weight(
         PredictorMode::Fixed(sigma) => sigma,
         // During warm-up the markers are disabled: the EMA baseline answers.
         _ if grid_updates < config.warmup => 0.0,
-        PredictorMode::Blend => {
+        PredictorMode::Blend | PredictorMode::BlendBy(ReliabilityStatistic::Correlation) => {
             let (r_cur, r_ema) = reliabilities(config, cell_moments);
             1.0 / (1.0 + (-config.kappa * (r_cur - r_ema)).exp())
+        }
+        PredictorMode::BlendBy(ReliabilityStatistic::RelativeError) => {
+            let (e_cur, e_ema) = relative_errors(config, cell_moments);
+            inverse_error_weight(config, e_cur, e_ema)
+        }
+        PredictorMode::BlendBy(ReliabilityStatistic::ScaleRatio) => {
+            let (d_cur, d_ema) = scale_mismatches(config, cell_moments);
+            1.0 / (1.0 + (-config.kappa * (d_ema - d_cur)).exp())
         }
         PredictorMode::Switch => {
             let (r_cur, r_ema) = reliabilities(config, cell_moments);
@@ -266,6 +314,82 @@ mod tests {
             "{rc} {re}"
         );
         assert_eq!(combine(0.25, [4.0, 0.0, -8.0], [0.0, 4.0, -8.0]), [1.0, 3.0, 0.0]);
+    }
+
+    #[test]
+    fn relative_error_sees_a_lagging_factor_the_correlation_cannot() {
+        let cfg = ReliabilityConfig { epsilon: 1e-7, ..config() };
+        let mut rng = 11u64;
+        // The EMA predictor lags: it still answers half the light (a factor, as when a light
+        // dims), the High-LR one tracks it with noise. Both correlate almost perfectly with y.
+        let (mut direct_cur, mut direct_ema, mut direct_qy) =
+            ([0.0f32; 3], [0.0f32; 3], [0.0f32; 3]);
+        let mut streams = Vec::new();
+        let m = run(300, |_| {
+            let y = [lcg(&mut rng) + 0.5, lcg(&mut rng) + 0.5, lcg(&mut rng) + 0.5];
+            let fc: [f32; 3] = std::array::from_fn(|c| y[c] + 0.05 * (lcg(&mut rng) - 0.5));
+            let fe = y.map(|v| 0.5 * v);
+            streams.push((y, fc, fe));
+            (y, fc, fe)
+        });
+        // The same errors as EMAs of their own, sample by sample.
+        for (y, fc, fe) in &streams {
+            for c in 0..3 {
+                direct_cur[c] = ema_step(cfg.lambda, direct_cur[c], (y[c] - fc[c]).powi(2));
+                direct_ema[c] = ema_step(cfg.lambda, direct_ema[c], (y[c] - fe[c]).powi(2));
+                direct_qy[c] = ema_step(cfg.lambda, direct_qy[c], y[c] * y[c]);
+            }
+        }
+        let relative =
+            |e: [f32; 3]| (0..3).map(|c| e[c] / (direct_qy[c] + cfg.epsilon)).sum::<f32>() / 3.0;
+        let (e_cur, e_ema) = relative_errors(&cfg, &m);
+        // f32 moments of size ~1 cancel to a difference of ~1e-3: a few ulps of 1 is the bound.
+        assert!((e_cur - relative(direct_cur)).abs() < 1e-5, "{e_cur} vs {}", relative(direct_cur));
+        assert!((e_ema - relative(direct_ema)).abs() < 1e-5, "{e_ema} vs {}", relative(direct_ema));
+        // Half the light: (y - y/2)² / y² = 1/4 exactly, whatever y.
+        assert!((e_ema - 0.25).abs() < 1e-4, "{e_ema}");
+        let (r_cur, r_ema) = reliabilities(&cfg, &m);
+        let paper = high_lr_weight(&cfg, PredictorMode::Blend, 1000, &m);
+        let by_error = high_lr_weight(
+            &cfg,
+            PredictorMode::BlendBy(ReliabilityStatistic::RelativeError),
+            1000,
+            &m,
+        );
+        // Eq. 3 sees two reliable predictors (σ near 1/2); the error weighting picks High-LR.
+        assert!(
+            r_ema > 0.999 && r_cur > 0.95 && (paper - 0.5).abs() < 0.1,
+            "{r_cur} {r_ema} σ {paper}"
+        );
+        let expected = (e_ema + cfg.epsilon) / (e_cur + e_ema + 2.0 * cfg.epsilon);
+        assert!(by_error > 0.99 && (by_error - expected).abs() < 1e-6, "σ = {by_error}");
+        assert_eq!(
+            high_lr_weight(
+                &cfg,
+                PredictorMode::BlendBy(ReliabilityStatistic::Correlation),
+                1000,
+                &m
+            ),
+            paper
+        );
+        // The gain through the origin sees the factor too: ρ_EMA = 2, so σ ≈ logistic(4 ln 2).
+        let (d_cur, d_ema) = scale_mismatches(&cfg, &m);
+        assert!((d_ema - 2f32.ln()).abs() < 1e-4 && d_cur < 0.01, "{d_cur} {d_ema}");
+        let by_scale = high_lr_weight(
+            &cfg,
+            PredictorMode::BlendBy(ReliabilityStatistic::ScaleRatio),
+            1000,
+            &m,
+        );
+        let expected = 1.0 / (1.0 + (-cfg.kappa * (d_ema - d_cur)).exp());
+        assert!(by_scale > 0.9 && (by_scale - expected).abs() < 1e-6, "σ = {by_scale}");
+        // Warm-up holds for it too, and an empty cell is an even blend.
+        let warm = PredictorMode::BlendBy(ReliabilityStatistic::RelativeError);
+        assert_eq!(high_lr_weight(&cfg, warm, cfg.warmup - 1, &m), 0.0);
+        assert_eq!(high_lr_weight(&cfg, warm, 1000, &[0.0; MOMENTS_PER_CELL]), 0.5);
+        let scale = PredictorMode::BlendBy(ReliabilityStatistic::ScaleRatio);
+        assert_eq!(high_lr_weight(&cfg, scale, cfg.warmup - 1, &m), 0.0);
+        assert_eq!(high_lr_weight(&cfg, scale, 1000, &[0.0; MOMENTS_PER_CELL]), 0.5);
     }
 
     #[test]

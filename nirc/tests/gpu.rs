@@ -4,7 +4,7 @@
 mod common;
 
 use common::*;
-use nirc::config::PredictorMode;
+use nirc::config::{PredictorMode, ReliabilityStatistic};
 use nirc::gpu::shaders::WeightPlacement;
 use nirc::gpu::upload;
 use nirc::{CacheState, CpuCache, NeuralCache, ReliabilitySample};
@@ -340,6 +340,38 @@ fn reliability_stream(rule: nirc::config::MomentUpdate, resolution: u32, log2_ce
             off_half += ((w.sigma - 0.5).abs() > 0.2) as usize;
         }
         assert!(off_half > 100, "{mode:?}: the reliabilities must decide ({off_half})");
+    }
+    // The blends by the other statistics: σ and the blended radiance as the CPU's, and each a
+    // statistic of its own (not eq. 3's σ again).
+    let paper = cpu.infer(&queries, PredictorMode::Blend);
+    for statistic in [ReliabilityStatistic::RelativeError, ReliabilityStatistic::ScaleRatio] {
+        let by_error = PredictorMode::BlendBy(statistic);
+        let mut differs = 0;
+        for ((g, w), p) in cache
+            .infer_queries(gpu(), &queries, by_error)
+            .unwrap()
+            .iter()
+            .zip(cpu.infer(&queries, by_error))
+            .zip(&paper)
+        {
+            assert!(
+                close(g.sigma, w.sigma, 1e-4, 1e-5),
+                "{by_error:?}: σ {} vs {}",
+                g.sigma,
+                w.sigma
+            );
+            for c in 0..3 {
+                assert!(
+                    close(g.radiance[c], w.radiance[c], 1e-4, 1e-6),
+                    "{:?} vs {:?}",
+                    g.radiance,
+                    w.radiance
+                );
+            }
+            // 10x the σ tolerance above: a different statistic, not rounding.
+            differs += ((w.sigma - p.sigma).abs() > 1e-3) as usize;
+        }
+        assert!(differs > 150, "{statistic:?} gives eq. 3's σ ({differs} of 300 differ)");
     }
     // The fixed blend ignores the grid: σ is the setting, the radiance the blend of both.
     let fixed = PredictorMode::Fixed(0.3);
