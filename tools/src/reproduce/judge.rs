@@ -29,10 +29,13 @@ impl Verdict {
 pub struct Judged {
     pub flicker: String,
     pub verdict: Verdict,
+    /// The per-seed values the verdict was judged on (for a relation both methods', the first
+    /// method's first); empty when there were none.
+    pub values: Vec<f64>,
 }
 
 fn not_comparable(reason: String) -> Judged {
-    Judged { flicker: "-".into(), verdict: Verdict::NotComparable(reason) }
+    Judged { flicker: "-".into(), verdict: Verdict::NotComparable(reason), values: Vec::new() }
 }
 
 /// The mean of `values` and the half-width of its two-sided `confidence` interval.
@@ -51,7 +54,10 @@ pub fn judge(
     let values = |m: &str| per_seed(m).map_err(|e| format!("{m}: {e}"));
     let band = |v: Vec<f64>, value: f64, tolerance: f64, confidence: f64| {
         if v.len() < 2 {
-            return not_comparable(format!("{} seed(s); an interval needs at least 2", v.len()));
+            let mut j =
+                not_comparable(format!("{} seed(s); an interval needs at least 2", v.len()));
+            j.values = v;
+            return j;
         }
         let (mean, half) = interval(&v, confidence);
         let (lo, hi) = (mean - half, mean + half);
@@ -66,7 +72,7 @@ pub fn judge(
                 confidence * 100.0
             ))
         };
-        Judged { flicker, verdict }
+        Judged { flicker, verdict, values: v }
     };
     match comparison {
         Comparison::NotComparable { reason, .. } => not_comparable(reason.clone()),
@@ -95,7 +101,7 @@ pub fn judge(
                 d.n
             );
             let verdict = if upper < 0.0 { Verdict::Reproduced } else { Verdict::NotReproduced };
-            Judged { flicker, verdict }
+            Judged { flicker, verdict, values: [a, b].concat() }
         }
         Comparison::Value { method, value, tolerance, confidence } => match values(method) {
             Ok(v) => band(v, *value, *tolerance, *confidence),
