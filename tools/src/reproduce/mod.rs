@@ -9,4 +9,4 @@ pub mod run;
 
 pub use claims::{Claim, Claims, Comparison, Scale};
 pub use judge::{Judged, Verdict, judge};
-pub use run::{ReproduceOptions, ReproduceOutcome, reproduce};
+pub use run::{ClaimOutcome, ReproduceOptions, ReproduceOutcome, reproduce};

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 
-use super::claims::{Claims, Scale};
-use super::judge::{Verdict, judge};
+use super::claims::{Claims, Comparison, Scale};
+use super::judge::{Judged, judge};
 use super::report::{self, PaperResult};
 use crate::suite::run::play_cases;
 
@@ -27,8 +27,20 @@ pub struct ReproduceOptions {
 pub struct ReproduceOutcome {
     pub folder: PathBuf,
     pub markdown: String,
-    /// Per paper, per claim: (paper, claim id, verdict).
-    pub verdicts: Vec<(String, String, Verdict)>,
+    /// Every claim of every paper played, in file order.
+    pub claims: Vec<ClaimOutcome>,
+}
+
+/// One claim's outcome.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClaimOutcome {
+    pub paper: String,
+    pub id: String,
+    /// The claims file declares it not comparable (nothing is played for it).
+    pub declared_not_comparable: bool,
+    /// Its statistic is a measured time (differs run to run).
+    pub timing: bool,
+    pub judged: Judged,
 }
 
 /// The claims files `paper` names, every one loaded (so every error shows before anything plays).
@@ -61,7 +73,7 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
         PathBuf::from("runs").join(format!("reproduce_{}_{}", opts.paper, opts.scale.name()))
     });
     let mut papers = Vec::new();
-    let mut verdicts = Vec::new();
+    let mut outcomes = Vec::new();
     for claims in &all {
         let cases = claims.cases_for(opts.scale, opts.seeds);
         let label = format!("reproduce {}", claims.paper);
@@ -79,7 +91,13 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
                 (Some(r), Some(s)) => judge(&c.comparison, &|m| r.per_seed(m, s.metric, &s.window)),
                 _ => judge(&c.comparison, &|_| Err("not played".into())),
             };
-            verdicts.push((claims.paper.clone(), c.id.clone(), j.verdict.clone()));
+            outcomes.push(ClaimOutcome {
+                paper: claims.paper.clone(),
+                id: c.id.clone(),
+                declared_not_comparable: matches!(c.comparison, Comparison::NotComparable { .. }),
+                timing: c.statistic.as_ref().is_some_and(|s| s.metric.is_timing()),
+                judged: j.clone(),
+            });
             judged.push((c, j));
         }
         papers.push(PaperResult { claims, judged });
@@ -94,5 +112,5 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
     let markdown = report::markdown(&header, &papers);
     systems::output::write_text(&folder.join("reproduce.md"), &markdown)?;
     systems::output::write_text(&folder.join("reproduce.html"), &report::html(&header, &papers))?;
-    Ok(ReproduceOutcome { folder, markdown, verdicts })
+    Ok(ReproduceOutcome { folder, markdown, claims: outcomes })
 }
