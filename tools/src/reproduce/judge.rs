@@ -39,7 +39,7 @@ fn not_comparable(reason: String) -> Judged {
 }
 
 /// The mean of `values` and the half-width of its two-sided `confidence` interval.
-fn interval(values: &[f64], confidence: f64) -> (f64, f64) {
+pub(crate) fn interval(values: &[f64], confidence: f64) -> (f64, f64) {
     let s = Sample::of(values);
     let t = student_t::quantile(0.5 + confidence / 2.0, (s.n - 1) as f64);
     (s.mean, t * s.standard_error())

@@ -6,6 +6,7 @@ pub mod claims;
 pub mod judge;
 pub mod report;
 pub mod run;
+pub mod table;
 
 pub use claims::{Claim, Claims, Comparison, Scale};
 pub use judge::{Judged, Verdict, judge};

@@ -8,6 +8,7 @@ use anyhow::{Result, bail};
 use super::claims::{Claims, Comparison, Scale};
 use super::judge::{Judged, judge};
 use super::report::{self, PaperResult};
+use super::table::case_tables;
 use crate::suite::run::play_cases;
 
 pub struct ReproduceOptions {
@@ -100,7 +101,8 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
             });
             judged.push((c, j));
         }
-        papers.push(PaperResult { claims, judged });
+        let tables = case_tables(claims, &runs);
+        papers.push(PaperResult { claims, judged, tables });
     }
     let seeds = opts.seeds.map_or("each case's own".to_string(), |n| n.to_string());
     let header = format!(
