@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use tools::reproduce::{Claims, Comparison, Verdict, judge};
+use tools::suite::window::Window;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
@@ -112,8 +113,8 @@ fn below() -> Comparison {
     Comparison::Below { method: "a".into(), than: "b".into(), confidence: 0.95 }
 }
 
-fn values(a: Vec<f64>, b: Vec<f64>) -> impl Fn(&str) -> Result<Vec<f64>, String> {
-    move |m| match m {
+fn values(a: Vec<f64>, b: Vec<f64>) -> impl Fn(&str, Option<&Window>) -> Result<Vec<f64>, String> {
+    move |m, _| match m {
         "a" => Ok(a.clone()),
         "b" => Ok(b.clone()),
         _ => Err("not in the run".into()),
@@ -140,6 +141,28 @@ fn relations_are_judged_by_the_paired_upper_bound() {
         "{:?}",
         missing.verdict
     );
+}
+
+#[test]
+fn a_rise_compares_two_windows_of_one_method() {
+    let rises = Comparison::Rises {
+        method: "a".into(),
+        from: Window::Before { event: 0 },
+        confidence: 0.95,
+    };
+    // Before the event 0.10-0.12, after it 0.30-0.33 in every seed: reproduced.
+    let per_seed = |before: Vec<f64>, after: Vec<f64>| {
+        move |m: &str, w: Option<&Window>| match (m, w) {
+            ("a", Some(Window::Before { event: 0 })) => Ok(before.clone()),
+            ("a", None) => Ok(after.clone()),
+            _ => Err("not in the run".to_string()),
+        }
+    };
+    let j = judge(&rises, &per_seed(vec![0.10, 0.12, 0.11], vec![0.30, 0.33, 0.31]));
+    assert_eq!(j.verdict, Verdict::Reproduced, "{}", j.flicker);
+    // Falling instead: not reproduced.
+    let j = judge(&rises, &per_seed(vec![0.30, 0.33, 0.31], vec![0.10, 0.12, 0.11]));
+    assert_eq!(j.verdict, Verdict::NotReproduced, "{}", j.flicker);
 }
 
 #[test]

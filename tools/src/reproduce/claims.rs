@@ -137,6 +137,14 @@ pub enum Comparison {
         #[serde(default = "default_confidence")]
         confidence: f64,
     },
+    /// `Rises(method: "a", from: Before(event: 0))`: a's statistic over the claim's window is
+    /// higher than over `from`, judged as the paired per-seed differences of `Below`.
+    Rises {
+        method: String,
+        from: Window,
+        #[serde(default = "default_confidence")]
+        confidence: f64,
+    },
     /// The lab does not record what the claim needs (yet); `methods` are still checked.
     NotComparable {
         #[serde(default)]
@@ -149,7 +157,7 @@ impl Comparison {
     pub fn methods(&self) -> Vec<&str> {
         match self {
             Comparison::Below { method, than, .. } => vec![method, than],
-            Comparison::Value { method, .. } => vec![method],
+            Comparison::Value { method, .. } | Comparison::Rises { method, .. } => vec![method],
             Comparison::Ratio { method, to, .. } => vec![method, to],
             Comparison::NotComparable { methods, .. } => {
                 methods.iter().map(|m| m.as_str()).collect()
@@ -165,6 +173,9 @@ impl Comparison {
             }
             Comparison::Ratio { method, to, value, tolerance, .. } => {
                 format!("{method} / {to} = {value} ± {tolerance}")
+            }
+            Comparison::Rises { method, from, .. } => {
+                format!("{method} rises from {}", from.name())
             }
             Comparison::NotComparable { .. } => "not comparable".into(),
         }
@@ -373,7 +384,7 @@ impl Claims {
                 return Err(at("the id is used twice; expected distinct ids".into()));
             }
             match &claim.comparison {
-                Comparison::Below { confidence, .. } => {
+                Comparison::Below { confidence, .. } | Comparison::Rises { confidence, .. } => {
                     check_confidence(file, entry.line, *confidence)?
                 }
                 Comparison::Value { confidence, tolerance, .. }

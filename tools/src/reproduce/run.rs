@@ -89,8 +89,10 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
         let mut judged = Vec::new();
         for c in &claims.claims {
             let j = match (c.case.as_ref().and_then(|n| runs.get(n)), &c.statistic) {
-                (Some(r), Some(s)) => judge(&c.comparison, &|m| r.per_seed(m, s.metric, &s.window)),
-                _ => judge(&c.comparison, &|_| Err("not played".into())),
+                (Some(r), Some(s)) => {
+                    judge(&c.comparison, &|m, w| r.per_seed(m, s.metric, w.unwrap_or(&s.window)))
+                }
+                _ => judge(&c.comparison, &|_, _| Err("not played".into())),
             };
             outcomes.push(ClaimOutcome {
                 paper: claims.paper.clone(),
