@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use tools::reproduce::{Claims, Comparison, Verdict, judge};
+use tools::suite::window::Window;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
@@ -65,12 +66,55 @@ fn bad_claims_are_errors_at_file_and_line() {
     assert!(e.contains("bad.ron:8") && e.contains("no reference frames"), "{e}");
 }
 
+#[test]
+fn scale_parameters_are_checked_at_the_case_line() {
+    let with = |size: &str| {
+        let case = CASE.replace("seeds: [3, 4])", &format!("seeds: [3, 4], smoke: {size})"));
+        load_with(&case, &claim("corridor", "PathLength", "vb_rel_0.1"))
+    };
+    // The case is on line 5.
+    let e = with("(set: [(\"Termination.capacty\", 4096)])");
+    assert!(e.contains("bad.ron:5") && e.contains("smoke") && e.contains("capacty"), "{e}");
+    let e = with("(set: [(\"Nirc.pretrain_frames\", 8)])");
+    assert!(e.contains("bad.ron:5") && e.contains("Nirc.pretrain_frames"), "{e}");
+    // A label with a dot is still one label (the field is looked up, and missing).
+    let e = with("(set: [(\"vb_rel_0.1.name\", \"x\")])");
+    assert!(e.contains("bad.ron:5") && e.contains("Termination has no field 'name'"), "{e}");
+    // A parameter that renames a method would orphan the claims on it.
+    let cornell = "(name: \"cornell\", scenario: \"../scenarios/light_rotation_cornell_box.ron\", seeds: [1, 2], smoke: (set: [(\"nirc_ema_1spp.spp\", 2)]))";
+    let e = load_with(
+        cornell,
+        &claim("cornell", "Flip", "pt_1spp").replace("vb_rel_1", "nirc_ema_1spp"),
+    );
+    assert!(e.contains("bad.ron:5") && e.contains("change labels"), "{e}");
+    let e = with("(set: [(\"Termination.capacity\", 4096), (\"vb_rel_1.capacity\", 8)])");
+    assert!(e.contains("bad.ron:5") && e.contains("'vb_rel_1.capacity' is set twice"), "{e}");
+    let e = with("(seeds: 1)");
+    assert!(e.contains("bad.ron:5") && e.contains("at least 2"), "{e}");
+    // A kind's parameter reaches every method of that kind, labels with dots included.
+    let text = format!(
+        "Claims(\n    paper: \"x\",\n    title: \"x\",\n    cases: [\n        {},\n    ],\n    claims: [\n        {},\n    ],\n)\n",
+        CASE.replace(
+            "seeds: [3, 4])",
+            "seeds: [3, 4], smoke: (seeds: 2, set: [(\"Termination.capacity\", 4096)]))"
+        ),
+        claim("corridor", "PathLength", "vb_rel_0.1")
+    );
+    let claims = Claims::from_ron(&text, &root().join("claims/ok.ron")).unwrap();
+    let cases = claims.cases_for(tools::reproduce::Scale::Smoke, None);
+    let labels: Vec<&str> = cases[0].params.iter().map(|(l, _, _)| l.as_str()).collect();
+    assert_eq!(labels, ["vb_0.01", "vb_rel_0.01", "vb_rel_0.1", "vb_rel_1", "mse_100"]);
+    assert!(cases[0].params.iter().all(|(_, p, v)| p == &["capacity"] && v == 4096));
+    // Lab keeps the scenario's settings.
+    assert!(claims.cases_for(tools::reproduce::Scale::Lab, None)[0].params.is_empty());
+}
+
 fn below() -> Comparison {
     Comparison::Below { method: "a".into(), than: "b".into(), confidence: 0.95 }
 }
 
-fn values(a: Vec<f64>, b: Vec<f64>) -> impl Fn(&str) -> Result<Vec<f64>, String> {
-    move |m| match m {
+fn values(a: Vec<f64>, b: Vec<f64>) -> impl Fn(&str, Option<&Window>) -> Result<Vec<f64>, String> {
+    move |m, _| match m {
         "a" => Ok(a.clone()),
         "b" => Ok(b.clone()),
         _ => Err("not in the run".into()),
@@ -97,6 +141,28 @@ fn relations_are_judged_by_the_paired_upper_bound() {
         "{:?}",
         missing.verdict
     );
+}
+
+#[test]
+fn a_rise_compares_two_windows_of_one_method() {
+    let rises = Comparison::Rises {
+        method: "a".into(),
+        from: Window::Before { event: 0 },
+        confidence: 0.95,
+    };
+    // Before the event 0.10-0.12, after it 0.30-0.33 in every seed: reproduced.
+    let per_seed = |before: Vec<f64>, after: Vec<f64>| {
+        move |m: &str, w: Option<&Window>| match (m, w) {
+            ("a", Some(Window::Before { event: 0 })) => Ok(before.clone()),
+            ("a", None) => Ok(after.clone()),
+            _ => Err("not in the run".to_string()),
+        }
+    };
+    let j = judge(&rises, &per_seed(vec![0.10, 0.12, 0.11], vec![0.30, 0.33, 0.31]));
+    assert_eq!(j.verdict, Verdict::Reproduced, "{}", j.flicker);
+    // Falling instead: not reproduced.
+    let j = judge(&rises, &per_seed(vec![0.30, 0.33, 0.31], vec![0.10, 0.12, 0.11]));
+    assert_eq!(j.verdict, Verdict::NotReproduced, "{}", j.flicker);
 }
 
 #[test]

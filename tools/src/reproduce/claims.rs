@@ -55,6 +55,18 @@ pub struct Size {
     pub resolution: Option<(u32, u32)>,
     #[serde(default)]
     pub spp: Option<u32>,
+    /// Seeds at this scale: the case's first `seeds` (`--seeds` still overrides).
+    #[serde(default)]
+    pub seeds: Option<usize>,
+    /// Method parameters at this scale (what a smaller image alone does not shrink, such as
+    /// NIRC's pre-training): `("nirc_ema_1spp.pretrain_frames", 8)` sets one method's, as a
+    /// sweep's parameter; `("Nirc.pretrain_frames", 8)` every method of that kind. Kinds are
+    /// expanded to labels when the file is loaded. A parameter may not change a label.
+    #[serde(default)]
+    pub set: Vec<(String, serde_json::Value)>,
+    /// `set` per method: (label, field path, value), filled when the file is loaded.
+    #[serde(skip)]
+    pub params: Vec<(String, Vec<String>, serde_json::Value)>,
 }
 
 /// A scenario the claims play, at each scale.
@@ -125,6 +137,14 @@ pub enum Comparison {
         #[serde(default = "default_confidence")]
         confidence: f64,
     },
+    /// `Rises(method: "a", from: Before(event: 0))`: a's statistic over the claim's window is
+    /// higher than over `from`, judged as the paired per-seed differences of `Below`.
+    Rises {
+        method: String,
+        from: Window,
+        #[serde(default = "default_confidence")]
+        confidence: f64,
+    },
     /// The lab does not record what the claim needs (yet); `methods` are still checked.
     NotComparable {
         #[serde(default)]
@@ -137,7 +157,7 @@ impl Comparison {
     pub fn methods(&self) -> Vec<&str> {
         match self {
             Comparison::Below { method, than, .. } => vec![method, than],
-            Comparison::Value { method, .. } => vec![method],
+            Comparison::Value { method, .. } | Comparison::Rises { method, .. } => vec![method],
             Comparison::Ratio { method, to, .. } => vec![method, to],
             Comparison::NotComparable { methods, .. } => {
                 methods.iter().map(|m| m.as_str()).collect()
@@ -153,6 +173,9 @@ impl Comparison {
             }
             Comparison::Ratio { method, to, value, tolerance, .. } => {
                 format!("{method} / {to} = {value} ± {tolerance}")
+            }
+            Comparison::Rises { method, from, .. } => {
+                format!("{method} rises from {}", from.name())
             }
             Comparison::NotComparable { .. } => "not comparable".into(),
         }
@@ -215,6 +238,64 @@ pub struct Claims {
     pub case_lines: BTreeMap<String, (usize, usize)>,
 }
 
+/// `set` as (label, field path, value), a `Kind.field` parameter once per method of that kind;
+/// each applied to a copy of `methods` so that a wrong field or value, or a changed label, is
+/// an error here. Labels may hold dots (`vb_0.01`): the longest label followed by a dot wins.
+fn expand_set(
+    methods: &[systems::methods::Method],
+    set: &[(String, serde_json::Value)],
+) -> Result<Vec<(String, Vec<String>, serde_json::Value)>, String> {
+    let mut out: Vec<(String, Vec<String>, serde_json::Value)> = Vec::new();
+    let fields = |rest: &str| -> Vec<String> { rest.split('.').map(str::to_string).collect() };
+    for (param, value) in set {
+        let by_label = methods
+            .iter()
+            .map(|m| m.label())
+            .filter(|l| param.len() > l.len() + 1 && param.starts_with(&format!("{l}.")))
+            .max_by_key(|l| l.len());
+        let targets: Vec<(String, Vec<String>)> = match by_label {
+            Some(l) => vec![(l.clone(), fields(&param[l.len() + 1..]))],
+            None => {
+                let (kind, rest) = param.split_once('.').unwrap_or((param, ""));
+                methods
+                    .iter()
+                    .filter(|m| m.spec.name() == kind && !rest.is_empty())
+                    .map(|m| (m.label(), fields(rest)))
+                    .collect()
+            }
+        };
+        if targets.is_empty() {
+            return Err(format!(
+                "parameter '{param}'; expected METHOD_LABEL.field or Kind.field of the case's methods: {}",
+                methods
+                    .iter()
+                    .map(|m| format!("{} ({})", m.label(), m.spec.name()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
+        for (label, path) in targets {
+            if out.iter().any(|(l, p, _)| *l == label && *p == path) {
+                return Err(format!("'{label}.{}' is set twice", path.join(".")));
+            }
+            out.push((label, path, value.clone()));
+        }
+    }
+    let mut check = methods.to_vec();
+    crate::sweep::param::set_each(&mut check, &out)?;
+    // Claims name methods by label, the same at every scale.
+    let before: Vec<String> = methods.iter().map(|m| m.label()).collect();
+    let after: Vec<String> = check.iter().map(|m| m.label()).collect();
+    if before != after {
+        return Err(format!(
+            "the parameters change labels ({} become {}); expected parameters that keep them",
+            before.join(", "),
+            after.join(", ")
+        ));
+    }
+    Ok(out)
+}
+
 fn check_confidence(file: RonFile, line: usize, c: f64) -> Result<(), ScenarioError> {
     if c > 0.5 && c < 1.0 {
         Ok(())
@@ -274,6 +355,20 @@ impl Claims {
                 }
                 kinds.retain(|label, _| keep.contains(label));
             }
+            let mut played = spec.methods.clone();
+            if let Some(keep) = &case.methods {
+                played.retain(|m| keep.contains(&m.label()));
+            }
+            let name = case.name.clone();
+            for (scale, size) in
+                [("smoke", &mut case.smoke), ("lab", &mut case.lab), ("paper", &mut case.paper)]
+            {
+                let at = |m: String| file.error_at(&entry, format!("case '{name}': {scale}: {m}"));
+                if size.seeds.is_some_and(|n| n < 2) {
+                    return Err(at("seeds below 2; an interval needs at least 2".into()));
+                }
+                size.params = expand_set(&played, &size.set).map_err(at)?;
+            }
             let r = &spec.scenario.reference;
             let references = r.spp > 0 && r.frames != ReferenceFrames::None;
             methods.insert(case.name.clone(), CaseMethods { kinds, references });
@@ -289,7 +384,7 @@ impl Claims {
                 return Err(at("the id is used twice; expected distinct ids".into()));
             }
             match &claim.comparison {
-                Comparison::Below { confidence, .. } => {
+                Comparison::Below { confidence, .. } | Comparison::Rises { confidence, .. } => {
                     check_confidence(file, entry.line, *confidence)?
                 }
                 Comparison::Value { confidence, tolerance, .. }
@@ -377,7 +472,7 @@ impl Claims {
                     Scale::Paper => &c.paper,
                 };
                 let mut s = c.seeds.clone();
-                if let Some(n) = seeds {
+                if let Some(n) = seeds.or(size.seeds) {
                     let last = *s.iter().max().unwrap_or(&0);
                     s.truncate(n);
                     s.extend((1..).map(|i| last + i).take(n.saturating_sub(s.len())));
@@ -391,6 +486,7 @@ impl Claims {
                     resolution: size.resolution,
                     spp: size.spp,
                     methods: c.methods.clone(),
+                    params: size.params.clone(),
                     entry: Some(sim::scenario::MethodEntry { text: String::new(), line, column }),
                 }
             })

@@ -6,6 +6,7 @@
 use super::claims::Comparison;
 use crate::suite::student_t;
 use crate::suite::welch::Sample;
+use crate::suite::window::Window;
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Verdict {
@@ -29,29 +30,60 @@ impl Verdict {
 pub struct Judged {
     pub flicker: String,
     pub verdict: Verdict,
+    /// The per-seed values the verdict was judged on (for a relation both methods', the first
+    /// method's first); empty when there were none.
+    pub values: Vec<f64>,
 }
 
 fn not_comparable(reason: String) -> Judged {
-    Judged { flicker: "-".into(), verdict: Verdict::NotComparable(reason) }
+    Judged { flicker: "-".into(), verdict: Verdict::NotComparable(reason), values: Vec::new() }
 }
 
 /// The mean of `values` and the half-width of its two-sided `confidence` interval.
-fn interval(values: &[f64], confidence: f64) -> (f64, f64) {
+pub(crate) fn interval(values: &[f64], confidence: f64) -> (f64, f64) {
     let s = Sample::of(values);
     let t = student_t::quantile(0.5 + confidence / 2.0, (s.n - 1) as f64);
     (s.mean, t * s.standard_error())
 }
 
-/// Judges `comparison` with `per_seed(method)`: one value per seed (the same seeds, in the same
-/// order, for every method) or why there is none.
+/// `a` below `b` by the one-sided `confidence` upper bound of the paired differences.
+fn paired_below(a: Vec<f64>, b: Vec<f64>, confidence: f64) -> Judged {
+    if a.len() != b.len() || a.len() < 2 {
+        return not_comparable(format!(
+            "{} and {} seed(s); a paired interval needs the same seeds, at least 2",
+            a.len(),
+            b.len()
+        ));
+    }
+    let diffs: Vec<f64> = a.iter().zip(&b).map(|(x, y)| x - y).collect();
+    let d = Sample::of(&diffs);
+    let t = student_t::quantile(confidence, (d.n - 1) as f64);
+    let upper = d.mean + t * d.standard_error();
+    let flicker = format!(
+        "{:.4} vs {:.4}; difference {:+.4}, {:.0}% upper bound {upper:+.4} ({} seeds)",
+        Sample::of(&a).mean,
+        Sample::of(&b).mean,
+        d.mean,
+        confidence * 100.0,
+        d.n
+    );
+    let verdict = if upper < 0.0 { Verdict::Reproduced } else { Verdict::NotReproduced };
+    Judged { flicker, verdict, values: [a, b].concat() }
+}
+
+/// Judges `comparison` with `per_seed(method, window)`: one value per seed (the same seeds, in
+/// the same order, for every method) over `window` (`None`: the claim's), or why there is none.
 pub fn judge(
     comparison: &Comparison,
-    per_seed: &dyn Fn(&str) -> Result<Vec<f64>, String>,
+    per_seed: &dyn Fn(&str, Option<&Window>) -> Result<Vec<f64>, String>,
 ) -> Judged {
-    let values = |m: &str| per_seed(m).map_err(|e| format!("{m}: {e}"));
+    let values = |m: &str| per_seed(m, None).map_err(|e| format!("{m}: {e}"));
     let band = |v: Vec<f64>, value: f64, tolerance: f64, confidence: f64| {
         if v.len() < 2 {
-            return not_comparable(format!("{} seed(s); an interval needs at least 2", v.len()));
+            let mut j =
+                not_comparable(format!("{} seed(s); an interval needs at least 2", v.len()));
+            j.values = v;
+            return j;
         }
         let (mean, half) = interval(&v, confidence);
         let (lo, hi) = (mean - half, mean + half);
@@ -66,36 +98,22 @@ pub fn judge(
                 confidence * 100.0
             ))
         };
-        Judged { flicker, verdict }
+        Judged { flicker, verdict, values: v }
     };
     match comparison {
         Comparison::NotComparable { reason, .. } => not_comparable(reason.clone()),
-        Comparison::Below { method, than, confidence } => {
-            let (a, b) = match (values(method), values(than)) {
-                (Ok(a), Ok(b)) => (a, b),
-                (Err(e), _) | (_, Err(e)) => return not_comparable(e),
-            };
-            if a.len() != b.len() || a.len() < 2 {
-                return not_comparable(format!(
-                    "{} and {} seed(s); a paired interval needs the same seeds, at least 2",
-                    a.len(),
-                    b.len()
-                ));
+        Comparison::Below { method, than, confidence } => match (values(method), values(than)) {
+            (Ok(a), Ok(b)) => paired_below(a, b, *confidence),
+            (Err(e), _) | (_, Err(e)) => not_comparable(e),
+        },
+        // Rising: the earlier window's values below the claim's window's, paired per seed.
+        Comparison::Rises { method, from, confidence } => {
+            let before = per_seed(method, Some(from))
+                .map_err(|e| format!("{method} over {}: {e}", from.name()));
+            match (before, values(method)) {
+                (Ok(a), Ok(b)) => paired_below(a, b, *confidence),
+                (Err(e), _) | (_, Err(e)) => not_comparable(e),
             }
-            let diffs: Vec<f64> = a.iter().zip(&b).map(|(x, y)| x - y).collect();
-            let d = Sample::of(&diffs);
-            let t = student_t::quantile(*confidence, (d.n - 1) as f64);
-            let upper = d.mean + t * d.standard_error();
-            let flicker = format!(
-                "{:.4} vs {:.4}; difference {:+.4}, {:.0}% upper bound {upper:+.4} ({} seeds)",
-                Sample::of(&a).mean,
-                Sample::of(&b).mean,
-                d.mean,
-                confidence * 100.0,
-                d.n
-            );
-            let verdict = if upper < 0.0 { Verdict::Reproduced } else { Verdict::NotReproduced };
-            Judged { flicker, verdict }
         }
         Comparison::Value { method, value, tolerance, confidence } => match values(method) {
             Ok(v) => band(v, *value, *tolerance, *confidence),

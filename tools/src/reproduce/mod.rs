@@ -6,7 +6,8 @@ pub mod claims;
 pub mod judge;
 pub mod report;
 pub mod run;
+pub mod table;
 
 pub use claims::{Claim, Claims, Comparison, Scale};
 pub use judge::{Judged, Verdict, judge};
-pub use run::{ReproduceOptions, ReproduceOutcome, reproduce};
+pub use run::{ClaimOutcome, ReproduceOptions, ReproduceOutcome, reproduce};

@@ -3,11 +3,14 @@
 
 use super::claims::{Claim, Claims};
 use super::judge::{Judged, Verdict};
+use super::table::{self, CaseTable};
 
 /// One paper's claims and their outcomes.
 pub struct PaperResult<'a> {
     pub claims: &'a Claims,
     pub judged: Vec<(&'a Claim, Judged)>,
+    /// Each played case's methods against the claims' statistics.
+    pub tables: Vec<CaseTable>,
 }
 
 fn cell(s: &str) -> String {
@@ -48,6 +51,9 @@ pub fn markdown(header: &str, papers: &[PaperResult]) -> String {
                 cell(&c.departures.join("; ")),
             ));
         }
+        for t in &p.tables {
+            md.push_str(&table::markdown(t));
+        }
     }
     md
 }
@@ -87,6 +93,25 @@ pub fn html(header: &str, papers: &[PaperResult]) -> String {
             ));
         }
         h.push_str("</table>\n");
+        for t in &p.tables {
+            h.push_str(&format!(
+                "<h3>Case {} (mean [95% interval] over {} seeds)</h3>\n<table><tr><th>method</th>",
+                escape(&t.case),
+                t.seeds
+            ));
+            for c in &t.columns {
+                h.push_str(&format!("<th>{}</th>", escape(c)));
+            }
+            h.push_str("</tr>\n");
+            for (m, cells) in &t.rows {
+                h.push_str(&format!("<tr><td>{}</td>", escape(m)));
+                for c in cells {
+                    h.push_str(&format!("<td>{}</td>", escape(c)));
+                }
+                h.push_str("</tr>\n");
+            }
+            h.push_str("</table>\n");
+        }
     }
     h
 }

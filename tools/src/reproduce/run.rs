@@ -5,9 +5,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
 
-use super::claims::{Claims, Scale};
-use super::judge::{Verdict, judge};
+use super::claims::{Claims, Comparison, Scale};
+use super::judge::{Judged, judge};
 use super::report::{self, PaperResult};
+use super::table::case_tables;
 use crate::suite::run::play_cases;
 
 pub struct ReproduceOptions {
@@ -27,8 +28,20 @@ pub struct ReproduceOptions {
 pub struct ReproduceOutcome {
     pub folder: PathBuf,
     pub markdown: String,
-    /// Per paper, per claim: (paper, claim id, verdict).
-    pub verdicts: Vec<(String, String, Verdict)>,
+    /// Every claim of every paper played, in file order.
+    pub claims: Vec<ClaimOutcome>,
+}
+
+/// One claim's outcome.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClaimOutcome {
+    pub paper: String,
+    pub id: String,
+    /// The claims file declares it not comparable (nothing is played for it).
+    pub declared_not_comparable: bool,
+    /// Its statistic is a measured time (differs run to run).
+    pub timing: bool,
+    pub judged: Judged,
 }
 
 /// The claims files `paper` names, every one loaded (so every error shows before anything plays).
@@ -61,7 +74,7 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
         PathBuf::from("runs").join(format!("reproduce_{}_{}", opts.paper, opts.scale.name()))
     });
     let mut papers = Vec::new();
-    let mut verdicts = Vec::new();
+    let mut outcomes = Vec::new();
     for claims in &all {
         let cases = claims.cases_for(opts.scale, opts.seeds);
         let label = format!("reproduce {}", claims.paper);
@@ -76,13 +89,22 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
         let mut judged = Vec::new();
         for c in &claims.claims {
             let j = match (c.case.as_ref().and_then(|n| runs.get(n)), &c.statistic) {
-                (Some(r), Some(s)) => judge(&c.comparison, &|m| r.per_seed(m, s.metric, &s.window)),
-                _ => judge(&c.comparison, &|_| Err("not played".into())),
+                (Some(r), Some(s)) => {
+                    judge(&c.comparison, &|m, w| r.per_seed(m, s.metric, w.unwrap_or(&s.window)))
+                }
+                _ => judge(&c.comparison, &|_, _| Err("not played".into())),
             };
-            verdicts.push((claims.paper.clone(), c.id.clone(), j.verdict.clone()));
+            outcomes.push(ClaimOutcome {
+                paper: claims.paper.clone(),
+                id: c.id.clone(),
+                declared_not_comparable: matches!(c.comparison, Comparison::NotComparable { .. }),
+                timing: c.statistic.as_ref().is_some_and(|s| s.metric.is_timing()),
+                judged: j.clone(),
+            });
             judged.push((c, j));
         }
-        papers.push(PaperResult { claims, judged });
+        let tables = case_tables(claims, &runs);
+        papers.push(PaperResult { claims, judged, tables });
     }
     let seeds = opts.seeds.map_or("each case's own".to_string(), |n| n.to_string());
     let header = format!(
@@ -94,5 +116,5 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
     let markdown = report::markdown(&header, &papers);
     systems::output::write_text(&folder.join("reproduce.md"), &markdown)?;
     systems::output::write_text(&folder.join("reproduce.html"), &report::html(&header, &papers))?;
-    Ok(ReproduceOutcome { folder, markdown, verdicts })
+    Ok(ReproduceOutcome { folder, markdown, claims: outcomes })
 }

@@ -24,10 +24,26 @@ pub enum Metric {
     /// Mean |bias| of the transmittance image against the exact one (the VolumeTransmittance
     /// method's `mean_abs_bias` stat).
     MeanAbsBias,
+    /// Mean per-pixel standard deviation of the transmittance estimate (VolumeTransmittance's
+    /// `mean_std` stat).
+    MeanStd,
+    /// The frame's time in ms: the sum of its passes' times (GPU timestamps or per-pass wall
+    /// time), only when every pass was timed. A timing: it varies from run to run.
+    FrameMs,
+    /// Rays traced this frame (every method counts its own on the GPU).
+    Rays,
+    /// Paths shaded this frame.
+    Shaded,
+    /// Mean samples per SSS pixel (the Sss method's `sss_mean_spp` stat).
+    SssSpp,
+    /// Primary rays the sample cache traced this frame (SampleCache's `primary_rays` stat).
+    PrimaryRays,
+    /// Mean blend weight σ of the High-LR side over the image (Nirc's `blend_sigma` stat).
+    BlendSigma,
 }
 
 impl Metric {
-    pub const ALL: [Metric; 9] = [
+    pub const ALL: [Metric; 16] = [
         Metric::Flip,
         Metric::Cvvdp,
         Metric::Smape,
@@ -37,6 +53,13 @@ impl Metric {
         Metric::Psnr,
         Metric::PathLength,
         Metric::MeanAbsBias,
+        Metric::MeanStd,
+        Metric::FrameMs,
+        Metric::Rays,
+        Metric::Shaded,
+        Metric::SssSpp,
+        Metric::PrimaryRays,
+        Metric::BlendSigma,
     ];
 
     pub fn name(self) -> &'static str {
@@ -50,6 +73,13 @@ impl Metric {
             Metric::Cvvdp => "jod",
             Metric::PathLength => "path_length",
             Metric::MeanAbsBias => "mean_abs_bias",
+            Metric::MeanStd => "mean_std",
+            Metric::FrameMs => "frame_ms",
+            Metric::Rays => "rays",
+            Metric::Shaded => "shaded",
+            Metric::SssSpp => "sss_mean_spp",
+            Metric::PrimaryRays => "primary_rays",
+            Metric::BlendSigma => "blend_sigma",
         }
     }
 
@@ -64,17 +94,26 @@ impl Metric {
         self != Metric::Cvvdp
     }
 
+    /// A measured time: not reproducible run to run, so two runs agree on it only within noise.
+    pub fn is_timing(self) -> bool {
+        self == Metric::FrameMs
+    }
+
     /// Whether a method of plugin kind `kind` (`MethodPlugin::NAME`) records this metric in a
     /// run whose scenario has reference frames (`references`): the image metrics every method
     /// has (against a reference only where there is one), the stats only their method.
     pub fn recorded_by(self, kind: &str, references: bool) -> bool {
         match self {
             Metric::Smape | Metric::SmapeReprojected => true,
+            Metric::FrameMs | Metric::Rays | Metric::Shaded => true,
             Metric::Flip | Metric::Mse | Metric::RelMse | Metric::Psnr | Metric::Cvvdp => {
                 references
             }
             Metric::PathLength => kind == "Termination",
-            Metric::MeanAbsBias => kind == "VolumeTransmittance",
+            Metric::MeanAbsBias | Metric::MeanStd => kind == "VolumeTransmittance",
+            Metric::SssSpp => kind == "Sss",
+            Metric::PrimaryRays => kind == "SampleCache",
+            Metric::BlendSigma => kind == "Nirc",
         }
     }
 
@@ -87,10 +126,85 @@ impl Metric {
             Metric::RelMse => r.rel_mse,
             Metric::Psnr => r.psnr,
             Metric::Cvvdp => None,
+            Metric::FrameMs => r.passes_total_ms(),
+            Metric::Rays => r.rays.map(|n| n as f64),
+            Metric::Shaded => r.shaded.map(|n| n as f64),
             // Method stats, by the name the method reports them under.
-            Metric::PathLength | Metric::MeanAbsBias => {
-                r.stats.iter().find(|(n, _)| n == self.name()).map(|s| s.1)
-            }
+            Metric::PathLength
+            | Metric::MeanAbsBias
+            | Metric::MeanStd
+            | Metric::SssSpp
+            | Metric::PrimaryRays
+            | Metric::BlendSigma => r.stats.iter().find(|(n, _)| n == self.name()).map(|s| s.1),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record() -> FrameRecord {
+        FrameRecord {
+            method: "m".into(),
+            frame: 0,
+            cpu_ms: 50.0,
+            passes: vec![("trace".into(), Some(2.5)), ("shade".into(), Some(1.25))],
+            clock: None,
+            rays: Some(1200),
+            shaded: Some(576),
+            smape: None,
+            smape_reprojected: None,
+            disoccluded: None,
+            flip: None,
+            mse: None,
+            rel_mse: None,
+            psnr: None,
+            regions: vec![],
+            stats: vec![
+                ("sss_mean_spp".into(), 17.5),
+                ("primary_rays".into(), 300.0),
+                ("blend_sigma".into(), 0.25),
+                ("mean_std".into(), 0.01),
+            ],
+        }
+    }
+
+    #[test]
+    fn counts_times_and_stats_are_read_from_the_record() {
+        let r = record();
+        // The frame time is the passes' sum, not the CPU time.
+        assert_eq!(Metric::FrameMs.of(&r), Some(3.75));
+        assert_eq!(Metric::Rays.of(&r), Some(1200.0));
+        assert_eq!(Metric::Shaded.of(&r), Some(576.0));
+        assert_eq!(Metric::SssSpp.of(&r), Some(17.5));
+        assert_eq!(Metric::PrimaryRays.of(&r), Some(300.0));
+        assert_eq!(Metric::BlendSigma.of(&r), Some(0.25));
+        assert_eq!(Metric::MeanStd.of(&r), Some(0.01));
+        // A stat the method does not report is missing, not 0.
+        assert_eq!(Metric::PathLength.of(&r), None);
+        // One untimed pass: the frame has no time (a partial sum would look faster).
+        let mut untimed = record();
+        untimed.passes[1].1 = None;
+        assert_eq!(Metric::FrameMs.of(&untimed), None);
+        let mut no_passes = record();
+        no_passes.passes.clear();
+        assert_eq!(Metric::FrameMs.of(&no_passes), None);
+        // Names are distinct (they key baselines and run columns).
+        let mut names: Vec<&str> = Metric::ALL.iter().map(|m| m.name()).collect();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), Metric::ALL.len());
+    }
+
+    #[test]
+    fn stats_are_recorded_only_by_their_method() {
+        assert!(Metric::SssSpp.recorded_by("Sss", false));
+        assert!(!Metric::SssSpp.recorded_by("PathTracing", true));
+        assert!(Metric::BlendSigma.recorded_by("Nirc", true));
+        assert!(Metric::PrimaryRays.recorded_by("SampleCache", true));
+        assert!(!Metric::PrimaryRays.recorded_by("HashCache", true));
+        assert!(Metric::FrameMs.recorded_by("PathTracing", false));
+        assert!(Metric::FrameMs.is_timing() && !Metric::Rays.is_timing());
     }
 }

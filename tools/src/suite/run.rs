@@ -91,6 +91,13 @@ pub(crate) fn case_spec(
         }
         spec.methods.retain(|m| keep.contains(&m.label()));
     }
+    crate::sweep::param::set_each(&mut spec.methods, &case.params)
+        .map_err(|e| anyhow!("{at}: {e}"))?;
+    if !case.params.is_empty() {
+        // A parameter may change a label (`spp`); two equal ones would share a run column.
+        systems::methods::check_labels(&spec.scenario, &spec.methods)
+            .map_err(|e| anyhow!("{at}: {e}"))?;
+    }
     Ok((spec, overrides))
 }
 

@@ -29,6 +29,10 @@ pub struct Case {
     /// Only these method labels of the scenario (after `spp`); all when absent.
     #[serde(default)]
     pub methods: Option<Vec<String>>,
+    /// Method parameters (label, field path, value) set after `methods`: a claims file's
+    /// per-scale `set` (not read from suite files).
+    #[serde(skip)]
+    pub params: Vec<(String, Vec<String>, serde_json::Value)>,
     #[serde(skip)]
     pub entry: Option<MethodEntry>,
 }

@@ -54,6 +54,22 @@ pub fn apply(methods: &mut [Method], param: &str, value: &Value) -> Result<(), S
     set(method, &path, value).map_err(|e| format!("parameter '{param}': {e}"))
 }
 
+/// Sets each (label, field path, value) on the method of that label.
+pub fn set_each(
+    methods: &mut [Method],
+    params: &[(String, Vec<String>, serde_json::Value)],
+) -> Result<(), String> {
+    for (label, path, value) in params {
+        let m = methods
+            .iter_mut()
+            .find(|m| m.label() == *label)
+            .ok_or_else(|| format!("no method labelled '{label}'"))?;
+        let path: Vec<&str> = path.iter().map(String::as_str).collect();
+        set(m, &path, value).map_err(|e| format!("parameter '{label}.{}': {e}", path.join(".")))?;
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -82,6 +82,7 @@ impl Job {
             resolution: self.resolution,
             spp: self.spp,
             methods: self.methods.clone(),
+            params: Vec::new(),
             entry: None,
         }
     }

@@ -1,0 +1,127 @@
+//! `flicker reproduce all --scale smoke` end to end: every claim of every paper gets a verdict,
+//! every claim the files do not declare "not comparable" gets per-seed values, two runs with
+//! the same seeds give the same verdicts (timings excepted; values that are not bit-equal are
+//! printed), and a case whose run fails is an error with nothing written.
+
+use std::path::{Path, PathBuf};
+
+use tools::reproduce::{Claims, ReproduceOptions, Scale, reproduce};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("flicker-reproduce-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn options(claims_dir: PathBuf, paper: &str, out: PathBuf, cache: &Path) -> ReproduceOptions {
+    ReproduceOptions {
+        paper: paper.into(),
+        claims_dir,
+        scale: Scale::Smoke,
+        seeds: None,
+        out: Some(out),
+        cache_dir: Some(cache.to_path_buf()),
+        progress: false,
+    }
+}
+
+#[test]
+fn every_claim_gets_a_value_and_a_verdict_and_the_same_ones_twice() {
+    let dir = temp("all");
+    let claims_dir = root().join("claims");
+    let started = std::time::Instant::now();
+    let first =
+        reproduce(&options(claims_dir.clone(), "all", dir.join("first"), &dir.join("cache")))
+            .expect("reproduce all --scale smoke");
+    eprintln!("first run: {:.1} s\n{}", started.elapsed().as_secs_f64(), first.markdown);
+
+    // Every claim of every file, in file order, and nothing else.
+    let mut expected = Vec::new();
+    for entry in std::fs::read_dir(&claims_dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "ron") {
+            let c = Claims::load(&path).unwrap();
+            expected.extend(c.claims.iter().map(|claim| (c.paper.clone(), claim.id.clone())));
+        }
+    }
+    expected.sort();
+    let mut got: Vec<(String, String)> =
+        first.claims.iter().map(|c| (c.paper.clone(), c.id.clone())).collect();
+    got.sort();
+    assert_eq!(got, expected, "one outcome per claim");
+    for c in &first.claims {
+        if !c.declared_not_comparable {
+            assert!(
+                !c.judged.values.is_empty() && c.judged.values.iter().all(|v| v.is_finite()),
+                "{} {}: no values ({:?}: {})",
+                c.paper,
+                c.id,
+                c.judged.verdict,
+                c.judged.flicker
+            );
+        }
+    }
+    let md = std::fs::read_to_string(dir.join("first/reproduce.md")).unwrap();
+    assert!(first.claims.iter().all(|c| md.contains(&format!("| {}: ", c.id))), "{md}");
+
+    // The same seeds again (references and NIRC pre-training now from the cache): the same
+    // verdict for every claim whose statistic is not a measured time. Values that differ in
+    // the last digits are printed: a method whose GPU passes race is not bit-reproducible,
+    // which the verdicts must survive.
+    let started = std::time::Instant::now();
+    let second = reproduce(&options(claims_dir, "all", dir.join("second"), &dir.join("cache")))
+        .expect("second run");
+    eprintln!("second run: {:.1} s", started.elapsed().as_secs_f64());
+    assert_eq!(second.claims.len(), first.claims.len());
+    for (a, b) in first.claims.iter().zip(&second.claims) {
+        assert_eq!((&a.paper, &a.id), (&b.paper, &b.id));
+        assert_eq!(a.judged.values.len(), b.judged.values.len(), "{} {}", a.paper, a.id);
+        if a.timing {
+            continue;
+        }
+        assert_eq!(
+            a.judged.verdict, b.judged.verdict,
+            "{} {}: the verdict differs between two runs with the same seeds ({} against {})",
+            a.paper, a.id, a.judged.flicker, b.judged.flicker
+        );
+        if a.judged.values != b.judged.values {
+            eprintln!(
+                "not bit-reproducible: {} {}: {:?} against {:?}",
+                a.paper, a.id, a.judged.values, b.judged.values
+            );
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_case_whose_run_fails_is_an_error_and_nothing_is_written() {
+    let dir = temp("fails");
+    let claims_dir = dir.join("claims");
+    std::fs::create_dir_all(&claims_dir).unwrap();
+    // The jackknife claims with a smoke size no adapter has: the file loads (sizes are not an
+    // input error of the claims file), the run refuses it.
+    let text = std::fs::read_to_string(root().join("claims/jackknife-transmittance.ron"))
+        .unwrap()
+        .replace(
+            "\"../suites/scenarios/papers_volume_cloud.ron\"",
+            &format!(
+                "\"{}\", smoke: (resolution: (1000000, 1))",
+                root().join("suites/scenarios/papers_volume_cloud.ron").display()
+            ),
+        );
+    assert!(text.contains("1000000"), "the cloud case is in the file");
+    std::fs::write(claims_dir.join("jackknife-transmittance.ron"), text).unwrap();
+    let out = dir.join("out");
+    let e = reproduce(&options(claims_dir, "all", out.clone(), &dir.join("cache")))
+        .err()
+        .expect("a failing case is an error");
+    let e = format!("{e:#}");
+    assert!(e.contains("case 'cloud'"), "{e}");
+    assert!(!out.join("reproduce.md").exists() && !out.join("reproduce.html").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
