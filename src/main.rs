@@ -325,11 +325,16 @@ fn sweep(action: SweepAction) -> ExitCode {
     exit_code(result)
 }
 
-/// 0 when it passed, 1 when it ran and failed (a gate, a job), 2 when it could not run.
+/// 0 when it passed, 1 when it ran and failed (a gate, a job), 2 when it could not run, 130 when a
+/// signal stopped it.
 fn exit_code(result: anyhow::Result<bool>) -> ExitCode {
     match result {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
+        Err(e) if e.is::<systems::interrupt::Interrupted>() => {
+            eprintln!("{e}");
+            ExitCode::from(systems::interrupt::EXIT_CODE)
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::from(2)

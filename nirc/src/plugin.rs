@@ -657,14 +657,14 @@ fn reliability_stats(diag: &[[f32; 4]], valid: &[bool]) -> Vec<(String, f64)> {
     stats
 }
 
-/// Figure 3's colours: green where High-LR is preferred (σ), red where EMA is (1 - σ); black
-/// where no query was answered.
 /// Mean σ over the pixels that were answered (`.w` > 0), 0 if none.
 fn mean_answered_sigma(sigma: &[[f32; 4]]) -> f64 {
     let answered: Vec<f64> = sigma.iter().filter(|s| s[3] > 0.0).map(|s| s[0] as f64).collect();
     answered.iter().sum::<f64>() / f64::max(answered.len() as f64, 1.0)
 }
 
+/// Figure 3's colours: green where High-LR is preferred (σ), red where EMA is (1 - σ); black
+/// where no query was answered.
 pub fn preference_map(sigma: &[[f32; 4]]) -> Vec<[f32; 4]> {
     sigma
         .iter()

@@ -1,4 +1,5 @@
-//! The per-frame numbers a gate can judge, read from a run's frame records.
+//! The numbers a gate or a claim can judge: per-frame ones read from a run's frame records, and
+//! JOD, one number per window of frames.
 
 use serde::{Deserialize, Serialize};
 

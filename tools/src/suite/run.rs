@@ -148,8 +148,14 @@ pub(crate) fn play_cases(
             cache_dir: cache_dir.clone(),
             progress,
         };
-        let summary = run_spec(&spec, &run_opts)
-            .map_err(|e| anyhow!("case '{}' seed {seed}: {e:#}", case.name))?;
+        // A signal keeps its type, so that the command exits as an interrupted run does.
+        let summary = run_spec(&spec, &run_opts).map_err(|e| {
+            if e.is::<systems::interrupt::Interrupted>() {
+                e
+            } else {
+                anyhow!("case '{}' seed {seed}: {e:#}", case.name)
+            }
+        })?;
         let runs = played.entry(case.name.clone()).or_default();
         runs.frames = spec.scenario.frames;
         runs.events = event_frames(&spec);
