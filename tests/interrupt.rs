@@ -241,3 +241,65 @@ fn a_run_stopped_by_an_error_is_marked_failed_and_resumes_once_it_is_fixed() {
     assert!(run.join("reference/0003.exr").exists() && run.join("frames/taa/0004.exr").exists());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn runs_of_the_caches_resume_to_the_uninterrupted_frames() {
+    // The termination cache (new keys contending for 128 slots) and the sample cache with
+    // adaptive shading (a camera backing away: pixels receive more samples than they keep)
+    // make contended choices on the GPU every frame; a resume replays them and must meet the
+    // same rows. The run stops at frame 3 (its reference cannot be stored), then resumes.
+    let dir = std::env::temp_dir().join(format!("flicker-resume-caches-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let scenario = dir.join("caches.ron");
+    std::fs::write(
+        &scenario,
+        r#"Scenario(scene: Builtin("courtyard"), resolution: (32, 18), frames: 6, seed: 1, max_depth: 2,
+    methods: [
+        Termination(rule: VarianceBounding(t: 1.0, relative: true), capacity: 128, store_probability: 1.0, warmup_frames: 2),
+        SampleCache(retrace: Adaptive, shading: Adaptive, shading_rate: 0.7),
+    ],
+    reference: (spp: 2, frames: List([3])),
+    animations: [CameraPath(keys: [
+        (frame: 0.0, position: (0.0, 1.7, 1.5), target: (1.5, 1.6, -3.5)),
+        (frame: 6.0, position: (-3.0, 1.7, 4.0), target: (1.5, 1.6, -3.5)),
+    ])])"#,
+    )
+    .unwrap();
+    let cache = dir.join("cache");
+    std::fs::create_dir_all(&cache).unwrap();
+    std::fs::write(cache.join("references"), "in the way").unwrap();
+    let cut = dir.join("cut");
+    let mut cmd = flicker();
+    run_args(&mut cmd, &scenario, &cut, &cache);
+    let o = cmd.output().unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
+    assert_eq!(json(&cut.join("manifest.json"))["last_complete_frame"], 2);
+    std::fs::remove_file(cache.join("references")).unwrap();
+    ok(flicker()
+        .arg("run")
+        .arg("--resume")
+        .arg(&cut)
+        .arg("--quiet")
+        .arg("--cache-dir")
+        .arg(&cache)
+        .output()
+        .unwrap());
+    let full = dir.join("full");
+    let mut cmd = flicker();
+    run_args(&mut cmd, &scenario, &full, &cache);
+    ok(cmd.output().unwrap());
+    assert_eq!(results(&cut), results(&full), "frames.csv results differ");
+    let exrs: Vec<PathBuf> = files(&full)
+        .into_iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "exr"))
+        .map(|p| p.strip_prefix(&full).unwrap().to_path_buf())
+        .collect();
+    assert!(exrs.len() >= 12, "{} images", exrs.len());
+    for name in &exrs {
+        let (a, b) =
+            (std::fs::read(full.join(name)).unwrap(), std::fs::read(cut.join(name)).unwrap());
+        assert!(a == b, "{} differs from the uninterrupted run's", name.display());
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -1,41 +1,46 @@
-// Forward reprojection (section 3.1) with slot reservation on the occupancy/visibility mask
-// (listing 2, fixed). One thread per (source pixel, slot) of last frame's cache.
+// Forward reprojection (section 3.1) with slot reservation (listing 2, made deterministic).
+// One thread per (source pixel, slot) of last frame's cache reserves by key; then one per pixel
+// gathers the kept samples into its slots.
 
 import package::scene_bindings::{frame};
-import package::scene_geometry::{NO_HIT};
+import package::pt_sampling::{pcg_hash};
 import package::pt_scene::{project_offset};
-import package::sample_cache_bindings::{dst_slots, pixel_atomics, src_mask, src_slots, ssc, ssc_work};
-import package::sample_cache::storage::{SSC_ATOMICS, SSC_BACKGROUND_DEPTH, SSC_NO_DEPTH, SSC_DROPPED, SSC_REPROJECTED, SSC_WMAX, SSC_WMAX_ACC, SSC_WMIN, SSC_WMIN_ACC, ssc_background_dir, ssc_full, ssc_is_background, ssc_pixels, ssc_surface, ssc_visible_slots};
+import package::sample_cache_bindings::{dst_slots, pixel_atomics, reserve_keys, src_mask, src_slots, ssc, ssc_work};
+import package::sample_cache::storage::{SSC_ATOMICS, SSC_BACKGROUND_DEPTH, SSC_NO_DEPTH, SSC_DROPPED, SSC_REPROJECTED, SSC_WMAX, SSC_WMAX_ACC, SSC_WMIN, SSC_WMIN_ACC, ssc_background_dir, ssc_is_background, ssc_pixels, ssc_surface, ssc_visible_slots};
 import package::sample_cache::slope::{ssc_closer, ssc_slope};
 import package::kernel::{outside_image};
 
-// Listing 2 as printed `break`s after the first try whatever its outcome; the text says a lost
-// race retries on another slot while any remain. Here the loop only ends on success or when no
-// free slot is left; every failed try ORs its bit into `m`, so candidates strictly shrink.
-// Visible samples have priority (listing 2 lets a visible sample overwrite an invisible one in a
-// full pixel): they reserve in a pass of their own before the invisible ones, so an invisible
-// sample only ever takes a slot no visible sample wanted. Listing 2's overwrite within one pass
-// races: a visible sample could take the slot an invisible one had just reserved while free
-// slots remained, and both wrote it. Returns the slot or NO_HIT.
-fn ssc_try_reserve(pixel: u32, visible: bool) -> u32 {
-    let n = ssc.slots;
-    let full = ssc_full();
-    var m = atomicLoad(&pixel_atomics[SSC_ATOMICS * pixel]);
-    loop {
-        let candidates = ~m & full;
-        if candidates == 0u {
-            return NO_HIT;
+// Reservation by key (reservation.rs is the CPU twin). A sample's key is its visibility (0 =
+// visible, so visible samples come first, listing 2's priority) over its index in last frame's
+// cache XOR a per-frame mask (so that no source pixel or slot is preferred frame after frame).
+// A pixel keeps the N lowest keys that reach it: N words per pixel (`reserve_keys`, layered as
+// the slots) hold them sorted, inserted by a chain of atomics: at word i the key swaps with a
+// larger one (keeping the smaller) and the larger moves on to word i + 1, until an empty word
+// takes it or it falls off the end (dropped). Whatever order the threads run in, word i ends
+// with the i-th lowest key: the kept samples, and their order, do not depend on scheduling.
+// Listing 2's atomicOr race (any sample may win a full pixel) cannot give that. The words
+// store the complement of the key and use atomicMax, so that the frame's clear to 0 empties
+// them.
+const SSC_KEY_INVISIBLE: u32 = 0x80000000u;
+const SSC_KEY_INDEX: u32 = 0x3fffffffu;
+
+fn ssc_key_mask() -> u32 {
+    return pcg_hash(frame.frame ^ pcg_hash(frame.seed_lo ^ pcg_hash(frame.seed_hi))) & SSC_KEY_INDEX;
+}
+
+// Inserts `key` into pixel t's sorted words; false when it was dropped (the pixel holds N
+// lower keys).
+fn ssc_insert_key(t: u32, key: u32) -> bool {
+    let pixels = ssc_pixels();
+    var word = ~key;
+    for (var i = 0u; i < ssc.slots; i++) {
+        let previous = atomicMax(&reserve_keys[i * pixels + t], word);
+        if previous == 0u {
+            return true;
         }
-        let i = firstTrailingBit(candidates);
-        let o_bit = 1u << i;
-        let s_val = o_bit | select(0u, 1u << (i + n), visible);
-        let previous = atomicOr(&pixel_atomics[SSC_ATOMICS * pixel], s_val);
-        m = previous | s_val;
-        if (previous & o_bit) == 0u {
-            return i;
-        }
+        word = min(previous, word);
     }
-    return NO_HIT;
+    return false;
 }
 
 // Starts the frame's importance bounds: last frame's become this frame's bucket bounds.
@@ -47,9 +52,10 @@ fn begin_main() {
     atomicStore(&ssc_work[SSC_WMAX_ACC], 0u);
 }
 
-// One thread per (source pixel, slot) of last frame's cache; moves the samples whose visibility
-// bit is `visible_pass` (two passes, visible first: see ssc_try_reserve).
-fn ssc_reserve(id: vec3u, visible_pass: bool) {
+// One thread per (source pixel, slot) of last frame's cache: the sample's target pixel and its
+// key there.
+@compute @workgroup_size(8, 8, 1)
+fn reserve_main(@builtin(global_invocation_id) id: vec3u) {
     if outside_image(id, ssc.width, ssc.height) || id.z >= ssc.slots {
         return;
     }
@@ -60,19 +66,14 @@ fn ssc_reserve(id: vec3u, visible_pass: bool) {
         return;
     }
     let visible = ((mask >> (s + ssc.slots)) & 1u) != 0u;
-    if visible != visible_pass {
-        return;
-    }
-    let slot = src_slots[s * ssc_pixels() + source];
+    let index = s * ssc_pixels() + source;
+    let slot = src_slots[index];
     let eye = frame.camera.position;
     var image: vec2f;
-    var depth = SSC_BACKGROUND_DEPTH;
     if ssc_is_background(slot.hit) {
         image = project_offset(frame.camera, ssc_background_dir(slot.hit));
     } else {
-        let p = ssc_surface(slot.hit).position;
-        image = project_offset(frame.camera, p - eye);
-        depth = length(p - eye);
+        image = project_offset(frame.camera, ssc_surface(slot.hit).position - eye);
     }
     let size = vec2f(f32(ssc.width), f32(ssc.height));
     if !(all(image >= vec2f(0.0)) && all(image < size)) {
@@ -81,26 +82,49 @@ fn ssc_reserve(id: vec3u, visible_pass: bool) {
     }
     let target_pixel = min(vec2u(image), vec2u(ssc.width, ssc.height) - 1u);
     let t = target_pixel.y * ssc.width + target_pixel.x;
-    let i = ssc_try_reserve(t, visible);
-    if i == NO_HIT {
+    let key = select(SSC_KEY_INVISIBLE, 0u, visible) | (index ^ ssc_key_mask());
+    if !ssc_insert_key(t, key) {
         atomicAdd(&ssc_work[SSC_DROPPED], 1u);
+    }
+}
+
+// Per pixel after reserve_main: its kept samples into slots 0.. in key order, the reserved mask
+// (occupancy, visibility) and, for the slope test, the farthest visible depth.
+@compute @workgroup_size(8, 8, 1)
+fn gather_main(@builtin(global_invocation_id) id: vec3u) {
+    if outside_image(id, ssc.width, ssc.height) {
         return;
     }
-    dst_slots[i * ssc_pixels() + t] = slot;
-    if visible {
-        atomicMax(&pixel_atomics[SSC_ATOMICS * t + 1u], bitcast<u32>(depth));
+    let pixels = ssc_pixels();
+    let n = ssc.slots;
+    let p = id.y * ssc.width + id.x;
+    let key_mask = ssc_key_mask();
+    let eye = frame.camera.position;
+    var m = 0u;
+    var far = 0.0;
+    for (var i = 0u; i < n; i++) {
+        let word = atomicLoad(&reserve_keys[i * pixels + p]);
+        if word == 0u {
+            break;
+        }
+        let key = ~word;
+        let slot = src_slots[(key & SSC_KEY_INDEX) ^ key_mask];
+        dst_slots[i * pixels + p] = slot;
+        m |= 1u << i;
+        if (key & SSC_KEY_INVISIBLE) == 0u {
+            m |= 1u << (i + n);
+            if ssc.retrace == 2u {
+                var depth = SSC_BACKGROUND_DEPTH;
+                if !ssc_is_background(slot.hit) {
+                    depth = length(ssc_surface(slot.hit).position - eye);
+                }
+                far = max(far, depth);
+            }
+        }
     }
-    atomicAdd(&ssc_work[SSC_REPROJECTED], 1u);
-}
-
-@compute @workgroup_size(8, 8, 1)
-fn reserve_visible_main(@builtin(global_invocation_id) id: vec3u) {
-    ssc_reserve(id, true);
-}
-
-@compute @workgroup_size(8, 8, 1)
-fn reserve_invisible_main(@builtin(global_invocation_id) id: vec3u) {
-    ssc_reserve(id, false);
+    atomicStore(&pixel_atomics[SSC_ATOMICS * p], m);
+    atomicStore(&pixel_atomics[SSC_ATOMICS * p + 1u], bitcast<u32>(far));
+    atomicAdd(&ssc_work[SSC_REPROJECTED], countOneBits(m & ((1u << n) - 1u)));
 }
 
 // The paper's closest-depth texture (section 3.4), per pixel after the reservation: the depth of

@@ -4,7 +4,7 @@
 //! sparsely, and averaged into the image. See README.md in this folder for the map and choices.
 //!
 //! Passes per frame (shaders/sample_cache/, one compute pass each, timed):
-//! `reserve` (reproject.wgsl: begin_main, reserve_visible_main then reserve_invisible_main, closest_main), `trace` (retrace.wgsl: retrace_main,
+//! `reserve` (reproject.wgsl: begin_main, reserve_main, gather_main, closest_main), `trace` (retrace.wgsl: retrace_main,
 //! list_dispatch.wgsl retrace_args_main, retrace.wgsl retrace_list_main, finish_main),
 //! `shade` (shading_rate.wgsl rates_main + select_main, list_dispatch.wgsl shade_args_main,
 //! shade.wgsl shade_main), `reconstruct` (reconstruct.wgsl).
@@ -15,11 +15,15 @@
 //! pixels threads launch and those past the list's end exit).
 //!
 //! 64-bit atomics: the paper packs (closest depth, slope Δn) into one 64-bit atomicMin during
-//! reprojection. WGSL core has only 32-bit atomics, so each pixel gets one u32 atomicMax of the
-//! farthest visible depth's float bits (positive IEEE floats order like their bit patterns), and
-//! the closest depth with its slope is recomputed exactly in the trace pass from the centre
-//! pixel's own samples, which that pass reads anyway. Same 8 bytes per pixel with the mask; no
+//! reprojection. WGSL core has only 32-bit atomics, so after the reservation one pass per pixel
+//! (`gather_main`) writes the farthest visible depth of the samples the pixel kept, and another
+//! (`closest_main`) the closest depth with its slope, both exact from the pixel's own samples; no
 //! precision lost to packing; t_max of the 3x3 neighbours still costs one load each.
+//!
+//! Deterministic: the same scene, seed and settings give the same bits on any adapter. A pixel
+//! keeps the N lowest reservation keys that reach it (`reservation.rs`), sorted by a chain of
+//! atomics whose result does not depend on the order threads run in; every random number is
+//! seeded by (seed, frame, pixel, slot); counters are integer atomics.
 
 pub mod density;
 pub mod reservation;
@@ -54,8 +58,8 @@ const STAGE_DISPATCHES: [std::ops::Range<usize>; 4] = [0..4, 4..8, 8..12, 12..13
 /// ([`CacheFrame::dispatch_timings`]) and the pass time is the sum of its dispatches'.
 pub const DISPATCHES: [&str; 13] = [
     "reserve/begin_main",
-    "reserve/reserve_visible_main",
-    "reserve/reserve_invisible_main",
+    "reserve/reserve_main",
+    "reserve/gather_main",
     "reserve/closest_main",
     "trace/retrace_main",
     "trace/retrace_args_main",
@@ -94,13 +98,13 @@ const AUDIT_WORD: u64 = 32;
 /// The cache's own @group(2), declared into its WGSL: params, source mask and slots (read),
 /// then pixel atomics, destination slots and mask, work lists, output, and the inputs of a TAA
 /// resolve over the image (colour, closest visible sample's primary attributes).
-const OWN_GROUP: [BufferBinding; 10] = [
+const OWN_GROUP: [BufferBinding; 11] = [
     BufferBinding::read("ssc", "SscParams"),
     BufferBinding::read("src_mask", "array<u32>"),
     BufferBinding::read("src_slots", "array<SscSlot>"),
-    // SSC_ATOMICS words per pixel: the mask being reserved (atomicOr), the farthest visible depth
-    // (atomicMax of its float bits), the retrace results (bits 0-15: visible, 16-31: traced),
-    // and the closest visible sample's depth and Δn (closest_main).
+    // SSC_ATOMICS words per pixel: the reserved mask and the farthest visible depth (gather_main),
+    // the retrace results (bits 0-15: visible, 16-31: traced), and the closest visible sample's
+    // depth and Δn (closest_main).
     BufferBinding::read_write("pixel_atomics", "array<atomic<u32>>"),
     BufferBinding::read_write("dst_slots", "array<SscSlot>"),
     BufferBinding::read_write("dst_mask", "array<u32>"),
@@ -109,6 +113,9 @@ const OWN_GROUP: [BufferBinding; 10] = [
     // The reconstruction again in the layouts `Taa::resolve_external` copies from.
     BufferBinding::read_write("ssc_colour", "array<vec4f>"),
     BufferBinding::read_write("ssc_primary", "array<TaaPrimary>"),
+    // The reservation's keys, N per pixel (layered as the slots): the complement of the
+    // lowest keys that reached the pixel, in order (reproject.wgsl).
+    BufferBinding::read_write("reserve_keys", "array<atomic<u32>>"),
 ];
 
 /// The cache passes' program: the shading library, the cache's structs and @group(2), its
@@ -265,6 +272,7 @@ pub struct SampleCache {
     params: wgpu::Buffer,
     caches: [Cache; 2],
     pixel_atomics: wgpu::Buffer,
+    reserve_keys: wgpu::Buffer,
     work: wgpu::Buffer,
     /// Indirect arguments of the retrace list (bytes 0-11) and the shade list (12-23), copied
     /// from `work`'s header (a buffer bound as storage cannot be a dispatch's indirect buffer).
@@ -290,8 +298,8 @@ pub struct SampleCache {
 
 struct Pipelines {
     begin: LibraryPipeline,
-    reserve_visible: LibraryPipeline,
-    reserve_invisible: LibraryPipeline,
+    reserve: LibraryPipeline,
+    gather: LibraryPipeline,
     closest: LibraryPipeline,
     retrace: LibraryPipeline,
     retrace_args: LibraryPipeline,
@@ -349,6 +357,13 @@ impl SampleCache {
             },
         ];
         let pixel_atomics = buffer("ssc pixel atomics", pixels * 4 * PIXEL_ATOMICS, rw)?;
+        // A reservation key holds a sample's index (slot × pixels + pixel) in 30 bits.
+        if n * pixels > 1 << 30 {
+            return Err(RenderError::Settings(format!(
+                "sample cache: {n} slots x {pixels} pixels is over the 2^30 samples a reservation key indexes"
+            )));
+        }
+        let reserve_keys = buffer("ssc reservation keys", pixels * n * 4, rw)?;
         let work = buffer("ssc work", (HEADER_WORDS + pixels * n) * 4, rw)?;
         let list_args = buffer(
             "ssc list dispatch",
@@ -370,8 +385,8 @@ impl SampleCache {
             layout,
             [
                 begin,
-                reserve_visible,
-                reserve_invisible,
+                reserve,
+                gather,
                 closest,
                 retrace,
                 retrace_args,
@@ -391,8 +406,8 @@ impl SampleCache {
             &OWN_GROUP,
             [
                 "begin_main",
-                "reserve_visible_main",
-                "reserve_invisible_main",
+                "reserve_main",
+                "gather_main",
                 "closest_main",
                 "retrace_main",
                 "retrace_args_main",
@@ -408,8 +423,8 @@ impl SampleCache {
         )?;
         let pipelines = Pipelines {
             begin,
-            reserve_visible,
-            reserve_invisible,
+            reserve,
+            gather,
             closest,
             retrace,
             retrace_args,
@@ -438,6 +453,7 @@ impl SampleCache {
                     &out,
                     &colour,
                     &primary,
+                    &reserve_keys,
                 ],
             )
         };
@@ -452,6 +468,7 @@ impl SampleCache {
             params,
             caches,
             pixel_atomics,
+            reserve_keys,
             work,
             list_args,
             indirect: true,
@@ -556,6 +573,7 @@ impl SampleCache {
         if stage == 0 {
             let encoder = timed.encoder();
             encoder.clear_buffer(&self.pixel_atomics, 0, None);
+            encoder.clear_buffer(&self.reserve_keys, 0, None);
             // Header words 0-5 and 10-31; 6-9 (importance bounds) carry over, begin_main moves them.
             encoder.clear_buffer(&self.work, 0, Some(24));
             encoder.clear_buffer(&self.work, 40, Some((HEADER_WORDS - 10) * 4));
@@ -574,8 +592,8 @@ impl SampleCache {
         // In the order of DISPATCHES: pipeline, direct workgroups, list.
         let dispatches: [(&LibraryPipeline, [u32; 3], Option<(u64, u64)>); 13] = [
             (&p.begin, [1, 1, 1], None),
-            (&p.reserve_visible, [gx, gy, s.slots], None),
-            (&p.reserve_invisible, [gx, gy, s.slots], None),
+            (&p.reserve, [gx, gy, s.slots], None),
+            (&p.gather, [gx, gy, 1], None),
             (&p.closest, [gx, gy, 1], None),
             (&p.retrace, [gx, gy, 1], None),
             (&p.retrace_args, [1, 1, 1], None),

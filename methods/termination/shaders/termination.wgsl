@@ -9,13 +9,23 @@
 //   tc_fold       per record: folds its vertices' estimates into the record's three moments
 //   tc_trace      per pixel: the path with the termination decision at every vertex; primary
 //                 vertices are candidates with probability store_probability
+//   tc_insert_*   per insertion request (a candidate whose key had no slot): rounds of claim
+//                 (atomicMin of the candidate index on the first empty slot of its probe window)
+//                 and win (the lowest claimant writes its key there), then a settle pass
 //   tc_store      per record: the winning candidate (lowest permuted index: deterministic, one
 //                 per record and frame) becomes one of the record's 4 stored vertices
 //
 // A slot is 4 u32 in `slots`: checksum (0 = empty), claim (permuted candidate index), vertices
-// stored so far, unused. `records` holds the records' moments, then the per-vertex estimates of
-// this frame; `vertices` the stored vertices, then the candidates (pixels, then propagation).
-// Records are never evicted (static scenes, the cache in equilibrium as in the paper's §6).
+// stored so far, insertion claim (candidate index). `records` holds the records' moments, then
+// the per-vertex estimates of this frame; `vertices` the stored vertices, then the candidates
+// (pixels, then propagation). `inserts` holds the insertion passes' indirect dispatch
+// (workgroups, 1, 1), the request count, then 4 words per request (candidate, home, checksum,
+// state). Records are never evicted (static scenes, the cache in equilibrium as in the paper's
+// §6).
+//
+// Every result is independent of the order invocations run in: sums are per invocation or
+// integer atomics, and every contended choice (a record's stored vertex, a key's slot) is an
+// atomicMin over candidate indices.
 
 import package::scene_bindings::{frame};
 import package::scene_tables::{material};
@@ -27,7 +37,7 @@ import package::pt_scene::{base_color_at, camera_ray_direction, escaped_radiance
 import package::pt_integrator::{emitted_radiance, next_event, path_radiance};
 import package::taa::primary::{primary_attributes};
 import package::termination_types::{TcRecord, TcVertex};
-import package::termination_bindings::{colour_out, counters, path_length, primary_out, records, slots, tc, vertices};
+import package::termination_bindings::{colour_out, counters, inserts, path_length, primary_out, records, slots, tc, vertices};
 import package::hash_cache_bindings::{hc};
 import package::hash_cache::hash_key::{HC_EMPTY, HC_NONE, VoxelKey, hc_key, hc_level};
 import package::termination::decision::{TC_PATH_TRACING, TcLocalStats, TcPathState, TcRule, tc_arrive_area_spread, tc_decide, tc_threshold};
@@ -74,31 +84,129 @@ fn tc_find(key: VoxelKey) -> u32 {
     return HC_NONE;
 }
 
-// The slot of `key`, inserted if absent (compare-exchange walk from home); HC_NONE when the
-// probe window is full of other keys.
-fn tc_insert(key: VoxelKey) -> u32 {
-    for (var i = 0u; i < hc.probe_limit; i++) {
-        let s = (key.home + i) % hc.capacity;
-        let r = atomicCompareExchangeWeak(&slots[4u * s], HC_EMPTY, key.checksum);
-        if r.exchanged {
-            atomicAdd(&counters[TC_COUNTER_INSERTED], 1u);
-            return s;
-        }
-        if r.old_value == key.checksum {
-            return s;
-        }
-        if r.old_value == HC_EMPTY {
-            i--; // spurious failure of the weak exchange
-        }
-    }
-    atomicAdd(&counters[TC_COUNTER_FAILED], 1u);
-    return HC_NONE;
+// Insertion requests (`inserts`): header words, then TC_REQUEST_WORDS per request.
+const TC_INSERT_GROUPS: u32 = 0u;       // workgroups of the insertion passes (indirect x; y = z = 1)
+const TC_INSERT_COUNT: u32 = 3u;
+const TC_INSERT_HEADER: u32 = 4u;
+const TC_REQUEST_WORDS: u32 = 4u;       // candidate, home, checksum, state
+const TC_INSERT_WORKGROUP: u32 = 256u;  // INSERT_WORKGROUP in cache.rs
+// A request's state: its probe index while pending, with TC_CLAIMED while it claims that slot;
+// TC_SETTLED once it has offered its vertex or failed.
+const TC_CLAIMED: u32 = 0x80000000u;
+const TC_SETTLED: u32 = 0xffffffffu;
+
+// Offers candidate `candidate` (its vertex already written) to `slot`'s record.
+fn tc_claim_vertex(slot: u32, candidate: u32) {
+    atomicMin(&slots[4u * slot + 1u], candidate ^ tc.candidate_mask);
 }
 
 // Offers the vertex hit by the ray (origin, dir) to `slot`; `candidate` indexes the candidates.
 fn tc_offer(slot: u32, candidate: u32, origin: vec3f, dir: vec3f) {
     vertices[4u * hc.capacity + candidate] = TcVertex(origin, 0.0, dir, 0.0);
-    atomicMin(&slots[4u * slot + 1u], candidate ^ tc.candidate_mask);
+    tc_claim_vertex(slot, candidate);
+}
+
+// Offers the vertex to the record of `key`, which has no slot yet: a request that the insertion
+// passes settle. Inserting in place (a compare-exchange walk) would give a contended slot to
+// whichever key gets there first, and a slot's index seeds its propagation: results would depend
+// on the order invocations run in.
+fn tc_request(key: VoxelKey, candidate: u32, origin: vec3f, dir: vec3f) {
+    vertices[4u * hc.capacity + candidate] = TcVertex(origin, 0.0, dir, 0.0);
+    let at = atomicAdd(&inserts[TC_INSERT_COUNT], 1u);
+    if at % TC_INSERT_WORKGROUP == 0u {
+        atomicAdd(&inserts[TC_INSERT_GROUPS], 1u);
+    }
+    let w = TC_INSERT_HEADER + TC_REQUEST_WORDS * at;
+    atomicStore(&inserts[w], candidate);
+    atomicStore(&inserts[w + 1u], key.home);
+    atomicStore(&inserts[w + 2u], key.checksum);
+    atomicStore(&inserts[w + 3u], 0u);
+}
+
+// The first word of invocation `id`'s request, or HC_NONE past the list's end. Nothing depends
+// on a request's place in the list (claims compare candidate indices).
+fn tc_request_word(id: vec3u) -> u32 {
+    if id.x >= atomicLoad(&inserts[TC_INSERT_COUNT]) {
+        return HC_NONE;
+    }
+    return TC_INSERT_HEADER + TC_REQUEST_WORDS * id.x;
+}
+
+// A pending request's walk from its probe index over the slots as the pass found them (no
+// checksum is written during a claim pass): its own key (offer there, settled), the first empty
+// slot (claim it: atomicMin of the candidate index; with `claim` false, fail instead), or the
+// end of the probe window (fail).
+fn tc_insert_walk(w: u32, claim: bool) {
+    let state = atomicLoad(&inserts[w + 3u]);
+    if state == TC_SETTLED {
+        return;
+    }
+    let candidate = atomicLoad(&inserts[w]);
+    let home = atomicLoad(&inserts[w + 1u]);
+    let checksum = atomicLoad(&inserts[w + 2u]);
+    for (var i = state & ~TC_CLAIMED; i < hc.probe_limit; i++) {
+        let s = (home + i) % hc.capacity;
+        let c = atomicLoad(&slots[4u * s]);
+        if c == checksum {
+            tc_claim_vertex(s, candidate);
+            atomicStore(&inserts[w + 3u], TC_SETTLED);
+            return;
+        }
+        if c == HC_EMPTY {
+            if !claim {
+                break;
+            }
+            atomicMin(&slots[4u * s + 3u], candidate);
+            atomicStore(&inserts[w + 3u], i | TC_CLAIMED);
+            return;
+        }
+    }
+    atomicAdd(&counters[TC_COUNTER_FAILED], 1u);
+    atomicStore(&inserts[w + 3u], TC_SETTLED);
+}
+
+@compute @workgroup_size(256, 1, 1)
+fn tc_insert_claim(@builtin(global_invocation_id) id: vec3u) {
+    let w = tc_request_word(id);
+    if w != HC_NONE {
+        tc_insert_walk(w, true);
+    }
+}
+
+// The lowest claimant of each claimed slot writes its key there and offers its vertex; the
+// others stay at that probe index: the next claim pass finds their own key there (the same key
+// won) or walks on.
+@compute @workgroup_size(256, 1, 1)
+fn tc_insert_win(@builtin(global_invocation_id) id: vec3u) {
+    let w = tc_request_word(id);
+    if w == HC_NONE {
+        return;
+    }
+    let state = atomicLoad(&inserts[w + 3u]);
+    if state == TC_SETTLED || (state & TC_CLAIMED) == 0u {
+        return;
+    }
+    let i = state & ~TC_CLAIMED;
+    let candidate = atomicLoad(&inserts[w]);
+    let s = (atomicLoad(&inserts[w + 1u]) + i) % hc.capacity;
+    if atomicLoad(&slots[4u * s + 3u]) != candidate {
+        atomicStore(&inserts[w + 3u], i);
+        return;
+    }
+    atomicStore(&slots[4u * s], atomicLoad(&inserts[w + 2u]));
+    atomicAdd(&counters[TC_COUNTER_INSERTED], 1u);
+    tc_claim_vertex(s, candidate);
+    atomicStore(&inserts[w + 3u], TC_SETTLED);
+}
+
+// After the last round: a request that lost its last claim finds its key (the same key won) or
+// fails.
+@compute @workgroup_size(256, 1, 1)
+fn tc_insert_settle(@builtin(global_invocation_id) id: vec3u) {
+    let w = tc_request_word(id);
+    if w != HC_NONE {
+        tc_insert_walk(w, false);
+    }
 }
 
 // mean^2 - Var(mean) from the running mean, the mean of squared vertex means and the weights'
@@ -175,7 +283,7 @@ fn tc_propagate(@builtin(global_invocation_id) id: vec3u) {
                 let sp2 = surface_point(hit2, o2, bs.wi);
                 let sh2 = orient(sp2, -bs.wi);
                 let key2 = tc_key(sp2.position, sh2.ns, rng_next2(&rng));
-                var s2 = tc_find(key2);
+                let s2 = tc_find(key2);
                 if s2 != HC_NONE && records[s2].vertices > 0.0 {
                     y += w * emitted_radiance(sp2, material(sp2.material), bs.wi, hit2.t, bs.pdf);
                     let r2 = records[s2];
@@ -194,11 +302,10 @@ fn tc_propagate(@builtin(global_invocation_id) id: vec3u) {
                 }
                 if k == 0u {
                     // Exploration: the hit may become a stored vertex of its record.
-                    if s2 == HC_NONE {
-                        s2 = tc_insert(key2);
-                    }
                     if s2 != HC_NONE {
                         tc_offer(s2, tc.pixels + id.x, o2, bs.wi);
+                    } else {
+                        tc_request(key2, tc.pixels + id.x, o2, bs.wi);
                     }
                 }
             }
@@ -312,9 +419,12 @@ fn tc_trace(@builtin(global_invocation_id) id: vec3u) {
             }
         }
         if depth == 0u && rng_next(&crng) < tc.store_probability {
-            let s = tc_insert(tc_key(sp.position, sh.ns, rng_next2(&crng)));
+            let key = tc_key(sp.position, sh.ns, rng_next2(&crng));
+            let s = tc_find(key);
             if s != HC_NONE {
                 tc_offer(s, index, origin, dir);
+            } else {
+                tc_request(key, index, origin, dir);
             }
         }
         if alpha < 1.0 {
@@ -357,6 +467,7 @@ fn tc_store(@builtin(global_invocation_id) id: vec3u) {
     }
     let claim = atomicLoad(&slots[4u * slot + 1u]);
     atomicStore(&slots[4u * slot + 1u], HC_NONE);
+    atomicStore(&slots[4u * slot + 3u], HC_NONE);
     if claim == HC_NONE {
         return;
     }

@@ -1,9 +1,15 @@
 //! The method's GPU state and passes (shaders/termination/termination.wgsl): the hashed grid of
-//! records, the propagation dispatch, the tracer with the termination decision, and the vertex
-//! store. One frame = propagate, fold, trace, store ([`TcPass`]), each its own timed pass, in
-//! three submissions: [`TerminationCache::update`] (propagate, fold: the records the image
-//! reads), [`TerminationCache::trace`] (the image), [`TerminationCache::store`] (after the image:
-//! the vertices the next frame propagates).
+//! records, the propagation dispatch, the tracer with the termination decision, the insertion
+//! of new keys and the vertex store. One frame = propagate, fold, trace, insert, store
+//! ([`TcPass`]), each its own timed pass, in three submissions: [`TerminationCache::update`]
+//! (propagate, fold: the records the image reads), [`TerminationCache::trace`] (the image),
+//! [`TerminationCache::store`] (after the image: the keys and vertices the next frame
+//! propagates).
+//!
+//! Deterministic: the same scene, seed and settings give the same bits on any adapter. Sums are
+//! per invocation or integer atomics; a record's stored vertex and a new key's slot are each
+//! the lowest candidate index that asked for them (atomicMin), the slot settled in rounds of
+//! claim and win ([`INSERT_ROUNDS`]).
 
 use super::gpu_decision::{decision_module, rule_words};
 use super::moments::RecordMoments;
@@ -29,13 +35,37 @@ pub const TC_PROPAGATE_PASS: &str = "tc_propagate";
 pub const TC_FOLD_PASS: &str = "tc_fold";
 pub const TC_TRACE_PASS: &str = "tc_trace";
 pub const TC_STORE_PASS: &str = "tc_store";
+/// The insertion of the frame's new keys: [`INSERT_ROUNDS`] claim and win dispatches and one
+/// settle dispatch, timed as one pass.
+pub const TC_INSERT_PASS: &str = "tc_insert";
 /// During the warm-up a record averages only its last few estimates: the propagation is an
 /// iteration from an empty cache, and its early, darker values must not linger.
 const WARMUP_MAX_VERTICES: u32 = 4;
 /// Words of `counters` (termination.wgsl's TC_COUNTER_*).
 const COUNTERS: u64 = 10;
-/// Entry points, in the order of [`TcPass`] (its discriminant indexes the pipelines).
-const PASSES: [&str; 4] = [TC_PROPAGATE_PASS, TC_FOLD_PASS, TC_TRACE_PASS, TC_STORE_PASS];
+/// Pass names, in the order of [`TcPass`].
+const PASSES: [&str; 5] =
+    [TC_PROPAGATE_PASS, TC_FOLD_PASS, TC_TRACE_PASS, TC_INSERT_PASS, TC_STORE_PASS];
+/// Entry points (indices of the pipelines): one per pass of [`PASSES`] but the insertion, whose
+/// three follow.
+const ENTRY_POINTS: [&str; 7] = [
+    TC_PROPAGATE_PASS,
+    TC_FOLD_PASS,
+    TC_TRACE_PASS,
+    TC_STORE_PASS,
+    "tc_insert_claim",
+    "tc_insert_win",
+    "tc_insert_settle",
+];
+/// Rounds of claim and win per frame: a request whose claim loses to another key's this many
+/// times fails, as one whose probe window is full does (both counted in `insert_failures`).
+/// A request loses a round only to another new key claiming the same empty slot in the same
+/// frame, so rounds beyond a few settle nothing: at most the probe window's length are needed.
+pub const INSERT_ROUNDS: u32 = 8;
+/// Threads per workgroup of the insertion passes (`TC_INSERT_WORKGROUP`).
+const INSERT_WORKGROUP: u64 = 256;
+/// Header words of `inserts` (indirect workgroups x, y, z; the request count).
+const INSERT_HEADER: [u32; 4] = [0, 1, 1, 0];
 
 /// The cache's passes in frame order; each is timed under its name (frames.csv's column).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,6 +76,8 @@ pub enum TcPass {
     Fold,
     /// Per pixel: the image, the rule deciding at every vertex over the folded records.
     Trace,
+    /// Per insertion request (a candidate vertex whose key has no slot): new keys get slots.
+    Insert,
     /// Per record: the winning candidate becomes a stored vertex, for the next frame.
     Store,
 }
@@ -53,13 +85,15 @@ pub enum TcPass {
 impl TcPass {
     /// The passes before the image, in one submission.
     pub const UPDATE: [TcPass; 2] = [TcPass::Propagate, TcPass::Fold];
+    /// The passes after the image, in one submission.
+    pub const STORE: [TcPass; 2] = [TcPass::Insert, TcPass::Store];
 
     pub fn name(self) -> &'static str {
         PASSES[self as usize]
     }
 }
 
-const OWN_GROUP: [BufferBinding; 9] = [
+const OWN_GROUP: [BufferBinding; 10] = [
     // The hash cache's parameters: its voxel keys (capacity, probe limit, LOD, jitter).
     BufferBinding::read("hc", "HashCacheParams"),
     BufferBinding::read("tc", "TcParams"),
@@ -71,6 +105,8 @@ const OWN_GROUP: [BufferBinding; 9] = [
     BufferBinding::read_write("colour_out", "array<vec4f>"),
     // Surface vertices of each pixel's path (the vertex after a blend counts α).
     BufferBinding::read_write("path_length", "array<f32>"),
+    // Insertion requests: indirect workgroups, count, then (candidate, home, checksum, state).
+    BufferBinding::read_write("inserts", "array<atomic<u32>>"),
 ];
 
 render::gpu_struct! {
@@ -138,7 +174,7 @@ render::gpu_struct! {
 const _: () = assert!(
     size_of::<TcParams>() == 48 && size_of::<TcRecord>() == 48 && size_of::<TcVertex>() == 32
 );
-const _: () = assert!(BYTES_PER_RECORD == 16 + 48 + 4 * 48 + 4 * 32 + 4 * 32);
+const _: () = assert!(BYTES_PER_RECORD == 16 + 48 + 4 * 48 + 4 * 32 + 4 * 32 + 4 * 16);
 
 /// Counters of one frame (counted on the GPU).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -148,6 +184,9 @@ pub struct TerminationStats {
     pub path_vertices: u32,
     pub trace_rays: u32,
     pub propagate_rays: u32,
+    /// New keys given a slot, and insertion requests refused (a full probe window). Counted by
+    /// the insertion after the image: 0 in [`TerminationCache::trace`]'s output, counted in
+    /// [`TerminationCache::render`]'s and [`TerminationCache::read_counters`] after the store.
     pub inserted: u32,
     pub insert_failures: u32,
     /// Vertices `tc_store` kept. It runs after the image ([`TerminationCache::store`]): 0 in
@@ -242,11 +281,15 @@ pub struct TerminationCache {
     primary: wgpu::Buffer,
     colour: wgpu::Buffer,
     path_length: wgpu::Buffer,
+    inserts: wgpu::Buffer,
+    /// The insertion passes' workgroups, copied from `inserts` (a buffer bound as storage
+    /// cannot be a dispatch's indirect buffer).
+    insert_args: wgpu::Buffer,
     frame: FrameBindings,
     group: wgpu::BindGroup,
-    /// Indexed by [`TcPass`].
-    pipelines: [render::pass_library::LibraryPipeline; 4],
-    /// One timer per submission: [`TcPass::UPDATE`], the trace, the store.
+    /// Indexed as [`ENTRY_POINTS`].
+    pipelines: [render::pass_library::LibraryPipeline; 7],
+    /// One timer per submission: [`TcPass::UPDATE`], the trace, [`TcPass::STORE`].
     update_timer: PassTimer,
     trace_timer: PassTimer,
     store_timer: PassTimer,
@@ -279,6 +322,16 @@ impl TerminationCache {
             "termination cache vertices (stored + candidates)",
             (cap * 2 * VERTICES_PER_RECORD + pixels) * 32,
         )?;
+        // One request at most per candidate (pixel or propagated vertex).
+        let requests = pixels + cap * VERTICES_PER_RECORD;
+        gpu.check_buffer_size("termination insertion requests", 16 + 16 * requests)?;
+        let insert_groups = requests.div_ceil(INSERT_WORKGROUP);
+        let max_groups = gpu.limits.max_compute_workgroups_per_dimension as u64;
+        if insert_groups > max_groups {
+            return Err(RenderError::Settings(format!(
+                "termination cache: {requests} candidates (pixels + 4 x capacity) need {insert_groups} workgroups of {INSERT_WORKGROUP} for insertion, over the adapter's {max_groups}"
+            )));
+        }
         gpu.check_workgroup_memory(TC_TRACE_PASS, 0)?;
         let device = &gpu.device;
         let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
@@ -296,8 +349,8 @@ impl TerminationCache {
         let hc = buffer("termination hc", size_of::<HashCacheParams>() as u64, parameters);
         let tc = buffer("termination tc", size_of::<TcParams>() as u64, parameters);
         let slots = buffer("termination slots", cap * 16, rw);
-        // Empty slots with no claim (claim = NONE).
-        let empty: Vec<[u32; 4]> = vec![[0, u32::MAX, 0, 0]; cap as usize];
+        // Empty slots with no claims (claim = NONE).
+        let empty: Vec<[u32; 4]> = vec![[0, u32::MAX, 0, u32::MAX]; cap as usize];
         gpu.queue.write_buffer(&slots, 0, bytemuck::cast_slice(&empty));
         let records = buffer(
             "termination records",
@@ -310,13 +363,35 @@ impl TerminationCache {
         let primary = buffer("termination primary", pixels * size_of::<TaaPrimary>() as u64, rw);
         let colour = buffer("termination colour", pixels * 16, rw);
         let path_length = buffer("termination path length", pixels * 4, rw);
-        let (layout, pipelines) =
-            scene.library_pass(gpu, "termination.wgsl", Self::program(), &OWN_GROUP, PASSES)?;
+        let inserts = buffer("termination insertion requests", 16 + 16 * requests, rw);
+        let insert_args = buffer(
+            "termination insertion dispatch",
+            12,
+            wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+        );
+        let (layout, pipelines) = scene.library_pass(
+            gpu,
+            "termination.wgsl",
+            Self::program(),
+            &OWN_GROUP,
+            ENTRY_POINTS,
+        )?;
         let group = render::compute::buffer_group(
             gpu,
             "termination",
             &layout,
-            &[&hc, &tc, &slots, &records, &vertices, &counters, &primary, &colour, &path_length],
+            &[
+                &hc,
+                &tc,
+                &slots,
+                &records,
+                &vertices,
+                &counters,
+                &primary,
+                &colour,
+                &path_length,
+                &inserts,
+            ],
         );
         Ok(Self {
             settings,
@@ -330,12 +405,14 @@ impl TerminationCache {
             primary,
             colour,
             path_length,
+            inserts,
+            insert_args,
             frame: FrameBindings::new(gpu, scene),
             group,
             pipelines,
             update_timer: PassTimer::new(gpu, &TcPass::UPDATE.map(TcPass::name)),
             trace_timer: PassTimer::new(gpu, &[TC_TRACE_PASS]),
-            store_timer: PassTimer::new(gpu, &[TC_STORE_PASS]),
+            store_timer: PassTimer::new(gpu, &TcPass::STORE.map(TcPass::name)),
             frames: 0,
         })
     }
@@ -405,7 +482,10 @@ impl TerminationCache {
         let updated = self.update(gpu, scene, camera, seed, frame)?;
         let mut out = self.trace(gpu, scene, updated)?;
         out.timings.extend(self.store(gpu, scene)?);
-        out.stats.stored = self.read_counters(gpu)?.stored;
+        let counted = self.read_counters(gpu)?;
+        out.stats.stored = counted.stored;
+        out.stats.inserted = counted.inserted;
+        out.stats.insert_failures = counted.insert_failures;
         Ok(out)
     }
 
@@ -472,11 +552,12 @@ impl TerminationCache {
         })
     }
 
-    /// After the frame's image: the winning candidates become stored vertices, which the next
-    /// frame propagates. Reads only the cache's own buffers and parameters (no ray), so other
-    /// methods' work since [`Self::trace`] changes nothing. Ends the frame.
+    /// After the frame's image: the frame's new keys get slots and the winning candidates become
+    /// stored vertices, which the next frame propagates. Reads only the cache's own buffers and
+    /// parameters (no ray), so other methods' work since [`Self::trace`] changes nothing. Ends
+    /// the frame.
     pub fn store(&mut self, gpu: &Gpu, scene: &SceneGpu) -> Result<Vec<PassTiming>, RenderError> {
-        let timings = self.submit(gpu, scene, &self.store_timer, &[TcPass::Store])?;
+        let timings = self.submit(gpu, scene, &self.store_timer, &TcPass::STORE)?;
         self.frames += 1;
         Ok(timings)
     }
@@ -544,6 +625,7 @@ impl TerminationCache {
         gpu.queue.write_buffer(&self.hc, 0, bytemuck::bytes_of(&hc));
         gpu.queue.write_buffer(&self.tc, 0, bytemuck::bytes_of(&tc));
         gpu.queue.write_buffer(&self.counters, 0, &[0u8; COUNTERS as usize * 4]);
+        gpu.queue.write_buffer(&self.inserts, 0, bytemuck::cast_slice(&INSERT_HEADER));
     }
 
     /// `passes` in order as one submission timed by `timer` (whose names are theirs).
@@ -557,7 +639,30 @@ impl TerminationCache {
         let mut timed = timer.begin(gpu, "termination");
         for (index, &p) in passes.iter().enumerate() {
             debug_assert_eq!(timer.names()[index], p.name());
-            let pipeline = &self.pipelines[p as usize];
+            if p == TcPass::Insert {
+                timed.encoder().copy_buffer_to_buffer(&self.inserts, 0, &self.insert_args, 0, 12);
+                timed.pass(index, |pass| {
+                    self.frame.bind(gpu, scene, pass);
+                    pass.set_bind_group(2, &self.group, &[]);
+                    let [claim, win, settle] = [4, 5, 6].map(|e| self.pipelines[e].get());
+                    for _ in 0..INSERT_ROUNDS.min(self.settings.probe_limit) {
+                        pass.set_pipeline(&claim);
+                        pass.dispatch_workgroups_indirect(&self.insert_args, 0);
+                        pass.set_pipeline(&win);
+                        pass.dispatch_workgroups_indirect(&self.insert_args, 0);
+                    }
+                    pass.set_pipeline(&settle);
+                    pass.dispatch_workgroups_indirect(&self.insert_args, 0);
+                })?;
+                continue;
+            }
+            let entry = match p {
+                TcPass::Propagate => 0,
+                TcPass::Fold => 1,
+                TcPass::Trace => 2,
+                TcPass::Insert | TcPass::Store => 3,
+            };
+            let pipeline = &self.pipelines[entry];
             let [x, y, z] = self.workgroups(p);
             timed.pass(index, |pass| {
                 pass.set_pipeline(&pipeline.get());
@@ -575,12 +680,14 @@ impl TerminationCache {
         match pass {
             TcPass::Propagate => [(records * VERTICES_PER_RECORD as u32).div_ceil(64), 1, 1],
             TcPass::Fold | TcPass::Store => [records.div_ceil(64), 1, 1],
+            // Dispatched indirectly over the frame's requests (`inserts`).
+            TcPass::Insert => [0, 1, 1],
             TcPass::Trace => [self.width.div_ceil(8), self.height.div_ceil(8), 1],
         }
     }
 
-    /// The frame's counters so far.
-    fn read_counters(&self, gpu: &Gpu) -> Result<TerminationStats, RenderError> {
+    /// The frame's counters so far (after [`Self::store`]: the insertions' and the store's too).
+    pub fn read_counters(&self, gpu: &Gpu) -> Result<TerminationStats, RenderError> {
         Ok(stats_of(&read_pod::<u32>(gpu, &self.counters, "termination counters")?))
     }
 }
@@ -608,7 +715,7 @@ impl TerminationCache {
         Ok(all[..self.settings.capacity as usize].to_vec())
     }
 
-    /// Slot words (checksum, claim, stored vertices, -), for tests.
+    /// Slot words (checksum, claim, stored vertices, insertion claim), for tests.
     pub fn read_slots(&self, gpu: &Gpu) -> Result<Vec<[u32; 4]>, RenderError> {
         read_pod(gpu, &self.slots, "termination slots")
     }

@@ -157,6 +157,17 @@ pub fn store(
             ));
         };
         output.add_timed(&timings);
+        // Insertions are settled after the image: their failures are counted by now.
+        let failures = state
+            .cache
+            .read_counters(&gpu.0)
+            .map_err(|e| method_failed(&info.label, clock.global, e))?
+            .insert_failures;
+        if let Some(stat) =
+            output.stats.iter_mut().find(|(name, _)| name == "cache_insert_failures")
+        {
+            stat.1 = failures as f64;
+        }
         frame.add_cpu(start);
     }
     Ok(())

@@ -73,8 +73,9 @@ impl Default for TerminationSettings {
 pub const VERTICES_PER_RECORD: u64 = 4;
 
 /// The cache's buffers per record: slot words (16), record moments (48), 4 per-vertex estimates
-/// (4 × 48), 4 stored vertices (4 × 32) and 4 propagation candidates (4 × 32).
-pub const BYTES_PER_RECORD: u64 = 16 + 48 + VERTICES_PER_RECORD * (48 + 32 + 32);
+/// (4 × 48), 4 stored vertices (4 × 32), 4 propagation candidates (4 × 32) and their 4
+/// insertion requests (4 × 16).
+pub const BYTES_PER_RECORD: u64 = 16 + 48 + VERTICES_PER_RECORD * (48 + 32 + 32 + 16);
 
 impl TerminationSettings {
     pub fn validate(&self) -> Result<(), RenderError> {
