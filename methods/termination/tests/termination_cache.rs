@@ -224,22 +224,26 @@ fn two_runs_give_the_same_bits_under_slot_contention() {
             ..settings(TerminationRule::VarianceBounding { t: 1.0, relative: true })
         };
         let mut cache = TerminationCache::new(gpu(), &sg, s).expect("termination cache");
-        let frames: Vec<TerminationOutput> = (0..2)
+        let frames: Vec<TerminationOutput> = (0..4)
             .map(|f| cache.render(gpu(), &sg, &scene.camera, 5, f).expect("render"))
             .collect();
         (frames, cache.read_slots(gpu()).unwrap(), cache.read_records(gpu()).unwrap())
     };
+    // Three runs: a race shows in some runs only (on lavapipe's two threads about one pair of
+    // runs in five differed before the insertion in rounds).
     let (a, slots_a, records_a) = run();
-    let (b, slots_b, records_b) = run();
-    // The case must contend: failed insertions (a full table) in both runs.
+    // The case must contend: failed insertions (a full table).
     assert!(a[1].stats.insert_failures > 0, "no contention: {:?}", a[1].stats);
-    for f in 0..2 {
-        assert_eq!(a[f].stats, b[f].stats, "frame {f}: counters");
-        assert!(a[f].radiance == b[f].radiance, "frame {f}: images differ");
-        assert!(a[f].path_length == b[f].path_length, "frame {f}: path lengths differ");
+    for run_b in 1..3 {
+        let (b, slots_b, records_b) = run();
+        for f in 0..4 {
+            assert_eq!(a[f].stats, b[f].stats, "run {run_b}, frame {f}: counters");
+            assert!(a[f].radiance == b[f].radiance, "run {run_b}, frame {f}: images differ");
+            assert!(a[f].path_length == b[f].path_length, "run {run_b}, frame {f}: path lengths");
+        }
+        assert!(slots_a == slots_b, "run {run_b}: slot tables differ");
+        assert!(records_a == records_b, "run {run_b}: records differ");
     }
-    assert!(slots_a == slots_b, "slot tables differ");
-    assert!(records_a == records_b, "records differ");
 }
 
 #[test]
