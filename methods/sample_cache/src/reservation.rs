@@ -83,8 +83,10 @@ mod tests {
             for i in (1..indices.len()).rev() {
                 indices.swap(i, (rng.next_u64() % (i as u64 + 1)) as usize);
             }
-            let keys: Vec<u32> =
-                indices[..count].iter().map(|&i| key(rng.next_u64() % 3 != 0, i, mask)).collect();
+            let keys: Vec<u32> = indices[..count]
+                .iter()
+                .map(|&i| key(!rng.next_u64().is_multiple_of(3), i, mask))
+                .collect();
             let expected = lowest(&keys, n);
             for _ in 0..4 {
                 let (kept, dropped) =
