@@ -146,7 +146,7 @@ fn play(p: &Prepared, opts: &SuiteOptions) -> Result<BTreeMap<String, CaseRuns>>
 /// One case at one seed, checked: a scenario to play, or frames on disk already measured.
 enum Planned {
     Play(Box<RunSpec>, Overrides),
-    Measured(MeasureOptions, Measured),
+    Measured(MeasureOptions, Box<Measured>),
 }
 
 /// Plays `cases` (read from `origin`) at each of their seeds into `FOLDER/CASE/seed_N`; every
@@ -168,7 +168,7 @@ pub(crate) fn play_cases(
                 let opts = frames.options(seed, &out);
                 let measured = Measured::read(&opts)
                     .map_err(|e| anyhow!("{} seed {seed}: {e:#}", case_at(origin, case)))?;
-                Planned::Measured(opts, measured)
+                Planned::Measured(opts, Box::new(measured))
             } else {
                 let (spec, overrides) = case_spec(origin, case, seed, &out)?;
                 Planned::Play(Box::new(spec), overrides)
