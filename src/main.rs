@@ -124,6 +124,9 @@ enum Command {
         /// Skip the image-metric benchmark (FLIP against NVIDIA's flip-evaluator, SMAPE).
         #[arg(long)]
         no_metrics: bool,
+        /// Only the image-metric benchmark (SMAPE, FLIP, JOD, cvvdp where installed; no GPU).
+        #[arg(long, conflicts_with = "no_metrics")]
+        metrics_only: bool,
         /// Timed repetitions of each image metric (the best is reported).
         #[arg(long, default_value_t = 3)]
         repeats: u32,
@@ -449,6 +452,9 @@ fn main() -> ExitCode {
             nirc_resolution,
         ),
         Command::Bench { out, json, memory: true, .. } => bench::command::memory(out, json),
+        Command::Bench { out, json, metrics_only: true, repeats, .. } => {
+            bench::command::metrics(out, json, repeats)
+        }
         Command::Bench { out, rays, frames, no_metrics, repeats, json, .. } => {
             bench::command::speed(out, json, rays, frames, no_metrics, repeats)
         }

@@ -94,14 +94,64 @@ pub fn memory(out: Option<PathBuf>, json: Option<PathBuf>) -> anyhow::Result<()>
     let resolutions = crate::speed::BenchOptions::default().resolutions;
     let scratch = std::env::temp_dir().join(format!("flicker-bench-memory-{}", std::process::id()));
     let (md, rows) = systems::memory::table(&resolutions, &scratch)?;
+    print_and_write(&md, out, json, &rows)
+}
+
+/// Prints the Markdown; writes it to `out` and `value` as JSON to `json` where given.
+fn print_and_write(
+    md: &str,
+    out: Option<PathBuf>,
+    json: Option<PathBuf>,
+    value: &impl serde::Serialize,
+) -> anyhow::Result<()> {
     print!("{md}");
     if let Some(path) = out {
-        systems::output::write_text(&path, &md)?;
+        systems::output::write_text(&path, md)?;
     }
     if let Some(path) = json {
-        systems::output::write_text(&path, &serde_json::to_string_pretty(&rows)?)?;
+        systems::output::write_text(&path, &serde_json::to_string_pretty(value)?)?;
     }
     Ok(())
+}
+
+/// The image metrics' timings (crate::image_metrics) at 1280x720, with JOD's rows at 160x90
+/// too: the Markdown section and the report.
+fn metrics_section(repeats: u32) -> anyhow::Result<(String, crate::image_metrics::BenchReport)> {
+    let mut md = String::new();
+    eprintln!("bench: image metrics at 1280x720");
+    let args = crate::image_metrics::BenchArgs {
+        width: 1280,
+        height: 720,
+        repeats,
+        no_reference: false,
+        smape_only: false,
+    };
+    let r = crate::image_metrics::bench(&args)?;
+    md.push_str(&format!(
+        "\n## Image metrics, {}x{} HDR pair ({} threads)\n\n| metric | ms |\n|---|---:|\n| SMAPE | {:.2} |\n| HDR-FLIP (flicker) | {:.1} |\n",
+        r.width, r.height, r.threads, r.smape_ms, r.flip_hdr_ms.unwrap_or(f64::NAN)
+    ));
+    if let (Some(ms), Some(speedup)) = (r.reference_flip_ms, r.speedup) {
+        md.push_str(&format!("| HDR-FLIP (flip-evaluator) | {ms:.1} |\n\nflip-evaluator time / flicker time: {speedup:.2}\n"));
+    }
+    md.push_str(&format!("\nPer frame: HDR-FLIP of one pair; ColorVideoVDP (JOD) per frame of a {}-frame video (the synthetic pair, fresh noise per frame; flicker on {} threads, `cvvdp` on the CPU with one torch thread, random frames):\n\n| size | HDR-FLIP ms | JOD ms (flicker) | JOD ms (cvvdp) | JOD |\n|---|---:|---:|---:|---:|\n", crate::image_metrics::JOD_FRAMES, r.threads));
+    for t in &r.jod {
+        let cvvdp = match &t.cvvdp {
+            Ok(ms) => format!("{ms:.1}"),
+            Err(why) => why.clone(),
+        };
+        md.push_str(&format!(
+            "| {}x{} | {:.1} | {:.1} | {cvvdp} | {:.3} |\n",
+            t.width, t.height, t.flip_ms, t.ms_per_frame, t.jod
+        ));
+    }
+    Ok((md, r))
+}
+
+/// `flicker bench --metrics-only`: the image metrics' timings alone (no GPU).
+pub fn metrics(out: Option<PathBuf>, json: Option<PathBuf>, repeats: u32) -> anyhow::Result<()> {
+    let (md, r) = metrics_section(repeats)?;
+    print_and_write(&md, out, json, &r)
 }
 
 pub fn speed(
@@ -116,29 +166,7 @@ pub fn speed(
     let report = crate::speed::run(&opts, |step| eprintln!("bench: {step}"))?;
     let mut md = report.markdown;
     if !no_metrics {
-        eprintln!("bench: image metrics at 1280x720");
-        let args = crate::image_metrics::BenchArgs {
-            width: 1280,
-            height: 720,
-            repeats,
-            no_reference: false,
-            smape_only: false,
-        };
-        let r = crate::image_metrics::bench(&args)?;
-        md.push_str(&format!(
-            "\n## Image metrics, {}x{} HDR pair ({} threads)\n\n| metric | ms |\n|---|---:|\n| SMAPE | {:.2} |\n| HDR-FLIP (flicker) | {:.1} |\n",
-            r.width, r.height, r.threads, r.smape_ms, r.flip_hdr_ms.unwrap_or(f64::NAN)
-        ));
-        if let (Some(ms), Some(speedup)) = (r.reference_flip_ms, r.speedup) {
-            md.push_str(&format!("| HDR-FLIP (flip-evaluator) | {ms:.1} |\n\nflip-evaluator time / flicker time: {speedup:.2}\n"));
-        }
-        md.push_str("\nColorVideoVDP (JOD), per frame of a video (the synthetic pair, fresh noise per frame):\n\n| size | frames | ms per frame | JOD |\n|---|---:|---:|---:|\n");
-        for t in &r.jod {
-            md.push_str(&format!(
-                "| {}x{} | {} | {:.1} | {:.3} |\n",
-                t.width, t.height, t.frames, t.ms_per_frame, t.jod
-            ));
-        }
+        md.push_str(&metrics_section(repeats)?.0);
     }
     print!("{md}");
     if let Some(path) = out {

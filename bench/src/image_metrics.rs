@@ -1,6 +1,7 @@
 //! Speed benchmark: SMAPE and FLIP at 1280x720 on a synthetic HDR pair, and NVIDIA's reference
 //! FLIP (`flip` from the `flip-evaluator` Python package) on the same pair when installed, and
-//! ColorVideoVDP's JOD per frame of a short video of such pairs at 160x90 and at the bench size.
+//! per frame at 160x90 and at the bench size: FLIP, ColorVideoVDP's JOD of a short video of such
+//! pairs, and the authors' `cvvdp` (PyTorch, CPU) on a video of that size where it is installed.
 //! Run it from a release build; it is a measurement, not a test.
 
 use std::path::PathBuf;
@@ -53,6 +54,11 @@ pub struct JodTiming {
     pub frames: u32,
     pub ms_per_frame: f64,
     pub jod: f64,
+    /// HDR-FLIP of one frame's pair at this size, beside JOD's cost per frame.
+    pub flip_ms: f64,
+    /// `cvvdp` on the CPU (one torch thread), ms per frame of a `frames`-frame video of this
+    /// size, or why there is none ("cvvdp not installed").
+    pub cvvdp: Result<f64, String>,
 }
 
 /// Frames of the timed JOD video: enough for its temporal filters to matter, few enough to time.
@@ -68,13 +74,42 @@ fn time_jod(width: u32, height: u32, repeats: u32) -> anyhow::Result<JodTiming> 
     let ms = best_ms(repeats, || {
         jod = metrics::jod(&reference, &test, 30.0, &settings, false).map(|r| r.jod)
     });
+    let flip_ms = best_ms(repeats, || {
+        std::hint::black_box(flip_hdr(&reference[0], &test[0], DEFAULT_PPD));
+    });
     Ok(JodTiming {
         width,
         height,
         frames: JOD_FRAMES,
         ms_per_frame: ms / JOD_FRAMES as f64,
         jod: jod?,
+        flip_ms,
+        cvvdp: time_cvvdp(width, height),
     })
+}
+
+/// `scripts/cvvdp_fixtures.py time`: the authors' ColorVideoVDP on the CPU, ms per frame.
+fn time_cvvdp(width: u32, height: u32) -> Result<f64, String> {
+    let installed = std::process::Command::new("python3")
+        .args(["-c", "import pycvvdp, torch"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !installed {
+        return Err("cvvdp not installed".into());
+    }
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/cvvdp_fixtures.py");
+    let out = std::process::Command::new("python3")
+        .arg(script)
+        .args(["time", &width.to_string(), &height.to_string(), &JOD_FRAMES.to_string()])
+        .output()
+        .map_err(|e| format!("cannot run {script}: {e}"))?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    // "cvvdp WxH N frames, 1 thread: S s (MS ms/frame)"
+    text.split('(')
+        .nth(1)
+        .and_then(|t| t.split_whitespace().next())
+        .and_then(|ms| ms.parse().ok())
+        .ok_or_else(|| format!("cvvdp failed: {text}{}", String::from_utf8_lossy(&out.stderr)))
 }
 
 fn best_ms(repeats: u32, mut f: impl FnMut()) -> f64 {

@@ -250,57 +250,92 @@ fn without_times(csv: &str) -> String {
     out
 }
 
-/// Measures the sequences and writes the run folder; returns the report's path.
-pub fn measure(opts: &MeasureOptions) -> anyhow::Result<PathBuf> {
-    let inputs = check_options(opts)?;
-    let (records, (w, h)) = measure_all(&inputs, opts.smape_epsilon)?;
-    let first = inputs.reference.frames[0].0;
-    let folder = RunFolder::new(&opts.out);
-    folder.prepare()?;
-    let count = inputs.reference.frames.len() as u32;
-    let names: Vec<&str> = inputs.tests.iter().map(|t| t.0.as_str()).collect();
-    let manifest = json!({
-        "scenario": "measure",
-        "measured": {
-            "reference": opts.reference.display().to_string(),
-            "tests": opts.tests.iter().map(|(n, d)| json!({"name": n, "dir": d.display().to_string()})).collect::<Vec<_>>(),
-            "motion": opts.motion.iter().map(|(n, d)| json!({"name": n, "dir": d.display().to_string()})).collect::<Vec<_>>(),
-            "first_frame": first,
-        },
-        "flicker_version": env!("CARGO_PKG_VERSION"),
-        "resolution": [w, h],
-        "frames": count,
-        "methods": names,
-        "reference": { "frames": (0..count).collect::<Vec<_>>() },
-        "events": opts.events.iter().map(|e| json!({"frame": e - first, "label": format!("input frame {e}")})).collect::<Vec<_>>(),
-        "regions": [],
-        "settings": {
-            "smape_epsilon": opts.smape_epsilon,
-            "time_step": 1.0 / opts.fps,
-            "cvvdp": opts.cvvdp,
-            "methods": names.iter().map(|n| json!({"label": n})).collect::<Vec<_>>(),
-        },
-    });
-    for (k, (n, path)) in inputs.reference.frames.iter().enumerate() {
-        let k = k as u32;
-        let img = load_checked(path, *n, Some((w, h)))?;
-        write_frame(&folder.reference(k, "exr"), &folder.reference(k, "png"), &img)?;
-        for (name, seq, motion) in &inputs.tests {
-            let img = load_checked(&seq.frames[k as usize].1, *n, Some((w, h)))?;
-            write_frame(&folder.frame(name, k, "exr"), &folder.frame(name, k, "png"), &img)?;
-            if let Some(m) = motion {
-                let mv = load_motion(&m.frames[k as usize].1, *n, (w, h))?;
-                let px: Vec<[f32; 4]> = mv.iter().map(|&[x, y]| [x, y, 0.0, 1.0]).collect();
-                output::write_exr(&folder.method_image(name, MOTION, k, "exr"), w, h, &px)?;
+/// Sequences read, checked and measured, nothing written yet: what `flicker measure` and a
+/// suite's measured case hold between checking every input and writing any run folder.
+pub struct Measured {
+    inputs: Inputs,
+    records: Vec<FrameRecord>,
+    size: (u32, u32),
+}
+
+impl Measured {
+    /// Reads and checks every input and measures every frame; writes nothing.
+    pub fn read(opts: &MeasureOptions) -> anyhow::Result<Self> {
+        let inputs = check_options(opts)?;
+        let (records, size) = measure_all(&inputs, opts.smape_epsilon)?;
+        Ok(Self { inputs, records, size })
+    }
+
+    /// Every test frame's record (frames renumbered from 0).
+    pub fn records(&self) -> &[FrameRecord] {
+        &self.records
+    }
+
+    pub fn frames(&self) -> u32 {
+        self.inputs.reference.frames.len() as u32
+    }
+
+    /// The input's first frame number: frame 0 of the run folder.
+    pub fn first_frame(&self) -> u32 {
+        self.inputs.reference.frames[0].0
+    }
+
+    /// Writes the run folder `opts.out` (the options `read` was given); returns the report's path.
+    pub fn write(&self, opts: &MeasureOptions) -> anyhow::Result<PathBuf> {
+        let (inputs, (w, h)) = (&self.inputs, self.size);
+        let first = self.first_frame();
+        let folder = RunFolder::new(&opts.out);
+        folder.prepare()?;
+        let count = self.frames();
+        let names: Vec<&str> = inputs.tests.iter().map(|t| t.0.as_str()).collect();
+        let manifest = json!({
+            "scenario": "measure",
+            "measured": {
+                "reference": opts.reference.display().to_string(),
+                "tests": opts.tests.iter().map(|(n, d)| json!({"name": n, "dir": d.display().to_string()})).collect::<Vec<_>>(),
+                "motion": opts.motion.iter().map(|(n, d)| json!({"name": n, "dir": d.display().to_string()})).collect::<Vec<_>>(),
+                "first_frame": first,
+            },
+            "flicker_version": env!("CARGO_PKG_VERSION"),
+            "resolution": [w, h],
+            "frames": count,
+            "methods": names,
+            "reference": { "frames": (0..count).collect::<Vec<_>>() },
+            "events": opts.events.iter().map(|e| json!({"frame": e - first, "label": format!("input frame {e}")})).collect::<Vec<_>>(),
+            "regions": [],
+            "settings": {
+                "smape_epsilon": opts.smape_epsilon,
+                "time_step": 1.0 / opts.fps,
+                "cvvdp": opts.cvvdp,
+                "methods": names.iter().map(|n| json!({"label": n})).collect::<Vec<_>>(),
+            },
+        });
+        for (k, (n, path)) in inputs.reference.frames.iter().enumerate() {
+            let k = k as u32;
+            let img = load_checked(path, *n, Some((w, h)))?;
+            write_frame(&folder.reference(k, "exr"), &folder.reference(k, "png"), &img)?;
+            for (name, seq, motion) in &inputs.tests {
+                let img = load_checked(&seq.frames[k as usize].1, *n, Some((w, h)))?;
+                write_frame(&folder.frame(name, k, "exr"), &folder.frame(name, k, "png"), &img)?;
+                if let Some(m) = motion {
+                    let mv = load_motion(&m.frames[k as usize].1, *n, (w, h))?;
+                    let px: Vec<[f32; 4]> = mv.iter().map(|&[x, y]| [x, y, 0.0, 1.0]).collect();
+                    output::write_exr(&folder.method_image(name, MOTION, k, "exr"), w, h, &px)?;
+                }
             }
         }
+        output::write_text(
+            &folder.frames_csv(),
+            &without_times(&systems::frame_record::to_csv(&self.records)),
+        )?;
+        output::write_json(&folder.manifest(), &manifest)?;
+        report::rebuild(&folder.root)
     }
-    output::write_text(
-        &folder.frames_csv(),
-        &without_times(&systems::frame_record::to_csv(&records)),
-    )?;
-    output::write_json(&folder.manifest(), &manifest)?;
-    report::rebuild(&folder.root)
+}
+
+/// Measures the sequences and writes the run folder; returns the report's path.
+pub fn measure(opts: &MeasureOptions) -> anyhow::Result<PathBuf> {
+    Measured::read(opts)?.write(opts)
 }
 
 #[cfg(test)]

@@ -1,6 +1,8 @@
 //! `flicker measure`: a flicker run's frames measured again from disk give the run's own
 //! metrics (the round trip), and bad input is refused naming the file and frame, with nothing
-//! written.
+//! written. The round trip is exact, not within a tolerance: a run records its frames as f32
+//! EXR (lossless), and measure reads them back through the same metric code, so every number
+//! comes from the same floats in the same order.
 
 use std::path::{Path, PathBuf};
 
@@ -27,12 +29,16 @@ fn options(reference: &Path, tests: &[(&str, PathBuf)], out: PathBuf) -> Measure
     }
 }
 
+/// The image metrics of frames.csv and summary.json (timings differ: measure has none).
+const METRICS: [&str; 7] =
+    ["smape", "smape_reprojected", "disoccluded", "flip", "mse", "rel_mse", "psnr"];
+
 /// frames.csv's metric columns, row by row: (method, frame, column) -> cell text.
 fn metric_cells(run: &Path) -> Vec<(String, String, String, String)> {
     let text = std::fs::read_to_string(run.join("frames.csv")).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let wanted = ["smape", "smape_reprojected", "disoccluded", "flip", "mse", "rel_mse", "psnr"];
+    let wanted = METRICS;
     lines
         .flat_map(|l| {
             let cells: Vec<&str> = l.split(',').collect();
@@ -45,11 +51,21 @@ fn metric_cells(run: &Path) -> Vec<(String, String, String, String)> {
         .collect()
 }
 
-fn overall_jod(run: &Path, method: &str) -> f64 {
+/// summary.json of `method`: its JOD per window, and its image metrics' means per window.
+fn summary_metrics(run: &Path, method: &str) -> (serde_json::Value, Vec<(String, String, f64)>) {
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(run.join("summary.json")).unwrap()).unwrap();
     let m = s["methods"].as_array().unwrap().iter().find(|m| m["method"] == method).unwrap();
-    m["jod"]["overall"].as_f64().unwrap_or_else(|| panic!("no overall JOD for {method}: {m}"))
+    assert!(m["jod"]["overall"].is_f64(), "no overall JOD for {method}: {m}");
+    let mut means = Vec::new();
+    for (window, columns) in m["means"].as_object().unwrap() {
+        for (column, v) in columns.as_object().unwrap() {
+            if METRICS.contains(&column.as_str()) {
+                means.push((window.clone(), column.clone(), v.as_f64().unwrap()));
+            }
+        }
+    }
+    (m["jod"].clone(), means)
 }
 
 #[test]
@@ -104,7 +120,10 @@ fn a_runs_frames_measured_again_give_the_runs_metrics() {
     assert!(ours.iter().any(|c| c.2 == "flip" && !c.3.is_empty()));
     assert!(ours.iter().any(|c| c.2 == "smape_reprojected" && !c.3.is_empty()));
     for l in &labels {
-        assert_eq!(overall_jod(&dir.join("measured"), l), overall_jod(&run, l), "{l}");
+        let (ours, theirs) = (summary_metrics(&dir.join("measured"), l), summary_metrics(&run, l));
+        assert_eq!(ours.0, theirs.0, "{l}: JOD per window, measured vs run");
+        assert!(ours.1.iter().any(|m| m.1 == "psnr"), "{l}: {:?}", ours.1);
+        assert_eq!(ours.1, theirs.1, "{l}: summary means, measured vs run");
     }
     assert!(dir.join("measured/report.html").exists());
     std::fs::remove_dir_all(&dir).ok();

@@ -481,6 +481,7 @@ impl Claims {
                 Case {
                     name: c.name.clone(),
                     scenario: c.scenario.clone(),
+                    measure: None,
                     seeds: s,
                     frames: size.frames,
                     resolution: size.resolution,

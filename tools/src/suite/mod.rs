@@ -6,6 +6,7 @@ pub mod baseline;
 pub mod gate;
 pub mod junit;
 pub mod markdown;
+pub mod measured;
 pub mod measurement;
 pub mod metric;
 pub mod run;

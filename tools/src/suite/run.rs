@@ -12,6 +12,7 @@ use super::gate::{GateResult, judge};
 use super::measurement::{CaseRuns, SeedRun};
 use super::spec::{Bound, Case, Suite};
 use super::{junit, markdown};
+use crate::measure::{MeasureOptions, Measured};
 use systems::playback::{Overrides, RunOptions, RunSpec, run_spec};
 
 pub struct SuiteOptions {
@@ -55,9 +56,31 @@ fn prepare(opts: &SuiteOptions) -> Result<Prepared> {
         .unwrap_or_else(|| PathBuf::from("runs").join(format!("suite_{}", suite.name)));
     let baselines = opts.baselines.clone().unwrap_or_else(|| suite.baseline_file());
     // The adapter keys the baseline; asked before anything plays so that a missing baseline
-    // is reported at once.
-    let adapter = Gpu::new()?.summary;
+    // is reported at once. Frames from disk are measured on the CPU: a suite of only those
+    // needs no GPU, and its baseline is the frames' alone.
+    let adapter = if suite.cases.iter().all(|c| c.measure.is_some()) {
+        measured_frames_adapter()
+    } else {
+        Gpu::new()?.summary
+    };
     Ok(Prepared { suite, folder, baselines, adapter })
+}
+
+/// What keys the baseline of a suite whose cases are all frames from disk.
+fn measured_frames_adapter() -> render::gpu::AdapterSummary {
+    render::gpu::AdapterSummary {
+        name: "frames from disk".into(),
+        backend: "cpu".into(),
+        driver: String::new(),
+        driver_info: String::new(),
+        device_type: "Cpu".into(),
+    }
+}
+
+/// `FILE:LINE:COLUMN: case 'NAME'`, where errors about a case start.
+fn case_at(origin: &Path, case: &Case) -> String {
+    let (line, column) = case.entry.as_ref().map_or((1, 1), |e| (e.line, e.column));
+    format!("{}:{line}:{column}: case '{}'", origin.display(), case.name)
 }
 
 /// A case's run at one seed, its methods filtered; input errors point at the case's line in
@@ -68,8 +91,7 @@ pub(crate) fn case_spec(
     seed: u64,
     out: &Path,
 ) -> Result<(RunSpec, Overrides)> {
-    let (line, column) = case.entry.as_ref().map_or((1, 1), |e| (e.line, e.column));
-    let at = format!("{}:{line}:{column}: case '{}'", origin.display(), case.name);
+    let at = case_at(origin, case);
     let overrides = Overrides {
         frames: case.frames,
         resolution: case.resolution,
@@ -121,8 +143,15 @@ fn play(p: &Prepared, opts: &SuiteOptions) -> Result<BTreeMap<String, CaseRuns>>
     play_cases(&p.suite.origin, &p.suite.cases, &p.folder, &opts.cache_dir, opts.progress, &label)
 }
 
+/// One case at one seed, checked: a scenario to play, or frames on disk already measured.
+enum Planned {
+    Play(Box<RunSpec>, Overrides),
+    Measured(MeasureOptions, Box<Measured>),
+}
+
 /// Plays `cases` (read from `origin`) at each of their seeds into `FOLDER/CASE/seed_N`; every
-/// case's input is checked before the first one plays. `label` names the runs in the log.
+/// case's input is checked (frames on disk read and measured) before the first one plays or
+/// any run folder is written. `label` names the runs in the log.
 pub(crate) fn play_cases(
     origin: &Path,
     cases: &[Case],
@@ -131,36 +160,63 @@ pub(crate) fn play_cases(
     progress: bool,
     label: &str,
 ) -> Result<BTreeMap<String, CaseRuns>> {
-    let mut specs = Vec::new();
+    let mut planned = Vec::new();
     for case in cases {
         for &seed in &case.seeds {
             let out = folder.join(&case.name).join(format!("seed_{seed}"));
-            let (spec, overrides) = case_spec(origin, case, seed, &out)?;
-            specs.push((case, seed, spec, overrides));
+            let plan = if let Some(frames) = &case.measure {
+                let opts = frames.options(seed, &out);
+                let measured = Measured::read(&opts)
+                    .map_err(|e| anyhow!("{} seed {seed}: {e:#}", case_at(origin, case)))?;
+                Planned::Measured(opts, Box::new(measured))
+            } else {
+                let (spec, overrides) = case_spec(origin, case, seed, &out)?;
+                Planned::Play(Box::new(spec), overrides)
+            };
+            planned.push((case, seed, plan));
         }
     }
     let mut played: BTreeMap<String, CaseRuns> = BTreeMap::new();
-    for (case, seed, spec, overrides) in specs {
+    for (case, seed, plan) in planned {
         eprintln!("{label}: case {} seed {seed}", case.name);
-        let run_opts = RunOptions {
-            scenario: case.scenario.clone(),
-            overrides,
-            cache_dir: cache_dir.clone(),
-            progress,
-        };
-        // A signal keeps its type, so that the command exits as an interrupted run does.
-        let summary = run_spec(&spec, &run_opts).map_err(|e| {
-            if e.is::<systems::interrupt::Interrupted>() {
-                e
-            } else {
-                anyhow!("case '{}' seed {seed}: {e:#}", case.name)
-            }
-        })?;
         let runs = played.entry(case.name.clone()).or_default();
-        runs.frames = spec.scenario.frames;
-        runs.events = event_frames(&spec);
-        let mut seed_run = SeedRun::from_records(seed, &summary.records);
-        seed_run.folder = Some(summary.folder.clone());
+        let seed_run = match plan {
+            Planned::Play(spec, overrides) => {
+                let run_opts = RunOptions {
+                    scenario: case.scenario.clone(),
+                    overrides,
+                    cache_dir: cache_dir.clone(),
+                    progress,
+                };
+                // A signal keeps its type, so that the command exits as an interrupted run does.
+                let summary = run_spec(&spec, &run_opts).map_err(|e| {
+                    if e.is::<systems::interrupt::Interrupted>() {
+                        e
+                    } else {
+                        anyhow!("case '{}' seed {seed}: {e:#}", case.name)
+                    }
+                })?;
+                runs.frames = spec.scenario.frames;
+                runs.events = event_frames(&spec);
+                let mut seed_run = SeedRun::from_records(seed, &summary.records);
+                seed_run.folder = Some(summary.folder.clone());
+                seed_run
+            }
+            Planned::Measured(opts, measured) => {
+                measured
+                    .write(&opts)
+                    .map_err(|e| anyhow!("case '{}' seed {seed}: {e:#}", case.name))?;
+                runs.frames = measured.frames();
+                let mut events: Vec<u32> =
+                    opts.events.iter().map(|e| e - measured.first_frame()).collect();
+                events.sort_unstable();
+                events.dedup();
+                runs.events = events;
+                let mut seed_run = SeedRun::from_records(seed, measured.records());
+                seed_run.folder = Some(opts.out.clone());
+                seed_run
+            }
+        };
         runs.seeds.push(seed_run);
     }
     Ok(played)

@@ -8,17 +8,23 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use sim::scenario::{MethodEntry, ScenarioError};
 
+use super::measured::MeasuredFrames;
 use super::metric::Metric;
 use super::window::Window;
 use crate::ron_file::{self, RonFile};
 
-/// One scenario played once per seed.
+/// One scenario played once per seed, or frames on disk measured (`measure`, suites only).
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Case {
     pub name: String,
     /// Relative paths are resolved against the suite file's folder.
+    #[serde(default)]
     pub scenario: PathBuf,
+    /// Frames from another renderer instead of a scenario; without `seeds`, one run (seed 0).
+    #[serde(default)]
+    pub measure: Option<MeasuredFrames>,
+    #[serde(default)]
     pub seeds: Vec<u64>,
     #[serde(default)]
     pub frames: Option<u32>,
@@ -116,15 +122,20 @@ pub struct Suite {
 }
 
 /// The `cases` of a suite or sweep file: each parsed at its place in the file, seeds checked,
-/// names distinct, scenario paths resolved against the file's folder.
+/// names distinct, scenario paths resolved against the file's folder. Cases over frames on disk
+/// (`measure`) only where `measured` (suites: a sweep varies what is rendered).
 pub(crate) fn parse_cases(
     file: RonFile,
     raw: &[Box<ron::value::RawValue>],
+    measured: bool,
 ) -> Result<Vec<Case>, ScenarioError> {
     let folder = file.origin.parent().unwrap_or(Path::new(""));
     let mut cases: Vec<Case> = Vec::new();
     for entry in file.entries("cases", raw) {
         let mut case: Case = file.entry(&entry)?;
+        if let Some(problem) = measured_case(&mut case, measured, folder) {
+            return Err(file.error_at(&entry, format!("case '{}': {problem}", case.name)));
+        }
         if case.seeds.is_empty() {
             return Err(file.error_at(
                 &entry,
@@ -147,7 +158,7 @@ pub(crate) fn parse_cases(
                 ),
             ));
         }
-        if case.scenario.is_relative() {
+        if case.measure.is_none() && case.scenario.is_relative() {
             case.scenario = folder.join(&case.scenario);
         }
         case.entry = Some(entry);
@@ -159,6 +170,48 @@ pub(crate) fn parse_cases(
     Ok(cases)
 }
 
+/// Checks a case's choice between a scenario and frames on disk; a measured case gets seed 0
+/// when it has no seeds and its folders resolved against `folder`.
+fn measured_case(case: &mut Case, allowed: bool, folder: &Path) -> Option<String> {
+    let scenario = !case.scenario.as_os_str().is_empty();
+    let Some(m) = &mut case.measure else {
+        return (!scenario).then(|| {
+            let frames =
+                if allowed { " or measure: (reference: DIR, tests: {NAME: DIR})" } else { "" };
+            format!("no scenario; expected scenario: \"scenarios/NAME.ron\"{frames}")
+        });
+    };
+    if !allowed {
+        return Some(
+            "measure: frames on disk are a suite's; expected scenario: \"scenarios/NAME.ron\""
+                .into(),
+        );
+    }
+    if scenario {
+        return Some("names a scenario and measure; expected one of them".into());
+    }
+    let rendering = [
+        ("frames", case.frames.is_some()),
+        ("resolution", case.resolution.is_some()),
+        ("spp", case.spp.is_some()),
+        ("methods", case.methods.is_some()),
+    ];
+    if let Some((field, _)) = rendering.iter().find(|f| f.1) {
+        return Some(format!(
+            "{field} sets how a scenario is played; a measured case's frames are its folders' (leave {field} out)"
+        ));
+    }
+    let seeded = !case.seeds.is_empty();
+    if let Some(problem) = m.problem(seeded) {
+        return Some(problem);
+    }
+    m.resolve(folder);
+    if !seeded {
+        case.seeds = vec![0];
+    }
+    None
+}
+
 impl Suite {
     pub fn load(path: &Path) -> Result<Suite, ScenarioError> {
         Self::from_ron(&ron_file::read(path, "suite file")?, path)
@@ -167,7 +220,7 @@ impl Suite {
     pub fn from_ron(text: &str, origin: &Path) -> Result<Suite, ScenarioError> {
         let file = RonFile { text, origin };
         let parsed: SuiteFile = file.parse()?;
-        let cases = parse_cases(file, &parsed.cases)?;
+        let cases = parse_cases(file, &parsed.cases, true)?;
         let names: BTreeSet<&str> = cases.iter().map(|c| c.name.as_str()).collect();
         let mut gates = Vec::new();
         for entry in file.entries("gates", &parsed.gates) {

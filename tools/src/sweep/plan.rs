@@ -77,6 +77,7 @@ impl Job {
         Case {
             name: self.case.clone(),
             scenario: self.scenario.clone(),
+            measure: None,
             seeds: vec![self.seed],
             frames: self.frames,
             resolution: self.resolution,

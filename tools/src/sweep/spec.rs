@@ -111,7 +111,7 @@ impl Sweep {
                 e
             }
         };
-        let cases = crate::suite::spec::parse_cases(file, &parsed.cases)?;
+        let cases = crate::suite::spec::parse_cases(file, &parsed.cases, false)?;
         let points = match (&parsed.grid, &parsed.list) {
             (Some(_), Some(_)) => {
                 let (line, col) = sim::scenario::line_col(text, text.find("list").unwrap_or(0));
