@@ -1,7 +1,6 @@
 //! Atomic writes of run outputs: every file appears whole or not at all
 //! ([`write_atomic`]: a temporary file beside the target, renamed into place).
 
-use std::io::Write;
 use std::path::Path;
 
 use anyhow::{Context, Result};
