@@ -30,7 +30,8 @@ pub use resources::{
     FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Progress, References, Run, RunOutput,
 };
 pub use stage::{
-    Stage, catch_failures, describe, failed, listing, method_failed, new_schedule, take_failure,
+    GpuFaults, Stage, catch_failures, describe, failed, listing, method_failed, new_schedule,
+    take_failure,
 };
 
 fn started(clock: Res<FrameClock>) -> bool {

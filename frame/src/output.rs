@@ -1,44 +1,15 @@
-//! Atomic writes of run outputs: every file appears whole or not at all.
-//!
-//! Each writer writes `NAME.tmp` beside the target and renames it into place, so an interrupted
-//! run never leaves a truncated image, CSV or manifest behind.
+//! Atomic writes of run outputs: every file appears whole or not at all
+//! ([`write_atomic`]: a temporary file beside the target, renamed into place).
 
-use std::fs;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::{Context, Result};
 use image::ImageEncoder;
 
 use crate::tonemap;
 
-/// Writes `bytes` to `path` through a temporary file and a rename.
-pub fn write_atomic(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {
-    if let Some(dir) = path.parent() {
-        fs::create_dir_all(dir).with_context(|| format!("creating folder {}", dir.display()))?;
-    }
-    let tmp = tmp_path(path);
-    let result = (|| {
-        let file = fs::File::create(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
-        let mut out = BufWriter::new(file);
-        write(&mut out)?;
-        out.flush()?;
-        out.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        fs::rename(&tmp, path)
-            .with_context(|| format!("renaming {} to {}", tmp.display(), path.display()))
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result
-}
-
-fn tmp_path(path: &Path) -> PathBuf {
-    // Per process: sweep jobs running side by side may store the same reference-cache entry.
-    let mut name = path.file_name().unwrap_or_default().to_os_string();
-    name.push(format!(".tmp{}", std::process::id()));
-    path.with_file_name(name)
-}
+/// The workspace's one atomic writer (it lives in `metrics`, below `frame` and `report`).
+pub use metrics::atomic::write_atomic;
 
 pub fn write_text(path: &Path, text: &str) -> Result<()> {
     write_atomic(path, |w| Ok(w.write_all(text.as_bytes())?))

@@ -8,6 +8,8 @@ use bevy_ecs::error::{BevyError, ErrorContext, FallbackErrorHandler};
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 
+use crate::resources::{FrameClock, Run};
+
 /// The stages of one frame, in execution order.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Stage {
@@ -67,7 +69,8 @@ pub fn new_schedule() -> Schedule {
         )
             .chain(),
     );
-    // Each stage checks on its own, so a failure stops the stages after it.
+    // Each stage checks on its own, so a failure (or a GPU fault of the stages before it)
+    // stops the stages after it: a frame with a fault is neither measured nor recorded.
     for stage in Stage::ALL {
         schedule.configure_sets(stage.run_if(no_failure));
     }
@@ -89,9 +92,28 @@ fn record_failure(error: BevyError, context: ErrorContext) {
     });
 }
 
-fn no_failure() -> bool {
+fn no_failure(
+    faults: Option<Res<GpuFaults>>,
+    run: Option<Res<Run>>,
+    clock: Option<Res<FrameClock>>,
+) -> bool {
+    if let Some(fault) = faults.and_then(|f| f.0.take()) {
+        let frame = clock.map_or(String::from("frame"), |c| match c.recorded {
+            true => format!("frame {}", c.frame),
+            false => format!("warm-up frame {}", c.global),
+        });
+        let size = run.map_or(String::new(), |r| format!(" at {}x{}", r.width, r.height));
+        FAILURE.with(|f| {
+            f.borrow_mut().get_or_insert(format!("{frame}{size}: {fault}"));
+        });
+    }
     FAILURE.with(|f| f.borrow().is_none())
 }
+
+/// The device's faults (out of memory, validation) during a frame: the next stage does not run,
+/// and the frame fails with the fault (render::gpu_fault).
+#[derive(Resource)]
+pub struct GpuFaults(pub render::gpu_fault::FaultSink);
 
 /// Makes failed systems stop the frame (later stages are skipped) instead of panicking; the
 /// error is then [`take_failure`]'s.

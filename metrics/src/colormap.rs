@@ -51,7 +51,8 @@ pub fn write_map_png(
     assert_eq!(map.len(), width as usize * height as usize, "map size must be width * height");
     let buf = ::image::RgbImage::from_raw(width, height, magma_bytes(map, 1.0))
         .expect("buffer size matches");
-    buf.save(path).with_context(|| format!("cannot write error map {}", path.display()))
+    crate::image::write_encoded(&buf, path)
+        .with_context(|| format!("cannot write error map {}", path.display()))
 }
 
 #[cfg(test)]

@@ -109,7 +109,15 @@ pub fn write_png_srgb(image: &Image, path: impl AsRef<Path>) -> anyhow::Result<(
         .collect();
     let buf =
         ::image::RgbImage::from_raw(image.width, image.height, bytes).expect("buffer size matches");
-    buf.save(path).with_context(|| format!("cannot write PNG {}", path.display()))
+    write_encoded(&buf, path).with_context(|| format!("cannot write PNG {}", path.display()))
+}
+
+/// An 8-bit image, in the format of `path`'s extension, through [`crate::atomic`].
+pub(crate) fn write_encoded(buf: &::image::RgbImage, path: &Path) -> anyhow::Result<()> {
+    let format = ::image::ImageFormat::from_path(path)?;
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    buf.write_to(&mut bytes, format)?;
+    crate::atomic::write_bytes(path, bytes.into_inner())
 }
 
 /// Writes linear RGB as a 32-bit float EXR: scan lines, ZIP compression, the most widely
@@ -127,9 +135,12 @@ pub fn write_exr(image: &Image, path: impl AsRef<Path>) -> anyhow::Result<()> {
         blocks: Blocks::ScanLines,
         line_order: LineOrder::Increasing,
     };
+    let mut bytes = std::io::Cursor::new(Vec::new());
     exr::image::Image::from_encoded_channels((w, image.height as usize), encoding, channels)
         .write()
-        .to_file(path)
+        .to_buffered(&mut bytes)
+        .with_context(|| format!("encoding EXR {}", path.display()))?;
+    crate::atomic::write_bytes(path, bytes.into_inner())
         .with_context(|| format!("cannot write EXR {}", path.display()))
 }
 

@@ -8,6 +8,7 @@
 //! - [`compare`]: the `compare REFERENCE TEST` command.
 //! - [`reference_flip`]: NVIDIA's FLIP as a subprocess; [`synthetic`]: test images.
 
+pub mod atomic;
 pub mod colormap;
 pub mod compare;
 pub mod cvvdp;

@@ -17,6 +17,9 @@ pub enum GpuError {
     Device { adapter: String, reason: String },
     #[error("{what} is {requested}, over this adapter's limit of {limit} ({adapter})")]
     OverLimit { what: String, requested: u64, limit: u64, adapter: String },
+    /// An out-of-memory or validation error of the device (crate::gpu_fault).
+    #[error("{pass} at {size}: {message}")]
+    Fault { pass: String, size: String, message: String },
 }
 
 /// Loop iterations one shader invocation may run in total on Mesa's llvmpipe (lavapipe):
@@ -53,10 +56,20 @@ pub struct Gpu {
 impl Gpu {
     /// Opens the default adapter (set `WGPU_ADAPTER_NAME` or `WGPU_BACKEND` to choose another).
     pub fn new() -> Result<Self, GpuError> {
-        pollster::block_on(Self::new_async())
+        pollster::block_on(Self::new_async(|adapter| adapter.clone()))
     }
 
-    async fn new_async() -> Result<Self, GpuError> {
+    /// As [`Gpu::new`] with a device that grants `limits(adapter's)` (lower limits make a
+    /// device that cannot hold what a scene needs: the fault tests).
+    pub fn with_device_limits(
+        limits: impl FnOnce(&wgpu::Limits) -> wgpu::Limits,
+    ) -> Result<Self, GpuError> {
+        pollster::block_on(Self::new_async(limits))
+    }
+
+    async fn new_async(
+        device_limits: impl FnOnce(&wgpu::Limits) -> wgpu::Limits,
+    ) -> Result<Self, GpuError> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = match wgpu::util::initialize_adapter_from_env(&instance, None).await {
@@ -83,7 +96,7 @@ impl Gpu {
         let wanted =
             wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let features = adapter.features() & wanted;
-        let limits = adapter.limits();
+        let limits = device_limits(&adapter.limits());
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("flicker"),

@@ -8,6 +8,7 @@ pub mod error;
 pub mod frame;
 pub mod frame_bindings;
 pub mod gpu;
+pub mod gpu_fault;
 pub mod gpu_struct;
 pub mod lights;
 pub mod materials;

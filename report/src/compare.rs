@@ -114,6 +114,6 @@ pub fn write_comparison(run_a: &Path, run_b: &Path, out: &Path) -> anyhow::Resul
         h.push_str(&viewer::script());
     }
     h.push_str("</body></html>\n");
-    crate::atomic::write(out, h)?;
+    metrics::atomic::write_bytes(out, h)?;
     Ok(out.to_path_buf())
 }

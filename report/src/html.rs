@@ -176,6 +176,6 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
     }
     h.push_str("</body></html>\n");
     let path = run_dir.join("report.html");
-    crate::atomic::write(&path, h)?;
+    metrics::atomic::write_bytes(&path, h)?;
     Ok(path)
 }

@@ -170,7 +170,7 @@ pub fn write_frame_images(
             let path = charts.join(format!("crops_{}_{frame:04}.png", region.name));
             let mut png = std::io::Cursor::new(Vec::new());
             tile(&[top, bottom]).write_to(&mut png, image::ImageFormat::Png)?;
-            crate::atomic::write(&path, png.into_inner())?;
+            metrics::atomic::write_bytes(&path, png.into_inner())?;
             crops.push((region.name.clone(), path));
         }
         out.push(FrameImages { frame, reference: ref_shown, methods: entries, crops });

@@ -3,7 +3,6 @@
 //! Reads what the playback wrote (`manifest.json`, `frames.csv`, `frames/<method>/NNNN.{exr,png}`,
 //! `reference/NNNN.{exr,png}`) and writes `summary.json`, `charts/*.{svg,png}` and `report.html`.
 
-pub mod atomic;
 pub mod charts;
 pub mod compare;
 pub mod data_uri;

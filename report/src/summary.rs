@@ -191,7 +191,7 @@ pub fn write_summary_with_window(run_dir: &Path, n: u32) -> anyhow::Result<()> {
     let mut summary = summarize(&manifest, &frames, n);
     add_jod(&mut summary, run_dir, &manifest)?;
     let path = run_dir.join("summary.json");
-    crate::atomic::write(&path, serde_json::to_string_pretty(&summary)?)
+    metrics::atomic::write_bytes(&path, serde_json::to_string_pretty(&summary)?)
 }
 
 #[cfg(test)]

@@ -97,8 +97,12 @@ impl FrameWorld {
         let settings =
             PathTracerSettings { width, height, max_depth: scenario.max_depth, rr_start_depth: 3 };
         let mut ledger = render::memory::DeviceLedger::start(&gpu);
+        // The device's faults become errors naming the step and the size (not wgpu's panic).
+        let faults = gpu.catch_faults();
+        let size = format!("{width}x{height}");
         let gpu_scene = SceneGpu::new(&gpu, sim.scene(), settings)
             .with_context(|| format!("{origin}: uploading the scene"))?;
+        faults.check("uploading the scene", &size).with_context(|| origin.clone())?;
         let wants_references =
             (0..scenario.frames).any(|f| scenario.reference.wants(f, scenario.frames));
         let reference_renderer = wants_references
@@ -111,6 +115,7 @@ impl FrameWorld {
             })
             .transpose()
             .with_context(|| format!("{origin}: preparing the reference renderer"))?;
+        faults.check("preparing the reference renderer", &size).with_context(|| origin.clone())?;
 
         let mut world = sim.into_world();
         world.insert_resource(GpuDevice(gpu));
@@ -138,6 +143,7 @@ impl FrameWorld {
             let gpu = &world.resource::<GpuDevice>().0;
             let medium = frame::scene_medium::SceneMedium::new(gpu, &scenario.media);
             world.insert_resource(medium);
+            faults.check("uploading the media", &size).with_context(|| origin.clone())?;
         }
         frame::catch_failures(&mut world);
         let mut memory = RunMemory {
@@ -150,12 +156,12 @@ impl FrameWorld {
             let entity = world
                 .spawn((MethodInfo { index, label: label.clone() }, MethodFrame::default()))
                 .id();
-            method.spec.spawn(&mut world, entity).with_context(|| {
-                format!(
-                    "{origin}:{}:{}: preparing method {label}",
-                    method.entry.line, method.entry.column
-                )
-            })?;
+            let at = || format!("{origin}:{}:{}", method.entry.line, method.entry.column);
+            method
+                .spec
+                .spawn(&mut world, entity)
+                .with_context(|| format!("{}: preparing method {label}", at()))?;
+            faults.check(&format!("preparing method {label}"), &size).with_context(at)?;
             let taken = ledger.take_buffers(&world.resource::<GpuDevice>().0);
             let (device_bytes, buffers) = taken.map_or((None, Vec::new()), |(d, b)| (Some(d), b));
             memory.methods.push(MethodMemory { label, device_bytes, buffers });
@@ -163,6 +169,7 @@ impl FrameWorld {
         // The ledger's last count is the world as built: no second allocator report.
         memory.device_bytes_built = ledger.total();
         world.insert_resource(memory);
+        world.insert_resource(frame::GpuFaults(faults));
         let schedule = crate::methods::schedule_for(&spec.methods);
         Ok(FrameWorld { world, schedule })
     }
@@ -182,9 +189,16 @@ impl FrameWorld {
             "warm-up".into()
         });
         self.schedule.run(&mut self.world);
-        match frame::take_failure() {
-            Some(e) => Err(anyhow!("{e}")),
-            None => Ok(()),
+        // A fault of the last stage: the stages' own checks catch the earlier ones.
+        let fault = self.world.resource::<frame::GpuFaults>().0.take();
+        match (frame::take_failure(), fault) {
+            (Some(e), _) => Err(anyhow!("{e}")),
+            (None, Some(fault)) => {
+                let run = self.world.resource::<Run>();
+                let frame = step.saturating_sub(warmup);
+                Err(anyhow!("frame {frame} at {}x{}: {fault}", run.width, run.height))
+            }
+            (None, None) => Ok(()),
         }
     }
 }
@@ -197,7 +211,11 @@ pub fn run(opts: &RunOptions) -> Result<RunSummary> {
 /// [`run`] of a scenario already loaded, with `opts.overrides` applied (a suite keeps only some
 /// of its methods first); `opts.scenario` names the file in the manifest.
 pub fn run_spec(spec: &RunSpec, opts: &RunOptions) -> Result<RunSummary> {
-    let gpu = Gpu::new()?;
+    run_spec_on(spec, opts, Gpu::new()?)
+}
+
+/// [`run_spec`] on the caller's device (the fault tests': one with lower limits).
+pub fn run_spec_on(spec: &RunSpec, opts: &RunOptions, gpu: Gpu) -> Result<RunSummary> {
     let manifest = crate::manifest::build(spec, &opts.scenario, &gpu, &opts.overrides)?;
     play(spec, gpu, manifest, opts.cache_dir.clone(), opts.progress, None)
 }

@@ -406,9 +406,9 @@ pub fn write_charts(
     {
         let (svg, map) = plot::to_svg(&chart)?;
         let svg_path = dir.join(format!("{stem}.svg"));
-        crate::atomic::write(&svg_path, &svg)?;
+        metrics::atomic::write_bytes(&svg_path, &svg)?;
         let png_path = dir.join(format!("{stem}.png"));
-        crate::atomic::write(&png_path, plot::to_png(&chart)?)?;
+        metrics::atomic::write_bytes(&png_path, plot::to_png(&chart)?)?;
         let frame_axis = (chart.kind == Kind::Lines && chart.x_label == "frame").then_some(map);
         out.push(WrittenChart { stem, title: chart.title, svg, frame_axis });
     }

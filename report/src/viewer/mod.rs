@@ -175,7 +175,7 @@ pub fn build(
         for (f, js) in chunks.iter().enumerate() {
             if let Some(js) = js {
                 let p = dir.join(format!("{f:04}.js"));
-                crate::atomic::write(&p, js)?;
+                metrics::atomic::write_bytes(&p, js)?;
             }
         }
     }
