@@ -18,6 +18,7 @@ pub mod gpu;
 pub mod image;
 pub mod jackknife;
 pub mod jackknife_function;
+pub mod jackknife_table;
 pub mod majorant_tracking;
 pub mod medium;
 pub mod mesh_inside;

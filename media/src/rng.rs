@@ -22,6 +22,13 @@ impl Pcg {
     }
 }
 
+/// A standard normal sample in f64 (Box–Muller on two PCG uniforms).
+pub fn normal_f64(rng: &mut Pcg) -> f64 {
+    let u1 = 1.0 - f64::from(rng.next_f32()); // (0, 1]
+    let u2 = f64::from(rng.next_f32());
+    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+}
+
 /// The stream of one estimate of an image: (seed, frame, pixel, sample) spread by odd
 /// multipliers (golden ratio and MurmurHash3's constants); the first PCG step mixes them.
 pub fn image_seed(seed: u32, frame: u32, pixel: u32, sample: u32) -> u32 {

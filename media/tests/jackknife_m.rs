@@ -1,13 +1,8 @@
 //! Eq. 3 and Eq. 6 for any m ≥ 2 (media::jackknife_function) and Table 1's analogue on normal
 //! inputs. Margins are standard errors of the same run (4.5 of them), not tuned constants.
 //!
-//! Table 1 (the paper: transmittance along Fig. 4a's profile, mN = 24 samples per estimate,
-//! 10^8 trials) needs σ(N), the standard deviation of one optical-depth estimate of N stratified
-//! samples, which the paper does not list. Two of its numbers fix it: the m = 2 row's std
-//! (V(K) = (e^{σ²} − 1) T²/2, Sec. 3.3) gives σ(12), the m = 1 row's bias (T (e^{σ²/2} − 1),
-//! Appendix A.1) gives σ(24), and σ(N) = σ(12) (12/N)^α between and beyond them (α from the
-//! two). T = 0.13411 is the m = 2 row's mean (its bias is 0.00000). Every other entry of the
-//! table is then predicted and printed beside the paper's; asserted is what normal inputs
+//! Table 1's model of σ(N) is media::jackknife_table's. Every entry of the table but the two
+//! that fix σ(N) is predicted and printed beside the paper's; asserted is what normal inputs
 //! guarantee (Eq. 3 unbiased for every m ≥ 2; the naive m = 1 estimate's bias and std in
 //! closed form) and the table's conclusion as far as normal inputs carry it (see the test).
 
@@ -17,41 +12,19 @@ use common::{Moments, normal};
 use media::Pcg;
 use media::jackknife::jackknife_estimates;
 use media::jackknife_function::{jackknife_function, jackknife_transmittance_m, mean_and_variance};
+use media::jackknife_table::{T, TABLE_1, sigma_of, trial};
 
 const Z: f64 = 4.5;
 const TRIALS: usize = 1_000_000;
 
-/// Table 1: (m, N, mean, bias, std).
-const TABLE_1: [(usize, u32, f64, f64, f64); 6] = [
-    (2, 12, 0.13411, 0.00000, 0.0405),
-    (3, 8, 0.13425, 0.00014, 0.0440),
-    (4, 6, 0.13421, 0.00010, 0.0528),
-    (6, 4, 0.13433, 0.00022, 0.0490),
-    (8, 3, 0.13485, 0.00074, 0.0694),
-    (1, 24, 0.13797, 0.00386, 0.0331),
-];
-const T: f64 = 0.13411;
-
-/// σ(N) of the model above.
-fn sigma_of(n: u32) -> f64 {
-    let s12 = (1.0 + 2.0 * (0.0405 / T).powi(2)).ln().sqrt();
-    let s24 = (2.0 * (1.0 + 0.00386 / T).ln()).sqrt();
-    let alpha = (s12 / s24).log2();
-    s12 * (12.0 / f64::from(n)).powf(alpha)
-}
-
 /// (estimate, its Moments) of `TRIALS` estimates from m normal optical depths N(τ, σ(N)²);
 /// m = 1: the naive exp(−X).
 fn row(m: usize, n: u32, seed: u32) -> Moments {
-    let (tau, sigma) = (-T.ln(), sigma_of(n));
     let mut rng = Pcg::new(seed);
     let mut k = Moments::default();
-    let mut x = vec![0.0; m];
+    let mut x = [0.0; 8];
     for _ in 0..TRIALS {
-        for v in x.iter_mut() {
-            *v = tau + sigma * normal(&mut rng);
-        }
-        k.add(if m == 1 { (-x[0]).exp() } else { jackknife_transmittance_m(&x) });
+        k.add(trial(m, n, &mut rng, &mut x));
     }
     k
 }

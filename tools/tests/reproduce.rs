@@ -191,3 +191,29 @@ fn values_and_ratios_are_judged_by_their_interval_against_the_band() {
     let reason = Comparison::NotComparable { methods: vec![], reason: "needs ms".into() };
     assert_eq!(judge(&reason, &v()).verdict, Verdict::NotComparable("needs ms".into()));
 }
+
+/// A computed case (a paper's closed form or CPU Monte Carlo) is checked like a played one:
+/// bad parameters, a scenario beside the computation, a method it does not compute and a
+/// statistic it does not give are errors at the file's line.
+#[test]
+fn computed_cases_are_checked_at_file_and_line() {
+    let table = "(name: \"t\", computation: JackknifeTable1(trials: 1000), seeds: [1, 2])";
+    let on = |metric: &str, a: &str, b: &str| {
+        format!(
+            "(id: \"c\", claim: \"c\", source: \"Table 1\", paper: \"p\", case: \"t\", statistic: (metric: {metric}, window: Overall), comparison: Below(method: \"{a}\", than: \"{b}\"), tolerance_from: \"seeds\")"
+        )
+    };
+    let e = load_with(&table.replace("1000", "1"), &on("MeanStd", "m2_n12", "m1_n24"));
+    assert!(e.contains("bad.ron:5") && e.contains("trials 1"), "{e}");
+    let both = table.replace("seeds:", "scenario: \"../scenarios/volume_mis.ron\", seeds:");
+    let e = load_with(&both, &on("MeanStd", "m2_n12", "m1_n24"));
+    assert!(e.contains("bad.ron:5") && e.contains("not both"), "{e}");
+    let e = load_with(table, &on("MeanStd", "m2_n13", "m1_n24"));
+    assert!(e.contains("bad.ron:8") && e.contains("unknown method 'm2_n13'"), "{e}");
+    let e = load_with(table, &on("Flip", "m2_n12", "m1_n24"));
+    assert!(e.contains("bad.ron:8") && e.contains("does not record the statistic flip"), "{e}");
+    let fig4 =
+        "(name: \"t\", computation: TerminationFig4(thresholds: [0.1, -1.0]), seeds: [1, 2])";
+    let e = load_with(fig4, &on("Mse", "vb_0.1", "bound_0.1"));
+    assert!(e.contains("bad.ron:5") && e.contains("thresholds -1"), "{e}");
+}

@@ -1,14 +1,10 @@
 //! Shared by the media tests: seeded normal samples, a running mean/variance, complex numbers.
 #![allow(dead_code)]
 
-use media::{Estimator, Pcg};
+use media::Estimator;
 
-/// A standard normal sample (Box–Muller on two PCG uniforms, in f64).
-pub fn normal(rng: &mut Pcg) -> f64 {
-    let u1 = 1.0 - f64::from(rng.next_f32()); // (0, 1]
-    let u2 = f64::from(rng.next_f32());
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-}
+#[allow(unused_imports)]
+pub use media::rng::normal_f64 as normal;
 
 /// Mean, variance and the standard errors of both, from sums of powers.
 #[derive(Default, Clone, Copy, Debug)]

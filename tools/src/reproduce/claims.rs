@@ -17,6 +17,8 @@ use crate::suite::metric::Metric;
 use crate::suite::spec::Case;
 use crate::suite::window::Window;
 
+use super::computation::Computation;
+
 /// How big a reproduction runs: `Smoke` (tiny: about two minutes a paper on 2 cores), `Lab`
 /// (the scenarios as shipped) or `Paper` (the paper's sizes where the file gives them).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -69,13 +71,17 @@ pub struct Size {
     pub params: Vec<(String, Vec<String>, serde_json::Value)>,
 }
 
-/// A scenario the claims play, at each scale.
+/// A scenario the claims play, at each scale, or a computation (a paper's closed form or CPU
+/// Monte Carlo test case); exactly one of the two.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ClaimCase {
     pub name: String,
     /// Relative paths are resolved against the claims file's folder.
-    pub scenario: PathBuf,
+    #[serde(default)]
+    pub scenario: Option<PathBuf>,
+    #[serde(default)]
+    pub computation: Option<Computation>,
     pub seeds: Vec<u64>,
     /// Only these method labels of the scenario; all when absent.
     #[serde(default)]
@@ -225,6 +231,8 @@ pub struct CaseMethods {
     pub kinds: BTreeMap<String, &'static str>,
     /// The scenario has reference frames (FLIP, MSE, PSNR are measured).
     pub references: bool,
+    /// A computed case: the metrics each method records.
+    pub computed: Option<BTreeMap<String, Vec<Metric>>>,
 }
 
 #[derive(Clone, Debug)]
@@ -333,14 +341,41 @@ impl Claims {
                     format!("two cases are named '{}'; expected distinct names", case.name),
                 ));
             }
-            if case.scenario.is_relative() {
-                case.scenario = folder.join(&case.scenario);
-            }
             let at = |m: String| file.error_at(&entry, format!("case '{}': {m}", case.name));
-            if !case.scenario.is_file() {
-                return Err(at(format!("scenario {} does not exist", case.scenario.display())));
+            let scenario_path = match (&mut case.scenario, &case.computation) {
+                (Some(p), None) => {
+                    if p.is_relative() {
+                        *p = folder.join(&*p);
+                    }
+                    p.clone()
+                }
+                (None, Some(c)) => {
+                    c.check().map_err(|e| at(format!("{}: {e}", c.name())))?;
+                    let computed = c.methods();
+                    let kinds = computed.keys().map(|l| (l.clone(), c.name())).collect();
+                    if case.methods.is_some() {
+                        return Err(at("methods: a computed case has no scenario to choose from; expected no methods".into()));
+                    }
+                    let references = false;
+                    methods.insert(
+                        case.name.clone(),
+                        CaseMethods { kinds, references, computed: Some(computed) },
+                    );
+                    case_lines.insert(case.name.clone(), (entry.line, entry.column));
+                    cases.push(case);
+                    continue;
+                }
+                _ => {
+                    return Err(at(
+                        "expected either scenario: \"PATH.ron\" or computation: ... (not both)"
+                            .into(),
+                    ));
+                }
+            };
+            if !scenario_path.is_file() {
+                return Err(at(format!("scenario {} does not exist", scenario_path.display())));
             }
-            let scenario = sim::Scenario::load(&case.scenario).map_err(|e| at(e.to_string()))?;
+            let scenario = sim::Scenario::load(&scenario_path).map_err(|e| at(e.to_string()))?;
             let spec = RunSpec::from_scenario(scenario, &Overrides::default())
                 .map_err(|e| at(format!("{e:#}")))?;
             let mut kinds: BTreeMap<String, &'static str> =
@@ -349,7 +384,7 @@ impl Claims {
                 if let Some(unknown) = keep.iter().find(|k| !kinds.contains_key(*k)) {
                     return Err(at(format!(
                         "no method labelled '{unknown}' in {}; its methods are: {}",
-                        case.scenario.display(),
+                        scenario_path.display(),
                         kinds.keys().cloned().collect::<Vec<_>>().join(", ")
                     )));
                 }
@@ -371,7 +406,7 @@ impl Claims {
             }
             let r = &spec.scenario.reference;
             let references = r.spp > 0 && r.frames != ReferenceFrames::None;
-            methods.insert(case.name.clone(), CaseMethods { kinds, references });
+            methods.insert(case.name.clone(), CaseMethods { kinds, references, computed: None });
             case_lines.insert(case.name.clone(), (entry.line, entry.column));
             cases.push(case);
         }
@@ -423,10 +458,16 @@ impl Claims {
                             case.kinds.keys().cloned().collect::<Vec<_>>().join(", ")
                         )));
                     };
+                    let recorded = |metric: Metric| match &case.computed {
+                        Some(c) => c.get(m).is_some_and(|ms| ms.contains(&metric)),
+                        None => metric.recorded_by(kind, case.references),
+                    };
                     if let Some(s) = &claim.statistic
-                        && !s.metric.recorded_by(kind, case.references)
+                        && !recorded(s.metric)
                     {
-                        let why = if case.references {
+                        let why = if case.computed.is_some() {
+                            " (a computed case)"
+                        } else if case.references {
                             ""
                         } else {
                             " (the scenario has no reference frames)"
@@ -453,6 +494,23 @@ impl Claims {
         })
     }
 
+    /// A case's seeds at `scale`: the file's first `n` seeds, continued upwards past its last
+    /// when `n` (`--seeds`, else the scale's `seeds`) is larger.
+    pub fn seeds_of(&self, c: &ClaimCase, scale: Scale, seeds: Option<usize>) -> Vec<u64> {
+        let size = match scale {
+            Scale::Smoke => &c.smoke,
+            Scale::Lab => &c.lab,
+            Scale::Paper => &c.paper,
+        };
+        let mut s = c.seeds.clone();
+        if let Some(n) = seeds.or(size.seeds) {
+            let last = *s.iter().max().unwrap_or(&0);
+            s.truncate(n);
+            s.extend((1..).map(|i| last + i).take(n.saturating_sub(s.len())));
+        }
+        s
+    }
+
     /// The suite cases the comparable claims need, sized for `scale`, each with `seeds` (the
     /// file's first `n` seeds, continued upwards past its last when `n` is larger).
     pub fn cases_for(&self, scale: Scale, seeds: Option<usize>) -> Vec<Case> {
@@ -465,22 +523,18 @@ impl Claims {
         self.cases
             .iter()
             .filter(|c| needed.contains(&c.name.as_str()))
-            .map(|c| {
+            .filter_map(|c| c.scenario.as_ref().map(|scenario| (c, scenario)))
+            .map(|(c, scenario)| {
                 let size = match scale {
                     Scale::Smoke => &c.smoke,
                     Scale::Lab => &c.lab,
                     Scale::Paper => &c.paper,
                 };
-                let mut s = c.seeds.clone();
-                if let Some(n) = seeds.or(size.seeds) {
-                    let last = *s.iter().max().unwrap_or(&0);
-                    s.truncate(n);
-                    s.extend((1..).map(|i| last + i).take(n.saturating_sub(s.len())));
-                }
+                let s = self.seeds_of(c, scale, seeds);
                 let (line, column) = self.case_lines.get(&c.name).copied().unwrap_or((1, 1));
                 Case {
                     name: c.name.clone(),
-                    scenario: c.scenario.clone(),
+                    scenario: scenario.clone(),
                     measure: None,
                     seeds: s,
                     frames: size.frames,

@@ -3,6 +3,7 @@
 //! comparable, written as reproduce.md and reproduce.html beside the paper's numbers.
 
 pub mod claims;
+pub mod computation;
 pub mod judge;
 pub mod report;
 pub mod run;

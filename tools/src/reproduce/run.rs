@@ -78,7 +78,7 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
     for claims in &all {
         let cases = claims.cases_for(opts.scale, opts.seeds);
         let label = format!("reproduce {}", claims.paper);
-        let runs = play_cases(
+        let mut runs = play_cases(
             &claims.origin,
             &cases,
             &folder.join(&claims.paper),
@@ -86,6 +86,15 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
             opts.progress,
             &label,
         )?;
+        for case in &claims.cases {
+            if let Some(c) = &case.computation {
+                eprintln!("{label}: case {} (computed: {})", case.name, c.name());
+                runs.insert(
+                    case.name.clone(),
+                    c.runs(&claims.seeds_of(case, opts.scale, opts.seeds)),
+                );
+            }
+        }
         let mut judged = Vec::new();
         for c in &claims.claims {
             let j = match (c.case.as_ref().and_then(|n| runs.get(n)), &c.statistic) {

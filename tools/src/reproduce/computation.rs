@@ -1,0 +1,196 @@
+//! Claim cases computed here instead of played as scenarios: the papers' own test cases that
+//! are closed forms or Monte Carlo on the CPU (the jackknife's Table 1 on normal inputs, the
+//! termination paper's sampling trees of Figs. 4 and 5). A computation names its "methods"
+//! (rows of the paper's table) and the metrics each records, and yields one value per method
+//! and metric per seed, as a one-frame run, so claims judge them as they judge scenario runs.
+
+use std::collections::BTreeMap;
+
+use serde::Deserialize;
+
+use crate::suite::measurement::{CaseRuns, SeedRun};
+use crate::suite::metric::Metric;
+
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Computation {
+    /// jackknife-transmittance Table 1 (mN = 24) on normal optical-depth inputs
+    /// (media::jackknife_table's model of σ(N)): methods `m{m}_n{N}` (m = 1: the naive
+    /// exp(−X)), `MeanAbsBias` = |mean − T| and `MeanStd` over `trials` trials per seed.
+    JackknifeTable1 { trials: usize },
+    /// variance-trading-termination Fig. 4: variance bounding on the exact sampling tree
+    /// (depth 8, albedo 0.9, left child 90%): methods `vb_{t}` with `Mse` = the estimator's
+    /// exact variance (exact caches: no bias), and `bound_{t}` with `Mse` = t.
+    TerminationFig4 { thresholds: Vec<f64> },
+    /// variance-trading-termination Fig. 5: MSE minimisation on the biased tree (depth 5, bias
+    /// 0.5 · 0.3^depth): methods `mse_{s}` per target s, `first_vertex` and `path_tracing`, with
+    /// `Mse` = the exact MSE of the average of `samples` estimates against the root's value.
+    TerminationFig5 { samples: f64, targets: Vec<f64> },
+}
+
+type Values = BTreeMap<String, BTreeMap<String, Vec<Option<f64>>>>;
+
+const TREE_ALBEDO: f64 = 0.9;
+
+fn put(out: &mut Values, method: String, metric: Metric, v: f64) {
+    out.entry(method).or_default().insert(metric.name().to_string(), vec![Some(v)]);
+}
+
+impl Computation {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Computation::JackknifeTable1 { .. } => "JackknifeTable1",
+            Computation::TerminationFig4 { .. } => "TerminationFig4",
+            Computation::TerminationFig5 { .. } => "TerminationFig5",
+        }
+    }
+
+    /// Each method label and the metrics it records.
+    pub fn methods(&self) -> BTreeMap<String, Vec<Metric>> {
+        match self {
+            Computation::JackknifeTable1 { .. } => media::jackknife_table::TABLE_1
+                .iter()
+                .map(|&(m, n, ..)| {
+                    (format!("m{m}_n{n}"), vec![Metric::MeanAbsBias, Metric::MeanStd])
+                })
+                .collect(),
+            Computation::TerminationFig4 { thresholds } => thresholds
+                .iter()
+                .flat_map(|t| [format!("vb_{t}"), format!("bound_{t}")])
+                .map(|l| (l, vec![Metric::Mse]))
+                .collect(),
+            Computation::TerminationFig5 { targets, .. } => targets
+                .iter()
+                .map(|s| format!("mse_{s}"))
+                .chain(["first_vertex".to_string(), "path_tracing".to_string()])
+                .map(|l| (l, vec![Metric::Mse]))
+                .collect(),
+        }
+    }
+
+    /// What is wrong with the parameters, if anything.
+    pub fn check(&self) -> Result<(), String> {
+        let positive =
+            |what: &str, v: &[f64]| match v.iter().find(|x| !(x.is_finite() && **x > 0.0)) {
+                Some(x) => Err(format!("{what} {x}; expected finite numbers > 0")),
+                None if v.is_empty() => Err(format!("no {what}; expected at least one")),
+                None => Ok(()),
+            };
+        match self {
+            Computation::JackknifeTable1 { trials } if *trials < 2 => {
+                Err(format!("trials {trials}; expected at least 2"))
+            }
+            Computation::JackknifeTable1 { .. } => Ok(()),
+            Computation::TerminationFig4 { thresholds } => positive("thresholds", thresholds),
+            Computation::TerminationFig5 { samples, targets } => {
+                positive("samples", &[*samples])?;
+                positive("targets", targets)
+            }
+        }
+    }
+
+    /// One seed's values.
+    pub fn compute(&self, seed: u64) -> Values {
+        let mut out = Values::new();
+        match self {
+            Computation::JackknifeTable1 { trials } => {
+                use media::jackknife_table::{T, TABLE_1, trial};
+                for (row, &(m, n, ..)) in TABLE_1.iter().enumerate() {
+                    // A stream per (seed, row): rows and seeds are independent.
+                    let mut rng =
+                        media::Pcg::new(media::rng::image_seed(seed as u32, 0, row as u32, 0));
+                    let mut x = [0.0; 8];
+                    let (mut s1, mut s2) = (0.0f64, 0.0f64);
+                    for _ in 0..*trials {
+                        let k = trial(m, n, &mut rng, &mut x);
+                        s1 += k;
+                        s2 += k * k;
+                    }
+                    let count = *trials as f64;
+                    let mean = s1 / count;
+                    let var = (s2 / count - mean * mean) * count / (count - 1.0);
+                    let label = format!("m{m}_n{n}");
+                    put(&mut out, label.clone(), Metric::MeanAbsBias, (mean - T).abs());
+                    put(&mut out, label, Metric::MeanStd, var.max(0.0).sqrt());
+                }
+            }
+            Computation::TerminationFig4 { thresholds } => {
+                let tree = termination::SamplingTree::exact(8, TREE_ALBEDO);
+                for &t in thresholds {
+                    let rule =
+                        termination::TerminationRule::VarianceBounding { t, relative: false };
+                    put(
+                        &mut out,
+                        format!("vb_{t}"),
+                        Metric::Mse,
+                        tree.estimator(&rule, 1.0).variance(),
+                    );
+                    put(&mut out, format!("bound_{t}"), Metric::Mse, t);
+                }
+            }
+            Computation::TerminationFig5 { samples, targets } => {
+                use termination::TerminationRule;
+                let tree = termination::SamplingTree::biased(5, TREE_ALBEDO, |d| {
+                    0.5 * 0.3f64.powi(d as i32)
+                });
+                let mut rules: Vec<(String, TerminationRule)> = targets
+                    .iter()
+                    .map(|&s| {
+                        let rule = TerminationRule::MseMinimisation {
+                            s,
+                            margin: termination::rule::default_margin(),
+                            bias_clamp: termination::rule::default_bias_clamp(),
+                        };
+                        (format!("mse_{s}"), rule)
+                    })
+                    .collect();
+                rules.push(("first_vertex".into(), TerminationRule::FirstVertex));
+                rules.push(("path_tracing".into(), TerminationRule::PathTracing));
+                for (label, rule) in rules {
+                    let mse = tree.mse(tree.estimator(&rule, 1.0), *samples);
+                    put(&mut out, label, Metric::Mse, mse);
+                }
+            }
+        }
+        out
+    }
+
+    /// Every seed, as a case's runs (one frame, no events).
+    pub fn runs(&self, seeds: &[u64]) -> CaseRuns {
+        let seeds = seeds
+            .iter()
+            .map(|&seed| SeedRun {
+                seed,
+                methods: self.compute(seed),
+                jod: BTreeMap::new(),
+                folder: None,
+            })
+            .collect();
+        CaseRuns { frames: 1, events: Vec::new(), seeds }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Fig. 4's tree: variance bounding meets t below the detach threshold; the values per seed
+    /// are exact (no seed dependence); Table 1's naive row carries its bias, Eq. 3's m = 2 not.
+    #[test]
+    fn computations_give_the_papers_quantities() {
+        let fig4 = Computation::TerminationFig4 { thresholds: vec![0.01, 1000.0] };
+        let v = fig4.compute(1);
+        let mse = |l: &str| v[l]["mse"][0].unwrap();
+        assert!((mse("vb_0.01") - 0.01).abs() <= 1e-9 * 0.01);
+        assert!(mse("vb_1000") < 1000.0);
+        assert_eq!(fig4.compute(2), v);
+        assert_eq!(fig4.methods().len(), 4);
+        let table = Computation::JackknifeTable1 { trials: 20_000 }.compute(3);
+        let bias = |l: &str| table[l]["mean_abs_bias"][0].unwrap();
+        // SE of the m = 2 mean: 0.0405 / sqrt(20000) ≈ 0.00029; the naive bias is 0.00386.
+        assert!(bias("m2_n12") < 5.0 * 0.00029, "{}", bias("m2_n12"));
+        assert!((bias("m1_n24") - 0.00386).abs() < 5.0 * 0.00029, "{}", bias("m1_n24"));
+        assert!(Computation::TerminationFig5 { samples: 10.0, targets: vec![] }.check().is_err());
+        assert!(Computation::JackknifeTable1 { trials: 1 }.check().is_err());
+    }
+}
