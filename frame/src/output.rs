@@ -85,6 +85,7 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<[f32; 4]>)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use metrics::atomic::tmp_path;
 
     #[test]
     fn exr_round_trips_and_leaves_no_temporary() {

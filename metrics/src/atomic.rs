@@ -37,7 +37,8 @@ pub fn write_bytes(path: &Path, bytes: impl AsRef<[u8]>) -> Result<()> {
         .with_context(|| format!("cannot write {}", path.display()))
 }
 
-fn tmp_path(path: &Path) -> PathBuf {
+/// The temporary file a write goes through before its rename.
+pub fn tmp_path(path: &Path) -> PathBuf {
     // Per process: sweep jobs running side by side may store the same reference-cache entry.
     let mut name = path.file_name().unwrap_or_default().to_os_string();
     name.push(format!(".tmp{}", std::process::id()));
