@@ -81,8 +81,8 @@ fn run(dir: &Path) -> Result<Vec<(String, [f64; 4])>> {
             let img = image(&folder.frame(m, f, "exr"))?;
             let (a, b) = (flip_hdr(&truth, &img, DEFAULT_PPD), flip_hdr(&pass, &img, DEFAULT_PPD));
             let v = [a.mean, b.mean, masked(&a.map), masked(&b.map)];
-            for k in 0..4 {
-                acc[k] += v[k] / frames.len() as f64;
+            for (a, v) in acc.iter_mut().zip(v) {
+                *a += v / frames.len() as f64;
             }
         }
     }
