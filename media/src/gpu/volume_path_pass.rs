@@ -389,8 +389,8 @@ impl Accumulator {
     pub(super) fn add(&mut self, samples: &[[f32; 4]], n: usize) {
         for (i, v) in samples.iter().enumerate() {
             let p = i / n;
-            for c in 0..3 {
-                self.sum[p][c] += f64::from(v[c]);
+            for (sum, x) in self.sum[p].iter_mut().zip(v) {
+                *sum += f64::from(*x);
             }
             let l = 0.2126 * f64::from(v[0]) + 0.7152 * f64::from(v[1]) + 0.0722 * f64::from(v[2]);
             self.lum[p].0 += l;
