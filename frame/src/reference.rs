@@ -7,6 +7,7 @@ use super::resources::{FrameClock, GpuDevice, GpuScene, Progress, References, Ru
 use super::stage::failed;
 use crate::frame_metrics as measure;
 use crate::reference_cache::{Lookup, ReferenceCache, ReferenceKey};
+use media::gpu::SubsurfacePathPass;
 use render::frame_bindings::FrameBindings;
 use render::gpu::Gpu;
 use render::path_tracer::PathTracer;
@@ -19,6 +20,9 @@ pub enum ReferenceRenderer {
     /// A scenario with media: the volumetric path tracer (the pass is `SceneMedium`'s, shared
     /// with the VolumePath methods), with the references' frame parameters.
     Volume(FrameBindings),
+    /// `reference: (random_walk: true)`: subsurface materials as media inside their meshes
+    /// (media::gpu::SubsurfacePathPass), with the references' frame parameters.
+    RandomWalk(Box<SubsurfacePathPass>, FrameBindings),
 }
 
 impl ReferenceRenderer {
@@ -28,6 +32,12 @@ impl ReferenceRenderer {
         } else {
             Self::Path(Box::new(PathTracer::new(gpu, scene)?))
         })
+    }
+
+    /// The random-walk reference of subsurface materials (a scenario without media).
+    pub fn random_walk(gpu: &Gpu, scene: &SceneGpu) -> anyhow::Result<Self> {
+        let pass = SubsurfacePathPass::new(gpu, scene).map_err(anyhow::Error::msg)?;
+        Ok(Self::RandomWalk(Box::new(pass), FrameBindings::new(gpu, scene)))
     }
 }
 
@@ -63,6 +73,9 @@ pub fn render_reference(
             media::gpu::VolumePathPass::shader_source(),
             m.cache_key()
         ),
+        None if scenario.reference.random_walk => {
+            format!("random walk\n{}", SubsurfacePathPass::shader_source())
+        }
         None => PathTracer::shader_source().to_string(),
     };
     let key = ReferenceCache::key(
@@ -113,6 +126,18 @@ pub fn render_reference(
                     .map(|(px, _, _)| px)
                     .map_err(|e| fail(&e))?
                 }
+                (Some(ReferenceRenderer::RandomWalk(pass, bindings)), None) => pass
+                    .render(
+                        &gpu.0,
+                        &gpu_scene.0,
+                        bindings,
+                        &scene.scene.materials,
+                        spp,
+                        reference_seed(scenario.seed),
+                        clock.global,
+                    )
+                    .map(|image| image.mean.iter().map(|c| [c[0], c[1], c[2], 1.0]).collect())
+                    .map_err(|e| fail(&e))?,
                 (Some(ReferenceRenderer::Path(tracer)), None) => tracer
                     .render_reference(
                         &gpu.0,

@@ -11,8 +11,10 @@ pub use rng::{SplitMix64, mix64};
 
 pub mod medium;
 pub mod medium_bound;
+pub mod subsurface_medium;
 pub use medium::{DensityKind, MediumDesc, MediumMotion, MediumState, RawGrid};
 pub use medium_bound::{ClosedMesh, MediumBound};
+pub use subsurface_medium::SubsurfaceMedium;
 
 use glam::{Mat4, Vec2, Vec3};
 use serde::{Deserialize, Serialize};

@@ -73,11 +73,16 @@ pub enum ReferenceFrames {
 pub struct ReferenceSpec {
     pub spp: u32,
     pub frames: ReferenceFrames,
+    /// Subsurface materials as homogeneous media inside their meshes, rendered by a random walk
+    /// (media::gpu::SubsurfacePathPass; coefficients by scene::SubsurfaceMedium): the ground
+    /// truth of the screen-space SSS. Off: subsurface materials shade as their diffuse base.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub random_walk: bool,
 }
 
 impl Default for ReferenceSpec {
     fn default() -> Self {
-        Self { spp: 64, frames: ReferenceFrames::None }
+        Self { spp: 64, frames: ReferenceFrames::None, random_walk: false }
     }
 }
 
@@ -521,6 +526,13 @@ impl Scenario {
                     message: format!("two media named '{}'; expected unique names", m.name),
                 });
             }
+        }
+        if file.reference.random_walk && !file.media.is_empty() {
+            return Err(ScenarioError {
+                file: origin.to_path_buf(),
+                position: text.find("random_walk").map(|at| line_col(text, at)),
+                message: "reference: random_walk with media; expected a scenario without media (the random walk renders subsurface materials only)".into(),
+            });
         }
         for m in &file.materials {
             if let Some(sss) = &m.subsurface {

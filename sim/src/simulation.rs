@@ -91,6 +91,27 @@ impl Names<'_> {
     }
 }
 
+/// With the random-walk reference on, every subsurface material must map to a medium
+/// (scene::SubsurfaceMedium: albedo in [0, 1], positive dmfp); the error points at its override
+/// in the scenario, else at `reference`.
+fn check_random_walk_media(world: &World, names: &Names) -> Result<(), SimError> {
+    let table = world.resource::<MaterialTable>();
+    for (m, name) in table.materials.iter().zip(&table.names) {
+        let Some(sss) = m.subsurface else { continue };
+        if let Err(e) = scene::SubsurfaceMedium::from_albedo(m.base_color, sss.dmfp) {
+            let text = &names.scenario.source;
+            return Err(SimError::Invalid {
+                file: names.scenario.origin.clone(),
+                position: find_quoted(text, name).or_else(|| {
+                    text.find("random_walk").map(|at| crate::scenario::line_col(text, at))
+                }),
+                message: format!("material '{name}': random-walk reference: {e}"),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// The scene of the current frame as the renderer sees it, and what changed since the last.
 /// [`extract_scene`] rewrites it (and marks it changed for ECS change detection) only when
 /// something changed.
@@ -202,6 +223,9 @@ impl Simulation {
         for o in &scenario.materials {
             let index = names.material(&world, &o.material)? as usize;
             world.resource_mut::<MaterialTable>().materials[index].subsurface = o.subsurface;
+        }
+        if scenario.reference.random_walk {
+            check_random_walk_media(&world, &names)?;
         }
 
         for (index, spec) in scenario.animations.iter().enumerate() {

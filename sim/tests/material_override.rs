@@ -44,3 +44,26 @@ fn bad_overrides_are_errors_at_file_line() {
     let e = Simulation::new(&scenario).err().expect("unknown material").to_string();
     assert!(e.contains("inline.ron:6:") && e.contains("skn") && e.contains("skin"), "{e}");
 }
+
+#[test]
+fn the_random_walk_reference_is_refused_with_media_and_kept_out_of_other_manifests() {
+    let with = |extra: &str| {
+        format!(
+            "Scenario(\n scene: Builtin(\"sss_sphere\"),\n resolution: (32, 18),\n frames: 2,\n methods: [PathTracing(spp: 1)],\n reference: (spp: 4, frames: Every(1), random_walk: true),\n{extra})"
+        )
+    };
+    let ok = Scenario::from_ron(
+        &with(" materials: [(material: \"skin\", subsurface: (dmfp: (0.3, 0.12, 0.06)))],\n"),
+        Path::new("inline.ron"),
+    )
+    .unwrap();
+    assert!(ok.reference.random_walk);
+    assert!(Simulation::new(&ok).is_ok());
+    let media = " media: [(name: \"fog\", kind: Homogeneous, box_min: (-1.0, 0.0, -1.0), box_max: (1.0, 1.0, 1.0), sigma_t: 1.0)],\n";
+    let e = Scenario::from_ron(&with(media), Path::new("inline.ron")).unwrap_err().to_string();
+    assert!(e.starts_with("inline.ron:6:") && e.contains("random_walk"), "{e}");
+    // Off (the default), the setting is not serialised: other scenarios' manifests unchanged.
+    let plain = load("").unwrap();
+    assert!(!plain.reference.random_walk);
+    assert!(!ron::to_string(&plain.reference).unwrap().contains("random_walk"));
+}

@@ -184,10 +184,14 @@ fn bad_values_are_refused() {
 
 #[test]
 fn method_labels_reference_frames_and_summary() {
-    let every = ReferenceSpec { spp: 16, frames: ReferenceFrames::Every(10) };
+    let every = ReferenceSpec { spp: 16, frames: ReferenceFrames::Every(10), random_walk: false };
     let wanted: Vec<u32> = (0..30).filter(|&f| every.wants(f, 25)).collect();
     assert_eq!(wanted, vec![0, 10, 20]);
-    let list = ReferenceSpec { spp: 16, frames: ReferenceFrames::List(vec![3, 7, 99]) };
+    let list = ReferenceSpec {
+        spp: 16,
+        frames: ReferenceFrames::List(vec![3, 7, 99]),
+        random_walk: false,
+    };
     assert_eq!((0..100).filter(|&f| list.wants(f, 50)).collect::<Vec<_>>(), vec![3, 7]);
     assert!(!(0..10).any(|f| ReferenceSpec::default().wants(f, 10)));
 

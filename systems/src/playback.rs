@@ -106,12 +106,13 @@ impl FrameWorld {
         let wants_references =
             (0..scenario.frames).any(|f| scenario.reference.wants(f, scenario.frames));
         let reference_renderer = wants_references
-            .then(|| {
-                frame::reference::ReferenceRenderer::new(
+            .then(|| match scenario.reference.random_walk && scenario.media.is_empty() {
+                true => frame::reference::ReferenceRenderer::random_walk(&gpu, &gpu_scene),
+                false => frame::reference::ReferenceRenderer::new(
                     &gpu,
                     &gpu_scene,
                     !scenario.media.is_empty(),
-                )
+                ),
             })
             .transpose()
             .with_context(|| format!("{origin}: preparing the reference renderer"))?;

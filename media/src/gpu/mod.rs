@@ -8,6 +8,7 @@ mod image_pass;
 mod medium;
 mod mis_pass;
 mod shaders;
+mod subsurface_path_pass;
 mod trials;
 mod volume_path_pass;
 
@@ -17,6 +18,9 @@ pub use image_pass::{ImageParams, ImagePass, PASS};
 pub use medium::{GpuMedium, MAX_MEDIA, MediumParams, RaySegment};
 pub use mis_pass::{MisParams, MisPass};
 pub use shaders::{modules, modules_at, program};
+pub use subsurface_path_pass::{
+    MAX_EVENTS, SUBSURFACE_PATH_PASS, SubsurfacePathParams, SubsurfacePathPass, coefficient_table,
+};
 pub use volume_path_pass::{
     Combination, Eq9Transmittance, MediumOptics, MisWeight, ShadowTransmittance, VOLUME_PATH_PASS,
     VolumeImage, VolumePathParams, VolumePathPass, VolumePathSettings,

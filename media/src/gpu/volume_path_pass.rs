@@ -320,8 +320,7 @@ impl VolumePathPass {
             mapped_at_creation: false,
         });
         let staging = Staging::new(gpu, "volume path samples", size);
-        let mut sum = vec![[0f64; 3]; pixels as usize];
-        let mut lum = vec![(0f64, 0f64); pixels as usize];
+        let mut image = Accumulator::new(pixels as usize);
         let mut first = 0;
         let mut timings = Vec::new();
         let pipeline = self.pipeline(gpu, scene, medium).map_err(|e| e.to_string())?;
@@ -368,31 +367,59 @@ impl VolumePathPass {
             staging.record(timed.encoder(), &samples, 0);
             merge(&mut timings, timed.submit().map_err(|e| e.to_string())?);
             let raw: Vec<[f32; 4]> = staging.read(gpu).map_err(|e| e.to_string())?;
-            for (i, v) in raw.iter().take((pixels * n) as usize).enumerate() {
-                let p = i / n as usize;
-                for c in 0..3 {
-                    sum[p][c] += f64::from(v[c]);
-                }
-                let l =
-                    0.2126 * f64::from(v[0]) + 0.7152 * f64::from(v[1]) + 0.0722 * f64::from(v[2]);
-                lum[p].0 += l;
-                lum[p].1 += l * l;
-            }
+            image.add(&raw[..(pixels * n) as usize], n as usize);
             first += n;
         }
+        Ok(image.finish(width, height, spp, timings))
+    }
+}
+
+/// Per pixel, sums of the samples' radiance and of their luminance and its square, batch by
+/// batch (samples of pixel p at p·n .. (p + 1)·n of a batch of n per pixel).
+pub(super) struct Accumulator {
+    sum: Vec<[f64; 3]>,
+    lum: Vec<(f64, f64)>,
+}
+
+impl Accumulator {
+    pub(super) fn new(pixels: usize) -> Self {
+        Self { sum: vec![[0f64; 3]; pixels], lum: vec![(0f64, 0f64); pixels] }
+    }
+
+    pub(super) fn add(&mut self, samples: &[[f32; 4]], n: usize) {
+        for (i, v) in samples.iter().enumerate() {
+            let p = i / n;
+            for (sum, x) in self.sum[p].iter_mut().zip(v) {
+                *sum += f64::from(*x);
+            }
+            let l = 0.2126 * f64::from(v[0]) + 0.7152 * f64::from(v[1]) + 0.0722 * f64::from(v[2]);
+            self.lum[p].0 += l;
+            self.lum[p].1 += l * l;
+        }
+    }
+
+    /// The mean and the variance of the mean's luminance over `spp` samples per pixel.
+    pub(super) fn finish(
+        self,
+        width: u32,
+        height: u32,
+        spp: u32,
+        timings: Vec<PassTiming>,
+    ) -> VolumeImage {
         let k = f64::from(spp);
-        let mean = sum.iter().map(|s| s.map(|c| (c / k) as f32)).collect();
-        let var_of_mean = lum
+        let mean = self.sum.iter().map(|s| s.map(|c| (c / k) as f32)).collect();
+        let var_of_mean = self
+            .lum
             .iter()
             .map(|&(s1, s2)| ((s2 / k - (s1 / k).powi(2)) * k / (k - 1.0).max(1.0)).max(0.0) / k)
             .collect();
-        Ok(VolumeImage {
+        VolumeImage {
             width,
             height,
             mean,
             var_of_mean,
             timings,
-            paths: u64::from(pixels) * u64::from(spp),
-        })
+            paths: (width * height) as u64 * u64::from(spp),
+        }
     }
 }
