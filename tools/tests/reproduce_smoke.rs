@@ -105,14 +105,14 @@ fn a_case_whose_run_fails_is_an_error_and_nothing_is_written() {
     std::fs::create_dir_all(&claims_dir).unwrap();
     // The jackknife claims with a smoke size no adapter has: the file loads (sizes are not an
     // input error of the claims file), the run refuses it.
+    // Every case's relative scenario path made absolute (the copy lives elsewhere).
+    let cloud = root().join("suites/scenarios/papers_volume_cloud.ron");
     let text = std::fs::read_to_string(root().join("claims/jackknife-transmittance.ron"))
         .unwrap()
+        .replace("\"../", &format!("\"{}/", root().display()))
         .replace(
-            "\"../suites/scenarios/papers_volume_cloud.ron\"",
-            &format!(
-                "\"{}\", smoke: (resolution: (1000000, 1))",
-                root().join("suites/scenarios/papers_volume_cloud.ron").display()
-            ),
+            &format!("\"{}\"", cloud.display()),
+            &format!("\"{}\", smoke: (resolution: (1000000, 1))", cloud.display()),
         );
     assert!(text.contains("1000000"), "the cloud case is in the file");
     std::fs::write(claims_dir.join("jackknife-transmittance.ron"), text).unwrap();
