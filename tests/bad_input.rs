@@ -147,15 +147,23 @@ fn an_unwritable_out_is_named_and_nothing_is_written() {
 
 #[test]
 fn a_resolution_over_the_buffer_limit_is_refused_with_the_limit() {
-    // 16000x16000 is within lavapipe's 2D texture limit (16384) and its per-pixel buffers
-    // (64 bytes a pixel: 16 GB) over any storage-buffer binding wgpu allows (under 4 GiB).
+    // From the adapter's limits: the widest image its 2D textures hold, and just enough rows
+    // that one RGBA f32 value a pixel (every method's image) is over its storage-buffer limit.
+    let gpu = render::gpu::Gpu::new().expect("a wgpu adapter (lavapipe on CI)");
+    let width = gpu.limits.max_texture_dimension_2d;
+    let limit = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
+    let height = limit / (u64::from(width) * 16) + 1;
+    assert!(height <= u64::from(width), "this adapter's buffers hold any image its textures do");
+    drop(gpu);
     let dir = scratch("buffer");
     let path = dir.join("scenario.ron");
     std::fs::write(&path, format!("Scenario({BASE},\n  methods: [PathTracing(spp: 1)], reference: (spp: 1, frames: List([])))")).unwrap();
-    let err = run_fails(&path, &["--resolution", "16000x16000"]);
+    let err = run_fails(&path, &["--resolution", &format!("{width}x{height}")]);
     assert!(
-        err.contains("scenario.ron:2:13:") && err.contains("limit") && err.contains("buffer"),
-        "{err}"
+        err.contains("scenario.ron:2:13:")
+            && err.contains("buffer")
+            && err.contains(&format!("limit of {limit}")),
+        "{width}x{height}: {err}"
     );
 }
 

@@ -31,13 +31,26 @@ fn plays_every_predictor_and_keeps_each_timed_frame() {
             r.ms_per_frame
         );
     }
+    // The overhead and its interval recomputed from the timed frames, independently of the
+    // bench's code: the mean of paired differences is the difference of the means, and with two
+    // frames the 95% half-width is t(0.975, 1 df) = 12.7062 (a table value) times the standard
+    // error |d1 - d2| / 2.
+    let (ema, blend) = (&t.rows[1], &t.rows[2]);
+    assert_eq!((ema.frame_ms.len(), blend.frame_ms.len()), (2, 2));
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let percent = |ms: f64| 100.0 * ms / mean(&ema.frame_ms);
+    let d: Vec<f64> = blend.frame_ms.iter().zip(&ema.frame_ms).map(|(b, e)| b - e).collect();
+    let (overhead, half) = (mean(&d), 12.7062 * (d[0] - d[1]).abs() / 2.0);
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-4 * b.abs().max(1e-3);
     let (lo, hi) = t.blend_overhead_frame_percent_ci95;
     assert!(
-        lo.is_finite()
-            && hi.is_finite()
-            && lo <= t.blend_overhead_frame_percent
-            && t.blend_overhead_frame_percent <= hi,
-        "{lo} {} {hi}",
-        t.blend_overhead_frame_percent
+        close(t.blend_overhead_frame_percent, percent(overhead))
+            && close(lo, percent(overhead - half))
+            && close(hi, percent(overhead + half)),
+        "bench: {} in [{lo}, {hi}]; from the frames: {} in [{}, {}]",
+        t.blend_overhead_frame_percent,
+        percent(overhead),
+        percent(overhead - half),
+        percent(overhead + half)
     );
 }
