@@ -12,11 +12,10 @@ use render::frame_bindings::FrameBindings;
 use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::pass_library::PassLibrary;
-use render::readback::Staging;
 use render::scene_features::SceneFeatures;
 use render::scene_gpu::SceneGpu;
 use render::shader::{Module, Program};
-use render::timing::{PassTimer, merge};
+use render::timing::PassTimer;
 use scene::{Material, SubsurfaceMedium};
 use wgpu::util::DeviceExt;
 
@@ -48,9 +47,6 @@ pub const SUBSURFACE_PATH_PASS: &str = "subsurface_path";
 /// survives 256 events with probability 0.99²⁵⁶ = 0.08 before it has left, and most of those
 /// have left by then; the GPU test bounds what is lost.
 pub const MAX_EVENTS: u32 = 256;
-
-/// Paths per dispatch (as the volumetric path tracer's).
-const PATHS_PER_DISPATCH: u32 = 1 << 18;
 
 /// The coefficient table of `materials`: each subsurface material's medium, zero elsewhere; or
 /// the first material that has none (its index and why).
@@ -153,31 +149,23 @@ impl SubsurfacePathPass {
             }
             held.1.clone()
         };
-        let (width, height) = {
-            let s = scene.settings();
-            (s.width, s.height)
-        };
-        let pixels = width * height;
-        let batch = (PATHS_PER_DISPATCH / pixels).clamp(1, spp.max(1));
         let device = &gpu.device;
-        let size = u64::from(pixels * batch) * 16;
-        let samples = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("subsurface path samples"),
-            size,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
         let coefficients = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("subsurface coefficients"),
             contents: bytemuck::cast_slice(&table),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let staging = Staging::new(gpu, "subsurface path samples", size);
-        let mut image = super::volume_path_pass::Accumulator::new(pixels as usize);
-        let mut timings = Vec::new();
-        let mut first = 0;
-        while first < spp {
-            let n = batch.min(spp - first);
+        let batched = super::volume_path_pass::Batched {
+            gpu,
+            scene,
+            bindings,
+            timer: &self.timer,
+            pass: SUBSURFACE_PATH_PASS,
+            label: "subsurface path",
+            pipeline: &pipeline,
+            medium: None,
+        };
+        batched.render(spp, seed, frame, |first, n, samples| {
             let params = SubsurfacePathParams {
                 spp: n,
                 first_sample: first,
@@ -189,29 +177,7 @@ impl SubsurfacePathPass {
                 contents: bytemuck::bytes_of(&params),
                 usage: wgpu::BufferUsages::STORAGE,
             });
-            bindings.prepare(gpu, scene, spp, 0, seed, frame);
-            let group = buffer_group(
-                gpu,
-                "subsurface path",
-                &self.layout,
-                &[&params, &coefficients, &samples],
-            );
-            let mut timed = self.timer.begin(gpu, SUBSURFACE_PATH_PASS);
-            timed
-                .pass(0, |pass| {
-                    pass.set_pipeline(&pipeline);
-                    bindings.bind(gpu, scene, pass);
-                    pass.set_bind_group(2, &group, &[]);
-                    let groups = (pixels * n).div_ceil(64);
-                    pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
-                })
-                .map_err(|e| e.to_string())?;
-            staging.record(timed.encoder(), &samples, 0);
-            merge(&mut timings, timed.submit().map_err(|e| e.to_string())?);
-            let raw: Vec<[f32; 4]> = staging.read(gpu).map_err(|e| e.to_string())?;
-            image.add(&raw[..(pixels * n) as usize], n as usize);
-            first += n;
-        }
-        Ok(image.finish(width, height, spp, timings))
+            buffer_group(gpu, "subsurface path", &self.layout, &[&params, &coefficients, samples])
+        })
     }
 }

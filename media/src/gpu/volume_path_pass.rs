@@ -305,27 +305,19 @@ impl VolumePathPass {
             packed[2 * i] = o.albedo.extend(0.0).into();
             packed[2 * i + 1] = o.emission.extend(0.0).into();
         }
-        let (width, height) = {
-            let s = scene.settings();
-            (s.width, s.height)
-        };
-        let pixels = width * height;
-        let batch = (PATHS_PER_DISPATCH / pixels).clamp(1, spp.max(1));
-        let device = &gpu.device;
-        let size = u64::from(pixels * batch) * 16;
-        let samples = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("volume path samples"),
-            size,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let staging = Staging::new(gpu, "volume path samples", size);
-        let mut image = Accumulator::new(pixels as usize);
-        let mut first = 0;
-        let mut timings = Vec::new();
         let pipeline = self.pipeline(gpu, scene, medium).map_err(|e| e.to_string())?;
-        while first < spp {
-            let n = batch.min(spp - first);
+        let device = &gpu.device;
+        let batched = Batched {
+            gpu,
+            scene,
+            bindings,
+            timer: &self.timer,
+            pass: VOLUME_PATH_PASS,
+            label: "volume path",
+            pipeline: &pipeline,
+            medium: Some(&medium.group),
+        };
+        batched.render(spp, seed, frame, |first, n, samples| {
             let params = VolumePathParams {
                 mis: settings.mis as u32,
                 eq10: u32::from(settings.combination == Combination::Eq10),
@@ -345,28 +337,80 @@ impl VolumePathPass {
                 contents: bytemuck::bytes_of(&params),
                 usage: wgpu::BufferUsages::STORAGE,
             });
-            bindings.prepare(gpu, scene, spp, 0, seed, frame);
             let optics = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("volume path optics"),
                 contents: bytemuck::cast_slice(&packed),
                 usage: wgpu::BufferUsages::STORAGE,
             });
-            let group =
-                buffer_group(gpu, "media volume path", &self.layout, &[&params, &optics, &samples]);
-            let mut timed = self.timer.begin(gpu, VOLUME_PATH_PASS);
+            buffer_group(gpu, "media volume path", &self.layout, &[&params, &optics, samples])
+        })
+    }
+}
+
+/// A pass that writes one radiance sample per path (group 2 its own, holding the samples buffer;
+/// group 3 the media, where it binds them), rendered in batches of at most `PATHS_PER_DISPATCH`
+/// paths and summed per pixel: the volumetric path tracer and the subsurface random walk.
+pub(super) struct Batched<'a> {
+    pub gpu: &'a Gpu,
+    pub scene: &'a SceneGpu,
+    pub bindings: &'a FrameBindings,
+    pub timer: &'a PassTimer,
+    /// The pass's name in timings.
+    pub pass: &'static str,
+    /// Prefix of the buffers' labels.
+    pub label: &'static str,
+    pub pipeline: &'a wgpu::ComputePipeline,
+    pub medium: Option<&'a wgpu::BindGroup>,
+}
+
+impl Batched<'_> {
+    /// `spp` samples per pixel; `group(first, n, samples)` gives the batch's group 2 for samples
+    /// `first .. first + n` of every pixel, written into `samples`.
+    pub(super) fn render(
+        &self,
+        spp: u32,
+        seed: u64,
+        frame: u32,
+        mut group: impl FnMut(u32, u32, &wgpu::Buffer) -> wgpu::BindGroup,
+    ) -> Result<VolumeImage, String> {
+        let (width, height) = {
+            let s = self.scene.settings();
+            (s.width, s.height)
+        };
+        let pixels = width * height;
+        let batch = (PATHS_PER_DISPATCH / pixels).clamp(1, spp.max(1));
+        let size = u64::from(pixels * batch) * 16;
+        let label = format!("{} samples", self.label);
+        let samples = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(&label),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let staging = Staging::new(self.gpu, &label, size);
+        let mut image = Accumulator::new(pixels as usize);
+        let mut timings = Vec::new();
+        let mut first = 0;
+        while first < spp {
+            let n = batch.min(spp - first);
+            self.bindings.prepare(self.gpu, self.scene, spp, 0, seed, frame);
+            let group = group(first, n, &samples);
+            let mut timed = self.timer.begin(self.gpu, self.pass);
             timed
                 .pass(0, |pass| {
-                    pass.set_pipeline(&pipeline);
-                    bindings.bind(gpu, scene, pass);
+                    pass.set_pipeline(self.pipeline);
+                    self.bindings.bind(self.gpu, self.scene, pass);
                     pass.set_bind_group(2, &group, &[]);
-                    pass.set_bind_group(3, &medium.group, &[]);
+                    if let Some(medium) = self.medium {
+                        pass.set_bind_group(3, medium, &[]);
+                    }
                     let groups = (pixels * n).div_ceil(64);
                     pass.dispatch_workgroups(groups.min(65535), groups.div_ceil(65535), 1);
                 })
                 .map_err(|e| e.to_string())?;
             staging.record(timed.encoder(), &samples, 0);
             merge(&mut timings, timed.submit().map_err(|e| e.to_string())?);
-            let raw: Vec<[f32; 4]> = staging.read(gpu).map_err(|e| e.to_string())?;
+            let raw: Vec<[f32; 4]> = staging.read(self.gpu).map_err(|e| e.to_string())?;
             image.add(&raw[..(pixels * n) as usize], n as usize);
             first += n;
         }
@@ -376,17 +420,17 @@ impl VolumePathPass {
 
 /// Per pixel, sums of the samples' radiance and of their luminance and its square, batch by
 /// batch (samples of pixel p at p·n .. (p + 1)·n of a batch of n per pixel).
-pub(super) struct Accumulator {
+struct Accumulator {
     sum: Vec<[f64; 3]>,
     lum: Vec<(f64, f64)>,
 }
 
 impl Accumulator {
-    pub(super) fn new(pixels: usize) -> Self {
+    fn new(pixels: usize) -> Self {
         Self { sum: vec![[0f64; 3]; pixels], lum: vec![(0f64, 0f64); pixels] }
     }
 
-    pub(super) fn add(&mut self, samples: &[[f32; 4]], n: usize) {
+    fn add(&mut self, samples: &[[f32; 4]], n: usize) {
         for (i, v) in samples.iter().enumerate() {
             let p = i / n;
             for (sum, x) in self.sum[p].iter_mut().zip(v) {
@@ -399,13 +443,7 @@ impl Accumulator {
     }
 
     /// The mean and the variance of the mean's luminance over `spp` samples per pixel.
-    pub(super) fn finish(
-        self,
-        width: u32,
-        height: u32,
-        spp: u32,
-        timings: Vec<PassTiming>,
-    ) -> VolumeImage {
+    fn finish(self, width: u32, height: u32, spp: u32, timings: Vec<PassTiming>) -> VolumeImage {
         let k = f64::from(spp);
         let mean = self.sum.iter().map(|s| s.map(|c| (c / k) as f32)).collect();
         let var_of_mean = self
