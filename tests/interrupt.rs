@@ -47,6 +47,37 @@ fn run_args(cmd: &mut Command, scenario: &Path, out: &Path, cache: &Path) {
         .arg(cache);
 }
 
+/// `flicker run --resume RUN` with the reference cache `cache`.
+fn resume(run: &Path, cache: &Path) -> Output {
+    flicker()
+        .arg("run")
+        .arg("--resume")
+        .arg(run)
+        .arg("--quiet")
+        .arg("--cache-dir")
+        .arg(cache)
+        .output()
+        .unwrap()
+}
+
+/// A reference cache in `dir` that cannot store references (`references` is a file): a run
+/// stops with an error at its first reference frame.
+fn references_blocked(dir: &Path) -> PathBuf {
+    let cache = dir.join("cache");
+    std::fs::create_dir_all(&cache).unwrap();
+    std::fs::write(cache.join("references"), "in the way").unwrap();
+    cache
+}
+
+/// Each of `names` (relative paths) byte-identical in `full` and `cut`.
+fn assert_same_bytes(full: &Path, cut: &Path, names: &[PathBuf]) {
+    for name in names {
+        let (a, b) =
+            (std::fs::read(full.join(name)).unwrap(), std::fs::read(cut.join(name)).unwrap());
+        assert!(a == b, "{} differs from the uninterrupted run's", name.display());
+    }
+}
+
 fn ok(o: Output) -> Output {
     assert!(o.status.success(), "stdout: {}\nstderr: {}", text(&o.stdout), text(&o.stderr));
     o
@@ -132,29 +163,13 @@ fn an_interrupted_run_says_so_and_resumes_to_the_uninterrupted_frames() {
     rows[2][rays] = (counted + 1).to_string();
     let forged_csv: Vec<String> = rows.iter().map(|r| r.join(",")).collect();
     std::fs::write(forged.join("frames.csv"), forged_csv.join("\n") + "\n").unwrap();
-    let o = flicker()
-        .arg("run")
-        .arg("--resume")
-        .arg(&forged)
-        .arg("--quiet")
-        .arg("--cache-dir")
-        .arg(&cache)
-        .output()
-        .unwrap();
+    let o = resume(&forged, &cache);
     let stderr = text(&o.stderr);
     assert!(!o.status.success());
     assert!(stderr.contains("frames.csv:3: rays of") && stderr.contains("replay"), "{stderr}");
 
     // Resumed: the same results and byte-identical images as the uninterrupted run.
-    let o = ok(flicker()
-        .arg("run")
-        .arg("--resume")
-        .arg(&cut)
-        .arg("--quiet")
-        .arg("--cache-dir")
-        .arg(&cache)
-        .output()
-        .unwrap());
+    let o = ok(resume(&cut, &cache));
     assert!(text(&o.stdout).contains("wrote"), "{}", text(&o.stdout));
     let manifest = json(&cut.join("manifest.json"));
     assert_eq!(manifest["status"], "complete");
@@ -172,11 +187,7 @@ fn an_interrupted_run_says_so_and_resumes_to_the_uninterrupted_frames() {
     let list = images(&full);
     assert_eq!(images(&cut), list);
     assert!(list.len() > 100, "{} images", list.len());
-    for name in &list {
-        let (a, b) =
-            (std::fs::read(full.join(name)).unwrap(), std::fs::read(cut.join(name)).unwrap());
-        assert!(a == b, "{} differs from the uninterrupted run's", name.display());
-    }
+    assert_same_bytes(&full, &cut, &list);
     assert!(!std::fs::read_to_string(cut.join("report.html")).unwrap().contains("Incomplete run"));
 
     // Nothing is left to resume; a folder that is no run is named.
@@ -206,9 +217,7 @@ fn a_run_stopped_by_an_error_is_marked_failed_and_resumes_once_it_is_fixed() {
     )
     .unwrap();
     // The reference cache cannot store frame 3's reference: `references` is a file.
-    let cache = dir.join("cache");
-    std::fs::create_dir_all(&cache).unwrap();
-    std::fs::write(cache.join("references"), "in the way").unwrap();
+    let cache = references_blocked(&dir);
     let run = dir.join("run");
     let mut cmd = flicker();
     run_args(&mut cmd, &scenario, &run, &cache);
@@ -225,15 +234,7 @@ fn a_run_stopped_by_an_error_is_marked_failed_and_resumes_once_it_is_fixed() {
     assert!(page.contains("Incomplete run") && page.contains("failed"));
 
     std::fs::remove_file(cache.join("references")).unwrap();
-    ok(flicker()
-        .arg("run")
-        .arg("--resume")
-        .arg(&run)
-        .arg("--quiet")
-        .arg("--cache-dir")
-        .arg(&cache)
-        .output()
-        .unwrap());
+    ok(resume(&run, &cache));
     let manifest = json(&run.join("manifest.json"));
     assert_eq!(manifest["status"], "complete");
     assert!(manifest.get("error").is_none(), "{manifest}");
@@ -266,9 +267,7 @@ fn runs_of_the_caches_resume_to_the_uninterrupted_frames() {
     ])])"#,
     )
     .unwrap();
-    let cache = dir.join("cache");
-    std::fs::create_dir_all(&cache).unwrap();
-    std::fs::write(cache.join("references"), "in the way").unwrap();
+    let cache = references_blocked(&dir);
     let cut = dir.join("cut");
     let mut cmd = flicker();
     run_args(&mut cmd, &scenario, &cut, &cache);
@@ -276,15 +275,7 @@ fn runs_of_the_caches_resume_to_the_uninterrupted_frames() {
     assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
     assert_eq!(json(&cut.join("manifest.json"))["last_complete_frame"], 2);
     std::fs::remove_file(cache.join("references")).unwrap();
-    ok(flicker()
-        .arg("run")
-        .arg("--resume")
-        .arg(&cut)
-        .arg("--quiet")
-        .arg("--cache-dir")
-        .arg(&cache)
-        .output()
-        .unwrap());
+    ok(resume(&cut, &cache));
     let full = dir.join("full");
     let mut cmd = flicker();
     run_args(&mut cmd, &scenario, &full, &cache);
@@ -296,10 +287,6 @@ fn runs_of_the_caches_resume_to_the_uninterrupted_frames() {
         .map(|p| p.strip_prefix(&full).unwrap().to_path_buf())
         .collect();
     assert!(exrs.len() >= 12, "{} images", exrs.len());
-    for name in &exrs {
-        let (a, b) =
-            (std::fs::read(full.join(name)).unwrap(), std::fs::read(cut.join(name)).unwrap());
-        assert!(a == b, "{} differs from the uninterrupted run's", name.display());
-    }
+    assert_same_bytes(&full, &cut, &exrs);
     std::fs::remove_dir_all(&dir).ok();
 }
