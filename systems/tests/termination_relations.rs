@@ -5,11 +5,13 @@
 //! - mean path length grows with the relative variance threshold t: in every seed, and in the
 //!   log ratio over t = 0.01 .. 1 with a margin from the seeds;
 //! - MSE minimisation's mean path length is below variance bounding's at absolute t = 0.01 in
-//!   the paper's radiance unit (Table 1): NOT reproduced here; the test asserts the measured
-//!   relations (corridor: MSE longer; door: no difference within the seeds' 95% interval);
-//! - at equal samples, variance bounding (relative t = 1, as in Fig. 10) has lower FLIP than
-//!   area spread at c = 0.01 in the door scene: NOT reproduced here; the test asserts the
-//!   measured relation (no difference within the seeds' 95% interval).
+//!   the paper's radiance unit (Table 1): reversed in the corridor, which the test asserts.
+//!
+//! Not asserted: the door's Table 1 relation and Fig. 10's FLIP relation (variance bounding at
+//! relative t = 1 against area spread at c = 0.01). Over three seeds their 95% intervals hold
+//! zero and the paper's effect alike, so asserting that no difference exists would pass for
+//! almost any tracer. `flicker reproduce variance-trading-termination` judges the door's
+//! relation over five seeds (claim `mse_shorter_than_vb_door`) and Fig. 10's in the corridor.
 //!
 //! At 32x18 the paper's 1% of primary vertices is 6 stored vertices a frame, too few to fill
 //! the cache in its warm-up (a seed then measures an empty cache: zero-variance records let
@@ -30,8 +32,6 @@ mod common;
 use common::assert_positive;
 
 const SEEDS: [u64; 3] = [3, 4, 5];
-/// Two-sided 95% t quantile for 2 degrees of freedom.
-const T975_DF2: f64 = 4.303;
 
 /// The scenario's methods named in `keep`, one recorded frame at 32x18: (method, path length,
 /// FLIP) per seed.
@@ -102,50 +102,16 @@ fn path_length_difference(runs: &[Vec<FrameRecord>], a: &str, b: &str) -> Vec<f6
     runs.iter().map(|r| value(r, a, path_length) - value(r, b, path_length)).collect()
 }
 
-/// Asserts that the two-sided 95% interval of the mean of `d` (over 3 seeds) contains zero:
-/// no difference measured; fails when one appears.
-fn assert_no_difference(what: &str, d: &[f64]) {
-    let n = d.len() as f64;
-    let m = d.iter().sum::<f64>() / n;
-    let sd = (d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)).sqrt();
-    let half = T975_DF2 * sd / n.sqrt();
-    eprintln!("{what}: per seed {d:.4?}, 95% interval [{:.4}, {:.4}]", m - half, m + half);
-    assert!(
-        m - half < 0.0 && m + half > 0.0,
-        "{what}: {d:.4?}: interval [{:.4}, {:.4}] no longer contains 0; update the README and this test",
-        m - half,
-        m + half
-    );
-}
-
 #[test]
 fn door_relations() {
-    let keep = ["vb_0.01", "vb_rel_0.01", "vb_rel_0.1", "vb_rel_1", "mse_100", "spread_0.01"];
+    let keep = ["vb_rel_0.01", "vb_rel_0.1", "vb_rel_1"];
     let runs: Vec<_> = SEEDS.iter().map(|&s| play("termination_door_gap.ron", &keep, s)).collect();
     for (seed, r) in SEEDS.iter().zip(&runs) {
         for m in keep {
-            eprintln!(
-                "door seed {seed} {m}: path length {:.3} FLIP {:.4}",
-                value(r, m, path_length),
-                value(r, m, |r| r.flip)
-            );
+            eprintln!("door seed {seed} {m}: path length {:.3}", value(r, m, path_length));
         }
     }
     path_length_relations("door", &runs);
-    // The paper's Fig. 10 relation (variance bounding at relative t = 1 below area spread at
-    // c = 0.01 in FLIP) does not reproduce at this size: the per-seed differences change sign
-    // (README "Termination relations"). What is measured, and asserted: the two are not
-    // distinguishable, the two-sided 95% interval of the mean difference contains zero.
-    let flip = |m: &str| runs.iter().map(|r| value(r, m, |r| r.flip)).collect::<Vec<f64>>();
-    let d: Vec<f64> =
-        flip("spread_0.01").iter().zip(flip("vb_rel_1")).map(|(a, b)| a - b).collect();
-    assert_no_difference("door: FLIP area spread c 0.01 - variance bounding relative t 1", &d);
-    // Table 1: MSE minimisation (s = 100) ends paths earlier than variance bounding at absolute
-    // t = 0.01 (in the paper's radiance unit). Not reproduced (README "Relations (tests)"): the
-    // lab's coarse records look biased, so the MSE rule defers, and the door's seeds spread
-    // widely. Asserted as measured: no difference.
-    let d = path_length_difference(&runs, "vb_0.01", "mse_100");
-    assert_no_difference("door: path length, variance bounding t 0.01 - MSE s 100", &d);
 }
 
 #[test]
