@@ -28,7 +28,7 @@ pub const PATHS_PER_DISPATCH: u64 = 1 << 20;
 /// Samples one invocation of the trace pass traces; a dispatch spreads its samples over
 /// workgroup z (see trace_main in path_tracer.wgsl for why invocations must stay short). An
 /// invocation starts its next sample's path as soon as one ends (path regeneration), so more
-/// samples per invocation keep its lanes busier (2 before regeneration; render/README.md), while
+/// samples per invocation keep its lanes busier (2 before regeneration; docs/lab/render-speed.md), while
 /// an invocation stays far below llvmpipe's loop cap.
 pub const SAMPLES_PER_THREAD: u32 = 8;
 

@@ -5,7 +5,7 @@
 //! Why: lavapipe runs a branch that no invocation takes under an empty mask instead of jumping
 //! over it, so next-event estimation towards a kind of light the scene lacks costs a light sample
 //! and a shadow ray's traversal per vertex all the same, and an untextured scene pays for four
-//! texel loads per hit (render/README.md). A pass compiled with the feature's constant `false`
+//! texel loads per hit (docs/lab/render-speed.md). A pass compiled with the feature's constant `false`
 //! has no such code. A GPU skips such branches anyway. No result changes: a light kind's
 //! estimator draws no random numbers when the scene has none of it.
 //!

@@ -6,7 +6,7 @@
 //! texel load is gathered. Why a read-only storage texture and not a sampled one: lavapipe
 //! fetches a sampled texel through an out-of-line function that looks up every lane's mip level,
 //! and reads a storage texel inline. `cargo run -p bench --example load_probe` measures chains of
-//! dependent 16-byte loads all three ways (render/README.md). BVH nodes and triangles are
+//! dependent 16-byte loads all three ways (docs/lab/render-speed.md). BVH nodes and triangles are
 //! read-only during a frame and fetched at data-dependent addresses on every traversal step,
 //! which is the case this helps; on GPUs a texel load is as fast as a buffer load
 //! (texture-bound BVHs are the classic layout, Aila & Laine 2009).
