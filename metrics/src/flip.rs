@@ -142,16 +142,11 @@ fn interleaved(image: &Image, f: impl Fn(f32) -> f32) -> flip_rs::RgbImage<f32> 
         .unwrap_or_else(|e| panic!("FLIP of a {}x{} image: {e}", image.width, image.height))
 }
 
-/// A non-finite pixel leaves FLIP undefined: every pixel NaN (the run's FLIP shows NaN) rather
-/// than a panic in the middle of a run.
+/// A non-finite pixel leaves FLIP undefined (flip-rs refuses the pair): every pixel NaN, so the
+/// run's FLIP shows NaN, rather than a panic in the middle of a run.
 fn undefined(reference: &Image, exposures: Option<ExposureRange>) -> FlipResult {
     let n = reference.width as usize * reference.height as usize;
-    FlipResult {
-        mean: f64::NAN,
-        map: vec![f32::NAN; n],
-        percentiles: Percentiles::of(&[]),
-        exposures,
-    }
+    FlipResult::new(vec![f32::NAN; n], exposures)
 }
 
 /// LDR-FLIP of `test` against `reference`; both linear RGB, clamped to [0, 1]. flip-rs reads
@@ -296,7 +291,8 @@ mod tests {
         assert_eq!(flip_hdr(&black, &black, DEFAULT_PPD).mean, 0.0);
         let mut nan = dark.clone();
         nan.rgb[3] = [f32::NAN, 0.0, 0.0];
-        assert!(flip_hdr(&dark, &nan, DEFAULT_PPD).mean.is_nan());
+        let undefined = flip_hdr(&dark, &nan, DEFAULT_PPD);
+        assert!(undefined.mean.is_nan() && undefined.percentiles.max.is_nan());
         assert!(flip_ldr(&dark, &nan, DEFAULT_PPD).mean.is_nan());
     }
 }
