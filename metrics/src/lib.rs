@@ -1,7 +1,8 @@
 //! Image metrics for temporal stability and accuracy.
 //!
 //! - [`smape`]: frame-to-frame flicker (SMAPE), optionally after motion-vector reprojection.
-//! - [`flip`]: LDR-FLIP and HDR-FLIP (Andersson et al. 2020, 2021) against a reference.
+//! - [`flip`]: LDR-FLIP and HDR-FLIP (Andersson et al. 2020, 2021) against a reference, by the
+//!   `flip-rs` crate (NVIDIA FLIP 1.7 ported).
 //! - [`error`]: MSE, relative MSE, PSNR.
 //! - [`cvvdp`]: ColorVideoVDP's JOD of a sequence against its reference, on a display model.
 //! - [`region`]: named rectangles of interest; any per-pixel map can be averaged over one.
