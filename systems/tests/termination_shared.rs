@@ -80,14 +80,13 @@ fn rules_on_one_cache_give_their_own_results_with_one_propagation() {
         let alone = play(&[method], &format!("alone{i}"));
         let name = method.0;
         for f in 0..FRAMES {
-            for (what, path) in [
-                ("image", |d: &RunFolder, m: &str, f| d.frame(m, f, "exr")),
-                ("path length", |d: &RunFolder, m: &str, f| {
-                    d.method_image(m, "path_length", f, "exr")
-                }),
-            ] {
-                let a = std::fs::read(path(&alone.folder, name, f)).expect("alone's image");
-                let b = std::fs::read(path(&together.folder, name, f)).expect("shared image");
+            for (what, image) in [("image", None), ("path length", Some("path_length"))] {
+                let path = |d: &RunFolder| match image {
+                    None => d.frame(name, f, "exr"),
+                    Some(image) => d.method_image(name, image, f, "exr"),
+                };
+                let a = std::fs::read(path(&alone.folder)).expect("alone's image");
+                let b = std::fs::read(path(&together.folder)).expect("shared image");
                 assert!(a == b, "{name} frame {f}: the {what} differs from the method's alone");
             }
             assert_eq!(
