@@ -4,7 +4,8 @@
 //! ([`TcPass`]), each its own timed pass, in three submissions: [`TerminationCache::update`]
 //! (propagate, fold: the records the image reads), [`TerminationCache::trace`] (the image),
 //! [`TerminationCache::store`] (after the image: the keys and vertices the next frame
-//! propagates).
+//! propagates). Rules of one cache key share the cache: each has a [`TerminationTracer`] and
+//! runs only the trace ([`TerminationCache::trace_with`]).
 //!
 //! Deterministic: the same scene, seed and settings give the same bits on any adapter. Sums are
 //! per invocation or integer atomics; a record's stored vertex and a new key's slot are each

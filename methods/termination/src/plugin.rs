@@ -15,7 +15,7 @@
 use std::time::Instant;
 
 use crate::TerminationCache;
-use crate::cache::TerminationTracer;
+use crate::TerminationTracer;
 use anyhow::Result;
 use bevy_ecs::prelude::*;
 use render::timing::PassTiming;
