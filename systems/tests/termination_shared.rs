@@ -30,6 +30,14 @@ const SHARED_PASSES: [&str; 4] = ["tc_propagate", "tc_fold", "tc_insert", "tc_st
 struct Run {
     records: Vec<FrameRecord>,
     folder: RunFolder,
+    /// The run's folder and its reference cache, removed when the run is dropped.
+    root: std::path::PathBuf,
+}
+
+impl Drop for Run {
+    fn drop(&mut self) {
+        std::fs::remove_dir_all(&self.root).ok();
+    }
 }
 
 fn play(methods: &[(&str, &str)], name: &str) -> Run {
@@ -58,7 +66,8 @@ fn play(methods: &[(&str, &str)], name: &str) -> Run {
         progress: false,
     };
     let summary = run_spec(&spec, &opts).expect("run");
-    Run { records: summary.records, folder: RunFolder::new(&summary.folder) }
+    let root = dir.parent().expect("a run folder's parent").to_path_buf();
+    Run { records: summary.records, folder: RunFolder::new(&summary.folder), root }
 }
 
 fn record<'a>(run: &'a Run, method: &str, frame: u32) -> &'a FrameRecord {
