@@ -331,9 +331,6 @@ pub struct TerminationCache {
     store_timer: PassTimer,
     /// Frames (warm-up included) run so far.
     frames: u32,
-    /// Propagations run so far (warm-up included): once per frame however many tracers read
-    /// the cache.
-    propagations: u32,
 }
 
 impl TerminationCache {
@@ -436,7 +433,6 @@ impl TerminationCache {
             update_timer: PassTimer::new(gpu, &TcPass::UPDATE.map(TcPass::name)),
             store_timer: PassTimer::new(gpu, &TcPass::STORE.map(TcPass::name)),
             frames: 0,
-            propagations: 0,
         })
     }
 
@@ -557,13 +553,11 @@ impl TerminationCache {
                 let frame = 0x8000_0000 + k;
                 self.begin_frame(gpu, scene, camera, seed, frame, WARMUP_MAX_VERTICES);
                 self.submit(gpu, scene, &self.update_timer, &TcPass::UPDATE, &self.own.group)?;
-                self.propagations += 1;
                 self.submit(gpu, scene, &self.own.timer, &[TcPass::Trace], &self.own.group)?;
                 self.store(gpu, scene)?;
             }
         }
         self.begin_frame(gpu, scene, camera, seed, frame, self.settings.max_vertices);
-        self.propagations += 1;
         self.submit(gpu, scene, &self.update_timer, &TcPass::UPDATE, &self.own.group)
     }
 
@@ -640,12 +634,6 @@ impl TerminationCache {
             self.submit(gpu, scene, &self.store_timer, &TcPass::STORE, &self.own.group)?;
         self.frames += 1;
         Ok(timings)
-    }
-
-    /// Propagations run so far, warm-up included: one a frame, however many tracers read the
-    /// cache.
-    pub fn propagations(&self) -> u32 {
-        self.propagations
     }
 
     /// The parameters of a pass with `settings`' rule in the frame of `frame` (its candidate
