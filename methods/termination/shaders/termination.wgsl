@@ -8,7 +8,8 @@
 //                 vertex for its own record (exploration)
 //   tc_fold       per record: folds its vertices' estimates into the record's three moments
 //   tc_trace      per pixel: the path with the termination decision at every vertex; primary
-//                 vertices are candidates with probability store_probability
+//                 vertices are candidates with probability store_probability (one tracer of a
+//                 shared cache offers them, tc.offers)
 //   tc_insert_*   per insertion request (a candidate whose key had no slot): rounds of claim
 //                 (atomicMin of the candidate index on the first empty slot of its probe window)
 //                 and win (the lowest claimant writes its key there), then a settle pass
@@ -420,11 +421,16 @@ fn tc_trace(@builtin(global_invocation_id) id: vec3u) {
         }
         if depth == 0u && rng_next(&crng) < tc.store_probability {
             let key = tc_key(sp.position, sh.ns, rng_next2(&crng));
-            let s = tc_find(key);
-            if s != HC_NONE {
-                tc_offer(s, index, origin, dir);
-            } else {
-                tc_request(key, index, origin, dir);
+            // Every rule but path tracing offers the same vertex here (its random numbers so
+            // far are the rule's lookup's): on a shared cache one tracer offers, the others only
+            // draw the numbers.
+            if tc.offers != 0u {
+                let s = tc_find(key);
+                if s != HC_NONE {
+                    tc_offer(s, index, origin, dir);
+                } else {
+                    tc_request(key, index, origin, dir);
+                }
             }
         }
         if alpha < 1.0 {

@@ -4,7 +4,8 @@
 //! ([`TcPass`]), each its own timed pass, in three submissions: [`TerminationCache::update`]
 //! (propagate, fold: the records the image reads), [`TerminationCache::trace`] (the image),
 //! [`TerminationCache::store`] (after the image: the keys and vertices the next frame
-//! propagates).
+//! propagates). Rules of one cache key share the cache: each has a [`TerminationTracer`] and
+//! runs only the trace ([`TerminationCache::trace_with`]).
 //!
 //! Deterministic: the same scene, seed and settings give the same bits on any adapter. Sums are
 //! per invocation or integer atomics; a record's stored vertex and a new key's slot are each
@@ -43,6 +44,9 @@ pub const TC_INSERT_PASS: &str = "tc_insert";
 const WARMUP_MAX_VERTICES: u32 = 4;
 /// Words of `counters` (termination.wgsl's TC_COUNTER_*).
 const COUNTERS: u64 = 10;
+/// Words of `counters` a trace writes (path vertices, trace rays, unknown records): a tracer's
+/// own; every other word counts the cache's passes.
+const TRACE_COUNTERS: [u64; 3] = [0, 1, 6];
 /// Pass names, in the order of [`TcPass`].
 const PASSES: [&str; 5] =
     [TC_PROPAGATE_PASS, TC_FOLD_PASS, TC_TRACE_PASS, TC_INSERT_PASS, TC_STORE_PASS];
@@ -128,6 +132,10 @@ render::gpu_struct! {
         /// 1: a propagation sample whose hit has no filled record goes on by path tracing
         /// (`Incomplete::PathTrace`); 0: its estimate is left out of filled records.
         pub incomplete_path_trace: u32 => "u32",
+        /// 1: the tracer offers its primary vertices to the records (one tracer per cache); 0:
+        /// it draws the same random numbers but writes nothing (a second rule on a shared
+        /// cache, whose offers would repeat the first's).
+        pub offers: u32 => "u32",
     }
 }
 
@@ -172,7 +180,7 @@ render::gpu_struct! {
 }
 
 const _: () = assert!(
-    size_of::<TcParams>() == 48 && size_of::<TcRecord>() == 48 && size_of::<TcVertex>() == 32
+    size_of::<TcParams>() == 52 && size_of::<TcRecord>() == 48 && size_of::<TcVertex>() == 32
 );
 const _: () = assert!(BYTES_PER_RECORD == 16 + 48 + 4 * 48 + 4 * 32 + 4 * 32 + 4 * 16);
 
@@ -269,29 +277,57 @@ pub struct TerminationOutput {
     pub shaded: u64,
 }
 
+/// One rule's tracer over a [`TerminationCache`]: its parameters (`tc`: the rule, survival),
+/// its counters and per-pixel outputs, and a bind group with the cache's shared buffers. Rules
+/// whose settings have the same [`TerminationSettings::cache_key`] build the same records, so
+/// one cache serves them all: its propagation, fold, insertion and store run once a frame, and
+/// each rule runs only `tc_trace` ([`TerminationCache::trace_with`]).
+pub struct TerminationTracer {
+    settings: TerminationSettings,
+    /// Whether this tracer's primary vertices are offered to the records (the first tracer of a
+    /// cache; the others' offers are the same vertices, see `TcParams::offers`).
+    offers: bool,
+    tc: wgpu::Buffer,
+    /// Only the trace's words (path vertices, trace rays, unknown records) are this tracer's;
+    /// the cache's passes count in the cache's own tracer.
+    counters: wgpu::Buffer,
+    primary: wgpu::Buffer,
+    colour: wgpu::Buffer,
+    path_length: wgpu::Buffer,
+    group: wgpu::BindGroup,
+    timer: PassTimer,
+}
+
+impl TerminationTracer {
+    pub fn settings(&self) -> TerminationSettings {
+        self.settings
+    }
+}
+
 pub struct TerminationCache {
     settings: TerminationSettings,
     width: u32,
     height: u32,
     hc: wgpu::Buffer,
-    tc: wgpu::Buffer,
     slots: wgpu::Buffer,
     records: wgpu::Buffer,
-    counters: wgpu::Buffer,
-    primary: wgpu::Buffer,
-    colour: wgpu::Buffer,
-    path_length: wgpu::Buffer,
+    vertices: wgpu::Buffer,
     inserts: wgpu::Buffer,
     /// The insertion passes' workgroups, copied from `inserts` (a buffer bound as storage
     /// cannot be a dispatch's indirect buffer).
     insert_args: wgpu::Buffer,
     frame: FrameBindings,
-    group: wgpu::BindGroup,
+    layout: wgpu::BindGroupLayout,
+    /// The cache's own tracer (the settings it was built with): its group binds every pass but
+    /// other rules' traces, its counters count them, and it traces the warm-up frames.
+    own: TerminationTracer,
+    /// This frame's parameters of the cache's passes, from which each tracer's are made.
+    frame_params: TcParams,
     /// Indexed as [`ENTRY_POINTS`].
     pipelines: [render::pass_library::LibraryPipeline; 7],
-    /// One timer per submission: [`TcPass::UPDATE`], the trace, [`TcPass::STORE`].
+    /// One timer per submission: [`TcPass::UPDATE`], [`TcPass::STORE`] (each tracer times its
+    /// own trace).
     update_timer: PassTimer,
-    trace_timer: PassTimer,
     store_timer: PassTimer,
     /// Frames (warm-up included) run so far.
     frames: u32,
@@ -347,7 +383,6 @@ impl TerminationCache {
             | wgpu::BufferUsages::COPY_DST;
         let parameters = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
         let hc = buffer("termination hc", size_of::<HashCacheParams>() as u64, parameters);
-        let tc = buffer("termination tc", size_of::<TcParams>() as u64, parameters);
         let slots = buffer("termination slots", cap * 16, rw);
         // Empty slots with no claims (claim = NONE).
         let empty: Vec<[u32; 4]> = vec![[0, u32::MAX, 0, u32::MAX]; cap as usize];
@@ -359,10 +394,6 @@ impl TerminationCache {
         );
         let vertices =
             buffer("termination vertices", (cap * 2 * VERTICES_PER_RECORD + pixels) * 32, rw);
-        let counters = buffer("termination counters", COUNTERS * 4, rw);
-        let primary = buffer("termination primary", pixels * size_of::<TaaPrimary>() as u64, rw);
-        let colour = buffer("termination colour", pixels * 16, rw);
-        let path_length = buffer("termination path length", pixels * 4, rw);
         let inserts = buffer("termination insertion requests", 16 + 16 * requests, rw);
         let insert_args = buffer(
             "termination insertion dispatch",
@@ -376,45 +407,61 @@ impl TerminationCache {
             &OWN_GROUP,
             ENTRY_POINTS,
         )?;
-        let group = render::compute::buffer_group(
-            gpu,
-            "termination",
-            &layout,
-            &[
-                &hc,
-                &tc,
-                &slots,
-                &records,
-                &vertices,
-                &counters,
-                &primary,
-                &colour,
-                &path_length,
-                &inserts,
-            ],
-        );
+        let shared = SharedBuffers {
+            hc: &hc,
+            slots: &slots,
+            records: &records,
+            vertices: &vertices,
+            inserts: &inserts,
+        };
+        let own = build_tracer(gpu, &layout, shared, settings, true, pixels);
         Ok(Self {
             settings,
             width,
             height,
             hc,
-            tc,
             slots,
             records,
-            counters,
-            primary,
-            colour,
-            path_length,
+            vertices,
             inserts,
             insert_args,
             frame: FrameBindings::new(gpu, scene),
-            group,
+            own,
+            layout,
+            frame_params: bytemuck::Zeroable::zeroed(),
             pipelines,
             update_timer: PassTimer::new(gpu, &TcPass::UPDATE.map(TcPass::name)),
-            trace_timer: PassTimer::new(gpu, &[TC_TRACE_PASS]),
             store_timer: PassTimer::new(gpu, &TcPass::STORE.map(TcPass::name)),
             frames: 0,
         })
+    }
+
+    /// A tracer for another rule over this cache; refused unless `settings` has this cache's
+    /// [`TerminationSettings::cache_key`] (only then are its records the ones it would build
+    /// alone). `offers`: whether its primary vertices are offered to the records; exactly one
+    /// tracer a frame must offer them (the plugin: the cache's first method).
+    pub fn tracer(
+        &self,
+        gpu: &Gpu,
+        settings: TerminationSettings,
+        offers: bool,
+    ) -> Result<TerminationTracer, RenderError> {
+        settings.validate()?;
+        if settings.cache_key() != self.settings.cache_key() {
+            return Err(RenderError::Settings(format!(
+                "termination cache: a tracer with settings {settings:?} cannot share the cache of {:?} (only the rule, survival and radiance unit may differ, and path tracing shares only with path tracing)",
+                self.settings
+            )));
+        }
+        let shared = SharedBuffers {
+            hc: &self.hc,
+            slots: &self.slots,
+            records: &self.records,
+            vertices: &self.vertices,
+            inserts: &self.inserts,
+        };
+        let pixels = self.width as u64 * self.height as u64;
+        Ok(build_tracer(gpu, &self.layout, shared, settings, offers, pixels))
     }
 
     /// The passes' program: the shading library, TAA's primary attributes, the hash cache's
@@ -490,8 +537,8 @@ impl TerminationCache {
     }
 
     /// The records the image reads: on the first call the cache is first filled for
-    /// `warmup_frames` whole frames, then this frame's propagation and fold (one submission).
-    /// Returns their times, for [`Self::trace`].
+    /// `warmup_frames` whole frames (traced by the cache's own tracer), then this frame's
+    /// propagation and fold (one submission). Returns their times, for [`Self::trace`].
     pub fn update(
         &mut self,
         gpu: &Gpu,
@@ -505,39 +552,65 @@ impl TerminationCache {
                 // Warm-up frames draw their own random numbers (frame indices no run reaches).
                 let frame = 0x8000_0000 + k;
                 self.begin_frame(gpu, scene, camera, seed, frame, WARMUP_MAX_VERTICES);
-                self.submit(gpu, scene, &self.update_timer, &TcPass::UPDATE)?;
-                self.submit(gpu, scene, &self.trace_timer, &[TcPass::Trace])?;
+                self.submit(gpu, scene, &self.update_timer, &TcPass::UPDATE, &self.own.group)?;
+                self.submit(gpu, scene, &self.own.timer, &[TcPass::Trace], &self.own.group)?;
                 self.store(gpu, scene)?;
             }
         }
         self.begin_frame(gpu, scene, camera, seed, frame, self.settings.max_vertices);
-        self.submit(gpu, scene, &self.update_timer, &TcPass::UPDATE)
+        self.submit(gpu, scene, &self.update_timer, &TcPass::UPDATE, &self.own.group)
     }
 
-    /// The frame's image after [`Self::update`] (`updated`: its times, reported first): the
-    /// tracer with the rule's decision over the folded records, and the frame's read-back. The
-    /// frame parameters are the cache's own, written by [`Self::update`].
+    /// The frame's image by the cache's own tracer (its settings' rule): [`Self::trace_with`].
     pub fn trace(
-        &mut self,
+        &self,
         gpu: &Gpu,
         scene: &SceneGpu,
         updated: Vec<PassTiming>,
     ) -> Result<TerminationOutput, RenderError> {
+        self.trace_with(gpu, scene, &self.own, updated)
+    }
+
+    /// The frame's image by `tracer` after [`Self::update`] (`updated`: times reported first,
+    /// empty for a tracer that does not report the cache's passes): the tracer with its rule's
+    /// decision over the folded records, and the frame's read-back. Its output is what the
+    /// tracer's rule gives alone: its image and trace counters with the cache's counts
+    /// (propagated vertices and rays, records).
+    pub fn trace_with(
+        &self,
+        gpu: &Gpu,
+        scene: &SceneGpu,
+        tracer: &TerminationTracer,
+        updated: Vec<PassTiming>,
+    ) -> Result<TerminationOutput, RenderError> {
+        // The frame's parameters with the tracer's rule; its trace counters cleared (the
+        // cache's words of the own tracer's counters are the frame's so far).
+        let tc = self.params(&tracer.settings, self.frame_params, tracer.offers);
+        gpu.queue.write_buffer(&tracer.tc, 0, bytemuck::bytes_of(&tc));
+        for word in TRACE_COUNTERS {
+            gpu.queue.write_buffer(&tracer.counters, word * 4, &[0u8; 4]);
+        }
         let mut timings = updated;
-        timings.extend(self.submit(gpu, scene, &self.trace_timer, &[TcPass::Trace])?);
-        let [colour, primary, path_length, counters] = copy_all(
+        timings.extend(self.submit(gpu, scene, &tracer.timer, &[TcPass::Trace], &tracer.group)?);
+        let [colour, primary, path_length, traced, counters] = copy_all(
             gpu,
             [
-                (&self.colour, "termination colour"),
-                (&self.primary, "termination primary hits"),
-                (&self.path_length, "termination path length"),
-                (&self.counters, "termination counters"),
+                (&tracer.colour, "termination colour"),
+                (&tracer.primary, "termination primary hits"),
+                (&tracer.path_length, "termination path length"),
+                (&tracer.counters, "termination trace counters"),
+                (&self.own.counters, "termination counters"),
             ],
         );
         let radiance = colour.read(gpu)?;
         let primary: Vec<TaaPrimary> = primary.read(gpu)?;
         let path_length: Vec<f32> = path_length.read(gpu)?;
-        let stats = stats_of(&counters.read(gpu)?);
+        let mut words: Vec<u32> = counters.read(gpu)?;
+        let traced: Vec<u32> = traced.read(gpu)?;
+        for word in TRACE_COUNTERS {
+            words[word as usize] = traced[word as usize];
+        }
+        let stats = stats_of(&words);
         let pixels = self.width as u64 * self.height as u64;
         Ok(TerminationOutput {
             radiance,
@@ -557,14 +630,38 @@ impl TerminationCache {
     /// parameters (no ray), so other methods' work since [`Self::trace`] changes nothing. Ends
     /// the frame.
     pub fn store(&mut self, gpu: &Gpu, scene: &SceneGpu) -> Result<Vec<PassTiming>, RenderError> {
-        let timings = self.submit(gpu, scene, &self.store_timer, &TcPass::STORE)?;
+        let timings =
+            self.submit(gpu, scene, &self.store_timer, &TcPass::STORE, &self.own.group)?;
         self.frames += 1;
         Ok(timings)
     }
 
-    /// Writes the frame's parameters (the cache's frame, `hc`, `tc`) and clears the counters.
+    /// The parameters of a pass with `settings`' rule in the frame of `frame` (its candidate
+    /// mask and record memory).
+    fn params(&self, settings: &TerminationSettings, frame: TcParams, offers: bool) -> TcParams {
+        let (rule_kind, relative, param, margin, bias_clamp) = rule_words(&settings.rule);
+        let param = match settings.rule {
+            TerminationRule::VarianceBounding { t, relative: false } => {
+                (t * settings.radiance_unit * settings.radiance_unit) as f32
+            }
+            _ => param,
+        };
+        TcParams {
+            rule_kind,
+            relative,
+            param,
+            margin,
+            bias_clamp,
+            survival: settings.survival as f32,
+            offers: offers as u32,
+            ..frame
+        }
+    }
+
+    /// Writes the frame's parameters (the cache's frame, `hc`, the own tracer's `tc`) and
+    /// clears the counters.
     fn begin_frame(
-        &self,
+        &mut self,
         gpu: &Gpu,
         scene: &SceneGpu,
         camera: &Camera,
@@ -600,41 +697,33 @@ impl TerminationCache {
             primary_jitter: [0.0; 2],
             pad2: [0.0; 2],
         };
-        let (rule_kind, relative, param, margin, bias_clamp) = rule_words(&s.rule);
-        let param = match s.rule {
-            TerminationRule::VarianceBounding { t, relative: false } => {
-                (t * s.radiance_unit * s.radiance_unit) as f32
-            }
-            _ => param,
-        };
-        let tc = TcParams {
-            rule_kind,
-            relative,
-            param,
-            margin,
-            bias_clamp,
-            survival: s.survival as f32,
+        let frame_params = TcParams {
             samples_per_vertex: s.samples_per_vertex,
             max_vertices: max_vertices.min(s.max_vertices) as f32,
             store_probability: s.store_probability as f32,
             pixels: self.width * self.height,
             candidate_mask: scene::mix64(seed ^ ((frame as u64) << 32)) as u32 & 0x0fff_ffff,
             incomplete_path_trace: (s.incomplete == Incomplete::PathTrace) as u32,
+            ..bytemuck::Zeroable::zeroed()
         };
+        self.frame_params = frame_params;
+        let tc = self.params(&self.settings, frame_params, self.own.offers);
         self.frame.prepare(gpu, scene, 1, 0, seed, frame);
         gpu.queue.write_buffer(&self.hc, 0, bytemuck::bytes_of(&hc));
-        gpu.queue.write_buffer(&self.tc, 0, bytemuck::bytes_of(&tc));
-        gpu.queue.write_buffer(&self.counters, 0, &[0u8; COUNTERS as usize * 4]);
+        gpu.queue.write_buffer(&self.own.tc, 0, bytemuck::bytes_of(&tc));
+        gpu.queue.write_buffer(&self.own.counters, 0, &[0u8; COUNTERS as usize * 4]);
         gpu.queue.write_buffer(&self.inserts, 0, bytemuck::cast_slice(&INSERT_HEADER));
     }
 
-    /// `passes` in order as one submission timed by `timer` (whose names are theirs).
+    /// `passes` in order as one submission timed by `timer` (whose names are theirs), bound
+    /// with `group` (the own tracer's, or another tracer's for its trace).
     fn submit(
         &self,
         gpu: &Gpu,
         scene: &SceneGpu,
         timer: &PassTimer,
         passes: &[TcPass],
+        group: &wgpu::BindGroup,
     ) -> Result<Vec<PassTiming>, RenderError> {
         let mut timed = timer.begin(gpu, "termination");
         for (index, &p) in passes.iter().enumerate() {
@@ -643,7 +732,7 @@ impl TerminationCache {
                 timed.encoder().copy_buffer_to_buffer(&self.inserts, 0, &self.insert_args, 0, 12);
                 timed.pass(index, |pass| {
                     self.frame.bind(gpu, scene, pass);
-                    pass.set_bind_group(2, &self.group, &[]);
+                    pass.set_bind_group(2, group, &[]);
                     let [claim, win, settle] = [4, 5, 6].map(|e| self.pipelines[e].get());
                     for _ in 0..INSERT_ROUNDS.min(self.settings.probe_limit) {
                         pass.set_pipeline(&claim);
@@ -667,7 +756,7 @@ impl TerminationCache {
             timed.pass(index, |pass| {
                 pass.set_pipeline(&pipeline.get());
                 self.frame.bind(gpu, scene, pass);
-                pass.set_bind_group(2, &self.group, &[]);
+                pass.set_bind_group(2, group, &[]);
                 pass.dispatch_workgroups(x, y, z);
             })?;
         }
@@ -688,7 +777,7 @@ impl TerminationCache {
 
     /// The frame's counters so far (after [`Self::store`]: the insertions' and the store's too).
     pub fn read_counters(&self, gpu: &Gpu) -> Result<TerminationStats, RenderError> {
-        Ok(stats_of(&read_pod::<u32>(gpu, &self.counters, "termination counters")?))
+        Ok(stats_of(&read_pod::<u32>(gpu, &self.own.counters, "termination counters")?))
     }
 }
 
@@ -705,6 +794,74 @@ fn stats_of(c: &[u32]) -> TerminationStats {
         propagated: c[7],
         incomplete: c[8],
         filled: c[9],
+    }
+}
+
+/// The cache's buffers every tracer binds.
+#[derive(Clone, Copy)]
+struct SharedBuffers<'a> {
+    hc: &'a wgpu::Buffer,
+    slots: &'a wgpu::Buffer,
+    records: &'a wgpu::Buffer,
+    vertices: &'a wgpu::Buffer,
+    inserts: &'a wgpu::Buffer,
+}
+
+/// A tracer's own buffers (sizes checked by [`TerminationCache::new`]) and its bind group.
+fn build_tracer(
+    gpu: &Gpu,
+    layout: &wgpu::BindGroupLayout,
+    shared: SharedBuffers,
+    settings: TerminationSettings,
+    offers: bool,
+    pixels: u64,
+) -> TerminationTracer {
+    let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
+        gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage,
+            mapped_at_creation: false,
+        })
+    };
+    let rw =
+        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+    let tc = buffer(
+        "termination tc",
+        size_of::<TcParams>() as u64,
+        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+    );
+    let counters = buffer("termination counters", COUNTERS * 4, rw);
+    let primary = buffer("termination primary", pixels * size_of::<TaaPrimary>() as u64, rw);
+    let colour = buffer("termination colour", pixels * 16, rw);
+    let path_length = buffer("termination path length", pixels * 4, rw);
+    let group = render::compute::buffer_group(
+        gpu,
+        "termination",
+        layout,
+        &[
+            shared.hc,
+            &tc,
+            shared.slots,
+            shared.records,
+            shared.vertices,
+            &counters,
+            &primary,
+            &colour,
+            &path_length,
+            shared.inserts,
+        ],
+    );
+    TerminationTracer {
+        settings,
+        offers,
+        tc,
+        counters,
+        primary,
+        colour,
+        path_length,
+        group,
+        timer: PassTimer::new(gpu, &[TC_TRACE_PASS]),
     }
 }
 

@@ -13,7 +13,10 @@ pub mod rule;
 pub mod sampling_tree;
 pub mod settings;
 
-pub use cache::{CacheStatistics, TcPass, TerminationCache, TerminationOutput, TerminationStats};
+pub use cache::{
+    CacheStatistics, TcPass, TerminationCache, TerminationOutput, TerminationStats,
+    TerminationTracer,
+};
 pub use decision::{Decision, LocalStats, PathState, arrive_area_spread, decide, path_threshold};
 pub use moments::{RecordMoments, vertex_estimates};
 pub use rule::TerminationRule;

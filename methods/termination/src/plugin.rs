@@ -1,16 +1,21 @@
 //! Path tracing terminated into a hashed radiance cache by variance trading
-//! (render::termination, ../shared/seeds/variance-trading-termination.txt). Three systems: in
-//! Render the records' update (`update`: propagation and fold, after the warm-up on the first
-//! frame) and the image (`trace`: the tracer with the rule's decision), which reports the image,
-//! the pass times (tc_trace and tc_propagate separately) and the mean path length
-//! (`path_length`, vertices per path counted on the GPU), with the per-pixel path length as the
-//! image `path_length` (the paper's Fig. 11); in Learn the vertex store (`store`), whose time
-//! joins the frame's. Propagation traces the frame's scene from its camera and the fold feeds
-//! the image, so both stay before it.
+//! (render::termination, ../shared/seeds/variance-trading-termination.txt). The methods whose
+//! settings have one [`TerminationSettings::cache_key`] share one [`SharedTerminationCache`]
+//! entity (their records are bit-identical, as the paper's rules share one propagation); each
+//! method has its own tracer. Three systems: in Render the records' update once per cache
+//! (`update`: propagation and fold, after the warm-up on the first frame) and each method's
+//! image (`trace`: the tracer with the rule's decision), which reports the image, the pass
+//! times and the mean path length (`path_length`, vertices per path counted on the GPU), with
+//! the per-pixel path length as the image `path_length` (the paper's Fig. 11); in Learn the
+//! insertion and vertex store once per cache (`store`). The cache's passes (tc_propagate,
+//! tc_fold, tc_insert, tc_store) and their CPU time are reported by the cache's first method
+//! (its owner) only; every method reports its own tc_trace. Propagation traces the frame's
+//! scene from its camera and the fold feeds the image, so both stay before it.
 
 use std::time::Instant;
 
 use crate::TerminationCache;
+use crate::TerminationTracer;
 use anyhow::Result;
 use bevy_ecs::prelude::*;
 use render::timing::PassTiming;
@@ -25,11 +30,23 @@ pub fn label(s: &TerminationSettings) -> String {
     format!("termination_{}", s.rule.label())
 }
 
+/// One cache shared by the methods with its key: its passes run once a frame.
+#[derive(Component)]
+pub struct SharedTerminationCache {
+    key: TerminationSettings,
+    cache: TerminationCache,
+    /// The first method of this cache: it offers the primary vertices and reports the
+    /// cache's passes.
+    owner: Entity,
+    /// This frame's update times, from `update` to the owner's `trace`.
+    updated: Option<Vec<PassTiming>>,
+}
+
+/// One termination method: its tracer over its cache.
 #[derive(Component)]
 pub struct TerminationState {
-    cache: TerminationCache,
-    /// This frame's update times, from `update` to `trace`.
-    updated: Option<Vec<PassTiming>>,
+    cache: Entity,
+    tracer: TerminationTracer,
 }
 
 pub struct Plugin;
@@ -56,48 +73,78 @@ impl MethodPlugin for Plugin {
     }
 
     fn spawn(world: &mut World, entity: Entity, settings: &TerminationSettings) -> Result<()> {
-        let (gpu, gpu_scene) = (&world.resource::<GpuDevice>().0, &world.resource::<GpuScene>().0);
-        // Validates the settings and checks the cache's buffers against the adapter's limits.
-        let cache = TerminationCache::new(gpu, gpu_scene, *settings)?;
-        world.entity_mut(entity).insert(TerminationState { cache, updated: None });
+        settings.validate()?;
+        let key = settings.cache_key();
+        let existing = world
+            .query::<(Entity, &SharedTerminationCache)>()
+            .iter(world)
+            .find(|(_, c)| c.key == key)
+            .map(|(e, _)| e);
+        let (cache, offers) = match existing {
+            Some(e) => (e, false),
+            None => {
+                let (gpu, gpu_scene) =
+                    (&world.resource::<GpuDevice>().0, &world.resource::<GpuScene>().0);
+                // Checks the cache's buffers against the adapter's limits.
+                let cache = TerminationCache::new(gpu, gpu_scene, *settings)?;
+                let shared = SharedTerminationCache { key, cache, owner: entity, updated: None };
+                (world.spawn(shared).id(), true)
+            }
+        };
+        let tracer = {
+            let gpu = &world.resource::<GpuDevice>().0;
+            let shared = world.get::<SharedTerminationCache>(cache).expect("a cache entity");
+            shared.cache.tracer(gpu, *settings, offers)?
+        };
+        world.entity_mut(entity).insert(TerminationState { cache, tracer });
         Ok(())
     }
 }
 
-/// The records the image reads: the warm-up on the first frame, then propagation and fold.
+/// The records the images read, once per cache: the warm-up on the first frame, then
+/// propagation and fold. The CPU time is the owner's.
 pub fn update(
     gpu: Res<GpuDevice>,
     gpu_scene: Res<GpuScene>,
     run: Res<Run>,
     clock: Res<FrameClock>,
     scene: Res<sim::ExtractedScene>,
-    mut methods: Query<(&mut TerminationState, &MethodInfo, &mut MethodFrame)>,
+    mut caches: Query<&mut SharedTerminationCache>,
+    mut methods: Query<(&MethodInfo, &mut MethodFrame)>,
 ) -> Result<(), BevyError> {
-    for (mut state, info, mut frame) in &mut methods {
+    for mut shared in &mut caches {
         let start = Instant::now();
-        let updated = state
+        let Ok((info, mut frame)) = methods.get_mut(shared.owner) else {
+            return Err(method_failed("termination", clock.global, "a cache without its owner"));
+        };
+        let updated = shared
             .cache
             .update(&gpu.0, &gpu_scene.0, &scene.scene.camera, run.scenario.seed, clock.global)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
-        state.updated = Some(updated);
+        shared.updated = Some(updated);
         frame.add_cpu(start);
     }
     Ok(())
 }
 
 /// The frame's image (one path per pixel, the rule deciding at every vertex) and its output.
+/// The owner's output starts with the cache's update times.
 pub fn trace(
     gpu: Res<GpuDevice>,
     gpu_scene: Res<GpuScene>,
     clock: Res<FrameClock>,
-    mut methods: Query<(&mut TerminationState, &MethodInfo, &mut MethodFrame)>,
+    mut caches: Query<&mut SharedTerminationCache>,
+    mut methods: Query<(Entity, &TerminationState, &MethodInfo, &mut MethodFrame)>,
 ) -> Result<(), BevyError> {
-    for (mut state, info, mut frame) in &mut methods {
+    for (entity, state, info, mut frame) in &mut methods {
         let start = Instant::now();
-        let updated = state.updated.take().unwrap_or_default();
-        let out = state
+        let mut shared =
+            caches.get_mut(state.cache).map_err(|e| method_failed(&info.label, clock.global, e))?;
+        let updated =
+            if shared.owner == entity { shared.updated.take() } else { None }.unwrap_or_default();
+        let out = shared
             .cache
-            .trace(&gpu.0, &gpu_scene.0, updated)
+            .trace_with(&gpu.0, &gpu_scene.0, &state.tracer, updated)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let s = out.stats;
         frame.output = Some(MethodOutput {
@@ -113,7 +160,7 @@ pub fn trace(
                 ("cache_mean_p10".into(), out.cache.mean_quantiles[0]),
                 ("cache_mean_p50".into(), out.cache.mean_quantiles[1]),
                 ("cache_mean_p90".into(), out.cache.mean_quantiles[2]),
-                ("cache_bytes".into(), state.cache.cache_bytes() as f64),
+                ("cache_bytes".into(), shared.cache.cache_bytes() as f64),
                 ("cache_unknown_vertices".into(), s.unknown as f64),
                 ("cache_propagated_vertices".into(), s.propagated as f64),
                 // Propagated vertices with a sample that read no filled record: left out of
@@ -135,40 +182,46 @@ pub fn trace(
     Ok(())
 }
 
-/// After the image: the frame's candidates become the stored vertices the next frame
-/// propagates; the pass time joins the frame's output.
+/// After the images, once per cache: the frame's candidates become the stored vertices the
+/// next frame propagates; the pass times join the owner's output, the insertion failures every
+/// method's.
 pub fn store(
     gpu: Res<GpuDevice>,
     gpu_scene: Res<GpuScene>,
     clock: Res<FrameClock>,
-    mut methods: Query<(&mut TerminationState, &MethodInfo, &mut MethodFrame)>,
+    mut caches: Query<(Entity, &mut SharedTerminationCache)>,
+    mut methods: Query<(Entity, &TerminationState, &MethodInfo, &mut MethodFrame)>,
 ) -> Result<(), BevyError> {
-    for (mut state, info, mut frame) in &mut methods {
+    for (cache, mut shared) in &mut caches {
         let start = Instant::now();
-        let timings = state
-            .cache
-            .store(&gpu.0, &gpu_scene.0)
-            .map_err(|e| method_failed(&info.label, clock.global, e))?;
-        let Some(output) = frame.output.as_mut() else {
-            return Err(method_failed(
-                &info.label,
-                clock.global,
-                "the vertex store ran before the frame's image",
-            ));
-        };
-        output.add_timed(&timings);
+        let owner = shared.owner;
+        let fail = |e| method_failed("termination", clock.global, e);
+        let timings = shared.cache.store(&gpu.0, &gpu_scene.0).map_err(fail)?;
         // Insertions are settled after the image: their failures are counted by now.
-        let failures = state
-            .cache
-            .read_counters(&gpu.0)
-            .map_err(|e| method_failed(&info.label, clock.global, e))?
-            .insert_failures;
-        if let Some(stat) =
-            output.stats.iter_mut().find(|(name, _)| name == "cache_insert_failures")
-        {
-            stat.1 = failures as f64;
+        let failures = shared.cache.read_counters(&gpu.0).map_err(fail)?.insert_failures;
+        for (entity, state, info, mut frame) in &mut methods {
+            if state.cache != cache {
+                continue;
+            }
+            let Some(output) = frame.output.as_mut() else {
+                return Err(method_failed(
+                    &info.label,
+                    clock.global,
+                    "the vertex store ran before the frame's image",
+                ));
+            };
+            if entity == owner {
+                output.add_timed(&timings);
+            }
+            if let Some(stat) =
+                output.stats.iter_mut().find(|(name, _)| name == "cache_insert_failures")
+            {
+                stat.1 = failures as f64;
+            }
+            if entity == owner {
+                frame.add_cpu(start);
+            }
         }
-        frame.add_cpu(start);
     }
     Ok(())
 }

@@ -118,6 +118,18 @@ impl TerminationSettings {
         Ok(())
     }
 
+    /// Settings with equal keys build bit-identical records, so their rules can share one cache
+    /// (one propagation a frame): everything but the rule, the survival probability and the
+    /// radiance unit, which only the trace reads. Path tracing is its own key: it skips the
+    /// lookup's random numbers at the first vertex, so its stored vertices differ.
+    pub fn cache_key(&self) -> TerminationSettings {
+        let rule = match self.rule {
+            TerminationRule::PathTracing => TerminationRule::PathTracing,
+            _ => TerminationRule::FirstVertex,
+        };
+        TerminationSettings { rule, survival: 1.0, radiance_unit: 1.0, ..*self }
+    }
+
     /// Bytes of the cache's records (what `Gpu::check_buffer_size` sees per buffer is less).
     pub fn cache_bytes(&self) -> u64 {
         self.capacity as u64 * BYTES_PER_RECORD

@@ -206,16 +206,20 @@ pub fn speed_accuracy_charts(manifest: &Manifest, frames: &Frames) -> Vec<(Strin
     let trace = frames.column("gpu_ms_tc_trace").filter(|&c| frames.has_data(c));
     let propagate = frames.column("gpu_ms_tc_propagate").filter(|&c| frames.has_data(c));
     if let (Some(trace), Some(propagate)) = (trace, propagate) {
+        // Rules that share a cache report its propagation in the row of its first method (the
+        // rules listed before path tracing, which has its own): a rule without one reads the
+        // nearest method above it that has one.
+        let methods = frames.methods();
+        let propagation = |method: &str| {
+            let at = methods.iter().position(|m| m == method)?;
+            methods[..=at].iter().rev().find_map(|m| mean(&frames.series(m, propagate)))
+        };
         out.extend(scatter_charts(
             manifest,
             frames,
             "_tracer_propagation",
             "mean tracer + propagation GPU time (ms)",
-            |method| {
-                Some(
-                    mean(&frames.series(method, trace))? + mean(&frames.series(method, propagate))?,
-                )
-            },
+            |method| Some(mean(&frames.series(method, trace))? + propagation(method)?),
         ));
     }
     out
@@ -458,9 +462,10 @@ mod tests {
     fn termination_runs_chart_tracer_plus_propagation_time_with_its_pareto_front() {
         // Three rules and a path tracer without the cache's passes: the termination chart's x is
         // the mean of tc_trace plus the mean of tc_propagate; the path tracer is left out of it.
+        // mse shares vb's cache (no propagation of its own): it reads vb's.
         let csv = "method,frame,gpu_ms_total,gpu_ms_tc_trace,gpu_ms_tc_propagate,gpu_ms_pt,flip,smape\n\
                    vb,0,9,2,5,,0.5,\nvb,1,9,4,5,,,0.2\n\
-                   mse,0,9,1,5,,0.6,\nmse,1,9,1,5,,,0.1\n\
+                   mse,0,9,1,,,0.6,\nmse,1,9,1,,,,0.1\n\
                    spread,0,1,4,4,,0.7,\nspread,1,1,4,4,,,0.3\n\
                    pt,0,3,,,3,0.4,\npt,1,3,,,3,,0.4\n";
         let frames = Frames::parse(csv, Path::new("frames.csv")).unwrap();
