@@ -217,3 +217,88 @@ fn computed_cases_are_checked_at_file_and_line() {
     let e = load_with(fig4, &on("Mse", "vb_0.1", "bound_0.1"));
     assert!(e.contains("bad.ron:5") && e.contains("thresholds -1"), "{e}");
 }
+
+/// A metric computed from images (`SssPsnr`) names its reference method, of the case and of
+/// the metric's kind, one per case; a frames.csv metric names none: errors at the claim's line.
+#[test]
+fn image_metrics_name_their_reference_method() {
+    let toggle = "(name: \"toggle\", scenario: \"../scenarios/sss_toggle.ron\", seeds: [1, 2])";
+    let on = |statistic: &str| {
+        format!(
+            "(id: \"c\", claim: \"c\", source: \"Table 7.3\", paper: \"p\", case: \"toggle\", statistic: {statistic}, comparison: Below(method: \"ccv\", than: \"as\"), tolerance_from: \"seeds\")"
+        )
+    };
+    let e = load_with(toggle, &on("(metric: SssPsnr, window: Overall)"));
+    assert!(e.contains("bad.ron:8") && e.contains("needs a reference method"), "{e}");
+    let e = load_with(toggle, &on("(metric: SssPsnr, window: Overall, against: \"pass_1024\")"));
+    assert!(e.contains("bad.ron:8") && e.contains("against: no method 'pass_1024'"), "{e}");
+    let e = load_with(toggle, &on("(metric: Smape, window: Overall, against: \"pass_2048\")"));
+    assert!(e.contains("bad.ron:8") && e.contains("read from frames.csv"), "{e}");
+    // The case's methods chosen without the reference: it is not played.
+    let without = toggle.replace("seeds:", "methods: [\"as\", \"ccv\"], seeds:");
+    let e = load_with(&without, &on("(metric: SssPsnr, window: Overall, against: \"pass_2048\")"));
+    assert!(e.contains("bad.ron:8") && e.contains("against: no method 'pass_2048'"), "{e}");
+    // Two claims on one case against different references.
+    let two = format!(
+        "{},\n        {}",
+        on("(metric: SssPsnr, window: Overall, against: \"pass_2048\")"),
+        on("(metric: SssPsnr, window: Overall, against: \"fixed64\")")
+            .replace("\"c\", claim", "\"d\", claim")
+    );
+    let e = load_with(toggle, &two);
+    assert!(e.contains("bad.ron:9") && e.contains("one reference per case"), "{e}");
+    // The shipped SSS claims load, and their case plays the reference.
+    let claims = Claims::load(&root().join("claims/realtime-sss-thesis.ron")).unwrap();
+    let case = &claims.cases_for(tools::reproduce::Scale::Smoke, None)[0];
+    assert!(case.methods.as_ref().unwrap().iter().any(|m| m == "pass_2048"));
+}
+
+#[test]
+fn differences_are_judged_by_their_interval_against_the_band() {
+    let difference = |value: f64, tolerance: f64| Comparison::Difference {
+        method: "a".into(),
+        to: "b".into(),
+        value,
+        tolerance,
+        confidence: 0.95,
+    };
+    // a − b = 0.29, 0.30, 0.31: mean 0.30, standard error 0.0058, t(0.975, 2) = 4.30: 0.30 ±
+    // 0.025.
+    let v = || values(vec![47.85, 47.86, 47.87], vec![47.56, 47.56, 47.56]);
+    assert_eq!(judge(&difference(0.3, 0.1), &v()).verdict, Verdict::Reproduced);
+    assert_eq!(judge(&difference(1.76, 0.1), &v()).verdict, Verdict::NotReproduced);
+    // The sign matters: b − a is −0.30.
+    assert_eq!(judge(&difference(-0.3, 0.1), &v()).verdict, Verdict::NotReproduced);
+    assert!(matches!(judge(&difference(0.4, 0.08), &v()).verdict, Verdict::NotComparable(_)));
+    let short = judge(&difference(0.3, 0.1), &values(vec![1.0, 2.0], vec![1.0]));
+    assert!(
+        matches!(short.verdict, Verdict::NotComparable(ref w) if w.contains("same seeds")),
+        "{:?}",
+        short.verdict
+    );
+}
+
+/// `not_run` (passes of a shared cache a method would not run alone) goes with FrameMs only, on
+/// methods of the case, one attribution per case: errors at the claim's line.
+#[test]
+fn passes_not_run_alone_are_checked_at_file_and_line() {
+    let cornell = "(name: \"cornell\", scenario: \"../scenarios/light_rotation_cornell_box.ron\", seeds: [1, 2])";
+    let on = |statistic: &str| {
+        format!(
+            "(id: \"c\", claim: \"c\", source: \"Table 1\", paper: \"p\", case: \"cornell\", statistic: {statistic}, comparison: Ratio(method: \"nirc_blend_1spp\", to: \"nirc_ema_1spp\", value: 1.03, tolerance: 0.01), tolerance_from: \"paper\")"
+        )
+    };
+    let ms = |not_run: &str| format!("(metric: FrameMs, window: Overall, not_run: {not_run})");
+    let e = load_with(cornell, &on(&ms("[(\"nirc_emma_1spp\", [\"nirc_reliability\"])]")));
+    assert!(e.contains("bad.ron:8") && e.contains("not_run: no method 'nirc_emma_1spp'"), "{e}");
+    let flip = "(metric: Flip, window: Overall, not_run: [(\"nirc_ema_1spp\", [\"nirc_ema\"])])";
+    let e = load_with(cornell, &on(flip));
+    assert!(e.contains("bad.ron:8") && e.contains("only with FrameMs"), "{e}");
+    let two = format!(
+        "{},\n        {}",
+        on(&ms("[(\"nirc_ema_1spp\", [\"nirc_reliability\"])]")),
+        on(&ms("[]")).replace("\"c\", claim", "\"d\", claim")
+    );
+    let e = load_with(cornell, &two);
+    assert!(e.contains("bad.ron:9") && e.contains("one attribution per case"), "{e}");
+}

@@ -100,11 +100,27 @@ pub struct ClaimCase {
 pub struct Statistic {
     pub metric: Metric,
     pub window: Window,
+    /// The method of the case whose frames are the reference of a metric computed from images
+    /// (`SssPsnr`: the converged pass); only for those, and one per case.
+    #[serde(default)]
+    pub against: Option<String>,
+    /// `FrameMs` only: per method label, passes of a cache it shares with other methods of the
+    /// run that it would not run alone, left out of its time (`reproduce::alone`): a paper that
+    /// times each method in its own run charges it only what it runs. One list per case.
+    #[serde(default)]
+    pub not_run: Vec<(String, Vec<String>)>,
 }
 
 impl Statistic {
     pub fn describe(&self) -> String {
-        format!("{} {}", self.metric.name(), self.window.name())
+        let mut name = self.metric.name().to_string();
+        if let Some(a) = &self.against {
+            name.push_str(&format!(" vs {a}"));
+        }
+        for (m, passes) in &self.not_run {
+            name.push_str(&format!(" ({m} without {})", passes.join(", ")));
+        }
+        format!("{name} {}", self.window.name())
     }
 }
 
@@ -143,6 +159,17 @@ pub enum Comparison {
         #[serde(default = "default_confidence")]
         confidence: f64,
     },
+    /// `Difference(method: "a", to: "b", value: 0.3, tolerance: 0.2)`: the per-seed difference
+    /// a − b lies within value ± tolerance (for a logarithmic statistic such as PSNR in dB,
+    /// where a ratio of values means nothing).
+    Difference {
+        method: String,
+        to: String,
+        value: f64,
+        tolerance: f64,
+        #[serde(default = "default_confidence")]
+        confidence: f64,
+    },
     /// `Rises(method: "a", from: Before(event: 0))`: a's statistic over the claim's window is
     /// higher than over `from`, judged as the paired per-seed differences of `Below`.
     Rises {
@@ -164,7 +191,9 @@ impl Comparison {
         match self {
             Comparison::Below { method, than, .. } => vec![method, than],
             Comparison::Value { method, .. } | Comparison::Rises { method, .. } => vec![method],
-            Comparison::Ratio { method, to, .. } => vec![method, to],
+            Comparison::Ratio { method, to, .. } | Comparison::Difference { method, to, .. } => {
+                vec![method, to]
+            }
             Comparison::NotComparable { methods, .. } => {
                 methods.iter().map(|m| m.as_str()).collect()
             }
@@ -179,6 +208,9 @@ impl Comparison {
             }
             Comparison::Ratio { method, to, value, tolerance, .. } => {
                 format!("{method} / {to} = {value} ± {tolerance}")
+            }
+            Comparison::Difference { method, to, value, tolerance, .. } => {
+                format!("{method} − {to} = {value} ± {tolerance}")
             }
             Comparison::Rises { method, from, .. } => {
                 format!("{method} rises from {}", from.name())
@@ -304,6 +336,86 @@ fn expand_set(
     Ok(out)
 }
 
+/// A metric computed from images names a reference method (`against`) of the case, of the
+/// metric's kind, the same for every claim on the case; other metrics name none.
+fn check_against(
+    s: &Statistic,
+    case: &CaseMethods,
+    name: &str,
+    seen: &mut BTreeMap<String, String>,
+) -> Result<(), String> {
+    let metric = s.metric.name();
+    let Some(a) = &s.against else {
+        return if s.metric.from_images() {
+            Err(format!(
+                "the statistic {metric} needs a reference method; expected e.g. against: \"pass_2048\""
+            ))
+        } else {
+            Ok(())
+        };
+    };
+    if !s.metric.from_images() {
+        return Err(format!(
+            "against: \"{a}\" with the statistic {metric}, which is read from frames.csv; expected no against"
+        ));
+    }
+    let Some(kind) = case.kinds.get(a) else {
+        return Err(format!(
+            "against: no method '{a}' in case '{name}'; its methods are: {}",
+            case.kinds.keys().cloned().collect::<Vec<_>>().join(", ")
+        ));
+    };
+    if !s.metric.recorded_by(kind, case.references) {
+        return Err(format!("against: '{a}' ({kind}) has no images {metric} can be measured on"));
+    }
+    match seen.get(name) {
+        Some(other) if other != a => Err(format!(
+            "against: '{a}', but another claim on case '{name}' measures {metric} against '{other}'; expected one reference per case"
+        )),
+        _ => {
+            seen.insert(name.to_string(), a.clone());
+            Ok(())
+        }
+    }
+}
+
+/// `not_run` only with `FrameMs`, on methods of the case, and the same for every `FrameMs`
+/// claim on the case (one time per method and frame).
+fn check_not_run(
+    s: &Statistic,
+    case: &CaseMethods,
+    name: &str,
+    seen: &mut BTreeMap<String, Vec<(String, Vec<String>)>>,
+) -> Result<(), String> {
+    if s.metric != Metric::FrameMs {
+        return match s.not_run.first() {
+            Some(_) => Err(format!(
+                "not_run with the statistic {}; expected it only with FrameMs",
+                s.metric.name()
+            )),
+            None => Ok(()),
+        };
+    }
+    if let Some((m, _)) = s.not_run.iter().find(|(m, _)| !case.kinds.contains_key(m)) {
+        return Err(format!(
+            "not_run: no method '{m}' in case '{name}'; its methods are: {}",
+            case.kinds.keys().cloned().collect::<Vec<_>>().join(", ")
+        ));
+    }
+    if case.computed.is_some() && !s.not_run.is_empty() {
+        return Err("not_run on a computed case, which has no passes".into());
+    }
+    match seen.get(name) {
+        Some(other) if *other != s.not_run => Err(format!(
+            "not_run differs from another FrameMs claim's on case '{name}'; expected one attribution per case"
+        )),
+        _ => {
+            seen.insert(name.to_string(), s.not_run.clone());
+            Ok(())
+        }
+    }
+}
+
 fn check_confidence(file: RonFile, line: usize, c: f64) -> Result<(), ScenarioError> {
     if c > 0.5 && c < 1.0 {
         Ok(())
@@ -411,6 +523,10 @@ impl Claims {
             cases.push(case);
         }
         let mut claims: Vec<Claim> = Vec::new();
+        // Per case, the reference method of its metrics computed from images.
+        let mut against: BTreeMap<String, String> = BTreeMap::new();
+        // Per case, the passes its methods' FrameMs leaves out.
+        let mut not_run: BTreeMap<String, Vec<(String, Vec<String>)>> = BTreeMap::new();
         for entry in file.entries("claims", &parsed.claims) {
             let mut claim: Claim = file.entry(&entry)?;
             claim.line = entry.line;
@@ -423,7 +539,8 @@ impl Claims {
                     check_confidence(file, entry.line, *confidence)?
                 }
                 Comparison::Value { confidence, tolerance, .. }
-                | Comparison::Ratio { confidence, tolerance, .. } => {
+                | Comparison::Ratio { confidence, tolerance, .. }
+                | Comparison::Difference { confidence, tolerance, .. } => {
                     check_confidence(file, entry.line, *confidence)?;
                     if !(tolerance.is_finite() && *tolerance >= 0.0) {
                         return Err(at(format!("tolerance {tolerance}; expected a number >= 0")));
@@ -448,6 +565,11 @@ impl Claims {
                 return Err(at(
                     "no statistic; expected e.g. statistic: (metric: Flip, window: Overall)".into(),
                 ));
+            }
+            if let (Some(case), Some(s)) = (case, &claim.statistic) {
+                let name = claim.case.as_deref().unwrap_or_default();
+                check_against(s, case, name, &mut against).map_err(at)?;
+                check_not_run(s, case, name, &mut not_run).map_err(at)?;
             }
             if let Some(case) = case {
                 for m in claim.comparison.methods() {

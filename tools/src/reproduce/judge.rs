@@ -1,7 +1,7 @@
 //! Judging one claim on per-seed values: a relation between two methods by the one-sided upper
-//! bound of their paired differences, a value or ratio by its two-sided interval against the
-//! claim's band. Too few seeds, a missing value or an interval wider than the band is "not
-//! comparable", with the reason.
+//! bound of their paired differences, a value, ratio or difference by its two-sided interval
+//! against the claim's band. Too few seeds, a missing value or an interval wider than the band
+//! is "not comparable", with the reason.
 
 use super::claims::Comparison;
 use crate::suite::student_t;
@@ -71,6 +71,20 @@ fn paired_below(a: Vec<f64>, b: Vec<f64>, confidence: f64) -> Judged {
     Judged { flicker, verdict, values: [a, b].concat() }
 }
 
+/// Two methods' per-seed values combined seed by seed (`what`: "a ratio"), or why not.
+fn paired(
+    a: Result<Vec<f64>, String>,
+    b: Result<Vec<f64>, String>,
+    what: &str,
+    combine: impl Fn(Vec<f64>, Vec<f64>) -> Result<Vec<f64>, String>,
+) -> Result<Vec<f64>, String> {
+    let (a, b) = (a?, b?);
+    if a.len() != b.len() {
+        return Err(format!("{} and {} seed(s); {what} needs the same seeds", a.len(), b.len()));
+    }
+    combine(a, b)
+}
+
 /// Judges `comparison` with `per_seed(method, window)`: one value per seed (the same seeds, in
 /// the same order, for every method) over `window` (`None`: the claim's), or why there is none.
 pub fn judge(
@@ -120,20 +134,23 @@ pub fn judge(
             Err(e) => not_comparable(e),
         },
         Comparison::Ratio { method, to, value, tolerance, confidence } => {
-            match (values(method), values(to)) {
-                (Ok(a), Ok(b)) if a.len() == b.len() => {
-                    if b.contains(&0.0) {
-                        return not_comparable(format!("{to} is 0 in a seed; no ratio"));
-                    }
-                    let r: Vec<f64> = a.iter().zip(&b).map(|(x, y)| x / y).collect();
-                    band(r, *value, *tolerance, *confidence)
+            let per_seed = |a: Vec<f64>, b: Vec<f64>| {
+                if b.contains(&0.0) {
+                    return Err(format!("{to} is 0 in a seed; no ratio"));
                 }
-                (Ok(a), Ok(b)) => not_comparable(format!(
-                    "{} and {} seed(s); a ratio needs the same seeds",
-                    a.len(),
-                    b.len()
-                )),
-                (Err(e), _) | (_, Err(e)) => not_comparable(e),
+                Ok(a.iter().zip(&b).map(|(x, y)| x / y).collect())
+            };
+            match paired(values(method), values(to), "a ratio", per_seed) {
+                Ok(r) => band(r, *value, *tolerance, *confidence),
+                Err(e) => not_comparable(e),
+            }
+        }
+        Comparison::Difference { method, to, value, tolerance, confidence } => {
+            let per_seed =
+                |a: Vec<f64>, b: Vec<f64>| Ok(a.iter().zip(&b).map(|(x, y)| x - y).collect());
+            match paired(values(method), values(to), "a difference", per_seed) {
+                Ok(d) => band(d, *value, *tolerance, *confidence),
+                Err(e) => not_comparable(e),
             }
         }
     }

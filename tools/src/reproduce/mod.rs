@@ -2,11 +2,13 @@
 //! over seeds through the suite machinery, each judged reproduced / not reproduced / not
 //! comparable, written as reproduce.md and reproduce.html beside the paper's numbers.
 
+pub mod alone;
 pub mod claims;
 pub mod computation;
 pub mod judge;
 pub mod report;
 pub mod run;
+pub mod sss_psnr;
 pub mod table;
 
 pub use claims::{Claim, Claims, Comparison, Scale};

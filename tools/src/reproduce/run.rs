@@ -1,6 +1,7 @@
 //! Playing what the claims need: each paper's cases over seeds through the suite's
 //! `play_cases`, then every claim judged on its case's per-seed window means.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Result, bail};
@@ -9,6 +10,7 @@ use super::claims::{Claims, Comparison, Scale};
 use super::judge::{Judged, judge};
 use super::report::{self, PaperResult};
 use super::table::case_tables;
+use crate::suite::measurement::CaseRuns;
 use crate::suite::run::play_cases;
 
 pub struct ReproduceOptions {
@@ -64,6 +66,35 @@ pub fn load_claims(dir: &Path, paper: &str) -> Result<Vec<Claims>> {
     paths.iter().map(|p| Claims::load(p).map_err(anyhow::Error::from)).collect()
 }
 
+/// What the claims' statistics read from the run folders rather than frame records, added to
+/// each played seed's run once per case: `SssPsnr` against the claim's `against` method, and
+/// `FrameMs` less the shared passes a method would not run alone (`not_run`).
+fn add_from_folders(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> Result<()> {
+    let (mut images, mut alone): (Vec<&str>, Vec<&str>) = (Vec::new(), Vec::new());
+    for c in &claims.claims {
+        let (Some(case), Some(s)) = (&c.case, &c.statistic) else { continue };
+        let Some(r) = runs.get_mut(case) else { continue };
+        let at = |e: anyhow::Error| anyhow::anyhow!("case '{case}': {}: {e:#}", s.describe());
+        if let Some(against) = &s.against
+            && s.metric.from_images()
+            && !images.contains(&case.as_str())
+        {
+            images.push(case);
+            let frames = r.frames;
+            for seed in &mut r.seeds {
+                super::sss_psnr::add(seed, against, frames).map_err(at)?;
+            }
+        }
+        if !s.not_run.is_empty() && !alone.contains(&case.as_str()) {
+            alone.push(case);
+            for seed in &mut r.seeds {
+                super::alone::leave_out(seed, &s.not_run).map_err(at)?;
+            }
+        }
+    }
+    Ok(())
+}
+
 /// `flicker reproduce`: plays, judges, writes reproduce.md and reproduce.html.
 pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
     if opts.seeds.is_some_and(|n| n < 2) {
@@ -95,6 +126,7 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
                 );
             }
         }
+        add_from_folders(claims, &mut runs)?;
         let mut judged = Vec::new();
         for c in &claims.claims {
             let j = match (c.case.as_ref().and_then(|n| runs.get(n)), &c.statistic) {

@@ -41,6 +41,11 @@ pub enum Metric {
     PrimaryRays,
     /// Mean blend weight σ of the High-LR side over the image (Nirc's `blend_sigma` stat).
     BlendSigma,
+    /// PSNR (dB) of luminance over the SSS pixels against another method's frames of the same
+    /// run (realtime-sss-thesis Table 7.3 against its converged pass). Not a frames.csv column:
+    /// `flicker reproduce` computes it from the run folder's images (`from_images`), so it is
+    /// not in `ALL` and no suite gate reads it.
+    SssPsnr,
 }
 
 impl Metric {
@@ -81,12 +86,19 @@ impl Metric {
             Metric::SssSpp => "sss_mean_spp",
             Metric::PrimaryRays => "primary_rays",
             Metric::BlendSigma => "blend_sigma",
+            Metric::SssPsnr => "sss_psnr",
         }
     }
 
     /// Errors get worse upwards, PSNR and JOD downwards.
     pub fn higher_is_better(self) -> bool {
-        matches!(self, Metric::Psnr | Metric::Cvvdp)
+        matches!(self, Metric::Psnr | Metric::Cvvdp | Metric::SssPsnr)
+    }
+
+    /// Computed from a run's images against another method's (`reproduce::sss_psnr`), not read
+    /// from frame records.
+    pub fn from_images(self) -> bool {
+        self == Metric::SssPsnr
     }
 
     /// Whether the metric is a per-frame number (its window value is a mean of frames); JOD is
@@ -115,6 +127,7 @@ impl Metric {
             Metric::SssSpp => kind == "Sss",
             Metric::PrimaryRays => kind == "SampleCache",
             Metric::BlendSigma => kind == "Nirc",
+            Metric::SssPsnr => kind == "Sss",
         }
     }
 
@@ -126,7 +139,7 @@ impl Metric {
             Metric::Mse => r.mse,
             Metric::RelMse => r.rel_mse,
             Metric::Psnr => r.psnr,
-            Metric::Cvvdp => None,
+            Metric::Cvvdp | Metric::SssPsnr => None,
             Metric::FrameMs => r.passes_total_ms(),
             Metric::Rays => r.rays.map(|n| n as f64),
             Metric::Shaded => r.shaded.map(|n| n as f64),

@@ -234,6 +234,15 @@ impl Suite {
                     ),
                 ));
             }
+            if gate.metric.from_images() {
+                return Err(file.error_at(
+                    &entry,
+                    format!(
+                        "metric {} is computed by `flicker reproduce` against a claim's `against` method; expected a metric of frames.csv",
+                        gate.metric.name()
+                    ),
+                ));
+            }
             match gate.bound {
                 Bound::Relative { tolerance: t } if !(t.is_finite() && t >= 0.0) => {
                     return Err(file.error_at(
