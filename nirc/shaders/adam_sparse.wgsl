@@ -1,14 +1,11 @@
 // Sparse updates of the hash grid (`optimizer.sparse_grid`; CPU mirror: the grid branch of
 // src/cpu/cache.rs). tiny-cuda-nn's Adam skips every grid parameter whose gradient is exactly
 // zero this step and debiases each with its own step count; here Adam and the EMA both do.
-// The training pass lists each grid quad its scatter touched once (sparse_mark, generated in
-// src/gpu/shaders.rs); these passes run over that list only, with indirect dispatches sized by
-// `list_touched`. The list's order depends on the threads, but each quad's update reads and
-// writes that quad alone, so the results do not. Per step:
-//   clear_touched   zeroes the previous step's listed accumulators and their bits
-//   reset_touched   empties the list (one thread)
-//   (the training pass lists the quads it scatters into)
-//   list_touched    the list's length and the dispatch size of the passes below (one thread)
+// The training pass marks each grid quad its scatter touched (sparse_mark, generated in
+// src/gpu/shaders.rs) and touched_list.wgsl lists the marked quads in ascending order; these
+// passes run over that list only, with indirect dispatches sized by it. Per step:
+//   clear_touched   zeroes the gradient sums of the previous step's list
+//   (the training pass marks the quads it scatters into; touched_list.wgsl lists them)
 //   check_grid, apply_grid, ema_grid   Adam's check and apply, then the EMA, over the list
 
 import package::nirc::config::{WG_SIZE};
@@ -20,46 +17,24 @@ import package::nirc::adam_step::{MLP_QUADS, Update, adam_m, adam_v, counters, e
 @group(0) @binding(11) var<storage, read_write> grid_steps: array<vec4<u32>>;
 // (β1^t, β2^t, α^t, 0) by step count t (cpu::optimizer::BiasPowers).
 @group(0) @binding(12) var<storage, read> bias_powers: array<vec4<f32>>;
-// Grid quads the step touched (relative to the grid's first quad), each once.
+// Grid quads the step touched (relative to the grid's first quad), ascending, each once.
 @group(0) @binding(13) var<storage, read> touched: array<u32>;
-// [0]: quads listed so far (the training pass appends), [1]: the list's length as the passes
-// over it read it (set by list_touched).
-@group(0) @binding(14) var<storage, read_write> touched_len: array<u32, 4>;
-// One bit per grid quad: listed this step.
-@group(0) @binding(15) var<storage, read_write> touched_bits: array<atomic<u32>>;
+// The list's length (touched_list.wgsl).
+@group(0) @binding(14) var<storage, read> touched_len: u32;
 // The gradient sums again, writable (only clear_touched binds them here).
 @group(0) @binding(16) var<storage, read_write> grid_accum_out: array<vec4<u32>>;
-// The indirect dispatch of the passes over the list: (workgroups, 1, 1).
-@group(0) @binding(17) var<storage, read_write> list_dispatch: array<u32, 4>;
-
-// Grid quads per invocation of the passes over the list (as PARAM_QUADS_PER_INVOCATION).
-const LIST_QUADS_PER_INVOCATION: u32 = 4u;
 
 @compute @workgroup_size(64)
 fn clear_touched(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let stride = groups.x * WG_SIZE;
-    for (var i = gid.x; i < touched_len[1]; i += stride) {
+    // Loaded once: on lavapipe every storage load is a loop over the SIMD lanes.
+    let n = touched_len;
+    for (var i = gid.x; i < n; i += stride) {
         let r = touched[i];
         grid_accum_out[3u * r] = vec4<u32>(0u);
         grid_accum_out[3u * r + 1u] = vec4<u32>(0u);
         grid_accum_out[3u * r + 2u] = vec4<u32>(0u);
-        atomicAnd(&touched_bits[r / 32u], ~(1u << (r % 32u)));
     }
-}
-
-@compute @workgroup_size(1)
-fn reset_touched() {
-    touched_len[0] = 0u;
-}
-
-@compute @workgroup_size(1)
-fn list_touched() {
-    let n = touched_len[0];
-    touched_len[1] = n;
-    let groups = (n + WG_SIZE * LIST_QUADS_PER_INVOCATION - 1u) / (WG_SIZE * LIST_QUADS_PER_INVOCATION);
-    list_dispatch[0] = min(groups, 65535u);
-    list_dispatch[1] = 1u;
-    list_dispatch[2] = 1u;
 }
 
 // The bias corrections of a quad whose parameters have taken `t` steps (this one included).
@@ -111,7 +86,8 @@ fn sparse_ema(q: u32, w1: vec4<f32>, moved: vec4<bool>, pw: SparsePowers) -> vec
 fn check_grid(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     var ok = true;
     let stride = groups.x * WG_SIZE;
-    for (var i = gid.x; i < touched_len[1]; i += stride) {
+    let n = touched_len;
+    for (var i = gid.x; i < n; i += stride) {
         let r = touched[i];
         let s = sparse_update(r);
         let e = sparse_ema(MLP_QUADS + r, s.u.w, s.moved, s.pw);
@@ -128,7 +104,8 @@ fn apply_grid(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         return;
     }
     let stride = groups.x * WG_SIZE;
-    for (var i = gid.x; i < touched_len[1]; i += stride) {
+    let n = touched_len;
+    for (var i = gid.x; i < n; i += stride) {
         let r = touched[i];
         let q = MLP_QUADS + r;
         let s = sparse_update(r);
@@ -146,7 +123,8 @@ fn ema_grid(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
         return;
     }
     let stride = groups.x * WG_SIZE;
-    for (var i = gid.x; i < touched_len[1]; i += stride) {
+    let n = touched_len;
+    for (var i = gid.x; i < n; i += stride) {
         let r = touched[i];
         let q = MLP_QUADS + r;
         // The steps were counted by apply_grid: the EMA debiases with the new counts.

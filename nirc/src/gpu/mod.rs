@@ -12,8 +12,8 @@
 //! 4. adam_ema check, apply   Adam; any non-finite value raises a flag and nothing is written
 //!    adam_ema ema_update     debiased EMA of the new weights (skipped on a flagged step)
 //!    (adam_sparse            with sparse grid updates, the grid's part of both over the quads
-//!                            the step touched only: clear and reset before pass 1, the list's
-//!                            dispatch size after it)
+//!                            the step touched only, listed in ascending order by touched_list
+//!                            after pass 3; the last step's sums cleared before pass 1)
 //! 5. reliability_walk        per cell (its list's head): the per-sample EMAs of the moments in
 //!                            record order
 //!    reliability_update      per cell: keep the new moments (or the batch-mean step)
@@ -120,9 +120,9 @@ struct Pipelines {
     infer: wgpu::ComputePipeline,
     /// The register form's staging of both predictors' MLP weights (lane_stage.wgsl).
     lane_stage: Option<wgpu::ComputePipeline>,
-    /// With sparse grid updates: clear_touched, reset_touched, list_touched, check_grid,
-    /// apply_grid, ema_grid (adam_sparse.wgsl).
-    sparse: Option<[wgpu::ComputePipeline; 6]>,
+    /// With sparse grid updates: clear_touched, check_grid, apply_grid, ema_grid
+    /// (adam_sparse.wgsl), count_blocks, scan_blocks, emit_list (touched_list.wgsl).
+    sparse: Option<[wgpu::ComputePipeline; 7]>,
 }
 
 /// The buffers of sparse grid updates (adam_sparse.wgsl).
@@ -131,10 +131,14 @@ struct SparseBuffers {
     grid_steps: wgpu::Buffer,
     /// `cpu::optimizer::BiasPowers`.
     bias_powers: wgpu::Buffer,
-    /// The grid quads the step touched, each once; their bits; [listed, list length, 0, 0].
+    /// The grid quads the step touched, ascending; their bits; the list's length.
     touched: wgpu::Buffer,
     touched_bits: wgpu::Buffer,
     touched_len: wgpu::Buffer,
+    /// Per block of the bitmask, its count and then its first slot (touched_list.wgsl).
+    block_offsets: wgpu::Buffer,
+    /// Blocks of the bitmask (workgroups of count_blocks and emit_list).
+    blocks: u32,
     /// The indirect dispatch of the passes over the list.
     list_dispatch: wgpu::Buffer,
 }
@@ -177,7 +181,7 @@ pub struct TrainStep {
     ema: wgpu::BindGroup,
     finish: wgpu::BindGroup,
     /// With sparse grid updates, the groups of adam_sparse.wgsl's passes (as `Pipelines::sparse`).
-    sparse: Option<[wgpu::BindGroup; 6]>,
+    sparse: Option<[wgpu::BindGroup; 7]>,
 }
 
 /// How many workgroups a dispatch runs: a count, or what the GPU wrote into a buffer.
@@ -212,6 +216,9 @@ pub struct NeuralCache {
 /// read from `counters`) is then paid once per 4 quads. On lavapipe one quad per invocation
 /// made these passes 1.3-1.6x slower (nirc/README.md); 16 was slower again.
 const PARAM_QUADS_PER_INVOCATION: u64 = 4;
+
+/// Words of the touched bitmask per block of touched_list.wgsl (its BLOCK_WORDS: 4 per thread).
+const TOUCHED_BLOCK_WORDS: u64 = 4 * WORKGROUP_SIZE as u64;
 
 fn groups_for(threads: u64) -> u32 {
     threads.div_ceil(WORKGROUP_SIZE as u64).clamp(1, 65535) as u32
@@ -436,19 +443,19 @@ impl NeuralCache {
         .expect("three pipelines");
         let tiled = placement.tiled_training();
         let sparse = if config.optimizer.sparse_grid {
-            Some(render::compute::pipelines_auto_layout(
+            let [clear, check, apply, ema] = render::compute::pipelines_auto_layout(
                 gpu,
                 "nirc adam_sparse",
                 &shaders::program(config, layout, "adam_sparse", grid_width),
-                [
-                    "clear_touched",
-                    "reset_touched",
-                    "list_touched",
-                    "check_grid",
-                    "apply_grid",
-                    "ema_grid",
-                ],
-            )?)
+                ["clear_touched", "check_grid", "apply_grid", "ema_grid"],
+            )?;
+            let [count, scan, emit] = render::compute::pipelines_auto_layout(
+                gpu,
+                "nirc touched_list",
+                &shaders::program(config, layout, "touched_list", grid_width),
+                ["count_blocks", "scan_blocks", "emit_list"],
+            )?;
+            Some([clear, check, apply, ema, count, scan, emit])
         } else {
             None
         };
@@ -605,6 +612,8 @@ impl NeuralCache {
             return Ok(None);
         }
         let quads = layout.grid_params() as u64 / 4;
+        let words = quads.div_ceil(32);
+        let blocks = words.div_ceil(TOUCHED_BLOCK_WORDS);
         let table = crate::cpu::optimizer::BiasPowers::new(&config.optimizer, &config.ema)?;
         Ok(Some(SparseBuffers {
             grid_steps: storage_init(
@@ -618,8 +627,10 @@ impl NeuralCache {
                 bytemuck::cast_slice(&table.rows),
             )?,
             touched: storage(gpu, "nirc touched grid quads", quads * 4)?,
-            touched_bits: storage(gpu, "nirc touched grid quad bits", quads.div_ceil(32) * 4)?,
+            touched_bits: storage(gpu, "nirc touched grid quad bits", words * 4)?,
             touched_len: storage(gpu, "nirc touched grid quad count", 16)?,
+            block_offsets: storage(gpu, "nirc touched grid blocks", blocks * 4)?,
+            blocks: blocks as u32,
             list_dispatch: {
                 gpu.check_buffer_size("nirc touched grid dispatch", 16)?;
                 gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -745,12 +756,7 @@ impl NeuralCache {
             fb_entries.push((10, &b.partials));
         }
         if let Some(sb) = &b.sparse {
-            let [bits, list, len] = shaders::SPARSE_MARK_BINDINGS;
-            fb_entries.extend([
-                (bits, &sb.touched_bits),
-                (list, &sb.touched),
-                (len, &sb.touched_len),
-            ]);
+            fb_entries.push((shaders::SPARSE_MARK_BINDING, &sb.touched_bits));
         }
         let fb = bind_with_views(
             gpu,
@@ -819,14 +825,14 @@ impl NeuralCache {
         }))
     }
 
-    /// The bind groups of adam_sparse.wgsl's passes for a step with `call`, in the order of
-    /// `Pipelines::sparse`; none without sparse grid updates.
-    fn sparse_groups(&self, gpu: &Gpu, call: &wgpu::Buffer) -> Option<[wgpu::BindGroup; 6]> {
+    /// The bind groups of adam_sparse.wgsl's and touched_list.wgsl's passes for a step with
+    /// `call`, in the order of `Pipelines::sparse`; none without sparse grid updates.
+    fn sparse_groups(&self, gpu: &Gpu, call: &wgpu::Buffer) -> Option<[wgpu::BindGroup; 7]> {
         let b = &self.buffers;
         let (pipelines, sb) = (self.pipelines.sparse.as_ref()?, b.sparse.as_ref()?);
         let mirror = self.grid_views(grid_textures::WRITE_BINDINGS);
         let (params_out, ema_out) = mirror.split_at(mirror.len() / 2);
-        let [clear, reset, list, check, apply, ema] = pipelines;
+        let [clear, check, apply, ema, count, scan, emit] = pipelines;
         let over_list = |label: &str,
                          pipeline: &wgpu::ComputePipeline,
                          extra: &[(u32, &wgpu::Buffer)],
@@ -852,15 +858,8 @@ impl NeuralCache {
                 gpu,
                 "nirc clear touched",
                 clear,
-                &[
-                    (13, &sb.touched),
-                    (14, &sb.touched_len),
-                    (15, &sb.touched_bits),
-                    (16, &b.grid_accum),
-                ],
+                &[(13, &sb.touched), (14, &sb.touched_len), (16, &b.grid_accum)],
             ),
-            bind(gpu, "nirc reset touched", reset, &[(14, &sb.touched_len)]),
-            bind(gpu, "nirc list touched", list, &[(14, &sb.touched_len), (17, &sb.list_dispatch)]),
             over_list("nirc adam check grid", check, &[(3, &b.ema)], &[]),
             over_list("nirc adam apply grid", apply, &[], params_out),
             bind_with_views(
@@ -880,6 +879,24 @@ impl NeuralCache {
                     (14, &sb.touched_len),
                 ],
                 ema_out,
+            ),
+            bind(gpu, "nirc count touched", count, &[(15, &sb.touched_bits), (18, &sb.block_offsets)]),
+            bind(
+                gpu,
+                "nirc scan touched",
+                scan,
+                &[
+                    (14, &sb.touched_len),
+                    (15, &sb.touched_bits),
+                    (17, &sb.list_dispatch),
+                    (18, &sb.block_offsets),
+                ],
+            ),
+            bind(
+                gpu,
+                "nirc list touched",
+                emit,
+                &[(13, &sb.touched), (15, &sb.touched_bits), (18, &sb.block_offsets)],
             ),
         ])
     }
@@ -920,11 +937,13 @@ impl NeuralCache {
         Ok(())
     }
 
-    /// Zeroes the step's accumulators: every grid gradient sum, or with sparse grid updates none
-    /// (`clear_touched` zeroes the last step's touched ones, a stage of the step).
+    /// Zeroes the step's accumulators: every grid gradient sum, or with sparse grid updates the
+    /// touched bitmask only (`clear_touched` zeroes the last step's listed sums, a stage of the
+    /// step).
     fn clear_step(&self, encoder: &mut wgpu::CommandEncoder) {
-        if self.buffers.sparse.is_none() {
-            encoder.clear_buffer(&self.buffers.grid_accum, 0, None);
+        match &self.buffers.sparse {
+            Some(sb) => encoder.clear_buffer(&sb.touched_bits, 0, None),
+            None => encoder.clear_buffer(&self.buffers.grid_accum, 0, None),
         }
         encoder.clear_buffer(&self.buffers.reliability_accum, 0, None);
     }
@@ -944,7 +963,6 @@ impl NeuralCache {
                 &groups[0],
                 list,
             ));
-            stages.push(("reset the touched list", &pipelines[1], &groups[1], Groups::Direct(1)));
         }
         stages.extend([
             (
@@ -976,16 +994,16 @@ impl NeuralCache {
         ));
         if let Some(((pipelines, groups), sb)) = sparse {
             let list = Groups::Indirect(&sb.list_dispatch);
-            stages.push((
-                "list the touched grid quads",
-                &pipelines[2],
-                &groups[2],
-                Groups::Direct(1),
-            ));
-            stages.push(("adam check (MLP)", &p.adam_check, &s.check, all));
-            stages.push(("adam check (touched grid quads)", &pipelines[3], &groups[3], list));
-            stages.push(("adam apply (MLP)", &p.adam_apply, &s.apply, all));
-            stages.push(("adam apply (touched grid quads)", &pipelines[4], &groups[4], list));
+            let blocks = Groups::Direct(sb.blocks);
+            stages.extend([
+                ("count the touched grid quads", &pipelines[4], &groups[4], blocks),
+                ("scan the counts", &pipelines[5], &groups[5], Groups::Direct(1)),
+                ("list the touched grid quads", &pipelines[6], &groups[6], blocks),
+                ("adam check (MLP)", &p.adam_check, &s.check, all),
+                ("adam check (touched grid quads)", &pipelines[1], &groups[1], list),
+                ("adam apply (MLP)", &p.adam_apply, &s.apply, all),
+                ("adam apply (touched grid quads)", &pipelines[2], &groups[2], list),
+            ]);
         } else {
             stages.push(("adam check (every parameter)", &p.adam_check, &s.check, all));
             stages.push(("adam apply (every parameter)", &p.adam_apply, &s.apply, all));
@@ -1014,8 +1032,8 @@ impl NeuralCache {
                 ("ema update (MLP)", &p.ema_update, &s.ema, all),
                 (
                     "ema update (touched grid quads)",
-                    &pipelines[5],
-                    &groups[5],
+                    &pipelines[3],
+                    &groups[3],
                     Groups::Indirect(&sb.list_dispatch),
                 ),
             ],
@@ -1397,7 +1415,7 @@ impl NeuralCache {
     pub fn touched_grid_quads(&self, gpu: &Gpu) -> Result<u32, NircError> {
         let Some(sb) = &self.buffers.sparse else { return Ok(0) };
         let len: Vec<u32> = read_pod(gpu, &sb.touched_len, "nirc touched grid quad count")?;
-        Ok(len[1])
+        Ok(len[0])
     }
 
     pub fn counters(&self, gpu: &Gpu) -> Result<Counters, NircError> {

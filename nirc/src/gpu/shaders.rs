@@ -265,23 +265,20 @@ pub fn program(
     Program::new(modules).entry(entry)
 }
 
-/// Bindings of the training passes' list of touched grid quads (sparse grid updates): the
-/// bits, the list, its length.
-pub const SPARSE_MARK_BINDINGS: [u32; 3] = [14, 15, 16];
+/// Binding of the training passes' bitmask of touched grid quads (sparse grid updates).
+pub const SPARSE_MARK_BINDING: u32 = 14;
 
-/// `mark_touched(index)` of the training passes: with sparse grid updates, it lists the grid
-/// quads of a corner's FEATURES parameters (index: the first) that the step has not listed yet,
-/// each once whatever the threads' order (adam_sparse.wgsl); without, nothing.
+/// `mark_touched(index)` of the training passes: with sparse grid updates, it sets the bits of
+/// the grid quads of a corner's FEATURES parameters (index: the first), which touched_list.wgsl
+/// then lists in ascending order; without, nothing.
 fn sparse_mark_module(sparse: bool) -> &'static str {
     if sparse {
         "import package::nirc::config::{FEATURES, MLP_PARAMS};\n\
          @group(0) @binding(14) var<storage, read_write> touched_bits: array<atomic<u32>>;\n\
-         @group(0) @binding(15) var<storage, read_write> touched: array<u32>;\n\
-         @group(0) @binding(16) var<storage, read_write> touched_len: array<atomic<u32>, 4>;\n\
          fn mark_quad(r: u32) {\n    let word = r / 32u;\n    let bit = 1u << (r % 32u);\n    \
-         // A plain look first: most corners of the coarse levels are listed already.\n    \
-         if (atomicLoad(&touched_bits[word]) & bit) == 0u && (atomicOr(&touched_bits[word], bit) & bit) == 0u {\n        \
-         touched[atomicAdd(&touched_len[0], 1u)] = r;\n    }\n}\n\
+         // A plain look first: most corners of the coarse levels are marked already.\n    \
+         if (atomicLoad(&touched_bits[word]) & bit) == 0u {\n        \
+         atomicOr(&touched_bits[word], bit);\n    }\n}\n\
          fn mark_touched(index: u32) {\n    \
          for (var r = (index - MLP_PARAMS) / 4u; r <= (index + FEATURES - 1u - MLP_PARAMS) / 4u; r++) {\n        \
          mark_quad(r);\n    }\n}\n"
@@ -291,7 +288,7 @@ fn sparse_mark_module(sparse: bool) -> &'static str {
 }
 
 /// The passes, by name.
-const PASSES: [&str; 13] = [
+const PASSES: [&str; 14] = [
     "train_tile",
     "infer_tile",
     "infer_lane",
@@ -304,6 +301,7 @@ const PASSES: [&str; 13] = [
     "weight_gradient",
     "adam_ema",
     "adam_sparse",
+    "touched_list",
     "finish_step",
 ];
 
@@ -347,6 +345,7 @@ fn pass_files(pass: &str) -> (Vec<Module>, Module) {
         "weight_gradient" => (vec![], nirc_file!("weight_gradient.wgsl")),
         "adam_ema" => (vec![], nirc_file!("adam_ema.wgsl")),
         "adam_sparse" => (vec![], nirc_file!("adam_sparse.wgsl")),
+        "touched_list" => (vec![], nirc_file!("touched_list.wgsl")),
         "finish_step" => (vec![], nirc_file!("finish_step.wgsl")),
         other => panic!("unknown NIRC pass '{other}'"),
     }
