@@ -249,3 +249,30 @@ fn gpu_sparse_steps_equal_dense_steps_when_every_entry_is_reached() {
     assert_vec_close("adam m", &s.adam_m, &d.adam_m, 1e-6, 0.0);
     assert_vec_close("adam v", &s.adam_v, &d.adam_v, 1e-6, 0.0);
 }
+
+/// Sparse steps give the same bits twice (as the dense ones do: the gradient sums are
+/// fixed-point and the touched list is in ascending order, whatever the threads' order).
+#[test]
+fn gpu_sparse_steps_are_deterministic() {
+    let config = sparse(small_config());
+    let state = randomized_state(&config, 61);
+    let run = || {
+        let cache = NeuralCache::from_state(gpu(), &state, Some(WeightPlacement::Tiled)).unwrap();
+        let mut rng = Rng(62);
+        for step in 0..6 {
+            let batch =
+                if step < 4 { corner_records(&mut rng, 130) } else { records(&mut rng, 40) };
+            cache.train_records(gpu(), &batch).unwrap();
+        }
+        (cache.download_state(gpu()).unwrap(), cache.touched_grid_quads(gpu()).unwrap())
+    };
+    let (a, touched_a) = run();
+    let (b, touched_b) = run();
+    assert!(touched_a > 0);
+    assert_eq!(touched_a, touched_b);
+    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(a.grid_steps, b.grid_steps);
+    assert!(bits(&a.params) == bits(&b.params), "params differ between two runs");
+    assert!(bits(&a.ema) == bits(&b.ema), "EMA differs between two runs");
+    assert!(bits(&a.adam_m) == bits(&b.adam_m) && bits(&a.adam_v) == bits(&b.adam_v));
+}

@@ -880,7 +880,12 @@ impl NeuralCache {
                 ],
                 ema_out,
             ),
-            bind(gpu, "nirc count touched", count, &[(15, &sb.touched_bits), (18, &sb.block_offsets)]),
+            bind(
+                gpu,
+                "nirc count touched",
+                count,
+                &[(15, &sb.touched_bits), (18, &sb.block_offsets)],
+            ),
             bind(
                 gpu,
                 "nirc scan touched",
