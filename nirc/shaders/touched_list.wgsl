@@ -20,8 +20,11 @@ import package::nirc::config::{WG_SIZE};
 @group(0) @binding(15) var<storage, read> touched_bits: array<u32>;
 // The indirect dispatch of the passes over the list: (workgroups, 1, 1).
 @group(0) @binding(17) var<storage, read_write> list_dispatch: array<u32, 4>;
-// Per block: its set bits (count_blocks), then its first slot (scan_blocks).
-@group(0) @binding(18) var<storage, read_write> block_offsets: array<u32>;
+// Per block: its set bits (count_blocks).
+@group(0) @binding(18) var<storage, read_write> block_counts: array<u32>;
+// Per block: its first slot in the list (scan_blocks; apart from the counts, so that each pass
+// can be rerun alone, as the bench times them).
+@group(0) @binding(19) var<storage, read_write> block_offsets: array<u32>;
 
 // Consecutive words per thread, so that a thread's quads go to consecutive slots.
 const WORDS_PER_THREAD: u32 = 4u;
@@ -72,7 +75,7 @@ fn scan_workgroup(t: u32, v: u32) -> u32 {
 fn count_blocks(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) t: u32) {
     let total = scan_workgroup(t, thread_bits(BLOCK_WORDS * wid.x + WORDS_PER_THREAD * t));
     if t == WG_SIZE - 1u {
-        block_offsets[wid.x] = total;
+        block_counts[wid.x] = total;
     }
 }
 
@@ -84,7 +87,7 @@ fn scan_blocks(@builtin(local_invocation_index) t: u32) {
         let i = base + t;
         var count = 0u;
         if i < blocks {
-            count = block_offsets[i];
+            count = block_counts[i];
         }
         let inclusive = scan_workgroup(t, count);
         if i < blocks {

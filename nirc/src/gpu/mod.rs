@@ -135,7 +135,8 @@ struct SparseBuffers {
     touched: wgpu::Buffer,
     touched_bits: wgpu::Buffer,
     touched_len: wgpu::Buffer,
-    /// Per block of the bitmask, its count and then its first slot (touched_list.wgsl).
+    /// Per block of the bitmask, its count and its first slot (touched_list.wgsl).
+    block_counts: wgpu::Buffer,
     block_offsets: wgpu::Buffer,
     /// Blocks of the bitmask (workgroups of count_blocks and emit_list).
     blocks: u32,
@@ -629,7 +630,8 @@ impl NeuralCache {
             touched: storage(gpu, "nirc touched grid quads", quads * 4)?,
             touched_bits: storage(gpu, "nirc touched grid quad bits", words * 4)?,
             touched_len: storage(gpu, "nirc touched grid quad count", 16)?,
-            block_offsets: storage(gpu, "nirc touched grid blocks", blocks * 4)?,
+            block_counts: storage(gpu, "nirc touched grid block counts", blocks * 4)?,
+            block_offsets: storage(gpu, "nirc touched grid block offsets", blocks * 4)?,
             blocks: blocks as u32,
             list_dispatch: {
                 gpu.check_buffer_size("nirc touched grid dispatch", 16)?;
@@ -884,7 +886,7 @@ impl NeuralCache {
                 gpu,
                 "nirc count touched",
                 count,
-                &[(15, &sb.touched_bits), (18, &sb.block_offsets)],
+                &[(15, &sb.touched_bits), (18, &sb.block_counts)],
             ),
             bind(
                 gpu,
@@ -894,14 +896,15 @@ impl NeuralCache {
                     (14, &sb.touched_len),
                     (15, &sb.touched_bits),
                     (17, &sb.list_dispatch),
-                    (18, &sb.block_offsets),
+                    (18, &sb.block_counts),
+                    (19, &sb.block_offsets),
                 ],
             ),
             bind(
                 gpu,
                 "nirc list touched",
                 emit,
-                &[(13, &sb.touched), (15, &sb.touched_bits), (18, &sb.block_offsets)],
+                &[(13, &sb.touched), (15, &sb.touched_bits), (19, &sb.block_offsets)],
             ),
         ])
     }
