@@ -50,9 +50,23 @@ pub fn nirc(
         r.layer_probe_16x16_gflops
     );
     let mut md = md;
-    md.push_str("\n| training step, stage by stage (each submitted alone) | ms |\n|---|---:|\n");
-    for (name, ms) in &r.train_stages_ms {
-        md.push_str(&format!("| {name} | {ms:.2} |\n"));
+    md.push_str(&format!(
+        "| training with sparse grid updates (records/s) | {:.0} |\n| training with sparse grid updates (GFLOP/s, % of ceiling) | {:.2} ({:.1}%) |\n| grid quads the sparse step touched | {} of {} |\n",
+        r.train_sparse_records_per_s,
+        r.train_sparse_gflops,
+        r.train_sparse_percent_of_peak,
+        r.sparse_touched_quads,
+        r.grid_quads
+    ));
+    for (title, stages) in
+        [("dense", &r.train_stages_ms), ("sparse grid updates", &r.train_sparse_stages_ms)]
+    {
+        md.push_str(&format!(
+            "\n| training step ({title}), stage by stage (each submitted alone) | ms |\n|---|---:|\n"
+        ));
+        for (name, ms) in stages {
+            md.push_str(&format!("| {name} | {ms:.2} |\n"));
+        }
     }
     use anyhow::Context as _;
     drop(gpu);
@@ -71,6 +85,10 @@ pub fn nirc(
         print!("{section}");
         md.push_str(&section);
     }
+    let targets = crate::nirc_targets::targets(&r, table.as_ref());
+    let section = crate::nirc_targets::markdown(&targets);
+    print!("{section}");
+    md.push_str(&section);
     if let Some(path) = out {
         systems::output::write_text(&path, &md)?;
     }
@@ -79,6 +97,7 @@ pub fn nirc(
             throughput: r,
             blend_overhead_frame_percent: table.as_ref().map(|t| t.blend_overhead_frame_percent),
             frames: table,
+            targets,
         };
         systems::output::write_text(&path, &serde_json::to_string_pretty(&j)?)?;
     }

@@ -10,6 +10,7 @@ pub mod bvh2_geometry;
 pub mod command;
 pub mod image_metrics;
 pub mod nirc_frames;
+pub mod nirc_targets;
 pub mod nirc_throughput;
 pub mod ray_order;
 pub mod speed;

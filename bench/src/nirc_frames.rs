@@ -71,6 +71,8 @@ pub struct BenchJson {
     /// The blend's cost over EMA-only in whole frames (`frames`), as the paper's Table 1.
     pub blend_overhead_frame_percent: Option<f64>,
     pub frames: Option<Table1>,
+    /// The speed targets as shares of the ceiling, beside the measured shares.
+    pub targets: Vec<crate::nirc_targets::Target>,
 }
 
 fn scenario_text(resolution: (u32, u32), warmup: u32, frames: u32, predictor: &str) -> String {

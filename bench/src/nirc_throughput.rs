@@ -45,6 +45,16 @@ pub struct BenchReport {
     pub layer_probe_16x16_gflops: f64,
     /// Milliseconds per stage of one training step, each stage submitted alone.
     pub train_stages_ms: Vec<(String, f64)>,
+    /// The same training step with sparse grid updates (`optimizer.sparse_grid`), timed right
+    /// after the dense one on the same records: records/s, GFLOP/s (counted as `train_gflops`),
+    /// share of the ceiling, and its stages.
+    pub train_sparse_records_per_s: f64,
+    pub train_sparse_gflops: f64,
+    pub train_sparse_percent_of_peak: f64,
+    pub train_sparse_stages_ms: Vec<(String, f64)>,
+    /// Grid quads the sparse step touched, of all grid quads.
+    pub sparse_touched_quads: u32,
+    pub grid_quads: u32,
 }
 
 fn records(n: u32) -> Vec<TrainingRecord> {
@@ -103,6 +113,19 @@ pub fn run(
         .into_iter()
         .map(|(n, s)| (n.to_string(), 1e3 * s))
         .collect();
+    // Sparse grid updates on the same records, timed the same way.
+    let mut sparse_config = config.clone();
+    sparse_config.optimizer.sparse_grid = true;
+    let sparse_state = CacheState::initial(&sparse_config, SceneBounds::new([0.0; 3], [1.0; 3]))?;
+    let sparse = NeuralCache::from_state(gpu, &sparse_state, placement)?;
+    let train_sparse_s = time(gpu, reps, || sparse.train(gpu, &recs, batch))?;
+    let train_sparse_stages_ms = sparse
+        .train_stage_seconds(gpu, &recs, batch, reps)?
+        .into_iter()
+        .map(|(n, s)| (n.to_string(), 1e3 * s))
+        .collect();
+    let sparse_touched_quads = sparse.touched_grid_quads(gpu)?;
+    drop(sparse);
     let q: Vec<CacheQuery> = records(queries).iter().map(|r| r.query()).collect();
     let qbuf = upload(gpu, "bench queries", &q);
     let out = answer_buffer(gpu, queries);
@@ -111,6 +134,7 @@ pub fn run(
     let probes = probes(gpu, reps)?;
     let flops = 2.0 * cache.layout.forward_macs() as f64;
     let train_gflops = batch as f64 * 3.0 * flops / train_s / 1e9;
+    let train_sparse_gflops = batch as f64 * 3.0 * flops / train_sparse_s / 1e9;
     let infer_gflops = queries as f64 * flops / ema_s / 1e9;
     Ok(BenchReport {
         adapter: gpu.summary.to_string(),
@@ -132,6 +156,12 @@ pub fn run(
         layer_probe_4x16_gflops: probes.layer_4x16_gflops,
         layer_probe_16x16_gflops: probes.layer_16x16_gflops,
         train_stages_ms,
+        train_sparse_records_per_s: batch as f64 / train_sparse_s,
+        train_sparse_gflops,
+        train_sparse_percent_of_peak: 100.0 * train_sparse_gflops / probes.fma_gflops,
+        train_sparse_stages_ms,
+        sparse_touched_quads,
+        grid_quads: cache.layout.grid_params() / 4,
     })
 }
 

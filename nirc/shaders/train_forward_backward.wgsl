@@ -8,6 +8,7 @@ import package::nirc::config::{ACT_FLOATS, DELTA_FLOATS, FEATURES, LEVELS, MLP_P
 import package::nirc::bindings::{call, counters, hyper, losses, records, samples, scratch_set};
 import package::nirc::bindings_common::{is_finite, normalize_to_bounds};
 import package::nirc::fixed_sum::{fixed_add};
+import package::nirc::sparse_mark::{mark_touched};
 import package::nirc::loss::{relative_l2};
 import package::nirc::encoding::{level_corners};
 import package::nirc::mlp::{acts, d_input, deltas, encode_input, mlp_backward, mlp_forward};
@@ -51,6 +52,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
     for (var l = 0u; l < LEVELS; l++) {
         let corners = level_corners(l, p);
         for (var c = 0u; c < 8u; c++) {
+            mark_touched(corners.index[c]);
             for (var k = 0u; k < FEATURES; k++) {
                 let g = corners.weight[c] * d_input[l * FEATURES + k];
                 ok = fixed_add(3u * (corners.index[c] + k - MLP_PARAMS), g) && ok;

@@ -13,6 +13,7 @@ import package::nirc::tile::{Block, OPT, RQ, TILE, tile_a, tile_matmul, tile_w};
 import package::nirc::bindings_common::{is_finite, normalize_to_bounds};
 import package::nirc::mlp_layout::{act_base, delta_base, mat_cols, mat_offset, mat_rows};
 import package::nirc::fixed_sum::{fixed_add};
+import package::nirc::sparse_mark::{mark_touched};
 import package::nirc::loss::{relative_l2};
 import package::nirc::encoding::{cell_at, corner_sum, direction_feature, level_corner, level_corners};
 import package::nirc::grid::{GRID_PAIRS, corner_pair};
@@ -164,7 +165,8 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
             }
         }
     }
-    // 5. Hash-grid gradients, per record, corner by corner.
+    // 5. Hash-grid gradients, per record, corner by corner (with sparse grid updates, each
+    //    corner's quads are listed for adam_sparse.wgsl).
     if in_range {
         for (var l = 0u; l < LEVELS; l++) {
             let cell = cell_at(p, level_resolution[l]);
@@ -175,6 +177,7 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
             }
             for (var c = 0u; c < 8u; c++) {
                 let corner = level_corner(l, cell, c);
+                mark_touched(corner.index);
                 for (var k = 0u; k < FEATURES; k++) {
                     ok = fixed_add(3u * (corner.index + k - MLP_PARAMS), corner.weight * d[k]) && ok;
                 }

@@ -139,12 +139,19 @@ pub struct AdamConfig {
     pub beta1: f32,
     pub beta2: f32,
     pub epsilon: f32,
+    /// Sparse updates of the hash grid (tiny-cuda-nn's Adam, which NRC uses): a table entry
+    /// whose gradient is exactly zero this step is left alone by Adam and by the EMA, and each
+    /// entry debiases with its own step count. The MLP weights stay dense. Off by default (plain
+    /// Adam on every parameter); left out of the serialised settings when off, so that warm-start
+    /// keys of dense caches do not change.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub sparse_grid: bool,
 }
 
 impl Default for AdamConfig {
     fn default() -> Self {
         // NRC: lr 1e-3..1e-2, β2 = 0.99, ε = 1e-15; β1 = 0.9 (Adam's default).
-        Self { learning_rate: 1e-2, beta1: 0.9, beta2: 0.99, epsilon: 1e-15 }
+        Self { learning_rate: 1e-2, beta1: 0.9, beta2: 0.99, epsilon: 1e-15, sparse_grid: false }
     }
 }
 
@@ -364,6 +371,9 @@ impl NircConfig {
         }
         if !(0.0..1.0).contains(&self.ema.alpha) {
             return bad("ema.alpha", format!("{} not in [0, 1)", self.ema.alpha));
+        }
+        if self.optimizer.sparse_grid {
+            crate::cpu::optimizer::BiasPowers::new(&self.optimizer, &self.ema)?;
         }
         let r = &self.reliability;
         if r.resolution == 0 || !(1..=24).contains(&r.log2_cells) {

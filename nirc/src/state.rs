@@ -2,7 +2,8 @@
 //! the same for the CPU reference and the GPU, and its file format for warm starts.
 //!
 //! File: b"FLKNIRC1", u64 length of a JSON header {config, bounds, counters}, the JSON, then the
-//! arrays params, ema, adam_m, adam_v, reliability, each as u64 count + little-endian f32s.
+//! arrays params, ema, adam_m, adam_v, reliability, each as u64 count + little-endian f32s; with
+//! sparse grid updates (`optimizer.sparse_grid`) then grid_steps as u64 count + little-endian u32s.
 
 use crate::bounds::SceneBounds;
 use crate::config::NircConfig;
@@ -29,6 +30,9 @@ pub struct CacheState {
     pub counters: Counters,
     /// cells x `MOMENTS_PER_CELL`.
     pub reliability: Vec<f32>,
+    /// With sparse grid updates, each grid parameter's own Adam step count (index i is parameter
+    /// `layout.mlp_params + i`); empty without them.
+    pub grid_steps: Vec<u32>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -81,7 +85,13 @@ impl CacheState {
             adam_v: vec![0.0; n],
             counters: Counters::default(),
             reliability: vec![0.0; cell_count(&config.reliability) as usize * MOMENTS_PER_CELL],
+            grid_steps: vec![0; Self::grid_steps_len(config, &layout)],
         })
+    }
+
+    /// Length of `grid_steps`: the grid's parameters with sparse updates, else 0.
+    pub fn grid_steps_len(config: &NircConfig, layout: &ParameterLayout) -> usize {
+        if config.optimizer.sparse_grid { layout.grid_params() as usize } else { 0 }
     }
 
     pub fn layout(&self) -> ParameterLayout {
@@ -104,6 +114,12 @@ impl CacheState {
             bytes.extend_from_slice(&(array.len() as u64).to_le_bytes());
             for v in array.iter() {
                 bytes.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        if self.config.optimizer.sparse_grid {
+            bytes.extend_from_slice(&(self.grid_steps.len() as u64).to_le_bytes());
+            for t in &self.grid_steps {
+                bytes.extend_from_slice(&t.to_le_bytes());
             }
         }
         // Write then rename, so a crash never leaves half a state under the final name.
@@ -156,6 +172,18 @@ impl CacheState {
                     .collect::<Vec<f32>>(),
             );
         }
+        let mut grid_steps = Vec::new();
+        if header.config.optimizer.sparse_grid {
+            let expected = Self::grid_steps_len(&header.config, &layout);
+            let n = u64::from_le_bytes(take(8, "grid_steps")?.try_into().unwrap()) as usize;
+            if n != expected {
+                return Err(bad(format!("grid_steps has {n} values, the config needs {expected}")));
+            }
+            grid_steps = take(n * 4, "grid_steps")?
+                .chunks_exact(4)
+                .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
+                .collect();
+        }
         if at != bytes.len() {
             return Err(bad(format!("{} trailing bytes", bytes.len() - at)));
         }
@@ -173,6 +201,7 @@ impl CacheState {
             adam_v,
             counters: header.counters,
             reliability,
+            grid_steps,
         })
     }
 }

@@ -5,7 +5,7 @@
 use super::encoding::encode;
 use super::loss::{denominators, relative_l2};
 use super::mlp::{Activations, backward, forward};
-use super::optimizer::{adam_ema_update, next_powers};
+use super::optimizer::{BiasPowers, adam_ema_update, next_powers, sparse_adam_ema_update};
 use super::real::Real;
 use crate::config::{NircConfig, PredictorMode};
 use crate::fixed_sum::FixedSum;
@@ -198,20 +198,50 @@ impl CpuCache {
         finite &= grad.iter().all(|g| g.is_finite());
         let st = &mut self.state;
         let powers = next_powers(&st.counters, &cfg.optimizer, &cfg.ema);
+        // Sparse grid updates: a grid parameter with a zero gradient keeps (w, m, v, w̄) and its
+        // step count; the others step with their own counts. The MLP is dense either way.
+        let table = cfg
+            .optimizer
+            .sparse_grid
+            .then(|| BiasPowers::new(&cfg.optimizer, &cfg.ema).expect("validated config"));
         let mut updated = Vec::with_capacity(grad.len());
+        let mut steps = st.grid_steps.clone();
         if finite {
             for (i, &g) in grad.iter().enumerate() {
-                let u = adam_ema_update(
-                    &cfg.optimizer,
-                    &cfg.ema,
-                    powers,
-                    st.counters.alpha_pow,
-                    st.params[i],
-                    st.adam_m[i],
-                    st.adam_v[i],
-                    st.ema[i],
-                    g,
-                );
+                let (w, m, v, e) = (st.params[i], st.adam_m[i], st.adam_v[i], st.ema[i]);
+                let u = match &table {
+                    Some(table) if i >= grid_base => {
+                        let t = &mut steps[i - grid_base];
+                        match sparse_adam_ema_update(
+                            &cfg.optimizer,
+                            &cfg.ema,
+                            table,
+                            *t,
+                            w,
+                            m,
+                            v,
+                            e,
+                            g,
+                        ) {
+                            Some((u, next)) => {
+                                *t = next;
+                                u
+                            }
+                            None => (w, m, v, e),
+                        }
+                    }
+                    _ => adam_ema_update(
+                        &cfg.optimizer,
+                        &cfg.ema,
+                        powers,
+                        st.counters.alpha_pow,
+                        w,
+                        m,
+                        v,
+                        e,
+                        g,
+                    ),
+                };
                 finite &= u.0.is_finite() && u.1.is_finite() && u.2.is_finite() && u.3.is_finite();
                 updated.push(u);
             }
@@ -227,6 +257,7 @@ impl CpuCache {
             (st.params[i], st.adam_m[i], st.adam_v[i], st.ema[i]) = (w, m, v, e);
         }
         st.reliability = moments;
+        st.grid_steps = steps;
         st.counters.step += 1;
         st.counters.grid_updates += 1;
         (st.counters.beta1_pow, st.counters.beta2_pow, st.counters.alpha_pow) = powers;

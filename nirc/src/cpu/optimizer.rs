@@ -90,9 +90,98 @@ pub fn adam_ema_update(
     (w1, m1, v1, e1)
 }
 
+/// Most rows a [`BiasPowers`] table may have (16 MiB on the GPU).
+const MAX_BIAS_ROWS: usize = 1 << 20;
+
+/// The powers (β1^t, β2^t, α^t, 0) for each per-entry step count t of sparse grid updates, as
+/// running products from t = 0: the multiplications `Counters` does, so an entry that steps
+/// every step gets the dense step's bits. The table ends at the first t where every 1 − power is
+/// exactly 1.0 in f32; a larger count reads the last row, whose bias corrections are then the
+/// same (tiny-cuda-nn computes powf(β, t) per parameter instead, which the CPU and GPU need not
+/// round alike).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BiasPowers {
+    pub rows: Vec<[f32; 4]>,
+}
+
+impl BiasPowers {
+    pub fn new(adam: &AdamConfig, ema: &EmaConfig) -> Result<Self, crate::NircError> {
+        let mut rows = vec![[1.0f32, 1.0, 1.0, 0.0]];
+        loop {
+            let last = *rows.last().expect("one row");
+            if last[..3].iter().all(|&p| 1.0 - p == 1.0) {
+                return Ok(Self { rows });
+            }
+            if rows.len() >= MAX_BIAS_ROWS {
+                return Err(crate::NircError::Config(format!(
+                    "optimizer.sparse_grid: β1 = {}, β2 = {}, ema.alpha = {} need more than {} \
+                     per-entry bias corrections (a β this close to 1 never settles)",
+                    adam.beta1, adam.beta2, ema.alpha, MAX_BIAS_ROWS
+                )));
+            }
+            rows.push([last[0] * adam.beta1, last[1] * adam.beta2, last[2] * ema.alpha, 0.0]);
+        }
+    }
+
+    /// (β1^t, β2^t, α^t).
+    pub fn at(&self, t: u32) -> (f32, f32, f32) {
+        let r = self.rows[(t as usize).min(self.rows.len() - 1)];
+        (r[0], r[1], r[2])
+    }
+}
+
+/// One hash-grid parameter under sparse updates: `None` (nothing changes, its step count
+/// included) where the gradient is exactly zero; else its new (w, m, v, w̄) and step count, Adam
+/// and the EMA debiased with the parameter's own count t (tiny-cuda-nn's per-parameter steps).
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub fn sparse_adam_ema_update(
+    adam: &AdamConfig,
+    ema: &EmaConfig,
+    table: &BiasPowers,
+    steps: u32,
+    w: f32,
+    m: f32,
+    v: f32,
+    w_ema: f32,
+    g: f32,
+) -> Option<((f32, f32, f32, f32), u32)> {
+    if g == 0.0 {
+        return None;
+    }
+    let t = steps + 1;
+    Some((adam_ema_update(adam, ema, table.at(t), table.at(t - 1).2, w, m, v, w_ema, g), t))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bias_power_rows_are_the_dense_running_products_until_they_settle() {
+        let (adam, ema) = (AdamConfig::default(), EmaConfig::default());
+        let table = BiasPowers::new(&adam, &ema).unwrap();
+        let mut c = Counters::default();
+        for t in 0..table.rows.len() as u32 + 50 {
+            let (b1, b2, a) = table.at(t);
+            // Bit for bit the dense step's powers while the table lasts; past it, the same bias
+            // corrections (1 - power is 1.0 in both).
+            if (t as usize) < table.rows.len() {
+                assert_eq!((b1, b2, a), (c.beta1_pow, c.beta2_pow, c.alpha_pow), "t={t}");
+            } else {
+                assert_eq!((1.0 - b1, 1.0 - b2, 1.0 - a), (1.0, 1.0, 1.0), "t={t}");
+                assert_eq!(
+                    (1.0 - c.beta1_pow, 1.0 - c.beta2_pow, 1.0 - c.alpha_pow),
+                    (1.0, 1.0, 1.0)
+                );
+            }
+            (c.beta1_pow, c.beta2_pow, c.alpha_pow) = next_powers(&c, &adam, &ema);
+        }
+        // 0.99^t < 2^-25 from t = 1725 on: the table is about that long, not a fitted length.
+        assert!((1700..1760).contains(&table.rows.len()), "{}", table.rows.len());
+        let close = AdamConfig { beta2: 0.9999999, ..adam };
+        assert!(BiasPowers::new(&close, &ema).is_err());
+    }
 
     #[test]
     fn debiased_ema_of_a_constant_sequence_is_the_constant() {

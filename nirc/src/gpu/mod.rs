@@ -11,6 +11,9 @@
 //! 3. weight_gradient         per weight and chunk of records, then over chunks (no atomics)
 //! 4. adam_ema check, apply   Adam; any non-finite value raises a flag and nothing is written
 //!    adam_ema ema_update     debiased EMA of the new weights (skipped on a flagged step)
+//!    (adam_sparse            with sparse grid updates, the grid's part of both over the quads
+//!                            the step touched only, listed in ascending order by touched_list
+//!                            after pass 3; the last step's sums cleared before pass 1)
 //! 5. reliability_walk        per cell (its list's head): the per-sample EMAs of the moments in
 //!                            record order
 //!    reliability_update      per cell: keep the new moments (or the batch-mean step)
@@ -117,6 +120,28 @@ struct Pipelines {
     infer: wgpu::ComputePipeline,
     /// The register form's staging of both predictors' MLP weights (lane_stage.wgsl).
     lane_stage: Option<wgpu::ComputePipeline>,
+    /// With sparse grid updates: clear_touched, check_grid, apply_grid, ema_grid
+    /// (adam_sparse.wgsl), count_blocks, scan_blocks, emit_list (touched_list.wgsl).
+    sparse: Option<[wgpu::ComputePipeline; 7]>,
+}
+
+/// The buffers of sparse grid updates (adam_sparse.wgsl).
+struct SparseBuffers {
+    /// Per grid parameter, its committed Adam steps (`CacheState::grid_steps`).
+    grid_steps: wgpu::Buffer,
+    /// `cpu::optimizer::BiasPowers`.
+    bias_powers: wgpu::Buffer,
+    /// The grid quads the step touched, ascending; their bits; the list's length.
+    touched: wgpu::Buffer,
+    touched_bits: wgpu::Buffer,
+    touched_len: wgpu::Buffer,
+    /// Per block of the bitmask, its count and its first slot (touched_list.wgsl).
+    block_counts: wgpu::Buffer,
+    block_offsets: wgpu::Buffer,
+    /// Blocks of the bitmask (workgroups of count_blocks and emit_list).
+    blocks: u32,
+    /// The indirect dispatch of the passes over the list.
+    list_dispatch: wgpu::Buffer,
 }
 
 struct Buffers {
@@ -140,6 +165,7 @@ struct Buffers {
     lane_staged: Option<wgpu::Buffer>,
     /// The grid mirror the register form reads (grid_textures.rs).
     grid: Option<grid_textures::GridTextures>,
+    sparse: Option<SparseBuffers>,
 }
 
 /// The bind groups of one training step ([`NeuralCache::prepare_step`]).
@@ -155,10 +181,19 @@ pub struct TrainStep {
     apply: wgpu::BindGroup,
     ema: wgpu::BindGroup,
     finish: wgpu::BindGroup,
+    /// With sparse grid updates, the groups of adam_sparse.wgsl's passes (as `Pipelines::sparse`).
+    sparse: Option<[wgpu::BindGroup; 7]>,
+}
+
+/// How many workgroups a dispatch runs: a count, or what the GPU wrote into a buffer.
+#[derive(Clone, Copy)]
+enum Groups<'a> {
+    Direct(u32),
+    Indirect(&'a wgpu::Buffer),
 }
 
 /// One dispatch of a training step: name (for the profile), pipeline, bind group, workgroups.
-type Stage<'a> = (&'static str, &'a wgpu::ComputePipeline, &'a wgpu::BindGroup, u32);
+type Stage<'a> = (&'static str, &'a wgpu::ComputePipeline, &'a wgpu::BindGroup, Groups<'a>);
 
 /// Bind groups that depend on neither the caller's buffers nor the call's parameters.
 struct FixedBindGroups {
@@ -182,6 +217,9 @@ pub struct NeuralCache {
 /// read from `counters`) is then paid once per 4 quads. On lavapipe one quad per invocation
 /// made these passes 1.3-1.6x slower (nirc/README.md); 16 was slower again.
 const PARAM_QUADS_PER_INVOCATION: u64 = 4;
+
+/// Words of the touched bitmask per block of touched_list.wgsl (its BLOCK_WORDS: 4 per thread).
+const TOUCHED_BLOCK_WORDS: u64 = 4 * WORKGROUP_SIZE as u64;
 
 fn groups_for(threads: u64) -> u32 {
     threads.div_ceil(WORKGROUP_SIZE as u64).clamp(1, 65535) as u32
@@ -405,6 +443,23 @@ impl NeuralCache {
         )?)
         .expect("three pipelines");
         let tiled = placement.tiled_training();
+        let sparse = if config.optimizer.sparse_grid {
+            let [clear, check, apply, ema] = render::compute::pipelines_auto_layout(
+                gpu,
+                "nirc adam_sparse",
+                &shaders::program(config, layout, "adam_sparse", grid_width),
+                ["clear_touched", "check_grid", "apply_grid", "ema_grid"],
+            )?;
+            let [count, scan, emit] = render::compute::pipelines_auto_layout(
+                gpu,
+                "nirc touched_list",
+                &shaders::program(config, layout, "touched_list", grid_width),
+                ["count_blocks", "scan_blocks", "emit_list"],
+            )?;
+            Some([clear, check, apply, ema, count, scan, emit])
+        } else {
+            None
+        };
         Ok(Pipelines {
             train: one(if tiled { "train_tile" } else { "train_forward_backward" })?,
             weight_partial: (!tiled).then_some(weight_partial),
@@ -424,6 +479,7 @@ impl NeuralCache {
             lane_stage: (placement == WeightPlacement::Registers)
                 .then(|| one("lane_stage"))
                 .transpose()?,
+            sparse,
         })
     }
 
@@ -472,6 +528,7 @@ impl NeuralCache {
                 state.reliability.len(),
                 cell_count(&config.reliability) as usize * MOMENTS_PER_CELL,
             ),
+            ("grid_steps", state.grid_steps.len(), CacheState::grid_steps_len(config, layout)),
         ] {
             if len != expected {
                 return Err(NircError::Config(format!(
@@ -542,7 +599,50 @@ impl NeuralCache {
                 })
             }),
             grid: grid_width.map(|w| grid_textures::GridTextures::new(gpu, layout, state, w)),
+            sparse: Self::sparse_buffers(gpu, config, layout, state)?,
         })
+    }
+
+    fn sparse_buffers(
+        gpu: &Gpu,
+        config: &NircConfig,
+        layout: &ParameterLayout,
+        state: &CacheState,
+    ) -> Result<Option<SparseBuffers>, NircError> {
+        if !config.optimizer.sparse_grid {
+            return Ok(None);
+        }
+        let quads = layout.grid_params() as u64 / 4;
+        let words = quads.div_ceil(32);
+        let blocks = words.div_ceil(TOUCHED_BLOCK_WORDS);
+        let table = crate::cpu::optimizer::BiasPowers::new(&config.optimizer, &config.ema)?;
+        Ok(Some(SparseBuffers {
+            grid_steps: storage_init(
+                gpu,
+                "nirc grid step counts",
+                bytemuck::cast_slice(&state.grid_steps),
+            )?,
+            bias_powers: storage_init(
+                gpu,
+                "nirc bias corrections by step",
+                bytemuck::cast_slice(&table.rows),
+            )?,
+            touched: storage(gpu, "nirc touched grid quads", quads * 4)?,
+            touched_bits: storage(gpu, "nirc touched grid quad bits", words * 4)?,
+            touched_len: storage(gpu, "nirc touched grid quad count", 16)?,
+            block_counts: storage(gpu, "nirc touched grid block counts", blocks * 4)?,
+            block_offsets: storage(gpu, "nirc touched grid block offsets", blocks * 4)?,
+            blocks: blocks as u32,
+            list_dispatch: {
+                gpu.check_buffer_size("nirc touched grid dispatch", 16)?;
+                gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("nirc touched grid dispatch"),
+                    size: 16,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+                    mapped_at_creation: false,
+                })
+            },
+        }))
     }
 
     fn fixed_groups(gpu: &Gpu, p: &Pipelines, b: &Buffers) -> FixedBindGroups {
@@ -657,6 +757,9 @@ impl NeuralCache {
         if self.placement.tiled_training() {
             fb_entries.push((10, &b.partials));
         }
+        if let Some(sb) = &b.sparse {
+            fb_entries.push((shaders::SPARSE_MARK_BINDING, &sb.touched_bits));
+        }
         let fb = bind_with_views(
             gpu,
             "nirc train",
@@ -707,7 +810,9 @@ impl NeuralCache {
             &p.finish_step,
             &[(0, &call), (1, &b.hyper), (2, &b.counters)],
         );
+        let sparse = self.sparse_groups(gpu, &call);
         Ok(Some(TrainStep {
+            sparse,
             n,
             num_chunks,
             fb,
@@ -720,6 +825,88 @@ impl NeuralCache {
             ema,
             finish,
         }))
+    }
+
+    /// The bind groups of adam_sparse.wgsl's and touched_list.wgsl's passes for a step with
+    /// `call`, in the order of `Pipelines::sparse`; none without sparse grid updates.
+    fn sparse_groups(&self, gpu: &Gpu, call: &wgpu::Buffer) -> Option<[wgpu::BindGroup; 7]> {
+        let b = &self.buffers;
+        let (pipelines, sb) = (self.pipelines.sparse.as_ref()?, b.sparse.as_ref()?);
+        let mirror = self.grid_views(grid_textures::WRITE_BINDINGS);
+        let (params_out, ema_out) = mirror.split_at(mirror.len() / 2);
+        let [clear, check, apply, ema, count, scan, emit] = pipelines;
+        let over_list = |label: &str,
+                         pipeline: &wgpu::ComputePipeline,
+                         extra: &[(u32, &wgpu::Buffer)],
+                         views: &[(u32, &wgpu::TextureView)]| {
+            let mut entries: Vec<(u32, &wgpu::Buffer)> = vec![
+                (0, call),
+                (1, &b.hyper),
+                (2, &b.params),
+                (4, &b.adam_m),
+                (5, &b.adam_v),
+                (7, &b.grid_accum),
+                (8, &b.counters),
+                (11, &sb.grid_steps),
+                (12, &sb.bias_powers),
+                (13, &sb.touched),
+                (14, &sb.touched_len),
+            ];
+            entries.extend(extra);
+            bind_with_views(gpu, label, pipeline, &entries, views)
+        };
+        Some([
+            bind(
+                gpu,
+                "nirc clear touched",
+                clear,
+                &[(13, &sb.touched), (14, &sb.touched_len), (16, &b.grid_accum)],
+            ),
+            over_list("nirc adam check grid", check, &[(3, &b.ema)], &[]),
+            over_list("nirc adam apply grid", apply, &[], params_out),
+            bind_with_views(
+                gpu,
+                "nirc ema grid",
+                ema,
+                &[
+                    (0, call),
+                    (1, &b.hyper),
+                    (2, &b.params),
+                    (3, &b.ema),
+                    (7, &b.grid_accum),
+                    (8, &b.counters),
+                    (11, &sb.grid_steps),
+                    (12, &sb.bias_powers),
+                    (13, &sb.touched),
+                    (14, &sb.touched_len),
+                ],
+                ema_out,
+            ),
+            bind(
+                gpu,
+                "nirc count touched",
+                count,
+                &[(15, &sb.touched_bits), (18, &sb.block_counts)],
+            ),
+            bind(
+                gpu,
+                "nirc scan touched",
+                scan,
+                &[
+                    (14, &sb.touched_len),
+                    (15, &sb.touched_bits),
+                    (17, &sb.list_dispatch),
+                    (18, &sb.block_counts),
+                    (19, &sb.block_offsets),
+                ],
+            ),
+            bind(
+                gpu,
+                "nirc list touched",
+                emit,
+                &[(13, &sb.touched), (15, &sb.touched_bits), (19, &sb.block_offsets)],
+            ),
+        ])
     }
 
     /// Forward and backward passes, gradients and the Adam step of the High-LR weights (with the
@@ -758,8 +945,14 @@ impl NeuralCache {
         Ok(())
     }
 
+    /// Zeroes the step's accumulators: every grid gradient sum, or with sparse grid updates the
+    /// touched bitmask only (`clear_touched` zeroes the last step's listed sums, a stage of the
+    /// step).
     fn clear_step(&self, encoder: &mut wgpu::CommandEncoder) {
-        encoder.clear_buffer(&self.buffers.grid_accum, 0, None);
+        match &self.buffers.sparse {
+            Some(sb) => encoder.clear_buffer(&sb.touched_bits, 0, None),
+            None => encoder.clear_buffer(&self.buffers.grid_accum, 0, None),
+        }
         encoder.clear_buffer(&self.buffers.reliability_accum, 0, None);
     }
 
@@ -767,48 +960,93 @@ impl NeuralCache {
     /// gradients, the Adam step (name, pipeline, bind group, workgroups).
     fn adam_stages<'a>(&'a self, s: &'a TrainStep) -> Vec<Stage<'a>> {
         let p = &self.pipelines;
-        let all = self.param_groups();
-        let mut stages: Vec<Stage> = vec![
-            ("train (forward, backward)", &p.train, &s.fb, s.n.div_ceil(WORKGROUP_SIZE)),
+        let all = Groups::Direct(self.param_groups());
+        let sparse = p.sparse.as_ref().zip(s.sparse.as_ref()).zip(self.buffers.sparse.as_ref());
+        let mut stages: Vec<Stage> = Vec::new();
+        if let Some(((pipelines, groups), sb)) = sparse {
+            let list = Groups::Indirect(&sb.list_dispatch);
+            stages.push((
+                "clear the last step's touched grid quads",
+                &pipelines[0],
+                &groups[0],
+                list,
+            ));
+        }
+        stages.extend([
+            (
+                "train (forward, backward)",
+                &p.train,
+                &s.fb,
+                Groups::Direct(s.n.div_ceil(WORKGROUP_SIZE)),
+            ),
             (
                 "reliability accumulate",
                 &p.reliability_accumulate,
                 &s.accumulate,
-                groups_for(s.n as u64),
+                Groups::Direct(groups_for(s.n as u64)),
             ),
-        ];
+        ]);
         if let (Some(pipeline), Some(group)) = (&p.weight_partial, &s.partial) {
             stages.push((
                 "weight gradient partials",
                 pipeline,
                 group,
-                groups_for(self.layout.mlp_params as u64 * s.num_chunks as u64),
+                Groups::Direct(groups_for(self.layout.mlp_params as u64 * s.num_chunks as u64)),
             ));
         }
         stages.push((
             "weight gradient reduce",
             &p.weight_reduce,
             &s.reduce,
-            groups_for(self.layout.mlp_params as u64),
+            Groups::Direct(groups_for(self.layout.mlp_params as u64)),
         ));
-        stages.push(("adam check (every parameter)", &p.adam_check, &s.check, all));
-        stages.push(("adam apply (every parameter)", &p.adam_apply, &s.apply, all));
+        if let Some(((pipelines, groups), sb)) = sparse {
+            let list = Groups::Indirect(&sb.list_dispatch);
+            let blocks = Groups::Direct(sb.blocks);
+            stages.extend([
+                ("count the touched grid quads", &pipelines[4], &groups[4], blocks),
+                ("scan the counts", &pipelines[5], &groups[5], Groups::Direct(1)),
+                ("list the touched grid quads", &pipelines[6], &groups[6], blocks),
+                ("adam check (MLP)", &p.adam_check, &s.check, all),
+                ("adam check (touched grid quads)", &pipelines[1], &groups[1], list),
+                ("adam apply (MLP)", &p.adam_apply, &s.apply, all),
+                ("adam apply (touched grid quads)", &pipelines[2], &groups[2], list),
+            ]);
+        } else {
+            stages.push(("adam check (every parameter)", &p.adam_check, &s.check, all));
+            stages.push(("adam apply (every parameter)", &p.adam_apply, &s.apply, all));
+        }
         stages
     }
 
-    /// Workgroups of the passes over every parameter quad (Adam's check and apply, the EMA).
+    /// Workgroups of the dense passes over parameter quads (Adam's check and apply, the EMA):
+    /// every quad, or with sparse grid updates the MLP's.
     fn param_groups(&self) -> u32 {
-        groups_for((self.layout.total_params as u64 / 4).div_ceil(PARAM_QUADS_PER_INVOCATION))
+        let params = if self.buffers.sparse.is_some() {
+            self.layout.mlp_params
+        } else {
+            self.layout.total_params
+        };
+        groups_for((params as u64 / 4).div_ceil(PARAM_QUADS_PER_INVOCATION))
     }
 
-    /// The `nirc::ema` part: the debiased EMA of every parameter.
+    /// The `nirc::ema` part: the debiased EMA of every parameter (with sparse grid updates, of
+    /// the MLP and of the touched grid quads).
     fn ema_stages<'a>(&'a self, s: &'a TrainStep) -> Vec<Stage<'a>> {
-        vec![(
-            "ema update (every parameter)",
-            &self.pipelines.ema_update,
-            &s.ema,
-            self.param_groups(),
-        )]
+        let p = &self.pipelines;
+        let all = Groups::Direct(self.param_groups());
+        match (&p.sparse, &s.sparse, &self.buffers.sparse) {
+            (Some(pipelines), Some(groups), Some(sb)) => vec![
+                ("ema update (MLP)", &p.ema_update, &s.ema, all),
+                (
+                    "ema update (touched grid quads)",
+                    &pipelines[3],
+                    &groups[3],
+                    Groups::Indirect(&sb.list_dispatch),
+                ),
+            ],
+            _ => vec![("ema update (every parameter)", &p.ema_update, &s.ema, all)],
+        }
     }
 
     /// The `nirc::reliability_update` part: the per-sample moment walk (not for the batch-mean
@@ -817,21 +1055,33 @@ impl NeuralCache {
         let p = &self.pipelines;
         let mut stages: Vec<Stage> = Vec::new();
         if self.config.reliability.update == crate::config::MomentUpdate::PerSample {
-            stages.push(("reliability walk", &p.reliability_walk, &s.walk, groups_for(s.n as u64)));
+            stages.push((
+                "reliability walk",
+                &p.reliability_walk,
+                &s.walk,
+                Groups::Direct(groups_for(s.n as u64)),
+            ));
         }
         stages.push((
             "reliability update",
             &p.reliability_update,
             &self.groups.reliability_update,
-            groups_for(cell_count(&self.config.reliability) as u64),
+            Groups::Direct(groups_for(cell_count(&self.config.reliability) as u64)),
         ));
-        stages.push(("finish step", &p.finish_step, &s.finish, 1));
+        stages.push(("finish step", &p.finish_step, &s.finish, Groups::Direct(1)));
         stages
     }
 
     fn dispatch_stages(pass: &mut wgpu::ComputePass, stages: &[Stage]) {
         for &(_, pipeline, group, workgroups) in stages {
-            dispatch(pass, pipeline, group, workgroups);
+            match workgroups {
+                Groups::Direct(n) => dispatch(pass, pipeline, group, n),
+                Groups::Indirect(args) => {
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, group, &[]);
+                    pass.dispatch_workgroups_indirect(args, 0);
+                }
+            }
         }
     }
 
@@ -1168,6 +1418,14 @@ impl NeuralCache {
             .collect()
     }
 
+    /// With sparse grid updates, how many grid quads the last training step touched (0
+    /// without them).
+    pub fn touched_grid_quads(&self, gpu: &Gpu) -> Result<u32, NircError> {
+        let Some(sb) = &self.buffers.sparse else { return Ok(0) };
+        let len: Vec<u32> = read_pod(gpu, &sb.touched_len, "nirc touched grid quad count")?;
+        Ok(len[0])
+    }
+
     pub fn counters(&self, gpu: &Gpu) -> Result<Counters, NircError> {
         let counters: Vec<Counters> = read_pod(gpu, &self.buffers.counters, "nirc counters")?;
         counters.first().copied().ok_or_else(|| NircError::Readback {
@@ -1203,6 +1461,12 @@ impl NeuralCache {
                 "nirc reliability moments",
                 cell_count(&self.config.reliability) as usize * MOMENTS_PER_CELL,
             )?,
+            grid_steps: match &b.sparse {
+                Some(sb) => read_pod::<u32>(gpu, &sb.grid_steps, "nirc grid step counts")?
+                    [..CacheState::grid_steps_len(&self.config, &self.layout)]
+                    .to_vec(),
+                None => Vec::new(),
+            },
         })
     }
 

@@ -125,6 +125,12 @@ fn config_constants(config: &NircConfig, layout: &ParameterLayout) -> String {
     c("DIR_KIND", dir_kind);
     c("DIR_BANDS", dir_bands);
     c("MLP_PARAMS", layout.mlp_params);
+    // The quads the dense Adam and EMA passes cover: all, or with sparse grid updates the MLP's
+    // (adam_sparse.wgsl takes the grid).
+    c(
+        "DENSE_QUADS",
+        if config.optimizer.sparse_grid { layout.mlp_params } else { layout.total_params } / 4,
+    );
     c("MLP_WEIGHTS", layout.mlp_weights());
     c("TOTAL_PARAMS", layout.total_params);
     c("ACT_FLOATS", layout.activation_floats());
@@ -224,6 +230,12 @@ pub fn program(
             &[&super::grid_textures::write_module(grid_width)],
         ),
     ];
+    if pass == "train_tile" || pass == "train_forward_backward" {
+        modules.push(Module::generated(
+            "package::nirc::sparse_mark",
+            &[sparse_mark_module(config.optimizer.sparse_grid)],
+        ));
+    }
     let tile = match pass {
         "train_tile" => Some((TRAIN_TILE_RECORDS, true)),
         "infer_tile" => Some((INFER_TILE_QUERIES, false)),
@@ -253,8 +265,30 @@ pub fn program(
     Program::new(modules).entry(entry)
 }
 
+/// Binding of the training passes' bitmask of touched grid quads (sparse grid updates).
+pub const SPARSE_MARK_BINDING: u32 = 14;
+
+/// `mark_touched(index)` of the training passes: with sparse grid updates, it sets the bits of
+/// the grid quads of a corner's FEATURES parameters (index: the first), which touched_list.wgsl
+/// then lists in ascending order; without, nothing.
+fn sparse_mark_module(sparse: bool) -> &'static str {
+    if sparse {
+        "import package::nirc::config::{FEATURES, MLP_PARAMS};\n\
+         @group(0) @binding(14) var<storage, read_write> touched_bits: array<atomic<u32>>;\n\
+         fn mark_quad(r: u32) {\n    let word = r / 32u;\n    let bit = 1u << (r % 32u);\n    \
+         // A plain look first: most corners of the coarse levels are marked already.\n    \
+         if (atomicLoad(&touched_bits[word]) & bit) == 0u {\n        \
+         atomicOr(&touched_bits[word], bit);\n    }\n}\n\
+         fn mark_touched(index: u32) {\n    \
+         for (var r = (index - MLP_PARAMS) / 4u; r <= (index + FEATURES - 1u - MLP_PARAMS) / 4u; r++) {\n        \
+         mark_quad(r);\n    }\n}\n"
+    } else {
+        "fn mark_touched(index: u32) {}\n"
+    }
+}
+
 /// The passes, by name.
-const PASSES: [&str; 12] = [
+const PASSES: [&str; 14] = [
     "train_tile",
     "infer_tile",
     "infer_lane",
@@ -266,6 +300,8 @@ const PASSES: [&str; 12] = [
     "reliability_walk",
     "weight_gradient",
     "adam_ema",
+    "adam_sparse",
+    "touched_list",
     "finish_step",
 ];
 
@@ -308,14 +344,17 @@ fn pass_files(pass: &str) -> (Vec<Module>, Module) {
         ),
         "weight_gradient" => (vec![], nirc_file!("weight_gradient.wgsl")),
         "adam_ema" => (vec![], nirc_file!("adam_ema.wgsl")),
+        "adam_sparse" => (vec![], nirc_file!("adam_sparse.wgsl")),
+        "touched_list" => (vec![], nirc_file!("touched_list.wgsl")),
         "finish_step" => (vec![], nirc_file!("finish_step.wgsl")),
         other => panic!("unknown NIRC pass '{other}'"),
     }
 }
 
 /// The files the passes share (each pass's program lists them all; a pass links what it imports).
-fn shared_files() -> [Module; 11] {
+fn shared_files() -> [Module; 12] {
     [
+        nirc_file!("adam_step.wgsl"),
         nirc_file!("bindings_common.wgsl"),
         nirc_file!("weights.wgsl"),
         nirc_file!("mlp_layout.wgsl"),
