@@ -322,7 +322,7 @@ fn pass_times_name_their_passes_at_file_and_line() {
     assert!(e.contains("bad.ron:5") && e.contains("in a claim's statistic"), "{e}");
     // The shipped Table 1 cases list the tracer and the propagation apart.
     let claims = Claims::load(&root().join("claims/variance-trading-termination.ron")).unwrap();
-    let door = claims.cases.iter().find(|c| c.name == "door").unwrap();
+    let door = claims.cases.iter().find(|c| c.name == "door_spread").unwrap();
     let keys: Vec<String> = door.table.iter().map(|s| s.key()).collect();
     assert!(keys.contains(&"pass_ms tc_trace".to_string()), "{keys:?}");
     assert!(keys.contains(&"pass_ms tc_propagate".to_string()), "{keys:?}");
