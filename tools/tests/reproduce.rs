@@ -302,3 +302,28 @@ fn passes_not_run_alone_are_checked_at_file_and_line() {
     let e = load_with(cornell, &two);
     assert!(e.contains("bad.ron:9") && e.contains("one attribution per case"), "{e}");
 }
+
+/// `passes` (the passes `PassMs` sums) go with PassMs only, and PassMs needs them, in a claim's
+/// statistic or a case's table: errors at the claim's or the case's line.
+#[test]
+fn pass_times_name_their_passes_at_file_and_line() {
+    let with = |metric: &str| claim("corridor", metric, "vb_rel_0.1");
+    let e = load_with(CASE, &with("PassMs"));
+    assert!(e.contains("bad.ron:8") && e.contains("pass_ms without passes"), "{e}");
+    let e = load_with(CASE, &with("Flip, passes: [\"tc_trace\"]"));
+    assert!(e.contains("bad.ron:8") && e.contains("expected them only with PassMs"), "{e}");
+    let e = load_with(CASE, &with("PassMs, passes: [\"tc_trace\", \"tc_trace\"]"));
+    assert!(e.contains("bad.ron:8") && e.contains("expected distinct pass names"), "{e}");
+    let table = |t: &str| CASE.replace("seeds: [3, 4]", &format!("seeds: [3, 4], table: [{t}]"));
+    let ok = with("PathLength");
+    let e = load_with(&table("(metric: PassMs, window: Overall)"), &ok);
+    assert!(e.contains("bad.ron:5") && e.contains("table: pass_ms overall"), "{e}");
+    let e = load_with(&table("(metric: Flip, window: Overall, against: \"vb_rel_1\")"), &ok);
+    assert!(e.contains("bad.ron:5") && e.contains("in a claim's statistic"), "{e}");
+    // The shipped Table 1 cases list the tracer and the propagation apart.
+    let claims = Claims::load(&root().join("claims/variance-trading-termination.ron")).unwrap();
+    let door = claims.cases.iter().find(|c| c.name == "door_spread").unwrap();
+    let keys: Vec<String> = door.table.iter().map(|s| s.key()).collect();
+    assert!(keys.contains(&"pass_ms tc_trace".to_string()), "{keys:?}");
+    assert!(keys.contains(&"pass_ms tc_propagate".to_string()), "{keys:?}");
+}

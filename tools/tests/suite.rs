@@ -142,6 +142,11 @@ fn bad_suite_files_are_reported_at_file_line() {
         "Suite(\n  cases: [(name: \"c\", scenario: \"s.ron\", seeds: [1, 2], framez: 3)],\n  gates: [(metric: Smape, window: Overall, bound: Relative(tolerance: 0.1))],\n)",
     );
     assert!(e.starts_with("bad.ron:2:") && e.contains("framez"), "{e}");
+    // A metric only `flicker reproduce` reads (PassMs needs a claim's passes): the gate's line.
+    let e = load_error(&format!(
+        "Suite(\n    cases: [{case}],\n    gates: [\n      (metric: PassMs, window: Overall, bound: Absolute(limit: 1.0)),\n    ],\n)"
+    ));
+    assert!(e.starts_with("bad.ron:4:7: metric pass_ms"), "{e}");
     // Relative scenario paths resolve against the suite's folder.
     let ok = Suite::from_ron(&format!("Suite(cases: [{case}], gates: [(metric: Flip, window: Overall, bound: Absolute(limit: 1.0))])"), Path::new("dir/bad.ron")).unwrap();
     assert_eq!(ok.cases[0].scenario, Path::new("dir/s.ron"));

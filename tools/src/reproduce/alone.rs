@@ -5,53 +5,13 @@
 //! `not_run` names, per method, the shared passes it would not run alone, and its `FrameMs` is
 //! the frame's passes less those, read back from the run's frames.csv.
 
-use std::path::Path;
-
 use anyhow::{Context, Result, bail};
 use systems::run_folder::RunFolder;
 
 use crate::suite::measurement::SeedRun;
 use crate::suite::metric::Metric;
 
-/// frames.csv's rows as (method, frame, pass -> ms) for the passes in `passes`.
-fn pass_times(path: &Path, passes: &[String]) -> Result<Vec<(String, u32, Vec<Option<f64>>)>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    let column = |name: &str| header.iter().position(|h| *h == name);
-    let (Some(method), Some(frame)) = (column("method"), column("frame")) else {
-        bail!("{}: no method and frame columns", path.display())
-    };
-    // A pass's column is gpu_ms_PASS or wall_ms_PASS, by the clock that timed it.
-    let columns: Vec<Option<usize>> = passes
-        .iter()
-        .map(|p| column(&format!("gpu_ms_{p}")).or_else(|| column(&format!("wall_ms_{p}"))))
-        .collect();
-    if let Some(i) = columns.iter().position(Option::is_none) {
-        bail!("{}: no column of pass '{}'", path.display(), passes[i]);
-    }
-    let mut rows = Vec::new();
-    for (i, line) in lines.enumerate() {
-        let cells: Vec<&str> = line.split(',').collect();
-        let at = || format!("{}:{}", path.display(), i + 2);
-        let cell = |c: usize| cells.get(c).copied().with_context(|| format!("{}: short row", at()));
-        let times = columns
-            .iter()
-            .flatten()
-            .map(|&c| {
-                let s = cell(c)?;
-                if s.is_empty() {
-                    return Ok(None);
-                }
-                s.parse().map(Some).with_context(|| format!("{}: '{s}' is not a number", at()))
-            })
-            .collect::<Result<_>>()?;
-        let frame = cell(frame)?.parse().with_context(|| format!("{}: frame", at()))?;
-        rows.push((cell(method)?.to_string(), frame, times));
-    }
-    Ok(rows)
-}
+use super::pass_ms::pass_times;
 
 /// Each method of `not_run` gets `FrameMs` less its passes not run alone, per frame. A frame
 /// with a time had every pass it booked timed, so an empty cell there is a pass not booked that

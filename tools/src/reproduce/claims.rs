@@ -86,6 +86,10 @@ pub struct ClaimCase {
     /// Only these method labels of the scenario; all when absent.
     #[serde(default)]
     pub methods: Option<Vec<String>>,
+    /// Statistics shown in the case's table beside its claims' (a paper table's other
+    /// columns, such as Table 1's per-pass times): no `against` or `not_run`.
+    #[serde(default)]
+    pub table: Vec<Statistic>,
     #[serde(default)]
     pub smoke: Size,
     #[serde(default)]
@@ -109,6 +113,9 @@ pub struct Statistic {
     /// times each method in its own run charges it only what it runs. One list per case.
     #[serde(default)]
     pub not_run: Vec<(String, Vec<String>)>,
+    /// `PassMs` only: the passes whose ms it sums (`reproduce::pass_ms`), e.g. `["tc_trace"]`.
+    #[serde(default)]
+    pub passes: Vec<String>,
 }
 
 impl Statistic {
@@ -117,10 +124,22 @@ impl Statistic {
         if let Some(a) = &self.against {
             name.push_str(&format!(" vs {a}"));
         }
+        if !self.passes.is_empty() {
+            name.push_str(&format!(" ({})", self.passes.join(" + ")));
+        }
         for (m, passes) in &self.not_run {
             name.push_str(&format!(" ({m} without {})", passes.join(", ")));
         }
         format!("{name} {}", self.window.name())
+    }
+
+    /// The key of its series in a seed run's metrics: the metric's name, with `PassMs`'s
+    /// passes (one series per set of passes).
+    pub fn key(&self) -> String {
+        match self.metric {
+            Metric::PassMs => super::pass_ms::key(&self.passes),
+            m => m.name().to_string(),
+        }
     }
 }
 
@@ -416,6 +435,31 @@ fn check_not_run(
     }
 }
 
+/// `passes` with `PassMs` only, and there at least one, each named once.
+fn check_passes(s: &Statistic, case: &CaseMethods) -> Result<(), String> {
+    let metric = s.metric.name();
+    match (s.metric == Metric::PassMs, s.passes.is_empty()) {
+        (true, true) => {
+            return Err(format!("{metric} without passes; expected e.g. passes: [\"tc_trace\"]"));
+        }
+        (false, false) => {
+            return Err(format!(
+                "passes with the statistic {metric}; expected them only with PassMs"
+            ));
+        }
+        _ => {}
+    }
+    if case.computed.is_some() && !s.passes.is_empty() {
+        return Err("passes on a computed case, which has no passes".into());
+    }
+    for (i, p) in s.passes.iter().enumerate() {
+        if p.is_empty() || p.contains(',') || s.passes[..i].contains(p) {
+            return Err(format!("pass '{p}'; expected distinct pass names"));
+        }
+    }
+    Ok(())
+}
+
 fn check_confidence(file: RonFile, line: usize, c: f64) -> Result<(), ScenarioError> {
     if c > 0.5 && c < 1.0 {
         Ok(())
@@ -465,6 +509,9 @@ impl Claims {
                     c.check().map_err(|e| at(format!("{}: {e}", c.name())))?;
                     let computed = c.methods();
                     let kinds = computed.keys().map(|l| (l.clone(), c.name())).collect();
+                    if !case.table.is_empty() {
+                        return Err(at("table: a computed case's table holds its claims' statistics only; expected no table".into()));
+                    }
                     if case.methods.is_some() {
                         return Err(at("methods: a computed case has no scenario to choose from; expected no methods".into()));
                     }
@@ -518,7 +565,17 @@ impl Claims {
             }
             let r = &spec.scenario.reference;
             let references = r.spp > 0 && r.frames != ReferenceFrames::None;
-            methods.insert(case.name.clone(), CaseMethods { kinds, references, computed: None });
+            let case_methods = CaseMethods { kinds, references, computed: None };
+            for s in &case.table {
+                let at = |m: String| at(format!("table: {}: {m}", s.describe()));
+                if s.against.is_some() || !s.not_run.is_empty() {
+                    return Err(at(
+                        "against or not_run; expected them in a claim's statistic".into()
+                    ));
+                }
+                check_passes(s, &case_methods).map_err(at)?;
+            }
+            methods.insert(case.name.clone(), case_methods);
             case_lines.insert(case.name.clone(), (entry.line, entry.column));
             cases.push(case);
         }
@@ -570,6 +627,7 @@ impl Claims {
                 let name = claim.case.as_deref().unwrap_or_default();
                 check_against(s, case, name, &mut against).map_err(at)?;
                 check_not_run(s, case, name, &mut not_run).map_err(at)?;
+                check_passes(s, case).map_err(at)?;
             }
             if let Some(case) = case {
                 for m in claim.comparison.methods() {

@@ -6,6 +6,7 @@ pub mod alone;
 pub mod claims;
 pub mod computation;
 pub mod judge;
+pub mod pass_ms;
 pub mod report;
 pub mod run;
 pub mod sss_psnr;

@@ -11,6 +11,7 @@ use super::judge::{Judged, judge};
 use super::report::{self, PaperResult};
 use super::table::case_tables;
 use crate::suite::measurement::CaseRuns;
+use crate::suite::metric::Metric;
 use crate::suite::run::play_cases;
 
 pub struct ReproduceOptions {
@@ -68,16 +69,26 @@ pub fn load_claims(dir: &Path, paper: &str) -> Result<Vec<Claims>> {
 
 /// What the claims' statistics read from the run folders rather than frame records, added to
 /// each played seed's run once per case: `SssPsnr` against the claim's `against` method, and
-/// `FrameMs` less the shared passes a method would not run alone (`not_run`).
+/// `FrameMs` less the shared passes a method would not run alone (`not_run`), and `PassMs`
+/// over its passes (claims' statistics and the cases' table columns).
 fn add_from_folders(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> Result<()> {
     let (mut images, mut alone): (Vec<&str>, Vec<&str>) = (Vec::new(), Vec::new());
-    for c in &claims.claims {
-        let (Some(case), Some(s)) = (&c.case, &c.statistic) else { continue };
+    let mut passes: Vec<(&str, &[String])> = Vec::new();
+    let of_claims =
+        claims.claims.iter().filter_map(|c| c.case.as_deref().zip(c.statistic.as_ref()));
+    let of_tables = claims.cases.iter().flat_map(|c| c.table.iter().map(|s| (c.name.as_str(), s)));
+    for (case, s) in of_claims.chain(of_tables) {
         let Some(r) = runs.get_mut(case) else { continue };
         let at = |e: anyhow::Error| anyhow::anyhow!("case '{case}': {}: {e:#}", s.describe());
+        if s.metric == Metric::PassMs && !passes.contains(&(case, &s.passes[..])) {
+            passes.push((case, &s.passes));
+            for seed in &mut r.seeds {
+                super::pass_ms::add(seed, &s.passes).map_err(at)?;
+            }
+        }
         if let Some(against) = &s.against
             && s.metric.from_images()
-            && !images.contains(&case.as_str())
+            && !images.contains(&case)
         {
             images.push(case);
             let frames = r.frames;
@@ -85,7 +96,7 @@ fn add_from_folders(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> R
                 super::sss_psnr::add(seed, against, frames).map_err(at)?;
             }
         }
-        if !s.not_run.is_empty() && !alone.contains(&case.as_str()) {
+        if !s.not_run.is_empty() && !alone.contains(&case) {
             alone.push(case);
             for seed in &mut r.seeds {
                 super::alone::leave_out(seed, &s.not_run).map_err(at)?;
@@ -131,7 +142,10 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
         for c in &claims.claims {
             let j = match (c.case.as_ref().and_then(|n| runs.get(n)), &c.statistic) {
                 (Some(r), Some(s)) => {
-                    judge(&c.comparison, &|m, w| r.per_seed(m, s.metric, w.unwrap_or(&s.window)))
+                    let key = s.key();
+                    judge(&c.comparison, &|m, w| {
+                        r.per_seed_of(m, s.metric, &key, w.unwrap_or(&s.window))
+                    })
                 }
                 _ => judge(&c.comparison, &|_, _| Err("not played".into())),
             };

@@ -1,6 +1,6 @@
 //! Each played case's table: every method of the case against every statistic its claims
 //! read, the mean over seeds with its 95% interval (the numbers the claims are judged on, for
-//! all methods, as the paper's tables list them).
+//! all methods, as the paper's tables list them), and the case's own `table` columns.
 
 use std::collections::BTreeMap;
 
@@ -35,10 +35,13 @@ pub fn case_tables(claims: &Claims, runs: &BTreeMap<String, CaseRuns>) -> Vec<Ca
     for case in &claims.cases {
         let Some(r) = runs.get(&case.name) else { continue };
         let mut stats = Vec::new();
-        for c in claims.claims.iter().filter(|c| c.case.as_deref() == Some(case.name.as_str())) {
-            if let Some(s) = &c.statistic
-                && !stats.contains(s)
-            {
+        let of_claims = claims
+            .claims
+            .iter()
+            .filter(|c| c.case.as_deref() == Some(case.name.as_str()))
+            .filter_map(|c| c.statistic.as_ref());
+        for s in of_claims.chain(&case.table) {
+            if !stats.contains(s) {
                 stats.push(s.clone());
             }
         }
@@ -46,8 +49,10 @@ pub fn case_tables(claims: &Claims, runs: &BTreeMap<String, CaseRuns>) -> Vec<Ca
             .methods()
             .into_iter()
             .map(|m| {
-                let cells =
-                    stats.iter().map(|s| cell(r.per_seed(&m, s.metric, &s.window))).collect();
+                let cells = stats
+                    .iter()
+                    .map(|s| cell(r.per_seed_of(&m, s.metric, &s.key(), &s.window)))
+                    .collect();
                 (m, cells)
             })
             .collect();

@@ -68,10 +68,22 @@ impl SeedRun {
         metric: Metric,
         range: std::ops::Range<u32>,
     ) -> Option<f64> {
+        self.window_mean_of(method, metric, metric.name(), range)
+    }
+
+    /// `window_mean` of the series kept under `key` (a metric with parameters, such as
+    /// `PassMs`'s passes, keeps one series per parameter set).
+    pub fn window_mean_of(
+        &self,
+        method: &str,
+        metric: Metric,
+        key: &str,
+        range: std::ops::Range<u32>,
+    ) -> Option<f64> {
         if !metric.per_frame() {
             return self.jod(method, &range);
         }
-        let series = self.methods.get(method)?.get(metric.name())?;
+        let series = self.methods.get(method)?.get(key)?;
         let values: Vec<f64> = range
             .filter_map(|f| series.get(f as usize).copied().flatten())
             .filter(|v| v.is_finite())
@@ -105,6 +117,17 @@ impl CaseRuns {
         metric: Metric,
         window: &Window,
     ) -> Result<Vec<f64>, String> {
+        self.per_seed_of(method, metric, metric.name(), window)
+    }
+
+    /// `per_seed` of the series kept under `key` (`window_mean_of`).
+    pub fn per_seed_of(
+        &self,
+        method: &str,
+        metric: Metric,
+        key: &str,
+        window: &Window,
+    ) -> Result<Vec<f64>, String> {
         let range = window.frames(self.frames, &self.events).ok_or_else(|| {
             format!(
                 "window {} needs event {:?}, but the case has {} event(s)",
@@ -123,8 +146,8 @@ impl CaseRuns {
         self.seeds
             .iter()
             .map(|s| {
-                s.window_mean(method, metric, range.clone())
-                    .ok_or_else(|| format!("seed {}: no {} values for {method} in frames {range:?} (no reference frames there, or the method is not in the run)", s.seed, metric.name()))
+                s.window_mean_of(method, metric, key, range.clone())
+                    .ok_or_else(|| format!("seed {}: no {key} values for {method} in frames {range:?} (no reference frames there, or the method is not in the run)", s.seed))
             })
             .collect()
     }

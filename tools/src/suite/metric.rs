@@ -46,6 +46,11 @@ pub enum Metric {
     /// `flicker reproduce` computes it from the run folder's images (`from_images`), so it is
     /// not in `ALL` and no suite gate reads it.
     SssPsnr,
+    /// The summed ms of some of a frame's passes (`reproduce::pass_ms`, the claim's statistic
+    /// names them), a method's share of a cache's passes included: Table 1's tracer and
+    /// propagation columns. Read from frames.csv by `flicker reproduce`, not a frame record's
+    /// field, so it is not in `ALL`. A timing.
+    PassMs,
 }
 
 impl Metric {
@@ -87,6 +92,7 @@ impl Metric {
             Metric::PrimaryRays => "primary_rays",
             Metric::BlendSigma => "blend_sigma",
             Metric::SssPsnr => "sss_psnr",
+            Metric::PassMs => "pass_ms",
         }
     }
 
@@ -109,7 +115,7 @@ impl Metric {
 
     /// A measured time: not reproducible run to run, so two runs agree on it only within noise.
     pub fn is_timing(self) -> bool {
-        self == Metric::FrameMs
+        matches!(self, Metric::FrameMs | Metric::PassMs)
     }
 
     /// Whether a method of plugin kind `kind` (`MethodPlugin::NAME`) records this metric in a
@@ -118,7 +124,7 @@ impl Metric {
     pub fn recorded_by(self, kind: &str, references: bool) -> bool {
         match self {
             Metric::Smape | Metric::SmapeReprojected => true,
-            Metric::FrameMs | Metric::Rays | Metric::Shaded => true,
+            Metric::FrameMs | Metric::PassMs | Metric::Rays | Metric::Shaded => true,
             Metric::Flip | Metric::Mse | Metric::RelMse | Metric::Psnr | Metric::Cvvdp => {
                 references
             }
@@ -139,7 +145,7 @@ impl Metric {
             Metric::Mse => r.mse,
             Metric::RelMse => r.rel_mse,
             Metric::Psnr => r.psnr,
-            Metric::Cvvdp | Metric::SssPsnr => None,
+            Metric::Cvvdp | Metric::SssPsnr | Metric::PassMs => None,
             Metric::FrameMs => r.passes_total_ms(),
             Metric::Rays => r.rays.map(|n| n as f64),
             Metric::Shaded => r.shaded.map(|n| n as f64),

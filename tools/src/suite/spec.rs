@@ -243,6 +243,12 @@ impl Suite {
                     ),
                 ));
             }
+            if gate.metric == Metric::PassMs {
+                return Err(file.error_at(
+                    &entry,
+                    "metric pass_ms is summed by `flicker reproduce` over a claim's passes; expected a metric of frames.csv, e.g. FrameMs".into(),
+                ));
+            }
             match gate.bound {
                 Bound::Relative { tolerance: t } if !(t.is_finite() && t >= 0.0) => {
                     return Err(file.error_at(
