@@ -8,6 +8,7 @@ mod image_pass;
 mod medium;
 mod mis_pass;
 mod shaders;
+mod specialised_pipeline;
 mod subsurface_path_pass;
 mod trials;
 mod volume_path_pass;

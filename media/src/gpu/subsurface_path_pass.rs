@@ -5,8 +5,6 @@
 //! and geometry, 2 this pass's parameters, the coefficients per material and the per-sample
 //! radiance. Scenes without subsurface materials render as the path tracer renders them.
 
-use std::sync::Mutex;
-
 use render::compute::{BufferBinding, binding_layout, buffer_group, pipelines};
 use render::frame_bindings::FrameBindings;
 use render::gpu::Gpu;
@@ -20,6 +18,7 @@ use scene::{Material, SubsurfaceMedium};
 use wgpu::util::DeviceExt;
 
 use super::VolumeImage;
+use super::specialised_pipeline::SpecialisedPipeline;
 
 render::gpu_struct! {
     pub struct SubsurfacePathParams {
@@ -71,7 +70,7 @@ pub fn coefficient_table(materials: &[Material]) -> Result<Vec<[f32; 4]>, String
 
 pub struct SubsurfacePathPass {
     layout: wgpu::BindGroupLayout,
-    pipeline: Mutex<(SceneFeatures, wgpu::ComputePipeline)>,
+    pipeline: SpecialisedPipeline,
     timer: PassTimer,
 }
 
@@ -98,13 +97,9 @@ impl SubsurfacePathPass {
 
     pub fn new(gpu: &Gpu, scene: &SceneGpu) -> Result<Self, String> {
         let layout = binding_layout(gpu, "subsurface path", &BINDINGS);
-        let features = scene.features();
-        let pipeline = Self::compile(gpu, scene, &layout, features)?;
-        Ok(Self {
-            layout,
-            pipeline: Mutex::new((features, pipeline)),
-            timer: PassTimer::new(gpu, &[SUBSURFACE_PATH_PASS]),
-        })
+        let pipeline =
+            SpecialisedPipeline::new(scene.features(), |f| Self::compile(gpu, scene, &layout, f))?;
+        Ok(Self { layout, pipeline, timer: PassTimer::new(gpu, &[SUBSURFACE_PATH_PASS]) })
     }
 
     fn compile(
@@ -141,14 +136,8 @@ impl SubsurfacePathPass {
         gpu.check_loop_iterations(SUBSURFACE_PATH_PASS, u64::from(MAX_EVENTS) * 4)
             .map_err(|e| e.to_string())?;
         let table = coefficient_table(materials)?;
-        let pipeline = {
-            let features = scene.features();
-            let mut held = self.pipeline.lock().unwrap_or_else(|e| e.into_inner());
-            if held.0 != features {
-                *held = (features, Self::compile(gpu, scene, &self.layout, features)?);
-            }
-            held.1.clone()
-        };
+        let pipeline =
+            self.pipeline.get(scene.features(), |f| Self::compile(gpu, scene, &self.layout, f))?;
         let device = &gpu.device;
         let coefficients = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("subsurface coefficients"),

@@ -4,8 +4,6 @@
 //! optics and per-sample radiance, 3 the media (`GpuMedium`). A scene without media never builds
 //! this pass: the path tracer and its shaders are unchanged.
 
-use std::sync::Mutex;
-
 use glam::Vec3;
 use render::compute::{BufferBinding, binding_layout, buffer_group, pipelines};
 use render::error::RenderError;
@@ -22,6 +20,7 @@ use serde::{Deserialize, Serialize};
 use wgpu::util::DeviceExt;
 
 use super::medium::GpuMedium;
+use super::specialised_pipeline::SpecialisedPipeline;
 
 /// What a medium does to light beside extinction: single-scattering albedo σ_s/σ_t per channel,
 /// and emitted radiance per unit extinction (the source term σ_t(x) ε; zero: none).
@@ -194,11 +193,9 @@ pub const VOLUME_PATH_PASS: &str = "volume_path";
 
 pub struct VolumePathPass {
     layout: wgpu::BindGroupLayout,
-    /// The pipeline and the scene features it was compiled for: compiled again when the scene
-    /// has others (a light kind gained or lost, a deeper BVH), as the library's passes are
-    /// (`PassLibrary::specialise`; this pass binds a fourth group, which the library's passes do
-    /// not, so it holds its own).
-    pipeline: Mutex<(SceneFeatures, wgpu::ComputePipeline)>,
+    /// Compiled for the scene's features (this pass binds a fourth group, which the library's
+    /// passes do not, so it holds its own).
+    pipeline: SpecialisedPipeline,
     timer: PassTimer,
 }
 
@@ -227,13 +224,10 @@ impl VolumePathPass {
 
     pub fn new(gpu: &Gpu, scene: &SceneGpu, medium: &GpuMedium) -> Result<Self, RenderError> {
         let layout = binding_layout(gpu, "media volume path", &BINDINGS);
-        let features = scene.features();
-        let pipeline = Self::compile(gpu, scene, &layout, medium, features)?;
-        Ok(Self {
-            layout,
-            pipeline: Mutex::new((features, pipeline)),
-            timer: PassTimer::new(gpu, &[VOLUME_PATH_PASS]),
-        })
+        let pipeline = SpecialisedPipeline::new(scene.features(), |f| {
+            Self::compile(gpu, scene, &layout, medium, f)
+        })?;
+        Ok(Self { layout, pipeline, timer: PassTimer::new(gpu, &[VOLUME_PATH_PASS]) })
     }
 
     fn compile(
@@ -261,17 +255,12 @@ impl VolumePathPass {
         scene: &SceneGpu,
         medium: &GpuMedium,
     ) -> Result<wgpu::ComputePipeline, RenderError> {
-        let features = scene.features();
-        let mut held = self.pipeline.lock().unwrap_or_else(|e| e.into_inner());
-        if held.0 != features {
-            *held = (features, Self::compile(gpu, scene, &self.layout, medium, features)?);
-        }
-        Ok(held.1.clone())
+        self.pipeline.get(scene.features(), |f| Self::compile(gpu, scene, &self.layout, medium, f))
     }
 
     /// The scene features the pipeline was last compiled for.
     pub fn features(&self) -> SceneFeatures {
-        self.pipeline.lock().unwrap_or_else(|e| e.into_inner()).0
+        self.pipeline.features()
     }
 
     /// `spp` paths per pixel of the current scene and camera (seed and frame as the path
