@@ -835,6 +835,7 @@ impl NeuralCache {
         let mirror = self.grid_views(grid_textures::WRITE_BINDINGS);
         let (params_out, ema_out) = mirror.split_at(mirror.len() / 2);
         let [clear, check, apply, ema, count, scan, emit] = pipelines;
+        // What every pass over the touched list binds; Adam's add its moments, the EMA its average.
         let over_list = |label: &str,
                          pipeline: &wgpu::ComputePipeline,
                          extra: &[(u32, &wgpu::Buffer)],
@@ -843,8 +844,6 @@ impl NeuralCache {
                 (0, call),
                 (1, &b.hyper),
                 (2, &b.params),
-                (4, &b.adam_m),
-                (5, &b.adam_v),
                 (7, &b.grid_accum),
                 (8, &b.counters),
                 (11, &sb.grid_steps),
@@ -855,6 +854,7 @@ impl NeuralCache {
             entries.extend(extra);
             bind_with_views(gpu, label, pipeline, &entries, views)
         };
+        let moments: [(u32, &wgpu::Buffer); 2] = [(4, &b.adam_m), (5, &b.adam_v)];
         Some([
             bind(
                 gpu,
@@ -862,26 +862,9 @@ impl NeuralCache {
                 clear,
                 &[(13, &sb.touched), (14, &sb.touched_len), (16, &b.grid_accum)],
             ),
-            over_list("nirc adam check grid", check, &[(3, &b.ema)], &[]),
-            over_list("nirc adam apply grid", apply, &[], params_out),
-            bind_with_views(
-                gpu,
-                "nirc ema grid",
-                ema,
-                &[
-                    (0, call),
-                    (1, &b.hyper),
-                    (2, &b.params),
-                    (3, &b.ema),
-                    (7, &b.grid_accum),
-                    (8, &b.counters),
-                    (11, &sb.grid_steps),
-                    (12, &sb.bias_powers),
-                    (13, &sb.touched),
-                    (14, &sb.touched_len),
-                ],
-                ema_out,
-            ),
+            over_list("nirc adam check grid", check, &[moments[0], moments[1], (3, &b.ema)], &[]),
+            over_list("nirc adam apply grid", apply, &moments, params_out),
+            over_list("nirc ema grid", ema, &[(3, &b.ema)], ema_out),
             bind(
                 gpu,
                 "nirc count touched",
