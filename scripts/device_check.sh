@@ -4,7 +4,7 @@
 # lab`, with the release binary built at the commit being measured. Usage, on the device
 # machine, from the repository root:
 #   scripts/device_check.sh target/release/flicker OUT_DIR
-# Prints a Markdown block for README.md (wall time of each step) and copies the runs'
+# Prints a Markdown block for docs/gpu.md (wall time of each step) and copies the runs'
 # summary.json and frames.csv to OUT_DIR.
 set -uo pipefail
 bin=${1:?flicker binary}; out=${2:?output folder}
@@ -23,7 +23,7 @@ step bench "$bin" bench --no-metrics --out "$out/bench.md"
 cat "$out/bench.md"
 step light_rotation "$bin" run scenarios/light_rotation_cornell_box.ron --out /tmp/runs/light_rotation
 step hairball "$bin" run scenarios/hairball.ron --out /tmp/runs/hairball
-# The papers' claims at lab scale (README "What the papers claim, and what we measure").
+# The papers' claims at lab scale (docs/reproduce.md).
 step reproduce_lab "$bin" reproduce all --scale lab --out /tmp/runs/reproduce_lab --quiet
 cp /tmp/runs/reproduce_lab/reproduce.md "$out/reproduce_lab.md" 2>/dev/null
 for r in light_rotation hairball; do

@@ -1,4 +1,4 @@
-//! The layout of a run folder, in one place (README.md documents it for users).
+//! The layout of a run folder, in one place (docs/getting-started.md documents it for users).
 //!
 //! ```text
 //! RUN/manifest.json              scenario, commit, adapter, seed, settings, events, regions
