@@ -33,7 +33,7 @@
 //!
 //! Numbers below predate issue 15 (voxels then rounded up to a power of two, secondary-hit
 //! default); not rerun since. Issue 15's convergence numbers are in
-//! render/src/sample_cache/README.md.
+//! docs/lab/sample-cache-passes.md.
 //!
 //! Numbers (lavapipe, 2 shared CPU cores; an earlier courtyard version of issue5_bench at 320x180,
 //! camera moving, max depth 4, median GPU ms): secondary-hit lookup hc_age 5.2,
@@ -42,7 +42,7 @@
 //! resolve 11. fast_turn.ron at 64x36: mean frame-to-frame SMAPE 1 spp 0.46, hash cache 0.39,
 //! TAA 0.15, hash cache + TAA 0.13; relMSE at the reference frames 0.072, 0.052, 0.015-0.027,
 //! 0.010-0.023. Hairball 320x180, max depth 3, idle machine (`cargo run -j2 -p bench --example
-//! issue5_bench -- 320 180 12`, table in render/src/sample_cache/README.md): hc_age 7.5,
+//! issue5_bench -- 320 180 12`, table in docs/lab/sample-cache-fig7.md): hc_age 7.5,
 //! hc_trace 537, hc_update 399, hc_resolve 3.5 ms; 141 027 rays and 64 211 shaded paths
 //! (57 600 pixels + update paths) per frame.
 

@@ -1,7 +1,8 @@
 //! Stable sample cache (Philippi, Jensen & Frisvad 2025, "Stable Sample Caching for Interactive
 //! Stereoscopic Ray Tracing", sections 3.1-3.5): a screen-space cache of N first-hit samples per
 //! pixel, carried from frame to frame by forward reprojection, retraced sparsely, shaded
-//! sparsely, and averaged into the image. See README.md in this folder for the map and choices.
+//! sparsely, and averaged into the image. See README.md in this folder for the map, and
+//! docs/methods/sample-cache.md for the choices.
 //!
 //! Passes per frame (shaders/sample_cache/, one compute pass each, timed):
 //! `reserve` (reproject.wgsl: begin_main, reserve_main, gather_main, closest_main), `trace` (retrace.wgsl: retrace_main,

@@ -5,7 +5,8 @@
 //! separable baseline (`separable`), prefiltered irradiance MIPs for AFIS (`prefilter`), the
 //! hybrid of the two (`hybrid`), the random-walk reference (`random_walk`) and the path-traced
 //! ground truth of a flat plane built on it (`ground_truth`).
-//! README inside.
+//! The file map is in this crate's README.md; settings, results and departures in
+//! docs/methods/sss.md.
 
 pub mod control_variates;
 pub mod evaluation;

@@ -27,7 +27,7 @@
 //! Cost (lavapipe on 2 shared CPU cores, courtyard 320x180, max depth 4, median GPU ms of 5
 //! frames, an earlier courtyard version of issue5_bench): taa_trace 1034, taa_resolve 11.
 //! Hairball 320x180, max depth 3, mean of 10 frames on an idle machine (`cargo run -j2 -p bench
-//! --example issue5_bench -- 320 180 12`, table in render/src/sample_cache/README.md):
+//! --example issue5_bench -- 320 180 12`, table in docs/lab/sample-cache-fig7.md):
 //! taa_trace 912, taa_resolve 10.8; 191 905 rays per frame (GPU counter).
 
 pub mod jitter;
