@@ -11,7 +11,7 @@
 //!   alone and its MIS with equiangular sampling by Eq. 9 with the naive, jackknife and Miller
 //!   weights (all unbiased).
 //! - The MIS variants' order in MSE over three seeds, in the cloud (N = 4) and a sparse
-//!   explosion field (N = 1), as measured (see the test's comment and media/README.md).
+//!   explosion field (N = 1), as measured (see the test's comment and docs/lab/media-tests.md).
 //! - Medium emission (ε per unit extinction, source term σ_t ε): a non-scattering emissive slab
 //!   over a black ground gives ε (1 − exp(−σ_t ℓ)) per pixel; an emissive scattering medium
 //!   filling the scene (every path collides D + 1 times, escape has probability e^{−80}) gives
@@ -25,7 +25,7 @@
 //!   16 and 8) through a layered medium: the image is the path tracer's times E[K], which the
 //!   CPU twin gives (its bias included).
 //! - Eq. 9 with its T̃(t0) by ratio tracking and by the exact transmittance, against free flight
-//!   (a measurement for media/README.md; asserted: the exact-T̃ variant is unbiased); bad
+//!   (a measurement for docs/lab/media-tests.md; asserted: the exact-T̃ variant is unbiased); bad
 //!   jackknife settings refused by the pass.
 
 mod common;
@@ -488,8 +488,9 @@ const NAIVE_10: usize = 4;
 const JACKKNIFE_10: usize = 5;
 
 /// The MIS variants' order in MSE, as measured in two settings (not the paper's, see
-/// media/README.md): variant a is below b when the one-sided 95% Student t upper bound of the
-/// mean per-seed relative difference (a − b) / b is below zero; "alike" when the two-sided 95%
+/// docs/lab/media-tests.md): variant a is below b when the one-sided 95% Student t upper bound
+/// of the mean per-seed relative difference (a − b) / b is below zero; "alike" when the
+/// two-sided 95%
 /// interval lies within ±5%.
 /// The naive weight is g(X0) of one estimate (m = 1, Fig. 12d).
 /// - the cloud with N = 4 stratified samples per optical-depth estimate (S ≈ 0): Eq. 10 below
@@ -893,7 +894,7 @@ fn bad_jackknife_settings_are_refused_by_the_pass() {
 /// in volume_mis.ron)? T̃ swapped for the exact transmittance (regular tracking through the
 /// voxels; on the homogeneous medium the closed form exp(−σ_t ℓ)), in the cloud scene (N = 4)
 /// and with a homogeneous medium (σ_t 1) in the same box: MSE per seed against a 1024-spp
-/// reference, as `mis_errors`. Printed for media/README.md; asserted is only what holds
+/// reference, as `mis_errors`. Printed for docs/lab/media-tests.md; asserted is only what holds
 /// whatever the answer: Eq. 9 with the exact T̃ is unbiased (the per-seed relative bias of the
 /// image mean has a two-sided 95% t interval containing 0, widened by the reference's own
 /// relative standard error).

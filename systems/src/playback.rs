@@ -47,7 +47,7 @@ pub struct FrameWorld {
 
 /// A scenario with media refuses what would silently leave them out: methods that do not
 /// render media, and more media than the volumetric path tracer (references, VolumePath) binds
-/// (media/README.md).
+/// (docs/methods/volume.md).
 fn check_media_support(spec: &RunSpec, origin: &str) -> Result<()> {
     let scenario = &spec.scenario;
     if scenario.media.is_empty() {
@@ -57,7 +57,7 @@ fn check_media_support(spec: &RunSpec, origin: &str) -> Result<()> {
         let plugin = method.spec.plugin();
         if !plugin.sees_media() {
             anyhow::bail!(
-                "{origin}:{}:{}: method {} does not render participating media and the scenario declares media ('{}'); expected only VolumePath or VolumeTransmittance methods in a scenario with media (media/README.md)",
+                "{origin}:{}:{}: method {} does not render participating media and the scenario declares media ('{}'); expected only VolumePath or VolumeTransmittance methods in a scenario with media (docs/methods/volume.md)",
                 method.entry.line,
                 method.entry.column,
                 method.label(),
@@ -137,9 +137,9 @@ impl FrameWorld {
             cached: 0,
         });
         world.insert_resource(Progress(progress));
-        // The volumetric path tracer renders every declared medium (media/README.md). More than
-        // it binds pass check_media_support only without references and VolumePath, which are
-        // all that use it.
+        // The volumetric path tracer renders every declared medium (docs/methods/volume.md). More
+        // than it binds pass check_media_support only without references and VolumePath, which
+        // are all that use it.
         if !scenario.media.is_empty() && scenario.media.len() <= media::gpu::MAX_MEDIA {
             let gpu = &world.resource::<GpuDevice>().0;
             let medium = frame::scene_medium::SceneMedium::new(gpu, &scenario.media);

@@ -18,6 +18,7 @@ use crate::suite::spec::Case;
 use crate::suite::window::Window;
 
 use super::computation::Computation;
+use super::log_ratio::RatioExpectation;
 
 /// How big a reproduction runs: `Smoke` (tiny: about two minutes a paper on 2 cores), `Lab`
 /// (the scenarios as shipped) or `Paper` (the paper's sizes where the file gives them).
@@ -189,6 +190,16 @@ pub enum Comparison {
         #[serde(default = "default_confidence")]
         confidence: f64,
     },
+    /// `LogRatio(method: "a", to: "b", expect: Below(1.0))` or `expect: Near(value: 3.0,
+    /// tolerance: 0.5)`: the per-seed ratio a / b of the same runs, judged in the log
+    /// (`reproduce::log_ratio`): for claims about factors of a bias, a std or an error.
+    LogRatio {
+        method: String,
+        to: String,
+        expect: RatioExpectation,
+        #[serde(default = "default_confidence")]
+        confidence: f64,
+    },
     /// `Rises(method: "a", from: Before(event: 0))`: a's statistic over the claim's window is
     /// higher than over `from`, judged as the paired per-seed differences of `Below`.
     Rises {
@@ -210,9 +221,9 @@ impl Comparison {
         match self {
             Comparison::Below { method, than, .. } => vec![method, than],
             Comparison::Value { method, .. } | Comparison::Rises { method, .. } => vec![method],
-            Comparison::Ratio { method, to, .. } | Comparison::Difference { method, to, .. } => {
-                vec![method, to]
-            }
+            Comparison::Ratio { method, to, .. }
+            | Comparison::Difference { method, to, .. }
+            | Comparison::LogRatio { method, to, .. } => vec![method, to],
             Comparison::NotComparable { methods, .. } => {
                 methods.iter().map(|m| m.as_str()).collect()
             }
@@ -230,6 +241,9 @@ impl Comparison {
             }
             Comparison::Difference { method, to, value, tolerance, .. } => {
                 format!("{method} − {to} = {value} ± {tolerance}")
+            }
+            Comparison::LogRatio { method, to, expect, .. } => {
+                format!("{method} / {to} {} (log ratio)", expect.describe())
             }
             Comparison::Rises { method, from, .. } => {
                 format!("{method} rises from {}", from.name())
@@ -601,6 +615,13 @@ impl Claims {
                     check_confidence(file, entry.line, *confidence)?;
                     if !(tolerance.is_finite() && *tolerance >= 0.0) {
                         return Err(at(format!("tolerance {tolerance}; expected a number >= 0")));
+                    }
+                }
+                Comparison::LogRatio { confidence, expect, .. } => {
+                    check_confidence(file, entry.line, *confidence)?;
+                    expect.check().map_err(at)?;
+                    if let Some(s) = &claim.statistic {
+                        super::log_ratio::check_metric(s.metric).map_err(at)?;
                     }
                 }
                 Comparison::NotComparable { .. } => {}

@@ -145,6 +145,12 @@ pub fn judge(
                 Err(e) => not_comparable(e),
             }
         }
+        Comparison::LogRatio { method, to, expect, confidence } => {
+            match (values(method), values(to)) {
+                (Ok(a), Ok(b)) => super::log_ratio::judge(a, b, (method, to), expect, *confidence),
+                (Err(e), _) | (_, Err(e)) => not_comparable(e),
+            }
+        }
         Comparison::Difference { method, to, value, tolerance, confidence } => {
             let per_seed =
                 |a: Vec<f64>, b: Vec<f64>| Ok(a.iter().zip(&b).map(|(x, y)| x - y).collect());

@@ -6,6 +6,7 @@ pub mod alone;
 pub mod claims;
 pub mod computation;
 pub mod judge;
+pub mod log_ratio;
 pub mod pass_ms;
 pub mod report;
 pub mod run;

@@ -163,7 +163,7 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
     }
     let seeds = opts.seeds.map_or("each case's own".to_string(), |n| n.to_string());
     let header = format!(
-        "`flicker reproduce {} --scale {}` ({seeds} seeds), commit {}. Relations: the paired one-sided upper bound of the per-seed differences; values and ratios: the two-sided interval of the mean against the claim's band.",
+        "`flicker reproduce {} --scale {}` ({seeds} seeds), commit {}. Relations: the paired one-sided upper bound of the per-seed differences (log ratios: of the geometric mean ratio); values and ratios: the two-sided interval of the mean against the claim's band.",
         opts.paper,
         opts.scale.name(),
         systems::manifest::commit(&opts.claims_dir)

@@ -28,6 +28,10 @@ pub enum Metric {
     /// Mean per-pixel standard deviation of the transmittance estimate (VolumeTransmittance's
     /// `mean_std` stat).
     MeanStd,
+    /// RMS over pixels of the noise-corrected bias of the transmittance image against the
+    /// exact one (VolumeTransmittance's `rms_bias` stat, `media::image::rms_bias`): the bias
+    /// the jackknife paper reads from 2^18 spp, without the noise of a few dozen estimates.
+    RmsBias,
     /// The frame's time in ms: the sum of its passes' times (GPU timestamps or per-pass wall
     /// time), only when every pass was timed. A timing: it varies from run to run.
     FrameMs,
@@ -54,7 +58,7 @@ pub enum Metric {
 }
 
 impl Metric {
-    pub const ALL: [Metric; 16] = [
+    pub const ALL: [Metric; 17] = [
         Metric::Flip,
         Metric::Cvvdp,
         Metric::Smape,
@@ -65,6 +69,7 @@ impl Metric {
         Metric::PathLength,
         Metric::MeanAbsBias,
         Metric::MeanStd,
+        Metric::RmsBias,
         Metric::FrameMs,
         Metric::Rays,
         Metric::Shaded,
@@ -85,6 +90,7 @@ impl Metric {
             Metric::PathLength => "path_length",
             Metric::MeanAbsBias => "mean_abs_bias",
             Metric::MeanStd => "mean_std",
+            Metric::RmsBias => "rms_bias",
             Metric::FrameMs => "frame_ms",
             Metric::Rays => "rays",
             Metric::Shaded => "shaded",
@@ -129,7 +135,9 @@ impl Metric {
                 references
             }
             Metric::PathLength => kind == "Termination",
-            Metric::MeanAbsBias | Metric::MeanStd => kind == "VolumeTransmittance",
+            Metric::MeanAbsBias | Metric::MeanStd | Metric::RmsBias => {
+                kind == "VolumeTransmittance"
+            }
             Metric::SssSpp => kind == "Sss",
             Metric::PrimaryRays => kind == "SampleCache",
             Metric::BlendSigma => kind == "Nirc",
@@ -153,6 +161,7 @@ impl Metric {
             Metric::PathLength
             | Metric::MeanAbsBias
             | Metric::MeanStd
+            | Metric::RmsBias
             | Metric::SssSpp
             | Metric::PrimaryRays
             | Metric::BlendSigma => r.stats.iter().find(|(n, _)| n == self.name()).map(|s| s.1),
@@ -186,6 +195,7 @@ mod tests {
                 ("primary_rays".into(), 300.0),
                 ("blend_sigma".into(), 0.25),
                 ("mean_std".into(), 0.01),
+                ("rms_bias".into(), 0.02),
             ],
         }
     }
@@ -201,6 +211,7 @@ mod tests {
         assert_eq!(Metric::PrimaryRays.of(&r), Some(300.0));
         assert_eq!(Metric::BlendSigma.of(&r), Some(0.25));
         assert_eq!(Metric::MeanStd.of(&r), Some(0.01));
+        assert_eq!(Metric::RmsBias.of(&r), Some(0.02));
         // A stat the method does not report is missing, not 0.
         assert_eq!(Metric::PathLength.of(&r), None);
         // One untimed pass: the frame has no time (a partial sum would look faster).
@@ -224,6 +235,8 @@ mod tests {
         assert!(Metric::BlendSigma.recorded_by("Nirc", true));
         assert!(Metric::PrimaryRays.recorded_by("SampleCache", true));
         assert!(!Metric::PrimaryRays.recorded_by("HashCache", true));
+        assert!(Metric::RmsBias.recorded_by("VolumeTransmittance", false));
+        assert!(!Metric::RmsBias.recorded_by("VolumePath", true));
         assert!(Metric::FrameMs.recorded_by("PathTracing", false));
         assert!(Metric::FrameMs.is_timing() && !Metric::Rays.is_timing());
     }
