@@ -9,6 +9,7 @@ pub mod judge;
 pub mod pass_ms;
 pub mod report;
 pub mod run;
+pub mod sigma_regions;
 pub mod sss_psnr;
 pub mod table;
 
