@@ -7,7 +7,7 @@
 //! Each predictor plays the built-in Cornell box in a world of its own, so each pays the
 //! training step alone, as in the paper, where the scenario's methods share one. The worlds'
 //! frames are interleaved, in an order that changes every frame (`ORDERS`), so that drift in
-//! the machine's speed, the first-inference-after-training cost (nirc/README.md) and whatever a
+//! the machine's speed, the first-inference-after-training cost (docs/lab/nirc-speed.md) and whatever a
 //! frame leaves behind for the next fall on all three alike. A frame's time is the sum of its
 //! passes' times (`FrameRecord::passes_total_ms`: GPU timestamps, or each pass submitted alone
 //! where the adapter has none). The cache starts untrained

@@ -17,7 +17,7 @@
 // point, spot or 0.27°-wide sun, so the cache could not learn them. And small emissive
 // triangles (a corridor's ceiling lamps, a Cornell box's light) make the incident radiance a
 // needle in direction space that a small hash-grid MLP blurs away: the lights then reached the
-// primary hits only through that blur, and the image came out dark (measured: see README).
+// primary hits only through that blur, and the image came out dark (measured: docs/lab/nirc-lavapipe.md).
 // Each light path reaches x_k's estimate through exactly one strategy, so no MIS weight is
 // needed at x_k.
 // The cache learns Lc from `cache_target`, an unbiased one-sample estimate: the ray (x_k, w),

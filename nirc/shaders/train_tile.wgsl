@@ -155,7 +155,7 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) 
     // 5a. Prefetch. On a CPU the scatter below is locked adds at random places in a table of
     //     megabytes, and a locked add waits for the loads before it, so each cache miss would
     //     cost a full memory latency; plain loads of the same words first let the misses
-    //     overlap (about 5 ms of a 4096-record step on lavapipe, nirc/README.md).
+    //     overlap (about 5 ms of a 4096-record step on lavapipe, docs/lab/nirc-speed.md).
     var touched = 0u;
     if in_range {
         for (var l = 0u; l < LEVELS; l++) {

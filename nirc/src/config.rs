@@ -295,6 +295,12 @@ impl std::hash::Hash for PredictorMode {
 }
 
 impl PredictorMode {
+    /// Whether the mode blends or chooses by reliability, and so writes a preference map (its σ
+    /// per pixel, the paper's Fig. 3).
+    pub fn has_preference_map(self) -> bool {
+        matches!(self, PredictorMode::Blend | PredictorMode::Switch | PredictorMode::BlendBy(_))
+    }
+
     pub(crate) fn code(self) -> u32 {
         match self {
             PredictorMode::EmaOnly => 0,

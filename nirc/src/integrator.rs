@@ -41,7 +41,8 @@ pub struct CachePathSettings {
 
 impl Default for CachePathSettings {
     fn default() -> Self {
-        // 2048 records: about 1.5 s of training per frame on lavapipe at width 64 (README).
+        // 2048 records: about 1.5 s of training per frame on lavapipe at width 64
+        // (docs/lab/nirc-speed.md).
         Self { termination_vertex: 1, train_records: 2048, train_steps: 1 }
     }
 }

@@ -589,10 +589,7 @@ pub fn frame_output(
             stats.push(("own_sigma".into(), mean_answered_sigma(&r.sigma)));
         }
         let mut images = Vec::new();
-        if matches!(
-            m.mode,
-            PredictorMode::Blend | PredictorMode::Switch | PredictorMode::BlendBy(_)
-        ) {
+        if m.mode.has_preference_map() {
             images.push(MethodImage {
                 name: "preference".into(),
                 pixels: preference_map(&r.sigma),

@@ -303,6 +303,30 @@ fn passes_not_run_alone_are_checked_at_file_and_line() {
     assert!(e.contains("bad.ron:9") && e.contains("one attribution per case"), "{e}");
 }
 
+/// σ by region (`SigmaChanged`, `SigmaUnchanged`) is read from preference maps, which only the
+/// blends and the switch write: any other method is an error at the claim's line.
+#[test]
+fn sigma_by_region_needs_preference_maps_at_file_and_line() {
+    let cornell = "(name: \"cornell\", scenario: \"../scenarios/light_rotation_cornell_box.ron\", seeds: [1, 2])";
+    let on = |method: &str| {
+        format!(
+            "(id: \"c\", claim: \"c\", source: \"Fig. 3\", paper: \"p\", case: \"cornell\", statistic: (metric: SigmaChanged, window: After(event: 0, frames: 10)), comparison: Rises(method: \"{method}\", from: Before(event: 0)), tolerance_from: \"seeds\")"
+        )
+    };
+    let e = load_with(cornell, &on("nirc_ema_1spp"));
+    assert!(
+        e.contains("bad.ron:8")
+            && e.contains("'nirc_ema_1spp' writes no preference maps")
+            && e.contains("expected a blend or the switch: nirc_blend_1spp, nirc_switch_1spp"),
+        "{e}"
+    );
+    let e = load_with(cornell, &on("pt_1spp"));
+    assert!(
+        e.contains("bad.ron:8") && e.contains("does not record the statistic sigma_changed"),
+        "{e}"
+    );
+}
+
 /// `passes` (the passes `PassMs` sums) go with PassMs only, and PassMs needs them, in a claim's
 /// statistic or a case's table: errors at the claim's or the case's line.
 #[test]

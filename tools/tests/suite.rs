@@ -147,6 +147,11 @@ fn bad_suite_files_are_reported_at_file_line() {
         "Suite(\n    cases: [{case}],\n    gates: [\n      (metric: PassMs, window: Overall, bound: Absolute(limit: 1.0)),\n    ],\n)"
     ));
     assert!(e.starts_with("bad.ron:4:7: metric pass_ms"), "{e}");
+    // σ by region is computed from a run's preference maps: also the gate's line.
+    let e = load_error(&format!(
+        "Suite(\n    cases: [{case}],\n    gates: [\n      (metric: SigmaChanged, window: Overall, bound: Absolute(limit: 1.0)),\n    ],\n)"
+    ));
+    assert!(e.starts_with("bad.ron:4:7: metric sigma_changed"), "{e}");
     // Relative scenario paths resolve against the suite's folder.
     let ok = Suite::from_ron(&format!("Suite(cases: [{case}], gates: [(metric: Flip, window: Overall, bound: Absolute(limit: 1.0))])"), Path::new("dir/bad.ron")).unwrap();
     assert_eq!(ok.cases[0].scenario, Path::new("dir/s.ron"));

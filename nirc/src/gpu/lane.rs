@@ -1,6 +1,6 @@
 //! The register form of inference (`WeightPlacement::Registers`): `LANE_QUERIES` (4) queries per
 //! invocation, each staged weight loaded once for all of them (2x the queries/s of one per
-//! invocation on a newer lavapipe machine; nirc/README.md), their inputs and activations in named
+//! invocation on a newer lavapipe machine; docs/lab/nirc-speed.md), their inputs and activations in named
 //! registers, both predictors' MLP weights in one uniform buffer (`lane_stage.wgsl` copies them
 //! there, transposed, before each inference; `infer_lane.wgsl`).
 //! Why this shape, from `bench::nirc_throughput::register_layer_probe` on lavapipe (Mesa 22.3): a
@@ -17,7 +17,7 @@ use crate::layout::ParameterLayout;
 const XYZW: [&str; 4] = ["x", "y", "z", "w"];
 
 /// Queries per invocation of the register-form inference: each staged weight is loaded once for
-/// all of them (nirc/README.md, "Several queries per invocation").
+/// all of them (docs/lab/nirc-speed.md, "Several queries per invocation").
 pub const LANE_QUERIES: u32 = 4;
 
 /// Where each matrix starts in one predictor's staged weights (vec4s), and the vec4s of one

@@ -215,7 +215,7 @@ pub struct NeuralCache {
 /// Parameter quads each invocation of Adam's and the EMA's passes updates (their loops stride
 /// over the whole vector): the per-invocation work (the step's bias corrections and the flag,
 /// read from `counters`) is then paid once per 4 quads. On lavapipe one quad per invocation
-/// made these passes 1.3-1.6x slower (nirc/README.md); 16 was slower again.
+/// made these passes 1.3-1.6x slower (docs/lab/nirc-speed.md); 16 was slower again.
 const PARAM_QUADS_PER_INVOCATION: u64 = 4;
 
 /// Words of the touched bitmask per block of touched_list.wgsl (its BLOCK_WORDS: 4 per thread).

@@ -298,6 +298,8 @@ pub struct CaseMethods {
     pub references: bool,
     /// A computed case: the metrics each method records.
     pub computed: Option<BTreeMap<String, Vec<Metric>>>,
+    /// The labels of the NIRC methods that write preference maps (σ by region reads them).
+    pub preference_maps: Vec<String>,
 }
 
 #[derive(Clone, Debug)]
@@ -532,7 +534,12 @@ impl Claims {
                     let references = false;
                     methods.insert(
                         case.name.clone(),
-                        CaseMethods { kinds, references, computed: Some(computed) },
+                        CaseMethods {
+                            kinds,
+                            references,
+                            computed: Some(computed),
+                            preference_maps: Vec::new(),
+                        },
                     );
                     case_lines.insert(case.name.clone(), (entry.line, entry.column));
                     cases.push(case);
@@ -579,7 +586,16 @@ impl Claims {
             }
             let r = &spec.scenario.reference;
             let references = r.spp > 0 && r.frames != ReferenceFrames::None;
-            let case_methods = CaseMethods { kinds, references, computed: None };
+            let preference_maps = played
+                .iter()
+                .filter(|m| {
+                    m.spec
+                        .get::<nirc::plugin::NircSettings>()
+                        .is_some_and(|s| s.predictor.has_preference_map())
+                })
+                .map(|m| m.label())
+                .collect();
+            let case_methods = CaseMethods { kinds, references, computed: None, preference_maps };
             for s in &case.table {
                 let at = |m: String| at(format!("table: {}: {m}", s.describe()));
                 if s.against.is_some() || !s.not_run.is_empty() {
@@ -676,6 +692,16 @@ impl Claims {
                         return Err(at(format!(
                             "method '{m}' ({kind}) does not record the statistic {}{why}",
                             s.metric.name()
+                        )));
+                    }
+                    if let Some(s) = &claim.statistic
+                        && matches!(s.metric, Metric::SigmaChanged | Metric::SigmaUnchanged)
+                        && !case.preference_maps.iter().any(|p| p == m)
+                    {
+                        return Err(at(format!(
+                            "method '{m}' writes no preference maps, so it has no {}; expected a blend or the switch: {}",
+                            s.metric.name(),
+                            case.preference_maps.join(", ")
                         )));
                     }
                 }

@@ -10,6 +10,7 @@ pub mod log_ratio;
 pub mod pass_ms;
 pub mod report;
 pub mod run;
+pub mod sigma_regions;
 pub mod sss_psnr;
 pub mod table;
 

@@ -69,10 +69,11 @@ pub fn load_claims(dir: &Path, paper: &str) -> Result<Vec<Claims>> {
 
 /// What the claims' statistics read from the run folders rather than frame records, added to
 /// each played seed's run once per case: `SssPsnr` against the claim's `against` method, and
-/// `FrameMs` less the shared passes a method would not run alone (`not_run`), and `PassMs`
-/// over its passes (claims' statistics and the cases' table columns).
+/// `FrameMs` less the shared passes a method would not run alone (`not_run`), `PassMs`
+/// over its passes, and σ by region (claims' statistics and the cases' table columns).
 fn add_from_folders(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> Result<()> {
     let (mut images, mut alone): (Vec<&str>, Vec<&str>) = (Vec::new(), Vec::new());
+    let mut regions: Vec<&str> = Vec::new();
     let mut passes: Vec<(&str, &[String])> = Vec::new();
     let of_claims =
         claims.claims.iter().filter_map(|c| c.case.as_deref().zip(c.statistic.as_ref()));
@@ -94,6 +95,15 @@ fn add_from_folders(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> R
             let frames = r.frames;
             for seed in &mut r.seeds {
                 super::sss_psnr::add(seed, against, frames).map_err(at)?;
+            }
+        }
+        if matches!(s.metric, Metric::SigmaChanged | Metric::SigmaUnchanged)
+            && !regions.contains(&case)
+        {
+            regions.push(case);
+            let (frames, events) = (r.frames, r.events.clone());
+            for seed in &mut r.seeds {
+                super::sigma_regions::add(seed, frames, &events).map_err(at)?;
             }
         }
         if !s.not_run.is_empty() && !alone.contains(&case) {

@@ -55,6 +55,11 @@ pub enum Metric {
     /// propagation columns. Read from frames.csv by `flicker reproduce`, not a frame record's
     /// field, so it is not in `ALL`. A timing.
     PassMs,
+    /// A NIRC blend's mean σ over the fifth of the pixels whose reference changed most across
+    /// the case's first event, and over the fifth that changed least (`reproduce::sigma_regions`,
+    /// from the preference maps and references in the run folder; not in `ALL`).
+    SigmaChanged,
+    SigmaUnchanged,
 }
 
 impl Metric {
@@ -99,6 +104,8 @@ impl Metric {
             Metric::BlendSigma => "blend_sigma",
             Metric::SssPsnr => "sss_psnr",
             Metric::PassMs => "pass_ms",
+            Metric::SigmaChanged => "sigma_changed",
+            Metric::SigmaUnchanged => "sigma_unchanged",
         }
     }
 
@@ -142,6 +149,7 @@ impl Metric {
             Metric::PrimaryRays => kind == "SampleCache",
             Metric::BlendSigma => kind == "Nirc",
             Metric::SssPsnr => kind == "Sss",
+            Metric::SigmaChanged | Metric::SigmaUnchanged => kind == "Nirc" && references,
         }
     }
 
@@ -154,6 +162,7 @@ impl Metric {
             Metric::RelMse => r.rel_mse,
             Metric::Psnr => r.psnr,
             Metric::Cvvdp | Metric::SssPsnr | Metric::PassMs => None,
+            Metric::SigmaChanged | Metric::SigmaUnchanged => None,
             Metric::FrameMs => r.passes_total_ms(),
             Metric::Rays => r.rays.map(|n| n as f64),
             Metric::Shaded => r.shaded.map(|n| n as f64),

@@ -243,6 +243,15 @@ impl Suite {
                     ),
                 ));
             }
+            if matches!(gate.metric, Metric::SigmaChanged | Metric::SigmaUnchanged) {
+                return Err(file.error_at(
+                    &entry,
+                    format!(
+                        "metric {} is computed by `flicker reproduce` from a run's preference maps; expected a metric of frames.csv, e.g. BlendSigma",
+                        gate.metric.name()
+                    ),
+                ));
+            }
             if gate.metric == Metric::PassMs {
                 return Err(file.error_at(
                     &entry,

@@ -23,14 +23,27 @@ pub fn set(method: &mut Method, path: &[&str], value: &Value) -> Result<(), Stri
     }
     let mut at = &mut tree;
     let mut walked = method.spec.name().to_string();
-    for field in path {
+    for (i, field) in path.iter().enumerate() {
         let Value::Object(map) = at else {
             return Err(format!("{walked} is not a struct of fields, so it has no '{field}'"));
         };
         let known: Vec<String> = map.keys().cloned().collect();
-        at = map.get_mut(*field).ok_or_else(|| {
-            format!("{walked} has no field '{field}'; its fields are: {}", known.join(", "))
-        })?;
+        let missing =
+            format!("{walked} has no field '{field}'; its fields are: {}", known.join(", "));
+        // A field left out of the serde form at its default (`skip_serializing_if`, such as
+        // NIRC's `sparse_grid`) is still a field: the settings struct decides.
+        if !map.contains_key(*field) && i + 1 == path.len() {
+            map.insert(field.to_string(), value.clone());
+            return match method.spec.with_settings_json(tree) {
+                Ok(spec) => {
+                    method.spec = spec;
+                    Ok(())
+                }
+                Err(e) if e.to_string().contains("unknown field") => Err(missing),
+                Err(e) => Err(format!("{walked}.{field} = {value}: {e}")),
+            };
+        }
+        at = map.get_mut(*field).ok_or(missing)?;
         walked = format!("{walked}.{field}");
     }
     *at = value.clone();
@@ -91,6 +104,12 @@ mod tests {
 
         let e = set(&mut m, &["cache", "kapa"], &json!(1.0)).unwrap_err();
         assert!(e.contains("Nirc.cache has no field 'kapa'") && e.contains("reliability"), "{e}");
+        // A field the serde form leaves out at its default is set all the same.
+        set(&mut m, &["cache", "optimizer", "sparse_grid"], &json!(true)).unwrap();
+        let s = m.spec.get::<nirc::plugin::NircSettings>().expect("Nirc settings");
+        assert!(s.cache.optimizer.sparse_grid);
+        let e = set(&mut m, &["cache", "optimizer", "sparse"], &json!(true)).unwrap_err();
+        assert!(e.contains("Nirc.cache.optimizer has no field 'sparse'"), "{e}");
         let e = set(&mut m, &["spp"], &json!(1.5)).unwrap_err();
         assert!(e.contains("Nirc.spp = 1.5"), "{e}");
         let mut taa = vec![Method::parse("Taa()").unwrap()];
