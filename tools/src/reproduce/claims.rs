@@ -17,7 +17,9 @@ use crate::suite::metric::Metric;
 use crate::suite::spec::Case;
 use crate::suite::window::Window;
 
+use super::by_window::ByWindow;
 use super::computation::Computation;
+use super::events::CaseEvents;
 
 /// How big a reproduction runs: `Smoke` (tiny: about two minutes a paper on 2 cores), `Lab`
 /// (the scenarios as shipped) or `Paper` (the paper's sizes where the file gives them).
@@ -90,6 +92,9 @@ pub struct ClaimCase {
     /// columns, such as Table 1's per-pass times): no `against` or `not_run`.
     #[serde(default)]
     pub table: Vec<Statistic>,
+    /// Metrics over several windows, a table per metric (`reproduce::by_window`).
+    #[serde(default)]
+    pub by_window: Option<ByWindow>,
     #[serde(default)]
     pub smoke: Size,
     #[serde(default)]
@@ -483,6 +488,7 @@ impl Claims {
         let mut cases: Vec<ClaimCase> = Vec::new();
         let mut methods: BTreeMap<String, CaseMethods> = BTreeMap::new();
         let mut case_lines = BTreeMap::new();
+        let mut events: BTreeMap<String, CaseEvents> = BTreeMap::new();
         for entry in file.entries("cases", &parsed.cases) {
             let mut case: ClaimCase = file.entry(&entry)?;
             if case.seeds.is_empty() {
@@ -515,6 +521,13 @@ impl Claims {
                     if case.methods.is_some() {
                         return Err(at("methods: a computed case has no scenario to choose from; expected no methods".into()));
                     }
+                    if case.by_window.is_some() {
+                        return Err(at(
+                            "by_window: a computed case has no frames; expected no by_window"
+                                .into(),
+                        ));
+                    }
+                    events.insert(case.name.clone(), CaseEvents::default());
                     let references = false;
                     methods.insert(
                         case.name.clone(),
@@ -563,6 +576,7 @@ impl Claims {
                 }
                 size.params = expand_set(&played, &size.set).map_err(at)?;
             }
+            let case_events = CaseEvents::of(&spec.scenario, &case);
             let r = &spec.scenario.reference;
             let references = r.spp > 0 && r.frames != ReferenceFrames::None;
             let case_methods = CaseMethods { kinds, references, computed: None };
@@ -574,7 +588,15 @@ impl Claims {
                     ));
                 }
                 check_passes(s, &case_methods).map_err(at)?;
+                case_events.check(&s.window, &name).map_err(at)?;
             }
+            if let Some(by) = &case.by_window {
+                by.check(&case_methods).map_err(at)?;
+                for w in &by.windows {
+                    case_events.check(w, &name).map_err(|m| at(format!("by_window: {m}")))?;
+                }
+            }
+            events.insert(case.name.clone(), case_events);
             methods.insert(case.name.clone(), case_methods);
             case_lines.insert(case.name.clone(), (entry.line, entry.column));
             cases.push(case);
@@ -628,6 +650,11 @@ impl Claims {
                 check_against(s, case, name, &mut against).map_err(at)?;
                 check_not_run(s, case, name, &mut not_run).map_err(at)?;
                 check_passes(s, case).map_err(at)?;
+                let events = &events[name];
+                events.check(&s.window, name).map_err(at)?;
+                if let Comparison::Rises { from, .. } = &claim.comparison {
+                    events.check(from, name).map_err(|m| at(format!("from: {m}")))?;
+                }
             }
             if let Some(case) = case {
                 for m in claim.comparison.methods() {
@@ -700,9 +727,12 @@ impl Claims {
             .filter(|c| !matches!(c.comparison, Comparison::NotComparable { .. }))
             .filter_map(|c| c.case.as_deref())
             .collect();
+        // A case with tables of its own is played for them even where no claim needs it.
         self.cases
             .iter()
-            .filter(|c| needed.contains(&c.name.as_str()))
+            .filter(|c| {
+                needed.contains(&c.name.as_str()) || !c.table.is_empty() || c.by_window.is_some()
+            })
             .filter_map(|c| c.scenario.as_ref().map(|scenario| (c, scenario)))
             .map(|(c, scenario)| {
                 let size = match scale {
