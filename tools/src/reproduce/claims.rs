@@ -2,8 +2,9 @@
 //! the paper makes it, the paper's numbers, the case (scenario and methods) that tests it here,
 //! the statistic (a suite metric over a window), the comparison and where its tolerance comes
 //! from, and the known departures. Everything is checked before anything plays: an unknown
-//! case, a missing scenario, a method the case does not run and a statistic the method does not
-//! record are errors at the claim's file:line.
+//! case, a missing scenario, a method the case does not run, a statistic the method does not
+//! record and a window on an event the case's scenario lacks at some scale (`events`) are errors
+//! at the claim's file:line.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
