@@ -1,7 +1,7 @@
 //! Rules that read the same cache share one: in one run, the termination methods whose settings
 //! have one cache key (all but the rule, survival and radiance unit; path tracing apart) run the
 //! cache's passes once a frame, and each method's images and metrics are bit for bit those it
-//! gives alone (methods/termination/README.md, "One propagation for every rule").
+//! gives alone (methods/termination/README.md, "One frame").
 
 use std::path::Path;
 

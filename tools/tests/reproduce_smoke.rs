@@ -61,6 +61,8 @@ const GATES: &[(&str, &[&str])] = &[
             "fig5_own_target_below_fewer",
             "fig5_own_target_below_more",
             "fig5_beats_path_tracing",
+            "dynamic_short_history_reacts",
+            "dynamic_bias_estimate_lingers",
         ],
     ),
 ];

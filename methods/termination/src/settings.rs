@@ -4,7 +4,7 @@ use super::rule::TerminationRule;
 use render::error::RenderError;
 
 /// Every field but `rule` defaults to the paper's value where it gives one (§5), else to the
-/// value stated in render/src/termination/README.md.
+/// value stated in docs/methods/termination.md.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct TerminationSettings {
@@ -30,7 +30,7 @@ pub struct TerminationSettings {
     pub warmup_frames: u32,
     /// The radiance an absolute threshold t is stated in: the path variance is bounded by
     /// t · radiance_unit². Variance scales with the square of radiance, and the paper's t
-    /// belongs to its scenes' radiance scale, not to the lab's (README, Table 1).
+    /// belongs to its scenes' radiance scale, not to the lab's (docs/lab/termination-radiance-scale.md).
     pub radiance_unit: f64,
     /// A propagation sample whose hit has no filled record yet: its vertex estimate is left
     /// out of filled records (the default), or the sample goes on by path tracing.

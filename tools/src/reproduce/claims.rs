@@ -2,8 +2,9 @@
 //! the paper makes it, the paper's numbers, the case (scenario and methods) that tests it here,
 //! the statistic (a suite metric over a window), the comparison and where its tolerance comes
 //! from, and the known departures. Everything is checked before anything plays: an unknown
-//! case, a missing scenario, a method the case does not run and a statistic the method does not
-//! record are errors at the claim's file:line.
+//! case, a missing scenario, a method the case does not run, a statistic the method does not
+//! record and a window on an event the case's scenario lacks at some scale (`events`) are errors
+//! at the claim's file:line.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -17,8 +18,10 @@ use crate::suite::metric::Metric;
 use crate::suite::spec::Case;
 use crate::suite::window::Window;
 
+use super::by_window::ByWindow;
 use super::computation::Computation;
 use super::log_ratio::RatioExpectation;
+use super::events::CaseEvents;
 
 /// How big a reproduction runs: `Smoke` (tiny: about two minutes a paper on 2 cores), `Lab`
 /// (the scenarios as shipped) or `Paper` (the paper's sizes where the file gives them).
@@ -91,6 +94,9 @@ pub struct ClaimCase {
     /// columns, such as Table 1's per-pass times): no `against` or `not_run`.
     #[serde(default)]
     pub table: Vec<Statistic>,
+    /// Metrics over several windows, a table per metric (`reproduce::by_window`).
+    #[serde(default)]
+    pub by_window: Option<ByWindow>,
     #[serde(default)]
     pub smoke: Size,
     #[serde(default)]
@@ -499,6 +505,7 @@ impl Claims {
         let mut cases: Vec<ClaimCase> = Vec::new();
         let mut methods: BTreeMap<String, CaseMethods> = BTreeMap::new();
         let mut case_lines = BTreeMap::new();
+        let mut events: BTreeMap<String, CaseEvents> = BTreeMap::new();
         for entry in file.entries("cases", &parsed.cases) {
             let mut case: ClaimCase = file.entry(&entry)?;
             if case.seeds.is_empty() {
@@ -531,6 +538,13 @@ impl Claims {
                     if case.methods.is_some() {
                         return Err(at("methods: a computed case has no scenario to choose from; expected no methods".into()));
                     }
+                    if case.by_window.is_some() {
+                        return Err(at(
+                            "by_window: a computed case has no frames; expected no by_window"
+                                .into(),
+                        ));
+                    }
+                    events.insert(case.name.clone(), CaseEvents::default());
                     let references = false;
                     methods.insert(
                         case.name.clone(),
@@ -584,6 +598,7 @@ impl Claims {
                 }
                 size.params = expand_set(&played, &size.set).map_err(at)?;
             }
+            let case_events = CaseEvents::of(&spec.scenario, &case);
             let r = &spec.scenario.reference;
             let references = r.spp > 0 && r.frames != ReferenceFrames::None;
             let preference_maps = played
@@ -604,7 +619,15 @@ impl Claims {
                     ));
                 }
                 check_passes(s, &case_methods).map_err(at)?;
+                case_events.check(&s.window, &name).map_err(at)?;
             }
+            if let Some(by) = &case.by_window {
+                by.check(&case_methods).map_err(at)?;
+                for w in &by.windows {
+                    case_events.check(w, &name).map_err(|m| at(format!("by_window: {m}")))?;
+                }
+            }
+            events.insert(case.name.clone(), case_events);
             methods.insert(case.name.clone(), case_methods);
             case_lines.insert(case.name.clone(), (entry.line, entry.column));
             cases.push(case);
@@ -665,6 +688,11 @@ impl Claims {
                 check_against(s, case, name, &mut against).map_err(at)?;
                 check_not_run(s, case, name, &mut not_run).map_err(at)?;
                 check_passes(s, case).map_err(at)?;
+                let events = &events[name];
+                events.check(&s.window, name).map_err(at)?;
+                if let Comparison::Rises { from, .. } = &claim.comparison {
+                    events.check(from, name).map_err(|m| at(format!("from: {m}")))?;
+                }
             }
             if let Some(case) = case {
                 for m in claim.comparison.methods() {
@@ -747,9 +775,12 @@ impl Claims {
             .filter(|c| !matches!(c.comparison, Comparison::NotComparable { .. }))
             .filter_map(|c| c.case.as_deref())
             .collect();
+        // A case with tables of its own is played for them even where no claim needs it.
         self.cases
             .iter()
-            .filter(|c| needed.contains(&c.name.as_str()))
+            .filter(|c| {
+                needed.contains(&c.name.as_str()) || !c.table.is_empty() || c.by_window.is_some()
+            })
             .filter_map(|c| c.scenario.as_ref().map(|scenario| (c, scenario)))
             .map(|(c, scenario)| {
                 let size = match scale {

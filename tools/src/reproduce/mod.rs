@@ -3,8 +3,11 @@
 //! comparable, written as reproduce.md and reproduce.html beside the paper's numbers.
 
 pub mod alone;
+pub mod by_window;
 pub mod claims;
 pub mod computation;
+pub mod events;
+pub mod frame_columns;
 pub mod judge;
 pub mod log_ratio;
 pub mod pass_ms;

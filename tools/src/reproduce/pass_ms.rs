@@ -2,7 +2,7 @@
 //! frames.csv (Table 1 of the termination paper times the tracer and the propagation apart).
 //! Methods of one run may share a cache whose passes run once a frame: its first method's row
 //! books them and the others leave those cells empty (methods/termination/README.md, "One
-//! propagation for every rule"). A method's pass time is its own where its row has it, else its
+//! frame"). A method's pass time is its own where its row has it, else its
 //! cache's: the nearest row above it in the same frame that has it (frames.csv lists a frame's
 //! methods in the scenario's order, a cache's first method first).
 

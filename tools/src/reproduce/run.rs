@@ -75,6 +75,7 @@ fn add_from_folders(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> R
     let (mut images, mut alone): (Vec<&str>, Vec<&str>) = (Vec::new(), Vec::new());
     let mut regions: Vec<&str> = Vec::new();
     let mut passes: Vec<(&str, &[String])> = Vec::new();
+    add_columns(claims, runs)?;
     let of_claims =
         claims.claims.iter().filter_map(|c| c.case.as_deref().zip(c.statistic.as_ref()));
     let of_tables = claims.cases.iter().flat_map(|c| c.table.iter().map(|s| (c.name.as_str(), s)));
@@ -111,6 +112,32 @@ fn add_from_folders(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> R
             for seed in &mut r.seeds {
                 super::alone::leave_out(seed, &s.not_run).map_err(at)?;
             }
+        }
+    }
+    Ok(())
+}
+
+/// The frames.csv columns (`frame_columns`) the claims' statistics, the cases' tables and
+/// their `by_window` metrics read, once per case and metric.
+fn add_columns(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> Result<()> {
+    let of_claims = claims
+        .claims
+        .iter()
+        .filter_map(|c| c.case.as_deref().zip(c.statistic.as_ref().map(|s| s.metric)));
+    let of_cases = claims.cases.iter().flat_map(|c| {
+        let by = c.by_window.iter().flat_map(|b| b.metrics.iter().copied());
+        c.table.iter().map(|s| s.metric).chain(by).map(|m| (c.name.as_str(), m))
+    });
+    let mut done: Vec<(&str, Metric)> = Vec::new();
+    for (case, metric) in of_claims.chain(of_cases) {
+        if !super::frame_columns::reads(metric) || done.contains(&(case, metric)) {
+            continue;
+        }
+        done.push((case, metric));
+        let Some(r) = runs.get_mut(case) else { continue };
+        for seed in &mut r.seeds {
+            super::frame_columns::add(seed, metric)
+                .map_err(|e| anyhow::anyhow!("case '{case}': {}: {e:#}", metric.name()))?;
         }
     }
     Ok(())

@@ -18,7 +18,7 @@ pub struct CaseTable {
 }
 
 /// `mean [lo, hi]`, or why there is no number.
-fn cell(values: Result<Vec<f64>, String>) -> String {
+pub(crate) fn cell(values: Result<Vec<f64>, String>) -> String {
     match values {
         Ok(v) if v.len() >= 2 => {
             let (mean, half) = interval(&v, 0.95);
@@ -56,12 +56,15 @@ pub fn case_tables(claims: &Claims, runs: &BTreeMap<String, CaseRuns>) -> Vec<Ca
                 (m, cells)
             })
             .collect();
-        tables.push(CaseTable {
-            case: case.name.clone(),
-            seeds: r.seeds.len(),
-            columns: stats.iter().map(|s| s.describe()).collect(),
-            rows,
-        });
+        if !stats.is_empty() {
+            tables.push(CaseTable {
+                case: case.name.clone(),
+                seeds: r.seeds.len(),
+                columns: stats.iter().map(|s| s.describe()).collect(),
+                rows,
+            });
+        }
+        tables.extend(case.by_window.iter().flat_map(|b| b.tables(&case.name, r)));
     }
     tables
 }

@@ -60,6 +60,15 @@ pub enum Metric {
     /// from the preference maps and references in the run folder; not in `ALL`).
     SigmaChanged,
     SigmaUnchanged,
+    /// The termination cache's mean luminance E[Y] over its filled records (frames.csv's
+    /// `cache_mean`), and below their mean variance and squared bias: how the cache follows a
+    /// change of lighting. Read back from frames.csv by `flicker reproduce`
+    /// (`reproduce::frame_columns`), not in `ALL`, so sweeps and baselines keep their columns.
+    CacheMean,
+    /// `cache_variance`: the mean of E[Y²] − E[E[Y|y]²] over the filled records.
+    CacheVariance,
+    /// `cache_bias2`: the mean of E[E[Y|y]²] − E[Y]² over the filled records.
+    CacheBias2,
 }
 
 impl Metric {
@@ -106,6 +115,9 @@ impl Metric {
             Metric::PassMs => "pass_ms",
             Metric::SigmaChanged => "sigma_changed",
             Metric::SigmaUnchanged => "sigma_unchanged",
+            Metric::CacheMean => "cache_mean",
+            Metric::CacheVariance => "cache_variance",
+            Metric::CacheBias2 => "cache_bias2",
         }
     }
 
@@ -118,6 +130,15 @@ impl Metric {
     /// from frame records.
     pub fn from_images(self) -> bool {
         self == Metric::SssPsnr
+    }
+
+    /// Read back from a run's frames.csv by `flicker reproduce` only (not kept in a suite's
+    /// runs or baselines): a suite gate cannot judge it.
+    pub fn reproduce_only(self) -> bool {
+        matches!(
+            self,
+            Metric::PassMs | Metric::CacheMean | Metric::CacheVariance | Metric::CacheBias2
+        )
     }
 
     /// Whether the metric is a per-frame number (its window value is a mean of frames); JOD is
@@ -141,7 +162,9 @@ impl Metric {
             Metric::Flip | Metric::Mse | Metric::RelMse | Metric::Psnr | Metric::Cvvdp => {
                 references
             }
-            Metric::PathLength => kind == "Termination",
+            Metric::PathLength | Metric::CacheMean | Metric::CacheVariance | Metric::CacheBias2 => {
+                kind == "Termination"
+            }
             Metric::MeanAbsBias | Metric::MeanStd | Metric::RmsBias => {
                 kind == "VolumeTransmittance"
             }
@@ -173,7 +196,10 @@ impl Metric {
             | Metric::RmsBias
             | Metric::SssSpp
             | Metric::PrimaryRays
-            | Metric::BlendSigma => r.stats.iter().find(|(n, _)| n == self.name()).map(|s| s.1),
+            | Metric::BlendSigma
+            | Metric::CacheMean
+            | Metric::CacheVariance
+            | Metric::CacheBias2 => r.stats.iter().find(|(n, _)| n == self.name()).map(|s| s.1),
         }
     }
 }

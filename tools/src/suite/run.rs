@@ -124,8 +124,7 @@ pub(crate) fn case_spec(
 }
 
 /// Event frames in recorded frames: warm-up subtracted, events at one frame counted once.
-fn event_frames(spec: &RunSpec) -> Vec<u32> {
-    let s = &spec.scenario;
+pub(crate) fn event_frames(s: &sim::Scenario) -> Vec<u32> {
     let mut frames: Vec<u32> = s
         .events_summary()
         .into_iter()
@@ -197,7 +196,7 @@ pub(crate) fn play_cases(
                     }
                 })?;
                 runs.frames = spec.scenario.frames;
-                runs.events = event_frames(&spec);
+                runs.events = event_frames(&spec.scenario);
                 let mut seed_run = SeedRun::from_records(seed, &summary.records);
                 seed_run.folder = Some(summary.folder.clone());
                 seed_run

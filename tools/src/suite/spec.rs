@@ -258,6 +258,12 @@ impl Suite {
                     "metric pass_ms is summed by `flicker reproduce` over a claim's passes; expected a metric of frames.csv, e.g. FrameMs".into(),
                 ));
             }
+            if gate.metric.reproduce_only() {
+                return Err(file.error_at(
+                    &entry,
+                    format!("metric {} is read by `flicker reproduce` only; expected a metric a suite keeps, e.g. PathLength", gate.metric.name()),
+                ));
+            }
             match gate.bound {
                 Bound::Relative { tolerance: t } if !(t.is_finite() && t >= 0.0) => {
                     return Err(file.error_at(

@@ -19,6 +19,9 @@ pub enum Window {
         event: Option<usize>,
         skip: u32,
     },
+    /// `Around(event: 0, from: -4, to: 0)`: the frames `event + from` to `event + to`, the last
+    /// excluded (here the 4 frames before the event), clipped to the run.
+    Around { event: usize, from: i32, to: i32 },
 }
 
 impl Window {
@@ -29,6 +32,7 @@ impl Window {
             Window::After { event: e, frames: n } => format!("after_event_{e}({n})"),
             Window::Steady { event: None, skip } => format!("steady(+{skip})"),
             Window::Steady { event: Some(e), skip } => format!("steady_after_event_{e}(+{skip})"),
+            Window::Around { event: e, from, to } => format!("event_{e}{from:+}..{to:+}"),
         }
     }
 
@@ -38,7 +42,8 @@ impl Window {
             Window::Overall | Window::Steady { event: None, .. } => None,
             Window::Before { event: e }
             | Window::After { event: e, .. }
-            | Window::Steady { event: Some(e), .. } => Some(*e),
+            | Window::Steady { event: Some(e), .. }
+            | Window::Around { event: e, .. } => Some(*e),
         }
     }
 
@@ -55,6 +60,11 @@ impl Window {
                 skip.min(frames)..events.first().copied().unwrap_or(frames)
             }
             Window::Steady { event: Some(e), skip } => (event(e)? + skip).min(frames)..next(e),
+            Window::Around { event: e, from, to } => {
+                let start = event(e)? as i64;
+                let at = |offset: i32| (start + offset as i64).clamp(0, frames as i64) as u32;
+                at(from)..at(to).max(at(from))
+            }
         };
         Some(range)
     }
@@ -75,5 +85,13 @@ mod tests {
         assert_eq!(Window::Steady { event: Some(0), skip: 2 }.frames(16, &events), Some(6..10));
         assert_eq!(Window::Steady { event: Some(1), skip: 2 }.frames(16, &events), Some(12..16));
         assert_eq!(Window::Before { event: 2 }.frames(16, &events), None);
+        // Relative to an event, either side, clipped to the run.
+        let around = |event, from, to| Window::Around { event, from, to }.frames(16, &events);
+        assert_eq!(around(0, -4, 0), Some(0..4));
+        assert_eq!(around(0, -2, 3), Some(2..7));
+        assert_eq!(around(1, 2, 4), Some(12..14));
+        assert_eq!(around(1, 4, 12), Some(14..16));
+        assert_eq!(around(0, -8, -6), Some(0..0));
+        assert_eq!(around(2, 0, 1), None);
     }
 }

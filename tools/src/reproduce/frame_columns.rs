@@ -1,0 +1,83 @@
+//! Method stats that a run's frames.csv holds but a suite's runs do not keep (not in
+//! `Metric::ALL`, so sweeps and baselines keep their columns): the termination cache's
+//! statistics (`CacheMean`, `CacheVariance`, `CacheBias2`), read back per method and frame.
+
+use anyhow::{Context, Result, bail};
+use systems::run_folder::RunFolder;
+
+use crate::suite::measurement::SeedRun;
+use crate::suite::metric::Metric;
+
+/// Whether `metric` is read here (its frames.csv column is its name).
+pub fn reads(metric: Metric) -> bool {
+    matches!(metric, Metric::CacheMean | Metric::CacheVariance | Metric::CacheBias2)
+}
+
+/// Adds `metric`'s column of the seed's frames.csv to its methods' series (an empty cell: not
+/// recorded); a run without the column is an error naming the file.
+pub fn add(run: &mut SeedRun, metric: Metric) -> Result<()> {
+    let Some(root) = &run.folder else {
+        bail!("seed {}: no run folder to read {} from", run.seed, metric.name())
+    };
+    let path = RunFolder::new(root).frames_csv();
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    let column = |name: &str| header.iter().position(|h| *h == name);
+    let (Some(method), Some(frame), Some(value)) =
+        (column("method"), column("frame"), column(metric.name()))
+    else {
+        bail!("{}: no method, frame or {} column", path.display(), metric.name())
+    };
+    for (i, line) in lines.enumerate() {
+        let cells: Vec<&str> = line.split(',').collect();
+        let at = || format!("{}:{}", path.display(), i + 2);
+        let cell = |c: usize| cells.get(c).copied().with_context(|| format!("{}: short row", at()));
+        let f: usize = cell(frame)?.parse().with_context(|| format!("{}: frame", at()))?;
+        let v = match cell(value)? {
+            "" => None,
+            s => {
+                Some(s.parse::<f64>().with_context(|| format!("{}: '{s}' is not a number", at()))?)
+            }
+        };
+        let Some(metrics) = run.methods.get_mut(cell(method)?) else { continue };
+        let series = metrics.entry(metric.name().to_string()).or_default();
+        if series.len() <= f {
+            series.resize(f + 1, None);
+        }
+        series[f] = v;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    use super::*;
+
+    #[test]
+    fn a_column_becomes_each_methods_series() {
+        let dir =
+            std::env::temp_dir().join(format!("flicker-frame-columns-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("frames.csv"),
+            "method,frame,cache_mean,cache_bias2\nvb,0,0.5,0.1\npt,0,,\nvb,1,0.75,0.2\npt,1,,\n",
+        )
+        .unwrap();
+        let methods = ["vb", "pt"].into_iter().map(|m| (m.to_string(), BTreeMap::new())).collect();
+        let mut run = SeedRun { seed: 1, methods, jod: BTreeMap::new(), folder: Some(dir.clone()) };
+        add(&mut run, Metric::CacheMean).unwrap();
+        add(&mut run, Metric::CacheBias2).unwrap();
+        assert_eq!(run.methods["vb"]["cache_mean"], [Some(0.5), Some(0.75)]);
+        assert_eq!(run.methods["vb"]["cache_bias2"], [Some(0.1), Some(0.2)]);
+        // A method without the stat has no values, not zeros.
+        assert_eq!(run.methods["pt"]["cache_mean"], [None, None]);
+        assert_eq!(run.window_mean("vb", Metric::CacheMean, 0..2), Some(0.625));
+        let e = add(&mut run, Metric::CacheVariance).unwrap_err().to_string();
+        assert!(e.contains("no method, frame or cache_variance column"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
