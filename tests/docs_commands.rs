@@ -1,7 +1,9 @@
 //! The commands of the documents run. Every fenced block with info string `sh` in README.md,
 //! docs/** and the crate READMEs is played line by line at a small scale, with the test's own
 //! `flicker` binary; a block `sh untested` is not run but listed. A failing command fails the
-//! test naming its file:line and the tail of its stderr.
+//! test naming its file:line and the tail of its stderr. An `sh untested` block must follow a
+//! paragraph (which says why it is not run: its own test covers it, it needs a GPU or Slurm,
+//! it takes long); the test cannot judge the reason, it lists every untested block instead.
 //!
 //! A line of an `sh` block (after `\` continuations are joined and ` # comments` dropped) is:
 //! - `flicker ARGS` or `cargo run --release -- ARGS`: `flicker ARGS`, where ARGS starts with
@@ -44,11 +46,26 @@ struct Block {
 fn blocks(doc: &Doc) -> (Vec<Block>, Vec<String>) {
     let (mut out, mut errors) = (Vec::new(), Vec::new());
     let mut current: Option<(Block, usize, String)> = None;
+    // Whether the last block that ended was a paragraph (the reason an untested block gives).
+    let mut after_paragraph = false;
     for (event, range) in doc.events() {
         match event {
+            Event::End(TagEnd::Paragraph) => after_paragraph = true,
+            Event::End(
+                TagEnd::Heading(_)
+                | TagEnd::Table
+                | TagEnd::List(_)
+                | TagEnd::BlockQuote(_)
+                | TagEnd::HtmlBlock,
+            ) => after_paragraph = false,
             Event::Start(Tag::CodeBlock(CodeBlockKind::Fenced(info))) => {
                 let words: Vec<&str> = info.split_whitespace().collect();
                 let place = doc.place(range.start);
+                if words == ["sh", "untested"] && !after_paragraph {
+                    errors.push(format!(
+                        "{place}: an ```sh untested block without a paragraph before it; expected the text before it to say why it is not run"
+                    ));
+                }
                 match words.as_slice() {
                     ["sh"] | ["sh", "untested"] => {
                         let block = Block { place, untested: words.len() == 2, lines: Vec::new() };
@@ -69,6 +86,7 @@ fn blocks(doc: &Doc) -> (Vec<Block>, Vec<String>) {
                 }
             }
             Event::End(TagEnd::CodeBlock) => {
+                after_paragraph = false;
                 if let Some((mut block, first_line, text)) = current.take() {
                     block.lines = command_lines(&text, first_line);
                     out.push(block);
@@ -416,12 +434,22 @@ fn runs_get_the_small_scale_and_a_sandbox() {
 fn a_failing_command_fails_naming_file_and_line() {
     let text = "# Fixture\n\n```sh\nflicker scenes\nflicker run scenarios/no_such_scenario.ron\n```\n\n\
                 Not run here: it needs Slurm.\n\n```sh untested\nsbatch runs/x/sweep.sbatch\n```\n\n\
-                ```sh\ncargo test --workspace\n```\n\n```bash\nflicker scenes\n```\n";
-    let o = run_documents(&[Doc::new("fixture.md", text)], &scratch("fixture"));
+                ```sh\ncargo test --workspace\n```\n\n```bash\nflicker scenes\n```\n\n\
+                ## Heading\n\n```sh untested\nflicker reproduce all\n```\n";
+    let mut o = run_documents(&[Doc::new("fixture.md", text)], &scratch("fixture"));
     assert_eq!(o.ran.len(), 2, "{:?}", o.ran);
-    assert_eq!(o.untested, ["fixture.md:10: sbatch runs/x/sweep.sbatch"]);
-    assert_eq!(o.failures.len(), 3, "{:#?}", o.failures);
-    assert!(o.failures[0].starts_with("fixture.md:17: a ```bash block"), "{}", o.failures[0]);
+    assert_eq!(
+        o.untested,
+        ["fixture.md:10: sbatch runs/x/sweep.sbatch", "fixture.md:24: flicker reproduce all"]
+    );
+    assert_eq!(o.failures.len(), 4, "{:#?}", o.failures);
+    assert!(o.failures[0].starts_with("fixture.md:18: a ```bash block"), "{}", o.failures[0]);
+    assert!(
+        o.failures[1].starts_with("fixture.md:24: an ```sh untested block without a paragraph"),
+        "{}",
+        o.failures[1]
+    );
+    o.failures.remove(1);
     assert!(
         o.failures[1]
             .starts_with("fixture.md:5: `flicker run scenarios/no_such_scenario.ron` exited with"),
@@ -434,7 +462,7 @@ fn a_failing_command_fails_naming_file_and_line() {
         o.failures[1]
     );
     assert!(
-        o.failures[2].starts_with("fixture.md:14: `cargo test --workspace`: not a command"),
+        o.failures[2].starts_with("fixture.md:15: `cargo test --workspace`: not a command"),
         "{}",
         o.failures[2]
     );

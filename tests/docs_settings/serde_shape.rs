@@ -44,7 +44,8 @@ pub fn struct_shape<T: Serialize + DeserializeOwned + 'static>(
 ) -> Result<Shape, String> {
     let fields = match T::deserialize(Probe(None)) {
         Err(Found::Fields(f)) => f,
-        other => return Err(format!("not a struct: {:?}", other.err())),
+        Err(other) => return Err(format!("not a struct: {other}")),
+        Ok(_) => return Err("the probe gave a value".into()),
     };
     shape::<T>(fields, minimal)
 }
@@ -83,9 +84,22 @@ fn shape<T: Serialize + DeserializeOwned + 'static>(
         }
     }
     let (_, serialized) = split_fields(&whole)?;
+    // serde lists a field's aliases (`#[serde(alias = "w")]`) among its fields; an alias of a
+    // required field is found by giving both: serde refuses the primary name as a duplicate.
+    let is_alias = |name: &str| {
+        !serialized.iter().any(|(n, _)| n == name)
+            && given.iter().any(|(primary, value)| {
+                let mut both = given.clone();
+                both.push((name.to_string(), value.clone()));
+                reserialize(&join_fields(&prefix, &both))
+                    .is_err_and(|e| e.contains(&format!("duplicate field named `{primary}`")))
+            })
+    };
+    let fields: Vec<String> =
+        fields.iter().filter(|f| !is_alias(f)).map(|f| f.to_string()).collect();
     let prefix_owned = prefix.clone();
     Ok(Shape {
-        fields: fields.iter().map(|f| f.to_string()).collect(),
+        fields,
         required: given.iter().map(|(n, _)| n.clone()).collect(),
         defaults: serialized.into_iter().collect(),
         whole,
@@ -153,7 +167,9 @@ fn split_top(text: &str, sep: char) -> Vec<String> {
     out
 }
 
-/// RON text without the whitespace outside string literals, so `(0.0, 1.0)` equals `(0.0,1.0)`.
+/// RON text without the whitespace outside string literals, so `(0.0, 1.0)` equals `(0.0,1.0)`,
+/// and without the raw-identifier prefix ron writes for a variant named like a RON keyword
+/// (`r#None` for `ReferenceFrames::None`, which a scenario writes and reads as `None`).
 pub fn normalized(text: &str) -> String {
     let (mut out, mut in_str, mut escaped) = (String::new(), false, false);
     for c in text.trim().chars() {
@@ -163,6 +179,12 @@ pub fn normalized(text: &str) -> String {
         } else if c == '"' {
             in_str = true;
         } else if c.is_whitespace() {
+            continue;
+        } else if c == '#'
+            && out.ends_with('r')
+            && !out[..out.len() - 1].ends_with(|p: char| p.is_alphanumeric() || p == '_')
+        {
+            out.pop();
             continue;
         }
         out.push(c);
@@ -179,7 +201,10 @@ enum Found {
 
 impl fmt::Display for Found {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{self:?}")
+        match self {
+            Found::Fields(fields) => write!(f, "fields {fields:?}"),
+            Found::Other(what) => f.write_str(what),
+        }
     }
 }
 

@@ -45,7 +45,6 @@ pub fn tables(doc: &Doc) -> Result<Vec<Table>, Vec<String>> {
     let mut pending: Option<(String, String)> = None;
     let mut table: Option<Table> = None;
     let mut in_head = false;
-    let mut header: Vec<String> = Vec::new();
     // The current row's cells: for each, its code spans, its plain text and its link texts.
     let mut cells: Vec<(Vec<String>, String, Vec<String>)> = Vec::new();
     let mut link: Option<String> = None;
@@ -68,10 +67,12 @@ pub fn tables(doc: &Doc) -> Result<Vec<Table>, Vec<String>> {
             Event::Start(Tag::Table(_)) => {
                 if let Some((place, type_name)) = pending.take() {
                     table = Some(Table { place, type_name, rows: Vec::new() });
-                    header.clear();
                 }
             }
-            Event::Start(Tag::TableHead) => in_head = true,
+            Event::Start(Tag::TableHead) => {
+                in_head = true;
+                cells.clear();
+            }
             Event::End(TagEnd::TableHead) => {
                 in_head = false;
                 let texts: Vec<String> =
@@ -84,7 +85,6 @@ pub fn tables(doc: &Doc) -> Result<Vec<Table>, Vec<String>> {
                         t.place, t.type_name
                     ));
                 }
-                header = texts;
             }
             Event::Start(Tag::TableRow) => {
                 cells.clear();
@@ -137,7 +137,6 @@ pub fn tables(doc: &Doc) -> Result<Vec<Table>, Vec<String>> {
     if let Some((p, n)) = pending {
         errors.push(format!("{p}: marker of {n} is not followed by its table"));
     }
-    let _ = header;
     if errors.is_empty() { Ok(out) } else { Err(errors) }
 }
 
