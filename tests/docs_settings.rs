@@ -205,6 +205,28 @@ fn every_shipped_method_has_its_settings_registered() {
     }
 }
 
+/// A settings struct nested in a registered type (`NircSettings.cache: NircConfig`) is
+/// registered too, so that it needs a table.
+#[test]
+fn nested_settings_structs_are_registered() {
+    let entries = registry();
+    let mut missing = Vec::new();
+    for e in &entries {
+        for (field, name) in (e.shape)().map(|s| s.nested).unwrap_or_default() {
+            if lookup(&entries, &name).is_none() {
+                missing.push(format!("{}.{field}: {name}", e.name));
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "settings structs missing from the registry:\n{}",
+        missing.join("\n")
+    );
+    let nirc = lookup(&entries, "NircSettings").unwrap().unwrap().nested;
+    assert!(nirc.contains(&("cache".to_string(), "NircConfig".to_string())), "{nirc:?}");
+}
+
 /// Every registered type's shape can be read (its minimal text parses, and gives exactly its
 /// required fields).
 #[test]

@@ -27,6 +27,9 @@ pub struct Shape {
     pub defaults: BTreeMap<String, String>,
     /// RON text of the whole default value (the minimal text parsed and serialized).
     pub whole: String,
+    /// The fields whose default is a struct, with that struct's type name (the last segment of
+    /// its path): what the registry must list too.
+    pub nested: Vec<(String, String)>,
     /// Parses the minimal text with `field: value` added and serializes it.
     pub with_field: Box<dyn Fn(&str, &str) -> Result<String, String>>,
 }
@@ -97,8 +100,10 @@ fn shape<T: Serialize + DeserializeOwned + 'static>(
     };
     let fields: Vec<String> =
         fields.iter().filter(|f| !is_alias(f)).map(|f| f.to_string()).collect();
+    let nested = nested_structs(&minimal_value::<T>(minimal)?, &serialized)?;
     let prefix_owned = prefix.clone();
     Ok(Shape {
+        nested,
         fields,
         required: given.iter().map(|(n, _)| n.clone()).collect(),
         defaults: serialized.into_iter().collect(),
@@ -109,6 +114,37 @@ fn shape<T: Serialize + DeserializeOwned + 'static>(
             reserialize(&join_fields(&prefix_owned, &all))
         }),
     })
+}
+
+/// The minimal text parsed, serialized with struct names (`NircConfig(encoding: ...)`).
+fn minimal_value<T: Serialize + DeserializeOwned>(minimal: &str) -> Result<String, String> {
+    let value: T = options().from_str(minimal).map_err(|e| e.to_string())?;
+    ron::ser::to_string_pretty(&value, ron::ser::PrettyConfig::new().struct_names(true))
+        .map_err(|e| e.to_string())
+}
+
+/// The fields whose default is a struct with named fields: a name that the serialization with
+/// struct names has and the one without lacks is a struct's (an enum variant's name is in
+/// both), `(a: ...)` with named fields rather than a tuple such as a vector.
+fn nested_structs(
+    named: &str,
+    plain: &[(String, String)],
+) -> Result<Vec<(String, String)>, String> {
+    let mut out = Vec::new();
+    for (field, text) in split_fields(named)?.1 {
+        let Some((_, plain_text)) = plain.iter().find(|(f, _)| *f == field) else { continue };
+        let strip = |t: &str| {
+            t.trim().strip_prefix("Some(").map_or(t.trim().to_string(), |r| r.to_string())
+        };
+        let (named_text, plain_text) = (strip(&text), strip(plain_text));
+        let name_len = named_text.find(|c: char| !(c.is_alphanumeric() || c == '_')).unwrap_or(0);
+        let opens_fields = plain_text.starts_with('(')
+            && split_fields(&plain_text).is_ok_and(|(_, f)| !f.is_empty());
+        if name_len > 0 && named_text[name_len..].starts_with('(') && opens_fields {
+            out.push((field, named_text[..name_len].to_string()));
+        }
+    }
+    Ok(out)
 }
 
 /// `Name(a: 1, b: (2, 3))` or `(a: 1)` into its name (maybe empty) and its fields' texts.
