@@ -1,9 +1,10 @@
 //! The commands of the documents run. Every fenced block with info string `sh` in README.md,
 //! docs/** and the crate READMEs is played line by line at a small scale, with the test's own
 //! `flicker` binary; a block `sh untested` is not run but listed. A failing command fails the
-//! test naming its file:line and the tail of its stderr. An `sh untested` block must follow a
-//! paragraph (which says why it is not run: its own test covers it, it needs a GPU or Slurm,
-//! it takes long); the test cannot judge the reason, it lists every untested block instead.
+//! test naming its file:line and the tail of its stderr. An `sh untested` block must have a
+//! paragraph right before or right after it (which says why it is not run: its own test covers
+//! it, it needs a GPU or Slurm, it takes long); the test cannot judge the reason, it lists every
+//! untested block instead.
 //!
 //! A line of an `sh` block (after `\` continuations are joined and ` # comments` dropped) is:
 //! - `flicker ARGS` or `cargo run --release -- ARGS`: `flicker ARGS`, where ARGS starts with
@@ -46,9 +47,28 @@ struct Block {
 fn blocks(doc: &Doc) -> (Vec<Block>, Vec<String>) {
     let (mut out, mut errors) = (Vec::new(), Vec::new());
     let mut current: Option<(Block, usize, String)> = None;
-    // Whether the last block that ended was a paragraph (the reason an untested block gives).
+    // Whether the last block that ended was a paragraph (the reason an untested block gives),
+    // and an untested block with none before it, waiting for one right after it.
     let mut after_paragraph = false;
+    let mut unexplained: Option<String> = None;
+    let no_reason = |place: String| {
+        format!(
+            "{place}: an ```sh untested block without a paragraph right before or after it; expected the text next to it to say why it is not run"
+        )
+    };
     for (event, range) in doc.events() {
+        match &event {
+            Event::Start(Tag::Paragraph) => unexplained = None,
+            Event::Start(
+                Tag::Heading { .. }
+                | Tag::CodeBlock(_)
+                | Tag::Table(_)
+                | Tag::List(_)
+                | Tag::BlockQuote(_)
+                | Tag::HtmlBlock,
+            ) => errors.extend(unexplained.take().map(no_reason)),
+            _ => {}
+        }
         match event {
             Event::End(TagEnd::Paragraph) => after_paragraph = true,
             Event::End(
@@ -62,9 +82,7 @@ fn blocks(doc: &Doc) -> (Vec<Block>, Vec<String>) {
                 let words: Vec<&str> = info.split_whitespace().collect();
                 let place = doc.place(range.start);
                 if words == ["sh", "untested"] && !after_paragraph {
-                    errors.push(format!(
-                        "{place}: an ```sh untested block without a paragraph before it; expected the text before it to say why it is not run"
-                    ));
+                    unexplained = Some(place.clone());
                 }
                 match words.as_slice() {
                     ["sh"] | ["sh", "untested"] => {
@@ -95,6 +113,7 @@ fn blocks(doc: &Doc) -> (Vec<Block>, Vec<String>) {
             _ => {}
         }
     }
+    errors.extend(unexplained.take().map(no_reason));
     (out, errors)
 }
 
@@ -438,17 +457,23 @@ fn a_failing_command_fails_naming_file_and_line() {
     let text = "# Fixture\n\n```sh\nflicker scenes\nflicker run scenarios/no_such_scenario.ron\n```\n\n\
                 Not run here: it needs Slurm.\n\n```sh untested\nsbatch runs/x/sweep.sbatch\n```\n\n\
                 ```sh\ncargo test --workspace\n```\n\n```bash\nflicker scenes\n```\n\n\
-                ## Heading\n\n```sh untested\nflicker reproduce all\n```\n";
+                ## Heading\n\n```sh untested\nflicker reproduce all\n```\n\n## Other\n\n\
+                ```sh untested\nflicker bench\n```\n\n(Not run here: it takes minutes.)\n";
     let mut o = run_documents(&[Doc::new("fixture.md", text)], &scratch("fixture"));
     assert_eq!(o.ran.len(), 2, "{:?}", o.ran);
     assert_eq!(
         o.untested,
-        ["fixture.md:10: sbatch runs/x/sweep.sbatch", "fixture.md:24: flicker reproduce all"]
+        [
+            "fixture.md:10: sbatch runs/x/sweep.sbatch",
+            "fixture.md:24: flicker reproduce all",
+            "fixture.md:30: flicker bench"
+        ]
     );
     assert_eq!(o.failures.len(), 4, "{:#?}", o.failures);
     assert!(o.failures[0].starts_with("fixture.md:18: a ```bash block"), "{}", o.failures[0]);
     assert!(
-        o.failures[1].starts_with("fixture.md:24: an ```sh untested block without a paragraph"),
+        o.failures[1]
+            .starts_with("fixture.md:24: an ```sh untested block without a paragraph right"),
         "{}",
         o.failures[1]
     );

@@ -28,7 +28,7 @@ pub struct Row {
 pub enum Cell {
     /// One code span: the RON text of the default.
     Ron(String),
-    /// The word `required`.
+    /// The word `required` (plain or in backticks: no RON value is called that).
     Required,
     /// A link to another settings type's table; its text names the type.
     Link { text: String },
@@ -150,7 +150,7 @@ fn row(place: String, cells: &[(Vec<String>, String, Vec<String>)]) -> Row {
     };
     let default = if let [l] = links.as_slice() {
         Cell::Link { text: l.trim_matches('`').to_string() }
-    } else if text.trim() == "required" {
+    } else if text.trim() == "required" || text.trim() == "`required`" {
         Cell::Required
     } else if let [one] = codes.as_slice()
         && text.trim() == format!("`{one}`")
