@@ -269,10 +269,11 @@ fn default_smape_epsilon() -> f32 {
     0.01
 }
 
-/// The file as written.
-#[derive(Deserialize)]
+/// The file as written. Public and serialisable only so that the scenario reference's test
+/// (tests/docs_settings.rs) reads its fields and defaults from serde rather than from prose.
+#[derive(Deserialize, Serialize)]
 #[serde(rename = "Scenario", deny_unknown_fields)]
-struct ScenarioFile {
+pub struct ScenarioFile {
     #[serde(default)]
     name: Option<String>,
     scene: SceneSource,
