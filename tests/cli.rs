@@ -125,7 +125,14 @@ fn two_runs_give_byte_identical_frames_and_a_complete_run_folder() {
         ]);
         assert!(o.status.success(), "run failed: {}", text(&o.stderr));
         let stdout = text(&o.stdout);
-        assert!(stdout.contains(&format!("{expect_cached} from cache")), "{stdout}");
+        // The summary line, then the report's path, last.
+        let last: Vec<&str> = stdout.lines().rev().take(2).collect();
+        assert!(
+            last[1].starts_with(&format!("wrote {} (3 frames;", out.display()))
+                && last[1].ends_with(&format!("{expect_cached} from cache)")),
+            "{stdout}"
+        );
+        assert_eq!(last[0], format!("report: {}", out.join("report.html").display()), "{stdout}");
         outs.push(out);
     }
     for method in ["pt_1spp", "pt_2spp"] {
