@@ -30,7 +30,7 @@ enum Command {
     /// manifest.json says `interrupted` with the last complete frame, the exit code is 130, and
     /// `--resume` continues it. A second signal stops it at once.
     Run {
-        /// The scenario file (RON), e.g. scenarios/cornell_box.ron
+        /// The scenario file (RON), e.g. scenarios/showcase.ron
         #[arg(required_unless_present = "resume")]
         scenario: Option<PathBuf>,
         /// Continue the interrupted run in this folder from its last complete frame, with its
@@ -412,6 +412,7 @@ fn main() -> ExitCode {
                     summary.references_rendered,
                     summary.references_cached
                 );
+                println!("report: {}", summary.report.display());
             })
         }
         Command::Schedule { scenario } => {

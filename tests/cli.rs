@@ -125,7 +125,17 @@ fn two_runs_give_byte_identical_frames_and_a_complete_run_folder() {
         ]);
         assert!(o.status.success(), "run failed: {}", text(&o.stderr));
         let stdout = text(&o.stdout);
-        assert!(stdout.contains(&format!("{expect_cached} from cache")), "{stdout}");
+        // The summary line, then the report's path, last.
+        let lines: Vec<&str> = stdout.lines().collect();
+        let [.., summary, report] = lines.as_slice() else {
+            panic!("two lines expected: {stdout}")
+        };
+        assert!(
+            summary.starts_with(&format!("wrote {} (", out.display()))
+                && summary.ends_with(&format!("{expect_cached} from cache)")),
+            "{stdout}"
+        );
+        assert_eq!(*report, format!("report: {}", out.join("report.html").display()), "{stdout}");
         outs.push(out);
     }
     for method in ["pt_1spp", "pt_2spp"] {

@@ -36,6 +36,8 @@ pub struct RunSummary {
     pub records: Vec<FrameRecord>,
     pub references_rendered: u32,
     pub references_cached: u32,
+    /// The run's report.html.
+    pub report: PathBuf,
 }
 
 /// The frame's world of a scenario: the simulation's world with the run's resources, one
@@ -308,13 +310,14 @@ pub(crate) fn play(
     let records = std::mem::take(&mut world.resource_mut::<RunOutput>().records);
     let references = world.resource::<References>();
     let (rendered, cached) = (references.rendered, references.cached);
-    report::rebuild(&folder.root)
+    let report = report::rebuild(&folder.root)
         .with_context(|| format!("writing the report of {}", folder.root.display()))?;
     Ok(RunSummary {
         folder: folder.root,
         records,
         references_rendered: rendered,
         references_cached: cached,
+        report,
     })
 }
 

@@ -93,6 +93,14 @@ fn load(run_dir: &Path, method: Option<&str>, frame: u32) -> anyhow::Result<Opti
     Ok(None)
 }
 
+/// The frame the viewer opens on: the first recorded frame (one with an image on disk) at or
+/// after the first scripted event, where the change shows; frame 0 when the run has no event,
+/// or none of its frames from the event on was recorded (an interrupted run).
+pub fn opening_frame(events: &[crate::run::Event], recorded: &[bool]) -> u32 {
+    let Some(first) = events.iter().map(|e| e.frame).min() else { return 0 };
+    (first as usize..recorded.len()).find(|&f| recorded[f]).map_or(0, |f| f as u32)
+}
+
 /// Builds a viewer of `frame_count` frames over `panels`, or `None` when no frame is on disk.
 /// `flip_maps` holds the FLIP map of (frame, panel label) where a reference exists; `manifest`
 /// gives the events, reference frames and settings (frame rate, SMAPE's epsilon).
@@ -190,8 +198,10 @@ pub fn build(
         .unwrap_or(0.01);
     let magma: Vec<u8> = (0..256).flat_map(|i| metrics::magma(i as f32 / 255.0)).collect();
     let names: Vec<&str> = panels.iter().map(|p| p.label.as_str()).collect();
+    let recorded: Vec<bool> = chunks.iter().map(Option::is_some).collect();
+    let start = opening_frame(&manifest.events, &recorded);
     let config = json!({
-        "width": width, "height": height, "frames": frame_count, "fps": fps, "labels": names,
+        "width": width, "height": height, "frames": frame_count, "fps": fps, "labels": names, "start": start,
         "smape_epsilon": smape_epsilon, "motion_steps": encoding::MOTION_STEPS, "linked": linked.then(|| format!("{}/", out.linked_dir)), "magma": magma,
     });
 
@@ -200,7 +210,7 @@ pub fn build(
     h.push_str("<button id=\"play\" type=\"button\">play</button>");
     let _ = write!(
         h,
-        "<div class=\"timeline\"><input type=\"range\" id=\"frame-slider\" min=\"0\" max=\"{}\" value=\"0\" step=\"1\" aria-label=\"frame\">",
+        "<div class=\"timeline\"><input type=\"range\" id=\"frame-slider\" min=\"0\" max=\"{}\" value=\"{start}\" step=\"1\" aria-label=\"frame\">",
         frame_count.saturating_sub(1)
     );
     let pos = |f: u32| 100.0 * f as f64 / frame_count.saturating_sub(1).max(1) as f64;
@@ -221,7 +231,7 @@ pub fn build(
             pos(f)
         );
     }
-    h.push_str("</div><span id=\"frame-label\">frame 0</span>");
+    let _ = write!(h, "</div><span id=\"frame-label\">frame {start}</span>");
     h.push_str("<label>exposure <input type=\"range\" id=\"exposure\" min=\"-10\" max=\"10\" step=\"0.25\" value=\"0\"></label><span id=\"exposure-label\">0 EV</span>");
     h.push_str("<span class=\"modes\"><button type=\"button\" data-mode=\"image\" class=\"on\">image</button>");
     if !flip_maps.is_empty() {

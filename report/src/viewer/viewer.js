@@ -266,6 +266,7 @@
     whenShown: () => (done === token ? Promise.resolve() : new Promise(r => waiters.push(r))),
   };
   fit();
+  // #frame=N in the address, else the frame the report chose (the first event's, or 0).
   const start = /frame=(\d+)/.exec(location.hash);
-  show(start ? +start[1] : 0);
+  show(start ? +start[1] : C.start);
 })();
