@@ -20,8 +20,8 @@ use crate::suite::window::Window;
 
 use super::by_window::ByWindow;
 use super::computation::Computation;
-use super::log_ratio::RatioExpectation;
 use super::events::CaseEvents;
+use super::log_ratio::RatioExpectation;
 
 /// How big a reproduction runs: `Smoke` (tiny: about two minutes a paper on 2 cores), `Lab`
 /// (the scenarios as shipped) or `Paper` (the paper's sizes where the file gives them).
