@@ -1,4 +1,4 @@
-//! Voxel keys of the hash cache on the CPU, bit for bit as render/shaders/hash_cache/hash_key.wgsl:
+//! Voxel keys of the hash cache on the CPU, bit for bit as methods/hash_cache/shaders/hash_key.wgsl:
 //! level of detail, voxel jitter, normal axis, home slot and checksum.
 
 use glam::{IVec3, Vec2, Vec3};

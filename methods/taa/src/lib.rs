@@ -1,7 +1,7 @@
 //! Temporal anti-aliasing (TAA) over jittered 1 spp path tracing: the baseline of issue 5.
 //!
 //! Two passes per frame:
-//! - `taa_trace` (render/shaders/taa_trace.wgsl, after the shading library): one path per pixel
+//! - `taa_trace` (methods/taa/shaders/trace.wgsl, after the shading library): one path per pixel
 //!   through the frame's Halton (2, 3) jitter point ([`jitter`]), plus that sample's own primary
 //!   hit (depth, normal, instance, motion, depth from the previous camera);
 //! - `taa_resolve` (render/shaders/taa_resolve.wgsl): reprojection of the history by the motion
