@@ -2,11 +2,13 @@
 //! `Metric::ALL`, so sweeps and baselines keep their columns): the termination cache's
 //! statistics (`CacheMean`, `CacheVariance`, `CacheBias2`), read back per method and frame.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use systems::run_folder::RunFolder;
 
 use crate::suite::measurement::SeedRun;
 use crate::suite::metric::Metric;
+
+use super::frames_csv::rows;
 
 /// Whether `metric` is read here (its frames.csv column is its name).
 pub fn reads(metric: Metric) -> bool {
@@ -20,33 +22,19 @@ pub fn add(run: &mut SeedRun, metric: Metric) -> Result<()> {
         bail!("seed {}: no run folder to read {} from", run.seed, metric.name())
     };
     let path = RunFolder::new(root).frames_csv();
-    let text =
-        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    let column = |name: &str| header.iter().position(|h| *h == name);
-    let (Some(method), Some(frame), Some(value)) =
-        (column("method"), column("frame"), column(metric.name()))
-    else {
-        bail!("{}: no method, frame or {} column", path.display(), metric.name())
-    };
-    for (i, line) in lines.enumerate() {
-        let cells: Vec<&str> = line.split(',').collect();
-        let at = || format!("{}:{}", path.display(), i + 2);
-        let cell = |c: usize| cells.get(c).copied().with_context(|| format!("{}: short row", at()));
-        let f: usize = cell(frame)?.parse().with_context(|| format!("{}: frame", at()))?;
-        let v = match cell(value)? {
-            "" => None,
-            s => {
-                Some(s.parse::<f64>().with_context(|| format!("{}: '{s}' is not a number", at()))?)
-            }
-        };
-        let Some(metrics) = run.methods.get_mut(cell(method)?) else { continue };
-        let series = metrics.entry(metric.name().to_string()).or_default();
+    let name = metric.name();
+    let rows = rows(&path, |header| match header.iter().position(|h| *h == name) {
+        Some(c) => Ok(vec![c]),
+        None => bail!("{}: no method, frame or {name} column", path.display()),
+    })?;
+    for (method, frame, values) in rows {
+        let Some(metrics) = run.methods.get_mut(&method) else { continue };
+        let series = metrics.entry(name.to_string()).or_default();
+        let f = frame as usize;
         if series.len() <= f {
             series.resize(f + 1, None);
         }
-        series[f] = v;
+        series[f] = values[0];
     }
     Ok(())
 }

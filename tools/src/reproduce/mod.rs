@@ -8,6 +8,7 @@ pub mod claims;
 pub mod computation;
 pub mod events;
 pub mod frame_columns;
+pub mod frames_csv;
 pub mod judge;
 pub mod log_ratio;
 pub mod pass_ms;

@@ -8,64 +8,42 @@
 
 use std::path::Path;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use systems::run_folder::RunFolder;
 
 use crate::suite::measurement::SeedRun;
 use crate::suite::metric::Metric;
 
+use super::frames_csv::{Row, rows};
+
 /// One frames.csv row: method, frame and the ms of each asked pass (`None`: an empty cell).
-pub type PassRow = (String, u32, Vec<Option<f64>>);
+pub type PassRow = Row;
 
 /// frames.csv's rows, in file order, with the ms of the passes in `passes`; a pass the run has
 /// no column for is an error naming it and the file.
 pub fn pass_times(path: &Path, passes: &[String]) -> Result<Vec<PassRow>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
-    let column = |name: &str| header.iter().position(|h| *h == name);
-    let (Some(method), Some(frame)) = (column("method"), column("frame")) else {
-        bail!("{}: no method and frame columns", path.display())
-    };
-    // A pass's column is gpu_ms_PASS or wall_ms_PASS, by the clock that timed it.
-    let columns: Vec<Option<usize>> = passes
-        .iter()
-        .map(|p| column(&format!("gpu_ms_{p}")).or_else(|| column(&format!("wall_ms_{p}"))))
-        .collect();
-    if let Some(i) = columns.iter().position(Option::is_none) {
-        let known: Vec<&str> = header
+    rows(path, |header| {
+        let column = |name: &str| header.iter().position(|h| *h == name);
+        // A pass's column is gpu_ms_PASS or wall_ms_PASS, by the clock that timed it.
+        let columns: Vec<Option<usize>> = passes
             .iter()
-            .filter_map(|h| h.strip_prefix("gpu_ms_").or_else(|| h.strip_prefix("wall_ms_")))
-            .filter(|p| *p != "total")
+            .map(|p| column(&format!("gpu_ms_{p}")).or_else(|| column(&format!("wall_ms_{p}"))))
             .collect();
-        bail!(
-            "{}: no column of pass '{}'; its passes are: {}",
-            path.display(),
-            passes[i],
-            known.join(", ")
-        );
-    }
-    let mut rows = Vec::new();
-    for (i, line) in lines.enumerate() {
-        let cells: Vec<&str> = line.split(',').collect();
-        let at = || format!("{}:{}", path.display(), i + 2);
-        let cell = |c: usize| cells.get(c).copied().with_context(|| format!("{}: short row", at()));
-        let times = columns
-            .iter()
-            .flatten()
-            .map(|&c| {
-                let s = cell(c)?;
-                if s.is_empty() {
-                    return Ok(None);
-                }
-                s.parse().map(Some).with_context(|| format!("{}: '{s}' is not a number", at()))
-            })
-            .collect::<Result<_>>()?;
-        let frame = cell(frame)?.parse().with_context(|| format!("{}: frame", at()))?;
-        rows.push((cell(method)?.to_string(), frame, times));
-    }
-    Ok(rows)
+        if let Some(i) = columns.iter().position(Option::is_none) {
+            let known: Vec<&str> = header
+                .iter()
+                .filter_map(|h| h.strip_prefix("gpu_ms_").or_else(|| h.strip_prefix("wall_ms_")))
+                .filter(|p| *p != "total")
+                .collect();
+            bail!(
+                "{}: no column of pass '{}'; its passes are: {}",
+                path.display(),
+                passes[i],
+                known.join(", ")
+            );
+        }
+        Ok(columns.into_iter().flatten().collect())
+    })
 }
 
 /// Per row: the sum of its passes, each its own or its cache's (the nearest row above in the
