@@ -6,7 +6,7 @@
 //! crashes (segmentation fault, flip-evaluator 1.7) on flicker's EXRs. Prints one table row per
 //! pair and implementation: max, mean and 99.9th percentile of |Δ| and the share of pixels off
 //! by more than 1e-3 and 1e-2. (The hand-written FLIP this was first run against is at commit
-//! 1427ae4, metrics/README.md.)
+//! 1427ae4, docs/lab/metrics-jod-flip.md.)
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

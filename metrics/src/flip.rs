@@ -1,6 +1,6 @@
 //! FLIP, the perceptual difference evaluator for alternating images (Andersson et al. 2020), and
 //! its HDR extension (Andersson et al. 2021), computed by the `flip-rs` crate (a port of NVIDIA
-//! FLIP 1.7 whose maps equal NVIDIA's `flip-evaluator`'s; metrics/README.md). This file is the
+//! FLIP 1.7 whose maps equal NVIDIA's `flip-evaluator`'s; docs/lab/metrics-jod-flip.md). This file is the
 //! adapter: our images in, our map, mean, percentiles and exposure range out.
 
 use crate::image::{Image, linear_to_srgb};

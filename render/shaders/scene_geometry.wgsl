@@ -215,7 +215,7 @@ fn sg_intersect_node(node: SgNode, ray: SgRay, t_max: f32) -> u32 {
 
 // The stack is read and written at constant indices only, one select per entry, so that it stays
 // in registers: an array indexed at run time goes to per-invocation scratch memory on lavapipe,
-// accessed one lane at a time (render/README.md). The cost grows with the stack's size, hence a
+// accessed one lane at a time (docs/lab/render-speed.md). The cost grows with the stack's size, hence a
 // stack sized for the scene.
 fn sg_push(stack: ptr<function, array<vec2u, SG_STACK_SIZE>>, size: u32, group: vec2u) {
     for (var i = 0u; i < SG_STACK_SIZE; i++) {
@@ -265,7 +265,7 @@ fn sg_trip(
 // Two-level traversal, one loop per level: TLAS leaves are instances, and entering one runs the
 // BLAS loop to its end (the ray in object space; t is unchanged: the direction is transformed,
 // not normalised) before the TLAS loop's next trip. lavapipe runs every statement of a loop's
-// body on every trip, under a mask when no invocation needs it (render/README.md), so the
+// body on every trip, under a mask when no invocation needs it (docs/lab/render-speed.md), so the
 // instance entry lives in the TLAS loop, which few trips reach, and not in the BLAS loop, where
 // it would cost every node visit. Both loops share one stack: the BLAS pushes above the TLAS's
 // entries and stops when it falls back to them. The visiting order is that of a single loop:

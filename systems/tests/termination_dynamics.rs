@@ -191,7 +191,7 @@ fn cache_follows_a_flash_and_forgets_it_slower_than_its_memory() {
     // The cache keeps more of the flash than its memory alone would ((1 - 1/n)^4 a frame, the
     // bound above): a record's new estimates read neighbouring records that still hold the
     // flash (propagation is a feedback loop through the scene's interreflection), so the
-    // excess outlives the running mean. Measured: README "Dynamic scenes".
+    // excess outlives the running mean. Measured: docs/lab/termination-dynamics.md.
     for (i, n) in [64.0f64, 16.0].into_iter().enumerate() {
         let bound = (1.0 - 1.0 / n).powi(4);
         let d: Vec<f64> = factor[i].iter().map(|f| f - bound).collect();
@@ -228,7 +228,7 @@ fn glossy_surfaces_bias_termination_into_direction_independent_records() {
     // cache costs is the FLIP of the first-vertex rule (every path ends in the record at its
     // primary hit) against the reference minus the path tracer's (same cache, same samples).
     // Variance bounding at relative t = 1 moved the same way in every seed but within the
-    // seeds' spread (README "Where a rule fails"); it is left out to keep the test short.
+    // seeds' spread (docs/lab/termination-dynamics.md, "Where a rule fails"); it is left out to keep the test short.
     let keep = ["first_vertex", "pt"];
     let mut excess = vec![];
     for &seed in &SEEDS {

@@ -125,7 +125,7 @@ fn corridor_relations() {
     }
     path_length_relations("corridor", &runs);
     // Table 1's relation (MSE minimisation shorter than variance bounding at absolute t = 0.01)
-    // is reversed here (README "Relations (tests)"): asserted as measured, MSE is longer.
+    // is reversed here (docs/lab/termination-relations.md): asserted as measured, MSE is longer.
     let d = path_length_difference(&runs, "mse_100", "vb_0.01");
     assert_positive("corridor: path length, MSE s 100 - variance bounding t 0.01", &d);
 }

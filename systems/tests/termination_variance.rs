@@ -163,7 +163,7 @@ fn variance_bounding_against_t_with_roulette() {
     );
     // At 20% path length and image variance grow with t (Fig. 7, both panels). At 100% and 60%
     // they do not by a margin over the seeds at 32x18: t = 1 runs to path tracing's length
-    // (9.6 vertices) in every seed and t = 0.01 already does in one (README, "Fig. 7").
+    // (9.6 vertices) in every seed and t = 0.01 already does in one (docs/lab/termination-fig7.md).
     assert_positive(
         "survival 20%: ln(path length at t 1 / at t 0.01)",
         &ln("vb_1_q20", "vb_0.01_q20", length),
@@ -177,7 +177,7 @@ fn variance_bounding_against_t_with_roulette() {
     // being completely converged": the variance / frames outgrows the bias the longer paths
     // remove). The paper's main relation (MSE falls with t as bias falls) does not show by a
     // margin at 100% or 60%: 16 frames leave the mean image's variance above the cache's bias
-    // (README, "Fig. 7").
+    // (docs/lab/termination-fig7.md).
     assert_positive(
         "survival 20%: ln(MSE at t 1 / at t 0.01)",
         &ln("vb_1_q20", "vb_0.01_q20", |x: &Measured| x.mse),
@@ -185,7 +185,7 @@ fn variance_bounding_against_t_with_roulette() {
     // NOT the paper's: the image variance exceeds the bound t · unit² (the records' local
     // variances, from K = 4 samples per stored vertex, miss the rare paths through the door's
     // gap that make most of a pixel's variance). Asserted as measured; fails if the bound
-    // starts to hold (then update the README and this test).
+    // starts to hold (then update docs/lab/termination-fig7.md and this test).
     let bound = 0.01 * unit * unit;
     assert_positive(
         "survival 100%, t 0.01: ln(image variance / t · unit²)",
