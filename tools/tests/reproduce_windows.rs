@@ -28,7 +28,7 @@ fn flash(extra: &str) -> String {
 
 fn claim(window: &str, comparison: &str) -> String {
     format!(
-        "(id: \"c\", claim: \"c\", source: \"s\", paper: \"p\", case: \"flash\", statistic: (metric: CacheMean, window: {window}), comparison: {comparison}, tolerance_from: \"seeds\")"
+        "(id: \"c\", claim: \"c\", source: \"s\", paper: \"p\", case: \"flash\", statistic: (metric: CacheMean, window: {window}), comparison: {comparison}, smallest_effect: Relative(0.05), smallest_effect_from: \"argued\")"
     )
 }
 
@@ -109,7 +109,7 @@ fn by_window_tables_are_checked_at_the_case() {
 #[test]
 fn cache_statistics_are_recorded_by_termination_only() {
     let rotation = "(name: \"flash\", scenario: \"../scenarios/termination_light_rotation_corridor.ron\", seeds: [3, 4])";
-    let c = "(id: \"c\", claim: \"c\", source: \"s\", paper: \"p\", case: \"flash\", statistic: (metric: CacheBias2, window: Overall), comparison: Below(method: \"pt_1spp\", than: \"vb_rel_1\"), tolerance_from: \"seeds\")";
+    let c = "(id: \"c\", claim: \"c\", source: \"s\", paper: \"p\", case: \"flash\", statistic: (metric: CacheBias2, window: Overall), comparison: Below(method: \"pt_1spp\", than: \"vb_rel_1\"), smallest_effect: Relative(0.05), smallest_effect_from: \"argued\")";
     let e = load(rotation, c).unwrap_err();
     assert!(
         e.contains("bad.ron:8") && e.contains("does not record the statistic cache_bias2"),

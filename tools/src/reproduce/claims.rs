@@ -1,7 +1,7 @@
 //! Claims files (RON, `claims/PAPER.ron`): a paper's headline claims as data. Each names where
 //! the paper makes it, the paper's numbers, the case (scenario and methods) that tests it here,
-//! the statistic (a suite metric over a window), the comparison and where its tolerance comes
-//! from, and the known departures. Everything is checked before anything plays: an unknown
+//! the statistic (a suite metric over a window), the comparison, the smallest effect that
+//! matters and where it comes from, and the known departures. Everything is checked before anything plays: an unknown
 //! case, a missing scenario, a method the case does not run, a statistic the method does not
 //! record and a window on an event the case's scenario lacks at some scale (`events`) are errors
 //! at the claim's file:line.
@@ -158,47 +158,52 @@ fn default_confidence() -> f64 {
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Comparison {
-    /// `Below(method: "a", than: "b")`: a's statistic is lower than b's in the same runs,
-    /// judged by the one-sided upper bound of the paired per-seed differences.
+    /// `Below(method: "a", than: "b")`: a's statistic is lower than b's in the same runs, by
+    /// at least the claim's smallest effect, judged on the paired per-seed differences.
     Below {
         method: String,
         than: String,
         #[serde(default = "default_confidence")]
         confidence: f64,
     },
-    /// `Value(method: "a", value: 0.3, tolerance: 0.05)`: a's mean lies within value ± tolerance
-    /// (its two-sided interval inside the band).
-    Value {
+    /// `NotAbove(method: "a", than: "b")`: a's statistic is not above b's by the claim's
+    /// smallest effect or more (the paper's "no worse than"), on the paired differences.
+    NotAbove {
         method: String,
-        value: f64,
-        tolerance: f64,
+        than: String,
         #[serde(default = "default_confidence")]
         confidence: f64,
     },
-    /// `Ratio(method: "a", to: "b", value: 0.5, tolerance: 0.1)`: the per-seed ratio a / b lies
-    /// within value ± tolerance.
+    /// `Value(method: "a", value: 0.3)`: a's mean is the paper's value, within the claim's
+    /// smallest effect.
+    Value {
+        method: String,
+        value: f64,
+        #[serde(default = "default_confidence")]
+        confidence: f64,
+    },
+    /// `Ratio(method: "a", to: "b", value: 0.5)`: the per-seed ratio a / b is the paper's
+    /// value, within the claim's smallest effect.
     Ratio {
         method: String,
         to: String,
         value: f64,
-        tolerance: f64,
         #[serde(default = "default_confidence")]
         confidence: f64,
     },
-    /// `Difference(method: "a", to: "b", value: 0.3, tolerance: 0.2)`: the per-seed difference
-    /// a − b lies within value ± tolerance (for a logarithmic statistic such as PSNR in dB,
-    /// where a ratio of values means nothing).
+    /// `Difference(method: "a", to: "b", value: 0.3)`: the per-seed difference a − b is the
+    /// paper's value, within the claim's smallest effect (for a logarithmic statistic such as
+    /// PSNR in dB, where a ratio of values means nothing).
     Difference {
         method: String,
         to: String,
         value: f64,
-        tolerance: f64,
         #[serde(default = "default_confidence")]
         confidence: f64,
     },
-    /// `LogRatio(method: "a", to: "b", expect: Below(1.0))` or `expect: Near(value: 3.0,
-    /// tolerance: 0.5)`: the per-seed ratio a / b of the same runs, judged in the log
-    /// (`reproduce::log_ratio`): for claims about factors of a bias, a std or an error.
+    /// `LogRatio(method: "a", to: "b", expect: Below(1.0))` or `expect: Near(3.0)`: the
+    /// per-seed ratio a / b of the same runs, judged in the log (`reproduce::log_ratio`): for
+    /// claims about factors of a bias, a std or an error.
     LogRatio {
         method: String,
         to: String,
@@ -225,7 +230,9 @@ pub enum Comparison {
 impl Comparison {
     pub fn methods(&self) -> Vec<&str> {
         match self {
-            Comparison::Below { method, than, .. } => vec![method, than],
+            Comparison::Below { method, than, .. } | Comparison::NotAbove { method, than, .. } => {
+                vec![method, than]
+            }
             Comparison::Value { method, .. } | Comparison::Rises { method, .. } => vec![method],
             Comparison::Ratio { method, to, .. }
             | Comparison::Difference { method, to, .. }
@@ -239,14 +246,11 @@ impl Comparison {
     pub fn describe(&self) -> String {
         match self {
             Comparison::Below { method, than, .. } => format!("{method} below {than}"),
-            Comparison::Value { method, value, tolerance, .. } => {
-                format!("{method} = {value} ± {tolerance}")
-            }
-            Comparison::Ratio { method, to, value, tolerance, .. } => {
-                format!("{method} / {to} = {value} ± {tolerance}")
-            }
-            Comparison::Difference { method, to, value, tolerance, .. } => {
-                format!("{method} − {to} = {value} ± {tolerance}")
+            Comparison::NotAbove { method, than, .. } => format!("{method} not above {than}"),
+            Comparison::Value { method, value, .. } => format!("{method} = {value}"),
+            Comparison::Ratio { method, to, value, .. } => format!("{method} / {to} = {value}"),
+            Comparison::Difference { method, to, value, .. } => {
+                format!("{method} − {to} = {value}")
             }
             Comparison::LogRatio { method, to, expect, .. } => {
                 format!("{method} / {to} {} (log ratio)", expect.describe())
@@ -255,6 +259,46 @@ impl Comparison {
                 format!("{method} rises from {}", from.name())
             }
             Comparison::NotComparable { .. } => "not comparable".into(),
+        }
+    }
+}
+
+/// A claim's smallest effect that matters, in the statistic's unit or as a share.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+pub enum Effect {
+    /// `Absolute(0.005)`: in the statistic's unit (a ratio's for `Ratio` and `LogRatio`).
+    Absolute(f64),
+    /// `Relative(0.05)`: a share of the baseline: the `than` method's mean for `Below`, the
+    /// claim window's for `Rises`, the paper's value for a value, the factor for `LogRatio`.
+    Relative(f64),
+}
+
+impl Effect {
+    /// δ in the statistic's unit, `base` the value a relative margin is a share of.
+    pub fn margin(&self, base: f64) -> f64 {
+        match *self {
+            Effect::Absolute(d) => d,
+            Effect::Relative(r) => r * base.abs(),
+        }
+    }
+
+    pub fn describe(&self) -> String {
+        match *self {
+            Effect::Absolute(d) => format!("{d}"),
+            Effect::Relative(r) => format!("{}%", r * 100.0),
+        }
+    }
+
+    /// A margin above 0; a share below 1.
+    pub fn check(&self) -> Result<(), String> {
+        match *self {
+            Effect::Absolute(d) if !(d.is_finite() && d > 0.0) => Err(format!(
+                "smallest_effect: Absolute({d}); expected a number above 0, e.g. Absolute(0.005)"
+            )),
+            Effect::Relative(r) if !(r.is_finite() && r > 0.0 && r < 1.0) => Err(format!(
+                "smallest_effect: Relative({r}); expected a share between 0 and 1, e.g. Relative(0.05)"
+            )),
+            _ => Ok(()),
         }
     }
 }
@@ -277,8 +321,13 @@ pub struct Claim {
     #[serde(default)]
     pub statistic: Option<Statistic>,
     pub comparison: Comparison,
-    /// Where the tolerance (or the confidence) comes from: the paper, the spread over seeds.
-    pub tolerance_from: String,
+    /// The smallest effect that matters: a relation's smallest difference (or factor) worth
+    /// the name, a value's largest departure from the paper's number that still agrees.
+    pub smallest_effect: Effect,
+    /// Where it comes from: the paper (its ± or its stated precision) or an argued perceptual
+    /// or practical threshold (a FLIP step, a JOD step, a share of frame time); never from the
+    /// lab's own runs of the claim.
+    pub smallest_effect_from: String,
     #[serde(default)]
     pub departures: Vec<String>,
     /// The claim's line in its file (filled when loaded).
@@ -644,21 +693,24 @@ impl Claims {
             if claims.iter().any(|c| c.id == claim.id) {
                 return Err(at("the id is used twice; expected distinct ids".into()));
             }
+            claim.smallest_effect.check().map_err(at)?;
+            if claim.smallest_effect_from.trim().is_empty() {
+                return Err(at("smallest_effect_from is empty; expected where the margin comes from: the paper or an argued threshold".into()));
+            }
             match &claim.comparison {
-                Comparison::Below { confidence, .. } | Comparison::Rises { confidence, .. } => {
+                Comparison::Below { confidence, .. }
+                | Comparison::NotAbove { confidence, .. }
+                | Comparison::Rises { confidence, .. } => {
                     check_confidence(file, entry.line, *confidence)?
                 }
-                Comparison::Value { confidence, tolerance, .. }
-                | Comparison::Ratio { confidence, tolerance, .. }
-                | Comparison::Difference { confidence, tolerance, .. } => {
+                Comparison::Value { confidence, .. }
+                | Comparison::Ratio { confidence, .. }
+                | Comparison::Difference { confidence, .. } => {
                     check_confidence(file, entry.line, *confidence)?;
-                    if !(tolerance.is_finite() && *tolerance >= 0.0) {
-                        return Err(at(format!("tolerance {tolerance}; expected a number >= 0")));
-                    }
                 }
                 Comparison::LogRatio { confidence, expect, .. } => {
                     check_confidence(file, entry.line, *confidence)?;
-                    expect.check().map_err(at)?;
+                    expect.check(&claim.smallest_effect).map_err(at)?;
                     if let Some(s) = &claim.statistic {
                         super::log_ratio::check_metric(s.metric).map_err(at)?;
                     }

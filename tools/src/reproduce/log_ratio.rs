@@ -4,50 +4,47 @@
 //! times more bias", "13 to 32 times less std") and a factor's spread is symmetric in the log;
 //! the mean of the logs is the log of the geometric mean ratio, which the report shows.
 //!
-//! `Below(1.0)` is a sign claim (a below b); `Below(0.5)` says "at most half". `Near(value: 3.0,
-//! tolerance: 0.5)` is the paper's ratio: the interval of the geometric mean ratio must lie
-//! within value ± tolerance (the paper's stated precision, e.g. "roughly three").
+//! `Below(1.0)` is a sign claim (a below b); `Below(0.5)` says "at most half". `Near(3.0)` is
+//! the paper's ratio ("roughly three"). The claim's smallest effect that matters sets the edge
+//! (`Below(f)`: the ratio below f − δ, or f · (1 − r) for a relative margin) or the band
+//! (`Near(v)`: v ± δ), both compared in the log (`judge::log_region`).
 
 use serde::Deserialize;
 
-use super::judge::{Judged, Verdict, interval};
+use super::claims::Effect;
+use super::judge::{Judged, judge_effects, log_region, not_comparable, num};
 use crate::suite::metric::Metric;
-use crate::suite::student_t;
-use crate::suite::welch::Sample;
 
 /// What the paper says about the ratio a / b.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum RatioExpectation {
-    /// a / b below this factor, by the one-sided upper bound of the geometric mean ratio.
+    /// a / b below this factor (less the claim's margin), by the upper bound of the geometric
+    /// mean ratio.
     Below(f64),
-    /// a / b = value ± tolerance, by the two-sided interval of the geometric mean ratio.
-    Near { value: f64, tolerance: f64 },
+    /// a / b = this factor ± the claim's margin, by the interval of the geometric mean ratio.
+    Near(f64),
 }
 
 impl RatioExpectation {
     pub fn describe(&self) -> String {
         match self {
             RatioExpectation::Below(r) => format!("below {r}"),
-            RatioExpectation::Near { value, tolerance } => format!("= {value} ± {tolerance}"),
+            RatioExpectation::Near(v) => format!("near {v}"),
         }
     }
 
-    /// A factor a ratio can be compared with in the log: positive, the band's low end too.
-    pub fn check(&self) -> Result<(), String> {
+    /// A factor a ratio can be compared with in the log, its margin leaving a positive ratio.
+    pub fn check(&self, effect: &Effect) -> Result<(), String> {
         match *self {
-            RatioExpectation::Below(r) if !(r.is_finite() && r > 0.0) => {
-                Err(format!("Below({r}); expected a factor above 0, e.g. Below(1.0)"))
-            }
-            RatioExpectation::Near { value, tolerance }
-                if !(value.is_finite() && tolerance.is_finite() && tolerance >= 0.0)
-                    || value - tolerance <= 0.0 =>
+            RatioExpectation::Below(r) | RatioExpectation::Near(r)
+                if !(r.is_finite() && r > 0.0) =>
             {
-                Err(format!(
-                    "Near(value: {value}, tolerance: {tolerance}); expected value − tolerance above 0 (a band of positive ratios)"
-                ))
+                Err(format!("{}; expected a factor above 0, e.g. Below(1.0)", self.describe()))
             }
-            _ => Ok(()),
+            _ => log_region(self, effect).map(|_| ()).map_err(|e| {
+                format!("{} with the smallest effect {}: {e}", self.describe(), effect.describe())
+            }),
         }
     }
 }
@@ -65,16 +62,14 @@ pub fn check_metric(metric: Metric) -> Result<(), String> {
     }
 }
 
-fn not_comparable(reason: String, values: Vec<f64>) -> Judged {
-    Judged { flicker: "-".into(), verdict: Verdict::NotComparable(reason), values }
-}
-
-/// Judges a / b against `expect` on the per-seed values of the same runs.
+/// Judges a / b against `expect`, with the claim's smallest effect, on the per-seed values
+/// of the same runs.
 pub fn judge(
     a: Vec<f64>,
     b: Vec<f64>,
     (method, to): (&str, &str),
     expect: &RatioExpectation,
+    effect: &Effect,
     confidence: f64,
 ) -> Judged {
     let values = [a.clone(), b.clone()].concat();
@@ -99,84 +94,79 @@ pub fn judge(
             values,
         );
     }
+    let region = match log_region(expect, effect) {
+        Ok(r) => r,
+        Err(e) => return not_comparable(e, values),
+    };
     let logs: Vec<f64> = a.iter().zip(&b).map(|(x, y)| (x / y).ln()).collect();
     let per_seed = logs.iter().map(|l| format!("{:.3}", l.exp())).collect::<Vec<_>>().join(", ");
-    let n = logs.len();
-    match *expect {
-        RatioExpectation::Below(r) => {
-            let s = Sample::of(&logs);
-            let t = student_t::quantile(confidence, (n - 1) as f64);
-            let upper = (s.mean + t * s.standard_error()).exp();
-            let flicker = format!(
-                "ratio per seed {per_seed}; geometric mean {:.3}, {:.0}% upper bound {upper:.3} ({n} seeds)",
-                s.mean.exp(),
-                confidence * 100.0
-            );
-            let verdict = if upper < r { Verdict::Reproduced } else { Verdict::NotReproduced };
-            Judged { flicker, verdict, values }
+    let (verdict, mean, lo, hi) = judge_effects(&logs, region, confidence);
+    let paper = match region {
+        super::judge::Region::Below { edge } => format!("paper below {}", num(edge.exp())),
+        super::judge::Region::Within { low, high } => {
+            format!("paper {} .. {}", num(low.exp()), num(high.exp()))
         }
-        RatioExpectation::Near { value, tolerance } => {
-            let (mean, half) = interval(&logs, confidence);
-            let (lo, hi) = ((mean - half).exp(), (mean + half).exp());
-            let flicker = format!(
-                "ratio per seed {per_seed}; geometric mean {:.3} [{lo:.3}, {hi:.3}] ({n} seeds)",
-                mean.exp()
-            );
-            let (low, high) = (value - tolerance, value + tolerance);
-            let verdict = if lo >= low && hi <= high {
-                Verdict::Reproduced
-            } else if hi < low || lo > high {
-                Verdict::NotReproduced
-            } else {
-                Verdict::NotComparable(format!(
-                    "the {:.0}% interval straddles the band {value} ± {tolerance}; more seeds",
-                    confidence * 100.0
-                ))
-            };
-            Judged { flicker, verdict, values }
-        }
-    }
+    };
+    let flicker = format!(
+        "{method} / {to} per seed {per_seed}; geometric mean {} [{}, {}], {paper} ({} seeds)",
+        num(mean.exp()),
+        num(lo.exp()),
+        num(hi.exp()),
+        logs.len()
+    );
+    Judged { flicker, verdict, values }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::reproduce::judge::Verdict;
 
     fn below(r: f64) -> RatioExpectation {
         RatioExpectation::Below(r)
     }
 
+    const ABS: Effect = Effect::Absolute(0.01);
+
     /// ln ratios ln 0.2, ln 0.25, ln 0.2: mean −1.535, standard error 0.0744, t(0.95, 2) =
-    /// 2.920: upper bound exp(−1.318) = 0.268. Below 1 and below 0.3, not below 0.25.
+    /// 2.920: bounds exp(−1.7522) = 0.1734 and exp(−1.3179) = 0.2677. Below 1 less 5% and below
+    /// 0.3 less 0.01; inconclusive against 0.25 less 0.01 (the edge 0.24 inside the bounds);
+    /// not below 0.15 less 0.01 (the edge 0.14 under the lower bound).
     #[test]
-    fn a_factor_is_judged_by_the_upper_bound_of_the_geometric_mean() {
+    fn a_factor_is_judged_by_the_bounds_of_the_geometric_mean() {
         let (a, b) = (vec![0.02, 0.05, 0.1], vec![0.1, 0.2, 0.5]);
-        let j = |r| judge(a.clone(), b.clone(), ("a", "b"), &below(r), 0.95);
-        assert_eq!(j(1.0).verdict, Verdict::Reproduced, "{}", j(1.0).flicker);
-        assert_eq!(j(0.3).verdict, Verdict::Reproduced);
-        assert_eq!(j(0.25).verdict, Verdict::NotReproduced, "{}", j(0.25).flicker);
-        assert!(j(1.0).flicker.contains("0.200, 0.250, 0.200"), "{}", j(1.0).flicker);
-        assert!(j(1.0).flicker.contains("upper bound 0.268"), "{}", j(1.0).flicker);
+        let j = |r, e: &Effect| judge(a.clone(), b.clone(), ("a", "b"), &below(r), e, 0.95);
+        let rel = Effect::Relative(0.05);
+        assert_eq!(j(1.0, &rel).verdict, Verdict::Reproduced, "{}", j(1.0, &rel).flicker);
+        assert_eq!(j(0.3, &ABS).verdict, Verdict::Reproduced);
+        assert!(matches!(j(0.25, &ABS).verdict, Verdict::Inconclusive { seeds: Some(_) }));
+        assert_eq!(j(0.15, &ABS).verdict, Verdict::NotReproduced, "{}", j(0.15, &ABS).flicker);
+        let f = j(1.0, &rel).flicker;
+        assert!(f.contains("0.200, 0.250, 0.200"), "{f}");
+        assert!(f.contains("[0.1734, 0.2677]") && f.contains("paper below 0.9500"), "{f}");
         // Scale-free: the same factors at values a thousand times larger judge alike, where a
         // difference of values would not.
         let big = judge(
             a.iter().map(|x| x * 1e3).collect(),
             b.iter().map(|x| x * 1e3).collect(),
             ("a", "b"),
-            &below(0.25),
+            &below(0.15),
+            &ABS,
             0.95,
         );
         assert_eq!(big.verdict, Verdict::NotReproduced);
     }
 
-    /// The paper's "roughly three": ratios 2.9, 3.0, 3.1 (geometric mean 2.999, 95% interval
-    /// [2.76, 3.26]) are within 3 ± 0.5; ratios near 2 are outside; a wide spread straddles.
+    /// The paper's "roughly three" (3 ± 0.5): ratios 2.9, 3.0, 3.1 are within it; ratios near
+    /// 2 are outside; a wide spread holds an edge.
     #[test]
     fn a_paper_ratio_is_judged_by_its_interval_against_the_band() {
-        let near = RatioExpectation::Near { value: 3.0, tolerance: 0.5 };
+        let near = RatioExpectation::Near(3.0);
         let b = vec![1.0, 2.0, 4.0];
+        let half = Effect::Absolute(0.5);
         let j = |r: [f64; 3]| {
-            judge(b.iter().zip(r).map(|(x, r)| x * r).collect(), b.clone(), ("a", "b"), &near, 0.95)
+            let a = b.iter().zip(r).map(|(x, r)| x * r).collect();
+            judge(a, b.clone(), ("a", "b"), &near, &half, 0.95)
         };
         assert_eq!(
             j([2.9, 3.0, 3.1]).verdict,
@@ -185,28 +175,31 @@ mod tests {
             j([2.9, 3.0, 3.1]).flicker
         );
         assert_eq!(j([1.9, 2.0, 2.1]).verdict, Verdict::NotReproduced);
-        assert!(matches!(j([2.0, 3.0, 4.5]).verdict, Verdict::NotComparable(_)));
+        assert!(matches!(j([2.0, 3.0, 4.5]).verdict, Verdict::Inconclusive { .. }));
     }
 
     #[test]
     fn values_a_log_cannot_take_are_not_comparable_with_the_method_named() {
-        let j = judge(vec![0.1, 0.0], vec![0.2, 0.2], ("jackknife", "naive"), &below(1.0), 0.95);
+        let j =
+            judge(vec![0.1, 0.0], vec![0.2, 0.2], ("jackknife", "naive"), &below(1.0), &ABS, 0.95);
         assert!(
             matches!(&j.verdict, Verdict::NotComparable(w) if w.contains("jackknife is 0")),
             "{:?}",
             j.verdict
         );
         assert_eq!(j.values.len(), 4);
-        let one = judge(vec![0.1], vec![0.2], ("a", "b"), &below(1.0), 0.95);
+        let one = judge(vec![0.1], vec![0.2], ("a", "b"), &below(1.0), &ABS, 0.95);
         assert!(matches!(one.verdict, Verdict::NotComparable(_)));
     }
 
     #[test]
     fn factors_and_statistics_a_log_ratio_cannot_judge_are_refused() {
-        assert!(below(0.0).check().is_err());
-        assert!(below(1.0).check().is_ok());
-        assert!(RatioExpectation::Near { value: 0.5, tolerance: 0.5 }.check().is_err());
-        assert!(RatioExpectation::Near { value: 3.0, tolerance: 0.5 }.check().is_ok());
+        assert!(below(0.0).check(&ABS).is_err());
+        assert!(below(1.0).check(&ABS).is_ok());
+        // A margin that leaves no positive ratio.
+        assert!(below(0.01).check(&Effect::Absolute(0.01)).is_err());
+        assert!(RatioExpectation::Near(0.5).check(&Effect::Absolute(0.5)).is_err());
+        assert!(RatioExpectation::Near(3.0).check(&Effect::Absolute(0.5)).is_ok());
         assert!(check_metric(Metric::Psnr).is_err());
         assert!(check_metric(Metric::RmsBias).is_ok());
     }

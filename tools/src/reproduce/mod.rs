@@ -1,6 +1,7 @@
 //! `flicker reproduce PAPER|all`: each seed paper's headline claims (`claims/PAPER.ron`), played
-//! over seeds through the suite machinery, each judged reproduced / not reproduced / not
-//! comparable, written as reproduce.md and reproduce.html beside the paper's numbers.
+//! over seeds through the suite machinery, each judged reproduced / not reproduced /
+//! inconclusive against its smallest effect that matters (or not comparable, with the reason),
+//! written as reproduce.md and reproduce.html beside the paper's numbers.
 
 pub mod alone;
 pub mod by_window;
@@ -18,6 +19,6 @@ pub mod sigma_regions;
 pub mod sss_psnr;
 pub mod table;
 
-pub use claims::{Claim, Claims, Comparison, Scale};
+pub use claims::{Claim, Claims, Comparison, Effect, Scale};
 pub use judge::{Judged, Verdict, judge};
 pub use run::{ClaimOutcome, ReproduceOptions, ReproduceOutcome, reproduce};

@@ -1,8 +1,10 @@
-//! reproduce.md and reproduce.html: one row per claim, the paper's number beside flicker's with
-//! its interval, the verdict and the known departures.
+//! reproduce.md and reproduce.html: per paper a conclusion built from its claims (counts per
+//! verdict, what holds, what fails and the departure its claims file names first, what is
+//! open), then one row per claim: the paper's number beside flicker's (both methods named)
+//! with its interval, the verdict and the known departures.
 
-use super::claims::{Claim, Claims};
-use super::judge::{Judged, Verdict};
+use super::claims::{Claim, Claims, Comparison};
+use super::judge::{Judged, VERDICTS, Verdict};
 use super::table::{self, CaseTable};
 
 /// One paper's claims and their outcomes.
@@ -18,23 +20,90 @@ fn cell(s: &str) -> String {
 }
 
 fn verdict_text(v: &Verdict) -> String {
-    match v {
-        Verdict::NotComparable(why) => format!("not comparable: {why}"),
-        v => v.name().to_string(),
+    v.text()
+}
+
+/// The comparison, where it is played (when it is) and the smallest effect with its source.
+fn test_text(c: &Claim) -> String {
+    let mut t = c.comparison.describe();
+    if let Some(case) = &c.case {
+        t.push_str(&format!(" on {case}"));
+    }
+    if let Some(s) = &c.statistic {
+        t.push_str(&format!(", {}", s.describe()));
+    }
+    format!(
+        "{t}; smallest effect {} (from: {})",
+        c.smallest_effect.describe(),
+        c.smallest_effect_from
+    )
+}
+
+/// `a, b and c`.
+fn and_list(items: &[String]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.clone(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
     }
 }
 
-fn test_text(c: &Claim) -> String {
-    let stat = c.statistic.as_ref().map(|s| s.describe()).unwrap_or_default();
-    let case = c.case.as_deref().unwrap_or("-");
-    format!("{} on {case}, {stat}", c.comparison.describe())
+/// A paper's conclusion: the counts per verdict, then what holds, what fails (with the
+/// departure its claims file names first) and what is open, from the judged claims.
+pub fn conclusion(judged: &[(&Claim, Judged)]) -> String {
+    let count = |name: &str| judged.iter().filter(|(_, j)| j.verdict.name() == name).count();
+    let counts: Vec<String> = VERDICTS.iter().map(|v| format!("{} {v}", count(v))).collect();
+    let mut out = format!("{} claims: {}.", judged.len(), counts.join(", "));
+    let of = |name: &str| -> Vec<(&Claim, &Judged)> {
+        judged.iter().filter(|(_, j)| j.verdict.name() == name).map(|(c, j)| (*c, j)).collect()
+    };
+    let held: Vec<String> = of(VERDICTS[0]).iter().map(|(c, _)| format!("`{}`", c.id)).collect();
+    if !held.is_empty() {
+        out.push_str(&format!(" Holds: {}.", and_list(&held)));
+    }
+    let failed: Vec<String> = of(VERDICTS[1])
+        .iter()
+        .map(|(c, _)| match c.departures.first() {
+            Some(d) => format!("`{}` (its claims file names first: {d})", c.id),
+            None => format!("`{}` (its claims file names no departure)", c.id),
+        })
+        .collect();
+    if !failed.is_empty() {
+        out.push_str(&format!(" Fails: {}.", and_list(&failed)));
+    }
+    let open: Vec<String> = of(VERDICTS[2])
+        .iter()
+        .map(|(c, j)| match j.verdict {
+            Verdict::Inconclusive { seeds: Some(n) } => format!("`{}` (about {n} seeds)", c.id),
+            _ => format!("`{}` (the mean sits on the margin)", c.id),
+        })
+        .collect();
+    let unjudged: Vec<String> = of(VERDICTS[3])
+        .iter()
+        .map(|(c, _)| {
+            let declared = matches!(c.comparison, Comparison::NotComparable { .. });
+            format!("`{}` ({})", c.id, if declared { "not measured by the lab" } else { "no data" })
+        })
+        .collect();
+    match (open.is_empty(), unjudged.is_empty()) {
+        (true, true) => {}
+        (false, true) => out.push_str(&format!(" Open: {}.", and_list(&open))),
+        (true, false) => out.push_str(&format!(" Not judged: {}.", and_list(&unjudged))),
+        (false, false) => out.push_str(&format!(
+            " Open: {}; not judged: {}.",
+            and_list(&open),
+            and_list(&unjudged)
+        )),
+    }
+    out
 }
 
 /// The Markdown report; `header` says how it was made (command, scale, seeds, commit).
 pub fn markdown(header: &str, papers: &[PaperResult]) -> String {
     let mut md = format!("# What the papers claim, and what we measure\n\n{header}\n");
     for p in papers {
-        md.push_str(&format!("\n## {} ({})\n\n", p.claims.title, p.claims.paper));
+        md.push_str(&format!("\n## {}\n\n{}.\n\n", p.claims.paper, p.claims.title));
+        md.push_str(&format!("{}\n\n", conclusion(&p.judged)));
         md.push_str(
             "| claim | where | paper | test | flicker (95% interval) | verdict | departures |\n",
         );
@@ -45,7 +114,7 @@ pub fn markdown(header: &str, papers: &[PaperResult]) -> String {
                 cell(&format!("{}: {}", c.id, c.claim)),
                 cell(&c.source),
                 cell(&c.paper),
-                cell(&format!("{} (tolerance: {})", test_text(c), c.tolerance_from)),
+                cell(&test_text(c)),
                 cell(&j.flicker),
                 cell(&verdict_text(&j.verdict)),
                 cell(&c.departures.join("; ")),
@@ -65,7 +134,7 @@ fn escape(s: &str) -> String {
 /// The same table as a standalone page, verdicts coloured.
 pub fn html(header: &str, papers: &[PaperResult]) -> String {
     let mut h = String::from(
-        "<!doctype html><meta charset=\"utf-8\"><title>flicker reproduce</title>\n<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:4px;vertical-align:top;font-size:90%}.reproduced{background:#d9f2d9}.not-reproduced{background:#f6d5d5}.not-comparable{background:#eee}</style>\n",
+        "<!doctype html><meta charset=\"utf-8\"><title>flicker reproduce</title>\n<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:4px;vertical-align:top;font-size:90%}.reproduced{background:#d9f2d9}.not-reproduced{background:#f6d5d5}.inconclusive{background:#fdf3cf}.not-comparable{background:#eee}</style>\n",
     );
     h.push_str(&format!(
         "<h1>What the papers claim, and what we measure</h1>\n<p>{}</p>\n",
@@ -73,20 +142,20 @@ pub fn html(header: &str, papers: &[PaperResult]) -> String {
     ));
     for p in papers {
         h.push_str(&format!(
-            "<h2>{} ({})</h2>\n<table><tr><th>claim</th><th>where</th><th>paper</th><th>test</th><th>flicker (95% interval)</th><th>verdict</th><th>departures</th></tr>\n",
+            "<h2>{} ({})</h2>\n<p>{}</p>\n<table><tr><th>claim</th><th>where</th><th>paper</th><th>test</th><th>flicker (95% interval)</th><th>verdict</th><th>departures</th></tr>\n",
             escape(&p.claims.title),
-            escape(&p.claims.paper)
+            escape(&p.claims.paper),
+            escape(&conclusion(&p.judged).replace('`', ""))
         ));
         for (c, j) in &p.judged {
             let class = j.verdict.name().replace(' ', "-");
             h.push_str(&format!(
-                "<tr><td><b>{}</b>: {}</td><td>{}</td><td>{}</td><td>{} (tolerance: {})</td><td>{}</td><td class=\"{class}\">{}</td><td>{}</td></tr>\n",
+                "<tr><td><b>{}</b>: {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"{class}\">{}</td><td>{}</td></tr>\n",
                 escape(&c.id),
                 escape(&c.claim),
                 escape(&c.source),
                 escape(&c.paper),
                 escape(&test_text(c)),
-                escape(&c.tolerance_from),
                 escape(&j.flicker),
                 escape(&verdict_text(&j.verdict)),
                 escape(&c.departures.join("; ")),

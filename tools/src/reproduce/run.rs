@@ -148,6 +148,7 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
     if opts.seeds.is_some_and(|n| n < 2) {
         bail!("--seeds {}: an interval needs at least 2 seeds", opts.seeds.unwrap_or(0));
     }
+    let started = std::time::Instant::now();
     let all = load_claims(&opts.claims_dir, &opts.paper)?;
     let folder = opts.out.clone().unwrap_or_else(|| {
         PathBuf::from("runs").join(format!("reproduce_{}_{}", opts.paper, opts.scale.name()))
@@ -180,11 +181,11 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
             let j = match (c.case.as_ref().and_then(|n| runs.get(n)), &c.statistic) {
                 (Some(r), Some(s)) => {
                     let key = s.key();
-                    judge(&c.comparison, &|m, w| {
+                    judge(&c.comparison, &c.smallest_effect, &|m, w| {
                         r.per_seed_of(m, s.metric, &key, w.unwrap_or(&s.window))
                     })
                 }
-                _ => judge(&c.comparison, &|_, _| Err("not played".into())),
+                _ => judge(&c.comparison, &c.smallest_effect, &|_, _| Err("not played".into())),
             };
             outcomes.push(ClaimOutcome {
                 paper: claims.paper.clone(),
@@ -200,13 +201,58 @@ pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
     }
     let seeds = opts.seeds.map_or("each case's own".to_string(), |n| n.to_string());
     let header = format!(
-        "`flicker reproduce {} --scale {}` ({seeds} seeds), commit {}. Relations: the paired one-sided upper bound of the per-seed differences (log ratios: of the geometric mean ratio); values and ratios: the two-sided interval of the mean against the claim's band.",
+        "`flicker reproduce {} --scale {}` ({seeds} seeds) at {}. Each claim's interval lies between the one-sided 95% bounds of its per-seed effect (relations: the paired differences; log ratios: the geometric mean ratio; values, ratios and differences: their mean), judged against the claim's smallest effect that matters.",
         opts.paper,
         opts.scale.name(),
-        systems::manifest::commit(&opts.claims_dir)
+        stamp(&opts.claims_dir, &folder, started.elapsed())
     );
     let markdown = report::markdown(&header, &papers);
     systems::output::write_text(&folder.join("reproduce.md"), &markdown)?;
     systems::output::write_text(&folder.join("reproduce.html"), &report::html(&header, &papers))?;
     Ok(ReproduceOutcome { folder, markdown, claims: outcomes })
+}
+
+/// Where a table was made: the commit, the build profile, the adapter of its played runs, the
+/// machine (cores, load average at the end) and the command's wall time.
+pub fn stamp(claims_dir: &Path, folder: &Path, wall: std::time::Duration) -> String {
+    let profile = if cfg!(debug_assertions) { "debug" } else { "release" };
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    let load = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .map(|l| l.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|| "unknown".into());
+    format!(
+        "commit {}, {profile} build, adapter {}, machine: {cores} cores, load average {load} at the end, {:.0} s wall",
+        systems::manifest::commit(claims_dir),
+        adapter_of(folder).unwrap_or_else(|| "none (computed cases only)".into()),
+        wall.as_secs_f64()
+    )
+}
+
+/// The adapter a played run's manifest.json names (the first found under `folder`).
+fn adapter_of(folder: &Path) -> Option<String> {
+    let mut dirs = vec![folder.to_path_buf()];
+    while let Some(dir) = dirs.pop() {
+        let mut entries: Vec<PathBuf> =
+            std::fs::read_dir(&dir).ok()?.filter_map(|e| e.ok().map(|e| e.path())).collect();
+        entries.sort();
+        for path in entries {
+            if path.is_dir() {
+                dirs.push(path);
+            } else if path.file_name().is_some_and(|n| n == "manifest.json") {
+                let json: serde_json::Value =
+                    serde_json::from_str(&std::fs::read_to_string(&path).ok()?).ok()?;
+                let a = &json["adapter"];
+                let field = |k: &str| a[k].as_str().unwrap_or_default().to_string();
+                return Some(format!(
+                    "{} ({}, {} {})",
+                    field("name"),
+                    field("backend"),
+                    field("driver"),
+                    field("driver_info")
+                ));
+            }
+        }
+    }
+    None
 }
