@@ -103,7 +103,11 @@ impl DirectIrradiancePass {
             pass.set_pipeline(&self.pipeline.get());
             self.frame.bind(gpu, scene, pass);
             pass.set_bind_group(2, &self.bind_group, &[]);
-            pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
+            pass.dispatch_workgroups(
+                self.width.div_ceil(WORKGROUP),
+                self.height.div_ceil(WORKGROUP),
+                1,
+            );
         })?;
         let timings = timed.submit()?;
         let e = render::readback::read_pod(gpu, &self.out, "sss direct irradiance")?;

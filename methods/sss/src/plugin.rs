@@ -11,7 +11,9 @@ use std::time::Instant;
 use crate::direct::{DirectIrradiancePass, IrradianceSource};
 use crate::gpu::SssPass;
 use crate::profile::scaling_from_dmfp;
-use crate::{DistantCount, Hybrid, Prefilter, Split, SpvgSettings, SssFrame, SssSettings, SssVariant};
+use crate::{
+    DistantCount, Hybrid, Prefilter, Split, SpvgSettings, SssFrame, SssSettings, SssVariant,
+};
 use anyhow::{Result, bail};
 use bevy_ecs::prelude::*;
 use glam::Vec3;
@@ -98,8 +100,11 @@ impl SssMethodSettings {
             Some(h) => format!("{base}_hybrid{}", h.taps),
             None => base,
         };
-        let base =
-            if self.irradiance == IrradianceSource::PathTraced { format!("{base}_pt") } else { base };
+        let base = if self.irradiance == IrradianceSource::PathTraced {
+            format!("{base}_pt")
+        } else {
+            base
+        };
         let base = if self.distant_count == DistantCount::GammaScaled {
             format!("{base}_eq520")
         } else {
@@ -236,9 +241,13 @@ impl MethodPlugin for Plugin {
             IrradianceSource::Direct => Some(DirectIrradiancePass::new(gpu, gpu_scene)?),
             IrradianceSource::PathTraced => None,
         };
-        world
-            .entity_mut(entity)
-            .insert(SssState { settings: s.clone(), tracer, direct, profiles, taa });
+        world.entity_mut(entity).insert(SssState {
+            settings: s.clone(),
+            tracer,
+            direct,
+            profiles,
+            taa,
+        });
         Ok(())
     }
 }
@@ -279,7 +288,8 @@ pub fn render(
         // The demodulated irradiance B(p) the passes scatter, per pixel (rgb).
         let b: Vec<[f32; 3]> = match state.direct.as_mut() {
             Some(direct) => {
-                let (e, t) = direct.render(&gpu.0, &gpu_scene.0, clock.global).map_err(|e| fail(&e))?;
+                let (e, t) =
+                    direct.render(&gpu.0, &gpu_scene.0, clock.global).map_err(|e| fail(&e))?;
                 render::timing::merge(&mut timings, t);
                 e.iter().map(|e| [e[0], e[1], e[2]]).collect()
             }
