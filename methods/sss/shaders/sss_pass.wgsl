@@ -198,9 +198,16 @@ fn sss_scatter(@builtin(global_invocation_id) id: vec3u, @builtin(workgroup_id) 
     let sp = SpvgParams(params.alpha0, params.kappa, params.sigma0_sq, params.n_min, params.n_max);
     let prev = reprojected(id.xy, t.w);
     let st = spvg_state(prev.h, sp);
+    // n_hat: SPVG's count (eq. 4.9), kept in the history; n: the distant samples taken
+    // (Algorithm 3: n_hat; eq. 5.20: max(1, floor(n_hat γ + ½))).
     var n = params.fixed_count;
+    var n_hat = n;
     if params.variant != 0u {
-        n = spvg_sample_count(st, sp);
+        n_hat = spvg_sample_count(st, sp);
+        n = n_hat;
+        if params.gamma_scaled != 0u {
+            n = max(1u, u32(floor(f32(n_hat) * gamma_s + 0.5)));
+        }
     }
     let offset = sss_pixel_offset(params.seed, params.frame, pixel);
     let centre_pos = vec2f(f32(id.x) + 0.5, f32(id.y) + 0.5);
@@ -239,7 +246,7 @@ fn sss_scatter(@builtin(global_invocation_id) id: vec3u, @builtin(workgroup_id) 
     } else if params.variant == 2u || params.variant == 3u {
         a = 1.0;
     }
-    history_out[pixel] = spvg_update(st, sp, f - a * g, n) + vec4f(0.0, 0.0, 0.0, t.w);
+    history_out[pixel] = spvg_update(st, sp, f - a * g, n_hat) + vec4f(0.0, 0.0, 0.0, t.w);
     if st.valid {
         cv_out[pixel] = cv_update(prev.j, params.a_cv, f, g);
     } else {

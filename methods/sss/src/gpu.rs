@@ -56,7 +56,9 @@ render::gpu_struct! {
         pub depth_tolerance: f32 => "f32",
         pub hybrid: u32 => "u32",
         pub hybrid_min_d: f32 => "f32",
-        pub hybrid_pad: [u32; 2] => "vec2u",
+        /// 1: eq. 5.20's m = n̂·γ; 0: Algorithm 3 (m estimated directly).
+        pub gamma_scaled: u32 => "u32",
+        pub pad: u32 => "u32",
         pub d_px: [f32; 4] => "vec4f",
         pub mip: [[u32; 4]; 8] => "array<vec4u, 8>",
     }
@@ -359,7 +361,8 @@ impl SssPass {
             depth_tolerance: settings.depth_tolerance,
             hybrid: hybrid as u32,
             hybrid_min_d: settings.hybrid.map_or(0.0, |h| h.min_d_px()),
-            hybrid_pad: [0; 2],
+            gamma_scaled: (settings.distant_count == crate::DistantCount::GammaScaled) as u32,
+            pad: 0,
             d_px: [frame.d_px[0], frame.d_px[1], frame.d_px[2], frame.d_sample()],
             mip: std::array::from_fn(|k| {
                 let (w, h) = prefilter::level_size(self.width, self.height, k as u32);

@@ -9,6 +9,7 @@
 //! docs/methods/sss.md.
 
 pub mod control_variates;
+pub mod direct;
 pub mod evaluation;
 pub mod gpu;
 pub mod ground_truth;
@@ -26,11 +27,12 @@ pub mod spvg;
 pub mod synthetic;
 
 pub use control_variates::EmCovariance;
+pub use direct::IrradianceSource;
 pub use hybrid::Hybrid;
 pub use prefilter::Prefilter;
 pub use profile::BurleyProfile;
 pub use screen_pass::{PixelHistory, PixelResult, SssFrame, SssSettings, SssVariant};
-pub use split::Split;
+pub use split::{DistantCount, Split};
 pub use spvg::{SpvgHistory, SpvgSettings};
 
 pub mod plugin;

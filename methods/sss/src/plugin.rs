@@ -8,9 +8,12 @@
 
 use std::time::Instant;
 
+use crate::direct::{DirectIrradiancePass, IrradianceSource};
 use crate::gpu::SssPass;
 use crate::profile::scaling_from_dmfp;
-use crate::{Hybrid, Prefilter, Split, SpvgSettings, SssFrame, SssSettings, SssVariant};
+use crate::{
+    DistantCount, Hybrid, Prefilter, Split, SpvgSettings, SssFrame, SssSettings, SssVariant,
+};
 use anyhow::{Result, bail};
 use bevy_ecs::prelude::*;
 use glam::Vec3;
@@ -28,7 +31,10 @@ pub struct SssMethodSettings {
     /// Adaptive (AS), OnlineCv (AS+OCV), ConstantCv (AS+CCV), Fixed(count: N) or
     /// Separable(taps: N) (Jimenez et al.'s two 1-D passes, N odd).
     pub variant: SssVariant,
-    /// Path-traced samples per pixel of the irradiance the pass scatters.
+    /// What the pass scatters: `Direct` (the thesis's deferred direct lighting, exact shadow
+    /// rays, no noise) or `PathTraced` (the path tracer's radiance over the albedo).
+    pub irradiance: IrradianceSource,
+    /// Path-traced samples per pixel of the image (and of the irradiance under `PathTraced`).
     pub spp: u32,
     /// Radii from g(ξ) (eq. 5.6) rather than the analytic inverse.
     pub fast_inverse: bool,
@@ -54,6 +60,8 @@ pub struct SssMethodSettings {
     /// on the prefiltered chain; needs `prefilter`) on the 8x8 tiles where the separable taps
     /// would lie more than max_gap_px apart, the separable passes elsewhere. None: the variant.
     pub hybrid: Option<Hybrid>,
+    /// Algorithm 3's distant count (SPVG estimates m) or eq. 5.20's m = n̂·γ.
+    pub distant_count: DistantCount,
 }
 
 impl Default for SssMethodSettings {
@@ -61,6 +69,7 @@ impl Default for SssMethodSettings {
         let s = SssSettings::default();
         Self {
             variant: s.variant,
+            irradiance: IrradianceSource::Direct,
             spp: 1,
             fast_inverse: s.fast_inverse,
             spvg: s.spvg,
@@ -72,6 +81,7 @@ impl Default for SssMethodSettings {
             split: s.split,
             monitor_gamma: s.monitor_gamma,
             hybrid: s.hybrid,
+            distant_count: s.distant_count,
         }
     }
 }
@@ -90,6 +100,16 @@ impl SssMethodSettings {
             Some(h) => format!("{base}_hybrid{}", h.taps),
             None => base,
         };
+        let base = if self.irradiance == IrradianceSource::PathTraced {
+            format!("{base}_pt")
+        } else {
+            base
+        };
+        let base = if self.distant_count == DistantCount::GammaScaled {
+            format!("{base}_eq520")
+        } else {
+            base
+        };
         if self.taa.is_some() { format!("{base}_taa") } else { base }
     }
 
@@ -106,6 +126,7 @@ impl SssMethodSettings {
             split: self.split,
             monitor_gamma: self.monitor_gamma,
             hybrid: self.hybrid,
+            distant_count: self.distant_count,
             ..Default::default()
         }
     }
@@ -130,6 +151,8 @@ pub struct SssState {
     settings: SssMethodSettings,
     /// The path tracer whose image and G-buffer the passes scatter.
     tracer: PathTracer,
+    /// The direct irradiance's pass under `IrradianceSource::Direct`.
+    direct: Option<DirectIrradiancePass>,
     profiles: Vec<SssProfile>,
     taa: Option<Taa>,
 }
@@ -214,7 +237,17 @@ impl MethodPlugin for Plugin {
         let gpu_scene = &world.resource::<GpuScene>().0;
         let taa = s.taa.map(|t| Taa::new(gpu, gpu_scene, t)).transpose()?;
         let tracer = PathTracer::new(gpu, gpu_scene)?;
-        world.entity_mut(entity).insert(SssState { settings: s.clone(), tracer, profiles, taa });
+        let direct = match s.irradiance {
+            IrradianceSource::Direct => Some(DirectIrradiancePass::new(gpu, gpu_scene)?),
+            IrradianceSource::PathTraced => None,
+        };
+        world.entity_mut(entity).insert(SssState {
+            settings: s.clone(),
+            tracer,
+            direct,
+            profiles,
+            taa,
+        });
         Ok(())
     }
 }
@@ -252,6 +285,25 @@ pub fn render(
             .collect();
         let settings = state.settings.pass_settings(run.scenario.seed);
         let mut timings = out.timings.clone();
+        // The demodulated irradiance B(p) the passes scatter, per pixel (rgb).
+        let b: Vec<[f32; 3]> = match state.direct.as_mut() {
+            Some(direct) => {
+                let (e, t) =
+                    direct.render(&gpu.0, &gpu_scene.0, clock.global).map_err(|e| fail(&e))?;
+                render::timing::merge(&mut timings, t);
+                e.iter().map(|e| [e[0], e[1], e[2]]).collect()
+            }
+            None => (0..out.radiance.len())
+                .map(|i| {
+                    let (l, a) = (out.radiance[i], Vec3::from(g.albedo[i]).max(Vec3::splat(1e-4)));
+                    [l[0] / a.x, l[1] / a.y, l[2] / a.z]
+                })
+                .collect(),
+        };
+        let irradiance_sum: f64 = (0..b.len())
+            .filter(|&i| profile_of[i].is_some())
+            .map(|i| crate::sampling::luminance(b[i]) as f64)
+            .sum();
         let mut radiance = out.radiance.clone();
         let mut counts = vec![0u32; radiance.len()];
         for (k, profile) in state.profiles.iter_mut().enumerate() {
@@ -261,8 +313,7 @@ pub fn render(
                     if profile_of[i] != Some(k) {
                         return [l[0], l[1], l[2], 0.0];
                     }
-                    let a = Vec3::from(g.albedo[i]).max(Vec3::splat(1e-4));
-                    [l[0] / a.x, l[1] / a.y, l[2] / a.z, focal / g.depth[i].max(1e-6)]
+                    [b[i][0], b[i][1], b[i][2], focal / g.depth[i].max(1e-6)]
                 })
                 .collect();
             let sss_frame = SssFrame {
@@ -310,6 +361,9 @@ pub fn render(
             stats: vec![
                 ("sss_mean_spp".into(), mean_spp),
                 ("sss_pixels".into(), sss_pixels as f64),
+                // The mean luminance of B(p) over the subsurface pixels: constant across seeds
+                // on a still frame under `Direct`.
+                ("sss_irradiance".into(), irradiance_sum / sss_pixels.max(1) as f64),
             ],
             images: vec![MethodImage { name: "sample_count".into(), pixels: counts, hdr: false }],
             ..MethodOutput::timed(

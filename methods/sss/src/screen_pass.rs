@@ -9,7 +9,7 @@ use super::prefilter::{self, MipChain, Prefilter};
 use super::reproject;
 use super::sampling::{luminance, pixel_offset, r2_point, radial_pdf, sample_radius};
 use super::separable;
-use super::split::{self, Split};
+use super::split::{self, DistantCount, Split};
 use super::spvg::{self, SpvgHistory, SpvgSettings};
 use serde::{Deserialize, Serialize};
 
@@ -66,6 +66,8 @@ pub struct SssSettings {
     /// The hybrid pass (Sec. 5.3.2): AFIS (the variant on the prefiltered chain) on some tiles,
     /// the separable passes on the others; None: the variant alone.
     pub hybrid: Option<Hybrid>,
+    /// Algorithm 3's m (SPVG estimates it) or eq. 5.20's m = n̂·γ; SPVG variants only.
+    pub distant_count: DistantCount,
 }
 
 impl SssSettings {
@@ -129,6 +131,7 @@ impl Default for SssSettings {
             monitor_gamma: MONITOR_GAMMA,
             depth_tolerance: taa::TaaSettings::default().depth_tolerance,
             hybrid: None,
+            distant_count: DistantCount::Estimated,
         }
     }
 }
@@ -313,12 +316,16 @@ fn pixel_step(
         return (PixelResult { rgb: s.rgb, count: 0 }, PixelHistory::default());
     }
     let st = spvg::state(&prev.spvg, &settings.spvg);
-    let m = match settings.variant {
-        SssVariant::Fixed { count } => count,
+    // n̂: SPVG's count (eq. 4.9), kept in the history; m: the distant samples taken.
+    let (n_hat, m) = match settings.variant {
+        SssVariant::Fixed { count } => (count, count),
         SssVariant::Separable { .. } => {
             unreachable!("the separable variant runs as two 1-D passes in `step`")
         }
-        _ => spvg::sample_count(&st, &settings.spvg),
+        _ => {
+            let n = spvg::sample_count(&st, &settings.spvg);
+            (n, split::distant_count(settings.distant_count, n, sp.gamma_s))
+        }
     };
     let s = scatter(frame, settings, chain, frame_index, x, y, m);
     // f̄ = L_o − (1 − γ)B (eq. 6.22), ḡ = G(t) = γB(t) (eq. 6.14), luminance, encoded.
@@ -335,7 +342,7 @@ fn pixel_step(
     let cv = if st.valid { prev.cv.update(settings.a_cv, f, g) } else { EmCovariance::start(f, g) };
     (
         PixelResult { rgb: s.rgb, count: m },
-        PixelHistory { spvg: spvg::update(&st, &settings.spvg, monitored, m), cv, w: t[3] },
+        PixelHistory { spvg: spvg::update(&st, &settings.spvg, monitored, n_hat), cv, w: t[3] },
     )
 }
 

@@ -43,6 +43,26 @@ impl Split {
     }
 }
 
+/// How the distant sample count m follows SPVG's estimate (Sec. 5.3.1).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum DistantCount {
+    /// Algorithm 3 (and the text after eq. 5.20: "we can directly estimate m̂ with Eq. 4.9"):
+    /// SPVG's count is m itself, clamped to [β_min, β_max].
+    #[default]
+    Estimated,
+    /// Eq. 5.20 as written: SPVG's count is n̂ (the total, clamped to [β_min, β_max], kept in
+    /// the history's n̄) and m = max(1, ⌊n̂·γ + ½⌋), γ the sampled channel's.
+    GammaScaled,
+}
+
+/// m of eq. 5.20 from SPVG's n̂ (`GammaScaled`), or n̂ itself (`Estimated`).
+pub fn distant_count(rule: DistantCount, n_hat: u32, gamma_s: f32) -> u32 {
+    match rule {
+        DistantCount::Estimated => n_hat,
+        DistantCount::GammaScaled => ((n_hat as f32 * gamma_s + 0.5).floor() as u32).max(1),
+    }
+}
+
 /// Burley's radial cdf in f32 (eq. 5.3).
 pub fn cdf(r: f32, d: f32) -> f32 {
     1.0 - 0.25 * (-r / d).exp() - 0.75 * (-r / (3.0 * d)).exp()
