@@ -1,6 +1,7 @@
 //! Table 1 from Algorithm 1's own estimates along the Fig. 4a-like profile
-//! (media::table1_alg1, one super-voxel over the ray, voxel noise 0.9), against the profile's exact transmittance. Margins are standard errors
-//! of the same run (4.5 of them), not tuned constants.
+//! (media::table1_alg1, one super-voxel over the ray, voxel noise 0.9), against the profile's
+//! exact transmittance. Margins are standard errors of the same run (4.5 of them), not tuned
+//! constants.
 //!
 //! Asserted: Alg. 1's optical depths are unbiased for τ in every row (its stratified samples
 //! and control variate; a shifted step offset fails here), and the table's conclusion: the naive

@@ -1,8 +1,9 @@
 //! Claim cases computed here instead of played as scenarios: the papers' own test cases that
 //! are closed forms or Monte Carlo on the CPU (the jackknife's Table 1 from Algorithm 1 along a
-//! Fig. 4a-like profile and on normal inputs, the termination paper's sampling trees of Figs. 4 and 5). A computation names its "methods"
-//! (rows of the paper's table) and the metrics each records, and yields one value per method
-//! and metric per seed, as a one-frame run, so claims judge them as they judge scenario runs.
+//! Fig. 4a-like profile and on normal inputs, the termination paper's sampling trees of Figs. 4
+//! and 5). A computation names its "methods" (rows of the paper's table) and the metrics each
+//! records, and yields one value per method and metric per seed, as a one-frame run, so claims
+//! judge them as they judge scenario runs.
 
 use std::collections::BTreeMap;
 
