@@ -1,11 +1,12 @@
 // The transmittance estimators by id (media::transmittance::Estimator::gpu_id): naive and
-// Kettunen's biased exp(−X), unbiased ray marching (power series, degree ≤ 8), the jackknife.
+// Kettunen's biased exp(−X), unbiased ray marching (power series, degree ≤ 8), the jackknife
+// (fixed N, or N tied to the importance: Fig. 8d).
 
 import package::media::types::{RaySegment};
 import package::media::media_rng::{media_rand};
 import package::media::media_jackknife::{jackknife};
 import package::media::media_tracking::{ratio_tracking, track_length};
-import package::media::media_optical_depth::{kettunen_sample_count, od_estimate, od_prepare, od_x};
+import package::media::media_optical_depth::{kettunen_sample_count, od_estimate, od_prepare, od_x, tied_sample_count};
 
 const EST_TRACK_LENGTH: u32 = 0u;
 const EST_RATIO_TRACKING: u32 = 1u;
@@ -13,6 +14,7 @@ const EST_BIASED_RAY_MARCHING: u32 = 2u;
 const EST_UNBIASED_RAY_MARCHING: u32 = 3u;
 const EST_NAIVE: u32 = 4u;
 const EST_JACKKNIFE: u32 = 5u;
+const EST_JACKKNIFE_TIED: u32 = 6u;
 const MAX_DEGREE: u32 = 8u;
 
 var<private> urm_prob: array<f32, 9>;
@@ -90,6 +92,12 @@ fn estimate_transmittance(s: RaySegment, kind: u32, samples: u32, multiplier: f3
             let prep = od_prepare(s, true);
             od_estimate(s, prep, 1u, samples, true, true, rng);
             return exp(-od_x[0]);
+        }
+        case EST_JACKKNIFE_TIED: {
+            // Fig. 8d: N tied to the importance, F_Δ = `multiplier` (the step).
+            let prep = od_prepare(s, true);
+            od_estimate(s, prep, 2u, tied_sample_count(prep.x, multiplier), true, true, rng);
+            return jackknife(od_x[0], od_x[1]);
         }
         default: {
             let prep = od_prepare(s, true);

@@ -31,6 +31,7 @@ pub mod regular_tracking;
 pub mod rng;
 pub mod stratified;
 pub mod supervoxel;
+pub mod table1_alg1;
 pub mod track_length;
 pub mod transmittance;
 pub mod unbiased_ray_marching;

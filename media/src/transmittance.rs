@@ -2,8 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::jackknife::jackknife_transmittance;
+use crate::jackknife::{JackknifeSettings, jackknife_transmittance, jackknife_transmittance_with};
 use crate::medium::{Estimate, Medium, Segment};
+use crate::optical_depth::SampleCount;
 use crate::ratio_tracking::ratio_tracking;
 use crate::ray_marching::{biased_ray_marching, naive};
 use crate::rng::Pcg;
@@ -30,6 +31,11 @@ pub enum Estimator {
     Jackknife {
         samples: u32,
     },
+    /// Eq. 4 from m = 2 estimates whose N is tied to the importance along the ray (Fig. 8d):
+    /// N = ceil(F / `step`) in [1, 64], F the integral of importance (Alg. 2).
+    JackknifeTied {
+        step: f32,
+    },
 }
 
 impl Estimator {
@@ -41,6 +47,7 @@ impl Estimator {
             Estimator::UnbiasedRayMarching { .. } => "unbiased_ray_marching",
             Estimator::Naive { .. } => "naive",
             Estimator::Jackknife { .. } => "jackknife",
+            Estimator::JackknifeTied { .. } => "jackknife_tied",
         }
     }
 
@@ -56,6 +63,13 @@ impl Estimator {
             }
             Estimator::Naive { samples } => naive(medium, seg, samples, rng),
             Estimator::Jackknife { samples } => jackknife_transmittance(medium, seg, samples, rng),
+            Estimator::JackknifeTied { step } => {
+                let settings = JackknifeSettings {
+                    estimates: 2,
+                    samples: SampleCount::PerImportance { step },
+                };
+                jackknife_transmittance_with(medium, seg, &settings, rng)
+            }
         }
     }
 }
@@ -70,6 +84,7 @@ impl Estimator {
             Estimator::UnbiasedRayMarching { multiplier } => (3, 0, multiplier),
             Estimator::Naive { samples } => (4, samples, 0.0),
             Estimator::Jackknife { samples } => (5, samples, 0.0),
+            Estimator::JackknifeTied { step } => (6, 0, step),
         }
     }
 }

@@ -85,6 +85,7 @@ fn cloud_image_matches_the_cpu_reference_estimate_for_estimate() {
     );
     for est in [
         Estimator::Jackknife { samples: 8 },
+        Estimator::JackknifeTied { step: 0.3 },
         Estimator::UnbiasedRayMarching { multiplier: 1.0 },
         Estimator::TrackLength,
     ] {

@@ -241,3 +241,38 @@ fn pass_times_name_their_passes_at_file_and_line() {
     assert!(keys.contains(&"pass_ms tc_trace".to_string()), "{keys:?}");
     assert!(keys.contains(&"pass_ms tc_propagate".to_string()), "{keys:?}");
 }
+
+/// The claim that σ favours the EMA predictor before the change reads a case pre-trained long
+/// enough for the EMA weights to catch up with the trained ones (1280 frames at lab scale; after
+/// the lab's 160 σ leans to High-LR, docs/lab/nirc-sigma.md), at the paper's 5000 at paper
+/// scale; the same claim on the 160-frame case stands beside it (the departure switched on).
+#[test]
+fn sigma_claim_reads_the_long_pretrained_case() {
+    let claims = Claims::load(&root().join("claims/reliability-weighted-nirc.ron")).unwrap();
+    let case_of = |id: &str| {
+        let c = claims.claims.iter().find(|c| c.id == id).unwrap_or_else(|| panic!("no {id}"));
+        c.case.clone().unwrap()
+    };
+    let pretrain = |scale, case: &str| -> Option<u64> {
+        let cases = claims.cases_for(scale, None);
+        let c = cases.iter().find(|c| c.name == case).unwrap();
+        let frames: Vec<u64> = c
+            .params
+            .iter()
+            .filter(|(_, path, _)| path == &["pretrain_frames"])
+            .map(|(_, _, v)| v.as_u64().unwrap())
+            .collect();
+        // Every NIRC method of the case pre-trains the same (they share one cache).
+        assert!(frames.windows(2).all(|w| w[0] == w[1]), "{frames:?}");
+        frames.first().copied()
+    };
+    let long = case_of("sigma_favours_ema_before_change");
+    assert!(pretrain(tools::reproduce::Scale::Lab, &long).is_some_and(|f| f >= 1280));
+    assert_eq!(pretrain(tools::reproduce::Scale::Paper, &long), Some(5000));
+    // The lab's case keeps the scenario's own 160 frames.
+    let lab = case_of("sigma_favours_ema_before_change_lab_pretraining");
+    assert_eq!(pretrain(tools::reproduce::Scale::Lab, &lab), None);
+    let scenario = root().join("scenarios/light_rotation_cornell_box.ron");
+    let text = std::fs::read_to_string(scenario).unwrap();
+    assert_eq!(text.matches("pretrain_frames: 160").count(), 5, "every NIRC method pre-trains 160");
+}

@@ -84,6 +84,11 @@ impl MethodPlugin for Plugin {
         if settings.spp == 0 {
             bail!("VolumeTransmittance: spp 0; expected at least 1 estimate per pixel");
         }
+        if let media::Estimator::JackknifeTied { step } = settings.estimator
+            && !(step.is_finite() && step > 0.0)
+        {
+            bail!("VolumeTransmittance: JackknifeTied(step: {step}); expected a finite F_Δ > 0");
+        }
         let media = &world.resource::<Run>().scenario.media;
         let desc = match &settings.medium {
             Some(name) => media.iter().find(|m| &m.name == name).ok_or_else(|| anyhow!("VolumeTransmittance: no medium named '{name}' in the scenario's media"))?,
