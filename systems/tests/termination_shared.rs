@@ -17,7 +17,7 @@ const METHODS: [(&str, &str); 5] = [
     ("vb_rel", "rule: VarianceBounding(t: 1.0, relative: true), capacity: 4096"),
     (
         "vb_q60",
-        "rule: VarianceBounding(t: 0.01), survival: 0.6, radiance_unit: 0.017, capacity: 4096",
+        "rule: VarianceBounding(t: 0.01), survival: 0.6, radiance_scale: Stated, radiance_unit: 0.017, capacity: 4096",
     ),
     ("spread", "rule: AreaSpread(c: 0.01), capacity: 4096"),
     ("pt", "rule: PathTracing, capacity: 4096"),
