@@ -172,10 +172,13 @@ pub fn trace(
                 ("cache_incomplete_vertices".into(), s.incomplete as f64),
                 ("cache_insert_failures".into(), s.insert_failures as f64),
         ];
-        if let TerminationRule::VarianceBounding { t, relative: false } = settings.rule {
+        if let TerminationRule::VarianceBounding { t, relative: false } = settings.rule
+            && t * unit * unit > 0.0
+        {
             // Fig. 7's bound on the path variance (luminance²), which the image variance is
-            // judged against (`flicker reproduce`'s variance_over_bound).
-            stats.push(("variance_bound".into(), t * unit * unit));
+            // judged against (`flicker reproduce`'s variance_over_bound). As log10: frames.csv
+            // keeps 6 decimals, and bounds are 1e-6 and below.
+            stats.push(("variance_bound_log10".into(), (t * unit * unit).log10()));
         }
         frame.output = Some(MethodOutput {
             stats,

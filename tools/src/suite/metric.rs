@@ -72,7 +72,7 @@ pub enum Metric {
     /// variance-trading-termination's Fig. 7: the image variance over its bound. Per frame, the
     /// mean over pixels of the squared deviation of the frame's luminance from the pixel's mean
     /// over the run's frames, times n/(n − 1), divided by the method's absolute threshold
-    /// t · unit² (frames.csv's `variance_bound`): over all the frames of a static scene's run
+    /// t · unit² (frames.csv's `variance_bound_log10`): over all the frames of a static scene's run
     /// (window Overall) the mean is the estimator's per-pixel variance over the bound
     /// (`reproduce::variance_bound`, from the run's images; not in `ALL`).
     VarianceOverBound,
