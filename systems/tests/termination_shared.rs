@@ -14,7 +14,10 @@ const FRAMES: u32 = 2;
 /// (name, settings) of the methods: three rules on one cache (one with roulette, one in another
 /// radiance unit), path tracing (its own cache), and a rule with another capacity (its own).
 const METHODS: [(&str, &str); 5] = [
-    ("vb_rel", "rule: VarianceBounding(t: 1.0, relative: true), capacity: 4096, samples_per_vertex: 4"),
+    (
+        "vb_rel",
+        "rule: VarianceBounding(t: 1.0, relative: true), capacity: 4096, samples_per_vertex: 4",
+    ),
     (
         "vb_q60",
         "rule: VarianceBounding(t: 0.01), survival: 0.6, radiance_scale: Stated, radiance_unit: 0.017, capacity: 4096, samples_per_vertex: 4",

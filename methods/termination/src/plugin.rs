@@ -151,26 +151,26 @@ pub fn trace(
         let settings = state.tracer.settings();
         let unit = shared.cache.radiance_unit(&settings);
         let mut stats: Vec<(String, f64)> = vec![
-                ("path_length".into(), out.mean_path_length),
-                ("cache_records".into(), s.filled as f64),
-                ("cache_mean".into(), out.cache.mean),
-                ("cache_variance".into(), out.cache.variance),
-                ("cache_bias2".into(), out.cache.bias2),
-                ("cache_variance_p10".into(), out.cache.variance_quantiles[0]),
-                ("cache_variance_p50".into(), out.cache.variance_quantiles[1]),
-                ("cache_variance_p90".into(), out.cache.variance_quantiles[2]),
-                ("cache_mean_p10".into(), out.cache.mean_quantiles[0]),
-                ("cache_mean_p50".into(), out.cache.mean_quantiles[1]),
-                ("cache_mean_p90".into(), out.cache.mean_quantiles[2]),
-                ("cache_bytes".into(), shared.cache.cache_bytes() as f64),
-                // The unit of an absolute threshold (t · unit²): stated, or the cache's mean.
-                ("radiance_unit".into(), unit),
-                ("cache_unknown_vertices".into(), s.unknown as f64),
-                ("cache_propagated_vertices".into(), s.propagated as f64),
-                // Propagated vertices with a sample that read no filled record: left out of
-                // filled records' moments (their share measures what that leaves out).
-                ("cache_incomplete_vertices".into(), s.incomplete as f64),
-                ("cache_insert_failures".into(), s.insert_failures as f64),
+            ("path_length".into(), out.mean_path_length),
+            ("cache_records".into(), s.filled as f64),
+            ("cache_mean".into(), out.cache.mean),
+            ("cache_variance".into(), out.cache.variance),
+            ("cache_bias2".into(), out.cache.bias2),
+            ("cache_variance_p10".into(), out.cache.variance_quantiles[0]),
+            ("cache_variance_p50".into(), out.cache.variance_quantiles[1]),
+            ("cache_variance_p90".into(), out.cache.variance_quantiles[2]),
+            ("cache_mean_p10".into(), out.cache.mean_quantiles[0]),
+            ("cache_mean_p50".into(), out.cache.mean_quantiles[1]),
+            ("cache_mean_p90".into(), out.cache.mean_quantiles[2]),
+            ("cache_bytes".into(), shared.cache.cache_bytes() as f64),
+            // The unit of an absolute threshold (t · unit²): stated, or the cache's mean.
+            ("radiance_unit".into(), unit),
+            ("cache_unknown_vertices".into(), s.unknown as f64),
+            ("cache_propagated_vertices".into(), s.propagated as f64),
+            // Propagated vertices with a sample that read no filled record: left out of
+            // filled records' moments (their share measures what that leaves out).
+            ("cache_incomplete_vertices".into(), s.incomplete as f64),
+            ("cache_insert_failures".into(), s.insert_failures as f64),
         ];
         if let TerminationRule::VarianceBounding { t, relative: false } = settings.rule
             && t * unit * unit > 0.0

@@ -361,12 +361,16 @@ fn incomplete_estimates_included_update_filled_records() {
             cache.read_records(gpu()).unwrap().into_iter().filter(|r| r.vertices > 0.0).collect();
         let n = filled.len() as f64;
         let vertices = filled.iter().map(|r| r.vertices as f64).sum::<f64>() / n;
-        let mean = filled.iter().map(|r| (r.mean[0] + r.mean[1] + r.mean[2]) as f64 / 3.0).sum::<f64>() / n;
+        let mean =
+            filled.iter().map(|r| (r.mean[0] + r.mean[1] + r.mean[2]) as f64 / 3.0).sum::<f64>()
+                / n;
         (vertices, mean)
     };
     let (v_out, m_out) = records(Incomplete::LeaveOut);
     let (v_in, m_in) = records(Incomplete::Include);
-    eprintln!("records: left out {v_out:.3} vertices, mean {m_out:.4}; included {v_in:.3}, {m_in:.4}");
+    eprintln!(
+        "records: left out {v_out:.3} vertices, mean {m_out:.4}; included {v_in:.3}, {m_in:.4}"
+    );
     assert!(v_in > v_out, "included estimates should add vertices: {v_in} vs {v_out}");
     assert!(m_in < m_out, "included estimates read 0: {m_in} vs {m_out}");
 }

@@ -20,11 +20,7 @@ pub const BOUND_COLUMN: &str = "variance_bound_log10";
 
 fn luminance_image(path: &std::path::Path) -> Result<Vec<f64>> {
     let image = metrics::load_image(path)?;
-    Ok(image
-        .rgb
-        .iter()
-        .map(|p| (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) as f64)
-        .collect())
+    Ok(image.rgb.iter().map(|p| (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) as f64).collect())
 }
 
 /// Per method with a bound (the absolute variance-bounding rules), the series of
@@ -34,13 +30,18 @@ pub fn add(run: &mut SeedRun, frames: u32) -> Result<()> {
         bail!("seed {}: no run folder to read {} from", run.seed, Metric::VarianceOverBound.name())
     };
     if frames < 2 {
-        bail!("{} needs at least 2 frames, the case has {frames}", Metric::VarianceOverBound.name());
+        bail!(
+            "{} needs at least 2 frames, the case has {frames}",
+            Metric::VarianceOverBound.name()
+        );
     }
     let folder = RunFolder::new(root);
     let path = folder.frames_csv();
     let rows = rows(&path, |header| match header.iter().position(|h| *h == BOUND_COLUMN) {
         Some(c) => Ok(vec![c]),
-        None => bail!("{}: no {BOUND_COLUMN} column (no absolute variance bounding)", path.display()),
+        None => {
+            bail!("{}: no {BOUND_COLUMN} column (no absolute variance bounding)", path.display())
+        }
     })?;
     let mut bounds: std::collections::BTreeMap<String, f64> = Default::default();
     for (method, frame, values) in rows {
