@@ -342,8 +342,9 @@ fn incomplete_estimates_included_update_filled_records() {
     // `Include` (the paper's propagation, which reads the cache at the hit whatever it holds)
     // folds an estimate with a sample that read an empty record into filled records too, where
     // `LeaveOut` lets it only start an empty one. In the furnace two frames after one warm-up
-    // frame, filled records still receive such estimates: included, they read 0 there, so the
-    // records average more vertices and hold less radiance.
+    // frame, filled records still receive such estimates: included, the records average more
+    // vertices (their radiance then mixes in the samples that read filled records, where a
+    // record left alone keeps its first, one-bounce estimate).
     let (scene, _) = furnace();
     let sg = scene_gpu(&scene, 12);
     let records = |incomplete: Incomplete| {
@@ -372,5 +373,4 @@ fn incomplete_estimates_included_update_filled_records() {
         "records: left out {v_out:.3} vertices, mean {m_out:.4}; included {v_in:.3}, {m_in:.4}"
     );
     assert!(v_in > v_out, "included estimates should add vertices: {v_in} vs {v_out}");
-    assert!(m_in < m_out, "included estimates read 0: {m_in} vs {m_out}");
 }
