@@ -14,14 +14,17 @@ const FRAMES: u32 = 2;
 /// (name, settings) of the methods: three rules on one cache (one with roulette, one in another
 /// radiance unit), path tracing (its own cache), and a rule with another capacity (its own).
 const METHODS: [(&str, &str); 5] = [
-    ("vb_rel", "rule: VarianceBounding(t: 1.0, relative: true), capacity: 4096"),
+    (
+        "vb_rel",
+        "rule: VarianceBounding(t: 1.0, relative: true), capacity: 4096, samples_per_vertex: 4",
+    ),
     (
         "vb_q60",
-        "rule: VarianceBounding(t: 0.01), survival: 0.6, radiance_unit: 0.017, capacity: 4096",
+        "rule: VarianceBounding(t: 0.01), survival: 0.6, radiance_scale: Stated, radiance_unit: 0.017, capacity: 4096, samples_per_vertex: 4",
     ),
-    ("spread", "rule: AreaSpread(c: 0.01), capacity: 4096"),
-    ("pt", "rule: PathTracing, capacity: 4096"),
-    ("first_small", "rule: FirstVertex, capacity: 2048"),
+    ("spread", "rule: AreaSpread(c: 0.01), capacity: 4096, samples_per_vertex: 4"),
+    ("pt", "rule: PathTracing, capacity: 4096, samples_per_vertex: 4"),
+    ("first_small", "rule: FirstVertex, capacity: 2048, samples_per_vertex: 4"),
 ];
 /// The cache of each method of [`METHODS`] (index of its owner, the first method with it).
 const OWNER: [usize; 5] = [0, 0, 0, 3, 4];

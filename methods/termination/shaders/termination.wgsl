@@ -265,9 +265,10 @@ fn tc_propagate(@builtin(global_invocation_id) id: vec3u) {
     var sum_b2 = 0.0; // the continuation's squares: Y = NEE + B, roulette keeps only B
     var deferred = 0.0;
     // A sample whose hit has no filled record yet reads 0, which darkens the record: such an
-    // estimate only starts an empty record (the iteration's bootstrap), never updates a filled one;
-    // or (tc.incomplete_path_trace) the sample goes on by path tracing from that hit, which keeps
-    // the estimate unbiased and complete.
+    // estimate only starts an empty record (the iteration's bootstrap), never updates a filled one
+    // (tc.incomplete 0); or the sample goes on by path tracing from that hit, which keeps the
+    // estimate unbiased and complete (1); or it counts as read, the empty record's 0 included, as
+    // the paper's propagation reads the cache at the hit (2).
     var complete = true;
     var unknown_hit = false;
     for (var k = 0u; k < tc.samples_per_vertex; k++) {
@@ -293,12 +294,12 @@ fn tc_propagate(@builtin(global_invocation_id) id: vec3u) {
                     deferred += lw * lw * tc_stats(r2).bias2;
                 } else {
                     unknown_hit = true;
-                    if tc.incomplete_path_trace != 0u {
+                    if tc.incomplete == 1u {
                         // The hit's emission and the path after it, to the frame's max depth.
                         y += w * path_radiance(o2, bs.wi, bs.pdf, 1u, &rng);
                     } else {
                         y += w * emitted_radiance(sp2, material(sp2.material), bs.wi, hit2.t, bs.pdf);
-                        complete = false;
+                        complete = complete && tc.incomplete == 2u;
                     }
                 }
                 if k == 0u {

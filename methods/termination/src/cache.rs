@@ -15,7 +15,9 @@
 use super::gpu_decision::{decision_module, rule_words};
 use super::moments::RecordMoments;
 use super::rule::TerminationRule;
-use super::settings::{BYTES_PER_RECORD, Incomplete, TerminationSettings, VERTICES_PER_RECORD};
+use super::settings::{
+    BYTES_PER_RECORD, Incomplete, RadianceScale, TerminationSettings, VERTICES_PER_RECORD,
+};
 use glam::Vec3;
 use hash_cache::{HashCacheParams, HashCacheSettings};
 use render::compute::{self, BufferBinding};
@@ -129,9 +131,10 @@ render::gpu_struct! {
         pub pixels: u32 => "u32",
         /// XOR of the candidate indices this frame: the lowest permuted index wins a record.
         pub candidate_mask: u32 => "u32",
-        /// 1: a propagation sample whose hit has no filled record goes on by path tracing
-        /// (`Incomplete::PathTrace`); 0: its estimate is left out of filled records.
-        pub incomplete_path_trace: u32 => "u32",
+        /// A propagation sample whose hit has no filled record: 0 its estimate is left out of
+        /// filled records (`Incomplete::LeaveOut`), 1 it goes on by path tracing (`PathTrace`),
+        /// 2 the estimate counts with the empty record read as 0 (`Include`).
+        pub incomplete: u32 => "u32",
         /// 1: the tracer offers its primary vertices to the records (one tracer per cache); 0:
         /// it draws the same random numbers but writes nothing (a second rule on a shared
         /// cache, whose offers would repeat the first's).
@@ -331,6 +334,9 @@ pub struct TerminationCache {
     store_timer: PassTimer,
     /// Frames (warm-up included) run so far.
     frames: u32,
+    /// `RadianceScale::CacheMean`'s unit: the mean luminance over the filled records the first
+    /// image reads (set by the first [`Self::update`], then fixed for the run).
+    derived_unit: Option<f64>,
 }
 
 impl TerminationCache {
@@ -433,6 +439,7 @@ impl TerminationCache {
             update_timer: PassTimer::new(gpu, &TcPass::UPDATE.map(TcPass::name)),
             store_timer: PassTimer::new(gpu, &TcPass::STORE.map(TcPass::name)),
             frames: 0,
+            derived_unit: None,
         })
     }
 
@@ -558,7 +565,23 @@ impl TerminationCache {
             }
         }
         self.begin_frame(gpu, scene, camera, seed, frame, self.settings.max_vertices);
-        self.submit(gpu, scene, &self.update_timer, &TcPass::UPDATE, &self.own.group)
+        let timings =
+            self.submit(gpu, scene, &self.update_timer, &TcPass::UPDATE, &self.own.group)?;
+        if self.derived_unit.is_none() {
+            // The scene's radiance scale, from the records the first image reads: fixed for
+            // the run, so that a static scene's frames stay independent estimates.
+            self.derived_unit = Some(CacheStatistics::of(&self.read_records(gpu)?).mean);
+        }
+        Ok(timings)
+    }
+
+    /// The radiance unit of an absolute threshold for `settings` (`radiance_scale`): the
+    /// stated one, or the cache's mean once derived (before that, during the warm-up, 1).
+    pub fn radiance_unit(&self, settings: &TerminationSettings) -> f64 {
+        match settings.radiance_scale {
+            RadianceScale::Stated => settings.radiance_unit,
+            RadianceScale::CacheMean => self.derived_unit.unwrap_or(1.0),
+        }
     }
 
     /// The frame's image by the cache's own tracer (its settings' rule): [`Self::trace_with`].
@@ -583,6 +606,19 @@ impl TerminationCache {
         tracer: &TerminationTracer,
         updated: Vec<PassTiming>,
     ) -> Result<TerminationOutput, RenderError> {
+        let absolute = matches!(
+            tracer.settings.rule,
+            TerminationRule::VarianceBounding { relative: false, .. }
+        );
+        if absolute && tracer.settings.radiance_scale == RadianceScale::CacheMean {
+            let unit = self.radiance_unit(&tracer.settings);
+            if !(unit > 0.0 && unit.is_finite()) {
+                return Err(RenderError::Settings(format!(
+                    "Termination radiance_scale CacheMean: the cache's mean radiance is {unit} after {} warm-up frames (no filled record to derive the unit from); use more warmup_frames or radiance_scale: Stated",
+                    self.settings.warmup_frames
+                )));
+            }
+        }
         // The frame's parameters with the tracer's rule; its trace counters cleared (the
         // cache's words of the own tracer's counters are the frame's so far).
         let tc = self.params(&tracer.settings, self.frame_params, tracer.offers);
@@ -642,7 +678,8 @@ impl TerminationCache {
         let (rule_kind, relative, param, margin, bias_clamp) = rule_words(&settings.rule);
         let param = match settings.rule {
             TerminationRule::VarianceBounding { t, relative: false } => {
-                (t * settings.radiance_unit * settings.radiance_unit) as f32
+                let unit = self.radiance_unit(settings);
+                (t * unit * unit) as f32
             }
             _ => param,
         };
@@ -703,7 +740,11 @@ impl TerminationCache {
             store_probability: s.store_probability as f32,
             pixels: self.width * self.height,
             candidate_mask: scene::mix64(seed ^ ((frame as u64) << 32)) as u32 & 0x0fff_ffff,
-            incomplete_path_trace: (s.incomplete == Incomplete::PathTrace) as u32,
+            incomplete: match s.incomplete {
+                Incomplete::LeaveOut => 0,
+                Incomplete::PathTrace => 1,
+                Incomplete::Include => 2,
+            },
             ..bytemuck::Zeroable::zeroed()
         };
         self.frame_params = frame_params;

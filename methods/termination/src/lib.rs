@@ -21,7 +21,7 @@ pub use decision::{Decision, LocalStats, PathState, arrive_area_spread, decide, 
 pub use moments::{RecordMoments, vertex_estimates};
 pub use rule::TerminationRule;
 pub use sampling_tree::{Moments, SamplingTree};
-pub use settings::{Incomplete, TerminationSettings};
+pub use settings::{Incomplete, RadianceScale, TerminationSettings};
 
 pub mod plugin;
 pub use plugin::Plugin;

@@ -16,6 +16,7 @@ use std::time::Instant;
 
 use crate::TerminationCache;
 use crate::TerminationTracer;
+use crate::rule::TerminationRule;
 use anyhow::Result;
 use bevy_ecs::prelude::*;
 use render::timing::PassTiming;
@@ -147,27 +148,40 @@ pub fn trace(
             .trace_with(&gpu.0, &gpu_scene.0, &state.tracer, updated)
             .map_err(|e| method_failed(&info.label, clock.global, e))?;
         let s = out.stats;
+        let settings = state.tracer.settings();
+        let unit = shared.cache.radiance_unit(&settings);
+        let mut stats: Vec<(String, f64)> = vec![
+            ("path_length".into(), out.mean_path_length),
+            ("cache_records".into(), s.filled as f64),
+            ("cache_mean".into(), out.cache.mean),
+            ("cache_variance".into(), out.cache.variance),
+            ("cache_bias2".into(), out.cache.bias2),
+            ("cache_variance_p10".into(), out.cache.variance_quantiles[0]),
+            ("cache_variance_p50".into(), out.cache.variance_quantiles[1]),
+            ("cache_variance_p90".into(), out.cache.variance_quantiles[2]),
+            ("cache_mean_p10".into(), out.cache.mean_quantiles[0]),
+            ("cache_mean_p50".into(), out.cache.mean_quantiles[1]),
+            ("cache_mean_p90".into(), out.cache.mean_quantiles[2]),
+            ("cache_bytes".into(), shared.cache.cache_bytes() as f64),
+            // The unit of an absolute threshold (t · unit²): stated, or the cache's mean.
+            ("radiance_unit".into(), unit),
+            ("cache_unknown_vertices".into(), s.unknown as f64),
+            ("cache_propagated_vertices".into(), s.propagated as f64),
+            // Propagated vertices with a sample that read no filled record: left out of
+            // filled records' moments (their share measures what that leaves out).
+            ("cache_incomplete_vertices".into(), s.incomplete as f64),
+            ("cache_insert_failures".into(), s.insert_failures as f64),
+        ];
+        if let TerminationRule::VarianceBounding { t, relative: false } = settings.rule
+            && t * unit * unit > 0.0
+        {
+            // Fig. 7's bound on the path variance (luminance²), which the image variance is
+            // judged against (`flicker reproduce`'s variance_over_bound). As log10: frames.csv
+            // keeps 6 decimals, and bounds are 1e-6 and below.
+            stats.push(("variance_bound_log10".into(), (t * unit * unit).log10()));
+        }
         frame.output = Some(MethodOutput {
-            stats: vec![
-                ("path_length".into(), out.mean_path_length),
-                ("cache_records".into(), s.filled as f64),
-                ("cache_mean".into(), out.cache.mean),
-                ("cache_variance".into(), out.cache.variance),
-                ("cache_bias2".into(), out.cache.bias2),
-                ("cache_variance_p10".into(), out.cache.variance_quantiles[0]),
-                ("cache_variance_p50".into(), out.cache.variance_quantiles[1]),
-                ("cache_variance_p90".into(), out.cache.variance_quantiles[2]),
-                ("cache_mean_p10".into(), out.cache.mean_quantiles[0]),
-                ("cache_mean_p50".into(), out.cache.mean_quantiles[1]),
-                ("cache_mean_p90".into(), out.cache.mean_quantiles[2]),
-                ("cache_bytes".into(), shared.cache.cache_bytes() as f64),
-                ("cache_unknown_vertices".into(), s.unknown as f64),
-                ("cache_propagated_vertices".into(), s.propagated as f64),
-                // Propagated vertices with a sample that read no filled record: left out of
-                // filled records' moments (their share measures what that leaves out).
-                ("cache_incomplete_vertices".into(), s.incomplete as f64),
-                ("cache_insert_failures".into(), s.insert_failures as f64),
-            ],
+            stats,
             // The paper's Fig. 11: vertices of each pixel's path (grey value = path length; the
             // EXR holds the exact values).
             images: vec![MethodImage {

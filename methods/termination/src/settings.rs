@@ -19,7 +19,9 @@ pub struct TerminationSettings {
     pub lod_scale: f32,
     /// Jittered lookups: stochastic interpolation between neighbouring records (§5).
     pub jitter: bool,
-    /// Samples per stored vertex and propagation (the U-statistic's K; the paper: a subgroup, 32).
+    /// Samples per stored vertex and propagation (the U-statistic's K; the paper: a subgroup,
+    /// 32, the default). K costs no memory (one invocation loops over its samples and keeps
+    /// three sums); propagation time grows about linearly with it.
     pub samples_per_vertex: u32,
     /// Vertex estimates a record averages before its mean turns exponential.
     pub max_vertices: u32,
@@ -31,10 +33,26 @@ pub struct TerminationSettings {
     /// The radiance an absolute threshold t is stated in: the path variance is bounded by
     /// t · radiance_unit². Variance scales with the square of radiance, and the paper's t
     /// belongs to its scenes' radiance scale, not to the lab's (docs/lab/termination-radiance-scale.md).
+    /// Read only with `radiance_scale: Stated`.
     pub radiance_unit: f64,
+    /// Where the radiance unit comes from: the scene's own cache (`CacheMean`, the default) or
+    /// `radiance_unit` as stated (the scenarios' values fitted to the paper's Table 1).
+    pub radiance_scale: RadianceScale,
     /// A propagation sample whose hit has no filled record yet: its vertex estimate is left
     /// out of filled records (the default), or the sample goes on by path tracing.
     pub incomplete: Incomplete,
+}
+
+/// The radiance an absolute variance threshold t is stated in (t · unit²).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum RadianceScale {
+    /// Derived from the scene: the mean luminance E[Y] over the cache's filled records when the
+    /// first image reads them (after the warm-up and the first frame's fold), then fixed for
+    /// the run. No result of the run's images enters it.
+    #[default]
+    CacheMean,
+    /// `radiance_unit` as the scenario states it.
+    Stated,
 }
 
 /// What propagation does with a sample whose BSDF hit has no filled record to end in.
@@ -48,6 +66,10 @@ pub enum Incomplete {
     /// ray to the hit, then the path tracer's loop): every estimate is complete and unbiased
     /// given the records it read.
     PathTrace,
+    /// The estimate counts like any other, the empty record read as 0: the paper's propagation
+    /// evaluates the cache at the hit, whatever it holds (§5), and fills the cache to
+    /// equilibrium first (§6), where no hit lacks its record.
+    Include,
 }
 
 impl Default for TerminationSettings {
@@ -59,11 +81,12 @@ impl Default for TerminationSettings {
             probe_limit: 8,
             lod_scale: 8.0,
             jitter: true,
-            samples_per_vertex: 4,
+            samples_per_vertex: 32,
             max_vertices: 64,
             store_probability: 0.01,
             warmup_frames: 16,
             radiance_unit: 1.0,
+            radiance_scale: RadianceScale::CacheMean,
             incomplete: Incomplete::LeaveOut,
         }
     }
@@ -120,14 +143,21 @@ impl TerminationSettings {
 
     /// Settings with equal keys build bit-identical records, so their rules can share one cache
     /// (one propagation a frame): everything but the rule, the survival probability and the
-    /// radiance unit, which only the trace reads. Path tracing is its own key: it skips the
+    /// radiance unit and scale, which only the trace reads (the cache derives its mean once for
+    /// all of its tracers). Path tracing is its own key: it skips the
     /// lookup's random numbers at the first vertex, so its stored vertices differ.
     pub fn cache_key(&self) -> TerminationSettings {
         let rule = match self.rule {
             TerminationRule::PathTracing => TerminationRule::PathTracing,
             _ => TerminationRule::FirstVertex,
         };
-        TerminationSettings { rule, survival: 1.0, radiance_unit: 1.0, ..*self }
+        TerminationSettings {
+            rule,
+            survival: 1.0,
+            radiance_unit: 1.0,
+            radiance_scale: RadianceScale::CacheMean,
+            ..*self
+        }
     }
 
     /// Bytes of the cache's records (what `Gpu::check_buffer_size` sees per buffer is less).

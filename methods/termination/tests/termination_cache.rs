@@ -6,7 +6,8 @@ use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::SceneDesc;
 use render::scene_gpu::SceneGpu;
 use termination::{
-    Incomplete, TerminationCache, TerminationOutput, TerminationRule, TerminationSettings,
+    Incomplete, RadianceScale, TerminationCache, TerminationOutput, TerminationRule,
+    TerminationSettings,
 };
 
 use common::{H, W, furnace, gpu, room_scene};
@@ -21,8 +22,18 @@ fn scene_gpu(scene: &SceneDesc, max_depth: u32) -> SceneGpu {
     .expect("scene")
 }
 
+/// The settings these tests were written for: K = 4 (fast on lavapipe) and absolute thresholds
+/// in radiance unit 1 (the room's and the furnace's own scale). `paper_conditions` tests the
+/// defaults (K = 32, the cache's mean as the unit).
 fn settings(rule: TerminationRule) -> TerminationSettings {
-    TerminationSettings { rule, capacity: 1 << 12, warmup_frames: 32, ..Default::default() }
+    TerminationSettings {
+        rule,
+        capacity: 1 << 12,
+        warmup_frames: 32,
+        samples_per_vertex: 4,
+        radiance_scale: RadianceScale::Stated,
+        ..Default::default()
+    }
 }
 
 /// `frames` frames of one rule (the first after the warm-up).
@@ -152,12 +163,7 @@ fn relative_threshold_without_a_first_record_path_traces() {
     // At a huge relative t every path is path traced: bit for bit the path tracing rule.
     let scene = room_scene();
     let sg = scene_gpu(&scene, 6);
-    let sparse = |rule| TerminationSettings {
-        rule,
-        capacity: 1 << 12,
-        warmup_frames: 1,
-        ..Default::default()
-    };
+    let sparse = |rule| TerminationSettings { warmup_frames: 1, ..settings(rule) };
     let render = |rule| {
         let mut cache = TerminationCache::new(gpu(), &sg, sparse(rule)).unwrap();
         (0..2).map(|f| cache.render(gpu(), &sg, &scene.camera, 5, f).unwrap()).collect::<Vec<_>>()
@@ -283,4 +289,88 @@ fn incomplete_samples_path_traced_make_the_first_estimates_complete() {
     // Bounds from the closed forms (0.25 and 0.5 less 0.5^13), halfway between them.
     assert!((left_out - 0.25).abs() < 0.125, "left out: {left_out}, expected 0.25");
     assert!((traced - 0.5).abs() < 0.125, "path traced: {traced}, expected 0.5");
+}
+
+#[test]
+fn paper_conditions_k_samples_and_the_cache_mean_unit() {
+    // The defaults are the paper's statistics: K = 32 samples per stored vertex (one BSDF ray
+    // each, so a propagated vertex traces more than 32 rays; K = 4 traces at most 4 · 2 + 1),
+    // and absolute thresholds in the cache's own mean radiance.
+    let scene = room_scene();
+    let sg = scene_gpu(&scene, 6);
+    let defaults = TerminationSettings {
+        rule: TerminationRule::VarianceBounding { t: 0.01, relative: false },
+        capacity: 1 << 12,
+        warmup_frames: 4,
+        store_probability: 0.1,
+        ..Default::default()
+    };
+    assert_eq!(defaults.radiance_scale, RadianceScale::CacheMean);
+    let mut cache = TerminationCache::new(gpu(), &sg, defaults).unwrap();
+    let out = cache.render(gpu(), &sg, &scene.camera, 5, 0).unwrap();
+    let vertices = (out.stats.propagated + out.stats.incomplete) as f64;
+    let per_vertex = out.stats.propagate_rays as f64 / vertices;
+    eprintln!("defaults: {vertices} propagated vertices, {per_vertex:.2} rays each");
+    assert!(vertices > 20.0, "{:?}", out.stats);
+    assert!(per_vertex > 32.0, "K = {}: {per_vertex} rays per vertex", defaults.samples_per_vertex);
+    // The unit is the mean luminance of the records the first image read (the room's are
+    // around 0.1, far from 1).
+    let unit = cache.radiance_unit(&defaults);
+    eprintln!("derived radiance unit {unit}, records' mean {}", out.cache.mean);
+    assert_eq!(unit, out.cache.mean);
+    assert!(unit > 0.0 && unit < 0.5, "derived unit {unit}");
+    // Stating that unit gives the same image, bit for bit; unit 1 (a threshold 1/unit² times
+    // higher) gives longer paths: the derived unit is what the threshold reads.
+    let stated = |radiance_unit: f64| {
+        let s = TerminationSettings {
+            radiance_scale: RadianceScale::Stated,
+            radiance_unit,
+            ..defaults
+        };
+        let mut c = TerminationCache::new(gpu(), &sg, s).unwrap();
+        c.render(gpu(), &sg, &scene.camera, 5, 0).unwrap()
+    };
+    let same = stated(unit);
+    assert!(same.radiance == out.radiance, "CacheMean and Stated({unit}) differ");
+    let one = stated(1.0);
+    eprintln!("path length: unit {unit} {}, unit 1 {}", out.mean_path_length, one.mean_path_length);
+    assert!(one.mean_path_length > out.mean_path_length, "unit 1 should give longer paths");
+}
+
+#[test]
+fn incomplete_estimates_included_update_filled_records() {
+    // `Include` (the paper's propagation, which reads the cache at the hit whatever it holds)
+    // folds an estimate with a sample that read an empty record into filled records too, where
+    // `LeaveOut` lets it only start an empty one. In the furnace two frames after one warm-up
+    // frame, filled records still receive such estimates: included, the records average more
+    // vertices (their radiance then mixes in the samples that read filled records, where a
+    // record left alone keeps its first, one-bounce estimate).
+    let (scene, _) = furnace();
+    let sg = scene_gpu(&scene, 12);
+    let records = |incomplete: Incomplete| {
+        let s = TerminationSettings {
+            incomplete,
+            warmup_frames: 1,
+            store_probability: 1.0,
+            ..settings(TerminationRule::FirstVertex)
+        };
+        let mut cache = TerminationCache::new(gpu(), &sg, s).unwrap();
+        let out: Vec<_> =
+            (0..2).map(|f| cache.render(gpu(), &sg, &scene.camera, 5, f).unwrap()).collect();
+        assert!(out[1].stats.incomplete > 0, "{incomplete:?}: {:?}", out[1].stats);
+        let filled: Vec<_> =
+            cache.read_records(gpu()).unwrap().into_iter().filter(|r| r.vertices > 0.0).collect();
+        let n = filled.len() as f64;
+        let vertices = filled.iter().map(|r| r.vertices as f64).sum::<f64>() / n;
+        let mean =
+            filled.iter().map(|r| (r.mean[0] + r.mean[1] + r.mean[2]) as f64 / 3.0).sum::<f64>()
+                / n;
+        (vertices, mean)
+    };
+    let (v_out, m_out) = records(Incomplete::LeaveOut);
+    let (v_in, m_in) = records(Incomplete::Include);
+    eprintln!(
+        "records: left out {v_out:.3} vertices, mean {m_out:.4}; included {v_in:.3}, {m_in:.4}"
+    );
+    assert!(v_in > v_out, "included estimates should add vertices: {v_in} vs {v_out}");
 }

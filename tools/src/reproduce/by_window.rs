@@ -30,7 +30,10 @@ impl ByWindow {
             if self.metrics[..i].contains(m) {
                 return Err(format!("by_window: {name} is listed twice"));
             }
-            if m.from_images() || *m == Metric::PassMs || !m.per_frame() {
+            if m.from_images()
+                || matches!(*m, Metric::PassMs | Metric::VarianceOverBound)
+                || !m.per_frame()
+            {
                 return Err(format!(
                     "by_window: {name} needs a claim's parameters or is not a per-frame number; expected a per-frame metric such as Flip or CacheMean"
                 ));

@@ -18,6 +18,7 @@ pub mod run;
 pub mod sigma_regions;
 pub mod sss_psnr;
 pub mod table;
+pub mod variance_bound;
 
 pub use claims::{Claim, Claims, Comparison, Effect, Scale};
 pub use judge::{Judged, Verdict, judge};

@@ -70,10 +70,11 @@ pub fn load_claims(dir: &Path, paper: &str) -> Result<Vec<Claims>> {
 /// What the claims' statistics read from the run folders rather than frame records, added to
 /// each played seed's run once per case: `SssPsnr` against the claim's `against` method, and
 /// `FrameMs` less the shared passes a method would not run alone (`not_run`), `PassMs`
-/// over its passes, and σ by region (claims' statistics and the cases' table columns).
+/// over its passes, Fig. 7's image variance over its bound (`variance_bound`), and σ by region (claims' statistics and the cases' table columns).
 fn add_from_folders(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> Result<()> {
     let (mut images, mut alone): (Vec<&str>, Vec<&str>) = (Vec::new(), Vec::new());
     let mut regions: Vec<&str> = Vec::new();
+    let mut bounded: Vec<&str> = Vec::new();
     let mut passes: Vec<(&str, &[String])> = Vec::new();
     add_columns(claims, runs)?;
     let of_claims =
@@ -96,6 +97,13 @@ fn add_from_folders(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> R
             let frames = r.frames;
             for seed in &mut r.seeds {
                 super::sss_psnr::add(seed, against, frames).map_err(at)?;
+            }
+        }
+        if s.metric == Metric::VarianceOverBound && !bounded.contains(&case) {
+            bounded.push(case);
+            let frames = r.frames;
+            for seed in &mut r.seeds {
+                super::variance_bound::add(seed, frames).map_err(at)?;
             }
         }
         if matches!(s.metric, Metric::SigmaChanged | Metric::SigmaUnchanged)

@@ -69,6 +69,13 @@ pub enum Metric {
     CacheVariance,
     /// `cache_bias2`: the mean of E[E[Y|y]²] − E[Y]² over the filled records.
     CacheBias2,
+    /// variance-trading-termination's Fig. 7: the image variance over its bound. Per frame, the
+    /// mean over pixels of the squared deviation of the frame's luminance from the pixel's mean
+    /// over the run's frames, times n/(n − 1), divided by the method's absolute threshold
+    /// t · unit² (frames.csv's `variance_bound_log10`): over all the frames of a static scene's run
+    /// (window Overall) the mean is the estimator's per-pixel variance over the bound
+    /// (`reproduce::variance_bound`, from the run's images; not in `ALL`).
+    VarianceOverBound,
 }
 
 impl Metric {
@@ -118,6 +125,7 @@ impl Metric {
             Metric::CacheMean => "cache_mean",
             Metric::CacheVariance => "cache_variance",
             Metric::CacheBias2 => "cache_bias2",
+            Metric::VarianceOverBound => "variance_over_bound",
         }
     }
 
@@ -137,7 +145,11 @@ impl Metric {
     pub fn reproduce_only(self) -> bool {
         matches!(
             self,
-            Metric::PassMs | Metric::CacheMean | Metric::CacheVariance | Metric::CacheBias2
+            Metric::PassMs
+                | Metric::CacheMean
+                | Metric::CacheVariance
+                | Metric::CacheBias2
+                | Metric::VarianceOverBound
         )
     }
 
@@ -162,9 +174,11 @@ impl Metric {
             Metric::Flip | Metric::Mse | Metric::RelMse | Metric::Psnr | Metric::Cvvdp => {
                 references
             }
-            Metric::PathLength | Metric::CacheMean | Metric::CacheVariance | Metric::CacheBias2 => {
-                kind == "Termination"
-            }
+            Metric::PathLength
+            | Metric::CacheMean
+            | Metric::CacheVariance
+            | Metric::CacheBias2
+            | Metric::VarianceOverBound => kind == "Termination",
             Metric::MeanAbsBias | Metric::MeanStd | Metric::RmsBias => {
                 kind == "VolumeTransmittance"
             }
@@ -184,7 +198,7 @@ impl Metric {
             Metric::Mse => r.mse,
             Metric::RelMse => r.rel_mse,
             Metric::Psnr => r.psnr,
-            Metric::Cvvdp | Metric::SssPsnr | Metric::PassMs => None,
+            Metric::Cvvdp | Metric::SssPsnr | Metric::PassMs | Metric::VarianceOverBound => None,
             Metric::SigmaChanged | Metric::SigmaUnchanged => None,
             Metric::FrameMs => r.passes_total_ms(),
             Metric::Rays => r.rays.map(|n| n as f64),
