@@ -4,6 +4,7 @@
 //! gives frames from any renderer the metrics and report of a run.
 
 pub mod measure;
+pub mod history;
 pub mod reproduce;
 pub mod ron_file;
 pub mod suite;
