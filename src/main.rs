@@ -468,10 +468,9 @@ fn main() -> ExitCode {
                     .map_err(anyhow::Error::from)
                     .and_then(|exe| distributed::plan(&opts, &dir, &exe))
                     .map(|(plan, _)| {
+                        let (n, d) = (plan.jobs.len(), dir.display());
                         println!(
-                            "planned {} jobs in {0}; run them with `flicker sweep local {0}`, `parallel < {0}/jobs.txt` or `sbatch {0}/sweep.sbatch`, then judge with --judge-from {0}",
-                            plan.jobs.len(),
-                            dir.display()
+                            "planned {n} jobs in {d}; run them with `flicker sweep local {d}`, `parallel < {d}/jobs.txt` or `sbatch {d}/sweep.sbatch`, then judge with --judge-from {d}"
                         );
                     }),
                 (None, judged) => {
@@ -506,8 +505,7 @@ fn main() -> ExitCode {
                 );
                 let flagged = shown.flagged_now();
                 for s in &flagged {
-                    let what: Vec<String> =
-                        s.latest_flags().iter().map(|f| f.describe()).collect();
+                    let what: Vec<String> = s.latest_flags().iter().map(|f| f.describe()).collect();
                     eprintln!("changed at the latest commit: {}: {}", s.key.id, what.join("; "));
                 }
                 !(fail_on_change && !flagged.is_empty())

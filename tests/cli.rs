@@ -380,19 +380,35 @@ fn history_of_the_suite(history: &Path, shown: &Path) {
     let verdicts: Vec<_> = r.entries.iter().map(|e| e.verdict.clone().unwrap()).collect();
     assert_eq!(verdicts, ["pass", "fail"]);
     assert!(r.entries.iter().all(|e| e.value.is_some() && e.lo.is_some()), "{:?}", r.entries);
-    let o = flicker(&["history", "--history", history.to_str().unwrap(), "--out", shown.to_str().unwrap(), "--fail-on-change"]);
+    let o = flicker(&[
+        "history",
+        "--history",
+        history.to_str().unwrap(),
+        "--out",
+        shown.to_str().unwrap(),
+        "--fail-on-change",
+    ]);
     assert_eq!(o.status.code(), Some(0), "one commit changes nothing: {}", text(&o.stderr));
     (r.commit, r.date) = ("f".repeat(40), "2999-01-01T00:00:00Z".into());
     r.entries[0].verdict = Some("fail".into());
     tools::history::append(history, &r).unwrap();
-    let args = ["history", "--history", history.to_str().unwrap(), "--out", shown.to_str().unwrap()];
+    let args =
+        ["history", "--history", history.to_str().unwrap(), "--out", shown.to_str().unwrap()];
     let o = flicker(&args);
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
     let o = flicker(&[&args[..], &["--fail-on-change"]].concat());
     assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
     let stdout = text(&o.stdout);
-    assert!(stdout.contains("| fffffff | 2999-01-01T00:00:00Z |") && stdout.contains("**verdict changed: pass -> fail**"), "{stdout}");
-    assert!(text(&o.stderr).contains("changed at the latest commit: box/pt_1spp/flip overall <= 1"), "{}", text(&o.stderr));
+    assert!(
+        stdout.contains("| fffffff | 2999-01-01T00:00:00Z |")
+            && stdout.contains("**verdict changed: pass -> fail**"),
+        "{stdout}"
+    );
+    assert!(
+        text(&o.stderr).contains("changed at the latest commit: box/pt_1spp/flip overall <= 1"),
+        "{}",
+        text(&o.stderr)
+    );
     let charts = std::fs::read_dir(shown.join("charts")).unwrap().count();
     assert_eq!(charts, 2, "a chart per gate");
     assert!(std::fs::read_to_string(shown.join("history.md")).unwrap().contains("verdict changed"));

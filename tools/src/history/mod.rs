@@ -80,9 +80,7 @@ pub fn show(opts: &ShowOptions) -> Result<Shown> {
     let mut all = series(&records);
     if let Some(f) = &opts.filter {
         all.retain(|s| {
-            s.key.id.contains(f.as_str())
-                || s.key.kind.name() == f
-                || s.key.scale == *f
+            s.key.id.contains(f.as_str()) || s.key.kind.name() == f || s.key.scale == *f
         });
     }
     let mut md = series::markdown(&all);

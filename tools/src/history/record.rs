@@ -112,7 +112,9 @@ impl Record {
 
 /// Letters, digits, `.`, `_` and `-`; anything else becomes `_` (a name in a file name).
 fn file_safe(s: &str) -> String {
-    s.chars().map(|c| if c.is_ascii_alphanumeric() || "._-".contains(c) { c } else { '_' }).collect()
+    s.chars()
+        .map(|c| if c.is_ascii_alphanumeric() || "._-".contains(c) { c } else { '_' })
+        .collect()
 }
 
 /// Appends `record` to the history in `dir`: a new file, written whole or not at all, whose
@@ -152,8 +154,8 @@ pub fn read(dir: &Path) -> Result<Vec<(PathBuf, Record)>> {
     files.sort();
     let mut records = Vec::new();
     for path in files {
-        let text =
-            std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("reading {}", path.display()))?;
         let record: Record = serde_json::from_str(&text).map_err(|e| {
             anyhow::anyhow!(
                 "{}:{}:{}: expected a results-history record (docs/history.md): {e}",

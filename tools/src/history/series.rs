@@ -19,9 +19,15 @@ pub struct Key {
 /// What changed from the commit before.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Flag {
-    VerdictChanged { from: String, to: String },
+    VerdictChanged {
+        from: String,
+        to: String,
+    },
     /// |value − previous| above the margin while the verdict held.
-    Drift { change: f64, margin: f64 },
+    Drift {
+        change: f64,
+        margin: f64,
+    },
 }
 
 impl Flag {

@@ -64,13 +64,10 @@ pub fn claim_margin(claim: &Claim, estimate: Option<&Estimate>) -> (Option<f64>,
         Comparison::Value { tolerance, .. }
         | Comparison::Ratio { tolerance, .. }
         | Comparison::Difference { tolerance, .. }
-        | Comparison::LogRatio {
-            expect: RatioExpectation::Near { tolerance, .. }, ..
-        } => (Some(*tolerance), "the claim's tolerance".into()),
-        _ => (
-            estimate.map(|e| (e.hi - e.lo) / 2.0),
-            "the half-width of the run's interval".into(),
-        ),
+        | Comparison::LogRatio { expect: RatioExpectation::Near { tolerance, .. }, .. } => {
+            (Some(*tolerance), "the claim's tolerance".into())
+        }
+        _ => (estimate.map(|e| (e.hi - e.lo) / 2.0), "the half-width of the run's interval".into()),
     }
 }
 

@@ -55,7 +55,12 @@ pub fn plan(opts: &ReproduceOptions, dir: &Path, exe: &Path) -> Result<(Plan, Me
     for claims in &all {
         for case in claims.cases_for(opts.scale, opts.seeds) {
             let scenario = std::fs::canonicalize(&case.scenario).map_err(|e| {
-                anyhow!("{}: case '{}': {}: {e}", claims.origin.display(), case.name, case.scenario.display())
+                anyhow!(
+                    "{}: case '{}': {}: {e}",
+                    claims.origin.display(),
+                    case.name,
+                    case.scenario.display()
+                )
             })?;
             for &seed in &case.seeds {
                 // Checked here, so that a bad case fails the plan, not a job on the cluster.
@@ -106,7 +111,10 @@ pub fn plan(opts: &ReproduceOptions, dir: &Path, exe: &Path) -> Result<(Plan, Me
         jobs: planned,
     };
     crate::sweep::plan::write(&plan, dir, exe)?;
-    systems::output::write_text(&dir.join(META_FILE), &(serde_json::to_string_pretty(&meta)? + "\n"))?;
+    systems::output::write_text(
+        &dir.join(META_FILE),
+        &(serde_json::to_string_pretty(&meta)? + "\n"),
+    )?;
     Ok((plan, meta))
 }
 
