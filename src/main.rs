@@ -508,7 +508,7 @@ fn main() -> ExitCode {
                     let what: Vec<String> = s.latest_flags().iter().map(|f| f.describe()).collect();
                     eprintln!("changed at the latest commit: {}: {}", s.key.id, what.join("; "));
                 }
-                !(fail_on_change && !flagged.is_empty())
+                !fail_on_change || flagged.is_empty()
             }));
         }
         Command::Run { scenario, resume, frames, resolution, spp, seed, out, cache_dir, quiet } => {

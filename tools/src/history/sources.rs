@@ -34,7 +34,7 @@ pub fn claim_estimate(comparison: &Comparison, judged: &Judged) -> Option<Estima
     let v = &judged.values;
     let halves = || {
         let n = v.len() / 2;
-        (v.len() % 2 == 0).then(|| (&v[..n], &v[n..]))
+        v.len().is_multiple_of(2).then(|| (&v[..n], &v[n..]))
     };
     match comparison {
         Comparison::Below { confidence, .. } | Comparison::Rises { confidence, .. } => {
