@@ -103,6 +103,37 @@ enum Command {
         /// Do not draw progress bars.
         #[arg(long)]
         quiet: bool,
+        /// Play nothing: write the cases' seeds as jobs into DIR (plan.json, jobs.txt for GNU
+        /// parallel, sweep.sbatch for a Slurm array), run them with `flicker sweep local DIR`,
+        /// `parallel < DIR/jobs.txt` or `sbatch DIR/sweep.sbatch`, then judge with --judge-from.
+        #[arg(long, value_name = "DIR", conflicts_with = "judge_from")]
+        plan: Option<PathBuf>,
+        /// Play nothing: judge the finished jobs planned in DIR with --plan (the same paper,
+        /// --scale and --seeds); the report goes to --out or DIR.
+        #[arg(long, value_name = "DIR")]
+        judge_from: Option<PathBuf>,
+        #[command(flatten)]
+        history: HistoryArgs,
+    },
+    /// Each claim's, gate's and bench ratio's value and interval across commits, from the
+    /// results history: a table (printed, and OUT/history.md) and a chart per series
+    /// (OUT/charts/), flagging a verdict that changed from one commit to the next and a drift
+    /// beyond the claim's margin while the verdict held.
+    History {
+        /// The results history [default: results/history].
+        #[arg(long, value_name = "DIR", default_value = tools::history::DEFAULT_DIR)]
+        history: PathBuf,
+        /// Where history.md and the charts go.
+        #[arg(long, default_value = "runs/history")]
+        out: PathBuf,
+        /// Only the series whose id contains TEXT, or of this kind (reproduce, suite, bench)
+        /// or scale.
+        #[arg(long, value_name = "TEXT")]
+        only: Option<String>,
+        /// Exit with code 1 when a series' latest commit changed verdict or drifted against
+        /// the commit before (for CI).
+        #[arg(long)]
+        fail_on_change: bool,
     },
     /// Parameter sweeps: a grid or list over method parameters, cases and seeds, one run folder
     /// per job, run here, with GNU parallel or as a Slurm array, merged into one summary.
@@ -155,7 +186,35 @@ enum Command {
         /// Also write the numbers as JSON to this file (with --nirc: the neural cache's).
         #[arg(long)]
         json: Option<PathBuf>,
+        #[command(flatten)]
+        history: HistoryArgs,
     },
+}
+
+/// Where a run's values, intervals and verdicts are appended.
+#[derive(clap::Args)]
+struct HistoryArgs {
+    /// Append this run's values, intervals and verdicts to the results history in DIR (one
+    /// file per run; keep it in git or on a shared disk).
+    #[arg(long, value_name = "DIR", default_value = tools::history::DEFAULT_DIR)]
+    history: PathBuf,
+    /// Do not append to the results history.
+    #[arg(long, conflicts_with = "history")]
+    no_history: bool,
+}
+
+impl HistoryArgs {
+    /// Appends what `record` builds, unless switched off; a history that cannot be written is
+    /// a warning (the run's own results are written already).
+    fn append(&self, record: impl FnOnce() -> anyhow::Result<tools::history::Record>) {
+        if self.no_history {
+            return;
+        }
+        match record().and_then(|r| tools::history::append(&self.history, &r)) {
+            Ok(path) => println!("history: {}", path.display()),
+            Err(e) => eprintln!("warning: results history not written: {e:#}"),
+        }
+    }
 }
 
 #[derive(Subcommand)]
@@ -183,15 +242,17 @@ struct SuiteArgs {
     /// Do not draw progress bars.
     #[arg(long)]
     quiet: bool,
+    #[command(flatten)]
+    history: HistoryArgs,
 }
 
 impl SuiteArgs {
-    fn options(self) -> tools::suite::SuiteOptions {
+    fn options(&self) -> tools::suite::SuiteOptions {
         tools::suite::SuiteOptions {
-            suite: self.suite,
-            out: self.out,
-            cache_dir: self.cache_dir,
-            baselines: self.baselines,
+            suite: self.suite.clone(),
+            out: self.out.clone(),
+            cache_dir: self.cache_dir.clone(),
+            baselines: self.baselines.clone(),
             progress: !self.quiet,
         }
     }
@@ -203,6 +264,7 @@ fn suite(action: SuiteAction) -> ExitCode {
         SuiteAction::Run(args) => tools::suite::run(&args.options()).map(|outcome| {
             print!("{}", outcome.markdown);
             println!("\nwrote {} and {}", outcome.summary.display(), outcome.junit.display());
+            args.history.append(|| tools::history::suite_record(&outcome, &args.suite));
             outcome.passed()
         }),
         SuiteAction::Bless(args) => tools::suite::bless(&args.options()).map(|file| {
@@ -379,7 +441,18 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Suite { action } => return suite(action),
         Command::Sweep { action } => return sweep(action),
-        Command::Reproduce { paper, scale, seeds, out, claims, cache_dir, quiet } => {
+        Command::Reproduce {
+            paper,
+            scale,
+            seeds,
+            out,
+            claims,
+            cache_dir,
+            quiet,
+            plan,
+            judge_from,
+            history,
+        } => {
             let opts = tools::reproduce::ReproduceOptions {
                 paper,
                 claims_dir: claims,
@@ -389,10 +462,54 @@ fn main() -> ExitCode {
                 cache_dir,
                 progress: !quiet,
             };
-            tools::reproduce::reproduce(&opts).map(|outcome| {
-                print!("{}", outcome.markdown);
-                println!("\nwrote {}", outcome.folder.join("reproduce.md").display());
-            })
+            use tools::reproduce::distributed;
+            match (plan, judge_from) {
+                (Some(dir), _) => std::env::current_exe()
+                    .map_err(anyhow::Error::from)
+                    .and_then(|exe| distributed::plan(&opts, &dir, &exe))
+                    .map(|(plan, _)| {
+                        let (n, d) = (plan.jobs.len(), dir.display());
+                        println!(
+                            "planned {n} jobs in {d}; run them with `flicker sweep local {d}`, `parallel < {d}/jobs.txt` or `sbatch {d}/sweep.sbatch`, then judge with --judge-from {d}"
+                        );
+                    }),
+                (None, judged) => {
+                    let outcome = match &judged {
+                        Some(dir) => distributed::judge_from(&opts, dir),
+                        None => tools::reproduce::reproduce(&opts),
+                    };
+                    outcome.map(|outcome| {
+                        print!("{}", outcome.markdown);
+                        println!("\nwrote {}", outcome.folder.join("reproduce.md").display());
+                        history.append(|| {
+                            tools::history::reproduce_record(
+                                &outcome,
+                                &opts.claims_dir,
+                                &opts.paper,
+                                opts.scale.name(),
+                            )
+                        });
+                    })
+                }
+            }
+        }
+        Command::History { history, out, only, fail_on_change } => {
+            let opts = tools::history::ShowOptions { history, out, filter: only };
+            return exit_code(tools::history::show(&opts).map(|shown| {
+                print!("{}", shown.markdown);
+                println!(
+                    "\nwrote {} and {} charts in {}",
+                    shown.report.display(),
+                    shown.charts.len(),
+                    opts.out.join("charts").display()
+                );
+                let flagged = shown.flagged_now();
+                for s in &flagged {
+                    let what: Vec<String> = s.latest_flags().iter().map(|f| f.describe()).collect();
+                    eprintln!("changed at the latest commit: {}: {}", s.key.id, what.join("; "));
+                }
+                !fail_on_change || flagged.is_empty()
+            }));
         }
         Command::Run { scenario, resume, frames, resolution, spp, seed, out, cache_dir, quiet } => {
             let played = match (resume, scenario) {
@@ -453,11 +570,17 @@ fn main() -> ExitCode {
             nirc_resolution,
         ),
         Command::Bench { out, json, memory: true, .. } => bench::command::memory(out, json),
-        Command::Bench { out, json, metrics_only: true, repeats, .. } => {
-            bench::command::metrics(out, json, repeats)
+        Command::Bench { out, json, metrics_only: true, repeats, history, .. } => {
+            bench::command::metrics(out, json, repeats).map(|(adapter, entries)| {
+                history.append(|| Ok(bench::command::record("metrics", &adapter, entries)))
+            })
         }
-        Command::Bench { out, rays, frames, no_metrics, repeats, json, .. } => {
-            bench::command::speed(out, json, rays, frames, no_metrics, repeats)
+        Command::Bench { out, rays, frames, no_metrics, repeats, json, history, .. } => {
+            bench::command::speed(out, json, rays, frames, no_metrics, repeats).map(
+                |(adapter, entries)| {
+                    history.append(|| Ok(bench::command::record("speed", &adapter, entries)))
+                },
+            )
         }
     };
     match result {

@@ -339,6 +339,8 @@ fn suite_exit_codes_summary_and_junit() {
         out.to_str().unwrap(),
         "--cache-dir",
         dir.join("cache").to_str().unwrap(),
+        "--history",
+        dir.join("history").to_str().unwrap(),
     ]);
     assert_eq!(
         o.status.code(),
@@ -358,10 +360,56 @@ fn suite_exit_codes_summary_and_junit() {
     assert!(
         out.join("box/seed_1/frames.csv").exists() && out.join("box/seed_2/report.html").exists()
     );
+    history_of_the_suite(&dir.join("history"), &dir.join("shown"));
     // A bad suite file: exit code 2, the error at file:line.
     std::fs::write(&suite, "Suite(\n  cases: [],\n  gates: [(metric: Flip, window: Overall, bound: Absolute(limit: 1.0))],\n  extra: 1,\n)\n").unwrap();
     let o = flicker(&["suite", "run", suite.to_str().unwrap(), "--quiet"]);
     let stderr = text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("tiny.ron:4:"), "{stderr}");
+}
+
+/// The suite run's record in the history (one entry per gate), and `flicker history` over it
+/// and a copy at a later commit whose first gate failed: a verdict change, exit code 1 with
+/// `--fail-on-change`.
+fn history_of_the_suite(history: &Path, shown: &Path) {
+    let records = tools::history::read(history).unwrap();
+    assert_eq!(records.len(), 1);
+    let (_, mut r) = records.into_iter().next().unwrap();
+    assert_eq!(r.kind, tools::history::Kind::Suite);
+    let verdicts: Vec<_> = r.entries.iter().map(|e| e.verdict.clone().unwrap()).collect();
+    assert_eq!(verdicts, ["pass", "fail"]);
+    assert!(r.entries.iter().all(|e| e.value.is_some() && e.lo.is_some()), "{:?}", r.entries);
+    let o = flicker(&[
+        "history",
+        "--history",
+        history.to_str().unwrap(),
+        "--out",
+        shown.to_str().unwrap(),
+        "--fail-on-change",
+    ]);
+    assert_eq!(o.status.code(), Some(0), "one commit changes nothing: {}", text(&o.stderr));
+    (r.commit, r.date) = ("f".repeat(40), "2999-01-01T00:00:00Z".into());
+    r.entries[0].verdict = Some("fail".into());
+    tools::history::append(history, &r).unwrap();
+    let args =
+        ["history", "--history", history.to_str().unwrap(), "--out", shown.to_str().unwrap()];
+    let o = flicker(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let o = flicker(&[&args[..], &["--fail-on-change"]].concat());
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
+    let stdout = text(&o.stdout);
+    assert!(
+        stdout.contains("| fffffff | 2999-01-01T00:00:00Z |")
+            && stdout.contains("**verdict changed: pass -> fail**"),
+        "{stdout}"
+    );
+    assert!(
+        text(&o.stderr).contains("changed at the latest commit: box/pt_1spp/flip overall <= 1"),
+        "{}",
+        text(&o.stderr)
+    );
+    let charts = std::fs::read_dir(shown.join("charts")).unwrap().count();
+    assert_eq!(charts, 2, "a chart per gate");
+    assert!(std::fs::read_to_string(shown.join("history.md")).unwrap().contains("verdict changed"));
 }

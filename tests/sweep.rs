@@ -3,7 +3,9 @@
 //! 8-task Slurm array on a one-node cluster this test starts on localhost (munged, slurmctld,
 //! slurmd; Debian's `slurm-wlm` and `munge`, installed by scripts/setup.sh), and through GNU
 //! parallel reading the plan's job file. The merged summaries must agree in every number but
-//! the timings. If the cluster does not come up the test fails with the daemons' logs.
+//! the timings. `flicker reproduce --plan` of a small claims file runs on the same cluster and
+//! on the local executor, and `--judge-from` must write the report of a run played in one
+//! process. If the cluster does not come up the test fails with the daemons' logs.
 
 use std::net::TcpListener;
 use std::path::{Path, PathBuf};
@@ -352,6 +354,37 @@ impl Drop for Cluster {
     }
 }
 
+/// A claims file of two claims on the smoke suite's Cornell box at 16x9 (TAA against 1 spp
+/// path tracing over 2 seeds): `DIR/claims/tiny.ron`.
+fn tiny_claims(dir: &Path) -> PathBuf {
+    let claims = dir.join("claims");
+    std::fs::create_dir_all(&claims).unwrap();
+    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("suites/scenarios/smoke_cornell.ron");
+    std::fs::write(
+        claims.join("tiny.ron"),
+        format!(
+            "Claims(\n    paper: \"tiny\",\n    title: \"Tiny\",\n    cases: [\n        (name: \"cornell\", scenario: \"{}\", seeds: [1, 2], methods: [\"pt_1spp\", \"taa\"],\n         smoke: (resolution: (16, 9), frames: 3)),\n    ],\n    claims: [\n        (id: \"taa_steadier\", claim: \"c\", source: \"s\", paper: \"p\", case: \"cornell\", statistic: (metric: Smape, window: Overall), comparison: Below(method: \"taa\", than: \"pt_1spp\"), smallest_effect: Relative(0.05), smallest_effect_from: \"s\"),\n        (id: \"taa_flip\", claim: \"c\", source: \"s\", paper: \"p\", case: \"cornell\", statistic: (metric: Flip, window: Overall), comparison: Value(method: \"taa\", value: 0.3), smallest_effect: Absolute(0.3), smallest_effect_from: \"p\"),\n    ],\n)\n",
+            scenario.display()
+        ),
+    )
+    .unwrap();
+    claims
+}
+
+/// `flicker reproduce tiny --scale smoke` with `extra`.
+fn reproduce_tiny(claims: &Path, extra: &[&str]) -> Output {
+    let mut args = vec!["reproduce", "tiny", "--scale", "smoke", "--quiet", "--claims"];
+    args.push(claims.to_str().unwrap());
+    args.extend_from_slice(extra);
+    flicker(&args)
+}
+
+/// reproduce.md without its first lines (title and the command that made it).
+fn claims_report(dir: &Path) -> String {
+    let md = std::fs::read_to_string(dir.join("reproduce.md")).unwrap();
+    md.lines().skip(3).collect::<Vec<_>>().join("\n")
+}
+
 #[test]
 fn sweep_runs_locally_and_on_slurm_with_identical_numbers() {
     let dir = scratch("slurm");
@@ -380,6 +413,55 @@ fn sweep_runs_locally_and_on_slurm_with_identical_numbers() {
     );
     ok(&flicker(&["sweep", "merge", local.to_str().unwrap()]), "sweep merge (local, after rerun)");
     assert_eq!(numbers(&local), local_numbers, "a rerun job changed the merged numbers");
+
+    // Reproduce: played in one process, then as jobs of the local executor (judging before
+    // they ran names the pending jobs).
+    let claims = tiny_claims(&dir);
+    let history = dir.join("history");
+    let (played, by_jobs, on_slurm) = (dir.join("played"), dir.join("jobs"), dir.join("rslurm"));
+    let h = ["--history", history.to_str().unwrap()];
+    ok(
+        &reproduce_tiny(&claims, &[&["--out", played.to_str().unwrap()], &h[..]].concat()),
+        "reproduce (played)",
+    );
+    let reference = claims_report(&played);
+    assert!(
+        reference.contains("| taa_steadier") && reference.contains("| taa_flip"),
+        "{reference}"
+    );
+    for d in [&by_jobs, &on_slurm] {
+        let o = reproduce_tiny(&claims, &["--plan", d.to_str().unwrap()]);
+        ok(&o, "reproduce --plan");
+        assert!(text(&o.stdout).contains("planned 2 jobs"), "{}", text(&o.stdout));
+    }
+    let judge = |d: &Path| {
+        reproduce_tiny(&claims, &[&["--judge-from", d.to_str().unwrap()], &h[..]].concat())
+    };
+    let o = judge(&by_jobs);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(text(&o.stderr).contains("2 of 2 jobs have not finished (0,1)"), "{}", text(&o.stderr));
+    // Another scale than planned is refused.
+    let o = flicker(&[
+        "reproduce",
+        "tiny",
+        "--scale",
+        "lab",
+        "--claims",
+        claims.to_str().unwrap(),
+        "--judge-from",
+        by_jobs.to_str().unwrap(),
+    ]);
+    assert!(
+        text(&o.stderr).contains("holds the jobs of `flicker reproduce tiny --scale smoke`"),
+        "{}",
+        text(&o.stderr)
+    );
+    ok(
+        &flicker(&["sweep", "local", by_jobs.to_str().unwrap(), "--jobs", "2"]),
+        "sweep local (reproduce jobs)",
+    );
+    ok(&judge(&by_jobs), "reproduce --judge-from (local executor)");
+    assert_eq!(claims_report(&by_jobs), reference, "judged from the local executor's jobs");
 
     // Slurm: the same plan as an 8-task array on a one-node cluster.
     ok(
@@ -412,7 +494,32 @@ fn sweep_runs_locally_and_on_slurm_with_identical_numbers() {
         cluster.logs()
     );
     let job_id = text(&o.stdout).trim().to_string();
+    let o = cluster
+        .slurm("sbatch")
+        .args(["--wait", "--parsable"])
+        .arg(on_slurm.join("sweep.sbatch"))
+        .output()
+        .expect("sbatch runs");
+    assert!(
+        o.status.success(),
+        "sbatch --wait (reproduce) failed: {}{}",
+        text(&o.stderr),
+        cluster.logs()
+    );
+    let reproduce_id = text(&o.stdout).trim().to_string();
     drop(cluster);
+    for i in 0..2 {
+        assert!(
+            on_slurm.join(format!("logs/slurm_{reproduce_id}_{i}.out")).exists(),
+            "no output of reproduce task {i}"
+        );
+    }
+    ok(&judge(&on_slurm), "reproduce --judge-from (slurm)");
+    assert_eq!(claims_report(&on_slurm), reference, "judged from the Slurm array's jobs");
+    // Each judged run appended a record to the history, as the played one did.
+    let records = tools::history::read(&history).unwrap();
+    assert_eq!(records.len(), 3);
+    assert!(records.iter().all(|(_, r)| r.entries.len() == 2 && r.scale == "smoke"));
     // Every array task left its Slurm output file, so Slurm (not this test) ran the jobs.
     for i in 0..8 {
         assert!(

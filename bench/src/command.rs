@@ -167,10 +167,38 @@ fn metrics_section(repeats: u32) -> anyhow::Result<(String, crate::image_metrics
     Ok((md, r))
 }
 
-/// `flicker bench --metrics-only`: the image metrics' timings alone (no GPU).
-pub fn metrics(out: Option<PathBuf>, json: Option<PathBuf>, repeats: u32) -> anyhow::Result<()> {
+/// What measured the image metrics: this machine's CPU threads.
+fn cpu_adapter(threads: usize) -> String {
+    format!("cpu ({threads} threads)")
+}
+
+/// `flicker bench --metrics-only`: the image metrics' timings alone (no GPU). Returns what
+/// measured and the results history's entries (the ratio to NVIDIA's flip-evaluator).
+pub fn metrics(
+    out: Option<PathBuf>,
+    json: Option<PathBuf>,
+    repeats: u32,
+) -> anyhow::Result<(String, Vec<History>)> {
     let (md, r) = metrics_section(repeats)?;
-    print_and_write(&md, out, json, &r)
+    print_and_write(&md, out, json, &r)?;
+    let entries = tools::history::sources::bench_metrics_entries(&serde_json::to_value(&r)?);
+    Ok((cpu_adapter(r.threads), entries))
+}
+
+/// A results-history entry of the bench.
+pub type History = tools::history::Entry;
+
+/// The results-history record of a bench run (`form`: `speed` or `metrics`).
+pub fn record(form: &str, adapter: &str, entries: Vec<History>) -> tools::history::Record {
+    let mut r = tools::history::Record::now(
+        tools::history::Kind::Bench,
+        form,
+        "-",
+        adapter,
+        std::path::Path::new("."),
+    );
+    r.entries = entries;
+    r
 }
 
 pub fn speed(
@@ -180,12 +208,15 @@ pub fn speed(
     frames: u32,
     no_metrics: bool,
     repeats: u32,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<(String, Vec<History>)> {
     let opts = crate::speed::BenchOptions { rays, frames, ..Default::default() };
     let report = crate::speed::run(&opts, |step| eprintln!("bench: {step}"))?;
     let mut md = report.markdown;
+    let mut entries = tools::history::sources::bench_speed_entries(&report.json);
     if !no_metrics {
-        md.push_str(&metrics_section(repeats)?.0);
+        let (section, r) = metrics_section(repeats)?;
+        md.push_str(&section);
+        entries.extend(tools::history::sources::bench_metrics_entries(&serde_json::to_value(&r)?));
     }
     print!("{md}");
     if let Some(path) = out {
@@ -194,5 +225,8 @@ pub fn speed(
     if let Some(path) = json {
         systems::output::write_text(&path, &serde_json::to_string_pretty(&report.json)?)?;
     }
-    Ok(())
+    let a = &report.json["adapter"];
+    let adapter =
+        format!("{} / {}", a["name"].as_str().unwrap_or("?"), a["backend"].as_str().unwrap_or("?"));
+    Ok((adapter, entries))
 }

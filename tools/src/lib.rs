@@ -3,6 +3,7 @@
 //! (`sweep`: jobs planned for local, GNU parallel or Slurm execution, then merged); `measure`
 //! gives frames from any renderer the metrics and report of a run.
 
+pub mod history;
 pub mod measure;
 pub mod reproduce;
 pub mod ron_file;

@@ -7,6 +7,7 @@ pub mod alone;
 pub mod by_window;
 pub mod claims;
 pub mod computation;
+pub mod distributed;
 pub mod events;
 pub mod frame_columns;
 pub mod frames_csv;

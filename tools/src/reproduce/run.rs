@@ -13,6 +13,7 @@ use super::table::case_tables;
 use crate::suite::measurement::CaseRuns;
 use crate::suite::metric::Metric;
 use crate::suite::run::play_cases;
+use crate::suite::spec::Case;
 
 pub struct ReproduceOptions {
     /// A paper's stem (`claims/PAPER.ron`) or `all`.
@@ -151,29 +152,41 @@ fn add_columns(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> Result
     Ok(())
 }
 
+/// How a paper's cases get their runs: played here, or read back from jobs run elsewhere.
+pub(crate) type CaseSource<'a> =
+    dyn FnMut(&Claims, &[Case], &str) -> Result<BTreeMap<String, CaseRuns>> + 'a;
+
 /// `flicker reproduce`: plays, judges, writes reproduce.md and reproduce.html.
 pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
+    let folder = opts.out.clone().unwrap_or_else(|| {
+        PathBuf::from("runs").join(format!("reproduce_{}_{}", opts.paper, opts.scale.name()))
+    });
+    let mut play = |claims: &Claims, cases: &[Case], label: &str| {
+        let out = folder.join(&claims.paper);
+        play_cases(&claims.origin, cases, &out, &opts.cache_dir, opts.progress, label)
+    };
+    judge_papers(opts, &folder, &mut play)
+}
+
+/// Gets each paper's runs from `source`, judges every claim, writes reproduce.md and
+/// reproduce.html to `folder`.
+pub(crate) fn judge_papers(
+    opts: &ReproduceOptions,
+    folder: &Path,
+    source: &mut CaseSource,
+) -> Result<ReproduceOutcome> {
     if opts.seeds.is_some_and(|n| n < 2) {
         bail!("--seeds {}: an interval needs at least 2 seeds", opts.seeds.unwrap_or(0));
     }
     let started = std::time::Instant::now();
     let all = load_claims(&opts.claims_dir, &opts.paper)?;
-    let folder = opts.out.clone().unwrap_or_else(|| {
-        PathBuf::from("runs").join(format!("reproduce_{}_{}", opts.paper, opts.scale.name()))
-    });
+    let folder = folder.to_path_buf();
     let mut papers = Vec::new();
     let mut outcomes = Vec::new();
     for claims in &all {
         let cases = claims.cases_for(opts.scale, opts.seeds);
         let label = format!("reproduce {}", claims.paper);
-        let mut runs = play_cases(
-            &claims.origin,
-            &cases,
-            &folder.join(&claims.paper),
-            &opts.cache_dir,
-            opts.progress,
-            &label,
-        )?;
+        let mut runs = source(claims, &cases, &label)?;
         for case in &claims.cases {
             if let Some(c) = &case.computation {
                 eprintln!("{label}: case {} (computed: {})", case.name, c.name());

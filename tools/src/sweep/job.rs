@@ -11,6 +11,7 @@ use anyhow::{Result, anyhow};
 use serde::{Deserialize, Serialize};
 
 use super::plan::{Plan, done_file};
+use crate::suite::measurement::SeedRun;
 use crate::suite::metric::Metric;
 use systems::frame_record::FrameRecord;
 use systems::playback::{RunOptions, run_spec};
@@ -36,6 +37,18 @@ pub struct JobRecord {
     /// method label -> numbers
     pub methods: BTreeMap<String, MethodNumbers>,
     pub wall_s: f64,
+    /// The per-frame metrics, where the plan keeps them (`Plan::keep_frames`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub played: Option<Played>,
+}
+
+/// A job's run as a suite keeps it: its frames and events (recorded frames) and each
+/// method's per-frame metrics, so that a judge elsewhere reads what a played case would hold.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Played {
+    pub frames: u32,
+    pub events: Vec<u32>,
+    pub run: SeedRun,
 }
 
 fn mean(values: impl Iterator<Item = Option<f64>>) -> Option<f64> {
@@ -128,6 +141,11 @@ pub fn run_job(dir: &Path, index: usize, progress: bool) -> Result<JobRecord> {
         seed: job.seed,
         methods: with_jod(numbers(&summary.records), &summary.folder),
         wall_s: start.elapsed().as_secs_f64(),
+        played: plan.keep_frames.then(|| Played {
+            frames: spec.scenario.frames,
+            events: crate::suite::run::event_frames(&spec.scenario),
+            run: SeedRun::from_records(job.seed, &summary.records),
+        }),
     };
     systems::output::write_json(&done, &record)?;
     Ok(record)

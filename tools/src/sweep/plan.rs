@@ -31,6 +31,10 @@ pub struct Job {
     pub params: Vec<(String, serde_json::Value)>,
     /// The run folder, relative to the sweep's folder.
     pub folder: PathBuf,
+    /// The case's own parameters (`flicker reproduce --plan`: a scale's `set`), applied before
+    /// `params`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub case_params: Vec<(String, Vec<String>, serde_json::Value)>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -41,6 +45,10 @@ pub struct Plan {
     /// Reference cache of every job; `None`: `DIR/cache`, shared by the jobs.
     pub cache_dir: Option<PathBuf>,
     pub jobs: Vec<Job>,
+    /// Each job's record keeps its per-frame metrics (`flicker reproduce --judge-from` reads
+    /// them); a sweep's jobs keep only their means.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub keep_frames: bool,
 }
 
 pub const PLAN_FILE: &str = "plan.json";
@@ -83,7 +91,7 @@ impl Job {
             resolution: self.resolution,
             spp: self.spp,
             methods: self.methods.clone(),
-            params: Vec::new(),
+            params: self.case_params.clone(),
             entry: None,
         }
     }
@@ -148,6 +156,7 @@ pub fn jobs(sweep: &Sweep) -> Result<Vec<Job>> {
                         .map(|s| (s.param.clone(), s.value.clone()))
                         .collect(),
                     folder: PathBuf::from("runs").join(format!("job_{index:04}")),
+                    case_params: Vec::new(),
                 });
             }
         }
@@ -167,7 +176,14 @@ pub fn plan(sweep_file: &Path, dir: &Path, cache_dir: Option<PathBuf>, exe: &Pat
     let sweep = Sweep::load(sweep_file)?;
     let jobs = jobs(&sweep)?;
     let file = std::fs::canonicalize(sweep_file)?;
-    let plan = Plan { sweep: sweep.name.clone(), file, cache_dir, jobs };
+    let plan = Plan { sweep: sweep.name.clone(), file, cache_dir, jobs, keep_frames: false };
+    write(&plan, dir, exe)?;
+    Ok(plan)
+}
+
+/// Writes `plan` as `DIR/plan.json` with the executors' files `DIR/jobs.txt` and
+/// `DIR/sweep.sbatch`; refused where DIR holds another plan.
+pub fn write(plan: &Plan, dir: &Path, exe: &Path) -> Result<()> {
     let text = serde_json::to_string_pretty(&plan)? + "\n";
     let path = dir.join(PLAN_FILE);
     if let Ok(old) = std::fs::read_to_string(&path)
@@ -195,8 +211,8 @@ pub fn plan(sweep_file: &Path, dir: &Path, cache_dir: Option<PathBuf>, exe: &Pat
         .collect();
     systems::output::write_text(&dir.join("jobs.txt"), &lines)?;
     std::fs::create_dir_all(dir.join("logs"))?;
-    systems::output::write_text(&dir.join("sweep.sbatch"), &sbatch(&plan, &dir, &exe))?;
-    Ok(plan)
+    systems::output::write_text(&dir.join("sweep.sbatch"), &sbatch(plan, &dir, &exe))?;
+    Ok(())
 }
 
 /// The Slurm array script: task i runs job i. `sbatch --array=3,5 sweep.sbatch` reruns jobs 3
