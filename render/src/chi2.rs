@@ -21,10 +21,10 @@ use crate::shader::{Module, Program};
 /// The probability that a correct set of samplers fails any test of the set.
 pub const SIGNIFICANCE: f64 = 0.01;
 
-/// Chi-square tests in the workspace's set (render/tests/chi2_sampling.rs: 15,
+/// Chi-square tests in the workspace's set (render/tests/chi2_sampling.rs: 14,
 /// media/tests/chi2_equiangular.rs: 4, methods/sss/tests/chi2_burley.rs: 4): each rejects at
 /// the Šidák level 1 − (1 − [`SIGNIFICANCE`])^(1/n).
-pub const TESTS_IN_SET: u32 = 23;
+pub const TESTS_IN_SET: u32 = 24;
 
 /// The per-test rejection level: 1 − (1 − α)^(1/n).
 pub fn per_test_level() -> f64 {
