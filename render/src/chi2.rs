@@ -22,7 +22,7 @@ use crate::shader::{Module, Program};
 pub const SIGNIFICANCE: f64 = 0.01;
 
 /// Chi-square tests in the workspace's set (render/tests/chi2_sampling.rs: 14,
-/// media/tests/chi2_equiangular.rs: 4, methods/sss/tests/chi2_burley.rs: 4): each rejects at
+/// media/tests/chi2_equiangular.rs: 6, methods/sss/tests/chi2_burley.rs: 4): each rejects at
 /// the Šidák level 1 − (1 − [`SIGNIFICANCE`])^(1/n).
 pub const TESTS_IN_SET: u32 = 24;
 
