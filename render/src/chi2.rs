@@ -362,6 +362,39 @@ pub fn assert_fits(what: &str, observed: &[f64], integral: &[f64], draws: u64) -
     outcome
 }
 
+/// The environment variable that swaps a module of a test kernel's program for a file:
+/// `MODULE=PATH[;MODULE=PATH...]`, e.g. `package::pt_bsdf=/tmp/broken_pt_bsdf.wgsl`. How a
+/// break is shown without rebuilding: copy the module, break its pdf, run the test with it.
+pub const REPLACE_VAR: &str = "FLICKER_CHI2_REPLACE";
+
+/// `program` with the modules named in [`REPLACE_VAR`] read from their files (unchanged when
+/// it is not set).
+pub fn with_replacements(program: Program) -> Program {
+    let Ok(spec) = std::env::var(REPLACE_VAR) else {
+        return program;
+    };
+    let mut program = program;
+    for item in spec.split(';').filter(|s| !s.is_empty()) {
+        let (path, file) = item
+            .split_once('=')
+            .unwrap_or_else(|| panic!("{REPLACE_VAR}: expected MODULE=PATH, got {item:?}"));
+        let source = std::fs::read_to_string(file)
+            .unwrap_or_else(|e| panic!("{REPLACE_VAR}: {file}: {e}"));
+        let module = Module {
+            path: path.to_string().into(),
+            file: file.to_string().into(),
+            source: source.into(),
+        };
+        assert!(
+            program.modules.iter().chain(&program.entry_files).any(|m| m.path == module.path),
+            "{REPLACE_VAR}: the program has no module {path}"
+        );
+        program = program.replacing(&module);
+        eprintln!("{REPLACE_VAR}: {path} read from {file}");
+    }
+    program
+}
+
 /// A test kernel without the scene: its modules, and one @group(0) of three buffers that it
 /// imports from `BINDINGS_PATH`-like module of the caller's choice: `params` and `points`
 /// (read, `array<vec4f>`) and `result` (read-write, `array<vec4f>`, one per invocation).
@@ -392,7 +425,7 @@ impl Kernel {
         entries: [&str; N],
     ) -> Result<Self, RenderError> {
         let bindings = compute::group_module(bindings_path, 0, &KERNEL_BINDINGS, &[]);
-        let program = Program::new(modules).with([bindings]).entry(kernel);
+        let program = with_replacements(Program::new(modules).with([bindings]).entry(kernel));
         let layout = compute::binding_layout(gpu, "chi2 kernel", &KERNEL_BINDINGS);
         let pipelines = compute::pipelines(gpu, "chi2 kernel", &program, &[&layout], entries)?;
         Ok(Self { layout, pipelines: pipelines.to_vec() })

@@ -153,7 +153,9 @@ fn harness() -> &'static Harness {
             file: "render/tests/chi2/sampling_kernel.wgsl".into(),
             source: include_str!("chi2/sampling_kernel.wgsl").into(),
         };
-        let program: Program = PassLibrary::program([types, bindings], [kernel]);
+        // FLICKER_CHI2_REPLACE swaps a module for a (deliberately broken) copy: render::chi2.
+        let program: Program =
+            chi2::with_replacements(PassLibrary::program([types, bindings], [kernel]));
         let (layout, pipelines) = scene
             .library_pass(gpu, "chi2 sampling kernel", &program, &OWN, ENTRIES)
             .expect("the test kernel compiles");
