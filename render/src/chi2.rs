@@ -378,8 +378,8 @@ pub fn with_replacements(program: Program) -> Program {
         let (path, file) = item
             .split_once('=')
             .unwrap_or_else(|| panic!("{REPLACE_VAR}: expected MODULE=PATH, got {item:?}"));
-        let source = std::fs::read_to_string(file)
-            .unwrap_or_else(|e| panic!("{REPLACE_VAR}: {file}: {e}"));
+        let source =
+            std::fs::read_to_string(file).unwrap_or_else(|e| panic!("{REPLACE_VAR}: {file}: {e}"));
         let module = Module {
             path: path.to_string().into(),
             file: file.to_string().into(),
