@@ -5,17 +5,15 @@
 //! Any edit under those folders changes it and renders every reference anew: coarse, but a
 //! stale reference is impossible.
 
-#[allow(dead_code)] // `host_files` and `hash_files` are for the build script and the tests.
 mod sources;
 
-pub use sources::HOST_SOURCES;
+pub use sources::{HOST_SOURCES, hash_files, host_files};
 
 /// The hash of [`HOST_SOURCES`] as this binary was built.
 pub const HASH: &str = env!("FLICKER_HOST_SOURCE_HASH");
 
 #[cfg(test)]
 mod tests {
-    use super::sources::{hash_files, host_files};
     use super::*;
     use crate::reference_cache::{Lookup, ReferenceCache, ReferenceKey};
     use std::path::{Path, PathBuf};
