@@ -8,6 +8,7 @@
 pub mod extract;
 pub mod frame_metrics;
 pub mod frame_record;
+pub mod host_source;
 pub mod measure;
 pub mod method;
 pub mod method_output;

@@ -89,6 +89,7 @@ pub fn render_reference(
             rr_start_depth: settings.rr_start_depth,
             adapter: &gpu.0.summary.to_string(),
             shader_source: &shader_source,
+            host_source: crate::host_source::HASH,
         },
     );
     let frame = clock.frame;

@@ -1,6 +1,7 @@
 //! Path-traced references cached on disk under a hash of everything that affects the image:
-//! the scene as rendered at that frame, resolution, spp, seed, max depth, adapter and shader
-//! sources. A changed shader or scene can never pick up a stale reference.
+//! the scene as rendered at that frame, resolution, spp, seed, max depth, adapter, shader
+//! sources and the host code that shapes the image (`host_source::HASH`). A changed shader,
+//! host code or scene can never pick up a stale reference.
 //!
 //! An entry is one file, `references/KEY.ref`, written whole through a rename: a magic tag,
 //! width and height, the SHA-256 of the pixels, then the pixels (RGBA f32, little-endian). A
@@ -28,6 +29,8 @@ pub struct ReferenceKey<'a> {
     pub rr_start_depth: u32,
     pub adapter: &'a str,
     pub shader_source: &'a str,
+    /// The host code that shaped it: `host_source::HASH` of the binary that renders it.
+    pub host_source: &'a str,
 }
 
 impl ReferenceCache {
@@ -61,6 +64,7 @@ impl ReferenceCache {
         ));
         h.update(key.adapter.as_bytes());
         h.update(key.shader_source.as_bytes());
+        h.update(key.host_source.as_bytes());
         hash_scene(&mut h, scene);
         h.finalize().iter().map(|b| format!("{b:02x}")).collect()
     }
@@ -193,6 +197,7 @@ mod tests {
                 rr_start_depth: 3,
                 adapter: "a",
                 shader_source: "s",
+                host_source: "h",
             },
         )
     }

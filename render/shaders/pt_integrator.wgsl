@@ -8,7 +8,7 @@ import package::scene_tables::{material, light};
 import package::scene_geometry::{NO_HIT, SurfacePoint, surface_point, trace_any, trace_closest};
 import package::pt_sampling::{luminance, max_component, power_heuristic, rng_next, rng_next2, sample_uniform_sphere};
 import package::pt_bsdf::{Bsdf, bsdf_eval, bsdf_pdf, bsdf_sample, make_bsdf};
-import package::pt_lights::{FAR, sample_analytic_light, sample_emitter};
+import package::pt_lights::{FAR, emitter_pdf, sample_analytic_light, sample_emitter};
 import package::pt_scene::{Shading, base_color_at, environment_pdf, escaped_radiance, offset_origin, orient};
 
 // Next-event estimation at a surface point: every analytic light, one emissive triangle, the
@@ -108,7 +108,7 @@ fn emitted_radiance(sp: SurfacePoint, m: GpuMaterial, dir: vec3f, dist: f32, pre
     var w = 1.0;
     let emitter_weight = frame.emitter_weight;
     if prev_bsdf_pdf > 0.0 && emitter_weight > 0.0 {
-        let light_pdf = le_lum / emitter_weight * dist * dist / cos_light;
+        let light_pdf = emitter_pdf(le_lum, cos_light, dist, emitter_weight);
         w = power_heuristic(prev_bsdf_pdf, light_pdf);
     }
     return m.emission * w;

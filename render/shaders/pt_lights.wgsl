@@ -41,6 +41,16 @@ fn cone_solid_angle(one_minus_cos: f32) -> f32 {
     return TWO_PI * one_minus_cos;
 }
 
+// Solid-angle pdf with which sample_analytic_light picks `dir` from a directional light with an
+// angular radius (uniform in its cone); 0 outside the cone and for every other light. A BSDF-
+// sampled ray that escapes weighs the light's disk with it (pt_scene's escaped_radiance).
+fn directional_pdf(l: GpuLight, dir: vec3f) -> f32 {
+    if l.kind == LIGHT_DIRECTIONAL && l.a > 0.0 && 1.0 - dot(dir, -normalize(l.p1)) <= l.a {
+        return 1.0 / cone_solid_angle(l.a);
+    }
+    return 0.0;
+}
+
 fn sample_analytic_light(l: GpuLight, p: vec3f, u: vec2f) -> LightSample {
     var s: LightSample;
     if l.kind == LIGHT_DIRECTIONAL {
@@ -68,6 +78,15 @@ fn sample_analytic_light(l: GpuLight, p: vec3f, u: vec2f) -> LightSample {
         s.weight *= spot_falloff(dot(-s.wi, normalize(l.p1)), l.a, l.b);
     }
     return s;
+}
+
+// Solid-angle pdf with which sample_emitter picks the direction to an emissive point at distance
+// `dist` whose luminance is `le_lum` and whose front face makes cosine `cos_light` (> 0) with the
+// direction: luminance(Le) / W per unit area, W = `emitter_weight` (frame.emitter_weight),
+// times dist^2 / cos. A BSDF-sampled ray that hits an emitter weighs it with this pdf
+// (pt_integrator's emitted_radiance).
+fn emitter_pdf(le_lum: f32, cos_light: f32, dist: f32, emitter_weight: f32) -> f32 {
+    return le_lum / emitter_weight * dist * dist / cos_light;
 }
 
 // Index of the emissive triangle whose CDF interval holds u (binary search, <= 32 steps).

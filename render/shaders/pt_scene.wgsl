@@ -11,7 +11,7 @@ import package::scene_tables::{light};
 import package::scene_geometry::{Hit, NO_HIT, SurfacePoint, previous_world_position};
 import package::pt_sampling::{PI, max_component, power_heuristic};
 import package::pt_bsdf::{bsdf_pdf};
-import package::pt_lights::{LIGHT_DIRECTIONAL, cone_solid_angle};
+import package::pt_lights::{directional_pdf};
 
 const NO_TEXTURE: u32 = 0xffffffffu;
 
@@ -98,10 +98,11 @@ fn escaped_radiance(dir: vec3f, bsdf_pdf: f32) -> vec3f {
     }
     for (var i = 0u; i < frame.analytic_lights; i++) {
         let light = light(i);
-        if light.kind == LIGHT_DIRECTIONAL && light.a > 0.0 && 1.0 - dot(dir, -normalize(light.p1)) <= light.a {
+        let light_pdf = directional_pdf(light, dir);
+        if light_pdf > 0.0 {
             var w = 1.0;
             if bsdf_pdf > 0.0 {
-                w = power_heuristic(bsdf_pdf, 1.0 / cone_solid_angle(light.a));
+                w = power_heuristic(bsdf_pdf, light_pdf);
             }
             l += light.radiance * light.b * w;
         }

@@ -3,6 +3,7 @@
 /// The plain-data scene (its own crate, shared with `sim`).
 pub use ::scene;
 pub mod bvh;
+pub mod chi2;
 pub mod compute;
 pub mod error;
 pub mod frame;
