@@ -80,7 +80,8 @@ enum Command {
         action: SuiteAction,
     },
     /// Play what a seed paper's claims need (claims/PAPER.ron) over seeds and judge each claim:
-    /// reproduced, not reproduced or not comparable; writes reproduce.md and reproduce.html.
+    /// reproduced, not reproduced or inconclusive against its smallest effect that matters (not
+    /// comparable, with the reason, where there are no data); writes reproduce.md and .html.
     Reproduce {
         /// A paper (the stem of its claims file, e.g. reliability-weighted-nirc) or `all`.
         paper: String,
