@@ -37,8 +37,6 @@ const GATES: &[(&str, &[&str])] = &[
     (
         "reliability-weighted-nirc",
         &[
-            "blend_adapts_faster_than_ema",
-            "blend_flickers_less_than_highlr",
             "cache_beats_path_tracing",
         ],
     ),
