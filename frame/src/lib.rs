@@ -24,6 +24,7 @@ pub mod tonemap;
 
 use bevy_ecs::prelude::*;
 
+pub use sim::ExtractedScene;
 pub use method::{MethodPlugin, MethodSpec, Registered, RegisteredMethod};
 pub use method_output::{MethodImage, MethodOutput};
 pub use resources::{

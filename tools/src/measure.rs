@@ -28,6 +28,8 @@ pub struct MeasureOptions {
     pub fps: f64,
     /// Frames of events (the input's frame numbers), for the summary's windows.
     pub events: Vec<u32>,
+    /// A label per event (e.g. a package's "toggle 'lamp'"); empty: "input frame N".
+    pub labels: Vec<String>,
     pub out: PathBuf,
     pub cvvdp: CvvdpSettings,
     pub smape_epsilon: f32,
@@ -301,7 +303,7 @@ impl Measured {
             "frames": count,
             "methods": names,
             "reference": { "frames": (0..count).collect::<Vec<_>>() },
-            "events": opts.events.iter().map(|e| json!({"frame": e - first, "label": format!("input frame {e}")})).collect::<Vec<_>>(),
+            "events": opts.events.iter().enumerate().map(|(i, e)| json!({"frame": e - first, "label": opts.labels.get(i).cloned().unwrap_or_else(|| format!("input frame {e}"))})).collect::<Vec<_>>(),
             "regions": [],
             "settings": {
                 "smape_epsilon": opts.smape_epsilon,

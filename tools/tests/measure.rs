@@ -23,6 +23,7 @@ fn options(reference: &Path, tests: &[(&str, PathBuf)], out: PathBuf) -> Measure
         motion: Vec::new(),
         fps: 30.0,
         events: Vec::new(),
+        labels: Vec::new(),
         out,
         cvvdp: CvvdpSettings::default(),
         smape_epsilon: 0.01,
