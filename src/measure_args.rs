@@ -20,6 +20,11 @@ pub struct MeasureArgs {
     /// for reprojected SMAPE.
     #[arg(long = "motion", value_parser = parse_named)]
     pub motion: Vec<(String, PathBuf)>,
+    /// A test's per-frame times as NAME=FILE: a CSV with the header `frame,ms` (optionally more
+    /// columns, one per pass) and a row per frame in milliseconds; the test joins the
+    /// speed-against-accuracy charts.
+    #[arg(long = "timings", value_parser = parse_named)]
+    pub timings: Vec<(String, PathBuf)>,
     /// Frames per second of the sequences (JOD's temporal channels depend on it) [default: the
     /// package's, else 30].
     #[arg(long)]
@@ -68,6 +73,7 @@ impl MeasureArgs {
             reference: p.map_or_else(|| self.reference.unwrap_or_default(), |p| p.reference.clone()),
             tests: self.tests,
             motion: self.motion,
+            timings: self.timings,
             fps: self.fps.or(p.map(|p| p.fps)).unwrap_or(30.0),
             events,
             labels,

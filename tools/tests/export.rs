@@ -259,6 +259,7 @@ fn a_package_is_measured_and_one_missing_a_frame_is_refused() {
         fps: p.fps,
         events: p.events.iter().map(|e| e.0).collect(),
         labels: p.events.iter().map(|e| e.1.clone()).collect(),
+        timings: Vec::new(),
         out: out.clone(),
         cvvdp: p.cvvdp.clone(),
         smape_epsilon: p.smape_epsilon,

@@ -377,7 +377,7 @@ pub fn write(frames: &[SceneDesc], time_step: f32, aspect: f32, name: &str) -> R
     // The camera: looks down its node's -Z with +Y up.
     let camera_node = nodes.len();
     let pose = |c: &scene::Camera| {
-        let m = Mat4::look_at_rh(c.position, c.target, c.up).inverse();
+        let m = c.view().inverse();
         let (_, r, t) = m.to_scale_rotation_translation();
         (t, r.normalize())
     };

@@ -187,7 +187,6 @@ pub fn export(opts: &ExportOptions) -> Result<PathBuf> {
     Ok(path)
 }
 
-use std::io::Write as _;
 
 /// Renders the references and the denoiser inputs into the package.
 fn render(scenario: &Scenario, reference_spp: u32, opts: &ExportOptions) -> Result<()> {

@@ -95,6 +95,7 @@ impl MeasuredFrames {
             fps: self.fps,
             events: self.events.clone(),
             labels: Vec::new(),
+            timings: Vec::new(),
             out: out.to_path_buf(),
             cvvdp: self.cvvdp.clone(),
             smape_epsilon: metrics::smape::DEFAULT_EPS,
