@@ -434,7 +434,12 @@ pub fn write(frames: &[SceneDesc], time_step: f32, aspect: f32, name: &str) -> R
     if !animations.is_empty() {
         obj.insert("animations".into(), animations.into());
     }
-    obj.insert("extensions".into(), json!({"KHR_lights_punctual": {"lights": lights}}));
+    if lights.is_empty() {
+        // An empty list is an error to the validator: no lights, no extension.
+        extensions_used.retain(|e| *e != "KHR_lights_punctual");
+    } else {
+        obj.insert("extensions".into(), json!({"KHR_lights_punctual": {"lights": lights}}));
+    }
     obj.insert("extensionsUsed".into(), json!(extensions_used));
     while !b.bin.len().is_multiple_of(4) {
         b.bin.push(0);
