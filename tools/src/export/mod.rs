@@ -69,8 +69,9 @@ pub fn simulate(scenario: &Scenario) -> Result<Vec<scene::SceneDesc>> {
 }
 
 /// The package's own scenario: the glb, played with its recorded frames.
-fn package_scenario(s: &Scenario, reference_spp: u32) -> String {
-    let e = s.environment_or_zero();
+/// `environment`: the scene's (a built-in scene's own, or the scenario's).
+fn package_scenario(s: &Scenario, environment: glam::Vec3, reference_spp: u32) -> String {
+    let e = environment;
     format!(
         "// Written by `flicker export` from {origin}: this package's scene.glb played by flicker.\n\
          (\n    name: \"{name}_export\",\n    scene: Gltf(\"scene.glb\"),\n    environment: ({}, {}, {}),\n    resolution: ({}, {}),\n    frames: {},\n    time_step: {},\n    seed: {},\n    max_depth: {},\n    smape_epsilon: {},\n    cvvdp: (display: \"{}\", exposure: {}),\n    reference: (spp: {reference_spp}, frames: Every(1)),\n    methods: [PathTracing(spp: 1)],\n)\n",
@@ -95,15 +96,6 @@ fn package_scenario(s: &Scenario, reference_spp: u32) -> String {
 fn ron_f32(v: f32) -> String {
     let s = format!("{v:?}");
     if s.contains(['.', 'e', 'E']) { s } else { format!("{s}.0") }
-}
-
-trait EnvironmentOrZero {
-    fn environment_or_zero(&self) -> glam::Vec3;
-}
-impl EnvironmentOrZero for Scenario {
-    fn environment_or_zero(&self) -> glam::Vec3 {
-        self.environment.unwrap_or(glam::Vec3::ZERO)
-    }
 }
 
 /// Refuses a non-empty folder that is not an earlier package (so a typo never deletes files).
@@ -148,7 +140,7 @@ pub fn export(opts: &ExportOptions) -> Result<PathBuf> {
     prepare(&opts.out)?;
     let out = &opts.out;
     systems::output::write_atomic(&out.join(package::GLB), |f| Ok(f.write_all(&glb)?))?;
-    systems::output::write_text(&out.join(package::SCENARIO), &package_scenario(&scenario, reference_spp))?;
+    systems::output::write_text(&out.join(package::SCENARIO), &package_scenario(&scenario, frames[0].environment, reference_spp))?;
     systems::output::write_text(&out.join("CONVENTIONS.md"), CONVENTIONS)?;
     for (k, f) in frames.iter().enumerate() {
         let k = k as u32;
