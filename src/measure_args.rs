@@ -70,7 +70,8 @@ impl MeasureArgs {
             _ => (self.events, Vec::new()),
         };
         Ok(tools::measure::MeasureOptions {
-            reference: p.map_or_else(|| self.reference.unwrap_or_default(), |p| p.reference.clone()),
+            reference: p
+                .map_or_else(|| self.reference.unwrap_or_default(), |p| p.reference.clone()),
             tests: self.tests,
             motion: self.motion,
             timings: self.timings,

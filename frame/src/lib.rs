@@ -24,12 +24,12 @@ pub mod tonemap;
 
 use bevy_ecs::prelude::*;
 
-pub use sim::ExtractedScene;
 pub use method::{MethodPlugin, MethodSpec, Registered, RegisteredMethod};
 pub use method_output::{MethodImage, MethodOutput};
 pub use resources::{
     FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Progress, References, Run, RunOutput,
 };
+pub use sim::ExtractedScene;
 pub use stage::{
     GpuFaults, Stage, catch_failures, describe, failed, listing, method_failed, new_schedule,
     take_failure,

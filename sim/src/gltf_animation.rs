@@ -10,9 +10,7 @@ use glam::{Quat, Vec3, Vec4};
 use gltf::animation::util::ReadOutputs;
 use serde_json::Value;
 
-use crate::animation::{
-    CameraClip, Interpolation, LightClip, MaterialTrack, NodeClip, Track,
-};
+use crate::animation::{CameraClip, Interpolation, LightClip, MaterialTrack, NodeClip, Track};
 use crate::template::WorldTemplate;
 
 pub const ANIMATION_POINTER: &str = "KHR_animation_pointer";
@@ -35,8 +33,8 @@ pub fn split_pointer_channels(bytes: &[u8]) -> Result<(Vec<u8>, Vec<PointerChann
         return Ok((bytes.to_vec(), Vec::new()));
     }
     let glb = gltf::Glb::from_slice(bytes).map_err(|e| format!("cannot read the GLB: {e}"))?;
-    let mut json: Value = serde_json::from_slice(&glb.json)
-        .map_err(|e| format!("the GLB's JSON chunk: {e}"))?;
+    let mut json: Value =
+        serde_json::from_slice(&glb.json).map_err(|e| format!("the GLB's JSON chunk: {e}"))?;
     let Some(animations) = json.get_mut("animations").and_then(Value::as_array_mut) else {
         return Ok((bytes.to_vec(), Vec::new()));
     };
@@ -56,7 +54,9 @@ pub fn split_pointer_channels(bytes: &[u8]) -> Result<(Vec<u8>, Vec<PointerChann
             let part = format!("animation {a} channel {c}");
             let pointer = target["extensions"][ANIMATION_POINTER]["pointer"]
                 .as_str()
-                .ok_or_else(|| format!("{part}: path \"pointer\" without a {ANIMATION_POINTER} pointer"))?
+                .ok_or_else(|| {
+                    format!("{part}: path \"pointer\" without a {ANIMATION_POINTER} pointer")
+                })?
                 .to_string();
             let sampler = channel["sampler"]
                 .as_u64()
@@ -83,11 +83,7 @@ pub fn split_pointer_channels(bytes: &[u8]) -> Result<(Vec<u8>, Vec<PointerChann
         return Ok((bytes.to_vec(), Vec::new()));
     }
     let json = serde_json::to_vec(&json).map_err(|e| e.to_string())?;
-    let out = gltf::Glb {
-        header: glb.header,
-        json: std::borrow::Cow::Owned(json),
-        bin: glb.bin,
-    };
+    let out = gltf::Glb { header: glb.header, json: std::borrow::Cow::Owned(json), bin: glb.bin };
     Ok((out.to_vec().map_err(|e| e.to_string())?, taken))
 }
 
@@ -154,14 +150,10 @@ pub fn read_animations(
             }
         }
     }
-    let light_nodes: HashMap<usize, usize> = doc
-        .nodes()
-        .filter_map(|n| Some((n.light()?.index(), nodes[&n.index()])))
-        .collect();
-    let camera_nodes: HashMap<usize, usize> = doc
-        .nodes()
-        .filter_map(|n| Some((n.camera()?.index(), nodes[&n.index()])))
-        .collect();
+    let light_nodes: HashMap<usize, usize> =
+        doc.nodes().filter_map(|n| Some((n.light()?.index(), nodes[&n.index()]))).collect();
+    let camera_nodes: HashMap<usize, usize> =
+        doc.nodes().filter_map(|n| Some((n.camera()?.index(), nodes[&n.index()]))).collect();
     for p in pointers {
         let fail = |m: String| (p.part.clone(), format!("pointer {}: {m}", p.pointer));
         let times: Vec<f32> = accessor_values(doc, buffers, p.input).map_err(fail)?;
@@ -194,7 +186,11 @@ pub fn read_animations(
                 match *what {
                     "intensity" => clip.intensity_track = Some(f1().map_err(fail)?),
                     "color" => clip.color_track = Some(f3().map_err(fail)?),
-                    other => return Err(fail(format!("light property {other} cannot be animated; expected intensity or color"))),
+                    other => {
+                        return Err(fail(format!(
+                            "light property {other} cannot be animated; expected intensity or color"
+                        )));
+                    }
                 }
             }
             ["cameras", _, "perspective", "yfov"] => {

@@ -175,9 +175,9 @@ impl Timings {
             if cells.len() != columns.len() {
                 bail!("{at}: {} cells; expected {} like the header", cells.len(), columns.len());
             }
-            let frame: u32 = cells[0]
-                .parse()
-                .map_err(|_| anyhow::anyhow!("{at}: frame `{}`; expected a frame number", cells[0]))?;
+            let frame: u32 = cells[0].parse().map_err(|_| {
+                anyhow::anyhow!("{at}: frame `{}`; expected a frame number", cells[0])
+            })?;
             let mut ms = Vec::new();
             for (c, cell) in cells[1..].iter().enumerate() {
                 match cell.parse::<f64>() {

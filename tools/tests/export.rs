@@ -159,7 +159,8 @@ fn block_z_test(
                             let vb: Vec<f64> = b.iter().map(|s| s[fi][p][c] as f64).collect();
                             let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
                             let svar = |v: &[f64], m: f64| {
-                                v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() as f64 - 1.0)
+                                v.iter().map(|x| (x - m).powi(2)).sum::<f64>()
+                                    / (v.len() as f64 - 1.0)
                             };
                             let (ma, mb) = (mean(&va), mean(&vb));
                             let (sa, sb) = (svar(&va, ma) / ka, svar(&vb, mb) / kb);
@@ -180,7 +181,8 @@ fn block_z_test(
                         continue;
                     }
                     let dof = (var * var / var2_over_dof).max(1.0);
-                    let critical = StudentsT::new(0.0, 1.0, dof).unwrap().inverse_cdf(1.0 - alpha / 2.0);
+                    let critical =
+                        StudentsT::new(0.0, 1.0, dof).unwrap().inverse_cdf(1.0 - alpha / 2.0);
                     let t = d / se;
                     if t.abs() > critical {
                         failures.push(format!(
@@ -235,7 +237,9 @@ fn a_package_is_measured_and_one_missing_a_frame_is_refused() {
     for k in 0..3 {
         let name = format!("{k:04}.exr");
         let mut files = vec![package.join("reference").join(&name)];
-        files.extend(tools::export::INPUTS.iter().map(|i| package.join("inputs").join(i).join(&name)));
+        files.extend(
+            tools::export::INPUTS.iter().map(|i| package.join("inputs").join(i).join(&name)),
+        );
         for f in files {
             let (w, h, _) = systems::output::read_exr(&f).unwrap_or_else(|e| panic!("{e:#}"));
             assert_eq!((w, h), (32, 18), "{}", f.display());

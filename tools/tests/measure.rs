@@ -204,14 +204,23 @@ fn timings_put_an_outside_method_on_the_speed_charts() {
         std::fs::write(&p, text).unwrap();
         p
     };
-    let good = write("good.csv", "frame,ms,trace,denoise\n0,3.5,2,1\n1,4,2.5,1\n2,5,3,1.5\n3,4.5,3,1\n");
+    let good =
+        write("good.csv", "frame,ms,trace,denoise\n0,3.5,2,1\n1,4,2.5,1\n2,5,3,1.5\n3,4.5,3,1\n");
     let out = dir.join("out");
     let cases: [(&str, &str, &[&str]); 5] = [
         ("short.csv", "frame,ms\n0,1\n1,1\n2,1\n", &["short.csv", "frame 3 is missing"]),
-        ("long.csv", "frame,ms\n0,1\n1,1\n2,1\n3,1\n4,1\n", &["long.csv:6", "frame 4 has no reference frame"]),
+        (
+            "long.csv",
+            "frame,ms\n0,1\n1,1\n2,1\n3,1\n4,1\n",
+            &["long.csv:6", "frame 4 has no reference frame"],
+        ),
         ("bad.csv", "frame,ms\n0,1\n1,fast\n2,1\n3,1\n", &["bad.csv:3", "frame 1", "fast"]),
         ("header.csv", "frame,time\n0,1\n", &["header.csv:1", "frame,ms"]),
-        ("over.csv", "frame,ms,a\n0,1,2\n1,1,0\n2,1,0\n3,1,0\n", &["over.csv:2", "frame 0", "more than"]),
+        (
+            "over.csv",
+            "frame,ms,a\n0,1,2\n1,1,0\n2,1,0\n3,1,0\n",
+            &["over.csv:2", "frame 0", "more than"],
+        ),
     ];
     for (name, text, expected) in cases {
         let mut o = options(&reference, &[("mine", dir.join("mine"))], out.clone());
@@ -228,7 +237,9 @@ fn timings_put_an_outside_method_on_the_speed_charts() {
     let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("{name}: {csv}"));
+    let col = |name: &str| {
+        header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("{name}: {csv}"))
+    };
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     let totals: Vec<f64> = rows.iter().map(|r| r[col("wall_ms_total")].parse().unwrap()).collect();
     assert_eq!(totals, [3.5, 4.0, 5.0, 4.5]);

@@ -113,7 +113,9 @@ pub fn gbuffer_images(g: &GBuffer, scene: &render::scene::SceneDesc) -> Vec<Meth
         .instance_id
         .iter()
         .map(|&i| match scene.instances.get(i as usize) {
-            Some(inst) if i != NO_HIT => rgb(scene.materials[inst.material as usize].emission.into()),
+            Some(inst) if i != NO_HIT => {
+                rgb(scene.materials[inst.material as usize].emission.into())
+            }
             _ => rgb(scene.environment.into()),
         })
         .collect();

@@ -127,7 +127,10 @@ pub enum MaterialTrack {
     /// RGBA; the renderer uses RGB.
     BaseColor(Track<Vec4>),
     /// The emissive factor; emission = factor x the material's emissive strength.
-    Emissive { factor: Track<Vec3>, strength: f32 },
+    Emissive {
+        factor: Track<Vec3>,
+        strength: f32,
+    },
     Roughness(Track<f32>),
     Metallic(Track<f32>),
 }
@@ -175,7 +178,9 @@ pub fn play_clips(
         let m = &mut table.materials[*index as usize];
         match track {
             MaterialTrack::BaseColor(k) => m.base_color = k.sample(t).truncate(),
-            MaterialTrack::Emissive { factor, strength } => m.emission = factor.sample(t) * strength,
+            MaterialTrack::Emissive { factor, strength } => {
+                m.emission = factor.sample(t) * strength
+            }
             MaterialTrack::Roughness(k) => m.roughness = k.sample(t),
             MaterialTrack::Metallic(k) => m.metallic = k.sample(t),
         }
@@ -188,8 +193,8 @@ mod tests {
 
     #[test]
     fn linear_and_step_tracks_hit_their_keys_and_blend_between() {
-        let k = Track::new(vec![0.0, 1.0, 3.0], vec![0.0, 2.0, 6.0], Interpolation::Linear)
-            .unwrap();
+        let k =
+            Track::new(vec![0.0, 1.0, 3.0], vec![0.0, 2.0, 6.0], Interpolation::Linear).unwrap();
         assert_eq!(k.sample(-1.0), 0.0);
         assert_eq!(k.sample(1.0), 2.0);
         assert_eq!(k.sample(2.0), 4.0);

@@ -91,7 +91,9 @@ fn trs(m: Mat4, what: &str) -> Result<(Vec3, Quat, Vec3)> {
 fn light_pose(light: &Light) -> (Vec3, Quat, Vec3) {
     let aim = |d: Vec3| Quat::from_rotation_arc(Vec3::NEG_Z, d.normalize());
     match *light {
-        Light::Directional { direction, irradiance, .. } => (Vec3::ZERO, aim(direction), irradiance),
+        Light::Directional { direction, irradiance, .. } => {
+            (Vec3::ZERO, aim(direction), irradiance)
+        }
         Light::Point { position, intensity } => (position, Quat::IDENTITY, intensity),
         Light::Spot { position, direction, intensity, .. } => (position, aim(direction), intensity),
     }
@@ -129,7 +131,8 @@ struct Tracks<'a> {
 impl Tracks<'_> {
     fn node(&mut self, node: usize, path: &str, data: &[f32], width: usize) {
         let output = self.b.floats(data, width, None, false);
-        self.samplers.push(json!({"input": self.times, "output": output, "interpolation": "LINEAR"}));
+        self.samplers
+            .push(json!({"input": self.times, "output": output, "interpolation": "LINEAR"}));
         self.node_channels.push(json!({
             "sampler": self.samplers.len() - 1,
             "target": {"node": node, "path": path},
@@ -164,14 +167,24 @@ pub fn write(frames: &[SceneDesc], time_step: f32, aspect: f32, name: &str) -> R
         if f.instances.len() != first.instances.len()
             || f.lights.len() != first.lights.len()
             || f.materials.len() != first.materials.len()
-            || f.instances.iter().zip(&first.instances).any(|(a, b)| (a.mesh, a.material) != (b.mesh, b.material))
-            || f.lights.iter().zip(&first.lights).any(|(a, b)| std::mem::discriminant(a) != std::mem::discriminant(b))
+            || f.instances
+                .iter()
+                .zip(&first.instances)
+                .any(|(a, b)| (a.mesh, a.material) != (b.mesh, b.material))
+            || f.lights
+                .iter()
+                .zip(&first.lights)
+                .any(|(a, b)| std::mem::discriminant(a) != std::mem::discriminant(b))
         {
-            bail!("frame {k}: the scene's instances, lights or materials differ from frame 0's; expected a fixed set that moves");
+            bail!(
+                "frame {k}: the scene's instances, lights or materials differ from frame 0's; expected a fixed set that moves"
+            );
         }
     }
     if let Some((i, _)) = first.materials.iter().enumerate().find(|(_, m)| m.subsurface.is_some()) {
-        bail!("material {i} is a subsurface material; the export holds glTF metallic-roughness materials only");
+        bail!(
+            "material {i} is a subsurface material; the export holds glTF metallic-roughness materials only"
+        );
     }
     let mut b = Builder::default();
     let mut root = json!({
@@ -197,7 +210,8 @@ pub fn write(frames: &[SceneDesc], time_step: f32, aspect: f32, name: &str) -> R
     let mut materials = Vec::new();
     let mut strengths = Vec::new();
     for (i, m) in first.materials.iter().enumerate() {
-        let strength = frames.iter().map(|f| f.materials[i].emission.max_element()).fold(1.0f32, f32::max);
+        let strength =
+            frames.iter().map(|f| f.materials[i].emission.max_element()).fold(1.0f32, f32::max);
         strengths.push(strength);
         let c = m.base_color;
         let mut pbr = json!({
@@ -210,7 +224,8 @@ pub fn write(frames: &[SceneDesc], time_step: f32, aspect: f32, name: &str) -> R
         }
         let mut mat = json!({"name": format!("material{i}"), "pbrMetallicRoughness": pbr, "emissiveFactor": arr3(m.emission / strength)});
         if strength > 1.0 {
-            mat["extensions"]["KHR_materials_emissive_strength"] = json!({"emissiveStrength": strength});
+            mat["extensions"]["KHR_materials_emissive_strength"] =
+                json!({"emissiveStrength": strength});
             extensions_used.push("KHR_materials_emissive_strength");
         }
         if m.specular != 1.0 {
@@ -238,7 +253,8 @@ pub fn write(frames: &[SceneDesc], time_step: f32, aspect: f32, name: &str) -> R
                         let p = flat3(&src.positions);
                         let mut a = json!({"POSITION": b.floats(&p, 3, Some(ARRAY_BUFFER), true)});
                         if !src.normals.is_empty() {
-                            let n: Vec<Vec3> = src.normals.iter().map(|n| n.normalize_or(Vec3::Z)).collect();
+                            let n: Vec<Vec3> =
+                                src.normals.iter().map(|n| n.normalize_or(Vec3::Z)).collect();
                             a["NORMAL"] = b.floats(&flat3(&n), 3, Some(ARRAY_BUFFER), false).into();
                         }
                         if !src.uvs.is_empty() {
@@ -346,20 +362,30 @@ pub fn write(frames: &[SceneDesc], time_step: f32, aspect: f32, name: &str) -> R
             tr.node(node, "rotation", &q, 4);
         }
         if changes(&intensities) {
-            tr.pointer(format!("/extensions/KHR_lights_punctual/lights/{l}/intensity"), &intensities, 1);
+            tr.pointer(
+                format!("/extensions/KHR_lights_punctual/lights/{l}/intensity"),
+                &intensities,
+                1,
+            );
         }
         if changes(&colors) {
-            tr.pointer(format!("/extensions/KHR_lights_punctual/lights/{l}/color"), &flat3(&colors), 3);
+            tr.pointer(
+                format!("/extensions/KHR_lights_punctual/lights/{l}/color"),
+                &flat3(&colors),
+                3,
+            );
         }
     }
 
     // Materials over the frames.
     for (i, strength) in strengths.iter().enumerate() {
-        let emission: Vec<Vec3> = frames.iter().map(|f| f.materials[i].emission / strength).collect();
+        let emission: Vec<Vec3> =
+            frames.iter().map(|f| f.materials[i].emission / strength).collect();
         if changes(&emission) {
             tr.pointer(format!("/materials/{i}/emissiveFactor"), &flat3(&emission), 3);
         }
-        let base: Vec<Vec4> = frames.iter().map(|f| f.materials[i].base_color.extend(1.0)).collect();
+        let base: Vec<Vec4> =
+            frames.iter().map(|f| f.materials[i].base_color.extend(1.0)).collect();
         if changes(&base) {
             let v: Vec<f32> = base.iter().flat_map(|c| c.to_array()).collect();
             tr.pointer(format!("/materials/{i}/pbrMetallicRoughness/baseColorFactor"), &v, 4);
@@ -404,7 +430,8 @@ pub fn write(frames: &[SceneDesc], time_step: f32, aspect: f32, name: &str) -> R
     let mut animations = Vec::new();
     let Tracks { samplers, node_channels, pointer_samplers, pointer_channels, .. } = tr;
     if !node_channels.is_empty() {
-        animations.push(json!({"name": "transforms", "channels": node_channels, "samplers": samplers}));
+        animations
+            .push(json!({"name": "transforms", "channels": node_channels, "samplers": samplers}));
     }
     if !pointer_channels.is_empty() {
         animations.push(json!({"name": "properties", "channels": pointer_channels, "samplers": pointer_samplers}));
@@ -426,7 +453,8 @@ pub fn write(frames: &[SceneDesc], time_step: f32, aspect: f32, name: &str) -> R
     obj.insert("materials".into(), materials.into());
     obj.insert("cameras".into(), json!([{"type": "perspective", "perspective": {"yfov": fovs[0], "aspectRatio": aspect, "znear": 0.01, "zfar": 1000.0}}]));
     if !images.is_empty() {
-        let textures: Vec<Value> = (0..images.len()).map(|i| json!({"source": i, "sampler": 0})).collect();
+        let textures: Vec<Value> =
+            (0..images.len()).map(|i| json!({"source": i, "sampler": 0})).collect();
         obj.insert("images".into(), images.into());
         obj.insert("textures".into(), textures.into());
         obj.insert("samplers".into(), json!([{"wrapS": 10497, "wrapT": 10497}]));

@@ -140,7 +140,10 @@ pub fn export(opts: &ExportOptions) -> Result<PathBuf> {
     prepare(&opts.out)?;
     let out = &opts.out;
     systems::output::write_atomic(&out.join(package::GLB), |f| Ok(f.write_all(&glb)?))?;
-    systems::output::write_text(&out.join(package::SCENARIO), &package_scenario(&scenario, frames[0].environment, reference_spp))?;
+    systems::output::write_text(
+        &out.join(package::SCENARIO),
+        &package_scenario(&scenario, frames[0].environment, reference_spp),
+    )?;
     systems::output::write_text(&out.join("CONVENTIONS.md"), CONVENTIONS)?;
     for (k, f) in frames.iter().enumerate() {
         let k = k as u32;
@@ -178,7 +181,6 @@ pub fn export(opts: &ExportOptions) -> Result<PathBuf> {
     systems::output::write_json(&path, &manifest)?;
     Ok(path)
 }
-
 
 /// Renders the references and the denoiser inputs into the package.
 fn render(scenario: &Scenario, reference_spp: u32, opts: &ExportOptions) -> Result<()> {
@@ -218,8 +220,11 @@ fn render(scenario: &Scenario, reference_spp: u32, opts: &ExportOptions) -> Resu
 /// Re-encodes an EXR as RGB float, scan-line, ZIP (what NVIDIA's flip reads).
 fn copy_exr(from: &Path, to: &Path) -> Result<()> {
     let (w, h, rgba) = systems::output::read_exr(from)?;
-    let image =
-        metrics::Image { width: w, height: h, rgb: rgba.iter().map(|p| [p[0], p[1], p[2]]).collect() };
+    let image = metrics::Image {
+        width: w,
+        height: h,
+        rgb: rgba.iter().map(|p| [p[0], p[1], p[2]]).collect(),
+    };
     if let Some(dir) = to.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }

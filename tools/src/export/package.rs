@@ -33,12 +33,16 @@ pub struct Package {
 impl Package {
     pub fn read_manifest(dir: &Path) -> Result<Value> {
         let path = dir.join(MANIFEST);
-        let text =
-            std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
-        let v: Value = serde_json::from_str(&text)
-            .with_context(|| format!("{}: not JSON", path.display()))?;
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("{}: cannot read", path.display()))?;
+        let v: Value =
+            serde_json::from_str(&text).with_context(|| format!("{}: not JSON", path.display()))?;
         if v["format"] != FORMAT {
-            bail!("{}: format {}; expected \"{FORMAT}\" (a `flicker export` package)", path.display(), v["format"]);
+            bail!(
+                "{}: format {}; expected \"{FORMAT}\" (a `flicker export` package)",
+                path.display(),
+                v["format"]
+            );
         }
         Ok(v)
     }
