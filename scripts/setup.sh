@@ -2,7 +2,8 @@
 # Installs what flicker needs on a fresh Debian machine without a GPU (run as root):
 # Mesa's lavapipe (CPU Vulkan) for wgpu, Chromium to test the HTML report, Slurm and MUNGE
 # (tests/sweep.rs starts a one-node cluster of its own), GNU parallel (the same test runs a
-# sweep's job file through it), and NVIDIA's FLIP reference
+# sweep's job file through it), Node.js with the Khronos glTF validator (npm `gltf-validator`,
+# into .tools/node_modules: tools/tests/export.rs validates every exported .glb), and NVIDIA's FLIP reference
 # implementation (PyPI `flip-evaluator`) that the FLIP tests compare against.
 set -euo pipefail
 need_apt=()
@@ -12,6 +13,7 @@ command -v chromium >/dev/null || need_apt+=(chromium)
 command -v slurmctld >/dev/null && command -v slurmd >/dev/null && command -v sbatch >/dev/null || need_apt+=(slurm-wlm)
 command -v munged >/dev/null || need_apt+=(munge)
 command -v parallel >/dev/null || need_apt+=(parallel)
+command -v npm >/dev/null || need_apt+=(nodejs npm)
 if [ ${#need_apt[@]} -gt 0 ]; then
     export DEBIAN_FRONTEND=noninteractive
     # The packages' own services (munge, slurmctld, slurmd) must not start: the sweep test runs
@@ -31,3 +33,8 @@ python3 -m flip_evaluator.flip_python_api -h >/dev/null
 # the reference that `flicker bench` measures the WGSL path tracer against.
 python3 -c "import mitsuba" 2>/dev/null || python3 -m pip install --quiet mitsuba==3.9.1
 python3 -c "import mitsuba"
+# The Khronos glTF validator, pinned, in the checkout's .tools/ (not global): tools/tests/export.rs
+# runs it through scripts/gltf-validate.cjs on every exported .glb.
+root="$(cd "$(dirname "$0")/.." && pwd)"
+[ -e "$root/.tools/node_modules/gltf-validator/package.json" ] || npm install --silent --no-save --prefix "$root/.tools" gltf-validator@2.0.0-dev.3.10 >/dev/null
+node -e "require('$root/.tools/node_modules/gltf-validator')"

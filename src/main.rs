@@ -1,6 +1,7 @@
 //! `flicker`: play scenarios of dynamic scenes, measure how light-transport caches behave.
 
 mod compare_args;
+mod export_args;
 mod measure_args;
 mod report_args;
 mod runtime_dir;
@@ -71,6 +72,10 @@ enum Command {
     Compare(compare_args::CompareArgs),
     /// Rebuild summary.json, the charts and report.html of a run folder.
     Report(report_args::ReportArgs),
+    /// Write a scenario as a package any renderer can play: the scene and its motion as glTF
+    /// (.glb), per-frame camera and light records, the references and a denoiser's inputs
+    /// (EXR), and a manifest that `flicker measure --scenario DIR` reads (docs/export.md).
+    Export(export_args::ExportArgs),
     /// Measure frames from any renderer (EXR or PNG sequences) against a reference: a run folder
     /// with frames.csv, summary.json (with JOD) and the report, as `flicker run` writes.
     Measure(measure_args::MeasureArgs),
@@ -546,7 +551,11 @@ fn main() -> ExitCode {
             Ok(())
         }
         Command::Compare(args) => metrics::compare(&args.options()),
-        Command::Measure(args) => tools::measure::measure(&args.options())
+        Command::Export(args) => tools::export::export(&args.options())
+            .map(|manifest| println!("wrote {}", manifest.display())),
+        Command::Measure(args) => args
+            .options()
+            .and_then(|o| tools::measure::measure(&o))
             .map(|path| println!("wrote {}", path.display())),
         Command::Report(args) => {
             report::report(&args.options()).map(|path| println!("wrote {}", path.display()))

@@ -30,6 +30,7 @@ pub use method_output::{MethodImage, MethodOutput};
 pub use resources::{
     FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Progress, References, Run, RunOutput,
 };
+pub use sim::ExtractedScene;
 pub use stage::{
     GpuFaults, Stage, catch_failures, describe, failed, listing, method_failed, new_schedule,
     take_failure,

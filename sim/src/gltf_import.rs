@@ -6,6 +6,7 @@
 //! Light units are taken as they are (lux for directional, candela for point and spot) and
 //! used as the renderer's linear radiometric scale.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec2, Vec3};
@@ -162,8 +163,20 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
     if !path.is_file() {
         return Err(err("file", "not found; expected a .gltf or .glb file".into()));
     }
-    let (doc, buffers, images) =
-        gltf::import(path).map_err(|e| err("file", format!("cannot import: {e}")))?;
+    // A .glb may carry KHR_animation_pointer channels, which the `gltf` crate cannot read:
+    // they are taken out first (crate::gltf_animation).
+    let bytes = std::fs::read(path).map_err(|e| err("file", format!("cannot read: {e}")))?;
+    let (doc, buffers, images, pointers) = if bytes.starts_with(b"glTF") {
+        let (glb, pointers) =
+            crate::gltf_animation::split_pointer_channels(&bytes).map_err(|m| err("file", m))?;
+        let (d, b, i) =
+            gltf::import_slice(glb).map_err(|e| err("file", format!("cannot import: {e}")))?;
+        (d, b, i, pointers)
+    } else {
+        let (d, b, i) =
+            gltf::import(path).map_err(|e| err("file", format!("cannot import: {e}")))?;
+        (d, b, i, Vec::new())
+    };
 
     let mut t = WorldTemplate::default();
     for (i, image) in images.iter().enumerate() {
@@ -195,6 +208,7 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
             emission: Vec3::from(m.emissive_factor()) * strength,
             roughness: pbr.roughness_factor(),
             metallic: pbr.metallic_factor(),
+            specular: m.specular().map_or(1.0, |s| s.specular_factor()),
             subsurface,
             ..Material::default()
         };
@@ -228,6 +242,7 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
             return Err(err("scenes", "no scene; expected at least one scene with nodes".into()));
         }
     };
+    let mut indices: HashMap<usize, usize> = HashMap::new();
     let mut stack: Vec<(gltf::Node, Option<usize>)> =
         roots.into_iter().rev().map(|n| (n, None)).collect();
     while let Some((node, parent)) = stack.pop() {
@@ -248,7 +263,7 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
                 gltf::khr_lights_punctual::Kind::Directional => Light::Directional {
                     direction: Vec3::NEG_Z,
                     irradiance: color,
-                    angular_radius: 0.0,
+                    angular_radius: angular_radius(light.extras()),
                 },
                 gltf::khr_lights_punctual::Kind::Point => {
                     Light::Point { position: Vec3::ZERO, intensity: color }
@@ -276,6 +291,7 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
             }
         }
         let index = t.add_node(tn);
+        indices.insert(node.index(), index);
         for (k, instance) in extra_primitives.into_iter().enumerate() {
             let mut child = NodeTemplate::new(format!("{name}#{}", k + 1), Transform::IDENTITY);
             child.parent = Some(index);
@@ -286,5 +302,19 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
             stack.push((child, Some(index)));
         }
     }
+    crate::gltf_animation::read_animations(&doc, &buffers, &pointers, &indices, &mut t)
+        .map_err(|(part, message)| err(&part, message))?;
     Ok(t)
+}
+
+/// The extras key that carries a directional light's angular radius (radians): glTF's
+/// directional lights are infinitely far points, flicker's may be discs (soft shadows).
+pub const ANGULAR_RADIUS: &str = "flicker_angular_radius";
+
+fn angular_radius(extras: &gltf::json::Extras) -> f32 {
+    extras
+        .as_ref()
+        .and_then(|raw| serde_json::from_str::<serde_json::Value>(raw.get()).ok())
+        .and_then(|v| v[ANGULAR_RADIUS].as_f64())
+        .map_or(0.0, |r| r as f32)
 }

@@ -8,6 +8,7 @@ pub mod animation;
 pub mod components;
 pub mod extract;
 pub mod finite;
+pub mod gltf_animation;
 pub mod gltf_import;
 pub mod resources;
 pub mod rng;

@@ -130,6 +130,7 @@ pub fn advance_clock(mut clock: ResMut<Clock>) {
 pub fn animation_systems() -> bevy_ecs::schedule::ScheduleConfigs<bevy_ecs::system::ScheduleSystem>
 {
     (
+        animation::play_clips,
         animation::rotate,
         animation::rotate_once,
         animation::keyframes,

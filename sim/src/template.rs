@@ -4,6 +4,7 @@ use bevy_ecs::prelude::*;
 use glam::Vec3;
 use scene::{Light, Material, Mesh, Texture};
 
+use crate::animation::{CameraClip, LightClip, MaterialClips, NodeClip};
 use crate::components::{Camera, Intensity, LightSource, MeshInstance, Name, SpawnOrder};
 use crate::resources::{ActiveCamera, Environment, MaterialTable};
 use crate::transform::{GlobalTransform, Transform};
@@ -19,11 +20,25 @@ pub struct NodeTemplate {
     pub light: Option<Light>,
     /// Vertical field of view of a camera on this node.
     pub camera: Option<f32>,
+    /// glTF animation tracks of this node's transform, light and camera.
+    pub clip: Option<NodeClip>,
+    pub light_clip: Option<LightClip>,
+    pub camera_clip: Option<CameraClip>,
 }
 
 impl NodeTemplate {
     pub fn new(name: impl Into<String>, transform: Transform) -> Self {
-        Self { name: name.into(), parent: None, transform, mesh: None, light: None, camera: None }
+        Self {
+            name: name.into(),
+            parent: None,
+            transform,
+            mesh: None,
+            light: None,
+            camera: None,
+            clip: None,
+            light_clip: None,
+            camera_clip: None,
+        }
     }
 }
 
@@ -36,6 +51,8 @@ pub struct WorldTemplate {
     pub materials: MaterialTable,
     pub nodes: Vec<NodeTemplate>,
     pub environment: Vec3,
+    /// glTF animation tracks of material factors.
+    pub material_clips: MaterialClips,
 }
 
 impl WorldTemplate {
@@ -105,6 +122,7 @@ impl WorldTemplate {
     pub fn spawn(&self, world: &mut World) -> Vec<Entity> {
         world.insert_resource(self.materials.clone());
         world.insert_resource(Environment(self.environment));
+        world.insert_resource(self.material_clips.clone());
         let mut entities: Vec<Entity> = Vec::with_capacity(self.nodes.len());
         let mut active = None;
         for (order, node) in self.nodes.iter().enumerate() {
@@ -122,6 +140,15 @@ impl WorldTemplate {
             }
             if let Some(light) = node.light {
                 e.insert((LightSource(light), Intensity::default()));
+            }
+            if let Some(clip) = &node.clip {
+                e.insert(clip.clone());
+            }
+            if let Some(clip) = &node.light_clip {
+                e.insert(clip.clone());
+            }
+            if let Some(clip) = &node.camera_clip {
+                e.insert(clip.clone());
             }
             if let Some(vfov) = node.camera {
                 e.insert(Camera { vfov });

@@ -1,8 +1,10 @@
 //! Tools that drive many scenario runs through `systems::playback`: regression suites
 //! (`suite`: cases over seeds, gates judged against a blessed baseline) and parameter sweeps
 //! (`sweep`: jobs planned for local, GNU parallel or Slurm execution, then merged); `measure`
-//! gives frames from any renderer the metrics and report of a run.
+//! gives frames from any renderer the metrics and report of a run; `export` writes a scenario as
+//! a package (glTF, references, a denoiser's inputs) for any renderer.
 
+pub mod export;
 pub mod history;
 pub mod measure;
 pub mod reproduce;

@@ -25,9 +25,14 @@ pub struct MeasureOptions {
     pub tests: Vec<(String, PathBuf)>,
     /// (test name, folder) of motion vectors (EXR, R and G: pixels from a frame to the previous).
     pub motion: Vec<(String, PathBuf)>,
+    /// (test name, CSV file) of per-frame times ([`Timings`]): the test's frames.csv rows get
+    /// `wall_ms_total` and its passes, and it joins the speed-against-accuracy charts.
+    pub timings: Vec<(String, PathBuf)>,
     pub fps: f64,
     /// Frames of events (the input's frame numbers), for the summary's windows.
     pub events: Vec<u32>,
+    /// A label per event (e.g. a package's "toggle 'lamp'"); empty: "input frame N".
+    pub labels: Vec<String>,
     pub out: PathBuf,
     pub cvvdp: CvvdpSettings,
     pub smape_epsilon: f32,
@@ -134,10 +139,97 @@ fn load_motion(path: &Path, frame: u32, (w, h): (u32, u32)) -> anyhow::Result<Ve
     Ok(rgba.iter().map(|p| [p[0], p[1]]).collect())
 }
 
+/// A test's per-frame times from a CSV file: a header `frame,ms` and optionally one column per
+/// pass (`frame,ms,trace,denoise`), then one row per frame (the input's frame numbers) in
+/// milliseconds. Passes that add up to less than `ms` leave the rest as a pass `other`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Timings {
+    pub file: PathBuf,
+    pub passes: Vec<String>,
+    /// By frame number: the frame's total and each pass's time.
+    pub rows: BTreeMap<u32, (f64, Vec<f64>)>,
+}
+
+impl Timings {
+    /// Reads and checks `file`: every frame of `numbers` once, no other frame, every time a
+    /// finite number >= 0; errors name the file and line or frame.
+    pub fn read(file: &Path, numbers: &[u32]) -> anyhow::Result<Self> {
+        let text = std::fs::read_to_string(file)
+            .with_context(|| format!("{}: cannot read the timings", file.display()))?;
+        let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+        let Some((_, header)) = lines.next() else {
+            bail!("{}: empty; expected a header `frame,ms` and a row per frame", file.display())
+        };
+        let columns: Vec<&str> = header.split(',').map(str::trim).collect();
+        if columns.len() < 2 || columns[0] != "frame" || columns[1] != "ms" {
+            bail!(
+                "{}:1: header `{header}`; expected `frame,ms` then optional pass columns",
+                file.display()
+            );
+        }
+        let passes: Vec<String> = columns[2..].iter().map(|c| c.to_string()).collect();
+        let mut rows = BTreeMap::new();
+        for (i, line) in lines {
+            let at = format!("{}:{}", file.display(), i + 1);
+            let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+            if cells.len() != columns.len() {
+                bail!("{at}: {} cells; expected {} like the header", cells.len(), columns.len());
+            }
+            let frame: u32 = cells[0].parse().map_err(|_| {
+                anyhow::anyhow!("{at}: frame `{}`; expected a frame number", cells[0])
+            })?;
+            let mut ms = Vec::new();
+            for (c, cell) in cells[1..].iter().enumerate() {
+                match cell.parse::<f64>() {
+                    Ok(v) if v.is_finite() && v >= 0.0 => ms.push(v),
+                    _ => bail!(
+                        "{at}: frame {frame}: {} `{cell}`; expected milliseconds (a finite number >= 0)",
+                        columns[c + 1]
+                    ),
+                }
+            }
+            if !numbers.contains(&frame) {
+                bail!("{at}: frame {frame} has no reference frame");
+            }
+            let total = ms.remove(0);
+            if ms.iter().sum::<f64>() > total * (1.0 + 1e-9) + 1e-9 {
+                bail!("{at}: frame {frame}: its passes add up to more than its ms {total}");
+            }
+            if rows.insert(frame, (total, ms)).is_some() {
+                bail!("{at}: frame {frame} a second time; expected one row per frame");
+            }
+        }
+        if let Some(n) = numbers.iter().find(|n| !rows.contains_key(n)) {
+            bail!(
+                "{}: frame {n} is missing ({} rows for {} frames); expected one row per reference frame",
+                file.display(),
+                rows.len(),
+                numbers.len()
+            );
+        }
+        Ok(Self { file: file.to_path_buf(), passes, rows })
+    }
+
+    /// The frame's passes for frames.csv: the named ones and `other` (the rest of its total), or
+    /// a single pass `frame` when the file has no breakdown.
+    fn passes_of(&self, frame: u32) -> Vec<(String, Option<f64>)> {
+        let (total, ms) = &self.rows[&frame];
+        if self.passes.is_empty() {
+            return vec![("frame".into(), Some(*total))];
+        }
+        let mut out: Vec<(String, Option<f64>)> =
+            self.passes.iter().cloned().zip(ms.iter().map(|v| Some(*v))).collect();
+        out.push(("other".into(), Some((total - ms.iter().sum::<f64>()).max(0.0))));
+        out
+    }
+}
+
 /// The inputs, read and checked: every sequence has the reference's frame numbers.
 struct Inputs {
     reference: Sequence,
     tests: Vec<(String, Sequence, Option<Sequence>)>,
+    /// Per test (in `tests`' order), its times.
+    timings: Vec<Option<Timings>>,
 }
 
 fn check_options(opts: &MeasureOptions) -> anyhow::Result<Inputs> {
@@ -175,11 +267,21 @@ fn check_options(opts: &MeasureOptions) -> anyhow::Result<Inputs> {
         same_frames(&seq, &numbers, &reference.dir)?;
         t.2 = Some(seq);
     }
+    let mut timings: Vec<Option<Timings>> = vec![None; tests.len()];
+    for (name, file) in &opts.timings {
+        let Some(i) = tests.iter().position(|(n, ..)| n == name) else {
+            bail!("--timings {name}={}: no --test named {name}", file.display());
+        };
+        if timings[i].is_some() {
+            bail!("--timings {name}: two timing files for one test");
+        }
+        timings[i] = Some(Timings::read(file, &numbers)?);
+    }
     let (first, last) = (numbers[0], numbers[numbers.len() - 1]);
     if let Some(e) = opts.events.iter().find(|&&e| e < first || e > last) {
         bail!("--events: frame {e} is outside the sequences' frames {first}..={last}");
     }
-    Ok(Inputs { reference, tests })
+    Ok(Inputs { reference, tests, timings })
 }
 
 fn same_frames(seq: &Sequence, numbers: &[u32], reference: &Path) -> anyhow::Result<()> {
@@ -215,6 +317,11 @@ fn measure_all(inputs: &Inputs, eps: f32) -> anyhow::Result<(Vec<FrameRecord>, (
             let current = Frame { image, motion };
             let mut rec =
                 FrameRecord { method: name.clone(), frame: k as u32, ..Default::default() };
+            if let Some(t) = &inputs.timings[i] {
+                rec.passes = t.passes_of(*n);
+                // Another renderer's own clock: frames.csv's wall_ms columns.
+                rec.clock = Some(render::timing::Clock::Wall);
+            }
             smape_vs_previous(&mut rec, &current, previous[i].as_ref(), eps);
             error_vs_reference(&mut rec, &current, Some(&reference));
             records.push(rec);
@@ -234,8 +341,9 @@ fn write_frame(path_exr: &Path, path_png: &Path, img: &Image) -> anyhow::Result<
     output::write_png(path_png, img.width, img.height, &px, 1.0)
 }
 
-/// frames.csv with the `cpu_ms` cells empty: frames from elsewhere come without their cost, and
-/// a column of zeros would draw speed charts and mark a "fastest" method.
+/// frames.csv with the `cpu_ms` cells empty: frames from elsewhere come without flicker's CPU
+/// cost, and a column of zeros would draw speed charts and mark a "fastest" method (their own
+/// times, given with --timings, are in the wall_ms columns).
 fn without_times(csv: &str) -> String {
     let mut lines = csv.lines();
     let header = lines.next().unwrap_or_default();
@@ -294,6 +402,7 @@ impl Measured {
                 "reference": opts.reference.display().to_string(),
                 "tests": opts.tests.iter().map(|(n, d)| json!({"name": n, "dir": d.display().to_string()})).collect::<Vec<_>>(),
                 "motion": opts.motion.iter().map(|(n, d)| json!({"name": n, "dir": d.display().to_string()})).collect::<Vec<_>>(),
+                "timings": opts.timings.iter().map(|(n, f)| json!({"name": n, "file": f.display().to_string()})).collect::<Vec<_>>(),
                 "first_frame": first,
             },
             "flicker_version": env!("CARGO_PKG_VERSION"),
@@ -301,7 +410,7 @@ impl Measured {
             "frames": count,
             "methods": names,
             "reference": { "frames": (0..count).collect::<Vec<_>>() },
-            "events": opts.events.iter().map(|e| json!({"frame": e - first, "label": format!("input frame {e}")})).collect::<Vec<_>>(),
+            "events": opts.events.iter().enumerate().map(|(i, e)| json!({"frame": e - first, "label": opts.labels.get(i).cloned().unwrap_or_else(|| format!("input frame {e}"))})).collect::<Vec<_>>(),
             "regions": [],
             "settings": {
                 "smape_epsilon": opts.smape_epsilon,

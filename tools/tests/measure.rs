@@ -23,6 +23,8 @@ fn options(reference: &Path, tests: &[(&str, PathBuf)], out: PathBuf) -> Measure
         motion: Vec::new(),
         fps: 30.0,
         events: Vec::new(),
+        labels: Vec::new(),
+        timings: Vec::new(),
         out,
         cvvdp: CvvdpSettings::default(),
         smape_epsilon: 0.01,
@@ -184,5 +186,69 @@ fn bad_input_names_the_file_and_frame_and_writes_nothing() {
         let v = jod[w].as_f64().unwrap_or_else(|| panic!("no JOD for {w}: {s}"));
         assert!((0.0..=10.0).contains(&v), "{w}: {v}");
     }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `--timings`: an outside method's per-frame times land in frames.csv (wall_ms_total and its
+/// passes, the rest of the total as `other`) and put it on the speed-against-accuracy charts;
+/// timings of the wrong length or with a bad cell are errors naming the file and frame or line,
+/// with nothing written.
+#[test]
+fn timings_put_an_outside_method_on_the_speed_charts() {
+    let dir = temp("timings");
+    let reference = dir.join("reference");
+    sequence(&reference, 4, (8, 8), |_| 0.5);
+    sequence(&dir.join("mine"), 4, (8, 8), |f| 0.4 + 0.05 * f as f32);
+    let write = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let good =
+        write("good.csv", "frame,ms,trace,denoise\n0,3.5,2,1\n1,4,2.5,1\n2,5,3,1.5\n3,4.5,3,1\n");
+    let out = dir.join("out");
+    let cases: [(&str, &str, &[&str]); 5] = [
+        ("short.csv", "frame,ms\n0,1\n1,1\n2,1\n", &["short.csv", "frame 3 is missing"]),
+        (
+            "long.csv",
+            "frame,ms\n0,1\n1,1\n2,1\n3,1\n4,1\n",
+            &["long.csv:6", "frame 4 has no reference frame"],
+        ),
+        ("bad.csv", "frame,ms\n0,1\n1,fast\n2,1\n3,1\n", &["bad.csv:3", "frame 1", "fast"]),
+        ("header.csv", "frame,time\n0,1\n", &["header.csv:1", "frame,ms"]),
+        (
+            "over.csv",
+            "frame,ms,a\n0,1,2\n1,1,0\n2,1,0\n3,1,0\n",
+            &["over.csv:2", "frame 0", "more than"],
+        ),
+    ];
+    for (name, text, expected) in cases {
+        let mut o = options(&reference, &[("mine", dir.join("mine"))], out.clone());
+        o.timings = vec![("mine".into(), write(name, text))];
+        let e = format!("{:#}", measure(&o).unwrap_err());
+        for x in expected {
+            assert!(e.contains(x), "{name}: `{x}` not in: {e}");
+        }
+        assert!(!out.exists(), "{name}: something was written");
+    }
+    let mut o = options(&reference, &[("mine", dir.join("mine"))], out.clone());
+    o.timings = vec![("mine".into(), good)];
+    measure(&o).unwrap();
+    let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| {
+        header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("{name}: {csv}"))
+    };
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let totals: Vec<f64> = rows.iter().map(|r| r[col("wall_ms_total")].parse().unwrap()).collect();
+    assert_eq!(totals, [3.5, 4.0, 5.0, 4.5]);
+    assert_eq!(rows[0][col("wall_ms_other")].parse::<f64>().unwrap(), 0.5);
+    assert_eq!(rows[2][col("wall_ms_trace")].parse::<f64>().unwrap(), 3.0);
+    let charts: Vec<String> = std::fs::read_dir(out.join("charts"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(charts.iter().any(|c| c.starts_with("speed_vs_flip")), "{charts:?}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -22,7 +22,6 @@ const GATES: &[(&str, &[&str])] = &[
             "naive_slightly_lower_std",
             "table1_jackknife_unbiased",
             "table1_naive_lower_std",
-            "table1_m2_lowest_std",
             "fig10_track_length_std",
             "fig10_ratio_tracking_std",
             "fig10_unbiased_ray_marching_fails",

@@ -94,6 +94,8 @@ impl MeasuredFrames {
             motion: named(&self.motion),
             fps: self.fps,
             events: self.events.clone(),
+            labels: Vec::new(),
+            timings: Vec::new(),
             out: out.to_path_buf(),
             cvvdp: self.cvvdp.clone(),
             smape_epsilon: metrics::smape::DEFAULT_EPS,
