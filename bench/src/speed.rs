@@ -342,7 +342,7 @@ const REFERENCE_SIZE: u32 = 64;
 /// "Unlimited" depth on our side is a bound no Cornell-box path reaches under roulette (a path
 /// survives 1000 white bounces with probability below 0.73^997).
 const REFERENCE_INTEGRATOR: mitsuba::Integrator =
-    mitsuba::Integrator { max_depth: None, rr_depth: 3, moments: false };
+    mitsuba::Integrator { max_depth: None, rr_depth: 3 };
 const REFERENCE_MAX_DEPTH: u32 = 1000;
 
 struct ReferenceBench {

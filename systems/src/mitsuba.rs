@@ -46,9 +46,6 @@ pub struct Integrator {
     pub max_depth: Option<u32>,
     /// Depth at which Russian roulette starts.
     pub rr_depth: u32,
-    /// Wrap the path tracer in Mitsuba's `moment` integrator: the image then has 9 channels,
-    /// RGB, the mean RGB again and the per-pixel second moment of the samples.
-    pub moments: bool,
 }
 
 /// Mitsuba's BSDF element for one of our materials, exactly the same function.
@@ -138,16 +135,12 @@ pub fn write_scene_with_media(
     let rgb = |v: Vec3| format!("{} {} {}", v.x, v.y, v.z);
     let mut xml = String::from("<scene version=\"3.0.0\">\n");
     let depth = integrator.max_depth.map_or(-1, |d| d as i64);
-    let path = format!(
-        "<integrator type=\"{}\"><integer name=\"max_depth\" value=\"{depth}\"/><integer name=\"rr_depth\" value=\"{}\"/></integrator>",
+    writeln!(
+        xml,
+        "  <integrator type=\"{}\"><integer name=\"max_depth\" value=\"{depth}\"/><integer name=\"rr_depth\" value=\"{}\"/></integrator>",
         if media.is_empty() { "path" } else { "volpath" },
         integrator.rr_depth
-    );
-    if integrator.moments {
-        writeln!(xml, "  <integrator type=\"moment\">{path}</integrator>")?;
-    } else {
-        writeln!(xml, "  {path}")?;
-    }
+    )?;
     let c = &scene.camera;
     writeln!(
         xml,
@@ -215,7 +208,8 @@ pub fn write_scene_with_media(
         }
     }
     for (t, texture) in scene.textures.iter().enumerate() {
-        let rgb8: Vec<u8> = texture.rgba8.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+        let rgb8: Vec<u8> =
+            texture.rgba8.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
         let image = image::RgbImage::from_raw(texture.width, texture.height, rgb8)
             .with_context(|| format!("texture {t} '{}': texel count", texture.name))?;
         let file = dir.join(format!("texture_{t}.png"));

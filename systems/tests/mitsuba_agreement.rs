@@ -25,7 +25,7 @@ fn lambertian_cornell_box_matches_mitsuba() {
 
     let python = python().expect("python3 with the mitsuba package (scripts/setup.sh installs it)");
     let dir = std::env::temp_dir().join(format!("flicker-mitsuba-{}", std::process::id()));
-    let xml = write_scene(&scene, (size, size), &Integrator { max_depth: None, rr_depth: 3, moments: false }, &dir)
+    let xml = write_scene(&scene, (size, size), &Integrator { max_depth: None, rr_depth: 3 }, &dir)
         .unwrap();
     let exr = dir.join("mitsuba.exr");
     let run = render(&python, &xml, spp, &exr).unwrap();

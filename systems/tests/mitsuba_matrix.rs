@@ -3,10 +3,9 @@
 //! sRGB texture, metal from a mirror to roughness 1, a dielectric over a coloured base from
 //! roughness 0.2 to 1, and the depth limits 1 (direct light), 2 and unlimited.
 //! systems::mitsuba exports each scene from the same `SceneDesc`; scripts/mitsuba_matrix.py
-//! renders them all in one Python process with Mitsuba's scalar CPU path tracer under its
-//! `moment` integrator (each pixel's sample mean and second moment), while this test renders
-//! K independent images of each on the GPU (each pixel's mean and its standard error across
-//! them). Per scene, three tests whose tolerances are the two estimates' standard errors:
+//! renders them all in one Python process with Mitsuba's scalar CPU path tracer, K independent
+//! images of each (seeds), while this test renders K independent images of each on the GPU:
+//! each pixel's mean and its standard error from the spread of the K images, on both sides. Per scene, three tests whose tolerances are the two estimates' standard errors:
 //! Welch's t per pixel (the smallest p-value, Bonferroni over the pixels), the count of pixels
 //! with p < 1% against its binomial law, and the z of the image means. The family of
 //! 3 x scenes tests is held at a 1% false-alarm rate by Bonferroni.
@@ -58,11 +57,7 @@ fn path_tracer_matches_mitsuba_over_the_matrix() {
     let dir = std::env::temp_dir().join(format!("flicker-mitsuba-matrix-{}", std::process::id()));
     let mut jobs = Vec::new();
     for case in &cases {
-        let integrator = Integrator {
-            max_depth: Some(case.max_depth + 1),
-            rr_depth: RR_DEPTH,
-            moments: true,
-        };
+        let integrator = Integrator { max_depth: Some(case.max_depth + 1), rr_depth: RR_DEPTH };
         let xml = write_scene_with_media(
             &case.scene,
             &case.media,
@@ -72,7 +67,8 @@ fn path_tracer_matches_mitsuba_over_the_matrix() {
         )
         .unwrap_or_else(|e| panic!("{}: {e:#}", case.name));
         jobs.push(serde_json::json!({
-            "xml": xml, "spp": case.spp, "seed": 5, "out": dir.join(case.name).join("moments.f32"),
+            "xml": xml, "spp": case.spp / IMAGES, "images": IMAGES, "seed": 5,
+            "out": dir.join(case.name).join("images.f32"),
         }));
     }
     let jobs_file = dir.join("jobs.json");
@@ -111,8 +107,17 @@ fn path_tracer_matches_mitsuba_over_the_matrix() {
             let mut medium = SceneMedium::new(gpu, &case.media);
             (0..IMAGES)
                 .map(|k| {
-                    render_volume(gpu, &sg, &bindings, &mut medium, &REFERENCE_SETTINGS, spp, seed(k), 0)
-                        .map(|(px, _, _)| px)
+                    render_volume(
+                        gpu,
+                        &sg,
+                        &bindings,
+                        &mut medium,
+                        &REFERENCE_SETTINGS,
+                        spp,
+                        seed(k),
+                        0,
+                    )
+                    .map(|(px, _, _)| px)
                 })
                 .collect::<Result<_, _>>()
                 .unwrap()
@@ -134,27 +139,39 @@ fn path_tracer_matches_mitsuba_over_the_matrix() {
         "scene", "spp", "p_pixel", "worst_t", "outliers", "p_count", "mean_z", "mean_rel"
     );
     for (case, images) in cases.iter().zip(&ours) {
-        let raw = std::fs::read(dir.join(case.name).join("moments.f32")).unwrap();
+        let raw = std::fs::read(dir.join(case.name).join("images.f32")).unwrap();
         let theirs: Vec<f32> =
             raw.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
-        assert_eq!(theirs.len(), pixels * 9, "{}: Mitsuba's image size", case.name);
-        let n = case.spp as f64;
-        let k = images.len() as f64;
-        let (mut a, mut b) = (Vec::new(), Vec::new());
-        let mut their_sum = 0.0;
-        for i in 0..pixels {
-            let c = i % 3;
-            let xs: Vec<f64> = images.iter().map(|img| img[i][c] as f64).collect();
+        assert_eq!(theirs.len(), IMAGES as usize * pixels * 3, "{}: Mitsuba's images", case.name);
+        // Each pixel's mean over the K images and its squared standard error.
+        let estimate = |xs: &mut dyn Iterator<Item = f64>| {
+            let xs: Vec<f64> = xs.collect();
+            let k = xs.len() as f64;
             let mean = xs.iter().sum::<f64>() / k;
             let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (k - 1.0);
-            a.push(Estimate { mean, se2: var / k, dof: k - 1.0 });
-            let m1 = theirs[i * 9 + 3 + c] as f64;
-            let m2 = theirs[i * 9 + 6 + c] as f64;
-            let var = (m2 - m1 * m1).max(0.0) * n / (n - 1.0);
-            b.push(Estimate { mean: m1, se2: var / n, dof: n - 1.0 });
-            their_sum += m1;
+            Estimate { mean, se2: var / k, dof: k - 1.0 }
+        };
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for i in 0..pixels {
+            let c = i % 3;
+            a.push(estimate(&mut images.iter().map(|img| img[i][c] as f64)));
+            b.push(estimate(
+                &mut (0..IMAGES as usize).map(|k| theirs[(k * pixels + i) * 3 + c] as f64),
+            ));
         }
+        let their_sum: f64 = b.iter().map(|e| e.mean).sum();
         assert!(their_sum / pixels as f64 > 1e-3, "{}: Mitsuba's image is black", case.name);
+        if std::env::var("FLICKER_MITSUBA_DUMP").is_ok() {
+            for y in 0..SIZE as usize {
+                let row = |v: &[Estimate]| {
+                    (0..SIZE as usize)
+                        .map(|x| format!("{:5.2}", v[y * SIZE as usize + x].mean))
+                        .collect::<Vec<_>>()
+                        .join(" ")
+                };
+                eprintln!("{}  |  {}", row(&a), row(&b));
+            }
+        }
         // Both renderers sum a pixel's samples in f32: a mean is exact to spp ulps at most.
         let v = compare(&a, &b, case.spp as f64 * f32::EPSILON as f64 / 2.0);
         eprintln!(

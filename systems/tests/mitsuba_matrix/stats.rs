@@ -107,10 +107,11 @@ mod tests {
     #[test]
     fn agreeing_estimates_pass_and_a_shift_fails() {
         let e = |mean| Estimate { mean, se2: 0.01, dof: 1000.0 };
-        let a: Vec<Estimate> = (0..256).map(|i| e(1.0 + 0.1 * ((i * 7919) % 13) as f64 / 13.0)).collect();
+        let a: Vec<Estimate> =
+            (0..256).map(|i| e(1.0 + 0.1 * ((i * 7919) % 13) as f64 / 13.0)).collect();
         let v = compare(&a, &a, 0.0);
         assert!(v.p_max >= 1.0 && v.outliers == 0 && v.p_mean > 0.99, "{v:?}");
-        let b: Vec<Estimate> = a.iter().map(|x| e(x.mean + 0.5)).collect();
+        let b: Vec<Estimate> = a.iter().map(|x| e(x.mean + 1.0)).collect();
         let v = compare(&a, &b, 0.0);
         assert!(v.p_max < 1e-3 && v.p_count < 1e-3 && v.p_mean < 1e-3, "{v:?}");
     }
