@@ -19,7 +19,8 @@
 //! The scene with a homogeneous medium is rendered, as its reference is, by our volumetric path
 //! tracer (frame::scene_medium), against Mitsuba's `volpath`.
 //! `FLICKER_MITSUBA_CASES=a,b` runs only the named scenes (for breaking the renderer on
-//! purpose); the significance stays that of the whole matrix.
+//! purpose); the significance stays that of the whole matrix. `FLICKER_MITSUBA_DUMP=1` prints
+//! both images (the tested channel per pixel).
 
 #[path = "mitsuba_matrix/scenes.rs"]
 mod scenes;
