@@ -2,12 +2,16 @@
 # prints one JSON line: seconds of the timed render, paths traced, Dr.Jit's thread count and the
 # image's mean RGB. Usage: python3 scripts/mitsuba_render.py SCENE.xml SPP OUT.exr
 # (`pip install mitsuba`; flicker bench runs it when `python3 -c "import mitsuba"` works).
-import json, sys, time
+import json, os, sys, time
 
 import drjit as dr
 import mitsuba as mi
 
 mi.set_variant('scalar_rgb')
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import mitsuba_gltf_bsdf  # noqa: E402  (flicker's BSDF, for materials that are not Lambertian)
+
+mitsuba_gltf_bsdf.register()
 xml, spp, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 scene = mi.load_file(xml)
 mi.render(scene, spp=1)  # one-time set-up (BVH build, film) stays out of the timing
