@@ -396,8 +396,11 @@ fn white_furnace(metallic: f32, label: &str) {
     for roughness in [0.05, 0.3, 0.6, 1.0] {
         for theta in [0.0, 30.0, 60.0, 80.0, 89.0] {
             let p = Params { wo: view(theta), roughness, metallic, ..Default::default() };
-            let w: Vec<f64> =
-                h.run(Entry::BsdfSample, p, &[], n).iter().map(|r| (r[3] as f64).max(0.0)).collect();
+            let w: Vec<f64> = h
+                .run(Entry::BsdfSample, p, &[], n)
+                .iter()
+                .map(|r| (r[3] as f64).max(0.0))
+                .collect();
             let mean = w.iter().sum::<f64>() / n as f64;
             let var = w.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
             let se = (var / n as f64).sqrt();

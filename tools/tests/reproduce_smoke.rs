@@ -33,12 +33,7 @@ const GATES: &[(&str, &[&str])] = &[
         ],
     ),
     ("realtime-sss-thesis", &["adaptive_fewer_samples_than_fixed"]),
-    (
-        "reliability-weighted-nirc",
-        &[
-            "cache_beats_path_tracing",
-        ],
-    ),
+    ("reliability-weighted-nirc", &["cache_beats_path_tracing"]),
     (
         "stable-sample-caching",
         &[

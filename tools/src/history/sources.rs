@@ -5,9 +5,9 @@ use std::path::Path;
 
 use crate::reproduce::claims::{Claim, Comparison, Effect};
 use crate::reproduce::judge::{Judged, bounds};
-use crate::suite::welch::Sample;
 use crate::reproduce::log_ratio::RatioExpectation;
 use crate::suite::gate::{GateResult, Verdict as GateVerdict};
+use crate::suite::welch::Sample;
 
 use super::record::Entry;
 
