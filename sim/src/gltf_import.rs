@@ -210,7 +210,6 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
             metallic: pbr.metallic_factor(),
             specular: m.specular().map_or(1.0, |s| s.specular_factor()),
             subsurface,
-            ..Material::default()
         };
         t.add_material(m.name().unwrap_or(&format!("material{i}")), material);
     }
