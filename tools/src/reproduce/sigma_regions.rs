@@ -68,7 +68,8 @@ fn box_mean(image: &[f64], width: usize) -> Vec<f64> {
     out
 }
 
-fn luminance(path: &std::path::Path) -> Result<(Vec<f64>, usize)> {
+/// An image's Rec. 709 luminance per pixel, and its width.
+pub(super) fn luminance(path: &std::path::Path) -> Result<(Vec<f64>, usize)> {
     let image = metrics::load_image(path)?;
     let lum = image.rgb.iter().map(|p| (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) as f64);
     Ok((lum.collect(), image.width as usize))

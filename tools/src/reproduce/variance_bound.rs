@@ -13,15 +13,11 @@ use crate::suite::measurement::SeedRun;
 use crate::suite::metric::Metric;
 
 use super::frames_csv::rows;
+use super::sigma_regions::luminance;
 
 /// The frames.csv column of each absolute rule's threshold t · unit² (luminance²), as log10
 /// (frames.csv keeps 6 decimals; the bounds are 1e-6 and below).
 pub const BOUND_COLUMN: &str = "variance_bound_log10";
-
-fn luminance_image(path: &std::path::Path) -> Result<Vec<f64>> {
-    let image = metrics::load_image(path)?;
-    Ok(image.rgb.iter().map(|p| (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) as f64).collect())
-}
 
 /// Per method with a bound (the absolute variance-bounding rules), the series of
 /// `frames` frames; methods without a bound get none. Fewer than two frames is an error.
@@ -54,7 +50,8 @@ pub fn add(run: &mut SeedRun, frames: u32) -> Result<()> {
         let Some(metrics) = run.methods.get_mut(&method) else { continue };
         let images = (0..frames)
             .map(|f| {
-                luminance_image(&folder.frame(&method, f, "exr"))
+                luminance(&folder.frame(&method, f, "exr"))
+                    .map(|(l, _)| l)
                     .with_context(|| format!("seed {} frame {f}: {method}'s frame", run.seed))
             })
             .collect::<Result<Vec<_>>>()?;
