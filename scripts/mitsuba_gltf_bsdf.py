@@ -1,8 +1,10 @@
 # flicker's BSDF as a Mitsuba 3 plugin (`gltf`): the glTF 2.0 metallic-roughness model of
-# render/shaders/pt_bsdf.wgsl, f = (1 - F) c_diff / pi + F D G2 / (4 |n.v| |n.l|), with
-# c_diff = base (1 - metallic), Schlick's F between F0 = mix(0.04 specular, base, metallic) and
-# F90 = mix(specular, 1, metallic) at v.h, GGX D with alpha = max(roughness^2, 1e-3) and Smith's
-# height-correlated G2 = 1 / (1 + Lambda(v) + Lambda(l)).
+# render/shaders/pt_bsdf.wgsl, f = c_diff / pi (1 - F(n.v)) (1 - F(n.l)) / (1 - F_avg)
+# + F(v.h) D G2 / (4 |n.v| |n.l|), with c_diff = base (1 - metallic), Schlick's F between
+# F0 = mix(0.04 specular, base, metallic) and F90 = mix(specular, 1, metallic),
+# F_avg = F0 + (F90 - F0) / 21 (Schlick's cosine-weighted mean: the diffuse coupling of Shirley
+# et al. 1997), GGX D with alpha = max(roughness^2, 1e-3) and Smith's height-correlated
+# G2 = 1 / (1 + Lambda(v) + Lambda(l)).
 # No stock Mitsuba BSDF is this model term for term: `principled` has Disney's retro-reflective
 # diffuse and a Fresnel blended with the dielectric one, `roughconductor` the complex-IOR
 # conductor Fresnel, and both the separable G1(v) G1(l); so the matrix renders it through this
@@ -49,7 +51,10 @@ class GltfBsdf(mi.BSDF):
         if g1v > 0.0 and g1l > 0.0:
             g2 = 1.0 / (1.0 / g1v + 1.0 / g1l - 1.0)
             spec = f * (self.distr.eval(h) * g2 / (4.0 * cos_v * cos_l))
-        return ((mi.Color3f(1.0) - f) * self.c_diff * dr.inv_pi + spec) * cos_l
+        f_avg = self.f0 + (mi.Color3f(self.f90) - self.f0) * (1.0 / 21.0)
+        coupling = (mi.Color3f(1.0) - self.fresnel(cos_v)) * (mi.Color3f(1.0) - self.fresnel(cos_l)) \
+            / dr.maximum(mi.Color3f(1.0) - f_avg, mi.Color3f(1.0e-6))
+        return (coupling * self.c_diff * dr.inv_pi + spec) * cos_l
 
     def pdf_of(self, wi, wo):
         cos_v, cos_l = mi.Frame3f.cos_theta(wi), mi.Frame3f.cos_theta(wo)

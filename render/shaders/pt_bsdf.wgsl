@@ -1,8 +1,16 @@
 // glTF metallic-roughness BSDF: Lambertian diffuse + GGX microfacet specular (Walter et al.
-// 2007) with Smith height-correlated visibility (Heitz 2014) and Schlick Fresnel, combined as in
-// the glTF 2.0 spec appendix B: f = (1 - F) c_diff / pi + F D V. KHR_materials_specular's factor
-// scales the dielectric Fresnel (0 = pure Lambertian). All directions are world space, unit, and
-// `n` is the shading normal turned towards `wo`.
+// 2007) with Smith height-correlated visibility (Heitz 2014) and Schlick Fresnel:
+// f = c_diff / pi (1 - F(n.v)) (1 - F(n.l)) / (1 - F_avg) + F(v.h) D V.
+// The diffuse part is coupled to the Fresnel of both directions as in Shirley et al. 1997 ("A
+// practitioners' assessment of light reflection models"; F_avg = f0 + (f90 - f0) / 21 is
+// Schlick's cosine-weighted hemispherical mean), not by the glTF 2.0 spec appendix B's
+// (1 - F(v.h)): that weight lets a white dielectric reflect more than it receives at grazing
+// views (albedo 1.84 at roughness 0.05 and 89 degrees; render/tests/chi2_sampling.rs's white
+// furnace), because F(v.h) of a diffuse direction is far below the F(n.v) the specular lobe
+// takes. The coupled form is reciprocal, and the diffuse albedo from n.v is exactly
+// c_diff (1 - F(n.v)). KHR_materials_specular's factor scales the dielectric Fresnel
+// (0 = pure Lambertian). All directions are world space, unit, and `n` is the shading normal
+// turned towards `wo`.
 
 import package::pt_sampling::{INV_PI, PI, TWO_PI, basis_bitangent, basis_tangent, max_component, sample_cosine_hemisphere, to_world};
 
@@ -74,7 +82,15 @@ fn bsdf_eval(b: Bsdf, n: vec3f, wo: vec3f, wi: vec3f) -> vec3f {
     let v_dot_h = max(dot(wo, h), 0.0);
     let f = fresnel_schlick(b, v_dot_h);
     let specular = f * ggx_d(b.alpha, max(dot(n, h), 0.0)) * smith_visibility(b.alpha, n_dot_v, n_dot_l);
-    return (vec3f(1.0) - f) * b.c_diff * INV_PI + specular;
+    return diffuse_coupling(b, n_dot_v, n_dot_l) * b.c_diff * INV_PI + specular;
+}
+
+// (1 - F(n.v)) (1 - F(n.l)) / (1 - F_avg): the diffuse part's share of both directions
+// (Shirley et al. 1997). Its cosine-weighted integral over n.l is 1 - F(n.v).
+fn diffuse_coupling(b: Bsdf, n_dot_v: f32, n_dot_l: f32) -> vec3f {
+    let f_avg = b.f0 + (vec3f(b.f90) - b.f0) * (1.0 / 21.0);
+    let transmitted = (vec3f(1.0) - fresnel_schlick(b, n_dot_v)) * (vec3f(1.0) - fresnel_schlick(b, n_dot_l));
+    return transmitted / max(vec3f(1.0) - f_avg, vec3f(1.0e-6));
 }
 
 // Solid-angle pdf of bsdf_sample choosing wi.

@@ -458,7 +458,8 @@ fn emissive_rectangle_over_diffuse_plane() {
 }
 
 /// The glTF metallic-roughness BRDF written out on the CPU (f64), independently of the WGSL:
-/// (1 - F) c_diff / pi + F D V with GGX D, Smith height-correlated V and Schlick F on v.h.
+/// c_diff / pi (1 - F(n.v)) (1 - F(n.l)) / (1 - F_avg) + F(v.h) D V with GGX D, Smith
+/// height-correlated V and Schlick F (the diffuse coupling of Shirley et al. 1997).
 fn gltf_brdf(m: &Material, n: glam::DVec3, wo: glam::DVec3, wi: glam::DVec3) -> glam::DVec3 {
     use glam::DVec3;
     let (nv, nl) = (n.dot(wo), n.dot(wi));
@@ -472,12 +473,15 @@ fn gltf_brdf(m: &Material, n: glam::DVec3, wo: glam::DVec3, wi: glam::DVec3) -> 
     let f0 = DVec3::splat(0.04 * m.specular as f64).lerp(base, metallic);
     let f90 = m.specular as f64 + (1.0 - m.specular as f64) * metallic;
     let h = (wo + wi).normalize();
-    let f = f0 + (DVec3::splat(f90) - f0) * (1.0 - wo.dot(h)).clamp(0.0, 1.0).powi(5);
+    let schlick = |c: f64| f0 + (DVec3::splat(f90) - f0) * (1.0 - c).clamp(0.0, 1.0).powi(5);
+    let f = schlick(wo.dot(h));
+    let f_avg = f0 + (DVec3::splat(f90) - f0) / 21.0;
+    let coupling = (DVec3::ONE - schlick(nv)) * (DVec3::ONE - schlick(nl)) / (DVec3::ONE - f_avg);
     let nh = n.dot(h);
     let d = a2 / (PI * (nh * nh * (a2 - 1.0) + 1.0).powi(2));
     let v =
         0.5 / (nl * (nv * nv * (1.0 - a2) + a2).sqrt() + nv * (nl * nl * (1.0 - a2) + a2).sqrt());
-    (DVec3::ONE - f) * base * (1.0 - metallic) / PI + f * d * v
+    coupling * base * (1.0 - metallic) / PI + f * d * v
 }
 
 /// Directional albedo: the integral of f cos over the hemisphere above +y, by the midpoint rule
