@@ -98,6 +98,49 @@ pub fn conclusion(judged: &[(&Claim, Judged)]) -> String {
     out
 }
 
+/// Each claim judged again with one condition switched, beside the claim it varies:
+/// (claim, its verdict, what is switched, the variant's id, the variant's verdict).
+fn variants<'a>(judged: &'a [(&'a Claim, Judged)]) -> Vec<[String; 5]> {
+    let mut rows = Vec::new();
+    for (base, bj) in judged.iter().filter(|(c, _)| c.variant_of.is_none()) {
+        for (c, j) in judged {
+            if let Some(v) = c.variant_of.as_ref().filter(|v| v.claim == base.id) {
+                rows.push([
+                    base.id.clone(),
+                    verdict_text(&bj.verdict),
+                    v.switched.clone(),
+                    c.id.clone(),
+                    verdict_text(&j.verdict),
+                ]);
+            }
+        }
+    }
+    rows
+}
+
+/// The variants as a Markdown section, or nothing when the paper has none.
+fn variants_markdown(judged: &[(&Claim, Judged)]) -> String {
+    let rows = variants(judged);
+    if rows.is_empty() {
+        return String::new();
+    }
+    let mut md = String::from(
+        "\n### With and without each switched condition\n\n| claim | verdict | switched | verdict switched |\n|---|---|---|---|\n",
+    );
+    for [id, v, switched, vid, vv] in rows {
+        md.push_str(&format!(
+            "| `{}` | {} | {} (`{}`) | {} |\n",
+            cell(&id),
+            cell(&v),
+            cell(&switched),
+            cell(&vid),
+            cell(&vv)
+        ));
+    }
+    md.push('\n');
+    md
+}
+
 /// The Markdown report; `header` says how it was made (command, scale, seeds, commit).
 pub fn markdown(header: &str, papers: &[PaperResult]) -> String {
     let mut md = format!("# What the papers claim, and what we measure\n\n{header}\n");
@@ -120,6 +163,7 @@ pub fn markdown(header: &str, papers: &[PaperResult]) -> String {
                 cell(&c.departures.join("; ")),
             ));
         }
+        md.push_str(&variants_markdown(&p.judged));
         for t in &p.tables {
             md.push_str(&table::markdown(t));
         }
@@ -162,6 +206,21 @@ pub fn html(header: &str, papers: &[PaperResult]) -> String {
             ));
         }
         h.push_str("</table>\n");
+        let rows = variants(&p.judged);
+        if !rows.is_empty() {
+            h.push_str("<h3>With and without each switched condition</h3>\n<table><tr><th>claim</th><th>verdict</th><th>switched</th><th>verdict switched</th></tr>\n");
+            for [id, v, switched, vid, vv] in rows {
+                h.push_str(&format!(
+                    "<tr><td>{}</td><td>{}</td><td>{} ({})</td><td>{}</td></tr>\n",
+                    escape(&id),
+                    escape(&v),
+                    escape(&switched),
+                    escape(&vid),
+                    escape(&vv)
+                ));
+            }
+            h.push_str("</table>\n");
+        }
         for t in &p.tables {
             h.push_str(&format!(
                 "<h3>Case {} (mean [95% interval] over {} seeds)</h3>\n<table><tr><th>method</th>",
