@@ -164,9 +164,9 @@ pub(crate) fn play_cases(
         for &seed in &case.seeds {
             let out = folder.join(&case.name).join(format!("seed_{seed}"));
             let plan = if let Some(frames) = &case.measure {
-                let opts = frames.options(seed, &out);
-                let measured = Measured::read(&opts)
-                    .map_err(|e| anyhow!("{} seed {seed}: {e:#}", case_at(origin, case)))?;
+                let at = |e: anyhow::Error| anyhow!("{} seed {seed}: {e:#}", case_at(origin, case));
+                let opts = frames.options(seed, &out).map_err(at)?;
+                let measured = Measured::read(&opts).map_err(at)?;
                 Planned::Measured(opts, Box::new(measured))
             } else {
                 let (spec, overrides) = case_spec(origin, case, seed, &out)?;
