@@ -278,13 +278,13 @@ pub fn matrix() -> Vec<Case> {
         box_max: Vec3::new(-0.1, 1.3, 0.9),
         sigma_t: 6.0,
         resolution: (12, 10, 8),
-        albedo: Vec3::new(0.95, 0.8, 0.6),
+        albedo: Vec3::new(0.8, 0.6, 0.4),
         super_voxel: 4,
         ..fog
     };
     cases.push(Case { media: vec![cloud], ..case("medium_grid", s, many, 512) });
 
-    // Smooth shading normals: an ellipsoid as a 12 x 8 UV sphere with the exact normals at its
+    // Smooth shading normals: an ellipsoid as an 8 x 6 UV sphere (facets of two pixels and more) with the exact normals at its
     // vertices, turned and uniformly scaled by its instance (normals through the inverse
     // transpose), lit by the point light and the panel. The stretch is in the mesh, not the
     // instance: under a non-uniform instance scale the two renderers interpolate differently
@@ -297,15 +297,15 @@ pub fn matrix() -> Vec<Case> {
     let mut s = with_panel();
     s.lights.push(point());
     let mesh = s.meshes.len() as u32;
-    s.meshes.push(uv_ellipsoid(12, 8, Vec3::new(0.9, 0.7, 0.8)));
+    s.meshes.push(uv_ellipsoid(8, 6, Vec3::new(0.9, 0.7, 0.8)));
     s.materials.push(lambert(Vec3::new(0.75, 0.75, 0.7)));
     s.instances.push(Instance {
         mesh,
         material: s.materials.len() as u32 - 1,
         transform: Mat4::from_scale_rotation_translation(
-            Vec3::splat(0.5),
+            Vec3::splat(0.8),
             Quat::from_rotation_y(0.4),
-            Vec3::new(-0.45, 0.36, 0.55),
+            Vec3::new(-0.45, 0.57, 0.5),
         ),
     });
     cases.push(case("smooth_normals", s, 1, 1024));
