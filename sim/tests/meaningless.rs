@@ -202,6 +202,6 @@ fn scenes_that_emit_nothing_or_have_no_extent_are_refused() {
     // A triangle whose corners lie on one line: no surface at all.
     triangle_gltf(&dir, [[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [2.0, 2.0, 0.0]], true);
     let err = simulate(&dir, "").unwrap_err();
-    assert!(err.contains("s.ron:1:10: mesh 'tri' has no triangle of positive area"), "{err}");
+    assert!(err.contains("s.ron:1:10: mesh 'tri#0' has no triangle of positive area"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
