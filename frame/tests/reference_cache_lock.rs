@@ -43,7 +43,8 @@ fn a_killed_holder_releases_its_lock() {
     child.wait().unwrap();
     // The lock file stays, but the OS released the lock with its holder.
     assert!(cache.lock_path("k").exists());
-    let _lock = cache.lock("k", || panic!("a killed holder's lock must not be waited for")).unwrap();
+    let _lock =
+        cache.lock("k", || panic!("a killed holder's lock must not be waited for")).unwrap();
     drop(other);
     std::fs::remove_dir_all(&dir).unwrap();
 }

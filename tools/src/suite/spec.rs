@@ -341,13 +341,7 @@ impl Suite {
             ));
         }
         let name = file.name_or_stem(parsed.name, "suite");
-        Ok(Suite {
-            name,
-            cases,
-            gates,
-            other_adapter_tolerance: t,
-            origin: origin.to_path_buf(),
-        })
+        Ok(Suite { name, cases, gates, other_adapter_tolerance: t, origin: origin.to_path_buf() })
     }
 
     /// Where baselines of this suite live: `baselines/NAME.json` next to the suite file.
