@@ -299,7 +299,7 @@ pub(crate) fn check(s: &Scenario) -> Result<(), ScenarioError> {
                 .find_map(|(f, v)| v.filter(|v| !(0.0..=1.0).contains(v)).map(|v| (f, v)))
             {
                 return Err(p.error(
-                    at(*field),
+                    at(field),
                     format!("SetMaterial '{material}': {field} {v}; expected a value from 0 to 1"),
                 ));
             }
@@ -309,7 +309,7 @@ pub(crate) fn check(s: &Scenario) -> Result<(), ScenarioError> {
                 .find_map(|(f, v)| v.filter(|v| v.min_element() < 0.0).map(|v| (f, v)))
             {
                 return Err(p.error(
-                    at(*field),
+                    at(field),
                     format!(
                         "SetMaterial '{material}': {field} {}; expected values >= 0 in each channel",
                         v3(v)
