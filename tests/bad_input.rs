@@ -267,8 +267,12 @@ fn a_damaged_cached_reference_is_reported_and_rendered_again() {
     };
     let (stdout, _, rendered) = run("first");
     assert!(stdout.contains("1 rendered, 0 from cache"), "{stdout}");
-    let entries: Vec<PathBuf> =
-        std::fs::read_dir(cache.join("references")).unwrap().map(|e| e.unwrap().path()).collect();
+    // The entry, not its lock file (references/KEY.lock).
+    let entries: Vec<PathBuf> = std::fs::read_dir(cache.join("references"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "ref"))
+        .collect();
     assert_eq!(entries.len(), 1, "{entries:?}");
     let entry = &entries[0];
     let good = std::fs::read(entry).unwrap();

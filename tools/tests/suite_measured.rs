@@ -1,9 +1,9 @@
 //! Suites over frames on disk (another renderer's): the example suite on the committed ColorVideoVDP
 //! fixtures passes its gates; a renderer blessed on its frames passes against its baseline and
 //! fails it once its frames get noisier; bad frames are errors at the case's line naming the
-//! file and frame, with nothing written. A case over a `flicker export` package takes the
-//! package's references, frame rate and events, and an outside method's timings gate on its
-//! FrameMs. No GPU is needed.
+//! file and frame, with nothing written; a baseline blessed on another adapter stands in with a
+//! wider tolerance. A case over a `flicker export` package takes the package's references, frame
+//! rate and events, and an outside method's timings gate on its FrameMs. No GPU is needed.
 
 use std::path::{Path, PathBuf};
 
@@ -119,6 +119,43 @@ fn a_blessed_renderer_passes_and_fails_once_its_frames_get_noisier() {
     renderer(&dir, 0.2);
     let outcome = run(&opts).expect("suite runs");
     eprintln!("{}", outcome.markdown);
+    for r in &outcome.results {
+        let relative = !r.gate.starts_with("psnr");
+        let expected = if relative { Verdict::Fail } else { Verdict::Pass };
+        assert_eq!(r.verdict, expected, "{}: {}", r.gate, r.detail);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn another_adapters_baseline_stands_in_with_a_wider_tolerance() {
+    let dir = temp("stand_in");
+    renderer(&dir, 0.05);
+    std::fs::write(dir.join("suite.ron"), SUITE).unwrap();
+    let opts = options(dir.join("suite.ron"), &dir);
+    let path = bless(&opts).expect("bless");
+    // The baseline as if blessed on a GPU only: this adapter has none of its own.
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("frames from disk / cpu", "Some GPU (driver 1.2) / Vulkan");
+    std::fs::write(&path, text).unwrap();
+    let outcome = run(&opts).expect("a stand-in baseline is used, not an error");
+    eprintln!("{}", outcome.markdown);
+    assert!(
+        outcome.markdown.contains("no baseline blessed on adapter 'frames from disk / cpu'")
+            && outcome.markdown.contains("'Some GPU (driver 1.2) / Vulkan'")
+            && outcome.markdown.contains("flicker suite bless"),
+        "{}",
+        outcome.markdown
+    );
+    // Each relative gate's tolerance grew by the default other_adapter_tolerance, 0.05.
+    let tolerances: Vec<&str> = outcome.results.iter().map(|r| r.gate.as_str()).collect();
+    assert!(tolerances.iter().any(|g| g.ends_with("within 15.0% of baseline")), "{tolerances:?}");
+    assert!(tolerances.iter().any(|g| g.ends_with("within 7.0% of baseline")), "{tolerances:?}");
+    assert!(outcome.passed(), "{}", outcome.markdown);
+    // Four times the noise still fails the widened relative gates.
+    renderer(&dir, 0.2);
+    let outcome = run(&opts).expect("suite runs");
     for r in &outcome.results {
         let relative = !r.gate.starts_with("psnr");
         let expected = if relative { Verdict::Fail } else { Verdict::Pass };
