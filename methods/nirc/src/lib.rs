@@ -17,6 +17,7 @@ pub mod gpu;
 pub mod integrator;
 pub mod layout;
 pub mod plugin;
+pub mod recorded;
 pub mod records;
 pub mod reliability;
 pub mod state;
