@@ -240,9 +240,26 @@ impl<'de> Deserialize<'de> for Metric {
                 })
             }
             fn visit_enum<A: EnumAccess<'de>>(self, data: A) -> Result<Metric, A::Error> {
-                let (name, variant): (String, _) = data.variant()?;
+                let (Ident(name), variant) = data.variant()?;
                 variant.unit_variant()?;
                 self.visit_str(&name)
+            }
+        }
+        /// The variant's name, read as an identifier (a `String` would want a quoted string).
+        struct Ident(String);
+        impl<'de> Deserialize<'de> for Ident {
+            fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+                struct IdentVisitor;
+                impl Visitor<'_> for IdentVisitor {
+                    type Value = Ident;
+                    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                        f.write_str("a metric's name")
+                    }
+                    fn visit_str<E: de::Error>(self, name: &str) -> Result<Ident, E> {
+                        Ok(Ident(name.to_string()))
+                    }
+                }
+                deserializer.deserialize_identifier(IdentVisitor)
             }
         }
         deserializer.deserialize_enum("Metric", &[], MetricVisitor)
