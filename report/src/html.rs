@@ -54,13 +54,17 @@ fn chart_html(c: &WrittenChart) -> String {
     }
 }
 
-/// Writes RUN/report.html (and the charts and error maps it shows); returns its path.
-pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
+/// Writes RUN/report.html (and the charts and error maps it shows, the methods' `declared`
+/// charts among them); returns its path.
+pub fn write_report(
+    run_dir: &Path,
+    declared: &[crate::declared::MethodChart],
+) -> anyhow::Result<PathBuf> {
     let manifest = Manifest::load(run_dir)?;
     let frames = Frames::load(run_dir)?;
     let mut summary = summarize(&manifest, &frames, DEFAULT_WINDOW);
     crate::summary::add_jod_from_file(&mut summary, run_dir);
-    let charts = write_charts(run_dir, &manifest, &frames)?;
+    let charts = write_charts(run_dir, &manifest, &frames, declared)?;
     let methods =
         if manifest.methods.is_empty() { frames.methods() } else { manifest.methods.clone() };
     let frame_images = write_frame_images(run_dir, &manifest, &methods)?;

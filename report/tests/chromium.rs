@@ -64,7 +64,7 @@ fn check_page(bin: &Path, work: &Path, html: &str, name: &str) -> Outcome {
 fn report_displays_every_image_without_console_errors() {
     let bin = chromium();
     let run = common::fake_run("chromium");
-    let report = report::rebuild(&run).unwrap();
+    let report = report::rebuild(&run, &[]).unwrap();
     let html = std::fs::read_to_string(&report).unwrap();
     let work = run.join("browser");
     std::fs::create_dir_all(&work).unwrap();

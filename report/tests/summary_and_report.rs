@@ -65,7 +65,7 @@ fn summary_windows_and_means() {
 #[test]
 fn report_is_self_contained_with_charts_maps_and_crops() {
     let run = fake_run("report");
-    let path = report::rebuild(&run).unwrap();
+    let path = report::rebuild(&run, &[]).unwrap();
     assert_eq!(path, run.join("report.html"));
     let html = std::fs::read_to_string(&path).unwrap();
     for stem in [
@@ -162,7 +162,7 @@ fn minimal_run_without_reference_events_or_regions() {
         "method,frame,cpu_ms,smape\na,0,1.0,\na,1,1.2,0.5\na,2,1.1,0.25\n",
     )
     .unwrap();
-    let html = std::fs::read_to_string(report::rebuild(&run).unwrap()).unwrap();
+    let html = std::fs::read_to_string(report::rebuild(&run, &[]).unwrap()).unwrap();
     let s = read_json(&run.join("summary.json"));
     let names: Vec<&str> =
         s["windows"].as_array().unwrap().iter().map(|w| w["name"].as_str().unwrap()).collect();
@@ -175,7 +175,7 @@ fn minimal_run_without_reference_events_or_regions() {
     assert_eq!(html.matches("<img ").count(), 3, "smape, cpu_ms, speed vs smape");
     // A malformed manifest is reported with its path.
     std::fs::write(run.join("manifest.json"), "{").unwrap();
-    let err = format!("{:#}", report::rebuild(&run).unwrap_err());
+    let err = format!("{:#}", report::rebuild(&run, &[]).unwrap_err());
     assert!(err.contains("manifest.json"), "{err}");
     std::fs::remove_dir_all(&run).ok();
 }

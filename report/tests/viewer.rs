@@ -22,7 +22,7 @@ fn viewer_run(name: &str) -> (FakeRun, std::path::PathBuf) {
         ..FakeRun::default()
     };
     let dir = fake_run_with(name, &spec);
-    report::rebuild(&dir).unwrap();
+    report::rebuild(&dir, &[]).unwrap();
     (spec, dir)
 }
 
@@ -418,7 +418,7 @@ fn a_320x180_60_frame_6_method_report_shows_its_first_frame() {
     };
     let run = fake_run_with("large", &spec);
     let t = std::time::Instant::now();
-    report::rebuild(&run).unwrap();
+    report::rebuild(&run, &[]).unwrap();
     let build_s = t.elapsed().as_secs_f64();
     let html = std::fs::read_to_string(run.join("report.html")).unwrap();
     let page = run.join("timed.html");
@@ -480,6 +480,7 @@ fn compare_puts_two_runs_in_one_viewer_with_a_table_of_differences() {
         run_dir: None,
         compare: Some(vec![a.clone(), b.clone()]),
         out: None,
+        charts: vec![],
     };
     let page = report::report(&args).unwrap();
     assert_eq!(page, b.join("compare.html"));

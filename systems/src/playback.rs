@@ -285,7 +285,7 @@ pub(crate) fn play(
             }
             output::write_json(&folder.manifest(), &manifest)?;
             // What it has: the summary and the page of the frames so far (marked incomplete).
-            let report = report::rebuild(&folder.root);
+            let report = report::rebuild(&folder.root, &crate::methods::registry::charts());
             return Err(match error {
                 Some(e) => e,
                 None => {
@@ -310,7 +310,7 @@ pub(crate) fn play(
     let records = std::mem::take(&mut world.resource_mut::<RunOutput>().records);
     let references = world.resource::<References>();
     let (rendered, cached) = (references.rendered, references.cached);
-    let report = report::rebuild(&folder.root)
+    let report = report::rebuild(&folder.root, &crate::methods::registry::charts())
         .with_context(|| format!("writing the report of {}", folder.root.display()))?;
     Ok(RunSummary {
         folder: folder.root,

@@ -438,7 +438,7 @@ impl Measured {
             &without_times(&systems::frame_record::to_csv(&self.records)),
         )?;
         output::write_json(&folder.manifest(), &manifest)?;
-        report::rebuild(&folder.root)
+        report::rebuild(&folder.root, &systems::methods::registry::charts())
     }
 }
 

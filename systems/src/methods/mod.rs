@@ -1,8 +1,9 @@
 //! Rendering methods. Each is a plugin ([`MethodPlugin`], in `plugin.rs`): it owns its settings,
 //! label, samples per pixel, temporal window and `--spp` override, adds its systems to the
 //! frame's stages (`crate::frame::Stage`) and builds each instance, GPU state included, up front
-//! on the instance's entity. `registry.rs` lists them, one line each. Adding a method: its file
-//! (or folder) here with its settings, components, systems and plugin, and its registry line.
+//! on the instance's entity, and declares the statistics and charts it records. `registry.rs`
+//! lists them, one line each. Adding a method: its folder under `methods/` with its settings,
+//! components, systems and plugin, and its registry line.
 
 pub mod registry;
 pub mod spec;
@@ -10,7 +11,10 @@ pub mod spec;
 use anyhow::Result;
 use bevy_ecs::prelude::*;
 
-pub use frame::method::{MethodPlugin, MethodSpec, RegisteredMethod};
+pub use frame::method::{
+    Better, ChartSeries, ImageStatistic, MethodChart, MethodPlugin, MethodSpec, RegisteredMethod,
+    Source, Statistic,
+};
 pub use frame::temporal_window;
 pub use registry::register;
 pub use spec::{check_labels, parse_methods};

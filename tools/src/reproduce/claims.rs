@@ -14,6 +14,8 @@ use sim::scenario::{ReferenceFrames, ScenarioError};
 use systems::playback::{Overrides, RunSpec};
 
 use crate::ron_file::{self, RonFile};
+use systems::methods::ImageStatistic;
+
 use crate::suite::metric::Metric;
 use crate::suite::spec::Case;
 use crate::suite::window::Window;
@@ -790,7 +792,7 @@ impl Claims {
                         )));
                     }
                     if let Some(s) = &claim.statistic
-                        && matches!(s.metric, Metric::SigmaChanged | Metric::SigmaUnchanged)
+                        && s.metric.from_images_by() == Some(ImageStatistic::PreferenceRegions)
                         && !case.preference_maps.iter().any(|p| p == m)
                     {
                         return Err(at(format!(

@@ -259,7 +259,9 @@ impl Suite {
                     ),
                 ));
             }
-            if matches!(gate.metric, Metric::SigmaChanged | Metric::SigmaUnchanged) {
+            if gate.metric.from_images_by()
+                == Some(systems::methods::ImageStatistic::PreferenceRegions)
+            {
                 return Err(file.error_at(
                     &entry,
                     format!(
