@@ -259,7 +259,12 @@ fn check_stopped(o: &Output, run: &Path, full: &Path, methods: usize, status: &s
     let rows = results(run);
     assert_eq!(rows.len(), 1 + methods * frames as usize, "{rows:?}");
     assert_eq!(rows[..], results(full)[..rows.len()]);
-    let frame_of = |p: &PathBuf| p.file_stem().unwrap().to_string_lossy().parse::<u32>().unwrap();
+    // Frames are NNNN.exr and NNNN.png (maps too: their stems end in the frame's digits).
+    let frame_of = |p: &PathBuf| -> u32 {
+        let stem = p.file_stem().unwrap().to_string_lossy().into_owned();
+        let digits: String = stem.chars().rev().take_while(char::is_ascii_digit).collect();
+        digits.chars().rev().collect::<String>().parse().unwrap()
+    };
     let kept: Vec<PathBuf> = images(full).into_iter().filter(|p| frame_of(p) < frames).collect();
     let written = images(run);
     assert!(kept.iter().all(|p| written.contains(p)), "{kept:?} {written:?}");

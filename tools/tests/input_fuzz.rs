@@ -270,7 +270,7 @@ fn what_resume_reads() {
     let scenario = dir.join("tiny.ron");
     std::fs::write(
         &scenario,
-        "Scenario(scene: Builtin(\"cornell_box\"), resolution: (8, 8), frames: 3,\n  reference: (spp: 1, frames: List([])),\n  methods: [PathTracing(spp: 1), Taa(spp: 1)])",
+        "Scenario(scene: Builtin(\"cornell_box\"), resolution: (8, 8), frames: 3,\n  reference: (spp: 1, frames: List([])),\n  methods: [PathTracing(spp: 1), Taa()])",
     )
     .unwrap();
     let run = dir.join("run");
