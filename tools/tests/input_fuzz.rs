@@ -167,7 +167,7 @@ fn check_template(t: &sim::template::WorldTemplate) -> Result<(), String> {
             && mesh.normals.iter().all(|n| n.is_finite())
             && mesh.uvs.iter().all(|u| u.is_finite());
         assert!(finite, "mesh {i} has a non-finite vertex");
-        render::bvh::blas::Blas::build(i, mesh).map_err(|e| format!("imported, then: {e}"))?;
+        render::bvh::Blas::build(i, mesh).map_err(|e| format!("imported, then: {e}"))?;
     }
     Ok(())
 }
