@@ -169,6 +169,15 @@ fn check_template(t: &sim::template::WorldTemplate) -> Result<(), String> {
         assert!(finite, "mesh {i} has a non-finite vertex");
         render::bvh::Blas::build(i, mesh).map_err(|e| format!("imported, then: {e}"))?;
     }
+    for node in &t.nodes {
+        let tr = &node.transform;
+        let finite = tr.translation.is_finite() && tr.rotation.is_finite() && tr.scale.is_finite();
+        assert!(finite, "node '{}' has a non-finite transform", node.name);
+    }
+    for m in &t.materials.materials {
+        let numbers = [m.base_color.is_finite(), m.emission.is_finite(), m.roughness.is_finite()];
+        assert!(numbers.iter().all(|&b| b) && m.metallic.is_finite(), "{m:?}");
+    }
     Ok(())
 }
 
@@ -299,7 +308,12 @@ fn what_resume_reads() {
     let (manifest_file, csv_file) = (run.join("manifest.json"), run.join("frames.csv"));
     std::fs::write(&manifest_file, &manifest).unwrap();
     std::fs::write(&csv_file, &csv).unwrap();
-    let read = || systems::resume::read(&run).map(|_| ()).map_err(|e| format!("{e:#}"));
+    // A run folder read is one that resumes within the run: at most its frames are on disk.
+    let read = || {
+        let stored = systems::resume::read(&run).map_err(|e| format!("{e:#}"))?;
+        assert!(stored.from <= stored.spec.scenario.frames, "resumes at frame {}", stored.from);
+        Ok(())
+    };
     let stored = systems::resume::read(&run).expect("the unmutated run folder reads");
     assert_eq!(stored.from, 2);
 
