@@ -1,6 +1,7 @@
 //! GPU faults as errors: wgpu reports an out-of-memory or validation error through the device's
-//! error handler, whose default panics, and a lost device through its lost callback. A run sends them to a [`FaultSink`] instead and ends
-//! with an error that names the pass (wgpu's label of the object at fault) and the size.
+//! error handler, whose default panics, and a lost device through its lost callback. A run
+//! sends them to a [`FaultSink`] instead and ends with an error that names the pass (wgpu's
+//! label of the object at fault) and the size.
 
 use std::sync::{Arc, Mutex};
 
