@@ -107,8 +107,12 @@ fn no_failure(
         });
         let size = run.map_or(String::new(), |r| format!(" at {}x{}", r.width, r.height));
         let owner = last_owner().map_or(String::new(), |o| format!(", {o}"));
+        // A fault explains a system's error that followed it (a lost device fails every call
+        // after it): the fault comes first.
         FAILURE.with(|f| {
-            f.borrow_mut().get_or_insert(format!("{frame}{size}{owner}: {fault}"));
+            let mut f = f.borrow_mut();
+            let then = f.take().map_or(String::new(), |e| format!(" (then: {e})"));
+            *f = Some(format!("{frame}{size}{owner}: {fault}{then}"));
         });
     }
     FAILURE.with(|f| f.borrow().is_none())

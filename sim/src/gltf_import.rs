@@ -141,6 +141,13 @@ fn read_primitive(
             return Err(format!("{what} of vertex {v} is {:?}; expected finite numbers", values[v]));
         }
     }
+    // Where the BVH's surface areas overflow (render::bvh::MAX_COORDINATE, refused there too).
+    if let Some(v) = positions.iter().position(|p| p.abs().max_element() > 1e18) {
+        return Err(format!(
+            "POSITION of vertex {v} is {}; expected coordinates within ±1e18",
+            positions[v]
+        ));
+    }
     let flat: Vec<u32> = match reader.read_indices() {
         Some(i) => i.into_u32().collect(),
         None => (0..positions.len() as u32).collect(),
@@ -193,6 +200,20 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
     // A .glb may carry KHR_animation_pointer channels, which the `gltf` crate cannot read:
     // they are taken out first (crate::gltf_animation).
     let bytes = std::fs::read(path).map_err(|e| err("file", format!("cannot read: {e}")))?;
+    // The `gltf` crate panics on an image with no source (neither `uri` nor `bufferView`) or a
+    // `bufferView` image without `mimeType`; refused here first. A file that does not parse is
+    // reported by the import below.
+    if let Ok(parsed) = gltf::Gltf::from_slice(&bytes) {
+        for (i, image) in parsed.document.as_json().images.iter().enumerate() {
+            let missing = match (&image.buffer_view, &image.uri, &image.mime_type) {
+                (Some(_), _, None) => "a bufferView image without mimeType",
+                (None, None, _) => "neither uri nor bufferView",
+                _ => continue,
+            };
+            let part = label("image", image.name.as_deref(), i);
+            return Err(err(&part, format!("{missing}; expected a uri, or a bufferView and mimeType")));
+        }
+    }
     let (doc, buffers, images, pointers) = if bytes.starts_with(b"glTF") {
         let (glb, pointers) =
             crate::gltf_animation::split_pointer_channels(&bytes).map_err(|m| err("file", m))?;
