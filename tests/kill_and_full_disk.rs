@@ -169,10 +169,8 @@ fn runs_killed_at_random_frames_resume_to_the_uninterrupted_bytes() {
     let dir = scratch("sigkill");
     const METHODS: usize = 2;
     let scenario = write_scenario(&dir, &["PathTracing(spp: 1)", "Taa()"], 3);
-    let seed = std::env::var("FLICKER_KILL_SEED")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(nanos);
+    let seed =
+        std::env::var("FLICKER_KILL_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or_else(nanos);
     eprintln!("FLICKER_KILL_SEED={seed}");
     let mut rng = Rng(seed);
 
@@ -253,7 +251,14 @@ fn size(path: &Path) -> u64 {
 /// not write, the manifest is whole and says `status` and how far the run got, frames.csv ends
 /// at that frame, every image is whole (those of the frame that failed may be there) and
 /// equal to `full`'s, and no temporary file is left.
-fn check_stopped(o: &Output, run: &Path, full: &Path, methods: usize, status: &str, file: &str) -> Option<u32> {
+fn check_stopped(
+    o: &Output,
+    run: &Path,
+    full: &Path,
+    methods: usize,
+    status: &str,
+    file: &str,
+) -> Option<u32> {
     let stderr = text(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains(file) && stderr.contains("File too large"), "{stderr}");
@@ -296,7 +301,10 @@ fn a_full_disk_stops_the_run_cleanly_during_frames_the_summary_and_a_cache_write
     };
     let report: Vec<u64> =
         ["summary.json", "report.html"].iter().map(|f| size(&full.join(f))).collect();
-    eprintln!("manifest {manifest} B, image {largest_image} B, frames.csv {} B, report {report:?} B", csv.len());
+    eprintln!(
+        "manifest {manifest} B, image {largest_image} B, frames.csv {} B, report {report:?} B",
+        csv.len()
+    );
 
     // During frames: frames.csv passes the limit at a frame after the first; the manifest
     // (with an error message of a few hundred bytes) still fits.

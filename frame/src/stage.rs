@@ -152,7 +152,8 @@ pub fn own_systems(schedule: &mut Schedule, before: &HashSet<SystemKey>, owner: 
             LAST_OWNER.with(|o| *o.borrow_mut() = Some(owner.clone()));
             ok
         };
-        let condition: bevy_ecs::schedule::BoxedCondition = Box::new(IntoSystem::into_system(check));
+        let condition: bevy_ecs::schedule::BoxedCondition =
+            Box::new(IntoSystem::into_system(check));
         if let Some(conditions) = systems.get_conditions_mut(key) {
             conditions.push(bevy_ecs::schedule::ConditionWithAccess::new(condition));
         }

@@ -138,7 +138,10 @@ fn read_primitive(
         ("TEXCOORD_0", uvs.iter().map(|u| u.to_array().to_vec()).collect()),
     ] {
         if let Some(v) = values.iter().position(|v| v.iter().any(|c| !c.is_finite())) {
-            return Err(format!("{what} of vertex {v} is {:?}; expected finite numbers", values[v]));
+            return Err(format!(
+                "{what} of vertex {v} is {:?}; expected finite numbers",
+                values[v]
+            ));
         }
     }
     // Where the BVH's surface areas overflow (render::bvh::MAX_COORDINATE, refused there too).
@@ -211,7 +214,10 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
                 _ => continue,
             };
             let part = label("image", image.name.as_deref(), i);
-            return Err(err(&part, format!("{missing}; expected a uri, or a bufferView and mimeType")));
+            return Err(err(
+                &part,
+                format!("{missing}; expected a uri, or a bufferView and mimeType"),
+            ));
         }
     }
     let (doc, buffers, images, pointers) = if bytes.starts_with(b"glTF") {
@@ -250,7 +256,10 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
         };
         let factors = [
             ("baseColorFactor", c.to_vec()),
-            ("emissiveFactor times emissiveStrength", m.emissive_factor().map(|e| e * strength).to_vec()),
+            (
+                "emissiveFactor times emissiveStrength",
+                m.emissive_factor().map(|e| e * strength).to_vec(),
+            ),
             ("roughnessFactor", vec![pbr.roughness_factor()]),
             ("metallicFactor", vec![pbr.metallic_factor()]),
             ("specularFactor", vec![m.specular().map_or(1.0, |s| s.specular_factor())]),

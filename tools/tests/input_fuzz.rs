@@ -44,7 +44,8 @@ const TOKENS: &[&[u8]] = &[
 ];
 
 /// A little-endian u32 that headers and buffers treat specially (sizes, NaN, infinity).
-const WORDS: &[u32] = &[0, 1, 0x7fff_ffff, 0xffff_ffff, 0x7fc0_0000, 0x7f80_0000, 0xff80_0000, 65536];
+const WORDS: &[u32] =
+    &[0, 1, 0x7fff_ffff, 0xffff_ffff, 0x7fc0_0000, 0x7f80_0000, 0xff80_0000, 65536];
 
 #[derive(Clone, Debug)]
 enum Mutation {
@@ -260,7 +261,8 @@ fn frames_that_measure_reads() {
         };
         let target = test.join(format!("0001.{kind}"));
         let original = std::fs::read(&target).unwrap();
-        let read = || tools::measure::Measured::read(&opts).map(|_| ()).map_err(|e| format!("{e:#}"));
+        let read =
+            || tools::measure::Measured::read(&opts).map(|_| ()).map_err(|e| format!("{e:#}"));
         read().expect("the unmutated frames are measured");
         fuzz(&original, None, &target, read, |e| e.contains("frame 1"));
     }
