@@ -122,13 +122,13 @@ const FRAMES: u32 = 8;
 
 /// A moving object, a warm-up frame, `methods` (TAA's history carries state across frames) and
 /// a reference at frame `reference`: a resume that skipped the replay would differ.
-fn write_scenario(dir: &Path, methods: &[&str], reference: u32) -> PathBuf {
+fn write_scenario(dir: &Path, methods: &[&str], reference: u32, frames: u32) -> PathBuf {
     let scenario = dir.join("moving.ron");
     std::fs::write(
         &scenario,
         format!(
             r#"Scenario(
-    scene: Builtin("cornell_box"), resolution: (8, 8), frames: {FRAMES}, warmup_frames: 1, seed: 5,
+    scene: Builtin("cornell_box"), resolution: (8, 8), frames: {frames}, warmup_frames: 1, seed: 5,
     max_depth: 2, methods: [{}],
     animations: [Rotate(entity: "tall_box", axis: (0, 1, 0), degrees_per_second: 90)],
     reference: (spp: 2, frames: List([{reference}])),
@@ -168,7 +168,7 @@ fn kill_after(mut cmd: Command, run: &Path, rows: usize, delay: Duration) -> boo
 fn runs_killed_at_random_frames_resume_to_the_uninterrupted_bytes() {
     let dir = scratch("sigkill");
     const METHODS: usize = 2;
-    let scenario = write_scenario(&dir, &["PathTracing(spp: 1)", "Taa()"], 3);
+    let scenario = write_scenario(&dir, &["PathTracing(spp: 1)", "Taa()"], 3, FRAMES);
     let seed =
         std::env::var("FLICKER_KILL_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or_else(nanos);
     eprintln!("FLICKER_KILL_SEED={seed}");
@@ -289,7 +289,9 @@ fn a_full_disk_stops_the_run_cleanly_during_frames_the_summary_and_a_cache_write
     let dir = scratch("full-disk");
     // Several methods: frames.csv (rewritten whole each frame) outgrows the manifest.
     let methods = ["PathTracing(spp: 1)", "Taa()", "PathTracing(spp: 2)", "HashCache()"];
-    let scenario = write_scenario(&dir, &methods, 3);
+    // Enough frames that frames.csv (about 500 bytes a frame) outgrows the manifest (6 KB).
+    const FULL_DISK_FRAMES: u32 = 24;
+    let scenario = write_scenario(&dir, &methods, 3, FULL_DISK_FRAMES);
     let full = dir.join("full");
     ok(run_cmd(flicker(), &scenario, &full, &dir.join("cache_full")).output().unwrap());
     // What the uninterrupted run wrote, by size.
@@ -311,7 +313,7 @@ fn a_full_disk_stops_the_run_cleanly_during_frames_the_summary_and_a_cache_write
     // The limit falls between two frames' tables, clear of both (time columns vary by a few
     // bytes a row from run to run).
     let floor = manifest.max(largest_image) + 1024;
-    let (stop, limit) = (2..FRAMES as usize)
+    let (stop, limit) = (2..FULL_DISK_FRAMES as usize)
         .find_map(|f| {
             let limit = blocks(floor.max(csv_after(f - 1) + 100));
             (limit * 512 + 100 < csv_after(f)).then_some((f, limit))
@@ -334,11 +336,11 @@ fn a_full_disk_stops_the_run_cleanly_during_frames_the_summary_and_a_cache_write
         .output()
         .unwrap();
     let last = check_stopped(&o, &run, &full, methods.len(), "complete", "writing the report");
-    assert_eq!(last, Some(FRAMES - 1));
+    assert_eq!(last, Some(FULL_DISK_FRAMES - 1));
 
     // A reference cache entry over the limit: at 32x32 every entry and image is, and the
     // reference of frame 0 is stored before frame 0's images are written.
-    let scenario = write_scenario(&dir, &methods[..1], 0);
+    let scenario = write_scenario(&dir, &methods[..1], 0, 2);
     let (run, cache) = (dir.join("cache_write"), dir.join("cache_big"));
     let mut cmd = run_cmd(flicker_limited(blocks(manifest + 1024)), &scenario, &run, &cache);
     let o = cmd.args(["--resolution", "32x32"]).output().unwrap();
