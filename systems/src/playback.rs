@@ -194,12 +194,14 @@ impl FrameWorld {
         self.schedule.run(&mut self.world);
         // A fault of the last stage: the stages' own checks catch the earlier ones.
         let fault = self.world.resource::<frame::GpuFaults>().0.take();
+        let owner = frame::last_owner().map_or(String::new(), |o| format!(", {o}"));
         match (frame::take_failure(), fault) {
-            (Some(e), _) => Err(anyhow!("{e}")),
-            (None, Some(fault)) => {
+            (Some(e), None) => Err(anyhow!("{e}")),
+            (failure, Some(fault)) => {
                 let run = self.world.resource::<Run>();
                 let frame = step.saturating_sub(warmup);
-                Err(anyhow!("frame {frame} at {}x{}: {fault}", run.width, run.height))
+                let then = failure.map_or(String::new(), |e| format!(" (then: {e})"));
+                Err(anyhow!("frame {frame} at {}x{}{owner}: {fault}{then}", run.width, run.height))
             }
             (None, None) => Ok(()),
         }

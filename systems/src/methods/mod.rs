@@ -60,8 +60,18 @@ pub fn plugins(methods: &[Method]) -> Vec<&'static dyn RegisteredMethod> {
 pub fn schedule_for(methods: &[Method]) -> Schedule {
     let mut schedule = crate::frame::new_schedule();
     crate::frame::add_core_systems(&mut schedule);
+    // Each system is owned by its method (or is the frame's own), so a GPU fault names it.
+    crate::frame::own_systems(&mut schedule, &Default::default(), None);
     for plugin in plugins(methods) {
+        let before = crate::frame::system_keys(&schedule);
         plugin.add_systems(&mut schedule);
+        let labels: Vec<String> = methods
+            .iter()
+            .filter(|m| m.spec.plugin().name() == plugin.name())
+            .map(Method::label)
+            .collect();
+        let owner = format!("method {}", labels.join(", "));
+        crate::frame::own_systems(&mut schedule, &before, Some(&owner));
     }
     schedule
 }
