@@ -9,6 +9,7 @@ pub mod data_uri;
 pub mod html;
 pub mod images;
 pub mod jod;
+pub mod page;
 pub mod run;
 pub mod summary;
 pub mod table;

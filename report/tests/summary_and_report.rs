@@ -179,3 +179,104 @@ fn minimal_run_without_reference_events_or_regions() {
     assert!(err.contains("manifest.json"), "{err}");
     std::fs::remove_dir_all(&run).ok();
 }
+
+/// A name as it must stand in the markup: text or a double-quoted attribute value.
+fn escaped(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// No hostile name, and none of their markup, is in `html` as it was written.
+fn assert_no_raw_names(html: &str) {
+    let names =
+        HOSTILE_METHODS.iter().chain(&HOSTILE_REGIONS).chain([&HOSTILE_SCENARIO, &HOSTILE_EVENT]);
+    for n in names {
+        assert!(!html.contains(n), "{n} is in the page unescaped");
+    }
+    for markup in ["<img src=x", "<svg onload", "<!--", "</script><img", "</script><svg"] {
+        assert!(!html.contains(markup), "{markup} is in the page");
+    }
+}
+
+/// The viewer's JSON in its <script> elements: no `<` (no `</script>` or `<!--` can end or
+/// change them), and the configuration reads back the panels' names as they were.
+fn assert_script_json(html: &str, labels: &[String]) {
+    let config = html
+        .split("<script type=\"application/json\" id=\"flicker-config\">")
+        .nth(1)
+        .and_then(|s| s.split("</script>").next())
+        .expect("no viewer configuration");
+    let config: serde_json::Value = serde_json::from_str(config).unwrap();
+    assert_eq!(config["labels"], serde_json::json!(labels));
+    let chunks: Vec<&str> = html
+        .split("<script>flickerFrame(")
+        .skip(1)
+        .map(|s| s.split("</script>").next().unwrap())
+        .collect();
+    assert!(!chunks.is_empty());
+    for c in chunks {
+        assert!(!c.contains('<'), "a frame's data holds `<`: {}", &c[..c.len().min(200)]);
+        let json = c.split_once(',').unwrap().1.trim_end().trim_end_matches(");");
+        let data: serde_json::Map<String, serde_json::Value> = serde_json::from_str(json).unwrap();
+        assert!(
+            data.keys().all(|k| labels.iter().any(|l| k.ends_with(l.as_str()))),
+            "{:?}",
+            data.keys()
+        );
+    }
+}
+
+#[test]
+fn report_page_escapes_every_name_a_scenario_sets() {
+    let run = hostile_run("hostile-report");
+    let html = std::fs::read_to_string(report::rebuild(&run).unwrap()).unwrap();
+    assert_no_raw_names(&html);
+    let (scenario, event) = (escaped(HOSTILE_SCENARIO), escaped(HOSTILE_EVENT));
+    let mut parts = vec![
+        format!("<title>flicker run: {scenario}</title>"),
+        format!("<h1>flicker run: {scenario}</h1>"),
+        format!("<p>Events: frame 4: {event}</p>"),
+        format!("title=\"frame 4: {event}\">▼</span>"),
+        escaped(&format!("\"scenario\": \"{}\"", HOSTILE_SCENARIO.replace('"', "\\\""))),
+    ];
+    for m in HOSTILE_METHODS.map(escaped) {
+        parts.push(format!("data-label=\"{m}\""));
+        parts.push(format!("<figcaption>{m}<span class=\"value\"></span></figcaption>"));
+        parts.push(format!("<td class=\"m\">{m}</td>"));
+    }
+    for r in HOSTILE_REGIONS.map(escaped) {
+        parts.push(format!("alt=\"crops {r} frame 0\""));
+        parts.push(format!("<figcaption>frame 4, {r}: reference, "));
+    }
+    for p in parts {
+        assert!(html.contains(&p), "{p} is not in report.html");
+    }
+    let labels: Vec<String> =
+        std::iter::once("reference").chain(HOSTILE_METHODS).map(String::from).collect();
+    assert_script_json(&html, &labels);
+    std::fs::remove_dir_all(&run).ok();
+}
+
+#[test]
+fn comparison_page_escapes_every_name_a_scenario_sets() {
+    let (a, b) = (hostile_run("hostile-compare-a"), hostile_run("hostile-compare-b"));
+    let page = report::compare::write_comparison(&a, &b, &b.join("compare.html")).unwrap();
+    let html = std::fs::read_to_string(page).unwrap();
+    assert_no_raw_names(&html);
+    let scenario = escaped(HOSTILE_SCENARIO);
+    let mut parts = vec![format!("<td class=\"m\">{scenario}</td>")];
+    for m in HOSTILE_METHODS.map(escaped) {
+        parts.push(format!("data-label=\"A: {m}\""));
+        parts.push(format!("<figcaption>B: {m}<span class=\"value\"></span></figcaption>"));
+        parts.push(format!("<tr><td class=\"m\">{m}</td><td class=\"m\">FLIP</td>"));
+    }
+    for p in parts {
+        assert!(html.contains(&p), "{p} is not in compare.html");
+    }
+    let mut labels = vec!["reference".to_string()];
+    for m in HOSTILE_METHODS {
+        labels.extend([format!("A: {m}"), format!("B: {m}")]);
+    }
+    assert_script_json(&html, &labels);
+    std::fs::remove_dir_all(&a).ok();
+    std::fs::remove_dir_all(&b).ok();
+}
