@@ -199,58 +199,6 @@ pub fn differences_html(a: &Summary, b: &Summary, frames_a: &Frames, frames_b: &
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::run::{Manifest, MethodMemory};
-    use crate::summary::summarize;
-
-    /// A method name as a scenario or a folder may set it: markup and quotes.
-    const HOSTILE: &str = "<img src=x onerror=alert(1)>\"'&";
-    const ESCAPED: &str = "&lt;img src=x onerror=alert(1)&gt;&quot;'&amp;";
-
-    /// Two methods, one with a hostile name, over 4 frames with an event at frame 2.
-    fn hostile_summary() -> (Summary, Frames) {
-        let csv =
-            format!("method,frame,flip\n{HOSTILE},0,0.1\n{HOSTILE},3,0.2\npt,0,0.3\npt,3,0.4\n");
-        let frames = Frames::parse(&csv, std::path::Path::new("frames.csv")).unwrap();
-        let manifest: Manifest = serde_json::from_value(serde_json::json!({
-            "scenario": HOSTILE, "frames": 4, "events": [{"frame": 2, "label": HOSTILE}],
-            "memory": {"methods": [{"label": HOSTILE, "device_bytes": 1048576}]}
-        }))
-        .unwrap();
-        (summarize(&manifest, &frames, 1), frames)
-    }
-
-    /// The name is in the markup only escaped, as the text of a method cell.
-    fn assert_escaped(html: &str, cell: &str) {
-        assert!(!html.contains("<img") && !html.contains(HOSTILE), "unescaped name: {html}");
-        assert!(html.contains(&format!("<td class=\"m\">{cell}</td>")), "no escaped cell: {html}");
-    }
-
-    #[test]
-    fn the_summary_table_escapes_method_names() {
-        let (summary, frames) = hostile_summary();
-        let html = html(&summary, &frames).into_string();
-        assert_escaped(&html, ESCAPED);
-        assert_eq!(html.matches(ESCAPED).count(), summary.windows.len(), "{html}");
-    }
-
-    #[test]
-    fn the_memory_table_escapes_method_names() {
-        let memory = crate::run::Memory {
-            methods: vec![MethodMemory { label: HOSTILE.into(), device_bytes: Some(1 << 20) }],
-            ..Default::default()
-        };
-        let html = memory_html(&memory).into_string();
-        assert_escaped(&html, &format!("device: {ESCAPED}"));
-        assert!(html.contains("<td>1.00</td>"), "{html}");
-    }
-
-    #[test]
-    fn the_differences_table_escapes_method_names() {
-        let (summary, frames) = hostile_summary();
-        let html = differences_html(&summary, &summary, &frames, &frames).into_string();
-        assert_escaped(&html, ESCAPED);
-    }
-
     #[test]
     fn best_follows_the_direction_and_ignores_ties_and_gaps() {
         let v = [Some(0.3), None, Some(0.1), Some(0.2)];

@@ -3,7 +3,10 @@
 mod common;
 
 use common::*;
-use report::run::Frames;
+use maud::html;
+use report::run::{Frames, Manifest, Memory, MethodMemory};
+use report::summary::{Summary, summarize};
+use report::{page, table};
 
 #[test]
 fn summary_windows_and_means() {
@@ -279,4 +282,82 @@ fn comparison_page_escapes_every_name_a_scenario_sets() {
     assert_script_json(&html, &labels);
     std::fs::remove_dir_all(&a).ok();
     std::fs::remove_dir_all(&b).ok();
+}
+
+// The page builders, each with a name holding markup and quotes.
+
+/// A method name as a scenario or a folder may set it: markup and quotes.
+const HOSTILE_NAME: &str = "<img src=x onerror=alert(1)>\"'&";
+const ESCAPED: &str = "&lt;img src=x onerror=alert(1)&gt;&quot;'&amp;";
+
+/// Two methods, one with a hostile name, over 4 frames with an event at frame 2.
+fn hostile_summary() -> (Summary, Frames) {
+    let csv = format!(
+        "method,frame,flip\n{HOSTILE_NAME},0,0.1\n{HOSTILE_NAME},3,0.2\npt,0,0.3\npt,3,0.4\n"
+    );
+    let frames = Frames::parse(&csv, std::path::Path::new("frames.csv")).unwrap();
+    let manifest: Manifest = serde_json::from_value(serde_json::json!({
+        "scenario": HOSTILE_NAME, "frames": 4, "events": [{"frame": 2, "label": HOSTILE_NAME}],
+        "memory": {"methods": [{"label": HOSTILE_NAME, "device_bytes": 1048576}]}
+    }))
+    .unwrap();
+    (summarize(&manifest, &frames, 1), frames)
+}
+
+/// The name is in the markup only escaped, as the text of a method cell.
+fn assert_escaped(html: &str, cell: &str) {
+    assert!(!html.contains("<img") && !html.contains(HOSTILE_NAME), "unescaped name: {html}");
+    assert!(html.contains(&format!("<td class=\"m\">{cell}</td>")), "no escaped cell: {html}");
+}
+
+#[test]
+fn the_summary_table_escapes_method_names() {
+    let (summary, frames) = hostile_summary();
+    let html = table::html(&summary, &frames).into_string();
+    assert_escaped(&html, ESCAPED);
+    assert_eq!(html.matches(ESCAPED).count(), summary.windows.len(), "{html}");
+}
+
+#[test]
+fn the_memory_table_escapes_method_names() {
+    let memory = Memory {
+        methods: vec![MethodMemory { label: HOSTILE_NAME.into(), device_bytes: Some(1 << 20) }],
+        ..Default::default()
+    };
+    let html = table::memory_html(&memory).into_string();
+    assert_escaped(&html, &format!("device: {ESCAPED}"));
+    assert!(html.contains("<td>1.00</td>"), "{html}");
+}
+
+#[test]
+fn the_differences_table_escapes_method_names() {
+    let (summary, frames) = hostile_summary();
+    let html = table::differences_html(&summary, &summary, &frames, &frames).into_string();
+    assert_escaped(&html, ESCAPED);
+}
+
+const HOSTILE_PAGE: &str = "<img src=x onerror=alert(1)>\"'&</script><!--";
+
+#[test]
+fn the_title_is_escaped_and_the_style_kept() {
+    let page = page::document(HOSTILE_PAGE, "p>b{color:red}", html! { p { "body" } });
+    assert!(page.starts_with("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"));
+    assert!(
+        page.contains(
+            "<title>&lt;img src=x onerror=alert(1)&gt;&quot;'&amp;&lt;/script&gt;&lt;!--</title>"
+        ),
+        "{page}"
+    );
+    assert!(
+        page.contains("<style>p>b{color:red}</style></head><body>\n<p>body</p></body></html>\n")
+    );
+    assert!(!page.contains("<img"), "{page}");
+}
+
+#[test]
+fn json_in_a_script_cannot_close_it_and_reads_back_the_same() {
+    let value = serde_json::json!({ "labels": [HOSTILE_PAGE], HOSTILE_PAGE: 1 });
+    let text = page::script_json(&value).0;
+    assert!(!text.contains('<'), "{text}");
+    assert_eq!(serde_json::from_str::<serde_json::Value>(&text).unwrap(), value);
 }
