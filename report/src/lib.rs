@@ -10,6 +10,7 @@ pub mod declared;
 pub mod html;
 pub mod images;
 pub mod jod;
+pub mod page;
 pub mod run;
 pub mod summary;
 pub mod table;

@@ -415,6 +415,7 @@ fn a_320x180_60_frame_6_method_report_shows_its_first_frame() {
         static_noise: false,
         time_step: Some(1.0 / 30.0),
         motion: false,
+        ..FakeRun::default()
     };
     let run = fake_run_with("large", &spec);
     let t = std::time::Instant::now();
