@@ -183,7 +183,7 @@ fn names_with_markup_and_quotes_are_text_in_report_and_comparison() {
     let work = a.join("browser");
     std::fs::create_dir_all(&work).unwrap();
 
-    let out = names_in_dom(&bin, &work, &report::rebuild(&a).unwrap());
+    let out = names_in_dom(&bin, &work, &report::rebuild(&a, &[]).unwrap());
     assert_inert(&out);
     let title = format!("flicker run: {HOSTILE_SCENARIO}");
     assert_eq!((out["title"].as_str(), out["h1"].as_str()), (Some(&*title), Some(&*title)));

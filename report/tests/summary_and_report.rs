@@ -231,7 +231,7 @@ fn assert_script_json(html: &str, labels: &[String]) {
 #[test]
 fn report_page_escapes_every_name_a_scenario_sets() {
     let run = hostile_run("hostile-report");
-    let html = std::fs::read_to_string(report::rebuild(&run).unwrap()).unwrap();
+    let html = std::fs::read_to_string(report::rebuild(&run, &[]).unwrap()).unwrap();
     assert_no_raw_names(&html);
     let (scenario, event) = (escaped(HOSTILE_SCENARIO), escaped(HOSTILE_EVENT));
     let mut parts = vec![
