@@ -57,9 +57,14 @@ pub struct Point {
 impl Point {
     /// `abc1234` or `abc1234-dirty`.
     pub fn label(&self) -> String {
-        let c: String = self.commit.chars().take(7).collect();
-        if self.dirty { format!("{c}-dirty") } else { c }
+        commit_label(&self.commit, self.dirty)
     }
+}
+
+/// A commit as a short label: `abc1234` or `abc1234-dirty`.
+fn commit_label(commit: &str, dirty: bool) -> String {
+    let c: String = commit.chars().take(7).collect();
+    if dirty { format!("{c}-dirty") } else { c }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -297,20 +302,10 @@ pub fn against_last(history: &[Record], now: &Record) -> Vec<Change> {
             (Some(m), Some(s)) => Some(m.max(s)),
             (m, s) => m.or(s),
         };
-        let label = Point {
-            commit: r.commit.clone(),
-            dirty: r.dirty,
-            date: r.date.clone(),
-            profile: r.profile.clone(),
-            entry: last.clone(),
-            repeats: Vec::new(),
-            flags: Vec::new(),
-        }
-        .label();
         out.push(Change {
             id: e.id.clone(),
             last: last.value.unwrap_or(f64::NAN),
-            last_commit: label,
+            last_commit: commit_label(&r.commit, r.dirty),
             now: value,
             spread,
         });
