@@ -551,13 +551,18 @@ fn main() -> ExitCode {
                 }),
             };
             played.map(|summary| {
-                println!(
-                    "wrote {} ({} frames; references: {} rendered, {} from cache)",
-                    summary.folder.display(),
-                    summary.records.len(),
-                    summary.references_rendered,
-                    summary.references_cached
-                );
+                if summary.records.is_empty() {
+                    // A resumed run whose frames were all written: only its report was.
+                    println!("wrote the summary of {}", summary.folder.display());
+                } else {
+                    println!(
+                        "wrote {} ({} frames; references: {} rendered, {} from cache)",
+                        summary.folder.display(),
+                        summary.records.len(),
+                        summary.references_rendered,
+                        summary.references_cached
+                    );
+                }
                 println!("report: {}", summary.report.display());
             })
         }

@@ -308,12 +308,14 @@ pub(crate) fn play(
     RunMemory::finish(world);
     manifest["memory"] = serde_json::to_value(world.resource::<RunMemory>())?;
     set_status(&mut manifest, Status::Complete, last_complete);
+    // The frames are all written; the report is not yet (a stop in between is resumable).
+    let pending = folder.report_pending();
+    std::fs::write(&pending, "").with_context(|| format!("writing {}", pending.display()))?;
     output::write_json(&folder.manifest(), &manifest)?;
     let records = std::mem::take(&mut world.resource_mut::<RunOutput>().records);
     let references = world.resource::<References>();
     let (rendered, cached) = (references.rendered, references.cached);
-    let report = report::rebuild(&folder.root, &crate::methods::registry::charts())
-        .with_context(|| format!("writing the report of {}", folder.root.display()))?;
+    let report = write_report(&folder)?;
     Ok(RunSummary {
         folder: folder.root,
         records,
@@ -321,6 +323,16 @@ pub(crate) fn play(
         references_cached: cached,
         report,
     })
+}
+
+/// The summary, JOD maps and report.html of a run whose frames are all written, then the
+/// removal of its `report.pending`.
+pub(crate) fn write_report(folder: &RunFolder) -> Result<PathBuf> {
+    let report = report::rebuild(&folder.root, &crate::methods::registry::charts())
+        .with_context(|| format!("writing the report of {}", folder.root.display()))?;
+    let pending = folder.report_pending();
+    std::fs::remove_file(&pending).with_context(|| format!("removing {}", pending.display()))?;
+    Ok(report)
 }
 
 /// The replayed frames' rows against those the interrupted run wrote.

@@ -41,16 +41,7 @@ pub struct StoredRun {
 /// column where the text has one.
 pub fn read(run: &Path) -> Result<StoredRun> {
     let manifest_file = run.join("manifest.json");
-    let bytes = std::fs::read(&manifest_file).with_context(|| {
-        format!(
-            "{}: cannot read it; expected a run folder of `flicker run`",
-            manifest_file.display()
-        )
-    })?;
-    // From bytes: invalid UTF-8 is an error at its line and column too.
-    let manifest: Value = serde_json::from_slice(&bytes).map_err(|e| {
-        anyhow!("{}:{}:{}: not valid JSON: {e}", manifest_file.display(), e.line(), e.column())
-    })?;
+    let manifest = read_manifest(run)?;
     let status = Status::of(&manifest);
     if status == Status::Complete {
         bail!("{}: the run is complete; nothing to resume", manifest_file.display());
@@ -93,7 +84,36 @@ pub fn read(run: &Path) -> Result<StoredRun> {
     Ok(StoredRun { manifest, status, origin, overrides, spec, frames_csv, from })
 }
 
+/// RUN/manifest.json, parsed; errors name the file (and the line and column of bad JSON).
+fn read_manifest(run: &Path) -> Result<Value> {
+    let manifest_file = run.join("manifest.json");
+    let bytes = std::fs::read(&manifest_file).with_context(|| {
+        format!(
+            "{}: cannot read it; expected a run folder of `flicker run`",
+            manifest_file.display()
+        )
+    })?;
+    // From bytes: invalid UTF-8 is an error at its line and column too.
+    serde_json::from_slice(&bytes).map_err(|e| {
+        anyhow!("{}:{}:{}: not valid JSON: {e}", manifest_file.display(), e.line(), e.column())
+    })
+}
+
 pub fn resume(run: &Path, cache_dir: Option<PathBuf>, progress: bool) -> Result<RunSummary> {
+    // Stopped after its last frame, while its report was being written: only the report is left.
+    let folder = crate::run_folder::RunFolder::new(run);
+    if folder.report_pending().exists() && Status::of(&read_manifest(run)?) == Status::Complete {
+        eprintln!("{}: every frame was written; writing its summary and report", run.display());
+        remove_temporaries(run)?;
+        let report = crate::playback::write_report(&folder)?;
+        return Ok(RunSummary {
+            folder: run.to_path_buf(),
+            records: Vec::new(),
+            references_rendered: 0,
+            references_cached: 0,
+            report,
+        });
+    }
     let StoredRun { manifest: stored, status, origin, overrides, spec, frames_csv, from } =
         read(run)?;
     let manifest_file = run.join("manifest.json");
