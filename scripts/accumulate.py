@@ -14,7 +14,7 @@ Writes OUT/NNNN.exr (linear RGB, the package's frame numbers) and a timings CSV 
 `flicker measure --timings` reads: `frame,ms,reproject,blend`, where `ms` is the whole frame
 (reading and writing the EXRs included: the rest becomes flicker's pass `other`).
 
-Needs numpy and the OpenEXR Python bindings (scripts/setup.sh installs them).
+Needs numpy and the OpenEXR Python bindings (scripts/setup-tests.sh installs them).
 """
 
 import argparse

@@ -1,7 +1,7 @@
 //! Sweeps end to end through the `flicker` program: a deterministic plan, bad sweep files at
 //! file:line, and one 8-job sweep (sweeps/taa_alpha.ron) run by the local executor and as an
 //! 8-task Slurm array on a one-node cluster this test starts on localhost (munged, slurmctld,
-//! slurmd; Debian's `slurm-wlm` and `munge`, installed by scripts/setup.sh), and through GNU
+//! slurmd; Debian's `slurm-wlm` and `munge`, installed by scripts/setup-tests.sh), and through GNU
 //! parallel reading the plan's job file. The merged summaries must agree in every number but
 //! the timings. `flicker reproduce --plan` of a small claims file runs on the same cluster and
 //! on the local executor, and `--judge-from` must write the report of a run played in one
@@ -252,7 +252,7 @@ impl Cluster {
         match c.spawn() {
             Ok(child) => self.daemons.push((name, child)),
             Err(e) => panic!(
-                "cannot start {program} ({e}); install Debian's slurm-wlm and munge (scripts/setup.sh){}",
+                "cannot start {program} ({e}); install Debian's slurm-wlm and munge (scripts/setup-tests.sh){}",
                 self.logs()
             ),
         }
@@ -546,7 +546,7 @@ fn sweep_runs_locally_and_on_slurm_with_identical_numbers() {
         .args(["--jobs", "2", "--halt", "now,fail=1"])
         .stdin(jobs)
         .output()
-        .expect("GNU parallel runs (scripts/setup.sh installs it)");
+        .expect("GNU parallel runs (scripts/setup-tests.sh installs it)");
     ok(&o, "parallel < jobs.txt");
     ok(&flicker(&["sweep", "merge", par.to_str().unwrap()]), "sweep merge (parallel)");
     assert_eq!(

@@ -83,8 +83,12 @@ fn the_walkthrough_runs_as_written() {
         link(&root().join(shared), &dir.join(shared));
     }
     link(Path::new(env!("CARGO_BIN_EXE_flicker")), &dir.join("bin/flicker"));
-    let path =
-        format!("{}:{}", dir.join("bin").display(), std::env::var("PATH").unwrap_or_default());
+    // The page's `python3` is the tests' interpreter (the checkout's .venv where it exists).
+    let path = format!(
+        "{}:{}",
+        dir.join("bin").display(),
+        metrics::python::path_with_interpreter().to_string_lossy()
+    );
 
     for step in &steps {
         match step {

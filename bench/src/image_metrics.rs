@@ -90,7 +90,7 @@ fn time_jod(width: u32, height: u32, repeats: u32) -> anyhow::Result<JodTiming> 
 
 /// `scripts/cvvdp_fixtures.py time`: the authors' ColorVideoVDP on the CPU, ms per frame.
 fn time_cvvdp(width: u32, height: u32) -> Result<f64, String> {
-    let installed = std::process::Command::new("python3")
+    let installed = std::process::Command::new(metrics::python::interpreter())
         .args(["-c", "import pycvvdp, torch"])
         .output()
         .is_ok_and(|o| o.status.success());
@@ -98,7 +98,7 @@ fn time_cvvdp(width: u32, height: u32) -> Result<f64, String> {
         return Err("cvvdp not installed".into());
     }
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../scripts/cvvdp_fixtures.py");
-    let out = std::process::Command::new("python3")
+    let out = std::process::Command::new(metrics::python::interpreter())
         .arg(script)
         .args(["time", &width.to_string(), &height.to_string(), &JOD_FRAMES.to_string()])
         .output()

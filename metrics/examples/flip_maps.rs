@@ -38,7 +38,11 @@ fn nvidia_map(reference: &Image, test: &Image, scratch: &Path) -> anyhow::Result
         DEFAULT_PPD,
         out.display().to_string()
     );
-    let run = Command::new("python3").args(["-c", &script]).output().context("python3")?;
+    let python = metrics::python::interpreter();
+    let run = Command::new(&python)
+        .args(["-c", &script])
+        .output()
+        .context(python.display().to_string())?;
     ensure!(
         run.status.success(),
         "flip_evaluator ({}): {}",

@@ -17,6 +17,7 @@ pub mod error;
 pub mod flip;
 pub mod image;
 pub mod ordered_sum;
+pub mod python;
 pub mod reference_flip;
 pub mod region;
 pub mod smape;

@@ -8,7 +8,7 @@ use anyhow::Context;
 
 /// NVIDIA's FLIP command-line tool, run through the Python module (no reliance on PATH entry points).
 pub fn reference_flip_command() -> Command {
-    let mut c = Command::new("python3");
+    let mut c = Command::new(crate::python::interpreter());
     c.args(["-m", "flip_evaluator.flip_python_api"]);
     c
 }
@@ -29,7 +29,7 @@ pub fn run_reference_flip(
         .args(["-ppd", &ppd.to_string(), "-nerm", "-nexm", "-v", "2"])
         .output()
         .context(
-            "cannot run python3 -m flip_evaluator.flip_python_api (pip install flip-evaluator)",
+            "cannot run python3 -m flip_evaluator.flip_python_api (scripts/setup-tests.sh installs it)",
         )?;
     let text = String::from_utf8_lossy(&out.stdout);
     anyhow::ensure!(

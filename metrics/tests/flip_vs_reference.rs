@@ -110,7 +110,7 @@ fn flip_matches_nvidia_reference() {
     // A missing tool fails the test: FLIP is never reported as validated when it was not.
     assert!(
         reference_flip_available(),
-        "NVIDIA's FLIP is not installed: `python3 -m flip_evaluator.flip_python_api -h` failed (run scripts/setup.sh, or pip install flip-evaluator)"
+        "NVIDIA's FLIP is not installed: `python3 -m flip_evaluator.flip_python_api -h` failed (run scripts/setup-tests.sh, or set FLICKER_PYTHON to a Python that has flip-evaluator)"
     );
     let dir = work_dir();
     let base = ldr_base();

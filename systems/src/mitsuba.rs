@@ -327,9 +327,10 @@ impl MitsubaRun {
     }
 }
 
-/// The Python that has Mitsuba 3, if any: `$FLICKER_PYTHON` or `python3`.
+/// The Python that has Mitsuba 3, if any (metrics::python's rule: `$FLICKER_PYTHON`, the
+/// checkout's .venv, or `python3`).
 pub fn python() -> Option<String> {
-    let python = std::env::var("FLICKER_PYTHON").unwrap_or_else(|_| "python3".into());
+    let python = metrics::python::interpreter().to_string_lossy().into_owned();
     let ok = Command::new(&python)
         .args(["-c", "import mitsuba"])
         .output()

@@ -1,6 +1,6 @@
 //! Our path tracer against an independent one: the Lambertian Cornell box rendered by the WGSL
 //! path tracer and by Mitsuba 3's scalar CPU path tracer (systems::mitsuba exports the scene;
-//! scripts/setup.sh installs Mitsuba). Both converge to the same image, so they agree pixel by
+//! scripts/setup-tests.sh installs Mitsuba). Both converge to the same image, so they agree pixel by
 //! pixel and in the image mean within the standard errors of the two estimates, each measured
 //! from the spread of K independent images (the statistics of systems/tests/mitsuba_matrix.rs).
 //! A fixed relative margin would not do: at 2048 paths per pixel the image mean of one render
@@ -24,7 +24,7 @@ fn lambertian_cornell_box_matches_mitsuba() {
     let (size, spp) = (16u32, 2048u32);
     let scene = systems::mitsuba::lambertian_cornell_box((size, size)).unwrap();
 
-    let python = python().expect("python3 with the mitsuba package (scripts/setup.sh installs it)");
+    let python = python().expect("a Python with the mitsuba package (scripts/setup-tests.sh installs it into .venv; FLICKER_PYTHON names another)");
     let dir = std::env::temp_dir().join(format!("flicker-mitsuba-{}", std::process::id()));
     let xml = write_scene(&scene, (size, size), &Integrator { max_depth: None, rr_depth: 3 }, &dir)
         .unwrap();

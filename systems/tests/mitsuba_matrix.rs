@@ -57,7 +57,7 @@ fn path_tracer_matches_mitsuba_over_the_matrix() {
     assert!(!cases.is_empty(), "no scene named in FLICKER_MITSUBA_CASES={only:?}");
 
     // Mitsuba: every scene exported, then rendered in one background process.
-    let python = python().expect("python3 with the mitsuba package (scripts/setup.sh installs it)");
+    let python = python().expect("a Python with the mitsuba package (scripts/setup-tests.sh installs it into .venv; FLICKER_PYTHON names another)");
     let dir = std::env::temp_dir().join(format!("flicker-mitsuba-matrix-{}", std::process::id()));
     let mut jobs = Vec::new();
     for case in &cases {

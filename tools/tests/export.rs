@@ -38,16 +38,16 @@ fn scene_only(scenario: &Path, out: &Path, frames: Option<u32>) -> PathBuf {
 }
 
 /// The Khronos validator's report of `glb` (scripts/gltf-validate.cjs). Missing, it fails the
-/// test: scripts/setup.sh installs it, and CI runs that.
+/// test: scripts/setup-tests.sh installs it, and CI runs that.
 fn validate(glb: &Path) -> serde_json::Value {
     let out = Command::new("node")
         .arg(root().join("scripts/gltf-validate.cjs"))
         .arg(glb)
         .output()
-        .expect("node runs (scripts/setup.sh installs Node.js and the glTF validator)");
+        .expect("node runs (scripts/setup-tests.sh installs Node.js and the glTF validator)");
     assert!(
         out.status.success(),
-        "the Khronos glTF validator did not run on {}: {} (scripts/setup.sh installs it)",
+        "the Khronos glTF validator did not run on {}: {} (scripts/setup-tests.sh installs it)",
         glb.display(),
         String::from_utf8_lossy(&out.stderr)
     );

@@ -10,7 +10,7 @@ pub fn chromium() -> PathBuf {
         .into_iter()
         .find(|c| Command::new(c).arg("--version").output().is_ok_and(|o| o.status.success()))
         .map(PathBuf::from)
-        .expect("chromium not found (run scripts/setup.sh, or apt-get install chromium)")
+        .expect("chromium not found (run scripts/setup-tests.sh, or apt-get install chromium)")
 }
 
 /// Inserted first in <head>: records console errors, uncaught exceptions and failed resource
