@@ -246,11 +246,21 @@ fn a_device_below_the_scenes_needs_fails_before_anything_is_written() {
 #[test]
 fn a_setting_that_sizes_a_buffer_over_the_limit_names_the_method_and_the_bytes() {
     let dir = scratch("setting");
-    // 16 bytes per slot: 3.2 GB of slots, inside the settings' range and over the adapter's
-    // buffer limit (lavapipe's is 2^31 - 1 bytes; a larger limit makes this test fail).
-    let capacity = 200_000_000u64;
+    // A device granted at most 1 GiB per buffer (the adapter's limit where smaller), so that a
+    // table one slot over it stays inside the setting's range on any adapter.
+    let cap = |l: u64| l.min(1 << 30);
+    let gpu = render::gpu::Gpu::with_device_limits(|adapter| wgpu::Limits {
+        max_buffer_size: cap(adapter.max_buffer_size),
+        max_storage_buffer_binding_size: cap(adapter.max_storage_buffer_binding_size),
+        ..adapter.clone()
+    })
+    .expect("a device with a 1 GiB buffer limit");
+    let limit = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
+    // 16 bytes per slot: one slot more than the limit holds.
+    let capacity = limit / 16 + 1;
     let (spec, opts) = spec(&dir, &format!("PathTracing(spp: 1), HashCache(capacity: {capacity})"));
-    let err = format!("{:#}", run_spec(&spec, &opts).err().expect("the table is too large"));
+    let err =
+        format!("{:#}", run_spec_on(&spec, &opts, gpu).err().expect("the table is too large"));
     eprintln!("{err}");
     let bytes = (capacity * 16).to_string();
     for part in ["faults.ron:3:", "preparing method hash_cache", "hash cache slots", &bytes] {
