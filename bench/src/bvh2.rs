@@ -1,4 +1,4 @@
-//! Binary BVHs (obvhs's `Bvh2`) in two levels, the alternative to the CWBVH that issue 17 asks
+//! Binary BVHs (obvhs's `Bvh2`) in two levels, the alternative to the CWBVH
 //! to measure: one BVH2 per mesh over its triangles (the same obvhs build parameters as
 //! [`Blas`](render::bvh::Blas)) and one over the instances' world boxes, with a CPU reference
 //! traversal through obvhs's own `Bvh2::ray_traverse` per level. Only the traversal tests and

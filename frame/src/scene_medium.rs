@@ -1,4 +1,4 @@
-//! The scenario's participating media in the frame (issue 13): every declared medium, baked on
+//! The scenario's participating media in the frame: every declared medium, baked on
 //! load and at every frame whose animation state changed (its grid and super-voxel grid rebuilt,
 //! `media::Medium::new`), on the GPU together for the volumetric path tracer
 //! (media::gpu::VolumePathPass, where their extinctions add) that renders the references of a

@@ -1,4 +1,4 @@
-//! Each method's effective temporal window (issue 15: compare methods at equal windows, or print
+//! Each method's effective temporal window (to compare methods at equal windows, or print
 //! each method's window in the report): the number of frames of a box filter that averages
 //! white per-frame noise down to the same variance as the method's temporal filter, 1 / Σ h_k²
 //! of its normalised impulse response h over frames.

@@ -1,7 +1,7 @@
 //! The independent check of JOD: our ColorVideoVDP (the colorvideovdp crate through
 //! metrics::cvvdp) against the scores of `cvvdp`, the authors' PyTorch implementation, on tiny
 //! sequences rendered from our own scenarios (scripts/cvvdp_fixtures.py renders and scores
-//! them; this test needs no Python). The bound, 0.01 JOD, is the issue's; the crate's authors
+//! them; this test needs no Python). The bound, 0.01 JOD, is the one the project set; the crate's authors
 //! report agreement within 3e-6.
 
 use std::path::{Path, PathBuf};

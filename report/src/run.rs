@@ -27,7 +27,7 @@ pub struct MethodSettings {
     #[serde(default)]
     pub label: String,
     /// Effective temporal window, frames (systems::methods::temporal_window); absent in runs
-    /// before issue 15 and for methods that state none.
+    /// before temporal windows were recorded and for methods that state none.
     #[serde(default)]
     pub temporal_window: Option<f64>,
 }

@@ -198,7 +198,7 @@ pub fn write_summary_with_window(run_dir: &Path, n: u32) -> anyhow::Result<()> {
 mod temporal_window_tests {
     use super::*;
 
-    /// Issue 15: each method's effective temporal window goes from the manifest into the
+    /// Each method's effective temporal window goes from the manifest into the
     /// summary and the summary table; runs that state none show no column.
     #[test]
     fn the_manifest_temporal_windows_reach_the_summary_table() {

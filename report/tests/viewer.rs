@@ -398,7 +398,7 @@ fn open_seconds(bin: &Path, work: &Path, page: &Path) -> (f64, String) {
     (t.elapsed().as_secs_f64(), String::from_utf8_lossy(&out.stdout).into_owned())
 }
 
-/// The size named in the issue: 320x180, 60 frames, 6 methods. It opens with its first frame
+/// The size the viewer must handle: 320x180, 60 frames, 6 methods. It opens with its first frame
 /// (the event's) shown in every panel, from linked frames; the opening time (browser start to the first frame
 /// on screen, less the browser's start on an empty page) is printed, not asserted: speed
 /// belongs in benchmarks.

@@ -278,7 +278,7 @@ fn method_errors_point_into_the_file() {
 #[test]
 fn paper_scale_scenarios_parse_with_the_controls_and_the_nrc_batch() {
     // scenarios/paper/ is for GPUs (CI never plays it): check here that each file and its methods
-    // parse, with the six methods of issue 10 and NRC's batch.
+    // parse, with the six methods and NRC's batch.
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/paper");
     let mut count = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {

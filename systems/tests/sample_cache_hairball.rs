@@ -1,4 +1,4 @@
-//! Issue 5 relations on a moving hairball camera (scenarios/hairball_camera.ron at 64x36): the
+//! The caches' relations on a moving hairball camera (scenarios/hairball_camera.ron at 64x36): the
 //! stable sample cache flickers less than 1 spp path tracing and than 1 spp + TAA at the same
 //! shading budget (one path per pixel per frame), adaptive retracing traces clearly fewer rays
 //! than multi, and it leaves less stale visibility (ghosting) than single. Relations, not numbers.
@@ -180,7 +180,7 @@ fn hairball_camera_scenario_plays_end_to_end() {
     ] {
         assert!(labels.contains(label), "{label} missing from {labels:?}");
     }
-    // Each method's effective temporal window is in the manifest (issue 15): TAA's exponential
+    // Each method's effective temporal window is in the manifest: TAA's exponential
     // blend (α 0.1: 19 frames); the cache's plain running mean (the default, the paper's main
     // results) has no fixed window, alone or under TAA, so none is stated.
     let manifest: serde_json::Value = serde_json::from_str(

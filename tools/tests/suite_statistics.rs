@@ -1,4 +1,4 @@
-//! The suite's statistics on synthetic data (issue 11's must-hold): a relative gate judged by
+//! The suite's statistics on synthetic data: a relative gate judged by
 //! `tools::suite::gate::judge`, the same path `flicker suite run` takes, on per-seed values
 //! drawn from normal distributions with a deterministic RNG (SplitMix64 + Box-Muller).
 //!

@@ -13,7 +13,7 @@
 //!   primary hits, albedo demodulated; with lod_scale 1 voxels are the largest power of two not
 //!   above the pixel footprint, i.e. smaller than a pixel, as its §5 chooses), and the paper runs
 //!   it under TAA (`taa: true`, what the reprojection scenarios run as `hash_cache_taa`).
-//!   [`HashCacheLookup::SecondaryHit`] (issue 5's variant, label `hash_cache_secondary_hit`)
+//!   [`HashCacheLookup::SecondaryHit`] (a variant, label `hash_cache_secondary_hit`)
 //!   terminates the first bounce into the cache at its hit and caches outgoing radiance there
 //!   (not albedo demodulated).
 //! - Keys: WGSL has no 64-bit atomics, so the paper's 64-bit (last access, checksum) word becomes
@@ -31,18 +31,18 @@
 //!   before the claimant is known.
 //! - Cells are not split into parent/child levels (that is the paper's Hybrid, not HashCache).
 //!
-//! Numbers below predate issue 15 (voxels then rounded up to a power of two, secondary-hit
-//! default); not rerun since. Issue 15's convergence numbers are in
+//! Numbers below predate the exact voxel sizes (voxels then rounded up to a power of two,
+//! secondary-hit default); not rerun since. Later convergence numbers are in
 //! docs/lab/sample-cache-passes.md.
 //!
-//! Numbers (lavapipe, 2 shared CPU cores; an earlier courtyard version of issue5_bench at 320x180,
+//! Numbers (lavapipe, 2 shared CPU cores; an earlier courtyard version of cache_methods_bench at 320x180,
 //! camera moving, max depth 4, median GPU ms): secondary-hit lookup hc_age 5.2,
 //! hc_trace 334, hc_update 581, hc_resolve 6.2 (occupancy 0.17 of 2^18 slots, 18k update paths
 //! for 57.6k pixels); first-hit lookup 6.6 / 152 / 503 / 4.3 (occupancy 0.07); TAA trace 1034,
 //! resolve 11. fast_turn.ron at 64x36: mean frame-to-frame SMAPE 1 spp 0.46, hash cache 0.39,
 //! TAA 0.15, hash cache + TAA 0.13; relMSE at the reference frames 0.072, 0.052, 0.015-0.027,
 //! 0.010-0.023. Hairball 320x180, max depth 3, idle machine (`cargo run -j2 -p bench --example
-//! issue5_bench -- 320 180 12`, table in docs/lab/sample-cache-fig7.md): hc_age 7.5,
+//! cache_methods_bench -- 320 180 12`, table in docs/lab/sample-cache-fig7.md): hc_age 7.5,
 //! hc_trace 537, hc_update 399, hc_resolve 3.5 ms; 141 027 rays and 64 211 shaded paths
 //! (57 600 pixels + update paths) per frame.
 
@@ -111,7 +111,7 @@ impl HcPass {
 pub enum HashCacheLookup {
     /// The paper (the default): cells at the primary hits, albedo demodulated, sub-pixel voxels.
     FirstHit,
-    /// Issue 5: the first bounce ends in the cache at its hit (outgoing radiance there).
+    /// The first bounce ends in the cache at its hit (outgoing radiance there).
     SecondaryHit,
 }
 

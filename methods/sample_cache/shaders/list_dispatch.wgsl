@@ -1,4 +1,4 @@
-// Indirect dispatch of the work lists (issue 15): one thread writes the workgroup counts of the
+// Indirect dispatch of the work lists: one thread writes the workgroup counts of the
 // retrace list (after retrace_main filled it) or of the shade list (after select_main), so that
 // retrace_list_main and shade_main launch one thread per entry instead of N · pixels threads
 // that exit past the list's end. The host copies the three words into its indirect buffer.

@@ -749,7 +749,7 @@ fn default_blend_weight_is_the_running_mean() {
     assert!(checked.iter().sum::<u32>() > 20, "samples checked per material {checked:?}");
 }
 
-/// Issue 15, item 5: TAA over the sample cache (`SampleCache::resolve_taa`, the paper's error
+/// TAA over the sample cache (`SampleCache::resolve_taa`, the paper's error
 /// figures run every method under TAA). Under a moving camera: TAA's input is the cache's image
 /// and, per pixel, the primary attributes of the pixel's closest visible sample (instance,
 /// depth, oriented normal, motion, checked here on the CPU from the cache's state); its output
@@ -840,7 +840,7 @@ fn taa_resolves_the_cache_image_with_its_closest_samples() {
     }
 }
 
-/// Issue 15, item 2: under a moving camera, mean HDR-FLIP of each cache against a path-traced
+/// Under a moving camera, mean HDR-FLIP of each cache against a path-traced
 /// reference of the same frame (256 spp, frames 5, 8 and 11 of 12; the room at 32x18, the
 /// camera sliding 0.04 per frame and turning). Each cache is below 1 spp path tracing at every
 /// seed's mean over those frames, by the one-sided 95% Student-t bound of the per-seed
@@ -934,7 +934,7 @@ fn moving_camera_keeps_the_caches_near_the_per_frame_references() {
     }
 }
 
-/// Issue 15, item 7: the list passes (retrace_list_main, shade_main) dispatched indirectly with
+/// The list passes (retrace_list_main, shade_main) dispatched indirectly with
 /// the workgroup counts the GPU wrote (`list_dispatch`'s twin, checked here against the lists'
 /// lengths) give the same image, counters and cached samples, bit for bit, as the direct dispatch over
 /// N · pixels threads: the lists and each entry's work do not depend on the launch.

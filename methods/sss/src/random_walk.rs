@@ -1,4 +1,4 @@
-//! The path-traced subsurface reference (issue 14's second reference): an analogue random walk in
+//! The path-traced subsurface reference (the second reference): an analogue random walk in
 //! a homogeneous half-space (z < 0, isotropic phase, index-matched boundary, f64 on the CPU),
 //! tallying where light leaves the surface. It measures the diffusion model's own bias:
 //! Burley's profile (with its A and d) against transport that does not approximate it, under a

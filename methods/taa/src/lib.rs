@@ -1,4 +1,4 @@
-//! Temporal anti-aliasing (TAA) over jittered 1 spp path tracing: the baseline of issue 5.
+//! Temporal anti-aliasing (TAA) over jittered 1 spp path tracing: the temporal baseline.
 //!
 //! Two passes per frame:
 //! - `taa_trace` (methods/taa/shaders/trace.wgsl, after the shading library): one path per pixel
@@ -25,9 +25,9 @@
 //! - the primary ray is traced twice (once for its attributes, once inside `path_radiance`).
 //!
 //! Cost (lavapipe on 2 shared CPU cores, courtyard 320x180, max depth 4, median GPU ms of 5
-//! frames, an earlier courtyard version of issue5_bench): taa_trace 1034, taa_resolve 11.
+//! frames, an earlier courtyard version of cache_methods_bench): taa_trace 1034, taa_resolve 11.
 //! Hairball 320x180, max depth 3, mean of 10 frames on an idle machine (`cargo run -j2 -p bench
-//! --example issue5_bench -- 320 180 12`, table in docs/lab/sample-cache-fig7.md):
+//! --example cache_methods_bench -- 320 180 12`, table in docs/lab/sample-cache-fig7.md):
 //! taa_trace 912, taa_resolve 10.8; 191 905 rays per frame (GPU counter).
 
 pub mod jitter;

@@ -1,4 +1,4 @@
-//! Volumetric path tracing of a scenario with a medium (issue 13; media::gpu::VolumePathPass):
+//! Volumetric path tracing of a scenario with a medium (media::gpu::VolumePathPass):
 //! delta tracking, ratio-tracked shadow rays and, with `mis` set, equiangular sampling of
 //! positional lights combined with free-flight sampling by Eq. 9 or Eq. 10 of the
 //! jackknife-transmittance paper with the naive, jackknife or Miller et al.'s weights. What the

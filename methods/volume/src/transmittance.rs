@@ -1,4 +1,4 @@
-//! Primary-ray transmittance images of a participating medium (issue 13; the paper's Figs. 8
+//! Primary-ray transmittance images of a participating medium (the paper's Figs. 8
 //! and 10): one instance per transmittance estimator (media::Estimator), `spp` estimates per
 //! pixel along the camera ray through the pixel centre. Its image is the mean transmittance;
 //! its extra images are the bias map (mean − exact) and the per-pixel standard deviation of one

@@ -1,4 +1,4 @@
-//! The subsurface test scene (realtime-sss-thesis.txt, issue 14): a head-sized "skin" sphere
+//! The subsurface test scene (realtime-sss-thesis.txt): a head-sized "skin" sphere
 //! on a floor under a point light "lamp", a bar casting a hard shadow edge across it (where
 //! scattering shows), two dim "candle" lights, and a hidden "bird" prototype for boids. The
 //! skin is a plain diffuse material here; a scenario makes it subsurface with a material

@@ -1,10 +1,10 @@
-//! Issue 5 speed, every method side by side in one run on the moving hairball camera
+//! The caches' speed, every method side by side in one run on the moving hairball camera
 //! (scenarios/hairball_camera.ron): 1 spp path tracing, TAA, the hash cache (alone and under
 //! TAA) and the stable sample cache with single / multi / adaptive retracing. Prints per-pass
 //! times (GPU timestamps where the adapter has them, else per-pass wall time), rays and shaded
 //! paths per frame, the sample cache's per-dispatch times, and the paper's figure-7 ratios.
 //!
-//! cargo run -j2 -p bench --example issue5_bench -- [WIDTH HEIGHT FRAMES]
+//! cargo run -j2 -p bench --example cache_methods_bench -- [WIDTH HEIGHT FRAMES]
 //! (run it on an idle machine: on llvmpipe, concurrent load distorts the pass times)
 
 use std::collections::BTreeMap;
@@ -57,7 +57,7 @@ fn main() -> anyhow::Result<()> {
     let (w, h, frames) = match args.as_slice() {
         [w, h, f] => (*w, *h, *f),
         [] => (320, 180, 8),
-        _ => anyhow::bail!("usage: issue5_bench [WIDTH HEIGHT FRAMES]"),
+        _ => anyhow::bail!("usage: cache_methods_bench [WIDTH HEIGHT FRAMES]"),
     };
     anyhow::ensure!(frames > WARM_UP, "FRAMES must exceed the {WARM_UP} warm-up frames");
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/hairball_camera.ron");
