@@ -8,11 +8,12 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use metrics::frames_csv::Frames;
 
 use crate::charts::build::{WrittenChart, write_charts};
 use crate::data_uri::data_uri;
 use crate::images::write_frame_images;
-use crate::run::{Frames, Manifest};
+use crate::run::Manifest;
 use crate::summary::{DEFAULT_WINDOW, summarize};
 use crate::{table, viewer};
 
@@ -70,7 +71,7 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
             fi.methods.iter().map(move |m| ((fi.frame, m.method.clone()), m.flip.clone()))
         })
         .collect();
-    let frame_count = frames.frame_count(&manifest);
+    let frame_count = manifest.frame_count(&frames);
     let out = viewer::Output { dir: run_dir, linked_dir: viewer::LINKED_DIR };
     let viewer = viewer::build(
         &out,

@@ -2,8 +2,10 @@
 
 use std::fmt::Write as _;
 
+use metrics::frames_csv::Frames;
+
 use crate::html::esc;
-use crate::run::{Frames, Memory};
+use crate::run::Memory;
 use crate::summary::Summary;
 
 /// Columns of the table, when present: (frames.csv column, heading, which way is better).

@@ -3,7 +3,7 @@
 mod common;
 
 use common::*;
-use report::run::Frames;
+use metrics::frames_csv::Frames;
 
 #[test]
 fn summary_windows_and_means() {

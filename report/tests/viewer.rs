@@ -495,7 +495,7 @@ fn compare_puts_two_runs_in_one_viewer_with_a_table_of_differences() {
     );
 
     // Differences: the overall SMAPE of each run, from its frames.csv; B flickers less.
-    let frames = |dir: &Path| report::run::Frames::load(dir).unwrap();
+    let frames = |dir: &Path| metrics::frames_csv::Frames::load(dir).unwrap();
     let mean_smape = |dir: &Path, method: &str| {
         let f = frames(dir);
         let v: Vec<f64> =

@@ -4,10 +4,11 @@
 use std::path::Path;
 
 use anyhow::Context;
+use metrics::frames_csv::Frames;
 
 use super::plot::{self, XMap};
 use super::{Chart, Kind, Series, pareto_front};
-use crate::run::{Frames, Manifest};
+use crate::run::Manifest;
 
 /// Human-readable names of the known columns.
 fn label(column: &str) -> String {
@@ -329,7 +330,7 @@ pub fn jod_chart(manifest: &Manifest, frames: &Frames, jod: &JodTable) -> Option
     if series.is_empty() {
         return None;
     }
-    let last = frames.frame_count(manifest) as f64;
+    let last = manifest.frame_count(frames) as f64;
     let chart = Chart {
         title: format!("JOD per window (ColorVideoVDP, 10 = invisible) — {}", manifest.scenario),
         x_label: "frame".into(),
