@@ -20,26 +20,10 @@ pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
     write_text(path, &text)
 }
 
-/// Linear HDR radiance as a 32-bit float RGBA OpenEXR file.
+/// Linear HDR radiance as a 32-bit float RGBA OpenEXR file, in the workspace's one EXR layout
+/// (`metrics::image::write_exr_pixels`: scan lines, which NVIDIA's FLIP tool reads).
 pub fn write_exr(path: &Path, width: u32, height: u32, rgba: &[[f32; 4]]) -> Result<()> {
-    anyhow::ensure!(
-        rgba.len() == (width * height) as usize,
-        "image of {width}x{height} has {} pixels",
-        rgba.len()
-    );
-    write_atomic(path, |w| {
-        let mut cursor = std::io::Cursor::new(Vec::new());
-        image::codecs::openexr::OpenExrEncoder::new(&mut cursor)
-            .write_image(
-                bytemuck::cast_slice(rgba),
-                width,
-                height,
-                image::ExtendedColorType::Rgba32F,
-            )
-            .with_context(|| format!("encoding {}", path.display()))?;
-        w.write_all(cursor.get_ref())?;
-        Ok(())
-    })
+    metrics::image::write_exr_pixels(path, width, height, metrics::image::ExrPixels::Rgba(rgba))
 }
 
 /// Tone-mapped 8-bit sRGB PNG of linear radiance.
