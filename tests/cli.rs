@@ -356,7 +356,7 @@ fn suite_exit_codes_summary_and_junit() {
         "{summary}"
     );
     let junit = std::fs::read_to_string(out.join("junit.xml")).unwrap();
-    assert!(junit.contains("tests=\"2\" failures=\"1\" errors=\"0\""), "{junit}");
+    assert!(junit.contains("tests=\"2\" skipped=\"0\" failures=\"1\" errors=\"0\""), "{junit}");
     assert!(
         out.join("box/seed_1/frames.csv").exists() && out.join("box/seed_2/report.html").exists()
     );

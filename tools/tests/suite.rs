@@ -47,7 +47,10 @@ fn smoke_suite_passes_against_its_baseline() {
     assert!(outcome.passed(), "smoke suite failed:\n{}", outcome.markdown);
     let junit = std::fs::read_to_string(&outcome.junit).unwrap();
     assert!(
-        junit.contains(&format!("tests=\"{}\" failures=\"0\" errors=\"0\"", outcome.results.len())),
+        junit.contains(&format!(
+            "tests=\"{}\" skipped=\"0\" failures=\"0\" errors=\"0\"",
+            outcome.results.len()
+        )),
         "{junit}"
     );
     // Each case's run folder has its report.
