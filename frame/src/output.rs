@@ -73,7 +73,8 @@ mod tests {
 
     #[test]
     fn exr_round_trips_and_leaves_no_temporary() {
-        let dir = std::env::temp_dir().join(format!("flicker-output-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         let path = dir.join("a/0000.exr");
         let px = vec![[0.25, 1.5, 1e3, 1.0], [0.0, 0.125, 7.0, 1.0]];
         write_exr(&path, 2, 1, &px).unwrap();
@@ -84,12 +85,12 @@ mod tests {
         write_png(&dir.join("a/0000.png"), 2, 1, &px, 1.0).unwrap();
         let png = image::open(dir.join("a/0000.png")).unwrap().into_rgb8();
         assert_eq!(png.dimensions(), (2, 1));
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn failed_write_keeps_the_old_file() {
-        let dir = std::env::temp_dir().join(format!("flicker-output-fail-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         let path = dir.join("keep.txt");
         write_text(&path, "old").unwrap();
         let err = write_atomic(&path, |w| {
@@ -99,6 +100,5 @@ mod tests {
         assert!(err.is_err());
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
         assert!(!tmp_path(&path).exists());
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
