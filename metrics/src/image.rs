@@ -194,7 +194,8 @@ mod tests {
 
     #[test]
     fn png_and_exr_round_trip() {
-        let dir = std::env::temp_dir().join(format!("metrics-image-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         std::fs::create_dir_all(&dir).unwrap();
         let img = Image::from_fn(7, 5, |x, y| [x as f32 / 6.0, y as f32 / 4.0, 0.25]);
         write_exr(&img, dir.join("a.exr")).unwrap();
@@ -208,7 +209,6 @@ mod tests {
         }
         let err = load_image(dir.join("a.jpg")).unwrap_err().to_string();
         assert!(err.contains("a.jpg") && err.contains(".png or .exr"), "{err}");
-        std::fs::remove_dir_all(&dir).ok();
     }
 
     /// A run's frames were written by `image`'s OpenEXR encoder (tiles) before they went through
@@ -230,11 +230,11 @@ mod tests {
         ::image::codecs::openexr::OpenExrEncoder::new(&mut tiled)
             .write_image(&bytes, w, h, ::image::ExtendedColorType::Rgba32F)
             .unwrap();
-        let dir = std::env::temp_dir().join(format!("metrics-image-rgba-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         let path = dir.join("a.exr");
         write_exr_pixels(&path, w, h, ExrPixels::Rgba(&px)).unwrap();
         let scan_lines = std::fs::read(&path).unwrap();
-        std::fs::remove_dir_all(&dir).ok();
         let layout = |bytes: &[u8]| {
             let meta = MetaData::read_from_buffered(std::io::Cursor::new(bytes), false).unwrap();
             meta.headers[0].blocks
