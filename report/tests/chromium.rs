@@ -63,7 +63,8 @@ fn check_page(bin: &Path, work: &Path, html: &str, name: &str) -> Outcome {
 #[test]
 fn report_displays_every_image_without_console_errors() {
     let bin = chromium();
-    let run = common::fake_run("chromium");
+    let tmp = common::fake_run("chromium");
+    let run = tmp.path().to_path_buf();
     let report = report::rebuild(&run).unwrap();
     let html = std::fs::read_to_string(&report).unwrap();
     let work = run.join("browser");
@@ -105,5 +106,4 @@ fn report_displays_every_image_without_console_errors() {
         inked as f64 > 0.01 * (img.width() * img.height()) as f64,
         "screenshot mostly blank ({inked} inked pixels)"
     );
-    std::fs::remove_dir_all(&run).ok();
 }

@@ -7,7 +7,8 @@ use metrics::frames_csv::Frames;
 
 #[test]
 fn summary_windows_and_means() {
-    let run = fake_run("summary");
+    let tmp = fake_run("summary");
+    let run = tmp.path().to_path_buf();
     report::write_summary_with_window(&run, 5).unwrap();
     let s = read_json(&run.join("summary.json"));
     let names: Vec<&str> =
@@ -59,12 +60,12 @@ fn summary_windows_and_means() {
         ema["means"]["after_event_0"]["smape"].as_f64().unwrap()
             > ema["means"]["before_first_event"]["smape"].as_f64().unwrap()
     );
-    std::fs::remove_dir_all(&run).ok();
 }
 
 #[test]
 fn report_is_self_contained_with_charts_maps_and_crops() {
-    let run = fake_run("report");
+    let tmp = fake_run("report");
+    let run = tmp.path().to_path_buf();
     let path = report::rebuild(&run).unwrap();
     assert_eq!(path, run.join("report.html"));
     let html = std::fs::read_to_string(&path).unwrap();
@@ -147,14 +148,13 @@ fn report_is_self_contained_with_charts_maps_and_crops() {
     assert!(svg.contains("rotate light") && svg.contains("pt_1spp") && svg.contains("cache_ema"));
     if let Some(keep) = std::env::var_os("FLICKER_KEEP_REPORT") {
         std::fs::rename(&run, keep).unwrap();
-        return;
     }
-    std::fs::remove_dir_all(&run).ok();
 }
 
 #[test]
 fn minimal_run_without_reference_events_or_regions() {
-    let run = std::env::temp_dir().join(format!("report-minimal-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tmp.path().to_path_buf();
     std::fs::create_dir_all(&run).unwrap();
     std::fs::write(run.join("manifest.json"), r#"{"scenario": "tiny", "methods": ["a"]}"#).unwrap();
     std::fs::write(
@@ -177,5 +177,4 @@ fn minimal_run_without_reference_events_or_regions() {
     std::fs::write(run.join("manifest.json"), "{").unwrap();
     let err = format!("{:#}", report::rebuild(&run).unwrap_err());
     assert!(err.contains("manifest.json"), "{err}");
-    std::fs::remove_dir_all(&run).ok();
 }
