@@ -12,12 +12,8 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
 }
 
-fn temp(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("flicker-suite-measured-{}-{name}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn temp(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("flicker-suite-measured-{name}-")).tempdir().unwrap()
 }
 
 fn options(suite: PathBuf, dir: &Path) -> SuiteOptions {
@@ -82,7 +78,8 @@ const SUITE: &str = r#"Suite(
 
 #[test]
 fn the_example_suite_passes_on_the_committed_frames() {
-    let dir = temp("example");
+    let tmp = temp("example");
+    let dir = tmp.path().to_path_buf();
     let path = root().join("suites/measured.ron");
     let outcome = run(&options(path.clone(), &dir)).expect("the example suite runs");
     eprintln!("{}", outcome.markdown);
@@ -92,12 +89,12 @@ fn the_example_suite_passes_on_the_committed_frames() {
     assert!(outcome.passed(), "{}", outcome.markdown);
     assert!(outcome.results.iter().any(|r| r.gate.starts_with("jod")));
     assert!(outcome.folder.join("flicker/seed_0/report.html").exists());
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn a_blessed_renderer_passes_and_fails_once_its_frames_get_noisier() {
-    let dir = temp("bless");
+    let tmp = temp("bless");
+    let dir = tmp.path().to_path_buf();
     renderer(&dir, 0.05);
     std::fs::write(dir.join("suite.ron"), SUITE).unwrap();
     let opts = options(dir.join("suite.ron"), &dir);
@@ -122,12 +119,12 @@ fn a_blessed_renderer_passes_and_fails_once_its_frames_get_noisier() {
         let expected = if relative { Verdict::Fail } else { Verdict::Pass };
         assert_eq!(r.verdict, expected, "{}: {}", r.gate, r.detail);
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn bad_frames_are_errors_at_the_case_line_and_nothing_is_written() {
-    let dir = temp("bad");
+    let tmp = temp("bad");
+    let dir = tmp.path().to_path_buf();
     renderer(&dir, 0.05);
     let small = dir.join("small_1");
     std::fs::create_dir_all(&small).unwrap();
@@ -203,5 +200,4 @@ fn bad_frames_are_errors_at_the_case_line_and_nothing_is_written() {
         (Path::new("dir/r"), Path::new("/abs/m"))
     );
     assert_eq!(ok.cases[0].seeds, [0]);
-    std::fs::remove_dir_all(&dir).ok();
 }
