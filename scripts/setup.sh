@@ -33,6 +33,10 @@ python3 -m flip_evaluator.flip_python_api -h >/dev/null
 # the reference that `flicker bench` measures the WGSL path tracer against.
 python3 -c "import mitsuba" 2>/dev/null || python3 -m pip install --quiet mitsuba==3.9.1
 python3 -c "import mitsuba"
+# numpy and the OpenEXR bindings, pinned: the walk-through's outside method (scripts/accumulate.py,
+# run by tests/walkthrough.rs) reads and writes the exported EXRs with them.
+python3 -c "import numpy, OpenEXR" 2>/dev/null || python3 -m pip install --quiet OpenEXR==3.5.3 numpy==2.4.6
+python3 -c "import numpy, OpenEXR"
 # The Khronos glTF validator, pinned, in the checkout's .tools/ (not global): tools/tests/export.rs
 # runs it through scripts/gltf-validate.cjs on every exported .glb.
 root="$(cd "$(dirname "$0")/.." && pwd)"

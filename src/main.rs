@@ -221,6 +221,29 @@ impl HistoryArgs {
             Err(e) => eprintln!("warning: results history not written: {e:#}"),
         }
     }
+
+    /// `append`, then each of the record's ratios against the last kept record of the same
+    /// bench, build and adapter, read against its run-to-run spread: a loss shows the day it
+    /// lands.
+    fn append_compared(&self, record: impl FnOnce() -> anyhow::Result<tools::history::Record>) {
+        if self.no_history {
+            return;
+        }
+        let record = match record() {
+            Ok(r) => r,
+            Err(e) => return eprintln!("warning: results history not written: {e:#}"),
+        };
+        let before = tools::history::read(&self.history);
+        self.append(|| Ok(record.clone()));
+        match before {
+            Ok(h) => {
+                let h: Vec<_> = h.into_iter().map(|(_, r)| r).collect();
+                let changes = tools::history::series::against_last(&h, &record);
+                print!("{}", tools::history::series::changes_markdown(&changes));
+            }
+            Err(e) => eprintln!("warning: results history not read: {e:#}"),
+        }
+    }
 }
 
 #[derive(Subcommand)]
@@ -528,13 +551,18 @@ fn main() -> ExitCode {
                 }),
             };
             played.map(|summary| {
-                println!(
-                    "wrote {} ({} frames; references: {} rendered, {} from cache)",
-                    summary.folder.display(),
-                    summary.records.len(),
-                    summary.references_rendered,
-                    summary.references_cached
-                );
+                if summary.records.is_empty() {
+                    // A resumed run whose frames were all written: only its report was.
+                    println!("wrote the summary of {}", summary.folder.display());
+                } else {
+                    println!(
+                        "wrote {} ({} frames; references: {} rendered, {} from cache)",
+                        summary.folder.display(),
+                        summary.records.len(),
+                        summary.references_rendered,
+                        summary.references_cached
+                    );
+                }
                 println!("report: {}", summary.report.display());
             })
         }
@@ -582,13 +610,14 @@ fn main() -> ExitCode {
         Command::Bench { out, json, memory: true, .. } => bench::command::memory(out, json),
         Command::Bench { out, json, metrics_only: true, repeats, history, .. } => {
             bench::command::metrics(out, json, repeats).map(|(adapter, entries)| {
-                history.append(|| Ok(bench::command::record("metrics", &adapter, entries)))
+                history.append_compared(|| Ok(bench::command::record("metrics", &adapter, entries)))
             })
         }
         Command::Bench { out, rays, frames, no_metrics, repeats, json, history, .. } => {
             bench::command::speed(out, json, rays, frames, no_metrics, repeats).map(
                 |(adapter, entries)| {
-                    history.append(|| Ok(bench::command::record("speed", &adapter, entries)))
+                    history
+                        .append_compared(|| Ok(bench::command::record("speed", &adapter, entries)))
                 },
             )
         }

@@ -18,7 +18,12 @@ pub struct ReportArgs {
 
 impl ReportArgs {
     pub fn options(self) -> report::ReportOptions {
-        report::ReportOptions { run_dir: self.run_dir, compare: self.compare, out: self.out }
+        report::ReportOptions {
+            run_dir: self.run_dir,
+            compare: self.compare,
+            out: self.out,
+            charts: systems::methods::registry::charts(),
+        }
     }
 }
 

@@ -1,4 +1,4 @@
-//! Every bad input a user can give `flicker run` or `flicker suite`: a clear error naming the
+//! Every bad input a user can give `flicker run`, `flicker suite` or `flicker measure`: a clear error naming the
 //! file (at line:column where there is one) and what was expected, nothing written, no panic.
 //! All but the last three fail before the GPU is opened.
 
@@ -121,6 +121,53 @@ fn a_missing_scenario_file_is_named() {
     assert!(err.contains("no_such.ron") && err.contains("cannot read"), "{err}");
 }
 
+/// `flicker measure --scenario` (the command line's path through a package): a package missing a
+/// reference frame, and timings one row short, are errors naming the file and frame, with
+/// nothing written; the good inputs are measured (so the errors come from the bad files).
+#[test]
+fn measure_names_a_packages_missing_frame_and_short_timings() {
+    let tmp = scratch("measure");
+    let dir = tmp.path().to_path_buf();
+    let package = dir.join("package");
+    let manifest = r#"{"format": "flicker-export", "frames": 4, "fps": 30.0,
+        "events": [{"frame": 2, "label": "toggle 'lamp'"}],
+        "cvvdp": {"display": "standard_fhd", "exposure": 1.0}, "smape_epsilon": 0.01,
+        "reference": {"dir": "reference", "spp": 4}}"#;
+    std::fs::create_dir_all(&package).unwrap();
+    std::fs::write(package.join("manifest.json"), manifest).unwrap();
+    for (folder, v) in [("reference", 0.5), ("mine", 0.45)] {
+        std::fs::create_dir_all(dir.join(folder)).unwrap();
+        for k in 0..4 {
+            let img = metrics::Image::filled(8, 8, [v + 0.01 * k as f32; 3]);
+            metrics::write_exr(&img, dir.join(folder).join(format!("{k:04}.exr"))).unwrap();
+        }
+    }
+    std::fs::rename(dir.join("reference"), package.join("reference")).unwrap();
+    std::fs::write(dir.join("short.csv"), "frame,ms\n0,1\n1,1\n2,1\n").unwrap();
+    std::fs::write(dir.join("good.csv"), "frame,ms\n0,1\n1,1\n2,1\n3,1.5\n").unwrap();
+    let out = dir.join("out");
+    let measure = |timings: &str| {
+        let (p, m, t, o) =
+            (package.to_str().unwrap(), dir.join("mine"), dir.join(timings), out.to_str().unwrap());
+        let (m, t) = (format!("mine={}", m.display()), format!("mine={}", t.display()));
+        vec!["measure", "--scenario", p, "--test", &m, "--timings", &t, "--out", o]
+            .into_iter()
+            .map(String::from)
+            .collect::<Vec<_>>()
+    };
+    let args = measure("short.csv");
+    let err = fails(&args.iter().map(String::as_str).collect::<Vec<_>>(), &out);
+    assert!(err.contains("short.csv") && err.contains("frame 3 is missing"), "{err}");
+    let args = measure("good.csv");
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let ok = flicker(&args);
+    assert!(ok.status.success(), "{}", text(&ok.stderr));
+    std::fs::remove_dir_all(&out).unwrap();
+    std::fs::remove_file(package.join("reference/0002.exr")).unwrap();
+    let err = fails(&args, &out);
+    assert!(err.contains("reference/0002.exr") && err.contains("frame 2 is missing"), "{err}");
+}
+
 #[test]
 fn an_unwritable_out_is_named_and_nothing_is_written() {
     let tmp = scratch("unwritable");
@@ -224,8 +271,12 @@ fn a_damaged_cached_reference_is_reported_and_rendered_again() {
     };
     let (stdout, _, rendered) = run("first");
     assert!(stdout.contains("1 rendered, 0 from cache"), "{stdout}");
-    let entries: Vec<PathBuf> =
-        std::fs::read_dir(cache.join("references")).unwrap().map(|e| e.unwrap().path()).collect();
+    // The entry, not its lock file (references/KEY.lock).
+    let entries: Vec<PathBuf> = std::fs::read_dir(cache.join("references"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "ref"))
+        .collect();
     assert_eq!(entries.len(), 1, "{entries:?}");
     let entry = &entries[0];
     let good = std::fs::read(entry).unwrap();

@@ -215,10 +215,10 @@ fn good_links_pass() {
     let files = [
         ("docs/methods/nirc.md", "# NIRC\n\n## Settings\n\ntext\n"),
         ("scenarios/cornell_box.ron", ""),
-        ("nirc/src/plugin.rs", ""),
+        ("methods/nirc/src/plugin.rs", ""),
     ];
     let text = "See [settings](methods/nirc.md#settings), [the box](../scenarios/cornell_box.ron), \
-                [code](../nirc/src/plugin.rs#L40-L60), [here](#top), [web](https://example.org/x#y), \
+                [code](../methods/nirc/src/plugin.rs#L40-L60), [here](#top), [web](https://example.org/x#y), \
                 [folder](../scenarios/).\n\n# Top\n";
     assert_eq!(fixture_check("docs/guide.md", text, &files), Vec::<String>::new());
 }

@@ -14,6 +14,7 @@ mod tables;
 use docs_common::{Doc, documents};
 use serde_shape::{Shape, struct_shape, variant_shape};
 use systems::methods::MethodPlugin;
+use systems::methods::registry::PluginVisitor;
 
 /// A settings type the documents may name in a marker: its path as the marker writes it and
 /// how to read its shape.
@@ -47,28 +48,37 @@ macro_rules! variant {
     };
 }
 
-/// `method!(Plugin => crate::path::Settings, "minimal")`: a shipped method's settings; the
-/// compiler checks that they are the plugin's `Settings`.
-macro_rules! method {
-    ($($plugin:ident)::+ => $($p:ident)::+, $minimal:expr) => {{
-        let _same: fn(<$($plugin)::+ as MethodPlugin>::Settings) -> $($p)::+ = |s| s;
-        (<$($plugin)::+ as MethodPlugin>::NAME, settings!($($p)::+, $minimal))
-    }};
+/// A method's settings: named as the type is defined (`sample_cache::settings::SampleCacheSettings`),
+/// which a marker may write as its crate's re-export (`sample_cache::SampleCacheSettings`), and
+/// read from the plugin's `MINIMAL_SETTINGS`.
+fn method_entry<P: MethodPlugin>() -> Entry {
+    Entry {
+        name: std::any::type_name::<P::Settings>().to_string(),
+        shape: || struct_shape::<P::Settings>(P::MINIMAL_SETTINGS),
+    }
 }
 
-/// The shipped methods' settings, by method name.
+/// The registered methods' settings, by method name, read from the registry.
 fn methods() -> Vec<(&'static str, Entry)> {
-    vec![
-        method!(path_tracing::Plugin => path_tracing::PathTracingSettings, "(spp: 1)"),
-        method!(nirc::plugin::Plugin => nirc::plugin::NircSettings, "(spp: 1)"),
-        method!(sample_cache::Plugin => sample_cache::SampleCacheSettings, "()"),
-        method!(taa::Plugin => taa::TaaSettings, "()"),
-        method!(hash_cache::Plugin => hash_cache::HashCacheSettings, "()"),
-        method!(volume::transmittance::Plugin => volume::transmittance::VolumeSettings, "()"),
-        method!(volume::path::Plugin => volume::path::VolumePathMethod, "()"),
-        method!(termination::Plugin => termination::TerminationSettings, "()"),
-        method!(sss::Plugin => sss::plugin::SssMethodSettings, "()"),
-    ]
+    struct Settings(Vec<(&'static str, Entry)>);
+    impl PluginVisitor for Settings {
+        fn visit<P: MethodPlugin>(&mut self) {
+            self.0.push((P::NAME, method_entry::<P>()));
+        }
+    }
+    let mut settings = Settings(Vec::new());
+    systems::methods::registry::visit_shipped(&mut settings);
+    settings.0
+}
+
+/// Whether a marker's path names the entry's type: the same path, or the same crate and type
+/// name (a re-export at the crate's root).
+fn names_entry(marker: &str, entry: &str) -> bool {
+    let ends = |p: &str| {
+        let mut parts = p.split("::");
+        (parts.next().map(str::to_string), p.rsplit("::").next().map(str::to_string))
+    };
+    marker == entry || (marker.split("::").count() == 2 && ends(marker) == ends(entry))
 }
 
 /// Every type that must have a table: the scenario file's, and every method's settings with
@@ -147,7 +157,8 @@ fn check_documents(docs: &[Doc], entries: &[Entry]) -> (Vec<String>, Vec<String>
             }
         };
         for table in tables {
-            let Some(entry) = entries.iter().find(|e| e.name == table.type_name) else {
+            let Some(entry) = entries.iter().find(|e| names_entry(&table.type_name, &e.name))
+            else {
                 errors.push(format!(
                     "{}: `{}` is no registered settings type (tests/docs_settings.rs's registry)",
                     table.place, table.type_name
@@ -158,7 +169,7 @@ fn check_documents(docs: &[Doc], entries: &[Entry]) -> (Vec<String>, Vec<String>
                 Ok(shape) => errors.extend(tables::check(&table, &shape, &linked)),
                 Err(e) => errors.push(format!("{}: {}: {e}", table.place, table.type_name)),
             }
-            documented.push(table.type_name);
+            documented.push(entry.name.clone());
         }
     }
     (errors, documented)

@@ -5,6 +5,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+mod run_common;
+use run_common::results;
+
 fn flicker() -> Command {
     Command::new(env!("CARGO_BIN_EXE_flicker"))
 }
@@ -25,19 +28,6 @@ fn files(dir: &Path) -> Vec<PathBuf> {
     }
     out.sort();
     out
-}
-
-/// frames.csv without the time columns (they differ from run to run).
-fn results(run: &Path) -> Vec<Vec<String>> {
-    let csv = std::fs::read_to_string(run.join("frames.csv")).unwrap();
-    let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
-    let keep: Vec<usize> = (0..rows[0].len())
-        .filter(|&c| {
-            let h = rows[0][c];
-            !(h == "cpu_ms" || h.ends_with("_ms") || h.contains("_ms_"))
-        })
-        .collect();
-    rows.iter().map(|r| keep.iter().map(|&c| r[c].to_string()).collect()).collect()
 }
 
 fn run_args(cmd: &mut Command, scenario: &Path, out: &Path, cache: &Path) {

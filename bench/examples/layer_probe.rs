@@ -1,4 +1,4 @@
-//! Where the register form came from (nirc/src/gpu/lane.rs): one 64x64 layer with one record per
+//! Where the register form came from (methods/nirc/src/gpu/lane.rs): one 64x64 layer with one record per
 //! invocation and its inputs in registers, the weights read at constant or loop-uniform offsets
 //! from uniform, storage or workgroup memory, against the tiled probes; then the tiled and the
 //! register-form inference side by side in one process.

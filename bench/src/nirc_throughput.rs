@@ -290,7 +290,7 @@ pub fn probes(gpu: &Gpu, reps: u32) -> Result<Probes, NircError> {
 
 /// One 64x64 layer with one record per invocation, its 64 inputs in named registers, the weights
 /// read from `kind` memory ("uniform", "storage", "workgroup"); with `unroll_q` every offset is
-/// a constant, else the 16 output quads are a loop (the register form's shape, nirc/src/gpu/lane.rs).
+/// a constant, else the 16 output quads are a loop (the register form's shape, methods/nirc/src/gpu/lane.rs).
 /// Kind "uniform2": "uniform" with two records per invocation, each weight load feeding both.
 /// GFLOP/s, and the seconds of pipeline creation plus the first dispatch (lavapipe compiles then).
 pub fn register_layer_probe(

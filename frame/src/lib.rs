@@ -32,8 +32,8 @@ pub use resources::{
 };
 pub use sim::ExtractedScene;
 pub use stage::{
-    GpuFaults, Stage, catch_failures, describe, failed, listing, method_failed, new_schedule,
-    take_failure,
+    GpuFaults, Stage, catch_failures, describe, failed, last_owner, listing, method_failed,
+    new_schedule, own_systems, system_keys, take_failure,
 };
 
 fn started(clock: Res<FrameClock>) -> bool {

@@ -1,7 +1,7 @@
 //! What a method is to the lab: a [`MethodPlugin`] owns everything the rest of the code asks of
 //! a method (its scenario name, label, samples per pixel, temporal window, the `--spp`
-//! override, its systems and how to build an instance), so that nothing outside its own file
-//! matches on which method it is. [`MethodSpec`] holds one method's settings behind that trait;
+//! override, its systems, how to build an instance, and the statistics and charts it records),
+//! so that nothing outside its own folder matches on which method it is. [`MethodSpec`] holds one method's settings behind that trait;
 //! the registry (`systems::methods::registry`) lists the plugins.
 
 use std::any::Any;
@@ -12,6 +12,8 @@ use anyhow::Result;
 use bevy_ecs::prelude::{Entity, Schedule, World};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
+
+pub use report::declared::{Better, ChartSeries, ImageStatistic, MethodChart, Source, Statistic};
 
 /// A method family, implemented once per method on a unit struct (`taa::Plugin`). Its settings
 /// are a serde struct; a scenario writes `NAME(field: value, ...)`.
@@ -28,6 +30,17 @@ pub trait MethodPlugin: Sync + Send + 'static {
 
     /// The scenario's name of the method, e.g. `SampleCache`.
     const NAME: &'static str;
+
+    /// The smallest entry of its settings a scenario may write: `()` where every field has a
+    /// default (the documentation test reads the settings' fields and defaults from it).
+    const MINIMAL_SETTINGS: &'static str = "()";
+
+    /// The statistics it records besides every method's numbers (its frames.csv `stats`, and
+    /// what `flicker reproduce` computes for it): claims and suites name them.
+    const STATISTICS: &'static [Statistic] = &[];
+
+    /// The charts its frames.csv columns get in the report.
+    const CHARTS: &'static [MethodChart] = &[];
 
     /// The label of an unnamed instance, e.g. `pt_4spp`: its folder and its rows' key.
     fn label(settings: &Self::Settings) -> String;
@@ -70,6 +83,8 @@ pub trait RegisteredMethod: Sync {
     ) -> Result<MethodSpec, ron::error::SpannedError>;
     fn add_systems(&self, schedule: &mut Schedule);
     fn sees_media(&self) -> bool;
+    fn statistics(&self) -> &'static [Statistic];
+    fn charts(&self) -> &'static [MethodChart];
 }
 
 /// The registry's entry of plugin `P` (`Registered::<taa::Plugin>::ENTRY`).
@@ -99,6 +114,14 @@ impl<P: MethodPlugin> RegisteredMethod for Registered<P> {
 
     fn sees_media(&self) -> bool {
         P::sees_media()
+    }
+
+    fn statistics(&self) -> &'static [Statistic] {
+        P::STATISTICS
+    }
+
+    fn charts(&self) -> &'static [MethodChart] {
+        P::CHARTS
     }
 }
 

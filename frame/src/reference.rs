@@ -94,7 +94,24 @@ pub fn render_reference(
     );
     let frame = clock.frame;
     let references = &mut *references;
-    let lookup = references.cache.lookup(&key, width, height);
+    let mut lookup = references.cache.lookup(&key, width, height);
+    // A miss takes the entry's lock and looks again: another run or sweep job may have rendered
+    // it meanwhile, and whoever holds the lock renders it while the others wait.
+    let lock = match lookup {
+        Lookup::Hit(_) => None,
+        Lookup::Miss | Lookup::Damaged(_) => {
+            let lock = references
+                .cache
+                .lock(&key, || {
+                    progress.0.set_message(format!(
+                        "reference {frame:04}: waiting for another run rendering it"
+                    ))
+                })
+                .map_err(failed)?;
+            lookup = references.cache.lookup(&key, width, height);
+            Some(lock)
+        }
+    };
     if let Lookup::Damaged(why) = &lookup {
         progress.0.suspend(|| {
             eprintln!("warning: reference cache entry damaged, rendering it again: {why}")
@@ -158,6 +175,7 @@ pub fn render_reference(
             px
         }
     };
+    drop(lock);
     let measured = measure::Frame::from_radiance(width, height, &pixels, None);
     references.current = Some((pixels, measured));
     Ok(())

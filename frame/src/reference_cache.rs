@@ -6,6 +6,12 @@
 //! An entry is one file, `references/KEY.ref`, written whole through a rename: a magic tag,
 //! width and height, the SHA-256 of the pixels, then the pixels (RGBA f32, little-endian). A
 //! truncated or altered entry fails its checksum and is rendered again, never used.
+//!
+//! Runs and sweep jobs that share a cache render each entry once: whoever misses takes an
+//! exclusive advisory lock on `references/KEY.lock` (std's `File::lock`: `flock` on Unix,
+//! `LockFileEx` on Windows), looks again, and renders only if the entry is still missing. The
+//! OS releases the lock when its holder exits or is killed, so a lock file left behind never
+//! blocks anyone; the files stay (removing one would race with a run waiting on it).
 
 use std::path::{Path, PathBuf};
 
@@ -94,6 +100,39 @@ impl ReferenceCache {
         }
     }
 
+    /// The lock file of an entry.
+    pub fn lock_path(&self, key: &str) -> PathBuf {
+        self.dir.join("references").join(format!("{key}.lock"))
+    }
+
+    /// Takes the entry's lock, waiting while another process holds it (`waiting` is called
+    /// once before the wait, to say so). Released when the returned guard drops or the
+    /// process ends, however it ends.
+    pub fn lock(&self, key: &str, waiting: impl FnOnce()) -> Result<EntryLock> {
+        let path = self.lock_path(key);
+        let fail = |what: &str, e: std::io::Error| {
+            anyhow::anyhow!("reference cache: cannot {what} {}: {e}", path.display())
+        };
+        if let Some(dir) = path.parent() {
+            std::fs::create_dir_all(dir).map_err(|e| fail("create the folder of", e))?;
+        }
+        let file = std::fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .map_err(|e| fail("open", e))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                waiting();
+                file.lock().map_err(|e| fail("lock", e))?;
+            }
+            Err(std::fs::TryLockError::Error(e)) => return Err(fail("lock", e)),
+        }
+        Ok(EntryLock { _file: file })
+    }
+
     pub fn store(&self, key: &str, width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<()> {
         anyhow::ensure!(
             pixels.len() == (width * height) as usize,
@@ -113,6 +152,11 @@ impl ReferenceCache {
             Ok(())
         })
     }
+}
+
+/// An entry's lock, held until dropped (or until the process ends).
+pub struct EntryLock {
+    _file: std::fs::File,
 }
 
 /// What the cache holds for a key.

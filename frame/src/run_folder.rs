@@ -7,6 +7,7 @@
 //! RUN/frames/METHOD/motion/NNNN.exr  motion vectors (R, G: pixels to the previous frame)
 //! RUN/reference/NNNN.exr         path-traced reference of frame NNNN, and NNNN.png
 //! RUN/summary.json, RUN/report.html, RUN/charts/
+//! RUN/report.pending             while a complete run's summary and report are being written
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -43,6 +44,13 @@ impl RunFolder {
         self.root.join("frames").join(method).join(name).join(format!("{frame:04}.{ext}"))
     }
 
+    /// Stands beside a manifest that says "complete" until the summary, the JOD maps and the
+    /// report are written: a run stopped in between is complete but its report is not, and
+    /// `--resume` writes it.
+    pub fn report_pending(&self) -> PathBuf {
+        self.root.join("report.pending")
+    }
+
     pub fn reference(&self, frame: u32, ext: &str) -> PathBuf {
         self.root.join("reference").join(format!("{frame:04}.{ext}"))
     }
@@ -66,7 +74,9 @@ impl RunFolder {
                 for entry in ["frames", "reference", "charts"] {
                     remove_if_exists(&self.root.join(entry))?;
                 }
-                for file in ["manifest.json", "frames.csv", "summary.json", "report.html"] {
+                for file in
+                    ["manifest.json", "frames.csv", "summary.json", "report.html", "report.pending"]
+                {
                     remove_if_exists(&self.root.join(file))?;
                 }
             }

@@ -2,11 +2,11 @@
 //! exactly one stage, and the stages run in order (../shared/DESIGN.md, "One frame").
 
 use std::cell::RefCell;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use bevy_ecs::error::{BevyError, ErrorContext, FallbackErrorHandler};
 use bevy_ecs::prelude::*;
-use bevy_ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
+use bevy_ecs::schedule::{ScheduleLabel, SingleThreadedExecutor, SystemKey};
 
 use crate::resources::{FrameClock, Run};
 
@@ -81,6 +81,9 @@ thread_local! {
     /// The first failure of the frame being run on this thread (the executor is single threaded,
     /// so systems and the error handler run on the caller's thread).
     static FAILURE: RefCell<Option<String>> = const { RefCell::new(None) };
+    /// Whose system's conditions were checked last in this frame (see [`own_systems`]): a GPU
+    /// fault found before the next system is theirs.
+    static LAST_OWNER: RefCell<Option<String>> = const { RefCell::new(None) };
 }
 
 fn record_failure(error: BevyError, context: ErrorContext) {
@@ -103,11 +106,58 @@ fn no_failure(
             false => format!("warm-up frame {}", c.global),
         });
         let size = run.map_or(String::new(), |r| format!(" at {}x{}", r.width, r.height));
+        let owner = last_owner().map_or(String::new(), |o| format!(", {o}"));
+        // A fault explains a system's error that followed it (a lost device fails every call
+        // after it): the fault comes first.
         FAILURE.with(|f| {
-            f.borrow_mut().get_or_insert(format!("{frame}{size}: {fault}"));
+            let mut f = f.borrow_mut();
+            let then = f.take().map_or(String::new(), |e| format!(" (then: {e})"));
+            *f = Some(format!("{frame}{size}{owner}: {fault}{then}"));
         });
     }
     FAILURE.with(|f| f.borrow().is_none())
+}
+
+/// Who ran the last system of this frame whose conditions were checked ([`own_systems`]):
+/// "method LABEL" or "system NAME".
+pub fn last_owner() -> Option<String> {
+    LAST_OWNER.with(|o| o.borrow().clone())
+}
+
+/// The systems of `schedule` (added so far).
+pub fn system_keys(schedule: &Schedule) -> HashSet<SystemKey> {
+    schedule.graph().systems.iter().map(|(key, _, _)| key).collect()
+}
+
+/// Makes each system of `schedule` not in `before` check for a GPU fault before it runs (the
+/// fault is then the previous system's owner's, and this system and the rest of the frame do
+/// not run), then record `owner` as the last to run. `None`: each system is its own owner
+/// ("system NAME"). A fault names the method whose pass caused it, not only the stage.
+pub fn own_systems(schedule: &mut Schedule, before: &HashSet<SystemKey>, owner: Option<&str>) {
+    let systems = &mut schedule.graph_mut().systems;
+    let added: Vec<(SystemKey, String)> = systems
+        .iter()
+        .filter(|(key, _, _)| !before.contains(key))
+        .map(|(key, system, _)| {
+            let name = system.name().to_string();
+            let short = name.rsplit("::").next().unwrap_or(&name).to_string();
+            (key, owner.map_or(format!("system {short}"), str::to_string))
+        })
+        .collect();
+    for (key, owner) in added {
+        let check = move |faults: Option<Res<GpuFaults>>,
+                          run: Option<Res<Run>>,
+                          clock: Option<Res<FrameClock>>| {
+            let ok = no_failure(faults, run, clock);
+            LAST_OWNER.with(|o| *o.borrow_mut() = Some(owner.clone()));
+            ok
+        };
+        let condition: bevy_ecs::schedule::BoxedCondition =
+            Box::new(IntoSystem::into_system(check));
+        if let Some(conditions) = systems.get_conditions_mut(key) {
+            conditions.push(bevy_ecs::schedule::ConditionWithAccess::new(condition));
+        }
+    }
 }
 
 /// The device's faults (out of memory, validation) during a frame: the next stage does not run,
@@ -124,6 +174,7 @@ pub fn catch_failures(world: &mut World) {
 
 /// The failure of the last frame run on this thread, if any (and clears it).
 pub fn take_failure() -> Option<String> {
+    LAST_OWNER.with(|o| o.borrow_mut().take());
     FAILURE.with(|f| f.borrow_mut().take())
 }
 

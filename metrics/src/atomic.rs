@@ -28,13 +28,13 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<()
     if result.is_err() {
         let _ = fs::remove_file(&tmp);
     }
-    result
+    // A full disk fails a write or a flush, whose errors do not say which file.
+    result.with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// [`write_atomic`] of bytes already in memory.
 pub fn write_bytes(path: &Path, bytes: impl AsRef<[u8]>) -> Result<()> {
     write_atomic(path, |w| Ok(w.write_all(bytes.as_ref())?))
-        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// The temporary file a write goes through before its rename.

@@ -1,6 +1,7 @@
 //! GPU faults as errors: wgpu reports an out-of-memory or validation error through the device's
-//! error handler, whose default panics. A run sends them to a [`FaultSink`] instead and ends
-//! with an error that names the pass (wgpu's label of the object at fault) and the size.
+//! error handler, whose default panics, and a lost device through its lost callback. A run
+//! sends them to a [`FaultSink`] instead and ends with an error that names the pass (wgpu's
+//! label of the object at fault) and the size.
 
 use std::sync::{Arc, Mutex};
 
@@ -66,6 +67,20 @@ impl Gpu {
                 *first = Some(describe(&error));
             }
         }));
+        // A lost device (a driver reset, a removed GPU, `destroy`) fails every later call:
+        // its cause is the fault to report, not the errors that follow from it.
+        let lost = sink.0.clone();
+        self.device.set_device_lost_callback(move |reason, message| {
+            let mut first = lost.lock().unwrap_or_else(|e| e.into_inner());
+            let text = format!("GPU device lost ({reason:?}): {message}");
+            match first.as_mut() {
+                Some(earlier) if !earlier.starts_with("GPU device lost") => {
+                    *earlier = format!("{text}; then {earlier}")
+                }
+                Some(_) => {}
+                None => *first = Some(text),
+            }
+        });
         sink
     }
 }

@@ -2,14 +2,15 @@
 //! viewer, each method of A beside the same method of B, and one table of their differences.
 
 use std::collections::HashMap;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
+use maud::html;
 use metrics::frames_csv::Frames;
 
-use crate::html::{STYLE, esc};
+use crate::html::STYLE;
 use crate::images::write_frame_images;
+use crate::page;
 use crate::run::Manifest;
 use crate::summary::{DEFAULT_WINDOW, summarize};
 use crate::viewer::{self, Panel};
@@ -78,43 +79,42 @@ pub fn write_comparison(run_a: &Path, run_b: &Path, out: &Path) -> anyhow::Resul
         &flip_maps,
     )?;
 
-    let mut h = String::new();
     let title = format!("flicker: {} vs {}", run_a.display(), run_b.display());
-    let _ = write!(
-        h,
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}{}</style></head><body>\n",
-        esc(&title),
-        viewer::STYLE
-    );
-    let _ = writeln!(h, "<h1>{}</h1>", esc(&title));
-    h.push_str("<table id=\"runs\"><tr><th>run</th><th>folder</th><th>scenario</th><th>commit</th><th>frames</th><th>methods</th></tr>\n");
-    for (tag, dir, m, list) in [("A", run_a, &ma, &methods_a), ("B", run_b, &mb, &methods_b)] {
-        let commit = m.raw.get("commit").and_then(|c| c.as_str()).unwrap_or("");
-        let _ = writeln!(
-            h,
-            "<tr><td class=\"m\">{tag}</td><td class=\"m\">{}</td><td class=\"m\">{}</td><td class=\"m\"><code>{}</code></td><td>{}</td><td class=\"m\">{}</td></tr>",
-            esc(&dir.display().to_string()),
-            esc(&m.scenario),
-            esc(commit),
-            m.frames.map(|f| f.to_string()).unwrap_or_default(),
-            esc(&list.join(", "))
-        );
-    }
-    h.push_str("</table>\n");
-    match &viewer {
-        Some(v) => h.push_str(&v.html),
-        None => h.push_str("<p>Neither run has frames on disk: nothing to view.</p>\n"),
-    }
     let (mut sa, mut sb) =
         (summarize(&ma, &fa, DEFAULT_WINDOW), summarize(&mb, &fb, DEFAULT_WINDOW));
     crate::summary::add_jod_from_file(&mut sa, run_a);
     crate::summary::add_jod_from_file(&mut sb, run_b);
-    h.push_str("<h2>Differences</h2><p>Overall means of each method found in both runs; green where B is better, red where it is worse.</p>\n");
-    h.push_str(&crate::table::differences_html(&sa, &sb, &fa, &fb));
-    if viewer.is_some() {
-        h.push_str(&viewer::script());
-    }
-    h.push_str("</body></html>\n");
+    let body = html! {
+        h1 { (title) } "\n"
+        table id="runs" {
+            tr { th { "run" } th { "folder" } th { "scenario" } th { "commit" } th { "frames" } th { "methods" } }
+            "\n"
+            @for (tag, dir, m, list) in [("A", run_a, &ma, &methods_a), ("B", run_b, &mb, &methods_b)] {
+                tr {
+                    td class="m" { (tag) }
+                    td class="m" { (dir.display().to_string()) }
+                    td class="m" { (m.scenario) }
+                    td class="m" { code { (m.raw.get("commit").and_then(|c| c.as_str()).unwrap_or("")) } }
+                    td { (m.frames.map(|f| f.to_string()).unwrap_or_default()) }
+                    td class="m" { (list.join(", ")) }
+                }
+                "\n"
+            }
+        }
+        "\n"
+        @match &viewer {
+            Some(v) => (v.html),
+            None => { p { "Neither run has frames on disk: nothing to view." } "\n" },
+        }
+        h2 { "Differences" }
+        p { "Overall means of each method found in both runs; green where B is better, red where it is worse." }
+        "\n"
+        (crate::table::differences_html(&sa, &sb, &fa, &fb))
+        @if viewer.is_some() {
+            (viewer::script())
+        }
+    };
+    let h = page::document(&title, &format!("{STYLE}{}", viewer::STYLE), body);
     metrics::atomic::write_bytes(out, h)?;
     Ok(out.to_path_buf())
 }

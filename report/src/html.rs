@@ -4,10 +4,10 @@
 //! viewer's frames are inlined up to a size threshold (see `viewer`).
 
 use std::collections::HashMap;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use maud::{Markup, html};
 use metrics::frames_csv::Frames;
 
 use crate::charts::build::{WrittenChart, write_charts};
@@ -15,11 +15,7 @@ use crate::data_uri::data_uri;
 use crate::images::write_frame_images;
 use crate::run::Manifest;
 use crate::summary::{DEFAULT_WINDOW, summarize};
-use crate::{table, viewer};
-
-pub fn esc(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
-}
+use crate::{page, table, viewer};
 
 fn png_uri(path: &Path) -> anyhow::Result<String> {
     let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
@@ -36,32 +32,34 @@ figure{display:inline-block;margin:6px;vertical-align:top}figcaption{font-size:1
 img.px{image-rendering:pixelated}pre{background:#f7f7f7;padding:10px;overflow:auto;font-size:12px}";
 
 /// A chart as an image; charts against frame carry where frames lie (for the cursor).
-fn chart_html(c: &WrittenChart) -> String {
-    let img = format!(
-        "<img class=\"chart-img\" src=\"{}\" alt=\"{}\">",
-        data_uri("image/svg+xml", c.svg.as_bytes()),
-        esc(&c.title)
-    );
-    match c.frame_axis {
-        Some(m) => format!(
-            "<figure class=\"chart\" data-f0=\"{}\" data-f1=\"{}\" data-x0=\"{}\" data-x1=\"{}\" data-w=\"{}\">{img}<div class=\"cursor\"></div></figure>\n",
-            m.v0,
-            m.v1,
-            m.x0,
-            m.x1,
-            crate::charts::WIDTH
-        ),
-        None => format!("<figure class=\"chart\">{img}</figure>\n"),
+fn chart_html(c: &WrittenChart) -> Markup {
+    let img = html! {
+        img class="chart-img" src=(data_uri("image/svg+xml", c.svg.as_bytes())) alt=(c.title);
+    };
+    html! {
+        @match c.frame_axis {
+            Some(m) => {
+                figure class="chart" data-f0=(m.v0) data-f1=(m.v1) data-x0=(m.x0) data-x1=(m.x1) data-w=(crate::charts::WIDTH) {
+                    (img) div class="cursor" {}
+                }
+            }
+            None => figure class="chart" { (img) },
+        }
+        "\n"
     }
 }
 
-/// Writes RUN/report.html (and the charts and error maps it shows); returns its path.
-pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
+/// Writes RUN/report.html (and the charts and error maps it shows, the methods' `declared`
+/// charts among them); returns its path.
+pub fn write_report(
+    run_dir: &Path,
+    declared: &[crate::declared::MethodChart],
+) -> anyhow::Result<PathBuf> {
     let manifest = Manifest::load(run_dir)?;
     let frames = Frames::load(run_dir)?;
     let mut summary = summarize(&manifest, &frames, DEFAULT_WINDOW);
     crate::summary::add_jod_from_file(&mut summary, run_dir);
-    let charts = write_charts(run_dir, &manifest, &frames)?;
+    let charts = write_charts(run_dir, &manifest, &frames, declared)?;
     let methods =
         if manifest.methods.is_empty() { frames.methods() } else { manifest.methods.clone() };
     let frame_images = write_frame_images(run_dir, &manifest, &methods)?;
@@ -81,101 +79,98 @@ pub fn write_report(run_dir: &Path) -> anyhow::Result<PathBuf> {
         &flip_maps,
     )?;
 
-    let mut h = String::new();
     let title = format!("flicker run: {}", manifest.scenario);
-    let _ = write!(
-        h,
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}{}</style></head><body>\n",
-        esc(&title),
-        viewer::STYLE
-    );
-    let _ = writeln!(h, "<h1>{}</h1>", esc(&title));
     let raw = &manifest.raw;
     let field = |k: &str| {
         raw.get(k).map(|v| v.to_string().trim_matches('"').to_string()).unwrap_or_default()
     };
-    let _ = writeln!(
-        h,
-        "<p>commit <code>{}</code> · seed {} · resolution {} · {} frames · methods: {}</p>",
-        esc(&field("commit")),
-        esc(&field("seed")),
-        esc(&field("resolution")),
-        esc(&field("frames")),
-        esc(&methods.join(", "))
-    );
-    if let Some(status) = raw.get("status").and_then(|s| s.as_str()).filter(|s| *s != "complete") {
-        let last = raw.get("last_complete_frame").and_then(|f| f.as_u64());
-        let _ = writeln!(
-            h,
-            "<p class=\"incomplete\"><strong>Incomplete run</strong> ({}): {}. Continue it with <code>flicker run --resume</code>.</p>",
-            esc(status),
-            last.map_or("no recorded frame was written".into(), |f| format!(
-                "frames 0 to {f} of {} were written",
-                field("frames")
-            ))
-        );
-    }
-    if !manifest.events.is_empty() {
-        let ev: Vec<String> = manifest
-            .events
-            .iter()
-            .map(|e| format!("frame {}: {}", e.frame, esc(&e.label)))
-            .collect();
-        let _ = writeln!(h, "<p>Events: {}</p>", ev.join(" · "));
-    }
-    match &viewer {
-        Some(v) => h.push_str(&v.html),
-        None => h.push_str("<p>No frames of this run are on disk: nothing to view.</p>\n"),
-    }
-
+    let status = raw.get("status").and_then(|s| s.as_str()).filter(|s| *s != "complete");
+    let written = |last: Option<u64>| {
+        last.map_or("no recorded frame was written".into(), |f| {
+            format!("frames 0 to {f} of {} were written", field("frames"))
+        })
+    };
     let (speed, per_frame): (Vec<&WrittenChart>, Vec<&WrittenChart>) =
         charts.iter().partition(|c| c.stem.starts_with("speed_vs_"));
-    if !speed.is_empty() {
-        h.push_str("<h2>Speed vs accuracy</h2><div class=\"charts\">\n");
-        speed.iter().for_each(|c| h.push_str(&chart_html(c)));
-        h.push_str("</div>\n");
-    }
-    let _ = writeln!(
-        h,
-        "<h2>Summary</h2><p>Means per method over frame windows (transient = {} frames after an event); the best method of each column is marked (↓ lower is better, ↑ higher).</p>",
-        summary.window_frames
-    );
-    h.push_str(&table::html(&summary, &frames));
-    if let Some(memory) = &summary.memory {
-        h.push_str("<h2>Memory</h2><p>Device memory of buffers and textures (wgpu's allocator report) and the process's peak resident memory over the frames.</p>\n");
-        h.push_str(&table::memory_html(memory));
-    }
-    if !per_frame.is_empty() {
-        h.push_str("<h2>Charts</h2><div class=\"charts\">\n");
-        per_frame.iter().for_each(|c| h.push_str(&chart_html(c)));
-        h.push_str("</div>\n");
-    }
-
-    let crops: Vec<_> =
-        frame_images.iter().flat_map(|fi| fi.crops.iter().map(move |c| (fi, c))).collect();
-    let any_crops = !crops.is_empty();
-    if any_crops {
-        h.push_str("<h2>Regions at reference frames</h2><div>\n");
-    }
-    for (fi, (region, path)) in crops {
-        let _ = writeln!(
-            h,
-            "<figure><img class=\"px crop\" src=\"{uri}\" alt=\"crops {name} frame {frame}\"><figcaption>frame {frame}, {name}: reference, {list} (FLIP maps below)</figcaption></figure>",
-            uri = png_uri(path)?,
-            name = esc(region),
-            frame = fi.frame,
-            list =
-                esc(&fi.methods.iter().map(|m| m.method.as_str()).collect::<Vec<_>>().join(", "))
-        );
-    }
-    if any_crops {
-        h.push_str("</div>\n");
-    }
-    let _ = writeln!(h, "<h2>Manifest</h2><pre>{}</pre>", esc(&serde_json::to_string_pretty(raw)?));
-    if viewer.is_some() {
-        h.push_str(&viewer::script());
-    }
-    h.push_str("</body></html>\n");
+    let crops: Vec<_> = frame_images
+        .iter()
+        .flat_map(|fi| fi.crops.iter().map(move |(region, path)| (fi, region, path)))
+        .map(|(fi, region, path)| Ok((fi, region, png_uri(path)?)))
+        .collect::<anyhow::Result<_>>()?;
+    let manifest_text = serde_json::to_string_pretty(raw)?;
+    let body = html! {
+        h1 { (title) } "\n"
+        p {
+            "commit " code { (field("commit")) } " · seed " (field("seed")) " · resolution " (field("resolution"))
+            " · " (field("frames")) " frames · methods: " (methods.join(", "))
+        }
+        "\n"
+        @if let Some(status) = status {
+            p class="incomplete" {
+                strong { "Incomplete run" } " (" (status) "): "
+                (written(raw.get("last_complete_frame").and_then(|f| f.as_u64())))
+                ". Continue it with " code { "flicker run --resume" } "."
+            }
+            "\n"
+        }
+        @if !manifest.events.is_empty() {
+            p {
+                "Events: "
+                @for (i, e) in manifest.events.iter().enumerate() {
+                    @if i > 0 { " · " }
+                    "frame " (e.frame) ": " (e.label)
+                }
+            }
+            "\n"
+        }
+        @match &viewer {
+            Some(v) => (v.html),
+            None => { p { "No frames of this run are on disk: nothing to view." } "\n" },
+        }
+        @if !speed.is_empty() {
+            h2 { "Speed vs accuracy" }
+            div class="charts" { "\n" @for c in &speed { (chart_html(c)) } }
+            "\n"
+        }
+        h2 { "Summary" }
+        p {
+            "Means per method over frame windows (transient = " (summary.window_frames)
+            " frames after an event); the best method of each column is marked (↓ lower is better, ↑ higher)."
+        }
+        "\n"
+        (table::html(&summary, &frames))
+        @if let Some(memory) = &summary.memory {
+            h2 { "Memory" }
+            p { "Device memory of buffers and textures (wgpu's allocator report) and the process's peak resident memory over the frames." }
+            "\n"
+            (table::memory_html(memory))
+        }
+        @if !per_frame.is_empty() {
+            h2 { "Charts" }
+            div class="charts" { "\n" @for c in &per_frame { (chart_html(c)) } }
+            "\n"
+        }
+        @if !crops.is_empty() {
+            h2 { "Regions at reference frames" }
+            div {
+                "\n"
+                @for (fi, region, uri) in &crops {
+                    @let list = fi.methods.iter().map(|m| m.method.as_str()).collect::<Vec<_>>().join(", ");
+                    figure {
+                        img class="px crop" src=(uri) alt={ "crops " (region) " frame " (fi.frame) };
+                        figcaption { "frame " (fi.frame) ", " (region) ": reference, " (list) " (FLIP maps below)" }
+                    }
+                    "\n"
+                }
+            }
+            "\n"
+        }
+        h2 { "Manifest" } pre { (manifest_text) } "\n"
+        @if viewer.is_some() {
+            (viewer::script())
+        }
+    };
+    let h = page::document(&title, &format!("{STYLE}{}", viewer::STYLE), body);
     let path = run_dir.join("report.html");
     metrics::atomic::write_bytes(&path, h)?;
     Ok(path)

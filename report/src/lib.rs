@@ -6,9 +6,11 @@
 pub mod charts;
 pub mod compare;
 pub mod data_uri;
+pub mod declared;
 pub mod html;
 pub mod images;
 pub mod jod;
+pub mod page;
 pub mod run;
 pub mod summary;
 pub mod table;
@@ -16,16 +18,20 @@ pub mod viewer;
 
 use std::path::{Path, PathBuf};
 
+use declared::MethodChart;
+
 pub use html::write_report;
 pub use summary::{DEFAULT_WINDOW, write_summary, write_summary_with_window};
 
 /// What [`report`] writes: a run's report (`run_dir`), or the comparison of two runs
-/// (`compare`, the page at `out`, by default RUN_B/compare.html).
+/// (`compare`, the page at `out`, by default RUN_B/compare.html); `charts`: the registered
+/// methods' charts, drawn where the run has their columns.
 #[derive(Clone, Debug, Default)]
 pub struct ReportOptions {
     pub run_dir: Option<PathBuf>,
     pub compare: Option<Vec<PathBuf>>,
     pub out: Option<PathBuf>,
+    pub charts: Vec<MethodChart>,
 }
 
 /// Rebuilds summary.json, the charts and report.html of a run folder, or writes the comparison
@@ -39,15 +45,16 @@ pub fn report(args: &ReportOptions) -> anyhow::Result<PathBuf> {
         (None, Some(_)) if args.out.is_some() => anyhow::bail!(
             "--out names the page of --compare; a run's report is RUN_DIR/report.html"
         ),
-        (None, Some(run_dir)) => rebuild(run_dir),
+        (None, Some(run_dir)) => rebuild(run_dir, &args.charts),
         (None, None) => anyhow::bail!("give a run folder, or --compare RUN_A RUN_B"),
     }
 }
 
-/// Writes summary.json then report.html (which writes the charts).
-pub fn rebuild(run_dir: &Path) -> anyhow::Result<PathBuf> {
+/// Writes summary.json then report.html (which writes the charts, `charts` among them where the
+/// run has their columns).
+pub fn rebuild(run_dir: &Path, charts: &[MethodChart]) -> anyhow::Result<PathBuf> {
     write_summary(run_dir)?;
-    write_report(run_dir)
+    write_report(run_dir, charts)
 }
 
 #[cfg(test)]
@@ -60,6 +67,7 @@ mod tests {
             run_dir: Some("runs/a".into()),
             compare: None,
             out: Some("c.html".into()),
+            charts: vec![],
         };
         assert!(format!("{:#}", report(&stray_out).unwrap_err()).contains("--out"));
     }

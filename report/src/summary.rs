@@ -217,7 +217,7 @@ mod temporal_window_tests {
         let windows: Vec<_> =
             summary.methods.iter().map(|m| (m.method.as_str(), m.temporal_window)).collect();
         assert_eq!(windows, [("taa", Some(19.0)), ("ssc", Some(76.0)), ("pt", None)]);
-        let html = crate::table::html(&summary, &frames);
+        let html = crate::table::html(&summary, &frames).into_string();
         assert!(html.contains("temporal window (frames)</th>"), "{html}");
         assert!(
             html.contains(">ssc</td><td>76.0</td>") && html.contains(">pt</td><td></td>"),
@@ -229,7 +229,8 @@ mod temporal_window_tests {
 
         let old: Manifest =
             serde_json::from_str(r#"{"scenario": "s", "methods": ["taa", "ssc", "pt"]}"#).unwrap();
-        let html = crate::table::html(&summarize(&old, &frames, DEFAULT_WINDOW), &frames);
+        let html =
+            crate::table::html(&summarize(&old, &frames, DEFAULT_WINDOW), &frames).into_string();
         assert!(!html.contains("temporal window"), "{html}");
     }
 }
@@ -252,7 +253,7 @@ mod memory_tests {
         let json = serde_json::to_value(&summary).unwrap();
         assert_eq!(json["memory"]["methods"][0]["device_bytes"], 1048576);
         assert_eq!(json["memory"]["peak_resident_bytes"], 104857600);
-        let html = crate::table::memory_html(summary.memory.as_ref().unwrap());
+        let html = crate::table::memory_html(summary.memory.as_ref().unwrap()).into_string();
         assert!(html.contains(">device: pt</td><td>1.00</td>"), "{html}");
         assert!(html.contains(">process: peak resident</td><td>100.00</td>"), "{html}");
         let old: Manifest =

@@ -1,10 +1,8 @@
 //! The summary table: means per method and frame window, the best method of each column marked.
 
-use std::fmt::Write as _;
-
+use maud::{Markup, html};
 use metrics::frames_csv::Frames;
 
-use crate::html::esc;
 use crate::run::Memory;
 use crate::summary::Summary;
 
@@ -67,89 +65,94 @@ fn cell(summary: &Summary, m: usize, w: &str, c: &str) -> Option<f64> {
     m.means.get(w).and_then(|means| means.get(c)).copied()
 }
 
-pub fn html(summary: &Summary, frames: &Frames) -> String {
+pub fn html(summary: &Summary, frames: &Frames) -> Markup {
     let cols: Vec<_> =
         COLUMNS.iter().copied().filter(|(c, ..)| shown(summary, frames, c)).collect();
-    let mut h =
-        String::from("<table id=\"summary\"><tr><th>window</th><th>frames</th><th>method</th>");
-    // Each method's effective temporal window (issue 15): compare flicker at equal windows.
+    // Each method's effective temporal window: compare flicker at equal windows.
     let temporal = summary.methods.iter().any(|m| m.temporal_window.is_some());
-    if temporal {
-        h.push_str("<th title=\"box-filter frames of equal noise variance, nominal (systems::methods::temporal_window)\">temporal window (frames)</th>");
-    }
-    for (_, name, better) in &cols {
-        let hint = match better {
-            Better::Lower => " ↓",
-            Better::Higher => " ↑",
-            Better::Neither => "",
-        };
-        let _ = write!(h, "<th>{name}{hint}</th>");
-    }
-    h.push_str("</tr>\n");
-    for w in &summary.windows {
-        let value = |m: usize, c: &str| cell(summary, m, &w.name, c);
-        let bests: Vec<Option<usize>> = cols
-            .iter()
-            .map(|(c, _, better)| {
-                best(&(0..summary.methods.len()).map(|m| value(m, c)).collect::<Vec<_>>(), *better)
-            })
-            .collect();
-        for (mi, m) in summary.methods.iter().enumerate() {
-            let _ = write!(
-                h,
-                "<tr><td class=\"m\">{}</td><td>{}–{}</td><td class=\"m\">{}</td>",
-                esc(&w.name),
-                w.first,
-                w.last,
-                esc(&m.method)
-            );
-            if temporal {
-                let _ = write!(
-                    h,
-                    "<td>{}</td>",
-                    m.temporal_window.map(|v| format!("{v:.1}")).unwrap_or_default()
-                );
+    let hint = |better: &Better| match better {
+        Better::Lower => " ↓",
+        Better::Higher => " ↑",
+        Better::Neither => "",
+    };
+    html! {
+        table id="summary" {
+            tr {
+                th { "window" } th { "frames" } th { "method" }
+                @if temporal {
+                    th title="box-filter frames of equal noise variance, nominal (systems::methods::temporal_window)" { "temporal window (frames)" }
+                }
+                @for (_, name, better) in &cols { th { (name) (hint(better)) } }
             }
-            for (ci, (c, ..)) in cols.iter().enumerate() {
-                let text = value(mi, c).map(|v| format!("{v:.4}")).unwrap_or_default();
-                if bests[ci] == Some(mi) {
-                    let _ =
-                        write!(h, "<td class=\"best\" title=\"best in this window\">{text}</td>");
-                } else {
-                    let _ = write!(h, "<td>{text}</td>");
+            "\n"
+            @for w in &summary.windows {
+                @let value = |m: usize, c: &str| cell(summary, m, &w.name, c);
+                @let bests: Vec<Option<usize>> = cols
+                    .iter()
+                    .map(|(c, _, better)| {
+                        best(&(0..summary.methods.len()).map(|m| value(m, c)).collect::<Vec<_>>(), *better)
+                    })
+                    .collect();
+                @for (mi, m) in summary.methods.iter().enumerate() {
+                    tr {
+                        td class="m" { (w.name) } td { (w.first) "–" (w.last) } td class="m" { (m.method) }
+                        @if temporal {
+                            td { (m.temporal_window.map(|v| format!("{v:.1}")).unwrap_or_default()) }
+                        }
+                        @for (ci, (c, ..)) in cols.iter().enumerate() {
+                            @let text = value(mi, c).map(|v| format!("{v:.4}")).unwrap_or_default();
+                            @if bests[ci] == Some(mi) {
+                                td class="best" title="best in this window" { (text) }
+                            } @else {
+                                td { (text) }
+                            }
+                        }
+                    }
+                    "\n"
                 }
             }
-            h.push_str("</tr>\n");
         }
+        "\n"
     }
-    h.push_str("</table>\n");
-    h
 }
 
 /// The run's memory: each method's device MiB, the scene's, the device MiB when the world was
 /// built and after the last frame, and the process's peak resident MiB.
-pub fn memory_html(memory: &Memory) -> String {
+pub fn memory_html(memory: &Memory) -> Markup {
     let mib =
         |b: Option<f64>| b.map(|b| format!("{:.2}", b / (1024.0 * 1024.0))).unwrap_or_default();
-    let mut h = String::from("<table id=\"memory\"><tr><th>what</th><th>MiB</th></tr>\n");
-    let mut row = |what: &str, bytes: Option<f64>| {
-        let _ = writeln!(h, "<tr><td class=\"m\">{}</td><td>{}</td></tr>", esc(what), mib(bytes));
-    };
-    for m in &memory.methods {
-        row(&format!("device: {}", m.label), m.device_bytes.map(|b| b as f64));
+    let mut rows: Vec<(String, Option<f64>)> = memory
+        .methods
+        .iter()
+        .map(|m| (format!("device: {}", m.label), m.device_bytes.map(|b| b as f64)))
+        .collect();
+    let f = |b: Option<u64>| b.map(|b| b as f64);
+    rows.extend(
+        [
+            ("device: scene", memory.scene_device_bytes.map(|b| b as f64)),
+            ("device: all, built", f(memory.device_bytes_built)),
+            ("device: all, after the last frame", f(memory.device_bytes_end)),
+            ("process: peak resident", f(memory.peak_resident_bytes)),
+            ("process: resident after the last frame", f(memory.resident_bytes_end)),
+        ]
+        .map(|(what, bytes)| (what.to_string(), bytes)),
+    );
+    html! {
+        table id="memory" {
+            tr { th { "what" } th { "MiB" } }
+            "\n"
+            @for (what, bytes) in &rows {
+                tr { td class="m" { (what) } td { (mib(*bytes)) } }
+                "\n"
+            }
+        }
+        "\n"
     }
-    row("device: scene", memory.scene_device_bytes.map(|b| b as f64));
-    row("device: all, built", memory.device_bytes_built.map(|b| b as f64));
-    row("device: all, after the last frame", memory.device_bytes_end.map(|b| b as f64));
-    row("process: peak resident", memory.peak_resident_bytes.map(|b| b as f64));
-    row("process: resident after the last frame", memory.resident_bytes_end.map(|b| b as f64));
-    h.push_str("</table>\n");
-    h
 }
 
 /// Two runs side by side: per method present in both, the overall mean of each column in A and
 /// in B, and B − A (relative, in %), coloured by whether B is better.
-pub fn differences_html(a: &Summary, b: &Summary, frames_a: &Frames, frames_b: &Frames) -> String {
+pub fn differences_html(a: &Summary, b: &Summary, frames_a: &Frames, frames_b: &Frames) -> Markup {
     let cols: Vec<_> = COLUMNS
         .iter()
         .copied()
@@ -159,39 +162,44 @@ pub fn differences_html(a: &Summary, b: &Summary, frames_a: &Frames, frames_b: &
         let m = s.methods.iter().position(|m| m.method == method)?;
         cell(s, m, "overall", c)
     };
-    let mut h = String::from(
-        "<table id=\"differences\"><tr><th>method</th><th>column</th><th>A</th><th>B</th><th>B − A</th><th>change</th></tr>\n",
-    );
-    for m in a.methods.iter().filter(|m| b.methods.iter().any(|n| n.method == m.method)) {
-        for (c, name, better) in &cols {
-            let (Some(va), Some(vb)) = (overall(a, &m.method, c), overall(b, &m.method, c)) else {
-                continue;
-            };
-            let d = vb - va;
-            let class = match (better, d.partial_cmp(&0.0)) {
-                (Better::Lower, Some(std::cmp::Ordering::Less))
-                | (Better::Higher, Some(std::cmp::Ordering::Greater)) => " class=\"better\"",
-                (Better::Lower, Some(std::cmp::Ordering::Greater))
-                | (Better::Higher, Some(std::cmp::Ordering::Less)) => " class=\"worse\"",
-                _ => "",
-            };
-            let rel =
-                if va != 0.0 { format!("{:+.1} %", 100.0 * d / va.abs()) } else { String::new() };
-            let _ = writeln!(
-                h,
-                "<tr><td class=\"m\">{}</td><td class=\"m\">{name}</td><td>{va:.4}</td><td>{vb:.4}</td><td{class}>{d:+.4}</td><td{class}>{rel}</td></tr>",
-                esc(&m.method)
-            );
+    let both = a.methods.iter().filter(|m| b.methods.iter().any(|n| n.method == m.method));
+    let rows: Vec<(&str, &str, f64, f64, Option<&str>)> = both
+        .flat_map(|m| {
+            cols.iter().filter_map(move |(c, name, better)| {
+                let (va, vb) = (overall(a, &m.method, c)?, overall(b, &m.method, c)?);
+                let class = match (better, (vb - va).partial_cmp(&0.0)) {
+                    (Better::Lower, Some(std::cmp::Ordering::Less))
+                    | (Better::Higher, Some(std::cmp::Ordering::Greater)) => Some("better"),
+                    (Better::Lower, Some(std::cmp::Ordering::Greater))
+                    | (Better::Higher, Some(std::cmp::Ordering::Less)) => Some("worse"),
+                    _ => None,
+                };
+                Some((m.method.as_str(), *name, va, vb, class))
+            })
+        })
+        .collect();
+    html! {
+        table id="differences" {
+            tr { th { "method" } th { "column" } th { "A" } th { "B" } th { "B − A" } th { "change" } }
+            "\n"
+            @for (method, name, va, vb, class) in rows {
+                @let d = vb - va;
+                @let rel = if va != 0.0 { format!("{:+.1} %", 100.0 * d / va.abs()) } else { String::new() };
+                tr {
+                    td class="m" { (method) } td class="m" { (name) }
+                    td { (format!("{va:.4}")) } td { (format!("{vb:.4}")) }
+                    td class=[class] { (format!("{d:+.4}")) } td class=[class] { (rel) }
+                }
+                "\n"
+            }
         }
+        "\n"
     }
-    h.push_str("</table>\n");
-    h
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
     #[test]
     fn best_follows_the_direction_and_ignores_ties_and_gaps() {
         let v = [Some(0.3), None, Some(0.1), Some(0.2)];

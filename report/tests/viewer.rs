@@ -22,7 +22,7 @@ fn viewer_run(name: &str) -> (FakeRun, tempfile::TempDir) {
         ..FakeRun::default()
     };
     let dir = fake_run_with(name, &spec);
-    report::rebuild(dir.path()).unwrap();
+    report::rebuild(dir.path(), &[]).unwrap();
     (spec, dir)
 }
 
@@ -415,11 +415,12 @@ fn a_320x180_60_frame_6_method_report_shows_its_first_frame() {
         static_noise: false,
         time_step: Some(1.0 / 30.0),
         motion: false,
+        ..FakeRun::default()
     };
     let tmp = fake_run_with("large", &spec);
     let run = tmp.path().to_path_buf();
     let t = std::time::Instant::now();
-    report::rebuild(&run).unwrap();
+    report::rebuild(&run, &[]).unwrap();
     let build_s = t.elapsed().as_secs_f64();
     let html = std::fs::read_to_string(run.join("report.html")).unwrap();
     let page = run.join("timed.html");
@@ -482,6 +483,7 @@ fn compare_puts_two_runs_in_one_viewer_with_a_table_of_differences() {
         run_dir: None,
         compare: Some(vec![a.clone(), b.clone()]),
         out: None,
+        charts: vec![],
     };
     let page = report::report(&args).unwrap();
     assert_eq!(page, b.join("compare.html"));

@@ -7,6 +7,7 @@
 //! used as the renderer's linear radiometric scale.
 
 use std::collections::HashMap;
+use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec2, Vec3};
@@ -51,7 +52,7 @@ fn to_rgba8(data: &gltf::image::Data) -> Result<Vec<u8>, String> {
             ));
         }
     };
-    let texels = (data.width * data.height) as usize;
+    let texels = data.width as usize * data.height as usize;
     if data.pixels.len() != texels * channels * bytes_per {
         return Err(format!(
             "{} bytes of pixels for {}x{}",
@@ -75,8 +76,8 @@ fn to_rgba8(data: &gltf::image::Data) -> Result<Vec<u8>, String> {
     Ok(out)
 }
 
-fn node_transform(t: gltf::scene::Transform) -> Transform {
-    match t {
+fn node_transform(t: gltf::scene::Transform) -> Result<Transform, String> {
+    let transform = match t {
         gltf::scene::Transform::Matrix { matrix } => {
             Transform::from_matrix(Mat4::from_cols_array_2d(&matrix))
         }
@@ -85,6 +86,22 @@ fn node_transform(t: gltf::scene::Transform) -> Transform {
             Quat::from_array(rotation).normalize(),
             Vec3::from(scale),
         ),
+    };
+    // A zero quaternion normalizes to NaN; an infinite number stays infinite.
+    let Transform { translation, rotation, scale } = transform;
+    match translation.is_finite() && rotation.is_finite() && scale.is_finite() {
+        true => Ok(transform),
+        false => Err(format!(
+            "transform (translation {translation}, rotation {rotation}, scale {scale}) is not finite; expected finite numbers and a non-zero rotation"
+        )),
+    }
+}
+
+/// An error naming the first of `numbers` (name, values) that is not finite.
+fn check_finite(numbers: &[(&str, Vec<f32>)]) -> Result<(), String> {
+    match numbers.iter().find(|(_, v)| v.iter().any(|x| !x.is_finite())) {
+        Some((name, v)) => Err(format!("{name} {v:?} is not finite; expected finite numbers")),
+        None => Ok(()),
     }
 }
 
@@ -113,6 +130,26 @@ fn read_primitive(
         .unwrap_or_default();
     if !uvs.is_empty() && uvs.len() != positions.len() {
         return Err(format!("{} TEXCOORD_0 for {} positions", uvs.len(), positions.len()));
+    }
+    // A non-finite number would reach the BVH and every shaded pixel: refused at its vertex.
+    for (what, values) in [
+        ("POSITION", positions.iter().map(|p| p.to_array().to_vec()).collect::<Vec<_>>()),
+        ("NORMAL", normals.iter().map(|n| n.to_array().to_vec()).collect()),
+        ("TEXCOORD_0", uvs.iter().map(|u| u.to_array().to_vec()).collect()),
+    ] {
+        if let Some(v) = values.iter().position(|v| v.iter().any(|c| !c.is_finite())) {
+            return Err(format!(
+                "{what} of vertex {v} is {:?}; expected finite numbers",
+                values[v]
+            ));
+        }
+    }
+    // Where the BVH's surface areas overflow (render::bvh::MAX_COORDINATE, refused there too).
+    if let Some(v) = positions.iter().position(|p| p.abs().max_element() > 1e18) {
+        return Err(format!(
+            "POSITION of vertex {v} is {}; expected coordinates within ±1e18",
+            positions[v]
+        ));
     }
     let flat: Vec<u32> = match reader.read_indices() {
         Some(i) => i.into_u32().collect(),
@@ -166,6 +203,23 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
     // A .glb may carry KHR_animation_pointer channels, which the `gltf` crate cannot read:
     // they are taken out first (crate::gltf_animation).
     let bytes = std::fs::read(path).map_err(|e| err("file", format!("cannot read: {e}")))?;
+    // The `gltf` crate panics on an image with no source (neither `uri` nor `bufferView`) or a
+    // `bufferView` image without `mimeType`; refused here first. A file that does not parse is
+    // reported by the import below.
+    if let Ok(parsed) = gltf::Gltf::from_slice(&bytes) {
+        for (i, image) in parsed.document.as_json().images.iter().enumerate() {
+            let missing = match (&image.buffer_view, &image.uri, &image.mime_type) {
+                (Some(_), _, None) => "a bufferView image without mimeType",
+                (None, None, _) => "neither uri nor bufferView",
+                _ => continue,
+            };
+            let part = label("image", image.name.as_deref(), i);
+            return Err(err(
+                &part,
+                format!("{missing}; expected a uri, or a bufferView and mimeType"),
+            ));
+        }
+    }
     let (doc, buffers, images, pointers) = if bytes.starts_with(b"glTF") {
         let (glb, pointers) =
             crate::gltf_animation::split_pointer_channels(&bytes).map_err(|m| err("file", m))?;
@@ -200,6 +254,17 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
             ),
             _ => None,
         };
+        let factors = [
+            ("baseColorFactor", c.to_vec()),
+            (
+                "emissiveFactor times emissiveStrength",
+                m.emissive_factor().map(|e| e * strength).to_vec(),
+            ),
+            ("roughnessFactor", vec![pbr.roughness_factor()]),
+            ("metallicFactor", vec![pbr.metallic_factor()]),
+            ("specularFactor", vec![m.specular().map_or(1.0, |s| s.specular_factor())]),
+        ];
+        check_finite(&factors).map_err(|e| err(&label("material", m.name(), i), e))?;
         let material = Material {
             base_color: Vec3::new(c[0], c[1], c[2]),
             base_color_texture: pbr
@@ -248,7 +313,13 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
         let name =
             node.name().map(str::to_string).unwrap_or_else(|| format!("node{}", node.index()));
         let part = label("node", node.name(), node.index());
-        let mut tn = NodeTemplate::new(name.clone(), node_transform(node.transform()));
+        // glTF's nodes form trees: a node reached twice (a cycle, or two parents) is refused
+        // before it loops or is spawned twice.
+        if indices.contains_key(&node.index()) {
+            return Err(err(&part, "is a child of two nodes or of itself; expected a tree".into()));
+        }
+        let transform = node_transform(node.transform()).map_err(|m| err(&part, m))?;
+        let mut tn = NodeTemplate::new(name.clone(), transform);
         tn.parent = parent;
         let mut extra_primitives = Vec::new();
         if let Some(mesh) = node.mesh() {
@@ -257,6 +328,18 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
             extra_primitives.extend(list.iter().skip(1).copied());
         }
         if let Some(light) = node.light() {
+            let mut numbers = vec![
+                ("color", light.color().to_vec()),
+                ("intensity", vec![light.intensity()]),
+                ("flicker_angular_radius", vec![angular_radius(light.extras())]),
+            ];
+            if let gltf::khr_lights_punctual::Kind::Spot { inner_cone_angle, outer_cone_angle } =
+                light.kind()
+            {
+                numbers.push(("spot cone angles", vec![inner_cone_angle, outer_cone_angle]));
+            }
+            let at = || format!("{part} light {}", light.index());
+            check_finite(&numbers).map_err(|m| err(&at(), m))?;
             let color = Vec3::from(light.color()) * light.intensity();
             tn.light = Some(match light.kind() {
                 gltf::khr_lights_punctual::Kind::Directional => Light::Directional {
@@ -280,6 +363,12 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
         }
         if let Some(camera) = node.camera() {
             match camera.projection() {
+                gltf::camera::Projection::Perspective(p) if !(p.yfov() > 0.0 && p.yfov() < PI) => {
+                    return Err(err(
+                        &format!("{part} {}", label("camera", camera.name(), camera.index())),
+                        format!("yfov {}; expected an angle in (0, pi) radians", p.yfov()),
+                    ));
+                }
                 gltf::camera::Projection::Perspective(p) => tn.camera = Some(p.yfov()),
                 gltf::camera::Projection::Orthographic(_) => {
                     return Err(err(

@@ -10,6 +10,7 @@ pub mod extract;
 pub mod finite;
 pub mod gltf_animation;
 pub mod gltf_import;
+pub mod meaningless;
 pub mod resources;
 pub mod rng;
 pub mod scenario;

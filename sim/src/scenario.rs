@@ -582,7 +582,7 @@ impl Scenario {
         };
         let output = file.output.unwrap_or_else(|| PathBuf::from("runs").join(&name));
         let methods = raw_entries(text, "methods", &file.methods);
-        Ok(Scenario {
+        let scenario = Scenario {
             name,
             scene,
             camera: file.camera,
@@ -605,7 +605,9 @@ impl Scenario {
             materials: file.materials,
             origin: origin.to_path_buf(),
             source: text.to_string(),
-        })
+        };
+        crate::meaningless::check(&scenario)?;
+        Ok(scenario)
     }
 
     /// Discrete changes by frame, for charts: scripted events and one-shot rotations.

@@ -291,6 +291,24 @@ impl Simulation {
             ..Default::default()
         };
         extract_dynamic(&mut world, &mut scene);
+        // A run whose frames say nothing is refused before any is rendered.
+        let authored: Vec<scene::Light> =
+            world.query::<&LightSource>().iter(&world).map(|l| l.0).collect();
+        let problem = crate::meaningless::degenerate_geometry(&scene)
+            .or_else(|| crate::meaningless::nothing_emits(scenario, &authored, &scene));
+        if let Some(message) = problem {
+            let text = &scenario.source;
+            let key = if message.starts_with("nothing") && scenario.environment.is_some() {
+                "environment"
+            } else {
+                "scene"
+            };
+            return Err(SimError::Invalid {
+                file: scenario.origin.clone(),
+                position: crate::meaningless::key_position(text, key),
+                message,
+            });
+        }
         world.insert_resource(ExtractedScene { scene, changes: SceneChanges::ALL });
 
         let mut schedule = Schedule::default();

@@ -142,10 +142,16 @@ mod tests {
         std::fs::write(
             &path,
             "Scenario(scene: Builtin(\"cornell_box\"), resolution: (8, 8), frames: 8, warmup_frames: 8, methods: [PathTracing(spp: 1)],
-    events: [(frame: 3, action: Toggle(entity: \"ceiling_light\")), (frame: 12, action: Toggle(entity: \"ceiling_light\")), (frame: 16, action: Toggle(entity: \"ceiling_light\"))])",
+    events: [(frame: 3, action: Toggle(entity: \"ceiling_light\")), (frame: 12, action: Toggle(entity: \"ceiling_light\"))])",
         )
         .unwrap();
-        let scenario = sim::Scenario::load(&path).unwrap();
+        let mut scenario = sim::Scenario::load(&path).unwrap();
+        // A file is refused with an event after its last frame (sim::meaningless); a scenario
+        // cut short by --frames can have one.
+        scenario.events.push(sim::scenario::EventSpec {
+            frame: 16,
+            action: sim::scenario::ActionSpec::Toggle { entity: "ceiling_light".into() },
+        });
         // Simulation frame 12 is recorded frame 4; 3 falls in the warm-up, 16 after the last frame.
         let frames: Vec<u32> = super::recorded_events(&scenario).into_iter().map(|e| e.0).collect();
         assert_eq!(frames, [4]);

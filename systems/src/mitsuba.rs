@@ -3,7 +3,8 @@
 //! systems/tests/mitsuba_matrix.rs compares it with pixel by pixel. The export covers triangle
 //! meshes in world space (OBJ, with uvs), base-colour textures (PNG, sRGB, bilinear, repeat),
 //! emissive materials as one-sided area lights, point lights, spot lights with a hard cone,
-//! delta directional lights, a constant environment and the pinhole camera. Materials are
+//! delta directional lights, a constant environment, the pinhole camera and media filling their
+//! box (homogeneous, or our baked density grid as a `gridvolume`). Materials are
 //! exported exactly, never approximately: Lambertian ones (specular and metallic 0) as Mitsuba's
 //! `diffuse`, a white near-mirror metal as `conductor` without Fresnel, and every other
 //! metallic-roughness material as the `gltf` plugin of scripts/mitsuba_gltf_bsdf.py (no stock
@@ -97,29 +98,61 @@ pub fn write_scene(
     write_scene_with_media(scene, &[], size, integrator, dir)
 }
 
-/// A homogeneous medium filling its box (boundary index-matched, isotropic phase, as our
-/// volumetric path tracer's) as Mitsuba's `homogeneous` inside a `cube` with a `null` BSDF.
-/// Refused: heterogeneous densities (our baked grid would have to become a Mitsuba grid
-/// volume), other bounds, emission and motion.
-fn medium_xml(m: &MediumDesc) -> Result<String> {
+/// A medium filling its box (boundary index-matched, isotropic phase, as our volumetric path
+/// tracer's) as a Mitsuba medium inside a `cube` with a `null` BSDF: a homogeneous one as
+/// `homogeneous`; any other density as `heterogeneous` over a `gridvolume` holding our baked
+/// grid itself (`media::DensityGrid`, written to `dir/medium_{index}.vol`), looked up
+/// nearest-neighbour as ours: voxel (i, j, k) covers [i, i + 1) x [j, j + 1) x [k, k + 1) of
+/// the box in voxel units, in both renderers. Refused: other bounds, emission and motion.
+fn medium_xml(m: &MediumDesc, index: usize, dir: &Path) -> Result<String> {
     let what = format!("medium '{}'", m.name);
-    if m.kind != DensityKind::Homogeneous {
-        bail!("{what}: only homogeneous media are exported, not {:?}", m.kind);
-    }
     if m.bound != scene::MediumBound::Box || m.emission.is_some() || !m.motion.is_still() {
         bail!("{what}: only a still, non-emissive medium filling its box is exported");
     }
     let (centre, half) = (0.5 * (m.box_min + m.box_max), 0.5 * (m.box_max - m.box_min));
     let v = |v: Vec3| format!("{} {} {}", v.x, v.y, v.z);
+    let medium = if m.kind == DensityKind::Homogeneous {
+        format!(
+            "<medium type=\"homogeneous\" name=\"interior\"><float name=\"sigma_t\" value=\"{}\"/>\
+             <rgb name=\"albedo\" value=\"{}\"/><phase type=\"isotropic\"/></medium>",
+            m.sigma_t,
+            v(m.albedo)
+        )
+    } else {
+        let grid = media::DensityGrid::from_desc(m);
+        let file = format!("medium_{index}.vol");
+        write_grid_volume(&grid, &dir.join(&file))?;
+        // The grid volume maps the unit cube to world space; Mitsuba ignores the file's box.
+        // Its majorant is the grid's maximum (exact for nearest-neighbour lookups).
+        format!(
+            "<medium type=\"heterogeneous\" name=\"interior\">\
+             <volume type=\"gridvolume\" name=\"sigma_t\"><string name=\"filename\" value=\"{file}\"/>\
+             <string name=\"filter_type\" value=\"nearest\"/><transform name=\"to_world\"><scale value=\"{}\"/>\
+             <translate value=\"{}\"/></transform></volume>\
+             <float name=\"scale\" value=\"1\"/><rgb name=\"albedo\" value=\"{}\"/><phase type=\"isotropic\"/></medium>",
+            v(grid.box_max - grid.box_min),
+            v(grid.box_min),
+            v(m.albedo)
+        )
+    };
     Ok(format!(
         "  <shape type=\"cube\"><transform name=\"to_world\"><scale value=\"{}\"/><translate value=\"{}\"/></transform>\
-         <bsdf type=\"null\"/>\n    <medium type=\"homogeneous\" name=\"interior\"><float name=\"sigma_t\" value=\"{}\"/>\
-         <rgb name=\"albedo\" value=\"{}\"/><phase type=\"isotropic\"/></medium></shape>\n",
+         <bsdf type=\"null\"/>\n    {medium}</shape>\n",
         v(half),
         v(centre),
-        m.sigma_t,
-        v(m.albedo)
     ))
+}
+
+/// Mitsuba's binary grid volume (`.vol`, version 3): "VOL", 3, encoding 1 (f32), the
+/// resolution, 1 channel, the bounding box, then the values with x fastest, then y, then z
+/// (`data[(z * ny + y) * nx + x]`, our `DensityGrid` order), all little-endian.
+fn write_grid_volume(grid: &media::DensityGrid, path: &Path) -> Result<()> {
+    let mut bytes = b"VOL\x03".to_vec();
+    let ints = [1, grid.res.x as i32, grid.res.y as i32, grid.res.z as i32, 1];
+    bytes.extend(ints.iter().flat_map(|i| i.to_le_bytes()));
+    let bbox = [grid.box_min.to_array(), grid.box_max.to_array()].concat();
+    bytes.extend(bbox.iter().chain(&grid.data).flat_map(|f| f.to_le_bytes()));
+    std::fs::write(path, bytes).with_context(|| format!("writing {}", path.display()))
 }
 
 /// [`write_scene`] with participating media (see [`medium_xml`]); Mitsuba's `volpath` then
@@ -269,8 +302,8 @@ pub fn write_scene_with_media(
         }
         xml.push_str("  </shape>\n");
     }
-    for m in media {
-        xml.push_str(&medium_xml(m)?);
+    for (i, m) in media.iter().enumerate() {
+        xml.push_str(&medium_xml(m, i, dir)?);
     }
     xml.push_str("</scene>\n");
     let path = dir.join("scene.xml");

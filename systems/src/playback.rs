@@ -194,12 +194,14 @@ impl FrameWorld {
         self.schedule.run(&mut self.world);
         // A fault of the last stage: the stages' own checks catch the earlier ones.
         let fault = self.world.resource::<frame::GpuFaults>().0.take();
+        let owner = frame::last_owner().map_or(String::new(), |o| format!(", {o}"));
         match (frame::take_failure(), fault) {
-            (Some(e), _) => Err(anyhow!("{e}")),
-            (None, Some(fault)) => {
+            (Some(e), None) => Err(anyhow!("{e}")),
+            (failure, Some(fault)) => {
                 let run = self.world.resource::<Run>();
                 let frame = step.saturating_sub(warmup);
-                Err(anyhow!("frame {frame} at {}x{}: {fault}", run.width, run.height))
+                let then = failure.map_or(String::new(), |e| format!(" (then: {e})"));
+                Err(anyhow!("frame {frame} at {}x{}{owner}: {fault}{then}", run.width, run.height))
             }
             (None, None) => Ok(()),
         }
@@ -285,7 +287,7 @@ pub(crate) fn play(
             }
             output::write_json(&folder.manifest(), &manifest)?;
             // What it has: the summary and the page of the frames so far (marked incomplete).
-            let report = report::rebuild(&folder.root);
+            let report = report::rebuild(&folder.root, &crate::methods::registry::charts());
             return Err(match error {
                 Some(e) => e,
                 None => {
@@ -306,12 +308,14 @@ pub(crate) fn play(
     RunMemory::finish(world);
     manifest["memory"] = serde_json::to_value(world.resource::<RunMemory>())?;
     set_status(&mut manifest, Status::Complete, last_complete);
+    // The frames are all written; the report is not yet (a stop in between is resumable).
+    let pending = folder.report_pending();
+    std::fs::write(&pending, "").with_context(|| format!("writing {}", pending.display()))?;
     output::write_json(&folder.manifest(), &manifest)?;
     let records = std::mem::take(&mut world.resource_mut::<RunOutput>().records);
     let references = world.resource::<References>();
     let (rendered, cached) = (references.rendered, references.cached);
-    let report = report::rebuild(&folder.root)
-        .with_context(|| format!("writing the report of {}", folder.root.display()))?;
+    let report = write_report(&folder)?;
     Ok(RunSummary {
         folder: folder.root,
         records,
@@ -319,6 +323,16 @@ pub(crate) fn play(
         references_cached: cached,
         report,
     })
+}
+
+/// The summary, JOD maps and report.html of a run whose frames are all written, then the
+/// removal of its `report.pending`.
+pub(crate) fn write_report(folder: &RunFolder) -> Result<PathBuf> {
+    let report = report::rebuild(&folder.root, &crate::methods::registry::charts())
+        .with_context(|| format!("writing the report of {}", folder.root.display()))?;
+    let pending = folder.report_pending();
+    std::fs::remove_file(&pending).with_context(|| format!("removing {}", pending.display()))?;
+    Ok(report)
 }
 
 /// The replayed frames' rows against those the interrupted run wrote.

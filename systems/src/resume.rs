@@ -22,31 +22,102 @@ use crate::scenario::{Overrides, RunSpec};
 const SAME: [&str; 8] =
     ["seed", "resolution", "frames", "warmup_frames", "methods", "reference", "adapter", "regions"];
 
-pub fn resume(run: &Path, cache_dir: Option<PathBuf>, progress: bool) -> Result<RunSummary> {
+/// What `--resume` reads from a run folder, read and checked before the GPU is touched.
+pub struct StoredRun {
+    /// manifest.json as written.
+    pub manifest: Value,
+    pub status: Status,
+    /// The scenario file the run was started from.
+    pub origin: PathBuf,
+    pub overrides: Overrides,
+    /// The manifest's scenario text with its overrides.
+    pub spec: RunSpec,
+    /// frames.csv as written (empty if the run wrote none).
+    pub frames_csv: String,
+    /// The first recorded frame that frames.csv does not hold.
+    pub from: u32,
+}
+
+/// Reads RUN/manifest.json and RUN/frames.csv; every error names the file, and the line and
+/// column where the text has one.
+pub fn read(run: &Path) -> Result<StoredRun> {
     let manifest_file = run.join("manifest.json");
-    let text = std::fs::read_to_string(&manifest_file).with_context(|| {
+    let manifest = read_manifest(run)?;
+    let status = Status::of(&manifest);
+    if status == Status::Complete {
+        bail!("{}: the run is complete; nothing to resume", manifest_file.display());
+    }
+    let field = |key: &str| {
+        manifest[key]
+            .as_str()
+            .ok_or_else(|| anyhow!("{}: expected a string field `{key}`", manifest_file.display()))
+    };
+    let origin = PathBuf::from(field("scenario_origin").or_else(|_| field("scenario_file"))?);
+    // The scenario's own errors are at its line and column; the manifest holds its text.
+    let in_manifest = |part: &str| format!("{}: {part}", manifest_file.display());
+    let scenario = sim::Scenario::from_ron(field("scenario_text")?, &origin)
+        .with_context(|| in_manifest("scenario_text"))?;
+    let overrides = stored_overrides(&manifest["settings"]["overrides"], run)
+        .with_context(|| in_manifest("settings.overrides"))?;
+    let spec = RunSpec::from_scenario(scenario, &overrides)
+        .with_context(|| in_manifest("scenario_text with settings.overrides"))?;
+    let csv_file = run.join("frames.csv");
+    let frames_csv = match std::fs::read(&csv_file) {
+        Ok(bytes) => String::from_utf8(bytes).map_err(|e| {
+            let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+            let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
+            anyhow!("{}:{line}: expected UTF-8 text: {}", csv_file.display(), e.utf8_error())
+        })?,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+        Err(e) => return Err(e).with_context(|| format!("reading {}", csv_file.display())),
+    };
+    let from = last_frame(&frames_csv, &csv_file)?.map_or(0, |f| f + 1);
+    if from > spec.scenario.frames {
+        bail!(
+            "{}:{}: frame {} is beyond the run's {} recorded frames; expected frames below {}",
+            csv_file.display(),
+            frames_csv.lines().count(),
+            from - 1,
+            spec.scenario.frames,
+            spec.scenario.frames
+        );
+    }
+    Ok(StoredRun { manifest, status, origin, overrides, spec, frames_csv, from })
+}
+
+/// RUN/manifest.json, parsed; errors name the file (and the line and column of bad JSON).
+fn read_manifest(run: &Path) -> Result<Value> {
+    let manifest_file = run.join("manifest.json");
+    let bytes = std::fs::read(&manifest_file).with_context(|| {
         format!(
             "{}: cannot read it; expected a run folder of `flicker run`",
             manifest_file.display()
         )
     })?;
-    let stored: Value = serde_json::from_str(&text).map_err(|e| {
+    // From bytes: invalid UTF-8 is an error at its line and column too.
+    serde_json::from_slice(&bytes).map_err(|e| {
         anyhow!("{}:{}:{}: not valid JSON: {e}", manifest_file.display(), e.line(), e.column())
-    })?;
-    let status = Status::of(&stored);
-    if status == Status::Complete {
-        bail!("{}: the run is complete; nothing to resume", manifest_file.display());
+    })
+}
+
+pub fn resume(run: &Path, cache_dir: Option<PathBuf>, progress: bool) -> Result<RunSummary> {
+    // Stopped after its last frame, while its report was being written: only the report is left.
+    let folder = crate::run_folder::RunFolder::new(run);
+    if folder.report_pending().exists() && Status::of(&read_manifest(run)?) == Status::Complete {
+        eprintln!("{}: every frame was written; writing its summary and report", run.display());
+        remove_temporaries(run)?;
+        let report = crate::playback::write_report(&folder)?;
+        return Ok(RunSummary {
+            folder: run.to_path_buf(),
+            records: Vec::new(),
+            references_rendered: 0,
+            references_cached: 0,
+            report,
+        });
     }
-    let field = |key: &str| {
-        stored[key]
-            .as_str()
-            .ok_or_else(|| anyhow!("{}: expected a string field `{key}`", manifest_file.display()))
-    };
-    let origin = PathBuf::from(field("scenario_origin").or_else(|_| field("scenario_file"))?);
-    let scenario = sim::Scenario::from_ron(field("scenario_text")?, &origin)?;
-    let overrides = stored_overrides(&stored["settings"]["overrides"], run)
-        .with_context(|| format!("{}: settings.overrides", manifest_file.display()))?;
-    let spec = RunSpec::from_scenario(scenario, &overrides)?;
+    let StoredRun { manifest: stored, status, origin, overrides, spec, frames_csv, from } =
+        read(run)?;
+    let manifest_file = run.join("manifest.json");
     let gpu = Gpu::new()?;
     let rebuilt = crate::manifest::build(&spec, &origin, &gpu, &overrides)?;
     let mut differs: Vec<&str> = SAME.into_iter().filter(|k| stored[k] != rebuilt[k]).collect();
@@ -63,13 +134,6 @@ pub fn resume(run: &Path, cache_dir: Option<PathBuf>, progress: bool) -> Result<
             gpu.summary
         );
     }
-    let csv_file = run.join("frames.csv");
-    let frames_csv = match std::fs::read_to_string(&csv_file) {
-        Ok(text) => text,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
-        Err(e) => return Err(e).with_context(|| format!("reading {}", csv_file.display())),
-    };
-    let from = last_frame(&frames_csv, &csv_file)?.map_or(0, |f| f + 1);
     let mut manifest = stored.clone();
     if manifest.get("resumed").is_none() {
         manifest["resumed"] = Value::Array(Vec::new());
@@ -82,7 +146,27 @@ pub fn resume(run: &Path, cache_dir: Option<PathBuf>, progress: bool) -> Result<
         }));
     }
     manifest.as_object_mut().map(|m| m.remove("error"));
+    remove_temporaries(run)?;
     play(&spec, gpu, manifest, cache_dir, progress, Some(ResumeAt { from, frames_csv }))
+}
+
+/// Removes the temporary files (`NAME.tmpPID`, metrics::atomic) of writes that a hard stop
+/// (SIGKILL, a power cut) cut short: never a run's output, and each process names its own.
+fn remove_temporaries(dir: &Path) -> Result<()> {
+    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+        let path = entry?.path();
+        let name = path.file_name().unwrap_or_default().to_string_lossy().into_owned();
+        let temporary = name
+            .rsplit_once(".tmp")
+            .is_some_and(|(_, pid)| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()));
+        if path.is_dir() {
+            remove_temporaries(&path)?;
+        } else if temporary {
+            std::fs::remove_file(&path)
+                .with_context(|| format!("removing the unfinished write {}", path.display()))?;
+        }
+    }
+    Ok(())
 }
 
 fn stored_overrides(o: &Value, run: &Path) -> Result<Overrides> {

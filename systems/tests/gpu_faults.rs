@@ -3,9 +3,11 @@
 //!   device granted a quarter of the scene's per-pixel bytes): the run fails while it is built,
 //!   before its folder is touched;
 //! - during a frame, a buffer over the adapter's buffer limit at a resolution well inside its
-//!   texture limit, and a validation error of a compute pass: the frame is neither measured nor
-//!   recorded, manifest.json says `failed` with the error and the last complete frame, and the
-//!   frames before it stay whole.
+//!   texture limit, a validation error of a compute pass and a lost device: the error names the
+//!   method whose pass faulted, the frame is neither measured nor recorded, manifest.json says
+//!   `failed` with the error and the last complete frame, and the frames before it stay whole;
+//! - a method's setting that sizes a buffer over the adapter's limit: the run fails while it is
+//!   built, naming the method, its buffer and the bytes.
 //!
 //! The frame faults come from a method defined here (`FaultyPass`), registered like any other.
 
@@ -31,6 +33,8 @@ enum Fault {
     OverBufferLimit,
     /// A compute pass that dispatches without a pipeline.
     Validation,
+    /// The device destroyed, as a driver reset or a removed GPU loses it.
+    DeviceLost,
 }
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -106,6 +110,11 @@ fn faulty_render(
                     }
                     gpu.queue.submit([encoder.finish()]);
                 }
+                Fault::DeviceLost => {
+                    // As a method's readback would: the device reports its loss when polled.
+                    gpu.device.destroy();
+                    let _ = gpu.device.poll(wgpu::PollType::Poll);
+                }
             }
         }
         let black = vec![[0.0, 0.0, 0.0, 1.0]; pixels as usize];
@@ -162,15 +171,18 @@ fn faults_during_a_frame_fail_the_run_naming_the_pass_and_the_size() {
         // wgpu names the buffer and its bytes; the frame adds the resolution.
         (Fault::OverBufferLimit, "faulty per-pixel records", bytes.to_string()),
         (Fault::Validation, "faulty_shade", format!("{W}x{H}")),
+        (Fault::DeviceLost, "GPU device lost", format!("{W}x{H}")),
     ] {
         let tmp = scratch(&format!("{fault:?}"));
         let dir = tmp.path().to_path_buf();
         let (spec, opts) =
-            spec(&dir, &format!("PathTracing(spp: 1), FaultyPass(fault: {fault:?})"));
+            spec(&dir, &format!("FaultyPass(fault: {fault:?}), PathTracing(spp: 1)"));
         let err = format!("{:#}", run_spec(&spec, &opts).err().expect("the fault fails the run"));
         eprintln!("{fault:?}: {err}");
         let resolution = format!("{W}x{H}");
-        for part in [pass, &size, &resolution, &format!("frame {AT}")] {
+        // The method whose pass faulted, though PathTracing's systems run after it.
+        let method = format!("method faulty_{fault:?}");
+        for part in [pass, &size, &resolution, &format!("frame {AT}"), &method] {
             assert!(err.contains(part), "{fault:?}: the error names '{part}': {err}");
         }
         let run = dir.join("run");
@@ -224,5 +236,22 @@ fn a_device_below_the_scenes_needs_fails_before_anything_is_written() {
         err.contains("uploading the scene") || err.contains("preparing method"),
         "the error names the step: {err}"
     );
+    assert!(!dir.join("run").exists(), "a run that fails while built writes nothing");
+}
+
+#[test]
+fn a_setting_that_sizes_a_buffer_over_the_limit_names_the_method_and_the_bytes() {
+    let tmp = scratch("setting");
+    let dir = tmp.path().to_path_buf();
+    // 16 bytes per slot: 3.2 GB of slots, inside the settings' range and over the adapter's
+    // buffer limit (lavapipe's is 2^31 - 1 bytes; a larger limit makes this test fail).
+    let capacity = 200_000_000u64;
+    let (spec, opts) = spec(&dir, &format!("PathTracing(spp: 1), HashCache(capacity: {capacity})"));
+    let err = format!("{:#}", run_spec(&spec, &opts).err().expect("the table is too large"));
+    eprintln!("{err}");
+    let bytes = (capacity * 16).to_string();
+    for part in ["faults.ron:3:", "preparing method hash_cache", "hash cache slots", &bytes] {
+        assert!(err.contains(part), "the error names '{part}': {err}");
+    }
     assert!(!dir.join("run").exists(), "a run that fails while built writes nothing");
 }

@@ -1,7 +1,8 @@
 //! The WGSL path tracer against Mitsuba 3, pixel by pixel, over a matrix of small scenes: every
 //! light type (point, spot, directional, area, emissive meshes, the constant environment), a
 //! sRGB texture, metal from a mirror to roughness 1, a dielectric over a coloured base from
-//! roughness 0.2 to 1, and the depth limits 1 (direct light), 2 and unlimited.
+//! roughness 0.2 to 1, the depth limits 1 (direct light), 2 and unlimited, a homogeneous and a
+//! heterogeneous (grid) medium, and a curved mesh with smooth shading normals.
 //! systems::mitsuba exports each scene from the same `SceneDesc`; scripts/mitsuba_matrix.py
 //! renders them all in one Python process with Mitsuba's scalar CPU path tracer, K independent
 //! images of each (seeds), while this test renders K independent images of each on the GPU:
@@ -14,10 +15,12 @@
 //! (Burley's diffusion profile; the SSS method's tests use closed forms), the methods' caches
 //! (not renderers of the reference), spot lights with a soft edge (our smoothstep in the cosine
 //! is not Mitsuba's linear falloff in the angle), directional lights with an angular radius
-//! (Mitsuba's is a delta), heterogeneous media (our baked grid is not exported as a Mitsuba grid
-//! volume; the volumetric path tracer is checked against closed forms in media/tests).
-//! The scene with a homogeneous medium is rendered, as its reference is, by our volumetric path
-//! tracer (frame::scene_medium), against Mitsuba's `volpath`.
+//! (Mitsuba's is a delta), shading normals on paths that leave a surface on the side where its
+//! shading and geometric normals disagree (ours ends such a path, Mitsuba's BSDFs see the
+//! shading frame only), so the smooth-normal scene is lit directly from the camera's side.
+//! The scenes with media are rendered, as their references are, by our volumetric path tracer
+//! (frame::scene_medium), against Mitsuba's `volpath`; the grid medium goes to Mitsuba as our
+//! baked grid itself (a `gridvolume`, nearest-neighbour as ours).
 //! `FLICKER_MITSUBA_CASES=a,b` runs only the named scenes (for breaking the renderer on
 //! purpose); the significance stays that of the whole matrix. `FLICKER_MITSUBA_DUMP=1` prints
 //! both images (the tested channel per pixel).

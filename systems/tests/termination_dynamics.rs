@@ -206,13 +206,14 @@ fn cache_follows_a_flash_and_forgets_it_slower_than_its_memory() {
             &d,
         );
     }
-    // Termination moves: the flash raised the records' squared-bias estimate (E[E[Y|y]²]
-    // remembers the flash's 25-fold squares longer than E[Y]² does), and MSE minimisation defers
-    // termination where the local bias is large: its paths over the 4 frames after the flash
-    // are longer than the control's.
-    assert_positive(
-        "MSE minimisation: path length after the flash minus the control's",
-        &mse_length_change,
+    // Printed, not asserted: whether MSE minimisation's paths lengthen after the flash (the
+    // flash raises the records' squared-bias estimate) is a mechanism the lab measured, not a
+    // relation of the paper, and it did not survive the BSDF's coupled diffuse (per seed +0.22,
+    // −0.20, +0.05 vertices over seeds 3-5): docs/lab/termination-dynamics.md.
+    let n = mse_length_change.len() as f64;
+    eprintln!(
+        "MSE minimisation: path length after the flash minus the control's: per seed {mse_length_change:.4?}, mean {:.4}",
+        mse_length_change.iter().sum::<f64>() / n
     );
 }
 

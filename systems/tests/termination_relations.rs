@@ -33,6 +33,11 @@ use common::assert_positive;
 
 const SEEDS: [u64; 3] = [3, 4, 5];
 
+/// The door's records are a two-way draw at 32x18 (no record lit past the gap, or a few far too
+/// bright: docs/lab/termination-paper-conditions.md), so its path lengths spread widely across
+/// seeds: five seeds give its relation the power that three give the corridor's.
+const DOOR_SEEDS: [u64; 5] = [3, 4, 5, 6, 7];
+
 /// The scenario's methods named in `keep`, one recorded frame at 32x18: (method, path length,
 /// FLIP) per seed.
 fn play(scenario: &str, keep: &[&str], seed: u64) -> Vec<FrameRecord> {
@@ -78,7 +83,7 @@ fn path_length(r: &FrameRecord) -> Option<f64> {
     r.stats.iter().find(|(k, _)| k == "path_length").map(|s| s.1)
 }
 
-fn path_length_relations(scenario: &str, runs: &[Vec<FrameRecord>]) {
+fn path_length_relations(scenario: &str, seeds: &[u64], runs: &[Vec<FrameRecord>]) {
     let pl = |m: &str| runs.iter().map(|r| value(r, m, path_length)).collect::<Vec<f64>>();
     let (r001, r01, r1) = (pl("vb_rel_0.01"), pl("vb_rel_0.1"), pl("vb_rel_1"));
     // Grows with t in every seed: 6 of 6 paired comparisons (probability 1/64 if the order
@@ -87,7 +92,7 @@ fn path_length_relations(scenario: &str, runs: &[Vec<FrameRecord>]) {
         assert!(
             r001[s] < r01[s] && r01[s] < r1[s],
             "{scenario} seed {}: path length by relative t 0.01, 0.1, 1: {} {} {}",
-            SEEDS[s],
+            seeds[s],
             r001[s],
             r01[s],
             r1[s]
@@ -107,13 +112,14 @@ fn path_length_difference(runs: &[Vec<FrameRecord>], a: &str, b: &str) -> Vec<f6
 #[test]
 fn door_relations() {
     let keep = ["vb_rel_0.01", "vb_rel_0.1", "vb_rel_1"];
-    let runs: Vec<_> = SEEDS.iter().map(|&s| play("termination_door_gap.ron", &keep, s)).collect();
-    for (seed, r) in SEEDS.iter().zip(&runs) {
+    let runs: Vec<_> =
+        DOOR_SEEDS.iter().map(|&s| play("termination_door_gap.ron", &keep, s)).collect();
+    for (seed, r) in DOOR_SEEDS.iter().zip(&runs) {
         for m in keep {
             eprintln!("door seed {seed} {m}: path length {:.3}", value(r, m, path_length));
         }
     }
-    path_length_relations("door", &runs);
+    path_length_relations("door", &DOOR_SEEDS, &runs);
 }
 
 #[test]
@@ -125,7 +131,7 @@ fn corridor_relations() {
             eprintln!("corridor seed {seed} {m}: path length {:.3}", value(r, m, path_length));
         }
     }
-    path_length_relations("corridor", &runs);
+    path_length_relations("corridor", &SEEDS, &runs);
     // Table 1's relation (MSE minimisation shorter than variance bounding at absolute t = 0.01)
     // is reversed here (docs/lab/termination-relations.md): asserted as measured, MSE is longer.
     let d = path_length_difference(&runs, "mse_100", "vb_0.01");

@@ -242,3 +242,50 @@ fn the_bench_ratios_are_read_from_its_json() {
     let json = serde_json::json!({"traversal": [], "reference_paths_ratio_vs_mitsuba": null});
     assert!(bench_speed_entries(&json).is_empty());
 }
+
+/// The bench compares each ratio with the last kept record of the same bench, build and
+/// adapter, read against the run-to-run spread: repeats at one commit give the spread, a
+/// change beyond it is flagged, one within it is not, and another adapter's record is ignored.
+#[test]
+fn the_bench_compares_with_its_last_record_against_the_spread() {
+    use tools::history::series::{against_last, changes_markdown};
+    let bench = |commit: &str, date: &str, adapter: &str, value: f64| {
+        let mut r = record(
+            commit,
+            date,
+            vec![Entry {
+                verdict: None,
+                margin: None,
+                lo: None,
+                hi: None,
+                ..entry("reference/paths_over_mitsuba", value, 0.0, "-", 0.0)
+            }],
+        );
+        r.kind = Kind::Bench;
+        r.name = "speed".into();
+        r.scale = "-".into();
+        r.adapter = adapter.into();
+        r
+    };
+    // Commit a measured three times: 0.80, 0.84, 0.82 (sd 0.02, spread 2 sd = 0.04).
+    let mut history = vec![
+        bench("aaaaaaa1", DAY1, "llvmpipe / Vulkan", 0.80),
+        bench("aaaaaaa1", DAY1, "llvmpipe / Vulkan", 0.84),
+        bench("aaaaaaa1", DAY1, "llvmpipe / Vulkan", 0.82),
+    ];
+    // A later record on another adapter is not this bench's last record.
+    history.push(bench("ccccccc3", DAY2, "NVIDIA H100 / Vulkan", 2.5));
+    let loss = bench("bbbbbbb2", DAY3, "llvmpipe / Vulkan", 0.70);
+    let c = against_last(&history, &loss);
+    assert_eq!(c.len(), 1);
+    assert_eq!((c[0].last, c[0].last_commit.as_str(), c[0].now), (0.82, "aaaaaaa", 0.70));
+    assert!((c[0].spread.unwrap() - 0.04).abs() < 1e-9, "{:?}", c[0].spread);
+    assert!(c[0].beyond_spread(), "a loss of 0.12 against a spread of 0.04");
+    assert!(changes_markdown(&c).contains("**beyond the spread**"));
+    let same = bench("bbbbbbb2", DAY3, "llvmpipe / Vulkan", 0.85);
+    assert!(!against_last(&history, &same)[0].beyond_spread(), "0.03 is within 0.04");
+    // No earlier record of this adapter: nothing to compare, and the page says so.
+    let other = bench("bbbbbbb2", DAY3, "AMD / Vulkan", 1.0);
+    assert!(against_last(&history, &other).is_empty());
+    assert!(changes_markdown(&[]).contains("nothing to compare with"));
+}

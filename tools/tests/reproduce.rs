@@ -277,3 +277,48 @@ fn sigma_claim_reads_the_long_pretrained_case() {
     let text = std::fs::read_to_string(scenario).unwrap();
     assert_eq!(text.matches("pretrain_frames: 160").count(), 5, "every NIRC method pre-trains 160");
 }
+
+/// A claim judged again with one condition switched names the claim it varies, and the report
+/// sets the two verdicts side by side.
+#[test]
+fn variants_name_their_claim_and_sit_beside_it_in_the_report() {
+    use tools::reproduce::report::{PaperResult, markdown};
+    use tools::reproduce::{Judged, Verdict};
+    let base = claim("corridor", "PathLength", "vb_rel_0.1");
+    let variant = |of: &str, id: &str| {
+        base.replacen(
+            "(id: \"c\"",
+            &format!("(id: \"{id}\", variant_of: Some((claim: \"{of}\", switched: \"K = 4\"))"),
+            1,
+        )
+    };
+    // The variant is the second claim, on line 9.
+    let two = |v: String| format!("{base},\n        {v}");
+    let e = load_with(CASE, &two(variant("nope", "v")));
+    assert!(e.contains("bad.ron:9") && e.contains("variant_of: no claim 'nope'"), "{e}");
+    let e = load_with(CASE, &two(variant("v", "v")));
+    assert!(e.contains("bad.ron:9") && e.contains("is itself a variant"), "{e}");
+    let e =
+        load_with(CASE, &two(variant("c", "v").replace("switched: \"K = 4\"", "switched: \" \"")));
+    assert!(e.contains("bad.ron:9") && e.contains("switched is empty"), "{e}");
+
+    let text = format!(
+        "Claims(\n    paper: \"x\",\n    title: \"x\",\n    cases: [\n        {CASE},\n    ],\n    claims: [\n        {},\n    ],\n)\n",
+        two(variant("c", "v"))
+    );
+    let claims = Claims::from_ron(&text, &root().join("claims/x.ron")).unwrap();
+    let judged = |verdict| Judged { flicker: "f".into(), verdict, values: vec![1.0, 2.0] };
+    let paper = PaperResult {
+        claims: &claims,
+        judged: vec![
+            (&claims.claims[0], judged(Verdict::Reproduced)),
+            (&claims.claims[1], judged(Verdict::NotReproduced)),
+        ],
+        tables: vec![],
+    };
+    let md = markdown("header", &[paper]);
+    assert!(
+        md.contains("| `c` | reproduced | K = 4 (`v`) | not reproduced |"),
+        "the variant's row beside its claim:\n{md}"
+    );
+}

@@ -1,6 +1,6 @@
-//! `flicker suite`: the smoke suite against its blessed lavapipe baseline, the same suite with a
-//! deliberately broken method (NIRC's test-only `test_skip_ema`), a missing baseline, and bad
-//! suite files reported at file:line.
+//! `flicker suite`: the smoke suite against its blessed lavapipe baseline (a stand-in on any
+//! other adapter), the same suite with a deliberately broken method (NIRC's test-only
+//! `test_skip_ema`), a missing baseline, and bad suite files reported at file:line.
 
 use std::path::{Path, PathBuf};
 
@@ -153,6 +153,26 @@ fn bad_suite_files_are_reported_at_file_line() {
         "Suite(\n    cases: [{case}],\n    gates: [\n      (metric: SigmaChanged, window: Overall, bound: Absolute(limit: 1.0)),\n    ],\n)"
     ));
     assert!(e.starts_with("bad.ron:4:7: metric sigma_changed"), "{e}");
+    // Windows that can hold no frame: the gate's line.
+    let e = load_error(&format!(
+        "Suite(\n    cases: [{case}],\n    gates: [\n      (metric: Flip, window: After(event: 0, frames: 0), bound: Absolute(limit: 1.0)),\n    ],\n)"
+    ));
+    assert!(
+        e.starts_with("bad.ron:4:7: window after_event_0(0): frames: 0 is an empty window"),
+        "{e}"
+    );
+    let e = load_error(&format!(
+        "Suite(\n    cases: [{case}],\n    gates: [\n      (metric: Flip, window: Around(event: 0, from: 2, to: 2), bound: Absolute(limit: 1.0)),\n    ],\n)"
+    ));
+    assert!(e.starts_with("bad.ron:4:7: window event_0+2..+2: from: 2 is not before to: 2"), "{e}");
+    // A stand-in baseline's widening must be a fraction >= 0.
+    let e = load_error(&format!(
+        "Suite(\n    other_adapter_tolerance: -0.1,\n    cases: [{case}],\n    gates: [(metric: Flip, window: Overall, bound: Absolute(limit: 1.0))],\n)"
+    ));
+    assert!(
+        e.starts_with("bad.ron:2:5: other_adapter_tolerance -0.1; expected a fraction >= 0"),
+        "{e}"
+    );
     // Relative scenario paths resolve against the suite's folder.
     let ok = Suite::from_ron(&format!("Suite(cases: [{case}], gates: [(metric: Flip, window: Overall, bound: Absolute(limit: 1.0))])"), Path::new("dir/bad.ron")).unwrap();
     assert_eq!(ok.cases[0].scenario, Path::new("dir/s.ron"));

@@ -1,7 +1,9 @@
 //! Suites over frames on disk (another renderer's): the example suite on the committed ColorVideoVDP
 //! fixtures passes its gates; a renderer blessed on its frames passes against its baseline and
 //! fails it once its frames get noisier; bad frames are errors at the case's line naming the
-//! file and frame, with nothing written. No GPU is needed.
+//! file and frame, with nothing written; a baseline blessed on another adapter stands in with a
+//! wider tolerance. A case over a `flicker export` package takes the package's references, frame
+//! rate and events, and an outside method's timings gate on its FrameMs. No GPU is needed.
 
 use std::path::{Path, PathBuf};
 
@@ -122,6 +124,43 @@ fn a_blessed_renderer_passes_and_fails_once_its_frames_get_noisier() {
 }
 
 #[test]
+fn another_adapters_baseline_stands_in_with_a_wider_tolerance() {
+    let tmp = temp("stand_in");
+    let dir = tmp.path().to_path_buf();
+    renderer(&dir, 0.05);
+    std::fs::write(dir.join("suite.ron"), SUITE).unwrap();
+    let opts = options(dir.join("suite.ron"), &dir);
+    let path = bless(&opts).expect("bless");
+    // The baseline as if blessed on a GPU only: this adapter has none of its own.
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("frames from disk / cpu", "Some GPU (driver 1.2) / Vulkan");
+    std::fs::write(&path, text).unwrap();
+    let outcome = run(&opts).expect("a stand-in baseline is used, not an error");
+    eprintln!("{}", outcome.markdown);
+    assert!(
+        outcome.markdown.contains("no baseline blessed on adapter 'frames from disk / cpu'")
+            && outcome.markdown.contains("'Some GPU (driver 1.2) / Vulkan'")
+            && outcome.markdown.contains("flicker suite bless"),
+        "{}",
+        outcome.markdown
+    );
+    // Each relative gate's tolerance grew by the default other_adapter_tolerance, 0.05.
+    let tolerances: Vec<&str> = outcome.results.iter().map(|r| r.gate.as_str()).collect();
+    assert!(tolerances.iter().any(|g| g.ends_with("within 15.0% of baseline")), "{tolerances:?}");
+    assert!(tolerances.iter().any(|g| g.ends_with("within 7.0% of baseline")), "{tolerances:?}");
+    assert!(outcome.passed(), "{}", outcome.markdown);
+    // Four times the noise still fails the widened relative gates.
+    renderer(&dir, 0.2);
+    let outcome = run(&opts).expect("suite runs");
+    for r in &outcome.results {
+        let relative = !r.gate.starts_with("psnr");
+        let expected = if relative { Verdict::Fail } else { Verdict::Pass };
+        assert_eq!(r.verdict, expected, "{}: {}", r.gate, r.detail);
+    }
+}
+
+#[test]
 fn bad_frames_are_errors_at_the_case_line_and_nothing_is_written() {
     let tmp = temp("bad");
     let dir = tmp.path().to_path_buf();
@@ -168,7 +207,7 @@ fn bad_frames_are_errors_at_the_case_line_and_nothing_is_written() {
         );
         Suite::from_ron(&text, Path::new("s.ron")).expect_err("refused").to_string()
     };
-    let cases: [(&str, &str); 5] = [
+    let cases: [(&str, &str); 8] = [
         (
             "(name: \"c\", measure: (reference: \"r\", tests: {\"m\": \"m\"}), seeds: [1, 2])",
             "no {seed} in its folder",
@@ -183,6 +222,15 @@ fn bad_frames_are_errors_at_the_case_line_and_nothing_is_written() {
             "frames sets how a scenario is played",
         ),
         ("(name: \"c\", seeds: [1])", "no scenario; expected scenario:"),
+        ("(name: \"c\", measure: (tests: {\"m\": \"m\"}))", "no reference; expected reference:"),
+        (
+            "(name: \"c\", measure: (reference: \"r\", scenario: \"p\", tests: {\"m\": \"m\"}))",
+            "names a reference and a scenario package",
+        ),
+        (
+            "(name: \"c\", measure: (scenario: \"p\", tests: {\"m\": \"m\"}, timings: {\"n\": \"t.csv\"}))",
+            "timings names 'n', which is not a test",
+        ),
     ];
     for (case, expected) in cases {
         let e = load(case);
@@ -196,8 +244,118 @@ fn bad_frames_are_errors_at_the_case_line_and_nothing_is_written() {
     .unwrap();
     let m = ok.cases[0].measure.as_ref().unwrap();
     assert_eq!(
-        (m.reference.as_path(), m.tests["m"].as_path()),
-        (Path::new("dir/r"), Path::new("/abs/m"))
+        (m.reference.as_deref(), m.tests["m"].as_path()),
+        (Some(Path::new("dir/r")), Path::new("/abs/m"))
     );
     assert_eq!(ok.cases[0].seeds, [0]);
+}
+
+/// A `flicker export` package as `flicker measure --scenario` reads it, without a GPU: the
+/// manifest (24 fps, one event at frame 3, a display) and the ramp as its references.
+fn package(dir: &Path) {
+    frames(&dir.join("reference"), 0, 0.0);
+    let manifest = serde_json::json!({
+        "format": "flicker-export",
+        "frames": FRAMES,
+        "fps": 24.0,
+        "events": [{"frame": 3, "label": "toggle 'lamp'"}],
+        "cvvdp": {"display": "standard_fhd", "exposure": 1.0},
+        "smape_epsilon": 0.01,
+        "reference": {"dir": "reference"},
+    });
+    std::fs::write(dir.join("manifest.json"), manifest.to_string()).unwrap();
+}
+
+/// Per-frame times of seed `seed`: `scale` x (4 ms + a little per seed and frame), split into
+/// two passes.
+fn times(dir: &Path, seed: u64, scale: f64) -> PathBuf {
+    let mut text = String::from("frame,ms,trace,accumulate\n");
+    for f in 0..FRAMES {
+        let ms = scale * (4.0 + 0.1 * seed as f64 + 0.05 * f as f64);
+        text.push_str(&format!("{f},{ms},{},{}\n", 0.75 * ms, 0.2 * ms));
+    }
+    let path = dir.join(format!("times_{seed}.csv"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+const PACKAGE_SUITE: &str = r#"Suite(
+    cases: [
+        (
+            name: "outside",
+            measure: (
+                scenario: "package",
+                tests: {"mine": "mine_{seed}"},
+                timings: {"mine": "times_{seed}.csv"},
+            ),
+            seeds: [1, 2, 3],
+        ),
+    ],
+    gates: [
+        (metric: FrameMs, window: Overall, bound: Relative(tolerance: 0.1)),
+        (metric: FrameMs, window: Overall, bound: Absolute(limit: 20.0)),
+        (metric: Flip, window: After(event: 0, frames: 2), bound: Relative(tolerance: 0.1)),
+    ],
+)"#;
+
+/// A case over a package: its frame rate and events reach the run folders (the `After(event: 0)`
+/// gate is judged, not an error); the outside method's timings are blessed and gated: twice
+/// slower fails the relative FrameMs gate only. A package missing a reference frame and timings
+/// of the wrong length are errors at the case's line naming the file and frame, with nothing
+/// written.
+#[test]
+fn a_package_case_gates_an_outside_methods_frames_and_times() {
+    let tmp = temp("package");
+    let dir = tmp.path().to_path_buf();
+    package(&dir.join("package"));
+    for seed in 1..=3 {
+        frames(&dir.join(format!("mine_{seed}")), seed, 0.05);
+        times(&dir, seed, 1.0);
+    }
+    std::fs::write(dir.join("suite.ron"), PACKAGE_SUITE).unwrap();
+    let opts = options(dir.join("suite.ron"), &dir);
+    bless(&opts).expect("bless");
+    let outcome = run(&opts).expect("suite runs");
+    eprintln!("{}", outcome.markdown);
+    assert_eq!(outcome.results.len(), 3);
+    assert!(outcome.passed(), "{}", outcome.markdown);
+    let manifest: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(outcome.folder.join("outside/seed_2/manifest.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(manifest["events"][0]["label"], "toggle 'lamp'", "{manifest}");
+    assert!((manifest["settings"]["time_step"].as_f64().unwrap() - 1.0 / 24.0).abs() < 1e-12);
+    assert_eq!(manifest["settings"]["cvvdp"]["display"], "standard_fhd");
+    let csv = std::fs::read_to_string(outcome.folder.join("outside/seed_2/frames.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().contains("wall_ms_trace"), "{csv}");
+    // The same frames, twice as slow.
+    for seed in 1..=3 {
+        times(&dir, seed, 2.0);
+    }
+    let outcome = run(&opts).expect("suite runs");
+    eprintln!("{}", outcome.markdown);
+    let verdicts: Vec<(String, Verdict)> =
+        outcome.results.iter().map(|r| (r.gate.clone(), r.verdict.clone())).collect();
+    assert_eq!(
+        verdicts.iter().map(|v| v.1.clone()).collect::<Vec<_>>(),
+        [Verdict::Fail, Verdict::Pass, Verdict::Pass],
+        "{verdicts:?}"
+    );
+    std::fs::remove_dir_all(dir.join("out")).unwrap();
+    // Bad inputs: the first seed's timings one row short, then the package missing a frame.
+    let short = times(&dir, 1, 1.0);
+    let text = std::fs::read_to_string(&short).unwrap();
+    std::fs::write(&short, text.lines().take(FRAMES as usize).collect::<Vec<_>>().join("\n"))
+        .unwrap();
+    let at = format!("{}:3:9: case 'outside' seed 1: ", dir.join("suite.ron").display());
+    let e = format!("{:#}", run(&opts).err().expect("refused"));
+    assert!(e.starts_with(&at), "{e}");
+    assert!(e.contains("times_1.csv") && e.contains("frame 5 is missing"), "{e}");
+    assert!(!dir.join("out").exists(), "something was written");
+    times(&dir, 1, 1.0);
+    std::fs::remove_file(dir.join("package/reference/0004.exr")).unwrap();
+    let e = format!("{:#}", run(&opts).err().expect("refused"));
+    assert!(e.starts_with(&at), "{e}");
+    assert!(e.contains("reference/0004.exr") && e.contains("frame 4 is missing"), "{e}");
+    assert!(!dir.join("out").exists(), "something was written");
 }

@@ -40,6 +40,7 @@ pub struct Plugin;
 impl MethodPlugin for Plugin {
     type Settings = PathTracingSettings;
     const NAME: &'static str = "PathTracing";
+    const MINIMAL_SETTINGS: &'static str = "(spp: 1)";
 
     fn label(settings: &PathTracingSettings) -> String {
         settings.label()

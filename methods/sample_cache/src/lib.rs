@@ -775,4 +775,5 @@ fn tan_half_fov(scene: &SceneGpu) -> f32 {
 }
 
 pub mod plugin;
+pub mod recorded;
 pub use plugin::Plugin;

@@ -23,6 +23,7 @@ pub struct Plugin;
 impl MethodPlugin for Plugin {
     type Settings = SampleCacheSettings;
     const NAME: &'static str = "SampleCache";
+    const STATISTICS: &'static [frame::method::Statistic] = crate::recorded::STATISTICS;
 
     fn label(settings: &SampleCacheSettings) -> String {
         settings.label()

@@ -36,4 +36,5 @@ pub use split::{DistantCount, Split};
 pub use spvg::{SpvgHistory, SpvgSettings};
 
 pub mod plugin;
+pub mod recorded;
 pub use plugin::Plugin;

@@ -162,6 +162,7 @@ pub struct Plugin;
 impl MethodPlugin for Plugin {
     type Settings = SssMethodSettings;
     const NAME: &'static str = "Sss";
+    const STATISTICS: &'static [frame::method::Statistic] = crate::recorded::STATISTICS;
 
     fn label(settings: &SssMethodSettings) -> String {
         settings.label()

@@ -24,4 +24,5 @@ pub use sampling_tree::{Moments, SamplingTree};
 pub use settings::{Incomplete, RadianceScale, TerminationSettings};
 
 pub mod plugin;
+pub mod recorded;
 pub use plugin::Plugin;

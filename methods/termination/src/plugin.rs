@@ -55,6 +55,8 @@ pub struct Plugin;
 impl MethodPlugin for Plugin {
     type Settings = TerminationSettings;
     const NAME: &'static str = "Termination";
+    const STATISTICS: &'static [frame::method::Statistic] = crate::recorded::STATISTICS;
+    const CHARTS: &'static [frame::method::MethodChart] = crate::recorded::CHARTS;
 
     fn label(settings: &TerminationSettings) -> String {
         label(settings)

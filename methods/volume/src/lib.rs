@@ -4,4 +4,5 @@
 //! weights (`VolumePath`, [`path`]).
 
 pub mod path;
+pub mod recorded;
 pub mod transmittance;

@@ -55,6 +55,7 @@ pub struct Plugin;
 impl MethodPlugin for Plugin {
     type Settings = VolumeSettings;
     const NAME: &'static str = "VolumeTransmittance";
+    const STATISTICS: &'static [frame::method::Statistic] = crate::recorded::STATISTICS;
 
     fn label(settings: &VolumeSettings) -> String {
         settings.label()

@@ -47,12 +47,23 @@ impl Blas {
     }
 }
 
+/// The largest coordinate a mesh's position may have (see [`mesh_triangles`]).
+pub const MAX_COORDINATE: f32 = 1e18;
+
 /// A mesh's triangles for obvhs, after checking its indices, positions, and per-vertex
 /// attribute counts (`index` only for error messages).
 pub fn mesh_triangles(index: usize, mesh: &Mesh) -> Result<Vec<Triangle>, BvhError> {
     let err = |reason: String| BvhError::Mesh { index, name: mesh.name.clone(), reason };
     if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(err(format!("position {i} is not finite: {}", mesh.positions[i])));
+    }
+    // Beyond this the builder's surface areas (squared extents) overflow f32 and its SAH
+    // decisions become NaN (obvhs then indexes out of range).
+    if let Some(i) = mesh.positions.iter().position(|p| p.abs().max_element() > MAX_COORDINATE) {
+        return Err(err(format!(
+            "position {i} is {}; expected coordinates within ±{MAX_COORDINATE:e}",
+            mesh.positions[i]
+        )));
     }
     let n = mesh.positions.len() as u32;
     let mut tris = Vec::with_capacity(mesh.indices.len());

@@ -8,9 +8,11 @@ use metrics::frames_csv::Frames;
 
 use super::plot::{self, XMap};
 use super::{Chart, Kind, Series, pareto_front};
+use crate::declared::MethodChart;
 use crate::run::Manifest;
 
-/// Human-readable names of the known columns.
+/// Human-readable names of the columns every method has (a method names its own in its
+/// declared charts).
 fn label(column: &str) -> String {
     match column {
         "flip" => "FLIP vs reference".into(),
@@ -23,18 +25,13 @@ fn label(column: &str) -> String {
         "cpu_ms" => "CPU time (ms)".into(),
         "gpu_ms_total" => "GPU time (ms)".into(),
         "wall_ms_total" => "wall time of the passes (ms)".into(),
-        "path_length" => "mean path length (vertices)".into(),
-        "cache_mean" => "cache: mean record luminance E[Y]".into(),
-        "cache_variance" => "cache: mean record variance".into(),
-        "cache_bias2" => "cache: mean record squared bias".into(),
         c => c.replace('_', " "),
     }
 }
 
-/// Columns charted against frame, in this order, then per-region FLIP and SMAPE. The last four
-/// are the termination cache's (termination): how termination and the records'
-/// statistics move around an event.
-const FRAME_COLUMNS: [&str; 12] = [
+/// Columns of every method charted against frame, in this order; then the methods' declared
+/// columns (`MethodChart::Column`), then per-region FLIP and SMAPE.
+const FRAME_COLUMNS: [&str; 8] = [
     "flip",
     "smape",
     "smape_reprojected",
@@ -43,10 +40,6 @@ const FRAME_COLUMNS: [&str; 12] = [
     "gpu_ms_total",
     "wall_ms_total",
     "cpu_ms",
-    "path_length",
-    "cache_mean",
-    "cache_variance",
-    "cache_bias2",
 ];
 
 fn mean(v: &[(f64, f64)]) -> Option<f64> {
@@ -54,7 +47,13 @@ fn mean(v: &[(f64, f64)]) -> Option<f64> {
     (!f.is_empty()).then(|| f.iter().sum::<f64>() / f.len() as f64)
 }
 
-pub fn frame_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)> {
+/// Every column against frame, one line per method: the common ones, the `declared` columns of
+/// the methods, the regions'.
+pub fn frame_charts(
+    manifest: &Manifest,
+    frames: &Frames,
+    declared: &[MethodChart],
+) -> Vec<(String, Chart)> {
     let methods = frames.methods();
     let last_frame = frames
         .rows
@@ -65,24 +64,30 @@ pub fn frame_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)
         .max(manifest.frames.unwrap_or(1).saturating_sub(1)) as f64;
     let events: Vec<(f64, String)> =
         manifest.events.iter().map(|e| (e.frame as f64, e.label.clone())).collect();
-    let region_columns = manifest
-        .regions
-        .iter()
-        .flat_map(|r| [format!("{}_flip", r.name), format!("{}_smape", r.name)]);
-    let columns: Vec<String> =
-        FRAME_COLUMNS.iter().map(|s| s.to_string()).chain(region_columns).collect();
+    let common = FRAME_COLUMNS.iter().map(|s| (s.to_string(), label(s)));
+    let of_methods = declared.iter().filter_map(|c| match c {
+        MethodChart::Column { column, label } => Some((column.to_string(), label.to_string())),
+        MethodChart::Columns { .. } => None,
+    });
+    let regions = manifest.regions.iter().flat_map(|r| {
+        [format!("{}_flip", r.name), format!("{}_smape", r.name)].map(|c| {
+            let l = label(&c);
+            (c, l)
+        })
+    });
+    let columns: Vec<(String, String)> = common.chain(of_methods).chain(regions).collect();
     columns
         .into_iter()
-        .filter_map(|name| {
+        .filter_map(|(name, label)| {
             let c = frames.column(&name).filter(|&c| frames.has_data(c))?;
             let series = methods
                 .iter()
                 .map(|m| Series { name: m.clone(), points: frames.series(m, c) })
                 .collect();
             let chart = Chart {
-                title: format!("{} — {}", label(&name), manifest.scenario),
+                title: format!("{label} — {}", manifest.scenario),
                 x_label: "frame".into(),
-                y_label: label(&name),
+                y_label: label,
                 kind: Kind::Lines,
                 series,
                 events: events.clone(),
@@ -94,101 +99,49 @@ pub fn frame_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)
         .collect()
 }
 
-/// Figure 1 of reliability-weighted-nirc.txt: mean reliability per frame of the two predictors
-/// (stats columns `reliability_high_lr`, `reliability_ema` of the NIRC methods; every NIRC method
-/// of a cache reports the same values, so the first method with data is drawn).
-pub fn reliability_chart(manifest: &Manifest, frames: &Frames) -> Option<(String, Chart)> {
-    let cur = frames.column("reliability_high_lr").filter(|&c| frames.has_data(c))?;
-    let ema = frames.column("reliability_ema").filter(|&c| frames.has_data(c))?;
-    let method = frames
-        .methods()
-        .into_iter()
-        .find(|m| frames.series(m, cur).iter().any(|p| p.1.is_finite()))?;
-    let last_frame = frames.rows.iter().map(|r| r.frame).max().unwrap_or(0) as f64;
-    let chart = Chart {
-        title: format!("Mean reliability per predictor ({method}) — {}", manifest.scenario),
-        x_label: "frame".into(),
-        y_label: "mean reliability r̄".into(),
-        kind: Kind::Lines,
-        series: vec![
-            Series { name: "High-LR".into(), points: frames.series(&method, cur) },
-            Series { name: "EMA".into(), points: frames.series(&method, ema) },
-        ],
-        events: manifest.events.iter().map(|e| (e.frame as f64, e.label.clone())).collect(),
-        pareto: vec![],
-        x_extent: vec![0.0, last_frame],
+/// A method's `MethodChart::Columns` chart: its columns against frame for the first method
+/// with data in the first required column, with the reference lines; `None` where a required
+/// column has no data (a run without the method) or for a `Column` chart.
+pub fn method_chart(
+    manifest: &Manifest,
+    frames: &Frames,
+    chart: &MethodChart,
+) -> Option<(String, Chart)> {
+    let MethodChart::Columns { stem, title, y_label, series, lines } = *chart else {
+        return None;
     };
-    Some(("frames_reliability".into(), chart))
-}
-
-/// What σ does (issue 10): the blend rule's mean σ per frame and the share of queries with
-/// σ > 0.5 (stats `blend_sigma`, `prefer_high_lr`; shared by the NIRC methods of a cache), with
-/// the even mixture σ = 0.5 as a reference line.
-pub fn sigma_chart(manifest: &Manifest, frames: &Frames) -> Option<(String, Chart)> {
-    let sigma = frames.column("blend_sigma").filter(|&c| frames.has_data(c))?;
-    let method = frames
-        .methods()
-        .into_iter()
-        .find(|m| frames.series(m, sigma).iter().any(|p| p.1.is_finite()))?;
-    let last_frame = frames.rows.iter().map(|r| r.frame).max().unwrap_or(0) as f64;
-    let mut series =
-        vec![Series { name: "mean σ (blend rule)".into(), points: frames.series(&method, sigma) }];
-    if let Some(prefer) = frames.column("prefer_high_lr").filter(|&c| frames.has_data(c)) {
-        series.push(Series {
-            name: "share of queries with σ > 0.5".into(),
-            points: frames.series(&method, prefer),
-        });
+    let with_data = |column: &str| frames.column(column).filter(|&c| frames.has_data(c));
+    if series.iter().any(|s| s.required && with_data(s.column).is_none()) {
+        return None;
     }
-    series.push(Series {
-        name: "σ = 0.5 (even mixture)".into(),
-        points: vec![(0.0, 0.5), (last_frame, 0.5)],
-    });
-    let chart = Chart {
-        title: format!("Weight σ of the High-LR predictor ({method}) — {}", manifest.scenario),
-        x_label: "frame".into(),
-        y_label: "σ".into(),
-        kind: Kind::Lines,
-        series,
-        events: manifest.events.iter().map(|e| (e.frame as f64, e.label.clone())).collect(),
-        pareto: vec![],
-        x_extent: vec![0.0, last_frame],
-    };
-    Some(("frames_sigma".into(), chart))
-}
-
-/// Why σ stays near 0.5 or not (issue 10): per frame, the 10th, 50th and 90th percentiles over
-/// the queries of d = r̄_cur − r̄_EMA, the difference σ = 1 / (1 + e^(−κd)) is a function of
-/// (stats `reliability_diff_p10/p50/p90`), and the share of queries with |σ − 0.5| > 0.1.
-pub fn reliability_spread_chart(manifest: &Manifest, frames: &Frames) -> Option<(String, Chart)> {
-    let p50 = frames.column("reliability_diff_p50").filter(|&c| frames.has_data(c))?;
+    let key = with_data(series.iter().find(|s| s.required)?.column)?;
     let method = frames
         .methods()
         .into_iter()
-        .find(|m| frames.series(m, p50).iter().any(|p| p.1.is_finite()))?;
+        .find(|m| frames.series(m, key).iter().any(|p| p.1.is_finite()))?;
     let last_frame = frames.rows.iter().map(|r| r.frame).max().unwrap_or(0) as f64;
-    let mut series = Vec::new();
-    for (col, name) in [
-        ("reliability_diff_p10", "10th percentile of r̄_cur − r̄_EMA"),
-        ("reliability_diff_p50", "median"),
-        ("reliability_diff_p90", "90th percentile"),
-        ("sigma_far_from_even", "share of queries with |σ − 0.5| > 0.1"),
-    ] {
-        if let Some(c) = frames.column(col).filter(|&c| frames.has_data(c)) {
-            series.push(Series { name: name.into(), points: frames.series(&method, c) });
-        }
-    }
-    series.push(Series { name: "0".into(), points: vec![(0.0, 0.0), (last_frame, 0.0)] });
+    let mut drawn: Vec<Series> = series
+        .iter()
+        .filter_map(|s| {
+            let c = with_data(s.column)?;
+            Some(Series { name: s.legend.into(), points: frames.series(&method, c) })
+        })
+        .collect();
+    drawn.extend(lines.iter().map(|&(y, legend)| Series {
+        name: legend.into(),
+        points: vec![(0.0, y), (last_frame, y)],
+    }));
     let chart = Chart {
-        title: format!("Spread of the reliability difference ({method}) — {}", manifest.scenario),
+        title: format!("{title} ({method}) — {}", manifest.scenario),
         x_label: "frame".into(),
-        y_label: "r̄_cur − r̄_EMA; share".into(),
+        y_label: y_label.into(),
         kind: Kind::Lines,
-        series,
+        series: drawn,
         events: manifest.events.iter().map(|e| (e.frame as f64, e.label.clone())).collect(),
         pareto: vec![],
         x_extent: vec![0.0, last_frame],
     };
-    Some(("frames_reliability_spread".into(), chart))
+    Some((stem.to_string(), chart))
 }
 
 pub fn speed_accuracy_charts(manifest: &Manifest, frames: &Frames) -> Vec<(String, Chart)> {
@@ -389,10 +342,12 @@ pub struct WrittenChart {
     pub frame_axis: Option<XMap>,
 }
 
+/// Writes every chart the run has data for, the methods' `declared` ones among them.
 pub fn write_charts(
     run_dir: &Path,
     manifest: &Manifest,
     frames: &Frames,
+    declared: &[MethodChart],
 ) -> anyhow::Result<Vec<WrittenChart>> {
     let dir = run_dir.join("charts");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
@@ -401,11 +356,10 @@ pub fn write_charts(
     let jod_charts = jod.iter().flat_map(|j| {
         jod_chart(manifest, frames, j).into_iter().chain(speed_jod_chart(manifest, frames, j))
     });
-    for (stem, chart) in frame_charts(manifest, frames)
+    let of_methods = declared.iter().filter_map(|c| method_chart(manifest, frames, c));
+    for (stem, chart) in frame_charts(manifest, frames, declared)
         .into_iter()
-        .chain(reliability_chart(manifest, frames))
-        .chain(sigma_chart(manifest, frames))
-        .chain(reliability_spread_chart(manifest, frames))
+        .chain(of_methods)
         .chain(speed_accuracy_charts(manifest, frames))
         .chain(jod_charts)
     {
@@ -425,38 +379,30 @@ mod tests {
     use super::*;
 
     #[test]
-    fn sigma_and_reliability_charts_follow_the_nirc_columns() {
-        let csv = "method,frame,cpu_ms,reliability_high_lr,reliability_ema,blend_sigma,prefer_high_lr\n\
-                   pt_1spp,0,1,,,,\nnirc_blend_1spp,0,2,0.5,0.6,0.45,0.2\nnirc_blend_1spp,1,2,0.4,0.3,0.55,0.7\n";
+    fn declared_columns_are_charted_after_the_common_ones_and_before_the_regions() {
+        let csv = "method,frame,cpu_ms,flip,steps,empty,roi_flip\n\
+                   a,0,1,0.5,2,,0.1\na,1,1,0.4,3,,0.2\nb,0,1,0.6,,,0.3\n";
         let frames = Frames::parse(csv, Path::new("frames.csv")).unwrap();
-        let manifest: Manifest = serde_json::from_str(r#"{"scenario": "s", "frames": 2}"#).unwrap();
-        let (stem, chart) = sigma_chart(&manifest, &frames).expect("a σ chart");
-        assert_eq!(stem, "frames_sigma");
-        assert!(chart.title.contains("nirc_blend_1spp"));
-        assert_eq!(chart.series[0].points, vec![(0.0, 0.45), (1.0, 0.55)]);
-        assert_eq!(chart.series[1].points, vec![(0.0, 0.2), (1.0, 0.7)]);
-        assert_eq!(chart.series[2].points, vec![(0.0, 0.5), (1.0, 0.5)]);
-        let (_, r) = reliability_chart(&manifest, &frames).expect("a reliability chart");
-        assert_eq!(r.series[1].points, vec![(0.0, 0.6), (1.0, 0.3)]);
-        assert!(
-            reliability_spread_chart(&manifest, &frames).is_none(),
-            "no spread columns, no chart"
+        let manifest: Manifest = serde_json::from_str(
+            r#"{"scenario": "s", "frames": 2, "regions": [{"name": "roi", "x": 0, "y": 0, "width": 1, "height": 1}]}"#,
+        )
+        .unwrap();
+        let declared = [
+            MethodChart::Column { column: "steps", label: "steps taken" },
+            MethodChart::Column { column: "empty", label: "no data" },
+        ];
+        let charts = frame_charts(&manifest, &frames, &declared);
+        let stems: Vec<&str> = charts.iter().map(|c| c.0.as_str()).collect();
+        assert_eq!(stems, ["frames_flip", "frames_cpu_ms", "frames_steps", "frames_roi_flip"]);
+        let steps = &charts[2].1;
+        assert_eq!(
+            (steps.title.as_str(), steps.y_label.as_str()),
+            ("steps taken — s", "steps taken")
         );
-        let spread = "method,frame,cpu_ms,reliability_diff_p10,reliability_diff_p50,reliability_diff_p90,sigma_far_from_even\n\
-                      pt_1spp,0,1,,,,\nnirc_blend_1spp,0,2,-0.1,0.0,0.2,0.3\nnirc_blend_1spp,1,2,-0.2,0.1,0.3,0.4\n";
-        let spread = Frames::parse(spread, Path::new("frames.csv")).unwrap();
-        let (stem, chart) = reliability_spread_chart(&manifest, &spread).expect("a spread chart");
-        assert_eq!(stem, "frames_reliability_spread");
-        assert_eq!(chart.series[0].points, vec![(0.0, -0.1), (1.0, -0.2)]);
-        assert_eq!(chart.series[2].points, vec![(0.0, 0.2), (1.0, 0.3)]);
-        assert_eq!(chart.series[3].points, vec![(0.0, 0.3), (1.0, 0.4)]);
-        // A run without NIRC methods has neither chart.
-        let plain =
-            Frames::parse("method,frame,cpu_ms\npt_1spp,0,1\n", Path::new("frames.csv")).unwrap();
-        assert!(
-            sigma_chart(&manifest, &plain).is_none()
-                && reliability_chart(&manifest, &plain).is_none()
-        );
+        assert_eq!(steps.series[0].points, vec![(0.0, 2.0), (1.0, 3.0)]);
+        // Without the declaration the column is not drawn.
+        assert_eq!(frame_charts(&manifest, &frames, &[]).len(), 3);
+        assert!(method_chart(&manifest, &frames, &declared[0]).is_none(), "a Column chart");
     }
 
     #[test]

@@ -10,17 +10,17 @@
 pub mod encoding;
 
 use std::collections::HashMap;
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use base64::Engine;
 use base64::engine::general_purpose::STANDARD;
+use maud::{Markup, PreEscaped, html};
 use metrics::{Image, load_image};
 use rayon::prelude::*;
 use serde_json::json;
 
-use crate::html::esc;
+use crate::page;
 use crate::run::{MOTION, Manifest, frame_file};
 
 /// Encoded frames (base64 text) embedded in report.html up to this size; a larger run's frames
@@ -39,7 +39,7 @@ pub const STYLE: &str = include_str!("viewer.css");
 /// The viewer's part of the page.
 pub struct Viewer {
     /// Markup, data and script, to be placed at the top of the body.
-    pub html: String,
+    pub html: Markup,
     /// Total size of the encoded frames (base64).
     pub encoded_bytes: usize,
     pub linked: bool,
@@ -75,11 +75,11 @@ pub struct Output<'a> {
     pub linked_dir: &'a str,
 }
 
-/// One frame's data, as the page receives it.
+/// One frame's data, as the page receives it (inline in a <script>, or a linked file).
 fn chunk_js(frame: u32, entries: &[(String, String)]) -> String {
     let map: serde_json::Map<String, serde_json::Value> =
         entries.iter().map(|(k, v)| (k.clone(), json!(v))).collect();
-    format!("flickerFrame({frame},{});\n", serde_json::Value::Object(map))
+    format!("flickerFrame({frame},{});\n", page::script_json(&serde_json::Value::Object(map)).0)
 }
 
 /// The radiance of a frame: EXR when present, else the PNG made linear.
@@ -205,107 +205,99 @@ pub fn build(
         "smape_epsilon": smape_epsilon, "motion_steps": encoding::MOTION_STEPS, "linked": linked.then(|| format!("{}/", out.linked_dir)), "magma": magma,
     });
 
-    let mut h = String::new();
-    h.push_str("<section id=\"viewer\">\n<div class=\"controls\">");
-    h.push_str("<button id=\"play\" type=\"button\">play</button>");
-    let _ = write!(
-        h,
-        "<div class=\"timeline\"><input type=\"range\" id=\"frame-slider\" min=\"0\" max=\"{}\" value=\"{start}\" step=\"1\" aria-label=\"frame\">",
-        frame_count.saturating_sub(1)
-    );
-    let pos = |f: u32| 100.0 * f as f64 / frame_count.saturating_sub(1).max(1) as f64;
-    for e in &manifest.events {
-        let _ = write!(
-            h,
-            "<span class=\"event-mark\" data-frame=\"{}\" style=\"left:{:.3}%\" title=\"frame {}: {}\">▼</span>",
-            e.frame,
-            pos(e.frame),
-            e.frame,
-            esc(&e.label)
-        );
-    }
-    for &f in &manifest.reference.frames {
-        let _ = write!(
-            h,
-            "<span class=\"reference-mark\" style=\"left:{:.3}%\" title=\"reference at frame {f}\"></span>",
-            pos(f)
-        );
-    }
-    let _ = write!(h, "</div><span id=\"frame-label\">frame {start}</span>");
-    h.push_str("<label>exposure <input type=\"range\" id=\"exposure\" min=\"-10\" max=\"10\" step=\"0.25\" value=\"0\"></label><span id=\"exposure-label\">0 EV</span>");
-    h.push_str("<span class=\"modes\"><button type=\"button\" data-mode=\"image\" class=\"on\">image</button>");
-    if !flip_maps.is_empty() {
-        h.push_str("<button type=\"button\" data-mode=\"flip\">FLIP map</button>");
-    }
-    if any_jod.into_inner() {
-        h.push_str("<button type=\"button\" data-mode=\"jod\" title=\"ColorVideoVDP: 1 − JOD of the pixel / 10\">JOD map</button>");
-    }
-    h.push_str("<button type=\"button\" data-mode=\"smape\">SMAPE to previous frame</button>");
-    let any_motion = any_motion.into_inner();
-    if any_motion {
-        h.push_str("<button type=\"button\" data-mode=\"motion\">motion vectors</button>");
-    }
-    h.push_str("</span>");
-    h.push_str("<button id=\"fit\" type=\"button\">fit</button></div>\n<div id=\"panels\">");
+    let last = frame_count.saturating_sub(1);
+    let pos = |f: u32| format!("{:.3}", 100.0 * f as f64 / last.max(1) as f64);
     let scale = if (width as f64) < PANEL_WIDTH {
         (PANEL_WIDTH / width as f64).floor()
     } else {
         PANEL_WIDTH / width as f64
     };
     let (vw, vh) = ((width as f64 * scale).round(), (height as f64 * scale).round());
-    for p in panels {
-        let _ = write!(
-            h,
-            "<figure class=\"panel\" data-label=\"{n}\" data-reference=\"{r}\"><div class=\"view\" style=\"width:{vw}px;height:{vh}px\"><canvas width=\"{width}\" height=\"{height}\" style=\"width:{width}px;height:{height}px\"></canvas></div><figcaption>{n}<span class=\"value\"></span></figcaption></figure>",
-            n = esc(&p.label),
-            r = p.method.is_none()
-        );
-    }
-    h.push_str("</div>\n<p id=\"pixel-label\"></p>\n");
     let mb = |b: usize| b as f64 / (1 << 20) as f64;
     // Settings are f32 in the scenario: print 30 and 0.01, not 29.999998 and 0.009999999776482582.
     let short = |v: f64| format!("{}", (v * 1e4).round() / 1e4);
-    let (fps_text, eps_text) = (short(fps), short(smape_epsilon));
-    let _ = writeln!(
-        h,
-        "<p class=\"note\">Plays at {fps_text} frames/s (the scenario's time step). Wheel: zoom, drag: pan, double-click: fit; space: play/pause, arrows: step. \
-         Frames are decoded from RGBE (HDR) in the page; the exposure scales radiance before sRGB. SMAPE maps are computed in the page against the previous frame (ε = {eps_text}); \
-         FLIP maps exist at reference frames (grey ticks on the slider), scripted events are marked ▼. {} \
-         Frames: {:.1} MB, {} (frames are embedded up to {:.0} MB, linked from <code>{}/</code> beyond).</p>",
-        if any_motion {
-            "Motion vectors: hue gives the direction, brightness the length (brightest = the longest of the panel), values in pixels to the previous frame."
-        } else {
-            "This run records no motion vectors."
-        },
-        mb(encoded_bytes),
-        if linked {
-            format!(
-                "linked from <code>{}/</code>: keep the folder next to this page",
-                out.linked_dir
-            )
-        } else {
-            "embedded in this file".into()
-        },
-        mb(EMBED_LIMIT_BYTES),
-        out.linked_dir,
-    );
-    // `</` would end the script element early.
-    let _ = writeln!(
-        h,
-        "<script type=\"application/json\" id=\"flicker-config\">{}</script>",
-        config.to_string().replace("</", "<\\/")
-    );
-    h.push_str("<script>window.flickerChunks={};function flickerFrame(f,d){window.flickerChunks[f]=d;}</script>\n");
-    if !linked {
-        for js in chunks.iter().flatten() {
-            let _ = writeln!(h, "<script>{js}</script>");
+    let any_motion = any_motion.into_inner();
+    let motion_note = if any_motion {
+        "Motion vectors: hue gives the direction, brightness the length (brightest = the longest of the panel), values in pixels to the previous frame."
+    } else {
+        "This run records no motion vectors."
+    };
+    let html = html! {
+        section id="viewer" {
+            "\n"
+            div class="controls" {
+                button id="play" type="button" { "play" }
+                div class="timeline" {
+                    input type="range" id="frame-slider" min="0" max=(last) value=(start) step="1" aria-label="frame";
+                    @for e in &manifest.events {
+                        span class="event-mark" data-frame=(e.frame) style={ "left:" (pos(e.frame)) "%" } title={ "frame " (e.frame) ": " (e.label) } { "▼" }
+                    }
+                    @for &f in &manifest.reference.frames {
+                        span class="reference-mark" style={ "left:" (pos(f)) "%" } title={ "reference at frame " (f) } {}
+                    }
+                }
+                span id="frame-label" { "frame " (start) }
+                label { "exposure " input type="range" id="exposure" min="-10" max="10" step="0.25" value="0"; }
+                span id="exposure-label" { "0 EV" }
+                span class="modes" {
+                    button type="button" data-mode="image" class="on" { "image" }
+                    @if !flip_maps.is_empty() {
+                        button type="button" data-mode="flip" { "FLIP map" }
+                    }
+                    @if any_jod.into_inner() {
+                        button type="button" data-mode="jod" title="ColorVideoVDP: 1 − JOD of the pixel / 10" { "JOD map" }
+                    }
+                    button type="button" data-mode="smape" { "SMAPE to previous frame" }
+                    @if any_motion {
+                        button type="button" data-mode="motion" { "motion vectors" }
+                    }
+                }
+                button id="fit" type="button" { "fit" }
+            }
+            "\n"
+            div id="panels" {
+                @for p in panels {
+                    figure class="panel" data-label=(p.label) data-reference=(p.method.is_none()) {
+                        div class="view" style={ "width:" (vw) "px;height:" (vh) "px" } {
+                            canvas width=(width) height=(height) style={ "width:" (width) "px;height:" (height) "px" } {}
+                        }
+                        figcaption { (p.label) span class="value" {} }
+                    }
+                }
+            }
+            "\n"
+            p id="pixel-label" {}
+            "\n"
+            p class="note" {
+                "Plays at " (short(fps)) " frames/s (the scenario's time step). Wheel: zoom, drag: pan, double-click: fit; space: play/pause, arrows: step. "
+                "Frames are decoded from RGBE (HDR) in the page; the exposure scales radiance before sRGB. SMAPE maps are computed in the page against the previous frame (ε = " (short(smape_epsilon)) "); "
+                "FLIP maps exist at reference frames (grey ticks on the slider), scripted events are marked ▼. " (motion_note) " "
+                "Frames: " (format!("{:.1}", mb(encoded_bytes))) " MB, "
+                @if linked {
+                    "linked from " code { (out.linked_dir) "/" } ": keep the folder next to this page"
+                } @else {
+                    "embedded in this file"
+                }
+                " (frames are embedded up to " (format!("{:.0}", mb(EMBED_LIMIT_BYTES))) " MB, linked from " code { (out.linked_dir) "/" } " beyond)."
+            }
+            "\n"
+            script type="application/json" id="flicker-config" { (page::script_json(&config)) }
+            "\n"
+            script { (PreEscaped("window.flickerChunks={};function flickerFrame(f,d){window.flickerChunks[f]=d;}")) }
+            "\n"
+            @if !linked {
+                @for js in chunks.iter().flatten() {
+                    script { (PreEscaped(js)) }
+                    "\n"
+                }
+            }
         }
-    }
-    let _ = writeln!(h, "</section>");
-    Ok(Some(Viewer { html: h, encoded_bytes, linked }))
+        "\n"
+    };
+    Ok(Some(Viewer { html, encoded_bytes, linked }))
 }
 
 /// The viewer's script, placed after everything it drives (panels and charts).
-pub fn script() -> String {
-    format!("<script>{SCRIPT}</script>\n")
+pub fn script() -> Markup {
+    html! { script { (PreEscaped(SCRIPT)) } "\n" }
 }

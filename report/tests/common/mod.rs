@@ -35,6 +35,10 @@ pub struct FakeRun {
     pub time_step: Option<f64>,
     /// Whether the first method records motion vectors ([`motion`]).
     pub motion: bool,
+    /// The manifest's scenario name, the event's label and the regions (names a scenario sets).
+    pub scenario: String,
+    pub event_label: String,
+    pub regions: Vec<Region>,
 }
 
 /// The motion vectors the first method records when `FakeRun::motion` is set (pixels).
@@ -54,6 +58,9 @@ impl Default for FakeRun {
             static_noise: false,
             time_step: None,
             motion: false,
+            scenario: "fake_box".into(),
+            event_label: "rotate light 'sun' by 30°".into(),
+            regions: regions(),
         }
     }
 }
@@ -112,7 +119,7 @@ pub fn fake_run_with(name: &str, run: &FakeRun) -> tempfile::TempDir {
     let mut csv = String::from(
         "method,frame,cpu_ms,gpu_ms_total,gpu_ms_trace,smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr",
     );
-    for r in regions() {
+    for r in &run.regions {
         write!(csv, ",{0}_flip,{0}_smape", r.name).unwrap();
     }
     csv.push('\n');
@@ -151,7 +158,7 @@ pub fn fake_run_with(name: &str, run: &FakeRun) -> tempfile::TempDir {
                 }
                 None => csv.push_str(",,,"),
             }
-            for r in regions() {
+            for r in &run.regions {
                 let rf = flip.as_ref().and_then(|(fl, ..)| r.mean_of(&fl.map, w));
                 let rs = s.as_ref().and_then(|s| r.mean_of(&s.map, w));
                 let cell = |v: Option<f64>| v.map(|v| format!("{v:.6}")).unwrap_or_default();
@@ -163,11 +170,11 @@ pub fn fake_run_with(name: &str, run: &FakeRun) -> tempfile::TempDir {
     }
     std::fs::write(dir.join("frames.csv"), csv).unwrap();
     let manifest = serde_json::json!({
-        "scenario": "fake_box", "scenario_file": "scenarios/fake_box.ron", "commit": "0000000",
+        "scenario": run.scenario, "scenario_file": "scenarios/fake_box.ron", "commit": "0000000",
         "adapter": {"name": "none", "backend": "test"}, "seed": 1, "resolution": [w, h], "frames": run.frames,
         "methods": run.methods, "reference": {"spp": 64, "frames": reference_frames},
-        "events": [{"frame": event, "label": "rotate light 'sun' by 30°"}],
-        "regions": regions(), "settings": {"smape_epsilon": 0.01, "time_step": run.time_step}
+        "events": [{"frame": event, "label": run.event_label}],
+        "regions": run.regions, "settings": {"smape_epsilon": 0.01, "time_step": run.time_step}
     });
     std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&manifest).unwrap())
         .unwrap();
@@ -176,4 +183,32 @@ pub fn fake_run_with(name: &str, run: &FakeRun) -> tempfile::TempDir {
 
 pub fn read_json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Names that a scenario (or a folder of frames) sets, holding markup and quotes. In a page
+/// each must be text: `<img onerror>` run as markup calls alert, `<!--<script>` inside a
+/// <script> element hides the next `</script>`, `</script>` ends one early.
+pub const HOSTILE_METHODS: [&str; 2] = ["<img src=x onerror=alert(1)>\"'&", "<!--<script>\"'&"];
+pub const HOSTILE_SCENARIO: &str = "</script><img src=x onerror=alert(2)>\"'&";
+pub const HOSTILE_EVENT: &str = "</script><svg onload=alert(3)>\"'&";
+pub const HOSTILE_REGIONS: [&str; 2] = ["<img src=x onerror=alert(4)>\"'&", "<!--\"'&"];
+
+/// A short run whose methods, scenario, event and regions have hostile names.
+pub fn hostile_run(name: &str) -> tempfile::TempDir {
+    let regions = regions()
+        .into_iter()
+        .zip(HOSTILE_REGIONS)
+        .map(|(r, n)| Region { name: n.into(), ..r })
+        .collect();
+    let spec = FakeRun {
+        frames: 8,
+        event: 4,
+        reference_frames: vec![0, 4],
+        methods: HOSTILE_METHODS.map(String::from).to_vec(),
+        scenario: HOSTILE_SCENARIO.into(),
+        event_label: HOSTILE_EVENT.into(),
+        regions,
+        ..FakeRun::default()
+    };
+    fake_run_with(name, &spec)
 }

@@ -1,8 +1,9 @@
 //! Rendering methods. Each is a plugin ([`MethodPlugin`], in `plugin.rs`): it owns its settings,
 //! label, samples per pixel, temporal window and `--spp` override, adds its systems to the
 //! frame's stages (`crate::frame::Stage`) and builds each instance, GPU state included, up front
-//! on the instance's entity. `registry.rs` lists them, one line each. Adding a method: its file
-//! (or folder) here with its settings, components, systems and plugin, and its registry line.
+//! on the instance's entity, and declares the statistics and charts it records. `registry.rs`
+//! lists them, one line each. Adding a method: its folder under `methods/` with its settings,
+//! components, systems and plugin, and its registry line.
 
 pub mod registry;
 pub mod spec;
@@ -10,7 +11,10 @@ pub mod spec;
 use anyhow::Result;
 use bevy_ecs::prelude::*;
 
-pub use frame::method::{MethodPlugin, MethodSpec, RegisteredMethod};
+pub use frame::method::{
+    Better, ChartSeries, ImageStatistic, MethodChart, MethodPlugin, MethodSpec, RegisteredMethod,
+    Source, Statistic,
+};
 pub use frame::temporal_window;
 pub use registry::register;
 pub use spec::{check_labels, parse_methods};
@@ -56,8 +60,18 @@ pub fn plugins(methods: &[Method]) -> Vec<&'static dyn RegisteredMethod> {
 pub fn schedule_for(methods: &[Method]) -> Schedule {
     let mut schedule = crate::frame::new_schedule();
     crate::frame::add_core_systems(&mut schedule);
+    // Each system is owned by its method (or is the frame's own), so a GPU fault names it.
+    crate::frame::own_systems(&mut schedule, &Default::default(), None);
     for plugin in plugins(methods) {
+        let before = crate::frame::system_keys(&schedule);
         plugin.add_systems(&mut schedule);
+        let labels: Vec<String> = methods
+            .iter()
+            .filter(|m| m.spec.plugin().name() == plugin.name())
+            .map(Method::label)
+            .collect();
+        let owner = format!("method {}", labels.join(", "));
+        crate::frame::own_systems(&mut schedule, &before, Some(&owner));
     }
     schedule
 }

@@ -57,9 +57,14 @@ pub struct Point {
 impl Point {
     /// `abc1234` or `abc1234-dirty`.
     pub fn label(&self) -> String {
-        let c: String = self.commit.chars().take(7).collect();
-        if self.dirty { format!("{c}-dirty") } else { c }
+        commit_label(&self.commit, self.dirty)
     }
+}
+
+/// A commit as a short label: `abc1234` or `abc1234-dirty`.
+fn commit_label(commit: &str, dirty: bool) -> String {
+    let c: String = commit.chars().take(7).collect();
+    if dirty { format!("{c}-dirty") } else { c }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -249,4 +254,95 @@ pub fn chart(s: &Series) -> report::charts::Chart {
         pareto: Vec::new(),
         x_extent: vec![0.0, (s.points.len().max(2) - 1) as f64],
     }
+}
+
+/// A ratio of `now` against the last kept record of the same command, form, build and adapter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Change {
+    pub id: String,
+    /// The last kept record's value and its commit label.
+    pub last: f64,
+    pub last_commit: String,
+    pub now: f64,
+    /// The run-to-run spread the change is read against: the larger of the two records' margins
+    /// (half the range of a run's rounds) and twice the pooled standard deviation of repeated
+    /// runs at one commit over the series; none when neither is known.
+    pub spread: Option<f64>,
+}
+
+impl Change {
+    /// The change is beyond the run-to-run spread.
+    pub fn beyond_spread(&self) -> bool {
+        self.spread.is_some_and(|s| (self.now - self.last).abs() > s)
+    }
+}
+
+/// Each ratio of `now` against the last record of `history` (ordered by date, `now` not in
+/// it) from the same kind, name, build profile and adapter that has the ratio.
+pub fn against_last(history: &[Record], now: &Record) -> Vec<Change> {
+    let same = |r: &Record| {
+        r.kind == now.kind
+            && r.name == now.name
+            && r.profile == now.profile
+            && r.adapter == now.adapter
+    };
+    let mut with_now: Vec<Record> = history.iter().filter(|r| same(r)).cloned().collect();
+    with_now.push(now.clone());
+    let all = series(&with_now);
+    let mut out = Vec::new();
+    for e in &now.entries {
+        let Some(value) = e.value else { continue };
+        let Some((r, last)) = history.iter().rev().filter(|r| same(r)).find_map(|r| {
+            r.entries.iter().find(|x| x.id == e.id && x.value.is_some()).map(|x| (r, x))
+        }) else {
+            continue;
+        };
+        let repeats = all.iter().find(|s| s.key.id == e.id).and_then(|s| repeat_spread(&s.points));
+        let spread = match (step_margin(last, e, None), repeats) {
+            (Some(m), Some(s)) => Some(m.max(s)),
+            (m, s) => m.or(s),
+        };
+        out.push(Change {
+            id: e.id.clone(),
+            last: last.value.unwrap_or(f64::NAN),
+            last_commit: commit_label(&r.commit, r.dirty),
+            now: value,
+            spread,
+        });
+    }
+    out
+}
+
+/// The changes as a Markdown table (what `flicker bench` prints after its own table).
+pub fn changes_markdown(changes: &[Change]) -> String {
+    if changes.is_empty() {
+        return "\nNo earlier record of this bench, build and adapter in the results history: nothing to compare with.\n".into();
+    }
+    let mut md = String::from(
+        "\n## Against the last kept record\n\n| ratio | last (commit) | now | change | run-to-run spread | |\n|---|---|---|---|---|---|\n",
+    );
+    for c in changes {
+        let change = c.now - c.last;
+        let rel = if c.last != 0.0 {
+            format!(" ({:+.1}%)", 100.0 * change / c.last)
+        } else {
+            String::new()
+        };
+        md.push_str(&format!(
+            "| {} | {:.4} ({}) | {:.4} | {change:+.4}{rel} | {} | {} |\n",
+            c.id,
+            c.last,
+            c.last_commit,
+            c.now,
+            c.spread.map_or("unknown (no rounds or repeats yet)".into(), |s| format!("{s:.4}")),
+            if c.beyond_spread() {
+                "**beyond the spread**"
+            } else if c.spread.is_some() {
+                "within"
+            } else {
+                "-"
+            },
+        ));
+    }
+    md
 }

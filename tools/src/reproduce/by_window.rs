@@ -8,6 +8,8 @@ use serde::Deserialize;
 use super::claims::CaseMethods;
 use super::table::{CaseTable, cell};
 use crate::suite::measurement::CaseRuns;
+use systems::methods::ImageStatistic;
+
 use crate::suite::metric::Metric;
 use crate::suite::window::Window;
 
@@ -31,7 +33,8 @@ impl ByWindow {
                 return Err(format!("by_window: {name} is listed twice"));
             }
             if m.from_images()
-                || matches!(*m, Metric::PassMs | Metric::VarianceOverBound)
+                || *m == Metric::PassMs
+                || m.from_images_by() == Some(ImageStatistic::VarianceOverBound)
                 || !m.per_frame()
             {
                 return Err(format!(
@@ -102,7 +105,7 @@ mod tests {
             ],
         };
         let by = ByWindow {
-            metrics: vec![Metric::CacheMean],
+            metrics: vec![Metric::shipped("CacheMean")],
             windows: vec![
                 Window::Around { event: 0, from: -2, to: 0 },
                 Window::After { event: 0, frames: 2 },

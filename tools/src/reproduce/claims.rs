@@ -14,6 +14,8 @@ use sim::scenario::{ReferenceFrames, ScenarioError};
 use systems::playback::{Overrides, RunSpec};
 
 use crate::ron_file::{self, RonFile};
+use systems::methods::ImageStatistic;
+
 use crate::suite::metric::Metric;
 use crate::suite::spec::Case;
 use crate::suite::window::Window;
@@ -330,9 +332,24 @@ pub struct Claim {
     pub smallest_effect_from: String,
     #[serde(default)]
     pub departures: Vec<String>,
+    /// This claim is another claim of the file judged again with one condition switched (a
+    /// departure of ours turned on or off): the report sets the two verdicts side by side, so
+    /// a reader sees which condition a failure comes from.
+    #[serde(default)]
+    pub variant_of: Option<VariantOf>,
     /// The claim's line in its file (filled when loaded).
     #[serde(skip)]
     pub line: usize,
+}
+
+/// `variant_of: Some((claim: "cv_fewer_samples", switched: "irradiance: PathTraced"))`.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VariantOf {
+    /// The claim judged under the other condition; defined in the same file, itself no variant.
+    pub claim: String,
+    /// What differs from that claim's condition, in a phrase.
+    pub switched: String,
 }
 
 #[derive(Deserialize)]
@@ -775,7 +792,7 @@ impl Claims {
                         )));
                     }
                     if let Some(s) = &claim.statistic
-                        && matches!(s.metric, Metric::SigmaChanged | Metric::SigmaUnchanged)
+                        && s.metric.from_images_by() == Some(ImageStatistic::PreferenceRegions)
                         && !case.preference_maps.iter().any(|p| p == m)
                     {
                         return Err(at(format!(
@@ -790,6 +807,28 @@ impl Claims {
         }
         if claims.is_empty() {
             return Err(file.error(None, "no claims; expected at least one".into()));
+        }
+        for c in &claims {
+            let Some(v) = &c.variant_of else { continue };
+            let at = |m: String| file.error(Some((c.line, 1)), format!("claim '{}': {m}", c.id));
+            match claims.iter().find(|b| b.id == v.claim) {
+                None => {
+                    return Err(at(format!(
+                        "variant_of: no claim '{}' in this file; expected the id of the claim this one switches a condition of",
+                        v.claim
+                    )));
+                }
+                Some(b) if b.id == c.id || b.variant_of.is_some() => {
+                    return Err(at(format!(
+                        "variant_of: '{}' is itself a variant (or this claim); expected the claim judged under the other condition",
+                        v.claim
+                    )));
+                }
+                Some(_) if v.switched.trim().is_empty() => {
+                    return Err(at("variant_of: switched is empty; expected what differs, e.g. \"irradiance: PathTraced\"".into()));
+                }
+                Some(_) => {}
+            }
         }
         Ok(Claims {
             paper: parsed.paper,

@@ -50,8 +50,8 @@ fn put_row(out: &mut Values, m: usize, n: u32, trials: usize, s1: f64, s2: f64, 
     let mean = s1 / count;
     let var = (s2 / count - mean * mean) * count / (count - 1.0);
     let label = format!("m{m}_n{n}");
-    put(out, label.clone(), Metric::MeanAbsBias, (mean - t).abs());
-    put(out, label, Metric::MeanStd, var.max(0.0).sqrt());
+    put(out, label.clone(), Metric::shipped("MeanAbsBias"), (mean - t).abs());
+    put(out, label, Metric::shipped("MeanStd"), var.max(0.0).sqrt());
 }
 
 impl Computation {
@@ -70,12 +70,20 @@ impl Computation {
             Computation::JackknifeTable1 { .. } => media::jackknife_table::TABLE_1
                 .iter()
                 .map(|&(m, n, ..)| {
-                    (format!("m{m}_n{n}"), vec![Metric::MeanAbsBias, Metric::MeanStd])
+                    (
+                        format!("m{m}_n{n}"),
+                        vec![Metric::shipped("MeanAbsBias"), Metric::shipped("MeanStd")],
+                    )
                 })
                 .collect(),
             Computation::JackknifeTable1Alg1 { .. } => media::table1_alg1::ROWS
                 .iter()
-                .map(|&(m, n)| (format!("m{m}_n{n}"), vec![Metric::MeanAbsBias, Metric::MeanStd]))
+                .map(|&(m, n)| {
+                    (
+                        format!("m{m}_n{n}"),
+                        vec![Metric::shipped("MeanAbsBias"), Metric::shipped("MeanStd")],
+                    )
+                })
                 .collect(),
             Computation::TerminationFig4 { thresholds } => thresholds
                 .iter()

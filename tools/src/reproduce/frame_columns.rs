@@ -1,8 +1,9 @@
-//! Method stats that a run's frames.csv holds but a suite's runs do not keep (not in
-//! `Metric::ALL`, so sweeps and baselines keep their columns): the termination cache's
-//! statistics (`CacheMean`, `CacheVariance`, `CacheBias2`), read back per method and frame.
+//! Method statistics that a run's frames.csv holds but a suite's runs do not keep (declared
+//! `Source::FramesReproduceOnly`, so not in `Metric::all()` and sweeps and baselines keep their
+//! columns), e.g. the termination cache's `CacheMean`: read back per method and frame.
 
 use anyhow::{Result, bail};
+use systems::methods::Source;
 use systems::run_folder::RunFolder;
 
 use crate::suite::measurement::SeedRun;
@@ -12,7 +13,7 @@ use super::frames_csv::rows;
 
 /// Whether `metric` is read here (its frames.csv column is its name).
 pub fn reads(metric: Metric) -> bool {
-    matches!(metric, Metric::CacheMean | Metric::CacheVariance | Metric::CacheBias2)
+    metric.statistic().is_some_and(|s| s.source == Source::FramesReproduceOnly)
 }
 
 /// Adds `metric`'s column of the seed's frames.csv to its methods' series (an empty cell: not
@@ -57,14 +58,14 @@ mod tests {
         .unwrap();
         let methods = ["vb", "pt"].into_iter().map(|m| (m.to_string(), BTreeMap::new())).collect();
         let mut run = SeedRun { seed: 1, methods, jod: BTreeMap::new(), folder: Some(dir.clone()) };
-        add(&mut run, Metric::CacheMean).unwrap();
-        add(&mut run, Metric::CacheBias2).unwrap();
+        add(&mut run, Metric::shipped("CacheMean")).unwrap();
+        add(&mut run, Metric::shipped("CacheBias2")).unwrap();
         assert_eq!(run.methods["vb"]["cache_mean"], [Some(0.5), Some(0.75)]);
         assert_eq!(run.methods["vb"]["cache_bias2"], [Some(0.1), Some(0.2)]);
         // A method without the stat has no values, not zeros.
         assert_eq!(run.methods["pt"]["cache_mean"], [None, None]);
-        assert_eq!(run.window_mean("vb", Metric::CacheMean, 0..2), Some(0.625));
-        let e = add(&mut run, Metric::CacheVariance).unwrap_err().to_string();
+        assert_eq!(run.window_mean("vb", Metric::shipped("CacheMean"), 0..2), Some(0.625));
+        let e = add(&mut run, Metric::shipped("CacheVariance")).unwrap_err().to_string();
         assert!(e.contains("no method, frame or cache_variance column"), "{e}");
     }
 }

@@ -3,6 +3,8 @@
 //! open), then one row per claim: the paper's number beside flicker's (both methods named)
 //! with its interval, the verdict and the known departures.
 
+use maud::{PreEscaped, html};
+
 use super::claims::{Claim, Claims, Comparison};
 use super::judge::{Judged, VERDICTS, Verdict};
 use super::table::{self, CaseTable};
@@ -98,6 +100,49 @@ pub fn conclusion(judged: &[(&Claim, Judged)]) -> String {
     out
 }
 
+/// Each claim judged again with one condition switched, beside the claim it varies:
+/// (claim, its verdict, what is switched, the variant's id, the variant's verdict).
+fn variants<'a>(judged: &'a [(&'a Claim, Judged)]) -> Vec<[String; 5]> {
+    let mut rows = Vec::new();
+    for (base, bj) in judged.iter().filter(|(c, _)| c.variant_of.is_none()) {
+        for (c, j) in judged {
+            if let Some(v) = c.variant_of.as_ref().filter(|v| v.claim == base.id) {
+                rows.push([
+                    base.id.clone(),
+                    verdict_text(&bj.verdict),
+                    v.switched.clone(),
+                    c.id.clone(),
+                    verdict_text(&j.verdict),
+                ]);
+            }
+        }
+    }
+    rows
+}
+
+/// The variants as a Markdown section, or nothing when the paper has none.
+fn variants_markdown(judged: &[(&Claim, Judged)]) -> String {
+    let rows = variants(judged);
+    if rows.is_empty() {
+        return String::new();
+    }
+    let mut md = String::from(
+        "\n### With and without each switched condition\n\n| claim | verdict | switched | verdict switched |\n|---|---|---|---|\n",
+    );
+    for [id, v, switched, vid, vv] in rows {
+        md.push_str(&format!(
+            "| `{}` | {} | {} (`{}`) | {} |\n",
+            cell(&id),
+            cell(&v),
+            cell(&switched),
+            cell(&vid),
+            cell(&vv)
+        ));
+    }
+    md.push('\n');
+    md
+}
+
 /// The Markdown report; `header` says how it was made (command, scale, seeds, commit).
 pub fn markdown(header: &str, papers: &[PaperResult]) -> String {
     let mut md = format!("# What the papers claim, and what we measure\n\n{header}\n");
@@ -120,6 +165,7 @@ pub fn markdown(header: &str, papers: &[PaperResult]) -> String {
                 cell(&c.departures.join("; ")),
             ));
         }
+        md.push_str(&variants_markdown(&p.judged));
         for t in &p.tables {
             md.push_str(&table::markdown(t));
         }
@@ -127,60 +173,71 @@ pub fn markdown(header: &str, papers: &[PaperResult]) -> String {
     md
 }
 
-fn escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
-}
+const STYLE: &str = "body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:4px;vertical-align:top;font-size:90%}.reproduced{background:#d9f2d9}.not-reproduced{background:#f6d5d5}.inconclusive{background:#fdf3cf}.not-comparable{background:#eee}";
 
 /// The same table as a standalone page, verdicts coloured.
 pub fn html(header: &str, papers: &[PaperResult]) -> String {
-    let mut h = String::from(
-        "<!doctype html><meta charset=\"utf-8\"><title>flicker reproduce</title>\n<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:4px;vertical-align:top;font-size:90%}.reproduced{background:#d9f2d9}.not-reproduced{background:#f6d5d5}.inconclusive{background:#fdf3cf}.not-comparable{background:#eee}</style>\n",
-    );
-    h.push_str(&format!(
-        "<h1>What the papers claim, and what we measure</h1>\n<p>{}</p>\n",
-        escape(header)
-    ));
-    for p in papers {
-        h.push_str(&format!(
-            "<h2>{} ({})</h2>\n<p>{}</p>\n<table><tr><th>claim</th><th>where</th><th>paper</th><th>test</th><th>flicker (95% interval)</th><th>verdict</th><th>departures</th></tr>\n",
-            escape(&p.claims.title),
-            escape(&p.claims.paper),
-            escape(&conclusion(&p.judged).replace('`', ""))
-        ));
-        for (c, j) in &p.judged {
-            let class = j.verdict.name().replace(' ', "-");
-            h.push_str(&format!(
-                "<tr><td><b>{}</b>: {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"{class}\">{}</td><td>{}</td></tr>\n",
-                escape(&c.id),
-                escape(&c.claim),
-                escape(&c.source),
-                escape(&c.paper),
-                escape(&test_text(c)),
-                escape(&j.flicker),
-                escape(&verdict_text(&j.verdict)),
-                escape(&c.departures.join("; ")),
-            ));
-        }
-        h.push_str("</table>\n");
-        for t in &p.tables {
-            h.push_str(&format!(
-                "<h3>Case {} (mean [95% interval] over {} seeds)</h3>\n<table><tr><th>method</th>",
-                escape(&t.case),
-                t.seeds
-            ));
-            for c in &t.columns {
-                h.push_str(&format!("<th>{}</th>", escape(c)));
-            }
-            h.push_str("</tr>\n");
-            for (m, cells) in &t.rows {
-                h.push_str(&format!("<tr><td>{}</td>", escape(m)));
-                for c in cells {
-                    h.push_str(&format!("<td>{}</td>", escape(c)));
+    html! {
+        (PreEscaped("<!doctype html>"))
+        meta charset="utf-8";
+        title { "flicker reproduce" }
+        "\n"
+        style { (PreEscaped(STYLE)) }
+        "\n"
+        h1 { "What the papers claim, and what we measure" }
+        "\n"
+        p { (header) }
+        "\n"
+        @for p in papers {
+            h2 { (p.claims.title) " (" (p.claims.paper) ")" }
+            "\n"
+            p { (conclusion(&p.judged).replace('`', "")) }
+            "\n"
+            table {
+                tr {
+                    th { "claim" } th { "where" } th { "paper" } th { "test" }
+                    th { "flicker (95% interval)" } th { "verdict" } th { "departures" }
                 }
-                h.push_str("</tr>\n");
+                "\n"
+                @for (c, j) in &p.judged {
+                    tr {
+                        td { b { (c.id) } ": " (c.claim) }
+                        td { (c.source) } td { (c.paper) } td { (test_text(c)) } td { (j.flicker) }
+                        td class=(j.verdict.name().replace(' ', "-")) { (verdict_text(&j.verdict)) }
+                        td { (c.departures.join("; ")) }
+                    }
+                    "\n"
+                }
             }
-            h.push_str("</table>\n");
+            "\n"
+            @let rows = variants(&p.judged);
+            @if !rows.is_empty() {
+                h3 { "With and without each switched condition" }
+                "\n"
+                table {
+                    tr { th { "claim" } th { "verdict" } th { "switched" } th { "verdict switched" } }
+                    "\n"
+                    @for [id, v, switched, vid, vv] in &rows {
+                        tr { td { (id) } td { (v) } td { (switched) " (" (vid) ")" } td { (vv) } }
+                        "\n"
+                    }
+                }
+                "\n"
+            }
+            @for t in &p.tables {
+                h3 { "Case " (t.case) " (mean [95% interval] over " (t.seeds) " seeds)" }
+                "\n"
+                table {
+                    tr { th { "method" } @for c in &t.columns { th { (c) } } }
+                    "\n"
+                    @for (m, cells) in &t.rows {
+                        tr { td { (m) } @for c in cells { td { (c) } } }
+                        "\n"
+                    }
+                }
+                "\n"
+            }
         }
     }
-    h
+    .into_string()
 }

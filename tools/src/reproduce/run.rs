@@ -11,6 +11,8 @@ use super::judge::{Judged, judge};
 use super::report::{self, PaperResult};
 use super::table::case_tables;
 use crate::suite::measurement::CaseRuns;
+use systems::methods::ImageStatistic;
+
 use crate::suite::metric::Metric;
 use crate::suite::run::play_cases;
 use crate::suite::spec::Case;
@@ -100,14 +102,16 @@ fn add_from_folders(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> R
                 super::sss_psnr::add(seed, against, frames).map_err(at)?;
             }
         }
-        if s.metric == Metric::VarianceOverBound && !bounded.contains(&case) {
+        if s.metric.from_images_by() == Some(ImageStatistic::VarianceOverBound)
+            && !bounded.contains(&case)
+        {
             bounded.push(case);
             let frames = r.frames;
             for seed in &mut r.seeds {
                 super::variance_bound::add(seed, frames).map_err(at)?;
             }
         }
-        if matches!(s.metric, Metric::SigmaChanged | Metric::SigmaUnchanged)
+        if s.metric.from_images_by() == Some(ImageStatistic::PreferenceRegions)
             && !regions.contains(&case)
         {
             regions.push(case);

@@ -140,8 +140,8 @@ pub fn add(run: &mut SeedRun, frames: u32, events: &[u32]) -> Result<()> {
             unchanged.push(u);
         }
         let metrics = run.methods.get_mut(&m).expect("a method of the run");
-        metrics.insert(Metric::SigmaChanged.name().to_string(), changed);
-        metrics.insert(Metric::SigmaUnchanged.name().to_string(), unchanged);
+        metrics.insert(Metric::shipped("SigmaChanged").name().to_string(), changed);
+        metrics.insert(Metric::shipped("SigmaUnchanged").name().to_string(), unchanged);
     }
     Ok(())
 }

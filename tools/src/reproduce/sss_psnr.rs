@@ -29,7 +29,7 @@ fn sampled(path: &Path) -> Result<Vec<bool>> {
 /// (no PSNR against itself).
 pub fn add(run: &mut SeedRun, against: &str, frames: u32) -> Result<()> {
     let Some(root) = &run.folder else {
-        bail!("seed {}: no run folder to read {} from", run.seed, Metric::SssPsnr.name())
+        bail!("seed {}: no run folder to read {} from", run.seed, Metric::shipped("SssPsnr").name())
     };
     let folder = RunFolder::new(root);
     let at = |what: &str, f: u32| format!("seed {} frame {f}: {what}", run.seed);
@@ -60,7 +60,7 @@ pub fn add(run: &mut SeedRun, against: &str, frames: u32) -> Result<()> {
             series.push((any && peak > 0.0).then_some(db));
         }
         let metrics = run.methods.get_mut(&m).expect("a method of the run");
-        metrics.insert(Metric::SssPsnr.name().to_string(), series);
+        metrics.insert(Metric::shipped("SssPsnr").name().to_string(), series);
     }
     Ok(())
 }

@@ -23,12 +23,16 @@ pub const BOUND_COLUMN: &str = "variance_bound_log10";
 /// `frames` frames; methods without a bound get none. Fewer than two frames is an error.
 pub fn add(run: &mut SeedRun, frames: u32) -> Result<()> {
     let Some(root) = &run.folder else {
-        bail!("seed {}: no run folder to read {} from", run.seed, Metric::VarianceOverBound.name())
+        bail!(
+            "seed {}: no run folder to read {} from",
+            run.seed,
+            Metric::shipped("VarianceOverBound").name()
+        )
     };
     if frames < 2 {
         bail!(
             "{} needs at least 2 frames, the case has {frames}",
-            Metric::VarianceOverBound.name()
+            Metric::shipped("VarianceOverBound").name()
         );
     }
     let folder = RunFolder::new(root);
@@ -65,7 +69,7 @@ pub fn add(run: &mut SeedRun, frames: u32) -> Result<()> {
                 Some(sq / pixels as f64 * n as f64 / (n as f64 - 1.0) / bound)
             })
             .collect();
-        metrics.insert(Metric::VarianceOverBound.name().to_string(), series);
+        metrics.insert(Metric::shipped("VarianceOverBound").name().to_string(), series);
     }
     Ok(())
 }
@@ -101,7 +105,7 @@ mod tests {
         let methods = ["vb", "pt"].map(|m| (m.to_string(), BTreeMap::new())).into();
         let mut run = SeedRun { seed: 1, methods, jod: BTreeMap::new(), folder: Some(dir.clone()) };
         add(&mut run, 3).unwrap();
-        let mean = run.window_mean("vb", Metric::VarianceOverBound, 0..3).unwrap();
+        let mean = run.window_mean("vb", Metric::shipped("VarianceOverBound"), 0..3).unwrap();
         assert!((mean - 2.0).abs() < 1e-4, "{mean}");
         assert!(!run.methods["pt"].contains_key("variance_over_bound"));
         assert!(add(&mut run, 1).unwrap_err().to_string().contains("at least 2 frames"));

@@ -6,6 +6,7 @@ pub fn summary(
     suite: &str,
     adapter: &str,
     baseline: Option<(&str, &str)>,
+    stand_in: Option<&str>,
     results: &[GateResult],
 ) -> String {
     let failed = results.iter().filter(|r| !r.passed()).count();
@@ -18,11 +19,12 @@ pub fn summary(
         }
     );
     out.push_str(&format!("Adapter: {adapter}\n\n"));
-    match baseline {
-        Some((commit, date)) => {
+    match (baseline, stand_in) {
+        (Some(_), Some(note)) => out.push_str(&format!("Baseline: {note}\n\n")),
+        (Some((commit, date)), None) => {
             out.push_str(&format!("Baseline: commit {commit}, blessed {date}\n\n"))
         }
-        None => out.push_str("Baseline: none for this adapter (absolute gates only)\n\n"),
+        (None, _) => out.push_str("Baseline: none for this adapter (absolute gates only)\n\n"),
     }
     out.push_str("| result | case | method | gate | new mean | baseline mean | p | detail |\n|---|---|---|---|---:|---:|---:|---|\n");
     let mut rows: Vec<&GateResult> = results.iter().collect();

@@ -32,7 +32,7 @@ impl SeedRun {
         rows.sort_by_key(|r| (r.method.clone(), r.frame));
         for r in rows {
             let metrics = methods.entry(r.method.clone()).or_default();
-            for m in Metric::ALL.into_iter().filter(|m| m.per_frame()) {
+            for m in Metric::all().into_iter().filter(|m| m.per_frame()) {
                 let series = metrics.entry(m.name().to_string()).or_default();
                 series.resize(r.frame as usize, None);
                 series.push(m.of(r));

@@ -1,11 +1,19 @@
 //! The numbers a gate or a claim can judge: per-frame ones read from a run's frame records, and
 //! JOD, one number per window of frames.
 
-use serde::{Deserialize, Serialize};
+use std::fmt;
+
+use serde::de::{self, EnumAccess, VariantAccess, Visitor};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use systems::frame_record::FrameRecord;
+use systems::methods::registry;
+use systems::methods::{Better, ImageStatistic, Source, Statistic};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+/// A number every method has, or one a method declares (`Method`: its statistic's name, e.g.
+/// `PathLength`, looked up in the registry: `systems::methods::registry::statistic`). Claims and
+/// suites write either by name: `metric: Flip`, `metric: PathLength`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Metric {
     /// Mean FLIP against the reference (frames with a reference only).
     Flip,
@@ -19,19 +27,6 @@ pub enum Metric {
     /// ColorVideoVDP's JOD of the window's frames played as a video against the references (not
     /// a per-frame mean: report::jod). Higher is better; 10 = no visible difference.
     Cvvdp,
-    /// Mean path length in vertices (the termination method's `path_length` stat). Shorter is
-    /// "better": `Better(than: M)` on it says the method's paths are shorter than M's.
-    PathLength,
-    /// Mean |bias| of the transmittance image against the exact one (the VolumeTransmittance
-    /// method's `mean_abs_bias` stat).
-    MeanAbsBias,
-    /// Mean per-pixel standard deviation of the transmittance estimate (VolumeTransmittance's
-    /// `mean_std` stat).
-    MeanStd,
-    /// RMS over pixels of the noise-corrected bias of the transmittance image against the
-    /// exact one (VolumeTransmittance's `rms_bias` stat, `media::image::rms_bias`): the bias
-    /// the jackknife paper reads from 2^18 spp, without the noise of a few dozen estimates.
-    RmsBias,
     /// The frame's time in ms: the sum of its passes' times (GPU timestamps or per-pass wall
     /// time), only when every pass was timed. A timing: it varies from run to run.
     FrameMs,
@@ -39,66 +34,89 @@ pub enum Metric {
     Rays,
     /// Paths shaded this frame.
     Shaded,
-    /// Mean samples per SSS pixel (the Sss method's `sss_mean_spp` stat).
-    SssSpp,
-    /// Primary rays the sample cache traced this frame (SampleCache's `primary_rays` stat).
-    PrimaryRays,
-    /// Mean blend weight σ of the High-LR side over the image (Nirc's `blend_sigma` stat).
-    BlendSigma,
-    /// PSNR (dB) of luminance over the SSS pixels against another method's frames of the same
-    /// run (realtime-sss-thesis Table 7.3 against its converged pass). Not a frames.csv column:
-    /// `flicker reproduce` computes it from the run folder's images (`from_images`), so it is
-    /// not in `ALL` and no suite gate reads it.
-    SssPsnr,
     /// The summed ms of some of a frame's passes (`reproduce::pass_ms`, the claim's statistic
     /// names them), a method's share of a cache's passes included: Table 1's tracer and
     /// propagation columns. Read from frames.csv by `flicker reproduce`, not a frame record's
-    /// field, so it is not in `ALL`. A timing.
+    /// field, so it is not in `all`. A timing.
     PassMs,
-    /// A NIRC blend's mean σ over the fifth of the pixels whose reference changed most across
-    /// the case's first event, and over the fifth that changed least (`reproduce::sigma_regions`,
-    /// from the preference maps and references in the run folder; not in `ALL`).
-    SigmaChanged,
-    SigmaUnchanged,
-    /// The termination cache's mean luminance E[Y] over its filled records (frames.csv's
-    /// `cache_mean`), and below their mean variance and squared bias: how the cache follows a
-    /// change of lighting. Read back from frames.csv by `flicker reproduce`
-    /// (`reproduce::frame_columns`), not in `ALL`, so sweeps and baselines keep their columns.
-    CacheMean,
-    /// `cache_variance`: the mean of E[Y²] − E[E[Y|y]²] over the filled records.
-    CacheVariance,
-    /// `cache_bias2`: the mean of E[E[Y|y]²] − E[Y]² over the filled records.
-    CacheBias2,
-    /// variance-trading-termination's Fig. 7: the image variance over its bound. Per frame, the
-    /// mean over pixels of the squared deviation of the frame's luminance from the pixel's mean
-    /// over the run's frames, times n/(n − 1), divided by the method's absolute threshold
-    /// t · unit² (frames.csv's `variance_bound_log10`): over all the frames of a static scene's run
-    /// (window Overall) the mean is the estimator's per-pixel variance over the bound
-    /// (`reproduce::variance_bound`, from the run's images; not in `ALL`).
-    VarianceOverBound,
+    /// A statistic a method declares (`MethodPlugin::STATISTICS`), by its registered name.
+    Method(&'static str),
 }
 
-impl Metric {
-    pub const ALL: [Metric; 17] = [
-        Metric::Flip,
-        Metric::Cvvdp,
-        Metric::Smape,
-        Metric::SmapeReprojected,
-        Metric::Mse,
-        Metric::RelMse,
-        Metric::Psnr,
-        Metric::PathLength,
-        Metric::MeanAbsBias,
-        Metric::MeanStd,
-        Metric::RmsBias,
-        Metric::FrameMs,
-        Metric::Rays,
-        Metric::Shaded,
-        Metric::SssSpp,
-        Metric::PrimaryRays,
-        Metric::BlendSigma,
-    ];
+/// The metrics every method has, with the names claims and suites write.
+const COMMON: [(Metric, &str); 11] = [
+    (Metric::Flip, "Flip"),
+    (Metric::Smape, "Smape"),
+    (Metric::SmapeReprojected, "SmapeReprojected"),
+    (Metric::Mse, "Mse"),
+    (Metric::RelMse, "RelMse"),
+    (Metric::Psnr, "Psnr"),
+    (Metric::Cvvdp, "Cvvdp"),
+    (Metric::FrameMs, "FrameMs"),
+    (Metric::Rays, "Rays"),
+    (Metric::Shaded, "Shaded"),
+    (Metric::PassMs, "PassMs"),
+];
 
+impl Metric {
+    /// The metric a claim or a suite calls `name`: a common one, or a registered method's
+    /// statistic.
+    pub fn named(name: &str) -> Option<Metric> {
+        COMMON
+            .iter()
+            .find(|(_, n)| *n == name)
+            .map(|(m, _)| *m)
+            .or_else(|| registry::statistic(name).map(|(_, s)| Metric::Method(s.name)))
+    }
+
+    /// Every per-frame metric a frame record holds, which suites' runs, sweeps and baselines
+    /// keep: the common ones and the registered methods' frames.csv statistics.
+    pub fn all() -> Vec<Metric> {
+        let common = [
+            Metric::Flip,
+            Metric::Cvvdp,
+            Metric::Smape,
+            Metric::SmapeReprojected,
+            Metric::Mse,
+            Metric::RelMse,
+            Metric::Psnr,
+            Metric::FrameMs,
+            Metric::Rays,
+            Metric::Shaded,
+        ];
+        let of_methods = registry::statistics()
+            .into_iter()
+            .filter(|s| s.source == Source::Frames)
+            .map(|s| Metric::Method(s.name));
+        common.into_iter().chain(of_methods).collect()
+    }
+
+    /// The method's declaration of a `Method` metric.
+    pub fn statistic(self) -> Option<&'static Statistic> {
+        match self {
+            Metric::Method(name) => registry::statistic(name).map(|(_, s)| s),
+            _ => None,
+        }
+    }
+
+    /// How `flicker reproduce` computes it from a run's images, where it does.
+    pub fn from_images_by(self) -> Option<ImageStatistic> {
+        match self.statistic()?.source {
+            Source::Images(how) => Some(how),
+            _ => None,
+        }
+    }
+
+    /// The name claims and suites write: `Flip`, `PathLength`.
+    pub fn ident(self) -> &'static str {
+        match self {
+            Metric::Method(name) => name,
+            m => COMMON.iter().find(|(c, _)| *c == m).map(|(_, n)| *n).expect("listed"),
+        }
+    }
+
+    /// Its key: the series' name in runs, baselines and tables, a method statistic's frames.csv
+    /// column (`flip`, `path_length`).
     pub fn name(self) -> &'static str {
         match self {
             Metric::Flip => "flip",
@@ -108,49 +126,38 @@ impl Metric {
             Metric::RelMse => "rel_mse",
             Metric::Psnr => "psnr",
             Metric::Cvvdp => "jod",
-            Metric::PathLength => "path_length",
-            Metric::MeanAbsBias => "mean_abs_bias",
-            Metric::MeanStd => "mean_std",
-            Metric::RmsBias => "rms_bias",
             Metric::FrameMs => "frame_ms",
             Metric::Rays => "rays",
             Metric::Shaded => "shaded",
-            Metric::SssSpp => "sss_mean_spp",
-            Metric::PrimaryRays => "primary_rays",
-            Metric::BlendSigma => "blend_sigma",
-            Metric::SssPsnr => "sss_psnr",
             Metric::PassMs => "pass_ms",
-            Metric::SigmaChanged => "sigma_changed",
-            Metric::SigmaUnchanged => "sigma_unchanged",
-            Metric::CacheMean => "cache_mean",
-            Metric::CacheVariance => "cache_variance",
-            Metric::CacheBias2 => "cache_bias2",
-            Metric::VarianceOverBound => "variance_over_bound",
+            Metric::Method(name) => self.statistic().map_or(name, |s| s.column),
         }
     }
 
-    /// Errors get worse upwards, PSNR and JOD downwards.
+    /// Errors get worse upwards, PSNR and JOD downwards; a method's statistic says.
     pub fn higher_is_better(self) -> bool {
-        matches!(self, Metric::Psnr | Metric::Cvvdp | Metric::SssPsnr)
+        match self {
+            Metric::Psnr | Metric::Cvvdp => true,
+            m => m.statistic().is_some_and(|s| s.better == Better::Higher),
+        }
     }
 
-    /// Computed from a run's images against another method's (`reproduce::sss_psnr`), not read
-    /// from frame records.
+    /// Computed from a run's images against another method's (the claim's `against`,
+    /// `reproduce::sss_psnr`), not read from frame records.
     pub fn from_images(self) -> bool {
-        self == Metric::SssPsnr
+        self.from_images_by() == Some(ImageStatistic::PsnrAgainst)
     }
 
-    /// Read back from a run's frames.csv by `flicker reproduce` only (not kept in a suite's
-    /// runs or baselines): a suite gate cannot judge it.
+    /// Read back from a run's frames.csv or images by `flicker reproduce` only (not kept in a
+    /// suite's runs or baselines): a suite gate cannot judge it.
     pub fn reproduce_only(self) -> bool {
-        matches!(
-            self,
-            Metric::PassMs
-                | Metric::CacheMean
-                | Metric::CacheVariance
-                | Metric::CacheBias2
-                | Metric::VarianceOverBound
-        )
+        self == Metric::PassMs
+            || self.statistic().is_some_and(|s| {
+                matches!(
+                    s.source,
+                    Source::FramesReproduceOnly | Source::Images(ImageStatistic::VarianceOverBound)
+                )
+            })
     }
 
     /// Whether the metric is a per-frame number (its window value is a mean of frames); JOD is
@@ -166,7 +173,8 @@ impl Metric {
 
     /// Whether a method of plugin kind `kind` (`MethodPlugin::NAME`) records this metric in a
     /// run whose scenario has reference frames (`references`): the image metrics every method
-    /// has (against a reference only where there is one), the stats only their method.
+    /// has (against a reference only where there is one), a statistic only the method that
+    /// declares it.
     pub fn recorded_by(self, kind: &str, references: bool) -> bool {
         match self {
             Metric::Smape | Metric::SmapeReprojected => true,
@@ -174,19 +182,9 @@ impl Metric {
             Metric::Flip | Metric::Mse | Metric::RelMse | Metric::Psnr | Metric::Cvvdp => {
                 references
             }
-            Metric::PathLength
-            | Metric::CacheMean
-            | Metric::CacheVariance
-            | Metric::CacheBias2
-            | Metric::VarianceOverBound => kind == "Termination",
-            Metric::MeanAbsBias | Metric::MeanStd | Metric::RmsBias => {
-                kind == "VolumeTransmittance"
-            }
-            Metric::SssSpp => kind == "Sss",
-            Metric::PrimaryRays => kind == "SampleCache",
-            Metric::BlendSigma => kind == "Nirc",
-            Metric::SssPsnr => kind == "Sss",
-            Metric::SigmaChanged | Metric::SigmaUnchanged => kind == "Nirc" && references,
+            Metric::Method(name) => registry::statistic(name).is_some_and(|(method, s)| {
+                method.name() == kind && (references || !s.needs_references)
+            }),
         }
     }
 
@@ -198,22 +196,82 @@ impl Metric {
             Metric::Mse => r.mse,
             Metric::RelMse => r.rel_mse,
             Metric::Psnr => r.psnr,
-            Metric::Cvvdp | Metric::SssPsnr | Metric::PassMs | Metric::VarianceOverBound => None,
-            Metric::SigmaChanged | Metric::SigmaUnchanged => None,
+            Metric::Cvvdp | Metric::PassMs => None,
             Metric::FrameMs => r.passes_total_ms(),
             Metric::Rays => r.rays.map(|n| n as f64),
             Metric::Shaded => r.shaded.map(|n| n as f64),
-            // Method stats, by the name the method reports them under.
-            Metric::PathLength
-            | Metric::MeanAbsBias
-            | Metric::MeanStd
-            | Metric::RmsBias
-            | Metric::SssSpp
-            | Metric::PrimaryRays
-            | Metric::BlendSigma
-            | Metric::CacheMean
-            | Metric::CacheVariance
-            | Metric::CacheBias2 => r.stats.iter().find(|(n, _)| n == self.name()).map(|s| s.1),
+            // A method's statistic, by the column the method reports it under.
+            Metric::Method(_) => {
+                let s = self.statistic().filter(|s| !matches!(s.source, Source::Images(_)))?;
+                r.stats.iter().find(|(n, _)| n == s.column).map(|s| s.1)
+            }
+        }
+    }
+}
+
+/// Written as its name: `Flip`, `PathLength`.
+impl Serialize for Metric {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_unit_variant("Metric", 0, self.ident())
+    }
+}
+
+/// Read as a unit variant (`metric: Flip`, `metric: PathLength`): a common metric's name or a
+/// registered method's statistic's.
+impl<'de> Deserialize<'de> for Metric {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct MetricVisitor;
+        impl<'de> Visitor<'de> for MetricVisitor {
+            type Value = Metric;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a metric, e.g. Flip or a method's statistic such as PathLength")
+            }
+            fn visit_str<E: de::Error>(self, name: &str) -> Result<Metric, E> {
+                Metric::named(name).ok_or_else(|| {
+                    let known: Vec<&str> = COMMON
+                        .iter()
+                        .map(|(_, n)| *n)
+                        .chain(registry::statistics().iter().map(|s| s.name))
+                        .collect();
+                    E::custom(format!(
+                        "unknown metric `{name}`, expected one of {}",
+                        known.join(", ")
+                    ))
+                })
+            }
+            fn visit_enum<A: EnumAccess<'de>>(self, data: A) -> Result<Metric, A::Error> {
+                let (Ident(name), variant) = data.variant()?;
+                variant.unit_variant()?;
+                self.visit_str(&name)
+            }
+        }
+        /// The variant's name, read as an identifier (a `String` would want a quoted string).
+        struct Ident(String);
+        impl<'de> Deserialize<'de> for Ident {
+            fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+                struct IdentVisitor;
+                impl Visitor<'_> for IdentVisitor {
+                    type Value = Ident;
+                    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                        f.write_str("a metric's name")
+                    }
+                    fn visit_str<E: de::Error>(self, name: &str) -> Result<Ident, E> {
+                        Ok(Ident(name.to_string()))
+                    }
+                }
+                deserializer.deserialize_identifier(IdentVisitor)
+            }
+        }
+        deserializer.deserialize_enum("Metric", &[], MetricVisitor)
+    }
+}
+
+impl Metric {
+    /// A method statistic known to be registered (tools' own code naming a shipped one).
+    pub fn shipped(name: &str) -> Metric {
+        match Metric::named(name) {
+            Some(m) => m,
+            None => panic!("no registered method declares the statistic {name}"),
         }
     }
 }
@@ -256,13 +314,13 @@ mod tests {
         assert_eq!(Metric::FrameMs.of(&r), Some(3.75));
         assert_eq!(Metric::Rays.of(&r), Some(1200.0));
         assert_eq!(Metric::Shaded.of(&r), Some(576.0));
-        assert_eq!(Metric::SssSpp.of(&r), Some(17.5));
-        assert_eq!(Metric::PrimaryRays.of(&r), Some(300.0));
-        assert_eq!(Metric::BlendSigma.of(&r), Some(0.25));
-        assert_eq!(Metric::MeanStd.of(&r), Some(0.01));
-        assert_eq!(Metric::RmsBias.of(&r), Some(0.02));
+        assert_eq!(Metric::shipped("SssSpp").of(&r), Some(17.5));
+        assert_eq!(Metric::shipped("PrimaryRays").of(&r), Some(300.0));
+        assert_eq!(Metric::shipped("BlendSigma").of(&r), Some(0.25));
+        assert_eq!(Metric::shipped("MeanStd").of(&r), Some(0.01));
+        assert_eq!(Metric::shipped("RmsBias").of(&r), Some(0.02));
         // A stat the method does not report is missing, not 0.
-        assert_eq!(Metric::PathLength.of(&r), None);
+        assert_eq!(Metric::shipped("PathLength").of(&r), None);
         // One untimed pass: the frame has no time (a partial sum would look faster).
         let mut untimed = record();
         untimed.passes[1].1 = None;
@@ -271,22 +329,45 @@ mod tests {
         no_passes.passes.clear();
         assert_eq!(Metric::FrameMs.of(&no_passes), None);
         // Names are distinct (they key baselines and run columns).
-        let mut names: Vec<&str> = Metric::ALL.iter().map(|m| m.name()).collect();
+        let mut names: Vec<&str> = Metric::all().iter().map(|m| m.name()).collect();
         names.sort_unstable();
         names.dedup();
-        assert_eq!(names.len(), Metric::ALL.len());
+        assert_eq!(names.len(), Metric::all().len());
     }
 
     #[test]
     fn stats_are_recorded_only_by_their_method() {
-        assert!(Metric::SssSpp.recorded_by("Sss", false));
-        assert!(!Metric::SssSpp.recorded_by("PathTracing", true));
-        assert!(Metric::BlendSigma.recorded_by("Nirc", true));
-        assert!(Metric::PrimaryRays.recorded_by("SampleCache", true));
-        assert!(!Metric::PrimaryRays.recorded_by("HashCache", true));
-        assert!(Metric::RmsBias.recorded_by("VolumeTransmittance", false));
-        assert!(!Metric::RmsBias.recorded_by("VolumePath", true));
+        assert!(Metric::shipped("SssSpp").recorded_by("Sss", false));
+        assert!(!Metric::shipped("SssSpp").recorded_by("PathTracing", true));
+        assert!(Metric::shipped("BlendSigma").recorded_by("Nirc", true));
+        assert!(Metric::shipped("PrimaryRays").recorded_by("SampleCache", true));
+        assert!(!Metric::shipped("PrimaryRays").recorded_by("HashCache", true));
+        assert!(Metric::shipped("RmsBias").recorded_by("VolumeTransmittance", false));
+        assert!(!Metric::shipped("RmsBias").recorded_by("VolumePath", true));
         assert!(Metric::FrameMs.recorded_by("PathTracing", false));
         assert!(Metric::FrameMs.is_timing() && !Metric::Rays.is_timing());
+    }
+
+    #[test]
+    fn names_are_read_and_written_as_claims_write_them() {
+        let read = |text: &str| ron::from_str::<Metric>(text);
+        assert_eq!(read("Flip").unwrap(), Metric::Flip);
+        assert_eq!(read("PathLength").unwrap(), Metric::Method("PathLength"));
+        assert_eq!(Metric::shipped("PathLength").name(), "path_length");
+        assert_eq!(Metric::shipped("SssSpp").name(), "sss_mean_spp");
+        assert_eq!(ron::to_string(&Metric::shipped("SssPsnr")).unwrap(), "SssPsnr");
+        let e = read("PathLenght").unwrap_err().to_string();
+        assert!(e.contains("unknown metric `PathLenght`") && e.contains("PathLength"), "{e}");
+        // What a method's declaration says, read through the metric.
+        assert!(Metric::shipped("SssPsnr").higher_is_better() && Metric::Psnr.higher_is_better());
+        assert!(!Metric::shipped("BlendSigma").higher_is_better());
+        assert!(Metric::shipped("SssPsnr").from_images() && !Metric::Flip.from_images());
+        assert!(Metric::shipped("CacheMean").reproduce_only());
+        assert!(Metric::shipped("VarianceOverBound").reproduce_only());
+        assert!(!Metric::shipped("PathLength").reproduce_only());
+        assert!(!Metric::all().contains(&Metric::shipped("CacheMean")));
+        assert!(Metric::all().contains(&Metric::shipped("PathLength")));
+        assert!(Metric::shipped("SigmaChanged").recorded_by("Nirc", true));
+        assert!(!Metric::shipped("SigmaChanged").recorded_by("Nirc", false));
     }
 }

@@ -10,7 +10,7 @@ use render::gpu::Gpu;
 use super::baseline::{Baseline, BaselineFile, adapter_key, now};
 use super::gate::{GateResult, judge};
 use super::measurement::{CaseRuns, SeedRun};
-use super::spec::{Bound, Case, Suite};
+use super::spec::{Bound, Case, Gate, Suite};
 use super::{junit, markdown};
 use crate::measure::{MeasureOptions, Measured};
 use systems::playback::{Overrides, RunOptions, RunSpec, run_spec};
@@ -164,9 +164,9 @@ pub(crate) fn play_cases(
         for &seed in &case.seeds {
             let out = folder.join(&case.name).join(format!("seed_{seed}"));
             let plan = if let Some(frames) = &case.measure {
-                let opts = frames.options(seed, &out);
-                let measured = Measured::read(&opts)
-                    .map_err(|e| anyhow!("{} seed {seed}: {e:#}", case_at(origin, case)))?;
+                let at = |e: anyhow::Error| anyhow!("{} seed {seed}: {e:#}", case_at(origin, case));
+                let opts = frames.options(seed, &out).map_err(at)?;
+                let measured = Measured::read(&opts).map_err(at)?;
                 Planned::Measured(opts, Box::new(measured))
             } else {
                 let (spec, overrides) = case_spec(origin, case, seed, &out)?;
@@ -234,7 +234,8 @@ pub fn run(opts: &SuiteOptions) -> Result<SuiteOutcome> {
     let p = prepare(opts)?;
     let key = adapter_key(&p.adapter);
     let file = BaselineFile::load(&p.baselines)?;
-    let baseline = file.adapters.get(&key);
+    let chosen = file.for_adapter(&p.adapter);
+    let baseline = chosen.map(|c| c.baseline);
     let relative = p.suite.gates.iter().any(|g| matches!(g.bound, Bound::Relative { .. }));
     if relative && baseline.is_none() {
         let known: Vec<&str> = file.adapters.keys().map(String::as_str).collect();
@@ -246,9 +247,36 @@ pub fn run(opts: &SuiteOptions) -> Result<SuiteOutcome> {
             bless_hint(&p, opts)
         );
     }
+    // No baseline of this adapter: another's stands in, every relative gate's tolerance widened
+    // by the suite's other_adapter_tolerance, and the summary says so.
+    let stand_in = chosen.filter(|c| relative && !c.exact).map(|c| {
+        format!(
+            "no baseline blessed on adapter '{key}'; compared with the baseline of '{}' (commit {}, blessed {}), every relative gate's tolerance widened by {} (other_adapter_tolerance); {}",
+            c.key,
+            c.baseline.commit,
+            c.baseline.date,
+            p.suite.other_adapter_tolerance,
+            bless_hint(&p, opts)
+        )
+    });
+    if let Some(note) = &stand_in {
+        eprintln!("note: {note}");
+    }
+    let gates: Vec<Gate> = p
+        .suite
+        .gates
+        .iter()
+        .map(|g| match (&stand_in, &g.bound) {
+            (Some(_), Bound::Relative { tolerance }) => Gate {
+                bound: Bound::Relative { tolerance: tolerance + p.suite.other_adapter_tolerance },
+                ..g.clone()
+            },
+            _ => g.clone(),
+        })
+        .collect();
     let cases = play(&p, opts)?;
     let mut results = Vec::new();
-    for gate in &p.suite.gates {
+    for gate in &gates {
         for (name, runs) in &cases {
             for method in runs.methods().iter().filter(|m| gate.applies_to(name, m)) {
                 results.push(judge(
@@ -291,6 +319,7 @@ pub fn run(opts: &SuiteOptions) -> Result<SuiteOutcome> {
         &p.suite.name,
         &key,
         baseline.map(|b| (b.commit.as_str(), b.date.as_str())),
+        stand_in.as_deref(),
         &results,
     );
     let summary = p.folder.join("summary.md");

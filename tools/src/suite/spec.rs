@@ -110,6 +110,19 @@ struct SuiteFile {
     name: Option<String>,
     cases: Vec<Box<ron::value::RawValue>>,
     gates: Vec<Box<ron::value::RawValue>>,
+    #[serde(default = "default_other_adapter_tolerance")]
+    other_adapter_tolerance: f64,
+}
+
+/// What relative gates add to their tolerance when the baseline was blessed on another adapter.
+/// An argued threshold, not a measured one: the same seeds give the same noise only where two
+/// drivers round alike, and the Welch test's spread over seeds covers decorrelated noise; the
+/// margin covers what that spread cannot, systematic differences of a few percent in shader
+/// arithmetic (WGSL lets transcendental functions and FMA contraction differ by driver).
+pub const DEFAULT_OTHER_ADAPTER_TOLERANCE: f64 = 0.05;
+
+fn default_other_adapter_tolerance() -> f64 {
+    DEFAULT_OTHER_ADAPTER_TOLERANCE
 }
 
 #[derive(Clone, Debug)]
@@ -118,6 +131,9 @@ pub struct Suite {
     pub name: String,
     pub cases: Vec<Case>,
     pub gates: Vec<Gate>,
+    /// Added to relative gates' tolerance when the baseline is a stand-in blessed on another
+    /// adapter (`suite::baseline::BaselineFile::for_adapter`).
+    pub other_adapter_tolerance: f64,
     pub origin: PathBuf,
 }
 
@@ -243,7 +259,9 @@ impl Suite {
                     ),
                 ));
             }
-            if matches!(gate.metric, Metric::SigmaChanged | Metric::SigmaUnchanged) {
+            if gate.metric.from_images_by()
+                == Some(systems::methods::ImageStatistic::PreferenceRegions)
+            {
                 return Err(file.error_at(
                     &entry,
                     format!(
@@ -277,6 +295,9 @@ impl Suite {
                     );
                 }
                 _ => {}
+            }
+            if let Some(why) = gate.window.empty() {
+                return Err(file.error_at(&entry, format!("window {}: {why}", gate.window.name())));
             }
             if let Some(unknown) = gate.cases.iter().flatten().find(|c| !names.contains(c.as_str()))
             {
@@ -312,8 +333,17 @@ impl Suite {
         if gates.is_empty() {
             return Err(file.error(None, "no gates; expected e.g. gates: [(metric: Flip, window: Overall, bound: Relative(tolerance: 0.05))]".into()));
         }
+        let t = parsed.other_adapter_tolerance;
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(file.error(
+                file.text.find("other_adapter_tolerance").map(|at| sim::scenario::line_col(text, at)),
+                format!(
+                    "other_adapter_tolerance {t}; expected a fraction >= 0, e.g. {DEFAULT_OTHER_ADAPTER_TOLERANCE}"
+                ),
+            ));
+        }
         let name = file.name_or_stem(parsed.name, "suite");
-        Ok(Suite { name, cases, gates, origin: origin.to_path_buf() })
+        Ok(Suite { name, cases, gates, other_adapter_tolerance: t, origin: origin.to_path_buf() })
     }
 
     /// Where baselines of this suite live: `baselines/NAME.json` next to the suite file.

@@ -36,6 +36,20 @@ impl Window {
         }
     }
 
+    /// Why the window holds no frame in any run, if it holds none: an empty window judges
+    /// nothing.
+    pub fn empty(&self) -> Option<String> {
+        match *self {
+            Window::After { frames: 0, .. } => {
+                Some("frames: 0 is an empty window; expected at least 1 frame".into())
+            }
+            Window::Around { from, to, .. } if from >= to => Some(format!(
+                "from: {from} is not before to: {to} (the end is excluded), so the window is empty; expected from < to"
+            )),
+            _ => None,
+        }
+    }
+
     /// The event this window needs, if any.
     pub fn event(&self) -> Option<usize> {
         match self {

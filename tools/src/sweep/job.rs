@@ -71,7 +71,7 @@ pub fn numbers(records: &[FrameRecord]) -> BTreeMap<String, MethodNumbers> {
         .map(|(label, mut rows)| {
             rows.sort_by_key(|r| r.frame);
             // Times are kept apart (ms_per_frame, the summary's `timing`): they differ run to run.
-            let metrics = Metric::ALL
+            let metrics = Metric::all()
                 .iter()
                 .filter(|m| !m.is_timing())
                 .map(|m| (m.name().to_string(), mean(rows.iter().map(|r| m.of(r)))))

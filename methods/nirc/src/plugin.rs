@@ -150,6 +150,9 @@ pub struct Plugin;
 impl MethodPlugin for Plugin {
     type Settings = NircSettings;
     const NAME: &'static str = "Nirc";
+    const MINIMAL_SETTINGS: &'static str = "(spp: 1)";
+    const STATISTICS: &'static [frame::method::Statistic] = crate::recorded::STATISTICS;
+    const CHARTS: &'static [frame::method::MethodChart] = crate::recorded::CHARTS;
 
     fn label(settings: &NircSettings) -> String {
         settings.label()

@@ -1,7 +1,7 @@
 //! The cache on the GPU: buffers of the whole state, the WGSL passes, and the calls a path
 //! tracer makes (`train` on a buffer of training records, `infer` on a buffer of queries).
 //!
-//! A training step is one submission of these passes (nirc/shaders/):
+//! A training step is one submission of these passes (methods/nirc/shaders/):
 //!
 //! ```text
 //! 1. train_forward_backward  per record: both forwards, loss, backward; hash-grid gradients as

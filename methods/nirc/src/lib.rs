@@ -5,7 +5,7 @@
 //! to trust the fast (High-LR) predictor versus its EMA.
 //!
 //! - `cpu`: plain-Rust reference of every step (the ground truth of the tests).
-//! - `gpu`: the same in WGSL compute passes (`NeuralCache`), shaders in `nirc/shaders/`.
+//! - `gpu`: the same in WGSL compute passes (`NeuralCache`), shaders in `methods/nirc/shaders/`.
 //! - `state`: the whole cache state and its file format (warm starts).
 
 pub mod bounds;
@@ -17,6 +17,7 @@ pub mod gpu;
 pub mod integrator;
 pub mod layout;
 pub mod plugin;
+pub mod recorded;
 pub mod records;
 pub mod reliability;
 pub mod state;

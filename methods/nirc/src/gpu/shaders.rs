@@ -1,5 +1,5 @@
 //! Assembles the WGSL of each pass: generated constants (sizes, level tables, tile shapes), the
-//! shared files of nirc/shaders/, then the pass itself.
+//! shared files of methods/nirc/shaders/, then the pass itself.
 
 use crate::config::NircConfig;
 use crate::layout::ParameterLayout;
@@ -202,7 +202,7 @@ pub fn workgroup_bytes(layout: &ParameterLayout) -> u32 {
     train_bytes.max(infer_bytes)
 }
 
-/// A file of nirc/shaders/ as a module.
+/// A file of methods/nirc/shaders/ as a module.
 macro_rules! nirc_file {
     ($name:literal) => {
         render::wgsl_file!($name)

@@ -1,4 +1,4 @@
-//! Cache-terminated path tracing (NIRC): the passes of nirc/shaders/cache_paths.wgsl, which
+//! Cache-terminated path tracing (NIRC): the passes of methods/nirc/shaders/cache_paths.wgsl, which
 //! run on the scene on the GPU (`SceneGpu`) with their own frame parameters (`FrameBindings`).
 //!
 //! Per frame: `encode_paths` traces `spp` camera paths per pixel up to the termination vertex
