@@ -47,8 +47,7 @@ fn files(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
-/// A folder of its own, removed when the test ends (its name holds no `.tmp`, which
-/// `temporaries` looks for).
+/// A folder of its own, removed when the test ends.
 fn scratch(name: &str) -> tempfile::TempDir {
     tempfile::Builder::new().prefix(&format!("flicker-{name}-")).tempdir().unwrap()
 }
@@ -72,7 +71,10 @@ fn same_bytes(a: &Path, b: &Path, names: &[PathBuf]) {
 
 /// A write's temporary files (`NAME.tmpPID`, metrics::atomic) under `dir`.
 fn temporaries(dir: &Path) -> Vec<PathBuf> {
-    files(dir).into_iter().filter(|p| p.to_string_lossy().contains(".tmp")).collect()
+    files(dir)
+        .into_iter()
+        .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().contains(".tmp")))
+        .collect()
 }
 
 fn run_cmd(mut cmd: Command, scenario: &Path, out: &Path, cache: &Path) -> Command {

@@ -263,7 +263,7 @@ fn report_page_escapes_every_name_a_scenario_sets() {
 fn comparison_page_escapes_every_name_a_scenario_sets() {
     let (tmp_a, tmp_b) = (hostile_run("hostile-compare-a"), hostile_run("hostile-compare-b"));
     let (a, b) = (tmp_a.path(), tmp_b.path());
-    let page = report::compare::write_comparison(&a, &b, &b.join("compare.html")).unwrap();
+    let page = report::compare::write_comparison(a, b, &b.join("compare.html")).unwrap();
     let html = std::fs::read_to_string(page).unwrap();
     assert_no_raw_names(&html);
     let scenario = escaped(HOSTILE_SCENARIO);
