@@ -8,6 +8,8 @@
 #   scripts/same_results.sh run FLICKER OUT [DIR] run every scenario (of DIR, default scenarios/)
 #                                                 with one binary into OUT
 #   scripts/same_results.sh compare OUT_A OUT_B   compare two such folders
+#   scripts/same_results.sh pixels OUT_A OUT_B    the same, EXRs by channels and pixels (bit for
+#                                                 bit) where their bytes differ (a new layout)
 #
 # Each commit renders its own references (separate cache folders), so references are compared
 # too. Exit status 0 when everything matches, 1 when something differs.
@@ -48,8 +50,12 @@ case "${1:-}" in
         [ $# -eq 3 ] || { echo "usage: $0 compare OUT_A OUT_B" >&2; exit 2; }
         compare "$2" "$3"
         ;;
+    pixels)
+        [ $# -eq 3 ] || { echo "usage: $0 pixels OUT_A OUT_B" >&2; exit 2; }
+        python3 "$repo/scripts/same_results_compare.py" --pixels "$2" "$3"
+        ;;
     ""|-h|--help)
-        sed -n 2,14p "$0" | sed 's/^# \{0,1\}//'
+        sed -n 2,15p "$0" | sed 's/^# \{0,1\}//'
         exit 2
         ;;
     *)

@@ -9,11 +9,8 @@ fn flicker(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_flicker")).args(args).output().expect("flicker runs")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("flicker-bad-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("flicker-bad-{name}-")).tempdir().unwrap()
 }
 
 fn text(bytes: &[u8]) -> String {
@@ -42,7 +39,8 @@ const BASE: &str = "scene: Builtin(\"cornell_box\"), resolution: (8, 8), frames:
 
 #[test]
 fn non_finite_numbers_are_refused_at_their_line_and_column() {
-    let dir = scratch("finite");
+    let tmp = scratch("finite");
+    let dir = tmp.path().to_path_buf();
     let path = dir.join("scenario.ron");
     // Each case: a field written with a value that is not finite, on line 3 at the column of
     // the value, the key named.
@@ -96,7 +94,8 @@ fn non_finite_numbers_are_refused_at_their_line_and_column() {
 
 #[test]
 fn zero_frames_and_no_methods_are_refused() {
-    let dir = scratch("counts");
+    let tmp = scratch("counts");
+    let dir = tmp.path().to_path_buf();
     let path = dir.join("scenario.ron");
     std::fs::write(
         &path,
@@ -116,7 +115,8 @@ fn zero_frames_and_no_methods_are_refused() {
 
 #[test]
 fn a_missing_scenario_file_is_named() {
-    let dir = scratch("missing");
+    let tmp = scratch("missing");
+    let dir = tmp.path().to_path_buf();
     let err = run_fails(&dir.join("no_such.ron"), &[]);
     assert!(err.contains("no_such.ron") && err.contains("cannot read"), "{err}");
 }
@@ -126,7 +126,8 @@ fn a_missing_scenario_file_is_named() {
 /// nothing written; the good inputs are measured (so the errors come from the bad files).
 #[test]
 fn measure_names_a_packages_missing_frame_and_short_timings() {
-    let dir = scratch("measure");
+    let tmp = scratch("measure");
+    let dir = tmp.path().to_path_buf();
     let package = dir.join("package");
     let manifest = r#"{"format": "flicker-export", "frames": 4, "fps": 30.0,
         "events": [{"frame": 2, "label": "toggle 'lamp'"}],
@@ -165,12 +166,12 @@ fn measure_names_a_packages_missing_frame_and_short_timings() {
     std::fs::remove_file(package.join("reference/0002.exr")).unwrap();
     let err = fails(&args, &out);
     assert!(err.contains("reference/0002.exr") && err.contains("frame 2 is missing"), "{err}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn an_unwritable_out_is_named_and_nothing_is_written() {
-    let dir = scratch("unwritable");
+    let tmp = scratch("unwritable");
+    let dir = tmp.path().to_path_buf();
     let path = dir.join("scenario.ron");
     std::fs::write(&path, format!("Scenario({BASE}, methods: [PathTracing(spp: 1)], reference: (spp: 1, frames: List([])))")).unwrap();
     // A path under a file can be created by no one (permissions would not stop root).
@@ -202,7 +203,8 @@ fn a_resolution_over_the_buffer_limit_is_refused_with_the_limit() {
     let height = limit / (u64::from(width) * 16) + 1;
     assert!(height <= u64::from(width), "this adapter's buffers hold any image its textures do");
     drop(gpu);
-    let dir = scratch("buffer");
+    let tmp = scratch("buffer");
+    let dir = tmp.path().to_path_buf();
     let path = dir.join("scenario.ron");
     std::fs::write(&path, format!("Scenario({BASE},\n  methods: [PathTracing(spp: 1)], reference: (spp: 1, frames: List([])))")).unwrap();
     let err = run_fails(&path, &["--resolution", &format!("{width}x{height}")]);
@@ -216,7 +218,8 @@ fn a_resolution_over_the_buffer_limit_is_refused_with_the_limit() {
 
 #[test]
 fn a_malformed_baseline_is_named_at_its_line_before_anything_plays() {
-    let dir = scratch("baseline");
+    let tmp = scratch("baseline");
+    let dir = tmp.path().to_path_buf();
     std::fs::write(
         dir.join("scenario.ron"),
         format!("Scenario({BASE}, methods: [PathTracing(spp: 1)])"),
@@ -247,7 +250,8 @@ fn a_malformed_baseline_is_named_at_its_line_before_anything_plays() {
 
 #[test]
 fn a_damaged_cached_reference_is_reported_and_rendered_again() {
-    let dir = scratch("cache");
+    let tmp = scratch("cache");
+    let dir = tmp.path().to_path_buf();
     let cache = dir.join("cache");
     let path = dir.join("scenario.ron");
     std::fs::write(&path, format!("Scenario({BASE}, seed: 2, max_depth: 2, methods: [PathTracing(spp: 1)], reference: (spp: 4, frames: Every(1)))")).unwrap();

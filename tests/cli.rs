@@ -7,11 +7,8 @@ fn flicker(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_flicker")).args(args).output().expect("flicker runs")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("flicker-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("flicker-cli-{name}-")).tempdir().unwrap()
 }
 
 fn text(bytes: &[u8]) -> String {
@@ -38,7 +35,8 @@ fn tiny_scenario(dir: &Path, body: &str) -> PathBuf {
 
 #[test]
 fn malformed_ron_names_file_line_and_column() {
-    let dir = scratch("malformed");
+    let tmp = scratch("malformed");
+    let dir = tmp.path().to_path_buf();
     let path = tiny_scenario(
         &dir,
         "Scenario(\n    scene: Builtin(\"cornell_box\"),\n    resolution: (16, 9)\n    frames: 2,\n)\n",
@@ -49,7 +47,8 @@ fn malformed_ron_names_file_line_and_column() {
 
 #[test]
 fn unknown_entity_is_an_error_before_frame_zero() {
-    let dir = scratch("entity");
+    let tmp = scratch("entity");
+    let dir = tmp.path().to_path_buf();
     let path = tiny_scenario(
         &dir,
         r#"Scenario(scene: Builtin("cornell_box"), resolution: (16, 9), frames: 2,
@@ -62,7 +61,8 @@ fn unknown_entity_is_an_error_before_frame_zero() {
 
 #[test]
 fn unknown_scene_and_missing_gltf_are_errors() {
-    let dir = scratch("scene");
+    let tmp = scratch("scene");
+    let dir = tmp.path().to_path_buf();
     let path = tiny_scenario(
         &dir,
         r#"Scenario(scene: Builtin("cornel_box"), resolution: (16, 9), frames: 2, methods: [PathTracing(spp: 1)])"#,
@@ -83,7 +83,8 @@ fn unknown_scene_and_missing_gltf_are_errors() {
 
 #[test]
 fn oversize_resolution_is_refused_with_the_limit() {
-    let dir = scratch("oversize");
+    let tmp = scratch("oversize");
+    let dir = tmp.path().to_path_buf();
     let err = run_fails(
         Path::new("scenarios/cornell_box.ron"),
         &["--resolution", "100000x8"],
@@ -100,7 +101,8 @@ fn oversize_resolution_is_refused_with_the_limit() {
 
 #[test]
 fn two_runs_give_byte_identical_frames_and_a_complete_run_folder() {
-    let dir = scratch("determinism");
+    let tmp = scratch("determinism");
+    let dir = tmp.path().to_path_buf();
     let cache = dir.join("cache");
     let scenario = tiny_scenario(
         &dir,
@@ -246,7 +248,8 @@ fn schedule_lists_each_stage_and_the_methods_systems() {
 
 #[test]
 fn duplicate_method_labels_are_refused_before_anything_is_written() {
-    let dir = scratch("duplicate");
+    let tmp = scratch("duplicate");
+    let dir = tmp.path().to_path_buf();
     let path = tiny_scenario(
         &dir,
         "Scenario(scene: Builtin(\"cornell_box\"), resolution: (16, 9), frames: 2,\n  methods: [PathTracing(spp: 1),\n    PathTracing(spp: 1)])",
@@ -267,7 +270,8 @@ fn termination_survival_outside_0_1_is_refused_at_its_line() {
         ("survival: 0.0", "survival must be in (0, 1], got 0"),
         ("radiance_unit: 0.0", "radiance_unit must be positive"),
     ] {
-        let dir = scratch("survival");
+        let tmp = scratch("survival");
+        let dir = tmp.path().to_path_buf();
         let path = tiny_scenario(
             &dir,
             &format!(
@@ -281,7 +285,8 @@ fn termination_survival_outside_0_1_is_refused_at_its_line() {
 
 #[test]
 fn no_xdg_runtime_dir_message_when_it_is_unset_or_invalid() {
-    let dir = scratch("xdg");
+    let tmp = scratch("xdg");
+    let dir = tmp.path().to_path_buf();
     let scenario = tiny_scenario(
         &dir,
         r#"Scenario(scene: Builtin("cornell_box"), resolution: (16, 9), frames: 1, seed: 1, max_depth: 2,
@@ -312,12 +317,12 @@ fn no_xdg_runtime_dir_message_when_it_is_unset_or_invalid() {
         let stderr = run(value, name);
         assert!(!stderr.contains("XDG_RUNTIME_DIR"), "XDG_RUNTIME_DIR {value:?}: {stderr}");
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn suite_exit_codes_summary_and_junit() {
-    let dir = scratch("suite");
+    let tmp = scratch("suite");
+    let dir = tmp.path().to_path_buf();
     tiny_scenario(
         &dir,
         "Scenario(scene: Builtin(\"cornell_box\"), resolution: (16, 9), frames: 3, max_depth: 2, methods: [PathTracing(spp: 1)], reference: (spp: 8, frames: Every(1)))",
@@ -356,7 +361,7 @@ fn suite_exit_codes_summary_and_junit() {
         "{summary}"
     );
     let junit = std::fs::read_to_string(out.join("junit.xml")).unwrap();
-    assert!(junit.contains("tests=\"2\" failures=\"1\" errors=\"0\""), "{junit}");
+    assert!(junit.contains("tests=\"2\" skipped=\"0\" failures=\"1\" errors=\"0\""), "{junit}");
     assert!(
         out.join("box/seed_1/frames.csv").exists() && out.join("box/seed_2/report.html").exists()
     );

@@ -75,8 +75,8 @@ fn ok(o: Output) -> Output {
 
 #[test]
 fn an_interrupted_run_says_so_and_resumes_to_the_uninterrupted_frames() {
-    let dir = std::env::temp_dir().join(format!("flicker-interrupt-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(&dir).unwrap();
     let cache = dir.join("cache");
     // Methods with state carried across frames (TAA's history, the hash cache's cells), a
@@ -129,7 +129,13 @@ fn an_interrupted_run_says_so_and_resumes_to_the_uninterrupted_frames() {
     assert!(!cut.join(format!("frames/taa/{:04}.exr", last + 1)).exists());
     let page = std::fs::read_to_string(cut.join("report.html")).unwrap();
     assert!(page.contains("Incomplete run"), "the report must say the run is incomplete");
-    assert!(files(&cut).iter().all(|p| !p.to_string_lossy().contains(".tmp")));
+    // No write's temporary file (`NAME.tmpPID`, metrics::atomic) is left; the file names are
+    // read, not the paths (tempfile's folders are named `.tmpXXXXXX`).
+    let temporaries: Vec<_> = files(&cut)
+        .into_iter()
+        .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().contains(".tmp")))
+        .collect();
+    assert!(temporaries.is_empty(), "{temporaries:?}");
 
     // The whole run, uninterrupted.
     let full = dir.join("full");
@@ -191,13 +197,12 @@ fn an_interrupted_run_says_so_and_resumes_to_the_uninterrupted_frames() {
     );
     let o = flicker().args(["run", "--resume"]).arg(&cut).args(["--frames", "3"]).output().unwrap();
     assert!(!o.status.success() && text(&o.stderr).contains("--frames"), "{}", text(&o.stderr));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn a_run_stopped_by_an_error_is_marked_failed_and_resumes_once_it_is_fixed() {
-    let dir = std::env::temp_dir().join(format!("flicker-failed-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(&dir).unwrap();
     let scenario = dir.join("late_reference.ron");
     std::fs::write(
@@ -230,7 +235,6 @@ fn a_run_stopped_by_an_error_is_marked_failed_and_resumes_once_it_is_fixed() {
     assert!(manifest.get("error").is_none(), "{manifest}");
     assert_eq!(results(&run).len(), 1 + 5);
     assert!(run.join("reference/0003.exr").exists() && run.join("frames/taa/0004.exr").exists());
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
@@ -239,8 +243,8 @@ fn runs_of_the_caches_resume_to_the_uninterrupted_frames() {
     // adaptive shading (a camera backing away: pixels receive more samples than they keep)
     // make contended choices on the GPU every frame; a resume replays them and must meet the
     // same rows. The run stops at frame 3 (its reference cannot be stored), then resumes.
-    let dir = std::env::temp_dir().join(format!("flicker-resume-caches-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(&dir).unwrap();
     let scenario = dir.join("caches.ron");
     std::fs::write(
@@ -278,5 +282,4 @@ fn runs_of_the_caches_resume_to_the_uninterrupted_frames() {
         .collect();
     assert!(exrs.len() >= 12, "{} images", exrs.len());
     assert_same_bytes(&full, &cut, &exrs);
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -47,11 +47,9 @@ fn files(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("flicker-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A folder of its own, removed when the test ends.
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("flicker-{name}-")).tempdir().unwrap()
 }
 
 /// The images of a run (relative paths), without the charts.
@@ -73,7 +71,10 @@ fn same_bytes(a: &Path, b: &Path, names: &[PathBuf]) {
 
 /// A write's temporary files (`NAME.tmpPID`, metrics::atomic) under `dir`.
 fn temporaries(dir: &Path) -> Vec<PathBuf> {
-    files(dir).into_iter().filter(|p| p.to_string_lossy().contains(".tmp")).collect()
+    files(dir)
+        .into_iter()
+        .filter(|p| p.file_name().is_some_and(|n| n.to_string_lossy().contains(".tmp")))
+        .collect()
 }
 
 fn run_cmd(mut cmd: Command, scenario: &Path, out: &Path, cache: &Path) -> Command {
@@ -156,7 +157,8 @@ fn kill_after(mut cmd: Command, run: &Path, rows: usize, delay: Duration) -> boo
 
 #[test]
 fn runs_killed_at_random_frames_resume_to_the_uninterrupted_bytes() {
-    let dir = scratch("sigkill");
+    let tmp = scratch("sigkill");
+    let dir = tmp.path().to_path_buf();
     const METHODS: usize = 2;
     let scenario = write_scenario(&dir, &["PathTracing(spp: 1)", "Taa()"], 3, FRAMES);
     let seed =
@@ -209,7 +211,6 @@ fn runs_killed_at_random_frames_resume_to_the_uninterrupted_bytes() {
     // The cache holds whole entries only (a killed write may leave its temporary file, which
     // no lookup reads): each passes its checksum.
     assert_whole_entries(&cache, 8, 8);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The reference cache's files in `dir` but the lock files that stand beside its entries (a
@@ -286,7 +287,8 @@ fn check_stopped(
 
 #[test]
 fn a_full_disk_stops_the_run_cleanly_during_frames_the_summary_and_a_cache_write() {
-    let dir = scratch("full-disk");
+    let tmp = scratch("full-disk");
+    let dir = tmp.path().to_path_buf();
     // Several methods: frames.csv (rewritten whole each frame) outgrows the manifest.
     let methods = ["PathTracing(spp: 1)", "Taa()", "PathTracing(spp: 2)", "HashCache()"];
     // Enough frames that frames.csv (about 500 bytes a frame) outgrows the manifest (6 KB).
@@ -362,5 +364,4 @@ fn a_full_disk_stops_the_run_cleanly_during_frames_the_summary_and_a_cache_write
     // Nothing in the cache but the entry's lock: an entry over the limit cannot be whole, and
     // its temporary file is gone.
     assert!(cache_files(&cache).is_empty(), "{:?}", files(&cache));
-    std::fs::remove_dir_all(&dir).ok();
 }

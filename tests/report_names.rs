@@ -53,9 +53,8 @@ fn quoted(s: &str) -> String {
 #[test]
 fn a_played_scenario_with_markup_in_its_names_reports_them_as_text() {
     let bin = chromium();
-    let dir = std::env::temp_dir().join(format!("flicker-report-names-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = tempfile::Builder::new().prefix("flicker-report-names-").tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     // The test asset with its cube (mesh and node) renamed.
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let gltf = std::fs::read_to_string(root.join("scenarios/assets/test_scene.gltf")).unwrap();
@@ -123,5 +122,4 @@ fn a_played_scenario_with_markup_in_its_names_reports_them_as_text() {
         (manifest["scenario"].as_str(), manifest["regions"][0]["name"].as_str()),
         (Some(SCENARIO), Some(REGION))
     );
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -10,9 +10,8 @@ const RUNS: usize = 4;
 
 #[test]
 fn concurrent_runs_render_a_shared_reference_once() {
-    let dir = std::env::temp_dir().join(format!("flicker-shared-cache-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = tempfile::Builder::new().prefix("flicker-shared-cache-").tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     let scenario = dir.join("tiny.ron");
     // One recorded frame with a reference: 16x16 at 64 spp takes long enough (about a second
     // on lavapipe) that every process looks the entry up before the first has stored it.
@@ -63,5 +62,4 @@ fn concurrent_runs_render_a_shared_reference_once() {
     };
     let first = flip(&outs[0]);
     assert!(outs.iter().all(|o| flip(o) == first));
-    std::fs::remove_dir_all(&dir).ok();
 }

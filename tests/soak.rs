@@ -33,7 +33,8 @@ fn resident_at_end(dir: &Path, frames: u32) -> (u64, u64) {
 
 #[test]
 fn resident_memory_is_flat_over_frames() {
-    let dir = std::env::temp_dir().join(format!("flicker-soak-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(
         dir.join("soak.ron"),
@@ -56,7 +57,6 @@ fn resident_memory_is_flat_over_frames() {
         mib(per_1000),
         mib((long_csv - short_csv) as f64)
     );
-    std::fs::remove_dir_all(&dir).ok();
     assert!(
         per_1000 < ALLOWED_PER_1000_FRAMES,
         "memory grows by {:.1} MiB per 1,000 frames (allowed {:.0})",

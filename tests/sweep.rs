@@ -24,11 +24,8 @@ fn flicker_with_env(args: &[&str], env: &[(&str, &str)]) -> Output {
         .expect("flicker runs")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("flicker-sweep-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("flicker-sweep-{name}-")).tempdir().unwrap()
 }
 
 fn text(bytes: &[u8]) -> String {
@@ -61,7 +58,8 @@ fn numbers(dir: &Path) -> serde_json::Value {
 
 #[test]
 fn plan_is_deterministic() {
-    let dir = scratch("plan");
+    let tmp = scratch("plan");
+    let dir = tmp.path().to_path_buf();
     let (a, b) = (dir.join("a"), dir.join("nested/b"));
     for out in [&a, &b] {
         ok(
@@ -122,12 +120,12 @@ fn plan_is_deterministic() {
     let o = flicker(&["sweep", "plan", other.to_str().unwrap(), "--out", a.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o.stderr).contains("holds another sweep's plan"), "{}", text(&o.stderr));
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn shipped_sweeps_plan() {
-    let dir = scratch("shipped");
+    let tmp = scratch("shipped");
+    let dir = tmp.path().to_path_buf();
     let sweeps = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps");
     let mut files: Vec<PathBuf> = std::fs::read_dir(&sweeps)
         .unwrap()
@@ -143,12 +141,12 @@ fn shipped_sweeps_plan() {
             &format!("sweep plan {}", f.display()),
         );
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn bad_sweep_files_name_file_and_line() {
-    let dir = scratch("bad");
+    let tmp = scratch("bad");
+    let dir = tmp.path().to_path_buf();
     let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("suites/scenarios/smoke_cornell.ron");
     let head = format!(
         "Sweep(\n    cases: [(name: \"c\", scenario: \"{}\", seeds: [1], methods: [\"taa\"])],\n",
@@ -197,7 +195,6 @@ fn bad_sweep_files_name_file_and_line() {
         assert!(err.contains(what), "expected '{what}' in: {err}");
         assert!(!out.join("plan.json").exists(), "a bad sweep file must not leave a plan");
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// A free TCP port on localhost (bound, then released for the daemon).
@@ -387,7 +384,8 @@ fn claims_report(dir: &Path) -> String {
 
 #[test]
 fn sweep_runs_locally_and_on_slurm_with_identical_numbers() {
-    let dir = scratch("slurm");
+    let tmp = scratch("slurm");
+    let dir = tmp.path().to_path_buf();
     let sweep = sweep_file();
     let (local, slurm) = (dir.join("local"), dir.join("slurm"));
 
@@ -568,5 +566,4 @@ fn sweep_runs_locally_and_on_slurm_with_identical_numbers() {
     for f in ["speed_vs_flip.svg", "speed_vs_flip.png", "report.md"] {
         assert!(slurm.join(f).exists(), "merge wrote no {f}");
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -75,9 +75,9 @@ fn the_walkthrough_runs_as_written() {
     );
     assert!(steps.iter().any(|s| matches!(s, Step::Save { .. })), "{PAGE}: no suite file to save");
 
-    let tmp = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
-    let dir = tmp.join(format!("walkthrough_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let target_tmp = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let tmp = tempfile::Builder::new().prefix("walkthrough_").tempdir_in(&target_tmp).unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(dir.join("bin")).unwrap();
     for shared in ["scenarios", "scripts"] {
         link(&root().join(shared), &dir.join(shared));
@@ -103,7 +103,7 @@ fn the_walkthrough_runs_as_written() {
                     .args(["-euo", "pipefail", "-c", script])
                     .current_dir(&dir)
                     .env("PATH", &path)
-                    .env("FLICKER_CACHE_DIR", tmp.join("walkthrough_cache"))
+                    .env("FLICKER_CACHE_DIR", target_tmp.join("walkthrough_cache"))
                     .output()
                     .expect("bash runs");
                 let stdout = String::from_utf8_lossy(&out.stdout);
@@ -134,5 +134,4 @@ fn the_walkthrough_runs_as_written() {
     eprintln!("{summary}");
     assert!(summary.starts_with("# Suite suite: passed"), "{summary}");
     assert_eq!(summary.matches("| pass |").count(), 3, "{summary}");
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -18,7 +18,8 @@ reference!(SceneBvh2);
 #[test]
 fn bvh2_gpu_traversal_matches_obvhs_bvh2_and_brute_force() {
     let gpu = gpu();
-    let dir = std::env::temp_dir().join(format!("flicker-bvh2-traversal-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     let path = write_gltf(
         &dir,
         &torus(1.0, 0.35, 48, 24),
@@ -27,7 +28,7 @@ fn bvh2_gpu_traversal_matches_obvhs_bvh2_and_brute_force() {
         Vec3::new(0.2, -0.1, 0.3),
     );
     let gltf = load_gltf(&path);
-    std::fs::remove_dir_all(&dir).ok();
+    drop(tmp);
     let hairball = SceneDesc {
         meshes: vec![hairball(400, 8, 0.006, 2)],
         instances: vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }],

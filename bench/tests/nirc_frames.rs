@@ -5,8 +5,8 @@ use bench::nirc_frames::{PREDICTORS, run};
 
 #[test]
 fn plays_every_predictor_and_keeps_each_timed_frame() {
-    let scratch =
-        std::env::temp_dir().join(format!("flicker-test-nirc-frames-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let scratch = tmp.path().join("scratch");
     let t = run((16, 9), 1, 2, &scratch).expect("the frame bench runs on the test adapter");
     assert!(!scratch.exists(), "the scratch folder is removed");
     let names: Vec<&str> = t.rows.iter().map(|r| r.predictor.as_str()).collect();

@@ -1,6 +1,6 @@
 //! One row of `frames.csv`: timings and metrics of one method at one frame.
 
-use std::fmt::Write as _;
+use metrics::frames_csv::{self, Cell};
 
 #[derive(Clone, Debug, Default)]
 pub struct FrameRecord {
@@ -44,6 +44,15 @@ fn clock_prefix(row: &FrameRecord) -> &'static str {
 /// Writes the CSV; pass columns are the union over rows, so methods with different passes share
 /// one table. Empty cells mean "not measured".
 pub fn to_csv(rows: &[FrameRecord]) -> String {
+    let (columns, cells) = table(rows);
+    frames_csv::write(
+        &columns,
+        rows.iter().zip(cells).map(|(r, c)| (r.method.as_str(), r.frame, c)),
+    )
+}
+
+/// frames.csv's columns after `method,frame`, and each row's cells in them.
+pub fn table(rows: &[FrameRecord]) -> (Vec<String>, Vec<Vec<Cell>>) {
     let wall_total = rows.iter().any(|r| clock_prefix(r) == "wall");
     let mut passes: Vec<String> = Vec::new();
     let mut regions: Vec<String> = Vec::new();
@@ -66,77 +75,75 @@ pub fn to_csv(rows: &[FrameRecord]) -> String {
             }
         }
     }
-    let mut out = String::from("method,frame,cpu_ms,gpu_ms_total");
+    let mut columns: Vec<String> = vec!["cpu_ms".into(), "gpu_ms_total".into()];
     if wall_total {
-        out.push_str(",wall_ms_total");
+        columns.push("wall_ms_total".into());
     }
-    for p in &passes {
-        write!(out, ",{p}").unwrap();
-    }
-    out.push_str(",smape,smape_reprojected,disoccluded,flip,mse,rel_mse,psnr,rays,shaded");
+    columns.extend(passes.iter().cloned());
+    columns.extend(
+        [
+            "smape",
+            "smape_reprojected",
+            "disoccluded",
+            "flip",
+            "mse",
+            "rel_mse",
+            "psnr",
+            "rays",
+            "shaded",
+        ]
+        .map(String::from),
+    );
     for r in &regions {
-        write!(out, ",{r}_flip,{r}_smape").unwrap();
+        columns.extend([format!("{r}_flip"), format!("{r}_smape")]);
     }
-    for k in &stats {
-        write!(out, ",{k}").unwrap();
-    }
-    out.push('\n');
-    for row in rows {
-        let times: Vec<Option<f64>> = passes
-            .iter()
-            .map(|p| {
-                row.passes
+    columns.extend(stats.iter().cloned());
+    let count = |n: Option<u64>| n.map_or(Cell::Empty, Cell::Count);
+    let cells = rows
+        .iter()
+        .map(|row| {
+            let total = row.passes_total_ms();
+            let wall = clock_prefix(row) == "wall";
+            let mut cells =
+                vec![Cell::Fixed(row.cpu_ms, 4), Cell::six(if wall { None } else { total })];
+            if wall_total {
+                cells.push(Cell::six(if wall { total } else { None }));
+            }
+            cells.extend(passes.iter().map(|p| {
+                Cell::six(
+                    row.passes
+                        .iter()
+                        .find(|(q, _)| format!("{}_ms_{q}", clock_prefix(row)) == *p)
+                        .and_then(|(_, t)| *t),
+                )
+            }));
+            cells.extend([
+                Cell::six(row.smape),
+                Cell::six(row.smape_reprojected),
+                count(row.disoccluded),
+                Cell::six(row.flip),
+                Cell::six(row.mse),
+                Cell::six(row.rel_mse),
+                Cell::six(row.psnr),
+                count(row.rays),
+                count(row.shaded),
+            ]);
+            for r in &regions {
+                let found = row.regions.iter().find(|(q, _, _)| q == r);
+                cells.extend([
+                    Cell::six(found.and_then(|f| f.1)),
+                    Cell::six(found.and_then(|f| f.2)),
+                ]);
+            }
+            cells.extend(
+                stats
                     .iter()
-                    .find(|(q, _)| format!("{}_ms_{q}", clock_prefix(row)) == *p)
-                    .and_then(|(_, t)| *t)
-            })
-            .collect();
-        let total = row.passes_total_ms();
-        let wall = clock_prefix(row) == "wall";
-        write!(
-            out,
-            "{},{},{:.4},{}",
-            row.method,
-            row.frame,
-            row.cpu_ms,
-            cell(if wall { None } else { total })
-        )
-        .unwrap();
-        if wall_total {
-            write!(out, ",{}", cell(if wall { total } else { None })).unwrap();
-        }
-        for t in times {
-            write!(out, ",{}", cell(t)).unwrap();
-        }
-        write!(
-            out,
-            ",{},{},{},{},{},{},{},{},{}",
-            cell(row.smape),
-            cell(row.smape_reprojected),
-            row.disoccluded.map(|d| d.to_string()).unwrap_or_default(),
-            cell(row.flip),
-            cell(row.mse),
-            cell(row.rel_mse),
-            cell(row.psnr),
-            row.rays.map(|d| d.to_string()).unwrap_or_default(),
-            row.shaded.map(|d| d.to_string()).unwrap_or_default()
-        )
-        .unwrap();
-        for r in &regions {
-            let found = row.regions.iter().find(|(q, _, _)| q == r);
-            write!(out, ",{},{}", cell(found.and_then(|f| f.1)), cell(found.and_then(|f| f.2)))
-                .unwrap();
-        }
-        for k in &stats {
-            write!(out, ",{}", cell(row.stats.iter().find(|(q, _)| q == k).map(|s| s.1))).unwrap();
-        }
-        out.push('\n');
-    }
-    out
-}
-
-fn cell(v: Option<f64>) -> String {
-    v.map(|v| format!("{v:.6}")).unwrap_or_default()
+                    .map(|k| Cell::six(row.stats.iter().find(|(q, _)| q == k).map(|s| s.1))),
+            );
+            cells
+        })
+        .collect();
+    (columns, cells)
 }
 
 #[cfg(test)]

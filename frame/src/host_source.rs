@@ -58,7 +58,8 @@ mod tests {
         });
         assert_ne!(changed, HASH);
 
-        let dir = std::env::temp_dir().join(format!("flicker-host-source-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         let cache = ReferenceCache::new(&dir);
         let scene = render::scene::SceneDesc::default();
         let key = |host: &str| {
@@ -80,6 +81,5 @@ mod tests {
         cache.store(&key(HASH), 2, 1, &[[1.0; 4]; 2]).unwrap();
         assert!(matches!(cache.lookup(&key(HASH), 2, 1), Lookup::Hit(_)));
         assert!(matches!(cache.lookup(&key(&changed), 2, 1), Lookup::Miss));
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -20,26 +20,10 @@ pub fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<()> {
     write_text(path, &text)
 }
 
-/// Linear HDR radiance as a 32-bit float RGBA OpenEXR file.
+/// Linear HDR radiance as a 32-bit float RGBA OpenEXR file, in the workspace's one EXR layout
+/// (`metrics::image::write_exr_pixels`: scan lines, which NVIDIA's FLIP tool reads).
 pub fn write_exr(path: &Path, width: u32, height: u32, rgba: &[[f32; 4]]) -> Result<()> {
-    anyhow::ensure!(
-        rgba.len() == (width * height) as usize,
-        "image of {width}x{height} has {} pixels",
-        rgba.len()
-    );
-    write_atomic(path, |w| {
-        let mut cursor = std::io::Cursor::new(Vec::new());
-        image::codecs::openexr::OpenExrEncoder::new(&mut cursor)
-            .write_image(
-                bytemuck::cast_slice(rgba),
-                width,
-                height,
-                image::ExtendedColorType::Rgba32F,
-            )
-            .with_context(|| format!("encoding {}", path.display()))?;
-        w.write_all(cursor.get_ref())?;
-        Ok(())
-    })
+    metrics::image::write_exr_pixels(path, width, height, metrics::image::ExrPixels::Rgba(rgba))
 }
 
 /// Tone-mapped 8-bit sRGB PNG of linear radiance.
@@ -89,7 +73,8 @@ mod tests {
 
     #[test]
     fn exr_round_trips_and_leaves_no_temporary() {
-        let dir = std::env::temp_dir().join(format!("flicker-output-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         let path = dir.join("a/0000.exr");
         let px = vec![[0.25, 1.5, 1e3, 1.0], [0.0, 0.125, 7.0, 1.0]];
         write_exr(&path, 2, 1, &px).unwrap();
@@ -100,12 +85,12 @@ mod tests {
         write_png(&dir.join("a/0000.png"), 2, 1, &px, 1.0).unwrap();
         let png = image::open(dir.join("a/0000.png")).unwrap().into_rgb8();
         assert_eq!(png.dimensions(), (2, 1));
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn failed_write_keeps_the_old_file() {
-        let dir = std::env::temp_dir().join(format!("flicker-output-fail-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         let path = dir.join("keep.txt");
         write_text(&path, "old").unwrap();
         let err = write_atomic(&path, |w| {
@@ -115,6 +100,5 @@ mod tests {
         assert!(err.is_err());
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
         assert!(!tmp_path(&path).exists());
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

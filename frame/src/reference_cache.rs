@@ -268,19 +268,20 @@ mod tests {
 
     #[test]
     fn stores_and_loads() {
-        let dir = std::env::temp_dir().join(format!("flicker-refcache-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         let cache = ReferenceCache::new(&dir);
         let px = vec![[1.0, 2.0, 3.0, 1.0]; 8 * 4];
         assert!(cache.load("k", 8, 4).is_none());
         cache.store("k", 8, 4, &px).unwrap();
         assert_eq!(cache.load("k", 8, 4).unwrap(), px);
         assert!(cache.load("k", 4, 8).is_none());
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
     fn damaged_entries_are_named_never_used() {
-        let dir = std::env::temp_dir().join(format!("flicker-refcache-bad-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         let cache = ReferenceCache::new(&dir);
         let px: Vec<[f32; 4]> = (0..8 * 4).map(|i| [i as f32, 0.5, -1.0, 1.0]).collect();
         cache.store("k", 8, 4, &px).unwrap();
@@ -305,6 +306,5 @@ mod tests {
         sized[8] = 9;
         damaged(&sized, "9x4");
         damaged(b"", "something else");
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -103,7 +103,8 @@ mod tests {
 
     #[test]
     fn refuses_foreign_folders_and_replaces_runs() {
-        let dir = std::env::temp_dir().join(format!("flicker-runfolder-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(dir.join("thesis.tex"), "precious").unwrap();
         let run = RunFolder::new(&dir);
@@ -118,6 +119,5 @@ mod tests {
         run.prepare().unwrap();
         assert!(!run.frame("pt_1spp", 0, "exr").exists());
         assert!(!run.manifest().exists());
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

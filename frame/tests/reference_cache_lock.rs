@@ -20,11 +20,11 @@ fn lock_holder() {
 
 #[test]
 fn a_killed_holder_releases_its_lock() {
-    let dir = std::env::temp_dir().join(format!("flicker-refcache-lock-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     let mut child = std::process::Command::new(std::env::current_exe().unwrap())
         .args(["lock_holder", "--exact", "--ignored", "--nocapture"])
-        .env("FLICKER_LOCK_HOLDER_DIR", &dir)
+        .env("FLICKER_LOCK_HOLDER_DIR", dir)
         .spawn()
         .unwrap();
     let started = std::time::Instant::now();
@@ -33,7 +33,7 @@ fn a_killed_holder_releases_its_lock() {
         assert!(child.try_wait().unwrap().is_none(), "the child ended");
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
-    let cache = ReferenceCache::new(&dir);
+    let cache = ReferenceCache::new(dir);
     let other = std::fs::OpenOptions::new().write(true).open(cache.lock_path("k")).unwrap();
     assert!(
         matches!(other.try_lock(), Err(std::fs::TryLockError::WouldBlock)),
@@ -46,5 +46,4 @@ fn a_killed_holder_releases_its_lock() {
     let _lock =
         cache.lock("k", || panic!("a killed holder's lock must not be waited for")).unwrap();
     drop(other);
-    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -4,35 +4,12 @@ use std::path::Path;
 
 use anyhow::Context;
 
-/// Magma sampled at 17 evenly spaced points (sRGB-encoded display values), interpolated linearly.
-const MAGMA_KEYS: [[f32; 3]; 17] = [
-    [0.0015, 0.0005, 0.0139],
-    [0.0396, 0.0311, 0.1335],
-    [0.1131, 0.0655, 0.2768],
-    [0.2117, 0.0620, 0.4186],
-    [0.3167, 0.0717, 0.4854],
-    [0.4147, 0.1104, 0.5047],
-    [0.5128, 0.1482, 0.5076],
-    [0.6136, 0.1818, 0.4985],
-    [0.7164, 0.2150, 0.4753],
-    [0.8169, 0.2559, 0.4365],
-    [0.9043, 0.3196, 0.3881],
-    [0.9609, 0.4183, 0.3596],
-    [0.9867, 0.5356, 0.3822],
-    [0.9961, 0.6537, 0.4462],
-    [0.9969, 0.7696, 0.5349],
-    [0.9924, 0.8843, 0.6401],
-    [0.9871, 0.9914, 0.7495],
-];
-
-/// Magma colour of `v` in [0, 1] (clamped; NaN maps to 0), as 8-bit sRGB.
+/// Magma colour of `v` in [0, 1] (clamped; NaN maps to 0), as 8-bit sRGB: the nearest of the
+/// 256 entries of FLIP's own map (`flip_rs::MAGMA`, NVIDIA FLIP's `MapMagma`), as FLIP picks it.
 pub fn magma(v: f32) -> [u8; 3] {
     let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
-    let pos = v * (MAGMA_KEYS.len() - 1) as f32;
-    let i = (pos.floor() as usize).min(MAGMA_KEYS.len() - 2);
-    let f = pos - i as f32;
-    let (a, b) = (MAGMA_KEYS[i], MAGMA_KEYS[i + 1]);
-    std::array::from_fn(|c| ((a[c] + (b[c] - a[c]) * f) * 255.0 + 0.5) as u8)
+    let entry = flip_rs::MAGMA[(v * 255.0 + 0.5) as usize];
+    entry.map(|c| (c * 255.0 + 0.5) as u8)
 }
 
 /// Magma-coloured RGB bytes of a map, `scale` dividing values first (1 for FLIP; e.g. 2 for SMAPE).
@@ -72,5 +49,20 @@ mod tests {
             assert!(l >= last - 0.5, "magma must get lighter: {i}");
             last = l;
         }
+    }
+
+    /// The colours FLIP itself gives a map (`ErrorMap::colorize`, as its PNGs store them).
+    #[test]
+    fn colours_of_flips_own_heat_map() {
+        let values: Vec<f32> = (0..=1000).map(|i| i as f32 / 1000.0).collect();
+        let map = flip_rs::ErrorMap::new(values.len(), 1, values.clone()).unwrap();
+        let flip: Vec<u8> = map
+            .colorize()
+            .unwrap()
+            .pixels()
+            .iter()
+            .map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u8)
+            .collect();
+        assert_eq!(magma_bytes(&values, 1.0), flip);
     }
 }

@@ -120,26 +120,61 @@ pub(crate) fn write_encoded(buf: &::image::RgbImage, path: &Path) -> anyhow::Res
     crate::atomic::write_bytes(path, bytes.into_inner())
 }
 
-/// Writes linear RGB as a 32-bit float EXR: scan lines, ZIP compression, the most widely
-/// readable layout (tinyexr, used by NVIDIA's FLIP tool, rejects other layouts).
+/// The pixels of an EXR file: RGB, or RGBA (a run's frames keep their alpha).
+#[derive(Clone, Copy, Debug)]
+pub enum ExrPixels<'a> {
+    Rgb(&'a [[f32; 3]]),
+    Rgba(&'a [[f32; 4]]),
+}
+
+/// Writes linear RGB as a 32-bit float EXR (see [`write_exr_pixels`]).
 pub fn write_exr(image: &Image, path: impl AsRef<Path>) -> anyhow::Result<()> {
+    write_exr_pixels(path.as_ref(), image.width, image.height, ExrPixels::Rgb(&image.rgb))
+}
+
+/// The workspace's one EXR writer: 32-bit floats in scan lines, ZIP compression, the most widely
+/// readable layout (tinyexr, used by NVIDIA's FLIP tool, rejects tiled files). Written through
+/// [`crate::atomic`].
+pub fn write_exr_pixels(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: ExrPixels,
+) -> anyhow::Result<()> {
     use exr::prelude::*;
-    let path = path.as_ref();
-    let w = image.width as usize;
-    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
-        let p = image.rgb[y * w + x];
-        (p[0], p[1], p[2])
-    });
+    let (w, h) = (width as usize, height as usize);
+    let len = match pixels {
+        ExrPixels::Rgb(p) => p.len(),
+        ExrPixels::Rgba(p) => p.len(),
+    };
+    anyhow::ensure!(len == w * h, "{}: image of {width}x{height} has {len} pixels", path.display());
     let encoding = Encoding {
         compression: Compression::ZIP16,
         blocks: Blocks::ScanLines,
         line_order: LineOrder::Increasing,
     };
     let mut bytes = std::io::Cursor::new(Vec::new());
-    exr::image::Image::from_encoded_channels((w, image.height as usize), encoding, channels)
-        .write()
-        .to_buffered(&mut bytes)
-        .with_context(|| format!("encoding EXR {}", path.display()))?;
+    let encoded = match pixels {
+        ExrPixels::Rgb(px) => {
+            let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+                let p = px[y * w + x];
+                (p[0], p[1], p[2])
+            });
+            exr::image::Image::from_encoded_channels((w, h), encoding, channels)
+                .write()
+                .to_buffered(&mut bytes)
+        }
+        ExrPixels::Rgba(px) => {
+            let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
+                let p = px[y * w + x];
+                (p[0], p[1], p[2], p[3])
+            });
+            exr::image::Image::from_encoded_channels((w, h), encoding, channels)
+                .write()
+                .to_buffered(&mut bytes)
+        }
+    };
+    encoded.with_context(|| format!("encoding EXR {}", path.display()))?;
     crate::atomic::write_bytes(path, bytes.into_inner())
         .with_context(|| format!("cannot write EXR {}", path.display()))
 }
@@ -159,7 +194,8 @@ mod tests {
 
     #[test]
     fn png_and_exr_round_trip() {
-        let dir = std::env::temp_dir().join(format!("metrics-image-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         std::fs::create_dir_all(&dir).unwrap();
         let img = Image::from_fn(7, 5, |x, y| [x as f32 / 6.0, y as f32 / 4.0, 0.25]);
         write_exr(&img, dir.join("a.exr")).unwrap();
@@ -173,6 +209,56 @@ mod tests {
         }
         let err = load_image(dir.join("a.jpg")).unwrap_err().to_string();
         assert!(err.contains("a.jpg") && err.contains(".png or .exr"), "{err}");
-        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// A run's frames were written by `image`'s OpenEXR encoder (tiles) before they went through
+    /// [`write_exr_pixels`] (scan lines): same pixels, bit for bit, in the layout NVIDIA's FLIP
+    /// tool reads.
+    #[test]
+    fn rgba_in_scan_lines_has_the_pixels_of_the_tiled_encoder() {
+        use ::image::ImageEncoder;
+        use exr::prelude::*;
+        let (w, h) = (67u32, 70u32); // more than one 64-pixel tile each way
+        let px: Vec<[f32; 4]> = (0..w * h)
+            .map(|i| {
+                let v = (i as f32 * 0.37).sin() * 10f32.powi(i as i32 % 9 - 4);
+                [v, -v, i as f32, [1.0, 0.0, 0.5, f32::INFINITY][i as usize % 4]]
+            })
+            .collect();
+        let bytes: Vec<u8> = px.iter().flatten().flat_map(|v| v.to_ne_bytes()).collect();
+        let mut tiled = std::io::Cursor::new(Vec::new());
+        ::image::codecs::openexr::OpenExrEncoder::new(&mut tiled)
+            .write_image(&bytes, w, h, ::image::ExtendedColorType::Rgba32F)
+            .unwrap();
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
+        let path = dir.join("a.exr");
+        write_exr_pixels(&path, w, h, ExrPixels::Rgba(&px)).unwrap();
+        let scan_lines = std::fs::read(&path).unwrap();
+        let layout = |bytes: &[u8]| {
+            let meta = MetaData::read_from_buffered(std::io::Cursor::new(bytes), false).unwrap();
+            meta.headers[0].blocks
+        };
+        assert!(matches!(layout(tiled.get_ref()), exr::meta::BlockDescription::Tiles(_)));
+        assert_eq!(layout(&scan_lines), exr::meta::BlockDescription::ScanLines);
+        let read = |bytes: Vec<u8>| -> Vec<[u32; 4]> {
+            let image = read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .rgba_channels(
+                    |size, _| (size.width(), vec![[0u32; 4]; size.area()]),
+                    |(width, out), Vec2(x, y), (r, g, b, a): (f32, f32, f32, f32)| {
+                        out[y * *width + x] = [r, g, b, a].map(f32::to_bits)
+                    },
+                )
+                .first_valid_layer()
+                .all_attributes()
+                .from_buffered(std::io::Cursor::new(bytes))
+                .unwrap();
+            image.layer_data.channel_data.pixels.1
+        };
+        let expected: Vec<[u32; 4]> = px.iter().map(|p| p.map(f32::to_bits)).collect();
+        assert_eq!(read(tiled.into_inner()), expected);
+        assert_eq!(read(scan_lines), expected);
     }
 }

@@ -7,6 +7,7 @@
 //! - [`cvvdp`]: ColorVideoVDP's JOD of a sequence against its reference, on a display model.
 //! - [`region`]: named rectangles of interest; any per-pixel map can be averaged over one.
 //! - [`compare`]: the `compare REFERENCE TEST` command.
+//! - [`frames_csv`]: a run's frames.csv, its one writer and reader.
 //! - [`reference_flip`]: NVIDIA's FLIP as a subprocess; [`synthetic`]: test images.
 
 pub mod atomic;
@@ -15,6 +16,7 @@ pub mod compare;
 pub mod cvvdp;
 pub mod error;
 pub mod flip;
+pub mod frames_csv;
 pub mod image;
 pub mod ordered_sum;
 pub mod python;

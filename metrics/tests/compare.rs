@@ -6,15 +6,14 @@ use metrics::{
     DEFAULT_PPD, Image, flip_hdr, flip_ldr, load_image, psnr, smape, write_exr, write_png_srgb,
 };
 
-fn dir(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("metrics-compare-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("metrics-compare-{name}-")).tempdir().unwrap()
 }
 
 #[test]
 fn compare_matches_library_and_writes_map() {
-    let d = dir("ok");
+    let tmp = dir("ok");
+    let d = tmp.path().to_path_buf();
     let r = Image::from_fn(40, 30, |x, y| [x as f32 / 40.0 * 3.0, y as f32 / 30.0, 0.5]);
     let t =
         Image::from_fn(40, 30, |x, y| if (x + y) % 7 == 0 { [2.0, 0.1, 0.1] } else { r.get(x, y) });
@@ -43,12 +42,12 @@ fn compare_matches_library_and_writes_map() {
     let map = ::image::open(d.join("map.png")).unwrap().to_rgb8();
     assert_eq!(map.dimensions(), (40, 30));
     assert!(map.pixels().any(|p| p.0 != map.get_pixel(0, 0).0), "the map shows the differences");
-    std::fs::remove_dir_all(&d).ok();
 }
 
 #[test]
 fn compare_reports_bad_inputs_by_name() {
-    let d = dir("bad");
+    let tmp = dir("bad");
+    let d = tmp.path().to_path_buf();
     write_png_srgb(&Image::filled(8, 8, [0.5; 3]), d.join("a.png")).unwrap();
     write_png_srgb(&Image::filled(9, 8, [0.5; 3]), d.join("b.png")).unwrap();
     let err = compare_files(&d.join("a.png"), &d.join("b.png"), None, DEFAULT_PPD, 0.01)
@@ -68,5 +67,4 @@ fn compare_reports_bad_inputs_by_name() {
     // PNG holds sRGB: linear 0.5 is stored as byte 188 and read back as linear again.
     assert_eq!(::image::open(d.join("a.png")).unwrap().to_rgb8().get_pixel(0, 0).0, [188; 3]);
     assert!((load_image(d.join("a.png")).unwrap().get(0, 0)[0] - 0.5).abs() < 3e-3);
-    std::fs::remove_dir_all(&d).ok();
 }

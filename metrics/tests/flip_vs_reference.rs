@@ -3,7 +3,7 @@
 //! pixels. The reference tool runs as a subprocess on files this test writes; its grayscale map
 //! is an 8-bit PNG (quantisation ±0.002, well inside the tolerance).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use metrics::reference_flip::{reference_flip_available, reference_flip_command};
 use metrics::synthetic::{hash01, synthetic_hdr_pair};
@@ -12,10 +12,8 @@ use metrics::{DEFAULT_PPD, Image, flip_hdr, flip_ldr, load_image, write_exr, wri
 const W: u32 = 80;
 const H: u32 = 60;
 
-fn work_dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("metrics-flip-ref-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn work_dir() -> tempfile::TempDir {
+    tempfile::Builder::new().prefix("metrics-flip-ref-").tempdir().unwrap()
 }
 
 /// A textured LDR image: gradients, a checkerboard, a disc and fine stripes.
@@ -112,7 +110,8 @@ fn flip_matches_nvidia_reference() {
         reference_flip_available(),
         "NVIDIA's FLIP is not installed: `python3 -m flip_evaluator.flip_python_api -h` failed (run scripts/setup-tests.sh, or set FLICKER_PYTHON to a Python that has flip-evaluator)"
     );
-    let dir = work_dir();
+    let tmp = work_dir();
+    let dir = tmp.path().to_path_buf();
     let base = ldr_base();
     let ldr_pairs: Vec<(&str, Image, f32)> = vec![
         (
@@ -162,5 +161,4 @@ fn flip_matches_nvidia_reference() {
         let ours = flip_hdr(&load_image(&rp).unwrap(), &load_image(&tp).unwrap(), DEFAULT_PPD);
         check(name, ours.mean, &ours.map, reference(&dir, name, &rp, &tp, DEFAULT_PPD));
     }
-    std::fs::remove_dir_all(&dir).ok();
 }

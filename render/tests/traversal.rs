@@ -28,7 +28,8 @@ fn gpu_matches_cpu(
 
 #[test]
 fn gltf_mesh_gpu_traversal_matches_obvhs() {
-    let dir = std::env::temp_dir().join(format!("flicker-traversal-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     let path = write_gltf(
         &dir,
         &torus(1.0, 0.35, 48, 24),
@@ -37,7 +38,7 @@ fn gltf_mesh_gpu_traversal_matches_obvhs() {
         Vec3::new(0.2, -0.1, 0.3),
     );
     let scene = load_gltf(&path);
-    std::fs::remove_dir_all(&dir).ok();
+    drop(tmp);
     assert_eq!(scene.meshes.len(), 1);
     assert_eq!(scene.meshes[0].indices.len(), 48 * 24 * 2);
     let gpu = gpu();

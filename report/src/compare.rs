@@ -6,11 +6,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use maud::html;
+use metrics::frames_csv::Frames;
 
 use crate::html::STYLE;
 use crate::images::write_frame_images;
 use crate::page;
-use crate::run::{Frames, Manifest};
+use crate::run::Manifest;
 use crate::summary::{DEFAULT_WINDOW, summarize};
 use crate::viewer::{self, Panel};
 
@@ -69,7 +70,7 @@ pub fn write_comparison(run_a: &Path, run_b: &Path, out: &Path) -> anyhow::Resul
         .with_context(|| format!("cannot create {}", out_dir.display()))?;
     let stem = out.file_stem().and_then(|s| s.to_str()).unwrap_or("compare");
     let linked_dir = format!("{stem}_viewer");
-    let frame_count = fa.frame_count(&ma).max(fb.frame_count(&mb));
+    let frame_count = ma.frame_count(&fa).max(mb.frame_count(&fb));
     let viewer = viewer::build(
         &viewer::Output { dir: out_dir, linked_dir: &linked_dir },
         &panels,

@@ -8,11 +8,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use maud::{Markup, html};
+use metrics::frames_csv::Frames;
 
 use crate::charts::build::{WrittenChart, write_charts};
 use crate::data_uri::data_uri;
 use crate::images::write_frame_images;
-use crate::run::{Frames, Manifest};
+use crate::run::Manifest;
 use crate::summary::{DEFAULT_WINDOW, summarize};
 use crate::{page, table, viewer};
 
@@ -68,7 +69,7 @@ pub fn write_report(
             fi.methods.iter().map(move |m| ((fi.frame, m.method.clone()), m.flip.clone()))
         })
         .collect();
-    let frame_count = frames.frame_count(&manifest);
+    let frame_count = manifest.frame_count(&frames);
     let out = viewer::Output { dir: run_dir, linked_dir: viewer::LINKED_DIR };
     let viewer = viewer::build(
         &out,

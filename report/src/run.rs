@@ -1,9 +1,10 @@
-//! Reading a run folder: the manifest and frames.csv.
+//! Reading a run folder: the manifest (frames.csv is read by `metrics::frames_csv`).
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use metrics::Region;
+use metrics::frames_csv::Frames;
 use serde::Deserialize;
 
 #[derive(Clone, Debug, Deserialize)]
@@ -109,6 +110,11 @@ impl Manifest {
         m.events = merge_events(m.events);
         Ok(m)
     }
+
+    /// Frames of the run: those in frames.csv, or the manifest's count if larger.
+    pub fn frame_count(&self, frames: &Frames) -> u32 {
+        frames.rows.iter().map(|r| r.frame + 1).max().unwrap_or(0).max(self.frames.unwrap_or(0))
+    }
 }
 
 /// Events sorted by frame, those of one frame merged into one ("a + b"): windows, chart markers
@@ -125,121 +131,6 @@ pub fn merge_events(mut events: Vec<Event>) -> Vec<Event> {
         }
     }
     out
-}
-
-/// One row of frames.csv.
-#[derive(Clone, Debug)]
-pub struct Row {
-    pub method: String,
-    pub frame: u32,
-    /// One value per numeric column (`Frames::columns`); `None` for an empty cell.
-    pub values: Vec<Option<f64>>,
-}
-
-/// frames.csv: columns after `method,frame`, and the rows.
-#[derive(Clone, Debug)]
-pub struct Frames {
-    pub columns: Vec<String>,
-    pub rows: Vec<Row>,
-}
-
-impl Frames {
-    pub fn load(run_dir: &Path) -> anyhow::Result<Self> {
-        let path = run_dir.join("frames.csv");
-        let text = std::fs::read_to_string(&path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
-        Self::parse(&text, &path)
-    }
-
-    pub fn parse(text: &str, path: &Path) -> anyhow::Result<Self> {
-        let mut lines = text.lines().filter(|l| !l.trim().is_empty());
-        let header: Vec<&str> = lines
-            .next()
-            .with_context(|| format!("{}: empty file", path.display()))?
-            .split(',')
-            .collect();
-        if header.len() < 2 || header[0] != "method" || header[1] != "frame" {
-            bail!(
-                "{}: header must start with `method,frame`, found `{}`",
-                path.display(),
-                header.join(",")
-            );
-        }
-        let columns: Vec<String> = header[2..].iter().map(|s| s.trim().to_string()).collect();
-        let mut rows = Vec::new();
-        for (i, line) in lines.enumerate() {
-            let cells: Vec<&str> = line.split(',').collect();
-            if cells.len() != header.len() {
-                bail!(
-                    "{}: line {} has {} cells, the header has {}",
-                    path.display(),
-                    i + 2,
-                    cells.len(),
-                    header.len()
-                );
-            }
-            let frame = cells[1].trim().parse().with_context(|| {
-                format!(
-                    "{}: line {}: frame `{}` is not an integer",
-                    path.display(),
-                    i + 2,
-                    cells[1]
-                )
-            })?;
-            let values = cells[2..]
-                .iter()
-                .map(|c| {
-                    let c = c.trim();
-                    if c.is_empty() {
-                        Ok(None)
-                    } else {
-                        c.parse::<f64>().map(Some).with_context(|| {
-                            format!("{}: line {}: `{c}` is not a number", path.display(), i + 2)
-                        })
-                    }
-                })
-                .collect::<anyhow::Result<_>>()?;
-            rows.push(Row { method: cells[0].trim().to_string(), frame, values });
-        }
-        Ok(Self { columns, rows })
-    }
-
-    pub fn column(&self, name: &str) -> Option<usize> {
-        self.columns.iter().position(|c| c == name)
-    }
-
-    /// Methods in order of first appearance.
-    pub fn methods(&self) -> Vec<String> {
-        let mut out: Vec<String> = Vec::new();
-        for r in &self.rows {
-            if !out.contains(&r.method) {
-                out.push(r.method.clone());
-            }
-        }
-        out
-    }
-
-    /// (frame, value) of a column for one method, skipping empty cells, sorted by frame.
-    pub fn series(&self, method: &str, column: usize) -> Vec<(f64, f64)> {
-        let mut s: Vec<(f64, f64)> = self
-            .rows
-            .iter()
-            .filter(|r| r.method == method)
-            .filter_map(|r| r.values[column].map(|v| (r.frame as f64, v)))
-            .collect();
-        s.sort_by(|a, b| a.0.total_cmp(&b.0));
-        s
-    }
-
-    /// Frames of the run: those in frames.csv, or the manifest's count if larger.
-    pub fn frame_count(&self, manifest: &Manifest) -> u32 {
-        self.rows.iter().map(|r| r.frame + 1).max().unwrap_or(0).max(manifest.frames.unwrap_or(0))
-    }
-
-    /// Whether a column has at least one finite value.
-    pub fn has_data(&self, column: usize) -> bool {
-        self.rows.iter().any(|r| r.values[column].is_some_and(f64::is_finite))
-    }
 }
 
 /// The folder of a method's motion vectors, `frames/METHOD/motion/` (as systems::run_folder).
@@ -262,17 +153,5 @@ mod tests {
         let merged = merge_events(vec![ev(20, "rotate"), ev(5, "flash"), ev(20, "move")]);
         let got: Vec<(u32, &str)> = merged.iter().map(|e| (e.frame, e.label.as_str())).collect();
         assert_eq!(got, [(5, "flash"), (20, "rotate + move")]);
-    }
-
-    #[test]
-    fn parses_empty_cells_and_reports_bad_lines() {
-        let csv = "method,frame,cpu_ms,flip\na,0,1.5,\na,1,2.0,0.25\nb,0,3,0.5\n";
-        let f = Frames::parse(csv, Path::new("x/frames.csv")).unwrap();
-        assert_eq!(f.columns, ["cpu_ms", "flip"]);
-        assert_eq!(f.methods(), ["a", "b"]);
-        assert_eq!(f.series("a", 1), vec![(1.0, 0.25)]);
-        let err = Frames::parse("method,frame,x\na,0,zz\n", Path::new("x/frames.csv")).unwrap_err();
-        assert!(format!("{err:#}").contains("line 2") && format!("{err:#}").contains("frames.csv"));
-        assert!(Frames::parse("frame,method\n", Path::new("f.csv")).is_err());
     }
 }

@@ -6,9 +6,10 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use metrics::frames_csv::Frames;
 use serde::Serialize;
 
-use crate::run::{Frames, Manifest, Memory};
+use crate::run::{Manifest, Memory};
 
 /// Frames after an event counted as its transient.
 pub const DEFAULT_WINDOW: u32 = 10;
@@ -93,7 +94,7 @@ pub fn windows(manifest: &Manifest, frame_count: u32, n: u32) -> Vec<Window> {
 }
 
 pub fn summarize(manifest: &Manifest, frames: &Frames, n: u32) -> Summary {
-    let frame_count = frames.frame_count(manifest);
+    let frame_count = manifest.frame_count(frames);
     let windows = windows(manifest, frame_count, n);
     let methods = frames
         .methods()

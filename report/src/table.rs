@@ -1,8 +1,9 @@
 //! The summary table: means per method and frame window, the best method of each column marked.
 
 use maud::{Markup, html};
+use metrics::frames_csv::Frames;
 
-use crate::run::{Frames, Memory};
+use crate::run::Memory;
 use crate::summary::Summary;
 
 /// Columns of the table, when present: (frames.csv column, heading, which way is better).

@@ -63,7 +63,8 @@ fn check_page(bin: &Path, work: &Path, html: &str, name: &str) -> Outcome {
 #[test]
 fn report_displays_every_image_without_console_errors() {
     let bin = chromium();
-    let run = common::fake_run("chromium");
+    let tmp = common::fake_run("chromium");
+    let run = tmp.path().to_path_buf();
     let report = report::rebuild(&run, &[]).unwrap();
     let html = std::fs::read_to_string(&report).unwrap();
     let work = run.join("browser");
@@ -105,7 +106,6 @@ fn report_displays_every_image_without_console_errors() {
         inked as f64 > 0.01 * (img.width() * img.height()) as f64,
         "screenshot mostly blank ({inked} inked pixels)"
     );
-    std::fs::remove_dir_all(&run).ok();
 }
 
 /// Inserted first in <head>: records every alert() (an injected handler would call it).
@@ -179,11 +179,12 @@ fn assert_inert(out: &serde_json::Value) {
 fn names_with_markup_and_quotes_are_text_in_report_and_comparison() {
     use common::{HOSTILE_EVENT, HOSTILE_METHODS, HOSTILE_REGIONS, HOSTILE_SCENARIO};
     let bin = chromium();
-    let a = common::hostile_run("names-a");
+    let a_tmp = common::hostile_run("names-a");
+    let a = a_tmp.path();
     let work = a.join("browser");
     std::fs::create_dir_all(&work).unwrap();
 
-    let out = names_in_dom(&bin, &work, &report::rebuild(&a, &[]).unwrap());
+    let out = names_in_dom(&bin, &work, &report::rebuild(a, &[]).unwrap());
     assert_inert(&out);
     let title = format!("flicker run: {HOSTILE_SCENARIO}");
     assert_eq!((out["title"].as_str(), out["h1"].as_str()), (Some(&*title), Some(&*title)));
@@ -203,8 +204,9 @@ fn names_with_markup_and_quotes_are_text_in_report_and_comparison() {
     assert_eq!(manifest["scenario"], HOSTILE_SCENARIO);
     assert_eq!(out["shown"], 4, "the viewer opens on the event");
 
-    let b = common::hostile_run("names-b");
-    let page = report::compare::write_comparison(&a, &b, &work.join("compare.html")).unwrap();
+    let b_tmp = common::hostile_run("names-b");
+    let page =
+        report::compare::write_comparison(a, b_tmp.path(), &work.join("compare.html")).unwrap();
     let out = names_in_dom(&bin, &work, &page);
     assert_inert(&out);
     let mut panels = vec!["reference".to_string()];
@@ -215,6 +217,4 @@ fn names_with_markup_and_quotes_are_text_in_report_and_comparison() {
         assert_eq!(out[key], serde_json::json!(panels), "{key}");
     }
     assert!(out["methodCells"].as_array().unwrap().contains(&HOSTILE_SCENARIO.into()));
-    std::fs::remove_dir_all(&a).ok();
-    std::fs::remove_dir_all(&b).ok();
 }

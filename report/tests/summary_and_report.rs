@@ -4,13 +4,15 @@ mod common;
 
 use common::*;
 use maud::html;
-use report::run::{Frames, Manifest, Memory, MethodMemory};
+use metrics::frames_csv::Frames;
+use report::run::{Manifest, Memory, MethodMemory};
 use report::summary::{Summary, summarize};
 use report::{page, table};
 
 #[test]
 fn summary_windows_and_means() {
-    let run = fake_run("summary");
+    let tmp = fake_run("summary");
+    let run = tmp.path().to_path_buf();
     report::write_summary_with_window(&run, 5).unwrap();
     let s = read_json(&run.join("summary.json"));
     let names: Vec<&str> =
@@ -62,12 +64,12 @@ fn summary_windows_and_means() {
         ema["means"]["after_event_0"]["smape"].as_f64().unwrap()
             > ema["means"]["before_first_event"]["smape"].as_f64().unwrap()
     );
-    std::fs::remove_dir_all(&run).ok();
 }
 
 #[test]
 fn report_is_self_contained_with_charts_maps_and_crops() {
-    let run = fake_run("report");
+    let tmp = fake_run("report");
+    let run = tmp.path().to_path_buf();
     let path = report::rebuild(&run, &[]).unwrap();
     assert_eq!(path, run.join("report.html"));
     let html = std::fs::read_to_string(&path).unwrap();
@@ -150,14 +152,13 @@ fn report_is_self_contained_with_charts_maps_and_crops() {
     assert!(svg.contains("rotate light") && svg.contains("pt_1spp") && svg.contains("cache_ema"));
     if let Some(keep) = std::env::var_os("FLICKER_KEEP_REPORT") {
         std::fs::rename(&run, keep).unwrap();
-        return;
     }
-    std::fs::remove_dir_all(&run).ok();
 }
 
 #[test]
 fn minimal_run_without_reference_events_or_regions() {
-    let run = std::env::temp_dir().join(format!("report-minimal-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let run = tmp.path().to_path_buf();
     std::fs::create_dir_all(&run).unwrap();
     std::fs::write(run.join("manifest.json"), r#"{"scenario": "tiny", "methods": ["a"]}"#).unwrap();
     std::fs::write(
@@ -180,7 +181,6 @@ fn minimal_run_without_reference_events_or_regions() {
     std::fs::write(run.join("manifest.json"), "{").unwrap();
     let err = format!("{:#}", report::rebuild(&run, &[]).unwrap_err());
     assert!(err.contains("manifest.json"), "{err}");
-    std::fs::remove_dir_all(&run).ok();
 }
 
 /// A name as it must stand in the markup: text or a double-quoted attribute value.
@@ -230,7 +230,8 @@ fn assert_script_json(html: &str, labels: &[String]) {
 
 #[test]
 fn report_page_escapes_every_name_a_scenario_sets() {
-    let run = hostile_run("hostile-report");
+    let tmp = hostile_run("hostile-report");
+    let run = tmp.path().to_path_buf();
     let html = std::fs::read_to_string(report::rebuild(&run, &[]).unwrap()).unwrap();
     assert_no_raw_names(&html);
     let (scenario, event) = (escaped(HOSTILE_SCENARIO), escaped(HOSTILE_EVENT));
@@ -256,13 +257,13 @@ fn report_page_escapes_every_name_a_scenario_sets() {
     let labels: Vec<String> =
         std::iter::once("reference").chain(HOSTILE_METHODS).map(String::from).collect();
     assert_script_json(&html, &labels);
-    std::fs::remove_dir_all(&run).ok();
 }
 
 #[test]
 fn comparison_page_escapes_every_name_a_scenario_sets() {
-    let (a, b) = (hostile_run("hostile-compare-a"), hostile_run("hostile-compare-b"));
-    let page = report::compare::write_comparison(&a, &b, &b.join("compare.html")).unwrap();
+    let (tmp_a, tmp_b) = (hostile_run("hostile-compare-a"), hostile_run("hostile-compare-b"));
+    let (a, b) = (tmp_a.path(), tmp_b.path());
+    let page = report::compare::write_comparison(a, b, &b.join("compare.html")).unwrap();
     let html = std::fs::read_to_string(page).unwrap();
     assert_no_raw_names(&html);
     let scenario = escaped(HOSTILE_SCENARIO);
@@ -280,8 +281,6 @@ fn comparison_page_escapes_every_name_a_scenario_sets() {
         labels.extend([format!("A: {m}"), format!("B: {m}")]);
     }
     assert_script_json(&html, &labels);
-    std::fs::remove_dir_all(&a).ok();
-    std::fs::remove_dir_all(&b).ok();
 }
 
 // The page builders, each with a name holding markup and quotes.

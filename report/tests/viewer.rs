@@ -14,7 +14,7 @@ use serde_json::Value;
 /// Frames per second of the fixture (time step 0.05 s).
 const FPS: f64 = 20.0;
 
-fn viewer_run(name: &str) -> (FakeRun, std::path::PathBuf) {
+fn viewer_run(name: &str) -> (FakeRun, tempfile::TempDir) {
     let spec = FakeRun {
         static_noise: true,
         time_step: Some(1.0 / FPS),
@@ -22,7 +22,7 @@ fn viewer_run(name: &str) -> (FakeRun, std::path::PathBuf) {
         ..FakeRun::default()
     };
     let dir = fake_run_with(name, &spec);
-    report::rebuild(&dir, &[]).unwrap();
+    report::rebuild(dir.path(), &[]).unwrap();
     (spec, dir)
 }
 
@@ -150,7 +150,8 @@ fn f(v: &Value) -> f64 {
 #[test]
 fn slider_play_exposure_zoom_maps_and_pixel_values() {
     let bin = chromium();
-    let (spec, run) = viewer_run("interact");
+    let (spec, tmp) = viewer_run("interact");
+    let run = tmp.path().to_path_buf();
     let out = interact(&bin, &run);
     assert!(out.get("error").is_none(), "script error: {}", out["error"]);
     assert_eq!(out["errors"], serde_json::json!([]), "console errors");
@@ -297,7 +298,6 @@ fn slider_play_exposure_zoom_maps_and_pixel_values() {
         "{c0} {c15}"
     );
     assert!(f(&c15["left"]) > f(&c0["left"]) + 10.0);
-    std::fs::remove_dir_all(&run).ok();
 }
 
 /// The opening frame: the first recorded frame at or after the first event, else frame 0.
@@ -340,7 +340,8 @@ fn diff(a: &image::RgbImage, b: &image::RgbImage, r: [f64; 4]) -> f64 {
 #[test]
 fn screenshots_differ_where_the_scene_changes_and_only_there() {
     let bin = chromium();
-    let (_, run) = viewer_run("screens");
+    let (_, tmp) = viewer_run("screens");
+    let run = tmp.path().to_path_buf();
     // Panel positions, from the page itself in a window of the same size.
     let views = interact(&bin, &run)["views"].clone();
     let shot = |frame: u32| {
@@ -375,7 +376,6 @@ fn screenshots_differ_where_the_scene_changes_and_only_there() {
             diff(&b, &c, right)
         );
     }
-    std::fs::remove_dir_all(&run).ok();
 }
 
 /// A page that says when the viewer first showed a frame (the load event alone comes earlier).
@@ -417,7 +417,8 @@ fn a_320x180_60_frame_6_method_report_shows_its_first_frame() {
         motion: false,
         ..FakeRun::default()
     };
-    let run = fake_run_with("large", &spec);
+    let tmp = fake_run_with("large", &spec);
+    let run = tmp.path().to_path_buf();
     let t = std::time::Instant::now();
     report::rebuild(&run, &[]).unwrap();
     let build_s = t.elapsed().as_secs_f64();
@@ -468,15 +469,16 @@ fn a_320x180_60_frame_6_method_report_shows_its_first_frame() {
         linked > report::viewer::EMBED_LIMIT_BYTES as u64
             && size(&run.join("report.html")) < 2 << 20
     );
-    std::fs::remove_dir_all(&run).ok();
 }
 
 #[test]
 fn compare_puts_two_runs_in_one_viewer_with_a_table_of_differences() {
     let bin = chromium();
-    let a = fake_run_with("compare-a", &FakeRun::default());
+    let a_tmp = fake_run_with("compare-a", &FakeRun::default());
+    let a = a_tmp.path().to_path_buf();
     // B: the same scene with noise that holds still from frame to frame (less flicker).
-    let b = fake_run_with("compare-b", &FakeRun { static_noise: true, ..FakeRun::default() });
+    let b_tmp = fake_run_with("compare-b", &FakeRun { static_noise: true, ..FakeRun::default() });
+    let b = b_tmp.path().to_path_buf();
     let args = report::ReportOptions {
         run_dir: None,
         compare: Some(vec![a.clone(), b.clone()]),
@@ -497,7 +499,7 @@ fn compare_puts_two_runs_in_one_viewer_with_a_table_of_differences() {
     );
 
     // Differences: the overall SMAPE of each run, from its frames.csv; B flickers less.
-    let frames = |dir: &Path| report::run::Frames::load(dir).unwrap();
+    let frames = |dir: &Path| metrics::frames_csv::Frames::load(dir).unwrap();
     let mean_smape = |dir: &Path, method: &str| {
         let f = frames(dir);
         let v: Vec<f64> =
@@ -546,6 +548,4 @@ fn compare_puts_two_runs_in_one_viewer_with_a_table_of_differences() {
         element_text(&dom, "first-frame").as_deref(),
         Some(format!("shown {EVENT} empty 0 errors 0").as_str())
     );
-    std::fs::remove_dir_all(&a).ok();
-    std::fs::remove_dir_all(&b).ok();
 }

@@ -12,10 +12,8 @@ fn asset_path() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/assets/test_scene.gltf")
 }
 
-fn temp_dir(tag: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("flicker-sim-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn temp_dir(tag: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("flicker-sim-{tag}-")).tempdir().unwrap()
 }
 
 /// The committed asset is exactly what the generator writes. FLICKER_REGENERATE=1 rewrites a
@@ -123,7 +121,8 @@ fn missing_file_is_named() {
 
 #[test]
 fn broken_json_is_named() {
-    let dir = temp_dir("broken");
+    let tmp = temp_dir("broken");
+    let dir = tmp.path().to_path_buf();
     let path = dir.join("broken.gltf");
     std::fs::write(&path, "{ \"asset\": { \"version\": \"2.0\" }, \"nodes\": [ {").unwrap();
     let e = import(&path).unwrap_err().to_string();
@@ -133,7 +132,8 @@ fn broken_json_is_named() {
 
 #[test]
 fn unsupported_primitive_mode_names_mesh_and_primitive() {
-    let dir = temp_dir("lines");
+    let tmp = temp_dir("lines");
+    let dir = tmp.path().to_path_buf();
     let path = dir.join("lines.gltf");
     let text = support::test_asset::gltf_text().replacen("\"mode\": 4", "\"mode\": 1", 1);
     std::fs::write(&path, text).unwrap();
@@ -163,7 +163,8 @@ fn with_material_extensions(floor: serde_json::Value) -> String {
 
 #[test]
 fn subsurface_comes_from_diffuse_transmission_and_volume() {
-    let dir = temp_dir("subsurface");
+    let tmp = temp_dir("subsurface");
+    let dir = tmp.path().to_path_buf();
     let path = dir.join("skin.gltf");
     let volume =
         serde_json::json!({"attenuationDistance": 0.2, "attenuationColor": [0.8, 0.5, 0.25]});

@@ -186,8 +186,8 @@ fn simulate(dir: &Path, extra: &str) -> Result<(), String> {
 
 #[test]
 fn scenes_that_emit_nothing_or_have_no_extent_are_refused() {
-    let dir = std::env::temp_dir().join(format!("flicker-meaningless-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     let tri = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
     // No light, no emission, no environment: every frame black.
     triangle_gltf(&dir, tri, false);
@@ -216,5 +216,4 @@ fn scenes_that_emit_nothing_or_have_no_extent_are_refused() {
     triangle_gltf(&dir, [[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [2.0, 2.0, 0.0]], true);
     let err = simulate(&dir, "").unwrap_err();
     assert!(err.contains("s.ron:1:10: mesh 'tri#0' has no triangle of positive area"), "{err}");
-    std::fs::remove_dir_all(&dir).ok();
 }

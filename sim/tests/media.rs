@@ -110,7 +110,8 @@ fn an_animated_medium_moves_scales_spins_and_pulses_in_closed_form() {
 
 #[test]
 fn a_raw_density_grid_loads_relative_to_the_scenario_and_bad_files_name_their_line() {
-    let dir = std::env::temp_dir().join(format!("flicker_grid_{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(dir.join("assets")).unwrap();
     let grid =
         |name: &str, text: &str| std::fs::write(dir.join("assets").join(name), text).unwrap();
@@ -146,12 +147,12 @@ fn a_raw_density_grid_loads_relative_to_the_scenario_and_bad_files_name_their_li
     )
     .unwrap();
     assert_eq!(shipped.res, (16, 16, 16));
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn a_mesh_bound_loads_relative_to_the_scenario_and_bad_meshes_name_their_line() {
-    let dir = std::env::temp_dir().join(format!("flicker_mesh_bound_{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(dir.join("assets")).unwrap();
     let obj = |name: &str, text: &str| std::fs::write(dir.join("assets").join(name), text).unwrap();
     // An octahedron, outward-facing; variants with one face missing, one flipped, a bad index.
@@ -207,7 +208,6 @@ fn a_mesh_bound_loads_relative_to_the_scenario_and_bad_meshes_name_their_line() 
     )
     .unwrap();
     assert_eq!(torus.triangles.len(), 2 * 24 * 12);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

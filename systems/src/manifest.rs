@@ -135,7 +135,8 @@ pub fn commit(scenario_file: &Path) -> String {
 mod tests {
     #[test]
     fn events_are_placed_on_recorded_frames() {
-        let dir = std::env::temp_dir().join(format!("manifest-events-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("warm.ron");
         std::fs::write(
@@ -154,6 +155,5 @@ mod tests {
         // Simulation frame 12 is recorded frame 4; 3 falls in the warm-up, 16 after the last frame.
         let frames: Vec<u32> = super::recorded_events(&scenario).into_iter().map(|e| e.0).collect();
         assert_eq!(frames, [4]);
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -10,6 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, anyhow, bail};
+use metrics::frames_csv::Frames;
 use render::gpu::Gpu;
 use serde_json::Value;
 
@@ -201,17 +202,10 @@ fn stored_overrides(o: &Value, run: &Path) -> Result<Overrides> {
 /// The frame of frames.csv's last row (the file is rewritten whole after each frame, so every
 /// frame it has is complete).
 fn last_frame(csv: &str, file: &Path) -> Result<Option<u32>> {
-    let mut lines = csv.lines();
-    let Some(header) = lines.next() else { return Ok(None) };
-    let column = header
-        .split(',')
-        .position(|h| h == "frame")
-        .ok_or_else(|| anyhow!("{}:1: expected a `frame` column", file.display()))?;
-    let Some((n, last)) = lines.enumerate().last() else { return Ok(None) };
-    let cell = last.split(',').nth(column).unwrap_or_default();
-    cell.parse()
-        .map(Some)
-        .map_err(|_| anyhow!("{}:{}: expected a frame number, got '{cell}'", file.display(), n + 2))
+    if csv.trim().is_empty() {
+        return Ok(None);
+    }
+    Ok(Frames::parse(csv, file)?.rows.last().map(|r| r.frame))
 }
 
 /// Times differ from run to run; every other column is a result.
@@ -222,34 +216,39 @@ fn is_time(column: &str) -> bool {
 /// Checks that `replayed` (frames.csv text of the replayed frames) has `written`'s rows, cell
 /// for cell in every column but the times.
 pub(crate) fn same_rows(file: &Path, written: &str, replayed: &str) -> Result<()> {
-    let table = |text: &str| -> (Vec<String>, Vec<Vec<String>>) {
-        let mut lines = text.lines().map(|l| l.split(',').map(str::to_string).collect::<Vec<_>>());
-        let header = lines.next().unwrap_or_default();
-        (header, lines.collect())
-    };
-    let ((wh, wrows), (rh, rrows)) = (table(written), table(replayed));
-    if wrows.len() != rrows.len() {
+    let written = Frames::parse(written, file)?;
+    let replayed = Frames::parse(replayed, Path::new("the replayed frames.csv"))?;
+    if written.rows.len() != replayed.rows.len() {
         bail!(
             "{}: has {} rows, the replay of its frames gives {}; expected the same (is the run from another commit?); start it again instead",
             file.display(),
-            wrows.len(),
-            rrows.len()
+            written.rows.len(),
+            replayed.rows.len()
         );
     }
-    for (i, (w, r)) in wrows.iter().zip(&rrows).enumerate() {
-        for (c, name) in wh.iter().enumerate().filter(|(_, n)| !is_time(n)) {
-            let old = w.get(c).map_or("", String::as_str);
-            let new =
-                rh.iter().position(|h| h == name).and_then(|k| r.get(k)).map_or("", String::as_str);
-            if old != new {
-                bail!(
-                    "{}:{}: {} of {} at frame {} was '{old}', the replay gives '{new}'; results differ from the interrupted run's (another commit or adapter?); start it again instead",
-                    file.display(),
-                    i + 2,
-                    name,
-                    w.first().map_or("", String::as_str),
-                    w.get(1).map_or("", String::as_str)
-                );
+    let text = |v: Option<f64>| v.map(|v| v.to_string()).unwrap_or_default();
+    for (w, r) in written.rows.iter().zip(&replayed.rows) {
+        let differs = |name: &str, old: String, new: String| {
+            anyhow!(
+                "{}:{}: {name} of {} at frame {} was '{old}', the replay gives '{new}'; results differ from the interrupted run's (another commit or adapter?); start it again instead",
+                file.display(),
+                w.line,
+                w.method,
+                w.frame
+            )
+        };
+        if w.method != r.method {
+            return Err(differs("method", w.method.clone(), r.method.clone()));
+        }
+        if w.frame != r.frame {
+            return Err(differs("frame", w.frame.to_string(), r.frame.to_string()));
+        }
+        for (c, name) in written.columns.iter().enumerate().filter(|(_, n)| !is_time(n)) {
+            let old = w.values[c];
+            let new = replayed.column(name).and_then(|k| r.values[k]);
+            // Bit for bit: the same text gives the same number (NaN included).
+            if old.map(f64::to_bits) != new.map(f64::to_bits) {
+                return Err(differs(name, text(old), text(new)));
             }
         }
     }

@@ -122,12 +122,8 @@ fn faulty_render(
     }
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("flicker-gpu-faults-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("flicker-gpu-faults-{name}-")).tempdir().unwrap()
 }
 
 fn spec(dir: &Path, methods: &str) -> (RunSpec, RunOptions) {
@@ -177,7 +173,8 @@ fn faults_during_a_frame_fail_the_run_naming_the_pass_and_the_size() {
         (Fault::Validation, "faulty_shade", format!("{W}x{H}")),
         (Fault::DeviceLost, "GPU device lost", format!("{W}x{H}")),
     ] {
-        let dir = scratch(&format!("{fault:?}"));
+        let tmp = scratch(&format!("{fault:?}"));
+        let dir = tmp.path().to_path_buf();
         let (spec, opts) =
             spec(&dir, &format!("FaultyPass(fault: {fault:?}), PathTracing(spp: 1)"));
         let err = format!("{:#}", run_spec(&spec, &opts).err().expect("the fault fails the run"));
@@ -209,13 +206,13 @@ fn faults_during_a_frame_fail_the_run_naming_the_pass_and_the_size() {
             })
             .collect();
         assert!(stray.is_empty(), "{fault:?}: {stray:?}");
-        let _ = std::fs::remove_dir_all(&dir);
     }
 }
 
 #[test]
 fn a_device_below_the_scenes_needs_fails_before_anything_is_written() {
-    let dir = scratch("limits");
+    let tmp = scratch("limits");
+    let dir = tmp.path().to_path_buf();
     let (spec, opts) = spec(&dir, "PathTracing(spp: 1)");
     // A quarter of the bytes of one RGBA f32 image at the run's resolution: the path tracer's
     // per-pixel buffers, and the scene's, need more.
@@ -240,12 +237,12 @@ fn a_device_below_the_scenes_needs_fails_before_anything_is_written() {
         "the error names the step: {err}"
     );
     assert!(!dir.join("run").exists(), "a run that fails while built writes nothing");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn a_setting_that_sizes_a_buffer_over_the_limit_names_the_method_and_the_bytes() {
-    let dir = scratch("setting");
+    let tmp = scratch("setting");
+    let dir = tmp.path().to_path_buf();
     // A device granted at most 1 GiB per buffer (the adapter's limit where smaller), so that a
     // table one slot over it stays inside the setting's range on any adapter.
     let cap = |l: u64| l.min(1 << 30);
@@ -267,5 +264,4 @@ fn a_setting_that_sizes_a_buffer_over_the_limit_names_the_method_and_the_bytes()
         assert!(err.contains(part), "the error names '{part}': {err}");
     }
     assert!(!dir.join("run").exists(), "a run that fails while built writes nothing");
-    let _ = std::fs::remove_dir_all(&dir);
 }

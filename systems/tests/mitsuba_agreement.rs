@@ -25,7 +25,8 @@ fn lambertian_cornell_box_matches_mitsuba() {
     let scene = systems::mitsuba::lambertian_cornell_box((size, size)).unwrap();
 
     let python = python().expect("a Python with the mitsuba package (scripts/setup-tests.sh installs it into .venv; FLICKER_PYTHON names another)");
-    let dir = std::env::temp_dir().join(format!("flicker-mitsuba-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     let xml = write_scene(&scene, (size, size), &Integrator { max_depth: None, rr_depth: 3 }, &dir)
         .unwrap();
     let out = dir.join("images.f32");
@@ -63,7 +64,6 @@ fn lambertian_cornell_box_matches_mitsuba() {
     let run = mitsuba.wait_with_output().expect("Mitsuba's output");
     assert!(run.status.success(), "Mitsuba failed:\n{}", String::from_utf8_lossy(&run.stderr));
     let raw = std::fs::read(&out).unwrap();
-    std::fs::remove_dir_all(&dir).unwrap();
     let theirs: Vec<f32> =
         raw.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
     let pixels = (size * size) as usize;

@@ -58,7 +58,8 @@ fn path_tracer_matches_mitsuba_over_the_matrix() {
 
     // Mitsuba: every scene exported, then rendered in one background process.
     let python = python().expect("a Python with the mitsuba package (scripts/setup-tests.sh installs it into .venv; FLICKER_PYTHON names another)");
-    let dir = std::env::temp_dir().join(format!("flicker-mitsuba-matrix-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     let mut jobs = Vec::new();
     for case in &cases {
         let integrator = Integrator { max_depth: Some(case.max_depth + 1), rr_depth: RR_DEPTH };
@@ -214,6 +215,5 @@ fn path_tracer_matches_mitsuba_over_the_matrix() {
             ));
         }
     }
-    std::fs::remove_dir_all(&dir).unwrap();
     assert!(failures.is_empty(), "disagreements at level {alpha:.1e}:\n{}", failures.join("\n"));
 }

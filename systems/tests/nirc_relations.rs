@@ -67,8 +67,8 @@ fn play(
     events: &str,
     reference: bool,
 ) -> Vec<FrameRecord> {
-    let dir =
-        std::env::temp_dir().join(format!("nirc-relations-{}-{name}-{seed}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(&dir).unwrap();
     let file = scenario(&dir, name, seed, frames, warmup, pretrain, events, reference);
     let opts = RunOptions {
@@ -78,7 +78,6 @@ fn play(
         progress: false,
     };
     let summary = run(&opts).expect("run");
-    std::fs::remove_dir_all(&dir).ok();
     summary.records
 }
 

@@ -154,7 +154,8 @@ fn sample_cache_on_a_moving_hairball_camera() {
 fn hairball_camera_scenario_plays_end_to_end() {
     use systems::playback::{Overrides, RunOptions, run};
     let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/hairball_camera.ron");
-    let out = std::env::temp_dir().join(format!("flicker-ssc-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().to_path_buf();
     let summary = run(&RunOptions {
         scenario,
         overrides: Overrides {
@@ -237,5 +238,4 @@ fn hairball_camera_scenario_plays_end_to_end() {
         );
         assert!(r.passes.iter().all(|(_, ms)| ms.is_some()), "{}: {:?}", r.method, r.passes);
     }
-    let _ = std::fs::remove_dir_all(&out);
 }

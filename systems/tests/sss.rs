@@ -2,16 +2,17 @@
 //! sss_flash.ron, sss_toggle.ron, sss_boids.ron and sss_moving.ron at 32x18: counts within SPVG's clamp, a cold
 //! start at n_min, the fixed variant at its count, the count image written; and its input errors.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use statrs::distribution::{ContinuousCDF, StudentsT};
 use systems::frame_record::FrameRecord;
 use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};
 
-fn play(scenario: &str, frames: u32, keep: &[&str]) -> (Vec<FrameRecord>, PathBuf) {
+fn play(scenario: &str, frames: u32, keep: &[&str]) -> (Vec<FrameRecord>, tempfile::TempDir) {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("scenarios").join(scenario);
-    let dir = std::env::temp_dir().join(format!("sss-e2e-{}-{scenario}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     let overrides = Overrides {
         frames: Some(frames),
         resolution: Some((32, 18)),
@@ -28,7 +29,7 @@ fn play(scenario: &str, frames: u32, keep: &[&str]) -> (Vec<FrameRecord>, PathBu
         progress: false,
     };
     let summary = run_spec(&spec, &opts).expect("run");
-    (summary.records, dir)
+    (summary.records, tmp)
 }
 
 fn stat(r: &FrameRecord, name: &str) -> f64 {
@@ -38,7 +39,8 @@ fn stat(r: &FrameRecord, name: &str) -> f64 {
 #[test]
 fn sss_scenarios_play_with_clamped_counts() {
     for scenario in ["sss_flash.ron", "sss_toggle.ron", "sss_boids.ron", "sss_moving.ron"] {
-        let (records, dir) = play(scenario, 5, &["as", "ocv", "fixed64"]);
+        let (records, tmp) = play(scenario, 5, &["as", "ocv", "fixed64"]);
+        let dir = tmp.path().to_path_buf();
         assert_eq!(records.len(), 15, "{scenario}");
         for r in &records {
             let (spp, pixels) = (stat(r, "sss_mean_spp"), stat(r, "sss_pixels"));
@@ -65,13 +67,13 @@ fn sss_scenarios_play_with_clamped_counts() {
             assert!(r.passes.iter().any(|(p, _)| p == "sss_scatter"), "{scenario}: {:?}", r.passes);
         }
         assert!(dir.join("run/frames/as/sample_count/0004.png").exists(), "{scenario}");
-        std::fs::remove_dir_all(&dir).ok();
     }
 }
 
 #[test]
 fn sss_without_a_subsurface_material_is_refused() {
-    let dir = std::env::temp_dir().join(format!("sss-e2e-{}-plain", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("plain.ron");
     std::fs::write(&file, "Scenario(scene: Builtin(\"sss_sphere\"), resolution: (16, 9), frames: 1, methods: [Sss(variant: Adaptive)])").unwrap();
@@ -101,14 +103,14 @@ fn sss_without_a_subsurface_material_is_refused() {
     };
     let e = format!("{:#}", run_spec(&spec, &opts).err().expect("separable with prefilter"));
     assert!(e.contains("prefilter with Separable"), "{e}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// γ or ε_u outside [0, 1]: an error at the method's file:line naming the setting, and no run
 /// folder written.
 #[test]
 fn split_settings_outside_the_unit_interval_are_refused_at_file_line() {
-    let dir = std::env::temp_dir().join(format!("sss-e2e-{}-split", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("split.ron");
     for (bad, what) in [("(eps_u: 1.5)", "eps_u"), ("(gamma: Some(-0.2))", "gamma")] {
@@ -129,13 +131,17 @@ fn split_settings_outside_the_unit_interval_are_refused_at_file_line() {
         assert!(e.contains("split.ron:2:") && e.contains(what) && e.contains("[0, 1]"), "{e}");
         assert!(!out.exists(), "{bad}: the run folder was written");
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 const SKIN: &str = "(material: \"skin\", subsurface: (dmfp: (0.12, 0.05, 0.025)))";
 
 /// Plays an inline scenario on the skin sphere (constant lamp, no animation) at 32x18.
-fn play_inline(name: &str, seed: u64, frames: u32, methods: &str) -> (Vec<FrameRecord>, PathBuf) {
+fn play_inline(
+    name: &str,
+    seed: u64,
+    frames: u32,
+    methods: &str,
+) -> (Vec<FrameRecord>, tempfile::TempDir) {
     play_with_materials(name, seed, frames, methods, &[SKIN])
 }
 
@@ -145,8 +151,9 @@ fn play_with_materials(
     frames: u32,
     methods: &str,
     materials: &[&str],
-) -> (Vec<FrameRecord>, PathBuf) {
-    let dir = std::env::temp_dir().join(format!("sss-e2e-{}-{name}-{seed}", std::process::id()));
+) -> (Vec<FrameRecord>, tempfile::TempDir) {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join(format!("{name}.ron"));
     let text = format!(
@@ -162,7 +169,7 @@ fn play_with_materials(
         cache_dir: Some(dir.join("cache")),
         progress: false,
     };
-    (run_spec(&spec, &opts).expect("run").records, dir)
+    (run_spec(&spec, &opts).expect("run").records, tmp)
 }
 
 /// TAA after the pass (taa's resolve, Sec. 4.3): the first frame has no history and is
@@ -176,7 +183,8 @@ fn taa_after_the_pass_lowers_flicker_and_separable_runs() {
     let mut gaps = vec![];
     for seed in 1..=3u64 {
         let methods = "Sss(variant: Adaptive, name: \"as\"), Sss(variant: Adaptive, taa: (alpha: 0.1), name: \"as_taa\"), Sss(variant: Separable(taps: 25), name: \"separable\"), Sss(variant: Adaptive, prefilter: ())";
-        let (records, dir) = play_inline("taa", seed, FRAMES, methods);
+        let (records, tmp) = play_inline("taa", seed, FRAMES, methods);
+        let dir = tmp.path().to_path_buf();
         let image = |m: &str, f: u32| {
             systems::output::read_exr(&dir.join(format!("run/frames/{m}/{f:04}.exr"))).unwrap().2
         };
@@ -209,7 +217,6 @@ fn taa_after_the_pass_lowers_flicker_and_separable_runs() {
                 assert!(r.passes.iter().any(|(p, _)| p == pass), "{:?}", r.passes);
             }
         }
-        std::fs::remove_dir_all(&dir).ok();
     }
     let n = gaps.len() as f64;
     let mean = gaps.iter().sum::<f64>() / n;
@@ -227,8 +234,9 @@ fn taa_after_the_pass_lowers_flicker_and_separable_runs() {
 fn two_subsurface_materials_scatter_apart() {
     let methods = "Sss(variant: Adaptive, name: \"as\")";
     let floor = "(material: \"floor\", subsurface: (dmfp: (0.3, 0.2, 0.1)))";
-    let (one, dir_one) = play_with_materials("one_material", 4, 3, methods, &[SKIN]);
-    let (two, dir_two) = play_with_materials("two_materials", 4, 3, methods, &[SKIN, floor]);
+    let (one, tmp_one) = play_with_materials("one_material", 4, 3, methods, &[SKIN]);
+    let (two, tmp_two) = play_with_materials("two_materials", 4, 3, methods, &[SKIN, floor]);
+    let (dir_one, dir_two) = (tmp_one.path().to_path_buf(), tmp_two.path().to_path_buf());
     let last =
         |dir: &Path| systems::output::read_exr(&dir.join("run/frames/as/0002.exr")).unwrap().2;
     let counts = |dir: &Path| {
@@ -254,8 +262,6 @@ fn two_subsurface_materials_scatter_apart() {
     assert_eq!(pixels(&two), skin + floor);
     assert!(skin > 20 && floor > 100, "skin {skin}, floor {floor} pixels");
     assert!(floor_changed > floor / 2, "{floor_changed} of {floor} floor pixels scattered");
-    std::fs::remove_dir_all(&dir_one).ok();
-    std::fs::remove_dir_all(&dir_two).ok();
 }
 
 /// The hybrid pass (Sec. 5.3.2) end to end: with the default rule every hybrid pass is timed;
@@ -265,7 +271,8 @@ fn two_subsurface_materials_scatter_apart() {
 #[test]
 fn hybrid_runs_both_techniques_end_to_end() {
     let methods = "Sss(variant: Adaptive, prefilter: (), hybrid: (), name: \"hybrid\"), Sss(variant: Adaptive, prefilter: (), hybrid: (max_gap_px: 1e9), name: \"all_separable\"), Sss(variant: Adaptive, prefilter: (), hybrid: (max_gap_px: 1e-9), name: \"all_afis\"), Sss(variant: Adaptive, prefilter: (), name: \"afis\")";
-    let (records, dir) = play_inline("hybrid", 2, 3, methods);
+    let (records, tmp) = play_inline("hybrid", 2, 3, methods);
+    let dir = tmp.path().to_path_buf();
     let image = |m: &str, f: u32| {
         systems::output::read_exr(&dir.join(format!("run/frames/{m}/{f:04}.exr"))).unwrap().2
     };
@@ -295,9 +302,10 @@ fn hybrid_runs_both_techniques_end_to_end() {
             _ => {}
         }
     }
-    std::fs::remove_dir_all(&dir).ok();
+    drop(tmp);
+    let tmp = tempfile::tempdir().unwrap();
     let (dir, file) = {
-        let dir = std::env::temp_dir().join(format!("sss-e2e-{}-hybrid-bad", std::process::id()));
+        let dir = tmp.path().to_path_buf();
         std::fs::create_dir_all(&dir).unwrap();
         let file = dir.join("hybrid.ron");
         (dir, file)
@@ -318,7 +326,6 @@ fn hybrid_runs_both_techniques_end_to_end() {
     let e = format!("{:#}", run_spec(&spec, &opts).err().expect("hybrid without prefilter"));
     assert!(e.contains("hybrid without prefilter"), "{e}");
     assert!(!out.exists(), "the run folder was written");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// scenarios/sss_hybrid.ron at its own 96x54 (the profile's size in pixels decides): the hybrid
@@ -327,7 +334,8 @@ fn hybrid_runs_both_techniques_end_to_end() {
 #[test]
 fn the_hybrid_scenario_takes_both_paths() {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/sss_hybrid.ron");
-    let dir = std::env::temp_dir().join(format!("sss-e2e-{}-hybrid-scenario", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     let overrides = Overrides { frames: Some(1), out: Some(dir.join("run")), ..Default::default() };
     let mut spec = RunSpec::load(&file, &overrides).expect("scenario");
     spec.methods.retain(|m| m.label() != "pass_2048");
@@ -352,7 +360,6 @@ fn the_hybrid_scenario_takes_both_paths() {
     }
     eprintln!("{as_afis} pixels as AFIS alone, {as_separable} as separable alone");
     assert!(as_afis > 500 && as_separable > 500, "{as_afis} AFIS, {as_separable} separable pixels");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The thesis's irradiance (`irradiance: Direct`, the default) has no Monte Carlo noise: on the
@@ -365,7 +372,7 @@ fn the_direct_irradiance_is_the_same_on_every_seed_of_a_still_frame() {
     let mut direct = vec![];
     let mut traced = vec![];
     for seed in 1..=3u64 {
-        let (records, dir) = play_inline("direct_seeds", seed, 2, methods);
+        let (records, _tmp) = play_inline("direct_seeds", seed, 2, methods);
         for r in &records {
             let e = stat(r, "sss_irradiance");
             assert!(e > 0.0, "seed {seed} {} frame {}: irradiance {e}", r.method, r.frame);
@@ -377,7 +384,6 @@ fn the_direct_irradiance_is_the_same_on_every_seed_of_a_still_frame() {
                 _ => traced.push(e),
             }
         }
-        std::fs::remove_dir_all(&dir).ok();
     }
     assert_eq!(direct.len(), 6);
     assert!(direct.iter().all(|&e| e == direct[0]), "direct irradiance varies: {direct:?}");

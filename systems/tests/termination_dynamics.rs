@@ -38,8 +38,9 @@ fn play(
     edit: impl Fn(&mut RunSpec),
 ) -> Vec<FrameRecord> {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("scenarios").join(scenario);
-    let dir = std::env::temp_dir()
-        .join(format!("termination-dynamics-{}-{scenario}-{tag}-{seed}", std::process::id()));
+    let tmp =
+        tempfile::Builder::new().prefix(&format!("termination-dynamics-{tag}-")).tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     let overrides = Overrides {
         frames: Some(frames),
         resolution: Some((32, 18)),
@@ -63,11 +64,10 @@ fn play(
     let opts = RunOptions {
         scenario: PathBuf::from(&file),
         overrides,
-        cache_dir: Some(std::env::temp_dir().join("termination-dynamics-references")),
+        cache_dir: Some(dir.join("references")),
         progress: false,
     };
     let summary = run_spec(&spec, &opts).expect("run");
-    std::fs::remove_dir_all(&dir).ok();
     summary.records
 }
 

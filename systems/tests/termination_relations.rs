@@ -42,8 +42,8 @@ const DOOR_SEEDS: [u64; 5] = [3, 4, 5, 6, 7];
 /// FLIP) per seed.
 fn play(scenario: &str, keep: &[&str], seed: u64) -> Vec<FrameRecord> {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("scenarios").join(scenario);
-    let dir = std::env::temp_dir()
-        .join(format!("termination-relations-{}-{scenario}-{seed}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     let overrides = Overrides {
         frames: Some(1),
         resolution: Some((32, 18)),
@@ -66,11 +66,10 @@ fn play(scenario: &str, keep: &[&str], seed: u64) -> Vec<FrameRecord> {
     let opts = RunOptions {
         scenario: PathBuf::from(&file),
         overrides,
-        cache_dir: Some(std::env::temp_dir().join("termination-relations-references")),
+        cache_dir: Some(dir.join("references")),
         progress: false,
     };
     let summary = run_spec(&spec, &opts).expect("run");
-    std::fs::remove_dir_all(&dir).ok();
     summary.records
 }
 

@@ -34,13 +34,7 @@ struct Run {
     records: Vec<FrameRecord>,
     folder: RunFolder,
     /// The run's folder and its reference cache, removed when the run is dropped.
-    root: std::path::PathBuf,
-}
-
-impl Drop for Run {
-    fn drop(&mut self) {
-        std::fs::remove_dir_all(&self.root).ok();
-    }
+    _root: tempfile::TempDir,
 }
 
 fn play(methods: &[(&str, &str)], name: &str) -> Run {
@@ -56,9 +50,9 @@ fn play(methods: &[(&str, &str)], name: &str) -> Run {
         "Scenario(scene: Builtin(\"door_gap\"), resolution: (16, 9), frames: {FRAMES}, seed: 3, max_depth: 8,\n methods: [{}],\n reference: (spp: 0, frames: None))",
         methods.join(",\n ")
     );
-    let dir = std::env::temp_dir()
-        .join(format!("termination-shared-{}-{name}", std::process::id()))
-        .join("run");
+    let root =
+        tempfile::Builder::new().prefix(&format!("termination-shared-{name}-")).tempdir().unwrap();
+    let dir = root.path().join("run");
     let scenario = sim::Scenario::from_ron(&text, Path::new("inline.ron")).expect("scenario");
     let overrides = Overrides { out: Some(dir.clone()), ..Default::default() };
     let spec = RunSpec::from_scenario(scenario, &overrides).expect("spec");
@@ -69,8 +63,7 @@ fn play(methods: &[(&str, &str)], name: &str) -> Run {
         progress: false,
     };
     let summary = run_spec(&spec, &opts).expect("run");
-    let root = dir.parent().expect("a run folder's parent").to_path_buf();
-    Run { records: summary.records, folder: RunFolder::new(&summary.folder), root }
+    Run { records: summary.records, folder: RunFolder::new(&summary.folder), _root: root }
 }
 
 fn record<'a>(run: &'a Run, method: &str, frame: u32) -> &'a FrameRecord {

@@ -51,8 +51,8 @@ fn luminance(p: &[f32; 4]) -> f64 {
 
 fn play(seed: u64) -> (Vec<Measured>, f64) {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("scenarios").join(SCENARIO);
-    let dir =
-        std::env::temp_dir().join(format!("termination-variance-{}-{seed}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     let overrides =
         Overrides { seed: Some(seed), out: Some(dir.join("run")), ..Default::default() };
     let mut spec = RunSpec::load(&file, &overrides).expect("scenario");
@@ -74,7 +74,7 @@ fn play(seed: u64) -> (Vec<Measured>, f64) {
     let opts = RunOptions {
         scenario: PathBuf::from(&file),
         overrides,
-        cache_dir: Some(std::env::temp_dir().join("termination-variance-references")),
+        cache_dir: Some(dir.join("references")),
         progress: false,
     };
     let summary = run_spec(&spec, &opts).expect("run");
@@ -105,7 +105,6 @@ fn play(seed: u64) -> (Vec<Measured>, f64) {
             Measured { method, path_length, variance, mse }
         })
         .collect();
-    std::fs::remove_dir_all(&dir).ok();
     (measured, unit)
 }
 
@@ -213,8 +212,8 @@ fn survival_outside_zero_to_one_is_refused_where_it_stands() {
         let text = format!(
             "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1,\n methods: [Termination(rule: FirstVertex, survival: {survival})])"
         );
-        let out = std::env::temp_dir()
-            .join(format!("flicker_termination_bad_{i}_{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join(format!("flicker_termination_bad_{i}"));
         let scenario = sim::Scenario::from_ron(&text, Path::new("inline.ron")).unwrap();
         let spec = RunSpec::from_scenario(
             scenario,

@@ -39,11 +39,8 @@ fn stat(r: &systems::frame_record::FrameRecord, name: &str) -> f64 {
 #[test]
 fn volume_scenarios_play_every_estimator() {
     for scenario in ["volume_cloud.ron", "volume_explosion.ron"] {
-        let out = std::env::temp_dir().join(format!(
-            "flicker_volume_{}_{}",
-            std::process::id(),
-            scenario
-        ));
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join(format!("flicker_volume_{scenario}"));
         let summary = play(scenario, &out);
         assert_eq!(summary.records.len(), 6, "{scenario}: one row per estimator");
         for r in &summary.records {
@@ -77,7 +74,6 @@ fn volume_scenarios_play_every_estimator() {
             stat(by("naive"), "lookups_per_estimate"),
             stat(by("jackknife"), "lookups_per_estimate")
         );
-        let _ = std::fs::remove_dir_all(&out);
     }
 }
 
@@ -85,7 +81,8 @@ fn volume_scenarios_play_every_estimator() {
 fn a_scenario_without_media_refuses_the_method() {
     let text = "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1, methods: [VolumeTransmittance(spp: 1)])";
     let scenario = sim::Scenario::from_ron(text, Path::new("inline.ron")).unwrap();
-    let out = std::env::temp_dir().join(format!("flicker_volume_none_{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("flicker_volume_none");
     let spec = RunSpec::from_scenario(
         scenario,
         &Overrides { out: Some(out.clone()), ..Default::default() },

@@ -36,7 +36,8 @@ fn play(scenario: &str, frames: Option<u32>, out: &Path) -> RunSummary {
 
 #[test]
 fn volume_mis_plays_every_weight_against_the_volumetric_reference() {
-    let out = std::env::temp_dir().join(format!("flicker_volume_mis_{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("flicker_volume_mis");
     let summary = play("volume_mis.ron", None, &out);
     assert_eq!(summary.records.len(), 6, "one row per weight and combination");
     assert_eq!(summary.references_rendered, 1);
@@ -50,12 +51,12 @@ fn volume_mis_plays_every_weight_against_the_volumetric_reference() {
         );
         println!("{}: FLIP {flip:.4}, rel MSE {:?}", r.method, r.rel_mse);
     }
-    let _ = std::fs::remove_dir_all(&out);
 }
 
 #[test]
 fn the_moving_light_scenario_rebakes_its_cloud_and_measures_flicker() {
-    let out = std::env::temp_dir().join(format!("flicker_volume_moving_{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("flicker_volume_moving");
     let summary = play("volume_moving_light.ron", Some(2), &out);
     // The lamp moves and the cloud turns and pulses: no frame's reference is another's.
     assert_eq!(summary.references_rendered, 2, "cached {}", summary.references_cached);
@@ -70,12 +71,12 @@ fn the_moving_light_scenario_rebakes_its_cloud_and_measures_flicker() {
             r.flip
         );
     }
-    let _ = std::fs::remove_dir_all(&out);
 }
 
 #[test]
 fn the_mesh_bound_scenario_plays_two_media_and_rebakes_its_turning_torus() {
-    let out = std::env::temp_dir().join(format!("flicker_volume_mesh_{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("flicker_volume_mesh");
     let summary = play("volume_mesh_bound.ron", Some(2), &out);
     // The torus-bounded cloud turns: each frame has its own reference.
     assert_eq!(summary.references_rendered, 2, "cached {}", summary.references_cached);
@@ -89,14 +90,13 @@ fn the_mesh_bound_scenario_plays_two_media_and_rebakes_its_turning_torus() {
             r.flip
         );
     }
-    let _ = std::fs::remove_dir_all(&out);
 }
 
 /// The error of running an inline scenario (refused before any frame).
 fn refusal(text: &str, name: &str) -> String {
     let scenario = sim::Scenario::from_ron(text, Path::new("inline.ron")).unwrap();
-    let out =
-        std::env::temp_dir().join(format!("flicker_volume_path_{name}_{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join(format!("flicker_volume_path_{name}"));
     let spec = RunSpec::from_scenario(
         scenario,
         &Overrides { out: Some(out.clone()), ..Default::default() },
@@ -113,7 +113,6 @@ fn refusal(text: &str, name: &str) -> String {
     )
     .err()
     .expect("refused");
-    let _ = std::fs::remove_dir_all(&out);
     format!("{e:#}")
 }
 
@@ -167,8 +166,8 @@ fn more_media_than_the_path_tracer_binds_play_without_references() {
         many.join(", ")
     );
     let scenario = sim::Scenario::from_ron(&text, Path::new("inline.ron")).unwrap();
-    let out = std::env::temp_dir()
-        .join(format!("flicker_volume_path_many_transmittance_{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("flicker_volume_path_many_transmittance");
     let spec = RunSpec::from_scenario(
         scenario,
         &Overrides { out: Some(out.clone()), ..Default::default() },
@@ -183,7 +182,6 @@ fn more_media_than_the_path_tracer_binds_play_without_references() {
             progress: false,
         },
     );
-    let _ = std::fs::remove_dir_all(&out);
     summary.unwrap_or_else(|e| panic!("{e:#}"));
 }
 
@@ -217,8 +215,8 @@ fn bad_jackknife_settings_and_super_voxel_size_are_refused_where_they_stand() {
         let text = format!(
             "Scenario(scene: Builtin(\"cornell_box\"), resolution: (32, 18), frames: 1,\n methods: [{method}],\n media: [{medium}])"
         );
-        let out = std::env::temp_dir()
-            .join(format!("flicker_volume_path_bad_{i}_{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join(format!("flicker_volume_path_bad_{i}"));
         let e = match sim::Scenario::from_ron(&text, Path::new("inline.ron")) {
             Err(e) => e.to_string(),
             Ok(scenario) => {

@@ -10,6 +10,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
+use metrics::frames_csv::{self, Cell};
 use metrics::{CvvdpSettings, Image, load_image};
 use serde_json::json;
 use systems::frame_record::FrameRecord;
@@ -344,18 +345,15 @@ fn write_frame(path_exr: &Path, path_png: &Path, img: &Image) -> anyhow::Result<
 /// frames.csv with the `cpu_ms` cells empty: frames from elsewhere come without flicker's CPU
 /// cost, and a column of zeros would draw speed charts and mark a "fastest" method (their own
 /// times, given with --timings, are in the wall_ms columns).
-fn without_times(csv: &str) -> String {
-    let mut lines = csv.lines();
-    let header = lines.next().unwrap_or_default();
-    let Some(col) = header.split(',').position(|c| c == "cpu_ms") else { return csv.to_string() };
-    let mut out = format!("{header}\n");
-    for line in lines {
-        let cells: Vec<&str> =
-            line.split(',').enumerate().map(|(i, c)| if i == col { "" } else { c }).collect();
-        out.push_str(&cells.join(","));
-        out.push('\n');
+fn without_times(records: &[FrameRecord]) -> String {
+    let (columns, mut cells) = systems::frame_record::table(records);
+    if let Some(col) = columns.iter().position(|c| c == "cpu_ms") {
+        for row in &mut cells {
+            row[col] = Cell::Empty;
+        }
     }
-    out
+    let rows = records.iter().zip(cells).map(|(r, c)| (r.method.as_str(), r.frame, c));
+    frames_csv::write(&columns, rows)
 }
 
 /// Sequences read, checked and measured, nothing written yet: what `flicker measure` and a
@@ -433,10 +431,7 @@ impl Measured {
                 }
             }
         }
-        output::write_text(
-            &folder.frames_csv(),
-            &without_times(&systems::frame_record::to_csv(&self.records)),
-        )?;
+        output::write_text(&folder.frames_csv(), &without_times(&self.records))?;
         output::write_json(&folder.manifest(), &manifest)?;
         report::rebuild(&folder.root, &systems::methods::registry::charts())
     }
@@ -449,13 +444,16 @@ pub fn measure(opts: &MeasureOptions) -> anyhow::Result<PathBuf> {
 
 #[cfg(test)]
 mod tests {
-    use super::frame_number;
+    use super::{FrameRecord, frame_number};
     use std::path::Path;
 
     #[test]
     fn measured_frames_have_no_times() {
-        let csv = "method,frame,cpu_ms,flip\na,0,0.0000,0.5\n";
-        assert_eq!(super::without_times(csv), "method,frame,cpu_ms,flip\na,0,,0.5\n");
+        let a = FrameRecord { method: "a".into(), flip: Some(0.5), ..Default::default() };
+        let csv = super::without_times(&[a]);
+        let (header, row) = csv.split_once('\n').unwrap();
+        assert!(header.starts_with("method,frame,cpu_ms,gpu_ms_total,"), "{header}");
+        assert!(row.starts_with("a,0,,,") && row.contains(",0.500000,"), "{row}");
     }
 
     #[test]

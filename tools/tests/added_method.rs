@@ -128,9 +128,8 @@ fn a_method_added_through_the_registry_plays_like_a_shipped_one() {
     // A second registration under the same name is refused, as is a shipped name.
     assert!(register::<EmaPlugin>().is_err());
 
-    let dir: PathBuf =
-        std::env::temp_dir().join(format!("flicker-added-method-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let tmp = tempfile::tempdir().unwrap();
+    let dir: PathBuf = tmp.path().to_path_buf();
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("ema.ron");
     std::fs::write(
@@ -254,5 +253,4 @@ fn a_method_added_through_the_registry_plays_like_a_shipped_one() {
     assert_eq!(claim.judged.values.len(), 6, "both methods' value per seed");
     assert_eq!(claim.judged.verdict.name(), "reproduced", "{}", claim.judged.flicker);
     assert!(outcome.markdown.contains("ema_step"), "{}", outcome.markdown);
-    let _ = std::fs::remove_dir_all(&dir);
 }

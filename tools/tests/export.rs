@@ -16,11 +16,8 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
 }
 
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("flicker-export-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn temp(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("flicker-export-{name}-")).tempdir().unwrap()
 }
 
 const ROUND_TRIP: &str = "tools/tests/data/export_round_trip.ron";
@@ -58,7 +55,8 @@ fn validate(glb: &Path) -> serde_json::Value {
 /// round-trip scenario: the validator finds no error.
 #[test]
 fn every_exported_glb_passes_the_khronos_validator() {
-    let dir = temp("validator");
+    let tmp = temp("validator");
+    let dir = tmp.path().to_path_buf();
     let scenarios = [
         ROUND_TRIP,
         "scenarios/showcase.ron",
@@ -203,7 +201,8 @@ fn block_z_test(
 #[test]
 fn flicker_plays_its_export_and_renders_the_same_references() {
     let start = std::time::Instant::now();
-    let dir = temp("round_trip");
+    let tmp = temp("round_trip");
+    let dir = tmp.path().to_path_buf();
     let original = Scenario::load(&root().join(ROUND_TRIP)).unwrap();
     let package = dir.join("package");
     scene_only(&original.origin, &package, None);
@@ -223,7 +222,8 @@ fn flicker_plays_its_export_and_renders_the_same_references() {
 /// the file and frame, before anything is written.
 #[test]
 fn a_package_is_measured_and_one_missing_a_frame_is_refused() {
-    let dir = temp("package");
+    let tmp = temp("package");
+    let dir = tmp.path().to_path_buf();
     let package = dir.join("package");
     export(&ExportOptions {
         scenario: root().join(ROUND_TRIP),

@@ -3,18 +3,13 @@
 //! nothing, a damaged file named with its line, and each command's entries (a claim's value,
 //! interval and margin; the bench's ratios).
 
-use std::path::PathBuf;
-
 use tools::history::series::{Flag, series};
 use tools::history::sources::{bench_speed_entries, claim_entry, claim_estimate};
 use tools::history::{Entry, Kind, Record, append, read};
 use tools::reproduce::{Claims, Judged, Verdict};
 
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("flicker-history-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn temp(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("flicker-history-{name}-")).tempdir().unwrap()
 }
 
 fn entry(id: &str, value: f64, half: f64, verdict: &str, margin: f64) -> Entry {
@@ -52,7 +47,8 @@ const DAY3: &str = "2026-12-03T10:00:00Z";
 
 #[test]
 fn records_of_two_commits_read_back_in_order() {
-    let dir = temp("two");
+    let tmp = temp("two");
+    let dir = tmp.path().to_path_buf();
     // Written newest first: the reader orders by date, not by when the file appeared.
     // Binary fractions: serde_json (without its `float_roundtrip` feature) may read a decimal
     // back one unit in the last place off.
@@ -68,7 +64,6 @@ fn records_of_two_commits_read_back_in_order() {
     let commits: Vec<&str> = s[0].points.iter().map(|p| p.commit.as_str()).collect();
     assert_eq!(commits, ["aaaaaaa1", "bbbbbbb2"]);
     assert_eq!(s[0].points[1].entry.value, Some(0.5));
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -134,7 +129,8 @@ fn a_drift_beyond_the_margin_is_flagged_while_the_verdict_holds() {
 
 #[test]
 fn concurrent_writers_lose_no_record() {
-    let dir = temp("concurrent");
+    let tmp = temp("concurrent");
+    let dir = tmp.path().to_path_buf();
     // Threads of one process share its id and, here, the date and commit: the hardest case for
     // unique names.
     let threads = 8;
@@ -156,12 +152,12 @@ fn concurrent_writers_lose_no_record() {
     ids.sort();
     ids.dedup();
     assert_eq!(ids.len(), threads * each, "a record was overwritten");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn a_damaged_file_is_named_with_its_line() {
-    let dir = temp("damaged");
+    let tmp = temp("damaged");
+    let dir = tmp.path().to_path_buf();
     let good = append(&dir, &record("a1", DAY1, vec![entry("p/c", 0.1, 0.01, "reproduced", 0.05)]))
         .unwrap();
     let text = std::fs::read_to_string(&good).unwrap();
@@ -179,7 +175,6 @@ fn a_damaged_file_is_named_with_its_line() {
     std::fs::remove_file(&bad).unwrap();
     std::fs::write(good.with_extension("json.tmp123"), "{").unwrap();
     assert_eq!(read(&dir).unwrap().len(), 1);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 fn claims() -> Claims {

@@ -115,12 +115,8 @@ fn cases() -> u32 {
     std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(300)
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("flicker-input-fuzz-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("flicker-input-fuzz-{name}-")).tempdir().unwrap()
 }
 
 /// Writes each mutation of `original` to `target` and runs `read`, which returns the error's
@@ -184,7 +180,8 @@ fn check_template(t: &sim::template::WorldTemplate) -> Result<(), String> {
 
 #[test]
 fn gltf_scenes() {
-    let dir = scratch("gltf");
+    let tmp = scratch("gltf");
+    let dir = tmp.path().to_path_buf();
     let original = std::fs::read(root().join("scenarios/assets/test_scene.gltf")).unwrap();
     let import = |path: &Path| -> Result<(), String> {
         let t = sim::gltf_import::import(path).map_err(|e| e.to_string())?;
@@ -223,7 +220,6 @@ fn gltf_scenes() {
     let bin_at = glb.len() - bin.len();
     fuzz(&glb, Some((bin_at, glb.len())), &path, || import(&path), |_| true);
     fuzz(&glb, Some((0, bin_at)), &path, || import(&path), |_| true);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// An 8x8 frame with a gradient (SMAPE and FLIP see something).
@@ -234,7 +230,8 @@ fn frame(seed: f32) -> Vec<[f32; 4]> {
 #[test]
 fn frames_that_measure_reads() {
     use systems::output::{write_exr, write_png};
-    let dir = scratch("measure");
+    let tmp = scratch("measure");
+    let dir = tmp.path().to_path_buf();
     for kind in ["exr", "png"] {
         let (reference, test) = (dir.join(format!("ref_{kind}")), dir.join(format!("test_{kind}")));
         for (folder, seed) in [(&reference, 1.0), (&test, 0.9)] {
@@ -266,7 +263,6 @@ fn frames_that_measure_reads() {
         read().expect("the unmutated frames are measured");
         fuzz(&original, None, &target, read, |e| e.contains("frame 1"));
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// "FILE:LINE" or "FILE:LINE:COLUMN" somewhere in `e`, for the file named `name`.
@@ -281,7 +277,8 @@ fn has_line(e: &str, name: &str) -> bool {
 #[test]
 fn what_resume_reads() {
     use systems::frame_record::{FrameRecord, to_csv};
-    let dir = scratch("resume");
+    let tmp = scratch("resume");
+    let dir = tmp.path().to_path_buf();
     let scenario = dir.join("tiny.ron");
     std::fs::write(
         &scenario,
@@ -331,5 +328,4 @@ fn what_resume_reads() {
     // A cell's error has the line (the reader reads the frame column of the last row).
     let name = csv_file.display().to_string();
     fuzz(csv.as_bytes(), None, &csv_file, read, |e| has_line(e, &name) || e.contains("header"));
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -10,10 +10,8 @@ use metrics::CvvdpSettings;
 use systems::playback::{self, Overrides, RunOptions};
 use tools::measure::{MeasureOptions, measure};
 
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("flicker-measure-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn temp(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("flicker-measure-{name}-")).tempdir().unwrap()
 }
 
 fn options(reference: &Path, tests: &[(&str, PathBuf)], out: PathBuf) -> MeasureOptions {
@@ -72,7 +70,8 @@ fn summary_metrics(run: &Path, method: &str) -> (serde_json::Value, Vec<(String,
 
 #[test]
 fn a_runs_frames_measured_again_give_the_runs_metrics() {
-    let dir = temp("round_trip");
+    let tmp = temp("round_trip");
+    let dir = tmp.path().to_path_buf();
     let scenario = dir.join("still.ron");
     std::fs::write(
         &scenario,
@@ -128,7 +127,6 @@ fn a_runs_frames_measured_again_give_the_runs_metrics() {
         assert_eq!(ours.1, theirs.1, "{l}: summary means, measured vs run");
     }
     assert!(dir.join("measured/report.html").exists());
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A tiny sequence of `n` frames of `w`x`h` in `dir` (EXR), value `v` per frame.
@@ -142,7 +140,8 @@ fn sequence(dir: &Path, n: u32, (w, h): (u32, u32), v: impl Fn(u32) -> f32) {
 
 #[test]
 fn bad_input_names_the_file_and_frame_and_writes_nothing() {
-    let dir = temp("bad");
+    let tmp = temp("bad");
+    let dir = tmp.path().to_path_buf();
     let reference = dir.join("reference");
     sequence(&reference, 4, (8, 8), |_| 0.5);
     sequence(&dir.join("ok"), 4, (8, 8), |f| 0.4 + 0.05 * f as f32);
@@ -186,7 +185,6 @@ fn bad_input_names_the_file_and_frame_and_writes_nothing() {
         let v = jod[w].as_f64().unwrap_or_else(|| panic!("no JOD for {w}: {s}"));
         assert!((0.0..=10.0).contains(&v), "{w}: {v}");
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// `--timings`: an outside method's per-frame times land in frames.csv (wall_ms_total and its
@@ -195,7 +193,8 @@ fn bad_input_names_the_file_and_frame_and_writes_nothing() {
 /// with nothing written.
 #[test]
 fn timings_put_an_outside_method_on_the_speed_charts() {
-    let dir = temp("timings");
+    let tmp = temp("timings");
+    let dir = tmp.path().to_path_buf();
     let reference = dir.join("reference");
     sequence(&reference, 4, (8, 8), |_| 0.5);
     sequence(&dir.join("mine"), 4, (8, 8), |f| 0.4 + 0.05 * f as f32);
@@ -250,5 +249,4 @@ fn timings_put_an_outside_method_on_the_speed_charts() {
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     assert!(charts.iter().any(|c| c.starts_with("speed_vs_flip")), "{charts:?}");
-    std::fs::remove_dir_all(&dir).ok();
 }

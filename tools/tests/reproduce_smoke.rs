@@ -64,10 +64,8 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
 }
 
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("flicker-reproduce-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn temp(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("flicker-reproduce-{name}-")).tempdir().unwrap()
 }
 
 fn options(claims_dir: PathBuf, paper: &str, out: PathBuf, cache: &Path) -> ReproduceOptions {
@@ -84,7 +82,8 @@ fn options(claims_dir: PathBuf, paper: &str, out: PathBuf, cache: &Path) -> Repr
 
 #[test]
 fn every_claim_gets_a_value_and_a_verdict_and_the_same_ones_twice() {
-    let dir = temp("all");
+    let tmp = temp("all");
+    let dir = tmp.path().to_path_buf();
     let claims_dir = root().join("claims");
     let started = std::time::Instant::now();
     let first =
@@ -171,12 +170,12 @@ fn every_claim_gets_a_value_and_a_verdict_and_the_same_ones_twice() {
     );
     // The gates last, so that a changed verdict still shows whether the numbers repeat.
     assert!(failed.is_empty(), "gates no longer reproduced at smoke scale:\n{}", failed.join("\n"));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn a_case_whose_run_fails_is_an_error_and_nothing_is_written() {
-    let dir = temp("fails");
+    let tmp = temp("fails");
+    let dir = tmp.path().to_path_buf();
     let claims_dir = dir.join("claims");
     std::fs::create_dir_all(&claims_dir).unwrap();
     // The jackknife claims with a smoke size no adapter has: the file loads (sizes are not an
@@ -199,5 +198,4 @@ fn a_case_whose_run_fails_is_an_error_and_nothing_is_written() {
     let e = format!("{e:#}");
     assert!(e.contains("case 'cloud'"), "{e}");
     assert!(!out.join("reproduce.md").exists() && !out.join("reproduce.html").exists());
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -14,12 +14,8 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
 }
 
-fn temp(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("flicker-suite-measured-{}-{name}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn temp(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new().prefix(&format!("flicker-suite-measured-{name}-")).tempdir().unwrap()
 }
 
 fn options(suite: PathBuf, dir: &Path) -> SuiteOptions {
@@ -84,7 +80,8 @@ const SUITE: &str = r#"Suite(
 
 #[test]
 fn the_example_suite_passes_on_the_committed_frames() {
-    let dir = temp("example");
+    let tmp = temp("example");
+    let dir = tmp.path().to_path_buf();
     let path = root().join("suites/measured.ron");
     let outcome = run(&options(path.clone(), &dir)).expect("the example suite runs");
     eprintln!("{}", outcome.markdown);
@@ -94,12 +91,12 @@ fn the_example_suite_passes_on_the_committed_frames() {
     assert!(outcome.passed(), "{}", outcome.markdown);
     assert!(outcome.results.iter().any(|r| r.gate.starts_with("jod")));
     assert!(outcome.folder.join("flicker/seed_0/report.html").exists());
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn a_blessed_renderer_passes_and_fails_once_its_frames_get_noisier() {
-    let dir = temp("bless");
+    let tmp = temp("bless");
+    let dir = tmp.path().to_path_buf();
     renderer(&dir, 0.05);
     std::fs::write(dir.join("suite.ron"), SUITE).unwrap();
     let opts = options(dir.join("suite.ron"), &dir);
@@ -124,12 +121,12 @@ fn a_blessed_renderer_passes_and_fails_once_its_frames_get_noisier() {
         let expected = if relative { Verdict::Fail } else { Verdict::Pass };
         assert_eq!(r.verdict, expected, "{}: {}", r.gate, r.detail);
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn another_adapters_baseline_stands_in_with_a_wider_tolerance() {
-    let dir = temp("stand_in");
+    let tmp = temp("stand_in");
+    let dir = tmp.path().to_path_buf();
     renderer(&dir, 0.05);
     std::fs::write(dir.join("suite.ron"), SUITE).unwrap();
     let opts = options(dir.join("suite.ron"), &dir);
@@ -161,12 +158,12 @@ fn another_adapters_baseline_stands_in_with_a_wider_tolerance() {
         let expected = if relative { Verdict::Fail } else { Verdict::Pass };
         assert_eq!(r.verdict, expected, "{}: {}", r.gate, r.detail);
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn bad_frames_are_errors_at_the_case_line_and_nothing_is_written() {
-    let dir = temp("bad");
+    let tmp = temp("bad");
+    let dir = tmp.path().to_path_buf();
     renderer(&dir, 0.05);
     let small = dir.join("small_1");
     std::fs::create_dir_all(&small).unwrap();
@@ -251,7 +248,6 @@ fn bad_frames_are_errors_at_the_case_line_and_nothing_is_written() {
         (Some(Path::new("dir/r")), Path::new("/abs/m"))
     );
     assert_eq!(ok.cases[0].seeds, [0]);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// A `flicker export` package as `flicker measure --scenario` reads it, without a GPU: the
@@ -309,7 +305,8 @@ const PACKAGE_SUITE: &str = r#"Suite(
 /// written.
 #[test]
 fn a_package_case_gates_an_outside_methods_frames_and_times() {
-    let dir = temp("package");
+    let tmp = temp("package");
+    let dir = tmp.path().to_path_buf();
     package(&dir.join("package"));
     for seed in 1..=3 {
         frames(&dir.join(format!("mine_{seed}")), seed, 0.05);
@@ -361,5 +358,4 @@ fn a_package_case_gates_an_outside_methods_frames_and_times() {
     assert!(e.starts_with(&at), "{e}");
     assert!(e.contains("reference/0004.exr") && e.contains("frame 4 is missing"), "{e}");
     assert!(!dir.join("out").exists(), "something was written");
-    std::fs::remove_dir_all(&dir).ok();
 }

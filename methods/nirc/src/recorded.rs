@@ -83,8 +83,9 @@ pub const CHARTS: &[MethodChart] = &[
 mod tests {
     use std::path::Path;
 
+    use metrics::frames_csv::Frames;
     use report::charts::build::method_chart;
-    use report::run::{Frames, Manifest};
+    use report::run::Manifest;
 
     use super::*;
 

@@ -124,7 +124,8 @@ fn saved_state_loads_identically_and_bad_files_are_refused() {
     for _ in 0..3 {
         cache.train_step(&records(&mut rng, 100));
     }
-    let dir = std::env::temp_dir().join(format!("nirc-cpu-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("state.nirc");
     cache.state.save(&path).unwrap();
@@ -145,5 +146,4 @@ fn saved_state_loads_identically_and_bad_files_are_refused() {
     std::fs::write(&path, b"not a cache").unwrap();
     let err = CacheState::load(&path).unwrap_err().to_string();
     assert!(err.contains("FLKNIRC1"), "{err}");
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -398,7 +398,8 @@ fn save_load_reproduces_the_next_step_and_inference_exactly() {
     for _ in 0..3 {
         cache.train_records(gpu(), &records(&mut rng, 200)).unwrap();
     }
-    let dir = std::env::temp_dir().join(format!("nirc-gpu-{}", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("warm.nirc");
     cache.save(gpu(), &path).unwrap();
@@ -429,7 +430,6 @@ fn save_load_reproduces_the_next_step_and_inference_exactly() {
             "{mode:?}"
         );
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]

@@ -360,10 +360,10 @@ fn saved_and_loaded_cache_renders_the_next_frames_identically() {
         "σ of the blend = σ of the diagnostics"
     );
     assert!(rel.iter().any(|r| r[0] != r[1]), "the two predictors' reliabilities differ somewhere");
-    let file = std::env::temp_dir().join(format!("nirc-integrator-{}.state", std::process::id()));
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("nirc-integrator.state");
     cache.save(g, &file).unwrap();
     let loaded = NeuralCache::load(g, &file).unwrap();
-    std::fs::remove_file(&file).ok();
     for frame in 4..6 {
         let a = cache_frame(&paths, &cache, &t, &out, frame);
         let b = cache_frame(&paths, &loaded, &t, &out, frame);

@@ -212,11 +212,10 @@ fn gpu_sparse_steps_match_the_cpu_twin() {
             }
         }
         // The step counts survive a save and a load.
-        let path = std::env::temp_dir()
-            .join(format!("nirc-sparse-{}-{placement:?}.nirc", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join(format!("nirc-sparse-{placement:?}.nirc"));
         got.save(&path).unwrap();
         assert_eq!(CacheState::load(&path).unwrap(), got);
-        std::fs::remove_file(&path).unwrap();
     }
 }
 

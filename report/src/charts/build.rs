@@ -4,11 +4,12 @@
 use std::path::Path;
 
 use anyhow::Context;
+use metrics::frames_csv::Frames;
 
 use super::plot::{self, XMap};
 use super::{Chart, Kind, Series, pareto_front};
 use crate::declared::MethodChart;
-use crate::run::{Frames, Manifest};
+use crate::run::Manifest;
 
 /// Human-readable names of the columns every method has (a method names its own in its
 /// declared charts).
@@ -282,7 +283,7 @@ pub fn jod_chart(manifest: &Manifest, frames: &Frames, jod: &JodTable) -> Option
     if series.is_empty() {
         return None;
     }
-    let last = frames.frame_count(manifest) as f64;
+    let last = manifest.frame_count(frames) as f64;
     let chart = Chart {
         title: format!("JOD per window (ColorVideoVDP, 10 = invisible) — {}", manifest.scenario),
         x_label: "frame".into(),

@@ -7,7 +7,7 @@
 pub mod browser;
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use metrics::synthetic::hash01;
 use metrics::{
@@ -95,7 +95,7 @@ pub fn regions() -> Vec<Region> {
 }
 
 /// Writes the run folder and returns its path.
-pub fn fake_run(name: &str) -> PathBuf {
+pub fn fake_run(name: &str) -> tempfile::TempDir {
     fake_run_with(name, &FakeRun::default())
 }
 
@@ -104,10 +104,11 @@ pub fn method_frame(run: &FakeRun, m: usize, f: u32) -> Image {
     render(run, m, f)
 }
 
-pub fn fake_run_with(name: &str, run: &FakeRun) -> PathBuf {
+pub fn fake_run_with(name: &str, run: &FakeRun) -> tempfile::TempDir {
     let (w, h, event) = (run.width, run.height, run.event);
-    let dir = std::env::temp_dir().join(format!("report-fake-run-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let tmp =
+        tempfile::Builder::new().prefix(&format!("report-fake-run-{name}-")).tempdir().unwrap();
+    let dir = tmp.path().to_path_buf();
     std::fs::create_dir_all(dir.join("reference")).unwrap();
     let reference_frames = &run.reference_frames;
     for &f in reference_frames {
@@ -177,7 +178,7 @@ pub fn fake_run_with(name: &str, run: &FakeRun) -> PathBuf {
     });
     std::fs::write(dir.join("manifest.json"), serde_json::to_string_pretty(&manifest).unwrap())
         .unwrap();
-    dir
+    tmp
 }
 
 pub fn read_json(path: &Path) -> serde_json::Value {
@@ -193,7 +194,7 @@ pub const HOSTILE_EVENT: &str = "</script><svg onload=alert(3)>\"'&";
 pub const HOSTILE_REGIONS: [&str; 2] = ["<img src=x onerror=alert(4)>\"'&", "<!--\"'&"];
 
 /// A short run whose methods, scenario, event and regions have hostile names.
-pub fn hostile_run(name: &str) -> PathBuf {
+pub fn hostile_run(name: &str) -> tempfile::TempDir {
     let regions = regions()
         .into_iter()
         .zip(HOSTILE_REGIONS)

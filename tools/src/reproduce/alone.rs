@@ -49,7 +49,8 @@ mod tests {
     /// did not book it); a pass the run does not have is an error naming it.
     #[test]
     fn a_method_is_charged_only_the_passes_it_runs() {
-        let dir = std::env::temp_dir().join(format!("flicker-alone-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(
             dir.join("frames.csv"),
@@ -74,6 +75,5 @@ mod tests {
         assert_eq!(ms("blend"), [Some(11.0), Some(13.0)]);
         let e = leave_out(&mut run, &[("ema".into(), vec!["ema_update".into()])]).unwrap_err();
         assert!(e.to_string().contains("no column of pass 'ema_update'"), "{e}");
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

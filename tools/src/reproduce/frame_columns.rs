@@ -48,8 +48,8 @@ mod tests {
 
     #[test]
     fn a_column_becomes_each_methods_series() {
-        let dir =
-            std::env::temp_dir().join(format!("flicker-frame-columns-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(
             dir.join("frames.csv"),
@@ -67,6 +67,5 @@ mod tests {
         assert_eq!(run.window_mean("vb", Metric::shipped("CacheMean"), 0..2), Some(0.625));
         let e = add(&mut run, Metric::shipped("CacheVariance")).unwrap_err().to_string();
         assert!(e.contains("no method, frame or cache_variance column"), "{e}");
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

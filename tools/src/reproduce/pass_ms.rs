@@ -100,7 +100,8 @@ mod tests {
     /// frame (never from another frame); a pass in neither leaves the frame untimed.
     #[test]
     fn a_method_gets_its_own_passes_and_its_caches() {
-        let dir = std::env::temp_dir().join(format!("flicker-pass-ms-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         std::fs::create_dir_all(&dir).unwrap();
         // vb and mse share one cache (vb, first, books tc_propagate); pt has its own.
         std::fs::write(
@@ -141,6 +142,5 @@ mod tests {
             ),
             "{e}"
         );
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -163,8 +163,8 @@ mod tests {
     /// without preference maps get nothing.
     #[test]
     fn sigma_over_the_pixels_that_changed_most_and_least() {
-        let dir =
-            std::env::temp_dir().join(format!("flicker-sigma-regions-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         let folder = RunFolder::new(&dir);
         let before = vec![1.0f32; 20];
         let after: Vec<f32> = (0..20).map(|x| 1.0 + x as f32).collect();
@@ -197,6 +197,5 @@ mod tests {
         // Without an event inside the run there is nothing to rank by.
         let e = add(&mut run, 3, &[]).unwrap_err().to_string();
         assert!(e.contains("needs an event"), "{e}");
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

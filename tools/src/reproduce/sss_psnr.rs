@@ -80,7 +80,8 @@ mod tests {
     /// unsampled pixel's 9.0 neither counts nor sets the peak); the reference gets no series.
     #[test]
     fn psnr_over_the_sampled_pixels_against_the_reference() {
-        let dir = std::env::temp_dir().join(format!("flicker-sss-psnr-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         let folder = RunFolder::new(&dir);
         for f in 0..2 {
             write_exr(&folder.frame("ref", f, "exr"), 3, 1, &grey(&[1.0, 0.5, 9.0])).unwrap();
@@ -104,6 +105,5 @@ mod tests {
         std::fs::remove_file(folder.frame("b", 1, "exr")).unwrap();
         let e = format!("{:#}", add(&mut run, "ref", 2).unwrap_err());
         assert!(e.contains("frame 1") && e.contains("b's frame"), "{e}");
-        std::fs::remove_dir_all(&dir).ok();
     }
 }

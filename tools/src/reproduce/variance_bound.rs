@@ -89,7 +89,8 @@ mod tests {
     /// mean variance 0.5, over the bound 0.25: 2; a method without a bound gets no series.
     #[test]
     fn mean_pixel_variance_over_the_bound() {
-        let dir = std::env::temp_dir().join(format!("flicker-var-bound-{}", std::process::id()));
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().to_path_buf();
         let folder = RunFolder::new(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         for (f, v) in [0.0f32, 1.0, 2.0].iter().enumerate() {
@@ -108,6 +109,5 @@ mod tests {
         assert!((mean - 2.0).abs() < 1e-4, "{mean}");
         assert!(!run.methods["pt"].contains_key("variance_over_bound"));
         assert!(add(&mut run, 1).unwrap_err().to_string().contains("at least 2 frames"));
-        std::fs::remove_dir_all(&dir).ok();
     }
 }
