@@ -10,7 +10,7 @@ use tools::gallery::{self, GalleryOptions};
 const CASE: &str = "termination_glossy";
 const FAILING: &str = "vb_rel_1";
 const BASELINE: &str = "pt";
-const COLUMNS: [&str; 3] = ["flip", "smape", "mean_path_length"];
+const COLUMNS: [&str; 3] = ["flip", "smape", "path_length"];
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()

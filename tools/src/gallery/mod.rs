@@ -275,7 +275,7 @@ pub fn failures(opts: &GalleryOptions) -> Result<PathBuf> {
         if reference.exists() {
             order.push_str(" and the path-traced reference");
         }
-        let _ = writeln!(contents, "- [{}: {}](#{})", case.method, case.name, case.name.replace('_', "-"));
+        let _ = writeln!(contents, "- [{}: {}](#{})", case.method, case.name, case.name);
         let _ = write!(
             body,
             "\n### {name}\n\n[`{method}`]({page}) in `{scenario}`: `{failing}` against `{baseline}`. {why}\n\n\
