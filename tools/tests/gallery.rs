@@ -112,6 +112,29 @@ fn failure_page_shows_the_runs_frames_numbers_and_command() {
     // FLIP, SMAPE and path length at least, of both methods.
     assert!(numbers >= 6, "{numbers} numbers");
 
+    // The pictured frame's row: frames.csv's values of that frame.
+    let csv = std::fs::read_to_string(run.join("frames.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    for method in [FAILING, BASELINE] {
+        let row: Vec<&str> = csv
+            .lines()
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .find(|r| r[0] == method && r[1] == "0")
+            .unwrap_or_else(|| panic!("{method} frame 0 in frames.csv"));
+        let cells: Vec<String> = COLUMNS
+            .iter()
+            .map(|c| {
+                let v: f64 = row[header.iter().position(|h| h == c).unwrap()].parse().unwrap();
+                gallery::number(v)
+            })
+            .collect();
+        let line = format!(
+            "| frame 0 (pictured; frames.csv) | 0 | `{method}` | {} | — |",
+            cells.join(" | ")
+        );
+        assert!(text.contains(&line), "no row\n{line}\nin\n{text}");
+    }
+
     // The command that plays the run again, as a tested shell block.
     let command = format!(
         "```sh\nflicker run scenarios/termination_failure_glossy.ron --frames 2 --resolution 32x18 --out {}\n```",

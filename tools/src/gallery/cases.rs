@@ -42,7 +42,8 @@ pub const CASES: &[Case] = &[
         why: "A room lit only through a door gap (the paper's section 5, very dark regions): at one \
               path per pixel almost no training path reaches the light, so the targets are rare \
               fireflies, neither predictor's reliability rises above zero and the blend's σ stays \
-              near 0.5, an even mix that cannot prefer the better predictor when the door opens.",
+              near 0.5, an even mix that cannot prefer the better predictor when the door opens. Both predictors read one cache, so its reliabilities and σ are the same \
+              in both rows.",
     },
     Case {
         name: "nirc_glossy",
@@ -58,7 +59,8 @@ pub const CASES: &[Case] = &[
         why: "The Cornell box turned into rough metal, then its light tilted (section 5, long \
               glossy chains): incident radiance depends on direction more sharply than a small \
               cache resolves from sparse view-dependent targets, so the reliabilities stay low \
-              and the blend barely leaves an even mix.",
+              and the blend barely leaves an even mix. Both predictors read one cache, so its reliabilities and σ are the same in \
+              both rows.",
     },
     Case {
         name: "nirc_thin",
@@ -74,7 +76,8 @@ pub const CASES: &[Case] = &[
         why: "A turning hairball (section 5, thin geometry): strands are far thinner than a \
               reliability cell, so each cell mixes strands, floor and gaps; as strands move \
               through cells the reliabilities swing from frame to frame and the blend cannot \
-              settle.",
+              settle. Both predictors read one cache, so its reliabilities and σ are the same in \
+              both rows.",
     },
     Case {
         name: "termination_glossy",

@@ -19,7 +19,11 @@ pub fn side_by_side(panels: &[&Path], out: &Path) -> Result<()> {
         .collect::<Result<_>>()?;
     let (w, h) = images.first().context("no panels")?.dimensions();
     if let Some((p, i)) = panels.iter().zip(&images).find(|(_, i)| i.dimensions() != (w, h)) {
-        anyhow::bail!("{} is {:?}, expected {w}x{h} as the first panel", p.display(), i.dimensions());
+        anyhow::bail!(
+            "{} is {:?}, expected {w}x{h} as the first panel",
+            p.display(),
+            i.dimensions()
+        );
     }
     let n = images.len() as u32;
     let mut strip = RgbImage::from_pixel(n * w + (n - 1) * GAP, h, Rgb([40, 40, 40]));
