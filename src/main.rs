@@ -66,7 +66,8 @@ enum Command {
         /// The scenario file (RON), e.g. scenarios/light_rotation_cornell_box.ron
         scenario: PathBuf,
     },
-    /// List the built-in scenes.
+    /// List the built-in scenes: each one's entities, lights and materials, the names that
+    /// animations and events address.
     Scenes,
     /// Compare a test image with a reference (PNG or EXR): mean FLIP, SMAPE, PSNR, error map.
     Compare(compare_args::CompareArgs),
@@ -140,6 +141,13 @@ enum Command {
         /// the commit before (for CI).
         #[arg(long)]
         fail_on_change: bool,
+    },
+    /// Guide pages made from runs played by this one command: `failures` (each method's failure
+    /// case: its frame beside the baseline's and the reference, its numbers, the command that
+    /// reproduces them) and `speed` (speed against accuracy: the charts and numbers of one run).
+    Gallery {
+        #[command(subcommand)]
+        page: GalleryPage,
     },
     /// Parameter sweeps: a grid or list over method parameters, cases and seeds, one run folder
     /// per job, run here, with GNU parallel or as a Slurm array, merged into one summary.
@@ -242,6 +250,59 @@ impl HistoryArgs {
                 print!("{}", tools::history::series::changes_markdown(&changes));
             }
             Err(e) => eprintln!("warning: results history not read: {e:#}"),
+        }
+    }
+}
+
+#[derive(Subcommand)]
+enum GalleryPage {
+    /// Play each method's failure case and write the failure-cases page and its pictures.
+    Failures(GalleryArgs),
+    /// Play the showcase and write the speed-accuracy page's charts and numbers.
+    Speed(GalleryArgs),
+}
+
+#[derive(clap::Args)]
+struct GalleryArgs {
+    /// The page: only its part between `<!-- generated: flicker gallery MODE -->` and
+    /// `<!-- end generated -->` is written (a missing page is created).
+    #[arg(long)]
+    out: PathBuf,
+    /// Where the pictures go [default: images/failures or images/speed-accuracy beside the page].
+    #[arg(long)]
+    images: Option<PathBuf>,
+    /// Where the runs go.
+    #[arg(long, default_value = "runs/gallery")]
+    runs: PathBuf,
+    /// Only this failure case (its name on the page).
+    #[arg(long)]
+    only: Option<String>,
+    /// Recorded frames of every run (overrides each case's own).
+    #[arg(long)]
+    frames: Option<u32>,
+    /// Image size of every run as WIDTHxHEIGHT (overrides each case's own).
+    #[arg(long, value_parser = parse_resolution)]
+    resolution: Option<(u32, u32)>,
+    /// Cache folder for references [default: $FLICKER_CACHE_DIR or ~/.cache/flicker].
+    #[arg(long)]
+    cache_dir: Option<PathBuf>,
+    /// Do not draw progress bars.
+    #[arg(long)]
+    quiet: bool,
+}
+
+impl GalleryArgs {
+    fn options(self) -> tools::gallery::GalleryOptions {
+        tools::gallery::GalleryOptions {
+            page: self.out,
+            images: self.images,
+            runs: self.runs,
+            root: PathBuf::from("."),
+            only: self.only,
+            resolution: self.resolution,
+            frames: self.frames,
+            cache_dir: self.cache_dir,
+            progress: !self.quiet,
         }
     }
 }
@@ -459,6 +520,7 @@ fn main() -> ExitCode {
     let plays = matches!(
         cli.command,
         Command::Run { .. }
+            | Command::Gallery { .. }
             | Command::Suite { .. }
             | Command::Reproduce { .. }
             | Command::Sweep { action: SweepAction::Job { .. } }
@@ -566,16 +628,20 @@ fn main() -> ExitCode {
                 println!("report: {}", summary.report.display());
             })
         }
+        Command::Gallery { page } => {
+            let written = match page {
+                GalleryPage::Failures(args) => tools::gallery::failures(&args.options()),
+                GalleryPage::Speed(args) => tools::gallery::speed(&args.options()),
+            };
+            written.map(|page| println!("wrote {}", page.display()))
+        }
         Command::Schedule { scenario } => {
             systems::scenario::RunSpec::load(&scenario, &Overrides::default())
                 .and_then(|spec| systems::methods::describe_schedule(&spec.methods))
                 .map(|text| print!("{text}"))
         }
         Command::Scenes => {
-            for name in sim::scenes::names() {
-                let description = sim::scenes::describe(name).unwrap_or_default();
-                println!("{name:<16} {description}");
-            }
+            print!("{}", sim::scenes::listing());
             Ok(())
         }
         Command::Compare(args) => metrics::compare(&args.options()),

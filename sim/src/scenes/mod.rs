@@ -72,9 +72,106 @@ pub fn build(name: &str) -> Option<WorldTemplate> {
     SCENES.iter().find(|s| s.name == name).map(|s| (s.build)())
 }
 
+/// What scenarios can name in a built-in scene: its entities (nodes, in spawn order), its lights
+/// (analytic lights, emissive meshes and the sky) and its materials.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Inventory {
+    pub entities: Vec<String>,
+    /// Each light as `NAME (KIND)`.
+    pub lights: Vec<String>,
+    pub materials: Vec<String>,
+}
+
+/// The inventory of a scene as built.
+pub fn inventory(t: &WorldTemplate) -> Inventory {
+    let mut lights = Vec::new();
+    for n in &t.nodes {
+        let kind = match (n.light, n.mesh) {
+            (Some(scene::Light::Point { .. }), _) => "point light",
+            (Some(scene::Light::Spot { .. }), _) => "spot light",
+            (Some(scene::Light::Directional { .. }), _) => "directional light",
+            (None, Some(m))
+                if t.materials.materials[m.material as usize].emission.max_element() > 0.0 =>
+            {
+                "emissive mesh"
+            }
+            _ => continue,
+        };
+        lights.push(format!("{} ({kind})", n.name));
+    }
+    if t.environment.max_element() > 0.0 {
+        lights.push("environment (constant sky radiance)".into());
+    }
+    Inventory {
+        entities: t.nodes.iter().map(|n| n.name.clone()).collect(),
+        lights,
+        materials: t.materials.names.iter().filter(|n| !n.is_empty()).cloned().collect(),
+    }
+}
+
+/// `flicker scenes`: every built-in scene with its description, entities, lights and materials.
+pub fn listing() -> String {
+    let mut out = String::new();
+    for s in SCENES {
+        let inv = inventory(&(s.build)());
+        out.push_str(&format!("{}: {}\n", s.name, s.description));
+        out.push_str(&format!("  entities:  {}\n", inv.entities.join(", ")));
+        out.push_str(&format!("  lights:    {}\n", inv.lights.join(", ")));
+        out.push_str(&format!("  materials: {}\n", inv.materials.join(", ")));
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn listing_names_every_entity_light_and_material() {
+        let text = listing();
+        for s in SCENES {
+            // Each scene's block: the indented lines under its header.
+            let header = format!("{}: {}", s.name, s.description);
+            let block: Vec<&str> = text
+                .lines()
+                .skip_while(|l| *l != header)
+                .skip(1)
+                .take_while(|l| l.starts_with("  "))
+                .collect();
+            let block = block.join("\n");
+            let t = (s.build)();
+            let line = |key: &str| {
+                block
+                    .lines()
+                    .find_map(|l| l.trim_start().strip_prefix(key))
+                    .unwrap_or_else(|| panic!("{}: no `{key}` line in\n{block}", s.name))
+                    .trim()
+                    .split(", ")
+                    .map(String::from)
+                    .collect::<Vec<_>>()
+            };
+            let nodes: Vec<String> = t.nodes.iter().map(|n| n.name.clone()).collect();
+            assert_eq!(line("entities:"), nodes, "{}", s.name);
+            let lights = line("lights:");
+            for n in &t.nodes {
+                let lit = n.light.is_some()
+                    || n.mesh.is_some_and(|m| {
+                        t.materials.materials[m.material as usize].emission.max_element() > 0.0
+                    });
+                let listed = lights.iter().any(|l| l.starts_with(&format!("{} (", n.name)));
+                assert_eq!(lit, listed, "{}: light {} in {lights:?}", s.name, n.name);
+            }
+            assert_eq!(
+                t.environment.max_element() > 0.0,
+                lights.iter().any(|l| l.starts_with("environment")),
+                "{}: sky",
+                s.name
+            );
+            for m in t.materials.names.iter().filter(|m| !m.is_empty()) {
+                assert!(line("materials:").contains(m), "{}: material {m}", s.name);
+            }
+        }
+    }
 
     #[test]
     fn every_scene_builds_with_light_camera_and_valid_indices() {
