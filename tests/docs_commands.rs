@@ -338,71 +338,39 @@ struct Outcome {
     untested: Vec<String>,
 }
 
-/// Plays every document, two at a time: a document's lines run in order (a later line reads
-/// what an earlier one wrote), the documents are independent (each has its own sandbox; the
-/// cache is shared, as concurrent runs share it). Outcomes are merged in document order.
 fn run_documents(docs: &[Doc], scratch: &Path) -> Outcome {
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut each: Vec<(usize, Outcome)> = std::thread::scope(|s| {
-        let workers: Vec<_> = (0..2)
-            .map(|_| {
-                s.spawn(|| {
-                    let mut done = Vec::new();
-                    loop {
-                        let n = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        let Some(doc) = docs.get(n) else { break done };
-                        done.push((n, run_document(n, doc, scratch)));
-                    }
-                })
-            })
-            .collect();
-        workers.into_iter().flat_map(|w| w.join().unwrap()).collect()
-    });
-    each.sort_by_key(|(n, _)| *n);
-    let mut o = Outcome { failures: Vec::new(), ran: Vec::new(), untested: Vec::new() };
-    for (_, d) in each {
-        o.failures.extend(d.failures);
-        o.ran.extend(d.ran);
-        o.untested.extend(d.untested);
-    }
-    o
-}
-
-fn run_document(n: usize, doc: &Doc, scratch: &Path) -> Outcome {
     let mut o = Outcome { failures: Vec::new(), ran: Vec::new(), untested: Vec::new() };
     // References and NIRC warm starts are keyed by what they depend on: one cache for every
     // run of the test and across runs (a warm start of 160 pre-training frames costs about 20 s
     // at 32x18 on lavapipe).
     let cache = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("docs_commands_cache");
-    let sandbox = Sandbox { tmp: scratch.join(format!("doc{n}")), cache: cache.clone() };
-    let (blocks, errors) = blocks(doc);
-    o.failures.extend(errors);
-    for block in blocks {
-        if block.untested {
-            let first = block.lines.first().map_or("", |(_, l)| l.as_str());
-            o.untested.push(format!("{}: {first}", block.place));
-            continue;
-        }
-        for (line, command) in &block.lines {
-            let place = format!("{}:{line}", doc.path.display());
-            match flicker_args(command) {
-                Ok(None) => {}
-                Ok(Some(args)) => {
-                    let args = sandbox.rewrite(&args);
-                    let start = Instant::now();
-                    let result = run_flicker(&args, &cache);
-                    o.ran.push(format!(
-                        "{place}: flicker {} ({:.1} s)",
-                        args.join(" "),
-                        start.elapsed().as_secs_f64()
-                    ));
-                    if let Err(e) = result {
-                        o.failures.push(format!("{place}: `{command}` {e}"));
+    for (n, doc) in docs.iter().enumerate() {
+        let sandbox = Sandbox { tmp: scratch.join(format!("doc{n}")), cache: cache.clone() };
+        let (blocks, errors) = blocks(doc);
+        o.failures.extend(errors);
+        for block in blocks {
+            if block.untested {
+                let first = block.lines.first().map_or("", |(_, l)| l.as_str());
+                o.untested.push(format!("{}: {first}", block.place));
+                continue;
+            }
+            for (line, command) in &block.lines {
+                let place = format!("{}:{line}", doc.path.display());
+                match flicker_args(command) {
+                    Ok(None) => {}
+                    Ok(Some(args)) => {
+                        let args = sandbox.rewrite(&args);
+                        let start = Instant::now();
+                        let result = run_flicker(&args, &cache);
+                        o.ran.push(format!("{place}: flicker {} ({:.1} s)", args.join(" "), start.elapsed().as_secs_f64()));
+                        if let Err(e) = result {
+                            o.failures.push(format!("{place}: `{command}` {e}"));
+                        }
                     }
+                    Err(why) => o.failures.push(format!(
+                        "{place}: `{command}`: {why}; mark the block ```sh untested and say why in the text"
+                    )),
                 }
-                Err(why) => o.failures.push(format!(
-                    "{place}: `{command}`: {why}; mark the block ```sh untested and say why in the text"
-                )),
             }
         }
     }
