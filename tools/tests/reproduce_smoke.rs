@@ -1,8 +1,17 @@
-//! `flicker reproduce all --scale smoke` end to end: every claim of every paper gets a verdict,
-//! every claim the files do not declare "not comparable" gets per-seed values, two independent
-//! runs with the same seeds (the second with fresh reference and NIRC warm-start caches) give
-//! the same numbers, bit for bit, and the same verdicts (measured times excepted), and a case
-//! whose run fails is an error with nothing written.
+//! `flicker reproduce PAPER --scale smoke` end to end, one test per paper (so that the papers
+//! play side by side on the test runner's threads): every claim of the paper gets a verdict,
+//! every claim the file does not declare "not comparable" gets per-seed values, and a case whose
+//! run fails is an error with nothing written. `every_claims_file_has_its_test` keeps the list
+//! of papers equal to the claims files, so every claim of every paper is still played.
+//!
+//! Determinism: the papers in `REPLAYED` are played twice with the same seeds (the second time
+//! with fresh reference and NIRC warm-start caches) and must give the same numbers, bit for bit,
+//! and the same verdicts (measured times excepted). Replayed are the papers whose methods no
+//! other test plays twice end to end (subsurface scattering; the volume methods, media and the
+//! CPU computations of the jackknife paper); the others' methods have their own bit-for-bit tests
+//! (NIRC: `methods/nirc/tests/integrator.rs`, `sparse_updates.rs`; the sample cache, TAA, path
+//! tracing: `methods/sample_cache/tests/sample_cache.rs`, `tests/cli.rs`; termination:
+//! `methods/termination/tests/termination_cache.rs`, `systems/tests/termination_shared.rs`).
 //!
 //! The claims that smoke scale reproduces are also regression gates (they were the papers
 //! suite's gates): each claim in `GATES` must be judged "reproduced", so a method that gets
@@ -11,7 +20,7 @@
 
 use std::path::{Path, PathBuf};
 
-use tools::reproduce::{Claims, ReproduceOptions, Scale, reproduce};
+use tools::reproduce::{Claims, ReproduceOptions, ReproduceOutcome, Scale, reproduce};
 
 /// (paper, claim) that `--scale smoke` reproduces, every one not judged on a measured time.
 const GATES: &[(&str, &[&str])] = &[
@@ -60,6 +69,18 @@ const GATES: &[(&str, &[&str])] = &[
     ),
 ];
 
+/// Every paper this file plays, one test each (`every_claims_file_has_its_test`).
+const PAPERS: &[&str] = &[
+    "jackknife-transmittance",
+    "realtime-sss-thesis",
+    "reliability-weighted-nirc",
+    "stable-sample-caching",
+    "variance-trading-termination",
+];
+
+/// The papers played a second time for determinism (see the file's comment).
+const REPLAYED: &[&str] = &["jackknife-transmittance", "realtime-sss-thesis"];
+
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
 }
@@ -80,30 +101,25 @@ fn options(claims_dir: PathBuf, paper: &str, out: PathBuf, cache: &Path) -> Repr
     }
 }
 
-#[test]
-fn every_claim_gets_a_value_and_a_verdict_and_the_same_ones_twice() {
-    let tmp = temp("all");
+/// Plays `paper` at smoke scale (twice where it is in `REPLAYED`) and checks its claims: each
+/// one an outcome, values where comparable, a line in reproduce.md, the same bits on the replay,
+/// and its gates reproduced.
+fn plays(paper: &str) {
+    let tmp = temp(paper);
     let dir = tmp.path().to_path_buf();
     let claims_dir = root().join("claims");
     let started = std::time::Instant::now();
     let first =
-        reproduce(&options(claims_dir.clone(), "all", dir.join("first"), &dir.join("cache")))
-            .expect("reproduce all --scale smoke");
-    eprintln!("first run: {:.1} s\n{}", started.elapsed().as_secs_f64(), first.markdown);
+        reproduce(&options(claims_dir.clone(), paper, dir.join("first"), &dir.join("cache")))
+            .unwrap_or_else(|e| panic!("reproduce {paper} --scale smoke: {e:#}"));
+    eprintln!("{paper}: first run {:.1} s\n{}", started.elapsed().as_secs_f64(), first.markdown);
 
-    // Every claim of every file, in file order, and nothing else.
-    let mut expected = Vec::new();
-    for entry in std::fs::read_dir(&claims_dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_some_and(|e| e == "ron") {
-            let c = Claims::load(&path).unwrap();
-            expected.extend(c.claims.iter().map(|claim| (c.paper.clone(), claim.id.clone())));
-        }
-    }
-    expected.sort();
-    let mut got: Vec<(String, String)> =
+    // Every claim of the file, in file order, and nothing else.
+    let c = Claims::load(&claims_dir.join(format!("{paper}.ron"))).unwrap();
+    let expected: Vec<(String, String)> =
+        c.claims.iter().map(|claim| (c.paper.clone(), claim.id.clone())).collect();
+    let got: Vec<(String, String)> =
         first.claims.iter().map(|c| (c.paper.clone(), c.id.clone())).collect();
-    got.sort();
     assert_eq!(got, expected, "one outcome per claim");
     for c in &first.claims {
         if !c.declared_not_comparable {
@@ -118,11 +134,12 @@ fn every_claim_gets_a_value_and_a_verdict_and_the_same_ones_twice() {
         }
     }
     let md = std::fs::read_to_string(dir.join("first/reproduce.md")).unwrap();
-    let failed: Vec<String> = GATES
+    assert!(first.claims.iter().all(|c| md.contains(&format!("| {}: ", c.id))), "{md}");
+    let gates = GATES.iter().find(|(p, _)| *p == paper).map_or(&[][..], |(_, ids)| ids);
+    let failed: Vec<String> = gates
         .iter()
-        .flat_map(|(paper, ids)| ids.iter().map(move |id| (*paper, *id)))
-        .filter_map(|(paper, id)| {
-            let c = first.claims.iter().find(|c| c.paper == paper && c.id == id);
+        .filter_map(|id| {
+            let c = first.claims.iter().find(|c| c.paper == paper && c.id == *id);
             match c {
                 None => Some(format!("{paper} {id}: no such claim")),
                 Some(c) if c.timing => Some(format!("{paper} {id}: judged on a time")),
@@ -135,15 +152,32 @@ fn every_claim_gets_a_value_and_a_verdict_and_the_same_ones_twice() {
             }
         })
         .collect();
-    assert!(first.claims.iter().all(|c| md.contains(&format!("| {}: ", c.id))), "{md}");
 
-    // The same seeds again, independently: fresh reference and NIRC warm-start caches, so
-    // references and pre-training are made again rather than read back. Every method is
-    // bit-reproducible on one adapter, so every number (measured times excepted) is the same.
+    if REPLAYED.contains(&paper) {
+        replayed_gives_the_same_bits(paper, &first, &claims_dir, &dir);
+    }
+    // The gates last, so that a changed verdict still shows whether the numbers repeat.
+    assert!(failed.is_empty(), "gates no longer reproduced at smoke scale:\n{}", failed.join("\n"));
+}
+
+/// The same seeds again, independently: fresh reference and NIRC warm-start caches, so
+/// references and pre-training are made again rather than read back. Every method is
+/// bit-reproducible on one adapter, so every number (measured times excepted) is the same.
+fn replayed_gives_the_same_bits(
+    paper: &str,
+    first: &ReproduceOutcome,
+    claims_dir: &Path,
+    dir: &Path,
+) {
     let started = std::time::Instant::now();
-    let second = reproduce(&options(claims_dir, "all", dir.join("second"), &dir.join("fresh")))
-        .expect("second run");
-    eprintln!("second run: {:.1} s", started.elapsed().as_secs_f64());
+    let second = reproduce(&options(
+        claims_dir.to_path_buf(),
+        paper,
+        dir.join("second"),
+        &dir.join("fresh"),
+    ))
+    .expect("second run");
+    eprintln!("{paper}: second run {:.1} s", started.elapsed().as_secs_f64());
     assert!(dir.join("fresh").is_dir(), "the second run made its own caches");
     assert_eq!(second.claims.len(), first.claims.len());
     let mut differ = Vec::new();
@@ -168,8 +202,51 @@ fn every_claim_gets_a_value_and_a_verdict_and_the_same_ones_twice() {
         "two independent runs with the same seeds differ:\n{}",
         differ.join("\n")
     );
-    // The gates last, so that a changed verdict still shows whether the numbers repeat.
-    assert!(failed.is_empty(), "gates no longer reproduced at smoke scale:\n{}", failed.join("\n"));
+}
+
+#[test]
+fn every_claims_file_has_its_test() {
+    let mut files: Vec<String> = std::fs::read_dir(root().join("claims"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .map(|p| Claims::load(&p).unwrap().paper)
+        .collect();
+    files.sort();
+    assert_eq!(files, PAPERS, "each claims file needs its test in this file");
+    for (paper, _) in GATES {
+        assert!(PAPERS.contains(paper), "gates of {paper}, which is not played");
+    }
+    for paper in REPLAYED {
+        assert!(PAPERS.contains(paper), "replayed {paper}, which is not played");
+    }
+}
+
+// One test per paper, numbered longest first: the test runner starts tests in the order of their
+// names, and the NIRC paper takes about as long as all the others together.
+#[test]
+fn paper_2_jackknife_transmittance() {
+    plays("jackknife-transmittance");
+}
+
+#[test]
+fn paper_3_realtime_sss_thesis() {
+    plays("realtime-sss-thesis");
+}
+
+#[test]
+fn paper_1_reliability_weighted_nirc() {
+    plays("reliability-weighted-nirc");
+}
+
+#[test]
+fn paper_5_stable_sample_caching() {
+    plays("stable-sample-caching");
+}
+
+#[test]
+fn paper_4_variance_trading_termination() {
+    plays("variance-trading-termination");
 }
 
 #[test]

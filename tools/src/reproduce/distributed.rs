@@ -53,7 +53,8 @@ pub fn plan(opts: &ReproduceOptions, dir: &Path, exe: &Path) -> Result<(Plan, Me
     let mut jobs = Vec::new();
     let mut planned = Vec::new();
     for claims in &all {
-        for case in claims.cases_for(opts.scale, opts.seeds) {
+        // A case whose runs are another's at this scale is judged on that one's (`same_runs`).
+        for case in super::run::same_runs(&claims.cases_for(opts.scale, opts.seeds)).0 {
             let scenario = std::fs::canonicalize(&case.scenario).map_err(|e| {
                 anyhow!(
                     "{}: case '{}': {}: {e}",

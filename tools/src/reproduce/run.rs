@@ -160,6 +160,23 @@ fn add_columns(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> Result
 pub(crate) type CaseSource<'a> =
     dyn FnMut(&Claims, &[Case], &str) -> Result<BTreeMap<String, CaseRuns>> + 'a;
 
+/// The cases to play, and (case, played case) for each case whose runs would be another's: the
+/// same scenario, seeds, sizes, methods and parameters (cases that differ only at another scale,
+/// as the NIRC paper's two pre-training lengths at smoke scale). A run is deterministic, so the
+/// second case's runs would be the same bits; they are played once.
+pub(crate) fn same_runs(cases: &[Case]) -> (Vec<Case>, Vec<(String, String)>) {
+    let runs_of = |c: &Case| Case { name: String::new(), entry: None, ..c.clone() };
+    let mut played: Vec<Case> = Vec::new();
+    let mut same = Vec::new();
+    for c in cases {
+        match played.iter().find(|p| runs_of(p) == runs_of(c)) {
+            Some(p) => same.push((c.name.clone(), p.name.clone())),
+            None => played.push(c.clone()),
+        }
+    }
+    (played, same)
+}
+
 /// `flicker reproduce`: plays, judges, writes reproduce.md and reproduce.html.
 pub fn reproduce(opts: &ReproduceOptions) -> Result<ReproduceOutcome> {
     let folder = opts.out.clone().unwrap_or_else(|| {
@@ -190,7 +207,16 @@ pub(crate) fn judge_papers(
     for claims in &all {
         let cases = claims.cases_for(opts.scale, opts.seeds);
         let label = format!("reproduce {}", claims.paper);
-        let mut runs = source(claims, &cases, &label)?;
+        let (played, same) = same_runs(&cases);
+        let mut runs = source(claims, &played, &label)?;
+        for (case, as_case) in same {
+            if let Some(r) = runs.get(&as_case).cloned() {
+                eprintln!(
+                    "{label}: case {case}: the runs of case {as_case} (the same at this scale)"
+                );
+                runs.insert(case, r);
+            }
+        }
         for case in &claims.cases {
             if let Some(c) = &case.computation {
                 eprintln!("{label}: case {} (computed: {})", case.name, c.name());
@@ -280,4 +306,38 @@ fn adapter_of(folder: &Path) -> Option<String> {
         }
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn case(name: &str, seeds: &[u64], frames: u32) -> Case {
+        Case {
+            name: name.into(),
+            scenario: "a.ron".into(),
+            measure: None,
+            seeds: seeds.to_vec(),
+            frames: Some(frames),
+            resolution: Some((16, 9)),
+            spp: None,
+            methods: None,
+            params: vec![("Nirc".into(), vec!["pretrain_frames".into()], 16.into())],
+            entry: None,
+        }
+    }
+
+    /// Cases with the same runs are played once; a case differing in anything played is not.
+    #[test]
+    fn cases_with_the_same_runs_are_played_once() {
+        let (played, same) =
+            same_runs(&[case("a", &[1, 2], 24), case("b", &[1, 2], 24), case("c", &[1, 3], 24)]);
+        let names: Vec<&str> = played.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names, ["a", "c"]);
+        assert_eq!(same, [("b".to_string(), "a".to_string())]);
+        let mut d = case("d", &[1, 2], 24);
+        d.params[0].2 = 1280.into();
+        let (played, same) = same_runs(&[case("a", &[1, 2], 24), d, case("e", &[1, 2], 8)]);
+        assert_eq!((played.len(), same.len()), (3, 0));
+    }
 }
