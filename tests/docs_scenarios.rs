@@ -41,7 +41,7 @@ fn ron_blocks(doc: &Doc) -> Vec<(String, String)> {
                 if info.split_whitespace().next() == Some("ron") =>
             {
                 // The block's text starts on the line after the fence.
-                current = Some((format!("{}", doc.place(range.start + 1)), String::new()));
+                current = Some((doc.place(range.start + 1), String::new()));
             }
             Event::Text(t) => {
                 if let Some((_, text)) = &mut current {
