@@ -96,7 +96,9 @@ mod tests {
         // Read through the settings' serde form: tools knows no method's settings type.
         let s = m.spec.settings_json().unwrap();
         let (kappa, alpha) = (&s["cache"]["reliability"]["kappa"], &s["cache"]["ema"]["alpha"]);
-        assert_eq!((kappa.as_f64(), alpha.as_f64()), (Some(2.0), Some(0.9)));
+        // Both are f32 settings.
+        let f32_of = |v: &serde_json::Value| v.as_f64().map(|v| v as f32);
+        assert_eq!((f32_of(kappa), f32_of(alpha)), (Some(2.0), Some(0.9)));
         // Everything else as parsed.
         let expected = Method::parse("Nirc(spp: 1, predictor: Blend)").unwrap();
         let mut e = expected.spec.settings_json().unwrap();
