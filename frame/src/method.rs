@@ -13,7 +13,10 @@ use bevy_ecs::prelude::{Entity, Schedule, World};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
-pub use report::declared::{Better, ChartSeries, ImageStatistic, MethodChart, Source, Statistic};
+pub use report::declared::{
+    Better, ChartSeries, FolderInput, FolderRun, FolderSeries, FolderStatistic, MethodChart,
+    Source, Statistic,
+};
 
 /// A method family, implemented once per method on a unit struct (`taa::Plugin`). Its settings
 /// are a serde struct; a scenario writes `NAME(field: value, ...)`.
@@ -59,6 +62,13 @@ pub trait MethodPlugin: Sync + Send + 'static {
     /// Whether the method renders the scenario's participating media; the others would render
     /// a scene with media as if it had none, so such scenarios refuse them.
     fn sees_media() -> bool {
+        false
+    }
+
+    /// Whether an instance with these settings writes the per-frame image map `name` (its
+    /// `MethodOutput` extra images, e.g. NIRC's `preference`): a statistic read from such maps
+    /// ([`FolderInput::EventAndMap`]) is refused on methods that write none.
+    fn writes_image(_settings: &Self::Settings, _name: &str) -> bool {
         false
     }
 
@@ -165,6 +175,11 @@ impl MethodSpec {
         self.0.set_spp(spp)
     }
 
+    /// Whether it writes the per-frame image map `name` (`MethodPlugin::writes_image`).
+    pub fn writes_image(&self, name: &str) -> bool {
+        self.0.writes_image(name)
+    }
+
     /// Builds one instance on `entity`.
     pub fn spawn(&self, world: &mut World, entity: Entity) -> Result<()> {
         self.0.spawn(world, entity)
@@ -234,6 +249,7 @@ trait AnySettings: Send + Sync {
     fn spp(&self) -> f64;
     fn temporal_window(&self) -> Option<f64>;
     fn set_spp(&mut self, spp: u32);
+    fn writes_image(&self, name: &str) -> bool;
     fn spawn(&self, world: &mut World, entity: Entity) -> Result<()>;
     fn settings(&self) -> &dyn Any;
     fn settings_mut(&mut self) -> &mut dyn Any;
@@ -273,6 +289,10 @@ impl<P: MethodPlugin> AnySettings for Typed<P> {
 
     fn set_spp(&mut self, spp: u32) {
         P::set_spp(&mut self.settings, spp)
+    }
+
+    fn writes_image(&self, name: &str) -> bool {
+        P::writes_image(&self.settings, name)
     }
 
     fn spawn(&self, world: &mut World, entity: Entity) -> Result<()> {

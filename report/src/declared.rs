@@ -2,8 +2,11 @@
 //! JOD, times, rays): its statistics and its charts. A method lists them in its own folder
 //! (`MethodPlugin::STATISTICS`, `MethodPlugin::CHARTS`); suites and `flicker reproduce` find a
 //! statistic by its name through the registry, and the report draws the charts of every
-//! registered method whose columns a run has. Plain data, so that the crates reading run
-//! folders need no method crate.
+//! registered method whose columns a run has; a statistic computed from a run folder's images
+//! carries the method's own function ([`FolderStatistic`]). Data and function pointers, so
+//! that the crates reading run folders need no method crate.
+
+use std::path::Path;
 
 /// Which way a statistic is better.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -12,21 +15,66 @@ pub enum Better {
     Higher,
 }
 
-/// How `flicker reproduce` computes a statistic from a run's images (the computations live in
-/// `tools::reproduce`; a statistic names the one it needs).
+/// What a statistic computed from a run folder needs of its claim and case, checked when a
+/// claims file loads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ImageStatistic {
-    /// Per frame, the PSNR of the statistic's method against the frames of another method of
-    /// the same run, the claim's `against` (`reproduce::sss_psnr`).
-    PsnrAgainst,
-    /// Per frame, the mean of the method's preference maps over the pixels whose reference
-    /// changed most (`changed`) or least across the case's first event
-    /// (`reproduce::sigma_regions`).
-    PreferenceRegions,
-    /// Per frame, the image variance over the pixel's mean across the run, over the method's
-    /// bound (`reproduce::variance_bound`); its mean over a static run's frames is the
-    /// estimator's variance over the bound.
-    VarianceOverBound,
+pub enum FolderInput {
+    /// Another method of the same run to compare with: the claim's `against`.
+    Against,
+    /// The case's first event, and methods whose settings write the image map `map`
+    /// (`MethodPlugin::writes_image`); `writers` says which do, for errors
+    /// (`a blend or the switch`).
+    EventAndMap { map: &'static str, writers: &'static str },
+    /// Every frame of the run: one number per run (its mean over the Overall window), so
+    /// neither a suite nor `by_window` reads it.
+    WholeRun,
+}
+
+/// A run folder as a [`FolderStatistic`] reads it.
+#[derive(Clone, Copy, Debug)]
+pub struct FolderRun<'a> {
+    /// The run folder (`frame::run_folder::RunFolder`'s root).
+    pub folder: &'a Path,
+    /// The run's seed, for errors.
+    pub seed: u64,
+    /// The run's method labels.
+    pub methods: &'a [String],
+    /// The run's recorded frames.
+    pub frames: u32,
+    /// The case's events, in recorded frames.
+    pub events: &'a [u32],
+    /// The claim's `against` method (with [`FolderInput::Against`]).
+    pub against: Option<&'a str>,
+}
+
+/// What a [`FolderStatistic`] computed: per method label and column, the per-frame values.
+pub type FolderSeries = Vec<(String, &'static str, Vec<Option<f64>>)>;
+
+/// A statistic `flicker reproduce` computes from a run folder's images (and frames.csv), the
+/// computation living in the method crate that declares it.
+#[derive(Clone, Copy)]
+pub struct FolderStatistic {
+    /// Names the computation: the statistics one computation fills (σ where the reference
+    /// changed most and least) share it, and it runs once per case.
+    pub id: &'static str,
+    pub input: FolderInput,
+    pub compute: fn(&FolderRun) -> anyhow::Result<FolderSeries>,
+}
+
+/// The same computation: the same `id` and input (function addresses are not compared, they
+/// may differ between codegen units).
+impl PartialEq for FolderStatistic {
+    fn eq(&self, other: &Self) -> bool {
+        self.id == other.id && self.input == other.input
+    }
+}
+
+impl Eq for FolderStatistic {}
+
+impl std::fmt::Debug for FolderStatistic {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FolderStatistic").field("id", &self.id).field("input", &self.input).finish()
+    }
 }
 
 /// Where a statistic's per-frame values come from.
@@ -38,8 +86,8 @@ pub enum Source {
     /// A frames.csv column that only `flicker reproduce` reads: suites' runs, sweeps and
     /// baselines keep their columns without it.
     FramesReproduceOnly,
-    /// Computed by `flicker reproduce` from the run folder's images.
-    Images(ImageStatistic),
+    /// Computed by `flicker reproduce` from the run folder's images, by the method's code.
+    Images(FolderStatistic),
 }
 
 /// One statistic a method records: per frame, so a window's value is the mean of its frames'

@@ -20,6 +20,7 @@ pub mod plugin;
 pub mod recorded;
 pub mod records;
 pub mod reliability;
+pub mod sigma_regions;
 pub mod state;
 
 pub use bounds::SceneBounds;

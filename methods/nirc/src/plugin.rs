@@ -154,6 +154,11 @@ impl MethodPlugin for Plugin {
     const STATISTICS: &'static [frame::method::Statistic] = crate::recorded::STATISTICS;
     const CHARTS: &'static [frame::method::MethodChart] = crate::recorded::CHARTS;
 
+    /// The blends and the switch write `preference` maps (σ per pixel; σ by region reads them).
+    fn writes_image(settings: &NircSettings, name: &str) -> bool {
+        name == "preference" && settings.predictor.has_preference_map()
+    }
+
     fn label(settings: &NircSettings) -> String {
         settings.label()
     }

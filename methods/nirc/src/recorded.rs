@@ -2,13 +2,18 @@
 //! region of change (claims and suites name them), and the report's charts of reliability and
 //! σ (Figure 1 of reliability-weighted-nirc.txt; what σ does and why it stays near 0.5).
 
-use frame::method::{ChartSeries, ImageStatistic, MethodChart, Source, Statistic};
+use frame::method::{ChartSeries, FolderInput, FolderStatistic, MethodChart, Source, Statistic};
 
 /// σ by region: the mean of the preference maps over the fifth of the pixels whose reference
-/// changed most across the case's first event, and over the fifth that changed least.
+/// changed most across the case's first event, and over the fifth that changed least; one
+/// computation (`sigma_regions.rs`) fills both.
 const fn sigma_region(name: &'static str, column: &'static str, label: &'static str) -> Statistic {
     Statistic {
-        source: Source::Images(ImageStatistic::PreferenceRegions),
+        source: Source::Images(FolderStatistic {
+            id: "sigma_by_region",
+            input: FolderInput::EventAndMap { map: "preference", writers: "a blend or the switch" },
+            compute: crate::sigma_regions::sigma_by_region,
+        }),
         needs_references: true,
         ..Statistic::frames(name, column, label, "")
     }
@@ -17,8 +22,16 @@ const fn sigma_region(name: &'static str, column: &'static str, label: &'static 
 pub const STATISTICS: &[Statistic] = &[
     // Mean blend weight σ of the High-LR side over the image (the `blend_sigma` stat).
     Statistic::frames("BlendSigma", "blend_sigma", "mean blend weight σ of High-LR", ""),
-    sigma_region("SigmaChanged", "sigma_changed", "mean σ where the reference changed most"),
-    sigma_region("SigmaUnchanged", "sigma_unchanged", "mean σ where the reference changed least"),
+    sigma_region(
+        "SigmaChanged",
+        crate::sigma_regions::CHANGED,
+        "mean σ where the reference changed most",
+    ),
+    sigma_region(
+        "SigmaUnchanged",
+        crate::sigma_regions::UNCHANGED,
+        "mean σ where the reference changed least",
+    ),
 ];
 
 pub const CHARTS: &[MethodChart] = &[

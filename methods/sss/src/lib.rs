@@ -17,6 +17,7 @@ pub mod hybrid;
 pub mod inverse;
 pub mod prefilter;
 pub mod profile;
+pub mod psnr_against;
 pub mod random_walk;
 pub mod reproject;
 pub mod sampling;

@@ -12,6 +12,7 @@ pub mod moments;
 pub mod rule;
 pub mod sampling_tree;
 pub mod settings;
+pub mod variance_bound;
 
 pub use cache::{
     CacheStatistics, TcPass, TerminationCache, TerminationOutput, TerminationStats,

@@ -2,7 +2,7 @@
 //! cache's statistics around a change of lighting, and Fig. 7's image variance over its bound
 //! (variance-trading-termination.txt); the report charts the per-frame ones.
 
-use frame::method::{ImageStatistic, MethodChart, Source, Statistic};
+use frame::method::{FolderInput, FolderStatistic, MethodChart, Source, Statistic};
 
 /// A statistic of the cache's filled records, read back from frames.csv by `flicker reproduce`
 /// only (suites' runs and baselines keep their columns without them).
@@ -20,12 +20,16 @@ pub const STATISTICS: &[Statistic] = &[
     // Fig. 7: per frame, the mean over pixels of the squared deviation of the frame's luminance
     // from the pixel's mean over the run's frames, times n/(n − 1), over the method's absolute
     // threshold t · unit² (frames.csv's `variance_bound_log10`); over a static scene's run
-    // (window Overall) the estimator's per-pixel variance over the bound.
+    // (window Overall) the estimator's per-pixel variance over the bound (`variance_bound.rs`).
     Statistic {
-        source: Source::Images(ImageStatistic::VarianceOverBound),
+        source: Source::Images(FolderStatistic {
+            id: "variance_over_bound",
+            input: FolderInput::WholeRun,
+            compute: crate::variance_bound::variance_over_bound,
+        }),
         ..Statistic::frames(
             "VarianceOverBound",
-            "variance_over_bound",
+            crate::variance_bound::COLUMN,
             "image variance over its bound",
             "",
         )

@@ -8,7 +8,7 @@ use serde::Deserialize;
 use super::claims::CaseMethods;
 use super::table::{CaseTable, cell};
 use crate::suite::measurement::CaseRuns;
-use systems::methods::ImageStatistic;
+use systems::methods::FolderInput;
 
 use crate::suite::metric::Metric;
 use crate::suite::window::Window;
@@ -34,7 +34,7 @@ impl ByWindow {
             }
             if m.from_images()
                 || *m == Metric::PassMs
-                || m.from_images_by() == Some(ImageStatistic::VarianceOverBound)
+                || m.from_images_by().is_some_and(|i| i.input == FolderInput::WholeRun)
                 || !m.per_frame()
             {
                 return Err(format!(

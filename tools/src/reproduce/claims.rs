@@ -14,7 +14,7 @@ use sim::scenario::{ReferenceFrames, ScenarioError};
 use systems::playback::{Overrides, RunSpec};
 
 use crate::ron_file::{self, RonFile};
-use systems::methods::ImageStatistic;
+use systems::methods::{FolderInput, Source};
 
 use crate::suite::metric::Metric;
 use crate::suite::spec::Case;
@@ -370,8 +370,9 @@ pub struct CaseMethods {
     pub references: bool,
     /// A computed case: the metrics each method records.
     pub computed: Option<BTreeMap<String, Vec<Metric>>>,
-    /// The labels of the NIRC methods that write preference maps (σ by region reads them).
-    pub preference_maps: Vec<String>,
+    /// Per image map a registered statistic reads (`FolderInput::EventAndMap`), the labels of
+    /// the methods that write it (NIRC's blends and switch write `preference`).
+    pub image_maps: BTreeMap<&'static str, Vec<String>>,
 }
 
 #[derive(Clone, Debug)]
@@ -618,7 +619,7 @@ impl Claims {
                             kinds,
                             references,
                             computed: Some(computed),
-                            preference_maps: Vec::new(),
+                            image_maps: BTreeMap::new(),
                         },
                     );
                     case_lines.insert(case.name.clone(), (entry.line, entry.column));
@@ -667,16 +668,21 @@ impl Claims {
             let case_events = CaseEvents::of(&spec.scenario, &case);
             let r = &spec.scenario.reference;
             let references = r.spp > 0 && r.frames != ReferenceFrames::None;
-            let preference_maps = played
-                .iter()
-                .filter(|m| {
-                    m.spec
-                        .get::<nirc::plugin::NircSettings>()
-                        .is_some_and(|s| s.predictor.has_preference_map())
+            let image_maps = systems::methods::registry::statistics()
+                .into_iter()
+                .filter_map(|s| match s.source {
+                    Source::Images(i) => match i.input {
+                        FolderInput::EventAndMap { map, .. } => Some(map),
+                        _ => None,
+                    },
+                    _ => None,
                 })
-                .map(|m| m.label())
+                .map(|map| {
+                    let writers = played.iter().filter(|m| m.spec.writes_image(map));
+                    (map, writers.map(|m| m.label()).collect())
+                })
                 .collect();
-            let case_methods = CaseMethods { kinds, references, computed: None, preference_maps };
+            let case_methods = CaseMethods { kinds, references, computed: None, image_maps };
             for s in &case.table {
                 let at = |m: String| at(format!("table: {}: {m}", s.describe()));
                 if s.against.is_some() || !s.not_run.is_empty() {
@@ -792,14 +798,17 @@ impl Claims {
                         )));
                     }
                     if let Some(s) = &claim.statistic
-                        && s.metric.from_images_by() == Some(ImageStatistic::PreferenceRegions)
-                        && !case.preference_maps.iter().any(|p| p == m)
+                        && let Some(FolderInput::EventAndMap { map, writers }) =
+                            s.metric.from_images_by().map(|i| i.input)
                     {
-                        return Err(at(format!(
-                            "method '{m}' writes no preference maps, so it has no {}; expected a blend or the switch: {}",
-                            s.metric.name(),
-                            case.preference_maps.join(", ")
-                        )));
+                        let written = case.image_maps.get(map).map_or(&[][..], |w| &w[..]);
+                        if !written.iter().any(|p| p == m) {
+                            return Err(at(format!(
+                                "method '{m}' writes no {map} maps, so it has no {}; expected {writers}: {}",
+                                s.metric.name(),
+                                written.join(", ")
+                            )));
+                        }
                     }
                 }
             }

@@ -9,6 +9,7 @@ pub mod claims;
 pub mod computation;
 pub mod distributed;
 pub mod events;
+pub mod folder_statistic;
 pub mod frame_columns;
 pub mod frames_csv;
 pub mod judge;
@@ -16,10 +17,7 @@ pub mod log_ratio;
 pub mod pass_ms;
 pub mod report;
 pub mod run;
-pub mod sigma_regions;
-pub mod sss_psnr;
 pub mod table;
-pub mod variance_bound;
 
 pub use claims::{Claim, Claims, Comparison, Effect, Scale};
 pub use judge::{Judged, Verdict, judge};

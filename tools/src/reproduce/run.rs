@@ -11,7 +11,7 @@ use super::judge::{Judged, judge};
 use super::report::{self, PaperResult};
 use super::table::case_tables;
 use crate::suite::measurement::CaseRuns;
-use systems::methods::ImageStatistic;
+use systems::methods::FolderInput;
 
 use crate::suite::metric::Metric;
 use crate::suite::run::play_cases;
@@ -71,13 +71,14 @@ pub fn load_claims(dir: &Path, paper: &str) -> Result<Vec<Claims>> {
 }
 
 /// What the claims' statistics read from the run folders rather than frame records, added to
-/// each played seed's run once per case: `SssPsnr` against the claim's `against` method, and
-/// `FrameMs` less the shared passes a method would not run alone (`not_run`), `PassMs`
-/// over its passes, Fig. 7's image variance over its bound (`variance_bound`), and σ by region (claims' statistics and the cases' table columns).
+/// each played seed's run once per case: `FrameMs` less the shared passes a method would not
+/// run alone (`not_run`), `PassMs` over its passes, and the statistics their methods compute
+/// from the run's images (`folder_statistic`: SSS's PSNR against the claim's `against`
+/// method, Fig. 7's image variance over its bound, σ by region), for the claims' statistics
+/// and the cases' table columns.
 fn add_from_folders(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> Result<()> {
-    let (mut images, mut alone): (Vec<&str>, Vec<&str>) = (Vec::new(), Vec::new());
-    let mut regions: Vec<&str> = Vec::new();
-    let mut bounded: Vec<&str> = Vec::new();
+    let mut alone: Vec<&str> = Vec::new();
+    let mut images: Vec<(&str, &str)> = Vec::new();
     let mut passes: Vec<(&str, &[String])> = Vec::new();
     add_columns(claims, runs)?;
     let of_claims =
@@ -92,32 +93,21 @@ fn add_from_folders(claims: &Claims, runs: &mut BTreeMap<String, CaseRuns>) -> R
                 super::pass_ms::add(seed, &s.passes).map_err(at)?;
             }
         }
-        if let Some(against) = &s.against
-            && s.metric.from_images()
-            && !images.contains(&case)
+        if let Some(statistic) = s.metric.from_images_by()
+            && (s.against.is_some() || statistic.input != FolderInput::Against)
+            && !images.contains(&(case, statistic.id))
         {
-            images.push(case);
-            let frames = r.frames;
-            for seed in &mut r.seeds {
-                super::sss_psnr::add(seed, against, frames).map_err(at)?;
-            }
-        }
-        if s.metric.from_images_by() == Some(ImageStatistic::VarianceOverBound)
-            && !bounded.contains(&case)
-        {
-            bounded.push(case);
-            let frames = r.frames;
-            for seed in &mut r.seeds {
-                super::variance_bound::add(seed, frames).map_err(at)?;
-            }
-        }
-        if s.metric.from_images_by() == Some(ImageStatistic::PreferenceRegions)
-            && !regions.contains(&case)
-        {
-            regions.push(case);
+            images.push((case, statistic.id));
             let (frames, events) = (r.frames, r.events.clone());
             for seed in &mut r.seeds {
-                super::sigma_regions::add(seed, frames, &events).map_err(at)?;
+                super::folder_statistic::add(
+                    seed,
+                    &statistic,
+                    frames,
+                    &events,
+                    s.against.as_deref(),
+                )
+                .map_err(at)?;
             }
         }
         if !s.not_run.is_empty() && !alone.contains(&case) {

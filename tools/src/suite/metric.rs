@@ -8,7 +8,7 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use systems::frame_record::FrameRecord;
 use systems::methods::registry;
-use systems::methods::{Better, ImageStatistic, Source, Statistic};
+use systems::methods::{Better, FolderInput, FolderStatistic, Source, Statistic};
 
 /// A number every method has, or one a method declares (`Method`: its statistic's name, e.g.
 /// `PathLength`, looked up in the registry: `systems::methods::registry::statistic`). Claims and
@@ -99,8 +99,9 @@ impl Metric {
         }
     }
 
-    /// How `flicker reproduce` computes it from a run's images, where it does.
-    pub fn from_images_by(self) -> Option<ImageStatistic> {
+    /// How `flicker reproduce` computes it from a run's images, where it does (the method's
+    /// computation, run through `reproduce::folder_statistic`).
+    pub fn from_images_by(self) -> Option<FolderStatistic> {
         match self.statistic()?.source {
             Source::Images(how) => Some(how),
             _ => None,
@@ -142,21 +143,20 @@ impl Metric {
         }
     }
 
-    /// Computed from a run's images against another method's (the claim's `against`,
-    /// `reproduce::sss_psnr`), not read from frame records.
+    /// Computed from a run's images against another method's (the claim's `against`, e.g.
+    /// SSS's PSNR), not read from frame records.
     pub fn from_images(self) -> bool {
-        self.from_images_by() == Some(ImageStatistic::PsnrAgainst)
+        self.from_images_by().is_some_and(|i| i.input == FolderInput::Against)
     }
 
     /// Read back from a run's frames.csv or images by `flicker reproduce` only (not kept in a
     /// suite's runs or baselines): a suite gate cannot judge it.
     pub fn reproduce_only(self) -> bool {
         self == Metric::PassMs
-            || self.statistic().is_some_and(|s| {
-                matches!(
-                    s.source,
-                    Source::FramesReproduceOnly | Source::Images(ImageStatistic::VarianceOverBound)
-                )
+            || self.statistic().is_some_and(|s| match s.source {
+                Source::FramesReproduceOnly => true,
+                Source::Images(i) => i.input == FolderInput::WholeRun,
+                Source::Frames => false,
             })
     }
 

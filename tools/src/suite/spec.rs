@@ -259,13 +259,13 @@ impl Suite {
                     ),
                 ));
             }
-            if gate.metric.from_images_by()
-                == Some(systems::methods::ImageStatistic::PreferenceRegions)
+            if let Some(systems::methods::FolderInput::EventAndMap { map, .. }) =
+                gate.metric.from_images_by().map(|i| i.input)
             {
                 return Err(file.error_at(
                     &entry,
                     format!(
-                        "metric {} is computed by `flicker reproduce` from a run's preference maps; expected a metric of frames.csv, e.g. BlendSigma",
+                        "metric {} is computed by `flicker reproduce` from a run's {map} maps; expected a metric of frames.csv, e.g. BlendSigma",
                         gate.metric.name()
                     ),
                 ));

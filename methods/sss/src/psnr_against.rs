@@ -1,22 +1,24 @@
-//! realtime-sss-thesis Table 7.3's PSNR column: per frame, the PSNR of luminance over the
-//! subsurface pixels of a method's frame against the converged pass of the same run (the
-//! thesis's ground truth is its own pass at 1024 spp per frame, Sec. 7.4, so the PSNR measures
-//! the sampling's noise, not the diffusion model's error). The subsurface pixels are those the
-//! reference pass sampled (its `sample_count` image non-zero); the peak is the reference's
-//! largest luminance over those pixels and the run's frames, one constant per run, so that a
-//! difference of two methods' PSNR is the ratio of their errors whatever the peak.
+//! realtime-sss-thesis Table 7.3's PSNR column (`SssPsnr`, computed by `flicker reproduce` from
+//! a run folder): per frame, the PSNR of luminance over the subsurface pixels of a method's
+//! frame against the converged pass of the same run (the thesis's ground truth is its own pass
+//! at 1024 spp per frame, Sec. 7.4, so the PSNR measures the sampling's noise, not the diffusion
+//! model's error). The subsurface pixels are those the reference pass sampled (its
+//! `sample_count` image non-zero); the peak is the reference's largest luminance over those
+//! pixels and the run's frames, one constant per run, so that a difference of two methods' PSNR
+//! is the ratio of their errors whatever the peak.
 
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use systems::run_folder::RunFolder;
+use frame::method::{FolderRun, FolderSeries};
+use frame::run_folder::RunFolder;
 
-use crate::suite::measurement::SeedRun;
-use crate::suite::metric::Metric;
+/// The statistic's frames.csv-style column.
+pub const COLUMN: &str = "sss_psnr";
 
 fn luminance_image(path: &Path) -> Result<Vec<f32>> {
     let image = metrics::load_image(path)?;
-    Ok(image.rgb.iter().map(|p| sss::sampling::luminance(*p)).collect())
+    Ok(image.rgb.iter().map(|p| crate::sampling::luminance(*p)).collect())
 }
 
 fn sampled(path: &Path) -> Result<Vec<bool>> {
@@ -24,14 +26,14 @@ fn sampled(path: &Path) -> Result<Vec<bool>> {
     Ok(image.rgb.iter().map(|p| p.iter().any(|c| *c > 0.0)).collect())
 }
 
-/// Per method of `run` other than `against`, the per-frame PSNR (dB) against `against`'s frames
-/// of the same run, `frames` frames from the run folder; `against`'s own series stays empty
-/// (no PSNR against itself).
-pub fn add(run: &mut SeedRun, against: &str, frames: u32) -> Result<()> {
-    let Some(root) = &run.folder else {
-        bail!("seed {}: no run folder to read {} from", run.seed, Metric::shipped("SssPsnr").name())
+/// Per method of `run` other than its `against`, the per-frame PSNR (dB) against `against`'s
+/// frames of the same run; `against` itself gets no series (no PSNR against itself).
+pub fn psnr_against(run: &FolderRun) -> Result<FolderSeries> {
+    let Some(against) = run.against else {
+        bail!("seed {}: {COLUMN} needs a reference method (the claim's against)", run.seed)
     };
-    let folder = RunFolder::new(root);
+    let frames = run.frames;
+    let folder = RunFolder::new(run.folder);
     let at = |what: &str, f: u32| format!("seed {} frame {f}: {what}", run.seed);
     let mut references = Vec::new();
     let mut masks = Vec::new();
@@ -49,28 +51,25 @@ pub fn add(run: &mut SeedRun, against: &str, frames: u32) -> Result<()> {
         .zip(&masks)
         .flat_map(|(r, m)| r.iter().zip(m).filter(|(_, m)| **m).map(|(l, _)| *l as f64))
         .fold(0.0, f64::max);
-    let methods: Vec<String> = run.methods.keys().filter(|m| *m != against).cloned().collect();
-    for m in methods {
+    let mut out = FolderSeries::new();
+    for m in run.methods.iter().filter(|m| *m != against) {
         let mut series = Vec::with_capacity(frames as usize);
         for f in 0..frames as usize {
-            let image = luminance_image(&folder.frame(&m, f as u32, "exr"))
+            let image = luminance_image(&folder.frame(m, f as u32, "exr"))
                 .with_context(|| at(&format!("{m}'s frame"), f as u32))?;
             let any = masks[f].iter().any(|s| *s);
-            let db = sss::evaluation::psnr_luminance(&image, &references[f], &masks[f], peak);
+            let db = crate::evaluation::psnr_luminance(&image, &references[f], &masks[f], peak);
             series.push((any && peak > 0.0).then_some(db));
         }
-        let metrics = run.methods.get_mut(&m).expect("a method of the run");
-        metrics.insert(Metric::shipped("SssPsnr").name().to_string(), series);
+        out.push((m.clone(), COLUMN, series));
     }
-    Ok(())
+    Ok(out)
 }
 
 #[cfg(test)]
 mod tests {
-    use std::collections::BTreeMap;
-
     use super::*;
-    use systems::output::{write_exr, write_png_linear};
+    use frame::output::{write_exr, write_png_linear};
 
     fn grey(values: &[f32]) -> Vec<[f32; 4]> {
         values.iter().map(|&v| [v, v, v, 1.0]).collect()
@@ -91,19 +90,28 @@ mod tests {
             write_png_linear(&folder.method_image("ref", "sample_count", f, "png"), 3, 1, &counts)
                 .unwrap();
         }
-        let methods = ["a", "b", "ref"].map(|m| (m.to_string(), BTreeMap::new())).into();
-        let mut run = SeedRun { seed: 1, methods, jod: BTreeMap::new(), folder: Some(dir.clone()) };
-        add(&mut run, "ref", 2).unwrap();
-        let psnr = |m: &str| run.methods[m]["sss_psnr"].clone();
+        let methods = ["a", "b", "ref"].map(String::from);
+        let run = FolderRun {
+            folder: &dir,
+            seed: 1,
+            methods: &methods,
+            frames: 2,
+            events: &[],
+            against: Some("ref"),
+        };
+        let out = psnr_against(&run).unwrap();
+        let psnr = |m: &str| {
+            out.iter().find(|(n, c, _)| n == m && *c == "sss_psnr").map(|s| s.2.clone()).unwrap()
+        };
         // a: MSE (0.1² + 0) / 2 = 0.005 at peak 1: 10 log10(200) = 23.0103 dB; b: MSE 0.02.
         let a = psnr("a");
         assert_eq!(a.len(), 2);
         assert!((a[0].unwrap() - 23.0103).abs() < 1e-3, "{a:?}");
         assert!((psnr("b")[1].unwrap() - 16.9897).abs() < 1e-3);
-        assert!(!run.methods["ref"].contains_key("sss_psnr"));
+        assert!(!out.iter().any(|(m, _, _)| m == "ref"));
         // A missing frame is an error naming the method and frame.
         std::fs::remove_file(folder.frame("b", 1, "exr")).unwrap();
-        let e = format!("{:#}", add(&mut run, "ref", 2).unwrap_err());
+        let e = format!("{:#}", psnr_against(&run).unwrap_err());
         assert!(e.contains("frame 1") && e.contains("b's frame"), "{e}");
     }
 }

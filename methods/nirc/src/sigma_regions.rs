@@ -10,10 +10,12 @@
 //! otherwise be the "unchanged" fifth. Each seed ranks its own references.
 
 use anyhow::{Context, Result, bail};
-use systems::run_folder::RunFolder;
+use frame::method::{FolderRun, FolderSeries};
+use frame::run_folder::RunFolder;
 
-use crate::suite::measurement::SeedRun;
-use crate::suite::metric::Metric;
+/// The statistics' columns: σ over the pixels that changed most, and least.
+pub const CHANGED: &str = "sigma_changed";
+pub const UNCHANGED: &str = "sigma_unchanged";
 
 /// The share of the pixels in each class (the most and the least changed).
 const SHARE: f64 = 0.2;
@@ -69,7 +71,7 @@ fn box_mean(image: &[f64], width: usize) -> Vec<f64> {
 }
 
 /// An image's Rec. 709 luminance per pixel, and its width.
-pub(super) fn luminance(path: &std::path::Path) -> Result<(Vec<f64>, usize)> {
+fn luminance(path: &std::path::Path) -> Result<(Vec<f64>, usize)> {
     let image = metrics::load_image(path)?;
     let lum = image.rgb.iter().map(|p| (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) as f64);
     Ok((lum.collect(), image.width as usize))
@@ -98,14 +100,11 @@ fn sigma_by_class(path: &std::path::Path, classes: &[Option<bool>]) -> Result<[O
     Ok(sums.map(|(s, n)| (n > 0).then(|| s / n as f64)))
 }
 
-/// Adds `SigmaChanged` and `SigmaUnchanged` per frame to every method of `run` that wrote
-/// preference maps (the blends and the switch); `events` are the case's events in recorded
-/// frames, `frames` its frame count.
-pub fn add(run: &mut SeedRun, frames: u32, events: &[u32]) -> Result<()> {
-    let Some(root) = &run.folder else {
-        bail!("seed {}: no run folder to read references and preference maps from", run.seed)
-    };
-    let folder = RunFolder::new(root);
+/// `SigmaChanged` and `SigmaUnchanged` per frame of every method of `run` that wrote
+/// preference maps (the blends and the switch), ranked across the case's first event.
+pub fn sigma_by_region(run: &FolderRun) -> Result<FolderSeries> {
+    let (frames, events) = (run.frames, run.events);
+    let folder = RunFolder::new(run.folder);
     let Some(&event) = events.first().filter(|e| **e > 0 && **e < frames) else {
         bail!("seed {}: σ by region needs an event after the first recorded frame", run.seed)
     };
@@ -117,9 +116,9 @@ pub fn add(run: &mut SeedRun, frames: u32, events: &[u32]) -> Result<()> {
     if before.len() != after.len() {
         bail!("seed {}: the references before and after the event differ in size", run.seed);
     }
-    let methods: Vec<String> = run.methods.keys().cloned().collect();
-    for m in methods {
-        let answered_before = folder.method_image(&m, "preference", event - 1, "png");
+    let mut out = FolderSeries::new();
+    for m in run.methods {
+        let answered_before = folder.method_image(m, "preference", event - 1, "png");
         if !answered_before.exists() {
             continue;
         }
@@ -133,25 +132,22 @@ pub fn add(run: &mut SeedRun, frames: u32, events: &[u32]) -> Result<()> {
         let classes = classes(&before, &after, width, &answered);
         let (mut changed, mut unchanged) = (Vec::new(), Vec::new());
         for f in 0..frames {
-            let path = folder.method_image(&m, "preference", f, "png");
+            let path = folder.method_image(m, "preference", f, "png");
             let [c, u] = sigma_by_class(&path, &classes)
                 .with_context(|| format!("seed {} frame {f}: {m}'s preference map", run.seed))?;
             changed.push(c);
             unchanged.push(u);
         }
-        let metrics = run.methods.get_mut(&m).expect("a method of the run");
-        metrics.insert(Metric::shipped("SigmaChanged").name().to_string(), changed);
-        metrics.insert(Metric::shipped("SigmaUnchanged").name().to_string(), unchanged);
+        out.push((m.clone(), CHANGED, changed));
+        out.push((m.clone(), UNCHANGED, unchanged));
     }
-    Ok(())
+    Ok(out)
 }
 
 #[cfg(test)]
 mod tests {
-    use std::collections::BTreeMap;
-
     use super::*;
-    use systems::output::{write_exr, write_png_linear};
+    use frame::output::{write_exr, write_png_linear};
 
     fn grey(values: &[f32]) -> Vec<[f32; 4]> {
         values.iter().map(|&v| [v, v, v, 1.0]).collect()
@@ -182,10 +178,19 @@ mod tests {
             write_png_linear(&folder.method_image("blend", "preference", f, "png"), 20, 1, &map)
                 .unwrap();
         }
-        let methods = ["blend", "ema"].map(|m| (m.to_string(), BTreeMap::new())).into();
-        let mut run = SeedRun { seed: 1, methods, jod: BTreeMap::new(), folder: Some(dir.clone()) };
-        add(&mut run, 3, &[1]).unwrap();
-        let series = |m: &str| run.methods["blend"][m].clone();
+        let methods = ["blend", "ema"].map(String::from);
+        let mut run = FolderRun {
+            folder: &dir,
+            seed: 1,
+            methods: &methods,
+            frames: 3,
+            events: &[1],
+            against: None,
+        };
+        let out = sigma_by_region(&run).unwrap();
+        let series = |c: &str| {
+            out.iter().find(|(m, s, _)| m == "blend" && *s == c).map(|s| s.2.clone()).unwrap()
+        };
         let changed = series("sigma_changed");
         // 8-bit PNG: within half a step of 255.
         for (f, s) in changed.iter().enumerate() {
@@ -193,9 +198,10 @@ mod tests {
             assert!((s.unwrap() - expected).abs() < 0.01, "frame {f}: {s:?}");
         }
         assert!(series("sigma_unchanged").iter().all(|s| (s.unwrap() - 0.3).abs() < 0.01));
-        assert!(run.methods["ema"].is_empty());
+        assert!(!out.iter().any(|(m, _, _)| m == "ema"));
         // Without an event inside the run there is nothing to rank by.
-        let e = add(&mut run, 3, &[]).unwrap_err().to_string();
+        run.events = &[];
+        let e = sigma_by_region(&run).unwrap_err().to_string();
         assert!(e.contains("needs an event"), "{e}");
     }
 }
