@@ -245,3 +245,34 @@ fn empty_scene_and_bad_input() {
     };
     assert!(SceneGeometry::new(&gpu, &bad).is_err(), "a singular transform is refused");
 }
+
+/// Geometry too far apart for f32 BVH bounds to enclose is refused, naming what falls out: a
+/// cube with one vertex pulled out to -2^41 (its box's quantized offset rounds past the cube),
+/// then two cubes as instances 2^41 apart. At ordinary distances both build.
+#[test]
+fn geometry_beyond_f32_bounds_is_refused() {
+    use render::bvh::SceneBvh;
+    let far = -(2f32.powi(41));
+    let at =
+        |x: f32| Instance { mesh: 0, material: 0, transform: Mat4::from_translation(Vec3::X * x) };
+    let scene = |mesh: render::scene::Mesh, instances: Vec<Instance>| SceneDesc {
+        meshes: vec![mesh],
+        instances,
+        ..Default::default()
+    };
+    for x in [-2.0, -1e3] {
+        let mut near = cube();
+        near.positions[0].x = x;
+        SceneBvh::new(&scene(near, vec![at(0.0)])).unwrap_or_else(|e| panic!("{x}: {e}"));
+        SceneBvh::new(&scene(cube(), vec![at(0.0), at(x)])).unwrap_or_else(|e| panic!("{x}: {e}"));
+    }
+    let mut stretched = cube();
+    stretched.positions[0].x = far;
+    let err = SceneBvh::new(&scene(stretched, vec![at(0.0)])).err().expect("refused").to_string();
+    assert!(err.contains("mesh 0 'cube'") && err.contains("falls outside its BVH box"), "{err}");
+    let err = SceneBvh::new(&scene(cube(), vec![at(0.0), at(1.0), at(far)]))
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(err.contains("falls outside its TLAS box"), "{err}");
+}

@@ -119,7 +119,10 @@ pub fn read_animations(
         for channel in animation.channels() {
             let part = format!("animation {} channel {}", animation.index(), channel.index());
             let fail = |m: String| (part.clone(), m);
-            let node = nodes[&channel.target().node().index()];
+            // A node outside the rendered scene: nothing it moves is drawn.
+            let Some(&node) = nodes.get(&channel.target().node().index()) else {
+                continue;
+            };
             let reader = channel.reader(read);
             let times: Vec<f32> =
                 reader.read_inputs().ok_or_else(|| fail("no key times".into()))?.collect();
@@ -151,9 +154,9 @@ pub fn read_animations(
         }
     }
     let light_nodes: HashMap<usize, usize> =
-        doc.nodes().filter_map(|n| Some((n.light()?.index(), nodes[&n.index()]))).collect();
+        doc.nodes().filter_map(|n| Some((n.light()?.index(), *nodes.get(&n.index())?))).collect();
     let camera_nodes: HashMap<usize, usize> =
-        doc.nodes().filter_map(|n| Some((n.camera()?.index(), nodes[&n.index()]))).collect();
+        doc.nodes().filter_map(|n| Some((n.camera()?.index(), *nodes.get(&n.index())?))).collect();
     for p in pointers {
         let fail = |m: String| (p.part.clone(), format!("pointer {}: {m}", p.pointer));
         let times: Vec<f32> = accessor_values(doc, buffers, p.input).map_err(fail)?;
@@ -172,7 +175,7 @@ pub fn read_animations(
                 let light = index(3).ok_or_else(|| fail("no light index".into()))?;
                 let node = *light_nodes
                     .get(&light)
-                    .ok_or_else(|| fail(format!("light {light} is on no node")))?;
+                    .ok_or_else(|| fail(format!("light {light} is on no node of the scene")))?;
                 let spec = doc
                     .lights()
                     .and_then(|mut l| l.nth(light))
@@ -197,7 +200,7 @@ pub fn read_animations(
                 let camera = index(1).ok_or_else(|| fail("no camera index".into()))?;
                 let node = *camera_nodes
                     .get(&camera)
-                    .ok_or_else(|| fail(format!("camera {camera} is on no node")))?;
+                    .ok_or_else(|| fail(format!("camera {camera} is on no node of the scene")))?;
                 template.nodes[node].camera_clip = Some(CameraClip(f1().map_err(fail)?));
             }
             ["materials", _, rest @ ..] => {

@@ -113,6 +113,17 @@ fn read_primitive(
     if primitive.mode() != gltf::mesh::Mode::Triangles {
         return Err(format!("mode {:?} is not supported; expected triangles", primitive.mode()));
     }
+    // The `gltf` crate's index reader treats any other component type as unreachable.
+    if let Some(indices) = primitive.indices() {
+        use gltf::accessor::DataType;
+        if !matches!(indices.data_type(), DataType::U8 | DataType::U16 | DataType::U32) {
+            return Err(format!(
+                "indices accessor {} has component type {:?}; expected an unsigned byte, short or int",
+                indices.index(),
+                indices.data_type()
+            ));
+        }
+    }
     let reader = primitive.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
     let positions: Vec<Vec3> = reader
         .read_positions()
@@ -203,11 +214,42 @@ pub fn import(path: &Path) -> Result<WorldTemplate, GltfError> {
     // A .glb may carry KHR_animation_pointer channels, which the `gltf` crate cannot read:
     // they are taken out first (crate::gltf_animation).
     let bytes = std::fs::read(path).map_err(|e| err("file", format!("cannot read: {e}")))?;
-    // The `gltf` crate panics on an image with no source (neither `uri` nor `bufferView`) or a
-    // `bufferView` image without `mimeType`; refused here first. A file that does not parse is
-    // reported by the import below.
-    if let Ok(parsed) = gltf::Gltf::from_slice(&bytes) {
-        for (i, image) in parsed.document.as_json().images.iter().enumerate() {
+    // The `gltf` crate subtracts the 12-byte header from the length the header declares.
+    if bytes.starts_with(b"glTF") && bytes.len() >= 12 {
+        let length = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
+        if length < 12 {
+            return Err(err(
+                "GLB header",
+                format!("length {length}; expected at least the 12-byte header"),
+            ));
+        }
+    }
+    // The `gltf` crate panics on an image with no source (neither `uri` nor `bufferView`), a
+    // `bufferView` image without `mimeType`, or (in its own validation) a POSITION accessor
+    // index past the accessors; refused here first, on the unvalidated JSON. A file that does
+    // not parse is reported by the import below.
+    if let Ok(parsed) = gltf::Gltf::from_slice_without_validation(&bytes) {
+        let json = parsed.document.as_json();
+        for (m, mesh) in json.meshes.iter().enumerate() {
+            for (p, primitive) in mesh.primitives.iter().enumerate() {
+                for (semantic, accessor) in &primitive.attributes {
+                    if accessor.value() >= json.accessors.len() {
+                        let part =
+                            format!("{} primitive {p}", label("mesh", mesh.name.as_deref(), m));
+                        let semantic = semantic.to_string();
+                        return Err(err(
+                            &part,
+                            format!(
+                                "{semantic} uses accessor {}, but the file has {} accessors",
+                                accessor.value(),
+                                json.accessors.len()
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        for (i, image) in json.images.iter().enumerate() {
             let missing = match (&image.buffer_view, &image.uri, &image.mime_type) {
                 (Some(_), _, None) => "a bufferView image without mimeType",
                 (None, None, _) => "neither uri nor bufferView",

@@ -145,6 +145,85 @@ fn unsupported_primitive_mode_names_mesh_and_primitive() {
     assert_eq!(e, expected);
 }
 
+/// An attribute's accessor past the file's accessors is an error naming mesh, primitive and
+/// attribute (the `gltf` crate's own validation indexes the POSITION accessor unchecked and
+/// panics).
+#[test]
+fn attribute_accessor_out_of_range_names_mesh_and_primitive() {
+    let tmp = temp_dir("accessor");
+    let path = tmp.path().join("accessor.gltf");
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&support::test_asset::gltf_text()).unwrap();
+    let accessors = doc["accessors"].as_array().unwrap().len();
+    doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = serde_json::json!(accessors);
+    std::fs::write(&path, serde_json::to_string(&doc).unwrap()).unwrap();
+    let e = import(&path).unwrap_err().to_string();
+    let expected = format!(
+        "{}: mesh 'Cube' primitive 0: POSITION uses accessor {accessors}, but the file has {accessors} accessors",
+        path.display()
+    );
+    assert_eq!(e, expected);
+}
+
+/// Float indices are an error naming mesh and primitive (the `gltf` crate's index reader treats
+/// them as unreachable and panics).
+#[test]
+fn float_indices_name_mesh_and_primitive() {
+    let tmp = temp_dir("indices");
+    let path = tmp.path().join("indices.gltf");
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&support::test_asset::gltf_text()).unwrap();
+    let a = doc["meshes"][0]["primitives"][0]["indices"].as_u64().unwrap() as usize;
+    doc["accessors"][a]["componentType"] = serde_json::json!(5126);
+    std::fs::write(&path, serde_json::to_string(&doc).unwrap()).unwrap();
+    let e = import(&path).unwrap_err().to_string();
+    let expected = format!(
+        "{}: mesh 'Cube' primitive 0: indices accessor {a} has component type F32; expected an unsigned byte, short or int",
+        path.display()
+    );
+    assert_eq!(e, expected);
+}
+
+/// A GLB header declaring less than its own 12 bytes is an error naming the header.
+#[test]
+fn glb_header_shorter_than_itself_is_named() {
+    let tmp = temp_dir("glb-header");
+    let path = tmp.path().join("short.glb");
+    let mut bytes = b"glTF".to_vec();
+    bytes.extend(2u32.to_le_bytes());
+    bytes.extend(4u32.to_le_bytes());
+    bytes.extend([0; 20]);
+    std::fs::write(&path, &bytes).unwrap();
+    let e = import(&path).unwrap_err().to_string();
+    let expected =
+        format!("{}: GLB header: length 4; expected at least the 12-byte header", path.display());
+    assert_eq!(e, expected);
+}
+
+/// A node outside the scene may carry a light and an animation: the scene imports without them.
+#[test]
+fn nodes_outside_the_scene_are_left_out() {
+    let tmp = temp_dir("outside");
+    let path = tmp.path().join("outside.gltf");
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&support::test_asset::gltf_text()).unwrap();
+    let before = import(&asset_path()).unwrap();
+    // One more node, in no scene, holding light 0 and animated.
+    let nodes = doc["nodes"].as_array_mut().unwrap();
+    nodes.push(
+        serde_json::json!({"name": "Outside", "extensions": {"KHR_lights_punctual": {"light": 0}}}),
+    );
+    let outside = nodes.len() - 1;
+    doc["animations"] = serde_json::json!([{
+        "samplers": [{"input": 0, "output": 0}],
+        "channels": [{"sampler": 0, "target": {"node": outside, "path": "translation"}}],
+    }]);
+    std::fs::write(&path, serde_json::to_string(&doc).unwrap()).unwrap();
+    let t = import(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(t.nodes.len(), before.nodes.len());
+    assert!(t.nodes.iter().all(|n| n.name != "Outside"));
+}
+
 /// The test asset with material extensions set: FloorGrey diffusely transmitting with a volume
 /// (subsurface), Checker with a volume only (no subsurface: KHR_materials_volume alone belongs
 /// to refractive transmission).

@@ -1,12 +1,7 @@
 //! Bottom-level acceleration structure: one CWBVH per mesh, in object space, built once.
 
-use std::time::Duration;
-
 use glam::{Vec3, Vec3A};
-use obvhs::{
-    BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh_from_tris,
-    triangle::Triangle,
-};
+use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, triangle::Triangle};
 
 use super::BvhError;
 use crate::scene::Mesh;
@@ -38,8 +33,22 @@ impl Blas {
                 stack_need: 0,
             });
         }
-        let bvh =
-            build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut Duration::default());
+        let bvh = super::build::build_cwbvh(&tris, BvhBuildParams::medium_build());
+        let covered = |p: u32, b: &Aabb| {
+            let t = &tris[p as usize];
+            [t.v0, t.v1, t.v2].iter().all(|v| super::build::contains(b, *v))
+        };
+        if let Some(t) = super::build::first_uncovered(&bvh, covered) {
+            let tri = &tris[t as usize];
+            return Err(BvhError::Mesh {
+                index,
+                name: mesh.name.clone(),
+                reason: format!(
+                    "triangle {t} ({}, {}, {}) falls outside its BVH box: the mesh spans {} to {}, too far for f32 bounds to hold features this small; expected a smaller extent (split the mesh, or bring its far vertices in)",
+                    tri.v0, tri.v1, tri.v2, bvh.total_aabb.min, bvh.total_aabb.max
+                ),
+            });
+        }
         let triangles = leaf_order(&bvh.primitive_indices, &tris);
         let depth = cwbvh_depth(&bvh);
         let stack_need = super::stack_need::blas_stack_need(&bvh);

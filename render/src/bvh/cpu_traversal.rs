@@ -37,7 +37,7 @@ impl SceneBvh {
             .map(|(i, m)| Blas::build(i, m))
             .collect::<Result<Vec<_>, _>>()?;
         let instances = instance_transforms(&scene.instances, blas.len())?;
-        let tlas = Tlas::build(&instances, &blas);
+        let tlas = Tlas::build(&instances, &blas)?;
         let mesh_names = scene.meshes.iter().map(|m| m.name.clone()).collect();
         let bvh = Self { blas, tlas, instances, mesh_names };
         bvh.check_stack_depth()?;
@@ -61,7 +61,7 @@ impl SceneBvh {
         let table_changed = next != self.instances;
         self.instances = next;
         if moved {
-            self.tlas = Tlas::build(&self.instances, &self.blas);
+            self.tlas = Tlas::build(&self.instances, &self.blas)?;
             self.check_stack_depth()?;
             Ok(InstanceUpdate::Rebuilt)
         } else if table_changed {

@@ -11,6 +11,7 @@
 //! - [`random_rays`], [`displaced_sphere`]: seeded rays and a procedural mesh (tests, benchmark).
 
 mod blas;
+mod build;
 mod cpu_traversal;
 mod procedural;
 mod ray_batch;
@@ -79,6 +80,10 @@ pub enum BvhError {
     InstanceMesh { instance: usize, mesh: u32, meshes: usize },
     #[error("instance {instance} has a non-invertible or non-finite transform {transform}")]
     InstanceTransform { instance: usize, transform: String },
+    #[error(
+        "instance {instance} (world bounds {bounds}) falls outside its TLAS box: the instances span {scene}, too far for f32 bounds to hold one this small; expected instances closer together"
+    )]
+    InstanceBounds { instance: usize, bounds: String, scene: String },
     #[error(
         "BVH too deep for the GPU traversal stack: it can need {needed} entries (TLAS depth {tlas}, deepest BLAS depth {blas} in mesh '{mesh}'), more than the {limit} the stack holds"
     )]

@@ -1,10 +1,8 @@
 //! Top-level acceleration structure: a CWBVH over the world-space boxes of the instances.
 //! Instances move every frame, so it is rebuilt (PLOC over N boxes is cheap next to tracing).
 
-use std::time::Duration;
-
 use glam::{Mat4, Vec3, Vec3A};
-use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh};
+use obvhs::{BvhBuildParams, aabb::Aabb, cwbvh::CwBvh};
 
 use super::{Blas, BvhError, blas::cwbvh_depth};
 use crate::scene::Instance;
@@ -61,7 +59,7 @@ pub struct Tlas {
 
 impl Tlas {
     /// Builds over the instances whose mesh has triangles; the others can never be hit.
-    pub fn build(instances: &[InstanceTransforms], blas: &[Blas]) -> Self {
+    pub fn build(instances: &[InstanceTransforms], blas: &[Blas]) -> Result<Self, BvhError> {
         let mut ids = Vec::with_capacity(instances.len());
         let mut boxes = Vec::with_capacity(instances.len());
         for (i, inst) in instances.iter().enumerate() {
@@ -73,9 +71,26 @@ impl Tlas {
             boxes.push(world_bounds(&inst.object_to_world, &b.bounds));
         }
         if boxes.is_empty() {
-            return Self { bvh: CwBvh::default(), bounds: Aabb::empty(), depth: 0, stack_need: 0 };
+            return Ok(Self {
+                bvh: CwBvh::default(),
+                bounds: Aabb::empty(),
+                depth: 0,
+                stack_need: 0,
+            });
         }
-        let mut bvh = build_cwbvh(&boxes, BvhBuildParams::fast_build(), &mut Duration::default());
+        let mut bvh = super::build::build_cwbvh(&boxes, BvhBuildParams::fast_build());
+        let covered = |p: u32, b: &Aabb| {
+            let w = &boxes[p as usize];
+            super::build::contains(b, w.min) && super::build::contains(b, w.max)
+        };
+        if let Some(p) = super::build::first_uncovered(&bvh, covered) {
+            let scene = boxes.iter().fold(Aabb::empty(), |acc, b| acc.union(b));
+            return Err(BvhError::InstanceBounds {
+                instance: ids[p as usize] as usize,
+                bounds: format!("{} to {}", boxes[p as usize].min, boxes[p as usize].max),
+                scene: format!("{} to {}", scene.min, scene.max),
+            });
+        }
         for p in &mut bvh.primitive_indices {
             *p = ids[*p as usize];
         }
@@ -85,7 +100,7 @@ impl Tlas {
             &bvh,
             blas.iter().map(|b| b.stack_need).max().unwrap_or(0),
         );
-        Self { bvh, bounds, depth, stack_need }
+        Ok(Self { bvh, bounds, depth, stack_need })
     }
 }
 
