@@ -246,11 +246,12 @@ fn empty_scene_and_bad_input() {
     assert!(SceneGeometry::new(&gpu, &bad).is_err(), "a singular transform is refused");
 }
 
-/// Geometry too far apart for f32 BVH bounds to enclose is refused, naming what falls out: a
-/// cube with one vertex pulled out to -2^41 (its box's quantized offset rounds past the cube),
-/// then two cubes as instances 2^41 apart. At ordinary distances both build.
+/// Geometry far apart builds in every build type (obvhs's debug self-check, with an absolute
+/// tolerance of 1e-5, panicked on it): a cube with one vertex pulled out to 2^41, and cubes as
+/// instances 2^41 apart, with the BVH's boxes holding their primitives up to f32 rounding
+/// (checked in `Blas::build` and `Tlas::build`; a shrunken box is refused, bvh/build.rs).
 #[test]
-fn geometry_beyond_f32_bounds_is_refused() {
+fn far_apart_geometry_builds() {
     use render::bvh::SceneBvh;
     let far = -(2f32.powi(41));
     let at =
@@ -260,19 +261,9 @@ fn geometry_beyond_f32_bounds_is_refused() {
         instances,
         ..Default::default()
     };
-    for x in [-2.0, -1e3] {
-        let mut near = cube();
-        near.positions[0].x = x;
-        SceneBvh::new(&scene(near, vec![at(0.0)])).unwrap_or_else(|e| panic!("{x}: {e}"));
-        SceneBvh::new(&scene(cube(), vec![at(0.0), at(x)])).unwrap_or_else(|e| panic!("{x}: {e}"));
-    }
     let mut stretched = cube();
     stretched.positions[0].x = far;
-    let err = SceneBvh::new(&scene(stretched, vec![at(0.0)])).err().expect("refused").to_string();
-    assert!(err.contains("mesh 0 'cube'") && err.contains("falls outside its BVH box"), "{err}");
-    let err = SceneBvh::new(&scene(cube(), vec![at(0.0), at(1.0), at(far)]))
-        .err()
-        .expect("refused")
-        .to_string();
-    assert!(err.contains("falls outside its TLAS box"), "{err}");
+    SceneBvh::new(&scene(stretched, vec![at(0.0)])).unwrap_or_else(|e| panic!("{e}"));
+    SceneBvh::new(&scene(cube(), vec![at(0.0), at(1.0), at(far)]))
+        .unwrap_or_else(|e| panic!("{e}"));
 }

@@ -81,9 +81,9 @@ pub enum BvhError {
     #[error("instance {instance} has a non-invertible or non-finite transform {transform}")]
     InstanceTransform { instance: usize, transform: String },
     #[error(
-        "instance {instance} (world bounds {bounds}) falls outside its TLAS box: the instances span {scene}, too far for f32 bounds to hold one this small; expected instances closer together"
+        "instance {instance} (world bounds {bounds}) lies outside its TLAS box by more than f32 rounding: a defect of the BVH build, please report it with this scene"
     )]
-    InstanceBounds { instance: usize, bounds: String, scene: String },
+    InstanceBounds { instance: usize, bounds: String },
     #[error(
         "BVH too deep for the GPU traversal stack: it can need {needed} entries (TLAS depth {tlas}, deepest BLAS depth {blas} in mesh '{mesh}'), more than the {limit} the stack holds"
     )]

@@ -79,16 +79,14 @@ impl Tlas {
             });
         }
         let mut bvh = super::build::build_cwbvh(&boxes, BvhBuildParams::fast_build());
-        let covered = |p: u32, b: &Aabb| {
+        let covered = |p: u32, b: &Aabb, scale: Vec3A| {
             let w = &boxes[p as usize];
-            super::build::contains(b, w.min) && super::build::contains(b, w.max)
+            super::build::contains(b, w.min, scale) && super::build::contains(b, w.max, scale)
         };
         if let Some(p) = super::build::first_uncovered(&bvh, covered) {
-            let scene = boxes.iter().fold(Aabb::empty(), |acc, b| acc.union(b));
             return Err(BvhError::InstanceBounds {
                 instance: ids[p as usize] as usize,
                 bounds: format!("{} to {}", boxes[p as usize].min, boxes[p as usize].max),
-                scene: format!("{} to {}", scene.min, scene.max),
             });
         }
         for p in &mut bvh.primitive_indices {
