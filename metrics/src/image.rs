@@ -83,6 +83,9 @@ pub fn load_image(path: impl AsRef<Path>) -> anyhow::Result<Image> {
     if ext != "png" && ext != "exr" {
         bail!("{}: expected a .png or .exr image", path.display());
     }
+    if ext == "exr" {
+        check_exr_size(path)?;
+    }
     let decoded =
         ::image::open(path).with_context(|| format!("cannot read image {}", path.display()))?;
     let (width, height) = (decoded.width(), decoded.height());
@@ -97,6 +100,41 @@ pub fn load_image(path: impl AsRef<Path>) -> anyhow::Result<Image> {
         px.pixels().map(|p| [p[0], p[1], p[2]]).collect()
     };
     Ok(Image::new(width, height, rgb))
+}
+
+/// The most bytes one decoded image may take: the `image` crate's default allocation limit, which
+/// it applies to the display window of an EXR but not to the data window the `exr` crate
+/// decodes (a header claiming a data window of 10^8 columns made it allocate 109 GB and abort).
+pub const MAX_DECODED_BYTES: u64 = 512 << 20;
+
+/// Refuses an EXR whose data window, or tile, would decode to more than [`MAX_DECODED_BYTES`].
+fn check_exr_size(path: &Path) -> anyhow::Result<()> {
+    let meta = exr::meta::MetaData::read_from_file(path, false)
+        .with_context(|| format!("cannot read image {}", path.display()))?;
+    for (i, header) in meta.headers.iter().enumerate() {
+        // Four bytes per sample at most (f32 or u32), per channel.
+        let per_pixel = 4 * header.channels.list.len() as u64;
+        let mut regions = vec![("data window", header.layer_size)];
+        if let exr::meta::BlockDescription::Tiles(tiles) = &header.blocks {
+            regions.push(("tile", tiles.tile_size));
+        }
+        for (what, size) in regions {
+            let bytes = (size.width() as u64)
+                .saturating_mul(size.height() as u64)
+                .saturating_mul(per_pixel);
+            if bytes > MAX_DECODED_BYTES {
+                bail!(
+                    "{}: layer {i}'s {what} is {}x{} pixels of {} channels ({bytes} bytes decoded); expected at most {} MiB per image",
+                    path.display(),
+                    size.width(),
+                    size.height(),
+                    header.channels.list.len(),
+                    MAX_DECODED_BYTES >> 20
+                );
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Writes linear RGB clamped to [0, 1] as an 8-bit sRGB PNG.
@@ -209,6 +247,23 @@ mod tests {
         }
         let err = load_image(dir.join("a.jpg")).unwrap_err().to_string();
         assert!(err.contains("a.jpg") && err.contains(".png or .exr"), "{err}");
+    }
+
+    /// An EXR whose header claims a data window of 10^8 columns is refused before decoding, with
+    /// the file and the size named (decoding it allocated 109 GB and aborted the process).
+    #[test]
+    fn an_exr_claiming_a_huge_data_window_is_refused() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("huge.exr");
+        write_exr(&Image::from_fn(4, 4, |_, _| [0.5, 0.5, 0.5]), &path).unwrap();
+        let mut bytes = std::fs::read(&path).unwrap();
+        let key = b"dataWindow\0box2i\0";
+        let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+        // box2i: xMin, yMin, xMax, yMax.
+        bytes[at + 8..at + 12].copy_from_slice(&100_000_000i32.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let err = load_image(&path).unwrap_err().to_string();
+        assert!(err.contains("huge.exr") && err.contains("100000001x4 pixels"), "{err}");
     }
 
     /// A run's frames were written by `image`'s OpenEXR encoder (tiles) before they went through
