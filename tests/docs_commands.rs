@@ -1,5 +1,5 @@
 //! The commands of the documents run. Every fenced block with info string `sh` in README.md,
-//! docs/** and the crate READMEs is played line by line at a small scale, with the test's own
+//! CONTRIBUTING.md, docs/** and the crate READMEs is played line by line at a small scale, with the test's own
 //! `flicker` binary; a block `sh untested` is not run but listed. A failing command fails the
 //! test naming its file:line and the tail of its stderr. An `sh untested` block must have a
 //! paragraph right before or right after it (which says why it is not run: its own test covers

@@ -1,5 +1,5 @@
-//! Every relative link and image in the user documents (README.md, docs/**, crate READMEs)
-//! points at a file or folder of the repository, and every `#anchor` at a heading of the
+//! Every relative link and image in the documents (README.md, CONTRIBUTING.md, docs/**, crate
+//! READMEs) points at a file or folder of the repository, and every `#anchor` at a heading of the
 //! linked Markdown file by GitHub's slug rules (or at a line, `#L12`, of another file).
 //! External links (a scheme such as https:) are not fetched.
 

@@ -54,7 +54,7 @@ pub fn markdown_options() -> Options {
 /// runs/).
 pub fn documents() -> Vec<Doc> {
     let root = root();
-    let mut paths = vec![PathBuf::from("README.md")];
+    let mut paths = vec![PathBuf::from("README.md"), PathBuf::from("CONTRIBUTING.md")];
     markdown_under(&root, Path::new("docs"), &mut paths);
     for entry in read_dir_sorted(&root) {
         let name = entry.file_name().unwrap().to_string_lossy().into_owned();
