@@ -326,6 +326,15 @@ mod tests {
         (total.parse().unwrap(), per)
     }
 
+    /// One group of `groups`, or a failure that shows the conclusion without it.
+    fn group<'a>(
+        g: &'a BTreeMap<&'static str, Vec<(String, String)>>,
+        name: &str,
+        text: &str,
+    ) -> &'a Vec<(String, String)> {
+        g.get(name).unwrap_or_else(|| panic!("no group '{name}' in: {text}"))
+    }
+
     fn ids(group: Option<&Vec<(String, String)>>) -> Vec<&str> {
         group.map_or(vec![], |g| g.iter().map(|(id, _)| id.as_str()).collect())
     }
@@ -362,8 +371,10 @@ mod tests {
         assert_eq!(ids(g.get("open")), ["open_c", "open_d"], "{text}");
         assert_eq!(ids(g.get("not judged")), ["unjudged_e", "unjudged_f"], "{text}");
         // A declared claim is said to be unmeasured, one without data to have none.
-        let notes: BTreeMap<&str, &str> =
-            g["not judged"].iter().map(|(id, n)| (id.as_str(), n.as_str())).collect();
+        let notes: BTreeMap<&str, &str> = group(&g, "not judged", &text)
+            .iter()
+            .map(|(id, n)| (id.as_str(), n.as_str()))
+            .collect();
         assert!(notes["unjudged_e"].contains("not measured by the lab"), "{text}");
         assert!(notes["unjudged_f"].contains("no data"), "{text}");
 
@@ -387,7 +398,8 @@ mod tests {
         let judged: Vec<(&Claim, Judged)> =
             claims.iter().zip(verdicts).map(|(c, v)| (c, hand_made(v))).collect();
         let text = conclusion(&judged);
-        let fails: BTreeMap<String, String> = groups(&text)["fails"].iter().cloned().collect();
+        let fails: BTreeMap<String, String> =
+            group(&groups(&text), "fails", &text).iter().cloned().collect();
         assert_eq!(fails.len(), 2, "{text}");
         assert!(fails["with"].contains("a profile of our own"), "{text}");
         assert!(!fails["with"].contains("fewer bounces"), "only the first: {text}");
@@ -405,7 +417,8 @@ mod tests {
         let judged: Vec<(&Claim, Judged)> =
             claims.iter().zip(verdicts).map(|(c, v)| (c, hand_made(v))).collect();
         let text = conclusion(&judged);
-        let open: BTreeMap<String, String> = groups(&text)["open"].iter().cloned().collect();
+        let open: BTreeMap<String, String> =
+            group(&groups(&text), "open", &text).iter().cloned().collect();
         assert!(open["some"].contains("37 seeds"), "{text}");
         assert!(open["none"].contains("sits on the margin"), "{text}");
         assert!(!open["none"].chars().any(|c| c.is_ascii_digit()), "no number of seeds: {text}");
