@@ -196,6 +196,85 @@ fn two_runs_give_byte_identical_frames_and_a_complete_run_folder() {
     assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
 }
 
+/// A warm-started neural cache is the same bits when played again from fresh caches: each run
+/// starts from an empty cache folder, so it renders its own reference and pre-trains its own
+/// warm start (nothing loaded from the other run), and the two write byte-identical warm starts,
+/// frames and per-frame numbers (measured times excepted). The independent repeat the
+/// reproduce smoke test makes for its replayed papers, for the NIRC warm start at a tiny size.
+#[test]
+fn a_warm_started_neural_cache_gives_the_same_bits_from_fresh_caches() {
+    let tmp = scratch("nirc-warm-start");
+    let dir = tmp.path().to_path_buf();
+    let scenario = tiny_scenario(
+        &dir,
+        r#"Scenario(
+            scene: Builtin("cornell_box"), resolution: (16, 9), frames: 3, seed: 7, max_depth: 3,
+            methods: [Nirc(spp: 1, pretrain_frames: 4,
+                cache: (
+                    encoding: (levels: 8, features_per_level: 2, log2_table_size: 12, base_resolution: 4, growth_factor: 1.5),
+                    network: (width: 32, hidden_layers: 1),
+                    reliability: (resolution: 16, log2_cells: 12, warmup: 16),
+                    max_batch: 512,
+                ),
+                paths: (termination_vertex: 1, train_records: 512))],
+            reference: (spp: 8, frames: List([2])),
+        )"#,
+    );
+    let mut runs = Vec::new();
+    for i in 0..2 {
+        let (out, cache) = (dir.join(format!("run{i}")), dir.join(format!("cache{i}")));
+        let o = flicker(&[
+            "run",
+            scenario.to_str().unwrap(),
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+            "--cache-dir",
+            cache.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "run failed: {}", text(&o.stderr));
+        let stdout = text(&o.stdout);
+        assert!(stdout.contains("references: 1 rendered, 0 from cache"), "{stdout}");
+        let warm: Vec<PathBuf> = walk(&cache.join("nirc"))
+            .into_iter()
+            .filter(|p| p.extension().is_some_and(|e| e == "nirc"))
+            .collect();
+        assert_eq!(warm.len(), 1, "the run pre-trained and saved its warm start: {warm:?}");
+        runs.push((out, warm[0].clone()));
+    }
+    let ((a, warm_a), (b, warm_b)) = (&runs[0], &runs[1]);
+    assert_eq!(warm_a.file_name(), warm_b.file_name(), "the same warm-start key");
+    assert!(
+        std::fs::read(warm_a).unwrap() == std::fs::read(warm_b).unwrap(),
+        "the warm starts pre-trained from fresh caches differ"
+    );
+    for frame in 0..3 {
+        let name = format!("frames/nirc_blend_1spp/{frame:04}.exr");
+        let (fa, fb) =
+            (std::fs::read(a.join(&name)).unwrap(), std::fs::read(b.join(&name)).unwrap());
+        assert!(fa == fb, "{name} differs between two runs from fresh caches");
+    }
+    // Every per-frame number but the measured times (FLIP, training loss, reliabilities, σ, ...).
+    let numbers = |run: &Path| -> Vec<Vec<String>> {
+        let csv = std::fs::read_to_string(run.join("frames.csv")).unwrap();
+        let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+        let keep: Vec<usize> = (0..header.len()).filter(|&i| !header[i].contains("ms")).collect();
+        assert!(
+            keep.iter().any(|&i| header[i] == "flip")
+                && keep.iter().any(|&i| header[i] == "train_loss")
+        );
+        csv.lines()
+            .map(|l| {
+                let cells: Vec<&str> = l.split(',').collect();
+                keep.iter().map(|&i| cells[i].to_string()).collect()
+            })
+            .collect()
+    };
+    let (na, nb) = (numbers(a), numbers(b));
+    assert_eq!(na.len(), 4, "a header and three frames");
+    assert_eq!(na, nb, "frames.csv's numbers differ between two runs from fresh caches");
+}
+
 #[test]
 fn scenes_lists_every_builtin() {
     let o = flicker(&["scenes"]);

@@ -144,3 +144,51 @@ fn commits_are_found_and_abbreviations_counted_once() {
     assert_eq!(commits(&format!("commit {full} (0123456)")), [full]);
     assert!(commits("no hashes: reproduced, 1280x720, decade").is_empty());
 }
+
+/// A verdict comes from one commit and one place: the method pages (docs/methods/) hold no
+/// table of claims or verdicts of their own, and a page that names a paper's `flicker
+/// reproduce` links to that paper's part of the generated table (docs_links checks the anchor).
+#[test]
+fn method_pages_leave_verdicts_to_the_generated_table() {
+    let ids = claim_ids();
+    let papers: Vec<String> = std::fs::read_dir(root().join("claims"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .map(|p| p.file_stem().unwrap().to_str().unwrap().to_string())
+        .collect();
+    let dir = root().join("docs/methods");
+    let mut pages = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "md") {
+            continue;
+        }
+        pages += 1;
+        let text = std::fs::read_to_string(&path).unwrap();
+        let name = path.strip_prefix(root()).unwrap().display().to_string();
+        for (n, line) in text.lines().enumerate().filter(|(_, l)| l.trim_start().starts_with('|')) {
+            let row = cells(line);
+            assert!(
+                !row.iter().any(|c| c.eq_ignore_ascii_case("verdict")),
+                "{name}:{}: a table with a verdict column; link the paper's part of docs/reproduce.md's generated table instead",
+                n + 1
+            );
+            assert!(
+                !ids.contains(&row[0]),
+                "{name}:{}: a row for claim '{}'; its verdict and numbers belong to docs/reproduce.md's generated table",
+                n + 1,
+                row[0]
+            );
+        }
+        for paper in &papers {
+            if text.contains(&format!("flicker reproduce {paper}")) {
+                assert!(
+                    text.contains(&format!("../reproduce.md#{paper})")),
+                    "{name} plays `flicker reproduce {paper}` but does not link ../reproduce.md#{paper}"
+                );
+            }
+        }
+    }
+    assert!(pages >= 5, "{pages} method pages in {}", dir.display());
+}

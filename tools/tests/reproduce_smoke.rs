@@ -9,7 +9,8 @@
 //! and the same verdicts (measured times excepted). Replayed are the papers whose methods no
 //! other test plays twice end to end (subsurface scattering; the volume methods, media and the
 //! CPU computations of the jackknife paper); the others' methods have their own bit-for-bit tests
-//! (NIRC: `methods/nirc/tests/integrator.rs`, `sparse_updates.rs`; the sample cache, TAA, path
+//! (NIRC: `methods/nirc/tests/integrator.rs`, `sparse_updates.rs`, and a warm-started cache
+//! played twice from fresh caches, `tests/cli.rs`; the sample cache, TAA, path
 //! tracing: `methods/sample_cache/tests/sample_cache.rs`, `tests/cli.rs`; termination:
 //! `methods/termination/tests/termination_cache.rs`, `systems/tests/termination_shared.rs`).
 //!
