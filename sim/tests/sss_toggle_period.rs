@@ -18,7 +18,8 @@ fn regular() -> PathBuf {
 fn switches(scenario: &Scenario, entity: &str, frames: u32) -> Vec<(u32, f64)> {
     let mut sim = Simulation::new(scenario).unwrap_or_else(|e| panic!("{e}"));
     let id = sim.entity(entity).unwrap_or_else(|| panic!("no entity '{entity}'"));
-    let emission = |sim: &Simulation| sim.world().get::<Intensity>(id).expect("an intensity").factor();
+    let emission =
+        |sim: &Simulation| sim.world().get::<Intensity>(id).expect("an intensity").factor();
     let mut before = emission(&sim);
     assert!(before > 0.0, "{entity} is off at frame 0");
     let mut out = Vec::new();

@@ -8,8 +8,8 @@ use sss::gpu::SssPass;
 use sss::prefilter::MipChain;
 use sss::screen_pass::step;
 use sss::{
-    DistantCount, EmCovariance, PixelHistory, PixelResult, Prefilter, Split, SpvgHistory, SpvgSettings, SssFrame,
-    SssSettings, SssVariant,
+    DistantCount, EmCovariance, PixelHistory, PixelResult, Prefilter, Split, SpvgHistory,
+    SpvgSettings, SssFrame, SssSettings, SssVariant,
 };
 
 const W: u32 = 20;

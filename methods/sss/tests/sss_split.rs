@@ -214,7 +214,8 @@ fn the_pass_takes_eq_5_20s_count_when_gamma_scaled() {
     }
     // γ under ε_u: no distant samples, eq. 5.20's m̂ = 0, not max(1, ·).
     let tiny = flat([0.5; 3], [0.05; 3]);
-    let s = SssSettings { spvg, distant_count: sss::DistantCount::GammaScaled, ..Default::default() };
+    let s =
+        SssSettings { spvg, distant_count: sss::DistantCount::GammaScaled, ..Default::default() };
     let (r, _) = step(&tiny, &s, 0, &[]);
     assert!(r.iter().all(|r| r.count == 0), "{:?}", r[0]);
 }
