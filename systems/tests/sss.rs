@@ -392,3 +392,34 @@ fn the_direct_irradiance_is_the_same_on_every_seed_of_a_still_frame() {
     assert!(spread > 0.0, "the path-traced irradiance did not vary: {traced:?}");
     eprintln!("direct {:.6}, path traced {traced:?}", direct[0]);
 }
+
+/// `distant_count: GammaScaled` reaches the pass through a scenario: with SPVG's count pinned
+/// (n_min = n_max = 16) and a constant γ, every frame's mean count per SSS pixel is eq. 5.20's
+/// round(16·γ) (4 at γ = 0.25, 8 at 0.5, 12 at 0.75), and Algorithm 3's 16 without the setting.
+#[test]
+fn gamma_scaled_counts_follow_eq_5_20_through_a_run() {
+    let method = |gamma: f64, rule: &str, name: &str| {
+        format!(
+            "Sss(variant: Adaptive, spvg: (n_min: 16, n_max: 16), split: (gamma: Some({gamma}), eps_u: 0.01), distant_count: {rule}, name: \"{name}\")"
+        )
+    };
+    let methods = [
+        method(0.25, "GammaScaled", "quarter"),
+        method(0.5, "GammaScaled", "half"),
+        method(0.75, "GammaScaled", "three_quarters"),
+        method(0.25, "Estimated", "algorithm3"),
+    ]
+    .join(", ");
+    let (records, _tmp) = play_inline("eq520", 5, 3, &methods);
+    assert_eq!(records.len(), 12);
+    for r in &records {
+        let expected = match r.method.as_str() {
+            "quarter" => 4.0,
+            "half" => 8.0,
+            "three_quarters" => 12.0,
+            _ => 16.0,
+        };
+        assert!(stat(r, "sss_pixels") > 20.0, "{} frame {}", r.method, r.frame);
+        assert_eq!(stat(r, "sss_mean_spp"), expected, "{} frame {}", r.method, r.frame);
+    }
+}

@@ -130,9 +130,14 @@ fn a_runs_frames_measured_again_give_the_runs_metrics() {
 }
 
 /// A tiny sequence of `n` frames of `w`x`h` in `dir` (EXR), value `v` per frame.
-fn sequence(dir: &Path, n: u32, (w, h): (u32, u32), v: impl Fn(u32) -> f32) {
+fn sequence(dir: &Path, n: u32, wh: (u32, u32), v: impl Fn(u32) -> f32) {
+    sequence_from(dir, 0, n, wh, v)
+}
+
+/// `sequence` with its frames numbered from `first` in the file names.
+fn sequence_from(dir: &Path, first: u32, n: u32, (w, h): (u32, u32), v: impl Fn(u32) -> f32) {
     std::fs::create_dir_all(dir).unwrap();
-    for f in 0..n {
+    for f in first..first + n {
         let img = metrics::Image::filled(w, h, [v(f); 3]);
         metrics::write_exr(&img, dir.join(format!("frame_{f:03}.exr"))).unwrap();
     }
@@ -234,19 +239,38 @@ fn timings_put_an_outside_method_on_the_speed_charts() {
     o.timings = vec![("mine".into(), good)];
     measure(&o).unwrap();
     let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
-    let mut lines = csv.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| {
-        header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("{name}: {csv}"))
-    };
-    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
-    let totals: Vec<f64> = rows.iter().map(|r| r[col("wall_ms_total")].parse().unwrap()).collect();
-    assert_eq!(totals, [3.5, 4.0, 5.0, 4.5]);
-    assert_eq!(rows[0][col("wall_ms_other")].parse::<f64>().unwrap(), 0.5);
-    assert_eq!(rows[2][col("wall_ms_trace")].parse::<f64>().unwrap(), 3.0);
+    assert_eq!(column(&csv, "wall_ms_total"), [3.5, 4.0, 5.0, 4.5]);
+    assert_eq!(column(&csv, "wall_ms_other")[0], 0.5);
+    assert_eq!(column(&csv, "wall_ms_trace")[2], 3.0);
     let charts: Vec<String> = std::fs::read_dir(out.join("charts"))
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
     assert!(charts.iter().any(|c| c.starts_with("speed_vs_flip")), "{charts:?}");
+    // Timings are matched by the inputs' own frame numbers, not by position: frames numbered
+    // from 7 (frames.csv counts from 0) take the rows of 7, 8, 9 and 10.
+    let (reference, mine) = (dir.join("reference_7"), dir.join("mine_7"));
+    sequence_from(&reference, 7, 4, (8, 8), |_| 0.5);
+    sequence_from(&mine, 7, 4, (8, 8), |f| 0.4 + 0.05 * f as f32);
+    let late = write("late.csv", "frame,ms\n8,6\n7,5\n10,8\n9,7\n");
+    let out = dir.join("out_7");
+    let mut o = options(&reference, &[("mine", mine)], out.clone());
+    o.timings = vec![("mine".into(), late)];
+    measure(&o).unwrap();
+    let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    assert_eq!(column(&csv, "frame"), [0.0, 1.0, 2.0, 3.0], "{csv}");
+    assert_eq!(column(&csv, "wall_ms_total"), [5.0, 6.0, 7.0, 8.0], "{csv}");
+}
+
+/// frames.csv's column `name`, row by row, as numbers.
+fn column(csv: &str, name: &str) -> Vec<f64> {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let i = header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no {name}: {csv}"));
+    lines
+        .map(|l| {
+            let cell = l.split(',').nth(i).unwrap();
+            cell.parse().unwrap_or_else(|e| panic!("{name} `{cell}` in `{l}`: {e}"))
+        })
+        .collect()
 }

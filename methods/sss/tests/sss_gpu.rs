@@ -8,8 +8,8 @@ use sss::gpu::SssPass;
 use sss::prefilter::MipChain;
 use sss::screen_pass::step;
 use sss::{
-    EmCovariance, PixelHistory, PixelResult, Prefilter, Split, SpvgHistory, SpvgSettings, SssFrame,
-    SssSettings, SssVariant,
+    DistantCount, EmCovariance, PixelHistory, PixelResult, Prefilter, Split, SpvgHistory,
+    SpvgSettings, SssFrame, SssSettings, SssVariant,
 };
 
 const W: u32 = 20;
@@ -138,26 +138,31 @@ fn gpu_pass_matches_the_cpu_reference() {
 fn gpu_pass_matches_with_motion(gpu: &Gpu, frame: SssFrame) {
     let mut pass = SssPass::new(gpu, W, H).unwrap();
     let thesis = Some(Split::default());
+    let (estimated, eq520) = (DistantCount::Estimated, DistantCount::GammaScaled);
     let variants = [
-        (SssVariant::Fixed { count: 64 }, false, thesis, 2.2),
-        (SssVariant::Adaptive, true, thesis, 2.2),
-        (SssVariant::OnlineCv, true, thesis, 2.2),
-        (SssVariant::ConstantCv, true, thesis, 2.2),
-        (SssVariant::Adaptive, false, thesis, 2.2),
-        (SssVariant::Adaptive, true, None, 1.0),
-        (SssVariant::OnlineCv, true, Some(Split { gamma: Some(0.4), eps_u: 0.3 }), 1.0),
+        (SssVariant::Fixed { count: 64 }, false, thesis, 2.2, estimated),
+        (SssVariant::Adaptive, true, thesis, 2.2, estimated),
+        (SssVariant::OnlineCv, true, thesis, 2.2, estimated),
+        (SssVariant::ConstantCv, true, thesis, 2.2, estimated),
+        (SssVariant::Adaptive, false, thesis, 2.2, estimated),
+        (SssVariant::Adaptive, true, None, 1.0, estimated),
+        (SssVariant::OnlineCv, true, Some(Split { gamma: Some(0.4), eps_u: 0.3 }), 1.0, estimated),
+        // Eq. 5.20's m = n̂·γ: Burley's γ per pixel and a constant one.
+        (SssVariant::Adaptive, true, thesis, 2.2, eq520),
+        (SssVariant::ConstantCv, true, Some(Split { gamma: Some(0.4), eps_u: 0.01 }), 2.2, eq520),
     ];
-    for (variant, fast_inverse, split, monitor_gamma) in variants {
+    for (variant, fast_inverse, split, monitor_gamma, distant_count) in variants {
         let settings = SssSettings {
             variant,
             fast_inverse,
             seed: 3,
             split,
             monitor_gamma,
+            distant_count,
             ..Default::default()
         };
         let what = format!(
-            "{variant:?} fast {fast_inverse} {split:?} gamma {monitor_gamma} moving {}",
+            "{variant:?} fast {fast_inverse} {split:?} gamma {monitor_gamma} {distant_count:?} moving {}",
             !frame.motion.is_empty()
         );
         let start = histories(&settings.spvg);
@@ -170,7 +175,27 @@ fn gpu_pass_matches_with_motion(gpu: &Gpu, frame: SssFrame) {
         if !matches!(variant, SssVariant::Fixed { .. }) {
             let counts: std::collections::BTreeSet<u32> =
                 results.iter().map(|r| r.count).filter(|&c| c > 0).collect();
-            assert!(counts.len() > 5 && counts.contains(&8), "{what}: {counts:?}");
+            assert!(counts.len() > 5, "{what}: {counts:?}");
+            if distant_count == estimated {
+                assert!(counts.contains(&8), "{what}: {counts:?}");
+            }
+        }
+        // Eq. 5.20 on the GPU: with a constant γ each pixel takes max(1, round(n̂·γ)) of the
+        // n̂ that Algorithm 3 would take from the same history.
+        if let (DistantCount::GammaScaled, Some(Split { gamma: Some(g), .. })) =
+            (distant_count, split)
+        {
+            let algorithm3 = SssSettings { distant_count: estimated, ..settings };
+            let (n_hat, _) = step(&frame, &algorithm3, 5, &start);
+            let mut scaled = 0;
+            for (i, (r, n)) in results.iter().zip(&n_hat).enumerate() {
+                if n.count > 0 {
+                    let m = ((n.count as f32 * g).round() as u32).max(1);
+                    assert_eq!(r.count, m, "{what} pixel {i}: n̂ {}", n.count);
+                    scaled += (m != n.count) as usize;
+                }
+            }
+            assert!(scaled > 100, "{what}: {scaled} pixels scaled");
         }
         // Second frame from the GPU's own (flipped) history.
         pass.dispatch(gpu, &frame, &settings, 6).unwrap();

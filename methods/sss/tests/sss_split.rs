@@ -148,3 +148,74 @@ fn split_settings_outside_the_unit_interval_are_refused() {
     }
     assert!(SssSettings::default().validate().is_ok());
 }
+
+/// Eq. 5.20 (`DistantCount::GammaScaled`) on hand-made inputs: m̂ = n̂·γ, rounded to the
+/// nearest count and at least 1 (the pixels under ε_u are left out before it, see below);
+/// `Estimated` (Algorithm 3) takes SPVG's count as m itself.
+#[test]
+fn eq_5_20_scales_spvgs_count_by_gamma() {
+    use sss::DistantCount::{Estimated, GammaScaled};
+    // (n̂, γ, m): n̂·γ = 32, 2, 33.68, 3.7, 1.3, 19.8, 64, and 0.4 (one sample).
+    for (n_hat, gamma, m) in [
+        (64, 0.5, 32),
+        (8, 0.25, 2),
+        (40, 0.842, 34),
+        (10, 0.37, 4),
+        (13, 0.1, 1),
+        (20, 0.99, 20),
+        (64, 1.0, 64),
+        (8, 0.05, 1),
+    ] {
+        assert_eq!(split::distant_count(GammaScaled, n_hat, gamma), m, "n̂ {n_hat} γ {gamma}");
+        assert_eq!(split::distant_count(Estimated, n_hat, gamma), n_hat, "n̂ {n_hat} γ {gamma}");
+    }
+}
+
+/// The CPU pass takes eq. 5.20's count where the settings say `GammaScaled`: with SPVG's count
+/// pinned (n_min = n_max = 40, so n̂ = 40 on every frame) every pixel of a flat frame takes
+/// m = round(40·γ) distant samples on each of three frames, γ = 1 − cdf(r0) of Table 5.1 from
+/// the pixel's d (computed here in f64 from eq. 5.3) or a constant γ; the history keeps n̂, not
+/// m. `Estimated` takes 40 on the same frames. Where γ < ε_u no sample is taken (eq. 5.20's
+/// first case) under either rule.
+#[test]
+fn the_pass_takes_eq_5_20s_count_when_gamma_scaled() {
+    let spvg = sss::SpvgSettings { n_min: 40, n_max: 40, ..Default::default() };
+    let burley_gamma = |d: f64| {
+        let r0 = std::f64::consts::FRAC_1_SQRT_2;
+        0.25 * (-r0 / d).exp() + 0.75 * (-r0 / (3.0 * d)).exp()
+    };
+    let cases = [
+        (0.5, None, burley_gamma(0.5)),
+        (2.0, None, burley_gamma(2.0)),
+        (6.0, None, burley_gamma(6.0)),
+        (2.0, Some(0.3), 0.3),
+        (2.0, Some(0.55), 0.55),
+    ];
+    for (d, constant, gamma) in cases {
+        let frame = flat([0.6, 0.5, 0.4], [d as f32; 3]);
+        let m = (40.0 * gamma).round() as u32;
+        for (rule, expected) in [(sss::DistantCount::GammaScaled, m), (Default::default(), 40)] {
+            let s = SssSettings {
+                spvg,
+                split: Some(Split { gamma: constant, eps_u: 0.01 }),
+                distant_count: rule,
+                ..Default::default()
+            };
+            let mut history = Vec::new();
+            for frame_index in 0..3 {
+                let (r, h) = step(&frame, &s, frame_index, &history);
+                for (r, h) in r.iter().zip(&h) {
+                    assert_eq!(r.count, expected, "d {d} γ {gamma} {rule:?} frame {frame_index}");
+                    assert_eq!(h.spvg.nbar, 40.0, "d {d} {rule:?}: the history keeps n̂");
+                }
+                history = h;
+            }
+        }
+    }
+    // γ under ε_u: no distant samples, eq. 5.20's m̂ = 0, not max(1, ·).
+    let tiny = flat([0.5; 3], [0.05; 3]);
+    let s =
+        SssSettings { spvg, distant_count: sss::DistantCount::GammaScaled, ..Default::default() };
+    let (r, _) = step(&tiny, &s, 0, &[]);
+    assert!(r.iter().all(|r| r.count == 0), "{:?}", r[0]);
+}
