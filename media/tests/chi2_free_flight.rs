@@ -130,7 +130,8 @@ fn subsurface_chromatic_free_flight_fits_the_mixture_pdf() {
             eval(&ts).iter().zip(xs).map(|(r, &x)| r[0] as f64 * warp.jacobian(x)).collect()
         });
         let survival = eval(&[l as f64])[0][1] as f64;
-        let what = format!("WGSL chromatic free flight, σ_t {sigma_t:?}, throughput {beta:?}, L {l}");
+        let what =
+            format!("WGSL chromatic free flight, σ_t {sigma_t:?}, throughput {beta:?}, L {l}");
         assert_fits_with_escapes(&what, observed, integral, escapes, survival);
     }
 }

@@ -299,10 +299,8 @@ fn ggx_visible_normals_at_low_roughness_fit_their_pdf() {
             let bins = LobeBins { axis: mirror, scale: alpha, theta: 32, phi: 64 };
             let what = format!("GGX visible normals, roughness {roughness}, view {theta}°");
             let drawn = h.run(Entry::BsdfSample, p, &[], DRAWS);
-            let observed =
-                bins.histogram(drawn.iter().map(|r| ([r[0], r[1], r[2]], r[3] >= 0.0)));
-            let integral =
-                bins.integrate(&observed, &mut |dirs| h.pdf(Entry::BsdfPdf, p, dirs));
+            let observed = bins.histogram(drawn.iter().map(|r| ([r[0], r[1], r[2]], r[3] >= 0.0)));
+            let integral = bins.integrate(&observed, &mut |dirs| h.pdf(Entry::BsdfPdf, p, dirs));
             let o = chi2::assert_fits(&what, &observed, &integral, DRAWS as u64);
             // The chi-square approximation's condition: few draws in bins expected below 5.
             let expected: Vec<f64> = integral.iter().map(|i| i * DRAWS as f64).collect();
