@@ -6,7 +6,7 @@
 // crosses the boundary again, and the path goes on from there in the same direction. One
 // channel's σ_t draws each free flight, the channel chosen in proportion to the throughput, and
 // the sample is weighted by the mixture pdf over the three channels (one-sample MIS with the
-// balance heuristic, as Chiang, Kutz & Burley 2016's chromatic walk). At every scattering
+// balance heuristic, as Chiang, Kutz & Burley 2016's chromatic walk; media_free_flight.wgsl). At every scattering
 // vertex: NEE of the lights through the boundary (transmittance exp(−σ_t d) to where the shadow
 // ray leaves the mesh, then the rest as any shadow ray). A walk is one vertex of the path (its
 // exit continues at the next depth); walks longer than sp.max_events are dropped (absorbed).
@@ -21,6 +21,7 @@ import package::pt_scene::{base_color_at, camera_ray_direction, environment_pdf,
 import package::pt_integrator::{emitted_radiance, next_event};
 import package::pt_sampling::{rng_seed};
 import package::media::subsurface_path_bindings::{coefficients, samples, sp};
+import package::media::media_free_flight::{channel_probabilities, free_flight_pdf, free_flight_survival, sample_free_flight};
 
 const INV_4PI: f32 = 0.0795774715459477;
 
@@ -96,18 +97,16 @@ fn random_walk(m: u32, entry: vec3f, dir_in: vec3f, throughput: ptr<function, ve
     var dir = dir_in;
     for (var event = 0u; event < sp.max_events; event++) {
         let beta = *throughput;
-        let total = beta.x + beta.y + beta.z;
-        if total <= 0.0 {
+        if beta.x + beta.y + beta.z <= 0.0 {
             return out;
         }
-        let q = beta / total;
+        let q = channel_probabilities(beta);
         let u = rng_next(rng);
-        let c = select(select(2u, 1u, u < q.x + q.y), 0u, u < q.x);
-        let t = -log(1.0 - rng_next(rng)) / sigma_t[c];
+        let t = sample_free_flight(sigma_t, q, u, rng_next(rng));
         let h = trace_closest(p, dir, t);
         if h.instance != NO_HIT {
             let tr = exp(-sigma_t * h.t);
-            *throughput = beta * tr / dot(q, tr);
+            *throughput = beta * tr / free_flight_survival(sigma_t, q, h.t);
             let s = surface_point(h, p, dir);
             out.p = s.position;
             out.ng = s.geometric_normal;
@@ -117,7 +116,7 @@ fn random_walk(m: u32, entry: vec3f, dir_in: vec3f, throughput: ptr<function, ve
             return out;
         }
         let tr = exp(-sigma_t * t);
-        *throughput = beta * sigma_s * tr / dot(q, sigma_t * tr);
+        *throughput = beta * sigma_s * tr / free_flight_pdf(sigma_t, q, t);
         p += dir * t;
         out.scattered = true;
         *radiance += *throughput * next_event_inside(p, sigma_t, rng);

@@ -48,9 +48,15 @@ fn fresnel_schlick(b: Bsdf, cos_theta: f32) -> vec3f {
     return b.f0 + (vec3f(b.f90) - b.f0) * (x2 * x2 * x);
 }
 
-fn ggx_d(alpha: f32, n_dot_h: f32) -> f32 {
+// D(h) of the unit half vector h. (n.h)^2 (a^2 - 1) + 1 = sin^2 + a^2 cos^2 of h's angle, with
+// sin^2 from h's part across n: 1 - (n.h)^2 in f32 loses most of its digits where a low
+// roughness lobe lives (1 - n.h = 3e-6 at its peak at roughness 0.05), which made D 0.4% too
+// high over that lobe (render/tests/chi2_sampling.rs, docs/lab/chi2-sampling.md).
+fn ggx_d(alpha: f32, n: vec3f, h: vec3f) -> f32 {
     let a2 = alpha * alpha;
-    let d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
+    let c = max(dot(n, h), 0.0);
+    let across = h - c * n;
+    let d = dot(across, across) + a2 * c * c;
     return a2 / (PI * d * d);
 }
 
@@ -81,7 +87,7 @@ fn bsdf_eval(b: Bsdf, n: vec3f, wo: vec3f, wi: vec3f) -> vec3f {
     let h = normalize(wo + wi);
     let v_dot_h = max(dot(wo, h), 0.0);
     let f = fresnel_schlick(b, v_dot_h);
-    let specular = f * ggx_d(b.alpha, max(dot(n, h), 0.0)) * smith_visibility(b.alpha, n_dot_v, n_dot_l);
+    let specular = f * ggx_d(b.alpha, n, h) * smith_visibility(b.alpha, n_dot_v, n_dot_l);
     return diffuse_coupling(b, n_dot_v, n_dot_l) * b.c_diff * INV_PI + specular;
 }
 
@@ -105,7 +111,7 @@ fn bsdf_pdf(b: Bsdf, n: vec3f, wo: vec3f, wi: vec3f) -> f32 {
     // Visible-normal pdf G1(v) D(h) (v.h) / (n.v), mapped to wi by the reflection Jacobian
     // 1 / (4 v.h): G1(v) D(h) / (4 n.v) = D(h) / (2 (n.v + sqrt(a^2 + (1 - a^2)(n.v)^2))).
     let a2 = b.alpha * b.alpha;
-    let pdf_spec = ggx_d(b.alpha, max(dot(n, h), 0.0)) / (2.0 * (n_dot_v + sqrt(a2 + (1.0 - a2) * n_dot_v * n_dot_v)));
+    let pdf_spec = ggx_d(b.alpha, n, h) / (2.0 * (n_dot_v + sqrt(a2 + (1.0 - a2) * n_dot_v * n_dot_v)));
     return p_spec * pdf_spec + (1.0 - p_spec) * n_dot_l * INV_PI;
 }
 

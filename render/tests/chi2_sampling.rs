@@ -19,7 +19,7 @@
 use std::sync::OnceLock;
 
 use glam::{Mat4, Vec3};
-use render::chi2::{self, SphereBins};
+use render::chi2::{self, LobeBins, SphereBins};
 use render::compute::{self, BufferBinding};
 use render::frame_bindings::FrameBindings;
 use render::pass_library::{LibraryPipeline, PassLibrary};
@@ -266,7 +266,7 @@ fn cosine_hemisphere_fits_its_pdf() {
 
 /// GGX visible normals on a white metal (c_diff = 0: the specular lobe alone), at roughness
 /// (glTF's, alpha = r^2) 0.3, 0.6, 1 and views 0°, 45° and 80° from the normal. Below 0.3 the
-/// lobe falls inside a few bins of this resolution and the test loses its power.
+/// lobe falls inside a few bins of this resolution: the next test bins it around its axis.
 #[test]
 fn ggx_visible_normals_fit_their_pdf() {
     let h = harness();
@@ -279,6 +279,42 @@ fn ggx_visible_normals_fit_their_pdf() {
                 Entry::BsdfPdf,
                 p,
             );
+        }
+    }
+}
+
+/// GGX visible normals at low roughness (0.05, 0.1, 0.2: alpha 0.0025 to 0.04), views 0°, 45°
+/// and 80°, on bins around the mirror direction (chi2::LobeBins, scale alpha): 32 x 64 bins
+/// that share the lobe, so that the bins below the chi-square's 5 expected draws (pooled) hold
+/// under 1% of the draws. On the uniform θ/φ bins of the test above, the lobe at roughness 0.05
+/// falls inside a single bin.
+#[test]
+fn ggx_visible_normals_at_low_roughness_fit_their_pdf() {
+    let h = harness();
+    for roughness in [0.05f32, 0.1, 0.2] {
+        for theta in [0.0, 45.0, 80.0] {
+            let p = Params { wo: view(theta), roughness, metallic: 1.0, ..Default::default() };
+            let mirror = [-p.wo.x as f64, -p.wo.y as f64, p.wo.z as f64];
+            let alpha = (roughness * roughness) as f64;
+            let bins = LobeBins { axis: mirror, scale: alpha, theta: 32, phi: 64 };
+            let what = format!("GGX visible normals, roughness {roughness}, view {theta}°");
+            let drawn = h.run(Entry::BsdfSample, p, &[], DRAWS);
+            let observed = bins.histogram(drawn.iter().map(|r| ([r[0], r[1], r[2]], r[3] >= 0.0)));
+            let integral = bins.integrate(&observed, &mut |dirs| h.pdf(Entry::BsdfPdf, p, dirs));
+            let o = chi2::assert_fits(&what, &observed, &integral, DRAWS as u64);
+            // The chi-square approximation's condition: few draws in bins expected below 5.
+            let expected: Vec<f64> = integral.iter().map(|i| i * DRAWS as f64).collect();
+            let small = expected
+                .iter()
+                .filter(|&&e| e > 0.0 && e < chi2::MIN_EXPECTED)
+                .fold(0.0, |a, e| a + e);
+            let fraction = small / expected.iter().sum::<f64>();
+            eprintln!(
+                "{what} (lobe bins): chi2 {:.1} dof {} p {:.3} integral {:.5} valid {:.5}; \
+                 draws expected in bins below 5: {:.2e}",
+                o.statistic, o.dof, o.p_value, o.integral, o.valid_fraction, fraction
+            );
+            assert!(fraction < 0.01, "{what}: {fraction} of the draws in bins expected below 5");
         }
     }
 }

@@ -86,7 +86,10 @@ impl SubsurfacePathPass {
             &BINDINGS,
             &[&types],
         );
-        PassLibrary::program([types, bindings], [render::wgsl_file!("media_subsurface_path.wgsl")])
+        PassLibrary::program(
+            [types, bindings, render::wgsl_file!("media_free_flight.wgsl")],
+            [render::wgsl_file!("media_subsurface_path.wgsl")],
+        )
     }
 
     /// Every WGSL source of the pass: part of the key of cached references.
