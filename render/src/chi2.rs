@@ -82,13 +82,7 @@ impl SphereBins {
 
     /// Counts of `dirs` per bin; a direction with `valid` false is not counted.
     pub fn histogram(&self, samples: impl IntoIterator<Item = ([f32; 3], bool)>) -> Vec<f64> {
-        let mut h = vec![0.0; self.count()];
-        for (d, valid) in samples {
-            if valid && let Some(i) = self.index(d) {
-                h[i] += 1.0;
-            }
-        }
-        h
+        direction_histogram(self.count(), |d| self.index(d), samples)
     }
 
     fn direction(theta: f64, phi: f64) -> [f32; 3] {
@@ -101,15 +95,7 @@ impl SphereBins {
     fn points(&self, bin: usize, fine: usize) -> Vec<([f32; 3], f64)> {
         let (dt, dp) = (PI / self.theta as f64, 2.0 * PI / self.phi as f64);
         let (t0, p0) = ((bin / self.phi) as f64 * dt, (bin % self.phi) as f64 * dp);
-        let axis = |n0: f64, step: f64| -> Vec<(f64, f64)> {
-            if fine > 0 {
-                (0..fine)
-                    .map(|k| (n0 + (k as f64 + 0.5) / fine as f64 * step, step / fine as f64))
-                    .collect()
-            } else {
-                GAUSS5.iter().map(|&(x, w)| (n0 + 0.5 * (x + 1.0) * step, 0.5 * w * step)).collect()
-            }
-        };
+        let axis = |n0: f64, step: f64| quadrature(n0, step, fine);
         let (ts, ps) = (axis(t0, dt), axis(p0, dp));
         let mut out = Vec::with_capacity(ts.len() * ps.len());
         for &(t, wt) in &ts {
@@ -211,13 +197,7 @@ impl LobeBins {
 
     /// Counts per bin of the valid directions.
     pub fn histogram(&self, samples: impl IntoIterator<Item = ([f32; 3], bool)>) -> Vec<f64> {
-        let mut h = vec![0.0; self.count()];
-        for (d, valid) in samples {
-            if valid && let Some(i) = self.index(d) {
-                h[i] += 1.0;
-            }
-        }
-        h
+        direction_histogram(self.count(), |d| self.index(d), samples)
     }
 
     /// Points and solid-angle weights (sin θ' dθ'/dx dx dφ) covering `bin` (as
@@ -225,15 +205,7 @@ impl LobeBins {
     fn points(&self, bin: usize, fine: usize) -> Vec<([f32; 3], f64)> {
         let (dx, dp) = (1.0 / self.theta as f64, 2.0 * PI / self.phi as f64);
         let (x0, p0) = ((bin / self.phi) as f64 * dx, (bin % self.phi) as f64 * dp);
-        let axis = |n0: f64, step: f64| -> Vec<(f64, f64)> {
-            if fine > 0 {
-                (0..fine)
-                    .map(|k| (n0 + (k as f64 + 0.5) / fine as f64 * step, step / fine as f64))
-                    .collect()
-            } else {
-                GAUSS5.iter().map(|&(x, w)| (n0 + 0.5 * (x + 1.0) * step, 0.5 * w * step)).collect()
-            }
-        };
+        let axis = |n0: f64, step: f64| quadrature(n0, step, fine);
         let [t, b, a] = self.frame();
         let s = self.scale;
         let mut out = Vec::new();
@@ -266,6 +238,33 @@ impl LobeBins {
             &mut |bin, fine| self.points(bin, fine),
             pdf,
         )
+    }
+}
+
+/// Counts per bin (of `count`, as `index` places them) of the valid directions.
+fn direction_histogram(
+    count: usize,
+    index: impl Fn([f32; 3]) -> Option<usize>,
+    samples: impl IntoIterator<Item = ([f32; 3], bool)>,
+) -> Vec<f64> {
+    let mut h = vec![0.0; count];
+    for (d, valid) in samples {
+        if valid && let Some(i) = index(d) {
+            h[i] += 1.0;
+        }
+    }
+    h
+}
+
+/// Points and weights covering [n0, n0 + step]: `fine` midpoints, or Gauss-Legendre's five
+/// nodes when `fine` is 0.
+fn quadrature(n0: f64, step: f64, fine: usize) -> Vec<(f64, f64)> {
+    if fine > 0 {
+        (0..fine)
+            .map(|k| (n0 + (k as f64 + 0.5) / fine as f64 * step, step / fine as f64))
+            .collect()
+    } else {
+        GAUSS5.iter().map(|&(x, w)| (n0 + 0.5 * (x + 1.0) * step, 0.5 * w * step)).collect()
     }
 }
 
@@ -303,12 +302,8 @@ impl IntervalBins {
     fn points(&self, bin: usize, fine: usize) -> Vec<(f64, f64)> {
         let w = (self.hi - self.lo) / self.bins as f64;
         let x0 = self.lo + bin as f64 * w;
-        if fine > 0 {
-            let n = fine * fine;
-            (0..n).map(|k| (x0 + (k as f64 + 0.5) / n as f64 * w, w / n as f64)).collect()
-        } else {
-            GAUSS5.iter().map(|&(x, g)| (x0 + 0.5 * (x + 1.0) * w, 0.5 * g * w)).collect()
-        }
+        // As many points as a direction bin's fine grid has.
+        quadrature(x0, w, fine * fine)
     }
 
     /// The integral of the pdf over every bin; `pdf` evaluates it at a batch of points
