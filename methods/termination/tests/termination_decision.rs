@@ -63,6 +63,63 @@ fn mse_minimisation_compares_current_and_deferred_mse() {
     assert_eq!(decide(&rule, 1.0, &mut s, &stats(2.0, 0.5, 5.0)), Decision::Continue);
 }
 
+/// At the primary vertex the path variance is 0 and the throughput cancels (§4.3: "termination
+/// is entirely dependent on the local statistics"); with the deferred bias clamped (a next record
+/// at least as biased as this one), current = B², deferred = P/s + c·B²/m, and the rule ends the
+/// path iff B² <= m·(P/s + c·B²/m), i.e. iff the record's squared bias is at most
+/// m / (s·(1 − c)) of its local variance: 1.1 / (100 · 0.9) = 1.22% with the paper's s = 100,
+/// margin 1.1 and the 90% clamp. Table 1's MSE path length of 1.00 needs records that unbiased.
+#[test]
+fn mse_minimisation_ends_at_the_first_vertex_below_the_closed_form_bias_share() {
+    // Hand-computed: s = 100, margin 1.1, clamp 0.1, P = 1: the share is 0.0122.
+    let rule = TerminationRule::MseMinimisation { s: 100.0, margin: 1.1, bias_clamp: 0.1 };
+    let at_first = |bias2: f64, deferred: f64, throughput2: f64| {
+        let mut s = PathState { throughput2, vertex: 1, ..Default::default() };
+        decide(&rule, 1.0, &mut s, &stats(1.0, bias2, deferred))
+    };
+    // B² = 0.012: current 0.012 <= 1.1 · (0.01 + 0.0012/1.1) = 0.0122: terminate.
+    assert_eq!(at_first(0.012, 1.0, 1.0), Decision::Terminate);
+    // B² = 0.0123: 0.0123 > 1.1 · 0.01 + 0.00123 = 0.01223: continue.
+    assert_eq!(at_first(0.0123, 1.0, 1.0), Decision::Continue);
+    // The throughput cancels: the same decisions at any prefix weight.
+    assert_eq!(at_first(0.012, 1.0, 37.0), Decision::Terminate);
+    assert_eq!(at_first(0.0123, 1.0, 37.0), Decision::Continue);
+    // A next record less biased than the clamp: B² <= 1.1 · (0.01 + 0.0005) = 0.01155 only.
+    assert_eq!(at_first(0.0115, 0.0005, 1.0), Decision::Terminate);
+    assert_eq!(at_first(0.0116, 0.0005, 1.0), Decision::Continue);
+
+    // The closed form m / (s (1 − c)) over parameters, just below and just above it, and with
+    // roulette of survival q (local variance V + (1/q − 1) E[B²], deferred bias / q, still
+    // clamped).
+    for s_target in [1.0, 10.0, 100.0, 1000.0] {
+        for margin in [1.0, 1.1, 2.0] {
+            for clamp in [0.1, 0.5] {
+                for q in [1.0, 0.2] {
+                    let rule =
+                        TerminationRule::MseMinimisation { s: s_target, margin, bias_clamp: clamp };
+                    let base = stats(2.0, 0.0, 0.0);
+                    let p = base.variance_with_roulette(q);
+                    let share = margin / (s_target * (1.0 - clamp));
+                    for (factor, expected) in
+                        [(1.0 - 1e-6, Decision::Terminate), (1.0 + 1e-6, Decision::Continue)]
+                    {
+                        let bias2 = share * p * factor;
+                        let mut st =
+                            PathState { throughput2: 3.0, vertex: 1, ..Default::default() };
+                        let d = decide(&rule, q, &mut st, &stats(2.0, bias2, 10.0 * bias2));
+                        assert_eq!(
+                            d,
+                            expected,
+                            "s {s_target}, margin {margin}, clamp {clamp}, q {q}: B²/P = {}",
+                            bias2 / p
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn area_spread_never_ends_at_the_primary_vertex_and_ends_past_c() {
     let rule = TerminationRule::AreaSpread { c: 0.01 };
