@@ -7,7 +7,6 @@ use render::error::RenderError;
 use render::gpu::Gpu;
 use render::readback::Staging;
 use render::shader::{Module, Program};
-use wgpu::util::DeviceExt;
 
 /// `package::termination::decision`: the decision, imported by the cache's passes and the probe.
 pub fn decision_module() -> Module {
@@ -74,11 +73,11 @@ pub fn decide_on_gpu(gpu: &Gpu, cases: &[DecisionCase]) -> Result<Vec<[f32; 3]>,
         &program,
         ["tc_decide_probe"],
     )?;
-    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("decision cases"),
-        contents: bytemuck::cast_slice(&words),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
+    let input = gpu.buffer_init(
+        "decision cases",
+        bytemuck::cast_slice(&words),
+        wgpu::BufferUsages::STORAGE,
+    );
     let size = (cases.len().max(1) * 16) as u64;
     let output = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("decisions"),
