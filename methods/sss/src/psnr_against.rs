@@ -58,12 +58,24 @@ pub fn psnr_against(run: &FolderRun) -> Result<FolderSeries> {
             let image = luminance_image(&folder.frame(m, f as u32, "exr"))
                 .with_context(|| at(&format!("{m}'s frame"), f as u32))?;
             let any = masks[f].iter().any(|s| *s);
-            let db = crate::evaluation::psnr_luminance(&image, &references[f], &masks[f], peak);
+            let db = psnr_luminance(&image, &references[f], &masks[f], peak);
             series.push((any && peak > 0.0).then_some(db));
         }
         out.push((m.clone(), COLUMN, series));
     }
     Ok(out)
+}
+
+/// PSNR of luminance over the masked pixels, peak `peak`.
+pub fn psnr_luminance(result: &[f32], reference: &[f32], mask: &[bool], peak: f64) -> f64 {
+    let (mut se, mut n) = (0.0f64, 0usize);
+    for ((r, f), _) in result.iter().zip(reference).zip(mask).filter(|(_, m)| **m) {
+        let e = *r as f64 - *f as f64;
+        se += e * e;
+        n += 1;
+    }
+    let mse = se / n.max(1) as f64;
+    10.0 * (peak * peak / mse.max(1e-30)).log10()
 }
 
 #[cfg(test)]
