@@ -222,7 +222,7 @@ fn cache_files(dir: &Path) -> Vec<PathBuf> {
 /// Every entry of the reference cache in `dir` decodes with its checksum; nothing else is in
 /// it but the temporary files of killed writes and the entries' lock files.
 fn assert_whole_entries(dir: &Path, width: u32, height: u32) {
-    let cache = systems::reference_cache::ReferenceCache::new(dir);
+    let cache = frame::reference_cache::ReferenceCache::new(dir);
     let entries: Vec<PathBuf> =
         cache_files(dir).into_iter().filter(|p| !temporaries(dir).contains(p)).collect();
     for entry in &entries {

@@ -90,7 +90,7 @@ pub fn nirc(
     print!("{section}");
     md.push_str(&section);
     if let Some(path) = out {
-        systems::output::write_text(&path, &md)?;
+        frame::output::write_text(&path, &md)?;
     }
     if let Some(path) = json {
         let j = crate::nirc_frames::BenchJson {
@@ -99,7 +99,7 @@ pub fn nirc(
             frames: table,
             targets,
         };
-        systems::output::write_text(&path, &serde_json::to_string_pretty(&j)?)?;
+        frame::output::write_text(&path, &serde_json::to_string_pretty(&j)?)?;
     }
     frames
         .map(|_| ())
@@ -125,10 +125,10 @@ fn print_and_write(
 ) -> anyhow::Result<()> {
     print!("{md}");
     if let Some(path) = out {
-        systems::output::write_text(&path, md)?;
+        frame::output::write_text(&path, md)?;
     }
     if let Some(path) = json {
-        systems::output::write_text(&path, &serde_json::to_string_pretty(value)?)?;
+        frame::output::write_text(&path, &serde_json::to_string_pretty(value)?)?;
     }
     Ok(())
 }
@@ -220,10 +220,10 @@ pub fn speed(
     }
     print!("{md}");
     if let Some(path) = out {
-        systems::output::write_text(&path, &md)?;
+        frame::output::write_text(&path, &md)?;
     }
     if let Some(path) = json {
-        systems::output::write_text(&path, &serde_json::to_string_pretty(&report.json)?)?;
+        frame::output::write_text(&path, &serde_json::to_string_pretty(&report.json)?)?;
     }
     let a = &report.json["adapter"];
     let adapter =

@@ -14,12 +14,12 @@
 //! (`pretrain_frames: 0`): a frame does the same work whatever the weights.
 
 use anyhow::{Context, Result};
+use frame::RunOutput;
+use frame::run_folder::RunFolder;
 use indicatif::ProgressBar;
 use render::gpu::Gpu;
 use sim::Scenario;
-use systems::frame::RunOutput;
 use systems::playback::{FrameWorld, Overrides, RunSpec};
-use systems::run_folder::RunFolder;
 use tools::suite::welch::Sample;
 
 /// The predictors of Table 1, in its column order.

@@ -4,7 +4,7 @@
 use bevy_ecs::prelude::*;
 
 use super::resources::{FrameClock, MethodFrame, MethodInfo, References, Run};
-use crate::frame_metrics as measure;
+use crate::frame_metrics;
 
 /// The method's output as a frame to measure; the record starts with its label and counters.
 pub fn prepare(
@@ -15,7 +15,8 @@ pub fn prepare(
     for (info, mut m) in &mut methods {
         let Some(out) = m.output.as_ref() else { continue };
         let motion = (!out.motion.is_empty()).then_some(out.motion.as_slice());
-        let current = measure::Frame::from_radiance(run.width, run.height, &out.radiance, motion);
+        let current =
+            frame_metrics::Frame::from_radiance(run.width, run.height, &out.radiance, motion);
         let record = crate::frame_record::FrameRecord {
             method: info.label.clone(),
             frame: clock.frame,
@@ -37,7 +38,7 @@ pub fn smape_vs_previous(run: Res<Run>, mut methods: Query<&mut MethodFrame>) {
     for mut m in &mut methods {
         let m = &mut *m;
         let Some(current) = &m.current else { continue };
-        m.smape_map = measure::smape_vs_previous(
+        m.smape_map = frame_metrics::smape_vs_previous(
             &mut m.record,
             current,
             m.previous.as_ref(),
@@ -52,7 +53,7 @@ pub fn flip_vs_reference(references: Res<References>, mut methods: Query<&mut Me
     for mut m in &mut methods {
         let m = &mut *m;
         let Some(current) = &m.current else { continue };
-        m.flip_map = measure::error_vs_reference(&mut m.record, current, reference);
+        m.flip_map = frame_metrics::error_vs_reference(&mut m.record, current, reference);
     }
 }
 
@@ -63,7 +64,7 @@ pub fn regions(run: Res<Run>, mut methods: Query<&mut MethodFrame>) {
         if m.current.is_none() {
             continue;
         }
-        measure::regions(
+        frame_metrics::regions(
             &mut m.record,
             &run.scenario,
             run.width,

@@ -26,6 +26,11 @@ pub fn write_exr(path: &Path, width: u32, height: u32, rgba: &[[f32; 4]]) -> Res
     metrics::image::write_exr_pixels(path, width, height, metrics::image::ExrPixels::Rgba(rgba))
 }
 
+/// Values as opaque grey RGBA pixels (a per-pixel count or statistic as an image).
+pub fn grey_pixels(values: impl IntoIterator<Item = f32>) -> Vec<[f32; 4]> {
+    values.into_iter().map(|v| [v, v, v, 1.0]).collect()
+}
+
 /// Tone-mapped 8-bit sRGB PNG of linear radiance.
 pub fn write_png(
     path: &Path,

@@ -582,14 +582,9 @@ pub struct KernelBuffers {
 
 impl KernelBuffers {
     pub fn new(gpu: &Gpu, params: &[[f32; 4]], points: &[[f32; 4]], count: u32) -> Self {
-        use wgpu::util::DeviceExt;
         let init = |label: &str, data: &[[f32; 4]]| {
             let data: &[[f32; 4]] = if data.is_empty() { &[[0.0; 4]] } else { data };
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: bytemuck::cast_slice(data),
-                usage: wgpu::BufferUsages::STORAGE,
-            })
+            gpu.buffer_init(label, bytemuck::cast_slice(data), wgpu::BufferUsages::STORAGE)
         };
         let result = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("chi2 result"),

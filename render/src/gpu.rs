@@ -199,6 +199,48 @@ impl Gpu {
         }
     }
 
+    /// A buffer holding `contents`: every pass makes its buffers from bytes through here.
+    pub fn buffer_init(
+        &self,
+        label: &str,
+        contents: &[u8],
+        usage: wgpu::BufferUsages,
+    ) -> wgpu::Buffer {
+        use wgpu::util::DeviceExt;
+        self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents,
+            usage,
+        })
+    }
+
+    /// [`Gpu::buffer_init`] after refusing `contents` larger than the adapter binds (an error
+    /// naming `label`).
+    pub fn checked_buffer_init(
+        &self,
+        label: &str,
+        contents: &[u8],
+        usage: wgpu::BufferUsages,
+    ) -> Result<wgpu::Buffer, GpuError> {
+        self.check_buffer_size(label, contents.len() as u64)?;
+        Ok(self.buffer_init(label, contents, usage))
+    }
+
+    /// Records commands into a new encoder labelled `label` and submits them (nothing is
+    /// submitted when `record` fails): every one-off submission goes through here.
+    pub fn submit<T, E>(
+        &self,
+        label: &str,
+        record: impl FnOnce(&mut wgpu::CommandEncoder) -> Result<T, E>,
+    ) -> Result<T, E> {
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        let out = record(&mut encoder)?;
+        self.queue.submit([encoder.finish()]);
+        Ok(out)
+    }
+
     fn over(&self, what: &str, requested: u64, limit: u64) -> GpuError {
         GpuError::OverLimit {
             what: what.into(),

@@ -20,7 +20,6 @@ use crate::scene_features::SceneFeatures;
 use crate::shader::Program;
 use crate::texel_table::TexelTable;
 use glam::Vec3;
-use wgpu::util::DeviceExt;
 
 /// @group(0)'s buffers: frame parameters, texels (declared into the library's WGSL).
 pub const GROUP: [BufferBinding; 2] =
@@ -91,15 +90,6 @@ impl SceneGpu {
         let geometry = SceneGeometry::new(gpu, scene)?;
         let (materials_cpu, texels) = pack_materials(scene)?;
         let light_table = build_light_table(scene)?;
-        let device = &gpu.device;
-        let storage = |label: &str, contents: &[u8]| -> Result<wgpu::Buffer, RenderError> {
-            gpu.check_buffer_size(label, contents.len() as u64)?;
-            Ok(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            }))
-        };
         let materials = TexelTable::new(
             gpu,
             "materials",
@@ -107,7 +97,11 @@ impl SceneGpu {
             bytemuck::cast_slice(&materials_cpu),
             0,
         )?;
-        let texels = storage("base-colour texels", bytemuck::cast_slice(&texels))?;
+        let texels = gpu.checked_buffer_init(
+            "base-colour texels",
+            bytemuck::cast_slice(&texels),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        )?;
         let lights = TexelTable::new(
             gpu,
             "lights",
@@ -195,12 +189,11 @@ impl SceneGpu {
             if buffer.size() == bytes.len() as u64 {
                 gpu.queue.write_buffer(buffer, 0, bytes);
             } else {
-                gpu.check_buffer_size(label, bytes.len() as u64)?;
-                *buffer = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents: bytes,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                });
+                *buffer = gpu.checked_buffer_init(
+                    label,
+                    bytes,
+                    wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                )?;
                 reallocated = true;
             }
         }

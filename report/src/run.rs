@@ -27,7 +27,7 @@ pub struct ReferenceInfo {
 pub struct MethodSettings {
     #[serde(default)]
     pub label: String,
-    /// Effective temporal window, frames (systems::methods::temporal_window); absent in runs
+    /// Effective temporal window, frames (frame::temporal_window); absent in runs
     /// before temporal windows were recorded and for methods that state none.
     #[serde(default)]
     pub temporal_window: Option<f64>,
@@ -133,7 +133,7 @@ pub fn merge_events(mut events: Vec<Event>) -> Vec<Event> {
     out
 }
 
-/// The folder of a method's motion vectors, `frames/METHOD/motion/` (as systems::run_folder).
+/// The folder of a method's motion vectors, `frames/METHOD/motion/` (as frame::run_folder).
 pub const MOTION: &str = "motion";
 
 pub fn frame_file(run_dir: &Path, method: Option<&str>, frame: u32, ext: &str) -> PathBuf {

@@ -1,5 +1,6 @@
-//! The frame as a bevy_ecs schedule (`frame`), the rendering methods as plugins (`methods`),
-//! measurement, recording, and scenario playback.
+//! Scenario playback over the frame crate's schedule (`playback`), the rendering methods'
+//! registry (`methods`), resuming, interrupts, the manifest, the run's device memory and Mitsuba 3
+//! as an independent renderer (`mitsuba`).
 
 pub mod interrupt;
 pub mod manifest;
@@ -9,9 +10,3 @@ pub mod mitsuba;
 pub mod playback;
 pub mod resume;
 pub mod scenario;
-
-/// The frame (its own crate, which knows no method) and what a run writes, under the names the
-/// rest of this crate and its users know them by.
-pub use ::frame;
-pub use frame::frame_metrics as measure;
-pub use frame::{frame_record, output, reference_cache, run_folder, tonemap};

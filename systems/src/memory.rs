@@ -12,9 +12,9 @@ use indicatif::ProgressBar;
 use render::gpu::Gpu;
 use serde::Serialize;
 
-use crate::frame::GpuDevice;
 use crate::playback::{FrameWorld, Overrides, RunSpec};
-use crate::run_folder::RunFolder;
+use frame::GpuDevice;
+use frame::run_folder::RunFolder;
 
 /// One method instance's device memory.
 #[derive(Clone, Debug, Serialize)]

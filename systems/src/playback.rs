@@ -1,5 +1,5 @@
 //! `flicker run`: builds the frame's world and schedule from a scenario and runs the schedule
-//! once per frame (crate::frame); the run folder gets the images, frames.csv and the report.
+//! once per frame (frame); the run folder gets the images, frames.csv and the report.
 
 use std::path::PathBuf;
 
@@ -11,16 +11,16 @@ use render::path_tracer::PathTracerSettings;
 use render::scene_gpu::SceneGpu;
 use sim::Simulation;
 
-use crate::frame::{
+use crate::memory::{MethodMemory, RunMemory};
+pub use crate::scenario::{Overrides, RunSpec};
+use frame::frame_record::FrameRecord;
+use frame::output;
+use frame::reference_cache::ReferenceCache;
+use frame::run_folder::RunFolder;
+use frame::{
     self, FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Progress, References, Run,
     RunOutput,
 };
-use crate::frame_record::FrameRecord;
-use crate::memory::{MethodMemory, RunMemory};
-use crate::output;
-use crate::reference_cache::ReferenceCache;
-use crate::run_folder::RunFolder;
-pub use crate::scenario::{Overrides, RunSpec};
 
 pub struct RunOptions {
     pub scenario: PathBuf,
@@ -337,7 +337,7 @@ pub(crate) fn write_report(folder: &RunFolder) -> Result<PathBuf> {
 
 /// The replayed frames' rows against those the interrupted run wrote.
 fn replay_matches(world: &World, resume: &ResumeAt, folder: &RunFolder) -> Result<()> {
-    let replayed = crate::frame_record::to_csv(&world.resource::<RunOutput>().records);
+    let replayed = frame::frame_record::to_csv(&world.resource::<RunOutput>().records);
     crate::resume::same_rows(&folder.frames_csv(), &resume.frames_csv, &replayed)
 }
 

@@ -102,7 +102,7 @@ fn read_manifest(run: &Path) -> Result<Value> {
 
 pub fn resume(run: &Path, cache_dir: Option<PathBuf>, progress: bool) -> Result<RunSummary> {
     // Stopped after its last frame, while its report was being written: only the report is left.
-    let folder = crate::run_folder::RunFolder::new(run);
+    let folder = frame::run_folder::RunFolder::new(run);
     if folder.report_pending().exists() && Status::of(&read_manifest(run)?) == Status::Complete {
         eprintln!("{}: every frame was written; writing its summary and report", run.display());
         remove_temporaries(run)?;

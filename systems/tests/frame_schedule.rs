@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use bevy_ecs::prelude::*;
-use systems::frame::{self, Stage};
+use frame::{self, Stage};
 use systems::methods::Method;
 use systems::scenario::{Overrides, RunSpec};
 

@@ -15,8 +15,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use bevy_ecs::prelude::*;
+use frame::{FrameClock, GpuDevice, MethodFrame, Run, Stage};
 use serde::{Deserialize, Serialize};
-use systems::frame::{FrameClock, GpuDevice, MethodFrame, Run, Stage};
 use systems::methods::{MethodOutput, MethodPlugin, register};
 use systems::playback::{RunOptions, run_spec, run_spec_on};
 use systems::scenario::{Overrides, RunSpec};

@@ -13,7 +13,7 @@
 
 use std::path::{Path, PathBuf};
 
-use systems::frame_record::FrameRecord;
+use frame::frame_record::FrameRecord;
 use systems::playback::{Overrides, RunOptions, run};
 
 mod common;

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
+use frame::frame_record::FrameRecord;
 use statrs::distribution::{ContinuousCDF, StudentsT};
-use systems::frame_record::FrameRecord;
 use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};
 
@@ -186,7 +186,7 @@ fn taa_after_the_pass_lowers_flicker_and_separable_runs() {
         let (records, tmp) = play_inline("taa", seed, FRAMES, methods);
         let dir = tmp.path().to_path_buf();
         let image = |m: &str, f: u32| {
-            systems::output::read_exr(&dir.join(format!("run/frames/{m}/{f:04}.exr"))).unwrap().2
+            frame::output::read_exr(&dir.join(format!("run/frames/{m}/{f:04}.exr"))).unwrap().2
         };
         assert_eq!(image("as", 0), image("as_taa", 0), "seed {seed}: frame 0 has no history");
         assert_ne!(image("as", 3), image("as_taa", 3), "seed {seed}: TAA changed nothing");
@@ -237,8 +237,7 @@ fn two_subsurface_materials_scatter_apart() {
     let (one, tmp_one) = play_with_materials("one_material", 4, 3, methods, &[SKIN]);
     let (two, tmp_two) = play_with_materials("two_materials", 4, 3, methods, &[SKIN, floor]);
     let (dir_one, dir_two) = (tmp_one.path().to_path_buf(), tmp_two.path().to_path_buf());
-    let last =
-        |dir: &Path| systems::output::read_exr(&dir.join("run/frames/as/0002.exr")).unwrap().2;
+    let last = |dir: &Path| frame::output::read_exr(&dir.join("run/frames/as/0002.exr")).unwrap().2;
     let counts = |dir: &Path| {
         metrics::load_image(dir.join("run/frames/as/sample_count/0002.png")).unwrap().rgb
     };
@@ -274,7 +273,7 @@ fn hybrid_runs_both_techniques_end_to_end() {
     let (records, tmp) = play_inline("hybrid", 2, 3, methods);
     let dir = tmp.path().to_path_buf();
     let image = |m: &str, f: u32| {
-        systems::output::read_exr(&dir.join(format!("run/frames/{m}/{f:04}.exr"))).unwrap().2
+        frame::output::read_exr(&dir.join(format!("run/frames/{m}/{f:04}.exr"))).unwrap().2
     };
     for r in &records {
         let spp = stat(r, "sss_mean_spp");
@@ -346,9 +345,8 @@ fn the_hybrid_scenario_takes_both_paths() {
         progress: false,
     };
     run_spec(&spec, &opts).expect("run");
-    let image = |m: &str| {
-        systems::output::read_exr(&dir.join(format!("run/frames/{m}/0000.exr"))).unwrap().2
-    };
+    let image =
+        |m: &str| frame::output::read_exr(&dir.join(format!("run/frames/{m}/0000.exr"))).unwrap().2;
     let (hybrid, afis, separable) = (image("hybrid"), image("afis"), image("separable"));
     let (mut as_afis, mut as_separable) = (0, 0);
     for ((h, a), s) in hybrid.iter().zip(&afis).zip(&separable) {

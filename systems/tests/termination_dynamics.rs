@@ -17,8 +17,8 @@
 
 use std::path::{Path, PathBuf};
 
+use frame::frame_record::FrameRecord;
 use sim::ReferenceFrames;
-use systems::frame_record::FrameRecord;
 use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};
 

@@ -24,7 +24,7 @@
 
 use std::path::{Path, PathBuf};
 
-use systems::frame_record::FrameRecord;
+use frame::frame_record::FrameRecord;
 use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};
 

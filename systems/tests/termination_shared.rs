@@ -5,9 +5,9 @@
 
 use std::path::Path;
 
-use systems::frame_record::FrameRecord;
+use frame::frame_record::FrameRecord;
+use frame::run_folder::RunFolder;
 use systems::playback::{RunOptions, run_spec};
-use systems::run_folder::RunFolder;
 use systems::scenario::{Overrides, RunSpec};
 
 const FRAMES: u32 = 2;

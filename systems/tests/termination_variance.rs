@@ -13,10 +13,10 @@
 
 use std::path::{Path, PathBuf};
 
-use systems::frame_record::FrameRecord;
-use systems::output::read_exr;
+use frame::frame_record::FrameRecord;
+use frame::output::read_exr;
+use frame::run_folder::RunFolder;
 use systems::playback::{RunOptions, run_spec};
-use systems::run_folder::RunFolder;
 use systems::scenario::{Overrides, RunSpec};
 
 mod common;

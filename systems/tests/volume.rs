@@ -28,7 +28,7 @@ fn play(scenario: &str, out: &Path) -> systems::playback::RunSummary {
     .unwrap_or_else(|e| panic!("{e:#}"))
 }
 
-fn stat(r: &systems::frame_record::FrameRecord, name: &str) -> f64 {
+fn stat(r: &frame::frame_record::FrameRecord, name: &str) -> f64 {
     r.stats
         .iter()
         .find(|(n, _)| n == name)

@@ -10,13 +10,13 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
+use frame::frame_metrics::{Frame, error_vs_reference, smape_vs_previous};
+use frame::frame_record::FrameRecord;
+use frame::output;
+use frame::run_folder::{MOTION, RunFolder};
 use metrics::frames_csv::{self, Cell};
 use metrics::{CvvdpSettings, Image, load_image};
 use serde_json::json;
-use systems::frame_record::FrameRecord;
-use systems::measure::{Frame, error_vs_reference, smape_vs_previous};
-use systems::output;
-use systems::run_folder::{MOTION, RunFolder};
 
 /// What to measure and where to write it.
 #[derive(Clone, Debug)]
@@ -346,7 +346,7 @@ fn write_frame(path_exr: &Path, path_png: &Path, img: &Image) -> anyhow::Result<
 /// cost, and a column of zeros would draw speed charts and mark a "fastest" method (their own
 /// times, given with --timings, are in the wall_ms columns).
 fn without_times(records: &[FrameRecord]) -> String {
-    let (columns, mut cells) = systems::frame_record::table(records);
+    let (columns, mut cells) = frame::frame_record::table(records);
     if let Some(col) = columns.iter().position(|c| c == "cpu_ms") {
         for row in &mut cells {
             row[col] = Cell::Empty;

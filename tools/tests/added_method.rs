@@ -9,9 +9,9 @@ use std::time::Instant;
 
 use anyhow::Result;
 use bevy_ecs::prelude::*;
+use frame::{FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage};
 use render::path_tracer::PathTracer;
 use serde::{Deserialize, Serialize};
-use systems::frame::{FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage};
 use systems::methods::{MethodChart, MethodOutput, MethodPlugin, Statistic, register};
 use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};

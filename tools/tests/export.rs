@@ -117,7 +117,7 @@ fn references(
             },
         )
         .unwrap();
-        let folder = systems::run_folder::RunFolder::new(&summary.folder);
+        let folder = frame::run_folder::RunFolder::new(&summary.folder);
         out.push(
             frames
                 .iter()
@@ -241,7 +241,7 @@ fn a_package_is_measured_and_one_missing_a_frame_is_refused() {
             tools::export::INPUTS.iter().map(|i| package.join("inputs").join(i).join(&name)),
         );
         for f in files {
-            let (w, h, _) = systems::output::read_exr(&f).unwrap_or_else(|e| panic!("{e:#}"));
+            let (w, h, _) = frame::output::read_exr(&f).unwrap_or_else(|e| panic!("{e:#}"));
             assert_eq!((w, h), (32, 18), "{}", f.display());
         }
         let record: serde_json::Value = serde_json::from_str(

@@ -242,7 +242,7 @@ fn frame(seed: f32) -> Vec<[f32; 4]> {
 
 #[test]
 fn frames_that_measure_reads() {
-    use systems::output::{write_exr, write_png};
+    use frame::output::{write_exr, write_png};
     let tmp = scratch("measure");
     let dir = tmp.path().to_path_buf();
     for kind in ["exr", "png"] {
@@ -289,7 +289,7 @@ fn has_line(e: &str, name: &str) -> bool {
 
 #[test]
 fn what_resume_reads() {
-    use systems::frame_record::{FrameRecord, to_csv};
+    use frame::frame_record::{FrameRecord, to_csv};
     let tmp = scratch("resume");
     let dir = tmp.path().to_path_buf();
     let scenario = dir.join("tiny.ron");

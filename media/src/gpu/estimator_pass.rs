@@ -5,7 +5,6 @@ use render::compute::{BufferBinding, binding_layout, buffer_group, pipelines};
 use render::error::RenderError;
 use render::gpu::Gpu;
 use render::readback::Staging;
-use wgpu::util::DeviceExt;
 
 use super::medium::{GpuMedium, RaySegment};
 use crate::transmittance::Estimator;
@@ -65,16 +64,12 @@ impl EstimatorPass {
         let (kind, samples, multiplier) = estimator.gpu_settings();
         let params = RayParams { count: rays.len() as u32, kind, samples, multiplier };
         let device = &gpu.device;
-        let init = |label: &str, contents: &[u8], usage| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage,
-            })
+        let init = |label: &str, contents: &[u8]| {
+            gpu.buffer_init(label, contents, wgpu::BufferUsages::STORAGE)
         };
-        let params = init("ray params", bytemuck::bytes_of(&params), wgpu::BufferUsages::STORAGE);
-        let rays_buf = init("rays", bytemuck::cast_slice(rays), wgpu::BufferUsages::STORAGE);
-        let seeds_buf = init("seeds", bytemuck::cast_slice(seeds), wgpu::BufferUsages::STORAGE);
+        let params = init("ray params", bytemuck::bytes_of(&params));
+        let rays_buf = init("rays", bytemuck::cast_slice(rays));
+        let seeds_buf = init("seeds", bytemuck::cast_slice(seeds));
         let size = (rays.len() * 8) as u64;
         let results = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("results"),

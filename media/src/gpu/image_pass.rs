@@ -9,7 +9,6 @@ use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::readback::Staging;
 use render::timing::{PassTimer, PassTiming};
-use wgpu::util::DeviceExt;
 
 use super::medium::GpuMedium;
 use crate::image::{ImageKey, T_MAX};
@@ -92,18 +91,12 @@ impl ImagePass {
             multiplier,
         };
         let device = &gpu.device;
-        let init = |label: &str, contents: &[u8], usage| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage,
-            })
+        let init = |label: &str, contents: &[u8]| {
+            gpu.buffer_init(label, contents, wgpu::BufferUsages::STORAGE)
         };
-        let params =
-            init("media image params", bytemuck::bytes_of(&params), wgpu::BufferUsages::STORAGE);
+        let params = init("media image params", bytemuck::bytes_of(&params));
         let d4: Vec<[f32; 4]> = dirs.iter().map(|d| [d.x, d.y, d.z, 0.0]).collect();
-        let dirs_buf =
-            init("media image directions", bytemuck::cast_slice(&d4), wgpu::BufferUsages::STORAGE);
+        let dirs_buf = init("media image directions", bytemuck::cast_slice(&d4));
         let count = dirs.len() as u64 * u64::from(key.spp);
         gpu.check_buffer_size("media image results", count * 8).map_err(|e| e.to_string())?;
         let size = count * 8;

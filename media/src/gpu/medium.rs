@@ -4,7 +4,6 @@
 use bytemuck::Zeroable;
 use render::compute::{BufferBinding, binding_layout, buffer_group};
 use render::gpu::Gpu;
-use wgpu::util::DeviceExt;
 
 use crate::medium::{Medium, Segment};
 
@@ -97,19 +96,12 @@ impl GpuMedium {
                 medium.super_voxels.cells.iter().map(|c| [c.min, c.max, c.mean, c.rms_excess]),
             );
         }
-        let buffer = |label: &str, contents: &[u8], usage| {
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage,
-            })
+        let buffer = |label: &str, contents: &[u8]| {
+            gpu.buffer_init(label, contents, wgpu::BufferUsages::STORAGE)
         };
-        let params =
-            buffer("media params", bytemuck::cast_slice(&params), wgpu::BufferUsages::STORAGE);
-        let density =
-            buffer("media density", bytemuck::cast_slice(&density), wgpu::BufferUsages::STORAGE);
-        let super_voxels =
-            buffer("media super-voxels", bytemuck::cast_slice(&sv), wgpu::BufferUsages::STORAGE);
+        let params = buffer("media params", bytemuck::cast_slice(&params));
+        let density = buffer("media density", bytemuck::cast_slice(&density));
+        let super_voxels = buffer("media super-voxels", bytemuck::cast_slice(&sv));
         let layout = binding_layout(gpu, "media", &BINDINGS);
         let group = buffer_group(gpu, "media", &layout, &[&params, &density, &super_voxels]);
         Self { layout, group, count: media.len() }

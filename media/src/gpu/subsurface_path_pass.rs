@@ -15,7 +15,6 @@ use render::scene_gpu::SceneGpu;
 use render::shader::{Module, Program};
 use render::timing::PassTimer;
 use scene::{Material, SubsurfaceMedium};
-use wgpu::util::DeviceExt;
 
 use super::VolumeImage;
 use super::specialised_pipeline::SpecialisedPipeline;
@@ -141,12 +140,11 @@ impl SubsurfacePathPass {
         let table = coefficient_table(materials)?;
         let pipeline =
             self.pipeline.get(scene.features(), |f| Self::compile(gpu, scene, &self.layout, f))?;
-        let device = &gpu.device;
-        let coefficients = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("subsurface coefficients"),
-            contents: bytemuck::cast_slice(&table),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
+        let coefficients = gpu.buffer_init(
+            "subsurface coefficients",
+            bytemuck::cast_slice(&table),
+            wgpu::BufferUsages::STORAGE,
+        );
         let batched = super::volume_path_pass::Batched {
             gpu,
             scene,
@@ -164,11 +162,11 @@ impl SubsurfacePathPass {
                 materials: materials.len() as u32,
                 max_events: MAX_EVENTS,
             };
-            let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("subsurface path params"),
-                contents: bytemuck::bytes_of(&params),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
+            let params = gpu.buffer_init(
+                "subsurface path params",
+                bytemuck::bytes_of(&params),
+                wgpu::BufferUsages::STORAGE,
+            );
             buffer_group(gpu, "subsurface path", &self.layout, &[&params, &coefficients, samples])
         })
     }

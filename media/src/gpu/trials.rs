@@ -5,7 +5,6 @@
 use render::compute::buffer_group;
 use render::gpu::Gpu;
 use render::readback::Staging;
-use wgpu::util::DeviceExt;
 
 /// Runs `pipeline` over `seeds`; `T` is one trial's result as the shader writes it.
 pub(super) fn run_trials<T: bytemuck::Pod>(
@@ -17,15 +16,9 @@ pub(super) fn run_trials<T: bytemuck::Pod>(
     seeds: &[u32],
 ) -> Result<Vec<T>, String> {
     let device = &gpu.device;
-    let init = |contents: &[u8], usage| {
-        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents,
-            usage,
-        })
-    };
-    let params = init(params, wgpu::BufferUsages::STORAGE);
-    let seeds_buf = init(bytemuck::cast_slice(seeds), wgpu::BufferUsages::STORAGE);
+    let params = gpu.buffer_init(label, params, wgpu::BufferUsages::STORAGE);
+    let seeds_buf =
+        gpu.buffer_init(label, bytemuck::cast_slice(seeds), wgpu::BufferUsages::STORAGE);
     let size = (seeds.len() * std::mem::size_of::<T>()) as u64;
     let results = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),

@@ -17,7 +17,6 @@ use render::scene_gpu::SceneGpu;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming, merge};
 use serde::{Deserialize, Serialize};
-use wgpu::util::DeviceExt;
 
 use super::medium::GpuMedium;
 use super::specialised_pipeline::SpecialisedPipeline;
@@ -295,7 +294,6 @@ impl VolumePathPass {
             packed[2 * i + 1] = o.emission.extend(0.0).into();
         }
         let pipeline = self.pipeline(gpu, scene, medium).map_err(|e| e.to_string())?;
-        let device = &gpu.device;
         let batched = Batched {
             gpu,
             scene,
@@ -321,16 +319,16 @@ impl VolumePathPass {
                 _pad0: 0,
                 _pad1: 0,
             };
-            let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("volume path params"),
-                contents: bytemuck::bytes_of(&params),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
-            let optics = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("volume path optics"),
-                contents: bytemuck::cast_slice(&packed),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
+            let params = gpu.buffer_init(
+                "volume path params",
+                bytemuck::bytes_of(&params),
+                wgpu::BufferUsages::STORAGE,
+            );
+            let optics = gpu.buffer_init(
+                "volume path optics",
+                bytemuck::cast_slice(&packed),
+                wgpu::BufferUsages::STORAGE,
+            );
             buffer_group(gpu, "media volume path", &self.layout, &[&params, &optics, samples])
         })
     }

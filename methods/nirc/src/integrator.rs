@@ -20,7 +20,6 @@ use render::scene_gpu::SceneGpu;
 use render::shader::{Module, Program};
 use render::timing::TimedFrame;
 use serde::{Deserialize, Serialize};
-use wgpu::util::DeviceExt;
 
 /// How camera paths end in the cache and how many train it.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -216,11 +215,11 @@ impl CachePaths {
             termination_vertex: settings.termination_vertex,
             spp,
         };
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("nirc cache params"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
+        let params = gpu.buffer_init(
+            "nirc cache params",
+            bytemuck::bytes_of(&params),
+            wgpu::BufferUsages::STORAGE,
+        );
         let queries = buffer("nirc cache queries", query_count * size_of::<CacheQuery>() as u64)?;
         let meta = buffer("nirc query weights", query_count * META_BYTES)?;
         let records = buffer(

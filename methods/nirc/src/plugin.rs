@@ -23,6 +23,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use crate::config::ReliabilityStatistic;
+use crate::gpu::train::{StepPart, TrainStep};
 use crate::{
     CacheOutput, CachePathSettings, CachePaths, NeuralCache, NircConfig, PredictorMode, SceneBounds,
 };
@@ -113,7 +114,7 @@ pub struct NircCache {
     /// nirc_records, nirc_train, nirc_ema, nirc_reliability of this frame.
     train_times: Vec<PassTiming>,
     /// This frame's training step, from `train` to `reliability_update`.
-    step: Option<crate::gpu::TrainStep>,
+    step: Option<TrainStep>,
     stats: Vec<(String, f64)>,
     /// Motion vectors of the frame's pixel-centre primary hits (shared by every mode).
     motion: Vec<[f32; 2]>,
@@ -518,7 +519,7 @@ pub fn train(
             .prepare_step(gpu, c.paths.records(), c.paths.record_count())
             .map_err(|e| err(e.into()))?;
         if let Some(step) = &c.step {
-            c.cache.adam_timed(&mut timed, 1, step).map_err(|e| err(e.into()))?;
+            c.cache.part_timed(&mut timed, 1, step, StepPart::Adam).map_err(|e| err(e.into()))?;
         }
         c.train_times = timed.submit().map_err(|e| err(e.into()))?;
         c.rays = c.paths.read_rays(gpu).map_err(|e| err(e.into()))?;
@@ -542,7 +543,7 @@ pub fn ema(
             continue;
         }
         let mut timed = c.ema_timer.begin(gpu, "nirc ema");
-        c.cache.ema_timed(&mut timed, 0, step).map_err(|e| err(e.into()))?;
+        c.cache.part_timed(&mut timed, 0, step, StepPart::Ema).map_err(|e| err(e.into()))?;
         c.train_times.extend(timed.submit().map_err(|e| err(e.into()))?);
     }
     Ok(())
@@ -561,7 +562,9 @@ pub fn reliability_update(
         let c = &mut *c;
         if let Some(step) = c.step.take() {
             let mut timed = c.reliability_timer.begin(gpu, "nirc reliability");
-            c.cache.reliability_timed(&mut timed, 0, &step).map_err(|e| err(e.into()))?;
+            c.cache
+                .part_timed(&mut timed, 0, &step, StepPart::Reliability)
+                .map_err(|e| err(e.into()))?;
             c.train_times.extend(timed.submit().map_err(|e| err(e.into()))?);
         }
         let counters = c.cache.counters(gpu).map_err(|e| err(e.into()))?;

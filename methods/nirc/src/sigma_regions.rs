@@ -147,11 +147,7 @@ pub fn sigma_by_region(run: &FolderRun) -> Result<FolderSeries> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use frame::output::{write_exr, write_png_linear};
-
-    fn grey(values: &[f32]) -> Vec<[f32; 4]> {
-        values.iter().map(|&v| [v, v, v, 1.0]).collect()
-    }
+    use frame::output::{grey_pixels, write_exr, write_png_linear};
 
     /// A 20x1 image whose reference brightens more to the right: of the pixels the blend answered
     /// (the four least changed, on the left, are black: no query), the right fifth is "changed",
@@ -166,7 +162,8 @@ mod tests {
         let after: Vec<f32> = (0..20).map(|x| 1.0 + x as f32).collect();
         for f in 0..3 {
             let reference = if f < 1 { &before } else { &after };
-            write_exr(&folder.reference(f, "exr"), 20, 1, &grey(reference)).unwrap();
+            write_exr(&folder.reference(f, "exr"), 20, 1, &grey_pixels(reference.iter().copied()))
+                .unwrap();
             // σ rising over the frames on the right, 0.3 on the left.
             let map: Vec<[f32; 4]> = (0..20)
                 .map(|x| match x {

@@ -1,4 +1,4 @@
-//! The thesis's PSNR comparison against two references (sss::ground_truth): each variant of the
+//! The thesis's PSNR comparison against two references (support::ground_truth): each variant of the
 //! pass on a flat half-space of albedo 0.99 under a diagonal shadow edge with a falloff, PSNR of
 //! luminance against the screen-space pass itself at 4096 x 8 samples (the thesis's kind of
 //! reference: the diffusion model converged) and against the random walk's exitance (the
@@ -7,12 +7,15 @@
 //!
 //! cargo run -p sss --example sss_ground_truth -- [WIDTH HEIGHT WALKS]
 
-use sss::evaluation::psnr;
-use sss::ground_truth::WalkOffsets;
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use sss::profile::scaling_from_dmfp;
-use sss::random_walk::Medium;
 use sss::screen_pass::step;
 use sss::{PixelHistory, PixelResult, Prefilter, SssFrame, SssSettings, SssVariant};
+use support::evaluation::psnr;
+use support::ground_truth::WalkOffsets;
+use support::random_walk::Medium;
 
 fn main() {
     let args: Vec<u64> =

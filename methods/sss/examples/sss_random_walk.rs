@@ -1,4 +1,4 @@
-//! The diffusion model's own bias (sss::random_walk): a random walk in a half-space of
+//! The diffusion model's own bias (support::random_walk): a random walk in a half-space of
 //! unit mean free path and albedo α against Burley's profile with the walk's own A (its
 //! normal-incidence reflectance) and d = ℓ_d / s(A) (Θ3, eq. 2.44, ℓ_d = 1/σ_tr). Per α: A
 //! from the walk and from the H-function; under a searchlight the radii holding 50% and 90% of
@@ -8,9 +8,12 @@
 //!
 //! cargo run --release -p render --example sss_random_walk -- [PATHS]
 
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use sss::inverse::numeric_inverse;
 use sss::profile::{cdf, scaling_from_dmfp};
-use sss::random_walk::{Medium, plane_albedo, point_light, point_light_burley, searchlight};
+use support::random_walk::{Medium, plane_albedo, point_light, point_light_burley, searchlight};
 
 fn main() {
     let paths: u64 = std::env::args()

@@ -10,13 +10,16 @@
 //! (D_SCALE multiplies the profiles' d, relative to the image height: default 1, d = (0.15, 0.08,
 //! 0.04) of the height).
 
-use sss::evaluation::Accumulator;
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use sss::sampling::luminance;
 use sss::screen_pass::step;
-use sss::synthetic::{DynamicTest, frame};
 use sss::{SssSettings, SssVariant};
 use std::fmt::Write;
 use std::time::Instant;
+use support::evaluation::Accumulator;
+use support::synthetic::{DynamicTest, frame};
 
 const D_REL: [f32; 3] = [0.15, 0.08, 0.04];
 const VARIANTS: [(&str, SssVariant); 4] = [

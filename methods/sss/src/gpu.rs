@@ -14,7 +14,6 @@ use render::gpu_struct::GpuStruct;
 use render::readback::read_pod;
 use render::shader::{Module, Program};
 use render::timing::{PassTimer, PassTiming};
-use wgpu::util::DeviceExt;
 
 /// The largest count one invocation may take (a bounded per-invocation loop; the 2048-spp
 /// reference of the thesis fits).
@@ -150,11 +149,11 @@ impl SssPass {
         let [pipeline, horizontal, vertical, prefilter_pipeline, setup_pipeline, copy_pipeline] =
             render::compute::pipelines_auto_layout(gpu, "sss_scatter", &program(), PASSES)?;
         let size = width as u64 * height as u64 * 16;
-        let params = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("sss params"),
-            contents: bytemuck::bytes_of(&<SssParams as bytemuck::Zeroable>::zeroed()),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        });
+        let params = gpu.buffer_init(
+            "sss params",
+            bytemuck::bytes_of(&<SssParams as bytemuck::Zeroable>::zeroed()),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
         let irradiance = storage(gpu, "sss irradiance", size);
         let history = [storage(gpu, "sss history 0", size), storage(gpu, "sss history 1", size)];
         let cv = [storage(gpu, "sss cv 0", size), storage(gpu, "sss cv 1", size)];
@@ -237,11 +236,11 @@ impl SssPass {
         let separable = [(horizontal, h_group), (vertical, v_group)];
         let level_groups = (0..prefilter::MAX_LEVELS)
             .map(|k| {
-                let level = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("sss mip level"),
-                    contents: bytemuck::cast_slice(&[k, 0, 0, 0]),
-                    usage: wgpu::BufferUsages::STORAGE,
-                });
+                let level = gpu.buffer_init(
+                    "sss mip level",
+                    bytemuck::cast_slice(&[k, 0, 0, 0]),
+                    wgpu::BufferUsages::STORAGE,
+                );
                 separable_group(&prefilter_pipeline, &[&params, &irradiance, &mips, &level])
             })
             .collect();

@@ -3,29 +3,25 @@
 //! (`sampling`), single pass variance guiding (`spvg`), control variates in the sample-count
 //! domain (`control_variates`), the pass on the CPU (`screen_pass`) and in WGSL (`gpu`), the
 //! separable baseline (`separable`), prefiltered irradiance MIPs for AFIS (`prefilter`), the
-//! hybrid of the two (`hybrid`), the random-walk reference (`random_walk`) and the path-traced
-//! ground truth of a flat plane built on it (`ground_truth`).
+//! hybrid of the two (`hybrid`). The random-walk reference and the path-traced ground truth of a
+//! flat plane built on it are test support (tests/support/).
 //! The file map is in this crate's README.md; settings, results and departures in
 //! docs/methods/sss.md.
 
 pub mod control_variates;
 pub mod direct;
-pub mod evaluation;
 pub mod gpu;
-pub mod ground_truth;
 pub mod hybrid;
 pub mod inverse;
 pub mod prefilter;
 pub mod profile;
 pub mod psnr_against;
-pub mod random_walk;
 pub mod reproject;
 pub mod sampling;
 pub mod screen_pass;
 pub mod separable;
 pub mod split;
 pub mod spvg;
-pub mod synthetic;
 
 pub use control_variates::EmCovariance;
 pub use direct::IrradianceSource;

@@ -350,13 +350,7 @@ pub fn render(
             }
             None => radiance,
         };
-        let counts: Vec<[f32; 4]> = counts
-            .iter()
-            .map(|&c| {
-                let v = c as f32 / 64.0;
-                [v, v, v, 1.0]
-            })
-            .collect();
+        let counts = frame::output::grey_pixels(counts.iter().map(|&c| c as f32 / 64.0));
         let mean_spp = count_sum as f64 / sss_pixels.max(1) as f64;
         frame.output = Some(MethodOutput {
             stats: vec![

@@ -58,7 +58,7 @@ pub fn psnr_against(run: &FolderRun) -> Result<FolderSeries> {
             let image = luminance_image(&folder.frame(m, f as u32, "exr"))
                 .with_context(|| at(&format!("{m}'s frame"), f as u32))?;
             let any = masks[f].iter().any(|s| *s);
-            let db = crate::evaluation::psnr_luminance(&image, &references[f], &masks[f], peak);
+            let db = psnr_luminance(&image, &references[f], &masks[f], peak);
             series.push((any && peak > 0.0).then_some(db));
         }
         out.push((m.clone(), COLUMN, series));
@@ -66,14 +66,22 @@ pub fn psnr_against(run: &FolderRun) -> Result<FolderSeries> {
     Ok(out)
 }
 
+/// PSNR of luminance over the masked pixels, peak `peak`.
+pub fn psnr_luminance(result: &[f32], reference: &[f32], mask: &[bool], peak: f64) -> f64 {
+    let (mut se, mut n) = (0.0f64, 0usize);
+    for ((r, f), _) in result.iter().zip(reference).zip(mask).filter(|(_, m)| **m) {
+        let e = *r as f64 - *f as f64;
+        se += e * e;
+        n += 1;
+    }
+    let mse = se / n.max(1) as f64;
+    10.0 * (peak * peak / mse.max(1e-30)).log10()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use frame::output::{write_exr, write_png_linear};
-
-    fn grey(values: &[f32]) -> Vec<[f32; 4]> {
-        values.iter().map(|&v| [v, v, v, 1.0]).collect()
-    }
+    use frame::output::{grey_pixels, write_exr, write_png_linear};
 
     /// PSNR over the reference's sampled pixels only, the peak its largest luminance there (the
     /// unsampled pixel's 9.0 neither counts nor sets the peak); the reference gets no series.
@@ -83,10 +91,10 @@ mod tests {
         let dir = tmp.path().to_path_buf();
         let folder = RunFolder::new(&dir);
         for f in 0..2 {
-            write_exr(&folder.frame("ref", f, "exr"), 3, 1, &grey(&[1.0, 0.5, 9.0])).unwrap();
-            write_exr(&folder.frame("a", f, "exr"), 3, 1, &grey(&[0.9, 0.5, 0.0])).unwrap();
-            write_exr(&folder.frame("b", f, "exr"), 3, 1, &grey(&[0.8, 0.5, 0.0])).unwrap();
-            let counts = grey(&[1.0, 0.25, 0.0]);
+            write_exr(&folder.frame("ref", f, "exr"), 3, 1, &grey_pixels([1.0, 0.5, 9.0])).unwrap();
+            write_exr(&folder.frame("a", f, "exr"), 3, 1, &grey_pixels([0.9, 0.5, 0.0])).unwrap();
+            write_exr(&folder.frame("b", f, "exr"), 3, 1, &grey_pixels([0.8, 0.5, 0.0])).unwrap();
+            let counts = grey_pixels([1.0, 0.25, 0.0]);
             write_png_linear(&folder.method_image("ref", "sample_count", f, "png"), 3, 1, &counts)
                 .unwrap();
         }

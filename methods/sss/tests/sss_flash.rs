@@ -3,11 +3,13 @@
 //! samples (analytic inverse) of the unit-intensity frame, times I(t) (the irradiance is
 //! linear in I).
 
-use sss::evaluation::{Accumulator, RunMeasures};
+mod support;
+
 use sss::sampling::luminance;
 use sss::screen_pass::step;
-use sss::synthetic::{DynamicTest, flash_intensity, frame};
 use sss::{SssSettings, SssVariant};
+use support::evaluation::{Accumulator, RunMeasures};
+use support::synthetic::{DynamicTest, flash_intensity, frame};
 
 const W: u32 = 32;
 const H: u32 = 18;

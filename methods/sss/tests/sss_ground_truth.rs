@@ -1,14 +1,16 @@
-//! The screen-space pass against a path-traced ground truth (sss::ground_truth): a half-space of
+//! The screen-space pass against a path-traced ground truth (support::ground_truth): a half-space of
 //! albedo 0.99 under a shadow edge, Burley's d from the walk's own A and ℓ_d (Θ3). As the
 //! pass's count grows its result approaches the random walk's exitance to within the bound
 //! derived in ground_truth.rs, osc(E)·½·D (D: the radial cdfs' largest gap, measured on
 //! independent walks, plus its DKW margin), plus Hoeffding margins for the walk's and the
 //! pass's own noise (δ = 1e-3 each); a few samples are further off.
 
-use sss::ground_truth::{WalkOffsets, dkw_margin, hoeffding_margin};
+mod support;
+
 use sss::profile::scaling_from_dmfp;
-use sss::random_walk::Medium;
 use sss::{SssFrame, SssSettings, SssVariant};
+use support::ground_truth::{WalkOffsets, dkw_margin, hoeffding_margin};
+use support::random_walk::Medium;
 
 const W: u32 = 48;
 const H: u32 = 2;

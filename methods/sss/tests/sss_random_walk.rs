@@ -1,9 +1,11 @@
-//! The random-walk subsurface reference (sss::random_walk) against its analytic limits:
+//! The random-walk subsurface reference (support::random_walk) against its analytic limits:
 //! Gauss-Legendre quadrature, Chandrasekhar's H-function (its zeroth moment), the singly scattered fraction α(1 − ln 2)/2 of a normal beam, the whole
 //! reflectance 1 − H(1)√(1 − α) of the half-space, and its mean over the cosines of a point
 //! light, over 3 seeds each.
 
-use sss::random_walk::{
+mod support;
+
+use support::random_walk::{
     Medium, gauss_legendre_unit, h_function, plane_albedo, point_light, point_light_burley,
     searchlight,
 };

@@ -14,6 +14,8 @@
 //! the image within 4.5 standard errors (its variance the sum of the pixels' sample variances
 //! of the mean), and every pixel within 6.
 
+mod support;
+
 use glam::{Mat4, Vec2, Vec3};
 use media::gpu::SubsurfacePathPass;
 use render::frame::CameraBasis;
@@ -23,7 +25,7 @@ use render::scene::{Camera, Instance, Light, Material, SceneDesc};
 use render::scene_gpu::SceneGpu;
 use render::test_scenes::{box_mesh, gpu};
 use scene::Subsurface;
-use sss::random_walk::h_function;
+use support::random_walk::h_function;
 
 const W: u32 = 24;
 const H: u32 = 16;

@@ -495,12 +495,7 @@ impl Taa {
             )));
         }
         let init = |label: &str, contents: &[u8]| {
-            use wgpu::util::DeviceExt;
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: wgpu::BufferUsages::COPY_SRC,
-            })
+            gpu.buffer_init(label, contents, wgpu::BufferUsages::COPY_SRC)
         };
         let (c, p) = (
             init("taa external colour", bytemuck::cast_slice(colour)),

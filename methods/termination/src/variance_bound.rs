@@ -96,11 +96,7 @@ pub fn variance_over_bound(run: &FolderRun) -> Result<FolderSeries> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use frame::output::write_exr;
-
-    fn grey(values: &[f32]) -> Vec<[f32; 4]> {
-        values.iter().map(|&v| [v, v, v, 1.0]).collect()
-    }
+    use frame::output::{grey_pixels, write_exr};
 
     /// Two pixels over three frames: variances 1 (values 0, 1, 2) and 0 (constant) give a
     /// mean variance 0.5, over the bound 0.25: 2; a method without a bound gets no series.
@@ -111,8 +107,8 @@ mod tests {
         let folder = RunFolder::new(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         for (f, v) in [0.0f32, 1.0, 2.0].iter().enumerate() {
-            write_exr(&folder.frame("vb", f as u32, "exr"), 2, 1, &grey(&[*v, 3.0])).unwrap();
-            write_exr(&folder.frame("pt", f as u32, "exr"), 2, 1, &grey(&[*v, 3.0])).unwrap();
+            write_exr(&folder.frame("vb", f as u32, "exr"), 2, 1, &grey_pixels([*v, 3.0])).unwrap();
+            write_exr(&folder.frame("pt", f as u32, "exr"), 2, 1, &grey_pixels([*v, 3.0])).unwrap();
         }
         std::fs::write(
             dir.join("frames.csv"),

@@ -1,9 +1,12 @@
 //! The termination decision on the GPU (shaders/termination/decision.wgsl) against the CPU
 //! reference (termination::decide) on the same inputs.
 
+use render::error::RenderError;
 use render::gpu::Gpu;
+use render::readback::Staging;
 use render::scene::SplitMix64;
-use termination::gpu_decision::{DecisionCase, decide_on_gpu};
+use render::shader::{Module, Program};
+use termination::gpu_decision::{decision_module, rule_words};
 use termination::{LocalStats, PathState, TerminationRule, decide};
 
 fn rules() -> Vec<TerminationRule> {
@@ -96,4 +99,91 @@ fn gpu_decision_matches_the_cpu_reference() {
         cases.len(),
         mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
     );
+}
+
+/// One case: the rule, roulette survival, the path state at the vertex and the local stats.
+#[derive(Clone, Copy, Debug)]
+pub struct DecisionCase {
+    pub rule: TerminationRule,
+    pub survival: f64,
+    pub state: PathState,
+    pub stats: LocalStats,
+    /// Whether the path's first hit had a filled record (the relative threshold's brightness
+    /// is then `stats.radiance`).
+    pub first_filled: bool,
+}
+
+/// (α, path variance after the decision, the path's threshold from `tc_threshold`) per case,
+/// computed by `tc_decide` in f32.
+pub fn decide_on_gpu(gpu: &Gpu, cases: &[DecisionCase]) -> Result<Vec<[f32; 3]>, RenderError> {
+    let mut words: Vec<[f32; 4]> = Vec::with_capacity(cases.len() * 6);
+    for c in cases {
+        let (kind, relative, param, margin, clamp) = rule_words(&c.rule);
+        let (s, st) = (&c.state, &c.stats);
+        words.push([f32::from_bits(kind), f32::from_bits(relative), param, margin]);
+        words.push([clamp, c.survival as f32, 0.0, 0.0]);
+        words.push([
+            s.throughput2 as f32,
+            s.path_variance as f32,
+            s.threshold as f32,
+            s.spread_sqrt as f32,
+        ]);
+        words.push([s.spread0 as f32, f32::from_bits(s.vertex), 0.0, 0.0]);
+        words.push([
+            st.radiance as f32,
+            st.variance as f32,
+            st.continuation2 as f32,
+            st.bias2 as f32,
+        ]);
+        words.push([st.deferred_bias2 as f32, c.first_filled as u32 as f32, 0.0, 0.0]);
+    }
+    let device = &gpu.device;
+    // The probe's entry point lives beside this test, not in the crate's shaders/.
+    let probe = Module::file(
+        env!("CARGO_PKG_NAME"),
+        "decision_probe.wgsl",
+        include_str!("decision_probe.wgsl"),
+    );
+    let program = Program::new(vec![decision_module()]).entry(probe);
+    let [pipeline] = render::compute::pipelines_auto_layout(
+        gpu,
+        "tc_decide_probe",
+        &program,
+        ["tc_decide_probe"],
+    )?;
+    let input = gpu.buffer_init(
+        "decision cases",
+        bytemuck::cast_slice(&words),
+        wgpu::BufferUsages::STORAGE,
+    );
+    let size = (cases.len().max(1) * 16) as u64;
+    let output = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("decisions"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("decision probe"),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
+        ],
+    });
+    let mut encoder = device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("decision probe") });
+    {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("tc_decide_probe"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups((cases.len() as u32).div_ceil(64), 1, 1);
+    }
+    let staging = Staging::copy_of(gpu, &mut encoder, &output, "decisions");
+    gpu.queue.submit([encoder.finish()]);
+    let out: Vec<[f32; 4]> = staging.read(gpu)?;
+    Ok(out.into_iter().take(cases.len()).map(|v| [v[0], v[1], v[2]]).collect())
 }

@@ -1,6 +1,6 @@
 //! Rendering methods. Each is a plugin ([`MethodPlugin`], in `plugin.rs`): it owns its settings,
 //! label, samples per pixel, temporal window and `--spp` override, adds its systems to the
-//! frame's stages (`crate::frame::Stage`) and builds each instance, GPU state included, up front
+//! frame's stages (`frame::Stage`) and builds each instance, GPU state included, up front
 //! on the instance's entity, and declares the statistics and charts it records. `registry.rs`
 //! lists them, one line each. Adding a method: its folder under `methods/` with its settings,
 //! components, systems and plugin, and its registry line.
@@ -21,7 +21,7 @@ pub use spec::{check_labels, parse_methods};
 
 use sim::MethodEntry;
 
-pub use crate::frame::{MethodImage, MethodOutput};
+pub use frame::{MethodImage, MethodOutput};
 
 /// One method of a run: its settings, its label and where the scenario wrote it.
 #[derive(Clone, Debug, PartialEq)]
@@ -58,12 +58,12 @@ pub fn plugins(methods: &[Method]) -> Vec<&'static dyn RegisteredMethod> {
 
 /// The frame's schedule for `methods`: the core systems and each used method's systems.
 pub fn schedule_for(methods: &[Method]) -> Schedule {
-    let mut schedule = crate::frame::new_schedule();
-    crate::frame::add_core_systems(&mut schedule);
+    let mut schedule = frame::new_schedule();
+    frame::add_core_systems(&mut schedule);
     // Each system is owned by its method (or is the frame's own), so a GPU fault names it.
-    crate::frame::own_systems(&mut schedule, &Default::default(), None);
+    frame::own_systems(&mut schedule, &Default::default(), None);
     for plugin in plugins(methods) {
-        let before = crate::frame::system_keys(&schedule);
+        let before = frame::system_keys(&schedule);
         plugin.add_systems(&mut schedule);
         let labels: Vec<String> = methods
             .iter()
@@ -71,7 +71,7 @@ pub fn schedule_for(methods: &[Method]) -> Schedule {
             .map(Method::label)
             .collect();
         let owner = format!("method {}", labels.join(", "));
-        crate::frame::own_systems(&mut schedule, &before, Some(&owner));
+        frame::own_systems(&mut schedule, &before, Some(&owner));
     }
     schedule
 }
@@ -81,12 +81,12 @@ pub fn schedule_for(methods: &[Method]) -> Schedule {
 pub fn describe_schedule(methods: &[Method]) -> Result<String> {
     let mut schedule = schedule_for(methods);
     let listing =
-        crate::frame::listing(&mut schedule, &mut World::new()).map_err(|e| anyhow::anyhow!(e))?;
+        frame::listing(&mut schedule, &mut World::new()).map_err(|e| anyhow::anyhow!(e))?;
     let mut text = String::from("methods\n");
     for m in methods {
         text += &format!("  {} ({})\n", m.label(), m.spec.plugin().name());
     }
-    text += &crate::frame::describe(&listing);
+    text += &frame::describe(&listing);
     Ok(text)
 }
 

@@ -23,10 +23,10 @@ pub mod record;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
+use frame::run_folder::RunFolder;
 use serde_json::json;
 use sim::{MethodEntry, ReferenceFrames, Scenario, Simulation};
 use systems::playback::{Overrides, RunOptions, RunSpec};
-use systems::run_folder::RunFolder;
 
 pub use package::{INPUTS, Package};
 
@@ -139,18 +139,18 @@ pub fn export(opts: &ExportOptions) -> Result<PathBuf> {
 
     prepare(&opts.out)?;
     let out = &opts.out;
-    systems::output::write_atomic(&out.join(package::GLB), |f| Ok(f.write_all(&glb)?))?;
-    systems::output::write_text(
+    frame::output::write_atomic(&out.join(package::GLB), |f| Ok(f.write_all(&glb)?))?;
+    frame::output::write_text(
         &out.join(package::SCENARIO),
         &package_scenario(&scenario, frames[0].environment, reference_spp),
     )?;
-    systems::output::write_text(&out.join("CONVENTIONS.md"), CONVENTIONS)?;
+    frame::output::write_text(&out.join("CONVENTIONS.md"), CONVENTIONS)?;
     for (k, f) in frames.iter().enumerate() {
         let k = k as u32;
         let labels: Vec<&str> =
             events.iter().filter(|(e, _)| *e == k).map(|(_, l)| l.as_str()).collect();
         let rec = record::frame(k, scenario.time_step, &frames[0], f, (w, h), &labels);
-        systems::output::write_json(&out.join("frames").join(format!("{k:04}.json")), &rec)?;
+        frame::output::write_json(&out.join("frames").join(format!("{k:04}.json")), &rec)?;
     }
     if !opts.scene_only {
         render(&scenario, reference_spp, opts)?;
@@ -178,7 +178,7 @@ pub fn export(opts: &ExportOptions) -> Result<PathBuf> {
         "inputs": if opts.scene_only { json!(null) } else { json!({"dir": "inputs", "kinds": INPUTS, "spp": 1}) },
     });
     let path = out.join(package::MANIFEST);
-    systems::output::write_json(&path, &manifest)?;
+    frame::output::write_json(&path, &manifest)?;
     Ok(path)
 }
 
@@ -219,7 +219,7 @@ fn render(scenario: &Scenario, reference_spp: u32, opts: &ExportOptions) -> Resu
 
 /// Re-encodes an EXR as RGB float, scan-line, ZIP (what NVIDIA's flip reads).
 fn copy_exr(from: &Path, to: &Path) -> Result<()> {
-    let (w, h, rgba) = systems::output::read_exr(from)?;
+    let (w, h, rgba) = frame::output::read_exr(from)?;
     let image = metrics::Image {
         width: w,
         height: h,

@@ -214,7 +214,7 @@ fn write_generated(page: &Path, mode: &str, title: &str, generated: &str) -> Res
     if let Some(dir) = page.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)?;
     }
-    systems::output::write_text(page, &text)
+    frame::output::write_text(page, &text)
 }
 
 /// `path` as the page links it: relative to the page's folder where it lies under it.

@@ -88,7 +88,7 @@ pub fn show(opts: &ShowOptions) -> Result<Shown> {
         md.push_str(&format!("\nNo records in {}.\n", opts.history.display()));
     }
     let report = opts.out.join("history.md");
-    systems::output::write_text(&report, &md)?;
+    frame::output::write_text(&report, &md)?;
     let mut charts = Vec::new();
     for (i, s) in all.iter().enumerate() {
         let name: String = format!("{}_{}_{}", s.key.kind.name(), s.key.scale, s.key.id)
@@ -97,7 +97,7 @@ pub fn show(opts: &ShowOptions) -> Result<Shown> {
             .collect();
         let path = opts.out.join("charts").join(format!("{i:03}_{name}.svg"));
         let (svg, _) = report::charts::plot::to_svg(&series::chart(s))?;
-        systems::output::write_text(&path, &svg)?;
+        frame::output::write_text(&path, &svg)?;
         charts.push(path);
     }
     Ok(Shown { series: all, markdown: md, report, charts })

@@ -138,7 +138,7 @@ pub fn append(dir: &Path, record: &Record) -> Result<PathBuf> {
     );
     let path = dir.join(record.kind.name()).join(file_safe(&record.scale)).join(name);
     let text = serde_json::to_string_pretty(record)? + "\n";
-    systems::output::write_text(&path, &text)
+    frame::output::write_text(&path, &text)
         .with_context(|| format!("appending to the results history {}", dir.display()))?;
     Ok(path)
 }

@@ -6,7 +6,7 @@
 //! the frame's passes less those, read back from the run's frames.csv.
 
 use anyhow::{Context, Result, bail};
-use systems::run_folder::RunFolder;
+use frame::run_folder::RunFolder;
 
 use crate::suite::measurement::SeedRun;
 use crate::suite::metric::Metric;

@@ -112,7 +112,7 @@ pub fn plan(opts: &ReproduceOptions, dir: &Path, exe: &Path) -> Result<(Plan, Me
         jobs: planned,
     };
     crate::sweep::plan::write(&plan, dir, exe)?;
-    systems::output::write_text(
+    frame::output::write_text(
         &dir.join(META_FILE),
         &(serde_json::to_string_pretty(&meta)? + "\n"),
     )?;

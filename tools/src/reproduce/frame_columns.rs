@@ -3,8 +3,8 @@
 //! columns), e.g. the termination cache's `CacheMean`: read back per method and frame.
 
 use anyhow::{Result, bail};
+use frame::run_folder::RunFolder;
 use systems::methods::Source;
-use systems::run_folder::RunFolder;
 
 use crate::suite::measurement::SeedRun;
 use crate::suite::metric::Metric;

@@ -9,7 +9,7 @@
 use std::path::Path;
 
 use anyhow::{Result, bail};
-use systems::run_folder::RunFolder;
+use frame::run_folder::RunFolder;
 
 use crate::suite::measurement::SeedRun;
 use crate::suite::metric::Metric;

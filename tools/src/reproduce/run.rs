@@ -248,8 +248,8 @@ pub(crate) fn judge_papers(
         stamp(&opts.claims_dir, &folder, started.elapsed())
     );
     let markdown = report::markdown(&header, &papers);
-    systems::output::write_text(&folder.join("reproduce.md"), &markdown)?;
-    systems::output::write_text(&folder.join("reproduce.html"), &report::html(&header, &papers))?;
+    frame::output::write_text(&folder.join("reproduce.md"), &markdown)?;
+    frame::output::write_text(&folder.join("reproduce.html"), &report::html(&header, &papers))?;
     Ok(ReproduceOutcome { folder, markdown, claims: outcomes })
 }
 

@@ -70,7 +70,7 @@ impl BaselineFile {
     }
 
     pub fn save(&self, path: &Path) -> Result<()> {
-        systems::output::write_text(path, &(serde_json::to_string_pretty(self)? + "\n"))
+        frame::output::write_text(path, &(serde_json::to_string_pretty(self)? + "\n"))
     }
 }
 

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::metric::Metric;
 use super::window::Window;
-use systems::frame_record::FrameRecord;
+use frame::frame_record::FrameRecord;
 
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SeedRun {

@@ -6,7 +6,7 @@ use std::fmt;
 use serde::de::{self, EnumAccess, VariantAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-use systems::frame_record::FrameRecord;
+use frame::frame_record::FrameRecord;
 use systems::methods::registry;
 use systems::methods::{Better, FolderInput, FolderStatistic, Source, Statistic};
 

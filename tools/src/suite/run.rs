@@ -324,8 +324,8 @@ pub fn run(opts: &SuiteOptions) -> Result<SuiteOutcome> {
     );
     let summary = p.folder.join("summary.md");
     let junit_path = p.folder.join("junit.xml");
-    systems::output::write_text(&summary, &md)?;
-    systems::output::write_text(&junit_path, &junit::report(&p.suite.name, &results))?;
+    frame::output::write_text(&summary, &md)?;
+    frame::output::write_text(&junit_path, &junit::report(&p.suite.name, &results))?;
     Ok(SuiteOutcome { results, folder: p.folder, summary, junit: junit_path, markdown: md })
 }
 

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use super::plan::{Plan, done_file};
 use crate::suite::measurement::SeedRun;
 use crate::suite::metric::Metric;
-use systems::frame_record::FrameRecord;
+use frame::frame_record::FrameRecord;
 use systems::playback::{RunOptions, run_spec};
 
 /// One method's numbers in one job.
@@ -147,6 +147,6 @@ pub fn run_job(dir: &Path, index: usize, progress: bool) -> Result<JobRecord> {
             run: SeedRun::from_records(job.seed, &summary.records),
         }),
     };
-    systems::output::write_json(&done, &record)?;
+    frame::output::write_json(&done, &record)?;
     Ok(record)
 }

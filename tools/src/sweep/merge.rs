@@ -186,7 +186,7 @@ pub fn merge(dir: &Path) -> Result<Merged> {
         configurations,
     };
     let summary_file = dir.join("summary.json");
-    systems::output::write_json(&summary_file, &summary)?;
+    frame::output::write_json(&summary_file, &summary)?;
 
     let chart = Chart {
         title: format!("Speed vs accuracy ({}) — sweep {}", accuracy.to_uppercase(), plan.sweep),
@@ -206,11 +206,11 @@ pub fn merge(dir: &Path) -> Result<Merged> {
     let stem = format!("speed_vs_{accuracy}");
     let (svg, _) = plot::to_svg(&chart)?;
     let chart_file = dir.join(format!("{stem}.svg"));
-    systems::output::write_text(&chart_file, &svg)?;
+    frame::output::write_text(&chart_file, &svg)?;
     let png = plot::to_png(&chart)?;
-    systems::output::write_atomic(&dir.join(format!("{stem}.png")), |w| Ok(w.write_all(&png)?))?;
+    frame::output::write_atomic(&dir.join(format!("{stem}.png")), |w| Ok(w.write_all(&png)?))?;
     let report = dir.join("report.md");
-    systems::output::write_text(&report, &markdown(&summary, &stem))?;
+    frame::output::write_text(&report, &markdown(&summary, &stem))?;
     Ok(Merged { summary, summary_file, chart: chart_file, report })
 }
 

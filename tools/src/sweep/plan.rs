@@ -196,7 +196,7 @@ pub fn write(plan: &Plan, dir: &Path, exe: &Path) -> Result<()> {
     }
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let dir = std::fs::canonicalize(dir)?;
-    systems::output::write_text(&path, &text)?;
+    frame::output::write_text(&path, &text)?;
     let exe = std::fs::canonicalize(exe).unwrap_or_else(|_| exe.to_path_buf());
     let job_line = |i: usize| {
         format!("{} sweep job {} --index {i} --quiet", shell_quote(&exe), shell_quote(&dir))
@@ -209,9 +209,9 @@ pub fn write(plan: &Plan, dir: &Path, exe: &Path) -> Result<()> {
             format!("{} > {} 2>&1\n", job_line(j.index), shell_quote(&log_file(&dir, j.index)))
         })
         .collect();
-    systems::output::write_text(&dir.join("jobs.txt"), &lines)?;
+    frame::output::write_text(&dir.join("jobs.txt"), &lines)?;
     std::fs::create_dir_all(dir.join("logs"))?;
-    systems::output::write_text(&dir.join("sweep.sbatch"), &sbatch(plan, &dir, &exe))?;
+    frame::output::write_text(&dir.join("sweep.sbatch"), &sbatch(plan, &dir, &exe))?;
     Ok(())
 }
 

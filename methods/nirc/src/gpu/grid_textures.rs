@@ -12,7 +12,6 @@
 //! Texel t holds parameters MLP_PARAMS + 4t .. + 4t + 3, at (t % width, t / width): a grid quad
 //! is one store, and an entry's two features are one half of a fetched texel.
 
-use crate::gpu::shaders::WeightPlacement;
 use crate::layout::ParameterLayout;
 use crate::state::CacheState;
 use render::gpu::Gpu;
@@ -36,10 +35,10 @@ fn texels(layout: &ParameterLayout) -> u32 {
     layout.grid_params() / 4
 }
 
-/// The texture width if the register form would use the mirror on this adapter: two features
-/// per level, `rgba32float` storage textures, and a texture within the adapter's size limit.
-/// Otherwise the passes read the grid from the parameter buffers.
-pub fn width_for(gpu: &Gpu, layout: &ParameterLayout, placement: WeightPlacement) -> Option<u32> {
+/// The texture width if the register form can use the mirror on this adapter: two features per
+/// level, `rgba32float` storage textures, and a texture within the adapter's size limit.
+/// Otherwise (and in the other forms) the passes read the grid from the parameter buffers.
+pub fn width_for(gpu: &Gpu, layout: &ParameterLayout) -> Option<u32> {
     let max = gpu.limits.max_texture_dimension_2d;
     let width = MAX_WIDTH.min(max);
     let fits = texels(layout).div_ceil(width) <= max;
@@ -48,8 +47,7 @@ pub fn width_for(gpu: &Gpu, layout: &ParameterLayout, placement: WeightPlacement
         .get_texture_format_features(wgpu::TextureFormat::Rgba32Float)
         .allowed_usages
         .contains(wgpu::TextureUsages::STORAGE_BINDING);
-    (placement == WeightPlacement::Registers && layout.features_per_level == 2 && fits && storage)
-        .then_some(width)
+    (layout.features_per_level == 2 && fits && storage).then_some(width)
 }
 
 impl GridTextures {

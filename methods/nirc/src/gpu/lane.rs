@@ -166,7 +166,7 @@ fn net(layout: &ParameterLayout, bases: &[u32]) -> String {
 /// predictor's layers; those past the end compute the last query again and write nothing.
 pub fn queries_module() -> String {
     let kq = LANE_QUERIES;
-    let wg = crate::gpu::shaders::WORKGROUP_SIZE;
+    let wg = super::WORKGROUP_SIZE;
     let list = |f: &dyn Fn(u32) -> String| (0..kq).map(f).collect::<Vec<_>>().join(", ");
     let mut s = String::from(
         "import package::nirc::bindings::{call, hyper, queries};\nimport package::nirc::bindings_common::{normalize_to_bounds};\nimport package::nirc::lane::{LANE_W_VEC4, LaneOut, lane_inputs, lane_net};\nimport package::nirc::answer::{Predictors, write_predictions};\n\n",

@@ -1,12 +1,11 @@
 //! Assembles the WGSL of each pass: generated constants (sizes, level tables, tile shapes), the
 //! shared files of methods/nirc/shaders/, then the pass itself.
 
+use super::WORKGROUP_SIZE;
 use crate::config::NircConfig;
 use crate::layout::ParameterLayout;
 use crate::reliability::cell_count;
 use render::shader::{Module, Program};
-
-pub const WORKGROUP_SIZE: u32 = 64;
 
 /// Records per partial sum of the weight gradient (`cpu::cache::GRADIENT_CHUNK`): one training
 /// tile.

@@ -231,7 +231,7 @@ pub fn point_light_burley(
     let mut tally = ExitTally::new(bin_width, bins);
     for _ in 0..paths {
         let (p, _) = point_light_entry(height, &mut rng);
-        let r = super::inverse::numeric_inverse(uniform(&mut rng).min(1.0 - 1e-12), d);
+        let r = sss::inverse::numeric_inverse(uniform(&mut rng).min(1.0 - 1e-12), d);
         let phi = 2.0 * PI * uniform(&mut rng);
         let (x, y) = (p[0] + r * phi.cos(), p[1] + r * phi.sin());
         tally.add((x * x + y * y).sqrt(), albedo, 2);

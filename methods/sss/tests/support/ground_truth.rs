@@ -14,9 +14,9 @@
 //! sup|G_b − G_w| ≤ ½ sup|F_b − F_w|, F the radial cdfs. Hence
 //! |pass(n → ∞) − truth| ≤ osc(e)·½·D with D = sup_r |F_Burley(r) − F_walk(r)|.
 
-use super::profile::cdf;
 use super::random_walk::{Medium, searchlight_exits};
-use super::screen_pass::SssFrame;
+use sss::SssFrame;
+use sss::profile::cdf;
 
 /// The clamped bilinear irradiance at p (pixels, texel centres at +0.5), channel c.
 pub fn bilinear(frame: &SssFrame, p: [f64; 2], c: usize) -> f64 {

@@ -1,8 +1,9 @@
 //! Table 7.3's measures for a run of the pass: mean samples per SSS pixel, PSNR of the
 //! scattered luminance against a reference, frame-to-frame SMAPE, and the per-pixel mean count.
 
-use super::sampling::luminance;
-use super::screen_pass::{PixelResult, SssFrame};
+use sss::psnr_against::psnr_luminance;
+use sss::sampling::luminance;
+use sss::{PixelResult, SssFrame};
 
 /// What one variant's run measured.
 #[derive(Clone, Debug, Default)]
@@ -15,18 +16,6 @@ pub struct RunMeasures {
     pub smape: f64,
     /// Per pixel, the mean count over the run.
     pub count_image: Vec<f32>,
-}
-
-/// PSNR of luminance over the masked pixels, peak `peak`.
-pub fn psnr_luminance(result: &[f32], reference: &[f32], mask: &[bool], peak: f64) -> f64 {
-    let (mut se, mut n) = (0.0f64, 0usize);
-    for ((r, f), _) in result.iter().zip(reference).zip(mask).filter(|(_, m)| **m) {
-        let e = *r as f64 - *f as f64;
-        se += e * e;
-        n += 1;
-    }
-    let mse = se / n.max(1) as f64;
-    10.0 * (peak * peak / mse.max(1e-30)).log10()
 }
 
 /// SMAPE = mean over the masked pixels of 2|a − b| / (|a| + |b| + ε) on luminance.

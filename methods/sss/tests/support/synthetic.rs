@@ -3,8 +3,8 @@
 //! non-SSS strip on the left (mask 0), and per test what changes over time. The irradiance is
 //! computed in closed form (cos θ / dist², hard disc and bar occluders), not path traced.
 
-use super::sampling::pcg_hash;
-use super::screen_pass::SssFrame;
+use sss::SssFrame;
+use sss::sampling::pcg_hash;
 
 /// Which of the thesis's dynamic tests.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
