@@ -5,6 +5,7 @@
 //! runs. Also here: what the stages write (the run folder, frames.csv rows, the reference
 //! cache, atomic output) and what a method is to the frame (`method`).
 
+pub mod computation;
 pub mod extract;
 pub mod frame_metrics;
 pub mod frame_record;

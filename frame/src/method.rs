@@ -13,6 +13,7 @@ use bevy_ecs::prelude::{Entity, Schedule, World};
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
+pub use crate::computation::{Computed, ComputedValues, DeclaredComputation};
 pub use report::declared::{
     Better, ChartSeries, FolderInput, FolderRun, FolderSeries, FolderStatistic, MethodChart,
     Source, Statistic,
@@ -44,6 +45,10 @@ pub trait MethodPlugin: Sync + Send + 'static {
 
     /// The charts its frames.csv columns get in the report.
     const CHARTS: &'static [MethodChart] = &[];
+
+    /// Its paper's test cases that claims compute instead of play (closed forms, CPU Monte
+    /// Carlo), by the name a claims file writes.
+    const COMPUTATIONS: &'static [DeclaredComputation] = &[];
 
     /// The label of an unnamed instance, e.g. `pt_4spp`: its folder and its rows' key.
     fn label(settings: &Self::Settings) -> String;
@@ -95,6 +100,7 @@ pub trait RegisteredMethod: Sync {
     fn sees_media(&self) -> bool;
     fn statistics(&self) -> &'static [Statistic];
     fn charts(&self) -> &'static [MethodChart];
+    fn computations(&self) -> &'static [DeclaredComputation];
 }
 
 /// The registry's entry of plugin `P` (`Registered::<taa::Plugin>::ENTRY`).
@@ -132,6 +138,10 @@ impl<P: MethodPlugin> RegisteredMethod for Registered<P> {
 
     fn charts(&self) -> &'static [MethodChart] {
         P::CHARTS
+    }
+
+    fn computations(&self) -> &'static [DeclaredComputation] {
+        P::COMPUTATIONS
     }
 }
 

@@ -131,6 +131,24 @@ fn computed_cases_are_checked_at_file_and_line() {
         "(name: \"t\", computation: TerminationFig4(thresholds: [0.1, -1.0]), seeds: [1, 2])";
     let e = load_with(fig4, &on("Mse", "vb_0.1", "bound_0.1"));
     assert!(e.contains("bad.ron:5") && e.contains("thresholds -1"), "{e}");
+    // The name is looked up among the methods' declared computations; the fields are the
+    // declaring method's to read.
+    let e = load_with(
+        &table.replace("JackknifeTable1(", "JackknifeTable2("),
+        &on("MeanStd", "m2_n12", "m1_n24"),
+    );
+    assert!(
+        e.contains("bad.ron:5")
+            && e.contains("unknown computation 'JackknifeTable2'")
+            && e.contains("JackknifeTable1Alg1")
+            && e.contains("TerminationFig5"),
+        "{e}"
+    );
+    let e = load_with(
+        &table.replace("trials: 1000", "trails: 1000"),
+        &on("MeanStd", "m2_n12", "m1_n24"),
+    );
+    assert!(e.contains("bad.ron:5") && e.contains("trails"), "{e}");
 }
 
 /// A metric computed from images (`SssPsnr`) names its reference method, of the case and of

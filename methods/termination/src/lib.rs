@@ -7,6 +7,7 @@
 
 pub mod cache;
 pub mod decision;
+pub mod figures;
 pub mod gpu_decision;
 pub mod moments;
 pub mod rule;

@@ -56,6 +56,8 @@ impl MethodPlugin for Plugin {
     type Settings = TerminationSettings;
     const NAME: &'static str = "Termination";
     const STATISTICS: &'static [frame::method::Statistic] = crate::recorded::STATISTICS;
+    const COMPUTATIONS: &'static [frame::method::DeclaredComputation] =
+        crate::figures::COMPUTATIONS;
     const CHARTS: &'static [frame::method::MethodChart] = crate::recorded::CHARTS;
 
     fn label(settings: &TerminationSettings) -> String {

@@ -5,4 +5,5 @@
 
 pub mod path;
 pub mod recorded;
+pub mod table1;
 pub mod transmittance;

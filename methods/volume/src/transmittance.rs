@@ -56,6 +56,7 @@ impl MethodPlugin for Plugin {
     type Settings = VolumeSettings;
     const NAME: &'static str = "VolumeTransmittance";
     const STATISTICS: &'static [frame::method::Statistic] = crate::recorded::STATISTICS;
+    const COMPUTATIONS: &'static [frame::method::DeclaredComputation] = crate::table1::COMPUTATIONS;
 
     fn label(settings: &VolumeSettings) -> String {
         settings.label()

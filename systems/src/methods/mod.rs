@@ -12,8 +12,8 @@ use anyhow::Result;
 use bevy_ecs::prelude::*;
 
 pub use frame::method::{
-    Better, ChartSeries, FolderInput, FolderRun, FolderSeries, FolderStatistic, MethodChart,
-    MethodPlugin, MethodSpec, RegisteredMethod, Source, Statistic,
+    Better, ChartSeries, Computed, DeclaredComputation, FolderInput, FolderRun, FolderSeries,
+    FolderStatistic, MethodChart, MethodPlugin, MethodSpec, RegisteredMethod, Source, Statistic,
 };
 pub use frame::temporal_window;
 pub use registry::register;

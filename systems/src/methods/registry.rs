@@ -6,7 +6,9 @@
 
 use std::sync::{LazyLock, RwLock};
 
-use frame::method::{MethodChart, MethodPlugin, Registered, RegisteredMethod, Statistic};
+use frame::method::{
+    DeclaredComputation, MethodChart, MethodPlugin, Registered, RegisteredMethod, Statistic,
+};
 
 /// Something done once per plugin type (the registry's entries; the documentation test reads
 /// each method's settings type).
@@ -63,6 +65,9 @@ pub fn register<P: MethodPlugin>() -> anyhow::Result<()> {
     if find(P::NAME).is_some() {
         anyhow::bail!("a method named '{}' is already registered", P::NAME);
     }
+    if let Some(c) = P::COMPUTATIONS.iter().find(|c| computation(c.name).is_some()) {
+        anyhow::bail!("method '{}': its computation {} is also another method's", P::NAME, c.name);
+    }
     for s in P::STATISTICS {
         if let Some((other, _)) = all().into_iter().find_map(|m| {
             m.statistics().iter().find(|t| t.name == s.name || t.column == s.column).map(|t| (m, t))
@@ -100,6 +105,16 @@ pub fn statistics() -> Vec<&'static Statistic> {
     all().into_iter().flat_map(|m| m.statistics()).collect()
 }
 
+/// The computation a claims file calls `name` (`TerminationFig4`), declared by a method.
+pub fn computation(name: &str) -> Option<&'static DeclaredComputation> {
+    all().into_iter().find_map(|m| m.computations().iter().find(|c| c.name == name))
+}
+
+/// Every registered method's computations' names, for error messages.
+pub fn computation_names() -> Vec<&'static str> {
+    all().into_iter().flat_map(|m| m.computations().iter().map(|c| c.name)).collect()
+}
+
 /// Every registered method's charts, in registry order: what the report draws where a run has
 /// their columns.
 pub fn charts() -> Vec<MethodChart> {
@@ -109,6 +124,20 @@ pub fn charts() -> Vec<MethodChart> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn computations_are_found_by_name_with_distinct_names() {
+        assert!(
+            computation("TerminationFig4").is_some()
+                && computation("JackknifeTable1Alg1").is_some()
+        );
+        assert!(computation("Flip").is_none() && computation("Termination").is_none());
+        let mut names = computation_names();
+        let count = names.len();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!((names.len(), count), (4, 4), "{names:?}");
+    }
 
     #[test]
     fn statistics_are_found_by_name_with_their_method() {
