@@ -93,7 +93,7 @@ pub fn nirc(
         frame::output::write_text(&path, &md)?;
     }
     if let Some(path) = json {
-        let j = crate::nirc_frames::BenchJson {
+        let j = BenchJson {
             throughput: r,
             blend_overhead_frame_percent: table.as_ref().map(|t| t.blend_overhead_frame_percent),
             frames: table,
@@ -229,4 +229,16 @@ pub fn speed(
     let adapter =
         format!("{} / {}", a["name"].as_str().unwrap_or("?"), a["backend"].as_str().unwrap_or("?"));
     Ok((adapter, entries))
+}
+
+/// The JSON of `flicker bench --nirc`: the throughput report and, unless skipped, whole frames.
+#[derive(serde::Serialize)]
+struct BenchJson {
+    #[serde(flatten)]
+    pub throughput: crate::nirc_throughput::BenchReport,
+    /// The blend's cost over EMA-only in whole frames (`frames`), as the paper's Table 1.
+    pub blend_overhead_frame_percent: Option<f64>,
+    pub frames: Option<crate::nirc_frames::Table1>,
+    /// The speed targets as shares of the ceiling, beside the measured shares.
+    pub targets: Vec<crate::nirc_targets::Target>,
 }

@@ -63,18 +63,6 @@ pub struct Table1 {
     pub blend_infer_extra_frame_percent: f64,
 }
 
-/// The JSON of `flicker bench --nirc`: the throughput report and, unless skipped, whole frames.
-#[derive(serde::Serialize)]
-pub struct BenchJson {
-    #[serde(flatten)]
-    pub throughput: crate::nirc_throughput::BenchReport,
-    /// The blend's cost over EMA-only in whole frames (`frames`), as the paper's Table 1.
-    pub blend_overhead_frame_percent: Option<f64>,
-    pub frames: Option<Table1>,
-    /// The speed targets as shares of the ceiling, beside the measured shares.
-    pub targets: Vec<crate::nirc_targets::Target>,
-}
-
 fn scenario_text(resolution: (u32, u32), warmup: u32, frames: u32, predictor: &str) -> String {
     format!(
         "Scenario(\n    scene: Builtin(\"cornell_box\"),\n    resolution: ({}, {}),\n    frames: {frames},\n    warmup_frames: {warmup},\n    seed: 21,\n    max_depth: 6,\n    methods: [Nirc(spp: 1, predictor: {predictor}, pretrain_frames: 0)],\n    reference: (spp: 1, frames: None),\n)\n",
