@@ -181,7 +181,6 @@ impl CachePaths {
         // No var<workgroup> in cache_paths.wgsl.
         gpu.check_workgroup_memory("nirc cache_paths", 0)?;
 
-        let device = &gpu.device;
         let (
             layout,
             [
@@ -198,17 +197,7 @@ impl CachePaths {
             &OWN_GROUP,
             ["queries_main", "targets_main", "compact_main", "oracle_main", "resolve_main"],
         )?;
-        let buffer = |label: &str, bytes: u64| -> Result<wgpu::Buffer, NircError> {
-            gpu.check_buffer_size(label, bytes)?;
-            Ok(device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: bytes.max(16),
-                usage: wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::COPY_SRC
-                    | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            }))
-        };
+        let buffer = |label: &str, bytes: u64| crate::gpu::setup::storage(gpu, label, bytes);
         let params = CacheParams {
             query_count: query_count as u32,
             record_count: settings.train_records,

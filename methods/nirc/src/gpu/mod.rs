@@ -27,7 +27,7 @@ mod infer;
 pub mod lane;
 pub mod readback;
 mod reliability_grid;
-mod setup;
+pub(crate) mod setup;
 pub mod shaders;
 pub mod train;
 

@@ -21,7 +21,8 @@ const ACCUM_PER_CELL: u64 = 73;
 /// Words of the touched bitmask per block of touched_list.wgsl (its BLOCK_WORDS: 4 per thread).
 const TOUCHED_BLOCK_WORDS: u64 = 4 * WORKGROUP_SIZE as u64;
 
-fn storage(gpu: &Gpu, label: &str, bytes: u64) -> Result<wgpu::Buffer, NircError> {
+/// A storage buffer of `bytes` (at least 16), copyable both ways, its size checked first.
+pub(crate) fn storage(gpu: &Gpu, label: &str, bytes: u64) -> Result<wgpu::Buffer, NircError> {
     gpu.check_buffer_size(label, bytes)?;
     Ok(gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
