@@ -7,10 +7,10 @@
 //! ray marching (Alg. 1 and 2: `optical_depth`), naive and Kettunen's biased exp(−X)
 //! (`ray_marching`), unbiased ray marching, the jackknife (Eq. 4; Eq. 3 and Eq. 6 for any m in
 //! `jackknife_function`), their selection (`transmittance`),
-//! MIS weights (`mis`), equiangular sampling (`equiangular`), the closed-form MIS setting of
-//! Eqs. 9/10 (`mis_trial`) and the 1-D stratified sampling of Sec. 4.1 (`stratified`).
+//! MIS weights (`mis`), equiangular sampling (`equiangular`) and the 1-D stratified sampling of
+//! Sec. 4.1 (`stratified`). The closed-form settings of Sec. 3 and Eqs. 9/10, which only the
+//! tests use, live with them (media/tests/probes/).
 
-pub mod closed_form;
 pub mod dda;
 pub mod density;
 pub mod equiangular;
@@ -23,7 +23,6 @@ pub mod majorant_tracking;
 pub mod medium;
 pub mod mesh_inside;
 pub mod mis;
-pub mod mis_trial;
 pub mod optical_depth;
 pub mod ratio_tracking;
 pub mod ray_marching;

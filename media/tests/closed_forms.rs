@@ -4,17 +4,18 @@
 //! jackknife's bias is below the naive estimate's (slightly negative on Laplace). Margins are
 //! standard errors of the same run (4.5 of them), not tuned constants. The same closed forms
 //! hold on the GPU (media_closed_form_trials.wgsl, 10^6 trials each), whose trials equal the
-//! CPU twin's (media::closed_form) on the same random numbers.
+//! CPU twin's (tests/probes/closed_form.rs) on the same random numbers.
 
 mod common;
+mod probes;
 
 use common::{C, Moments, normal};
 use std::sync::OnceLock;
 
 use media::Pcg;
-use media::closed_form::{ErrorDistribution, trial};
-use media::gpu::{ClosedFormParams, ClosedFormPass};
 use media::jackknife::jackknife;
+use probes::closed_form::{ErrorDistribution, trial};
+use probes::closed_form_pass::{ClosedFormParams, ClosedFormPass};
 use render::gpu::Gpu;
 
 const TRIALS: usize = 1_000_000;

@@ -4,12 +4,14 @@
 //! (an accept/reject or a ceil), so up to 1% of estimates may differ; none may be NaN.
 
 mod common;
+mod probes;
 
 use std::sync::OnceLock;
 
 use glam::{UVec3, Vec3};
-use media::gpu::{EstimatorPass, GpuMedium, MediumParams, RaySegment};
+use media::gpu::{GpuMedium, MediumParams, RaySegment};
 use media::{DensityGrid, DensityKind, Medium, Pcg, Segment};
+use probes::estimator_pass::EstimatorPass;
 use render::gpu::Gpu;
 use render::gpu_struct::layout_mismatches;
 

@@ -1,4 +1,4 @@
-//! Eqs. 9 and 10 in closed form (media::mis_trial: homogeneous medium, point light, equiangular
+//! Eqs. 9 and 10 in closed form (tests/probes/mis_trial.rs: homogeneous medium, point light, equiangular
 //! vs free-flight sampling, normal optical-depth estimates), 10^6 trials on the CPU reference and
 //! on the GPU: Eq. 9 is unbiased with the naive, jackknife and Miller weights; Eq. 10's bias
 //! equals its prediction ∫ (E g̃(t) − g(t)) L_s(t) (p0(t) + p1(t)) dt, with E g̃ integrated over the
@@ -7,11 +7,12 @@
 //! trial equals the CPU reference trial for trial on the same seeds.
 
 mod common;
+mod probes;
 
 use common::{C, Moments};
 use media::Pcg;
-use media::gpu::{MisParams, MisPass};
-use media::mis_trial::{MisSetup, MisTrial, trial};
+use probes::mis_pass::{MisParams, MisPass};
+use probes::mis_trial::{MisSetup, MisTrial, trial};
 use render::gpu::Gpu;
 use render::gpu_struct::layout_mismatches;
 

@@ -10,10 +10,10 @@
 //! its draws stay those of the pair, so every trial consumes the same numbers); the jackknife's
 //! Re g(X̄ + iS) reads both. The WGSL twin is media/shaders/media_mis_trials.wgsl (same draws, same order).
 
-use crate::equiangular::Equiangular;
-use crate::jackknife::jackknife;
-use crate::mis::{Ratio, eq9, eq10, miller_weight};
-use crate::rng::Pcg;
+use media::Pcg;
+use media::equiangular::Equiangular;
+use media::jackknife::jackknife;
+use media::mis::{Ratio, eq9, eq10, miller_weight};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MisSetup {

@@ -1,4 +1,5 @@
-// The closed-form MIS setting of media::mis_trial, one trial per invocation with its own seed:
+// The closed-form MIS setting of mis_trial.rs (beside this file), one trial per invocation with its
+// own seed:
 // the same draws in the same order as the CPU reference.
 
 import package::media::media_rng::{media_rand};

@@ -1,11 +1,11 @@
 //! The closed-form setting of the paper's Sec. 3 (Figs. 2 and 3), the twin of
-//! media/shaders/media_closed_form_trials.wgsl: two synthetic optical-depth estimates
+//! closed_form_trials.wgsl beside this file: two synthetic optical-depth estimates
 //! X_j = τ + σ e_j, e_j i.i.d. with mean 0 and variance 1 from a normal or one of Fig. 2's other
 //! distributions, and per trial the jackknife K (Eq. 4) and the naive exp(−X̄). In f32 with the
 //! WGSL's operations, so that the GPU's trials equal these to rounding.
 
-use crate::jackknife::jackknife;
-use crate::rng::Pcg;
+use media::Pcg;
+use media::jackknife::jackknife;
 
 /// The distribution of the estimates' error e (all with variance 1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,4 +1,4 @@
-// The closed-form setting of Sec. 3 (media::closed_form), one trial per invocation with its own
+// The closed-form setting of Sec. 3 (closed_form.rs beside this file), one trial per invocation with its own
 // seed: X_j = τ + σ e_j from cf_params.kind's distribution, the jackknife K (Eq. 4) and the
 // naive exp(−X̄); the same draws in the same order as the CPU twin.
 

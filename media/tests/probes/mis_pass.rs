@@ -8,7 +8,7 @@ use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::shader::{Module, Program};
 
-use crate::mis_trial::{MisSetup, MisTrial};
+use super::mis_trial::{MisSetup, MisTrial};
 
 render::gpu_struct! {
     pub struct MisParams {
@@ -51,7 +51,7 @@ impl MisPass {
             types,
             bindings,
         ])
-        .entry(render::wgsl_file!("media_mis_trials.wgsl"));
+        .entry(super::module("mis_trials", include_str!("mis_trials.wgsl")));
         let [pipeline] = pipelines(gpu, "media mis trials", &program, &[&layout], ["mis_trials"])?;
         Ok(Self { layout, pipeline })
     }

@@ -8,7 +8,7 @@ use render::gpu::Gpu;
 use render::gpu_struct::GpuStruct;
 use render::shader::{Module, Program};
 
-use crate::closed_form::ErrorDistribution;
+use super::closed_form::ErrorDistribution;
 
 render::gpu_struct! {
     pub struct ClosedFormParams {
@@ -47,7 +47,7 @@ impl ClosedFormPass {
             types,
             bindings,
         ])
-        .entry(render::wgsl_file!("media_closed_form_trials.wgsl"));
+        .entry(super::module("closed_form_trials", include_str!("closed_form_trials.wgsl")));
         let [pipeline] = pipelines(
             gpu,
             "media closed-form trials",

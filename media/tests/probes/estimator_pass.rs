@@ -6,8 +6,8 @@ use render::error::RenderError;
 use render::gpu::Gpu;
 use render::readback::Staging;
 
-use super::medium::{GpuMedium, RaySegment};
-use crate::transmittance::Estimator;
+use media::Estimator;
+use media::gpu::{GpuMedium, RaySegment};
 
 render::gpu_struct! {
     pub struct RayParams {
@@ -41,11 +41,11 @@ impl EstimatorPass {
     pub fn new(gpu: &Gpu, medium: &GpuMedium) -> Result<Self, RenderError> {
         use render::gpu_struct::GpuStruct;
         let layout = binding_layout(gpu, "media rays", &BINDINGS);
-        let program = super::shaders::program(
+        let program = media::gpu::program(
             "rays",
             RayParams::WGSL,
             &BINDINGS,
-            render::wgsl_file!("media_rays.wgsl"),
+            super::module("rays", include_str!("rays.wgsl")),
         );
         let [pipeline] =
             pipelines(gpu, "media rays", &program, &[&medium.layout, &layout], ["estimate_rays"])?;

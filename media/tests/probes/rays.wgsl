@@ -1,4 +1,4 @@
-// One estimate per segment with the segment's own seed (media::gpu::EstimatorPass): what the
+// One estimate per segment with the segment's own seed (tests/probes/estimator_pass.rs): what the
 // GPU-vs-CPU tests compare, estimate by estimate.
 
 import package::media::media_grid::{media_lookups};
