@@ -62,6 +62,23 @@ pub fn peak_resident_bytes() -> Option<u64> {
     status_kib("VmHWM:").map(|k| k * 1024)
 }
 
+/// Bytes the allocator has handed out and not taken back (glibc's `mallinfo2`: chunks in use in
+/// every arena plus those it mapped on their own); `None` with another C library. Unlike
+/// resident memory this falls when memory is freed: freed pages stay resident and later
+/// allocations reuse them, so a leak can hide in resident memory for hundreds of frames.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+pub fn heap_bytes() -> Option<u64> {
+    // SAFETY: mallinfo2 takes no arguments and only reads the allocator's counters.
+    let info = unsafe { libc::mallinfo2() };
+    Some(info.uordblks as u64 + info.hblkhd as u64)
+}
+
+/// See the glibc version: no portable counter elsewhere.
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+pub fn heap_bytes() -> Option<u64> {
+    None
+}
+
 /// The process's resident memory now (VmRSS), bytes; `None` off Linux.
 pub fn resident_bytes() -> Option<u64> {
     status_kib("VmRSS:").map(|k| k * 1024)
@@ -122,6 +139,20 @@ impl DeviceLedger {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    fn heap_bytes_count_a_live_allocation_and_drop_it_when_freed() {
+        const MIB: u64 = 1 << 20;
+        // 64 MiB, far above what the other tests of this binary allocate meanwhile.
+        let before = heap_bytes().unwrap();
+        let block = vec![1u8; (64 * MIB) as usize];
+        let held = heap_bytes().unwrap();
+        drop(std::hint::black_box(block));
+        let after = heap_bytes().unwrap();
+        assert!(held >= before + 60 * MIB, "holding 64 MiB: {before} -> {held} bytes");
+        assert!(after + 60 * MIB <= held, "64 MiB freed: {held} -> {after} bytes");
+    }
 
     #[test]
     fn reads_kib_lines_of_proc_status() {

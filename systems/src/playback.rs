@@ -265,6 +265,7 @@ pub(crate) fn play(
         let stop = match frames.run_frame(step, warmup) {
             Err(e) => Some((Status::Failed, Some(e))),
             Ok(()) => {
+                RunMemory::frame_played(&mut frames.world, step + 1);
                 if let Some(frame) = step.checked_sub(warmup).filter(|f| *f >= from) {
                     last_complete = Some(frame);
                 }
@@ -305,7 +306,7 @@ pub(crate) fn play(
     }
     bar.finish_with_message("done");
     let world = &mut frames.world;
-    RunMemory::finish(world);
+    RunMemory::finish(world, total);
     manifest["memory"] = serde_json::to_value(world.resource::<RunMemory>())?;
     set_status(&mut manifest, Status::Complete, last_complete);
     // The frames are all written; the report is not yet (a stop in between is resumable).
