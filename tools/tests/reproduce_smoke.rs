@@ -12,7 +12,7 @@
 //! (NIRC: `methods/nirc/tests/integrator.rs`, `sparse_updates.rs`, and a warm-started cache
 //! played twice from fresh caches, `tests/cli.rs`; the sample cache, TAA, path
 //! tracing: `methods/sample_cache/tests/sample_cache.rs`, `tests/cli.rs`; termination:
-//! `methods/termination/tests/termination_cache.rs`, `systems/tests/termination_shared.rs`).
+//! `methods/termination/tests/termination_cache.rs`, `methods/termination/tests/termination_shared.rs`).
 //!
 //! The claims that smoke scale reproduces are also regression gates (they were the papers
 //! suite's gates): each claim in `GATES` must be judged "reproduced", so a method that gets

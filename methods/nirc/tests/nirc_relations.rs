@@ -16,8 +16,7 @@ use std::path::{Path, PathBuf};
 use frame::frame_record::FrameRecord;
 use systems::playback::{Overrides, RunOptions, run};
 
-mod common;
-use common::assert_positive;
+use testkit::relations::assert_positive;
 
 const CACHE: &str = "cache: (
             encoding: (levels: 8, features_per_level: 2, log2_table_size: 12, base_resolution: 4, growth_factor: 1.5),

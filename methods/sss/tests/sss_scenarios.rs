@@ -10,7 +10,7 @@ use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};
 
 fn play(scenario: &str, frames: u32, keep: &[&str]) -> (Vec<FrameRecord>, tempfile::TempDir) {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("scenarios").join(scenario);
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join("scenarios").join(scenario);
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().to_path_buf();
     let overrides = Overrides {
@@ -332,7 +332,7 @@ fn hybrid_runs_both_techniques_end_to_end() {
 /// or of the separable passes alone (the skin's, the far floor's), each on many pixels.
 #[test]
 fn the_hybrid_scenario_takes_both_paths() {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/sss_hybrid.ron");
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/sss_hybrid.ron");
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().to_path_buf();
     let overrides = Overrides { frames: Some(1), out: Some(dir.join("run")), ..Default::default() };

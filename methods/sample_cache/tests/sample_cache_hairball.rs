@@ -107,7 +107,7 @@ fn holds_paired(name: &str, pairs: &[(f64, f64)]) {
 
 #[test]
 fn sample_cache_on_a_moving_hairball_camera() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/hairball_camera.ron");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/hairball_camera.ron");
     let mut scenario = Scenario::load(&path).expect("hairball_camera.ron");
     scenario.resolution = (64, 36);
     let gpu = Gpu::new().expect("a wgpu adapter");
@@ -153,7 +153,8 @@ fn sample_cache_on_a_moving_hairball_camera() {
 #[test]
 fn hairball_camera_scenario_plays_end_to_end() {
     use systems::playback::{Overrides, RunOptions, run};
-    let scenario = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/hairball_camera.ron");
+    let scenario =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/hairball_camera.ron");
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().to_path_buf();
     let summary = run(&RunOptions {

@@ -9,7 +9,7 @@
 //! accumulated variance Σ P_j by t · radiance_unit² with the cache's own estimates of P_j.
 //!
 //! Each relation holds over the seeds with a one-sided 95% Student-t bound of the mean per-seed
-//! value (common::assert_positive), so its margin comes from the spread across seeds.
+//! value (testkit::relations::assert_positive), so its margin comes from the spread across seeds.
 
 use std::path::{Path, PathBuf};
 
@@ -19,8 +19,7 @@ use frame::run_folder::RunFolder;
 use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};
 
-mod common;
-use common::assert_positive;
+use testkit::relations::assert_positive;
 
 const SEEDS: [u64; 3] = [3, 4, 5];
 const SCENARIO: &str = "termination_variance_door.ron";
@@ -50,7 +49,7 @@ fn luminance(p: &[f32; 4]) -> f64 {
 }
 
 fn play(seed: u64) -> (Vec<Measured>, f64) {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("scenarios").join(SCENARIO);
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join("scenarios").join(SCENARIO);
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().to_path_buf();
     let overrides =

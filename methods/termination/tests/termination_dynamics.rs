@@ -13,7 +13,7 @@
 //! propagation is a feedback loop (a record's estimates read its neighbours' records).
 //!
 //! Each relation holds over the seeds with a one-sided 95% Student-t bound of the mean per-seed
-//! value (common::assert_positive), so its margin comes from the spread across seeds.
+//! value (testkit::relations::assert_positive), so its margin comes from the spread across seeds.
 
 use std::path::{Path, PathBuf};
 
@@ -22,8 +22,7 @@ use sim::ReferenceFrames;
 use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};
 
-mod common;
-use common::assert_positive;
+use testkit::relations::assert_positive;
 
 const SEEDS: [u64; 3] = [3, 4, 5];
 
@@ -37,7 +36,7 @@ fn play(
     tag: &str,
     edit: impl Fn(&mut RunSpec),
 ) -> Vec<FrameRecord> {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("scenarios").join(scenario);
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join("scenarios").join(scenario);
     let tmp =
         tempfile::Builder::new().prefix(&format!("termination-dynamics-{tag}-")).tempdir().unwrap();
     let dir = tmp.path().to_path_buf();

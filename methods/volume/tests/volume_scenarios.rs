@@ -8,7 +8,7 @@ use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};
 
 fn play(scenario: &str, out: &Path) -> systems::playback::RunSummary {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios").join(scenario);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios").join(scenario);
     let overrides = Overrides {
         resolution: Some((32, 18)),
         spp: Some(8),

@@ -12,7 +12,7 @@ use systems::playback::{RunOptions, RunSummary, run_spec};
 use systems::scenario::{Overrides, RunSpec};
 
 fn play(scenario: &str, frames: Option<u32>, out: &Path) -> RunSummary {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios").join(scenario);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios").join(scenario);
     let overrides = Overrides {
         resolution: Some((32, 18)),
         spp: Some(2),

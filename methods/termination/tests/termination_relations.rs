@@ -28,8 +28,7 @@ use frame::frame_record::FrameRecord;
 use systems::playback::{RunOptions, run_spec};
 use systems::scenario::{Overrides, RunSpec};
 
-mod common;
-use common::assert_positive;
+use testkit::relations::assert_positive;
 
 const SEEDS: [u64; 3] = [3, 4, 5];
 
@@ -41,7 +40,7 @@ const DOOR_SEEDS: [u64; 5] = [3, 4, 5, 6, 7];
 /// The scenario's methods named in `keep`, one recorded frame at 32x18: (method, path length,
 /// FLIP) per seed.
 fn play(scenario: &str, keep: &[&str], seed: u64) -> Vec<FrameRecord> {
-    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("scenarios").join(scenario);
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join("scenarios").join(scenario);
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().to_path_buf();
     let overrides = Overrides {

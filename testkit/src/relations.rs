@@ -1,8 +1,5 @@
-//! Statistics shared by the relation tests that play a scenario over three seeds.
-#![allow(dead_code)]
-
-/// One-sided 95% t quantile for 2 degrees of freedom (three seeds).
-pub const T95_DF2: f64 = 2.920;
+//! Relations between methods over seeds: the per-seed differences' mean above zero with 95%
+//! confidence (one-sided Student t), the margin taken from the spread across seeds.
 
 /// One-sided 95% Student t quantiles for 2 to 6 degrees of freedom (3 to 7 seeds).
 const T95: [f64; 5] = [2.920, 2.353, 2.132, 2.015, 1.943];
