@@ -4,8 +4,10 @@
 //! instead. Timed per pass (`sss_scatter`, `sss_separable_h`, `sss_separable_v`) by `PassTimer`.
 
 use super::control_variates::EmCovariance;
+use super::frame_input::SssFrame;
+use super::pixel::{PixelHistory, PixelResult};
 use super::prefilter;
-use super::screen_pass::{PixelHistory, PixelResult, SssFrame, SssSettings, SssVariant};
+use super::screen_pass::{SssSettings, SssVariant};
 use super::separable;
 use super::spvg::SpvgHistory;
 use render::error::RenderError;

@@ -4,13 +4,15 @@
 //! (eq. 5.2, divided by A: the albedo is applied after the pass), and the histories update.
 
 use super::control_variates::EmCovariance;
+use super::frame_input::SssFrame;
 use super::hybrid::{self, Hybrid};
+use super::pixel::{PixelHistory, PixelResult};
 use super::prefilter::{self, MipChain, Prefilter};
 use super::reproject;
 use super::sampling::{luminance, pixel_offset, r2_point, radial_pdf, sample_radius};
 use super::separable;
 use super::split::{self, DistantCount, Split};
-use super::spvg::{self, SpvgHistory, SpvgSettings};
+use super::spvg::{self, SpvgSettings};
 use serde::{Deserialize, Serialize};
 
 /// How the count is chosen and what the history monitors.
@@ -134,46 +136,6 @@ impl Default for SssSettings {
             distant_count: DistantCount::Estimated,
         }
     }
-}
-
-/// One frame's input, row-major: per pixel the demodulated diffuse irradiance (rgb) and w, the
-/// pixels per unit of d at that pixel (0: not an SSS pixel; 1 when d is given in pixels); the
-/// profile's d per channel (in pixels where w = 1); the focal length in pixels.
-#[derive(Clone, Debug)]
-pub struct SssFrame {
-    pub width: u32,
-    pub height: u32,
-    pub irradiance: Vec<[f32; 4]>,
-    pub d_px: [f32; 3],
-    /// Pixels per scene unit at unit depth (depth = focal_px / w): eq. 7.1's depth difference;
-    /// 0 where depth is unknown (no depth term).
-    pub focal_px: f32,
-    /// Per pixel, where it was in the previous frame minus where it is (pixels, x right, y
-    /// down; the G-buffer's motion): the histories are read there. Empty: a still view.
-    pub motion: Vec<[f32; 2]>,
-}
-
-impl SssFrame {
-    /// The channel that radii are sampled for: the widest profile.
-    pub fn d_sample(&self) -> f32 {
-        self.d_px[0].max(self.d_px[1]).max(self.d_px[2])
-    }
-}
-
-/// A pixel's histories: SPVG's H and the control variates' J, and the w (pixels per scene
-/// unit, depth = focal/w) they were written at, for the reprojection's depth test (0: unknown).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PixelHistory {
-    pub spvg: SpvgHistory,
-    pub cv: EmCovariance,
-    pub w: f32,
-}
-
-/// A pixel's result: the scattered irradiance and the count it took.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PixelResult {
-    pub rgb: [f32; 3],
-    pub count: u32,
 }
 
 /// Eq. 7.1's sums for one Burley sample at q, radius r (drawn with density ∝ `pdf_s`): per
@@ -360,7 +322,8 @@ pub fn step(
         return (separable::step(frame, &kernel), vec![PixelHistory::default(); count]);
     }
     if let Some(h) = &settings.hybrid {
-        return hybrid::step(frame, settings, h, frame_index, history);
+        // P1: the whole image's Monte Carlo step; the hybrid keeps it on its AFIS tiles.
+        return hybrid::step(frame, h, monte_carlo_step(frame, settings, frame_index, history));
     }
     monte_carlo_step(frame, settings, frame_index, history)
 }

@@ -7,7 +7,8 @@
 //! weigh the kernel's mass over each tap's cell, the outermost cells taking the tails, so each
 //! channel's weights sum to 1. This file is the CPU twin of shaders/sss/separable.wgsl.
 
-use super::screen_pass::{PixelResult, SssFrame};
+use super::frame_input::SssFrame;
+use super::pixel::PixelResult;
 use std::f64::consts::PI;
 
 /// Tap offsets span ±RANGE times the widest channel's d (the kernel's mass beyond 8d is ~1%
