@@ -9,6 +9,7 @@ pub mod bvh2_batch;
 pub mod bvh2_geometry;
 pub mod command;
 pub mod image_metrics;
+pub mod memory_table;
 pub mod nirc_frames;
 pub mod nirc_targets;
 pub mod nirc_throughput;

@@ -313,7 +313,7 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
     }
     log("device memory per method");
     let scratch = std::env::temp_dir().join(format!("flicker-bench-memory-{}", std::process::id()));
-    let (memory_md, memory_rows) = systems::memory::table(&opts.resolutions, &scratch)?;
+    let (memory_md, memory_rows) = crate::memory_table::table(&opts.resolutions, &scratch)?;
     write!(md, "\n{memory_md}")?;
     let json = serde_json::json!({
         "adapter": gpu.summary,

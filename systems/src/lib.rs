@@ -8,5 +8,6 @@ pub mod memory;
 pub mod methods;
 pub mod mitsuba;
 pub mod playback;
+pub mod replayed_rows;
 pub mod resume;
 pub mod scenario;

@@ -338,7 +338,7 @@ pub(crate) fn write_report(folder: &RunFolder) -> Result<PathBuf> {
 /// The replayed frames' rows against those the interrupted run wrote.
 fn replay_matches(world: &World, resume: &ResumeAt, folder: &RunFolder) -> Result<()> {
     let replayed = frame::frame_record::to_csv(&world.resource::<RunOutput>().records);
-    crate::resume::same_rows(&folder.frames_csv(), &resume.frames_csv, &replayed)
+    crate::replayed_rows::same_rows(&folder.frames_csv(), &resume.frames_csv, &replayed)
 }
 
 fn progress_bar(enabled: bool, len: u64) -> ProgressBar {
