@@ -68,7 +68,7 @@ fn check_media_support(spec: &RunSpec, origin: &str) -> Result<()> {
         }
     }
     let references = (0..scenario.frames).any(|f| scenario.reference.wants(f, scenario.frames));
-    let volume_path = spec.methods.iter().any(|m| m.spec.is::<volume::path::VolumePathMethod>());
+    let volume_path = spec.methods.iter().any(|m| m.spec.is::<volume::path::VolumePathSettings>());
     if let (Some(extra), true) =
         (scenario.media.get(media::gpu::MAX_MEDIA), references || volume_path)
     {

@@ -7,7 +7,7 @@ use super::control_variates::EmCovariance;
 use super::frame_input::SssFrame;
 use super::pixel::{PixelHistory, PixelResult};
 use super::prefilter;
-use super::screen_pass::{SssSettings, SssVariant};
+use super::screen_pass::{SssPassSettings, SssVariant};
 use super::separable;
 use super::spvg::SpvgHistory;
 use render::error::RenderError;
@@ -295,7 +295,7 @@ impl SssPass {
         &mut self,
         gpu: &Gpu,
         frame: &SssFrame,
-        settings: &SssSettings,
+        settings: &SssPassSettings,
         frame_index: u32,
     ) -> Result<Vec<PassTiming>, RenderError> {
         if (frame.width, frame.height) != (self.width, self.height)

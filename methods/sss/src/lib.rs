@@ -32,7 +32,7 @@ pub use hybrid::Hybrid;
 pub use pixel::{PixelHistory, PixelResult};
 pub use prefilter::Prefilter;
 pub use profile::BurleyProfile;
-pub use screen_pass::{SssSettings, SssVariant};
+pub use screen_pass::{SssPassSettings, SssVariant};
 pub use split::{DistantCount, Split};
 pub use spvg::{SpvgHistory, SpvgSettings};
 

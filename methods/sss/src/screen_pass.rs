@@ -45,7 +45,7 @@ impl SssVariant {
 
 /// The pass's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SssSettings {
+pub struct SssPassSettings {
     pub variant: SssVariant,
     pub spvg: SpvgSettings,
     /// Sample radii with g(ξ) of eq. 5.6 instead of the analytic inverse.
@@ -72,7 +72,7 @@ pub struct SssSettings {
     pub distant_count: DistantCount,
 }
 
-impl SssSettings {
+impl SssPassSettings {
     /// Every setting the pass reads, with what was expected.
     pub fn validate(&self) -> Result<(), String> {
         self.spvg.validate()?;
@@ -118,7 +118,7 @@ impl SssSettings {
 /// is the display gamma of the SDR output its Table 7.3 runs recorded.
 pub const MONITOR_GAMMA: f32 = 2.2;
 
-impl Default for SssSettings {
+impl Default for SssPassSettings {
     fn default() -> Self {
         Self {
             variant: SssVariant::Adaptive,
@@ -186,7 +186,7 @@ pub fn depth_difference_px(focal_px: f32, centre_w: f32, w: f32) -> f32 {
 }
 
 /// The frame's MIP chain when the settings prefilter.
-pub fn mip_chain(frame: &SssFrame, settings: &SssSettings) -> Option<MipChain> {
+pub fn mip_chain(frame: &SssFrame, settings: &SssPassSettings) -> Option<MipChain> {
     settings
         .prefilter
         .map(|p| MipChain::build(frame.width, frame.height, &frame.irradiance, p.levels))
@@ -207,7 +207,7 @@ pub struct Scattered {
 /// eq. 5.18. m = 0 gives the direct term alone.
 pub fn scatter(
     frame: &SssFrame,
-    settings: &SssSettings,
+    settings: &SssPassSettings,
     chain: Option<&MipChain>,
     frame_index: u32,
     x: u32,
@@ -259,7 +259,7 @@ pub fn encode(y: f32, monitor_gamma: f32) -> f32 {
 /// One pixel's step: count, samples, histories (the Monte Carlo variants).
 fn pixel_step(
     frame: &SssFrame,
-    settings: &SssSettings,
+    settings: &SssPassSettings,
     chain: Option<&MipChain>,
     frame_index: u32,
     x: u32,
@@ -312,7 +312,7 @@ fn pixel_step(
 /// the separable variant keeps none). Errors: a separable kernel that cannot be built.
 pub fn step(
     frame: &SssFrame,
-    settings: &SssSettings,
+    settings: &SssPassSettings,
     frame_index: u32,
     history: &[PixelHistory],
 ) -> (Vec<PixelResult>, Vec<PixelHistory>) {
@@ -332,7 +332,7 @@ pub fn step(
 /// reprojected histories.
 pub(crate) fn monte_carlo_step(
     frame: &SssFrame,
-    settings: &SssSettings,
+    settings: &SssPassSettings,
     frame_index: u32,
     history: &[PixelHistory],
 ) -> (Vec<PixelResult>, Vec<PixelHistory>) {
