@@ -1,6 +1,6 @@
-//! The screen-space SSS pass in WGSL (shaders/sss/sss_pass.wgsl, entry `sss_scatter`): the
+//! The screen-space SSS pass in WGSL (shaders/sss_pass.wgsl, entry `sss_scatter`): the
 //! same per-pixel step as `screen_pass::pixel_step`, one invocation per pixel, with ping-pong
-//! histories on the GPU; the separable variant runs shaders/sss/separable.wgsl's two 1-D passes
+//! histories on the GPU; the separable variant runs shaders/separable.wgsl's two 1-D passes
 //! instead. Timed per pass (`sss_scatter`, `sss_separable_h`, `sss_separable_v`) by `PassTimer`.
 
 use super::control_variates::EmCovariance;

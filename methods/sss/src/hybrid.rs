@@ -5,7 +5,7 @@
 //! on the separable tiles (the AFIS tiles keep their AFIS result there: "we use the AFIS result
 //! as an approximation for the first pass in the Separable filter", so the vertical pass reads no
 //! hole at a border); P3, the vertical pass, writes buffer two on the separable tiles; P4 copies
-//! the AFIS tiles' result from buffer one into buffer two. CPU twin of shaders/sss/hybrid.wgsl.
+//! the AFIS tiles' result from buffer one into buffer two. CPU twin of shaders/hybrid.wgsl.
 //!
 //! The decision rule. The thesis leaves the technique to the user ("the type can be
 //! pre-determined or by custom process on the fly") and motivates the choice by the separable

@@ -1,4 +1,4 @@
-//! Screen-space subsurface scattering (render::sss, realtime-sss-thesis.txt): the path
+//! Screen-space subsurface scattering (the `sss` crate, realtime-sss-thesis.txt): the path
 //! tracer's image, demodulated by the G-buffer albedo on the pixels of each subsurface material
 //! (up to 8, each with its own profile and pass), is scattered by the thesis's pass (Burley sampling with SPVG counts and control
 //! variates, or a fixed count, or the separable baseline, or the hybrid of AFIS and separable)
