@@ -5,13 +5,13 @@
 use std::fmt::Write as _;
 use std::time::Instant;
 
+use crate::mitsuba::{self, lambertian_cornell_box};
 use anyhow::{Context, Result};
 use render::bvh::displaced_sphere;
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::{Instance, Material, SceneDesc};
 use render::scene_gpu::SceneGpu;
-use systems::mitsuba::{self, lambertian_cornell_box};
 use systems::scenario::builtin_scene;
 
 use crate::traversal::{PAIRED_ROUNDS, median, traversal_benchmark};
