@@ -1,4 +1,4 @@
-# Renders the scenes of systems/tests/mitsuba_matrix.rs with Mitsuba 3 (scalar_rgb) in one
+# Renders the scenes of bench/tests/mitsuba_matrix.rs with Mitsuba 3 (scalar_rgb) in one
 # process: each scene `images` times with seeds seed, seed + 1, ..., so that every pixel's mean
 # has a standard error from their spread. Usage: python3 scripts/mitsuba_matrix.py JOBS.json,
 # JOBS a list of {"xml": ..., "spp": N per image, "images": K, "seed": S, "out": ...}; each `out`

@@ -38,7 +38,7 @@ fn cornell_box_reference_is_stable_under_seed_change() {
 /// L = 1. Radiance L everywhere solves the rendering equation for any geometry, so every pixel
 /// is exactly 1: a tracer biased in its albedo, Russian roulette, path truncation or
 /// environment weights fails, however stable under seed change. (The lit box against an
-/// independent renderer: systems/tests/mitsuba_agreement.rs.)
+/// independent renderer: bench/tests/mitsuba_agreement.rs.)
 #[test]
 fn cornell_box_white_furnace_reference_is_one() {
     let gpu = Gpu::new().expect("a wgpu adapter (lavapipe on CI)");

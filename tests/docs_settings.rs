@@ -86,7 +86,7 @@ fn names_entry(marker: &str, entry: &str) -> bool {
 fn registry() -> Vec<Entry> {
     let mut out = vec![
         settings!(
-            sim::scenario::ScenarioFile,
+            sim::scenario_file::ScenarioFile,
             r#"(scene: Builtin("cornell_box"), resolution: (1, 1), frames: 1, methods: [PathTracing(spp: 1)])"#
         ),
         settings!(sim::scenario::CameraSpec, "(position: (0, 0, 1), target: (0, 0, 0))"),
@@ -123,9 +123,9 @@ fn registry() -> Vec<Entry> {
         settings!(nirc::NircConfig, "()"),
         settings!(nirc::config::HashGridConfig, "()"),
         settings!(nirc::config::NetworkConfig, "()"),
-        settings!(nirc::config::AdamConfig, "()"),
+        settings!(nirc::optimizer_config::AdamConfig, "()"),
         settings!(nirc::config::LossConfig, "()"),
-        settings!(nirc::config::EmaConfig, "()"),
+        settings!(nirc::optimizer_config::EmaConfig, "()"),
         settings!(nirc::config::ReliabilityConfig, "()"),
         settings!(nirc::CachePathSettings, "()"),
         settings!(sss::SpvgSettings, "()"),

@@ -1,6 +1,6 @@
 // Two-level traversal of obvhs's binary BVHs (Bvh2) with plain f32 boxes: the alternative to the
-// CWBVH of scene_geometry.wgsl that the bench measures (src/bvh/bvh2.rs). The nodes are bound at
-// @group(2) (src/bvh/bvh2_geometry.rs); the instance table, the ray set-up and the watertight
+// CWBVH of scene_geometry.wgsl that the bench measures (src/bvh2.rs). The nodes are bound at
+// @group(2) (src/bvh2_geometry.rs); the instance table, the ray set-up and the watertight
 // triangle test are scene_geometry.wgsl's (@group(1)), so both traversals give the same hits.
 // The loop follows obvhs's Bvh2::ray_traverse_dynamic: test both children of an inner node,
 // visit the nearer, push the farther (its child pair), and intersect BLAS leaves as soon as

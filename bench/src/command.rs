@@ -108,11 +108,11 @@ pub fn nirc(
 
 /// `flicker bench`: the speed tables (crate::speed) and, unless `no_metrics`, the image metrics'
 /// timings (crate::image_metrics).
-/// `flicker bench --memory`: the device memory table of every method (systems::memory).
+/// `flicker bench --memory`: the device memory table of every method (`memory_table`).
 pub fn memory(out: Option<PathBuf>, json: Option<PathBuf>) -> anyhow::Result<()> {
     let resolutions = crate::speed::BenchOptions::default().resolutions;
     let scratch = std::env::temp_dir().join(format!("flicker-bench-memory-{}", std::process::id()));
-    let (md, rows) = systems::memory::table(&resolutions, &scratch)?;
+    let (md, rows) = crate::memory_table::table(&resolutions, &scratch)?;
     print_and_write(&md, out, json, &rows)
 }
 

@@ -1,5 +1,6 @@
 //! Benchmarks, probes and experiments, kept out of the libraries they measure: `flicker bench`
-//! (`speed`: traversal, reference paths against Mitsuba 3, frame time; `image_metrics`; the
+//! (`speed`: traversal, reference paths against Mitsuba 3 (`mitsuba`, also the renderer the
+//! Mitsuba tests compare against), frame time; `image_metrics`; the
 //! neural cache's `nirc_throughput` and whole `nirc_frames`), the traversal measurement
 //! (`traversal`) with its experiments (`ray_order`, the BVH2 traversal `bvh2*`), and the
 //! wavefront path tracer (`wavefront`). No rendering method uses any of it.
@@ -9,6 +10,8 @@ pub mod bvh2_batch;
 pub mod bvh2_geometry;
 pub mod command;
 pub mod image_metrics;
+pub mod memory_table;
+pub mod mitsuba;
 pub mod nirc_frames;
 pub mod nirc_targets;
 pub mod nirc_throughput;

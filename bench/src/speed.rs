@@ -5,13 +5,13 @@
 use std::fmt::Write as _;
 use std::time::Instant;
 
+use crate::mitsuba::{self, lambertian_cornell_box};
 use anyhow::{Context, Result};
 use render::bvh::displaced_sphere;
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::{Instance, Material, SceneDesc};
 use render::scene_gpu::SceneGpu;
-use systems::mitsuba::{self, lambertian_cornell_box};
 use systems::scenario::builtin_scene;
 
 use crate::traversal::{PAIRED_ROUNDS, median, traversal_benchmark};
@@ -313,7 +313,7 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
     }
     log("device memory per method");
     let scratch = std::env::temp_dir().join(format!("flicker-bench-memory-{}", std::process::id()));
-    let (memory_md, memory_rows) = systems::memory::table(&opts.resolutions, &scratch)?;
+    let (memory_md, memory_rows) = crate::memory_table::table(&opts.resolutions, &scratch)?;
     write!(md, "\n{memory_md}")?;
     let json = serde_json::json!({
         "adapter": gpu.summary,

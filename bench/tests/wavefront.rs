@@ -93,7 +93,9 @@ fn the_wavefront_follows_passes_compiled_for_every_feature() {
     let mut sg = SceneGpu::new(gpu(), &scene, settings()).expect("scene");
     let mut tracer = PathTracer::new(gpu(), &sg).expect("tracer");
     sg.update(gpu(), &scene);
-    sg.library().specialise(gpu(), &sg, SceneFeatures::ALL).expect("compile for every feature");
+    sg.library()
+        .specialise(gpu(), sg.library_groups(), SceneFeatures::ALL)
+        .expect("compile for every feature");
     let pixels = (W * H) as u64;
     let wavefront = Wavefront::with_wave_paths(gpu(), &sg, pixels * 8).expect("wavefront");
     tracer.set_paths_per_dispatch(gpu(), pixels * 8).expect("dispatch size");

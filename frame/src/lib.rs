@@ -28,8 +28,9 @@ use bevy_ecs::prelude::*;
 
 pub use method::{MethodPlugin, MethodSpec, Registered, RegisteredMethod};
 pub use method_output::{MethodImage, MethodOutput};
+pub use reference::References;
 pub use resources::{
-    FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Progress, References, Run, RunOutput,
+    FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Progress, Run, RunOutput,
 };
 pub use sim::ExtractedScene;
 pub use stage::{

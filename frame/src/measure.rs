@@ -3,7 +3,8 @@
 
 use bevy_ecs::prelude::*;
 
-use super::resources::{FrameClock, MethodFrame, MethodInfo, References, Run};
+use super::reference::References;
+use super::resources::{FrameClock, MethodFrame, MethodInfo, Run};
 use crate::frame_metrics;
 
 /// The method's output as a frame to measure; the record starts with its label and counters.

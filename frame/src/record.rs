@@ -3,7 +3,8 @@
 
 use bevy_ecs::prelude::*;
 
-use super::resources::{FrameClock, MethodFrame, MethodInfo, Progress, References, Run, RunOutput};
+use super::reference::References;
+use super::resources::{FrameClock, MethodFrame, MethodInfo, Progress, Run, RunOutput};
 use super::stage::failed;
 use crate::run_folder::MOTION;
 use crate::{frame_record, output};

@@ -3,7 +3,7 @@
 
 use bevy_ecs::prelude::*;
 
-use super::resources::{FrameClock, GpuDevice, GpuScene, Progress, References, Run};
+use super::resources::{FrameClock, GpuDevice, GpuScene, Progress, Run};
 use super::stage::failed;
 use crate::frame_metrics as measure;
 use crate::reference_cache::{Lookup, ReferenceCache, ReferenceKey};
@@ -12,6 +12,19 @@ use render::frame_bindings::FrameBindings;
 use render::gpu::Gpu;
 use render::path_tracer::PathTracer;
 use render::scene_gpu::SceneGpu;
+
+/// The reference of this frame, where the scenario wants one, the reference cache and what
+/// renders the references.
+#[derive(Resource)]
+pub struct References {
+    pub cache: ReferenceCache,
+    /// None when the scenario wants no reference.
+    pub renderer: Option<ReferenceRenderer>,
+    /// Linear radiance of this frame's reference and the same ready to measure.
+    pub current: Option<(Vec<[f32; 4]>, measure::Frame)>,
+    pub rendered: u32,
+    pub cached: u32,
+}
 
 /// What renders the references, with its own frame parameters and outputs.
 pub enum ReferenceRenderer {

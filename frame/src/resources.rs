@@ -1,6 +1,6 @@
-//! What the frame's systems share: the GPU, the scene on it, the run, the frame's number,
-//! the references and the records (resources), and each method instance's frame (components
-//! of the method's entity).
+//! What the frame's systems share: the GPU, the scene on it, the run, the frame's number and
+//! the records (resources; the references' is `reference::References`), and each method
+//! instance's frame (components of the method's entity).
 
 use std::path::PathBuf;
 
@@ -11,10 +11,8 @@ use render::scene_gpu::SceneGpu;
 use sim::Scenario;
 
 use super::method_output::MethodOutput;
-use super::reference::ReferenceRenderer;
 use crate::frame_metrics as measure;
 use crate::frame_record::FrameRecord;
-use crate::reference_cache::ReferenceCache;
 use crate::run_folder::RunFolder;
 
 /// The device every pass runs on.
@@ -58,19 +56,6 @@ pub struct RunOutput {
     /// A resumed run's recorded frames below this are on disk already: they are played again
     /// (to rebuild the methods' state) and measured, but not written.
     pub replay_until: u32,
-}
-
-/// The reference of this frame, where the scenario wants one, the reference cache and what
-/// renders the references.
-#[derive(Resource)]
-pub struct References {
-    pub cache: ReferenceCache,
-    /// None when the scenario wants no reference.
-    pub renderer: Option<ReferenceRenderer>,
-    /// Linear radiance of this frame's reference and the same ready to measure.
-    pub current: Option<(Vec<[f32; 4]>, measure::Frame)>,
-    pub rendered: u32,
-    pub cached: u32,
 }
 
 /// The progress bar (hidden with `--quiet`).

@@ -1,6 +1,6 @@
 // The scene as the path tracer's passes see it: frame uniform, materials, lights, camera, and
 // the helpers every pass that shades surfaces needs. @group(0), read only (layout in
-// scene_bindings.rs); every pass binds it and puts its own buffers in @group(2). The structs
+// src/scene_group.rs); every pass binds it and puts its own buffers in @group(2). The structs
 // Frame, CameraFrame and GpuMaterial are declared once in Rust (render/src/frame.rs,
 // materials.rs: gpu_struct!) as package::scene_types (PassLibrary::modules).
 

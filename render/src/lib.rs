@@ -19,6 +19,7 @@ pub mod path_tracer;
 pub mod readback;
 pub mod scene_features;
 pub mod scene_gpu;
+pub mod scene_group;
 pub mod shader;
 pub mod test_scenes;
 pub mod texel_table;

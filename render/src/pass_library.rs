@@ -16,17 +16,16 @@ use crate::gpu_struct::GpuStruct;
 use crate::lights::GpuLight;
 use crate::materials::GpuMaterial;
 use crate::scene_features::SceneFeatures;
-use crate::scene_gpu::SceneGpu;
 use crate::shader::{Module, Program};
 
 /// Storage buffers a pass built on the library binds before its own: @group(0) (scene) and
 /// @group(1) (geometry). Add the pass's own to check the adapter limit.
 pub const LIBRARY_STORAGE_BUFFERS: u32 =
-    crate::scene_gpu::STORAGE_BUFFERS + SceneGeometry::STORAGE_BUFFERS;
+    crate::scene_group::STORAGE_BUFFERS + SceneGeometry::STORAGE_BUFFERS;
 
 /// Texel tables (read-only storage textures) of the same two groups.
 pub const LIBRARY_TEXEL_TABLES: u32 =
-    crate::scene_gpu::TABLES.len() as u32 + SceneGeometry::TEXEL_TABLES;
+    crate::scene_group::TABLES.len() as u32 + SceneGeometry::TEXEL_TABLES;
 
 /// A pipeline of the library, compiled for the features the scene has now. Fetch it with
 /// [`Self::get`] each time a pass is recorded: [`PassLibrary::specialise`] replaces it when the
@@ -48,7 +47,11 @@ impl PartialEq for LibraryPipeline {
 }
 
 type Compile = Box<
-    dyn Fn(&Gpu, &SceneGpu, SceneFeatures) -> Result<Vec<wgpu::ComputePipeline>, RenderError>
+    dyn Fn(
+            &Gpu,
+            [&wgpu::BindGroupLayout; 2],
+            SceneFeatures,
+        ) -> Result<Vec<wgpu::ComputePipeline>, RenderError>
         + Send,
 >;
 
@@ -90,7 +93,7 @@ impl PassLibrary {
     pub fn specialise(
         &self,
         gpu: &Gpu,
-        scene: &SceneGpu,
+        groups: [&wgpu::BindGroupLayout; 2],
         features: SceneFeatures,
     ) -> Result<(), RenderError> {
         let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
@@ -99,7 +102,7 @@ impl PassLibrary {
         }
         for pass in state.passes.values_mut() {
             if !pass.variants.contains_key(&features) {
-                let compiled = (pass.compile)(gpu, scene, features)?;
+                let compiled = (pass.compile)(gpu, groups, features)?;
                 pass.variants.insert(features, compiled);
             }
         }
@@ -127,8 +130,8 @@ impl PassLibrary {
             let bindings = crate::texel_table::group_module(
                 "package::scene_bindings",
                 0,
-                &crate::scene_gpu::GROUP,
-                &crate::scene_gpu::TABLES,
+                &crate::scene_group::GROUP,
+                &crate::scene_group::TABLES,
                 &[&types],
             );
             let mut modules = vec![types, bindings];
@@ -200,12 +203,13 @@ impl PassLibrary {
 
     /// The layout of a pass's own @group(2) and the pipelines of `entries` in `program` (a
     /// [`Self::program`] whose own modules include `compute::group_module(.., 2, own, ..)`, so a
-    /// pass states its buffers once), compiled for the library's scene features. Refuses a pass
+    /// pass states its buffers once), compiled for the library's scene features against the
+    /// scene's `groups` ([`crate::scene_gpu::SceneGpu::library_groups`]). Refuses a pass
     /// with more storage buffers or textures than the adapter binds. Equal passes are compiled once per run.
     pub fn pass<const N: usize>(
         &self,
         gpu: &Gpu,
-        scene: &SceneGpu,
+        groups: [&wgpu::BindGroupLayout; 2],
         pass: &str,
         program: &Program,
         own: &[BufferBinding],
@@ -231,9 +235,9 @@ impl PassLibrary {
         let compile: Compile = {
             let (name, program, layout, entries) =
                 (pass.to_string(), program.clone(), layout.clone(), entries.map(String::from));
-            Box::new(move |gpu: &Gpu, scene: &SceneGpu, features: SceneFeatures| {
+            Box::new(move |gpu: &Gpu, [scene, geometry]: [&wgpu::BindGroupLayout; 2], features| {
                 let specialised = program.replacing(&features.module());
-                let groups = [scene.layout(), scene.geometry().bind_group_layout(), &layout];
+                let groups = [scene, geometry, &layout];
                 Ok(compute::pipelines(
                     gpu,
                     &name,
@@ -245,7 +249,7 @@ impl PassLibrary {
             })
         };
         let features = state.features;
-        let compiled = compile(gpu, scene, features)?;
+        let compiled = compile(gpu, groups, features)?;
         let pipelines: Vec<LibraryPipeline> =
             compiled.iter().map(|p| LibraryPipeline(Arc::new(Mutex::new(p.clone())))).collect();
         let held = <[LibraryPipeline; N]>::try_from(pipelines.clone())

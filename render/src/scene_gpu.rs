@@ -8,7 +8,7 @@
 //! says the tables were reallocated.
 
 use crate::bvh::SceneGeometry;
-use crate::compute::{self, BufferBinding};
+use crate::compute::BufferBinding;
 use crate::error::RenderError;
 use crate::frame::{CameraBasis, FrameParams};
 use crate::gpu::Gpu;
@@ -17,23 +17,10 @@ use crate::materials::{GpuMaterial, NO_TEXTURE, pack_materials};
 use crate::pass_library::{LibraryPipeline, PassLibrary};
 use crate::scene::{Camera, SceneChanges, SceneDesc};
 use crate::scene_features::SceneFeatures;
+use crate::scene_group::{GROUP, LIGHT_TEXELS, MATERIAL_TEXELS, TABLES};
 use crate::shader::Program;
 use crate::texel_table::TexelTable;
 use glam::Vec3;
-
-/// @group(0)'s buffers: frame parameters, texels (declared into the library's WGSL).
-pub const GROUP: [BufferBinding; 2] =
-    [BufferBinding::read("frame", "Frame"), BufferBinding::read("texels", "array<u32>")];
-/// Its texel tables after the buffers: `GpuMaterial`s (3 texels) and `GpuLight`s (4 texels),
-/// read through scene_tables.wgsl.
-pub const TABLES: [&str; 2] = ["material_table", "light_table"];
-const MATERIAL_TEXELS: u32 = 3;
-const LIGHT_TEXELS: u32 = 4;
-const _: () = assert!(size_of::<crate::materials::GpuMaterial>() == 16 * MATERIAL_TEXELS as usize);
-const _: () = assert!(size_of::<crate::lights::GpuLight>() == 16 * LIGHT_TEXELS as usize);
-
-/// Storage buffers of @group(0).
-pub const STORAGE_BUFFERS: u32 = compute::storage_buffers(&GROUP);
 
 /// Image size and path depth: what every pass's frame parameters carry besides the scene (the
 /// path tracer's settings; `render::path_tracer` re-exports it).
@@ -158,7 +145,7 @@ impl SceneGpu {
         changes: SceneChanges,
     ) -> Result<(), RenderError> {
         self.upload_changed(gpu, scene, changes)?;
-        self.library.specialise(gpu, self, self.features())
+        self.library.specialise(gpu, self.library_groups(), self.features())
     }
 
     fn upload_changed(
@@ -282,12 +269,18 @@ impl SceneGpu {
         own: &[BufferBinding],
         entries: [&str; N],
     ) -> Result<(wgpu::BindGroupLayout, [LibraryPipeline; N]), RenderError> {
-        self.library.pass(gpu, self, pass, program, own, entries)
+        self.library.pass(gpu, self.library_groups(), pass, program, own, entries)
     }
 
     /// Layout of @group(0) (a method's frame parameters and the scene's tables).
     pub fn layout(&self) -> &wgpu::BindGroupLayout {
         &self.layout
+    }
+
+    /// The layouts of @group(0) and @group(1), which every pass of the library binds before its
+    /// own (what [`PassLibrary`] compiles its passes against).
+    pub fn library_groups(&self) -> [&wgpu::BindGroupLayout; 2] {
+        [&self.layout, self.geometry.bind_group_layout()]
     }
 
     /// @group(1) and the scene's bounds.

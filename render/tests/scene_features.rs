@@ -37,7 +37,9 @@ fn passes_for_the_scene_s_lights_render_what_passes_for_every_light_do() {
         "the room has only its emissive panel, and no textures"
     );
     let own = tracer.render(gpu(), &sg, 4, 7, 0).expect("frame");
-    sg.library().specialise(gpu(), &sg, SceneFeatures::ALL).expect("compile for every feature");
+    sg.library()
+        .specialise(gpu(), sg.library_groups(), SceneFeatures::ALL)
+        .expect("compile for every feature");
     assert_eq!(sg.library().features(), SceneFeatures::ALL);
     let every = tracer.render(gpu(), &sg, 4, 7, 0).expect("frame");
     assert!(own.radiance.iter().any(|p| p[0] > 0.0), "the room is lit");

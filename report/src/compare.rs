@@ -12,8 +12,9 @@ use crate::html::STYLE;
 use crate::images::write_frame_images;
 use crate::page;
 use crate::run::Manifest;
-use crate::summary::{DEFAULT_WINDOW, summarize};
+use crate::summary::summarize;
 use crate::viewer::{self, Panel};
+use crate::window::DEFAULT_WINDOW;
 
 /// The methods of a run, as report.html lists them.
 fn methods(manifest: &Manifest, frames: &Frames) -> Vec<String> {

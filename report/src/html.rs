@@ -14,7 +14,8 @@ use crate::charts::build::{WrittenChart, write_charts};
 use crate::data_uri::data_uri;
 use crate::images::write_frame_images;
 use crate::run::Manifest;
-use crate::summary::{DEFAULT_WINDOW, summarize};
+use crate::summary::summarize;
+use crate::window::DEFAULT_WINDOW;
 use crate::{page, table, viewer};
 
 fn png_uri(path: &Path) -> anyhow::Result<String> {

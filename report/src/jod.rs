@@ -10,7 +10,7 @@ use anyhow::Context;
 use metrics::{CvvdpSettings, Image, load_image};
 
 use crate::run::{Manifest, frame_file};
-use crate::summary::Window;
+use crate::window::Window;
 
 /// The run's JOD settings (manifest `settings.cvvdp`), the metric's defaults where absent.
 pub fn settings(manifest: &Manifest) -> anyhow::Result<CvvdpSettings> {

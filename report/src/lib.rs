@@ -15,13 +15,15 @@ pub mod run;
 pub mod summary;
 pub mod table;
 pub mod viewer;
+pub mod window;
 
 use std::path::{Path, PathBuf};
 
 use declared::MethodChart;
 
 pub use html::write_report;
-pub use summary::{DEFAULT_WINDOW, write_summary, write_summary_with_window};
+pub use summary::{write_summary, write_summary_with_window};
+pub use window::DEFAULT_WINDOW;
 
 /// What [`report`] writes: a run's report (`run_dir`), or the comparison of two runs
 /// (`compare`, the page at `out`, by default RUN_B/compare.html); `charts`: the registered

@@ -14,6 +14,7 @@ pub mod meaningless;
 pub mod resources;
 pub mod rng;
 pub mod scenario;
+pub mod scenario_file;
 pub mod scenes;
 pub mod simulation;
 pub mod template;

@@ -68,7 +68,7 @@ fn check_media_support(spec: &RunSpec, origin: &str) -> Result<()> {
         }
     }
     let references = (0..scenario.frames).any(|f| scenario.reference.wants(f, scenario.frames));
-    let volume_path = spec.methods.iter().any(|m| m.spec.is::<volume::path::VolumePathMethod>());
+    let volume_path = spec.methods.iter().any(|m| m.spec.is::<volume::path::VolumePathSettings>());
     if let (Some(extra), true) =
         (scenario.media.get(media::gpu::MAX_MEDIA), references || volume_path)
     {
@@ -339,7 +339,7 @@ pub(crate) fn write_report(folder: &RunFolder) -> Result<PathBuf> {
 /// The replayed frames' rows against those the interrupted run wrote.
 fn replay_matches(world: &World, resume: &ResumeAt, folder: &RunFolder) -> Result<()> {
     let replayed = frame::frame_record::to_csv(&world.resource::<RunOutput>().records);
-    crate::resume::same_rows(&folder.frames_csv(), &resume.frames_csv, &replayed)
+    crate::replayed_rows::same_rows(&folder.frames_csv(), &resume.frames_csv, &replayed)
 }
 
 fn progress_bar(enabled: bool, len: u64) -> ProgressBar {

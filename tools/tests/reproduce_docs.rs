@@ -5,7 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use tools::reproduce::Claims;
-use tools::reproduce::judge::{VERDICTS, rules};
+use tools::reproduce::judge::rules;
+use tools::reproduce::verdict::VERDICTS;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()

@@ -6,8 +6,8 @@
 //! Bounds by hand: three seeds, one-sided 95%, t(0.95, 2) = 2.92; a spread of 0.01 (values
 //! x − 0.01, x, x + 0.01) has standard error 0.00577 and bounds x ± 0.0169.
 
-use tools::reproduce::judge::{Region, decide, seeds_to_settle};
 use tools::reproduce::log_ratio::RatioExpectation;
+use tools::reproduce::verdict::{Region, decide, seeds_to_settle};
 use tools::reproduce::{Comparison, Effect, Judged, Verdict, judge};
 use tools::suite::window::Window;
 

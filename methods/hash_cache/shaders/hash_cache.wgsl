@@ -1,5 +1,5 @@
 // World-space hash cache (HashCache of stable-sample-caching.txt §4-5): the passes of one frame.
-// Built on the pass library, taa_primary.wgsl and hash_key.wgsl.
+// Built on the pass library, TAA's primary.wgsl and hash_key.wgsl.
 //
 //   hc_age      per slot:  evict cells not accessed for more than max_age frames; reset claims
 //   hc_trace    per pixel: jittered primary ray, direct part of the pixel, key point (the first

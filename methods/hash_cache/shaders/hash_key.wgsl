@@ -1,7 +1,7 @@
 // Voxel keys of the world-space hash cache: level of detail from the pixel footprint at the
 // point's camera distance (and its incidence angle), voxel jitter in the tangent plane, the
 // normal's major axis, and two hashes of the voxel (home slot, checksum).
-// Mirrored bit for bit by render/src/hash_cache/key.rs.
+// Mirrored bit for bit by src/key.rs.
 
 import package::pt_sampling::{basis_bitangent, basis_tangent, hash_mix, pcg_hash};
 import package::hash_cache_bindings::{hc};

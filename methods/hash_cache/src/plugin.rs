@@ -1,4 +1,4 @@
-//! World-space hash cache (render::hash_cache), optionally under TAA as the paper runs it. Two
+//! World-space hash cache (the crate's `lib.rs`), optionally under TAA as the paper runs it. Two
 //! systems, both in Render: the cache's upkeep (`update`: age = eviction, then lookups and
 //! updates), then the image (`resolve`: the cache's colour, and TAA's resolve of it). Nothing of
 //! the cache runs after the image: the image reads the cells this frame's update wrote, and the

@@ -4,6 +4,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::optimizer_config::{AdamConfig, EmaConfig};
+
 /// Everything that defines a cache. Two caches with equal configs, bounds and seed start from
 /// identical states.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -131,30 +133,6 @@ impl Default for NetworkConfig {
     }
 }
 
-/// Adam (Kingma and Ba 2014), applied to every parameter (MLP weights and hash-table entries).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct AdamConfig {
-    pub learning_rate: f32,
-    pub beta1: f32,
-    pub beta2: f32,
-    pub epsilon: f32,
-    /// Sparse updates of the hash grid (tiny-cuda-nn's Adam, which NRC uses): a table entry
-    /// whose gradient is exactly zero this step is left alone by Adam and by the EMA, and each
-    /// entry debiases with its own step count. The MLP weights stay dense. Off by default (plain
-    /// Adam on every parameter); left out of the serialised settings when off, so that warm-start
-    /// keys of dense caches do not change.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub sparse_grid: bool,
-}
-
-impl Default for AdamConfig {
-    fn default() -> Self {
-        // NRC: lr 1e-3..1e-2, β2 = 0.99, ε = 1e-15; β1 = 0.9 (Adam's default).
-        Self { learning_rate: 1e-2, beta1: 0.9, beta2: 0.99, epsilon: 1e-15, sparse_grid: false }
-    }
-}
-
 /// Relative L2 (NRC): (f - y)^2 / (sg(f)^2 + epsilon), sg = stop-gradient, averaged over the
 /// batch and the three channels.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -176,19 +154,6 @@ pub enum LossNormalization {
 impl Default for LossConfig {
     fn default() -> Self {
         Self { epsilon: 0.01, normalization: LossNormalization::PerChannel }
-    }
-}
-
-/// EMA of the weights, debiased: w̄_t = (α w̄_{t-1} (1 - α^{t-1}) + (1 - α) w_t) / (1 - α^t).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct EmaConfig {
-    pub alpha: f32,
-}
-
-impl Default for EmaConfig {
-    fn default() -> Self {
-        Self { alpha: 0.99 }
     }
 }
 

@@ -16,6 +16,7 @@ pub mod fixed_sum;
 pub mod gpu;
 pub mod integrator;
 pub mod layout;
+pub mod optimizer_config;
 pub mod plugin;
 pub mod recorded;
 pub mod records;

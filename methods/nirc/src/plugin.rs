@@ -57,7 +57,7 @@ pub struct NircSettings {
     pub pretrain_frames: u32,
     /// TEST ONLY: never update the EMA weights, so that EMA-only (and the blend's EMA side)
     /// answer from the initial network. A deliberately broken method for the test that the
-    /// smoke suite catches a regression (systems/tests/suite.rs); never set it in a scenario
+    /// smoke suite catches a regression (tools/tests/suite.rs); never set it in a scenario
     /// meant for results.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub test_skip_ema: bool,

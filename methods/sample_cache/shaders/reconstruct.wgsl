@@ -1,6 +1,6 @@
 // Reconstruction (section 3.3): the mean radiance of the pixel's visible, shaded samples; motion
 // from the closest visible sample (where it was last frame), for reprojected metrics. The same
-// colour and that sample's primary attributes (taa_primary.wgsl) also go to ssc_colour and
+// colour and that sample's primary attributes (TAA's primary.wgsl) also go to ssc_colour and
 // ssc_primary, the inputs of a TAA resolve over the cache.
 
 import package::scene_bindings::{frame};

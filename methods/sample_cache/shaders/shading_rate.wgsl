@@ -13,7 +13,7 @@ import package::sample_cache::selection::{ssc_bucket, ssc_forced_shade, ssc_impo
 import package::kernel::{outside_image};
 
 // One thread: the threshold bucket and its coin probability from the histogram and the budget
-// (twin of sample_cache/shading_rate.rs `threshold`).
+// (twin of src/shading_rate.rs `threshold`).
 @compute @workgroup_size(1, 1, 1)
 fn rates_main() {
     let m = ssc.buckets;

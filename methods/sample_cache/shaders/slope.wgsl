@@ -1,4 +1,4 @@
-// Slope test of adaptive retracing (section 3.4, eqs. 1 and 2; twin of sample_cache/slope.rs).
+// Slope test of adaptive retracing (section 3.4, eqs. 1 and 2; twin of src/slope.rs).
 
 // Eq. 1: expected spread of first-hit distances inside one pixel frustum on a locally flat
 // surface, Δn = t_s |1 - cos θ / cos(θ - φ)|, θ the angle between the normal and the direction to

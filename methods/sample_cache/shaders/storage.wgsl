@@ -1,5 +1,5 @@
 // Stable sample cache (Philippi, Jensen & Frisvad 2025): storage, packing and the per-frame
-// parameters. Its bindings (@group(2)) are generated from OWN_GROUP in sample_cache/mod.rs.
+// parameters. Its bindings (@group(2)) are generated from OWN_GROUP in src/lib.rs.
 //
 // Layout. N slots per pixel, "layered": slot s of pixel p lives at s * pixels + p (the paper's
 // array of textures, one per slot index). A slot is 32 bytes: the first hit packed into a vec4u

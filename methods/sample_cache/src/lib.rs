@@ -4,7 +4,7 @@
 //! sparsely, and averaged into the image. See README.md in this folder for the map, and
 //! docs/methods/sample-cache.md for the choices.
 //!
-//! Passes per frame (shaders/sample_cache/, one compute pass each, timed):
+//! Passes per frame (shaders/, one compute pass each, timed):
 //! `reserve` (reproject.wgsl: begin_main, reserve_main, gather_main, closest_main), `trace` (retrace.wgsl: retrace_main,
 //! list_dispatch.wgsl retrace_args_main, retrace.wgsl retrace_list_main, finish_main),
 //! `shade` (shading_rate.wgsl rates_main + select_main, list_dispatch.wgsl shade_args_main,

@@ -1,4 +1,4 @@
-//! The stable sample cache (render::sample_cache) as four systems, one per stage of the paper's
+//! The stable sample cache (the crate's `lib.rs`) as four systems, one per stage of the paper's
 //! frame: reproject (forward reprojection and slot reservation), retrace, shade, reconstruct;
 //! with `taa: true` the reconstruction is resolved by TAA (taa), as the paper's error
 //! figures run every method.

@@ -1,5 +1,5 @@
 //! The slope test of adaptive retracing (section 3.4, eqs. 1 and 2 and appendix A), the CPU twin
-//! of shaders/sample_cache/slope.wgsl.
+//! of shaders/slope.wgsl.
 
 /// Eq. 1: Δn = t |1 - cos θ / cos(θ - φ)|.
 pub fn slope(t: f32, cos_theta: f32, phi: f32) -> f32 {

@@ -1,4 +1,4 @@
-//! Storage and packing of the cache (twin of shaders/sample_cache/storage.wgsl), and the mask
+//! Storage and packing of the cache (twin of shaders/storage.wgsl), and the mask
 //! invariants every frame must keep.
 //!
 //! Slot s of pixel p is element `s * pixels + p` (one layer per slot index). A slot is 32 bytes:

@@ -12,7 +12,7 @@ mod support;
 
 use sss::profile::scaling_from_dmfp;
 use sss::screen_pass::step;
-use sss::{PixelHistory, PixelResult, Prefilter, SssFrame, SssSettings, SssVariant};
+use sss::{PixelHistory, PixelResult, Prefilter, SssFrame, SssPassSettings, SssVariant};
 use support::evaluation::psnr;
 use support::ground_truth::WalkOffsets;
 use support::random_walk::Medium;
@@ -44,9 +44,9 @@ fn main() {
         .iter()
         .map(|t| t.map(|v| v as f32))
         .collect();
-    let plain = SssSettings { fast_inverse: false, split: None, ..Default::default() };
+    let plain = SssPassSettings { fast_inverse: false, split: None, ..Default::default() };
     let converged: Vec<[f32; 3]> = {
-        let s = SssSettings { variant: SssVariant::Fixed { count: 4096 }, ..plain };
+        let s = SssPassSettings { variant: SssVariant::Fixed { count: 4096 }, ..plain };
         let mut sum = vec![[0.0f32; 3]; (w * h) as usize];
         for f in 0..8 {
             for (a, r) in sum.iter_mut().zip(step(&frame, &s, f, &[]).0) {
@@ -72,18 +72,18 @@ fn main() {
         psnr(&as_is(&converged), &truth, &frame, peak)
     );
     let variants = [
-        ("fixed 8", SssSettings { variant: SssVariant::Fixed { count: 8 }, ..plain }),
-        ("fixed 64", SssSettings { variant: SssVariant::Fixed { count: 64 }, ..plain }),
-        ("AS (split, fast inverse)", SssSettings::default()),
+        ("fixed 8", SssPassSettings { variant: SssVariant::Fixed { count: 8 }, ..plain }),
+        ("fixed 64", SssPassSettings { variant: SssVariant::Fixed { count: 64 }, ..plain }),
+        ("AS (split, fast inverse)", SssPassSettings::default()),
         (
             "AS+OCV (split, fast inverse)",
-            SssSettings { variant: SssVariant::OnlineCv, ..Default::default() },
+            SssPassSettings { variant: SssVariant::OnlineCv, ..Default::default() },
         ),
         (
             "AFIS a = 1/16",
-            SssSettings { prefilter: Some(Prefilter::default()), ..Default::default() },
+            SssPassSettings { prefilter: Some(Prefilter::default()), ..Default::default() },
         ),
-        ("separable 25", SssSettings { variant: SssVariant::Separable { taps: 25 }, ..plain }),
+        ("separable 25", SssPassSettings { variant: SssVariant::Separable { taps: 25 }, ..plain }),
     ];
     for (name, s) in variants {
         let mut history: Vec<PixelHistory> = vec![];

@@ -1,6 +1,6 @@
 //! Table 7.3's relations (thesis Sec. 7.4) on the CPU twin of the pass (`screen_pass::step`),
 //! paired over seeds: per synthetic test (flash, toggle, boids) and seed, AS, AS+OCV, AS+CCV and
-//! fixed 64 with the thesis's settings (`SssSettings::default()`: σ0² = 1e-4, α = 0.2, κ = 0.2,
+//! fixed 64 with the thesis's settings (`SssPassSettings::default()`: σ0² = 1e-4, α = 0.2, κ = 0.2,
 //! ε_a = a_cv = 1e-6, ε_u = 0.01, [8, 64], gamma-encoded luminance); mean spp over SSS pixels
 //! and frames, CPU ms per frame, PSNR of luminance against the pass at 2048 spp (analytic
 //! inverse) on every 6th frame after frame 10, frame-to-frame SMAPE. Prints the per-seed rows,
@@ -15,7 +15,7 @@ mod support;
 
 use sss::sampling::luminance;
 use sss::screen_pass::step;
-use sss::{SssSettings, SssVariant};
+use sss::{SssPassSettings, SssVariant};
 use std::fmt::Write;
 use std::time::Instant;
 use support::evaluation::Accumulator;
@@ -47,7 +47,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let mut relations = String::new();
     for test in [DynamicTest::Flash, DynamicTest::Toggle, DynamicTest::Boids] {
-        let reference_settings = SssSettings {
+        let reference_settings = SssPassSettings {
             variant: SssVariant::Fixed { count: 2048 },
             fast_inverse: false,
             seed: 1000,
@@ -66,7 +66,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut m = vec![vec![]; VARIANTS.len()];
         for seed in 1..=seeds {
             for (k, (name, variant)) in VARIANTS.iter().enumerate() {
-                let settings = SssSettings { variant: *variant, seed, ..Default::default() };
+                let settings = SssPassSettings { variant: *variant, seed, ..Default::default() };
                 let (mut acc, mut history, mut ms) = (Accumulator::default(), vec![], 0.0);
                 for t in 0..frames {
                     let f = frame(test, width, height, t, d_rel);

@@ -1,4 +1,4 @@
-// Eq. 5.12's MIP level (twin of render::sss::prefilter::level); the chain's layout per level
+// Eq. 5.12's MIP level (twin of sss::prefilter::level); the chain's layout per level
 // (offset, width, height) comes in SssParams::mip, computed on the host.
 
 // Eq. 5.12 in pixels: l = ½ max(log2(A_s / a), 0), A_s = 2πr / (n pdf(r)) texels per sample.

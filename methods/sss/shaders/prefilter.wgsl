@@ -1,5 +1,5 @@
 // The irradiance prefiltering pass (thesis Sec. 5.2 and 5.4's P2; CPU twin
-// render/src/sss/prefilter.rs): one dispatch per level. Level 0 is the irradiance with the SSS
+// src/prefilter.rs): one dispatch per level. Level 0 is the irradiance with the SSS
 // mask as its share; level k is the 2x2 mean of level k-1 over SSS texels, with their share.
 
 import package::sss_types::SssParams;

@@ -1,4 +1,4 @@
-// The SSS pass's per-sample math (twin of render/src/sss/sampling.rs): R2 points shifted per
+// The SSS pass's per-sample math (twin of src/sampling.rs): R2 points shifted per
 // pixel, Burley radii (analytic inverse eq. 5.4 or fast inverse eq. 5.6), the radial density.
 
 import package::pt_sampling::pcg_hash;

@@ -1,4 +1,4 @@
-// The separable SSS baseline (render::sss::separable, its CPU twin; P2 and P3 of the hybrid pass,
+// The separable SSS baseline (sss::separable, its CPU twin; P2 and P3 of the hybrid pass,
 // which skip the AFIS tiles): a horizontal pass from the
 // irradiance into `intermediate`, then a vertical pass from it into `scattered`, each a sum of
 // the pre-integrated Burley kernel's taps (offset in units of the widest d, weight rgb).

@@ -1,5 +1,5 @@
 // SPVG (eqs. 4.3, 4.4, 4.9-4.12) and the control variates' EMC and coefficient (eqs. 6.16,
-// 6.21); twins of render/src/sss/spvg.rs and control_variates.rs.
+// 6.21); twins of src/spvg.rs and src/control_variates.rs.
 
 struct SpvgParams {
     alpha0: f32,

@@ -1,4 +1,4 @@
-// The screen-space SSS pass (render::sss::gpu; CPU twin render/src/sss/screen_pass.rs): one
+// The screen-space SSS pass (sss::gpu; CPU twin src/screen_pass.rs): one
 // invocation per pixel picks its count with SPVG, takes that many Burley samples of the
 // demodulated diffuse irradiance, and writes the scattered value and its histories.
 

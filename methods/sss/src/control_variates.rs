@@ -1,7 +1,7 @@
 //! Control variates in the sample-count domain (thesis Ch. 6): the exponential moving covariance
 //! (EMC, eq. 6.16) of the pixel's scattered value f̄ and its in-frame constant control G(t)
 //! (the centre irradiance, eq. 6.14), and the coefficient a_t = (Cov + ε_a)/(Var + ε_a)
-//! (eq. 6.21) clamped to D = [0, a0 + f̄/ḡ] (Sec. 6.5.4). f32, as shaders/sss/spvg.wgsl.
+//! (eq. 6.21) clamped to D = [0, a0 + f̄/ḡ] (Sec. 6.5.4). f32, as shaders/spvg.wgsl.
 
 /// J_t of one pixel: ζ = EMA of (f̄, ḡ), Cov(f̄, ḡ), Var(ḡ) (Σ.xx is never read, Sec. 6.5.5).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

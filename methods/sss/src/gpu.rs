@@ -1,11 +1,13 @@
-//! The screen-space SSS pass in WGSL (shaders/sss/sss_pass.wgsl, entry `sss_scatter`): the
+//! The screen-space SSS pass in WGSL (shaders/sss_pass.wgsl, entry `sss_scatter`): the
 //! same per-pixel step as `screen_pass::pixel_step`, one invocation per pixel, with ping-pong
-//! histories on the GPU; the separable variant runs shaders/sss/separable.wgsl's two 1-D passes
+//! histories on the GPU; the separable variant runs shaders/separable.wgsl's two 1-D passes
 //! instead. Timed per pass (`sss_scatter`, `sss_separable_h`, `sss_separable_v`) by `PassTimer`.
 
 use super::control_variates::EmCovariance;
+use super::frame_input::SssFrame;
+use super::pixel::{PixelHistory, PixelResult};
 use super::prefilter;
-use super::screen_pass::{PixelHistory, PixelResult, SssFrame, SssSettings, SssVariant};
+use super::screen_pass::{SssPassSettings, SssVariant};
 use super::separable;
 use super::spvg::SpvgHistory;
 use render::error::RenderError;
@@ -293,7 +295,7 @@ impl SssPass {
         &mut self,
         gpu: &Gpu,
         frame: &SssFrame,
-        settings: &SssSettings,
+        settings: &SssPassSettings,
         frame_index: u32,
     ) -> Result<Vec<PassTiming>, RenderError> {
         if (frame.width, frame.height) != (self.width, self.height)

@@ -5,7 +5,7 @@
 //! on the separable tiles (the AFIS tiles keep their AFIS result there: "we use the AFIS result
 //! as an approximation for the first pass in the Separable filter", so the vertical pass reads no
 //! hole at a border); P3, the vertical pass, writes buffer two on the separable tiles; P4 copies
-//! the AFIS tiles' result from buffer one into buffer two. CPU twin of shaders/sss/hybrid.wgsl.
+//! the AFIS tiles' result from buffer one into buffer two. CPU twin of shaders/hybrid.wgsl.
 //!
 //! The decision rule. The thesis leaves the technique to the user ("the type can be
 //! pre-determined or by custom process on the fly") and motivates the choice by the separable
@@ -14,7 +14,8 @@
 //! tile's largest profile d (in pixels) spreads the outermost gap over more than `max_gap_px`
 //! pixels, the 1-D passes skip texels and band, and the tile takes AFIS; elsewhere separable.
 
-use super::screen_pass::{PixelHistory, PixelResult, SssFrame, SssSettings};
+use super::frame_input::SssFrame;
+use super::pixel::{PixelHistory, PixelResult};
 use super::separable;
 use serde::{Deserialize, Serialize};
 
@@ -96,22 +97,19 @@ pub fn technique_at(frame: &SssFrame, tiles: &[Technique], i: usize) -> Techniqu
     tiles[((y / TILE) * frame.width.div_ceil(TILE) + x / TILE) as usize]
 }
 
-/// P1-P4 on the CPU: AFIS (the settings' Monte Carlo variant on the prefiltered chain) with its
-/// histories on the AFIS tiles, the two separable passes elsewhere; separable pixels keep no
-/// history (an AFIS tile that was separable last frame cold-starts, eqs. 4.11-4.12).
+/// P2-P4 on the CPU after P1, `p1` (the settings' Monte Carlo variant on the prefiltered chain
+/// over the whole image, with its histories; each pixel reads only the irradiance, the chain and
+/// its own history, so the others' results do not change it): P1's result and histories on the
+/// AFIS tiles, the two separable passes elsewhere; separable pixels keep no history (an AFIS tile
+/// that was separable last frame cold-starts, eqs. 4.11-4.12).
 pub fn step(
     frame: &SssFrame,
-    settings: &SssSettings,
     hybrid: &Hybrid,
-    frame_index: u32,
-    history: &[PixelHistory],
+    p1: (Vec<PixelResult>, Vec<PixelHistory>),
 ) -> (Vec<PixelResult>, Vec<PixelHistory>) {
     let tiles = tile_techniques(frame, hybrid);
     let afis = |i: usize| technique_at(frame, &tiles, i) == Technique::Afis;
-    // P1: the whole image's Monte Carlo step, kept on the AFIS tiles (each pixel reads only the
-    // irradiance, the chain and its own history: the others' results do not change it).
-    let (p1, mut next) =
-        super::screen_pass::monte_carlo_step(frame, settings, frame_index, history);
+    let (p1, mut next) = p1;
     let kernel = separable::kernel(hybrid.taps, frame.d_px).unwrap_or_else(|e| panic!("{e}"));
     // P2: buffer one, horizontal on the separable tiles, the AFIS result on the AFIS tiles.
     let mut one = separable::pass(frame, &frame.irradiance, &kernel, true);

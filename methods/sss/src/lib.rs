@@ -10,9 +10,11 @@
 
 pub mod control_variates;
 pub mod direct;
+pub mod frame_input;
 pub mod gpu;
 pub mod hybrid;
 pub mod inverse;
+pub mod pixel;
 pub mod prefilter;
 pub mod profile;
 pub mod psnr_against;
@@ -25,10 +27,12 @@ pub mod spvg;
 
 pub use control_variates::EmCovariance;
 pub use direct::IrradianceSource;
+pub use frame_input::SssFrame;
 pub use hybrid::Hybrid;
+pub use pixel::{PixelHistory, PixelResult};
 pub use prefilter::Prefilter;
 pub use profile::BurleyProfile;
-pub use screen_pass::{PixelHistory, PixelResult, SssFrame, SssSettings, SssVariant};
+pub use screen_pass::{SssPassSettings, SssVariant};
 pub use split::{DistantCount, Split};
 pub use spvg::{SpvgHistory, SpvgSettings};
 

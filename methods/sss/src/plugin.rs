@@ -1,4 +1,4 @@
-//! Screen-space subsurface scattering (render::sss, realtime-sss-thesis.txt): the path
+//! Screen-space subsurface scattering (the `sss` crate, realtime-sss-thesis.txt): the path
 //! tracer's image, demodulated by the G-buffer albedo on the pixels of each subsurface material
 //! (up to 8, each with its own profile and pass), is scattered by the thesis's pass (Burley sampling with SPVG counts and control
 //! variates, or a fixed count, or the separable baseline, or the hybrid of AFIS and separable)
@@ -12,7 +12,7 @@ use crate::direct::{DirectIrradiancePass, IrradianceSource};
 use crate::gpu::SssPass;
 use crate::profile::scaling_from_dmfp;
 use crate::{
-    DistantCount, Hybrid, Prefilter, Split, SpvgSettings, SssFrame, SssSettings, SssVariant,
+    DistantCount, Hybrid, Prefilter, Split, SpvgSettings, SssFrame, SssPassSettings, SssVariant,
 };
 use anyhow::{Result, bail};
 use bevy_ecs::prelude::*;
@@ -27,7 +27,7 @@ use frame::{MethodImage, MethodOutput, MethodPlugin};
 /// `Sss(variant: Adaptive, spp: 1)`; the thesis's parameters by default.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct SssMethodSettings {
+pub struct SssSettings {
     /// Adaptive (AS), OnlineCv (AS+OCV), ConstantCv (AS+CCV), Fixed(count: N) or
     /// Separable(taps: N) (Jimenez et al.'s two 1-D passes, N odd).
     pub variant: SssVariant,
@@ -64,9 +64,9 @@ pub struct SssMethodSettings {
     pub distant_count: DistantCount,
 }
 
-impl Default for SssMethodSettings {
+impl Default for SssSettings {
     fn default() -> Self {
-        let s = SssSettings::default();
+        let s = SssPassSettings::default();
         Self {
             variant: s.variant,
             irradiance: IrradianceSource::Direct,
@@ -86,7 +86,7 @@ impl Default for SssMethodSettings {
     }
 }
 
-impl SssMethodSettings {
+impl SssSettings {
     pub fn label(&self) -> String {
         let base: String = match self.variant {
             SssVariant::Fixed { count } => format!("sss_fixed{count}"),
@@ -113,8 +113,8 @@ impl SssMethodSettings {
         if self.taa.is_some() { format!("{base}_taa") } else { base }
     }
 
-    fn pass_settings(&self, seed: u64) -> SssSettings {
-        SssSettings {
+    fn pass_settings(&self, seed: u64) -> SssPassSettings {
+        SssPassSettings {
             variant: self.variant,
             spvg: self.spvg,
             fast_inverse: self.fast_inverse,
@@ -148,7 +148,7 @@ pub struct SssProfile {
 
 #[derive(Component)]
 pub struct SssState {
-    settings: SssMethodSettings,
+    settings: SssSettings,
     /// The path tracer whose image and G-buffer the passes scatter.
     tracer: PathTracer,
     /// The direct irradiance's pass under `IrradianceSource::Direct`.
@@ -160,23 +160,23 @@ pub struct SssState {
 pub struct Plugin;
 
 impl MethodPlugin for Plugin {
-    type Settings = SssMethodSettings;
+    type Settings = SssSettings;
     const NAME: &'static str = "Sss";
     const STATISTICS: &'static [frame::method::Statistic] = crate::recorded::STATISTICS;
 
-    fn label(settings: &SssMethodSettings) -> String {
+    fn label(settings: &SssSettings) -> String {
         settings.label()
     }
 
-    fn spp(settings: &SssMethodSettings) -> f64 {
+    fn spp(settings: &SssSettings) -> f64 {
         settings.spp as f64
     }
 
-    fn temporal_window(_settings: &SssMethodSettings) -> Option<f64> {
+    fn temporal_window(_settings: &SssSettings) -> Option<f64> {
         Some(1.0)
     }
 
-    fn set_spp(settings: &mut SssMethodSettings, spp: u32) {
+    fn set_spp(settings: &mut SssSettings, spp: u32) {
         settings.spp = spp;
     }
 
@@ -184,7 +184,7 @@ impl MethodPlugin for Plugin {
         schedule.add_systems(render.in_set(Stage::Render));
     }
 
-    fn spawn(world: &mut World, entity: Entity, s: &SssMethodSettings) -> Result<()> {
+    fn spawn(world: &mut World, entity: Entity, s: &SssSettings) -> Result<()> {
         if s.spp == 0 {
             bail!("Sss: spp 0; expected at least 1 path-traced sample per pixel");
         }

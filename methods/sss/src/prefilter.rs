@@ -1,5 +1,5 @@
 //! Prefiltered irradiance MIPs and adaptive filtered importance sampling (AFIS, thesis Sec. 5.2,
-//! eqs. 5.10-5.13, Algorithm 2); the twin of shaders/sss/prefilter.wgsl.
+//! eqs. 5.10-5.13, Algorithm 2); the twin of shaders/prefilter.wgsl.
 //!
 //! The irradiance is averaged 2x2 into a MIP chain each frame. A Burley sample reads the chain at
 //! a level set by how much screen area the sample stands for: with n samples drawn from the

@@ -6,7 +6,7 @@
 //! 4.11-4.12) off screen, where the previous frame had no SSS history there, or where the depth
 //! stored with that history disagrees with this pixel's by more than the TAA's tolerance.
 
-use super::screen_pass::PixelHistory;
+use super::pixel::PixelHistory;
 
 /// The previous frame's texel that pixel (x, y) came from; None off screen.
 pub fn reprojected_texel(

@@ -1,4 +1,4 @@
-//! The pass's per-sample math in f32, the twin of shaders/sss/sampling.wgsl: a per-pixel
+//! The pass's per-sample math in f32, the twin of shaders/sampling.wgsl: a per-pixel
 //! Cranley-Patterson offset of the R2 sequence (the thesis's online sequence, Sec. 5.1.2), the
 //! sampled radius (analytic inverse eq. 5.4 or fast inverse eq. 5.6) and the per-channel weight.
 

@@ -4,13 +4,15 @@
 //! (eq. 5.2, divided by A: the albedo is applied after the pass), and the histories update.
 
 use super::control_variates::EmCovariance;
+use super::frame_input::SssFrame;
 use super::hybrid::{self, Hybrid};
+use super::pixel::{PixelHistory, PixelResult};
 use super::prefilter::{self, MipChain, Prefilter};
 use super::reproject;
 use super::sampling::{luminance, pixel_offset, r2_point, radial_pdf, sample_radius};
 use super::separable;
 use super::split::{self, DistantCount, Split};
-use super::spvg::{self, SpvgHistory, SpvgSettings};
+use super::spvg::{self, SpvgSettings};
 use serde::{Deserialize, Serialize};
 
 /// How the count is chosen and what the history monitors.
@@ -43,7 +45,7 @@ impl SssVariant {
 
 /// The pass's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SssSettings {
+pub struct SssPassSettings {
     pub variant: SssVariant,
     pub spvg: SpvgSettings,
     /// Sample radii with g(ξ) of eq. 5.6 instead of the analytic inverse.
@@ -70,7 +72,7 @@ pub struct SssSettings {
     pub distant_count: DistantCount,
 }
 
-impl SssSettings {
+impl SssPassSettings {
     /// Every setting the pass reads, with what was expected.
     pub fn validate(&self) -> Result<(), String> {
         self.spvg.validate()?;
@@ -116,7 +118,7 @@ impl SssSettings {
 /// is the display gamma of the SDR output its Table 7.3 runs recorded.
 pub const MONITOR_GAMMA: f32 = 2.2;
 
-impl Default for SssSettings {
+impl Default for SssPassSettings {
     fn default() -> Self {
         Self {
             variant: SssVariant::Adaptive,
@@ -134,46 +136,6 @@ impl Default for SssSettings {
             distant_count: DistantCount::Estimated,
         }
     }
-}
-
-/// One frame's input, row-major: per pixel the demodulated diffuse irradiance (rgb) and w, the
-/// pixels per unit of d at that pixel (0: not an SSS pixel; 1 when d is given in pixels); the
-/// profile's d per channel (in pixels where w = 1); the focal length in pixels.
-#[derive(Clone, Debug)]
-pub struct SssFrame {
-    pub width: u32,
-    pub height: u32,
-    pub irradiance: Vec<[f32; 4]>,
-    pub d_px: [f32; 3],
-    /// Pixels per scene unit at unit depth (depth = focal_px / w): eq. 7.1's depth difference;
-    /// 0 where depth is unknown (no depth term).
-    pub focal_px: f32,
-    /// Per pixel, where it was in the previous frame minus where it is (pixels, x right, y
-    /// down; the G-buffer's motion): the histories are read there. Empty: a still view.
-    pub motion: Vec<[f32; 2]>,
-}
-
-impl SssFrame {
-    /// The channel that radii are sampled for: the widest profile.
-    pub fn d_sample(&self) -> f32 {
-        self.d_px[0].max(self.d_px[1]).max(self.d_px[2])
-    }
-}
-
-/// A pixel's histories: SPVG's H and the control variates' J, and the w (pixels per scene
-/// unit, depth = focal/w) they were written at, for the reprojection's depth test (0: unknown).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PixelHistory {
-    pub spvg: SpvgHistory,
-    pub cv: EmCovariance,
-    pub w: f32,
-}
-
-/// A pixel's result: the scattered irradiance and the count it took.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PixelResult {
-    pub rgb: [f32; 3],
-    pub count: u32,
 }
 
 /// Eq. 7.1's sums for one Burley sample at q, radius r (drawn with density ∝ `pdf_s`): per
@@ -224,7 +186,7 @@ pub fn depth_difference_px(focal_px: f32, centre_w: f32, w: f32) -> f32 {
 }
 
 /// The frame's MIP chain when the settings prefilter.
-pub fn mip_chain(frame: &SssFrame, settings: &SssSettings) -> Option<MipChain> {
+pub fn mip_chain(frame: &SssFrame, settings: &SssPassSettings) -> Option<MipChain> {
     settings
         .prefilter
         .map(|p| MipChain::build(frame.width, frame.height, &frame.irradiance, p.levels))
@@ -245,7 +207,7 @@ pub struct Scattered {
 /// eq. 5.18. m = 0 gives the direct term alone.
 pub fn scatter(
     frame: &SssFrame,
-    settings: &SssSettings,
+    settings: &SssPassSettings,
     chain: Option<&MipChain>,
     frame_index: u32,
     x: u32,
@@ -297,7 +259,7 @@ pub fn encode(y: f32, monitor_gamma: f32) -> f32 {
 /// One pixel's step: count, samples, histories (the Monte Carlo variants).
 fn pixel_step(
     frame: &SssFrame,
-    settings: &SssSettings,
+    settings: &SssPassSettings,
     chain: Option<&MipChain>,
     frame_index: u32,
     x: u32,
@@ -350,7 +312,7 @@ fn pixel_step(
 /// the separable variant keeps none). Errors: a separable kernel that cannot be built.
 pub fn step(
     frame: &SssFrame,
-    settings: &SssSettings,
+    settings: &SssPassSettings,
     frame_index: u32,
     history: &[PixelHistory],
 ) -> (Vec<PixelResult>, Vec<PixelHistory>) {
@@ -360,7 +322,8 @@ pub fn step(
         return (separable::step(frame, &kernel), vec![PixelHistory::default(); count]);
     }
     if let Some(h) = &settings.hybrid {
-        return hybrid::step(frame, settings, h, frame_index, history);
+        // P1: the whole image's Monte Carlo step; the hybrid keeps it on its AFIS tiles.
+        return hybrid::step(frame, h, monte_carlo_step(frame, settings, frame_index, history));
     }
     monte_carlo_step(frame, settings, frame_index, history)
 }
@@ -369,7 +332,7 @@ pub fn step(
 /// reprojected histories.
 pub(crate) fn monte_carlo_step(
     frame: &SssFrame,
-    settings: &SssSettings,
+    settings: &SssPassSettings,
     frame_index: u32,
     history: &[PixelHistory],
 ) -> (Vec<PixelResult>, Vec<PixelHistory>) {

@@ -5,9 +5,10 @@
 //! integrates to A; the pass uses it divided by A (the albedo is applied after the pass).
 //! Taps sit at Jimenez's quadratic offsets (separable-sss's SeparableSSS.cpp, exponent 2) and
 //! weigh the kernel's mass over each tap's cell, the outermost cells taking the tails, so each
-//! channel's weights sum to 1. This file is the CPU twin of shaders/sss/separable.wgsl.
+//! channel's weights sum to 1. This file is the CPU twin of shaders/separable.wgsl.
 
-use super::screen_pass::{PixelResult, SssFrame};
+use super::frame_input::SssFrame;
+use super::pixel::PixelResult;
 use std::f64::consts::PI;
 
 /// Tap offsets span ±RANGE times the widest channel's d (the kernel's mass beyond 8d is ~1%

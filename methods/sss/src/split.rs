@@ -4,7 +4,7 @@
 //! sampled, with u drawn from (cdf(r0), 1] (r = g((1 − ξ)·cdf(r0) + ξ), eq. 5.17). Eq. 5.18 blends
 //! the two with the distant energy ratio γ: for Burley's profile γ = 1 − cdf(r0) (Table 5.1);
 //! eq. 5.20 and Algorithm 3 (lines 1-2) take no distant samples where γ < ε_u. f32, the same
-//! operations as shaders/sss/sss_pass.wgsl.
+//! operations as shaders/sss_pass.wgsl.
 
 use serde::{Deserialize, Serialize};
 

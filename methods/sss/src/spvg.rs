@@ -1,7 +1,7 @@
 //! Single pass variance guiding (SPVG, thesis Ch. 4): a per-pixel history H = (μ, σ², n̄) of the
 //! monitored value S, updated with an exponential moving average and variance (eqs. 4.3, 4.4),
 //! sets the next frame's sample count (eqs. 4.9, 4.10), with the history reset on disocclusion
-//! (eqs. 4.11, 4.12). f32, the same operations as shaders/sss/spvg.wgsl.
+//! (eqs. 4.11, 4.12). f32, the same operations as shaders/spvg.wgsl.
 
 use serde::{Deserialize, Serialize};
 

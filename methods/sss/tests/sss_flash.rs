@@ -7,7 +7,7 @@ mod support;
 
 use sss::sampling::luminance;
 use sss::screen_pass::step;
-use sss::{SssSettings, SssVariant};
+use sss::{SssPassSettings, SssVariant};
 use support::evaluation::{Accumulator, RunMeasures};
 use support::synthetic::{DynamicTest, flash_intensity, frame};
 
@@ -21,7 +21,7 @@ const D_REL: [f32; 3] = [0.15, 0.08, 0.04];
 const T95_DF2: f64 = 2.919_986;
 
 fn run(variant: SssVariant, seed: u32, reference: &[[f32; 3]], peak: f64) -> RunMeasures {
-    let settings = SssSettings { variant, seed, ..Default::default() };
+    let settings = SssPassSettings { variant, seed, ..Default::default() };
     let mut history = vec![];
     let mut acc = Accumulator::default();
     for t in 0..FRAMES {
@@ -47,7 +47,7 @@ fn lower_bound(v: &[f64]) -> f64 {
 fn flash_relations_of_table_7_3() {
     let base = frame(DynamicTest::Flash, W, H, 0, D_REL);
     assert_eq!(flash_intensity(0), 1.0);
-    let reference_settings = SssSettings {
+    let reference_settings = SssPassSettings {
         variant: SssVariant::Fixed { count: 2048 },
         fast_inverse: false,
         seed: 1000,

@@ -9,7 +9,7 @@ use sss::prefilter::MipChain;
 use sss::screen_pass::step;
 use sss::{
     DistantCount, EmCovariance, PixelHistory, PixelResult, Prefilter, Split, SpvgHistory,
-    SpvgSettings, SssFrame, SssSettings, SssVariant,
+    SpvgSettings, SssFrame, SssPassSettings, SssVariant,
 };
 
 const W: u32 = 20;
@@ -152,7 +152,7 @@ fn gpu_pass_matches_with_motion(gpu: &Gpu, frame: SssFrame) {
         (SssVariant::ConstantCv, true, Some(Split { gamma: Some(0.4), eps_u: 0.01 }), 2.2, eq520),
     ];
     for (variant, fast_inverse, split, monitor_gamma, distant_count) in variants {
-        let settings = SssSettings {
+        let settings = SssPassSettings {
             variant,
             fast_inverse,
             seed: 3,
@@ -185,7 +185,7 @@ fn gpu_pass_matches_with_motion(gpu: &Gpu, frame: SssFrame) {
         if let (DistantCount::GammaScaled, Some(Split { gamma: Some(g), .. })) =
             (distant_count, split)
         {
-            let algorithm3 = SssSettings { distant_count: estimated, ..settings };
+            let algorithm3 = SssPassSettings { distant_count: estimated, ..settings };
             let (n_hat, _) = step(&frame, &algorithm3, 5, &start);
             let mut scaled = 0;
             for (i, (r, n)) in results.iter().zip(&n_hat).enumerate() {
@@ -226,8 +226,8 @@ fn gpu_prefiltered_pass_matches_the_cpu_reference() {
         (SssVariant::Adaptive, Prefilter::default()),
         (SssVariant::Fixed { count: 24 }, Prefilter { a: 1.0, levels: 3 }),
     ] {
-        let plain = SssSettings { variant, seed: 3, ..Default::default() };
-        let settings = SssSettings { prefilter: Some(prefilter), ..plain };
+        let plain = SssPassSettings { variant, seed: 3, ..Default::default() };
+        let settings = SssPassSettings { prefilter: Some(prefilter), ..plain };
         let start = histories(&settings.spvg);
         pass.set_history(&gpu, &start);
         pass.dispatch(&gpu, &frame, &settings, 5).unwrap();
@@ -256,7 +256,7 @@ fn gpu_prefiltered_pass_matches_the_cpu_reference() {
         assert!(changed > 10, "{what}: prefiltering changed {changed} pixels");
     }
     // Separable has no samples to prefilter.
-    let bad = SssSettings {
+    let bad = SssPassSettings {
         variant: SssVariant::Separable { taps: 5 },
         prefilter: Some(Prefilter::default()),
         ..Default::default()
@@ -273,7 +273,7 @@ fn bad_sizes_and_counts_are_refused() {
         .dispatch(
             &gpu,
             &frame(),
-            &SssSettings { variant: SssVariant::Fixed { count: 5000 }, ..Default::default() },
+            &SssPassSettings { variant: SssVariant::Fixed { count: 5000 }, ..Default::default() },
             0,
         )
         .unwrap_err();
@@ -287,7 +287,7 @@ fn bad_sizes_and_counts_are_refused() {
         motion: Vec::new(),
     };
     assert!(
-        pass.dispatch(&gpu, &small, &SssSettings::default(), 0)
+        pass.dispatch(&gpu, &small, &SssPassSettings::default(), 0)
             .unwrap_err()
             .to_string()
             .contains("4x4")

@@ -8,7 +8,7 @@
 mod support;
 
 use sss::profile::scaling_from_dmfp;
-use sss::{SssFrame, SssSettings, SssVariant};
+use sss::{SssFrame, SssPassSettings, SssVariant};
 use support::ground_truth::{WalkOffsets, dkw_margin, hoeffding_margin};
 use support::random_walk::Medium;
 
@@ -32,7 +32,7 @@ fn frame(d_px: f32) -> SssFrame {
 /// The pass's mean over `frames` frames of `count` Burley samples (analytic inverse, the whole
 /// disc: no split), red channel.
 fn pass(frame: &SssFrame, count: u32, frames: u32) -> Vec<f64> {
-    let settings = SssSettings {
+    let settings = SssPassSettings {
         variant: SssVariant::Fixed { count },
         fast_inverse: false,
         split: None,

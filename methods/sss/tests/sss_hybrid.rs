@@ -6,7 +6,7 @@
 use render::gpu::Gpu;
 use sss::hybrid::{self, Hybrid, TILE, Technique};
 use sss::screen_pass::step;
-use sss::{PixelHistory, Prefilter, SssFrame, SssSettings, SssVariant};
+use sss::{PixelHistory, Prefilter, SssFrame, SssPassSettings, SssVariant};
 
 const W: u32 = 24;
 const H: u32 = 16;
@@ -42,8 +42,8 @@ fn lit(x: u32, y: u32) -> [f32; 3] {
     [l * f, 0.8 * l * f, 0.6 * l]
 }
 
-fn settings(hybrid: Hybrid) -> SssSettings {
-    SssSettings {
+fn settings(hybrid: Hybrid) -> SssPassSettings {
+    SssPassSettings {
         variant: SssVariant::Adaptive,
         prefilter: Some(Prefilter::default()),
         hybrid: Some(hybrid),
@@ -101,10 +101,12 @@ fn the_decision_rule_matches_the_tap_gap_reference() {
         let e = settings(bad).validate().unwrap_err();
         assert!(e.contains("hybrid"), "{e}");
     }
-    let no_prefilter = SssSettings { prefilter: None, ..settings(Hybrid::default()) };
+    let no_prefilter = SssPassSettings { prefilter: None, ..settings(Hybrid::default()) };
     assert!(no_prefilter.validate().unwrap_err().contains("prefilter"));
-    let separable =
-        SssSettings { variant: SssVariant::Separable { taps: 25 }, ..settings(Hybrid::default()) };
+    let separable = SssPassSettings {
+        variant: SssVariant::Separable { taps: 25 },
+        ..settings(Hybrid::default())
+    };
     assert!(separable.validate().unwrap_err().contains("Separable"));
 }
 
@@ -115,8 +117,8 @@ fn the_hybrid_is_afis_and_separable_where_each_is_chosen() {
     let s = settings(h);
     let tiles = hybrid::tile_techniques(&f, &h);
     let (hyb, hist) = step(&f, &s, 4, &[]);
-    let (afis, afis_hist) = step(&f, &SssSettings { hybrid: None, ..s }, 4, &[]);
-    let separable = SssSettings {
+    let (afis, afis_hist) = step(&f, &SssPassSettings { hybrid: None, ..s }, 4, &[]);
+    let separable = SssPassSettings {
         variant: SssVariant::Separable { taps: h.taps },
         prefilter: None,
         hybrid: None,

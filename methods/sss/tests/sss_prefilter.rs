@@ -4,7 +4,7 @@
 //! level offset breaks this); on a step edge prefiltering blurs, so it must differ there.
 
 use sss::screen_pass::{mip_chain, scatter};
-use sss::{Prefilter, SssFrame, SssSettings, SssVariant};
+use sss::{Prefilter, SssFrame, SssPassSettings, SssVariant};
 
 const W: u32 = 96;
 const H: u32 = 80;
@@ -25,8 +25,8 @@ fn frame(f: impl Fn(f32, f32) -> f32) -> SssFrame {
 fn prefiltering_is_exact_on_a_linear_irradiance() {
     let ramp = frame(|x, y| 0.2 + 0.01 * x + 0.004 * y);
     let plain =
-        SssSettings { variant: SssVariant::Fixed { count: 32 }, seed: 5, ..Default::default() };
-    let afis = SssSettings { prefilter: Some(Prefilter { a: 1.0 / 16.0, levels: 5 }), ..plain };
+        SssPassSettings { variant: SssVariant::Fixed { count: 32 }, seed: 5, ..Default::default() };
+    let afis = SssPassSettings { prefilter: Some(Prefilter { a: 1.0 / 16.0, levels: 5 }), ..plain };
     let chain = mip_chain(&ramp, &afis).expect("a chain");
     assert_eq!(chain.levels.len(), 5);
     // The top level's texel (1, 1) is the mean of a 16x16 block: the ramp at its centre.
@@ -56,8 +56,8 @@ fn prefiltering_is_exact_on_a_linear_irradiance() {
 fn prefiltering_blurs_an_edge() {
     let edge = frame(|x, _| if x < 48.0 { 1.0 } else { 0.1 });
     let plain =
-        SssSettings { variant: SssVariant::Fixed { count: 32 }, seed: 5, ..Default::default() };
-    let afis = SssSettings { prefilter: Some(Prefilter::default()), ..plain };
+        SssPassSettings { variant: SssVariant::Fixed { count: 32 }, seed: 5, ..Default::default() };
+    let afis = SssPassSettings { prefilter: Some(Prefilter::default()), ..plain };
     let chain = mip_chain(&edge, &afis).expect("a chain");
     let a = scatter(&edge, &plain, None, 3, 46, 40, 32).rgb;
     let b = scatter(&edge, &afis, Some(&chain), 3, 46, 40, 32).rgb;

@@ -5,7 +5,7 @@
 use render::scene::SplitMix64;
 use sss::screen_pass::step;
 use sss::spvg::{sample_count, state};
-use sss::{PixelHistory, SpvgHistory, SssFrame, SssSettings};
+use sss::{PixelHistory, SpvgHistory, SssFrame, SssPassSettings};
 
 const W: u32 = 24;
 const H: u32 = 10;
@@ -25,7 +25,7 @@ fn frame(dx: i32, motion: Vec<[f32; 2]>) -> SssFrame {
 }
 
 /// Valid histories whose counts differ from pixel to pixel (n̂ spread over [8, 64]).
-fn histories(settings: &SssSettings) -> Vec<PixelHistory> {
+fn histories(settings: &SssPassSettings) -> Vec<PixelHistory> {
     let mut rng = SplitMix64::new(11);
     (0..W * H)
         .map(|_| PixelHistory {
@@ -41,13 +41,13 @@ fn histories(settings: &SssSettings) -> Vec<PixelHistory> {
         .collect()
 }
 
-fn expected_count(h: &PixelHistory, settings: &SssSettings) -> u32 {
+fn expected_count(h: &PixelHistory, settings: &SssPassSettings) -> u32 {
     sample_count(&state(&h.spvg, &settings.spvg), &settings.spvg)
 }
 
 #[test]
 fn a_translated_view_reads_the_shifted_history() {
-    let settings = SssSettings::default();
+    let settings = SssPassSettings::default();
     let prev = histories(&settings);
     // The image moved SHIFT pixels right: each pixel was SHIFT pixels left last frame.
     let moving = frame(SHIFT, vec![[-SHIFT as f32, 0.0]; (W * H) as usize]);
@@ -82,7 +82,7 @@ fn a_translated_view_reads_the_shifted_history() {
 
 #[test]
 fn a_disocclusion_resets_the_history() {
-    let settings = SssSettings::default();
+    let settings = SssPassSettings::default();
     let mut prev = histories(&settings);
     // Last frame: columns 0-5 were another surface (no SSS history), columns 6-11 at 1.5x
     // this frame's w (depth 1/1.5 of this one: another surface in front), 12-17 at w within

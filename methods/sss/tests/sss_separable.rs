@@ -8,7 +8,7 @@ use sss::gpu::SssPass;
 use sss::profile::radial_pdf;
 use sss::screen_pass::step;
 use sss::separable::{MAX_TAPS, kernel, kernel_cdf, one_sided_tail, tap_offsets};
-use sss::{SssFrame, SssSettings, SssVariant};
+use sss::{SssFrame, SssPassSettings, SssVariant};
 
 /// P(X > a) for X = r cos φ, r from Burley's radial density, φ uniform: the mass beyond a of
 /// the profile's projection, as ½ ∫_a^∞ p(r) (1 − (2/π) asin(a/r)) dr. Substituting
@@ -133,7 +133,7 @@ fn rank_one_kernel_is_exact_for_a_vertical_edge_not_a_diagonal_one() {
         let frame = edge_frame(size, size, n, c, d_px);
         let (results, _) = step(
             &frame,
-            &SssSettings { variant: SssVariant::Separable { taps }, ..Default::default() },
+            &SssPassSettings { variant: SssVariant::Separable { taps }, ..Default::default() },
             0,
             &[],
         );
@@ -215,7 +215,7 @@ fn gpu_separable_matches_the_cpu_twin() {
     let mut pass = SssPass::new(&gpu, w, h).unwrap();
     for taps in [5, 25] {
         let settings =
-            SssSettings { variant: SssVariant::Separable { taps }, ..Default::default() };
+            SssPassSettings { variant: SssVariant::Separable { taps }, ..Default::default() };
         pass.dispatch(&gpu, &frame, &settings, 0).unwrap();
         let gpu_results = pass.results(&gpu).unwrap();
         let (cpu_results, _) = step(&frame, &settings, 0, &[]);
@@ -244,7 +244,7 @@ fn gpu_separable_matches_the_cpu_twin() {
         pass.dispatch(
             &gpu,
             &frame,
-            &SssSettings { variant: SssVariant::Separable { taps: 4 }, ..Default::default() },
+            &SssPassSettings { variant: SssVariant::Separable { taps: 4 }, ..Default::default() },
             0
         )
         .unwrap_err()

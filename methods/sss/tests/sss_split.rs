@@ -3,7 +3,7 @@
 
 use sss::screen_pass::{encode, scatter, step};
 use sss::split::{self, R0_PX};
-use sss::{PixelHistory, Split, SssFrame, SssSettings, SssVariant};
+use sss::{PixelHistory, Split, SssFrame, SssPassSettings, SssVariant};
 
 const W: u32 = 24;
 const H: u32 = 16;
@@ -31,13 +31,13 @@ fn flat_irradiance_split_equals_the_unsplit_integral() {
     let b = [0.9, 0.45, 0.2];
     for d_px in [[1.5, 0.8, 0.4], [3.0; 3], [0.6, 2.0, 9.0]] {
         let frame = flat(b, d_px);
-        let unsplit = SssSettings {
+        let unsplit = SssPassSettings {
             variant: SssVariant::Fixed { count: 16 },
             split: None,
             ..Default::default()
         };
         for split in [Split { gamma: None, eps_u: 0.0 }, Split { gamma: Some(0.3), eps_u: 0.0 }] {
-            let with = SssSettings { split: Some(split), ..unsplit };
+            let with = SssPassSettings { split: Some(split), ..unsplit };
             for (x, y) in [(0, 0), (11, 7), (23, 15), (5, 12)] {
                 let a = scatter(&frame, &unsplit, None, 2, x, y, 16);
                 let s = scatter(&frame, &with, None, 2, x, y, 16);
@@ -75,7 +75,7 @@ fn gamma_under_eps_u_takes_no_distant_samples() {
     let tiny = flat(b, [0.05; 3]);
     let gamma = 1.0 - split::cdf(R0_PX, 0.05);
     assert!(gamma < 0.01 && gamma > 0.0, "{gamma}");
-    let s = SssSettings::default();
+    let s = SssPassSettings::default();
     let (r, h) = step(&tiny, &s, 0, &[]);
     for (r, h) in r.iter().zip(&h) {
         assert_eq!(r.count, 0);
@@ -83,7 +83,7 @@ fn gamma_under_eps_u_takes_no_distant_samples() {
         assert_eq!(*h, PixelHistory::default());
     }
     // ε_u = 0: the same pixels sample (n_min on a cold start).
-    let s0 = SssSettings { split: Some(Split { gamma: None, eps_u: 0.0 }), ..s };
+    let s0 = SssPassSettings { split: Some(Split { gamma: None, eps_u: 0.0 }), ..s };
     let (r, _) = step(&tiny, &s0, 0, &[]);
     assert!(r.iter().all(|r| r.count == s.spvg.n_min));
 }
@@ -94,7 +94,7 @@ fn gamma_under_eps_u_takes_no_distant_samples() {
 fn spvg_tracks_the_distant_term() {
     let b = [0.8, 0.8, 0.8];
     let frame = flat(b, [2.0; 3]);
-    let s = SssSettings::default();
+    let s = SssPassSettings::default();
     let (r, h) = step(&frame, &s, 0, &[]);
     let gamma = 1.0 - split::cdf(R0_PX, 2.0);
     let expected = encode(0.8 * gamma, s.monitor_gamma);
@@ -120,7 +120,7 @@ fn bilateral_weights_stop_at_a_depth_edge() {
         focal_px,
         motion: Vec::new(),
     };
-    let s = SssSettings { variant: SssVariant::Fixed { count: 64 }, ..Default::default() };
+    let s = SssPassSettings { variant: SssVariant::Fixed { count: 64 }, ..Default::default() };
     let (x, y) = (W / 2 - 1, H / 2);
     let far = scatter(&edge(1e-4, 500.0), &s, None, 1, x, y, 64);
     for c in 0..3 {
@@ -143,10 +143,10 @@ fn split_settings_outside_the_unit_interval_are_refused() {
         Split { gamma: None, eps_u: 2.0 },
         Split { gamma: None, eps_u: f32::NAN },
     ] {
-        let s = SssSettings { split: Some(bad), ..Default::default() };
+        let s = SssPassSettings { split: Some(bad), ..Default::default() };
         assert!(s.validate().is_err(), "{bad:?}");
     }
-    assert!(SssSettings::default().validate().is_ok());
+    assert!(SssPassSettings::default().validate().is_ok());
 }
 
 /// Eq. 5.20 (`DistantCount::GammaScaled`) on hand-made inputs: m̂ = n̂·γ, rounded to the
@@ -195,7 +195,7 @@ fn the_pass_takes_eq_5_20s_count_when_gamma_scaled() {
         let frame = flat([0.6, 0.5, 0.4], [d as f32; 3]);
         let m = (40.0 * gamma).round() as u32;
         for (rule, expected) in [(sss::DistantCount::GammaScaled, m), (Default::default(), 40)] {
-            let s = SssSettings {
+            let s = SssPassSettings {
                 spvg,
                 split: Some(Split { gamma: constant, eps_u: 0.01 }),
                 distant_count: rule,
@@ -214,8 +214,11 @@ fn the_pass_takes_eq_5_20s_count_when_gamma_scaled() {
     }
     // γ under ε_u: no distant samples, eq. 5.20's m̂ = 0, not max(1, ·).
     let tiny = flat([0.5; 3], [0.05; 3]);
-    let s =
-        SssSettings { spvg, distant_count: sss::DistantCount::GammaScaled, ..Default::default() };
+    let s = SssPassSettings {
+        spvg,
+        distant_count: sss::DistantCount::GammaScaled,
+        ..Default::default()
+    };
     let (r, _) = step(&tiny, &s, 0, &[]);
     assert!(r.iter().all(|r| r.count == 0), "{:?}", r[0]);
 }

@@ -5,7 +5,7 @@ use render::scene::SplitMix64;
 use sss::control_variates::{EmCovariance, optimal_coefficient};
 use sss::screen_pass::step;
 use sss::spvg::{self, SpvgHistory, SpvgSettings};
-use sss::{PixelHistory, SssFrame, SssSettings};
+use sss::{PixelHistory, SssFrame, SssPassSettings};
 
 /// Standard normal by Box-Muller.
 fn normal(rng: &mut SplitMix64) -> f64 {
@@ -84,7 +84,7 @@ fn disocclusion_resets_the_history() {
         focal_px: 0.0,
         motion: Vec::new(),
     };
-    let settings = SssSettings::default();
+    let settings = SssPassSettings::default();
     let hot = PixelHistory { spvg: busy, ..Default::default() };
     let (r, h) = step(&frame, &settings, 0, &[hot; 4]);
     assert!(r.iter().all(|p| p.count == 64));

@@ -1,5 +1,5 @@
 // Primary-hit attributes of a jittered sample, written by every pass that feeds the TAA resolve
-// (taa_trace.wgsl, the hash cache). Needs the shading library (pt_scene: frame, camera helpers).
+// (trace.wgsl, the hash cache). Needs the shading library (pt_scene: frame, camera helpers).
 
 import package::scene_bindings::{frame};
 import package::scene_geometry::{Hit, NO_HIT, previous_world_position, surface_point};

@@ -4,7 +4,7 @@
 // previous position), clamp or clip it to the current 3x3 neighbourhood, blend exponentially.
 // The history keeps its length in w: the blend weight is max(alpha, 1 / (length + 1)), so a
 // fresh history averages uniformly until it reaches the exponential regime.
-// Mirrored on the CPU by render/src/taa/resolve_cpu.rs (keep them in step).
+// Mirrored on the CPU by src/resolve_cpu.rs (keep them in step).
 
 import package::taa_types::{TaaPrimary};
 import package::taa_resolve_bindings::{current, history, previous_primary, primary, resolved, taa};

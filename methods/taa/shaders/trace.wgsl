@@ -1,6 +1,6 @@
 // TAA input: one path per pixel through the frame's Halton jitter point, with the attributes of
-// its own primary hit (taa_primary.wgsl) for the history test of taa_resolve.wgsl.
-// Its buffers in @group(2) are declared in render/src/taa/mod.rs (TRACE_GROUP).
+// its own primary hit (primary.wgsl) for the history test of resolve.wgsl.
+// Its buffers in @group(2) are declared in src/lib.rs (TRACE_GROUP).
 
 import package::scene_bindings::{frame};
 import package::scene_geometry::{sg_rays_traced, trace_closest};

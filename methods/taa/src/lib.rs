@@ -4,7 +4,7 @@
 //! - `taa_trace` (methods/taa/shaders/trace.wgsl, after the shading library): one path per pixel
 //!   through the frame's Halton (2, 3) jitter point ([`jitter`]), plus that sample's own primary
 //!   hit (depth, normal, instance, motion, depth from the previous camera);
-//! - `taa_resolve` (render/shaders/taa_resolve.wgsl): reprojection of the history by the motion
+//! - `taa_resolve` (shaders/resolve.wgsl): reprojection of the history by the motion
 //!   vector (bilinear), history rejection on disocclusion (instance, relative depth and normal
 //!   test at the previous position), neighbourhood clamp (3x3 min/max, or variance clipping
 //!   mean +- gamma sigma), exponential blend with weight max(alpha, 1 / (length + 1)).
@@ -348,7 +348,7 @@ impl Taa {
         })
     }
 
-    /// The resolve pass's program: TAA's structs, its @group(0), taa_resolve.wgsl.
+    /// The resolve pass's program: TAA's structs, its @group(0), shaders/resolve.wgsl.
     fn resolve_program() -> Program {
         let types = types_module();
         let bindings = render::compute::group_module(
@@ -362,7 +362,7 @@ impl Taa {
     }
 
     /// The trace pass's program: the shading library, TAA's structs, the primary attributes, its
-    /// @group(2), taa_trace.wgsl.
+    /// @group(2), shaders/trace.wgsl.
     pub fn trace_program() -> &'static Program {
         static PROGRAM: std::sync::OnceLock<Program> = std::sync::OnceLock::new();
         PROGRAM.get_or_init(|| {

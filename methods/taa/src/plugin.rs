@@ -1,4 +1,4 @@
-//! TAA over jittered 1 spp path tracing (render::taa): the temporal baseline. Two
+//! TAA over jittered 1 spp path tracing (the crate's `lib.rs`): the temporal baseline. Two
 //! systems: the jittered trace, then the resolve (reprojection, clamp, blend).
 
 use std::time::Instant;

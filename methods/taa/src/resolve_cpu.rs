@@ -1,4 +1,4 @@
-//! The TAA resolve of render/shaders/taa_resolve.wgsl on the CPU, operation for operation, to
+//! The TAA resolve of shaders/resolve.wgsl on the CPU, operation for operation, to
 //! check the GPU pass (reprojection, rejection, clamp, blend) in tests.
 
 use super::{TaaClamp, TaaPrimary, TaaSettings};

@@ -1,5 +1,5 @@
-// The termination decision at one path vertex: WGSL twin of render/src/termination/decision.rs
-// (checked against it in render/tests/termination_gpu.rs). Self-contained: no imports, no
+// The termination decision at one path vertex: WGSL twin of src/decision.rs
+// (checked against it in tests/termination_gpu.rs). Self-contained: no imports, no
 // bindings.
 
 const TC_VARIANCE_BOUNDING: u32 = 0u;

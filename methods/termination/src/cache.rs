@@ -1,4 +1,4 @@
-//! The method's GPU state and passes (shaders/termination/termination.wgsl): the hashed grid of
+//! The method's GPU state and passes (shaders/termination.wgsl): the hashed grid of
 //! records, the propagation dispatch, the tracer with the termination decision, the insertion
 //! of new keys and the vertex store. One frame = propagate, fold, trace, insert, store
 //! ([`TcPass`]), each its own timed pass, in three submissions: [`TerminationCache::update`]

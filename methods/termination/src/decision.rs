@@ -1,6 +1,6 @@
 //! The termination decision at one path vertex (the paper's Fig. 3, reconstructed from §4.2,
-//! §4.3 and §5; the WGSL twin is shaders/termination/decision.wgsl, checked against this one in
-//! render/tests/termination_gpu.rs).
+//! §4.3 and §5; the WGSL twin is shaders/decision.wgsl, checked against this one in
+//! tests/termination_gpu.rs).
 //!
 //! A path arrives at vertex x_l (l = 1 is the primary hit) with its squared prefix weight
 //! (g_l^pre)² (`throughput2`: the squared luminance of the throughput) and its path variance

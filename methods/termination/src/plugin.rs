@@ -1,5 +1,5 @@
 //! Path tracing terminated into a hashed radiance cache by variance trading
-//! (render::termination, ../shared/seeds/variance-trading-termination.txt). The methods whose
+//! (`cache`, ../shared/seeds/variance-trading-termination.txt). The methods whose
 //! settings have one [`TerminationSettings::cache_key`] share one [`SharedTerminationCache`]
 //! entity (their records are bit-identical, as the paper's rules share one propagation); each
 //! method has its own tracer. Three systems: in Render the records' update once per cache

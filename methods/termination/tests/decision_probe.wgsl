@@ -1,4 +1,4 @@
-// Runs tc_decide on a batch of cases (render::termination::gpu_decision, the GPU-vs-CPU test).
+// Runs tc_decide on a batch of cases (termination::gpu_decision, the GPU-vs-CPU test).
 // A case is 6 vec4f: rule (kind, relative, param, margin),
 // (bias_clamp, survival, -, -), state (throughput2, path_variance, threshold, spread_sqrt),
 // (spread0, vertex, -, -), stats (radiance, variance, continuation2, bias2),

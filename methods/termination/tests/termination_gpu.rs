@@ -1,4 +1,4 @@
-//! The termination decision on the GPU (shaders/termination/decision.wgsl) against the CPU
+//! The termination decision on the GPU (shaders/decision.wgsl) against the CPU
 //! reference (termination::decide) on the same inputs.
 
 use render::error::RenderError;

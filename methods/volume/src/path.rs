@@ -10,9 +10,7 @@ use std::time::Instant;
 
 use anyhow::{Result, bail};
 use bevy_ecs::prelude::*;
-use media::gpu::{
-    Combination, Eq9Transmittance, MisWeight, ShadowTransmittance, VolumePathSettings,
-};
+use media::gpu::{Combination, Eq9Transmittance, MisWeight, ShadowTransmittance};
 use render::frame_bindings::FrameBindings;
 use serde::{Deserialize, Serialize};
 
@@ -25,7 +23,7 @@ use frame::{MethodOutput, MethodPlugin};
 /// attenuates shadow rays by the jackknife instead of ratio tracking.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct VolumePathMethod {
+pub struct VolumePathSettings {
     pub spp: u32,
     pub mis: MisWeight,
     pub combination: Combination,
@@ -41,9 +39,9 @@ pub struct VolumePathMethod {
     pub eq9_transmittance: Eq9Transmittance,
 }
 
-impl Default for VolumePathMethod {
+impl Default for VolumePathSettings {
     fn default() -> Self {
-        let d = VolumePathSettings::default();
+        let d = media::gpu::VolumePathSettings::default();
         Self {
             spp: 4,
             mis: d.mis,
@@ -58,7 +56,7 @@ impl Default for VolumePathMethod {
     }
 }
 
-impl VolumePathMethod {
+impl VolumePathSettings {
     pub fn label(&self) -> String {
         let mis = match self.mis {
             MisWeight::None => "free_flight".to_string(),
@@ -86,8 +84,9 @@ impl VolumePathMethod {
         format!("volume_pt_{mis}{exact}{shadow}_{}spp", self.spp)
     }
 
-    fn settings(&self) -> VolumePathSettings {
-        VolumePathSettings {
+    /// The pass's settings (media's `VolumePathPass`).
+    fn settings(&self) -> media::gpu::VolumePathSettings {
+        media::gpu::VolumePathSettings {
             mis: self.mis,
             combination: self.combination,
             samples: self.samples,
@@ -102,27 +101,27 @@ impl VolumePathMethod {
 
 /// The method's settings and its frame parameters.
 #[derive(Component)]
-pub struct VolumePath(VolumePathMethod, FrameBindings);
+pub struct VolumePath(VolumePathSettings, FrameBindings);
 
 pub struct Plugin;
 
 impl MethodPlugin for Plugin {
-    type Settings = VolumePathMethod;
+    type Settings = VolumePathSettings;
     const NAME: &'static str = "VolumePath";
 
-    fn label(settings: &VolumePathMethod) -> String {
+    fn label(settings: &VolumePathSettings) -> String {
         settings.label()
     }
 
-    fn spp(settings: &VolumePathMethod) -> f64 {
+    fn spp(settings: &VolumePathSettings) -> f64 {
         settings.spp as f64
     }
 
-    fn temporal_window(_settings: &VolumePathMethod) -> Option<f64> {
+    fn temporal_window(_settings: &VolumePathSettings) -> Option<f64> {
         Some(1.0)
     }
 
-    fn set_spp(settings: &mut VolumePathMethod, spp: u32) {
+    fn set_spp(settings: &mut VolumePathSettings, spp: u32) {
         settings.spp = spp;
     }
 
@@ -134,7 +133,7 @@ impl MethodPlugin for Plugin {
         schedule.add_systems(render.in_set(Stage::Render));
     }
 
-    fn spawn(world: &mut World, entity: Entity, s: &VolumePathMethod) -> Result<()> {
+    fn spawn(world: &mut World, entity: Entity, s: &VolumePathSettings) -> Result<()> {
         if s.spp == 0 {
             bail!("VolumePath: spp 0; expected at least 1 sample per pixel");
         }

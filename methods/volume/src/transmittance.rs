@@ -22,7 +22,7 @@ use frame::{MethodImage, MethodOutput, MethodPlugin};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct VolumeSettings {
+pub struct VolumeTransmittanceSettings {
     pub estimator: Estimator,
     /// Estimates per pixel per frame.
     pub spp: u32,
@@ -30,13 +30,13 @@ pub struct VolumeSettings {
     pub medium: Option<String>,
 }
 
-impl Default for VolumeSettings {
+impl Default for VolumeTransmittanceSettings {
     fn default() -> Self {
         Self { estimator: Estimator::Jackknife { samples: 8 }, spp: 16, medium: None }
     }
 }
 
-impl VolumeSettings {
+impl VolumeTransmittanceSettings {
     pub fn label(&self) -> String {
         format!("volume_{}_{}spp", self.estimator.label(), self.spp)
     }
@@ -47,30 +47,30 @@ pub struct VolumeState {
     medium: Medium,
     gpu_medium: GpuMedium,
     pass: ImagePass,
-    settings: VolumeSettings,
+    settings: VolumeTransmittanceSettings,
 }
 
 pub struct Plugin;
 
 impl MethodPlugin for Plugin {
-    type Settings = VolumeSettings;
+    type Settings = VolumeTransmittanceSettings;
     const NAME: &'static str = "VolumeTransmittance";
     const STATISTICS: &'static [frame::method::Statistic] = crate::recorded::STATISTICS;
     const COMPUTATIONS: &'static [frame::method::DeclaredComputation] = crate::table1::COMPUTATIONS;
 
-    fn label(settings: &VolumeSettings) -> String {
+    fn label(settings: &VolumeTransmittanceSettings) -> String {
         settings.label()
     }
 
-    fn spp(settings: &VolumeSettings) -> f64 {
+    fn spp(settings: &VolumeTransmittanceSettings) -> f64 {
         settings.spp as f64
     }
 
-    fn temporal_window(_settings: &VolumeSettings) -> Option<f64> {
+    fn temporal_window(_settings: &VolumeTransmittanceSettings) -> Option<f64> {
         Some(1.0)
     }
 
-    fn set_spp(settings: &mut VolumeSettings, spp: u32) {
+    fn set_spp(settings: &mut VolumeTransmittanceSettings, spp: u32) {
         settings.spp = spp;
     }
 
@@ -82,7 +82,11 @@ impl MethodPlugin for Plugin {
         schedule.add_systems(render.in_set(Stage::Render));
     }
 
-    fn spawn(world: &mut World, entity: Entity, settings: &VolumeSettings) -> Result<()> {
+    fn spawn(
+        world: &mut World,
+        entity: Entity,
+        settings: &VolumeTransmittanceSettings,
+    ) -> Result<()> {
         if settings.spp == 0 {
             bail!("VolumeTransmittance: spp 0; expected at least 1 estimate per pixel");
         }

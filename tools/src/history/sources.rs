@@ -3,9 +3,10 @@
 
 use std::path::Path;
 
-use crate::reproduce::claims::{Claim, Comparison, Effect};
-use crate::reproduce::judge::{Judged, bounds};
+use crate::reproduce::claims::{Claim, Comparison};
+use crate::reproduce::effect::Effect;
 use crate::reproduce::log_ratio::RatioExpectation;
+use crate::reproduce::verdict::{Judged, bounds};
 use crate::suite::gate::{GateResult, Verdict as GateVerdict};
 use crate::suite::welch::Sample;
 

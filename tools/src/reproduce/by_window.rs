@@ -5,7 +5,7 @@
 
 use serde::Deserialize;
 
-use super::claims::CaseMethods;
+use super::case_methods::CaseMethods;
 use super::table::{CaseTable, cell};
 use crate::suite::measurement::CaseRuns;
 use systems::methods::FolderInput;

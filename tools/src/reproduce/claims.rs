@@ -21,7 +21,9 @@ use crate::suite::spec::Case;
 use crate::suite::window::Window;
 
 use super::by_window::ByWindow;
+use super::case_methods::CaseMethods;
 use super::computation::Computation;
+use super::effect::Effect;
 use super::events::CaseEvents;
 use super::log_ratio::RatioExpectation;
 
@@ -265,46 +267,6 @@ impl Comparison {
     }
 }
 
-/// A claim's smallest effect that matters, in the statistic's unit or as a share.
-#[derive(Clone, Debug, PartialEq, Deserialize)]
-pub enum Effect {
-    /// `Absolute(0.005)`: in the statistic's unit (a ratio's for `Ratio` and `LogRatio`).
-    Absolute(f64),
-    /// `Relative(0.05)`: a share of the baseline: the `than` method's mean for `Below`, the
-    /// claim window's for `Rises`, the paper's value for a value, the factor for `LogRatio`.
-    Relative(f64),
-}
-
-impl Effect {
-    /// δ in the statistic's unit, `base` the value a relative margin is a share of.
-    pub fn margin(&self, base: f64) -> f64 {
-        match *self {
-            Effect::Absolute(d) => d,
-            Effect::Relative(r) => r * base.abs(),
-        }
-    }
-
-    pub fn describe(&self) -> String {
-        match *self {
-            Effect::Absolute(d) => format!("{d}"),
-            Effect::Relative(r) => format!("{}%", r * 100.0),
-        }
-    }
-
-    /// A margin above 0; a share below 1.
-    pub fn check(&self) -> Result<(), String> {
-        match *self {
-            Effect::Absolute(d) if !(d.is_finite() && d > 0.0) => Err(format!(
-                "smallest_effect: Absolute({d}); expected a number above 0, e.g. Absolute(0.005)"
-            )),
-            Effect::Relative(r) if !(r.is_finite() && r > 0.0 && r < 1.0) => Err(format!(
-                "smallest_effect: Relative({r}); expected a share between 0 and 1, e.g. Relative(0.05)"
-            )),
-            _ => Ok(()),
-        }
-    }
-}
-
 /// One headline claim of the paper.
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -360,19 +322,6 @@ struct ClaimsFile {
     title: String,
     cases: Vec<Box<ron::value::RawValue>>,
     claims: Vec<Box<ron::value::RawValue>>,
-}
-
-/// A case's method labels and the plugin kind of each, read from its scenario.
-#[derive(Clone, Debug)]
-pub struct CaseMethods {
-    pub kinds: BTreeMap<String, &'static str>,
-    /// The scenario has reference frames (FLIP, MSE, PSNR are measured).
-    pub references: bool,
-    /// A computed case: the metrics each method records.
-    pub computed: Option<BTreeMap<String, Vec<Metric>>>,
-    /// Per image map a registered statistic reads (`FolderInput::EventAndMap`), the labels of
-    /// the methods that write it (NIRC's blends and switch write `preference`).
-    pub image_maps: BTreeMap<&'static str, Vec<String>>,
 }
 
 #[derive(Clone, Debug)]
@@ -664,7 +613,14 @@ impl Claims {
                 }
                 size.params = expand_set(&played, &size.set).map_err(at)?;
             }
-            let case_events = CaseEvents::of(&spec.scenario, &case);
+            let case_events = CaseEvents::of(
+                &spec.scenario,
+                [
+                    ("smoke", case.smoke.frames),
+                    ("lab", case.lab.frames),
+                    ("paper", case.paper.frames),
+                ],
+            );
             let r = &spec.scenario.reference;
             let references = r.spp > 0 && r.frames != ReferenceFrames::None;
             let image_maps = systems::methods::registry::statistics()

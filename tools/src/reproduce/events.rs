@@ -7,7 +7,6 @@
 
 use sim::Scenario;
 
-use super::claims::ClaimCase;
 use crate::suite::window::Window;
 
 /// A case's recorded frames and event frames at each scale.
@@ -20,13 +19,14 @@ pub struct CaseEvents {
 }
 
 impl CaseEvents {
-    /// The events of `scenario` at each of `case`'s scales (its `frames` overrides).
-    pub fn of(scenario: &Scenario, case: &ClaimCase) -> CaseEvents {
-        let scales = [("smoke", &case.smoke), ("lab", &case.lab), ("paper", &case.paper)]
+    /// The events of `scenario` at each of a case's scales, given as (scale, its `frames`
+    /// override).
+    pub fn of(scenario: &Scenario, scales: [(&'static str, Option<u32>); 3]) -> CaseEvents {
+        let scales = scales
             .into_iter()
-            .map(|(name, size)| {
+            .map(|(name, frames)| {
                 let mut s = scenario.clone();
-                s.frames = size.frames.unwrap_or(s.frames);
+                s.frames = frames.unwrap_or(s.frames);
                 (name, s.frames, crate::suite::run::event_frames(&s))
             })
             .collect();

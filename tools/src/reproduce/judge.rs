@@ -3,7 +3,7 @@
 //! Every comparison becomes a per-seed effect (a difference, a value, a ratio, a log ratio)
 //! and the interval of its mean between the one-sided `confidence` lower and upper bounds (the
 //! (2·confidence − 1) two-sided interval, as in the two one-sided tests of equivalence). The
-//! claim's smallest effect that matters (δ, `claims::Effect`) turns the paper's claim into a
+//! claim's smallest effect that matters (δ, `effect::Effect`) turns the paper's claim into a
 //! region of effects: a relation (`Below`, `NotAbove`, `Rises`, `LogRatio` below a factor) is
 //! the side beyond an edge; a value (`Value`, `Ratio`, `Difference`, `LogRatio` near a factor) is the
 //! band within δ of the paper's number. Then (`decide`):
@@ -17,165 +17,11 @@
 //! methods, a value that is not a number, a ratio's zero) are *not comparable*, with the
 //! reason; so are claims the lab declares it does not measure.
 
-use super::claims::{Comparison, Effect};
-use super::log_ratio::RatioExpectation;
-use crate::suite::student_t;
+use super::claims::Comparison;
+use super::effect::Effect;
+use super::verdict::{Judged, Region, judge_effects, not_comparable, num};
 use crate::suite::welch::Sample;
 use crate::suite::window::Window;
-
-#[derive(Clone, Debug, PartialEq)]
-pub enum Verdict {
-    Reproduced,
-    NotReproduced,
-    /// The interval holds an edge of the paper's region. `seeds`: about how many seeds would
-    /// likely settle it (`None`: the mean sits on the edge, or more than `MAX_SEEDS`).
-    Inconclusive {
-        seeds: Option<usize>,
-    },
-    /// The data cannot be judged (or the lab does not measure the claim), with the reason.
-    NotComparable(String),
-}
-
-/// The verdicts' names, in the order the report counts them.
-pub const VERDICTS: [&str; 4] = ["reproduced", "not reproduced", "inconclusive", "not comparable"];
-
-/// The largest number of seeds an inconclusive verdict names.
-pub const MAX_SEEDS: usize = 10_000;
-
-impl Verdict {
-    pub fn name(&self) -> &'static str {
-        match self {
-            Verdict::Reproduced => VERDICTS[0],
-            Verdict::NotReproduced => VERDICTS[1],
-            Verdict::Inconclusive { .. } => VERDICTS[2],
-            Verdict::NotComparable(_) => VERDICTS[3],
-        }
-    }
-
-    /// The name with what settles an inconclusive verdict or the reason for not comparable.
-    pub fn text(&self) -> String {
-        match self {
-            Verdict::Inconclusive { seeds: Some(n) } => {
-                format!("inconclusive (about {n} seeds would likely settle it)")
-            }
-            Verdict::Inconclusive { seeds: None } => format!(
-                "inconclusive (the mean sits on the margin's edge: no number of seeds up to {MAX_SEEDS} likely settles it)"
-            ),
-            Verdict::NotComparable(why) => format!("not comparable: {why}"),
-            v => v.name().to_string(),
-        }
-    }
-}
-
-/// A claim's outcome: what flicker measured (with its interval) and the verdict.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Judged {
-    pub flicker: String,
-    pub verdict: Verdict,
-    /// The per-seed values the verdict was judged on (for a relation both methods', the first
-    /// method's first); empty when there were none.
-    pub values: Vec<f64>,
-}
-
-pub(crate) fn not_comparable(reason: String, values: Vec<f64>) -> Judged {
-    let flicker = if values.is_empty() { "not measured".into() } else { "-".into() };
-    Judged { flicker, verdict: Verdict::NotComparable(reason), values }
-}
-
-/// The mean of `values` and the half-width of its two-sided `confidence` interval.
-pub(crate) fn interval(values: &[f64], confidence: f64) -> (f64, f64) {
-    let s = Sample::of(values);
-    let t = student_t::quantile(0.5 + confidence / 2.0, (s.n - 1) as f64);
-    (s.mean, t * s.standard_error())
-}
-
-/// The mean of `effects` and its one-sided `confidence` lower and upper bounds.
-pub(crate) fn bounds(effects: &[f64], confidence: f64) -> (f64, f64, f64) {
-    let s = Sample::of(effects);
-    let t = student_t::quantile(confidence, (s.n - 1) as f64);
-    let half = t * s.standard_error();
-    (s.mean, s.mean - half, s.mean + half)
-}
-
-/// Where the paper's claim puts the effect, given its smallest effect that matters.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Region {
-    /// A relation: effects below `edge` (0 − δ for a difference).
-    Below { edge: f64 },
-    /// A value: effects within [low, high] (the paper's number ± δ).
-    Within { low: f64, high: f64 },
-}
-
-impl Region {
-    fn edges(self) -> Vec<f64> {
-        match self {
-            Region::Below { edge } => vec![edge],
-            Region::Within { low, high } => vec![low, high],
-        }
-    }
-}
-
-/// The verdict of an interval [lo, hi] against the paper's region (the rule of the docs'
-/// table: `rules`). Inconclusive carries no seeds here (`judge_effects` estimates them).
-pub fn decide(region: Region, lo: f64, hi: f64) -> Verdict {
-    let undecided = Verdict::Inconclusive { seeds: None };
-    match region {
-        Region::Below { edge } if hi < edge => Verdict::Reproduced,
-        Region::Below { edge } if lo > edge => Verdict::NotReproduced,
-        Region::Below { .. } => undecided,
-        Region::Within { low, high } if lo >= low && hi <= high => Verdict::Reproduced,
-        Region::Within { low, high } if hi < low || lo > high => Verdict::NotReproduced,
-        Region::Within { .. } => undecided,
-    }
-}
-
-/// About how many seeds would likely settle an interval that holds an edge: the smallest n
-/// at which, were the effect's true mean and spread the observed ones, the interval would
-/// clear the nearest edge with 80% probability, (t(confidence) + t(0.8)) · s / √n below the
-/// distance from the mean to that edge. `None` when the mean sits on the edge or n would pass
-/// `MAX_SEEDS`.
-pub fn seeds_to_settle(effects: &[f64], region: Region, confidence: f64) -> Option<usize> {
-    let s = Sample::of(effects);
-    let sd = s.standard_error() * (s.n as f64).sqrt();
-    let distance = region.edges().iter().map(|e| (s.mean - e).abs()).fold(f64::INFINITY, f64::min);
-    if !(distance > 0.0 && sd.is_finite()) {
-        return None;
-    }
-    let settles = |n: usize| {
-        let df = (n - 1) as f64;
-        (student_t::quantile(confidence, df) + student_t::quantile(0.8, df)) * sd
-            / (n as f64).sqrt()
-            <= distance
-    };
-    // The left side falls with n: bisect on it.
-    let (mut lo, mut hi) = (s.n.max(2), MAX_SEEDS);
-    if !settles(hi) {
-        return None;
-    }
-    while hi - lo > 1 {
-        let mid = (lo + hi) / 2;
-        if settles(mid) { hi = mid } else { lo = mid }
-    }
-    Some(hi)
-}
-
-/// The verdict of per-seed `effects` against `region`, with the seeds that would likely settle
-/// an inconclusive one; also the mean and bounds.
-pub fn judge_effects(effects: &[f64], region: Region, confidence: f64) -> (Verdict, f64, f64, f64) {
-    let (mean, lo, hi) = bounds(effects, confidence);
-    let verdict = match decide(region, lo, hi) {
-        Verdict::Inconclusive { .. } => {
-            Verdict::Inconclusive { seeds: seeds_to_settle(effects, region, confidence) }
-        }
-        v => v,
-    };
-    (verdict, mean, lo, hi)
-}
-
-/// A number for the report: four decimals, or four significant digits when smaller.
-pub fn num(x: f64) -> String {
-    if x != 0.0 && x.abs() < 1e-3 { format!("{x:.3e}") } else { format!("{x:.4}") }
-}
 
 fn mean(v: &[f64]) -> f64 {
     Sample::of(v).mean
@@ -417,34 +263,6 @@ pub fn judge(
                 Ok(d) => band(d, &format!("{method} − {to}"), *value, effect, *confidence),
                 Err(e) => none(e),
             }
-        }
-    }
-}
-
-/// The region of a log ratio's expectation in the log, with δ from `effect`, or why the margin
-/// leaves no positive ratio.
-pub fn log_region(expect: &RatioExpectation, effect: &Effect) -> Result<Region, String> {
-    let ln = |r: f64, what: &str| {
-        if r > 0.0 && r.is_finite() {
-            Ok(r.ln())
-        } else {
-            Err(format!("{what} {r}; the margin leaves no positive ratio"))
-        }
-    };
-    match *expect {
-        RatioExpectation::Below(f) => {
-            let edge = match *effect {
-                Effect::Absolute(d) => f - d,
-                Effect::Relative(r) => f * (1.0 - r),
-            };
-            Ok(Region::Below { edge: ln(edge, "the edge")? })
-        }
-        RatioExpectation::Near(v) => {
-            let d = effect.margin(v);
-            Ok(Region::Within {
-                low: ln(v - d, "the band's low end")?,
-                high: ln(v + d, "the band's high end")?,
-            })
         }
     }
 }

@@ -7,12 +7,12 @@
 //! `Below(1.0)` is a sign claim (a below b); `Below(0.5)` says "at most half". `Near(3.0)` is
 //! the paper's ratio ("roughly three"). The claim's smallest effect that matters sets the edge
 //! (`Below(f)`: the ratio below f − δ, or f · (1 − r) for a relative margin) or the band
-//! (`Near(v)`: v ± δ), both compared in the log (`judge::log_region`).
+//! (`Near(v)`: v ± δ), both compared in the log (`log_region`).
 
 use serde::Deserialize;
 
-use super::claims::Effect;
-use super::judge::{Judged, judge_effects, log_region, not_comparable, num};
+use super::effect::Effect;
+use super::verdict::{Judged, Region, judge_effects, not_comparable, num};
 use crate::suite::metric::Metric;
 
 /// What the paper says about the ratio a / b.
@@ -102,8 +102,8 @@ pub fn judge(
     let per_seed = logs.iter().map(|l| format!("{:.3}", l.exp())).collect::<Vec<_>>().join(", ");
     let (verdict, mean, lo, hi) = judge_effects(&logs, region, confidence);
     let paper = match region {
-        super::judge::Region::Below { edge } => format!("paper below {}", num(edge.exp())),
-        super::judge::Region::Within { low, high } => {
+        Region::Below { edge } => format!("paper below {}", num(edge.exp())),
+        Region::Within { low, high } => {
             format!("paper {} .. {}", num(low.exp()), num(high.exp()))
         }
     };
@@ -117,10 +117,38 @@ pub fn judge(
     Judged { flicker, verdict, values }
 }
 
+/// The region of a log ratio's expectation in the log, with δ from `effect`, or why the margin
+/// leaves no positive ratio.
+pub fn log_region(expect: &RatioExpectation, effect: &Effect) -> Result<Region, String> {
+    let ln = |r: f64, what: &str| {
+        if r > 0.0 && r.is_finite() {
+            Ok(r.ln())
+        } else {
+            Err(format!("{what} {r}; the margin leaves no positive ratio"))
+        }
+    };
+    match *expect {
+        RatioExpectation::Below(f) => {
+            let edge = match *effect {
+                Effect::Absolute(d) => f - d,
+                Effect::Relative(r) => f * (1.0 - r),
+            };
+            Ok(Region::Below { edge: ln(edge, "the edge")? })
+        }
+        RatioExpectation::Near(v) => {
+            let d = effect.margin(v);
+            Ok(Region::Within {
+                low: ln(v - d, "the band's low end")?,
+                high: ln(v + d, "the band's high end")?,
+            })
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::reproduce::judge::Verdict;
+    use crate::reproduce::verdict::Verdict;
 
     fn below(r: f64) -> RatioExpectation {
         RatioExpectation::Below(r)

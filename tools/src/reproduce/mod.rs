@@ -5,9 +5,11 @@
 
 pub mod alone;
 pub mod by_window;
+pub mod case_methods;
 pub mod claims;
 pub mod computation;
 pub mod distributed;
+pub mod effect;
 pub mod events;
 pub mod folder_statistic;
 pub mod frame_columns;
@@ -18,7 +20,10 @@ pub mod pass_ms;
 pub mod report;
 pub mod run;
 pub mod table;
+pub mod verdict;
 
-pub use claims::{Claim, Claims, Comparison, Effect, Scale};
-pub use judge::{Judged, Verdict, judge};
+pub use claims::{Claim, Claims, Comparison, Scale};
+pub use effect::Effect;
+pub use judge::judge;
 pub use run::{ClaimOutcome, ReproduceOptions, ReproduceOutcome, reproduce};
+pub use verdict::{Judged, Verdict};

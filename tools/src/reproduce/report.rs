@@ -6,8 +6,8 @@
 use maud::{PreEscaped, html};
 
 use super::claims::{Claim, Claims, Comparison};
-use super::judge::{Judged, VERDICTS, Verdict};
 use super::table::{self, CaseTable};
+use super::verdict::{Judged, VERDICTS, Verdict};
 
 /// One paper's claims and their outcomes.
 pub struct PaperResult<'a> {
@@ -252,9 +252,10 @@ mod tests {
     use std::path::PathBuf;
 
     use super::*;
-    use crate::reproduce::claims::Effect;
-    use crate::reproduce::judge::{judge, num};
+    use crate::reproduce::effect::Effect;
+    use crate::reproduce::judge::judge;
     use crate::reproduce::log_ratio::RatioExpectation;
+    use crate::reproduce::verdict::num;
     use crate::suite::window::Window;
 
     fn claim(id: &str, comparison: Comparison, departures: &[&str]) -> Claim {

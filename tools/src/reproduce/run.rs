@@ -7,9 +7,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{Result, bail};
 
 use super::claims::{Claims, Comparison, Scale};
-use super::judge::{Judged, judge};
+use super::judge::judge;
 use super::report::{self, PaperResult};
-use super::table::case_tables;
+use super::table::{CaseTable, cell};
+use super::verdict::Judged;
 use crate::suite::measurement::CaseRuns;
 use systems::methods::FolderInput;
 
@@ -296,6 +297,46 @@ fn adapter_of(folder: &Path) -> Option<String> {
         }
     }
     None
+}
+
+/// The tables of the cases in `runs`, in the claims file's order of cases.
+pub fn case_tables(claims: &Claims, runs: &BTreeMap<String, CaseRuns>) -> Vec<CaseTable> {
+    let mut tables = Vec::new();
+    for case in &claims.cases {
+        let Some(r) = runs.get(&case.name) else { continue };
+        let mut stats = Vec::new();
+        let of_claims = claims
+            .claims
+            .iter()
+            .filter(|c| c.case.as_deref() == Some(case.name.as_str()))
+            .filter_map(|c| c.statistic.as_ref());
+        for s in of_claims.chain(&case.table) {
+            if !stats.contains(s) {
+                stats.push(s.clone());
+            }
+        }
+        let rows = r
+            .methods()
+            .into_iter()
+            .map(|m| {
+                let cells = stats
+                    .iter()
+                    .map(|s| cell(r.per_seed_of(&m, s.metric, &s.key(), &s.window)))
+                    .collect();
+                (m, cells)
+            })
+            .collect();
+        if !stats.is_empty() {
+            tables.push(CaseTable {
+                case: case.name.clone(),
+                seeds: r.seeds.len(),
+                columns: stats.iter().map(|s| s.describe()).collect(),
+                rows,
+            });
+        }
+        tables.extend(case.by_window.iter().flat_map(|b| b.tables(&case.name, r)));
+    }
+    tables
 }
 
 #[cfg(test)]

@@ -2,11 +2,7 @@
 //! read, the mean over seeds with its 95% interval (the numbers the claims are judged on, for
 //! all methods, as the paper's tables list them), and the case's own `table` columns.
 
-use std::collections::BTreeMap;
-
-use super::claims::Claims;
-use super::judge::interval;
-use crate::suite::measurement::CaseRuns;
+use super::verdict::interval;
 
 pub struct CaseTable {
     pub case: String,
@@ -27,46 +23,6 @@ pub(crate) fn cell(values: Result<Vec<f64>, String>) -> String {
         Ok(v) => v.first().map_or("-".into(), |x| format!("{x:.4}")),
         Err(_) => "-".into(),
     }
-}
-
-/// The tables of the cases in `runs`, in the claims file's order of cases.
-pub fn case_tables(claims: &Claims, runs: &BTreeMap<String, CaseRuns>) -> Vec<CaseTable> {
-    let mut tables = Vec::new();
-    for case in &claims.cases {
-        let Some(r) = runs.get(&case.name) else { continue };
-        let mut stats = Vec::new();
-        let of_claims = claims
-            .claims
-            .iter()
-            .filter(|c| c.case.as_deref() == Some(case.name.as_str()))
-            .filter_map(|c| c.statistic.as_ref());
-        for s in of_claims.chain(&case.table) {
-            if !stats.contains(s) {
-                stats.push(s.clone());
-            }
-        }
-        let rows = r
-            .methods()
-            .into_iter()
-            .map(|m| {
-                let cells = stats
-                    .iter()
-                    .map(|s| cell(r.per_seed_of(&m, s.metric, &s.key(), &s.window)))
-                    .collect();
-                (m, cells)
-            })
-            .collect();
-        if !stats.is_empty() {
-            tables.push(CaseTable {
-                case: case.name.clone(),
-                seeds: r.seeds.len(),
-                columns: stats.iter().map(|s| s.describe()).collect(),
-                rows,
-            });
-        }
-        tables.extend(case.by_window.iter().flat_map(|b| b.tables(&case.name, r)));
-    }
-    tables
 }
 
 /// A table as Markdown.

@@ -2,7 +2,7 @@
 //! weights. The powers β1^t, β2^t, α^t are carried as running products (not pow) so that the
 //! GPU, which does the same multiplications, gets the same bits.
 
-use crate::config::{AdamConfig, EmaConfig};
+use crate::optimizer_config::{AdamConfig, EmaConfig};
 use serde::{Deserialize, Serialize};
 
 render::gpu_struct! {

@@ -1,18 +1,18 @@
 //! Our path tracer against an independent one: the Lambertian Cornell box rendered by the WGSL
-//! path tracer and by Mitsuba 3's scalar CPU path tracer (systems::mitsuba exports the scene;
+//! path tracer and by Mitsuba 3's scalar CPU path tracer (bench::mitsuba exports the scene;
 //! scripts/setup-tests.sh installs Mitsuba). Both converge to the same image, so they agree pixel by
 //! pixel and in the image mean within the standard errors of the two estimates, each measured
-//! from the spread of K independent images (the statistics of systems/tests/mitsuba_matrix.rs).
+//! from the spread of K independent images (the statistics of bench/tests/mitsuba_matrix.rs).
 //! A fixed relative margin would not do: at 2048 paths per pixel the image mean of one render
 //! varies by about 1% (sd) from seed to seed, so a margin of a few sigma is a fitted number.
 
 #[path = "mitsuba_matrix/stats.rs"]
 mod stats;
 
+use bench::mitsuba::{Integrator, python, write_scene};
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene_gpu::SceneGpu;
 use stats::{Estimate, compare};
-use systems::mitsuba::{Integrator, python, write_scene};
 
 /// Independent images per renderer: the standard errors come from their spread.
 const IMAGES: u32 = 16;
@@ -22,7 +22,7 @@ const FAMILY_ALPHA: f64 = 0.01;
 #[test]
 fn lambertian_cornell_box_matches_mitsuba() {
     let (size, spp) = (16u32, 2048u32);
-    let scene = systems::mitsuba::lambertian_cornell_box((size, size)).unwrap();
+    let scene = bench::mitsuba::lambertian_cornell_box((size, size)).unwrap();
 
     let python = python().expect("a Python with the mitsuba package (scripts/setup-tests.sh installs it into .venv; FLICKER_PYTHON names another)");
     let tmp = tempfile::tempdir().unwrap();

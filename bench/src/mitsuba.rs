@@ -1,6 +1,6 @@
 //! A scene in Mitsuba 3's XML, and Mitsuba's scalar CPU path tracer run on it: the independent
 //! CPU renderer that `flicker bench` measures the WGSL path tracer against and that
-//! systems/tests/mitsuba_matrix.rs compares it with pixel by pixel. The export covers triangle
+//! bench/tests/mitsuba_matrix.rs compares it with pixel by pixel. The export covers triangle
 //! meshes in world space (OBJ, with uvs), base-colour textures (PNG, sRGB, bilinear, repeat),
 //! emissive materials as one-sided area lights, point lights, spot lights with a hard cone,
 //! delta directional lights, a constant environment, the pinhole camera and media filling their
@@ -30,9 +30,9 @@ const MIN_ALPHA: f32 = 1.0e-3;
 
 /// The built-in Cornell box with every material Lambertian (specular 0): the scene both our
 /// path tracer and Mitsuba's `diffuse` BSDF render exactly (the bench's reference measurement
-/// and systems/tests/mitsuba_agreement.rs).
+/// and bench/tests/mitsuba_agreement.rs).
 pub fn lambertian_cornell_box(resolution: (u32, u32)) -> Result<SceneDesc> {
-    let mut scene = crate::scenario::builtin_scene("cornell_box", resolution)?;
+    let mut scene = systems::scenario::builtin_scene("cornell_box", resolution)?;
     for m in &mut scene.materials {
         m.specular = 0.0;
     }

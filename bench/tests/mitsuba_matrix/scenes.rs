@@ -268,7 +268,7 @@ pub fn matrix() -> Vec<Case> {
     // A heterogeneous medium: an fBm cloud baked to a grid that is not a cube in voxels
     // (12 x 10 x 8, so that an axis swapped in the export changes the image) nor in space, with
     // 4^3-voxel super-voxels (several local majorants); Mitsuba gets the same grid (see
-    // systems::mitsuba). Peak extinction 6: optical depths up to about 4 through the box.
+    // bench::mitsuba). Peak extinction 6: optical depths up to about 4 through the box.
     let mut s = with_panel();
     s.lights.push(point());
     let cloud = MediumDesc {

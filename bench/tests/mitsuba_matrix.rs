@@ -3,7 +3,7 @@
 //! sRGB texture, metal from a mirror to roughness 1, a dielectric over a coloured base from
 //! roughness 0.2 to 1, the depth limits 1 (direct light), 2 and unlimited, a homogeneous and a
 //! heterogeneous (grid) medium, and a curved mesh with smooth shading normals.
-//! systems::mitsuba exports each scene from the same `SceneDesc`; scripts/mitsuba_matrix.py
+//! bench::mitsuba exports each scene from the same `SceneDesc`; scripts/mitsuba_matrix.py
 //! renders them all in one Python process with Mitsuba's scalar CPU path tracer, K independent
 //! images of each (seeds), while this test renders K independent images of each on the GPU:
 //! each pixel's mean and its standard error from the spread of the K images, on both sides. Per scene, three tests whose tolerances are the two estimates' standard errors:
@@ -30,13 +30,13 @@ mod scenes;
 #[path = "mitsuba_matrix/stats.rs"]
 mod stats;
 
+use bench::mitsuba::{Integrator, python, write_scene_with_media};
 use frame::scene_medium::{REFERENCE_SETTINGS, SceneMedium, render_volume};
 use render::frame_bindings::FrameBindings;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene_gpu::SceneGpu;
 use scenes::SIZE;
 use stats::{Estimate, compare};
-use systems::mitsuba::{Integrator, python, write_scene_with_media};
 
 /// Our independent images per scene (their spread gives each pixel's standard error).
 const IMAGES: u32 = 16;
