@@ -40,7 +40,7 @@ impl ExportArgs {
         tools::export::ExportOptions {
             scenario: self.scenario,
             out: self.out,
-            overrides: systems::playback::Overrides {
+            overrides: playback::play::Overrides {
                 frames: self.frames,
                 resolution: self.resolution,
                 seed: self.seed,

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use systems::playback::{self, Overrides, RunOptions};
+use playback::play::{self, Overrides, RunOptions};
 
 #[derive(Parser)]
 #[command(
@@ -486,9 +486,9 @@ fn exit_code(result: anyhow::Result<bool>) -> ExitCode {
     match result {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
-        Err(e) if e.is::<systems::interrupt::Interrupted>() => {
+        Err(e) if e.is::<playback::interrupt::Interrupted>() => {
             eprintln!("{e}");
-            ExitCode::from(systems::interrupt::EXIT_CODE)
+            ExitCode::from(playback::interrupt::EXIT_CODE)
         }
         Err(e) => {
             eprintln!("error: {e:#}");
@@ -525,7 +525,7 @@ fn main() -> ExitCode {
             | Command::Reproduce { .. }
             | Command::Sweep { action: SweepAction::Job { .. } }
     );
-    if plays && let Err(e) = systems::interrupt::install() {
+    if plays && let Err(e) = playback::interrupt::install() {
         eprintln!("error: cannot catch SIGINT/SIGTERM: {e:#}");
         return ExitCode::FAILURE;
     }
@@ -604,8 +604,8 @@ fn main() -> ExitCode {
         }
         Command::Run { scenario, resume, frames, resolution, spp, seed, out, cache_dir, quiet } => {
             let played = match (resume, scenario) {
-                (Some(run), _) => systems::resume::resume(&run, cache_dir, !quiet),
-                (None, scenario) => playback::run(&RunOptions {
+                (Some(run), _) => playback::resume::resume(&run, cache_dir, !quiet),
+                (None, scenario) => play::run(&RunOptions {
                     scenario: scenario.unwrap_or_default(),
                     overrides: Overrides { frames, resolution, spp, seed, out },
                     cache_dir,
@@ -636,8 +636,8 @@ fn main() -> ExitCode {
             written.map(|page| println!("wrote {}", page.display()))
         }
         Command::Schedule { scenario } => {
-            systems::scenario::RunSpec::load(&scenario, &Overrides::default())
-                .and_then(|spec| systems::methods::describe_schedule(&spec.methods))
+            playback::scenario::RunSpec::load(&scenario, &Overrides::default())
+                .and_then(|spec| playback::methods::describe_schedule(&spec.methods))
                 .map(|text| print!("{text}"))
         }
         Command::Scenes => {
@@ -690,9 +690,9 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) if e.is::<systems::interrupt::Interrupted>() => {
+        Err(e) if e.is::<playback::interrupt::Interrupted>() => {
             eprintln!("{e}");
-            ExitCode::from(systems::interrupt::EXIT_CODE)
+            ExitCode::from(playback::interrupt::EXIT_CODE)
         }
         Err(e) => {
             eprintln!("error: {e:#}");

@@ -22,7 +22,7 @@ impl ReportArgs {
             run_dir: self.run_dir,
             compare: self.compare,
             out: self.out,
-            charts: systems::methods::registry::charts(),
+            charts: playback::methods::registry::charts(),
         }
     }
 }

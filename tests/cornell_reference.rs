@@ -10,7 +10,7 @@ use render::scene_gpu::SceneGpu;
 fn cornell_box_reference_is_stable_under_seed_change() {
     let gpu = Gpu::new().expect("a wgpu adapter (lavapipe on CI)");
     let (width, height) = (16, 9);
-    let scene = systems::scenario::builtin_scene("cornell_box", (width, height)).unwrap();
+    let scene = playback::scenario::builtin_scene("cornell_box", (width, height)).unwrap();
     let settings = PathTracerSettings { width, height, max_depth: 8, rr_start_depth: 3 };
     let mut sg = SceneGpu::new(&gpu, &scene, settings).unwrap();
     let mut tracer = PathTracer::new(&gpu, &sg).unwrap();
@@ -43,7 +43,7 @@ fn cornell_box_reference_is_stable_under_seed_change() {
 fn cornell_box_white_furnace_reference_is_one() {
     let gpu = Gpu::new().expect("a wgpu adapter (lavapipe on CI)");
     let (width, height) = (16, 9);
-    let mut scene = systems::scenario::builtin_scene("cornell_box", (width, height)).unwrap();
+    let mut scene = playback::scenario::builtin_scene("cornell_box", (width, height)).unwrap();
     scene.lights.clear();
     scene.environment = glam::Vec3::ONE;
     for m in &mut scene.materials {

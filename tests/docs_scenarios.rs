@@ -15,8 +15,8 @@ mod docs_common;
 use std::path::Path;
 
 use docs_common::{Doc, documents, root};
+use playback::scenario::{Overrides, RunSpec};
 use pulldown_cmark::{CodeBlockKind, Event, Tag, TagEnd};
-use systems::scenario::{Overrides, RunSpec};
 
 /// The scenario fields a part of a scenario may start with.
 const FIELDS: [&str; 9] = [

@@ -12,9 +12,9 @@ mod serde_shape;
 mod tables;
 
 use docs_common::{Doc, documents};
+use playback::methods::MethodPlugin;
+use playback::methods::registry::PluginVisitor;
 use serde_shape::{Shape, struct_shape, variant_shape};
-use systems::methods::MethodPlugin;
-use systems::methods::registry::PluginVisitor;
 
 /// A settings type the documents may name in a marker: its path as the marker writes it and
 /// how to read its shape.
@@ -67,7 +67,7 @@ fn methods() -> Vec<(&'static str, Entry)> {
         }
     }
     let mut settings = Settings(Vec::new());
-    systems::methods::registry::visit_shipped(&mut settings);
+    playback::methods::registry::visit_shipped(&mut settings);
     settings.0
 }
 
@@ -208,7 +208,7 @@ fn every_settings_type_has_a_table() {
 #[test]
 fn every_shipped_method_has_its_settings_registered() {
     let listed: Vec<&str> = methods().iter().map(|(n, _)| *n).collect();
-    for name in systems::methods::registry::names() {
+    for name in playback::methods::registry::names() {
         assert!(
             listed.contains(&name),
             "method {name}: add its settings to tests/docs_settings.rs's methods()"

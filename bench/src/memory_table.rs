@@ -1,5 +1,5 @@
 //! `flicker bench`'s device memory table: each shipped method's world built (no frame played)
-//! at the bench's resolutions, the device bytes its state allocated (`systems::memory`).
+//! at the bench's resolutions, the device bytes its state allocated (`playback::memory`).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -7,11 +7,11 @@ use std::path::Path;
 use anyhow::Result;
 use frame::run_folder::RunFolder;
 use indicatif::ProgressBar;
+use playback::memory::{MethodMemory, RunMemory};
+use playback::play::FrameWorld;
+use playback::scenario::{Overrides, RunSpec};
 use render::gpu::Gpu;
 use serde::Serialize;
-use systems::memory::{MethodMemory, RunMemory};
-use systems::playback::FrameWorld;
-use systems::scenario::{Overrides, RunSpec};
 
 const MIB: f64 = 1024.0 * 1024.0;
 

@@ -32,7 +32,7 @@ const MIN_ALPHA: f32 = 1.0e-3;
 /// path tracer and Mitsuba's `diffuse` BSDF render exactly (the bench's reference measurement
 /// and bench/tests/mitsuba_agreement.rs).
 pub fn lambertian_cornell_box(resolution: (u32, u32)) -> Result<SceneDesc> {
-    let mut scene = systems::scenario::builtin_scene("cornell_box", resolution)?;
+    let mut scene = playback::scenario::builtin_scene("cornell_box", resolution)?;
     for m in &mut scene.materials {
         m.specular = 0.0;
     }

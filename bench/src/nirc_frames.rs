@@ -17,9 +17,9 @@ use anyhow::{Context, Result};
 use frame::RunOutput;
 use frame::run_folder::RunFolder;
 use indicatif::ProgressBar;
+use playback::play::{FrameWorld, Overrides, RunSpec};
 use render::gpu::Gpu;
 use sim::Scenario;
-use systems::playback::{FrameWorld, Overrides, RunSpec};
 use tools::suite::welch::Sample;
 
 /// The predictors of Table 1, in its column order.

@@ -7,12 +7,12 @@ use std::time::Instant;
 
 use crate::mitsuba::{self, lambertian_cornell_box};
 use anyhow::{Context, Result};
+use playback::scenario::builtin_scene;
 use render::bvh::displaced_sphere;
 use render::gpu::Gpu;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::{Instance, Material, SceneDesc};
 use render::scene_gpu::SceneGpu;
-use systems::scenario::builtin_scene;
 
 use crate::traversal::{PAIRED_ROUNDS, median, traversal_benchmark};
 use crate::wavefront::{Kernel, KernelTimes, Wavefront};

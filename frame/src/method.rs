@@ -2,7 +2,7 @@
 //! a method (its scenario name, label, samples per pixel, temporal window, the `--spp`
 //! override, its systems, how to build an instance, and the statistics and charts it records),
 //! so that nothing outside its own folder matches on which method it is. [`MethodSpec`] holds one method's settings behind that trait;
-//! the registry (`systems::methods::registry`) lists the plugins.
+//! the registry (`playback::methods::registry`) lists the plugins.
 
 use std::any::Any;
 use std::fmt;

@@ -48,7 +48,7 @@ pub struct MethodMemory {
     pub device_bytes: Option<i64>,
 }
 
-/// The run's memory (the manifest's `memory`, written by systems::memory after the frames);
+/// The run's memory (the manifest's `memory`, written by playback::memory after the frames);
 /// absent in older runs and in runs that did not finish.
 #[derive(Clone, Debug, Default, Deserialize, serde::Serialize)]
 pub struct Memory {

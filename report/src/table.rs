@@ -80,7 +80,7 @@ pub fn html(summary: &Summary, frames: &Frames) -> Markup {
             tr {
                 th { "window" } th { "frames" } th { "method" }
                 @if temporal {
-                    th title="box-filter frames of equal noise variance, nominal (systems::methods::temporal_window)" { "temporal window (frames)" }
+                    th title="box-filter frames of equal noise variance, nominal (playback::methods::temporal_window)" { "temporal window (frames)" }
                 }
                 @for (_, name, better) in &cols { th { (name) (hint(better)) } }
             }

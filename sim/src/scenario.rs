@@ -31,7 +31,7 @@ fn builtin_name<'de, D: Deserializer<'de>>(d: D) -> Result<String, D::Error> {
 }
 
 /// One entry of the scenario's `methods: [...]`, as written. The world knows nothing of
-/// rendering methods (`systems` parses them, each with its own settings struct); it keeps each
+/// rendering methods (`playback` parses them, each with its own settings struct); it keeps each
 /// entry's text and its place in the file, so a method's errors point at the file's line.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct MethodEntry {
@@ -287,7 +287,7 @@ pub struct Scenario {
     /// Defaults to `runs/<name>` (relative to the working directory).
     pub output: PathBuf,
     pub max_depth: u32,
-    /// The methods as written; `systems` parses them.
+    /// The methods as written; `playback` parses them.
     pub methods: Vec<MethodEntry>,
     pub reference: ReferenceSpec,
     pub regions: Vec<Region>,

@@ -1,4 +1,4 @@
-//! Tools that drive many scenario runs through `systems::playback`: regression suites
+//! Tools that drive many scenario runs through `playback::play`: regression suites
 //! (`suite`: cases over seeds, gates judged against a blessed baseline) and parameter sweeps
 //! (`sweep`: jobs planned for local, GNU parallel or Slurm execution, then merged); `measure`
 //! gives frames from any renderer the metrics and report of a run; `export` writes a scenario as

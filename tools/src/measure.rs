@@ -433,7 +433,7 @@ impl Measured {
         }
         output::write_text(&folder.frames_csv(), &without_times(&self.records))?;
         output::write_json(&folder.manifest(), &manifest)?;
-        report::rebuild(&folder.root, &systems::methods::registry::charts())
+        report::rebuild(&folder.root, &playback::methods::registry::charts())
     }
 }
 

@@ -1,5 +1,5 @@
 //! A method added through the registry alone: an exponential moving average of 1-spp path
-//! tracing, defined here, registered with `systems::methods::register`, named in a scenario,
+//! tracing, defined here, registered with `playback::methods::register`, named in a scenario,
 //! played, and seen in the schedule, frames.csv and the report like a shipped method; with a
 //! statistic of its own (declared with its plugin) in frames.csv, its chart in the report, and a
 //! claim on that statistic that `flicker reproduce` reads, judges and reports.
@@ -10,11 +10,11 @@ use std::time::Instant;
 use anyhow::Result;
 use bevy_ecs::prelude::*;
 use frame::{FrameClock, GpuDevice, GpuScene, MethodFrame, MethodInfo, Run, Stage};
+use playback::methods::{MethodChart, MethodOutput, MethodPlugin, Statistic, register};
+use playback::play::{RunOptions, run_spec};
+use playback::scenario::{Overrides, RunSpec};
 use render::path_tracer::PathTracer;
 use serde::{Deserialize, Serialize};
-use systems::methods::{MethodChart, MethodOutput, MethodPlugin, Statistic, register};
-use systems::playback::{RunOptions, run_spec};
-use systems::scenario::{Overrides, RunSpec};
 
 /// `EmaPathTracing(alpha: 0.5)`: each frame's 1-spp image blended into the last with weight α.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -68,7 +68,7 @@ impl MethodPlugin for EmaPlugin {
     }
 
     fn temporal_window(settings: &EmaSettings) -> Option<f64> {
-        Some(systems::methods::temporal_window::exponential(settings.alpha as f64))
+        Some(playback::methods::temporal_window::exponential(settings.alpha as f64))
     }
 
     fn add_systems(schedule: &mut Schedule) {
@@ -143,7 +143,7 @@ fn a_method_added_through_the_registry_plays_like_a_shipped_one() {
     assert_eq!(spec.methods[1].spec.temporal_window(), Some(7.0));
 
     // `flicker schedule`: the method and its system in Render.
-    let listing = systems::methods::describe_schedule(&spec.methods).unwrap();
+    let listing = playback::methods::describe_schedule(&spec.methods).unwrap();
     assert!(listing.contains("ema_pt_0.25 (EmaPathTracing)"), "{listing}");
     let render = listing.find("\nRender\n").expect(&listing);
     let learn = listing.find("\nLearn\n").expect(&listing);

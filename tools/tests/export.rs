@@ -7,9 +7,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use playback::play::{self, Overrides, RunOptions, RunSpec};
 use sim::{ReferenceFrames, Scenario};
 use statrs::distribution::{ContinuousCDF, StudentsT};
-use systems::playback::{self, Overrides, RunOptions, RunSpec};
 use tools::export::{ExportOptions, export};
 
 fn root() -> PathBuf {
@@ -107,7 +107,7 @@ fn references(
         s.reference.frames = ReferenceFrames::List(frames.to_vec());
         s.output = dir.join(format!("{}_{seed}", s.name));
         let spec = RunSpec::from_scenario(s, &Overrides::default()).unwrap();
-        let summary = playback::run_spec(
+        let summary = play::run_spec(
             &spec,
             &RunOptions {
                 scenario: spec.scenario.origin.clone(),

@@ -169,9 +169,9 @@ fn an_unknown_case_is_named_with_the_known_ones() {
 #[test]
 fn every_case_names_a_shipped_scenario_with_both_methods() {
     for case in gallery::CASES {
-        let spec = systems::scenario::RunSpec::load(
+        let spec = playback::scenario::RunSpec::load(
             &root().join(case.scenario),
-            &systems::playback::Overrides::default(),
+            &playback::play::Overrides::default(),
         )
         .unwrap_or_else(|e| panic!("{}: {e:#}", case.name));
         let labels: Vec<String> = spec.methods.iter().map(|m| m.label()).collect();

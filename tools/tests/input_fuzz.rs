@@ -299,13 +299,13 @@ fn what_resume_reads() {
     )
     .unwrap();
     let run = dir.join("run");
-    let overrides = systems::scenario::Overrides { out: Some(run.clone()), ..Default::default() };
-    let spec = systems::scenario::RunSpec::load(&scenario, &overrides).unwrap();
+    let overrides = playback::scenario::Overrides { out: Some(run.clone()), ..Default::default() };
+    let spec = playback::scenario::RunSpec::load(&scenario, &overrides).unwrap();
     // The manifest as a run writes it, stopped after frame 1.
     let gpu = render::gpu::Gpu::new().unwrap();
-    let mut manifest = systems::manifest::build(&spec, &scenario, &gpu, &overrides).unwrap();
+    let mut manifest = playback::manifest::build(&spec, &scenario, &gpu, &overrides).unwrap();
     drop(gpu);
-    systems::manifest::set_status(&mut manifest, systems::manifest::Status::Interrupted, Some(1));
+    playback::manifest::set_status(&mut manifest, playback::manifest::Status::Interrupted, Some(1));
     let manifest = serde_json::to_string_pretty(&manifest).unwrap();
     let rows: Vec<FrameRecord> = (0..2)
         .flat_map(|frame| {
@@ -326,11 +326,11 @@ fn what_resume_reads() {
     std::fs::write(&csv_file, &csv).unwrap();
     // A run folder read is one that resumes within the run: at most its frames are on disk.
     let read = || {
-        let stored = systems::resume::read(&run).map_err(|e| format!("{e:#}"))?;
+        let stored = playback::resume::read(&run).map_err(|e| format!("{e:#}"))?;
         assert!(stored.from <= stored.spec.scenario.frames, "resumes at frame {}", stored.from);
         Ok(())
     };
-    let stored = systems::resume::read(&run).expect("the unmutated run folder reads");
+    let stored = playback::resume::read(&run).expect("the unmutated run folder reads");
     assert_eq!(stored.from, 2);
 
     // A JSON syntax error has a line and column; a field's error names the field.

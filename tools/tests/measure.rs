@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use metrics::CvvdpSettings;
-use systems::playback::{self, Overrides, RunOptions};
+use playback::play::{self, Overrides, RunOptions};
 use tools::measure::{MeasureOptions, measure};
 
 fn temp(name: &str) -> tempfile::TempDir {
@@ -93,7 +93,7 @@ fn a_runs_frames_measured_again_give_the_runs_metrics() {
         cache_dir: Some(dir.join("cache")),
         progress: false,
     };
-    let summary = playback::run(&opts).expect("the run plays");
+    let summary = play::run(&opts).expect("the run plays");
     let labels: Vec<String> = {
         let mut l: Vec<String> = summary.records.iter().map(|r| r.method.clone()).collect();
         l.dedup();

@@ -179,7 +179,7 @@ fn scenarios() {
             Ok(s) => s,
             Err(e) => return Err(located(&e).map_err(|e| e.to_string())?),
         };
-        systems::scenario::RunSpec::from_scenario(scenario, &Default::default())
+        playback::scenario::RunSpec::from_scenario(scenario, &Default::default())
             .map(|_| ())
             .map_err(|e| format!("{e:#}"))
     });

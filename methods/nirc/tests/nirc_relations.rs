@@ -14,7 +14,7 @@
 use std::path::{Path, PathBuf};
 
 use frame::frame_record::FrameRecord;
-use systems::playback::{Overrides, RunOptions, run};
+use playback::play::{Overrides, RunOptions, run};
 
 use testkit::relations::assert_positive;
 

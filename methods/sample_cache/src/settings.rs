@@ -56,7 +56,7 @@ pub struct SampleCacheSettings {
     pub shading_rate: f32,
     /// The image resolved by TAA (`taa`) over the cache's reconstruction and its closest
     /// visible samples' primary attributes: the paper applies TAA to every method for its error
-    /// figures. The cache itself is unchanged; `systems` runs the resolve.
+    /// figures. The cache itself is unchanged; `playback` runs the resolve.
     pub taa: bool,
 }
 

@@ -152,7 +152,7 @@ fn sample_cache_on_a_moving_hairball_camera() {
 
 #[test]
 fn hairball_camera_scenario_plays_end_to_end() {
-    use systems::playback::{Overrides, RunOptions, run};
+    use playback::play::{Overrides, RunOptions, run};
     let scenario =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/hairball_camera.ron");
     let tmp = tempfile::tempdir().unwrap();

@@ -1,13 +1,13 @@
-//! The Sss method (systems::methods::sss) end to end through playback on the shipped scenarios
+//! The Sss method (playback::methods::sss) end to end through playback on the shipped scenarios
 //! sss_flash.ron, sss_toggle.ron, sss_boids.ron and sss_moving.ron at 32x18: counts within SPVG's clamp, a cold
 //! start at n_min, the fixed variant at its count, the count image written; and its input errors.
 
 use std::path::Path;
 
 use frame::frame_record::FrameRecord;
+use playback::play::{RunOptions, run_spec};
+use playback::scenario::{Overrides, RunSpec};
 use statrs::distribution::{ContinuousCDF, StudentsT};
-use systems::playback::{RunOptions, run_spec};
-use systems::scenario::{Overrides, RunSpec};
 
 fn play(scenario: &str, frames: u32, keep: &[&str]) -> (Vec<FrameRecord>, tempfile::TempDir) {
     let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join("scenarios").join(scenario);

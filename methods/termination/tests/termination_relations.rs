@@ -25,8 +25,8 @@
 use std::path::{Path, PathBuf};
 
 use frame::frame_record::FrameRecord;
-use systems::playback::{RunOptions, run_spec};
-use systems::scenario::{Overrides, RunSpec};
+use playback::play::{RunOptions, run_spec};
+use playback::scenario::{Overrides, RunSpec};
 
 use testkit::relations::assert_positive;
 

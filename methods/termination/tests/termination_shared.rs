@@ -7,8 +7,8 @@ use std::path::Path;
 
 use frame::frame_record::FrameRecord;
 use frame::run_folder::RunFolder;
-use systems::playback::{RunOptions, run_spec};
-use systems::scenario::{Overrides, RunSpec};
+use playback::play::{RunOptions, run_spec};
+use playback::scenario::{Overrides, RunSpec};
 
 const FRAMES: u32 = 2;
 /// (name, settings) of the methods: three rules on one cache (one with roulette, one in another

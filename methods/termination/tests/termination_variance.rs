@@ -16,8 +16,8 @@ use std::path::{Path, PathBuf};
 use frame::frame_record::FrameRecord;
 use frame::output::read_exr;
 use frame::run_folder::RunFolder;
-use systems::playback::{RunOptions, run_spec};
-use systems::scenario::{Overrides, RunSpec};
+use playback::play::{RunOptions, run_spec};
+use playback::scenario::{Overrides, RunSpec};
 
 use testkit::relations::assert_positive;
 

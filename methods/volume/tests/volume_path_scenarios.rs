@@ -8,8 +8,8 @@
 
 use std::path::Path;
 
-use systems::playback::{RunOptions, RunSummary, run_spec};
-use systems::scenario::{Overrides, RunSpec};
+use playback::play::{RunOptions, RunSummary, run_spec};
+use playback::scenario::{Overrides, RunSpec};
 
 fn play(scenario: &str, frames: Option<u32>, out: &Path) -> RunSummary {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios").join(scenario);

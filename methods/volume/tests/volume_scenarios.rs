@@ -4,10 +4,10 @@
 
 use std::path::Path;
 
-use systems::playback::{RunOptions, run_spec};
-use systems::scenario::{Overrides, RunSpec};
+use playback::play::{RunOptions, run_spec};
+use playback::scenario::{Overrides, RunSpec};
 
-fn play(scenario: &str, out: &Path) -> systems::playback::RunSummary {
+fn play(scenario: &str, out: &Path) -> playback::play::RunSummary {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios").join(scenario);
     let overrides = Overrides {
         resolution: Some((32, 18)),

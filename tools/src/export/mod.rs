@@ -14,7 +14,7 @@
 //!
 //! The frames are simulated once (sim, no GPU) for the glTF and the records; the references and
 //! inputs are rendered by playing the scenario with `PathTracing(spp: 1, gbuffer: true)` and a
-//! reference at every frame (systems::playback), then re-encoded into the package.
+//! reference at every frame (playback::play), then re-encoded into the package.
 
 pub mod glb;
 pub mod package;
@@ -24,9 +24,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use frame::run_folder::RunFolder;
+use playback::play::{Overrides, RunOptions, RunSpec};
 use serde_json::json;
 use sim::{MethodEntry, ReferenceFrames, Scenario, Simulation};
-use systems::playback::{Overrides, RunOptions, RunSpec};
 
 pub use package::{INPUTS, Package};
 
@@ -135,7 +135,7 @@ pub fn export(opts: &ExportOptions) -> Result<PathBuf> {
     let (w, h) = scenario.resolution;
     let glb = glb::write(&frames, scenario.time_step, w as f32 / h as f32, &scenario.name)
         .with_context(|| format!("{}: exporting the scene", scenario.origin.display()))?;
-    let events = systems::manifest::recorded_events(&scenario);
+    let events = playback::manifest::recorded_events(&scenario);
 
     prepare(&opts.out)?;
     let out = &opts.out;
@@ -193,7 +193,7 @@ fn render(scenario: &Scenario, reference_spp: u32, opts: &ExportOptions) -> Resu
     s.output = scratch.clone();
     let spec = RunSpec::from_scenario(s, &Overrides::default())?;
     let label = spec.methods[0].label();
-    systems::playback::run_spec(
+    playback::play::run_spec(
         &spec,
         &RunOptions {
             scenario: opts.scenario.clone(),

@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
+use playback::play::{self, Overrides, RunOptions};
 use serde_json::Value;
-use systems::playback::{self, Overrides, RunOptions};
 
 pub use cases::{CASES, Case};
 
@@ -158,7 +158,7 @@ fn play(
     frames: u32,
     out: PathBuf,
 ) -> Result<PlayedRun> {
-    let played = playback::run(&RunOptions {
+    let played = play::run(&RunOptions {
         scenario: opts.root.join(scenario),
         overrides: Overrides {
             frames: Some(frames),
@@ -277,7 +277,7 @@ pub fn window_table(
 /// `flicker gallery failures`: plays each case and writes the failure-cases page.
 pub fn failures(opts: &GalleryOptions) -> Result<PathBuf> {
     let start = Instant::now();
-    let commit = systems::manifest::commit(&opts.root.join("Cargo.toml"));
+    let commit = playback::manifest::commit(&opts.root.join("Cargo.toml"));
     let cases: Vec<&Case> = match &opts.only {
         Some(name) => match CASES.iter().find(|c| c.name == name) {
             Some(c) => vec![c],
@@ -360,7 +360,7 @@ pub fn failures(opts: &GalleryOptions) -> Result<PathBuf> {
 /// numbers.
 pub fn speed(opts: &GalleryOptions) -> Result<PathBuf> {
     let start = Instant::now();
-    let commit = systems::manifest::commit(&opts.root.join("Cargo.toml"));
+    let commit = playback::manifest::commit(&opts.root.join("Cargo.toml"));
     let page_dir = opts.page.parent().unwrap_or(Path::new("")).to_path_buf();
     let images = opts.images.clone().unwrap_or_else(|| page_dir.join("images/speed-accuracy"));
     let frames = opts.frames.unwrap_or(SPEED_FRAMES);

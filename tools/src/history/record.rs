@@ -85,7 +85,7 @@ impl Record {
     /// A record of this checkout now: commit and dirty flag from git in `dir`'s checkout, the
     /// build profile of this program, the current UTC time.
     pub fn now(kind: Kind, name: &str, scale: &str, adapter: &str, dir: &Path) -> Record {
-        let full = systems::manifest::commit(&dir.join("x"));
+        let full = playback::manifest::commit(&dir.join("x"));
         let (commit, dirty) = match full.strip_suffix("-dirty") {
             Some(c) => (c.to_string(), true),
             None => (full, false),

@@ -8,7 +8,7 @@ use serde::Deserialize;
 use super::case_methods::CaseMethods;
 use super::table::{CaseTable, cell};
 use crate::suite::measurement::CaseRuns;
-use systems::methods::FolderInput;
+use playback::methods::FolderInput;
 
 use crate::suite::metric::Metric;
 use crate::suite::window::Window;

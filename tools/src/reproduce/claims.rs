@@ -9,12 +9,12 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use playback::play::{Overrides, RunSpec};
 use serde::Deserialize;
 use sim::scenario::{ReferenceFrames, ScenarioError};
-use systems::playback::{Overrides, RunSpec};
 
 use crate::ron_file::{self, RonFile};
-use systems::methods::{FolderInput, Source};
+use playback::methods::{FolderInput, Source};
 
 use crate::suite::metric::Metric;
 use crate::suite::spec::Case;
@@ -339,7 +339,7 @@ pub struct Claims {
 /// each applied to a copy of `methods` so that a wrong field or value, or a changed label, is
 /// an error here. Labels may hold dots (`vb_0.01`): the longest label followed by a dot wins.
 fn expand_set(
-    methods: &[systems::methods::Method],
+    methods: &[playback::methods::Method],
     set: &[(String, serde_json::Value)],
 ) -> Result<Vec<(String, Vec<String>, serde_json::Value)>, String> {
     let mut out: Vec<(String, Vec<String>, serde_json::Value)> = Vec::new();
@@ -623,7 +623,7 @@ impl Claims {
             );
             let r = &spec.scenario.reference;
             let references = r.spp > 0 && r.frames != ReferenceFrames::None;
-            let image_maps = systems::methods::registry::statistics()
+            let image_maps = playback::methods::registry::statistics()
                 .into_iter()
                 .filter_map(|s| match s.source {
                     Source::Images(i) => match i.input {

@@ -11,10 +11,10 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::sync::Arc;
 
+use playback::methods::Computed;
+use playback::methods::registry;
 use serde::de::{self, EnumAccess, MapAccess, VariantAccess, Visitor};
 use serde::{Deserialize, Deserializer};
-use systems::methods::Computed;
-use systems::methods::registry;
 
 use crate::suite::measurement::{CaseRuns, SeedRun};
 use crate::suite::metric::Metric;

@@ -4,8 +4,8 @@
 //! method's per-frame series out.
 
 use anyhow::{Result, bail};
-use systems::methods::FolderStatistic;
-use systems::methods::registry;
+use playback::methods::FolderStatistic;
+use playback::methods::registry;
 
 use crate::suite::measurement::SeedRun;
 
@@ -21,13 +21,13 @@ pub fn add(
     let Some(root) = &run.folder else {
         let names: Vec<&str> = registry::statistics()
             .into_iter()
-            .filter(|s| matches!(s.source, systems::methods::Source::Images(i) if i == *statistic))
+            .filter(|s| matches!(s.source, playback::methods::Source::Images(i) if i == *statistic))
             .map(|s| s.column)
             .collect();
         bail!("seed {}: no run folder to read {} from", run.seed, names.join(", "))
     };
     let methods: Vec<String> = run.methods.keys().cloned().collect();
-    let folder = systems::methods::FolderRun {
+    let folder = playback::methods::FolderRun {
         folder: root,
         seed: run.seed,
         methods: &methods,

@@ -4,7 +4,7 @@
 
 use anyhow::{Result, bail};
 use frame::run_folder::RunFolder;
-use systems::methods::Source;
+use playback::methods::Source;
 
 use crate::suite::measurement::SeedRun;
 use crate::suite::metric::Metric;

@@ -12,7 +12,7 @@ use super::report::{self, PaperResult};
 use super::table::{CaseTable, cell};
 use super::verdict::Judged;
 use crate::suite::measurement::CaseRuns;
-use systems::methods::FolderInput;
+use playback::methods::FolderInput;
 
 use crate::suite::metric::Metric;
 use crate::suite::run::play_cases;
@@ -265,7 +265,7 @@ pub fn stamp(claims_dir: &Path, folder: &Path, wall: std::time::Duration) -> Str
         .unwrap_or_else(|| "unknown".into());
     format!(
         "commit {}, {profile} build, adapter {}, machine: {cores} cores, load average {load} at the end, {:.0} s wall",
-        systems::manifest::commit(claims_dir),
+        playback::manifest::commit(claims_dir),
         adapter_of(folder).unwrap_or_else(|| "none (computed cases only)".into()),
         wall.as_secs_f64()
     )

@@ -7,11 +7,11 @@ use serde::de::{self, EnumAccess, VariantAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use frame::frame_record::FrameRecord;
-use systems::methods::registry;
-use systems::methods::{Better, FolderInput, FolderStatistic, Source, Statistic};
+use playback::methods::registry;
+use playback::methods::{Better, FolderInput, FolderStatistic, Source, Statistic};
 
 /// A number every method has, or one a method declares (`Method`: its statistic's name, e.g.
-/// `PathLength`, looked up in the registry: `systems::methods::registry::statistic`). Claims and
+/// `PathLength`, looked up in the registry: `playback::methods::registry::statistic`). Claims and
 /// suites write either by name: `metric: Flip`, `metric: PathLength`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Metric {

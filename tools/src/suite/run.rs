@@ -13,7 +13,7 @@ use super::measurement::{CaseRuns, SeedRun};
 use super::spec::{Bound, Case, Gate, Suite};
 use super::{junit, markdown};
 use crate::measure::{MeasureOptions, Measured};
-use systems::playback::{Overrides, RunOptions, RunSpec, run_spec};
+use playback::play::{Overrides, RunOptions, RunSpec, run_spec};
 
 pub struct SuiteOptions {
     pub suite: PathBuf,
@@ -117,7 +117,7 @@ pub(crate) fn case_spec(
         .map_err(|e| anyhow!("{at}: {e}"))?;
     if !case.params.is_empty() {
         // A parameter may change a label (`spp`); two equal ones would share a run column.
-        systems::methods::check_labels(&spec.scenario, &spec.methods)
+        playback::methods::check_labels(&spec.scenario, &spec.methods)
             .map_err(|e| anyhow!("{at}: {e}"))?;
     }
     Ok((spec, overrides))
@@ -189,7 +189,7 @@ pub(crate) fn play_cases(
                 };
                 // A signal keeps its type, so that the command exits as an interrupted run does.
                 let summary = run_spec(&spec, &run_opts).map_err(|e| {
-                    if e.is::<systems::interrupt::Interrupted>() {
+                    if e.is::<playback::interrupt::Interrupted>() {
                         e
                     } else {
                         anyhow!("case '{}' seed {seed}: {e:#}", case.name)
@@ -349,7 +349,7 @@ pub fn bless(opts: &SuiteOptions) -> Result<PathBuf> {
     }
     file.suite = p.suite.name.clone();
     let baseline = Baseline {
-        commit: systems::manifest::commit(&opts.suite),
+        commit: playback::manifest::commit(&opts.suite),
         date: now(),
         adapter: serde_json::to_value(&p.adapter)?,
         cases,

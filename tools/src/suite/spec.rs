@@ -259,7 +259,7 @@ impl Suite {
                     ),
                 ));
             }
-            if let Some(systems::methods::FolderInput::EventAndMap { map, .. }) =
+            if let Some(playback::methods::FolderInput::EventAndMap { map, .. }) =
                 gate.metric.from_images_by().map(|i| i.input)
             {
                 return Err(file.error_at(

@@ -14,7 +14,7 @@ use super::plan::{Plan, done_file};
 use crate::suite::measurement::SeedRun;
 use crate::suite::metric::Metric;
 use frame::frame_record::FrameRecord;
-use systems::playback::{RunOptions, run_spec};
+use playback::play::{RunOptions, run_spec};
 
 /// One method's numbers in one job.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -5,7 +5,7 @@
 
 use serde_json::Value;
 
-use systems::methods::Method;
+use playback::methods::Method;
 
 /// Sets `path` (after the method label) of `method` to `value`.
 pub fn set(method: &mut Method, path: &[&str], value: &Value) -> Result<(), String> {

@@ -13,7 +13,7 @@ use super::param;
 use super::spec::{Point, Sweep};
 use crate::suite::run::case_spec;
 use crate::suite::spec::Case;
-use systems::playback::{Overrides, RunSpec};
+use playback::play::{Overrides, RunSpec};
 
 /// One job: one case at one parameter point and one seed, one run folder.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -118,7 +118,7 @@ fn check_point(sweep: &Sweep, case: &Case, point: &Point) -> Result<()> {
             bail!("{}:{line}:{col}: case '{}': {e}", sweep.origin.display(), case.name);
         }
     }
-    systems::methods::check_labels(&spec.scenario, &spec.methods)
+    playback::methods::check_labels(&spec.scenario, &spec.methods)
         .map_err(|e| anyhow!("{}: point {}: {e}", sweep.origin.display(), point.label()))?;
     Ok(())
 }

@@ -5,8 +5,8 @@ use std::path::Path;
 
 use bevy_ecs::prelude::*;
 use frame::{self, Stage};
-use systems::methods::Method;
-use systems::scenario::{Overrides, RunSpec};
+use playback::methods::Method;
+use playback::scenario::{Overrides, RunSpec};
 
 fn spec(methods: &str) -> RunSpec {
     let text = format!(
@@ -18,7 +18,7 @@ fn spec(methods: &str) -> RunSpec {
 }
 
 fn listing(methods: &[Method]) -> Vec<(Stage, String)> {
-    let mut schedule = systems::methods::schedule_for(methods);
+    let mut schedule = playback::methods::schedule_for(methods);
     frame::listing(&mut schedule, &mut World::new()).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -157,7 +157,7 @@ fn cache_upkeep_runs_in_its_stage() {
     assert_eq!(in_stage(&l, Stage::Learn), Vec::<String>::new());
 
     // `flicker schedule` lists them under their stages.
-    let text = systems::methods::describe_schedule(
+    let text = playback::methods::describe_schedule(
         &spec("HashCache(), Termination(rule: FirstVertex)").methods,
     )
     .unwrap();
@@ -204,7 +204,7 @@ fn misplaced_systems_are_detected() {
 #[test]
 fn describe_groups_systems_by_stage() {
     let text =
-        systems::methods::describe_schedule(&spec("Taa(), PathTracing(spp: 2)").methods).unwrap();
+        playback::methods::describe_schedule(&spec("Taa(), PathTracing(spp: 2)").methods).unwrap();
     let at = |s: &str| text.find(s).unwrap_or_else(|| panic!("{s} missing from:\n{text}"));
     assert!(at("  taa (Taa)") < at("  pt_2spp (PathTracing)"));
     let stages: Vec<usize> = Stage::ALL.iter().map(|s| at(&format!("\n{}\n", s.name()))).collect();

@@ -16,10 +16,10 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use bevy_ecs::prelude::*;
 use frame::{FrameClock, GpuDevice, MethodFrame, Run, Stage};
+use playback::methods::{MethodOutput, MethodPlugin, register};
+use playback::play::{RunOptions, run_spec, run_spec_on};
+use playback::scenario::{Overrides, RunSpec};
 use serde::{Deserialize, Serialize};
-use systems::methods::{MethodOutput, MethodPlugin, register};
-use systems::playback::{RunOptions, run_spec, run_spec_on};
-use systems::scenario::{Overrides, RunSpec};
 
 const W: u32 = 16;
 const H: u32 = 9;

@@ -15,7 +15,7 @@ use render::gpu::Gpu;
 use serde_json::Value;
 
 use crate::manifest::Status;
-use crate::playback::{ResumeAt, RunSummary, play};
+use crate::play::{ResumeAt, RunSummary, play};
 use crate::scenario::{Overrides, RunSpec};
 
 /// What must be the same for the replay to give the run's frames.
@@ -106,7 +106,7 @@ pub fn resume(run: &Path, cache_dir: Option<PathBuf>, progress: bool) -> Result<
     if folder.report_pending().exists() && Status::of(&read_manifest(run)?) == Status::Complete {
         eprintln!("{}: every frame was written; writing its summary and report", run.display());
         remove_temporaries(run)?;
-        let report = crate::playback::write_report(&folder)?;
+        let report = crate::play::write_report(&folder)?;
         return Ok(RunSummary {
             folder: run.to_path_buf(),
             records: Vec::new(),
