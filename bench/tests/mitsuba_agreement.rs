@@ -45,7 +45,7 @@ fn lambertian_cornell_box_matches_mitsuba() {
         .spawn()
         .expect("starting Mitsuba");
 
-    let gpu = render::test_scenes::gpu();
+    let gpu = testkit::test_scenes::gpu();
     let mut sg = SceneGpu::new(
         gpu,
         &scene,

@@ -88,7 +88,7 @@ fn path_tracer_matches_mitsuba_over_the_matrix() {
         .expect("starting Mitsuba");
 
     // Ours, meanwhile: IMAGES independent images per scene.
-    let gpu = render::test_scenes::gpu();
+    let gpu = testkit::test_scenes::gpu();
     let mut ours = Vec::new();
     for case in &cases {
         let settings = PathTracerSettings {

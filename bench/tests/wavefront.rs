@@ -2,7 +2,7 @@
 //! megakernel: same samples, same random numbers, same order of sums, so the same image when
 //! both run the same batches.
 
-use render::test_scenes as common;
+use testkit::test_scenes as common;
 
 use bench::wavefront::Wavefront;
 use common::{H, W, gpu, room_scene};

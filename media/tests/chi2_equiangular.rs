@@ -1,4 +1,4 @@
-//! Chi-square goodness-of-fit tests (render::chi2) of equiangular sampling (Kulla and Fajardo
+//! Chi-square goodness-of-fit tests (testkit::chi2) of equiangular sampling (Kulla and Fajardo
 //! 2012), the volume path tracer's distance sampler towards a point light: the WGSL of
 //! media_mis.wgsl (drawn and its pdf evaluated by a test kernel, tests/chi2/equiangular_kernel.wgsl)
 //! and its CPU twin (media::equiangular), each against its own pdf over the sampled interval.
@@ -9,10 +9,10 @@
 //! close to the ray, far from it, its foot point before the interval) on each side.
 
 use media::equiangular::Equiangular;
-use render::chi2::{self, IntervalBins, Kernel};
 use render::pass_library::PassLibrary;
 use render::shader::Module;
-use render::test_scenes::gpu;
+use testkit::chi2::{self, IntervalBins, Kernel};
+use testkit::test_scenes::gpu;
 
 const DRAWS: u32 = 1 << 20;
 

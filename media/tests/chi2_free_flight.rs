@@ -1,4 +1,4 @@
-//! Chi-square goodness-of-fit tests (render::chi2) of the two free-flight distance samplers, run
+//! Chi-square goodness-of-fit tests (testkit::chi2) of the two free-flight distance samplers, run
 //! in their WGSL through small test kernels:
 //!
 //! - the subsurface random walk's chromatic free flight (media_free_flight.wgsl, called by
@@ -20,10 +20,10 @@
 use glam::{UVec3, Vec3};
 use media::gpu::{GpuMedium, RaySegment};
 use media::{DensityGrid, DensityKind, Medium, Segment};
-use render::chi2::{self, IntervalBins, Kernel};
 use render::pass_library::PassLibrary;
 use render::shader::{Module, Program};
-use render::test_scenes::gpu;
+use testkit::chi2::{self, IntervalBins, Kernel};
+use testkit::test_scenes::gpu;
 
 const DRAWS: u32 = 1 << 20;
 

@@ -3,7 +3,6 @@
 /// The plain-data scene (its own crate, shared with `sim`).
 pub use ::scene;
 pub mod bvh;
-pub mod chi2;
 pub mod compute;
 pub mod error;
 pub mod frame;
@@ -21,6 +20,5 @@ pub mod scene_features;
 pub mod scene_gpu;
 pub mod scene_group;
 pub mod shader;
-pub mod test_scenes;
 pub mod texel_table;
 pub mod timing;

@@ -1,5 +1,5 @@
 //! Chi-square goodness-of-fit tests of every sampling routine of the path tracer's WGSL library
-//! (render::chi2, as Mitsuba 3's chi2 tests): the BSDF's sampling (cosine hemisphere, GGX
+//! (testkit::chi2, as Mitsuba 3's chi2 tests): the BSDF's sampling (cosine hemisphere, GGX
 //! visible normals at several roughnesses and view angles, the two lobes' mixture), the
 //! emitters chosen through the light CDF built in src/lights.rs and a point on the chosen
 //! triangle, the directional light's disk, and the environment. Each routine is drawn on the GPU
@@ -19,14 +19,14 @@
 use std::sync::OnceLock;
 
 use glam::{Mat4, Vec3};
-use render::chi2::{self, LobeBins, SphereBins};
 use render::compute::{self, BufferBinding};
 use render::frame_bindings::FrameBindings;
 use render::pass_library::{LibraryPipeline, PassLibrary};
 use render::scene::{Instance, Light, Material, Mesh, SceneDesc};
 use render::scene_gpu::{PathTracerSettings, SceneGpu};
 use render::shader::{Module, Program};
-use render::test_scenes::gpu;
+use testkit::chi2::{self, LobeBins, SphereBins};
+use testkit::test_scenes::gpu;
 
 const DRAWS: u32 = 1 << 20;
 const BINS: SphereBins = SphereBins { theta: 32, phi: 64 };
@@ -153,7 +153,7 @@ fn harness() -> &'static Harness {
             file: "render/tests/chi2/sampling_kernel.wgsl".into(),
             source: include_str!("chi2/sampling_kernel.wgsl").into(),
         };
-        // FLICKER_CHI2_REPLACE swaps a module for a (deliberately broken) copy: render::chi2.
+        // FLICKER_CHI2_REPLACE swaps a module for a (deliberately broken) copy: testkit::chi2.
         let program: Program =
             chi2::with_replacements(PassLibrary::program([types, bindings], [kernel]));
         let (layout, pipelines) = scene

@@ -2,7 +2,7 @@
 //! as passes compiled for every feature and the largest traversal stack, and compiled again when
 //! the scene gains a feature (a held pass recompiled: methods/taa/tests/scene_features.rs).
 
-use render::test_scenes as common;
+use testkit::test_scenes as common;
 
 use common::{H, W, gpu, room_scene};
 use glam::{Mat4, Vec3};

@@ -3,8 +3,8 @@
 
 use glam::{Mat4, Quat, Vec2, Vec3};
 use render::scene::{Camera, Instance, Light, Material, Mesh, SceneDesc, Texture};
-use render::test_scenes::box_mesh;
 use scene::{DensityKind, MediumDesc};
+use testkit::test_scenes::box_mesh;
 
 /// Image side in pixels (square images).
 pub const SIZE: u32 = 16;

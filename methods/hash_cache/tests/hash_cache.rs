@@ -12,7 +12,7 @@ use render::scene_gpu::SceneGpu;
 use taa::{Taa, TaaSettings, resolve_cpu};
 
 use common::{H, W, furnace, gpu, room_scene};
-use render::test_scenes as common;
+use testkit::test_scenes as common;
 
 fn scene_gpu(scene: &SceneDesc, max_depth: u32) -> SceneGpu {
     SceneGpu::new(

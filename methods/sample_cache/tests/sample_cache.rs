@@ -21,7 +21,7 @@ use sample_cache::{
 use std::sync::OnceLock;
 use taa::{Taa, TaaSettings, resolve_cpu};
 
-use render::test_scenes as common;
+use testkit::test_scenes as common;
 
 const W: u32 = 64;
 const H: u32 = 36;

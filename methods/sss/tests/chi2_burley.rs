@@ -1,4 +1,4 @@
-//! Chi-square goodness-of-fit tests (render::chi2) of the SSS pass's radius sampling: the
+//! Chi-square goodness-of-fit tests (testkit::chi2) of the SSS pass's radius sampling: the
 //! analytic inverse of Burley's radial cdf (eqs. 5.4/5.5) in WGSL (sampling.wgsl, drawn and its
 //! pdf evaluated by tests/chi2/burley_kernel.wgsl) and in its CPU twin (sss::sampling), each
 //! against the radial density (e^{-r/d} + e^{-r/(3d)}) / (4d) that weighs the samples.
@@ -12,10 +12,10 @@
 //!
 //! Sizes: 2^20 draws per configuration, 64 bins; d = 0.5 and 3 on each side.
 
-use render::chi2::{self, IntervalBins, Kernel};
 use render::pass_library::PassLibrary;
 use render::shader::Module;
-use render::test_scenes::gpu;
+use testkit::chi2::{self, IntervalBins, Kernel};
+use testkit::test_scenes::gpu;
 
 const DRAWS: u32 = 1 << 20;
 const SHAPES: [f32; 2] = [0.5, 3.0];

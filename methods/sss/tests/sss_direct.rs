@@ -12,8 +12,8 @@ use glam::{Mat4, Vec3};
 use render::path_tracer::PathTracerSettings;
 use render::scene::{Camera, Instance, Light, Material, Mesh, SceneDesc};
 use render::scene_gpu::SceneGpu;
-use render::test_scenes::{box_mesh, gpu};
 use sss::direct::{DirectIrradiancePass, direct_irradiance};
+use testkit::test_scenes::{box_mesh, gpu};
 
 const W: u32 = 24;
 const H: u32 = 16;

@@ -23,9 +23,9 @@ use render::frame_bindings::FrameBindings;
 use render::path_tracer::PathTracerSettings;
 use render::scene::{Camera, Instance, Light, Material, SceneDesc};
 use render::scene_gpu::SceneGpu;
-use render::test_scenes::{box_mesh, gpu};
 use scene::Subsurface;
 use support::random_walk::h_function;
+use testkit::test_scenes::{box_mesh, gpu};
 
 const W: u32 = 24;
 const H: u32 = 16;

@@ -5,8 +5,8 @@ use render::compute::BufferBinding;
 use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene_features::SceneFeatures;
 use render::scene_gpu::SceneGpu;
-use render::test_scenes::{H, W, gpu, lit_open_scene, open_scene};
 use taa::Taa;
+use testkit::test_scenes::{H, W, gpu, lit_open_scene, open_scene};
 
 fn settings() -> PathTracerSettings {
     PathTracerSettings { width: W, height: H, max_depth: 4, rr_start_depth: 2 }

@@ -11,7 +11,7 @@ use termination::{
 };
 
 use common::{H, W, furnace, gpu, room_scene};
-use render::test_scenes as common;
+use testkit::test_scenes as common;
 
 fn scene_gpu(scene: &SceneDesc, max_depth: u32) -> SceneGpu {
     SceneGpu::new(

@@ -1,9 +1,9 @@
 //! Scenes and a device shared by the GPU tests of the method crates (hash cache, termination
 //! cache, sample cache) and render's own.
 
-use crate::gpu::Gpu;
-use crate::scene::{Camera, Instance, Light, Material, Mesh, SceneDesc, Texture};
 use glam::{Mat4, Quat, Vec3};
+use render::gpu::Gpu;
+use render::scene::{Camera, Instance, Light, Material, Mesh, SceneDesc, Texture};
 use std::sync::OnceLock;
 
 /// The tests' image size.

@@ -13,10 +13,10 @@
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 use std::f64::consts::PI;
 
-use crate::compute::{self, BufferBinding};
-use crate::error::RenderError;
-use crate::gpu::Gpu;
-use crate::shader::{Module, Program};
+use render::compute::{self, BufferBinding};
+use render::error::RenderError;
+use render::gpu::Gpu;
+use render::shader::{Module, Program};
 
 /// The probability that a correct set of samplers fails any test of the set.
 pub const SIGNIFICANCE: f64 = 0.01;
@@ -607,7 +607,7 @@ impl KernelBuffers {
 
     /// The results (after the dispatch was submitted).
     pub fn read(&self, gpu: &Gpu) -> Vec<[f32; 4]> {
-        crate::readback::read_pod(gpu, &self.result, "chi2 result").expect("chi2 readback")
+        render::readback::read_pod(gpu, &self.result, "chi2 result").expect("chi2 readback")
     }
 }
 
@@ -626,7 +626,7 @@ mod tests {
     fn accepts_a_right_pdf_and_rejects_a_wrong_one() {
         let bins = SphereBins { theta: 16, phi: 32 };
         let draws = 200_000u64;
-        let mut rng = scene::SplitMix64::new(3);
+        let mut rng = render::scene::SplitMix64::new(3);
         let mut next = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
         let samples: Vec<([f32; 3], bool)> = (0..draws)
             .map(|_| {
@@ -655,7 +655,7 @@ mod tests {
         let bins = LobeBins { axis, scale: 0.003, theta: 32, phi: 64 };
         let [t, b, a] = bins.frame();
         let draws = 1u64 << 20;
-        let mut rng = scene::SplitMix64::new(5);
+        let mut rng = render::scene::SplitMix64::new(5);
         let mut next = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
         let alpha = 0.003f64;
         let samples: Vec<([f32; 3], bool)> = (0..draws)
