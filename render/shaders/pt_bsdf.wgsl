@@ -15,8 +15,11 @@
 // A Lambertian material (f0 = f90 = 0: metallic 0 and specular 0) takes a shortcut: with no
 // Fresnel the coupling is exactly 1, the specular term and lobe probability exactly 0, so
 // c_diff / pi and n.l / pi are the general formulas' own values, bit for bit, without their
-// arithmetic (render/tests/chi2_sampling.rs compares the two paths).
+// arithmetic (render/tests/chi2_sampling.rs compares the two paths). A scene without specular
+// lobes compiles the general code out (HAS_SPECULAR false, render/src/scene_features.rs): lavapipe
+// would otherwise run it under an empty mask.
 
+import package::scene_features::{HAS_SPECULAR};
 import package::pt_sampling::{INV_PI, PI, TWO_PI, basis_bitangent, basis_tangent, max_component, sample_cosine_hemisphere, to_world};
 
 struct Bsdf {
@@ -83,9 +86,10 @@ fn specular_probability(b: Bsdf, n_dot_v: f32) -> f32 {
     return fs / (fs + fd);
 }
 
-// True when the BSDF is exactly Lambertian: no Fresnel reflection at any angle.
+// True when the BSDF is exactly Lambertian: no Fresnel reflection at any angle; always in a
+// scene without specular lobes.
 fn is_lambertian(b: Bsdf) -> bool {
-    return all(b.f0 == vec3f(0.0)) && b.f90 == 0.0;
+    return !HAS_SPECULAR || (all(b.f0 == vec3f(0.0)) && b.f90 == 0.0);
 }
 
 fn bsdf_eval(b: Bsdf, n: vec3f, wo: vec3f, wi: vec3f) -> vec3f {

@@ -29,12 +29,13 @@ fn passes_for_the_scene_s_lights_render_what_passes_for_every_light_do() {
         emitters: true,
         environment: false,
         textures: false,
+        specular: false,
         traversal_stack: stack,
     };
     assert_eq!(
         sg.library().features(),
         room,
-        "the room has only its emissive panel, and no textures"
+        "the room has only its emissive panel, no textures and Lambertian materials"
     );
     let own = tracer.render(gpu(), &sg, 4, 7, 0).expect("frame");
     sg.library().specialise(gpu(), &sg, SceneFeatures::ALL).expect("compile for every feature");
@@ -43,7 +44,7 @@ fn passes_for_the_scene_s_lights_render_what_passes_for_every_light_do() {
     assert!(own.radiance.iter().any(|p| p[0] > 0.0), "the room is lit");
     assert_eq!(
         own.radiance, every.radiance,
-        "the estimators of absent lights draw no random numbers and add nothing, and the stack holds what the BVH needs"
+        "the estimators of absent lights draw no random numbers and add nothing, the Lambertian BSDF's shortcut gives the general formulas' values, and the stack holds what the BVH needs"
     );
 }
 
