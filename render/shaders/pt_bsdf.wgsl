@@ -11,7 +11,15 @@
 // c_diff (1 - F(n.v)). KHR_materials_specular's factor scales the dielectric Fresnel
 // (0 = pure Lambertian). All directions are world space, unit, and `n` is the shading normal
 // turned towards `wo`.
+//
+// A Lambertian material (f0 = f90 = 0: metallic 0 and specular 0) takes a shortcut: with no
+// Fresnel the coupling is exactly 1, the specular term and lobe probability exactly 0, so
+// c_diff / pi and n.l / pi are the general formulas' own values, bit for bit, without their
+// arithmetic (render/tests/chi2_sampling.rs compares the two paths). A scene without specular
+// lobes compiles the general code out (HAS_SPECULAR false, render/src/scene_features.rs): lavapipe
+// would otherwise run it under an empty mask.
 
+import package::scene_features::{HAS_SPECULAR};
 import package::pt_sampling::{INV_PI, PI, TWO_PI, basis_bitangent, basis_tangent, max_component, sample_cosine_hemisphere, to_world};
 
 struct Bsdf {
@@ -78,12 +86,26 @@ fn specular_probability(b: Bsdf, n_dot_v: f32) -> f32 {
     return fs / (fs + fd);
 }
 
+// True when the BSDF is exactly Lambertian: no Fresnel reflection at any angle; always in a
+// scene without specular lobes.
+fn is_lambertian(b: Bsdf) -> bool {
+    return !HAS_SPECULAR || (all(b.f0 == vec3f(0.0)) && b.f90 == 0.0);
+}
+
 fn bsdf_eval(b: Bsdf, n: vec3f, wo: vec3f, wi: vec3f) -> vec3f {
     let n_dot_v = dot(n, wo);
     let n_dot_l = dot(n, wi);
     if n_dot_v <= 0.0 || n_dot_l <= 0.0 {
         return vec3f(0.0);
     }
+    if is_lambertian(b) {
+        return b.c_diff * INV_PI;
+    }
+    return bsdf_eval_general(b, n, wo, wi, n_dot_v, n_dot_l);
+}
+
+// bsdf_eval of any material, both directions above the surface.
+fn bsdf_eval_general(b: Bsdf, n: vec3f, wo: vec3f, wi: vec3f, n_dot_v: f32, n_dot_l: f32) -> vec3f {
     let h = normalize(wo + wi);
     let v_dot_h = max(dot(wo, h), 0.0);
     let f = fresnel_schlick(b, v_dot_h);
@@ -106,6 +128,14 @@ fn bsdf_pdf(b: Bsdf, n: vec3f, wo: vec3f, wi: vec3f) -> f32 {
     if n_dot_v <= 0.0 || n_dot_l <= 0.0 {
         return 0.0;
     }
+    if is_lambertian(b) {
+        return n_dot_l * INV_PI;
+    }
+    return bsdf_pdf_general(b, n, wo, wi, n_dot_v, n_dot_l);
+}
+
+// bsdf_pdf of any material, both directions above the surface.
+fn bsdf_pdf_general(b: Bsdf, n: vec3f, wo: vec3f, wi: vec3f, n_dot_v: f32, n_dot_l: f32) -> f32 {
     let p_spec = specular_probability(b, n_dot_v);
     let h = normalize(wo + wi);
     // Visible-normal pdf G1(v) D(h) (v.h) / (n.v), mapped to wi by the reflection Jacobian
@@ -137,6 +167,25 @@ fn bsdf_sample(b: Bsdf, n: vec3f, wo: vec3f, u_lobe: f32, u: vec2f) -> BsdfSampl
     if n_dot_v <= 0.0 {
         return s;
     }
+    if is_lambertian(b) {
+        // The general path with the lobe probability 0: the cosine hemisphere, its pdf and f.
+        s.wi = to_world(sample_cosine_hemisphere(u), n);
+        let n_dot_l = dot(n, s.wi);
+        s.pdf = select(0.0, n_dot_l * INV_PI, n_dot_l > 0.0);
+        if s.pdf <= 0.0 {
+            return s;
+        }
+        s.f = b.c_diff * INV_PI;
+        s.valid = true;
+        return s;
+    }
+    return bsdf_sample_general(b, n, wo, u_lobe, u, n_dot_v);
+}
+
+// bsdf_sample of any material, wo above the surface (n.v > 0).
+fn bsdf_sample_general(b: Bsdf, n: vec3f, wo: vec3f, u_lobe: f32, u: vec2f, n_dot_v: f32) -> BsdfSample {
+    var s: BsdfSample;
+    s.valid = false;
     let p_spec = specular_probability(b, n_dot_v);
     if u_lobe < p_spec {
         let t = basis_tangent(n);
@@ -147,11 +196,15 @@ fn bsdf_sample(b: Bsdf, n: vec3f, wo: vec3f, u_lobe: f32, u: vec2f) -> BsdfSampl
     } else {
         s.wi = to_world(sample_cosine_hemisphere(u), n);
     }
-    s.pdf = bsdf_pdf(b, n, wo, s.wi);
+    let n_dot_l = dot(n, s.wi);
+    if n_dot_l <= 0.0 {
+        return s;
+    }
+    s.pdf = bsdf_pdf_general(b, n, wo, s.wi, n_dot_v, n_dot_l);
     if s.pdf <= 0.0 {
         return s;
     }
-    s.f = bsdf_eval(b, n, wo, s.wi);
+    s.f = bsdf_eval_general(b, n, wo, s.wi, n_dot_v, n_dot_l);
     s.valid = true;
     return s;
 }

@@ -1,11 +1,13 @@
 //! What kinds of light and surface a scene has (analytic lights, emissive triangles, a constant
-//! environment, textured materials) and how deep its BVH is, as the WGSL constants the library's
-//! passes are compiled with.
+//! environment, textured materials, materials with a specular lobe) and how deep its BVH is, as
+//! the WGSL constants the library's passes are compiled with.
 //!
 //! Why: lavapipe runs a branch that no invocation takes under an empty mask instead of jumping
 //! over it, so next-event estimation towards a kind of light the scene lacks costs a light sample
 //! and a shadow ray's traversal per vertex all the same, and an untextured scene pays for four
-//! texel loads per hit (docs/lab/render-speed.md). A pass compiled with the feature's constant `false`
+//! texel loads per hit (docs/lab/render-speed.md), and a scene of Lambertian materials for the
+//! Fresnel-coupled diffuse and GGX arithmetic of every BSDF evaluation, whose values are exactly
+//! the Lambertian ones for it (pt_bsdf.wgsl). A pass compiled with the feature's constant `false`
 //! has no such code. A GPU skips such branches anyway. No result changes: a light kind's
 //! estimator draws no random numbers when the scene has none of it.
 //!
@@ -30,6 +32,9 @@ pub struct SceneFeatures {
     pub environment: bool,
     /// A material with a base-colour texture.
     pub textures: bool,
+    /// A material with a specular lobe (metallic or KHR specular factor above 0); without one
+    /// every BSDF is Lambertian.
+    pub specular: bool,
     /// Entries of the traversal stack: what the scene's BVH can need ([`Self::stack_for`]).
     pub traversal_stack: u32,
 }
@@ -42,6 +47,7 @@ impl SceneFeatures {
         emitters: true,
         environment: true,
         textures: true,
+        specular: true,
         traversal_stack: TRAVERSAL_STACK_SIZE,
     };
 
@@ -59,6 +65,7 @@ impl SceneFeatures {
             ("HAS_EMITTERS", self.emitters),
             ("HAS_ENVIRONMENT", self.environment),
             ("HAS_TEXTURES", self.textures),
+            ("HAS_SPECULAR", self.specular),
         ]
         .map(|(name, value)| format!("const {name}: bool = {value};"));
         let stack = format!("const TRAVERSAL_STACK_ENTRIES: u32 = {}u;", self.traversal_stack);

@@ -54,6 +54,8 @@ pub struct SceneGpu {
     environment: Vec3,
     /// Some material has a base-colour texture.
     textured: bool,
+    /// Some material has a specular lobe.
+    specular: bool,
     /// The most traversal-stack entries the scene's BVH has needed so far: the stack never
     /// shrinks within a run, so that a TLAS whose depth moves up and down under animation costs
     /// a compilation only when it grows past its deepest.
@@ -99,7 +101,9 @@ impl SceneGpu {
         let layout = crate::texel_table::group_layout(gpu, "scene", &GROUP, TABLES.len());
         let traversal_stack = geometry.stack_entries();
         let textured = textured(&materials_cpu);
-        let features = scene_features(&light_table, scene.environment, textured, traversal_stack);
+        let specular = specular(&materials_cpu);
+        let features =
+            scene_features(&light_table, scene.environment, textured, specular, traversal_stack);
         Ok(Self {
             settings,
             geometry,
@@ -114,6 +118,7 @@ impl SceneGpu {
             previous_camera: scene.camera,
             environment: scene.environment,
             textured,
+            specular,
             traversal_stack,
         })
     }
@@ -168,6 +173,7 @@ impl SceneGpu {
             reallocated |= self.materials.replace(gpu, bytemuck::cast_slice(materials))?;
             uploads.push((&mut self.texels, "base-colour texels", bytemuck::cast_slice(texels)));
             self.textured = textured(materials);
+            self.specular = specular(materials);
         }
         if let Some(table) = &light_table {
             reallocated |= self.lights.replace(gpu, bytemuck::cast_slice(&table.lights))?;
@@ -247,7 +253,13 @@ impl SceneGpu {
     /// The scene's features as last uploaded: what the library's passes are compiled for
     /// ([`PassLibrary::specialise`]).
     pub fn features(&self) -> SceneFeatures {
-        scene_features(&self.light_table, self.environment, self.textured, self.traversal_stack)
+        scene_features(
+            &self.light_table,
+            self.environment,
+            self.textured,
+            self.specular,
+            self.traversal_stack,
+        )
     }
 
     /// Point, spot and directional lights as last uploaded (`frame.analytic_lights`).
@@ -302,6 +314,7 @@ fn scene_features(
     lights: &LightTable,
     environment: Vec3,
     textured: bool,
+    specular: bool,
     traversal_stack: u32,
 ) -> SceneFeatures {
     SceneFeatures {
@@ -309,6 +322,7 @@ fn scene_features(
         emitters: lights.emitters > 0,
         environment: environment.max_element() > 0.0,
         textures: textured,
+        specular,
         traversal_stack: SceneFeatures::stack_for(traversal_stack),
     }
 }
@@ -318,4 +332,11 @@ fn textured(materials: &[GpuMaterial]) -> bool {
     materials
         .iter()
         .any(|m| m.texture_offset != NO_TEXTURE && m.texture_width > 0 && m.texture_height > 0)
+}
+
+/// Whether a material has a specular lobe: make_bsdf (pt_bsdf.wgsl) gives f0 = f90 = 0, a
+/// Lambertian BSDF, exactly when metallic and the specular factor are at most 0 (NaN counts as a
+/// lobe: such a material keeps the general code).
+fn specular(materials: &[GpuMaterial]) -> bool {
+    materials.iter().any(|m| !(m.metallic <= 0.0 && m.specular <= 0.0))
 }

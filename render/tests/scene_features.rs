@@ -29,12 +29,13 @@ fn passes_for_the_scene_s_lights_render_what_passes_for_every_light_do() {
         emitters: true,
         environment: false,
         textures: false,
+        specular: false,
         traversal_stack: stack,
     };
     assert_eq!(
         sg.library().features(),
         room,
-        "the room has only its emissive panel, and no textures"
+        "the room has only its emissive panel, no textures and Lambertian materials"
     );
     let own = tracer.render(gpu(), &sg, 4, 7, 0).expect("frame");
     sg.library()
@@ -45,7 +46,7 @@ fn passes_for_the_scene_s_lights_render_what_passes_for_every_light_do() {
     assert!(own.radiance.iter().any(|p| p[0] > 0.0), "the room is lit");
     assert_eq!(
         own.radiance, every.radiance,
-        "the estimators of absent lights draw no random numbers and add nothing, and the stack holds what the BVH needs"
+        "the estimators of absent lights draw no random numbers and add nothing, the Lambertian BSDF's shortcut gives the general formulas' values, and the stack holds what the BVH needs"
     );
 }
 
@@ -77,4 +78,25 @@ fn the_traversal_stack_never_shrinks_within_a_run() {
     );
     let frame = tracer.render(gpu(), &sg, 1, 7, 0).expect("frame");
     assert!(frame.radiance.iter().any(|p| p[0] > 0.0));
+}
+
+/// A glossy box (material 1, specular factor 1) keeps the general BSDF: its passes render what
+/// passes compiled for every feature do, and not the image of the same room with a Lambertian
+/// box, which the shortcut for scenes without specular lobes (pt_bsdf.wgsl) would give.
+#[test]
+fn a_scene_with_a_specular_lobe_keeps_the_general_bsdf() {
+    let mut glossy = room_scene();
+    glossy.materials[1].specular = 1.0;
+    let sg = SceneGpu::new(gpu(), &glossy, settings()).expect("scene");
+    let mut tracer = PathTracer::new(gpu(), &sg).expect("tracer");
+    let own = tracer.render(gpu(), &sg, 4, 7, 0).expect("frame");
+    let lambertian = SceneGpu::new(gpu(), &room_scene(), settings()).expect("scene");
+    let matte = PathTracer::new(gpu(), &lambertian)
+        .expect("tracer")
+        .render(gpu(), &lambertian, 4, 7, 0)
+        .expect("frame");
+    assert!(own.radiance != matte.radiance, "the glossy box reflects differently");
+    sg.library().specialise(gpu(), &sg, SceneFeatures::ALL).expect("compile for every feature");
+    let every = tracer.render(gpu(), &sg, 4, 7, 0).expect("frame");
+    assert_eq!(own.radiance, every.radiance, "the scene's passes evaluate the specular lobe");
 }

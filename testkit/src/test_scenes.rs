@@ -136,7 +136,8 @@ pub fn open_scene() -> SceneDesc {
     scene
 }
 
-/// [`open_scene`] with an environment, a point light and a checker texture on the box.
+/// [`open_scene`] with an environment, a point light and a glossy checker-textured box: every
+/// kind of light and surface (render::scene_features).
 pub fn lit_open_scene() -> SceneDesc {
     let mut scene = open_scene();
     scene.environment = Vec3::splat(0.3);
@@ -151,5 +152,6 @@ pub fn lit_open_scene() -> SceneDesc {
         rgba8: [dark, light, light, dark].concat(),
     });
     scene.materials[1].base_color_texture = Some(0);
+    scene.materials[1].specular = 1.0;
     scene
 }

@@ -1,5 +1,5 @@
 //! A pass a method holds is compiled again when the scene gains a feature: TAA's trace pass on
-//! the scene's library, before and after the scene gains lights and a texture.
+//! the scene's library, before and after the scene gains lights, a texture and a glossy material.
 
 use render::compute::BufferBinding;
 use render::path_tracer::{PathTracer, PathTracerSettings};
@@ -46,7 +46,7 @@ fn a_scene_that_gains_features_gets_passes_compiled_for_them() {
         PathTracer::new(gpu(), &lit).expect("tracer").render(gpu(), &lit, 4, 7, 0).expect("frame");
     assert_eq!(
         updated.radiance, fresh.radiance,
-        "after the update the passes sample the environment and the point light, and read the texture"
+        "after the update the passes sample the environment and the point light, read the texture and evaluate the specular lobe"
     );
     assert!(updated.radiance != dark.radiance);
 }

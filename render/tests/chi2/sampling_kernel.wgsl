@@ -4,14 +4,15 @@
 // library: @group(0) and @group(1) are the scene's, @group(2) these buffers.
 //
 // params[0] = (wo, roughness), params[1] = (base colour, metallic), params[2] = (origin,
-// specular), params[3] = (count, seed, light index, unused) as u32 bits. Samples: result[i] =
+// specular), params[3] = (count, seed, light index, path) as u32 bits; path 1 calls the BSDF's
+// general functions where the path_* kernels would call its public ones (Lambertian shortcut). Samples: result[i] =
 // (direction, w) with w < 0 for an invalid draw; pdfs: result[i].x = pdf at points[i].xyz.
 
 import package::scene_bindings::{frame};
 import package::scene_tables::{light, material};
 import package::scene_geometry::{NO_HIT, surface_point, trace_closest};
 import package::pt_sampling::{luminance, rng_next, rng_next2, rng_seed, sample_uniform_sphere};
-import package::pt_bsdf::{Bsdf, bsdf_eval, bsdf_pdf, bsdf_sample, make_bsdf};
+import package::pt_bsdf::{Bsdf, BsdfSample, bsdf_eval, bsdf_eval_general, bsdf_pdf, bsdf_pdf_general, bsdf_sample, bsdf_sample_general, make_bsdf};
 import package::pt_lights::{FAR, directional_pdf, emitter_pdf, sample_analytic_light, sample_emitter};
 import package::pt_scene::{environment_pdf};
 import package::chi2_bindings::{params, points, result};
@@ -139,4 +140,70 @@ fn environment_pdf_main(@builtin(global_invocation_id) id: vec3u) {
         return;
     }
     result[i] = vec4f(environment_pdf(), 0.0, 0.0, 0.0);
+}
+
+// The public BSDF functions (path 0, with the Lambertian shortcut) or the general ones (path 1),
+// after the same checks of the two directions' sides.
+fn general_path() -> bool {
+    return bitcast<u32>(params[3].w) == 1u;
+}
+
+fn path_sample(b: Bsdf, wo: vec3f, i: u32) -> BsdfSample {
+    var rng = stream(i);
+    let u_lobe = rng_next(&rng);
+    let u = rng_next2(&rng);
+    if !general_path() {
+        return bsdf_sample(b, N, wo, u_lobe, u);
+    }
+    var s: BsdfSample;
+    s.valid = false;
+    if dot(N, wo) <= 0.0 {
+        return s;
+    }
+    return bsdf_sample_general(b, N, wo, u_lobe, u, dot(N, wo));
+}
+
+// (pdf, f) of wo -> wi = points[i] through the chosen path.
+@compute @workgroup_size(64)
+fn path_eval_main(@builtin(global_invocation_id) id: vec3u) {
+    let i = index(id);
+    if i >= count() {
+        return;
+    }
+    let b = material_bsdf();
+    let wo = params[0].xyz;
+    let wi = points[i].xyz;
+    if !general_path() {
+        result[i] = vec4f(bsdf_pdf(b, N, wo, wi), bsdf_eval(b, N, wo, wi));
+        return;
+    }
+    let n_dot_v = dot(N, wo);
+    let n_dot_l = dot(N, wi);
+    if n_dot_v <= 0.0 || n_dot_l <= 0.0 {
+        result[i] = vec4f(0.0);
+        return;
+    }
+    result[i] = vec4f(bsdf_pdf_general(b, N, wo, wi, n_dot_v, n_dot_l), bsdf_eval_general(b, N, wo, wi, n_dot_v, n_dot_l));
+}
+
+// A draw's (wi, pdf) through the chosen path; pdf -1 for an invalid draw.
+@compute @workgroup_size(64)
+fn path_sample_main(@builtin(global_invocation_id) id: vec3u) {
+    let i = index(id);
+    if i >= count() {
+        return;
+    }
+    let s = path_sample(material_bsdf(), params[0].xyz, i);
+    result[i] = vec4f(s.wi, select(-1.0, s.pdf, s.valid));
+}
+
+// The same draw's (f, valid).
+@compute @workgroup_size(64)
+fn path_sample_value_main(@builtin(global_invocation_id) id: vec3u) {
+    let i = index(id);
+    if i >= count() {
+        return;
+    }
+    let s = path_sample(material_bsdf(), params[0].xyz, i);
+    result[i] = vec4f(s.f, select(0.0, 1.0, s.valid));
 }
