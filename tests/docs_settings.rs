@@ -120,13 +120,13 @@ fn registry() -> Vec<Entry> {
         ),
         settings!(scene::MediumMotion, "()"),
         // What the methods' settings nest.
-        settings!(nirc::NircConfig, "()"),
-        settings!(nirc::config::HashGridConfig, "()"),
-        settings!(nirc::config::NetworkConfig, "()"),
-        settings!(nirc::optimizer_config::AdamConfig, "()"),
-        settings!(nirc::config::LossConfig, "()"),
-        settings!(nirc::optimizer_config::EmaConfig, "()"),
-        settings!(nirc::config::ReliabilityConfig, "()"),
+        settings!(nirc::NircCacheSettings, "()"),
+        settings!(nirc::config::HashGridSettings, "()"),
+        settings!(nirc::config::NetworkSettings, "()"),
+        settings!(nirc::optimizer_config::AdamSettings, "()"),
+        settings!(nirc::config::LossSettings, "()"),
+        settings!(nirc::optimizer_config::EmaSettings, "()"),
+        settings!(nirc::config::ReliabilitySettings, "()"),
         settings!(nirc::CachePathSettings, "()"),
         settings!(sss::SpvgSettings, "()"),
         settings!(sss::Prefilter, "()"),
@@ -216,7 +216,7 @@ fn every_shipped_method_has_its_settings_registered() {
     }
 }
 
-/// A settings struct nested in a registered type (`NircSettings.cache: NircConfig`) is
+/// A settings struct nested in a registered type (`NircSettings.cache: NircCacheSettings`) is
 /// registered too, so that it needs a table.
 #[test]
 fn nested_settings_structs_are_registered() {
@@ -235,7 +235,7 @@ fn nested_settings_structs_are_registered() {
         missing.join("\n")
     );
     let nirc = lookup(&entries, "NircSettings").unwrap().unwrap().nested;
-    assert!(nirc.contains(&("cache".to_string(), "NircConfig".to_string())), "{nirc:?}");
+    assert!(nirc.contains(&("cache".to_string(), "NircCacheSettings".to_string())), "{nirc:?}");
 }
 
 /// Every registered type's shape can be read (its minimal text parses, and gives exactly its
@@ -375,17 +375,17 @@ fn links_to_nested_types_are_checked() {
     let nirc = "<!-- settings: nirc::plugin::NircSettings -->\n\
         | field | default | meaning |\n|---|---|---|\n\
         | `spp` | required | x |\n| `predictor` | `Blend` | x |\n\
-        | `cache` | [`NircConfig`](#nircconfig) | x |\n| `paths` | [`CachePathSettings`](#x) | x |\n\
+        | `cache` | [`NircCacheSettings`](#nircconfig) | x |\n| `paths` | [`CachePathSettings`](#x) | x |\n\
         | `pretrain_frames` | `0` | x |\n| `test_skip_ema` | `false` | x |\n";
     assert_eq!(fixture_errors(nirc), Vec::<String>::new());
     assert_fails(
-        &nirc.replace("[`NircConfig`]", "[`NircConfg`]"),
+        &nirc.replace("[`NircCacheSettings`]", "[`NircConfg`]"),
         6,
         "links to `NircConfg`, which is no registered settings type",
     );
     assert_fails(
-        &nirc.replace("[`NircConfig`]", "[`HashGridConfig`]"),
+        &nirc.replace("[`NircCacheSettings`]", "[`HashGridSettings`]"),
         6,
-        "not to HashGridConfig's defaults",
+        "not to HashGridSettings's defaults",
     );
 }

@@ -32,7 +32,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     if what != "variants" {
-        let config = nirc::NircConfig::default();
+        let config = nirc::NircCacheSettings::default();
         for placement in [WeightPlacement::Tiled, WeightPlacement::Registers] {
             let r = bench::nirc_throughput::run(&gpu, &config, Some(placement), 4096, 16384, 3)?;
             println!(

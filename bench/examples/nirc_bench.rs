@@ -3,7 +3,7 @@
 //! (`flicker bench --nirc` runs the default form and writes JSON). With `FLICKER_NIRC_MLP` set,
 //! only that form runs.
 
-use nirc::NircConfig;
+use nirc::NircCacheSettings;
 use nirc::gpu::shaders::WeightPlacement;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -13,7 +13,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let queries = args.get(1).copied().unwrap_or(16384);
     let reps = args.get(2).copied().unwrap_or(3);
     let gpu = render::gpu::Gpu::new()?;
-    let config = NircConfig::default();
+    let config = NircCacheSettings::default();
     let forms = match WeightPlacement::from_env()? {
         Some(one) => vec![one],
         None => vec![WeightPlacement::Registers, WeightPlacement::Tiled, WeightPlacement::Storage],

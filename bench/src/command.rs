@@ -20,7 +20,7 @@ pub fn nirc(
     );
     let r = crate::nirc_throughput::run(
         &gpu,
-        &nirc::NircConfig::default(),
+        &nirc::NircCacheSettings::default(),
         None,
         batch,
         queries,

@@ -7,7 +7,8 @@ use std::time::Instant;
 use nirc::gpu::shaders::WeightPlacement;
 use nirc::gpu::{NeuralCache, answer_buffer, readback, upload};
 use nirc::{
-    CacheQuery, CacheState, NircConfig, NircError, PredictorMode, SceneBounds, TrainingRecord,
+    CacheQuery, CacheState, NircCacheSettings, NircError, PredictorMode, SceneBounds,
+    TrainingRecord,
 };
 use render::gpu::Gpu;
 use wgpu::util::DeviceExt;
@@ -94,7 +95,7 @@ fn time<F: FnMut() -> Result<(), NircError>>(
 /// queries, `reps` repetitions each.
 pub fn run(
     gpu: &Gpu,
-    config: &NircConfig,
+    config: &NircCacheSettings,
     placement: Option<WeightPlacement>,
     batch: u32,
     queries: u32,

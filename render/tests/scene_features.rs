@@ -96,7 +96,9 @@ fn a_scene_with_a_specular_lobe_keeps_the_general_bsdf() {
         .render(gpu(), &lambertian, 4, 7, 0)
         .expect("frame");
     assert!(own.radiance != matte.radiance, "the glossy box reflects differently");
-    sg.library().specialise(gpu(), &sg, SceneFeatures::ALL).expect("compile for every feature");
+    sg.library()
+        .specialise(gpu(), sg.library_groups(), SceneFeatures::ALL)
+        .expect("compile for every feature");
     let every = tracer.render(gpu(), &sg, 4, 7, 0).expect("frame");
     assert_eq!(own.radiance, every.radiance, "the scene's passes evaluate the specular lobe");
 }

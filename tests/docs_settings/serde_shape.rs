@@ -116,7 +116,7 @@ fn shape<T: Serialize + DeserializeOwned + 'static>(
     })
 }
 
-/// The minimal text parsed, serialized with struct names (`NircConfig(encoding: ...)`).
+/// The minimal text parsed, serialized with struct names (`NircCacheSettings(encoding: ...)`).
 fn minimal_value<T: Serialize + DeserializeOwned>(minimal: &str) -> Result<String, String> {
     let value: T = options().from_str(minimal).map_err(|e| e.to_string())?;
     ron::ser::to_string_pretty(&value, ron::ser::PrettyConfig::new().struct_names(true))

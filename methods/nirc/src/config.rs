@@ -4,36 +4,36 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::optimizer_config::{AdamConfig, EmaConfig};
+use crate::optimizer_config::{AdamSettings, EmaSettings};
 
 /// Everything that defines a cache. Two caches with equal configs, bounds and seed start from
 /// identical states.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct NircConfig {
-    pub encoding: HashGridConfig,
+pub struct NircCacheSettings {
+    pub encoding: HashGridSettings,
     pub direction: DirectionEncoding,
-    pub network: NetworkConfig,
-    pub optimizer: AdamConfig,
-    pub loss: LossConfig,
-    pub ema: EmaConfig,
-    pub reliability: ReliabilityConfig,
+    pub network: NetworkSettings,
+    pub optimizer: AdamSettings,
+    pub loss: LossSettings,
+    pub ema: EmaSettings,
+    pub reliability: ReliabilitySettings,
     /// Largest number of training records one `train` call accepts (sizes the scratch buffers).
     pub max_batch: u32,
     /// Seed of the initial weights.
     pub seed: u64,
 }
 
-impl Default for NircConfig {
+impl Default for NircCacheSettings {
     fn default() -> Self {
         Self {
-            encoding: HashGridConfig::default(),
+            encoding: HashGridSettings::default(),
             direction: DirectionEncoding::default(),
-            network: NetworkConfig::default(),
-            optimizer: AdamConfig::default(),
-            loss: LossConfig::default(),
-            ema: EmaConfig::default(),
-            reliability: ReliabilityConfig::default(),
+            network: NetworkSettings::default(),
+            optimizer: AdamSettings::default(),
+            loss: LossSettings::default(),
+            ema: EmaSettings::default(),
+            reliability: ReliabilitySettings::default(),
             // NRC trains on 4 batches of 16384 records per frame.
             max_batch: 16384,
             seed: 0x5eed_0fc0_ffee,
@@ -46,7 +46,7 @@ impl Default for NircConfig {
 /// table is indexed densely, otherwise spatially hashed (collisions are left to the network).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct HashGridConfig {
+pub struct HashGridSettings {
     /// L
     pub levels: u32,
     /// F
@@ -60,7 +60,7 @@ pub struct HashGridConfig {
     pub init_scale: f32,
 }
 
-impl Default for HashGridConfig {
+impl Default for HashGridSettings {
     fn default() -> Self {
         // NRC/NIRC public settings: L = 16, F = 2, T in 2^15..2^19, b in 1.5..2.0.
         Self {
@@ -118,14 +118,14 @@ impl DirectionEncoding {
 /// blended radiance to >= 0 when it answers a query.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct NetworkConfig {
+pub struct NetworkSettings {
     /// 16, 32 or 64.
     pub width: u32,
     /// 1..=5.
     pub hidden_layers: u32,
 }
 
-impl Default for NetworkConfig {
+impl Default for NetworkSettings {
     fn default() -> Self {
         // 64 neurons as NRC; 2 hidden layers (NRC uses 2..5) so that one predictor's weights
         // (27.6 KiB with the default encoding) fit in 32 KiB of workgroup memory.
@@ -137,7 +137,7 @@ impl Default for NetworkConfig {
 /// batch and the three channels.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct LossConfig {
+pub struct LossSettings {
     pub epsilon: f32,
     /// Normalise each channel by its own prediction, or every channel by the luminance of the
     /// prediction (NRC's variant).
@@ -151,7 +151,7 @@ pub enum LossNormalization {
     Luminance,
 }
 
-impl Default for LossConfig {
+impl Default for LossSettings {
     fn default() -> Self {
         Self { epsilon: 0.01, normalization: LossNormalization::PerChannel }
     }
@@ -160,7 +160,7 @@ impl Default for LossConfig {
 /// Reliability grid (section 3.1/3.2 of reliability-weighted-nirc.txt).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct ReliabilityConfig {
+pub struct ReliabilitySettings {
     /// Voxels per axis over the scene bounds before hashing.
     pub resolution: u32,
     /// 2^log2_cells hashed cells; collisions are ignored as in the paper.
@@ -190,7 +190,7 @@ pub enum MomentUpdate {
     BatchMean,
 }
 
-impl Default for ReliabilityConfig {
+impl Default for ReliabilitySettings {
     fn default() -> Self {
         // λ ≈ 0.9, K = 128, κ = 4 from the paper; resolution, table size and ε are ours.
         Self {
@@ -288,7 +288,7 @@ impl PredictorMode {
     }
 }
 
-impl NircConfig {
+impl NircCacheSettings {
     /// Refuses settings outside what the cache implements, naming the field.
     pub fn validate(&self) -> Result<(), crate::NircError> {
         let bad = |what: &str, why: String| Err(crate::NircError::Config(format!("{what}: {why}")));
@@ -372,7 +372,7 @@ mod tests {
 
     #[test]
     fn defaults_are_the_public_nrc_settings_and_valid() {
-        let c = NircConfig::default();
+        let c = NircCacheSettings::default();
         c.validate().unwrap();
         assert_eq!((c.encoding.levels, c.encoding.features_per_level), (16, 2));
         assert_eq!((c.optimizer.beta2, c.optimizer.epsilon, c.ema.alpha), (0.99, 1e-15, 0.99));
@@ -385,21 +385,22 @@ mod tests {
 
     #[test]
     fn partial_settings_fill_in_defaults_and_unknown_fields_are_refused() {
-        let c: NircConfig = serde_json::from_str(
+        let c: NircCacheSettings = serde_json::from_str(
             r#"{"network": {"width": 32}, "direction": {"SphericalHarmonics": {"bands": 2}}}"#,
         )
         .unwrap();
-        assert_eq!(c.network, NetworkConfig { width: 32, hidden_layers: 2 });
+        assert_eq!(c.network, NetworkSettings { width: 32, hidden_layers: 2 });
         assert_eq!(c.direction.dims(), 4);
-        assert_eq!(c.encoding, HashGridConfig::default());
-        let back: NircConfig = serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
+        assert_eq!(c.encoding, HashGridSettings::default());
+        let back: NircCacheSettings =
+            serde_json::from_str(&serde_json::to_string(&c).unwrap()).unwrap();
         assert_eq!(back, c);
-        let err = serde_json::from_str::<NircConfig>(r#"{"network": {"widht": 32}}"#)
+        let err = serde_json::from_str::<NircCacheSettings>(r#"{"network": {"widht": 32}}"#)
             .unwrap_err()
             .to_string();
         assert!(err.contains("widht"), "{err}");
-        let bad = NircConfig {
-            network: NetworkConfig { width: 64, hidden_layers: 7 },
+        let bad = NircCacheSettings {
+            network: NetworkSettings { width: 64, hidden_layers: 7 },
             ..Default::default()
         };
         let err = bad.validate().unwrap_err().to_string();

@@ -3,7 +3,7 @@
 //! level by level (entry-major, F features per entry). Both regions end on a multiple of 4
 //! parameters (zero padding), so that no quad of parameters straddles them.
 
-use crate::config::NircConfig;
+use crate::config::NircCacheSettings;
 
 /// One hash-grid level.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,7 +44,7 @@ pub struct ParameterLayout {
 pub const OUTPUT_DIMS: u32 = 3;
 
 impl ParameterLayout {
-    pub fn new(config: &NircConfig) -> Self {
+    pub fn new(config: &NircCacheSettings) -> Self {
         let e = &config.encoding;
         let direction_dims = config.direction.dims();
         let input_dims = e.levels * e.features_per_level + direction_dims;

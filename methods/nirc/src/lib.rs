@@ -25,7 +25,7 @@ pub mod sigma_regions;
 pub mod state;
 
 pub use bounds::SceneBounds;
-pub use config::{NircConfig, PredictorMode};
+pub use config::{NircCacheSettings, PredictorMode};
 pub use cpu::cache::{CpuCache, StepReport};
 pub use error::NircError;
 pub use gpu::NeuralCache;

@@ -1,4 +1,4 @@
-//! The optimiser's settings, a part of [`crate::config::NircConfig`] of their own because the
+//! The optimiser's settings, a part of [`crate::config::NircCacheSettings`] of their own because the
 //! optimiser (`cpu::optimizer`, the GPU's training pass) reads them and the config's check builds
 //! the optimiser's tables: Adam and the EMA of the weights, with NRC's defaults.
 
@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 /// Adam (Kingma and Ba 2014), applied to every parameter (MLP weights and hash-table entries).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct AdamConfig {
+pub struct AdamSettings {
     pub learning_rate: f32,
     pub beta1: f32,
     pub beta2: f32,
@@ -21,7 +21,7 @@ pub struct AdamConfig {
     pub sparse_grid: bool,
 }
 
-impl Default for AdamConfig {
+impl Default for AdamSettings {
     fn default() -> Self {
         // NRC: lr 1e-3..1e-2, β2 = 0.99, ε = 1e-15; β1 = 0.9 (Adam's default).
         Self { learning_rate: 1e-2, beta1: 0.9, beta2: 0.99, epsilon: 1e-15, sparse_grid: false }
@@ -31,11 +31,11 @@ impl Default for AdamConfig {
 /// EMA of the weights, debiased: w̄_t = (α w̄_{t-1} (1 - α^{t-1}) + (1 - α) w_t) / (1 - α^t).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct EmaConfig {
+pub struct EmaSettings {
     pub alpha: f32,
 }
 
-impl Default for EmaConfig {
+impl Default for EmaSettings {
     fn default() -> Self {
         Self { alpha: 0.99 }
     }

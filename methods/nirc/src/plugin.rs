@@ -25,7 +25,8 @@ use std::time::Instant;
 use crate::config::ReliabilityStatistic;
 use crate::gpu::train::{StepPart, TrainStep};
 use crate::{
-    CacheOutput, CachePathSettings, CachePaths, NeuralCache, NircConfig, PredictorMode, SceneBounds,
+    CacheOutput, CachePathSettings, CachePaths, NeuralCache, NircCacheSettings, PredictorMode,
+    SceneBounds,
 };
 use anyhow::{Context, Result, bail};
 use bevy_ecs::error::BevyError;
@@ -48,7 +49,7 @@ pub struct NircSettings {
     #[serde(default)]
     pub predictor: PredictorMode,
     #[serde(default)]
-    pub cache: NircConfig,
+    pub cache: NircCacheSettings,
     #[serde(default)]
     pub paths: CachePathSettings,
     /// Training-only frames on the first frame's scene before anything renders (a warm start,

@@ -14,7 +14,7 @@
 //! updates (committed steps) for the whole grid.
 
 use crate::bounds::SceneBounds;
-use crate::config::{MomentUpdate, PredictorMode, ReliabilityConfig, ReliabilityStatistic};
+use crate::config::{MomentUpdate, PredictorMode, ReliabilitySettings, ReliabilityStatistic};
 use crate::fixed_sum::FixedSum;
 use crate::layout::spatial_hash;
 use crate::records::ReliabilitySample;
@@ -24,12 +24,12 @@ pub const MOMENTS_PER_CELL: usize = 24;
 const CUR: usize = 6;
 const EMA: usize = 15;
 
-pub fn cell_count(config: &ReliabilityConfig) -> u32 {
+pub fn cell_count(config: &ReliabilitySettings) -> u32 {
     1 << config.log2_cells
 }
 
 /// The hashed cell of a world-space position.
-pub fn cell_index(config: &ReliabilityConfig, bounds: &SceneBounds, position: [f32; 3]) -> u32 {
+pub fn cell_index(config: &ReliabilitySettings, bounds: &SceneBounds, position: [f32; 3]) -> u32 {
     let p = bounds.normalize(position);
     let r = config.resolution;
     let v: [u32; 3] = std::array::from_fn(|a| ((p[a] * r as f32) as u32).min(r - 1));
@@ -56,7 +56,7 @@ pub fn sample_quantities(s: &ReliabilitySample) -> [f32; MOMENTS_PER_CELL] {
 /// One grid update from a batch of samples, as the GPU computes it (see the module docs).
 /// Returns false (and changes nothing) if a sample is not finite.
 pub fn update(
-    config: &ReliabilityConfig,
+    config: &ReliabilitySettings,
     bounds: &SceneBounds,
     moments: &mut [f32],
     samples: &[ReliabilitySample],
@@ -115,7 +115,7 @@ pub fn ema_step(lambda: f32, x: f32, mean: f32) -> f32 {
 }
 
 /// Eq. 3 averaged over RGB: (r̄_cur, r̄_ema) of one cell.
-pub fn reliabilities(config: &ReliabilityConfig, cell_moments: &[f32]) -> (f32, f32) {
+pub fn reliabilities(config: &ReliabilitySettings, cell_moments: &[f32]) -> (f32, f32) {
     let m = cell_moments;
     let r = |p: usize| {
         let mut sum = 0.0f32;
@@ -136,7 +136,7 @@ pub fn reliabilities(config: &ReliabilityConfig, cell_moments: &[f32]) -> (f32, 
 /// against the targets, relative to the EMA of the targets' square. The EMA is linear, so
 /// E_λ[(y - f)²] = Q^y - 2 C^{y,f} + Q^f from the moments the grid keeps (clamped at 0 against
 /// rounding).
-pub fn relative_errors(config: &ReliabilityConfig, cell_moments: &[f32]) -> (f32, f32) {
+pub fn relative_errors(config: &ReliabilitySettings, cell_moments: &[f32]) -> (f32, f32) {
     let m = cell_moments;
     let e = |p: usize| {
         let mut sum = 0.0f32;
@@ -153,13 +153,13 @@ pub fn relative_errors(config: &ReliabilityConfig, cell_moments: &[f32]) -> (f32
 
 /// Inverse-error weighting of the High-LR predictor: σ = (e_EMA + ε) / (e_cur + e_EMA + 2ε)
 /// (an even blend where both errors vanish, as in an empty cell).
-pub fn inverse_error_weight(config: &ReliabilityConfig, e_cur: f32, e_ema: f32) -> f32 {
+pub fn inverse_error_weight(config: &ReliabilitySettings, e_cur: f32, e_ema: f32) -> f32 {
     (e_ema + config.epsilon) / (e_cur + e_ema + 2.0 * config.epsilon)
 }
 
 /// (d_cur, d_ema) of one cell: |ln ρ| of each predictor's gain ρ = (max(Σ_c C^{y,f}_c, 0) + ε) /
 /// (Σ_c Q^f_c + ε), the least-squares factor from f to y through the origin.
-pub fn scale_mismatches(config: &ReliabilityConfig, cell_moments: &[f32]) -> (f32, f32) {
+pub fn scale_mismatches(config: &ReliabilitySettings, cell_moments: &[f32]) -> (f32, f32) {
     let m = cell_moments;
     let d = |p: usize| {
         let (mut cyf, mut qf) = (0.0f32, 0.0f32);
@@ -174,7 +174,7 @@ pub fn scale_mismatches(config: &ReliabilityConfig, cell_moments: &[f32]) -> (f3
 
 /// Weight of the High-LR predictor for a query in a cell with these moments.
 pub fn high_lr_weight(
-    config: &ReliabilityConfig,
+    config: &ReliabilitySettings,
     mode: PredictorMode,
     grid_updates: u32,
     cell_moments: &[f32],
@@ -218,8 +218,8 @@ mod tests {
         ((*state >> 40) as f32) / (1u64 << 24) as f32
     }
 
-    fn config() -> ReliabilityConfig {
-        ReliabilityConfig { resolution: 4, log2_cells: 6, warmup: 8, ..Default::default() }
+    fn config() -> ReliabilitySettings {
+        ReliabilitySettings { resolution: 4, log2_cells: 6, warmup: 8, ..Default::default() }
     }
 
     /// Feeds `frames` updates of one sample each into the cell at the origin.
@@ -252,7 +252,7 @@ mod tests {
             // f = 0.5 y + 0.2 (cur) and f = 2 y (ema): both perfectly linear in y.
             (y, y.map(|v| 0.5 * v + 0.2), y.map(|v| 2.0 * v))
         });
-        let cfg = ReliabilityConfig { epsilon: 1e-7, ..config() };
+        let cfg = ReliabilitySettings { epsilon: 1e-7, ..config() };
         let (r_cur, r_ema) = reliabilities(&cfg, &m);
         assert!((r_cur - 1.0).abs() < 1e-3 && (r_ema - 1.0).abs() < 1e-3, "{r_cur} {r_ema}");
     }
@@ -271,7 +271,7 @@ mod tests {
                 (y, f, y.map(|v| 1.0 - v))
             });
             let (r_cur, r_ema) =
-                reliabilities(&ReliabilityConfig { epsilon: 1e-7, ..config() }, &m);
+                reliabilities(&ReliabilitySettings { epsilon: 1e-7, ..config() }, &m);
             assert!((r_ema + 1.0).abs() < 1e-3, "anti-correlated: {r_ema}");
             r_sum += r_cur;
             windows += 1;
@@ -282,7 +282,7 @@ mod tests {
 
     #[test]
     fn blend_weight_follows_the_reliabilities() {
-        let cfg = ReliabilityConfig { epsilon: 1e-7, ..config() };
+        let cfg = ReliabilitySettings { epsilon: 1e-7, ..config() };
         let mut rng = 3u64;
         // cur tracks y, ema is noise: σ -> logistic(κ (1 - ~0)) close to 1/(1+e^-4).
         let m = run(300, |_| {
@@ -318,7 +318,7 @@ mod tests {
 
     #[test]
     fn relative_error_sees_a_lagging_factor_the_correlation_cannot() {
-        let cfg = ReliabilityConfig { epsilon: 1e-7, ..config() };
+        let cfg = ReliabilitySettings { epsilon: 1e-7, ..config() };
         let mut rng = 11u64;
         // The EMA predictor lags: it still answers half the light (a factor, as when a light
         // dims), the High-LR one tracks it with noise. Both correlate almost perfectly with y.
@@ -409,7 +409,7 @@ mod tests {
         let (mut per_sample, mut batch_mean) = (vec![0.0f32; cells], vec![0.0f32; cells]);
         assert!(update(&cfg, &bounds, &mut per_sample, &batch));
         assert!(update(
-            &ReliabilityConfig { update: MomentUpdate::BatchMean, ..cfg.clone() },
+            &ReliabilitySettings { update: MomentUpdate::BatchMean, ..cfg.clone() },
             &bounds,
             &mut batch_mean,
             &batch

@@ -6,7 +6,7 @@
 //! sparse grid updates (`optimizer.sparse_grid`) then grid_steps as u64 count + little-endian u32s.
 
 use crate::bounds::SceneBounds;
-use crate::config::NircConfig;
+use crate::config::NircCacheSettings;
 use crate::cpu::optimizer::Counters;
 use crate::error::NircError;
 use crate::layout::ParameterLayout;
@@ -19,7 +19,7 @@ const MAGIC: &[u8; 8] = b"FLKNIRC1";
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct CacheState {
-    pub config: NircConfig,
+    pub config: NircCacheSettings,
     pub bounds: SceneBounds,
     /// High-LR weights W_t (the trained predictor), layout in `ParameterLayout`.
     pub params: Vec<f32>,
@@ -37,7 +37,7 @@ pub struct CacheState {
 
 #[derive(Serialize, Deserialize)]
 struct Header {
-    config: NircConfig,
+    config: NircCacheSettings,
     bounds: SceneBounds,
     counters: Counters,
 }
@@ -61,7 +61,7 @@ impl SplitMix {
 impl CacheState {
     /// Fresh state: MLP weights Xavier-uniform, hash-table entries uniform in ±init_scale, both
     /// from `config.seed`; EMA = weights; Adam moments and grid zero.
-    pub fn initial(config: &NircConfig, bounds: SceneBounds) -> Result<Self, NircError> {
+    pub fn initial(config: &NircCacheSettings, bounds: SceneBounds) -> Result<Self, NircError> {
         config.validate()?;
         let layout = ParameterLayout::new(config);
         let mut rng = SplitMix(config.seed);
@@ -90,7 +90,7 @@ impl CacheState {
     }
 
     /// Length of `grid_steps`: the grid's parameters with sparse updates, else 0.
-    pub fn grid_steps_len(config: &NircConfig, layout: &ParameterLayout) -> usize {
+    pub fn grid_steps_len(config: &NircCacheSettings, layout: &ParameterLayout) -> usize {
         if config.optimizer.sparse_grid { layout.grid_params() as usize } else { 0 }
     }
 

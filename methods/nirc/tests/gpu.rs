@@ -131,7 +131,8 @@ fn register_form_without_the_grid_mirror_matches_cpu() {
 /// after a training step changed the weights: the register form stages them per inference.
 #[test]
 fn register_form_matches_the_tiled_form() {
-    for config in [small_config(), nirc::NircConfig { max_batch: 256, ..Default::default() }] {
+    for config in [small_config(), nirc::NircCacheSettings { max_batch: 256, ..Default::default() }]
+    {
         let state = randomized_state(&config, 31);
         let batch = records(&mut Rng(6), 128);
         let queries: Vec<_> = records(&mut Rng(5), 150).iter().map(|r| r.query()).collect();
@@ -461,23 +462,23 @@ fn nan_target_rolls_the_step_back_and_is_counted() {
 
 #[test]
 fn other_encodings_widths_and_loss_normalisation_match_cpu() {
-    use nirc::config::{DirectionEncoding, LossNormalization, NetworkConfig};
+    use nirc::config::{DirectionEncoding, LossNormalization, NetworkSettings};
     let variants = [
         (
             DirectionEncoding::Identity,
             LossNormalization::Luminance,
-            NetworkConfig { width: 32, hidden_layers: 1 },
+            NetworkSettings { width: 32, hidden_layers: 1 },
         ),
         (
             DirectionEncoding::None,
             LossNormalization::PerChannel,
-            NetworkConfig { width: 16, hidden_layers: 3 },
+            NetworkSettings { width: 16, hidden_layers: 3 },
         ),
         // An odd width: the MLP's weights end inside a quad, so the layout pads before the grid.
         (
             DirectionEncoding::Identity,
             LossNormalization::PerChannel,
-            NetworkConfig { width: 5, hidden_layers: 1 },
+            NetworkSettings { width: 5, hidden_layers: 1 },
         ),
     ];
     for (direction, normalization, network) in variants {
@@ -613,10 +614,10 @@ fn networks_the_tiled_mlp_does_not_take_fall_back_to_storage_or_are_refused() {
     };
     assert_eq!(small.placement, expected);
     assert!(nirc::gpu::shaders::workgroup_bytes(&small.layout) <= 32768);
-    let default = nirc::layout::ParameterLayout::new(&nirc::NircConfig::default());
+    let default = nirc::layout::ParameterLayout::new(&nirc::NircCacheSettings::default());
     assert_eq!(nirc::gpu::shaders::workgroup_bytes(&default), 32768, "width 64: two 16 KiB tiles");
     let mut config = small_config();
-    config.network = nirc::config::NetworkConfig { width: 128, hidden_layers: 2 };
+    config.network = nirc::config::NetworkSettings { width: 128, hidden_layers: 2 };
     let big = NeuralCache::new(gpu(), &config, bounds()).unwrap();
     assert_eq!(big.placement, WeightPlacement::Storage);
     let state = CacheState::initial(&config, bounds()).unwrap();
@@ -645,7 +646,7 @@ fn networks_the_tiled_mlp_does_not_take_fall_back_to_storage_or_are_refused() {
 fn networks_over_the_drivers_loop_cap_are_refused() {
     let mut config = small_config();
     // Forward alone: 128 x 128 x 4 + ... ~ 72k multiply-adds per query, over llvmpipe's 65535.
-    config.network = nirc::config::NetworkConfig { width: 128, hidden_layers: 5 };
+    config.network = nirc::config::NetworkSettings { width: 128, hidden_layers: 5 };
     let result = NeuralCache::new(gpu(), &config, bounds());
     match gpu().loop_iteration_limit() {
         Some(limit) => {
@@ -660,7 +661,7 @@ fn networks_over_the_drivers_loop_cap_are_refused() {
         None => assert!(result.is_ok(), "no loop cap on this adapter, yet refused"),
     }
     // The defaults (width 64) stay well inside the cap.
-    let default = nirc::layout::ParameterLayout::new(&nirc::NircConfig::default());
+    let default = nirc::layout::ParameterLayout::new(&nirc::NircCacheSettings::default());
     assert!(default.loop_iterations_per_invocation(64) < render::gpu::LLVMPIPE_LOOP_ITERATIONS / 2);
 }
 

@@ -4,10 +4,10 @@
 mod common;
 
 use common::*;
-use nirc::config::{HashGridConfig, PredictorMode};
+use nirc::config::{HashGridSettings, PredictorMode};
 use nirc::cpu::encoding::grid_corners;
 use nirc::gpu::shaders::WeightPlacement;
-use nirc::{CacheState, CpuCache, NeuralCache, NircConfig, TrainingRecord};
+use nirc::{CacheState, CpuCache, NeuralCache, NircCacheSettings, TrainingRecord};
 use render::gpu::Gpu;
 use std::collections::BTreeSet;
 use std::sync::OnceLock;
@@ -17,7 +17,7 @@ fn gpu() -> &'static Gpu {
     GPU.get_or_init(|| Gpu::new().expect("a wgpu adapter (lavapipe on CI)"))
 }
 
-fn sparse(mut config: NircConfig) -> NircConfig {
+fn sparse(mut config: NircCacheSettings) -> NircCacheSettings {
     config.optimizer.sparse_grid = true;
     config
 }
@@ -103,9 +103,9 @@ fn cpu_sparse_steps_skip_unreached_entries_and_count_the_others() {
 
 /// A grid every record reaches everywhere (two levels of one cell, 8 vertices each): every
 /// grid parameter steps every step, so sparse updates are dense Adam, bit for bit.
-fn reached_everywhere() -> NircConfig {
-    NircConfig {
-        encoding: HashGridConfig {
+fn reached_everywhere() -> NircCacheSettings {
+    NircCacheSettings {
+        encoding: HashGridSettings {
             levels: 2,
             features_per_level: 2,
             log2_table_size: 10,

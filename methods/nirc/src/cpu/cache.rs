@@ -7,7 +7,7 @@ use super::loss::{denominators, relative_l2};
 use super::mlp::{Activations, backward, forward};
 use super::optimizer::{BiasPowers, adam_ema_update, next_powers, sparse_adam_ema_update};
 use super::real::Real;
-use crate::config::{NircConfig, PredictorMode};
+use crate::config::{NircCacheSettings, PredictorMode};
 use crate::fixed_sum::FixedSum;
 use crate::layout::ParameterLayout;
 use crate::records::{CacheAnswer, CacheQuery, ReliabilitySample, TrainingRecord};
@@ -37,7 +37,7 @@ fn xyz(v: [f32; 4]) -> [f32; 3] {
 
 /// Forward of one query through the network with parameters `params`.
 pub fn predict<T: Real>(
-    config: &NircConfig,
+    config: &NircCacheSettings,
     layout: &ParameterLayout,
     params: &[T],
     state: &CacheState,

@@ -2,13 +2,13 @@
 //! caller, over the batch). sg = stop-gradient: the denominator is a constant for the gradient.
 
 use super::real::Real;
-use crate::config::{LossConfig, LossNormalization};
+use crate::config::{LossNormalization, LossSettings};
 
 /// Rec. 709 luminance weights.
 pub const LUMINANCE: [f32; 3] = [0.2126, 0.7152, 0.0722];
 
 /// The denominators sg(f)^2 + ε per channel.
-pub fn denominators<T: Real>(config: &LossConfig, f: [T; 3]) -> [T; 3] {
+pub fn denominators<T: Real>(config: &LossSettings, f: [T; 3]) -> [T; 3] {
     let eps = T::from_f32(config.epsilon);
     match config.normalization {
         LossNormalization::PerChannel => [f[0] * f[0] + eps, f[1] * f[1] + eps, f[2] * f[2] + eps],

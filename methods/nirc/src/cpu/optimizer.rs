@@ -2,7 +2,7 @@
 //! weights. The powers β1^t, β2^t, α^t are carried as running products (not pow) so that the
 //! GPU, which does the same multiplications, gets the same bits.
 
-use crate::optimizer_config::{AdamConfig, EmaConfig};
+use crate::optimizer_config::{AdamSettings, EmaSettings};
 use serde::{Deserialize, Serialize};
 
 render::gpu_struct! {
@@ -51,7 +51,7 @@ impl Default for Counters {
 }
 
 /// The powers after this step: β1^t, β2^t, α^t with t = step + 1.
-pub fn next_powers(c: &Counters, adam: &AdamConfig, ema: &EmaConfig) -> (f32, f32, f32) {
+pub fn next_powers(c: &Counters, adam: &AdamSettings, ema: &EmaSettings) -> (f32, f32, f32) {
     (c.beta1_pow * adam.beta1, c.beta2_pow * adam.beta2, c.alpha_pow * ema.alpha)
 }
 
@@ -66,8 +66,8 @@ pub fn ema_weight(alpha: f32, alpha_pow: f32) -> f32 {
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn adam_ema_update(
-    adam: &AdamConfig,
-    ema: &EmaConfig,
+    adam: &AdamSettings,
+    ema: &EmaSettings,
     powers: (f32, f32, f32),
     alpha_pow_prev: f32,
     w: f32,
@@ -105,7 +105,7 @@ pub struct BiasPowers {
 }
 
 impl BiasPowers {
-    pub fn new(adam: &AdamConfig, ema: &EmaConfig) -> Result<Self, crate::NircError> {
+    pub fn new(adam: &AdamSettings, ema: &EmaSettings) -> Result<Self, crate::NircError> {
         let mut rows = vec![[1.0f32, 1.0, 1.0, 0.0]];
         loop {
             let last = *rows.last().expect("one row");
@@ -136,8 +136,8 @@ impl BiasPowers {
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn sparse_adam_ema_update(
-    adam: &AdamConfig,
-    ema: &EmaConfig,
+    adam: &AdamSettings,
+    ema: &EmaSettings,
     table: &BiasPowers,
     steps: u32,
     w: f32,
@@ -159,7 +159,7 @@ mod tests {
 
     #[test]
     fn bias_power_rows_are_the_dense_running_products_until_they_settle() {
-        let (adam, ema) = (AdamConfig::default(), EmaConfig::default());
+        let (adam, ema) = (AdamSettings::default(), EmaSettings::default());
         let table = BiasPowers::new(&adam, &ema).unwrap();
         let mut c = Counters::default();
         for t in 0..table.rows.len() as u32 + 50 {
@@ -179,15 +179,15 @@ mod tests {
         }
         // 0.99^t < 2^-25 from t = 1725 on: the table is about that long, not a fitted length.
         assert!((1700..1760).contains(&table.rows.len()), "{}", table.rows.len());
-        let close = AdamConfig { beta2: 0.9999999, ..adam };
+        let close = AdamSettings { beta2: 0.9999999, ..adam };
         assert!(BiasPowers::new(&close, &ema).is_err());
     }
 
     #[test]
     fn debiased_ema_of_a_constant_sequence_is_the_constant() {
-        let adam = AdamConfig::default();
+        let adam = AdamSettings::default();
         for alpha in [0.5f32, 0.9, 0.99, 0.999] {
-            let ema = EmaConfig { alpha };
+            let ema = EmaSettings { alpha };
             let w = 0.737_f32;
             // The first debiased value is w_1 itself whatever the initial w̄.
             let mut e = 123.0f32;
@@ -209,8 +209,8 @@ mod tests {
     #[test]
     fn debiased_ema_matches_the_plain_average_form() {
         // w̄_t equals (Σ_s (1-α) α^{t-s} w_s) / (1 - α^t): check in f64 against the update in f32.
-        let ema = EmaConfig { alpha: 0.9 };
-        let adam = AdamConfig::default();
+        let ema = EmaSettings { alpha: 0.9 };
+        let adam = AdamSettings::default();
         let ws: Vec<f32> = (0..50).map(|i| (i as f32 * 0.37).sin()).collect();
         let mut e = 0.0f32;
         let mut c = Counters::default();

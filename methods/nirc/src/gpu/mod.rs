@@ -32,7 +32,7 @@ pub mod shaders;
 pub mod train;
 
 use crate::bounds::SceneBounds;
-use crate::config::{NircConfig, PredictorMode};
+use crate::config::{NircCacheSettings, PredictorMode};
 use crate::cpu::optimizer::Counters;
 use crate::error::NircError;
 use crate::layout::ParameterLayout;
@@ -172,7 +172,7 @@ struct FixedBindGroups {
 
 /// The neural incident radiance cache on the GPU.
 pub struct NeuralCache {
-    pub config: NircConfig,
+    pub config: NircCacheSettings,
     pub bounds: SceneBounds,
     pub layout: ParameterLayout,
     pub placement: WeightPlacement,

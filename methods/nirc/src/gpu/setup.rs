@@ -7,7 +7,7 @@ use super::{
     grid_textures, lane,
 };
 use crate::bounds::SceneBounds;
-use crate::config::NircConfig;
+use crate::config::NircCacheSettings;
 use crate::error::NircError;
 use crate::layout::ParameterLayout;
 use crate::records::ReliabilitySample;
@@ -46,7 +46,7 @@ impl NeuralCache {
     /// A fresh cache (initial weights from `config.seed`) over `scene_bounds`.
     pub fn new(
         gpu: &Gpu,
-        config: &NircConfig,
+        config: &NircCacheSettings,
         scene_bounds: SceneBounds,
     ) -> Result<Self, NircError> {
         Self::from_state(gpu, &CacheState::initial(config, scene_bounds)?, None)
@@ -128,7 +128,7 @@ impl NeuralCache {
     /// error naming the pass.
     fn pipelines(
         gpu: &Gpu,
-        config: &NircConfig,
+        config: &NircCacheSettings,
         layout: &ParameterLayout,
         placement: WeightPlacement,
         grid_width: Option<u32>,
@@ -204,7 +204,7 @@ impl NeuralCache {
         })
     }
 
-    fn hyper(config: &NircConfig, bounds: &SceneBounds) -> Hyper {
+    fn hyper(config: &NircCacheSettings, bounds: &SceneBounds) -> Hyper {
         let inv = bounds.inv_extent();
         Hyper {
             bounds_min: [bounds.min[0], bounds.min[1], bounds.min[2], 0.0],
@@ -232,7 +232,7 @@ impl NeuralCache {
 
     fn buffers(
         gpu: &Gpu,
-        config: &NircConfig,
+        config: &NircCacheSettings,
         layout: &ParameterLayout,
         state: &CacheState,
         placement: WeightPlacement,
@@ -320,7 +320,7 @@ impl NeuralCache {
 
     fn sparse_buffers(
         gpu: &Gpu,
-        config: &NircConfig,
+        config: &NircCacheSettings,
         layout: &ParameterLayout,
         state: &CacheState,
     ) -> Result<Option<SparseBuffers>, NircError> {

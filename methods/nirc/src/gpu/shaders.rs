@@ -2,7 +2,7 @@
 //! shared files of methods/nirc/shaders/, then the pass itself.
 
 use super::WORKGROUP_SIZE;
-use crate::config::NircConfig;
+use crate::config::NircCacheSettings;
 use crate::layout::ParameterLayout;
 use crate::reliability::cell_count;
 use render::shader::{Module, Program};
@@ -112,7 +112,7 @@ pub fn structs() -> String {
 }
 
 /// The network's sizes, level tables and grid constants (`package::nirc::config`).
-fn config_constants(config: &NircConfig, layout: &ParameterLayout) -> String {
+fn config_constants(config: &NircCacheSettings, layout: &ParameterLayout) -> String {
     let (dir_kind, dir_bands) = config.direction.code();
     let mut s = String::new();
     let mut c = |name: &str, v: u32| s.push_str(&format!("const {name}: u32 = {v}u;\n"));
@@ -215,7 +215,7 @@ macro_rules! nirc_file {
 /// the pass's entry-point file. `grid_width`: the grid mirror's texture width where the
 /// passes read and write it (grid_textures.rs).
 pub fn program(
-    config: &NircConfig,
+    config: &NircCacheSettings,
     layout: &ParameterLayout,
     pass: &str,
     grid_width: Option<u32>,

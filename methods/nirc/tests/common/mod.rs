@@ -2,8 +2,8 @@
 //! known smooth function.
 #![allow(dead_code)]
 
-use nirc::config::{DirectionEncoding, HashGridConfig, NetworkConfig, ReliabilityConfig};
-use nirc::{CacheState, NircConfig, SceneBounds, TrainingRecord};
+use nirc::config::{DirectionEncoding, HashGridSettings, NetworkSettings, ReliabilitySettings};
+use nirc::{CacheState, NircCacheSettings, SceneBounds, TrainingRecord};
 
 pub struct Rng(pub u64);
 impl Rng {
@@ -26,9 +26,9 @@ impl Rng {
 }
 
 /// Width 16, 2 hidden layers, 4 levels (two dense, two hashed into 2^10 entries).
-pub fn small_config() -> NircConfig {
-    NircConfig {
-        encoding: HashGridConfig {
+pub fn small_config() -> NircCacheSettings {
+    NircCacheSettings {
+        encoding: HashGridSettings {
             levels: 4,
             features_per_level: 2,
             log2_table_size: 10,
@@ -37,8 +37,8 @@ pub fn small_config() -> NircConfig {
             init_scale: 1e-4,
         },
         direction: DirectionEncoding::SphericalHarmonics { bands: 3 },
-        network: NetworkConfig { width: 32, hidden_layers: 2 },
-        reliability: ReliabilityConfig {
+        network: NetworkSettings { width: 32, hidden_layers: 2 },
+        reliability: ReliabilitySettings {
             resolution: 8,
             log2_cells: 8,
             warmup: 2,
@@ -79,7 +79,7 @@ pub fn records(rng: &mut Rng, n: usize) -> Vec<TrainingRecord> {
 
 /// A state whose grid entries and weights are far from their tiny initial values, with EMA
 /// weights different from the trained ones.
-pub fn randomized_state(config: &NircConfig, seed: u64) -> CacheState {
+pub fn randomized_state(config: &NircCacheSettings, seed: u64) -> CacheState {
     let mut s = CacheState::initial(config, bounds()).unwrap();
     let mut rng = Rng(seed);
     let mlp = s.layout().mlp_params as usize;
