@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use playback::play::{Overrides, RunSpec};
 use serde::Deserialize;
-use sim::scenario::{ReferenceFrames, ScenarioError};
+use sim::scenario::{MethodEntry, ReferenceFrames, ScenarioError};
 
 use crate::ron_file::{self, RonFile};
 use playback::methods::{FolderInput, Source};
@@ -509,6 +509,301 @@ fn check_confidence(file: RonFile, line: usize, c: f64) -> Result<(), ScenarioEr
     }
 }
 
+/// One entry of `cases`, checked (`cases`: the entries before it): the case, the methods of its
+/// scenario or its computation, and its events.
+fn read_case(
+    file: RonFile,
+    entry: &MethodEntry,
+    folder: &Path,
+    cases: &[ClaimCase],
+) -> Result<(ClaimCase, CaseMethods, CaseEvents), ScenarioError> {
+    let mut case: ClaimCase = file.entry(entry)?;
+    if case.seeds.is_empty() {
+        return Err(file.error_at(
+            entry,
+            format!("case '{}' has no seeds; expected e.g. seeds: [1, 2, 3]", case.name),
+        ));
+    }
+    if cases.iter().any(|c| c.name == case.name) {
+        return Err(file.error_at(
+            entry,
+            format!("two cases are named '{}'; expected distinct names", case.name),
+        ));
+    }
+    let at = |m: String| file.error_at(entry, format!("case '{}': {m}", case.name));
+    let scenario_path = match (&mut case.scenario, &case.computation) {
+        (Some(p), None) => {
+            if p.is_relative() {
+                *p = folder.join(&*p);
+            }
+            p.clone()
+        }
+        (None, Some(c)) => {
+            let computed = c.methods().map_err(|e| at(format!("{}: {e}", c.name())))?;
+            let kinds = computed.keys().map(|l| (l.clone(), c.name())).collect();
+            if !case.table.is_empty() {
+                return Err(at("table: a computed case's table holds its claims' statistics only; expected no table".into()));
+            }
+            if case.methods.is_some() {
+                return Err(at(
+                    "methods: a computed case has no scenario to choose from; expected no methods"
+                        .into(),
+                ));
+            }
+            if case.by_window.is_some() {
+                return Err(at(
+                    "by_window: a computed case has no frames; expected no by_window".into()
+                ));
+            }
+            let references = false;
+            let methods = CaseMethods {
+                kinds,
+                references,
+                computed: Some(computed),
+                image_maps: BTreeMap::new(),
+            };
+            return Ok((case, methods, CaseEvents::default()));
+        }
+        _ => {
+            return Err(at(
+                "expected either scenario: \"PATH.ron\" or computation: ... (not both)".into(),
+            ));
+        }
+    };
+    let (case_methods, case_events) = scenario_case(file, entry, &mut case, &scenario_path)?;
+    Ok((case, case_methods, case_events))
+}
+
+/// A case that plays `scenario_path`: its methods (those it keeps) and events, its scales' sets
+/// expanded, its table and `by_window` checked against them.
+fn scenario_case(
+    file: RonFile,
+    entry: &MethodEntry,
+    case: &mut ClaimCase,
+    scenario_path: &Path,
+) -> Result<(CaseMethods, CaseEvents), ScenarioError> {
+    let at = |m: String| file.error_at(entry, format!("case '{}': {m}", case.name));
+    if !scenario_path.is_file() {
+        return Err(at(format!("scenario {} does not exist", scenario_path.display())));
+    }
+    let scenario = sim::Scenario::load(scenario_path).map_err(|e| at(e.to_string()))?;
+    let spec = RunSpec::from_scenario(scenario, &Overrides::default())
+        .map_err(|e| at(format!("{e:#}")))?;
+    let mut kinds: BTreeMap<String, &'static str> =
+        spec.methods.iter().map(|m| (m.label(), m.spec.name())).collect();
+    if let Some(keep) = &case.methods {
+        if let Some(unknown) = keep.iter().find(|k| !kinds.contains_key(*k)) {
+            return Err(at(format!(
+                "no method labelled '{unknown}' in {}; its methods are: {}",
+                scenario_path.display(),
+                kinds.keys().cloned().collect::<Vec<_>>().join(", ")
+            )));
+        }
+        kinds.retain(|label, _| keep.contains(label));
+    }
+    let mut played = spec.methods.clone();
+    if let Some(keep) = &case.methods {
+        played.retain(|m| keep.contains(&m.label()));
+    }
+    let name = case.name.clone();
+    for (scale, size) in
+        [("smoke", &mut case.smoke), ("lab", &mut case.lab), ("paper", &mut case.paper)]
+    {
+        let at = |m: String| file.error_at(entry, format!("case '{name}': {scale}: {m}"));
+        if size.seeds.is_some_and(|n| n < 2) {
+            return Err(at("seeds below 2; an interval needs at least 2".into()));
+        }
+        size.params = expand_set(&played, &size.set).map_err(at)?;
+    }
+    let case_events = CaseEvents::of(
+        &spec.scenario,
+        [("smoke", case.smoke.frames), ("lab", case.lab.frames), ("paper", case.paper.frames)],
+    );
+    let r = &spec.scenario.reference;
+    let references = r.spp > 0 && r.frames != ReferenceFrames::None;
+    let image_maps = playback::methods::registry::statistics()
+        .into_iter()
+        .filter_map(|s| match s.source {
+            Source::Images(i) => match i.input {
+                FolderInput::EventAndMap { map, .. } => Some(map),
+                _ => None,
+            },
+            _ => None,
+        })
+        .map(|map| {
+            let writers = played.iter().filter(|m| m.spec.writes_image(map));
+            (map, writers.map(|m| m.label()).collect())
+        })
+        .collect();
+    let case_methods = CaseMethods { kinds, references, computed: None, image_maps };
+    for s in &case.table {
+        let at = |m: String| at(format!("table: {}: {m}", s.describe()));
+        if s.against.is_some() || !s.not_run.is_empty() {
+            return Err(at("against or not_run; expected them in a claim's statistic".into()));
+        }
+        check_passes(s, &case_methods).map_err(at)?;
+        case_events.check(&s.window, &name).map_err(at)?;
+    }
+    if let Some(by) = &case.by_window {
+        by.check(&case_methods).map_err(at)?;
+        for w in &by.windows {
+            case_events.check(w, &name).map_err(|m| at(format!("by_window: {m}")))?;
+        }
+    }
+    Ok((case_methods, case_events))
+}
+
+/// One entry of `claims`, checked against the file's cases and the claims before it; `against`
+/// and `not_run` gather, per case, what its claims' statistics must agree on.
+fn read_claim(
+    file: RonFile,
+    entry: &MethodEntry,
+    claims: &[Claim],
+    methods: &BTreeMap<String, CaseMethods>,
+    events: &BTreeMap<String, CaseEvents>,
+    against: &mut BTreeMap<String, String>,
+    not_run: &mut BTreeMap<String, Vec<(String, Vec<String>)>>,
+) -> Result<Claim, ScenarioError> {
+    let mut claim: Claim = file.entry(entry)?;
+    claim.line = entry.line;
+    let at = |m: String| file.error_at(entry, format!("claim '{}': {m}", claim.id));
+    if claims.iter().any(|c| c.id == claim.id) {
+        return Err(at("the id is used twice; expected distinct ids".into()));
+    }
+    claim.smallest_effect.check().map_err(at)?;
+    if claim.smallest_effect_from.trim().is_empty() {
+        return Err(at("smallest_effect_from is empty; expected where the margin comes from: the paper or an argued threshold".into()));
+    }
+    match &claim.comparison {
+        Comparison::Below { confidence, .. }
+        | Comparison::NotAbove { confidence, .. }
+        | Comparison::Rises { confidence, .. } => check_confidence(file, entry.line, *confidence)?,
+        Comparison::Value { confidence, .. }
+        | Comparison::Ratio { confidence, .. }
+        | Comparison::Difference { confidence, .. } => {
+            check_confidence(file, entry.line, *confidence)?;
+        }
+        Comparison::LogRatio { confidence, expect, .. } => {
+            check_confidence(file, entry.line, *confidence)?;
+            expect.check(&claim.smallest_effect).map_err(at)?;
+            if let Some(s) = &claim.statistic {
+                super::log_ratio::check_metric(s.metric).map_err(at)?;
+            }
+        }
+        Comparison::NotComparable { .. } => {}
+    }
+    let comparable = !matches!(claim.comparison, Comparison::NotComparable { .. });
+    let case = match &claim.case {
+        Some(name) => Some(methods.get(name).ok_or_else(|| {
+            at(format!(
+                "no case '{name}'; the file's cases are: {}",
+                methods.keys().cloned().collect::<Vec<_>>().join(", ")
+            ))
+        })?),
+        None if comparable => {
+            return Err(at("no case; expected e.g. case: \"cornell\"".into()));
+        }
+        None => None,
+    };
+    if comparable && claim.statistic.is_none() {
+        return Err(at(
+            "no statistic; expected e.g. statistic: (metric: Flip, window: Overall)".into()
+        ));
+    }
+    if let (Some(case), Some(s)) = (case, &claim.statistic) {
+        let name = claim.case.as_deref().unwrap_or_default();
+        check_against(s, case, name, against).map_err(at)?;
+        check_not_run(s, case, name, not_run).map_err(at)?;
+        check_passes(s, case).map_err(at)?;
+        let events = &events[name];
+        events.check(&s.window, name).map_err(at)?;
+        if let Comparison::Rises { from, .. } = &claim.comparison {
+            events.check(from, name).map_err(|m| at(format!("from: {m}")))?;
+        }
+    }
+    if let Some(case) = case {
+        check_claim_methods(&claim, case, at)?;
+    }
+    Ok(claim)
+}
+
+/// Each method a claim compares is in its case and records the claim's statistic.
+fn check_claim_methods(
+    claim: &Claim,
+    case: &CaseMethods,
+    at: impl Fn(String) -> ScenarioError,
+) -> Result<(), ScenarioError> {
+    for m in claim.comparison.methods() {
+        let Some(kind) = case.kinds.get(m) else {
+            return Err(at(format!(
+                "unknown method '{m}' in case '{}'; its methods are: {}",
+                claim.case.as_deref().unwrap_or_default(),
+                case.kinds.keys().cloned().collect::<Vec<_>>().join(", ")
+            )));
+        };
+        let recorded = |metric: Metric| match &case.computed {
+            Some(c) => c.get(m).is_some_and(|ms| ms.contains(&metric)),
+            None => metric.recorded_by(kind, case.references),
+        };
+        if let Some(s) = &claim.statistic
+            && !recorded(s.metric)
+        {
+            let why = if case.computed.is_some() {
+                " (a computed case)"
+            } else if case.references {
+                ""
+            } else {
+                " (the scenario has no reference frames)"
+            };
+            return Err(at(format!(
+                "method '{m}' ({kind}) does not record the statistic {}{why}",
+                s.metric.name()
+            )));
+        }
+        if let Some(s) = &claim.statistic
+            && let Some(FolderInput::EventAndMap { map, writers }) =
+                s.metric.from_images_by().map(|i| i.input)
+        {
+            let written = case.image_maps.get(map).map_or(&[][..], |w| &w[..]);
+            if !written.iter().any(|p| p == m) {
+                return Err(at(format!(
+                    "method '{m}' writes no {map} maps, so it has no {}; expected {writers}: {}",
+                    s.metric.name(),
+                    written.join(", ")
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Each `variant_of` names another claim of the file that is no variant itself.
+fn check_variants(file: RonFile, claims: &[Claim]) -> Result<(), ScenarioError> {
+    for c in claims {
+        let Some(v) = &c.variant_of else { continue };
+        let at = |m: String| file.error(Some((c.line, 1)), format!("claim '{}': {m}", c.id));
+        match claims.iter().find(|b| b.id == v.claim) {
+            None => {
+                return Err(at(format!(
+                    "variant_of: no claim '{}' in this file; expected the id of the claim this one switches a condition of",
+                    v.claim
+                )));
+            }
+            Some(b) if b.id == c.id || b.variant_of.is_some() => {
+                return Err(at(format!(
+                    "variant_of: '{}' is itself a variant (or this claim); expected the claim judged under the other condition",
+                    v.claim
+                )));
+            }
+            Some(_) if v.switched.trim().is_empty() => {
+                return Err(at("variant_of: switched is empty; expected what differs, e.g. \"irradiance: PathTraced\"".into()));
+            }
+            Some(_) => {}
+        }
+    }
+    Ok(())
+}
+
 impl Claims {
     pub fn load(path: &Path) -> Result<Claims, ScenarioError> {
         Self::from_ron(&ron_file::read(path, "claims file")?, path)
@@ -523,137 +818,7 @@ impl Claims {
         let mut case_lines = BTreeMap::new();
         let mut events: BTreeMap<String, CaseEvents> = BTreeMap::new();
         for entry in file.entries("cases", &parsed.cases) {
-            let mut case: ClaimCase = file.entry(&entry)?;
-            if case.seeds.is_empty() {
-                return Err(file.error_at(
-                    &entry,
-                    format!("case '{}' has no seeds; expected e.g. seeds: [1, 2, 3]", case.name),
-                ));
-            }
-            if cases.iter().any(|c| c.name == case.name) {
-                return Err(file.error_at(
-                    &entry,
-                    format!("two cases are named '{}'; expected distinct names", case.name),
-                ));
-            }
-            let at = |m: String| file.error_at(&entry, format!("case '{}': {m}", case.name));
-            let scenario_path = match (&mut case.scenario, &case.computation) {
-                (Some(p), None) => {
-                    if p.is_relative() {
-                        *p = folder.join(&*p);
-                    }
-                    p.clone()
-                }
-                (None, Some(c)) => {
-                    let computed = c.methods().map_err(|e| at(format!("{}: {e}", c.name())))?;
-                    let kinds = computed.keys().map(|l| (l.clone(), c.name())).collect();
-                    if !case.table.is_empty() {
-                        return Err(at("table: a computed case's table holds its claims' statistics only; expected no table".into()));
-                    }
-                    if case.methods.is_some() {
-                        return Err(at("methods: a computed case has no scenario to choose from; expected no methods".into()));
-                    }
-                    if case.by_window.is_some() {
-                        return Err(at(
-                            "by_window: a computed case has no frames; expected no by_window"
-                                .into(),
-                        ));
-                    }
-                    events.insert(case.name.clone(), CaseEvents::default());
-                    let references = false;
-                    methods.insert(
-                        case.name.clone(),
-                        CaseMethods {
-                            kinds,
-                            references,
-                            computed: Some(computed),
-                            image_maps: BTreeMap::new(),
-                        },
-                    );
-                    case_lines.insert(case.name.clone(), (entry.line, entry.column));
-                    cases.push(case);
-                    continue;
-                }
-                _ => {
-                    return Err(at(
-                        "expected either scenario: \"PATH.ron\" or computation: ... (not both)"
-                            .into(),
-                    ));
-                }
-            };
-            if !scenario_path.is_file() {
-                return Err(at(format!("scenario {} does not exist", scenario_path.display())));
-            }
-            let scenario = sim::Scenario::load(&scenario_path).map_err(|e| at(e.to_string()))?;
-            let spec = RunSpec::from_scenario(scenario, &Overrides::default())
-                .map_err(|e| at(format!("{e:#}")))?;
-            let mut kinds: BTreeMap<String, &'static str> =
-                spec.methods.iter().map(|m| (m.label(), m.spec.name())).collect();
-            if let Some(keep) = &case.methods {
-                if let Some(unknown) = keep.iter().find(|k| !kinds.contains_key(*k)) {
-                    return Err(at(format!(
-                        "no method labelled '{unknown}' in {}; its methods are: {}",
-                        scenario_path.display(),
-                        kinds.keys().cloned().collect::<Vec<_>>().join(", ")
-                    )));
-                }
-                kinds.retain(|label, _| keep.contains(label));
-            }
-            let mut played = spec.methods.clone();
-            if let Some(keep) = &case.methods {
-                played.retain(|m| keep.contains(&m.label()));
-            }
-            let name = case.name.clone();
-            for (scale, size) in
-                [("smoke", &mut case.smoke), ("lab", &mut case.lab), ("paper", &mut case.paper)]
-            {
-                let at = |m: String| file.error_at(&entry, format!("case '{name}': {scale}: {m}"));
-                if size.seeds.is_some_and(|n| n < 2) {
-                    return Err(at("seeds below 2; an interval needs at least 2".into()));
-                }
-                size.params = expand_set(&played, &size.set).map_err(at)?;
-            }
-            let case_events = CaseEvents::of(
-                &spec.scenario,
-                [
-                    ("smoke", case.smoke.frames),
-                    ("lab", case.lab.frames),
-                    ("paper", case.paper.frames),
-                ],
-            );
-            let r = &spec.scenario.reference;
-            let references = r.spp > 0 && r.frames != ReferenceFrames::None;
-            let image_maps = playback::methods::registry::statistics()
-                .into_iter()
-                .filter_map(|s| match s.source {
-                    Source::Images(i) => match i.input {
-                        FolderInput::EventAndMap { map, .. } => Some(map),
-                        _ => None,
-                    },
-                    _ => None,
-                })
-                .map(|map| {
-                    let writers = played.iter().filter(|m| m.spec.writes_image(map));
-                    (map, writers.map(|m| m.label()).collect())
-                })
-                .collect();
-            let case_methods = CaseMethods { kinds, references, computed: None, image_maps };
-            for s in &case.table {
-                let at = |m: String| at(format!("table: {}: {m}", s.describe()));
-                if s.against.is_some() || !s.not_run.is_empty() {
-                    return Err(at(
-                        "against or not_run; expected them in a claim's statistic".into()
-                    ));
-                }
-                check_passes(s, &case_methods).map_err(at)?;
-                case_events.check(&s.window, &name).map_err(at)?;
-            }
-            if let Some(by) = &case.by_window {
-                by.check(&case_methods).map_err(at)?;
-                for w in &by.windows {
-                    case_events.check(w, &name).map_err(|m| at(format!("by_window: {m}")))?;
-                }
-            }
+            let (case, case_methods, case_events) = read_case(file, &entry, folder, &cases)?;
             events.insert(case.name.clone(), case_events);
             methods.insert(case.name.clone(), case_methods);
             case_lines.insert(case.name.clone(), (entry.line, entry.column));
@@ -665,135 +830,14 @@ impl Claims {
         // Per case, the passes its methods' FrameMs leaves out.
         let mut not_run: BTreeMap<String, Vec<(String, Vec<String>)>> = BTreeMap::new();
         for entry in file.entries("claims", &parsed.claims) {
-            let mut claim: Claim = file.entry(&entry)?;
-            claim.line = entry.line;
-            let at = |m: String| file.error_at(&entry, format!("claim '{}': {m}", claim.id));
-            if claims.iter().any(|c| c.id == claim.id) {
-                return Err(at("the id is used twice; expected distinct ids".into()));
-            }
-            claim.smallest_effect.check().map_err(at)?;
-            if claim.smallest_effect_from.trim().is_empty() {
-                return Err(at("smallest_effect_from is empty; expected where the margin comes from: the paper or an argued threshold".into()));
-            }
-            match &claim.comparison {
-                Comparison::Below { confidence, .. }
-                | Comparison::NotAbove { confidence, .. }
-                | Comparison::Rises { confidence, .. } => {
-                    check_confidence(file, entry.line, *confidence)?
-                }
-                Comparison::Value { confidence, .. }
-                | Comparison::Ratio { confidence, .. }
-                | Comparison::Difference { confidence, .. } => {
-                    check_confidence(file, entry.line, *confidence)?;
-                }
-                Comparison::LogRatio { confidence, expect, .. } => {
-                    check_confidence(file, entry.line, *confidence)?;
-                    expect.check(&claim.smallest_effect).map_err(at)?;
-                    if let Some(s) = &claim.statistic {
-                        super::log_ratio::check_metric(s.metric).map_err(at)?;
-                    }
-                }
-                Comparison::NotComparable { .. } => {}
-            }
-            let comparable = !matches!(claim.comparison, Comparison::NotComparable { .. });
-            let case = match &claim.case {
-                Some(name) => Some(methods.get(name).ok_or_else(|| {
-                    at(format!(
-                        "no case '{name}'; the file's cases are: {}",
-                        methods.keys().cloned().collect::<Vec<_>>().join(", ")
-                    ))
-                })?),
-                None if comparable => {
-                    return Err(at("no case; expected e.g. case: \"cornell\"".into()));
-                }
-                None => None,
-            };
-            if comparable && claim.statistic.is_none() {
-                return Err(at(
-                    "no statistic; expected e.g. statistic: (metric: Flip, window: Overall)".into(),
-                ));
-            }
-            if let (Some(case), Some(s)) = (case, &claim.statistic) {
-                let name = claim.case.as_deref().unwrap_or_default();
-                check_against(s, case, name, &mut against).map_err(at)?;
-                check_not_run(s, case, name, &mut not_run).map_err(at)?;
-                check_passes(s, case).map_err(at)?;
-                let events = &events[name];
-                events.check(&s.window, name).map_err(at)?;
-                if let Comparison::Rises { from, .. } = &claim.comparison {
-                    events.check(from, name).map_err(|m| at(format!("from: {m}")))?;
-                }
-            }
-            if let Some(case) = case {
-                for m in claim.comparison.methods() {
-                    let Some(kind) = case.kinds.get(m) else {
-                        return Err(at(format!(
-                            "unknown method '{m}' in case '{}'; its methods are: {}",
-                            claim.case.as_deref().unwrap_or_default(),
-                            case.kinds.keys().cloned().collect::<Vec<_>>().join(", ")
-                        )));
-                    };
-                    let recorded = |metric: Metric| match &case.computed {
-                        Some(c) => c.get(m).is_some_and(|ms| ms.contains(&metric)),
-                        None => metric.recorded_by(kind, case.references),
-                    };
-                    if let Some(s) = &claim.statistic
-                        && !recorded(s.metric)
-                    {
-                        let why = if case.computed.is_some() {
-                            " (a computed case)"
-                        } else if case.references {
-                            ""
-                        } else {
-                            " (the scenario has no reference frames)"
-                        };
-                        return Err(at(format!(
-                            "method '{m}' ({kind}) does not record the statistic {}{why}",
-                            s.metric.name()
-                        )));
-                    }
-                    if let Some(s) = &claim.statistic
-                        && let Some(FolderInput::EventAndMap { map, writers }) =
-                            s.metric.from_images_by().map(|i| i.input)
-                    {
-                        let written = case.image_maps.get(map).map_or(&[][..], |w| &w[..]);
-                        if !written.iter().any(|p| p == m) {
-                            return Err(at(format!(
-                                "method '{m}' writes no {map} maps, so it has no {}; expected {writers}: {}",
-                                s.metric.name(),
-                                written.join(", ")
-                            )));
-                        }
-                    }
-                }
-            }
+            let claim =
+                read_claim(file, &entry, &claims, &methods, &events, &mut against, &mut not_run)?;
             claims.push(claim);
         }
         if claims.is_empty() {
             return Err(file.error(None, "no claims; expected at least one".into()));
         }
-        for c in &claims {
-            let Some(v) = &c.variant_of else { continue };
-            let at = |m: String| file.error(Some((c.line, 1)), format!("claim '{}': {m}", c.id));
-            match claims.iter().find(|b| b.id == v.claim) {
-                None => {
-                    return Err(at(format!(
-                        "variant_of: no claim '{}' in this file; expected the id of the claim this one switches a condition of",
-                        v.claim
-                    )));
-                }
-                Some(b) if b.id == c.id || b.variant_of.is_some() => {
-                    return Err(at(format!(
-                        "variant_of: '{}' is itself a variant (or this claim); expected the claim judged under the other condition",
-                        v.claim
-                    )));
-                }
-                Some(_) if v.switched.trim().is_empty() => {
-                    return Err(at("variant_of: switched is empty; expected what differs, e.g. \"irradiance: PathTraced\"".into()));
-                }
-                Some(_) => {}
-            }
-        }
+        check_variants(file, &claims)?;
         Ok(Claims {
             paper: parsed.paper,
             title: parsed.title,
