@@ -267,3 +267,83 @@ fn far_apart_geometry_builds() {
     SceneBvh::new(&scene(cube(), vec![at(0.0), at(1.0), at(far)]))
         .unwrap_or_else(|e| panic!("{e}"));
 }
+
+/// Flat instances, whose world boxes have no thickness (a floor, a ceiling, a light 5 mm under
+/// it, a wall, one far from the origin, one turned), hit near their edges and corners and inside,
+/// by rays from other quads' surfaces moved off them as `offset_origin` moves a path's vertex,
+/// with t_max unbounded, just past the hit, or 0.1% short of it (a shadow ray to a light). The
+/// traversal tests an instance's padded world box before entering it (`sg_box_entered`); no
+/// hit the CPU finds may be culled by it.
+#[test]
+fn flat_instances_are_entered_by_every_ray_that_hits_them() {
+    use std::f32::consts::{FRAC_PI_2, PI};
+    let quad_at = |t: Vec3, r: Quat, s: Vec3| Instance {
+        mesh: 0,
+        material: 0,
+        transform: Mat4::from_scale_rotation_translation(s, r, t),
+    };
+    let down = Quat::from_rotation_x(PI);
+    let scene = SceneDesc {
+        meshes: vec![quad()],
+        instances: vec![
+            quad_at(Vec3::ZERO, Quat::IDENTITY, Vec3::ONE),
+            quad_at(Vec3::new(0.0, 2.0, 0.0), down, Vec3::ONE),
+            quad_at(Vec3::new(0.0, 1.995, 0.0), down, Vec3::new(0.25, 1.0, 0.2)),
+            quad_at(Vec3::new(-1.0, 1.0, 0.0), Quat::from_rotation_z(-FRAC_PI_2), Vec3::ONE),
+            quad_at(
+                Vec3::new(0.3, 0.7, -0.2),
+                Quat::from_axis_angle(Vec3::new(1.0, 2.0, 3.0).normalize(), 0.7),
+                Vec3::new(0.4, 1.0, 0.3),
+            ),
+            quad_at(Vec3::new(0.1, 0.3, 0.7), Quat::IDENTITY, Vec3::new(0.1, 1.0, 0.1)),
+            quad_at(Vec3::new(1000.0, 3.0, -500.0), Quat::IDENTITY, Vec3::splat(5.0)),
+        ],
+        ..Default::default()
+    };
+    let gpu = gpu();
+    let geometry = SceneGeometry::new(&gpu, &scene).unwrap();
+    let bvh = geometry.cpu();
+    let mut rng = SplitMix64::new(55);
+    // A point of instance i's quad: near an outer edge or corner (a hair inside, so that the
+    // object-space tests of the CPU and the GPU agree on it; off the diagonal the quad's two
+    // triangles share), or anywhere.
+    let point = |i: usize, rng: &mut SplitMix64| {
+        let (a, b) = match rng.next_u64() % 3 {
+            0 => (1.0 - 1e-5, rng.range(-1.0, 1.0)),
+            1 => (1.0 - 1e-5, 1.0 - 3e-5),
+            _ => (rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)),
+        };
+        let (a, b) = if rng.next_u64() % 2 == 0 { (a, b) } else { (b, a) };
+        let sign = |rng: &mut SplitMix64| if rng.next_u64() % 2 == 0 { 1.0 } else { -1.0 };
+        let local = Vec3::new(a * sign(rng), 0.0, b * sign(rng));
+        let m = bvh.instances[i].object_to_world;
+        (m.transform_point3(local), m.transform_vector3(Vec3::Y).normalize())
+    };
+    let near = scene.instances.len() - 1;
+    let mut rays = Vec::with_capacity(RAYS);
+    for k in 0..RAYS {
+        let target_instance = (rng.next_u64() % scene.instances.len() as u64) as usize;
+        let (target, _) = point(target_instance, &mut rng);
+        // From another quad's surface (the far quad from itself, or a point near it).
+        let from = if target_instance == near {
+            target + rng.unit_vector() * rng.range(0.5, 20.0)
+        } else {
+            let mut other = (rng.next_u64() % near as u64) as usize;
+            if other == target_instance {
+                other = (other + 1) % near;
+            }
+            let (p, n) = point(other, &mut rng);
+            let to = target - p;
+            let scale = 1.0e-4 * (1.0 + p.abs().max_element());
+            p + n * if to.dot(n) >= 0.0 { scale } else { -scale }
+        };
+        let t_max = match k % 3 {
+            0 => 1e30,
+            1 => 1.0 + 1e-5,
+            _ => 1.0 - 1e-3,
+        };
+        rays.push(RayQuery { origin: from, direction: target - from, t_max });
+    }
+    cpu_matches_brute_force("flat instances", &scene, bvh, &rays);
+    gpu_matches_cpu("flat instances", &gpu, &scene, &geometry, &rays);
+}
