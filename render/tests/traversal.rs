@@ -315,8 +315,8 @@ fn flat_instances_are_entered_by_every_ray_that_hits_them() {
             1 => (1.0 - 1e-5, 1.0 - 3e-5),
             _ => (rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)),
         };
-        let (a, b) = if rng.next_u64() % 2 == 0 { (a, b) } else { (b, a) };
-        let sign = |rng: &mut SplitMix64| if rng.next_u64() % 2 == 0 { 1.0 } else { -1.0 };
+        let (a, b) = if rng.next_u64().is_multiple_of(2) { (a, b) } else { (b, a) };
+        let sign = |rng: &mut SplitMix64| if rng.next_u64().is_multiple_of(2) { 1.0 } else { -1.0 };
         let local = Vec3::new(a * sign(rng), 0.0, b * sign(rng));
         let m = bvh.instances[i].object_to_world;
         (m.transform_point3(local), m.transform_vector3(Vec3::Y).normalize())
