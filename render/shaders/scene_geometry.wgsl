@@ -41,15 +41,21 @@ fn sg_triangle(slot: u32) -> SgTriangle {
     return SgTriangle(bitcast<vec3f>(a.xyz), a.w, bitcast<vec3f>(b.xyz), b.w, bitcast<vec3f>(c.xyz), c.w);
 }
 
-fn sg_tlas_leaf(slot: u32) -> SgTlasLeaf {
-    let m = mat4x4f(
-        bitcast<vec4f>(texel_fetch(sg_tlas_leaves, slot, 5u, 0u)),
-        bitcast<vec4f>(texel_fetch(sg_tlas_leaves, slot, 5u, 1u)),
-        bitcast<vec4f>(texel_fetch(sg_tlas_leaves, slot, 5u, 2u)),
-        bitcast<vec4f>(texel_fetch(sg_tlas_leaves, slot, 5u, 3u)),
+// A TLAS leaf's padded world box and instance (texels 0 and 1; the transform left zero), and its
+// transform (2-5), read apart: the transform only when the ray meets the box.
+fn sg_tlas_leaf_box(slot: u32) -> SgTlasLeaf {
+    let a = texel_fetch(sg_tlas_leaves, slot, 6u, 0u);
+    let b = texel_fetch(sg_tlas_leaves, slot, 6u, 1u);
+    return SgTlasLeaf(bitcast<vec3f>(a.xyz), a.w, bitcast<vec3f>(b.xyz), b.w, mat4x4f());
+}
+
+fn sg_tlas_leaf_transform(slot: u32) -> mat4x4f {
+    return mat4x4f(
+        bitcast<vec4f>(texel_fetch(sg_tlas_leaves, slot, 6u, 2u)),
+        bitcast<vec4f>(texel_fetch(sg_tlas_leaves, slot, 6u, 3u)),
+        bitcast<vec4f>(texel_fetch(sg_tlas_leaves, slot, 6u, 4u)),
+        bitcast<vec4f>(texel_fetch(sg_tlas_leaves, slot, 6u, 5u)),
     );
-    let e = texel_fetch(sg_tlas_leaves, slot, 5u, 4u);
-    return SgTlasLeaf(m, e.x, e.y, e.z, e.w);
 }
 
 fn sg_texel_f(table: texture_storage_2d<rgba32uint, read>, record: u32, texels: u32, j: u32) -> vec4f {
@@ -213,6 +219,26 @@ fn sg_intersect_node(node: SgNode, ray: SgRay, t_max: f32) -> u32 {
     return hits;
 }
 
+// Whether the ray meets the box before t_max: a slab test in world space, its far distance grown
+// by 2 gamma_3 (Ize 2013, "Robust BVH Ray Traversal") against rounding; the boxes are grown too
+// (LEAF_BOX_PAD). Why: a TLAS node's 8-bit boxes are coarse (1.6 cm steps in a 2 m room), so
+// without it a ray entered every instance whose box lay within a step of it: the wall it leaves
+// (its origin is 1e-4 off the surface) and, for a shadow ray ending 1 mm short of a ceiling
+// light, the light and the ceiling (Cornell box: 2.7 instances entered per shadow ray, 0.3 with
+// the test; docs/lab/reference-speed.md). Entering costs the transform and the BLAS root's fetch
+// and test.
+const SG_BOX_ROBUST: f32 = 1.0000004;
+
+fn sg_box_entered(ray: SgRay, lo: vec3f, hi: vec3f, t_max: f32) -> bool {
+    let a = (lo - ray.origin) * ray.inv_direction;
+    let b = (hi - ray.origin) * ray.inv_direction;
+    let near = min(a, b);
+    let far = max(a, b);
+    let t0 = max(max(near.x, near.y), max(near.z, 0.0));
+    let t1 = min(min(far.x, far.y), min(far.z, t_max));
+    return t0 <= t1 * SG_BOX_ROBUST;
+}
+
 // The stack is read and written at constant indices only, one select per entry, so that it stays
 // in registers: an array indexed at run time goes to per-invocation scratch memory on lavapipe,
 // accessed one lane at a time (docs/lab/render-speed.md). The cost grows with the stack's size, hence a
@@ -295,10 +321,14 @@ fn sg_traverse(world_origin: vec3f, world_direction: vec3f, t_max: f32, any_hit:
                 sg_push(&stack, stack_size, instances);
                 stack_size += 1u;
             }
-            let leaf = sg_tlas_leaf(instances.x + local);
-            instance = leaf.instance;
-            ray = sg_make_ray((leaf.world_to_object * vec4f(world_origin, 1.0)).xyz, (leaf.world_to_object * vec4f(world_direction, 0.0)).xyz);
-            blas_group = vec2u(leaf.blas_root, select(0u, 0x80000000u, leaf.blas_nodes != 0u));
+            let slot = instances.x + local;
+            let leaf = sg_tlas_leaf_box(slot);
+            if sg_box_entered(world_ray, leaf.box_min, leaf.box_max, hit.t) {
+                let world_to_object = sg_tlas_leaf_transform(slot);
+                instance = leaf.instance;
+                ray = sg_make_ray((world_to_object * vec4f(world_origin, 1.0)).xyz, (world_to_object * vec4f(world_direction, 0.0)).xyz);
+                blas_group = vec2u(leaf.blas_root, 0x80000000u);
+            }
         }
         let tlas_stack_size = stack_size;
         while (blas_group.y & 0xff000000u) != 0u {

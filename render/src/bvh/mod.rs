@@ -29,8 +29,8 @@ pub use ray_batch::{
 };
 pub use scene::rng::{SplitMix64, mix64};
 pub use scene_geometry::{
-    SceneGeometry, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTlasLeaf, SgTriangle, SgVertex,
-    sg_triangles, storage_buffer,
+    LEAF_BOX_PAD, SceneGeometry, SgInstance, SgInstanceHeader, SgMesh, SgNode, SgTlasLeaf,
+    SgTriangle, SgVertex, padded_leaf_box, sg_triangles, storage_buffer,
 };
 pub use tlas::InstanceTransforms;
 pub use tlas::{Tlas, world_bounds};

@@ -131,17 +131,32 @@ crate::gpu_struct! {
 }
 
 crate::gpu_struct! {
-    /// What traversal needs on entering a TLAS leaf, in TLAS leaf order (so no indirection).
+    /// What traversal needs on entering a TLAS leaf, in TLAS leaf order (so no indirection). Only
+    /// instances with triangles are TLAS leaves, so every leaf has a BLAS root node.
     pub struct SgTlasLeaf {
-        pub world_to_object: [f32; 16] => "mat4x4f",
+        /// The instance's world box grown by [`LEAF_BOX_PAD`]: traversal enters the instance
+        /// only if the ray meets it (scene_geometry.wgsl says why).
+        pub box_min: [f32; 3] => "vec3f",
         /// Index into the instance table.
         pub instance: u32 => "u32",
+        pub box_max: [f32; 3] => "vec3f",
         /// The instance's BLAS root in the node table.
         pub blas_root: u32 => "u32",
-        /// The BLAS's node count (0: a mesh without triangles).
-        pub blas_nodes: u32 => "u32",
-        pub pad: u32 => "u32",
+        pub world_to_object: [f32; 16] => "mat4x4f",
     }
+}
+
+/// How much a TLAS leaf's world box is grown on each side, relative to its largest coordinate
+/// magnitude: 256 times the rounding of the box's corners and of the slab test (2^-24 per
+/// operation), and a sixth of what `offset_origin` (pt_scene.wgsl) moves a ray off its surface
+/// (1e-4 of the point's magnitude), so that a ray leaving a flat instance misses its box.
+pub const LEAF_BOX_PAD: f32 = 1.0 / 65536.0;
+
+/// `b` grown by [`LEAF_BOX_PAD`] of its largest coordinate magnitude on every side.
+pub fn padded_leaf_box(b: &obvhs::aabb::Aabb) -> ([f32; 3], [f32; 3]) {
+    let (lo, hi) = (Vec3::from(b.min), Vec3::from(b.max));
+    let pad = Vec3::splat(lo.abs().max(hi.abs()).max_element() * LEAF_BOX_PAD);
+    ((lo - pad).into(), (hi + pad).into())
 }
 
 /// The geometry's storage buffer, @group(1) binding 0, declared once (WGSL and layout).
@@ -154,7 +169,7 @@ const _: () = assert!(crate::compute::storage_buffers(&GROUP) == STORAGE_BUFFERS
 const TABLES: [(&str, &str, u32); 7] = [
     ("sg_nodes", "SgNode", 5),
     ("sg_triangles", "SgTriangle", 3),
-    ("sg_tlas_leaves", "SgTlasLeaf", 5),
+    ("sg_tlas_leaves", "SgTlasLeaf", 6),
     ("sg_instances", "SgInstance", 13),
     ("sg_meshes", "SgMesh", 2),
     ("sg_vertices", "SgVertex", 2),
@@ -494,8 +509,8 @@ fn bind_group(
     crate::texel_table::group(gpu, "scene geometry", layout, &[header], &tables.each_ref())
 }
 
-/// The TLAS leaves in leaf order: each slot's instance, its world-to-object transform and its
-/// BLAS root.
+/// The TLAS leaves in leaf order: each slot's instance, its padded world box, its
+/// world-to-object transform and its BLAS root.
 fn tlas_leaves(bvh: &SceneBvh) -> Vec<u8> {
     let blas_roots = blas_roots(bvh);
     let leaves: Vec<SgTlasLeaf> = bvh
@@ -505,12 +520,16 @@ fn tlas_leaves(bvh: &SceneBvh) -> Vec<u8> {
         .iter()
         .map(|&instance| {
             let i = &bvh.instances[instance as usize];
+            let (box_min, box_max) = padded_leaf_box(&super::world_bounds(
+                &i.object_to_world,
+                &bvh.blas[i.mesh as usize].bounds,
+            ));
             SgTlasLeaf {
-                world_to_object: i.world_to_object.to_cols_array(),
+                box_min,
                 instance,
+                box_max,
                 blas_root: blas_roots[i.mesh as usize],
-                blas_nodes: bvh.blas[i.mesh as usize].bvh.nodes.len() as u32,
-                pad: 0,
+                world_to_object: i.world_to_object.to_cols_array(),
             }
         })
         .collect();
