@@ -180,6 +180,17 @@ fn sg_intersect_triangle(ray: SgRay, v0: vec3f, v1: vec3f, v2: vec3f, t_max: f32
 // (t = q * e / d + (p - o) / d). Returns the hit mask: bits 24-31 for inner children at
 // 24 + (slot ^ octant_inv) (so the highest bit is the nearest in ray order), bits 0-23 for the
 // primitives of hit leaves.
+//
+// The two terms of t cancel where the node's origin p is far from the ray (a node spanning a
+// scene with geometry 500 m away), so t's rounding error scales with |p - o| / |d|, not with
+// t: near and far distances move apart by SG_NODE_SLACK of the terms' magnitude, a bound on
+// that error (1/d, p - o, the product and the sum each round once, within 2^-23 of it; 2^-20
+// leaves a factor 2 over their sum). Without it, a ray hitting a quad 1e-5 inside its edge
+// near the origin missed it once the scene held a quad 1000 m away (obvhs's CPU traversal,
+// the same formula, misses it too; render/tests/traversal.rs). One slack per node, folded
+// into the offsets, costs the children's tests nothing.
+const SG_NODE_SLACK: f32 = 9.5367431640625e-7; // 2^-20
+
 fn sg_intersect_node(node: SgNode, ray: SgRay, t_max: f32) -> u32 {
     let e = vec3f(
         bitcast<f32>((node.exponents_imask & 0xffu) << 23u),
@@ -188,6 +199,9 @@ fn sg_intersect_node(node: SgNode, ray: SgRay, t_max: f32) -> u32 {
     );
     let scale = e * ray.inv_direction;
     let offset = (node.origin - ray.origin) * ray.inv_direction;
+    let slack = (abs(offset) + 255.0 * abs(scale)) * SG_NODE_SLACK;
+    let offset_near = offset - slack;
+    let offset_far = offset + slack;
     let negative = ray.direction < vec3f(0.0);
     var hits = 0u;
     for (var half = 0u; half < 2u; half++) {
@@ -207,8 +221,8 @@ fn sg_intersect_node(node: SgNode, ray: SgRay, t_max: f32) -> u32 {
             let shift = j * 8u;
             let q_near = vec3f(f32(extractBits(near_x, shift, 8u)), f32(extractBits(near_y, shift, 8u)), f32(extractBits(near_z, shift, 8u)));
             let q_far = vec3f(f32(extractBits(far_x, shift, 8u)), f32(extractBits(far_y, shift, 8u)), f32(extractBits(far_z, shift, 8u)));
-            let t_near = q_near * scale + offset;
-            let t_far = q_far * scale + offset;
+            let t_near = q_near * scale + offset_near;
+            let t_far = q_far * scale + offset_far;
             let t0 = max(max(t_near.x, t_near.y), max(t_near.z, 0.0));
             let t1 = min(min(t_far.x, t_far.y), min(t_far.z, t_max));
             if t0 <= t1 {
