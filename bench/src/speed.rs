@@ -173,11 +173,12 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
     )?;
     writeln!(
         md,
-        "| renderer | M paths/s | mean radiance (RGB) | ratio to Mitsuba |\n|---|---:|---|---:|"
+        "| renderer | M paths/s (median of {REFERENCE_ROUNDS} rounds) | mean radiance (RGB) | ratio to Mitsuba (median of {REFERENCE_ROUNDS} paired rounds) |\n|---|---:|---|---:|"
     )?;
     let mean = |m: [f64; 3]| format!("{:.4} {:.4} {:.4}", m[0], m[1], m[2]);
+    // The median of the paired rounds' ratios (not a ratio of medians).
     let mitsuba_ratio =
-        reference.mitsuba.as_ref().map(|m| reference.paths_per_s / m.paths_per_second());
+        (!reference.paired_ratios.is_empty()).then(|| median(&reference.paired_ratios));
     writeln!(
         md,
         "| flicker WGSL ({}) | {:.3} | {} | {} |",
@@ -211,6 +212,20 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
             "\nMitsuba 3 not measured: {}",
             reference.mitsuba_missing.as_deref().unwrap_or("?")
         )?,
+    }
+    if !reference.paired_ratios.is_empty() {
+        writeln!(
+            md,
+            "\nThe megakernel over Mitsuba in each round (ours timed, then Mitsuba's, alternating): {}; lowest {:.2}, highest {:.2}. The wavefront is timed once, against Mitsuba's median round.",
+            reference
+                .paired_ratios
+                .iter()
+                .map(|r| format!("{r:.2}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            reference.paired_ratios.iter().cloned().fold(f64::INFINITY, f64::min),
+            reference.paired_ratios.iter().cloned().fold(0.0, f64::max),
+        )?;
     }
     writeln!(
         md,
@@ -332,6 +347,7 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         "mitsuba_threads": reference.mitsuba.as_ref().map(|m| m.threads),
         "mitsuba_mean_rgb": reference.mitsuba.as_ref().map(|m| m.mean_rgb),
         "reference_paths_ratio_vs_mitsuba": mitsuba_ratio,
+        "reference_paired_ratios_vs_mitsuba": reference.paired_ratios,
         "frames": frame_rows,
         "memory": memory_rows,
     });
@@ -344,11 +360,18 @@ const REFERENCE_SIZE: u32 = 64;
 const REFERENCE_INTEGRATOR: mitsuba::Integrator =
     mitsuba::Integrator { max_depth: None, rr_depth: 3 };
 const REFERENCE_MAX_DEPTH: u32 = 1000;
+/// Paired rounds of the reference against Mitsuba (ours, then Mitsuba's, alternating): one timing
+/// each moved by a third between runs on an idle 2-core machine, so the ratio is the median of
+/// the rounds' ratios and their range its spread, as the traversal's.
+pub const REFERENCE_ROUNDS: usize = 3;
 
 struct ReferenceBench {
+    /// The megakernel's paths/s, the median of the rounds.
     paths_per_s: f64,
-    /// The megakernel's time for the whole reference.
+    /// The megakernel's time for the whole reference (the median round).
     seconds: f64,
+    /// Each round's paths/s over Mitsuba's in the same round (empty without Mitsuba).
+    paired_ratios: Vec<f64>,
     /// Each wavefront kernel's wall time when submitted alone, in crate::wavefront::Kernel order.
     wavefront_kernel_seconds: Vec<(String, f64)>,
     /// The same reference traced as a wavefront (crate::wavefront), and the largest difference
@@ -356,13 +379,14 @@ struct ReferenceBench {
     wavefront_paths_per_s: f64,
     wavefront_max_difference: f32,
     mean_rgb: [f64; 3],
+    /// Mitsuba's median round (by paths/s).
     mitsuba: Option<mitsuba::MitsubaRun>,
     mitsuba_missing: Option<String>,
 }
 
 /// Paths per second of a converging reference (the Cornell box at 64x64, unlimited depth with
 /// Russian roulette), and the same scene exported to Mitsuba 3 and rendered by its scalar CPU
-/// path tracer in this run, when Python has Mitsuba.
+/// path tracer in this run, when Python has Mitsuba, in [`REFERENCE_ROUNDS`] paired rounds.
 fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
     let size = REFERENCE_SIZE;
     let scene = lambertian_cornell_box((size, size))?;
@@ -376,10 +400,37 @@ fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
     let mut tracer = PathTracer::new(gpu, &gpu_scene)?;
     gpu_scene.update(gpu, &scene);
     tracer.render_reference(gpu, &gpu_scene, 1, 1, 0, &mut |_, _| {})?;
-    let start = Instant::now();
-    let image = tracer.render_reference(gpu, &gpu_scene, spp, 1, 0, &mut |_, _| {})?;
-    let seconds = start.elapsed().as_secs_f64();
-    let paths_per_s = (size * size) as f64 * spp as f64 / seconds;
+    let paths = (size * size) as f64 * spp as f64;
+    let (python, mitsuba_missing) = match mitsuba::python() {
+        None => (None, Some("no Python with the mitsuba package (pip install mitsuba; FLICKER_PYTHON picks the interpreter)".to_string())),
+        Some(python) => (Some(python), None),
+    };
+    let dir = std::env::temp_dir().join(format!("flicker_bench_mitsuba_{}", std::process::id()));
+    let xml = match &python {
+        Some(_) => Some(mitsuba::write_scene(&scene, (size, size), &REFERENCE_INTEGRATOR, &dir)?),
+        None => None,
+    };
+    let mut seconds_per_round = Vec::with_capacity(REFERENCE_ROUNDS);
+    let mut mitsuba_runs = Vec::with_capacity(REFERENCE_ROUNDS);
+    let mut image = Vec::new();
+    for _ in 0..REFERENCE_ROUNDS {
+        let start = Instant::now();
+        image = tracer.render_reference(gpu, &gpu_scene, spp, 1, 0, &mut |_, _| {})?;
+        seconds_per_round.push(start.elapsed().as_secs_f64());
+        if let (Some(python), Some(xml)) = (&python, &xml) {
+            mitsuba_runs.push(mitsuba::render(python, xml, spp, &dir.join("mitsuba.exr"))?);
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    let seconds = median(&seconds_per_round);
+    let paths_per_s = paths / seconds;
+    let paired_ratios: Vec<f64> = seconds_per_round
+        .iter()
+        .zip(&mitsuba_runs)
+        .map(|(s, m)| paths / s / m.paths_per_second())
+        .collect();
+    mitsuba_runs.sort_by(|a, b| a.paths_per_second().total_cmp(&b.paths_per_second()));
+    let mitsuba = mitsuba_runs.get(mitsuba_runs.len() / 2).cloned();
     let wavefront = Wavefront::new(gpu, &gpu_scene)?;
     wavefront.render_reference(gpu, &gpu_scene, &tracer, 1, 1, 0)?;
     let start = Instant::now();
@@ -407,19 +458,10 @@ fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
         .fold(0.0f32, f32::max);
     let n = image.len() as f64;
     let mean_rgb = [0, 1, 2].map(|c| image.iter().map(|p| p[c] as f64).sum::<f64>() / n);
-    let (mitsuba, mitsuba_missing) = match mitsuba::python() {
-        None => (None, Some("no Python with the mitsuba package (pip install mitsuba; FLICKER_PYTHON picks the interpreter)".to_string())),
-        Some(python) => {
-            let dir = std::env::temp_dir().join(format!("flicker_bench_mitsuba_{}", std::process::id()));
-            let xml = mitsuba::write_scene(&scene, (size, size), &REFERENCE_INTEGRATOR, &dir)?;
-            let run = mitsuba::render(&python, &xml, spp, &dir.join("mitsuba.exr"))?;
-            let _ = std::fs::remove_dir_all(&dir);
-            (Some(run), None)
-        }
-    };
     Ok(ReferenceBench {
         paths_per_s,
         seconds,
+        paired_ratios,
         wavefront_kernel_seconds,
         wavefront_paths_per_s,
         wavefront_max_difference,

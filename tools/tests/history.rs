@@ -229,6 +229,7 @@ fn the_bench_ratios_are_read_from_its_json() {
             {"scene": "hairball", "traversal_ratio_vs_obvhs": 3.0, "paired_ratios": [2.5, 3.0, 3.5]},
         ],
         "reference_paths_ratio_vs_mitsuba": 0.8,
+        "reference_paired_ratios_vs_mitsuba": [0.7, 0.8, 1.0],
     });
     let e = bench_speed_entries(&json);
     let ids: Vec<&str> = e.iter().map(|e| e.id.as_str()).collect();
@@ -237,7 +238,12 @@ fn the_bench_ratios_are_read_from_its_json() {
         (e[0].value, e[0].lo, e[0].hi, e[0].margin),
         (Some(3.0), Some(2.5), Some(3.5), Some(0.5))
     );
-    assert_eq!((e[1].value, e[1].margin), (Some(0.8), None));
+    assert_eq!((e[1].value, e[1].lo, e[1].hi), (Some(0.8), Some(0.7), Some(1.0)));
+    assert!((e[1].margin.unwrap() - 0.15).abs() < 1e-12, "{:?}", e[1].margin);
+    // A record from before the paired rounds: its spread is left to repeated runs.
+    let json = serde_json::json!({"traversal": [], "reference_paths_ratio_vs_mitsuba": 0.8});
+    let e = bench_speed_entries(&json);
+    assert_eq!((e[0].value, e[0].lo, e[0].margin), (Some(0.8), None, None));
     // Mitsuba not installed: no entry rather than a made-up number.
     let json = serde_json::json!({"traversal": [], "reference_paths_ratio_vs_mitsuba": null});
     assert!(bench_speed_entries(&json).is_empty());
