@@ -152,6 +152,11 @@ fn ratio(id: String, value: Option<f64>, rounds: &[f64], detail: &str) -> Option
     })
 }
 
+/// The numbers of a JSON array (none where it is missing).
+fn numbers(array: &serde_json::Value) -> Vec<f64> {
+    array.as_array().into_iter().flatten().filter_map(|v| v.as_f64()).collect()
+}
+
 /// The bench's side-by-side ratios from `flicker bench --json`'s speed report: WGSL traversal
 /// over obvhs on the CPU per scene and the reference path tracer's paths per second over
 /// Mitsuba 3's, each with its paired rounds.
@@ -159,30 +164,18 @@ pub fn bench_speed_entries(json: &serde_json::Value) -> Vec<Entry> {
     let mut out = Vec::new();
     for row in json["traversal"].as_array().into_iter().flatten() {
         let scene = row["scene"].as_str().unwrap_or("?");
-        let rounds: Vec<f64> = row["paired_ratios"]
-            .as_array()
-            .into_iter()
-            .flatten()
-            .filter_map(|v| v.as_f64())
-            .collect();
         out.extend(ratio(
             format!("traversal/{scene}/wgsl_over_obvhs"),
             row["traversal_ratio_vs_obvhs"].as_f64(),
-            &rounds,
+            &numbers(&row["paired_ratios"]),
             "WGSL CWBVH rays/s over obvhs CPU rays/s, median of paired rounds",
         ));
     }
     // Records from before the paired rounds have none: their spread comes from repeated runs.
-    let rounds: Vec<f64> = json["reference_paired_ratios_vs_mitsuba"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .filter_map(|v| v.as_f64())
-        .collect();
     out.extend(ratio(
         "reference/paths_over_mitsuba".into(),
         json["reference_paths_ratio_vs_mitsuba"].as_f64(),
-        &rounds,
+        &numbers(&json["reference_paired_ratios_vs_mitsuba"]),
         "reference path tracer paths/s over Mitsuba 3 scalar_rgb, median of paired rounds",
     ));
     out
