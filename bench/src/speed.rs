@@ -14,7 +14,7 @@ use render::path_tracer::{PathTracer, PathTracerSettings};
 use render::scene::{Instance, Material, SceneDesc};
 use render::scene_gpu::SceneGpu;
 
-use crate::traversal::{PAIRED_ROUNDS, median, traversal_benchmark};
+use crate::traversal::{PAIRED_ROUNDS, median, range, traversal_benchmark};
 use crate::wavefront::{Kernel, KernelTimes, Wavefront};
 
 pub struct BenchOptions {
@@ -125,6 +125,7 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         let b = traversal_benchmark(&gpu, scene, opts.rays, 1)
             .with_context(|| format!("traversal benchmark on {name}"))?;
         let ratio = median(&b.paired_ratios);
+        let (lowest, highest) = range(&b.paired_ratios);
         writeln!(
             md,
             "| {name} | {} | {} | {} | {:.3} | {:.3} | {:.2} | {:.2}, {:.2} | {:.3} | {:.3} | {:.2} | {:.3} | {:.2} | {:.2} | {:.1}% | {:.2}% | {:.2}% |",
@@ -134,8 +135,8 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
             b.gpu_rays_per_second / 1e6,
             b.cpu_rays_per_second / 1e6,
             ratio,
-            b.paired_ratios.iter().cloned().fold(f64::INFINITY, f64::min),
-            b.paired_ratios.iter().cloned().fold(0.0, f64::max),
+            lowest,
+            highest,
             b.gpu_sorted_rays_per_second / 1e6,
             b.cpu_sorted_rays_per_second / 1e6,
             b.gpu_sorted_rays_per_second / b.gpu_rays_per_second,
@@ -214,6 +215,7 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
         )?,
     }
     if !reference.paired_ratios.is_empty() {
+        let (lowest, highest) = range(&reference.paired_ratios);
         writeln!(
             md,
             "\nThe megakernel over Mitsuba in each round (ours timed, then Mitsuba's, alternating): {}; lowest {:.2}, highest {:.2}. The wavefront is timed once, against Mitsuba's median round.",
@@ -223,8 +225,8 @@ pub fn run(opts: &BenchOptions, mut log: impl FnMut(&str)) -> Result<BenchReport
                 .map(|r| format!("{r:.2}"))
                 .collect::<Vec<_>>()
                 .join(", "),
-            reference.paired_ratios.iter().cloned().fold(f64::INFINITY, f64::min),
-            reference.paired_ratios.iter().cloned().fold(0.0, f64::max),
+            lowest,
+            highest,
         )?;
     }
     writeln!(
@@ -401,15 +403,15 @@ fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
     gpu_scene.update(gpu, &scene);
     tracer.render_reference(gpu, &gpu_scene, 1, 1, 0, &mut |_, _| {})?;
     let paths = (size * size) as f64 * spp as f64;
-    let (python, mitsuba_missing) = match mitsuba::python() {
-        None => (None, Some("no Python with the mitsuba package (pip install mitsuba; FLICKER_PYTHON picks the interpreter)".to_string())),
-        Some(python) => (Some(python), None),
-    };
     let dir = std::env::temp_dir().join(format!("flicker_bench_mitsuba_{}", std::process::id()));
-    let xml = match &python {
-        Some(_) => Some(mitsuba::write_scene(&scene, (size, size), &REFERENCE_INTEGRATOR, &dir)?),
+    // The Python with Mitsuba and the scene exported for it, once for every round.
+    let mitsuba_job = match mitsuba::python() {
+        Some(python) => {
+            Some((python, mitsuba::write_scene(&scene, (size, size), &REFERENCE_INTEGRATOR, &dir)?))
+        }
         None => None,
     };
+    let mitsuba_missing = mitsuba_job.is_none().then(|| "no Python with the mitsuba package (pip install mitsuba; FLICKER_PYTHON picks the interpreter)".to_string());
     let mut seconds_per_round = Vec::with_capacity(REFERENCE_ROUNDS);
     let mut mitsuba_runs = Vec::with_capacity(REFERENCE_ROUNDS);
     let mut image = Vec::new();
@@ -417,7 +419,7 @@ fn reference_paths(gpu: &Gpu, spp: u32) -> Result<ReferenceBench> {
         let start = Instant::now();
         image = tracer.render_reference(gpu, &gpu_scene, spp, 1, 0, &mut |_, _| {})?;
         seconds_per_round.push(start.elapsed().as_secs_f64());
-        if let (Some(python), Some(xml)) = (&python, &xml) {
+        if let Some((python, xml)) = &mitsuba_job {
             mitsuba_runs.push(mitsuba::render(python, xml, spp, &dir.join("mitsuba.exr"))?);
         }
     }

@@ -208,6 +208,11 @@ pub fn traversal_benchmark(
     })
 }
 
+/// The lowest and the highest value (the spread of paired rounds).
+pub fn range(values: &[f64]) -> (f64, f64) {
+    values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)))
+}
+
 /// The median (the mean of the middle two for an even count).
 pub fn median(values: &[f64]) -> f64 {
     let mut v = values.to_vec();
